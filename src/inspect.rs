@@ -1,0 +1,366 @@
+//! `blendsynth inspect`: a readable account of an exported scene and of which node
+//! types blendsynth can evaluate.
+
+use std::collections::BTreeMap;
+use std::fmt::Write;
+
+use serde::Serialize;
+
+use crate::nodes::{support, Support};
+use crate::scene::{quote, Rna, Scene};
+
+#[derive(Debug, Serialize)]
+pub struct Report {
+    pub source_file: String,
+    pub blender_version: String,
+    pub file_version: Vec<u32>,
+    pub scene: SceneSummary,
+    pub objects: Vec<ObjectSummary>,
+    pub animation: Vec<AnimSummary>,
+    pub materials: Vec<String>,
+    pub node_trees: Vec<TreeSummary>,
+    pub images: Vec<ImageSummary>,
+    pub coverage: Vec<CoverageRow>,
+    /// True when every node type used is supported or structural.
+    pub all_supported: bool,
+    pub warnings: Vec<String>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct SceneSummary {
+    pub name: String,
+    pub frame_start: i32,
+    pub frame_end: i32,
+    pub frame_current: i32,
+    pub camera: Option<String>,
+    pub world: Option<String>,
+    pub resolution: Option<[i64; 2]>,
+    pub resolution_percentage: Option<i64>,
+    pub engine: Option<String>,
+    pub samples: Option<i64>,
+    pub adaptive_threshold: Option<f64>,
+    pub denoising: Option<bool>,
+    pub view_transform: Option<String>,
+    pub look: Option<String>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct ObjectSummary {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub kind: String,
+    pub data: Option<String>,
+    pub parent: Option<String>,
+    pub renders: bool,
+    pub materials: Vec<Option<String>>,
+    pub modifiers: Vec<String>,
+    pub constraints: Vec<ConstraintSummary>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct ConstraintSummary {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub kind: String,
+    pub target: Option<String>,
+    pub settings: Vec<String>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct AnimSummary {
+    /// Full Blender data path of the animated property, e.g. `curves["X"].eval_time`.
+    pub path: String,
+    pub array_index: usize,
+    pub driver: bool,
+    pub keyframes: usize,
+    pub interpolations: Vec<String>,
+    pub extrapolation: String,
+    pub modifiers: Vec<String>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct TreeSummary {
+    pub path: String,
+    pub bl_idname: String,
+    pub links: usize,
+    pub nodes: Vec<NodeSummary>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct NodeSummary {
+    pub name: String,
+    pub bl_idname: String,
+    pub mute: bool,
+    pub inputs: usize,
+    pub outputs: usize,
+    pub support: Support,
+}
+
+#[derive(Debug, Serialize)]
+pub struct ImageSummary {
+    pub name: String,
+    pub file: Option<String>,
+    pub missing: bool,
+}
+
+#[derive(Debug, Serialize)]
+pub struct CoverageRow {
+    pub bl_idname: String,
+    pub count: usize,
+    pub used_in: Vec<String>,
+    pub support: Support,
+}
+
+pub fn report(scene: &Scene) -> Report {
+    let f = &scene.file;
+    let s = &f.scene;
+    let render = &s.render;
+    let res = match (int(render, "resolution_x"), int(render, "resolution_y")) {
+        (Some(x), Some(y)) => Some([x, y]),
+        _ => None,
+    };
+    let scene_summary = SceneSummary {
+        name: s.name.clone(),
+        frame_start: s.frame_start,
+        frame_end: s.frame_end,
+        frame_current: s.frame_current,
+        camera: s.camera.clone(),
+        world: s.world.clone(),
+        resolution: res,
+        resolution_percentage: int(render, "resolution_percentage"),
+        engine: string(render, "engine"),
+        samples: int(&s.cycles, "samples"),
+        adaptive_threshold: s.cycles.get("adaptive_threshold").and_then(|v| v.as_f64()),
+        denoising: s.cycles.get("use_denoising").and_then(|v| v.as_bool()),
+        view_transform: string(&s.view_settings, "view_transform"),
+        look: string(&s.view_settings, "look"),
+    };
+
+    let objects = f
+        .objects
+        .iter()
+        .map(|o| ObjectSummary {
+            name: o.name.clone(),
+            kind: o.kind.clone(),
+            data: o.data.clone(),
+            parent: o.parent.clone(),
+            renders: !o.hide_render,
+            materials: o.material_slots.iter().map(|s| s.material.clone()).collect(),
+            modifiers: o
+                .modifiers
+                .iter()
+                .map(|m| match &m.node_group {
+                    Some(g) => format!("{} {:?} (node group {:?})", m.kind, m.name, g),
+                    None => format!("{} {:?}", m.kind, m.name),
+                })
+                .collect(),
+            constraints: o
+                .constraints
+                .iter()
+                .map(|c| ConstraintSummary {
+                    name: c.name.clone(),
+                    kind: c.kind.clone(),
+                    target: c.properties.get("target").and_then(|t| t.get("name")).and_then(|n| n.as_str()).map(str::to_string),
+                    settings: constraint_settings(&c.properties),
+                })
+                .collect(),
+        })
+        .collect();
+
+    let mut animation = Vec::new();
+    for a in &f.animation {
+        for (fc, driver) in a.fcurves.iter().map(|c| (c, false)).chain(a.drivers.iter().map(|c| (c, true))) {
+            let mut interps: Vec<String> = fc.keyframes.iter().map(|k| k.interpolation.clone()).collect();
+            interps.sort();
+            interps.dedup();
+            animation.push(AnimSummary {
+                path: format!("{}.{}", a.id_path, fc.data_path),
+                array_index: fc.array_index,
+                driver,
+                keyframes: fc.keyframes.len(),
+                interpolations: interps,
+                extrapolation: fc.extrapolation.clone(),
+                modifiers: fc.modifiers.iter().map(|m| m.kind.clone()).collect(),
+            });
+        }
+    }
+
+    let mut coverage: BTreeMap<String, (usize, Vec<String>)> = BTreeMap::new();
+    let mut node_trees = Vec::new();
+    for (path, t) in scene.node_trees() {
+        let nodes = t
+            .nodes
+            .iter()
+            .map(|n| {
+                let e = coverage.entry(n.bl_idname.clone()).or_default();
+                e.0 += 1;
+                if !e.1.contains(&path) {
+                    e.1.push(path.clone());
+                }
+                NodeSummary {
+                    name: n.name.clone(),
+                    bl_idname: n.bl_idname.clone(),
+                    mute: n.mute,
+                    inputs: n.inputs.len(),
+                    outputs: n.outputs.len(),
+                    support: support(&n.bl_idname),
+                }
+            })
+            .collect();
+        node_trees.push(TreeSummary { path, bl_idname: t.bl_idname.clone(), links: t.links.len(), nodes });
+    }
+    let coverage: Vec<CoverageRow> = coverage
+        .into_iter()
+        .map(|(bl_idname, (count, used_in))| CoverageRow { support: support(&bl_idname), bl_idname, count, used_in })
+        .collect();
+    let all_supported = coverage.iter().all(|r| r.support != Support::Unsupported);
+
+    Report {
+        source_file: f.source_file.clone(),
+        blender_version: f.blender_version.clone(),
+        file_version: f.file_version.clone(),
+        scene: scene_summary,
+        objects,
+        animation,
+        materials: f.materials.iter().map(|m| m.name.clone()).collect(),
+        node_trees,
+        images: f.images.iter().map(|i| ImageSummary { name: i.name.clone(), file: i.file.clone(), missing: i.missing }).collect(),
+        coverage,
+        all_supported,
+        warnings: f.warnings.clone(),
+    }
+}
+
+fn int(m: &Rna, k: &str) -> Option<i64> {
+    m.get(k).and_then(|v| v.as_i64())
+}
+fn string(m: &Rna, k: &str) -> Option<String> {
+    m.get(k).and_then(|v| v.as_str()).map(str::to_string)
+}
+
+/// The settings worth a glance, as `key=value`, for any constraint type: scalars only,
+/// skipping bookkeeping properties.
+fn constraint_settings(p: &Rna) -> Vec<String> {
+    const SKIP: &[&str] = &["name", "type", "show_expanded", "is_override_data", "active", "is_valid", "error_location", "error_rotation", "target", "enabled"];
+    p.iter()
+        .filter(|(k, v)| !SKIP.contains(&k.as_str()) && (v.is_boolean() || v.is_number() || v.is_string()))
+        .filter(|(_, v)| v.as_str() != Some(""))
+        .map(|(k, v)| format!("{k}={}", v.as_str().map(str::to_string).unwrap_or_else(|| v.to_string())))
+        .collect()
+}
+
+impl Report {
+    pub fn to_text(&self) -> String {
+        let mut o = String::new();
+        let _ = self.write_text(&mut o);
+        o
+    }
+
+    fn write_text(&self, o: &mut String) -> std::fmt::Result {
+        let s = &self.scene;
+        writeln!(o, "Scene {:?} from {} (saved by Blender {}, exported by Blender {})", s.name, self.source_file, dotted(&self.file_version), self.blender_version)?;
+        writeln!(o, "  frames {}..{} (current {}), camera {}, world {}", s.frame_start, s.frame_end, s.frame_current, opt(&s.camera), opt(&s.world))?;
+        if let Some([x, y]) = s.resolution {
+            write!(o, "  {}x{} at {}%", x, y, s.resolution_percentage.unwrap_or(100))?;
+        }
+        writeln!(
+            o,
+            ", engine {}, {} samples, noise threshold {}, denoising {}, view transform {} (look {})",
+            opt(&s.engine),
+            s.samples.map(|v| v.to_string()).unwrap_or("-".into()),
+            s.adaptive_threshold.map(|v| format!("{v:.3}")).unwrap_or("-".into()),
+            s.denoising.map(|d| if d { "on" } else { "off" }).unwrap_or("-"),
+            opt(&s.view_transform),
+            opt(&s.look)
+        )?;
+
+        writeln!(o, "\nObjects ({})", self.objects.len())?;
+        for ob in &self.objects {
+            write!(o, "  {} [{}]", ob.name, ob.kind)?;
+            if let Some(d) = &ob.data {
+                write!(o, " data {d:?}")?;
+            }
+            if let Some(p) = &ob.parent {
+                write!(o, " parent {p:?}")?;
+            }
+            if !ob.renders {
+                write!(o, " (hidden in render)")?;
+            }
+            writeln!(o)?;
+            let mats: Vec<String> = ob.materials.iter().map(|m| opt(m)).collect();
+            if !mats.is_empty() {
+                writeln!(o, "    materials: {}", mats.join(", "))?;
+            }
+            for m in &ob.modifiers {
+                writeln!(o, "    modifier {m}")?;
+            }
+            for c in &ob.constraints {
+                writeln!(o, "    constraint {} {:?} target {}: {}", c.kind, c.name, opt(&c.target), c.settings.join(" "))?;
+            }
+        }
+
+        writeln!(o, "\nAnimation ({} curves)", self.animation.len())?;
+        for a in &self.animation {
+            writeln!(
+                o,
+                "  {}[{}]{}: {} keyframes ({}), extrapolation {}{}",
+                a.path,
+                a.array_index,
+                if a.driver { " (driver)" } else { "" },
+                a.keyframes,
+                if a.interpolations.is_empty() { "-".to_string() } else { a.interpolations.join("/") },
+                a.extrapolation,
+                if a.modifiers.is_empty() { String::new() } else { format!(", modifiers {}", a.modifiers.join(", ")) }
+            )?;
+        }
+
+        writeln!(o, "\nMaterials ({}): {}", self.materials.len(), self.materials.iter().map(|m| quote(m)).collect::<Vec<_>>().join(", "))?;
+
+        for t in &self.node_trees {
+            writeln!(o, "\nNode tree {} [{}]: {} nodes, {} links", t.path, t.bl_idname, t.nodes.len(), t.links)?;
+            for n in &t.nodes {
+                writeln!(
+                    o,
+                    "  {:<32} {:<40} {:>2} in {:>2} out{}{}",
+                    n.name,
+                    n.bl_idname,
+                    n.inputs,
+                    n.outputs,
+                    if n.mute { "  muted" } else { "" },
+                    if n.support == Support::Unsupported { "  (unsupported)" } else { "" }
+                )?;
+            }
+        }
+
+        if !self.images.is_empty() {
+            writeln!(o, "\nImages")?;
+            for i in &self.images {
+                writeln!(o, "  {}: {}", i.name, if i.missing { "MISSING (not packed, file not found)".to_string() } else { opt(&i.file) })?;
+            }
+        }
+
+        let unsupported = self.coverage.iter().filter(|r| r.support == Support::Unsupported).count();
+        writeln!(o, "\nNode coverage: {} node types used, {} unsupported", self.coverage.len(), unsupported)?;
+        writeln!(o, "  {:<40} {:>5}  {:<12} used in", "node type", "count", "support")?;
+        for r in &self.coverage {
+            let sup = match r.support {
+                Support::Supported => "yes",
+                Support::Structural => "structural",
+                Support::Unsupported => "NO",
+            };
+            writeln!(o, "  {:<40} {:>5}  {:<12} {}", r.bl_idname, r.count, sup, r.used_in.join(", "))?;
+        }
+        for w in &self.warnings {
+            writeln!(o, "warning: {w}")?;
+        }
+        Ok(())
+    }
+}
+
+fn opt(v: &Option<String>) -> String {
+    v.clone().unwrap_or_else(|| "-".into())
+}
+
+fn dotted(v: &[u32]) -> String {
+    v.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(".")
+}

@@ -1,0 +1,11 @@
+//! blendsynth: renders Blender scenes without Blender, to make labelled synthetic
+//! training datasets.
+//!
+//! Data flows one way: a .blend is exported by Blender (`blender`) into the exchange
+//! format, read by `scene`, evaluated by `nodes` (shader and Geometry Nodes graphs),
+//! and reported on by `inspect`. See ARCHITECTURE.md.
+
+pub mod blender;
+pub mod inspect;
+pub mod nodes;
+pub mod scene;

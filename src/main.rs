@@ -1,0 +1,113 @@
+//! The `blendsynth` command line: parses arguments and calls the library.
+//!
+//! Exit codes: 0 success, 1 failure (one line naming what was wrong), 2 bad usage,
+//! 3 `inspect` found node types blendsynth does not support yet.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+
+use blendsynth::{blender, inspect, scene::Scene};
+
+#[derive(Parser)]
+#[command(name = "blendsynth", version, about = "Render Blender scenes without Blender, to make labelled synthetic training datasets")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Export a .blend file with Blender into a blendsynth scene folder, then validate it.
+    Convert {
+        /// The .blend file to convert.
+        input: PathBuf,
+        /// Output folder (created; an earlier export there is replaced).
+        #[arg(short, long)]
+        output: PathBuf,
+        /// Blender executable, or a Python interpreter with the bpy module.
+        /// Default: $BLENDSYNTH_BLENDER, then $BLENDSYNTH_BPY_PYTHON, then `blender` on PATH.
+        #[arg(long)]
+        blender: Option<PathBuf>,
+        /// Frame at which to write the evaluated reference meshes (default: the file's current frame).
+        #[arg(long, allow_negative_numbers = true)]
+        frame: Option<i32>,
+        /// Do not write evaluated reference meshes.
+        #[arg(long)]
+        no_evaluated: bool,
+    },
+    /// Describe an exported scene and list which node types blendsynth supports.
+    /// Exits with status 3 when the scene uses unsupported node types.
+    Inspect {
+        /// A folder written by `blendsynth convert`.
+        dir: PathBuf,
+        /// Print the report as JSON.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+enum Outcome {
+    Done,
+    Unsupported,
+}
+
+fn run(cli: Cli) -> Result<Outcome> {
+    match cli.command {
+        Command::Convert { input, output, blender, frame, no_evaluated } => {
+            let opts = blender::ConvertOptions { blender, frame, no_evaluated };
+            let scene = blender::convert(&input, &output, &opts)?;
+            let f = &scene.file;
+            println!(
+                "converted {} -> {}: {} objects, {} meshes, {} materials, {} node groups, {} animated ID(s) (Blender {})",
+                input.display(),
+                output.display(),
+                f.objects.len(),
+                f.meshes.len(),
+                f.materials.len(),
+                f.node_groups.len(),
+                f.animation.len(),
+                f.blender_version
+            );
+            for w in &f.warnings {
+                eprintln!("warning: {w}");
+            }
+            Ok(Outcome::Done)
+        }
+        Command::Inspect { dir, json } => {
+            let scene = Scene::load(&dir)?;
+            for i in 0..scene.file.meshes.len() {
+                scene.load_mesh(i)?;
+            }
+            let report = inspect::report(&scene);
+            if json {
+                println!("{}", serde_json::to_string_pretty(&report).context("cannot serialise the report")?);
+            } else {
+                print!("{}", report.to_text());
+            }
+            Ok(if report.all_supported { Outcome::Done } else { Outcome::Unsupported })
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            // --help and --version are not errors; clap knows which is which.
+            let _ = e.print();
+            return ExitCode::from(if e.use_stderr() { 2 } else { 0 });
+        }
+    };
+    match run(cli) {
+        Ok(Outcome::Done) => ExitCode::SUCCESS,
+        Ok(Outcome::Unsupported) => ExitCode::from(3),
+        Err(e) => {
+            let msg = format!("{e:#}").replace('\n', " ");
+            eprintln!("error: {msg}");
+            ExitCode::from(1)
+        }
+    }
+}

@@ -1,0 +1,520 @@
+//! Serde types for `scene.json`, version 1 (see `blender_export/FORMAT.md`).
+//!
+//! Fields the renderer and evaluators depend on are typed and required; the long tail of
+//! Blender settings that the exporter dumps generically from RNA is kept as JSON maps
+//! (`Rna`), so a newer Blender's extra properties load without a format change.
+//! Unknown keys are ignored everywhere, so newer exporters stay readable.
+
+use serde::{Deserialize, Serialize};
+
+/// The `format` tag every scene file must carry.
+pub const FORMAT_TAG: &str = "blendsynth-scene";
+/// The newest format version this build reads.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// Generic RNA values as the exporter dumps them (property identifier -> value).
+pub type Rna = serde_json::Map<String, serde_json::Value>;
+
+/// A 4x4 matrix as a list of rows (`m[row][col]`, translation in column 3), as
+/// Blender's `mathutils.Matrix` indexes it.
+pub type Matrix4 = [[f64; 4]; 4];
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct SceneFile {
+    pub format: String,
+    pub version: u32,
+    #[serde(default)]
+    pub exporter_version: u32,
+    pub blender_version: String,
+    #[serde(default)]
+    pub blender_version_tuple: Vec<u32>,
+    #[serde(default)]
+    pub file_version: Vec<u32>,
+    #[serde(default)]
+    pub source_file: String,
+    pub scene: SceneSettings,
+    pub objects: Vec<Object>,
+    pub meshes: Vec<MeshRef>,
+    #[serde(default)]
+    pub curves: Vec<Curve>,
+    pub materials: Vec<Material>,
+    #[serde(default)]
+    pub worlds: Vec<World>,
+    pub node_groups: Vec<NodeTree>,
+    #[serde(default)]
+    pub cameras: Vec<Camera>,
+    #[serde(default)]
+    pub lights: Vec<Light>,
+    #[serde(default)]
+    pub images: Vec<Image>,
+    #[serde(default)]
+    pub animation: Vec<AnimData>,
+    #[serde(default)]
+    pub evaluated: Vec<Evaluated>,
+    #[serde(default)]
+    pub color_management: ColorManagement,
+    #[serde(default)]
+    pub warnings: Vec<String>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct SceneSettings {
+    pub name: String,
+    pub frame_start: i32,
+    pub frame_end: i32,
+    pub frame_current: i32,
+    #[serde(default = "one_i32")]
+    pub frame_step: i32,
+    pub fps: f64,
+    #[serde(default = "one_f64")]
+    pub fps_base: f64,
+    pub camera: Option<String>,
+    #[serde(default)]
+    pub world: Option<String>,
+    #[serde(default)]
+    pub render: Rna,
+    #[serde(default)]
+    pub cycles: Rna,
+    #[serde(default)]
+    pub view_settings: Rna,
+    #[serde(default)]
+    pub display_settings: Rna,
+    #[serde(default)]
+    pub unit_settings: Rna,
+}
+
+fn one_i32() -> i32 {
+    1
+}
+fn one_f64() -> f64 {
+    1.0
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Object {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub kind: String,
+    pub data: Option<String>,
+    pub parent: Option<String>,
+    #[serde(default)]
+    pub parent_type: Option<String>,
+    pub matrix_world: Matrix4,
+    #[serde(default)]
+    pub matrix_local: Option<Matrix4>,
+    #[serde(default)]
+    pub matrix_basis: Option<Matrix4>,
+    #[serde(default)]
+    pub matrix_parent_inverse: Option<Matrix4>,
+    pub location: [f64; 3],
+    pub rotation_mode: String,
+    pub rotation_euler: [f64; 3],
+    pub rotation_quaternion: [f64; 4],
+    #[serde(default)]
+    pub rotation_axis_angle: Option<[f64; 4]>,
+    pub scale: [f64; 3],
+    #[serde(default)]
+    pub delta_location: Option<[f64; 3]>,
+    #[serde(default)]
+    pub delta_rotation_euler: Option<[f64; 3]>,
+    #[serde(default)]
+    pub delta_rotation_quaternion: Option<[f64; 4]>,
+    #[serde(default)]
+    pub delta_scale: Option<[f64; 3]>,
+    #[serde(default)]
+    pub hide_render: bool,
+    #[serde(default)]
+    pub hide_viewport: bool,
+    #[serde(default = "yes")]
+    pub visible: bool,
+    #[serde(default)]
+    pub pass_index: i32,
+    #[serde(default)]
+    pub collections: Vec<String>,
+    #[serde(default)]
+    pub material_slots: Vec<MaterialSlot>,
+    #[serde(default)]
+    pub modifiers: Vec<Modifier>,
+    #[serde(default)]
+    pub constraints: Vec<Constraint>,
+    #[serde(default)]
+    pub custom_properties: Rna,
+    #[serde(default)]
+    pub instance_type: Option<String>,
+    #[serde(default)]
+    pub instance_collection: Option<String>,
+}
+
+fn yes() -> bool {
+    true
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct MaterialSlot {
+    pub material: Option<String>,
+    #[serde(default)]
+    pub link: Option<String>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Modifier {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub kind: String,
+    #[serde(default = "yes")]
+    pub show_render: bool,
+    #[serde(default = "yes")]
+    pub show_viewport: bool,
+    #[serde(default)]
+    pub properties: Rna,
+    #[serde(default)]
+    pub node_group: Option<String>,
+    #[serde(default)]
+    pub inputs: Rna,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Constraint {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub kind: String,
+    #[serde(default)]
+    pub mute: bool,
+    #[serde(default = "one_f64")]
+    pub influence: f64,
+    #[serde(default)]
+    pub properties: Rna,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct MeshRef {
+    pub name: String,
+    pub file: String,
+    pub vertex_count: usize,
+    pub edge_count: usize,
+    pub face_count: usize,
+    pub corner_count: usize,
+    #[serde(default)]
+    pub materials: Vec<Option<String>>,
+    #[serde(default)]
+    pub uv_layers: Vec<String>,
+    #[serde(default)]
+    pub active_uv: Option<String>,
+    #[serde(default)]
+    pub active_render_uv: Option<String>,
+    #[serde(default)]
+    pub attributes: Vec<AttributeInfo>,
+    #[serde(default)]
+    pub texspace_location: Option<[f64; 3]>,
+    #[serde(default)]
+    pub texspace_size: Option<[f64; 3]>,
+    #[serde(default)]
+    pub use_auto_texspace: Option<bool>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct AttributeInfo {
+    pub name: String,
+    pub domain: String,
+    pub data_type: String,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Curve {
+    pub name: String,
+    #[serde(default)]
+    pub properties: Rna,
+    #[serde(default)]
+    pub materials: Vec<Option<String>>,
+    pub splines: Vec<Spline>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Spline {
+    #[serde(rename = "type")]
+    pub kind: String,
+    #[serde(default)]
+    pub use_cyclic_u: bool,
+    #[serde(default = "twelve")]
+    pub resolution_u: u32,
+    #[serde(default = "four")]
+    pub order_u: u32,
+    #[serde(default)]
+    pub use_endpoint_u: bool,
+    #[serde(default)]
+    pub use_bezier_u: bool,
+    #[serde(default = "yes")]
+    pub use_smooth: bool,
+    #[serde(default)]
+    pub material_index: u32,
+    #[serde(default)]
+    pub tilt_interpolation: Option<String>,
+    #[serde(default)]
+    pub radius_interpolation: Option<String>,
+    #[serde(default)]
+    pub bezier_points: Vec<BezierPoint>,
+    #[serde(default)]
+    pub points: Vec<SplinePoint>,
+}
+
+fn twelve() -> u32 {
+    12
+}
+fn four() -> u32 {
+    4
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct BezierPoint {
+    pub co: [f64; 3],
+    pub handle_left: [f64; 3],
+    pub handle_right: [f64; 3],
+    pub handle_left_type: String,
+    pub handle_right_type: String,
+    #[serde(default = "one_f64")]
+    pub radius: f64,
+    #[serde(default)]
+    pub tilt: f64,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct SplinePoint {
+    pub co: [f64; 4],
+    #[serde(default = "one_f64")]
+    pub radius: f64,
+    #[serde(default)]
+    pub tilt: f64,
+    #[serde(default = "one_f64")]
+    pub weight: f64,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Material {
+    pub name: String,
+    #[serde(default)]
+    pub use_nodes: bool,
+    pub node_tree: Option<NodeTree>,
+    #[serde(default)]
+    pub pass_index: i32,
+    #[serde(default)]
+    pub properties: Rna,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct World {
+    pub name: String,
+    #[serde(default)]
+    pub color: Option<[f64; 3]>,
+    #[serde(default)]
+    pub use_nodes: bool,
+    pub node_tree: Option<NodeTree>,
+    #[serde(default)]
+    pub properties: Rna,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct NodeTree {
+    pub name: String,
+    pub bl_idname: String,
+    #[serde(default)]
+    pub interface: Vec<InterfaceItem>,
+    pub nodes: Vec<Node>,
+    pub links: Vec<Link>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct InterfaceItem {
+    pub item_type: String,
+    #[serde(default)]
+    pub in_out: Option<String>,
+    pub name: String,
+    #[serde(default)]
+    pub identifier: Option<String>,
+    #[serde(default)]
+    pub socket_type: Option<String>,
+    #[serde(default)]
+    pub default_value: Option<serde_json::Value>,
+    #[serde(default)]
+    pub min_value: Option<serde_json::Value>,
+    #[serde(default)]
+    pub max_value: Option<serde_json::Value>,
+    #[serde(default)]
+    pub parent: Option<String>,
+    #[serde(default)]
+    pub properties: Rna,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Node {
+    pub name: String,
+    pub bl_idname: String,
+    #[serde(default)]
+    pub label: String,
+    #[serde(default)]
+    pub mute: bool,
+    #[serde(default)]
+    pub parent: Option<String>,
+    #[serde(default)]
+    pub location: Option<[f64; 2]>,
+    #[serde(default)]
+    pub hide: bool,
+    #[serde(default)]
+    pub node_tree: Option<String>,
+    #[serde(default)]
+    pub properties: Rna,
+    pub inputs: Vec<Socket>,
+    pub outputs: Vec<Socket>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Socket {
+    pub index: usize,
+    pub identifier: String,
+    pub name: String,
+    #[serde(rename = "type")]
+    pub kind: String,
+    #[serde(default)]
+    pub bl_idname: String,
+    #[serde(default)]
+    pub default_value: Option<serde_json::Value>,
+    #[serde(default)]
+    pub is_linked: bool,
+    #[serde(default)]
+    pub hide: bool,
+    #[serde(default = "yes")]
+    pub enabled: bool,
+    #[serde(default)]
+    pub hide_value: bool,
+    #[serde(default)]
+    pub is_multi_input: bool,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Link {
+    pub from_node: String,
+    pub from_socket: String,
+    #[serde(default)]
+    pub from_index: Option<usize>,
+    pub to_node: String,
+    pub to_socket: String,
+    #[serde(default)]
+    pub to_index: Option<usize>,
+    #[serde(default)]
+    pub is_muted: bool,
+    #[serde(default = "yes")]
+    pub is_valid: bool,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Camera {
+    pub name: String,
+    pub properties: Rna,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Light {
+    pub name: String,
+    #[serde(rename = "type")]
+    pub kind: String,
+    pub properties: Rna,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Image {
+    pub name: String,
+    #[serde(default)]
+    pub source: Option<String>,
+    #[serde(default)]
+    pub filepath: String,
+    pub file: Option<String>,
+    #[serde(default)]
+    pub packed: bool,
+    #[serde(default)]
+    pub missing: bool,
+    #[serde(default)]
+    pub colorspace: Option<String>,
+    #[serde(default)]
+    pub alpha_mode: Option<String>,
+    #[serde(default)]
+    pub size: Option<[u32; 2]>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct AnimData {
+    pub id_type: String,
+    pub id_name: String,
+    pub id_path: String,
+    #[serde(default)]
+    pub action: Option<String>,
+    #[serde(default)]
+    pub fcurves: Vec<FCurve>,
+    #[serde(default)]
+    pub drivers: Vec<FCurve>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct FCurve {
+    pub data_path: String,
+    #[serde(default)]
+    pub array_index: usize,
+    pub extrapolation: String,
+    #[serde(default)]
+    pub mute: bool,
+    pub keyframes: Vec<Keyframe>,
+    #[serde(default)]
+    pub modifiers: Vec<FModifier>,
+    /// Present on drivers only: the driver's RNA (type, expression, variables).
+    #[serde(default)]
+    pub driver: Option<Rna>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Keyframe {
+    pub co: [f64; 2],
+    pub handle_left: [f64; 2],
+    pub handle_right: [f64; 2],
+    #[serde(default)]
+    pub handle_left_type: Option<String>,
+    #[serde(default)]
+    pub handle_right_type: Option<String>,
+    pub interpolation: String,
+    #[serde(default)]
+    pub easing: Option<String>,
+    #[serde(default)]
+    pub back: Option<f64>,
+    #[serde(default)]
+    pub amplitude: Option<f64>,
+    #[serde(default)]
+    pub period: Option<f64>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct FModifier {
+    #[serde(rename = "type")]
+    pub kind: String,
+    #[serde(default)]
+    pub mute: bool,
+    #[serde(default)]
+    pub properties: Rna,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Evaluated {
+    pub object: String,
+    pub frame: f64,
+    pub file: String,
+    #[serde(default)]
+    pub vertex_count: Option<usize>,
+    #[serde(default)]
+    pub face_count: Option<usize>,
+    #[serde(default)]
+    pub instances_realized: Option<usize>,
+}
+
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct ColorManagement {
+    #[serde(default)]
+    pub dir: Option<String>,
+    #[serde(default)]
+    pub config: Option<String>,
+}

@@ -1,0 +1,202 @@
+//! The exchange format written by `blender_export/export_scene.py` and its loader.
+//!
+//! This is the only module that knows the JSON layout; everything downstream works on
+//! the typed structures it returns.
+
+pub mod error;
+pub mod format;
+pub mod mesh;
+mod validate;
+
+use std::path::{Component, Path, PathBuf};
+
+pub use error::SceneError;
+pub use format::*;
+pub use mesh::{read_glb, read_obj, Attribute, AttributeData, Domain, MeshData};
+
+/// An exported scene: its folder and the parsed, validated `scene.json`.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    pub dir: PathBuf,
+    pub file: SceneFile,
+}
+
+impl Scene {
+    /// Reads and validates `DIR/scene.json` (meshes are read on demand).
+    pub fn load(dir: &Path) -> Result<Scene, SceneError> {
+        let json_path = dir.join("scene.json");
+        if !dir.is_dir() {
+            return Err(SceneError::new(dir, "", "not a folder (expected an export made by `blendsynth convert`)"));
+        }
+        let bytes = std::fs::read(&json_path).map_err(|e| SceneError::new(&json_path, "", format!("cannot read: {e}")))?;
+        let file = parse_scene_json(&bytes, &json_path)?;
+        let scene = Scene { dir: dir.to_path_buf(), file };
+        validate::validate(&scene, &json_path)?;
+        Ok(scene)
+    }
+
+    pub fn json_path(&self) -> PathBuf {
+        self.dir.join("scene.json")
+    }
+
+    /// Resolves a path written in the scene file, refusing any that would leave the
+    /// scene folder (absolute paths, `..`, or a symlink pointing outside).
+    pub fn resolve(&self, rel: &str, location: &str) -> Result<PathBuf, SceneError> {
+        resolve_inside(&self.dir, rel).map_err(|m| SceneError::new(&self.json_path(), location, m))
+    }
+
+    pub fn object(&self, name: &str) -> Option<&Object> {
+        self.file.objects.iter().find(|o| o.name == name)
+    }
+    pub fn material(&self, name: &str) -> Option<&Material> {
+        self.file.materials.iter().find(|m| m.name == name)
+    }
+    pub fn node_group(&self, name: &str) -> Option<&NodeTree> {
+        self.file.node_groups.iter().find(|g| g.name == name)
+    }
+    pub fn mesh_ref(&self, name: &str) -> Option<&MeshRef> {
+        self.file.meshes.iter().find(|m| m.name == name)
+    }
+
+    /// Reads one mesh datablock's glb and checks it against the counts in scene.json.
+    pub fn load_mesh(&self, index: usize) -> Result<MeshData, SceneError> {
+        let r = &self.file.meshes[index];
+        let path = self.resolve(&r.file, &format!("meshes[{index}].file"))?;
+        let m = read_glb(&path)?;
+        let counts = [
+            ("vertex_count", r.vertex_count, m.vertex_count()),
+            ("edge_count", r.edge_count, m.edges.len()),
+            ("face_count", r.face_count, m.face_count()),
+            ("corner_count", r.corner_count, m.corner_count()),
+        ];
+        for (what, declared, found) in counts {
+            if declared != found {
+                return Err(SceneError::new(
+                    &self.json_path(),
+                    format!("meshes[{index}].{what}"),
+                    format!("says {declared} but {} holds {found}", path.display()),
+                ));
+            }
+        }
+        Ok(m)
+    }
+
+    /// Reads an evaluated (reference) mesh written by the exporter.
+    pub fn load_evaluated(&self, index: usize) -> Result<MeshData, SceneError> {
+        let e = &self.file.evaluated[index];
+        read_glb(&self.resolve(&e.file, &format!("evaluated[{index}].file"))?)
+    }
+
+    /// All node trees in the file, with a Blender data path prefix for each:
+    /// `node_groups["X"]`, `materials["X"].node_tree`, `worlds["X"].node_tree`.
+    pub fn node_trees(&self) -> Vec<(String, &NodeTree)> {
+        let mut out = Vec::new();
+        for m in &self.file.materials {
+            if let Some(t) = &m.node_tree {
+                out.push((format!("materials[{}].node_tree", quote(&m.name)), t));
+            }
+        }
+        for w in &self.file.worlds {
+            if let Some(t) = &w.node_tree {
+                out.push((format!("worlds[{}].node_tree", quote(&w.name)), t));
+            }
+        }
+        for g in &self.file.node_groups {
+            out.push((format!("node_groups[{}]", quote(&g.name)), g));
+        }
+        out
+    }
+}
+
+/// Quotes a name as Blender data paths do: `"Fat.001"`, with `"` and `\` escaped.
+pub fn quote(name: &str) -> String {
+    format!("\"{}\"", name.replace('\\', "\\\\").replace('"', "\\\""))
+}
+
+/// Parses scene.json bytes, turning serde errors into ones that name the JSON path
+/// (for wrong types and missing fields) or the line and column (for syntax).
+pub fn parse_scene_json(bytes: &[u8], path: &Path) -> Result<SceneFile, SceneError> {
+    // Check the tag first so a random JSON file gets a clear message, not a field error.
+    let head: serde_json::Result<serde_json::Value> = serde_json::from_slice(bytes);
+    let value = match head {
+        Ok(v) => v,
+        Err(e) => return Err(json_syntax_error(&e, bytes, path)),
+    };
+    match value.get("format").and_then(|f| f.as_str()) {
+        Some(FORMAT_TAG) => {}
+        Some(other) => return Err(SceneError::new(path, "format", format!("is {other:?}, expected {FORMAT_TAG:?}"))),
+        None => return Err(SceneError::new(path, "format", format!("missing: not a blendsynth scene (expected \"format\": {FORMAT_TAG:?})"))),
+    }
+    match value.get("version").and_then(|v| v.as_u64()) {
+        Some(v) if v as u32 <= FORMAT_VERSION && v >= 1 => {}
+        Some(v) => {
+            return Err(SceneError::new(path, "version", format!("format version {v} is not readable by this build (reads 1..={FORMAT_VERSION}); update blendsynth")))
+        }
+        None => return Err(SceneError::new(path, "version", "missing or not an integer")),
+    }
+    serde_path_to_error::deserialize(value).map_err(|e| {
+        let loc = e.path().to_string();
+        SceneError::new(path, if loc == "." { String::new() } else { loc }, e.into_inner().to_string())
+    })
+}
+
+fn json_syntax_error(e: &serde_json::Error, bytes: &[u8], path: &Path) -> SceneError {
+    let loc = format!("line {} column {}", e.line(), e.column());
+    let msg = if e.is_eof() {
+        format!("file ends early (truncated?): {e}")
+    } else {
+        // JSON has no NaN or infinity; Python writes them as bare words unless told not to.
+        let offset = line_col_offset(bytes, e.line(), e.column());
+        let rest = &bytes[offset.min(bytes.len())..];
+        let rest = rest.get(rest.iter().position(|b| !b.is_ascii_whitespace()).unwrap_or(0)..).unwrap_or(&[]);
+        let word = |w: &[u8]| rest.starts_with(w) || (rest.first() == Some(&b'-') && rest[1..].starts_with(w));
+        if word(b"NaN") || word(b"Infinity") || word(b"inf") {
+            format!("non-finite number (NaN or infinity) is not allowed: {e}")
+        } else {
+            e.to_string()
+        }
+    };
+    SceneError::new(path, loc, msg)
+}
+
+fn line_col_offset(bytes: &[u8], line: usize, col: usize) -> usize {
+    let mut l = 1;
+    let mut start = 0;
+    for (i, b) in bytes.iter().enumerate() {
+        if l == line {
+            break;
+        }
+        if *b == b'\n' {
+            l += 1;
+            start = i + 1;
+        }
+    }
+    // serde_json reports the column of the last byte it read.
+    start + col.saturating_sub(1)
+}
+
+/// Joins `rel` to `dir` if it stays inside `dir`; the error says why not.
+pub fn resolve_inside(dir: &Path, rel: &str) -> Result<PathBuf, String> {
+    if rel.is_empty() {
+        return Err("empty path".into());
+    }
+    if rel.contains('\\') || rel.contains('\0') {
+        return Err(format!("path {rel:?} must use '/' separators"));
+    }
+    let p = Path::new(rel);
+    for c in p.components() {
+        match c {
+            Component::Normal(_) | Component::CurDir => {}
+            Component::ParentDir => return Err(format!("path {rel:?} leaves the scene folder ('..')")),
+            Component::RootDir | Component::Prefix(_) => return Err(format!("path {rel:?} is absolute; paths must be relative to the scene folder")),
+        }
+    }
+    let joined = dir.join(p);
+    // A symlink inside the folder could still point outside it.
+    if let (Ok(real), Ok(real_dir)) = (joined.canonicalize(), dir.canonicalize()) {
+        if !real.starts_with(&real_dir) {
+            return Err(format!("path {rel:?} resolves outside the scene folder (symlink?)"));
+        }
+    }
+    Ok(joined)
+}

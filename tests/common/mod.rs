@@ -1,0 +1,102 @@
+//! Shared helpers for the integration tests.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+pub fn repo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+pub fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_blendsynth"))
+}
+
+/// Runs the CLI with a clean Blender environment plus `envs`.
+pub fn run(args: &[&str], envs: &[(&str, &str)]) -> Output {
+    let mut c = bin();
+    c.args(args).env_remove("BLENDSYNTH_BLENDER").env_remove("BLENDSYNTH_BPY_PYTHON");
+    for (k, v) in envs {
+        c.env(k, v);
+    }
+    c.output().expect("run blendsynth")
+}
+
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// A failure must be one line on stderr starting with `error:` and no panic.
+pub fn assert_clean_error(o: &Output, code: i32, must_contain: &[&str]) {
+    let err = stderr(o);
+    assert_eq!(o.status.code(), Some(code), "exit code; stderr: {err}");
+    assert!(!err.contains("panicked"), "panic: {err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "expected one error line, got: {err}");
+    assert!(lines[0].starts_with("error: "), "{err}");
+    for m in must_contain {
+        assert!(lines[0].contains(m), "error {:?} should mention {m:?}", lines[0]);
+    }
+}
+
+pub fn in_ci() -> bool {
+    std::env::var("CI").map(|v| v == "true").unwrap_or(false)
+}
+
+/// A Python interpreter with Blender's `bpy` module: $BLENDSYNTH_BPY_PYTHON, or the
+/// repository's `.venv` that `.ci/run` creates.
+pub fn bpy_python() -> Option<PathBuf> {
+    if let Some(p) = std::env::var_os("BLENDSYNTH_BPY_PYTHON").filter(|p| !p.is_empty()) {
+        return Some(PathBuf::from(p));
+    }
+    let venv = repo().join(".venv/bin/python");
+    if venv.is_file() {
+        let ok = Command::new(&venv).args(["-c", "import bpy"]).output().map(|o| o.status.success()).unwrap_or(false);
+        if ok {
+            return Some(venv);
+        }
+    }
+    None
+}
+
+/// The published colon scene, read from `../shared/published` (never copied here).
+pub fn published_colon() -> Option<PathBuf> {
+    let p = repo().join("../shared/published/colon_nodes.blend");
+    p.is_file().then_some(p)
+}
+
+/// Gets what a Blender-side test needs, or skips the test (returns None) on a user's
+/// machine without it. In CI (CI=true) a missing requirement is a failure.
+pub fn require<T>(what: &str, v: Option<T>) -> Option<T> {
+    if v.is_none() {
+        if in_ci() {
+            panic!("{what} is required in CI (CI=true) but was not found");
+        }
+        eprintln!("SKIPPED: {what} not found (set BLENDSYNTH_BPY_PYTHON or run .ci/run)");
+    }
+    v
+}
+
+pub fn copy_dir(src: &Path, dst: &Path) {
+    std::fs::create_dir_all(dst).unwrap();
+    for e in std::fs::read_dir(src).unwrap() {
+        let e = e.unwrap();
+        let to = dst.join(e.file_name());
+        if e.file_type().unwrap().is_dir() {
+            copy_dir(&e.path(), &to);
+        } else {
+            std::fs::copy(e.path(), &to).unwrap();
+        }
+    }
+}
+
+/// Runs a bpy script with the given python and returns stdout, panicking with stderr on failure.
+pub fn run_python(python: &Path, script: &Path, args: &[&str]) -> String {
+    let o = Command::new(python).arg(script).args(args).output().expect("run python");
+    assert!(o.status.success(), "{} failed: {}\n{}", script.display(), stderr(&o), stdout(&o));
+    stdout(&o)
+}
