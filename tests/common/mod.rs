@@ -100,3 +100,39 @@ pub fn run_python(python: &Path, script: &Path, args: &[&str]) -> String {
     assert!(o.status.success(), "{} failed: {}\n{}", script.display(), stderr(&o), stdout(&o));
     stdout(&o)
 }
+
+/// Counts from the export, in the layout `fixtures/blender_counts.py` prints from Blender.
+pub fn export_counts(s: &blendsynth::scene::Scene) -> serde_json::Value {
+    let mut trees = serde_json::Map::new();
+    for (path, t) in s.node_trees() {
+        let mut names: Vec<&str> = t.nodes.iter().map(|n| n.name.as_str()).collect();
+        names.sort();
+        let mut ids: Vec<&str> = t.nodes.iter().map(|n| n.bl_idname.as_str()).collect();
+        ids.sort();
+        trees.insert(
+            path,
+            serde_json::json!({
+                "nodes": t.nodes.len(),
+                "links": t.links.len(),
+                "inputs": t.nodes.iter().map(|n| n.inputs.len()).sum::<usize>(),
+                "outputs": t.nodes.iter().map(|n| n.outputs.len()).sum::<usize>(),
+                "node_names": names,
+                "bl_idnames": ids,
+            }),
+        );
+    }
+    let objects: serde_json::Map<String, serde_json::Value> = s
+        .file
+        .objects
+        .iter()
+        .map(|o| (o.name.clone(), serde_json::json!({"modifiers": o.modifiers.len(), "constraints": o.constraints.len()})))
+        .collect();
+    let mut anim = serde_json::Map::new();
+    for a in &s.file.animation {
+        anim.insert(
+            a.id_path.clone(),
+            serde_json::json!({"fcurves": a.fcurves.len(), "drivers": a.drivers.len(), "keyframes": a.fcurves.iter().map(|f| f.keyframes.len()).sum::<usize>()}),
+        );
+    }
+    serde_json::json!({"node_trees": trees, "objects": objects, "animation": anim})
+}
