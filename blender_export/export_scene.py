@@ -454,6 +454,7 @@ def obj_entry(o):
         "pass_index": o.pass_index, "collections": [c.name for c in o.users_collection],
         "material_slots": [{"material": s.material.name if s.material else None, "link": s.link} for s in o.material_slots],
         "modifiers": mods, "constraints": cons, "custom_properties": custom_props(o),
+        "track_axis": o.track_axis, "up_axis": o.up_axis,
         "instance_type": o.instance_type,
         "instance_collection": o.instance_collection.name if o.instance_collection else None,
     }
@@ -560,20 +561,26 @@ def q(name):
 def main():
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
     ap = argparse.ArgumentParser(prog="export_scene.py")
-    ap.add_argument("--in", dest="input", required=True)
+    ap.add_argument("--in", dest="input", help="the .blend to export (default: the file Blender already opened)")
     ap.add_argument("--out", required=True)
     ap.add_argument("--frame", type=int)
     ap.add_argument("--no-evaluated", action="store_true")
     args = ap.parse_args(argv)
-    if not os.path.isfile(args.input):
-        fail(f"input file not found: {args.input}")
-
-    # Never run Python carried by the file.
-    bpy.context.preferences.filepaths.use_scripts_auto_execute = False
-    try:
-        bpy.ops.wm.open_mainfile(filepath=os.path.abspath(args.input), load_ui=False, use_scripts=False)
-    except Exception as e:
-        fail(f"Blender cannot open {args.input}: {e}")
+    if args.input is None:
+        # `blender -b FILE --python export_scene.py -- --out DIR`: Blender opened FILE
+        # itself, so it is only safe when Blender was started with --disable-autoexec.
+        if not bpy.data.filepath:
+            fail("no input: pass --in FILE.blend (or open the file with `blender -b --disable-autoexec FILE`)")
+        args.input = bpy.data.filepath
+    else:
+        if not os.path.isfile(args.input):
+            fail(f"input file not found: {args.input}")
+        # Never run Python carried by the file.
+        bpy.context.preferences.filepaths.use_scripts_auto_execute = False
+        try:
+            bpy.ops.wm.open_mainfile(filepath=os.path.abspath(args.input), load_ui=False, use_scripts=False)
+        except Exception as e:
+            fail(f"Blender cannot open {args.input}: {e}")
 
     out = args.out
     for sub in ("", "meshes", "evaluated"):

@@ -5,6 +5,7 @@
 //! format, read by `scene`, evaluated by `nodes` (shader and Geometry Nodes graphs),
 //! and reported on by `inspect`. See ARCHITECTURE.md.
 
+pub mod anim;
 pub mod blender;
 pub mod inspect;
 pub mod nodes;

@@ -139,6 +139,12 @@ pub struct Object {
     pub constraints: Vec<Constraint>,
     #[serde(default)]
     pub custom_properties: Rna,
+    /// The object's own track and up axes (POS_X.., X/Y/Z): a child of a path curve
+    /// with "Follow" on is oriented by them.
+    #[serde(default)]
+    pub track_axis: Option<String>,
+    #[serde(default)]
+    pub up_axis: Option<String>,
     #[serde(default)]
     pub instance_type: Option<String>,
     #[serde(default)]
