@@ -480,10 +480,14 @@ def curve_entry(c):
 def image_entry(im, out_dir, used_names):
     d = {"name": im.name, "source": im.source, "filepath": im.filepath, "file": None, "packed": im.packed_file is not None,
          "missing": False, "colorspace": im.colorspace_settings.name, "alpha_mode": im.alpha_mode, "size": list(im.size)}
-    if im.source not in ("FILE", "SEQUENCE", "MOVIE", "TILED"):
+    if im.packed_file is None and im.source not in ("FILE", "SEQUENCE", "MOVIE", "TILED"):
+        if im.source == "GENERATED":
+            WARNINGS.append(f'images["{im.name}"]: generated image not packed; its pixels are not exported')
         return d
     os.makedirs(os.path.join(out_dir, "images"), exist_ok=True)
     base = re.sub(r"[^A-Za-z0-9._-]", "_", os.path.basename(im.filepath) or im.name) or "image"
+    if im.packed_file is not None and not os.path.splitext(base)[1]:
+        base += "." + {"JPEG": "jpg", "OPEN_EXR": "exr", "OPEN_EXR_MULTILAYER": "exr"}.get(im.file_format, im.file_format.lower())
     name = base
     k = 1
     while name in used_names:

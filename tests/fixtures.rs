@@ -71,3 +71,18 @@ fn geonodes_fixture_has_modifier_inputs() {
     assert!(g.interface.iter().any(|i| i.item_type == "SOCKET" && i.in_out.as_deref() == Some("INPUT")));
     assert!(!s.file.evaluated.is_empty(), "no evaluated reference mesh");
 }
+
+#[test]
+fn packed_image_is_exported_and_referenced() {
+    let dir = repo().join("fixtures/scenes/material_zoo");
+    let s = Scene::load(&dir).unwrap();
+    let img = s.file.images.iter().find(|i| i.name == "Swatch").expect("the packed image");
+    assert!(img.packed && !img.missing);
+    assert_eq!(img.size, Some([8, 8]));
+    let path = s.resolve(img.file.as_deref().expect("copied next to the export"), "images").unwrap();
+    let bytes = std::fs::read(&path).unwrap();
+    assert!(bytes.starts_with(b"\x89PNG"), "{} is not a PNG", path.display());
+    let node = s.file.materials.iter().flat_map(|m| m.node_tree.iter()).flat_map(|t| &t.nodes).find(|n| n.bl_idname == "ShaderNodeTexImage").unwrap();
+    assert_eq!(node.properties["image"]["name"], "Swatch");
+    assert_eq!(node.properties["interpolation"], "Closest");
+}

@@ -209,3 +209,22 @@ fn obj_keeps_vertices_one_to_one() {
         d => panic!("{d:?}"),
     }
 }
+
+#[test]
+fn inspect_exits_0_when_every_node_is_supported() {
+    // The animated camera scene without its world has no shader nodes at all.
+    let t = tempfile::tempdir().unwrap();
+    let dir = t.path().join("scene");
+    copy_dir(&repo().join("fixtures/scenes/animated_camera"), &dir);
+    let p = dir.join("scene.json");
+    let mut v: Value = serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
+    v["worlds"] = Value::Array(vec![]);
+    v["scene"]["world"] = Value::Null;
+    std::fs::write(&p, serde_json::to_vec(&v).unwrap()).unwrap();
+    let o = run(&["inspect", dir.to_str().unwrap()], &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    // And the unmodified scene, whose world uses unsupported nodes, exits 3.
+    let o = run(&["inspect", repo().join("fixtures/scenes/animated_camera").to_str().unwrap()], &[]);
+    assert_eq!(o.status.code(), Some(3));
+    assert!(stdout(&o).contains("ShaderNodeBackground"));
+}
