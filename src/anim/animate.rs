@@ -10,7 +10,7 @@
 
 use serde_json::Value;
 
-use super::datapath::{parse, Token};
+use crate::scene::datapath::{parse, Token};
 use super::error::AnimError;
 use super::fcurve::{CompiledFCurve, ValueKind};
 use crate::scene::{quote, AnimData, Camera, Curve, FCurve, Light, Object, Rna, SceneFile};
@@ -49,7 +49,7 @@ pub fn apply(anim: &[AnimData], frame: f64, data: &mut Datablocks) -> Result<Vec
     for ad in anim {
         for fc in &ad.fcurves {
             let label = fcurve_label(ad, fc);
-            let tokens = parse(&fc.data_path).map_err(|e| e.within(&label))?;
+            let tokens = parse(&fc.data_path).map_err(|e| AnimError::new(label.clone(), e))?;
             let Some(kind) = value_kind(ad, &tokens, fc.array_index, data) else {
                 unapplied.push(label);
                 continue;
@@ -65,7 +65,7 @@ pub fn apply(anim: &[AnimData], frame: f64, data: &mut Datablocks) -> Result<Vec
         }
         for d in &ad.drivers {
             let label = format!("{} driver {}[{}]", ad.id_path, d.data_path, d.array_index);
-            let tokens = parse(&d.data_path).map_err(|e| e.within(&label))?;
+            let tokens = parse(&d.data_path).map_err(|e| AnimError::new(label.clone(), e))?;
             // A driver on something that moves objects would be silently wrong if skipped.
             let moves = matches!(ad.id_type.as_str(), "OBJECT" | "CURVE");
             if moves && !d.mute && value_kind(ad, &tokens, d.array_index, data).is_some() {

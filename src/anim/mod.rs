@@ -4,7 +4,7 @@
 //! path, Track To, Damped Track).
 //!
 //! One idea per file: `fcurve` (keyframes, easing), `fmodifier` (modifier stack), `noise`
-//! (Perlin for the Noise modifier), `datapath` (RNA path parsing), `animate` (writing
+//! (Perlin for the Noise modifier), `animate` (writing
 //! animated values), `transform` (basis, parenting, solve order), `path` (curve path),
 //! `constraint`, `math`.
 
@@ -13,7 +13,6 @@
 
 mod animate;
 mod constraint;
-mod datapath;
 mod error;
 mod fcurve;
 mod fmodifier;

@@ -3,9 +3,11 @@
 //! This is the only module that knows the JSON layout; everything downstream works on
 //! the typed structures it returns.
 
+pub mod datapath;
 pub mod error;
 pub mod format;
 pub mod mesh;
+pub mod overrides;
 mod validate;
 
 use std::path::{Component, Path, PathBuf};
@@ -13,6 +15,7 @@ use std::path::{Component, Path, PathBuf};
 pub use error::SceneError;
 pub use format::*;
 pub use mesh::{read_glb, read_obj, Attribute, AttributeData, Domain, MeshData};
+pub use overrides::Override;
 
 /// An exported scene: its folder and the parsed, validated `scene.json`.
 #[derive(Debug, Clone)]

@@ -1,8 +1,6 @@
-//! Blender RNA data paths, as F-curves name the property they animate:
-//! `location`, `constraints["Follow Path"].offset`, `splines[0].bezier_points[2].co`,
-//! `["my prop"]`, `nodes["Math"].inputs[1].default_value`.
-
-use super::error::AnimError;
+//! Blender RNA data paths, as F-curves name the property they animate and as
+//! "Copy Full Data Path" gives them: `location`, `constraints["Follow Path"].offset`,
+//! `splines[0].bezier_points[2].co`, `["my prop"]`, `nodes["Math"].inputs[1].default_value`.
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum Token {
@@ -15,8 +13,8 @@ pub enum Token {
 }
 
 /// Parses a data path into tokens. Errors name the offending path.
-pub fn parse(path: &str) -> Result<Vec<Token>, AnimError> {
-    let bad = |why: &str| AnimError::new(format!("data path {path:?}"), why.to_string());
+pub fn parse(path: &str) -> Result<Vec<Token>, String> {
+    let bad = |why: &str| format!("data path {path:?}: {why}");
     let b = path.as_bytes();
     let mut i = 0;
     let mut out = Vec::new();
