@@ -5,6 +5,8 @@
 //! numbers, `support` reports it as unsupported: `blendsynth inspect` must never
 //! claim a node that would be evaluated as something else.
 
+pub mod graph;
+
 /// How blendsynth handles a node type (by its `bl_idname`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]

@@ -370,6 +370,16 @@ pub struct Node {
     pub properties: Rna,
     pub inputs: Vec<Socket>,
     pub outputs: Vec<Socket>,
+    /// Blender's pass-through links, used when the node is muted: input identifier
+    /// (`from`) to output identifier (`to`).
+    #[serde(default)]
+    pub internal_links: Vec<InternalLink>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct InternalLink {
+    pub from: String,
+    pub to: String,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
