@@ -10,3 +10,4 @@ pub mod blender;
 pub mod inspect;
 pub mod nodes;
 pub mod scene;
+pub mod shader;

@@ -9,7 +9,8 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 
-use blendsynth::{blender, inspect, scene::Scene};
+use blendsynth::shader::bake::{bake_emission, write_exr, BakeOptions};
+use blendsynth::{blender, inspect, scene::Override, scene::Scene};
 
 #[derive(Parser)]
 #[command(name = "blendsynth", version, about = "Render Blender scenes without Blender, to make labelled synthetic training datasets")]
@@ -38,6 +39,9 @@ enum Command {
         #[arg(long)]
         no_evaluated: bool,
     },
+    /// Evaluate an object's material over its UV map as Cycles' EMIT bake does (surface
+    /// emission at each texel), writing a float EXR.
+    Bake(BakeArgs),
     /// Describe an exported scene and list which node types blendsynth supports.
     /// Exits with status 3 when the scene uses unsupported node types.
     Inspect {
@@ -47,6 +51,27 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+}
+
+#[derive(clap::Args)]
+struct BakeArgs {
+    /// A folder written by `blendsynth convert`.
+    dir: PathBuf,
+    /// The mesh object whose material to bake.
+    #[arg(long)]
+    object: String,
+    /// UV map to bake over (default: the mesh's active render UV map).
+    #[arg(long)]
+    uv: Option<String>,
+    /// Image width and height in texels.
+    #[arg(long)]
+    size: u32,
+    /// Parameter override by Blender data path, PATH=VALUE (repeatable).
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    set: Vec<String>,
+    /// Output image (a float EXR).
+    #[arg(short, long)]
+    output: PathBuf,
 }
 
 enum Outcome {
@@ -74,6 +99,16 @@ fn run(cli: Cli) -> Result<Outcome> {
             for w in &f.warnings {
                 eprintln!("warning: {w}");
             }
+            Ok(Outcome::Done)
+        }
+        Command::Bake(a) => {
+            let overrides = a.set.iter().map(|s| Override::parse(s)).collect::<Result<Vec<_>, _>>().map_err(anyhow::Error::msg)?;
+            let scene = Scene::load(&a.dir)?.with_overrides(&overrides)?;
+            let opts = BakeOptions { object: a.object.clone(), uv: a.uv, size: a.size };
+            let start = std::time::Instant::now();
+            let baked = bake_emission(&scene, &opts).map_err(|e| anyhow::anyhow!("bake {:?}: {e}", a.object))?;
+            write_exr(&baked, &a.output).map_err(anyhow::Error::msg)?;
+            println!("baked {} ({}x{}) -> {} in {:.2} s", a.object, a.size, a.size, a.output.display(), start.elapsed().as_secs_f64());
             Ok(Outcome::Done)
         }
         Command::Inspect { dir, json } => {

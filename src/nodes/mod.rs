@@ -5,7 +5,46 @@
 //! numbers, `support` reports it as unsupported: `blendsynth inspect` must never
 //! claim a node that would be evaluated as something else.
 
+/// Declares a node-mode enum together with the Blender RNA enum identifiers it is parsed
+/// from (`from_blender`) and printed as (`blender_name`), plus `ALL` in Blender's order.
+macro_rules! blender_enum {
+    ($(#[$meta:meta])* $vis:vis enum $name:ident { $($(#[$vmeta:meta])* $variant:ident = $id:literal,)+ }) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        $vis enum $name { $($(#[$vmeta])* $variant,)+ }
+
+        impl $name {
+            /// Every mode, in the order Blender lists them.
+            pub const ALL: &'static [$name] = &[$($name::$variant,)+];
+
+            /// Parses Blender's enum identifier (e.g. `"MULTIPLY"`).
+            pub fn from_blender(id: &str) -> Option<Self> {
+                match id {
+                    $($id => Some($name::$variant),)+
+                    _ => None,
+                }
+            }
+
+            /// Blender's enum identifier for this mode.
+            pub fn blender_name(self) -> &'static str {
+                match self {
+                    $($name::$variant => $id,)+
+                }
+            }
+        }
+    };
+}
+
+pub mod blackbody;
+pub mod clamp;
+pub mod color;
 pub mod graph;
+pub mod map_range;
+pub mod math;
+pub mod mix;
+pub mod ramp;
+pub mod sepcomb;
+pub mod wavelength;
 
 /// How blendsynth handles a node type (by its `bl_idname`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -33,7 +72,37 @@ const STRUCTURAL: &[&str] = &[
 
 /// Evaluated node types, added family by family as each passes the Blender
 /// conformance suite.
-const SUPPORTED: &[&str] = &[];
+const SUPPORTED: &[&str] = &[
+    // math.rs
+    "ShaderNodeMath",
+    "ShaderNodeVectorMath",
+    // map_range.rs, clamp.rs
+    "ShaderNodeMapRange",
+    "ShaderNodeClamp",
+    // mix.rs
+    "ShaderNodeMix",
+    "ShaderNodeMixRGB",
+    // ramp.rs
+    "ShaderNodeValToRGB",
+    // color.rs
+    "ShaderNodeInvert",
+    "ShaderNodeGamma",
+    "ShaderNodeBrightContrast",
+    "ShaderNodeHueSaturation",
+    "ShaderNodeRGBToBW",
+    // sepcomb.rs
+    "ShaderNodeSeparateXYZ",
+    "ShaderNodeCombineXYZ",
+    "ShaderNodeSeparateColor",
+    "ShaderNodeCombineColor",
+    "ShaderNodeSeparateRGB",
+    "ShaderNodeCombineRGB",
+    "ShaderNodeSeparateHSV",
+    "ShaderNodeCombineHSV",
+    // blackbody.rs, wavelength.rs
+    "ShaderNodeBlackbody",
+    "ShaderNodeWavelength",
+];
 
 pub fn support(bl_idname: &str) -> Support {
     if STRUCTURAL.contains(&bl_idname) {

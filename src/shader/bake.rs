@@ -1,0 +1,186 @@
+//! Evaluating a material over an object's UV map, as Cycles' EMIT bake does: one shading
+//! point per texel centre that a UV triangle covers, the surface point and normal
+//! interpolated from the mesh, the surface's total emission recorded.
+
+use std::path::Path;
+
+use crate::nodes::math::{normalize3, Vec3};
+use crate::scene::{AttributeData, Scene};
+
+use super::compile::compile_material;
+use super::point::ShadingPoint;
+use super::program::Program;
+
+#[derive(Debug, Clone)]
+pub struct BakeOptions {
+    pub object: String,
+    /// UV map name (default: the mesh's active render UV map).
+    pub uv: Option<String>,
+    /// Image width and height in texels.
+    pub size: u32,
+}
+
+/// A baked image: RGBA floats, rows bottom to top as Blender stores images (row 0 is v
+/// near 0). Texels no triangle covers stay (0, 0, 0, 0).
+#[derive(Debug, Clone)]
+pub struct Baked {
+    pub size: u32,
+    pub pixels: Vec<[f32; 4]>,
+}
+
+pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String> {
+    let size = opts.size;
+    if size == 0 || size > 16384 {
+        return Err(format!("--size {size}: must be 1 to 16384"));
+    }
+    let obj = scene.object(&opts.object).ok_or_else(|| format!("no object {:?}", opts.object))?;
+    if obj.kind != "MESH" {
+        return Err(format!("object {:?} is a {}, not a mesh", obj.name, obj.kind));
+    }
+    let mesh_name = obj.data.as_deref().ok_or_else(|| format!("object {:?} has no mesh", obj.name))?;
+    let mesh_index = scene.file.meshes.iter().position(|m| m.name == mesh_name).ok_or_else(|| format!("mesh {mesh_name:?} missing"))?;
+    let info = &scene.file.meshes[mesh_index];
+    let mesh = scene.load_mesh(mesh_index).map_err(|e| e.to_string())?;
+    let uv_name = opts.uv.clone().or_else(|| info.active_render_uv.clone()).ok_or_else(|| format!("mesh {mesh_name:?} has no UV map"))?;
+    let uvs = match mesh.attribute(&uv_name).map(|a| &a.data) {
+        Some(AttributeData::Float2(v)) if v.len() == mesh.corner_count() => v,
+        _ => return Err(format!("mesh {mesh_name:?} has no UV map {uv_name:?}")),
+    };
+    let material_index: Vec<i32> = match mesh.attribute("material_index").map(|a| &a.data) {
+        Some(AttributeData::Int(v)) => v.clone(),
+        _ => vec![0; mesh.face_count()],
+    };
+
+    // One program per material slot; a face without a material emits nothing.
+    let mut programs: Vec<Option<Program>> = Vec::new();
+    let slots = if obj.material_slots.is_empty() { info.materials.clone() } else { obj.material_slots.iter().map(|s| s.material.clone()).collect() };
+    for m in &slots {
+        programs.push(match m {
+            Some(name) => Some(compile_material(scene, name).map_err(|e| e.to_string())?),
+            None => None,
+        });
+    }
+
+    let world = obj.matrix_world;
+    let inverse = invert4(&world).ok_or_else(|| format!("object {:?} has a singular transform", obj.name))?;
+    let normal_matrix = inverse_transpose3(&world).ok_or_else(|| format!("object {:?} has a singular transform", obj.name))?;
+    let (tex_loc, tex_size) = (info.texspace_location.unwrap_or([0.0; 3]), info.texspace_size.unwrap_or([1.0; 3]));
+
+    let n = size as usize;
+    let mut pixels = vec![[0.0f32; 4]; n * n];
+    let mut stacks: Vec<Vec<f32>> = programs.iter().map(|p| p.as_ref().map(Program::new_stack).unwrap_or_default()).collect();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let face = mesh.triangle_faces[t] as usize;
+        let slot = (material_index[face].max(0) as usize).min(programs.len().saturating_sub(1));
+        let Some(program) = programs.get(slot).and_then(Option::as_ref) else { continue };
+        let stack = &mut stacks[slot];
+        let c = tri.map(|c| c as usize);
+        let uv = c.map(|c| uvs[c]);
+        let px = uv.map(|u| [u[0] * size as f32, u[1] * size as f32]);
+        let (x0, x1) = span(px.map(|p| p[0]), n);
+        let (y0, y1) = span(px.map(|p| p[1]), n);
+        let area = edge(px[0], px[1], px[2]);
+        if area == 0.0 {
+            continue;
+        }
+        for y in y0..y1 {
+            for x in x0..x1 {
+                // Blender's bake rasteriser samples slightly off the texel centre
+                // (measured: +0.001 texel in u, +0.002 in v), so values match at its points.
+                let p = [x as f32 + 0.501, y as f32 + 0.502];
+                let (w0, w1, w2) = (edge(px[1], px[2], p) / area, edge(px[2], px[0], p) / area, edge(px[0], px[1], p) / area);
+                if w0 < 0.0 || w1 < 0.0 || w2 < 0.0 {
+                    continue;
+                }
+                let w = [w0, w1, w2];
+                let lerp = |v: [Vec3; 3]| -> Vec3 { std::array::from_fn(|k| w[0] * v[0][k] + w[1] * v[1][k] + w[2] * v[2][k]) };
+                let local = lerp(c.map(|c| mesh.positions[mesh.corner_verts[c] as usize]));
+                // Cycles moves vertices to world space and derives object coordinates back
+                // through the inverse transform; doing the same keeps its rounding.
+                let position = lerp(c.map(|c| transform_point(&world, mesh.positions[mesh.corner_verts[c] as usize])));
+                let local_n = normalize3(lerp(c.map(|c| mesh.corner_normals.get(c).copied().unwrap_or([0.0, 0.0, 1.0]))));
+                let sp = ShadingPoint {
+                    position,
+                    normal: normalize3(mul3x3(&normal_matrix, local_n)),
+                    object_position: transform_point(&inverse, position),
+                    object_normal: local_n,
+                    generated: std::array::from_fn(|k| ((local[k] as f64 - tex_loc[k]) / (2.0 * tex_size[k]) + 0.5) as f32),
+                    uv: { let u = lerp(c.map(|c| [uvs[c][0], uvs[c][1], 0.0])); [u[0], u[1], 0.0] },
+                };
+                program.run(&sp, stack);
+                let e = program.surface_emission(stack);
+                pixels[y * n + x] = [e[0], e[1], e[2], 1.0];
+            }
+        }
+    }
+    Ok(Baked { size, pixels })
+}
+
+/// Texel columns (or rows) whose centres can fall inside `[min, max]` of the coordinates.
+fn span(v: [f32; 3], n: usize) -> (usize, usize) {
+    let lo = v.iter().copied().fold(f32::INFINITY, f32::min);
+    let hi = v.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+    let a = (lo - 0.5).ceil().max(0.0) as usize;
+    let b = ((hi - 0.5).floor() + 1.0).clamp(0.0, n as f32) as usize;
+    (a.min(n), b)
+}
+
+fn edge(a: [f32; 2], b: [f32; 2], p: [f32; 2]) -> f32 {
+    (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
+}
+
+fn transform_point(m: &[[f64; 4]; 4], p: Vec3) -> Vec3 {
+    std::array::from_fn(|r| (m[r][0] * p[0] as f64 + m[r][1] * p[1] as f64 + m[r][2] * p[2] as f64 + m[r][3]) as f32)
+}
+
+fn mul3x3(m: &[[f64; 3]; 3], v: Vec3) -> Vec3 {
+    std::array::from_fn(|r| (m[r][0] * v[0] as f64 + m[r][1] * v[1] as f64 + m[r][2] * v[2] as f64) as f32)
+}
+
+/// The inverse of an affine transform (rows; last row 0 0 0 1).
+fn invert4(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
+    let it = inverse_transpose3(m)?;
+    // The inverse's 3x3 block is the transpose of the inverse transpose.
+    let r: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| it[j][i]));
+    let t = [m[0][3], m[1][3], m[2][3]];
+    let mut out = [[0.0; 4]; 4];
+    for i in 0..3 {
+        out[i][..3].copy_from_slice(&r[i]);
+        out[i][3] = -(r[i][0] * t[0] + r[i][1] * t[1] + r[i][2] * t[2]);
+    }
+    out[3][3] = 1.0;
+    Some(out)
+}
+
+fn inverse_transpose3(m: &[[f64; 4]; 4]) -> Option<[[f64; 3]; 3]> {
+    let a = |r: usize, c: usize| m[r][c];
+    let cof = |r: usize, c: usize| {
+        let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
+        let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
+        a(r1, c1) * a(r2, c2) - a(r1, c2) * a(r2, c1)
+    };
+    let det = a(0, 0) * cof(0, 0) + a(0, 1) * cof(0, 1) + a(0, 2) * cof(0, 2);
+    if det.abs() < 1e-30 {
+        return None;
+    }
+    // The inverse transpose is the cofactor matrix over the determinant.
+    Some(std::array::from_fn(|r| std::array::from_fn(|c| cof(r, c) / det)))
+}
+
+/// Writes a baked image as a 32-bit float RGBA EXR (top row first, as image files are),
+/// atomically: to a temporary file beside `path`, then renamed.
+pub fn write_exr(b: &Baked, path: &Path) -> Result<(), String> {
+    let n = b.size;
+    let mut img = image::Rgba32FImage::new(n, n);
+    for y in 0..n {
+        for x in 0..n {
+            let p = b.pixels[(y * n + x) as usize];
+            img.put_pixel(x, n - 1 - y, image::Rgba(p));
+        }
+    }
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+    let tmp = tempfile::Builder::new().prefix(".bake-").suffix(".exr").tempfile_in(dir).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    img.save_with_format(tmp.path(), image::ImageFormat::OpenExr).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    tmp.persist(path).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    Ok(())
+}

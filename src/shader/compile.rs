@@ -1,0 +1,473 @@
+//! Compiling a material's flattened node graph into a `Program`: stack slots for every
+//! value, constants laid out once, Blender's implicit conversions as explicit operations.
+//! A node or option the program cannot run is an error naming it, never a stand-in.
+
+use serde_json::Value;
+
+use crate::nodes::clamp::ClampType;
+use crate::nodes::color::{rgb_to_bw, LINEAR_REC709};
+use crate::nodes::graph::{active_output, flatten, FlatGraph, FlatNode, Source};
+use crate::nodes::map_range::MapRangeInterpolation;
+use crate::nodes::math::{MathOp, VectorMathOp};
+use crate::nodes::mix::MixBlend;
+use crate::nodes::ramp::{ColorBand, HueInterpolation, RampColorMode, RampInterpolation, RampStop, RampTable};
+use crate::nodes::sepcomb::ColorMode;
+use crate::scene::{Scene, Socket};
+
+use super::program::{Closure, Kind, Op, Program, Slot};
+
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct CompileError(pub String);
+
+impl std::fmt::Display for CompileError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+impl std::error::Error for CompileError {}
+
+/// Compiles the Cycles surface of material `name`.
+pub fn compile_material(scene: &Scene, name: &str) -> Result<Program, CompileError> {
+    let mat = scene.material(name).ok_or_else(|| CompileError(format!("no material {name:?}")))?;
+    let tree = mat.node_tree.as_ref().ok_or_else(|| CompileError(format!("material {name:?} has no node tree (use_nodes off)")))?;
+    let out = active_output(tree, "ShaderNodeOutputMaterial", "CYCLES")
+        .ok_or_else(|| CompileError(format!("material {name:?} has no Material Output for Cycles")))?;
+    let graph = flatten(tree, &scene.file.node_groups, &out.name).map_err(|e| CompileError(format!("material {name:?}: {e}")))?;
+    Compiler::new(&graph).run().map_err(|e| CompileError(format!("material {name:?}: {}", e.0)))
+}
+
+struct Compiler<'g, 'a> {
+    g: &'g FlatGraph<'a>,
+    initial: Vec<f32>,
+    ops: Vec<Op>,
+    ramps: Vec<RampTable>,
+    closures: Vec<Closure>,
+    /// Per flat node, per output index: where its value lives.
+    values: Vec<Vec<Option<(Slot, Kind)>>>,
+    /// Per flat node: the closure its (single) shader output makes.
+    closure_of: Vec<Option<u32>>,
+    surface: Option<u32>,
+}
+
+fn kind_of(socket_type: &str) -> Option<Kind> {
+    match socket_type {
+        "VALUE" | "INT" | "BOOLEAN" => Some(Kind::Float),
+        "VECTOR" => Some(Kind::Vector),
+        "RGBA" => Some(Kind::Color),
+        _ => None,
+    }
+}
+
+fn prop<'n>(n: &FlatNode<'n>, key: &str) -> Result<&'n Value, CompileError> {
+    n.property(key).ok_or_else(|| CompileError(format!("node {:?} lacks property {key:?}", n.path)))
+}
+fn prop_str<'n>(n: &FlatNode<'n>, key: &str) -> Result<&'n str, CompileError> {
+    prop(n, key)?.as_str().ok_or_else(|| CompileError(format!("node {:?}: property {key:?} is not a string", n.path)))
+}
+fn prop_bool(n: &FlatNode, key: &str) -> Result<bool, CompileError> {
+    prop(n, key)?.as_bool().ok_or_else(|| CompileError(format!("node {:?}: property {key:?} is not a boolean", n.path)))
+}
+fn mode<T>(n: &FlatNode, key: &str, parse: fn(&str) -> Option<T>) -> Result<T, CompileError> {
+    let v = prop_str(n, key)?;
+    parse(v).ok_or_else(|| CompileError(format!("node {:?}: {key} {v:?} is not supported", n.path)))
+}
+
+/// A JSON default value as three floats (a scalar fills all three).
+fn floats(v: &Value) -> [f32; 4] {
+    match v {
+        Value::Number(x) => {
+            let f = x.as_f64().unwrap_or(0.0) as f32;
+            [f, f, f, 1.0]
+        }
+        Value::Bool(b) => {
+            let f = if *b { 1.0 } else { 0.0 };
+            [f, f, f, 1.0]
+        }
+        Value::Array(a) => {
+            let mut out = [0.0, 0.0, 0.0, 1.0];
+            for (o, x) in out.iter_mut().zip(a) {
+                *o = x.as_f64().unwrap_or(0.0) as f32;
+            }
+            out
+        }
+        _ => [0.0, 0.0, 0.0, 1.0],
+    }
+}
+
+impl<'g, 'a> Compiler<'g, 'a> {
+    fn new(g: &'g FlatGraph<'a>) -> Self {
+        Compiler {
+            g,
+            initial: Vec::new(),
+            ops: Vec::new(),
+            ramps: Vec::new(),
+            closures: Vec::new(),
+            values: vec![Vec::new(); g.nodes.len()],
+            closure_of: vec![None; g.nodes.len()],
+            surface: None,
+        }
+    }
+
+    fn alloc(&mut self, kind: Kind) -> Slot {
+        let s = self.initial.len() as Slot;
+        self.initial.extend(std::iter::repeat_n(0.0, kind.width() as usize));
+        s
+    }
+
+    fn constant(&mut self, kind: Kind, v: [f32; 3]) -> Slot {
+        let s = self.alloc(kind);
+        let w = kind.width() as usize;
+        self.initial[s as usize..s as usize + w].copy_from_slice(&v[..w]);
+        s
+    }
+
+    /// A socket's default converted to `want`, as Blender converts unlinked values.
+    fn default_value(&mut self, sock: &Socket, want: Kind) -> Slot {
+        let v = sock.default_value.as_ref().map(floats).unwrap_or([0.0, 0.0, 0.0, 1.0]);
+        let rgb = [v[0], v[1], v[2]];
+        let have = kind_of(&sock.kind).unwrap_or(Kind::Float);
+        let value = match (have, want) {
+            (Kind::Float, _) => [v[0]; 3],
+            (Kind::Color, Kind::Float) => [rgb_to_bw(rgb, &LINEAR_REC709); 3],
+            (Kind::Vector, Kind::Float) => [(v[0] + v[1] + v[2]) * (1.0 / 3.0); 3],
+            _ => rgb,
+        };
+        self.constant(want, value)
+    }
+
+    /// The slot holding input `id` of node `n` as `want`.
+    fn input(&mut self, n: &FlatNode<'a>, id: &str, want: Kind) -> Result<Slot, CompileError> {
+        let Some(inp) = n.input(id) else {
+            return Err(CompileError(format!("node {:?} has no available input {id:?}", n.path)));
+        };
+        match inp.sources.first() {
+            None | Some(Source::Nothing) => Ok(self.constant(want, [0.0; 3])),
+            Some(Source::Default(sock)) => Ok(self.default_value(sock, want)),
+            Some(Source::GroupInput(i)) => Err(CompileError(format!("node {:?} reads group input {i:?}, which a material cannot provide", n.path))),
+            Some(Source::Link { node, output, .. }) => {
+                let (slot, have) = self.values[*node].get(*output).copied().flatten().ok_or_else(|| {
+                    let from = &self.g.nodes[*node];
+                    CompileError(format!("node {:?} output {:?} is not supported yet (used by {:?})", from.path, from.node.outputs[*output].identifier, n.path))
+                })?;
+                Ok(self.convert(slot, have, want))
+            }
+        }
+    }
+
+    fn convert(&mut self, src: Slot, have: Kind, want: Kind) -> Slot {
+        let op = match (have, want) {
+            // Vectors and colours share a layout.
+            (Kind::Vector | Kind::Color, Kind::Vector | Kind::Color) => return src,
+            (Kind::Float, Kind::Float) => return src,
+            (Kind::Vector, Kind::Float) => |src, dst| Op::VectorToFloat { src, dst },
+            (Kind::Color, Kind::Float) => |src, dst| Op::ColorToFloat { src, dst },
+            (Kind::Float, _) => |src, dst| Op::FloatToVector { src, dst },
+        };
+        let dst = self.alloc(want);
+        self.ops.push(op(src, dst));
+        dst
+    }
+
+    fn closure_input(&self, n: &FlatNode, id: &str) -> Result<Option<u32>, CompileError> {
+        match n.input(id).and_then(|i| i.sources.first()) {
+            Some(Source::Link { node, .. }) => match self.closure_of[*node] {
+                Some(c) => Ok(Some(c)),
+                None => Err(CompileError(format!("node {:?}: input {id:?} is linked to a non-shader output", n.path))),
+            },
+            _ => Ok(None),
+        }
+    }
+
+    fn outputs(&mut self, i: usize, n: &FlatNode, slots: &[(&str, Slot, Kind)]) {
+        let mut v = vec![None; n.node.outputs.len()];
+        for (id, slot, kind) in slots {
+            if let Some(k) = n.node.outputs.iter().position(|o| o.identifier == *id) {
+                v[k] = Some((*slot, *kind));
+            }
+        }
+        self.values[i] = v;
+    }
+
+    fn run(mut self) -> Result<Program, CompileError> {
+        use Kind::{Color as C, Float as F, Vector as V};
+        for i in 0..self.g.nodes.len() {
+            let n = &self.g.nodes[i];
+            match n.node.bl_idname.as_str() {
+                "ShaderNodeValue" => {
+                    let v = n.node.outputs[0].default_value.as_ref().map(floats).unwrap_or([0.0; 4]);
+                    let s = self.constant(F, [v[0]; 3]);
+                    self.outputs(i, n, &[("Value", s, F)]);
+                }
+                "ShaderNodeRGB" => {
+                    let v = n.node.outputs[0].default_value.as_ref().map(floats).unwrap_or([0.0; 4]);
+                    let s = self.constant(C, [v[0], v[1], v[2]]);
+                    self.outputs(i, n, &[("Color", s, C)]);
+                }
+                "ShaderNodeTexCoord" => {
+                    let (g, nn, uv, ob) = (self.alloc(V), self.alloc(V), self.alloc(V), self.alloc(V));
+                    self.ops.push(Op::TexCoord { generated: Some(g), normal: Some(nn), uv: Some(uv), object: Some(ob) });
+                    // Camera, Window and Reflection need a camera: left unset, so a use is an error.
+                    self.outputs(i, n, &[("Generated", g, V), ("Normal", nn, V), ("UV", uv, V), ("Object", ob, V)]);
+                }
+                "ShaderNodeUVMap" => {
+                    if !prop_str(n, "uv_map")?.is_empty() {
+                        return Err(CompileError(format!("node {:?}: a named UV map is not supported yet (only the active render UV)", n.path)));
+                    }
+                    let d = self.alloc(V);
+                    self.ops.push(Op::UvMap { dst: d });
+                    self.outputs(i, n, &[("UV", d, V)]);
+                }
+                "ShaderNodeMath" => {
+                    let op = mode(n, "operation", MathOp::from_blender)?;
+                    let clamp = prop_bool(n, "use_clamp")?;
+                    let (a, b, c) = (self.input(n, "Value", F)?, self.opt_input(n, "Value_001", F)?, self.opt_input(n, "Value_002", F)?);
+                    let d = self.alloc(F);
+                    self.ops.push(Op::Math { op, clamp, a, b, c, dst: d });
+                    self.outputs(i, n, &[("Value", d, F)]);
+                }
+                "ShaderNodeVectorMath" => {
+                    let op = mode(n, "operation", VectorMathOp::from_blender)?;
+                    let a = self.input(n, "Vector", V)?;
+                    let b = self.opt_input(n, "Vector_001", V)?;
+                    let c = self.opt_input(n, "Vector_002", V)?;
+                    let scale = self.opt_input(n, "Scale", F)?;
+                    let (vector, value) = (self.alloc(V), self.alloc(F));
+                    self.ops.push(Op::VectorMath { op, a, b, c, scale, vector, value });
+                    self.outputs(i, n, &[("Vector", vector, V), ("Value", value, F)]);
+                }
+                "ShaderNodeMapRange" => {
+                    let interp = mode(n, "interpolation_type", MapRangeInterpolation::from_blender)?;
+                    let clamp = prop_bool(n, "clamp")?;
+                    match prop_str(n, "data_type")? {
+                        "FLOAT" => {
+                            let ids = ["Value", "From Min", "From Max", "To Min", "To Max", "Steps"];
+                            let args = self.inputs6(n, ids, F)?;
+                            let d = self.alloc(F);
+                            self.ops.push(Op::MapRangeFloat { interp, clamp, args, dst: d });
+                            self.outputs(i, n, &[("Result", d, F)]);
+                        }
+                        "FLOAT_VECTOR" => {
+                            let ids = ["Vector", "From_Min_FLOAT3", "From_Max_FLOAT3", "To_Min_FLOAT3", "To_Max_FLOAT3", "Steps_FLOAT3"];
+                            let args = self.inputs6(n, ids, V)?;
+                            let d = self.alloc(V);
+                            self.ops.push(Op::MapRangeVector { interp, clamp, args, dst: d });
+                            self.outputs(i, n, &[("Vector", d, V)]);
+                        }
+                        other => return Err(CompileError(format!("node {:?}: Map Range data type {other:?} is not supported", n.path))),
+                    }
+                }
+                "ShaderNodeClamp" => {
+                    let kind = mode(n, "clamp_type", ClampType::from_blender)?;
+                    let (value, min, max) = (self.input(n, "Value", F)?, self.input(n, "Min", F)?, self.input(n, "Max", F)?);
+                    let d = self.alloc(F);
+                    self.ops.push(Op::Clamp { kind, value, min, max, dst: d });
+                    self.outputs(i, n, &[("Result", d, F)]);
+                }
+                "ShaderNodeMix" => self.mix(i)?,
+                "ShaderNodeMixRGB" => {
+                    let blend = mode(n, "blend_type", MixBlend::from_blender)?;
+                    let clamp = prop_bool(n, "use_clamp")?;
+                    let (factor, a, b) = (self.input(n, "Fac", F)?, self.input(n, "Color1", C)?, self.input(n, "Color2", C)?);
+                    let d = self.alloc(C);
+                    self.ops.push(Op::MixRgb { blend, clamp, factor, a, b, dst: d });
+                    self.outputs(i, n, &[("Color", d, C)]);
+                }
+                "ShaderNodeValToRGB" => {
+                    let table = self.ramp(n)?;
+                    let fac = self.input(n, "Fac", F)?;
+                    let (color, alpha) = (self.alloc(C), self.alloc(F));
+                    self.ops.push(Op::Ramp { table, fac, color, alpha });
+                    self.outputs(i, n, &[("Color", color, C), ("Alpha", alpha, F)]);
+                }
+                "ShaderNodeInvert" => {
+                    let (fac, color) = (self.input(n, "Fac", F)?, self.input(n, "Color", C)?);
+                    let d = self.alloc(C);
+                    self.ops.push(Op::Invert { fac, color, dst: d });
+                    self.outputs(i, n, &[("Color", d, C)]);
+                }
+                "ShaderNodeGamma" => {
+                    let (color, gamma) = (self.input(n, "Color", C)?, self.input(n, "Gamma", F)?);
+                    let d = self.alloc(C);
+                    self.ops.push(Op::Gamma { color, gamma, dst: d });
+                    self.outputs(i, n, &[("Color", d, C)]);
+                }
+                "ShaderNodeBrightContrast" => {
+                    let (color, bright, contrast) = (self.input(n, "Color", C)?, self.input(n, "Bright", F)?, self.input(n, "Contrast", F)?);
+                    let d = self.alloc(C);
+                    self.ops.push(Op::BrightContrast { color, bright, contrast, dst: d });
+                    self.outputs(i, n, &[("Color", d, C)]);
+                }
+                "ShaderNodeHueSaturation" => {
+                    let hue = self.input(n, "Hue", F)?;
+                    let saturation = self.input(n, "Saturation", F)?;
+                    let value = self.input(n, "Value", F)?;
+                    let fac = self.input(n, "Fac", F)?;
+                    let color = self.input(n, "Color", C)?;
+                    let d = self.alloc(C);
+                    self.ops.push(Op::HueSaturation { hue, saturation, value, fac, color, dst: d });
+                    self.outputs(i, n, &[("Color", d, C)]);
+                }
+                "ShaderNodeRGBToBW" => {
+                    let color = self.input(n, "Color", C)?;
+                    let d = self.alloc(F);
+                    self.ops.push(Op::RgbToBw { color, dst: d });
+                    self.outputs(i, n, &[("Val", d, F)]);
+                }
+                "ShaderNodeSeparateXYZ" => {
+                    let v = self.input(n, "Vector", V)?;
+                    let (x, y, z) = (self.alloc(F), self.alloc(F), self.alloc(F));
+                    self.ops.push(Op::SeparateXyz { v, x, y, z });
+                    self.outputs(i, n, &[("X", x, F), ("Y", y, F), ("Z", z, F)]);
+                }
+                "ShaderNodeCombineXYZ" => {
+                    let (x, y, z) = (self.input(n, "X", F)?, self.input(n, "Y", F)?, self.input(n, "Z", F)?);
+                    let d = self.alloc(V);
+                    self.ops.push(Op::CombineXyz { x, y, z, dst: d });
+                    self.outputs(i, n, &[("Vector", d, V)]);
+                }
+                kind @ ("ShaderNodeSeparateColor" | "ShaderNodeSeparateRGB" | "ShaderNodeSeparateHSV") => {
+                    let (cm, input, outs) = match kind {
+                        "ShaderNodeSeparateColor" => (mode(n, "mode", ColorMode::from_blender)?, "Color", ["Red", "Green", "Blue"]),
+                        "ShaderNodeSeparateRGB" => (ColorMode::Rgb, "Image", ["R", "G", "B"]),
+                        _ => (ColorMode::Hsv, "Color", ["H", "S", "V"]),
+                    };
+                    let color = self.input(n, input, C)?;
+                    let (a, b, c) = (self.alloc(F), self.alloc(F), self.alloc(F));
+                    self.ops.push(Op::SeparateColor { mode: cm, color, a, b, c });
+                    self.outputs(i, n, &[(outs[0], a, F), (outs[1], b, F), (outs[2], c, F)]);
+                }
+                kind @ ("ShaderNodeCombineColor" | "ShaderNodeCombineRGB" | "ShaderNodeCombineHSV") => {
+                    let (cm, ins, out) = match kind {
+                        "ShaderNodeCombineColor" => (mode(n, "mode", ColorMode::from_blender)?, ["Red", "Green", "Blue"], "Color"),
+                        "ShaderNodeCombineRGB" => (ColorMode::Rgb, ["R", "G", "B"], "Image"),
+                        _ => (ColorMode::Hsv, ["H", "S", "V"], "Color"),
+                    };
+                    let (a, b, c) = (self.input(n, ins[0], F)?, self.input(n, ins[1], F)?, self.input(n, ins[2], F)?);
+                    let d = self.alloc(C);
+                    self.ops.push(Op::CombineColor { mode: cm, a, b, c, dst: d });
+                    self.outputs(i, n, &[(out, d, C)]);
+                }
+                "ShaderNodeBlackbody" => {
+                    let temperature = self.input(n, "Temperature", F)?;
+                    let d = self.alloc(C);
+                    self.ops.push(Op::Blackbody { temperature, dst: d });
+                    self.outputs(i, n, &[("Color", d, C)]);
+                }
+                "ShaderNodeWavelength" => {
+                    let wavelength = self.input(n, "Wavelength", F)?;
+                    let d = self.alloc(C);
+                    self.ops.push(Op::Wavelength { wavelength, dst: d });
+                    self.outputs(i, n, &[("Color", d, C)]);
+                }
+                "ShaderNodeEmission" => {
+                    let (color, strength) = (self.input(n, "Color", C)?, self.input(n, "Strength", F)?);
+                    self.closure(i, Closure::Emission { color, strength });
+                }
+                "ShaderNodeBsdfPrincipled" => {
+                    let (color, strength) = (self.input(n, "Emission Color", C)?, self.input(n, "Emission Strength", F)?);
+                    self.closure(i, Closure::Bsdf { emission: Some((color, strength)) });
+                }
+                "ShaderNodeBsdfDiffuse" | "ShaderNodeBsdfGlossy" | "ShaderNodeBsdfAnisotropic" | "ShaderNodeBsdfGlass" | "ShaderNodeBsdfRefraction"
+                | "ShaderNodeBsdfTransparent" | "ShaderNodeBsdfTranslucent" | "ShaderNodeSubsurfaceScattering" | "ShaderNodeBsdfSheen" | "ShaderNodeHoldout" => {
+                    // No emission; their scattering parameters are compiled with the renderer.
+                    self.closure(i, Closure::Bsdf { emission: None });
+                }
+                "ShaderNodeMixShader" => {
+                    let fac = self.input(n, "Fac", F)?;
+                    let (a, b) = (self.closure_input(n, "Shader")?, self.closure_input(n, "Shader_001")?);
+                    self.closure(i, Closure::Mix { fac, a, b });
+                }
+                "ShaderNodeAddShader" => {
+                    let (a, b) = (self.closure_input(n, "Shader")?, self.closure_input(n, "Shader_001")?);
+                    self.closure(i, Closure::Add { a, b });
+                }
+                "ShaderNodeOutputMaterial" => {
+                    if n.input("Displacement").is_some_and(|d| matches!(d.sources.first(), Some(Source::Link { .. }))) {
+                        return Err(CompileError(format!("node {:?}: displacement is not supported yet", n.path)));
+                    }
+                    self.surface = self.closure_input(n, "Surface")?;
+                }
+                other => return Err(CompileError(format!("node {:?}: {other} is not supported yet", n.path))),
+            }
+        }
+        Ok(Program { ops: self.ops, initial: self.initial, ramps: self.ramps, closures: self.closures, surface: self.surface })
+    }
+
+    /// An input that may be unavailable for the node's mode (then a zero constant).
+    fn opt_input(&mut self, n: &FlatNode<'a>, id: &str, want: Kind) -> Result<Slot, CompileError> {
+        if n.input(id).is_some() {
+            self.input(n, id, want)
+        } else {
+            Ok(self.constant(want, [0.0; 3]))
+        }
+    }
+
+    fn inputs6(&mut self, n: &FlatNode<'a>, ids: [&str; 6], want: Kind) -> Result<[Slot; 6], CompileError> {
+        let mut out = [0; 6];
+        for (o, id) in out.iter_mut().zip(ids) {
+            *o = self.opt_input(n, id, want)?;
+        }
+        Ok(out)
+    }
+
+    fn closure(&mut self, i: usize, c: Closure) {
+        self.closures.push(c);
+        self.closure_of[i] = Some(self.closures.len() as u32 - 1);
+    }
+
+    fn mix(&mut self, i: usize) -> Result<(), CompileError> {
+        use Kind::{Color as C, Float as F, Vector as V};
+        let n = &self.g.nodes[i];
+        let clamp_factor = prop_bool(n, "clamp_factor")?;
+        match prop_str(n, "data_type")? {
+            "FLOAT" => {
+                let (factor, a, b) = (self.input(n, "Factor_Float", F)?, self.input(n, "A_Float", F)?, self.input(n, "B_Float", F)?);
+                let d = self.alloc(F);
+                self.ops.push(Op::MixFloat { clamp_factor, factor, a, b, dst: d });
+                self.outputs(i, n, &[("Result_Float", d, F)]);
+            }
+            "VECTOR" => {
+                let (a, b) = (self.input(n, "A_Vector", V)?, self.input(n, "B_Vector", V)?);
+                let d = self.alloc(V);
+                if prop_str(n, "factor_mode")? == "NON_UNIFORM" {
+                    let factor = self.input(n, "Factor_Vector", V)?;
+                    self.ops.push(Op::MixVectorNonUniform { clamp_factor, factor, a, b, dst: d });
+                } else {
+                    let factor = self.input(n, "Factor_Float", F)?;
+                    self.ops.push(Op::MixVector { clamp_factor, factor, a, b, dst: d });
+                }
+                self.outputs(i, n, &[("Result_Vector", d, V)]);
+            }
+            "RGBA" => {
+                let blend = mode(n, "blend_type", MixBlend::from_blender)?;
+                let clamp_result = prop_bool(n, "clamp_result")?;
+                let (factor, a, b) = (self.input(n, "Factor_Float", F)?, self.input(n, "A_Color", C)?, self.input(n, "B_Color", C)?);
+                let d = self.alloc(C);
+                self.ops.push(Op::MixColor { blend, clamp_factor, clamp_result, factor, a, b, dst: d });
+                self.outputs(i, n, &[("Result_Color", d, C)]);
+            }
+            other => return Err(CompileError(format!("node {:?}: Mix data type {other:?} is not supported", n.path))),
+        }
+        Ok(())
+    }
+
+    /// The node's colour band, sampled into a lookup table as Blender hands it to Cycles.
+    fn ramp(&mut self, n: &FlatNode) -> Result<u32, CompileError> {
+        let bad = |m: &str| CompileError(format!("node {:?}: color_ramp {m}", n.path));
+        let r = prop(n, "color_ramp")?;
+        let elements = r.get("elements").and_then(Value::as_array).ok_or_else(|| bad("has no elements"))?;
+        let mut stops = Vec::with_capacity(elements.len());
+        for e in elements {
+            let pos = e.get("position").and_then(Value::as_f64).ok_or_else(|| bad("element without position"))? as f32;
+            let c = e.get("color").map(floats).ok_or_else(|| bad("element without color"))?;
+            stops.push(RampStop { position: pos, color: c });
+        }
+        let s = |k: &str| r.get(k).and_then(Value::as_str).unwrap_or("");
+        let interp = RampInterpolation::from_blender(s("interpolation")).ok_or_else(|| bad("interpolation not supported"))?;
+        let cm = RampColorMode::from_blender(s("color_mode")).ok_or_else(|| bad("color mode not supported"))?;
+        let hue = HueInterpolation::from_blender(s("hue_interpolation")).ok_or_else(|| bad("hue interpolation not supported"))?;
+        let band = ColorBand::new(&stops, interp, cm, hue).ok_or_else(|| bad("needs 1 to 32 elements"))?;
+        self.ramps.push(RampTable::from_band(&band));
+        Ok(self.ramps.len() as u32 - 1)
+    }
+}

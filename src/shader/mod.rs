@@ -1,0 +1,12 @@
+//! Materials compiled into flat programs that run per shading point (`program`), from a
+//! node tree flattened by `nodes::graph` (`compile`), and evaluated over a mesh's UV
+//! map the way Cycles' EMIT bake does (`bake`).
+
+pub mod bake;
+pub mod compile;
+pub mod point;
+pub mod program;
+
+pub use compile::{compile_material, CompileError};
+pub use point::ShadingPoint;
+pub use program::Program;

@@ -1,0 +1,249 @@
+//! A compiled material: a flat list of operations over a float stack, run once per
+//! shading point with no allocation and no lookups by name (Cycles' SVM idea).
+
+use crate::nodes::clamp::{clamp_node, ClampType};
+use crate::nodes::color::{bright_contrast, gamma, hue_saturation, invert, rgb_to_bw, LINEAR_REC709};
+use crate::nodes::map_range::{map_range_float, map_range_vector, MapRangeInterpolation};
+use crate::nodes::math::{math_node, vector_math, MathOp, Vec3, VectorMathOp};
+use crate::nodes::mix::{mix_color, mix_float, mix_rgb, mix_vector, mix_vector_non_uniform, MixBlend};
+use crate::nodes::ramp::RampTable;
+use crate::nodes::sepcomb::{combine_color, separate_color, ColorMode};
+use crate::nodes::{blackbody, wavelength};
+
+use super::point::ShadingPoint;
+
+/// A float's position on the stack; vectors and colours take three in a row.
+pub type Slot = u32;
+
+/// The socket kinds a shader program carries.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    Float,
+    Vector,
+    Color,
+}
+
+impl Kind {
+    pub fn width(self) -> u32 {
+        match self {
+            Kind::Float => 1,
+            _ => 3,
+        }
+    }
+}
+
+#[derive(Debug, Clone)]
+pub enum Op {
+    /// Blender's implicit socket conversions.
+    VectorToFloat { src: Slot, dst: Slot },
+    ColorToFloat { src: Slot, dst: Slot },
+    FloatToVector { src: Slot, dst: Slot },
+    /// Texture Coordinate outputs this program uses (None: not used).
+    TexCoord { generated: Option<Slot>, normal: Option<Slot>, uv: Option<Slot>, object: Option<Slot> },
+    UvMap { dst: Slot },
+    Math { op: MathOp, clamp: bool, a: Slot, b: Slot, c: Slot, dst: Slot },
+    VectorMath { op: VectorMathOp, a: Slot, b: Slot, c: Slot, scale: Slot, vector: Slot, value: Slot },
+    MapRangeFloat { interp: MapRangeInterpolation, clamp: bool, args: [Slot; 6], dst: Slot },
+    MapRangeVector { interp: MapRangeInterpolation, clamp: bool, args: [Slot; 6], dst: Slot },
+    Clamp { kind: ClampType, value: Slot, min: Slot, max: Slot, dst: Slot },
+    MixFloat { clamp_factor: bool, factor: Slot, a: Slot, b: Slot, dst: Slot },
+    MixVector { clamp_factor: bool, factor: Slot, a: Slot, b: Slot, dst: Slot },
+    MixVectorNonUniform { clamp_factor: bool, factor: Slot, a: Slot, b: Slot, dst: Slot },
+    MixColor { blend: MixBlend, clamp_factor: bool, clamp_result: bool, factor: Slot, a: Slot, b: Slot, dst: Slot },
+    MixRgb { blend: MixBlend, clamp: bool, factor: Slot, a: Slot, b: Slot, dst: Slot },
+    Ramp { table: u32, fac: Slot, color: Slot, alpha: Slot },
+    Invert { fac: Slot, color: Slot, dst: Slot },
+    Gamma { color: Slot, gamma: Slot, dst: Slot },
+    BrightContrast { color: Slot, bright: Slot, contrast: Slot, dst: Slot },
+    HueSaturation { hue: Slot, saturation: Slot, value: Slot, fac: Slot, color: Slot, dst: Slot },
+    RgbToBw { color: Slot, dst: Slot },
+    SeparateXyz { v: Slot, x: Slot, y: Slot, z: Slot },
+    CombineXyz { x: Slot, y: Slot, z: Slot, dst: Slot },
+    SeparateColor { mode: ColorMode, color: Slot, a: Slot, b: Slot, c: Slot },
+    CombineColor { mode: ColorMode, a: Slot, b: Slot, c: Slot, dst: Slot },
+    Blackbody { temperature: Slot, dst: Slot },
+    Wavelength { wavelength: Slot, dst: Slot },
+}
+
+/// The shader part of a material: closures as a small tree over stack values.
+#[derive(Debug, Clone)]
+pub enum Closure {
+    Emission { color: Slot, strength: Slot },
+    /// A BSDF node: its emission, if it has one (Principled), counts for EMIT bakes;
+    /// its scattering is the renderer's business.
+    Bsdf { emission: Option<(Slot, Slot)> },
+    Mix { fac: Slot, a: Option<u32>, b: Option<u32> },
+    Add { a: Option<u32>, b: Option<u32> },
+}
+
+#[derive(Debug, Clone)]
+pub struct Program {
+    pub ops: Vec<Op>,
+    /// The stack as it starts: constants in place, the rest zero.
+    pub initial: Vec<f32>,
+    pub ramps: Vec<RampTable>,
+    pub closures: Vec<Closure>,
+    /// The closure plugged into the Material Output's Surface.
+    pub surface: Option<u32>,
+}
+
+fn v3(s: &[f32], at: Slot) -> Vec3 {
+    let i = at as usize;
+    [s[i], s[i + 1], s[i + 2]]
+}
+fn put3(s: &mut [f32], at: Slot, v: Vec3) {
+    let i = at as usize;
+    s[i..i + 3].copy_from_slice(&v);
+}
+
+impl Program {
+    /// A stack for `run`; reuse it across shading points.
+    pub fn new_stack(&self) -> Vec<f32> {
+        self.initial.clone()
+    }
+
+    /// Runs every operation for one shading point.
+    pub fn run(&self, sp: &ShadingPoint, s: &mut [f32]) {
+        s.copy_from_slice(&self.initial);
+        for op in &self.ops {
+            match *op {
+                Op::VectorToFloat { src, dst } => {
+                    let v = v3(s, src);
+                    s[dst as usize] = (v[0] + v[1] + v[2]) * (1.0 / 3.0);
+                }
+                Op::ColorToFloat { src, dst } => s[dst as usize] = rgb_to_bw(v3(s, src), &LINEAR_REC709),
+                Op::FloatToVector { src, dst } => {
+                    let f = s[src as usize];
+                    put3(s, dst, [f, f, f]);
+                }
+                Op::TexCoord { generated, normal, uv, object } => {
+                    if let Some(d) = generated {
+                        put3(s, d, sp.generated);
+                    }
+                    if let Some(d) = normal {
+                        put3(s, d, sp.object_normal);
+                    }
+                    if let Some(d) = uv {
+                        put3(s, d, sp.uv);
+                    }
+                    if let Some(d) = object {
+                        put3(s, d, sp.object_position);
+                    }
+                }
+                Op::UvMap { dst } => put3(s, dst, sp.uv),
+                Op::Math { op, clamp, a, b, c, dst } => s[dst as usize] = math_node(op, clamp, s[a as usize], s[b as usize], s[c as usize]),
+                Op::VectorMath { op, a, b, c, scale, vector, value } => {
+                    let r = vector_math(op, v3(s, a), v3(s, b), v3(s, c), s[scale as usize]);
+                    put3(s, vector, r.vector);
+                    s[value as usize] = r.value;
+                }
+                Op::MapRangeFloat { interp, clamp, args, dst } => {
+                    let a = args.map(|i| s[i as usize]);
+                    s[dst as usize] = map_range_float(interp, clamp, a[0], a[1], a[2], a[3], a[4], a[5]);
+                }
+                Op::MapRangeVector { interp, clamp, args, dst } => {
+                    let a = args.map(|i| v3(s, i));
+                    put3(s, dst, map_range_vector(interp, clamp, a[0], a[1], a[2], a[3], a[4], a[5]));
+                }
+                Op::Clamp { kind, value, min, max, dst } => s[dst as usize] = clamp_node(kind, s[value as usize], s[min as usize], s[max as usize]),
+                Op::MixFloat { clamp_factor, factor, a, b, dst } => s[dst as usize] = mix_float(clamp_factor, s[factor as usize], s[a as usize], s[b as usize]),
+                Op::MixVector { clamp_factor, factor, a, b, dst } => {
+                    let r = mix_vector(clamp_factor, s[factor as usize], v3(s, a), v3(s, b));
+                    put3(s, dst, r)
+                }
+                Op::MixVectorNonUniform { clamp_factor, factor, a, b, dst } => {
+                    let r = mix_vector_non_uniform(clamp_factor, v3(s, factor), v3(s, a), v3(s, b));
+                    put3(s, dst, r)
+                }
+                Op::MixColor { blend, clamp_factor, clamp_result, factor, a, b, dst } => {
+                    let r = mix_color(blend, clamp_factor, clamp_result, s[factor as usize], v3(s, a), v3(s, b));
+                    put3(s, dst, r)
+                }
+                Op::MixRgb { blend, clamp, factor, a, b, dst } => {
+                    let r = mix_rgb(blend, clamp, s[factor as usize], v3(s, a), v3(s, b));
+                    put3(s, dst, r)
+                }
+                Op::Ramp { table, fac, color, alpha } => {
+                    let (c, a) = self.ramps[table as usize].color_ramp(s[fac as usize]);
+                    put3(s, color, c);
+                    s[alpha as usize] = a;
+                }
+                Op::Invert { fac, color, dst } => {
+                    let r = invert(s[fac as usize], v3(s, color));
+                    put3(s, dst, r)
+                }
+                Op::Gamma { color, gamma: g, dst } => {
+                    let r = gamma(v3(s, color), s[g as usize]);
+                    put3(s, dst, r)
+                }
+                Op::BrightContrast { color, bright, contrast, dst } => {
+                    let r = bright_contrast(v3(s, color), s[bright as usize], s[contrast as usize]);
+                    put3(s, dst, r)
+                }
+                Op::HueSaturation { hue, saturation, value, fac, color, dst } => {
+                    let r = hue_saturation(s[hue as usize], s[saturation as usize], s[value as usize], s[fac as usize], v3(s, color));
+                    put3(s, dst, r)
+                }
+                Op::RgbToBw { color, dst } => s[dst as usize] = rgb_to_bw(v3(s, color), &LINEAR_REC709),
+                Op::SeparateXyz { v, x, y, z } => {
+                    let c = v3(s, v);
+                    s[x as usize] = c[0];
+                    s[y as usize] = c[1];
+                    s[z as usize] = c[2];
+                }
+                Op::CombineXyz { x, y, z, dst } => {
+                    let r = [s[x as usize], s[y as usize], s[z as usize]];
+                    put3(s, dst, r)
+                }
+                Op::SeparateColor { mode, color, a, b, c } => {
+                    let r = separate_color(mode, v3(s, color));
+                    s[a as usize] = r[0];
+                    s[b as usize] = r[1];
+                    s[c as usize] = r[2];
+                }
+                Op::CombineColor { mode, a, b, c, dst } => {
+                    let r = combine_color(mode, [s[a as usize], s[b as usize], s[c as usize]]);
+                    put3(s, dst, r)
+                }
+                Op::Blackbody { temperature, dst } => {
+                    let r = blackbody::blackbody(s[temperature as usize]);
+                    put3(s, dst, r)
+                }
+                Op::Wavelength { wavelength: w, dst } => {
+                    let r = wavelength::wavelength(s[w as usize], &LINEAR_REC709);
+                    put3(s, dst, r)
+                }
+            }
+        }
+    }
+
+    /// Total emission of the surface closure tree after `run` (what a Cycles EMIT bake
+    /// records): Mix Shader weights clamp their factor to [0, 1] as Cycles does.
+    pub fn surface_emission(&self, s: &[f32]) -> Vec3 {
+        match self.surface {
+            Some(c) => self.emission(c, s, 1.0),
+            None => [0.0; 3],
+        }
+    }
+
+    fn emission(&self, c: u32, s: &[f32], w: f32) -> Vec3 {
+        let add = |a: Vec3, b: Vec3| [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
+        let sub = |x: Option<u32>, w: f32| match x {
+            Some(x) if w != 0.0 => self.emission(x, s, w),
+            _ => [0.0; 3],
+        };
+        match self.closures[c as usize] {
+            Closure::Emission { color, strength } | Closure::Bsdf { emission: Some((color, strength)) } => {
+                let k = w * s[strength as usize];
+                let col = v3(s, color);
+                [col[0] * k, col[1] * k, col[2] * k]
+            }
+            Closure::Bsdf { emission: None } => [0.0; 3],
+            Closure::Mix { fac, a, b } => {
+                let f = s[fac as usize].clamp(0.0, 1.0);
+                add(sub(a, w * (1.0 - f)), sub(b, w * f))
+            }
+            Closure::Add { a, b } => add(sub(a, w), sub(b, w)),
+        }
+    }
+}
