@@ -1,0 +1,49 @@
+//! Shading-point throughput of compiled materials, single-threaded (points per second
+//! per core). `cargo bench --bench shading`.
+//!
+//! Materials: the bake-parity fixtures (fixtures/bake/scenes), which use only node
+//! families blendsynth evaluates today. Fat.001 and the noise + bump material need the
+//! texture nodes and join this list when those land.
+
+use std::hint::black_box;
+use std::path::Path;
+use std::time::Instant;
+
+use blendsynth::scene::Scene;
+use blendsynth::shader::{compile_material, ShadingPoint};
+
+fn main() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/bake/scenes");
+    for case in ["uv_math", "structure", "closures"] {
+        let scene = Scene::load(&root.join(case)).expect("fixture scene");
+        let material = scene.file.materials[0].name.clone();
+        let program = compile_material(&scene, &material).expect("compiles");
+        let mut stack = program.new_stack();
+        let n = 2_000_000u32;
+        let start = Instant::now();
+        let mut acc = 0.0f32;
+        for i in 0..n {
+            // Points spread over the unit square, as a bake or a render would visit them.
+            let u = (i % 1000) as f32 / 1000.0;
+            let v = (i / 1000) as f32 / (n / 1000) as f32;
+            let sp = ShadingPoint {
+                position: [u, v, 0.1],
+                normal: [0.0, 0.0, 1.0],
+                object_position: [2.0 * u - 1.0, 2.0 * v - 1.0, 0.0],
+                object_normal: [0.0, 0.0, 1.0],
+                generated: [u, v, 0.5],
+                uv: [u, v, 0.0],
+            };
+            program.run(black_box(&sp), &mut stack);
+            acc += program.surface_emission(&stack)[0];
+        }
+        let secs = start.elapsed().as_secs_f64();
+        black_box(acc);
+        println!(
+            "shading {case:<10} {:>4} ops: {:>6.1} M points/s per core ({:.1} ns/point)",
+            program.ops.len(),
+            n as f64 / secs / 1e6,
+            secs * 1e9 / n as f64
+        );
+    }
+}
