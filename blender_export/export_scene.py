@@ -5,6 +5,9 @@ Run inside Blender 4.2+:
 or with the bpy module:
     python export_scene.py --in F.blend --out DIR
 
+Options: --frame N (evaluate at frame N; default the file's current frame),
+--no-evaluated (skip the evaluated reference meshes).
+
 The .blend is opened by this script with auto-run scripts disabled: a .blend can carry
 Python (registered text blocks, driver expressions) and none of it may run.
 Everything is read generically through Blender's RNA, so node types and settings this
@@ -19,162 +22,202 @@ import re
 import shutil
 import struct
 import sys
+import time
+import traceback
 
 import bpy
 import numpy as np
 
 EXPORTER_VERSION = 1
 FLT_MAX = 3.4028234663852886e38
-MAX_DEPTH = 5
+MAX_DEPTH = 5            # nesting limit for non-ID structs (FORMAT.md "Generic RNA values")
+MAX_ARRAY = 1 << 16      # longer RNA arrays (preview pixels and the like) are not scene data
 
 WARNINGS = []
 
 
 def fail(msg):
+    # One line, prefixed so callers (src/blender) can pick it out of Blender's chatter.
+    msg = " ".join(str(msg).split())  # one line, even for Blender's multi-line errors
     print(f"blendsynth-export: error: {msg}", file=sys.stderr)
+    sys.stdout.flush()
+    sys.stderr.flush()
     sys.exit(1)
+
+
+def q(name):
+    """A name as a quoted key of a Blender data path: objects["A \\"B\\""]."""
+    return '"' + name.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def id_ref(idb):
+    return {"id_type": idb.id_type, "name": idb.name}
 
 
 # ---------------------------------------------------------------- generic RNA values
 
-def finite(x, where):
-    if math.isfinite(x):
-        return x
-    if math.isnan(x):
-        WARNINGS.append(f"{where}: NaN replaced by 0")
-        return 0.0
-    return FLT_MAX if x > 0 else -FLT_MAX
+# Bookkeeping every ID has (name, users, session_uid, preview pixels, ...): not scene
+# data, and session_uid would make exports differ run to run.
+ID_BASE = frozenset(p.identifier for p in bpy.types.ID.bl_rna.properties)
+# Properties every node has; the ones that matter are exported explicitly per node.
+NODE_BASE = frozenset(p.identifier for p in bpy.types.Node.bl_rna.properties)
 
 
-def plain(v, where="", depth=0):
-    """A Python/bpy value as JSON-ready data (ID pointers as {id_type, name})."""
-    if v is None or isinstance(v, (bool, str)):
+def py_value(v, where, depth):
+    """A value read from RNA or an ID property, as JSON-ready data. Floats are left
+    as they are; sanitize() makes the whole document finite at the end."""
+    if v is None or isinstance(v, (bool, int, float, str)):
         return v
-    if isinstance(v, int):
-        return v
-    if isinstance(v, float):
-        return finite(v, where)
     if isinstance(v, bpy.types.ID):
-        return {"id_type": v.id_type, "name": v.name}
+        return id_ref(v)
     if isinstance(v, bpy.types.bpy_struct):
-        return rna(v, depth + 1, where) if depth < MAX_DEPTH else None
-    if isinstance(v, (set, frozenset)):
+        return rna_value(v, depth + 1, where) if depth < MAX_DEPTH else None
+    if isinstance(v, (set, frozenset)):  # enum flags
         return sorted(v)
-    if hasattr(v, "to_list"):  # IDPropertyArray
-        return [plain(x, where, depth) for x in v.to_list()]
     if hasattr(v, "to_dict"):  # IDPropertyGroup
-        return {k: plain(x, where, depth) for k, x in v.to_dict().items()}
+        return {str(k): py_value(x, f"{where}[{k!r}]", depth) for k, x in v.to_dict().items()}
+    if hasattr(v, "to_list"):  # IDPropertyArray
+        return [py_value(x, where, depth) for x in v.to_list()]
     if isinstance(v, dict):
-        return {str(k): plain(x, where, depth) for k, x in v.items()}
-    try:
-        return [plain(x, where, depth) for x in v]  # mathutils types, bpy arrays
+        return {str(k): py_value(x, f"{where}[{k!r}]", depth) for k, x in v.items()}
+    if isinstance(v, (bytes, bytearray)):
+        return v.decode("utf-8", "replace")
+    try:  # bpy arrays (possibly nested), mathutils Vector/Color/Euler/Quaternion/Matrix rows
+        return [py_value(x, where, depth) for x in v]
     except TypeError:
         return str(v)
 
 
-def rna(struct_, depth=0, where="", skip=()):
-    """All RNA properties of a struct, recursively (ID pointers by name)."""
+def rna_value(struct_, depth=0, where="", skip=()):
+    """All RNA properties of `struct_` (walked through bl_rna.properties, no hand list):
+    ID pointers as {"id_type", "name"}, non-ID structs recursively up to MAX_DEPTH,
+    collections as lists. Properties that cannot be read are skipped."""
     out = {}
-    for prop in struct_.bl_rna.properties:
+    is_id = isinstance(struct_, bpy.types.ID)
+    try:
+        props = list(struct_.bl_rna.properties)
+    except Exception:
+        return out
+    for prop in props:
         ident = prop.identifier
-        if ident == "rna_type" or ident in skip:
-            continue
-        try:
-            value = getattr(struct_, ident)
-        except Exception:
+        if ident == "rna_type" or ident in skip or (is_id and ident in ID_BASE):
             continue
         w = f"{where}.{ident}"
+        try:
+            value = getattr(struct_, ident)
+        except Exception:  # context-dependent or unsupported in this build: leave out
+            continue
         try:
             if prop.type == "POINTER":
                 if value is None:
                     out[ident] = None
                 elif isinstance(value, bpy.types.ID):
-                    out[ident] = {"id_type": value.id_type, "name": value.name}
+                    out[ident] = id_ref(value)
                 elif depth < MAX_DEPTH:
-                    out[ident] = rna(value, depth + 1, w)
+                    out[ident] = rna_value(value, depth + 1, w)
             elif prop.type == "COLLECTION":
                 if depth < MAX_DEPTH:
-                    out[ident] = [
-                        {"id_type": x.id_type, "name": x.name} if isinstance(x, bpy.types.ID) else rna(x, depth + 1, f"{w}[{i}]")
-                        for i, x in enumerate(value)
-                    ]
+                    out[ident] = [id_ref(x) if isinstance(x, bpy.types.ID) else rna_value(x, depth + 1, f"{w}[{i}]")
+                                  for i, x in enumerate(value)]
             else:
-                out[ident] = plain(value, w, depth)
-        except Exception as e:  # a property that cannot be read in this context
+                if getattr(prop, "is_array", False) and len(value) > MAX_ARRAY:
+                    continue
+                out[ident] = py_value(value, w, depth)
+        except Exception as e:
             WARNINGS.append(f"{w}: not exported ({e})")
     return out
 
 
-# Properties every node has (exported explicitly or bookkeeping), not node settings.
-NODE_BASE = {p.identifier for p in bpy.types.Node.bl_rna.properties}
-SOCKET_SKIP_TYPES = {"SHADER", "GEOMETRY", "CUSTOM"}
+def sanitize(v, path, warnings):
+    """Makes every float finite (FORMAT.md): ±inf clamps to ±FLT_MAX, NaN becomes 0 and
+    is reported with its JSON path."""
+    if isinstance(v, float):
+        if math.isfinite(v):
+            return v
+        if math.isnan(v):
+            warnings.append(f"{path}: NaN replaced by 0")
+            return 0.0
+        return FLT_MAX if v > 0 else -FLT_MAX
+    if isinstance(v, dict):
+        return {k: sanitize(x, f"{path}.{k}" if path else k, warnings) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [sanitize(x, f"{path}[{i}]", warnings) for i, x in enumerate(v)]
+    return v
 
 
-def socket(s, index, where):
-    d = {
-        "index": index,
-        "identifier": s.identifier,
-        "name": s.name,
-        "type": s.type,
-        "bl_idname": s.bl_idname,
-        "is_linked": s.is_linked,
-        "hide": s.hide,
-        "enabled": s.enabled,
-        "hide_value": s.hide_value,
-        "is_multi_input": s.is_multi_input,
-    }
-    if hasattr(s, "default_value") and s.type not in SOCKET_SKIP_TYPES:
+# ---------------------------------------------------------------- node trees
+
+SOCKET_NO_DEFAULT = {"SHADER", "GEOMETRY", "CUSTOM"}
+
+
+def socket_entry(s, index, where):
+    d = {"index": index, "identifier": s.identifier, "name": s.name, "type": s.type, "bl_idname": s.bl_idname,
+         "is_linked": s.is_linked, "hide": s.hide, "enabled": s.enabled, "hide_value": s.hide_value,
+         "is_multi_input": s.is_multi_input}
+    if s.type not in SOCKET_NO_DEFAULT and hasattr(s, "default_value"):
         try:
-            d["default_value"] = plain(s.default_value, f"{where}.default_value")
+            d["default_value"] = py_value(s.default_value, f"{where}.default_value", 0)
         except Exception as e:
             WARNINGS.append(f"{where}.default_value: not exported ({e})")
     return d
 
 
-def node_tree(tree, where):
-    nodes = []
-    for n in tree.nodes:
-        nw = f'{where}.nodes["{n.name}"]'
-        group = getattr(n, "node_tree", None) if n.bl_idname in ("ShaderNodeGroup", "GeometryNodeGroup") or hasattr(n, "node_tree") else None
-        nodes.append({
-            "name": n.name,
-            "bl_idname": n.bl_idname,
-            "label": n.label,
-            "mute": n.mute,
-            "parent": n.parent.name if n.parent else None,
-            "location": [finite(n.location[0], nw), finite(n.location[1], nw)],
-            "hide": n.hide,
-            "node_tree": group.name if isinstance(group, bpy.types.NodeTree) else None,
-            "properties": rna(n, 0, nw, skip=NODE_BASE),
-            "inputs": [socket(s, i, f"{nw}.inputs[{i}]") for i, s in enumerate(n.inputs)],
-            "outputs": [socket(s, i, f"{nw}.outputs[{i}]") for i, s in enumerate(n.outputs)],
-        })
-    links = []
-    for l in tree.links:
-        links.append({
-            "from_node": l.from_node.name,
-            "from_socket": l.from_socket.identifier,
-            "from_index": list(l.from_node.outputs).index(l.from_socket),
-            "to_node": l.to_node.name,
-            "to_socket": l.to_socket.identifier,
-            "to_index": list(l.to_node.inputs).index(l.to_socket),
-            "is_muted": l.is_muted,
-            "is_valid": l.is_valid,
-        })
+def node_entry(n, where):
+    group = getattr(n, "node_tree", None)
+    return {
+        "name": n.name, "bl_idname": n.bl_idname, "label": n.label, "mute": n.mute,
+        "parent": n.parent.name if n.parent else None,
+        "location": [n.location[0], n.location[1]], "hide": n.hide,
+        "node_tree": group.name if isinstance(group, bpy.types.NodeTree) else None,
+        "properties": rna_value(n, 0, where, skip=NODE_BASE),
+        "inputs": [socket_entry(s, i, f"{where}.inputs[{i}]") for i, s in enumerate(n.inputs)],
+        "outputs": [socket_entry(s, i, f"{where}.outputs[{i}]") for i, s in enumerate(n.outputs)],
+    }
+
+
+def link_entry(l, out_index, in_index):
+    d = {"from_node": l.from_node.name, "from_socket": l.from_socket.identifier,
+         "from_index": out_index[l.from_node.name][l.from_socket.as_pointer()],
+         "to_node": l.to_node.name, "to_socket": l.to_socket.identifier,
+         "to_index": in_index[l.to_node.name][l.to_socket.as_pointer()],
+         "is_muted": l.is_muted, "is_valid": l.is_valid}
+    # Extra key (readers ignore unknown keys): the order of links into a multi-input
+    # socket (Join Geometry) is this id, not their order in tree.links.
+    if hasattr(l, "multi_input_sort_id"):
+        d["multi_input_sort_id"] = l.multi_input_sort_id
+    return d
+
+
+def interface_entry(item, where):
+    parent = getattr(item, "parent", None)
+    d = {"item_type": item.item_type, "name": item.name,
+         # Top-level items have the unnamed root panel as parent: report that as null.
+         "parent": parent.name if parent is not None and parent.parent is not None else None}
+    if item.item_type == "SOCKET":
+        d.update({"in_out": item.in_out, "identifier": item.identifier, "socket_type": item.socket_type})
+        for k in ("default_value", "min_value", "max_value"):
+            if hasattr(item, k):
+                try:
+                    d[k] = py_value(getattr(item, k), f"{where}.{k}", 0)
+                except Exception as e:
+                    WARNINGS.append(f"{where}.{k}: not exported ({e})")
+    # interface_items of a panel repeats its children, which items_tree lists anyway.
+    d["properties"] = rna_value(item, 0, where, skip={"parent", "default_value", "min_value", "max_value", "interface_items"})
+    return d
+
+
+def node_tree_entry(tree, where):
+    # Socket positions by pointer: links name sockets by identifier and index.
+    out_index = {n.name: {s.as_pointer(): i for i, s in enumerate(n.outputs)} for n in tree.nodes}
+    in_index = {n.name: {s.as_pointer(): i for i, s in enumerate(n.inputs)} for n in tree.nodes}
     interface = []
-    if hasattr(tree, "interface"):
-        for item in tree.interface.items_tree:
-            iw = f"{where}.interface[{item.name}]"
-            d = {"item_type": item.item_type, "name": item.name,
-                 "parent": item.parent.name if getattr(item, "parent", None) and item.parent.parent else None}
-            if item.item_type == "SOCKET":
-                d.update({"in_out": item.in_out, "identifier": item.identifier, "socket_type": item.socket_type})
-                for k in ("default_value", "min_value", "max_value"):
-                    if hasattr(item, k):
-                        d[k] = plain(getattr(item, k), f"{iw}.{k}")
-            d["properties"] = rna(item, 0, iw, skip={"parent", "default_value", "min_value", "max_value"})
-            interface.append(d)
-    return {"name": tree.name, "bl_idname": tree.bl_idname, "interface": interface, "nodes": nodes, "links": links}
+    if getattr(tree, "interface", None) is not None:
+        interface = [interface_entry(it, f"{where}.interface.items_tree[{i}]") for i, it in enumerate(tree.interface.items_tree)]
+    return {
+        "name": tree.name, "bl_idname": tree.bl_idname, "interface": interface,
+        "nodes": [node_entry(n, f"{where}.nodes[{q(n.name)}]") for n in tree.nodes],
+        "links": [link_entry(l, out_index, in_index) for l in tree.links],
+    }
 
 
 # ---------------------------------------------------------------- meshes (glb)
@@ -184,25 +227,29 @@ def safe_name(index, name):
 
 
 class Glb:
-    """Accumulates accessors in one BIN buffer."""
+    """Accumulates accessors in one BIN buffer and writes a glb (no Blender glTF exporter:
+    it would split vertices, and the exact Blender topology is the point)."""
 
-    def __init__(self):
-        self.chunks, self.offset, self.views, self.accessors = [], 0, [], []
+    def __init__(self, name):
+        self.name, self.chunks, self.offset, self.views, self.accessors = name, [], 0, [], []
 
-    def add(self, array, gltf_type, component):
+    def add(self, array, gltf_type, component, what):
         a = np.ascontiguousarray(array)
+        if a.shape[0] == 0:
+            return None  # FORMAT.md: accessors with zero elements are omitted
+        if a.dtype.kind == "f" and not np.isfinite(a).all():
+            if np.isnan(a).any():
+                WARNINGS.append(f"{self.name}: {what}: NaN replaced by 0")
+            a = np.nan_to_num(a, nan=0.0, posinf=FLT_MAX, neginf=-FLT_MAX)
         data = a.tobytes()
-        count = a.shape[0]
-        if count == 0:
-            return None
         self.views.append({"buffer": 0, "byteOffset": self.offset, "byteLength": len(data)})
-        acc = {"bufferView": len(self.views) - 1, "componentType": component, "count": int(count), "type": gltf_type}
-        if gltf_type == "VEC3" and component == 5126 and a.ndim == 2:
+        acc = {"bufferView": len(self.views) - 1, "componentType": component, "count": int(a.shape[0]), "type": gltf_type}
+        if gltf_type == "VEC3" and component == 5126:  # glTF requires bounds on POSITION
             acc["min"] = [float(x) for x in a.min(axis=0)]
             acc["max"] = [float(x) for x in a.max(axis=0)]
         self.accessors.append(acc)
         self.chunks.append(data)
-        pad = (-len(data)) % 4
+        pad = (-len(data)) % 4  # every view starts 4-byte aligned
         self.chunks.append(b"\0" * pad)
         self.offset += len(data) + pad
         return len(self.accessors) - 1
@@ -210,49 +257,59 @@ class Glb:
     def write(self, path, extras, primitive):
         binary = b"".join(self.chunks)
         doc = {"asset": {"version": "2.0", "generator": f"blendsynth export_scene.py v{EXPORTER_VERSION}"},
-               "buffers": [{"byteLength": len(binary)}] if binary else [],
-               "bufferViews": self.views, "accessors": self.accessors,
                "extras": {"blendsynth": extras}}
+        if binary:
+            doc.update({"buffers": [{"byteLength": len(binary)}], "bufferViews": self.views, "accessors": self.accessors})
         if primitive:
-            doc["meshes"] = [{"name": extras["name"], "primitives": [primitive]}]
-            doc["nodes"] = [{"mesh": 0, "name": extras["name"]}]
+            doc["meshes"] = [{"name": self.name, "primitives": [primitive]}]
+            doc["nodes"] = [{"mesh": 0, "name": self.name}]
             doc["scenes"] = [{"nodes": [0]}]
             doc["scene"] = 0
         js = json.dumps(doc, allow_nan=False, separators=(",", ":")).encode()
         js += b" " * ((-len(js)) % 4)
-        chunks = struct.pack("<II", len(js), 0x4E4F534A) + js
+        body = struct.pack("<II", len(js), 0x4E4F534A) + js
         if binary:
-            chunks += struct.pack("<II", len(binary), 0x004E4942) + binary
+            body += struct.pack("<II", len(binary), 0x004E4942) + binary
         tmp = path + ".tmp"
         with open(tmp, "wb") as f:
-            f.write(struct.pack("<III", 0x46546C67, 2, 12 + len(chunks)) + chunks)
+            f.write(struct.pack("<III", 0x46546C67, 2, 12 + len(body)))
+            f.write(body)
         os.replace(tmp, path)
 
 
 def get(coll, attr, n, width, dtype):
+    """foreach_get into a numpy array. dtypes match Blender's raw storage (uint32 for
+    index fields, int32 for INT attributes) so the fast memcpy path is taken."""
     a = np.empty(n * width, dtype=dtype)
     if n:
         coll.foreach_get(attr, a)
     return a.reshape(n, width) if width > 1 else a
 
 
-ATTR_LAYOUT = {  # data_type -> (foreach attribute, width, numpy dtype, glTF type, component)
+# data_type -> (foreach field, width, numpy dtype, glTF type, glTF component type)
+ATTR_LAYOUT = {
     "FLOAT": ("value", 1, np.float32, "SCALAR", 5126),
     "FLOAT2": ("vector", 2, np.float32, "VEC2", 5126),
     "FLOAT_VECTOR": ("vector", 3, np.float32, "VEC3", 5126),
     "FLOAT_COLOR": ("color", 4, np.float32, "VEC4", 5126),
-    "BYTE_COLOR": ("color", 4, np.float32, "VEC4", 5126),
-    "QUATERNION": ("value", 4, np.float32, "VEC4", 5126),
-    "FLOAT4X4": ("value", 16, np.float32, "MAT4", 5126),
+    "BYTE_COLOR": ("color", 4, np.float32, "VEC4", 5126),   # `color` is scene linear
+    "QUATERNION": ("value", 4, np.float32, "VEC4", 5126),   # w, x, y, z
+    "FLOAT4X4": ("value", 16, np.float32, "MAT4", 5126),    # foreach_get is column-major, as glTF
     "INT": ("value", 1, np.int32, "SCALAR", 5125),
     "INT32_2D": ("value", 2, np.int32, "VEC2", 5125),
     "INT8": ("value", 1, np.int8, "SCALAR", 5120),
-    "BOOLEAN": ("value", 1, bool, "SCALAR", 5121),
+    "BOOLEAN": ("value", 1, np.bool_, "SCALAR", 5121),
+}
+
+TOPOLOGY_LAYOUT = {  # extras key -> (glTF type, component)
+    "vertex_positions": ("VEC3", 5126), "edge_verts": ("VEC2", 5125), "face_offsets": ("SCALAR", 5125),
+    "corner_verts": ("SCALAR", 5125), "corner_edges": ("SCALAR", 5125), "corner_normals": ("VEC3", 5126),
+    "triangle_corners": ("SCALAR", 5125), "triangle_faces": ("SCALAR", 5125),
 }
 
 
-def mesh_arrays(me):
-    """Blender's exact mesh as numpy arrays: (counts, dict of arrays, attributes)."""
+def mesh_arrays(me, where):
+    """Blender's exact mesh as numpy arrays: (counts, arrays, attributes, uv names)."""
     nv, ne, nf, nc = len(me.vertices), len(me.edges), len(me.polygons), len(me.loops)
     me.calc_loop_triangles()
     nt = len(me.loop_triangles)
@@ -264,127 +321,138 @@ def mesh_arrays(me):
         "triangle_corners": get(me.loop_triangles, "loops", nt, 3, np.uint32).reshape(-1),
         "triangle_faces": get(me.loop_triangles, "polygon_index", nt, 1, np.uint32),
     }
-    starts = get(me.polygons, "loop_start", nf, 1, np.uint32)
-    arrays["face_offsets"] = np.append(starts, np.uint32(nc)).astype(np.uint32) if nf else np.zeros(0, np.uint32)
     if nf:
-        normals = me.corner_normals if hasattr(me, "corner_normals") else None
-        if normals is not None:
-            arrays["corner_normals"] = get(normals, "vector", nc, 3, np.float32)
-        else:  # Blender before 4.1
+        starts = get(me.polygons, "loop_start", nf, 1, np.uint32)
+        arrays["face_offsets"] = np.append(starts, np.uint32(nc)).astype(np.uint32)
+        if hasattr(me, "corner_normals"):  # Blender 4.1+
+            arrays["corner_normals"] = get(me.corner_normals, "vector", nc, 3, np.float32)
+        else:
             me.calc_normals_split()
             arrays["corner_normals"] = get(me.loops, "normal", nc, 3, np.float32)
+    else:
+        arrays["face_offsets"] = np.zeros(0, np.uint32)
     attrs = []
     for a in me.attributes:
         if a.name.startswith(".") or a.name == "position":
             continue
         layout = ATTR_LAYOUT.get(a.data_type)
-        if layout is None:
-            WARNINGS.append(f'meshes["{me.name}"].attributes["{a.name}"]: data type {a.data_type} not exported')
+        if layout is None:  # STRING, INT16_2D: not in format version 1
+            WARNINGS.append(f'{where}.attributes[{q(a.name)}]: data type {a.data_type} not exported')
             continue
         field, width, dtype, _, _ = layout
-        if a.data_type == "FLOAT4X4":
-            data = get(a.data, "value", len(a.data), 16, np.float32)
-            # Blender's foreach gives rows; glTF MAT4 is column-major.
-            data = data.reshape(-1, 4, 4).transpose(0, 2, 1).reshape(-1, 16)
-        else:
-            data = get(a.data, field, len(a.data), width, dtype)
-        attrs.append((a.name, a.domain, a.data_type, data))
-    return (nv, ne, nf, nc, nt), arrays, attrs
+        attrs.append((a.name, a.domain, a.data_type, get(a.data, field, len(a.data), width, dtype)))
+    return (nv, ne, nf, nc, nt), arrays, attrs, [uv.name for uv in me.uv_layers]
 
 
 def write_mesh_glb(path, name, counts, arrays, attrs, uv_names):
     nv, ne, nf, nc, nt = counts
-    g = Glb()
+    g = Glb(name)
     ex = {"version": 1, "name": name, "vertex_count": nv, "edge_count": ne, "face_count": nf,
-          "corner_count": nc, "triangle_count": nt, "attributes": []}
-    layout = {"vertex_positions": ("VEC3", 5126), "edge_verts": ("VEC2", 5125), "face_offsets": ("SCALAR", 5125),
-              "corner_verts": ("SCALAR", 5125), "corner_edges": ("SCALAR", 5125), "corner_normals": ("VEC3", 5126),
-              "triangle_corners": ("SCALAR", 5125), "triangle_faces": ("SCALAR", 5125)}
-    for key, (ty, comp) in layout.items():
+          "corner_count": nc, "triangle_count": nt}
+    for key, (ty, comp) in TOPOLOGY_LAYOUT.items():
         if key in arrays:
-            idx = g.add(arrays[key], ty, comp)
+            idx = g.add(arrays[key], ty, comp, key)
             if idx is not None:
                 ex[key] = idx
-    uv_accessors = {}
+    ex["attributes"] = []
+    uv_data = {}
     for aname, domain, dtype, data in attrs:
-        _, _, npt, ty, comp = ATTR_LAYOUT[dtype]
-        idx = g.add(data.astype(np.uint8) if dtype == "BOOLEAN" else data, ty, comp)
+        _, _, _, ty, comp = ATTR_LAYOUT[dtype]
+        idx = g.add(data.astype(np.uint8) if dtype == "BOOLEAN" else data, ty, comp, f"attribute {aname}")
         if idx is not None:
             ex["attributes"].append({"name": aname, "domain": domain, "data_type": dtype, "accessor": idx})
-            if aname in uv_names and domain == "CORNER" and dtype == "FLOAT2":
-                uv_accessors[aname] = data
+            if domain == "CORNER" and dtype == "FLOAT2":
+                uv_data[aname] = data
     primitive = None
     if nt:
-        # The viewable primitive: one glTF vertex per face corner.
-        cv = arrays["corner_verts"]
-        prim = {"attributes": {"POSITION": g.add(arrays["vertex_positions"][cv], "VEC3", 5126)},
+        # The viewable primitive: one glTF vertex per face corner, so corner normals and
+        # UV seams need no vertex splitting; indices are the loop triangles' corners.
+        prim = {"attributes": {"POSITION": g.add(arrays["vertex_positions"][arrays["corner_verts"]], "VEC3", 5126, "POSITION")},
                 "indices": ex["triangle_corners"], "mode": 4}
         if "corner_normals" in ex:
             prim["attributes"]["NORMAL"] = ex["corner_normals"]
-        for i, uv in enumerate(uv_names):
-            if uv in uv_accessors:
-                flipped = uv_accessors[uv].copy()
-                flipped[:, 1] = 1.0 - flipped[:, 1]
-                prim["attributes"][f"TEXCOORD_{i}"] = g.add(flipped, "VEC2", 5126)
+        for i, uv in enumerate(n for n in uv_names if n in uv_data):
+            flipped = uv_data[uv].copy()
+            flipped[:, 1] = 1.0 - flipped[:, 1]  # glTF's v runs top-down
+            prim["attributes"][f"TEXCOORD_{i}"] = g.add(flipped, "VEC2", 5126, f"TEXCOORD_{i}")
         primitive = prim
     g.write(path, ex, primitive)
 
 
-def export_mesh(me, path):
-    counts, arrays, attrs = mesh_arrays(me)
-    write_mesh_glb(path, me.name, counts, arrays, attrs, [uv.name for uv in me.uv_layers])
-    return counts
-
-
 def concat_meshes(parts):
-    """Joins (counts, arrays, attrs) triples into one mesh, offsetting indices;
-    attributes are kept where every part has them with the same type and domain."""
+    """Joins mesh_arrays() results into one mesh, offsetting indices. Attributes are kept
+    where every non-empty part has them with the same domain and type."""
+    parts = [p for p in parts if p[0][0] > 0] or parts[:1]
     if len(parts) == 1:
         return parts[0]
     keys = ["vertex_positions", "edge_verts", "corner_verts", "corner_edges", "triangle_corners",
             "triangle_faces", "corner_normals"]
-    out, offs = {k: [] for k in keys}, [0, 0, 0, 0]  # vertex, edge, corner, face
+    out = {k: [] for k in keys}
     face_offsets = [np.zeros(1, np.uint32)]
-    for counts, arrays, _ in parts:
-        nv, ne, nf, nc, nt = counts
+    nv = ne = nc = nf = 0
+    for (pv, pe, pf, pc, _), arrays, _, _ in parts:
         out["vertex_positions"].append(arrays["vertex_positions"])
-        out["edge_verts"].append(arrays["edge_verts"] + offs[0])
-        out["corner_verts"].append(arrays["corner_verts"] + offs[0])
-        out["corner_edges"].append(arrays["corner_edges"] + offs[1])
-        out["triangle_corners"].append(arrays["triangle_corners"] + offs[2])
-        out["triangle_faces"].append(arrays["triangle_faces"] + offs[3])
-        out["corner_normals"].append(arrays.get("corner_normals", np.zeros((nc, 3), np.float32)))
-        if nf:
-            face_offsets.append(arrays["face_offsets"][1:] + offs[2])
-        offs = [offs[0] + nv, offs[1] + ne, offs[2] + nc, offs[3] + nf]
-    arrays = {k: np.concatenate(v).astype(v[0].dtype) for k, v in out.items()}
-    arrays["face_offsets"] = np.concatenate(face_offsets).astype(np.uint32) if offs[3] else np.zeros(0, np.uint32)
+        out["edge_verts"].append(arrays["edge_verts"] + np.uint32(nv))
+        out["corner_verts"].append(arrays["corner_verts"] + np.uint32(nv))
+        out["corner_edges"].append(arrays["corner_edges"] + np.uint32(ne))
+        out["triangle_corners"].append(arrays["triangle_corners"] + np.uint32(nc))
+        out["triangle_faces"].append(arrays["triangle_faces"] + np.uint32(nf))
+        out["corner_normals"].append(arrays.get("corner_normals", np.zeros((pc, 3), np.float32)))
+        if pf:
+            face_offsets.append(arrays["face_offsets"][1:] + np.uint32(nc))
+        nv, ne, nc, nf = nv + pv, ne + pe, nc + pc, nf + pf
+    arrays = {k: np.concatenate(v) for k, v in out.items()}
+    arrays["face_offsets"] = np.concatenate(face_offsets) if nf else np.zeros(0, np.uint32)
+    if not nf:
+        del arrays["corner_normals"]
     common = None
-    for _, _, attrs in parts:
-        sig = {(a[0], a[1], a[2]) for a in attrs}
-        common = sig if common is None else common & sig
-    attrs = []
-    for name, domain, dtype in sorted(common or []):
-        attrs.append((name, domain, dtype, np.concatenate([d for _, _, p in parts for (n, dm, dt, d) in p if (n, dm, dt) == (name, domain, dtype)])))
-    nt = len(arrays["triangle_faces"])
-    return (offs[0], offs[1], offs[3], offs[2], nt), arrays, attrs
+    for _, _, attrs, _ in parts:
+        sig = [(a[0], a[1], a[2]) for a in attrs]
+        common = sig if common is None else [s for s in common if s in sig]
+    attrs = [(n, dom, dt, np.concatenate([d for _, _, pa, _ in parts for (pn, pd, pt, d) in pa if (pn, pd, pt) == (n, dom, dt)]))
+             for n, dom, dt in common or []]
+    uv_names = [u for u in parts[0][3] if all(u in p[3] for p in parts)]
+    return (nv, ne, nf, nc, len(arrays["triangle_faces"])), arrays, attrs, uv_names
 
 
-def evaluated_mesh(obj, depsgraph):
-    """The object's evaluated mesh plus realised instances, in the object's local space."""
-    ev = obj.evaluated_get(depsgraph)
-    parts, uv_names, n_inst = [], [], 0
-    me = ev.to_mesh()
-    try:
-        parts.append(mesh_arrays(me))
-        uv_names = [uv.name for uv in me.uv_layers]
-    finally:
-        ev.to_mesh_clear()
-    inv = np.array(ev.matrix_world.inverted(), dtype=np.float64)
+def transform_part(part, m):
+    """Moves a mesh_arrays() result by the 4x4 matrix m (positions and corner normals)."""
+    counts, arrays, attrs, uvs = part
+    p = arrays["vertex_positions"].astype(np.float64)
+    arrays["vertex_positions"] = (p @ m[:3, :3].T + m[:3, 3]).astype(np.float32)
+    if "corner_normals" in arrays:
+        n = arrays["corner_normals"].astype(np.float64) @ np.linalg.inv(m[:3, :3])  # inverse transpose
+        n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
+        arrays["corner_normals"] = n.astype(np.float32)
+    return counts, arrays, attrs, uvs
+
+
+NON_GEOMETRY = {"EMPTY", "LIGHT", "CAMERA", "SPEAKER", "LIGHT_PROBE", "ARMATURE", "LATTICE"}
+
+
+def evaluated_meshes(objs, depsgraph):
+    """For each object: its evaluated mesh plus the instances it generates (realised),
+    in its local space. One pass over depsgraph.object_instances (instance objects are
+    only valid during their iteration step, so each is converted right away)."""
+    parts, n_inst, inverse = {}, {}, {}
+    for o in objs:
+        ev = o.evaluated_get(depsgraph)
+        me = ev.to_mesh()
+        try:
+            parts[o.name] = [mesh_arrays(me, f"evaluated[{q(o.name)}]")]
+        finally:
+            ev.to_mesh_clear()
+        n_inst[o.name] = 0
+        inverse[o.name] = np.linalg.inv(np.array(ev.matrix_world, dtype=np.float64))
     for inst in depsgraph.object_instances:
-        if not inst.is_instance or inst.parent is None or inst.parent.original != obj:
+        if not inst.is_instance or inst.parent is None:
             continue
-        io = inst.object  # the instanced geometry (instance_object is the instancer)
+        owner = inst.parent.original.name
+        if owner not in parts:
+            continue
+        io = inst.object  # the instanced geometry (inst.parent is the instancer)
+        if io.type in NON_GEOMETRY:
+            continue
         try:
             ime = io.to_mesh()
         except RuntimeError:
@@ -392,68 +460,69 @@ def evaluated_mesh(obj, depsgraph):
         if ime is None:
             continue
         try:
-            counts, arrays, attrs = mesh_arrays(ime)
+            part = mesh_arrays(ime, f"evaluated[{q(owner)}].instance")
         finally:
             io.to_mesh_clear()
-        m = inv @ np.array(inst.matrix_world, dtype=np.float64)
-        p = arrays["vertex_positions"].astype(np.float64)
-        arrays["vertex_positions"] = (p @ m[:3, :3].T + m[:3, 3]).astype(np.float32)
-        if "corner_normals" in arrays:
-            nm = np.linalg.inv(m[:3, :3]).T
-            n = arrays["corner_normals"].astype(np.float64) @ nm.T
-            n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-30)
-            arrays["corner_normals"] = n.astype(np.float32)
-        parts.append((counts, arrays, attrs))
-        n_inst += 1
-    return concat_meshes(parts), uv_names, n_inst
+        parts[owner].append(transform_part(part, inverse[owner] @ np.array(inst.matrix_world, dtype=np.float64)))
+        n_inst[owner] += 1
+    return {name: (concat_meshes(p), n_inst[name]) for name, p in parts.items()}
 
 
 # ---------------------------------------------------------------- other datablocks
 
 def matrix(m):
-    return [[finite(float(m[r][c]), "matrix") for c in range(4)] for r in range(4)]
+    return [[float(m[r][c]) for c in range(4)] for r in range(4)]
 
 
-def custom_props(idb):
+def vec(v):
+    return [float(x) for x in v]
+
+
+def custom_props(idb, where):
     out = {}
     for k in idb.keys():
-        if k.startswith("_") or k == "cycles":
+        if k.startswith("_") or k == "cycles":  # add-on bookkeeping, not user data
             continue
         try:
-            out[k] = plain(idb[k], f"{idb.name}[{k}]")
-        except Exception:
-            pass
+            out[k] = py_value(idb[k], f"{where}[{q(k)}]", 0)
+        except Exception as e:
+            WARNINGS.append(f"{where}[{q(k)}]: not exported ({e})")
     return out
 
 
-def obj_entry(o):
-    w = f'objects["{o.name}"]'
-    mods = []
-    for m in o.modifiers:
-        d = {"name": m.name, "type": m.type, "show_render": m.show_render, "show_viewport": m.show_viewport,
-             "properties": rna(m, 0, f"{w}.modifiers[{m.name}]", skip={"name", "type", "show_render", "show_viewport"}),
-             "node_group": None, "inputs": {}}
-        if m.type == "NODES":
-            d["node_group"] = m.node_group.name if m.node_group else None
-            d["inputs"] = {k: plain(m[k], f"{w}.modifiers[{m.name}][{k}]") for k in m.keys()}
-        mods.append(d)
-    cons = [{"name": c.name, "type": c.type, "mute": c.mute, "influence": c.influence,
-             "properties": rna(c, 0, f"{w}.constraints[{c.name}]")} for c in o.constraints]
+def modifier_entry(m, where):
+    d = {"name": m.name, "type": m.type, "show_render": m.show_render, "show_viewport": m.show_viewport,
+         "properties": rna_value(m, 0, where, skip={"name", "type", "show_render", "show_viewport"}),
+         "node_group": None, "inputs": {}}
+    if m.type == "NODES":
+        d["node_group"] = m.node_group.name if m.node_group else None
+        # Group input values live in the modifier's ID properties, keyed by the group's
+        # interface identifiers (Socket_2, Socket_2_use_attribute, ...).
+        d["inputs"] = {k: py_value(m[k], f"{where}[{q(k)}]", 0) for k in m.keys()}
+    return d
+
+
+def object_entry(o, view_layer):
+    w = f"objects[{q(o.name)}]"
     return {
         "name": o.name, "type": o.type, "data": o.data.name if o.data else None,
         "parent": o.parent.name if o.parent else None, "parent_type": o.parent_type,
         "matrix_world": matrix(o.matrix_world), "matrix_local": matrix(o.matrix_local),
         "matrix_basis": matrix(o.matrix_basis), "matrix_parent_inverse": matrix(o.matrix_parent_inverse),
-        "location": plain(o.location), "rotation_mode": o.rotation_mode,
-        "rotation_euler": plain(o.rotation_euler), "rotation_quaternion": plain(o.rotation_quaternion),
-        "rotation_axis_angle": plain(o.rotation_axis_angle), "scale": plain(o.scale),
-        "delta_location": plain(o.delta_location), "delta_rotation_euler": plain(o.delta_rotation_euler),
-        "delta_rotation_quaternion": plain(o.delta_rotation_quaternion), "delta_scale": plain(o.delta_scale),
+        "location": vec(o.location), "rotation_mode": o.rotation_mode,
+        "rotation_euler": vec(o.rotation_euler), "rotation_quaternion": vec(o.rotation_quaternion),
+        "rotation_axis_angle": vec(o.rotation_axis_angle), "scale": vec(o.scale),
+        "delta_location": vec(o.delta_location), "delta_rotation_euler": vec(o.delta_rotation_euler),
+        "delta_rotation_quaternion": vec(o.delta_rotation_quaternion), "delta_scale": vec(o.delta_scale),
         "hide_render": o.hide_render, "hide_viewport": o.hide_viewport,
-        "visible": o.visible_get() if bpy.context.view_layer.objects.get(o.name) else False,
+        "visible": o.visible_get(view_layer=view_layer) if view_layer.objects.get(o.name) else False,
         "pass_index": o.pass_index, "collections": [c.name for c in o.users_collection],
         "material_slots": [{"material": s.material.name if s.material else None, "link": s.link} for s in o.material_slots],
-        "modifiers": mods, "constraints": cons, "custom_properties": custom_props(o),
+        "modifiers": [modifier_entry(m, f"{w}.modifiers[{q(m.name)}]") for m in o.modifiers],
+        "constraints": [{"name": c.name, "type": c.type, "mute": c.mute, "influence": c.influence,
+                         "properties": rna_value(c, 0, f"{w}.constraints[{q(c.name)}]")} for c in o.constraints],
+        "custom_properties": custom_props(o, w),
+        # Extra keys: Follow Path orients a child of a path by the object's own axes.
         "track_axis": o.track_axis, "up_axis": o.up_axis,
         "instance_type": o.instance_type,
         "instance_collection": o.instance_collection.name if o.instance_collection else None,
@@ -463,49 +532,51 @@ def obj_entry(o):
 def curve_entry(c):
     splines = []
     for s in c.splines:
-        d = {"type": s.type, "use_cyclic_u": s.use_cyclic_u, "resolution_u": s.resolution_u, "order_u": s.order_u,
-             "use_endpoint_u": s.use_endpoint_u, "use_bezier_u": s.use_bezier_u, "use_smooth": s.use_smooth,
-             "material_index": s.material_index, "tilt_interpolation": s.tilt_interpolation,
-             "radius_interpolation": s.radius_interpolation,
-             "bezier_points": [{"co": plain(p.co), "handle_left": plain(p.handle_left), "handle_right": plain(p.handle_right),
-                                "handle_left_type": p.handle_left_type, "handle_right_type": p.handle_right_type,
-                                "radius": p.radius, "tilt": p.tilt, "weight_softbody": p.weight_softbody}
-                               for p in s.bezier_points],
-             "points": [{"co": plain(p.co), "radius": p.radius, "tilt": p.tilt, "weight": p.weight} for p in s.points]}
-        splines.append(d)
-    return {"name": c.name, "properties": rna(c, 0, f'curves["{c.name}"]', skip={"splines", "materials", "animation_data", "shape_keys"}),
+        splines.append({
+            "type": s.type, "use_cyclic_u": s.use_cyclic_u, "resolution_u": s.resolution_u, "order_u": s.order_u,
+            "use_endpoint_u": s.use_endpoint_u, "use_bezier_u": s.use_bezier_u, "use_smooth": s.use_smooth,
+            "material_index": s.material_index, "tilt_interpolation": s.tilt_interpolation,
+            "radius_interpolation": s.radius_interpolation,
+            "bezier_points": [{"co": vec(p.co), "handle_left": vec(p.handle_left), "handle_right": vec(p.handle_right),
+                               "handle_left_type": p.handle_left_type, "handle_right_type": p.handle_right_type,
+                               "radius": p.radius, "tilt": p.tilt, "weight_softbody": p.weight_softbody}
+                              for p in s.bezier_points],
+            "points": [{"co": vec(p.co), "radius": p.radius, "tilt": p.tilt, "weight": p.weight} for p in s.points],
+        })
+    return {"name": c.name,
+            "properties": rna_value(c, 0, f"curves[{q(c.name)}]", skip={"splines", "materials", "animation_data", "shape_keys"}),
             "materials": [m.name if m else None for m in c.materials], "splines": splines}
 
 
 def image_entry(im, out_dir, used_names):
-    d = {"name": im.name, "source": im.source, "filepath": im.filepath, "file": None, "packed": im.packed_file is not None,
-         "missing": False, "colorspace": im.colorspace_settings.name, "alpha_mode": im.alpha_mode, "size": list(im.size)}
+    d = {"name": im.name, "source": im.source, "filepath": im.filepath, "file": None,
+         "packed": im.packed_file is not None, "missing": False,
+         "colorspace": im.colorspace_settings.name, "alpha_mode": im.alpha_mode, "size": [int(x) for x in im.size]}
     if im.packed_file is None and im.source not in ("FILE", "SEQUENCE", "MOVIE", "TILED"):
         if im.source == "GENERATED":
-            WARNINGS.append(f'images["{im.name}"]: generated image not packed; its pixels are not exported')
+            WARNINGS.append(f"images[{q(im.name)}]: generated image not packed; its pixels are not exported")
         return d
-    os.makedirs(os.path.join(out_dir, "images"), exist_ok=True)
-    base = re.sub(r"[^A-Za-z0-9._-]", "_", os.path.basename(im.filepath) or im.name) or "image"
+    base = re.sub(r"[^A-Za-z0-9._-]", "_", bpy.path.basename(im.filepath) or im.name) or "image"
     if im.packed_file is not None and not os.path.splitext(base)[1]:
+        # A packed generated image has no file name: name it by its packed format.
         base += "." + {"JPEG": "jpg", "OPEN_EXR": "exr", "OPEN_EXR_MULTILAYER": "exr"}.get(im.file_format, im.file_format.lower())
-    name = base
-    k = 1
+    name, k = base, 1
     while name in used_names:
         stem, ext = os.path.splitext(base)
-        name = f"{stem}.{k}{ext}"
-        k += 1
+        name, k = f"{stem}.{k}{ext}", k + 1
     target = os.path.join(out_dir, "images", name)
     if im.packed_file is not None:
+        os.makedirs(os.path.dirname(target), exist_ok=True)
         with open(target, "wb") as f:
             f.write(im.packed_file.data)
     else:
-        src = bpy.path.abspath(im.filepath)
-        if src and os.path.isfile(src):
-            shutil.copyfile(src, target)
-        else:
+        src = bpy.path.abspath(im.filepath, library=im.library)
+        if not (src and os.path.isfile(src)):
             d["missing"] = True
-            WARNINGS.append(f'images["{im.name}"]: file {im.filepath!r} not found and not packed')
+            WARNINGS.append(f"images[{q(im.name)}]: file {im.filepath!r} not found and not packed")
             return d
+        os.makedirs(os.path.dirname(target), exist_ok=True)
+        shutil.copyfile(src, target)
     used_names.add(name)
     d["file"] = f"images/{name}"
     return d
@@ -514,11 +585,15 @@ def image_entry(im, out_dir, used_names):
 # ---------------------------------------------------------------- animation
 
 def action_fcurves(anim):
+    """The F-curves that animate this ID. Layered actions (4.4+) may hold several slots,
+    so read the channelbag of the slot assigned to this ID; legacy actions: fcurves."""
     act = anim.action
     if act is None:
         return []
-    slot = getattr(anim, "action_slot", None)
-    if getattr(act, "is_action_layered", False) and hasattr(act, "layers") and slot is not None:
+    if getattr(act, "is_action_layered", False) and hasattr(act, "layers"):
+        slot = getattr(anim, "action_slot", None)
+        if slot is None:
+            return []  # no slot assigned: the action animates nothing on this ID
         curves = []
         for layer in act.layers:
             for strip in layer.strips:
@@ -529,76 +604,109 @@ def action_fcurves(anim):
     return list(getattr(act, "fcurves", []))
 
 
-def fcurve(fc, where):
+def fcurve_entry(fc, where):
     return {
         "data_path": fc.data_path, "array_index": fc.array_index, "extrapolation": fc.extrapolation, "mute": fc.mute,
-        "keyframes": [{"co": plain(k.co, where), "handle_left": plain(k.handle_left, where),
-                       "handle_right": plain(k.handle_right, where), "handle_left_type": k.handle_left_type,
-                       "handle_right_type": k.handle_right_type, "interpolation": k.interpolation, "easing": k.easing,
+        "keyframes": [{"co": vec(k.co), "handle_left": vec(k.handle_left), "handle_right": vec(k.handle_right),
+                       "handle_left_type": k.handle_left_type, "handle_right_type": k.handle_right_type,
+                       "interpolation": k.interpolation, "easing": k.easing,
                        "back": k.back, "amplitude": k.amplitude, "period": k.period} for k in fc.keyframe_points],
-        "modifiers": [{"type": m.type, "mute": m.mute, "properties": rna(m, 0, where)} for m in fc.modifiers],
+        "modifiers": [{"type": m.type, "mute": m.mute,
+                       "properties": rna_value(m, 0, f"{where}.modifiers[{i}]", skip={"type", "mute"})}
+                      for i, m in enumerate(fc.modifiers)],
     }
 
 
-def anim_entry(idb, id_path):
+def anim_entry(idb, id_path, id_type):
     anim = getattr(idb, "animation_data", None)
     if anim is None:
         return None
-    fcs = [fcurve(fc, f"{id_path}.{fc.data_path}") for fc in action_fcurves(anim)]
+    if any(len(t.strips) for t in anim.nla_tracks):
+        WARNINGS.append(f"{id_path}: NLA strips are not exported (only the active action and drivers)")
+    fcs = [fcurve_entry(fc, f"{id_path}.{fc.data_path}[{fc.array_index}]") for fc in action_fcurves(anim)]
     drivers = []
     for fc in anim.drivers:
-        d = fcurve(fc, f"{id_path}.{fc.data_path}")
-        d["driver"] = rna(fc.driver, 0, f"{id_path}.driver")
+        w = f"{id_path}.{fc.data_path}[{fc.array_index}]"
+        d = fcurve_entry(fc, w)
+        d["driver"] = rna_value(fc.driver, 0, f"{w}.driver")
         drivers.append(d)
     if not fcs and not drivers and anim.action is None:
         return None
-    return {"id_type": idb.id_type if hasattr(idb, "id_type") else "NODETREE", "id_name": idb.name, "id_path": id_path,
+    return {"id_type": id_type, "id_name": idb.name, "id_path": id_path,
             "action": anim.action.name if anim.action else None, "fcurves": fcs, "drivers": drivers}
 
 
-def q(name):
-    return '"' + name.replace("\\", "\\\\").replace('"', '\\"') + '"'
+def animation(data):
+    out = []
+    for coll_name in ("objects", "meshes", "curves", "cameras", "lights", "materials", "worlds", "scenes", "node_groups"):
+        for idb in getattr(data, coll_name):
+            path = f"{coll_name}[{q(idb.name)}]"
+            e = anim_entry(idb, path, idb.id_type)
+            if e:
+                out.append(e)
+            # Embedded node trees are IDs of their own with their own animation data.
+            tree = getattr(idb, "node_tree", None) if coll_name in ("materials", "worlds") else None
+            if tree is not None:
+                e = anim_entry(tree, f"{path}.node_tree", "NODETREE")
+                if e:
+                    out.append(e)
+    return out
 
 
 # ---------------------------------------------------------------- main
 
+def open_blend(path):
+    if not os.path.isfile(path):
+        fail(f"input file not found: {path}")
+    # Never run Python carried by the file: neither registered text blocks nor
+    # Python driver expressions. Set the preference too, in case anything re-reads it.
+    bpy.context.preferences.filepaths.use_scripts_auto_execute = False
+    try:
+        bpy.ops.wm.open_mainfile(filepath=os.path.abspath(path), load_ui=False, use_scripts=False)
+    except Exception as e:
+        fail(f"Blender cannot open {path}: {e}")
+
+
 def main():
+    t0 = time.time()
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
-    ap = argparse.ArgumentParser(prog="export_scene.py")
+    ap = argparse.ArgumentParser(prog="export_scene.py", description="Export a .blend to blendsynth's scene format")
     ap.add_argument("--in", dest="input", help="the .blend to export (default: the file Blender already opened)")
-    ap.add_argument("--out", required=True)
-    ap.add_argument("--frame", type=int)
-    ap.add_argument("--no-evaluated", action="store_true")
+    ap.add_argument("--out", required=True, help="output folder")
+    ap.add_argument("--frame", type=int, help="frame to evaluate at (default: the file's current frame)")
+    ap.add_argument("--no-evaluated", action="store_true", help="skip the evaluated reference meshes")
     args = ap.parse_args(argv)
     if args.input is None:
-        # `blender -b FILE --python export_scene.py -- --out DIR`: Blender opened FILE
-        # itself, so it is only safe when Blender was started with --disable-autoexec.
+        # `blender -b --disable-autoexec FILE --python export_scene.py -- --out DIR`:
+        # Blender opened FILE itself, safe only when started with --disable-autoexec.
         if not bpy.data.filepath:
-            fail("no input: pass --in FILE.blend (or open the file with `blender -b --disable-autoexec FILE`)")
+            fail("no input: pass --in FILE.blend")
         args.input = bpy.data.filepath
     else:
-        if not os.path.isfile(args.input):
-            fail(f"input file not found: {args.input}")
-        # Never run Python carried by the file.
-        bpy.context.preferences.filepaths.use_scripts_auto_execute = False
-        try:
-            bpy.ops.wm.open_mainfile(filepath=os.path.abspath(args.input), load_ui=False, use_scripts=False)
-        except Exception as e:
-            fail(f"Blender cannot open {args.input}: {e}")
+        open_blend(args.input)
 
     out = args.out
-    for sub in ("", "meshes", "evaluated"):
-        os.makedirs(os.path.join(out, sub), exist_ok=True)
-    scene = bpy.context.scene
-    if args.frame is not None:
-        scene.frame_set(args.frame)
-    depsgraph = bpy.context.evaluated_depsgraph_get()
+    try:
+        for sub in ("", "meshes", "evaluated"):
+            os.makedirs(os.path.join(out, sub), exist_ok=True)
+    except OSError as e:
+        fail(f"cannot create output folder {out}: {e}")
 
     data = bpy.data
+    scene = bpy.context.scene
+    view_layer = bpy.context.view_layer
+    if args.frame is not None:
+        scene.frame_set(args.frame)
+    # Evaluates animation, drivers and constraints at the current frame and flushes the
+    # results (matrix_world, animated properties) back to the original data we read.
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+
     meshes = []
     for i, me in enumerate(data.meshes):
         rel = f"meshes/{safe_name(i, me.name)}"
-        nv, ne, nf, nc, _ = export_mesh(me, os.path.join(out, rel))
+        counts, arrays, attrs, uvs = mesh_arrays(me, f"meshes[{q(me.name)}]")
+        write_mesh_glb(os.path.join(out, rel), me.name, counts, arrays, attrs, uvs)
+        nv, ne, nf, nc, _ = counts
         meshes.append({"name": me.name, "file": rel, "vertex_count": nv, "edge_count": ne, "face_count": nf,
                        "corner_count": nc, "materials": [m.name if m else None for m in me.materials],
                        "uv_layers": [uv.name for uv in me.uv_layers],
@@ -606,42 +714,28 @@ def main():
                        "active_render_uv": next((uv.name for uv in me.uv_layers if uv.active_render), None),
                        "attributes": [{"name": a.name, "domain": a.domain, "data_type": a.data_type}
                                       for a in me.attributes if not a.name.startswith(".")],
-                       "texspace_location": plain(me.texspace_location), "texspace_size": plain(me.texspace_size),
+                       "texspace_location": vec(me.texspace_location), "texspace_size": vec(me.texspace_size),
                        "use_auto_texspace": me.use_auto_texspace})
 
     evaluated = []
     if not args.no_evaluated:
-        for i, o in enumerate(data.objects):
-            if o.type != "MESH" or not o.modifiers:
-                continue
-            (counts, arrays, attrs), uv_names, n_inst = evaluated_mesh(o, depsgraph)
-            rel = f"evaluated/{safe_name(i, o.name)}"
-            write_mesh_glb(os.path.join(out, rel), o.name, counts, arrays, attrs, uv_names)
-            evaluated.append({"object": o.name, "frame": scene.frame_current + scene.frame_subframe, "file": rel,
+        index = {o.name: i for i, o in enumerate(data.objects)}
+        targets = [o for o in data.objects if o.type == "MESH" and len(o.modifiers) and view_layer.objects.get(o.name)]
+        for name, ((counts, arrays, attrs, uvs), n_inst) in evaluated_meshes(targets, depsgraph).items():
+            rel = f"evaluated/{safe_name(index[name], name)}"
+            write_mesh_glb(os.path.join(out, rel), name, counts, arrays, attrs, uvs)
+            evaluated.append({"object": name, "frame": scene.frame_current + scene.frame_subframe, "file": rel,
                               "vertex_count": counts[0], "face_count": counts[2], "instances_realized": n_inst})
 
     used_images = set()
-    images = [image_entry(im, out, used_images) for im in data.images if im.source != "VIEWER" and im.type != "RENDER_RESULT"]
-
-    animation = []
-    collections = [("objects", data.objects), ("meshes", data.meshes), ("curves", data.curves), ("cameras", data.cameras),
-                   ("lights", data.lights), ("materials", data.materials), ("worlds", data.worlds),
-                   ("scenes", data.scenes), ("node_groups", data.node_groups)]
-    for coll_name, coll in collections:
-        for idb in coll:
-            e = anim_entry(idb, f"{coll_name}[{q(idb.name)}]")
-            if e:
-                animation.append(e)
-            if coll_name in ("materials", "worlds") and idb.node_tree is not None:
-                e = anim_entry(idb.node_tree, f"{coll_name}[{q(idb.name)}].node_tree")
-                if e:
-                    e["id_type"] = "NODETREE"
-                    animation.append(e)
+    images = [image_entry(im, out, used_images) for im in data.images
+              if im.source != "VIEWER" and im.type not in ("RENDER_RESULT", "COMPOSITING")]
 
     cm = {"dir": None, "config": None}
     if scene.view_settings.view_transform not in ("Standard", "Raw"):
+        # Filmic, AgX, ... need the OCIO config and LUTs of the Blender that made the file.
         src = os.path.join(bpy.utils.resource_path("LOCAL"), "datafiles", "colormanagement")
-        if os.path.isdir(src):
+        if os.path.isfile(os.path.join(src, "config.ocio")):
             shutil.copytree(src, os.path.join(out, "colormanagement"), dirs_exist_ok=True)
             cm = {"dir": "colormanagement", "config": "colormanagement/config.ocio"}
         else:
@@ -656,39 +750,62 @@ def main():
             "frame_current": scene.frame_current, "frame_step": scene.frame_step,
             "fps": scene.render.fps, "fps_base": scene.render.fps_base,
             "camera": scene.camera.name if scene.camera else None, "world": scene.world.name if scene.world else None,
-            "render": rna(scene.render, 2, "scene.render"), "cycles": rna(scene.cycles, 2, "scene.cycles") if hasattr(scene, "cycles") else {},
-            "view_settings": rna(scene.view_settings, 1, "scene.view_settings"),
-            "display_settings": rna(scene.display_settings, 1, "scene.display_settings"),
-            "unit_settings": rna(scene.unit_settings, 1, "scene.unit_settings"),
+            "render": rna_value(scene.render, 0, "scene.render"),
+            "cycles": rna_value(scene.cycles, 0, "scene.cycles") if hasattr(scene, "cycles") else {},
+            "view_settings": rna_value(scene.view_settings, 0, "scene.view_settings"),
+            "display_settings": rna_value(scene.display_settings, 0, "scene.display_settings"),
+            "unit_settings": rna_value(scene.unit_settings, 0, "scene.unit_settings"),
         },
-        "objects": [obj_entry(o) for o in data.objects],
+        "objects": [object_entry(o, view_layer) for o in data.objects],
         "meshes": meshes,
         "curves": [curve_entry(c) for c in data.curves],
         "materials": [{"name": m.name, "use_nodes": m.use_nodes, "pass_index": m.pass_index,
-                       "node_tree": node_tree(m.node_tree, f"materials[{q(m.name)}].node_tree") if m.node_tree else None,
-                       "properties": rna(m, 2, f"materials[{q(m.name)}]", skip={"node_tree", "animation_data", "grease_pencil"})}
+                       "node_tree": node_tree_entry(m.node_tree, f"materials[{q(m.name)}].node_tree") if m.node_tree else None,
+                       "properties": rna_value(m, 0, f"materials[{q(m.name)}]", skip={"node_tree", "animation_data", "grease_pencil"})}
                       for m in data.materials],
-        "worlds": [{"name": w.name, "color": plain(w.color), "use_nodes": w.use_nodes,
-                    "node_tree": node_tree(w.node_tree, f"worlds[{q(w.name)}].node_tree") if w.node_tree else None,
-                    "properties": rna(w, 2, f"worlds[{q(w.name)}]", skip={"node_tree", "animation_data"})} for w in data.worlds],
-        "node_groups": [node_tree(g, f"node_groups[{q(g.name)}]") for g in data.node_groups],
-        "cameras": [{"name": c.name, "properties": rna(c, 1, f"cameras[{q(c.name)}]", skip={"animation_data"})} for c in data.cameras],
-        "lights": [{"name": l.name, "type": l.type, "properties": rna(l, 2, f"lights[{q(l.name)}]", skip={"node_tree", "animation_data"})}
+        "worlds": [{"name": w.name, "color": vec(w.color), "use_nodes": w.use_nodes,
+                    "node_tree": node_tree_entry(w.node_tree, f"worlds[{q(w.name)}].node_tree") if w.node_tree else None,
+                    "properties": rna_value(w, 0, f"worlds[{q(w.name)}]", skip={"node_tree", "animation_data"})}
+                   for w in data.worlds],
+        "node_groups": [node_tree_entry(g, f"node_groups[{q(g.name)}]") for g in data.node_groups],
+        "cameras": [{"name": c.name, "properties": rna_value(c, 0, f"cameras[{q(c.name)}]", skip={"animation_data"})}
+                    for c in data.cameras],
+        "lights": [{"name": l.name, "type": l.type,
+                    "properties": rna_value(l, 0, f"lights[{q(l.name)}]", skip={"node_tree", "animation_data"})}
                    for l in data.lights],
         "images": images,
-        "animation": animation,
+        "animation": animation(data),
         "evaluated": evaluated,
         "color_management": cm,
-        "warnings": WARNINGS,
     }
+    nan_warnings = []
+    doc = sanitize(doc, "", nan_warnings)
+    doc["warnings"] = WARNINGS + nan_warnings
+
     tmp = os.path.join(out, "scene.json.tmp")
-    with open(tmp, "w") as f:
+    with open(tmp, "w", encoding="utf-8") as f:
         json.dump(doc, f, indent=1, allow_nan=False)
-    os.replace(tmp, os.path.join(out, "scene.json"))
-    print(f"blendsynth-export: {os.path.basename(args.input)} -> {out}: {len(doc['objects'])} objects, {len(meshes)} meshes, "
-          f"{len(doc['materials'])} materials, {len(doc['node_groups'])} node groups, {len(evaluated)} evaluated, "
-          f"{len(WARNINGS)} warnings")
+    os.replace(tmp, os.path.join(out, "scene.json"))  # readers never see a half-written file
+    print(f"blendsynth-export: {os.path.basename(args.input)} -> {out}: {len(doc['objects'])} objects, "
+          f"{len(meshes)} meshes, {len(doc['materials'])} materials, {len(doc['node_groups'])} node groups, "
+          f"{len(doc['animation'])} animated IDs, {len(evaluated)} evaluated, {len(doc['warnings'])} warnings "
+          f"in {time.time() - t0:.1f}s")
 
 
 if __name__ == "__main__":
-    main()
+    code = 0
+    try:
+        main()
+    except SystemExit as e:  # fail() and argparse
+        code = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
+    except BaseException as e:  # a clear last line and a non-zero exit, also under `blender -b --python`
+        traceback.print_exc()
+        msg = " ".join(str(e).split())
+        print(f"blendsynth-export: error: export failed: {type(e).__name__}: {msg}", file=sys.stderr)
+        code = 1
+    # Leave without interpreter shutdown: once a .blend's Python driver has been
+    # evaluated (even only to be refused), the bpy 4.5 module hangs forever in
+    # shutdown. Every output file is already closed (and scene.json renamed into place).
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code)
