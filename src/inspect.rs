@@ -6,7 +6,8 @@ use std::fmt::Write;
 
 use serde::Serialize;
 
-use crate::nodes::{support, Support};
+use crate::nodes::{support_in, Support};
+use crate::shader::compile_material;
 use crate::scene::{quote, Rna, Scene};
 
 #[derive(Debug, Serialize)]
@@ -21,6 +22,8 @@ pub struct Report {
     pub node_trees: Vec<TreeSummary>,
     pub images: Vec<ImageSummary>,
     pub coverage: Vec<CoverageRow>,
+    /// Whether each material compiles for the renderer, and if not, why.
+    pub material_status: Vec<MaterialStatus>,
     /// True when every node type used is supported or structural.
     pub all_supported: bool,
     pub warnings: Vec<String>,
@@ -101,6 +104,13 @@ pub struct ImageSummary {
     pub name: String,
     pub file: Option<String>,
     pub missing: bool,
+}
+
+#[derive(Debug, Serialize)]
+pub struct MaterialStatus {
+    pub name: String,
+    /// None when the material compiles.
+    pub error: Option<String>,
 }
 
 #[derive(Debug, Serialize)]
@@ -185,17 +195,22 @@ pub fn report(scene: &Scene) -> Report {
         }
     }
 
-    let mut coverage: BTreeMap<String, (usize, Vec<String>)> = BTreeMap::new();
+    let mut coverage: BTreeMap<String, (usize, Vec<String>, Support)> = BTreeMap::new();
     let mut node_trees = Vec::new();
     for (path, t) in scene.node_trees() {
         let nodes = t
             .nodes
             .iter()
             .map(|n| {
-                let e = coverage.entry(n.bl_idname.clone()).or_default();
+                let sup = support_in(&t.bl_idname, &n.bl_idname);
+                let e = coverage.entry(n.bl_idname.clone()).or_insert((0, Vec::new(), sup));
                 e.0 += 1;
                 if !e.1.contains(&path) {
                     e.1.push(path.clone());
+                }
+                // A type is only as supported as its least supported use.
+                if sup == Support::Unsupported {
+                    e.2 = sup;
                 }
                 NodeSummary {
                     name: n.name.clone(),
@@ -203,7 +218,7 @@ pub fn report(scene: &Scene) -> Report {
                     mute: n.mute,
                     inputs: n.inputs.len(),
                     outputs: n.outputs.len(),
-                    support: support(&n.bl_idname),
+                    support: sup,
                 }
             })
             .collect();
@@ -211,9 +226,17 @@ pub fn report(scene: &Scene) -> Report {
     }
     let coverage: Vec<CoverageRow> = coverage
         .into_iter()
-        .map(|(bl_idname, (count, used_in))| CoverageRow { support: support(&bl_idname), bl_idname, count, used_in })
+        .map(|(bl_idname, (count, used_in, support))| CoverageRow { support, bl_idname, count, used_in })
         .collect();
-    let all_supported = coverage.iter().all(|r| r.support != Support::Unsupported);
+    // Node types alone do not tell everything (an unsupported option, a Texture
+    // Coordinate output, displacement): each material must also compile.
+    let material_status: Vec<MaterialStatus> = f
+        .materials
+        .iter()
+        .filter(|m| m.node_tree.is_some())
+        .map(|m| MaterialStatus { name: m.name.clone(), error: compile_material(scene, &m.name).err().map(|e| e.to_string()) })
+        .collect();
+    let all_supported = coverage.iter().all(|r| r.support != Support::Unsupported) && material_status.iter().all(|m| m.error.is_none());
 
     Report {
         source_file: f.source_file.clone(),
@@ -226,6 +249,7 @@ pub fn report(scene: &Scene) -> Report {
         node_trees,
         images: f.images.iter().map(|i| ImageSummary { name: i.name.clone(), file: i.file.clone(), missing: i.missing }).collect(),
         coverage,
+        material_status,
         all_supported,
         warnings: f.warnings.clone(),
     }
@@ -349,6 +373,15 @@ impl Report {
                 Support::Unsupported => "NO",
             };
             writeln!(o, "  {:<40} {:>5}  {:<12} {}", r.bl_idname, r.count, sup, r.used_in.join(", "))?;
+        }
+        if !self.material_status.is_empty() {
+            writeln!(o, "\nMaterials for the renderer")?;
+            for m in &self.material_status {
+                match &m.error {
+                    None => writeln!(o, "  {:?}: compiles", m.name)?,
+                    Some(e) => writeln!(o, "  {:?}: NOT YET: {e}", m.name)?,
+                }
+            }
         }
         for w in &self.warnings {
             writeln!(o, "warning: {w}")?;

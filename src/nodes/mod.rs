@@ -102,7 +102,25 @@ const SUPPORTED: &[&str] = &[
     // blackbody.rs, wavelength.rs
     "ShaderNodeBlackbody",
     "ShaderNodeWavelength",
+    // Shader structure, proven by whole-material bakes (tests/bake.rs): closure
+    // weights and emission. The Material Output's displacement is checked per material
+    // by the compiler (inspect's "Materials for the renderer").
+    "ShaderNodeEmission",
+    "ShaderNodeMixShader",
+    "ShaderNodeAddShader",
+    "ShaderNodeOutputMaterial",
 ];
+
+/// Support for a node inside a tree of type `tree` (`ShaderNodeTree`,
+/// `GeometryNodeTree`, ...): the shared maths only counts where an evaluator for that
+/// tree type runs it. Geometry Nodes trees are not evaluated yet, so only their
+/// structure is supported there.
+pub fn support_in(tree: &str, bl_idname: &str) -> Support {
+    match support(bl_idname) {
+        Support::Supported if tree != "ShaderNodeTree" => Support::Unsupported,
+        s => s,
+    }
+}
 
 pub fn support(bl_idname: &str) -> Support {
     if STRUCTURAL.contains(&bl_idname) {

@@ -1,0 +1,40 @@
+//! `inspect` tells what blendsynth can evaluate: per node type and tree type, and per
+//! material whether it compiles (with the reason when it does not).
+
+mod common;
+use common::*;
+
+use serde_json::Value;
+
+fn report(dir: &str) -> (Option<i32>, Value) {
+    let o = run(&["inspect", "--json", repo().join(dir).to_str().unwrap()], &[]);
+    (o.status.code(), serde_json::from_slice(&o.stdout).expect("JSON report"))
+}
+
+fn row<'a>(r: &'a Value, kind: &str) -> &'a Value {
+    r["coverage"].as_array().unwrap().iter().find(|c| c["bl_idname"] == kind).unwrap_or_else(|| panic!("{kind} not in coverage"))
+}
+
+#[test]
+fn shared_maths_counts_only_where_an_evaluator_runs_it() {
+    // Math and Combine XYZ are proven for shaders, but this file uses them in a
+    // Geometry Nodes tree, which blendsynth does not evaluate yet.
+    let (code, r) = report("fixtures/scenes/geonodes");
+    assert_eq!(code, Some(3));
+    assert_eq!(row(&r, "ShaderNodeMath")["support"], "unsupported");
+    assert_eq!(row(&r, "ShaderNodeCombineXYZ")["support"], "unsupported");
+    let (_, r) = report("fixtures/bake/scenes/uv_math");
+    assert_eq!(row(&r, "ShaderNodeMath")["support"], "supported");
+}
+
+#[test]
+fn materials_report_whether_they_compile() {
+    let (_, r) = report("fixtures/bake/scenes/structure");
+    let m = &r["material_status"][0];
+    assert_eq!(m["name"], "Structure");
+    assert!(m["error"].is_null(), "{m}");
+    let (code, r) = report("fixtures/scenes/material_zoo");
+    assert_eq!(code, Some(3));
+    let e = r["material_status"][0]["error"].as_str().expect("the zoo uses unsupported nodes");
+    assert!(e.contains("is not supported yet"), "{e}");
+}
