@@ -7,6 +7,7 @@
 
 pub mod anim;
 pub mod blender;
+pub mod geometry;
 pub mod inspect;
 pub mod nodes;
 pub mod scene;

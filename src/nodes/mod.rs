@@ -42,6 +42,8 @@ pub mod graph;
 pub mod map_range;
 pub mod math;
 pub mod mix;
+pub mod noise;
+pub mod random;
 pub mod ramp;
 pub mod sepcomb;
 pub mod wavelength;

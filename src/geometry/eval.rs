@@ -1,0 +1,405 @@
+//! The Geometry Nodes evaluator: an object's modifier stack, each NODES modifier's tree
+//! flattened (`nodes::graph::flatten`: groups inlined, reroutes and frames dropped, muted
+//! nodes passed through) and evaluated on demand from its Group Output, each node once.
+//!
+//! Inputs are evaluated lazily, so a Switch only evaluates the branch it takes (an
+//! unsupported node in the other branch is no error, as in Blender).
+
+use std::cell::RefCell;
+use std::collections::{HashMap, HashSet};
+use std::rc::Rc;
+
+use serde_json::Value as Json;
+
+use super::error::GeometryError;
+use super::field::{AttributeInput, Field, IdInput, IndexInput, PositionInput};
+use super::math::Mat4f;
+use super::mesh::Mesh;
+use super::set::GeometrySet;
+use super::types::{DataType, Domain, Value};
+use super::value::SocketValue;
+use crate::nodes::graph::{active_output, flatten, FlatGraph, FlatNode, Source};
+use crate::scene::{quote, Modifier, Node, NodeTree, Object, Scene};
+
+/// A node's results, by output socket identifier.
+pub type Outputs = HashMap<String, SocketValue>;
+
+/// Everything shared while evaluating objects of one scene at one frame.
+pub struct Session<'s> {
+    pub scene: &'s Scene,
+    pub frame: f64,
+    /// World matrices at `frame`, in `scene.file.objects` order.
+    pub world: Vec<Mat4f>,
+    /// Per node group: each link's `multi_input_sort_id` (0 when the export has none).
+    pub sort_ids: HashMap<String, Vec<i64>>,
+    cache: RefCell<HashMap<String, GeometrySet>>,
+    in_progress: RefCell<Vec<String>>,
+}
+
+impl<'s> Session<'s> {
+    pub fn new(scene: &'s Scene, frame: f64, world: Vec<Mat4f>, sort_ids: HashMap<String, Vec<i64>>) -> Self {
+        Session { scene, frame, world, sort_ids, cache: RefCell::new(HashMap::new()), in_progress: RefCell::new(Vec::new()) }
+    }
+
+    pub fn world_matrix(&self, object: &str) -> Option<Mat4f> {
+        let i = self.scene.file.objects.iter().position(|o| o.name == object)?;
+        self.world.get(i).copied()
+    }
+
+    /// The object's original geometry (its data, before modifiers).
+    pub fn original_geometry(&self, o: &Object) -> Result<GeometrySet, GeometryError> {
+        let here = format!("objects[{}]", quote(&o.name));
+        match o.kind.as_str() {
+            "MESH" => {
+                let data = o.data.as_deref().ok_or_else(|| GeometryError::new(format!("{here}: mesh object without mesh data")))?;
+                let index = self
+                    .scene
+                    .file
+                    .meshes
+                    .iter()
+                    .position(|m| m.name == data)
+                    .ok_or_else(|| GeometryError::new(format!("{here}: mesh {data:?} is not in the export")))?;
+                let md = self.scene.load_mesh(index)?;
+                Ok(GeometrySet::from_mesh(Mesh::from_scene(&md, &self.scene.file.meshes[index].materials)))
+            }
+            "EMPTY" | "CAMERA" | "LIGHT" | "LIGHT_PROBE" | "SPEAKER" => Ok(GeometrySet::default()),
+            other => Err(GeometryError::new(format!("{here}: {other} objects cannot be evaluated as geometry yet"))),
+        }
+    }
+
+    /// The object's evaluated geometry: original data through its modifier stack.
+    pub fn evaluate_object(&self, name: &str) -> Result<GeometrySet, GeometryError> {
+        if let Some(g) = self.cache.borrow().get(name) {
+            return Ok(g.clone());
+        }
+        if self.in_progress.borrow().iter().any(|n| n == name) {
+            return Err(GeometryError::new(format!("objects[{}]: depends on its own geometry (dependency cycle)", quote(name))));
+        }
+        let o = self.scene.object(name).ok_or_else(|| GeometryError::new(format!("no object named {name:?} in the export")))?;
+        self.in_progress.borrow_mut().push(name.to_string());
+        let result = self.evaluate_stack(o);
+        self.in_progress.borrow_mut().pop();
+        let g = result?;
+        self.cache.borrow_mut().insert(name.to_string(), g.clone());
+        Ok(g)
+    }
+
+    fn evaluate_stack(&self, o: &Object) -> Result<GeometrySet, GeometryError> {
+        let mut g = self.original_geometry(o)?;
+        for m in &o.modifiers {
+            if !m.show_render {
+                continue;
+            }
+            let here = format!("objects[{}].modifiers[{}]", quote(&o.name), quote(&m.name));
+            if m.kind != "NODES" {
+                return Err(GeometryError::new(format!("{here}: {} modifiers are not supported (only Geometry Nodes)", m.kind)));
+            }
+            g = self.evaluate_modifier(o, m, g).map_err(|e| e.within(&here))?;
+        }
+        Ok(g)
+    }
+
+    fn evaluate_modifier(&self, o: &Object, m: &Modifier, input: GeometrySet) -> Result<GeometrySet, GeometryError> {
+        let Some(group) = m.node_group.as_deref() else {
+            return Ok(input);
+        };
+        let tree = self.scene.node_group(group).ok_or_else(|| GeometryError::new(format!("node group {group:?} is not in the export")))?;
+        let out_node = active_output(tree, "NodeGroupOutput", "")
+            .ok_or_else(|| GeometryError::new(format!("node tree {:?} has no Group Output node", tree.name)))?;
+        let graph = flatten(tree, &self.scene.file.node_groups, &out_node.name).map_err(|e| GeometryError::new(e.0))?;
+        let mut inputs: HashMap<String, SocketValue> = HashMap::new();
+        let mut geometry_given = false;
+        for item in tree.interface.iter().filter(|i| i.item_type == "SOCKET" && i.in_out.as_deref() == Some("INPUT")) {
+            let Some(id) = item.identifier.as_deref() else { continue };
+            let kind = SocketValue::interface_kind(item.socket_type.as_deref().unwrap_or(""));
+            let v = if kind == "GEOMETRY" {
+                // Only the first geometry input receives the object's geometry.
+                let v = if geometry_given { GeometrySet::default() } else { input.clone() };
+                geometry_given = true;
+                SocketValue::Geometry(v)
+            } else if m.inputs.get(&format!("{id}_use_attribute")).is_some_and(|u| u.as_bool() == Some(true) || u.as_i64() == Some(1)) {
+                let name = m.inputs.get(&format!("{id}_attribute_name")).and_then(Json::as_str).unwrap_or_default();
+                let ty = DataType::from_socket(kind).unwrap_or(DataType::Float);
+                SocketValue::Field(Field::input(AttributeInput { id: super::attribute::AttrId::named(name), ty }))
+            } else if let Some(v) = m.inputs.get(id) {
+                SocketValue::from_json(kind, v).map_err(|e| GeometryError::new(format!("input {:?}: {e}", item.name)))?
+            } else if let Some(v) = &item.default_value {
+                SocketValue::from_json(kind, v).map_err(|e| GeometryError::new(format!("input {:?}: {e}", item.name)))?
+            } else {
+                SocketValue::zero(kind)
+            };
+            inputs.insert(id.to_string(), v);
+        }
+        let ev = Evaluator { session: self, tree, graph, group_inputs: inputs, object: o, memo: RefCell::new(HashMap::new()), busy: RefCell::new(HashSet::new()) };
+        let root = &ev.graph.nodes[ev.graph.root];
+        let ctx = NodeCtx { ev: &ev, idx: ev.graph.root };
+        let mut result = None;
+        let mut outputs: Vec<(String, SocketValue)> = Vec::new();
+        for inp in &root.inputs {
+            if inp.socket.kind == "CUSTOM" {
+                continue;
+            }
+            let v = ctx.input(&inp.socket.identifier)?;
+            if inp.socket.kind == "GEOMETRY" {
+                if result.is_none() {
+                    if let SocketValue::Geometry(g) = v {
+                        result = Some(g);
+                    }
+                }
+            } else {
+                outputs.push((inp.socket.identifier.clone(), v));
+            }
+        }
+        let mut g = result.unwrap_or_default();
+        // Field outputs become named attributes when the modifier names one.
+        for (id, v) in outputs {
+            let name = m.inputs.get(&format!("{id}_attribute_name")).and_then(Json::as_str).unwrap_or_default();
+            if name.is_empty() {
+                continue;
+            }
+            let SocketValue::Field(f) = v else { continue };
+            let item = tree.interface.iter().find(|i| i.identifier.as_deref() == Some(&id));
+            let domain = item
+                .and_then(|i| i.properties.get("attribute_domain"))
+                .and_then(Json::as_str)
+                .and_then(Domain::parse)
+                .unwrap_or(Domain::Point);
+            super::nodes::attribute::store(&mut g, &super::attribute::AttrId::named(name), domain, &f, &Field::Constant(Value::Bool(true)), None)
+                .map_err(|e| GeometryError::new(format!("output attribute {name:?}: {e}")))?;
+        }
+        Ok(g)
+    }
+}
+
+/// Evaluates one flattened tree.
+pub struct Evaluator<'a> {
+    pub session: &'a Session<'a>,
+    pub tree: &'a NodeTree,
+    pub graph: FlatGraph<'a>,
+    pub group_inputs: HashMap<String, SocketValue>,
+    /// The object whose modifier this is (Self Object, relative transforms).
+    pub object: &'a Object,
+    memo: RefCell<HashMap<usize, Rc<Outputs>>>,
+    busy: RefCell<HashSet<usize>>,
+}
+
+impl<'a> Evaluator<'a> {
+    fn node_outputs(&self, idx: usize) -> Result<Rc<Outputs>, GeometryError> {
+        if let Some(o) = self.memo.borrow().get(&idx) {
+            return Ok(o.clone());
+        }
+        if !self.busy.borrow_mut().insert(idx) {
+            return Err(GeometryError::new("cycle in the node graph"));
+        }
+        let ctx = NodeCtx { ev: self, idx };
+        let r = super::nodes::evaluate(&ctx);
+        self.busy.borrow_mut().remove(&idx);
+        let out = Rc::new(r?);
+        self.memo.borrow_mut().insert(idx, out.clone());
+        Ok(out)
+    }
+
+    /// The node tree whose node list holds `node` (to find its links).
+    fn tree_of(&self, node: &Node) -> Option<&'a NodeTree> {
+        self.session.scene.file.node_groups.iter().find(|t| t.nodes.iter().any(|n| std::ptr::eq(n, node)))
+    }
+}
+
+/// What a node implementation sees: its inputs (evaluated on demand) and settings.
+pub struct NodeCtx<'e, 'a> {
+    pub ev: &'e Evaluator<'a>,
+    pub idx: usize,
+}
+
+/// Node inputs that, unlinked, are a field rather than their socket value
+/// (`implicit_field` in Blender's node declarations).
+fn implicit_field(bl_idname: &str, identifier: &str) -> Option<Field> {
+    match (bl_idname, identifier) {
+        ("GeometryNodeSetPosition", "Position")
+        | ("GeometryNodeSampleNearest", "Sample Position")
+        | ("GeometryNodeSampleNearestSurface", "Sample Position")
+        | ("GeometryNodeProximity", "Source Position")
+        | ("GeometryNodeRaycast", "Source Position")
+        | ("GeometryNodeMeshToPoints", "Position") => Some(Field::input(PositionInput)),
+        // Texture nodes in Geometry Nodes read the position when their vector is unlinked.
+        ("ShaderNodeTexNoise" | "ShaderNodeTexVoronoi" | "ShaderNodeTexWave" | "ShaderNodeTexGradient" | "ShaderNodeTexMagic"
+        | "ShaderNodeTexChecker" | "ShaderNodeTexBrick" | "ShaderNodeTexWhiteNoise" | "ShaderNodeTexMusgrave", "Vector") => {
+            Some(Field::input(PositionInput))
+        }
+        ("FunctionNodeRandomValue", "ID") => Some(Field::input(IdInput)),
+        ("GeometryNodeExtrudeMesh", "Offset") => Some(Field::input(super::field::NormalInput)),
+        ("GeometryNodeSampleIndex", "Index") | ("GeometryNodeFieldAtIndex", "Index") => Some(Field::input(IndexInput)),
+        _ => None,
+    }
+}
+
+impl<'e, 'a> NodeCtx<'e, 'a> {
+    pub fn flat(&self) -> &'e FlatNode<'a> {
+        &self.ev.graph.nodes[self.idx]
+    }
+    pub fn node(&self) -> &'a Node {
+        self.ev.graph.nodes[self.idx].node
+    }
+    pub fn session(&self) -> &'e Session<'a> {
+        self.ev.session
+    }
+    /// An error naming the tree and node.
+    pub fn err(&self, msg: impl std::fmt::Display) -> GeometryError {
+        GeometryError::new(format!("node tree {:?}, node {:?} ({}): {msg}", self.ev.tree.name, self.flat().path, self.node().bl_idname))
+    }
+
+    pub fn prop(&self, key: &str) -> Option<&'a Json> {
+        self.node().properties.get(key)
+    }
+    pub fn prop_str(&self, key: &str) -> Result<&'a str, GeometryError> {
+        self.prop(key).and_then(Json::as_str).ok_or_else(|| self.err(format!("property {key:?} missing")))
+    }
+    pub fn prop_bool(&self, key: &str) -> Result<bool, GeometryError> {
+        self.prop(key).and_then(|v| v.as_bool().or_else(|| v.as_i64().map(|i| i != 0))).ok_or_else(|| self.err(format!("property {key:?} missing")))
+    }
+
+    /// Whether input `id` is available in the node's current mode.
+    pub fn has_input(&self, id: &str) -> bool {
+        self.flat().input(id).is_some()
+    }
+    /// Whether output `id` is linked to anything.
+    pub fn output_used(&self, id: &str) -> bool {
+        self.node().outputs.iter().any(|s| s.identifier == id && s.is_linked)
+    }
+
+    fn source_value(&self, src: &Source<'a>, consumer_kind: &str) -> Result<SocketValue, GeometryError> {
+        let v = match src {
+            Source::Link { node, output, .. } => {
+                let outs = self.ev.node_outputs(*node)?;
+                let from = &self.ev.graph.nodes[*node];
+                let id = &from.node.outputs[*output].identifier;
+                match outs.get(id) {
+                    Some(v) => v.clone(),
+                    None => {
+                        return Err(GeometryError::new(format!(
+                            "node tree {:?}, node {:?}: output {id:?} is not evaluated",
+                            self.ev.tree.name, from.path
+                        )))
+                    }
+                }
+            }
+            Source::Default(s) => {
+                let Some(dv) = &s.default_value else { return Ok(SocketValue::zero(&s.kind)) };
+                SocketValue::from_json(&s.kind, dv).map_err(|e| self.err(e))?
+            }
+            Source::GroupInput(id) => self.ev.group_inputs.get(*id).cloned().unwrap_or_else(|| SocketValue::zero(consumer_kind)),
+            Source::Nothing => SocketValue::zero(consumer_kind),
+        };
+        Ok(coerce(v, consumer_kind))
+    }
+
+    fn flat_input(&self, id: &str) -> Result<&'e crate::nodes::graph::FlatInput<'a>, GeometryError> {
+        self.flat().input(id).ok_or_else(|| self.err(format!("input {id:?} is not available")))
+    }
+
+    /// The value of input `id` (the first link of a multi-input).
+    pub fn input(&self, id: &str) -> Result<SocketValue, GeometryError> {
+        let inp = self.flat_input(id)?;
+        let unlinked = inp.sources.iter().all(|s| matches!(s, Source::Default(_) | Source::Nothing));
+        if unlinked {
+            if let Some(f) = implicit_field(&self.node().bl_idname, id) {
+                return Ok(SocketValue::Field(f));
+            }
+        }
+        match inp.sources.first() {
+            Some(s) => self.source_value(s, &inp.socket.kind),
+            None => Ok(SocketValue::zero(&inp.socket.kind)),
+        }
+    }
+
+    /// All values linked into multi-input `id`, in Blender's order (descending
+    /// `multi_input_sort_id`: top to bottom in the editor).
+    pub fn inputs_multi(&self, id: &str) -> Result<Vec<SocketValue>, GeometryError> {
+        let inp = self.flat_input(id)?;
+        let node = self.node();
+        let mut order: Vec<usize> = (0..inp.sources.len()).collect();
+        if inp.sources.len() > 1 {
+            if let Some(tree) = self.ev.tree_of(node) {
+                let ids = self.ev.session.sort_ids.get(&tree.name);
+                let keys: Vec<i64> = tree
+                    .links
+                    .iter()
+                    .enumerate()
+                    .filter(|(_, l)| l.to_node == node.name && l.to_socket == id && !l.is_muted && l.is_valid)
+                    .map(|(i, _)| ids.and_then(|v| v.get(i)).copied().unwrap_or(0))
+                    .collect();
+                if keys.len() == inp.sources.len() {
+                    order.sort_by_key(|&k| std::cmp::Reverse(keys[k]));
+                }
+            }
+        }
+        let mut out = Vec::new();
+        for k in order {
+            let s = &inp.sources[k];
+            if matches!(s, Source::Default(_) | Source::Nothing) && inp.socket.kind == "GEOMETRY" {
+                continue;
+            }
+            out.push(self.source_value(s, &inp.socket.kind)?);
+        }
+        Ok(out)
+    }
+
+    pub fn field(&self, id: &str, ty: DataType) -> Result<Field, GeometryError> {
+        match self.input(id)? {
+            SocketValue::Field(f) => Ok(f.convert(ty)),
+            other => Err(self.err(format!("input {id:?} is a {}, expected a value or field", other.kind()))),
+        }
+    }
+    /// A single value: an input fed by a field that depends on geometry is an error.
+    pub fn single(&self, id: &str, ty: DataType) -> Result<Value, GeometryError> {
+        match self.field(id, ty)? {
+            Field::Constant(v) => Ok(v),
+            _ => Err(self.err(format!("input {id:?} takes a single value but a field is connected"))),
+        }
+    }
+    pub fn float(&self, id: &str) -> Result<f32, GeometryError> {
+        Ok(self.single(id, DataType::Float)?.as_float())
+    }
+    pub fn int(&self, id: &str) -> Result<i32, GeometryError> {
+        Ok(self.single(id, DataType::Int)?.as_int())
+    }
+    pub fn bool(&self, id: &str) -> Result<bool, GeometryError> {
+        Ok(self.single(id, DataType::Bool)?.as_bool())
+    }
+    pub fn vector(&self, id: &str) -> Result<[f32; 3], GeometryError> {
+        Ok(self.single(id, DataType::Vector)?.as_vector())
+    }
+    pub fn geometry(&self, id: &str) -> Result<GeometrySet, GeometryError> {
+        match self.input(id)? {
+            SocketValue::Geometry(g) => Ok(g),
+            SocketValue::None => Ok(GeometrySet::default()),
+            other => Err(self.err(format!("input {id:?} is a {}, expected geometry", other.kind()))),
+        }
+    }
+    pub fn string(&self, id: &str) -> Result<String, GeometryError> {
+        match self.input(id)? {
+            SocketValue::String(s) | SocketValue::Menu(s) => Ok(s),
+            other => Err(self.err(format!("input {id:?} is a {}, expected a string", other.kind()))),
+        }
+    }
+}
+
+/// Converts a value to what a socket of type `kind` takes (Blender's implicit
+/// conversions between field types; anything else unchanged).
+fn coerce(v: SocketValue, kind: &str) -> SocketValue {
+    match (v, DataType::from_socket(kind)) {
+        (SocketValue::Field(f), Some(t)) => {
+            if Value::can_convert(f.data_type(), t) {
+                SocketValue::Field(f.convert(t))
+            } else {
+                SocketValue::Field(Field::Constant(Value::zero(t)))
+            }
+        }
+        (v, _) => v,
+    }
+}
+
+/// Builds an `Outputs` map.
+pub fn outputs<const N: usize>(items: [(&str, SocketValue); N]) -> Outputs {
+    items.into_iter().map(|(k, v)| (k.to_string(), v)).collect()
+}

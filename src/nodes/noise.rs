@@ -1,0 +1,451 @@
+//! Perlin noise and the Noise Texture node, as Blender's CPU implementation
+//! (`blenlib/intern/noise.cc`, used by Geometry Nodes and by the texture nodes evaluated on
+//! the CPU) computes it: Improved Perlin noise over the lookup3 hash, fractal variants
+//! (fBM, multifractal, hybrid / ridged multifractal, hetero terrain), seeded offsets and
+//! domain distortion.
+//!
+//! Precision follows the C++ exactly where it matters: `fade` and the bilinear blend are
+//! evaluated in double (their literals are doubles), everything else in single precision.
+//! Cycles' SVM kernel computes the same functions but `fade` in single precision (and with
+//! SSE/AVX variants), so its values may differ from these in the last bit.
+
+use super::random::{hash1, hash2, hash3, hash4, hash_float_to_float1, hash_float_to_float2};
+
+#[inline]
+fn fade(t: f32) -> f32 {
+    ((t * t * t) as f64 * (t as f64 * (t as f64 * 6.0 - 15.0) + 10.0)) as f32
+}
+
+#[inline]
+fn negate_if(v: f32, cond: u32) -> f32 {
+    if cond != 0 {
+        -v
+    } else {
+        v
+    }
+}
+
+#[inline]
+fn grad1(hash: u32, x: f32) -> f32 {
+    let h = hash & 15;
+    let g = (1 + (h & 7)) as f32;
+    negate_if(g, h & 8) * x
+}
+
+#[inline]
+fn grad2(hash: u32, x: f32, y: f32) -> f32 {
+    let h = hash & 7;
+    let u = if h < 4 { x } else { y };
+    let v = 2.0 * if h < 4 { y } else { x };
+    negate_if(u, h & 1) + negate_if(v, h & 2)
+}
+
+#[inline]
+fn grad3(hash: u32, x: f32, y: f32, z: f32) -> f32 {
+    let h = hash & 15;
+    let u = if h < 8 { x } else { y };
+    let vt = if h == 12 || h == 14 { x } else { z };
+    let v = if h < 4 { y } else { vt };
+    negate_if(u, h & 1) + negate_if(v, h & 2)
+}
+
+#[inline]
+fn grad4(hash: u32, x: f32, y: f32, z: f32, w: f32) -> f32 {
+    let h = hash & 31;
+    let u = if h < 24 { x } else { y };
+    let v = if h < 16 { y } else { z };
+    let s = if h < 8 { z } else { w };
+    negate_if(u, h & 1) + negate_if(v, h & 2) + negate_if(s, h & 4)
+}
+
+#[inline]
+fn lerp(v0: f32, v1: f32, x: f32) -> f32 {
+    (1.0 - x) * v0 + x * v1
+}
+
+#[inline]
+fn bi_mix(v0: f32, v1: f32, v2: f32, v3: f32, x: f32, y: f32) -> f32 {
+    let x1 = (1.0 - x as f64) as f32;
+    ((1.0 - y as f64) * (v0 * x1 + v1 * x) as f64 + (y * (v2 * x1 + v3 * x)) as f64) as f32
+}
+
+#[allow(clippy::too_many_arguments)]
+#[inline]
+fn tri_mix(v: [f32; 8], x: f32, y: f32, z: f32) -> f32 {
+    let x1 = (1.0 - x as f64) as f32;
+    let y1 = (1.0 - y as f64) as f32;
+    let z1 = (1.0 - z as f64) as f32;
+    z1 * (y1 * (v[0] * x1 + v[1] * x) + y * (v[2] * x1 + v[3] * x)) + z * (y1 * (v[4] * x1 + v[5] * x) + y * (v[6] * x1 + v[7] * x))
+}
+
+#[inline]
+fn floor_fraction(x: f32) -> (i32, f32) {
+    let f = x.floor();
+    (f as i32, x - f)
+}
+
+fn perlin_noise1(p: f32) -> f32 {
+    let (x, fx) = floor_fraction(p);
+    let u = fade(fx);
+    lerp(grad1(hash1(x as u32), fx), grad1(hash1(x.wrapping_add(1) as u32), fx - 1.0), u)
+}
+
+fn perlin_noise2(p: [f32; 2]) -> f32 {
+    let (x, fx) = floor_fraction(p[0]);
+    let (y, fy) = floor_fraction(p[1]);
+    let (u, v) = (fade(fx), fade(fy));
+    let h = |dx: i32, dy: i32| hash2(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32);
+    bi_mix(
+        grad2(h(0, 0), fx, fy),
+        grad2(h(1, 0), fx - 1.0, fy),
+        grad2(h(0, 1), fx, fy - 1.0),
+        grad2(h(1, 1), fx - 1.0, fy - 1.0),
+        u,
+        v,
+    )
+}
+
+fn perlin_noise3(p: [f32; 3]) -> f32 {
+    let (x, fx) = floor_fraction(p[0]);
+    let (y, fy) = floor_fraction(p[1]);
+    let (z, fz) = floor_fraction(p[2]);
+    let (u, v, w) = (fade(fx), fade(fy), fade(fz));
+    let g = |dx: i32, dy: i32, dz: i32| {
+        grad3(
+            hash3(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32, z.wrapping_add(dz) as u32),
+            fx - dx as f32,
+            fy - dy as f32,
+            fz - dz as f32,
+        )
+    };
+    tri_mix([g(0, 0, 0), g(1, 0, 0), g(0, 1, 0), g(1, 1, 0), g(0, 0, 1), g(1, 0, 1), g(0, 1, 1), g(1, 1, 1)], u, v, w)
+}
+
+fn perlin_noise4(p: [f32; 4]) -> f32 {
+    let (x, fx) = floor_fraction(p[0]);
+    let (y, fy) = floor_fraction(p[1]);
+    let (z, fz) = floor_fraction(p[2]);
+    let (w, fw) = floor_fraction(p[3]);
+    let (u, v, t, s) = (fade(fx), fade(fy), fade(fz), fade(fw));
+    let g = |dx: i32, dy: i32, dz: i32, dw: i32| {
+        grad4(
+            hash4(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32, z.wrapping_add(dz) as u32, w.wrapping_add(dw) as u32),
+            fx - dx as f32,
+            fy - dy as f32,
+            fz - dz as f32,
+            fw - dw as f32,
+        )
+    };
+    let a = tri_mix([g(0, 0, 0, 0), g(1, 0, 0, 0), g(0, 1, 0, 0), g(1, 1, 0, 0), g(0, 0, 1, 0), g(1, 0, 1, 0), g(0, 1, 1, 0), g(1, 1, 1, 0)], u, v, t);
+    let b = tri_mix([g(0, 0, 0, 1), g(1, 0, 0, 1), g(0, 1, 0, 1), g(1, 1, 0, 1), g(0, 0, 1, 1), g(1, 0, 1, 1), g(0, 1, 1, 1), g(1, 1, 1, 1)], u, v, t);
+    lerp(a, b, s)
+}
+
+/// A point of 1 to 4 dimensions, so the fractal functions are written once.
+pub trait NoisePoint: Copy {
+    fn perlin_signed(self) -> f32;
+    fn scaled(self, s: f32) -> Self;
+    fn plus(self, o: Self) -> Self;
+    /// `random_floatN_offset(seed)`.
+    fn offset(seed: f32) -> Self;
+    /// `perlin_distortion(p, strength)`.
+    fn distortion(self, strength: f32) -> Self;
+}
+
+fn correction(v: f32) -> f32 {
+    0.5 * (v.abs() >= 1_000_000.0) as u8 as f32
+}
+
+impl NoisePoint for f32 {
+    fn perlin_signed(self) -> f32 {
+        let p = self % 100000.0 + correction(self);
+        perlin_noise1(p) * 0.25
+    }
+    fn scaled(self, s: f32) -> Self {
+        s * self
+    }
+    fn plus(self, o: Self) -> Self {
+        self + o
+    }
+    fn offset(seed: f32) -> Self {
+        100.0 + hash_float_to_float1(seed) * 100.0
+    }
+    fn distortion(self, strength: f32) -> Self {
+        (self + Self::offset(0.0)).perlin_signed() * strength
+    }
+}
+
+fn offset_component(seed: f32, k: f32) -> f32 {
+    100.0 + hash_float_to_float2([seed, k]) * 100.0
+}
+
+impl NoisePoint for [f32; 2] {
+    fn perlin_signed(self) -> f32 {
+        let p = [self[0] % 100000.0 + correction(self[0]), self[1] % 100000.0 + correction(self[1])];
+        perlin_noise2(p) * 0.6616
+    }
+    fn scaled(self, s: f32) -> Self {
+        [s * self[0], s * self[1]]
+    }
+    fn plus(self, o: Self) -> Self {
+        [self[0] + o[0], self[1] + o[1]]
+    }
+    fn offset(seed: f32) -> Self {
+        [offset_component(seed, 0.0), offset_component(seed, 1.0)]
+    }
+    fn distortion(self, strength: f32) -> Self {
+        [self.plus(Self::offset(0.0)).perlin_signed() * strength, self.plus(Self::offset(1.0)).perlin_signed() * strength]
+    }
+}
+
+impl NoisePoint for [f32; 3] {
+    fn perlin_signed(self) -> f32 {
+        let p = [
+            self[0] % 100000.0 + correction(self[0]),
+            self[1] % 100000.0 + correction(self[1]),
+            self[2] % 100000.0 + correction(self[2]),
+        ];
+        perlin_noise3(p) * 0.9820
+    }
+    fn scaled(self, s: f32) -> Self {
+        [s * self[0], s * self[1], s * self[2]]
+    }
+    fn plus(self, o: Self) -> Self {
+        [self[0] + o[0], self[1] + o[1], self[2] + o[2]]
+    }
+    fn offset(seed: f32) -> Self {
+        [offset_component(seed, 0.0), offset_component(seed, 1.0), offset_component(seed, 2.0)]
+    }
+    fn distortion(self, strength: f32) -> Self {
+        [
+            self.plus(Self::offset(0.0)).perlin_signed() * strength,
+            self.plus(Self::offset(1.0)).perlin_signed() * strength,
+            self.plus(Self::offset(2.0)).perlin_signed() * strength,
+        ]
+    }
+}
+
+impl NoisePoint for [f32; 4] {
+    fn perlin_signed(self) -> f32 {
+        let mut p = [0.0; 4];
+        for i in 0..4 {
+            p[i] = self[i] % 100000.0 + correction(self[i]);
+        }
+        perlin_noise4(p) * 0.8344
+    }
+    fn scaled(self, s: f32) -> Self {
+        [s * self[0], s * self[1], s * self[2], s * self[3]]
+    }
+    fn plus(self, o: Self) -> Self {
+        [self[0] + o[0], self[1] + o[1], self[2] + o[2], self[3] + o[3]]
+    }
+    fn offset(seed: f32) -> Self {
+        [offset_component(seed, 0.0), offset_component(seed, 1.0), offset_component(seed, 2.0), offset_component(seed, 3.0)]
+    }
+    fn distortion(self, strength: f32) -> Self {
+        [
+            self.plus(Self::offset(0.0)).perlin_signed() * strength,
+            self.plus(Self::offset(1.0)).perlin_signed() * strength,
+            self.plus(Self::offset(2.0)).perlin_signed() * strength,
+            self.plus(Self::offset(3.0)).perlin_signed() * strength,
+        ]
+    }
+}
+
+/// Perlin noise in [0, 1].
+pub fn perlin<P: NoisePoint>(p: P) -> f32 {
+    p.perlin_signed() / 2.0 + 0.5
+}
+
+pub fn fbm<P: NoisePoint>(p: P, detail: f32, roughness: f32, lacunarity: f32, normalize: bool) -> f32 {
+    let mut fscale = 1.0f32;
+    let mut amp = 1.0f32;
+    let mut maxamp = 0.0f32;
+    let mut sum = 0.0f32;
+    for _ in 0..=(detail as i32) {
+        let t = p.scaled(fscale).perlin_signed();
+        sum += t * amp;
+        maxamp += amp;
+        amp *= roughness;
+        fscale *= lacunarity;
+    }
+    let rmd = detail - detail.floor();
+    if rmd != 0.0 {
+        let t = p.scaled(fscale).perlin_signed();
+        let sum2 = sum + t * amp;
+        return if normalize {
+            lerp(0.5 * sum / maxamp + 0.5, 0.5 * sum2 / (maxamp + amp) + 0.5, rmd)
+        } else {
+            lerp(sum, sum2, rmd)
+        };
+    }
+    if normalize {
+        0.5 * sum / maxamp + 0.5
+    } else {
+        sum
+    }
+}
+
+pub fn multi_fractal<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacunarity: f32) -> f32 {
+    let mut value = 1.0f32;
+    let mut pwr = 1.0f32;
+    for _ in 0..=(detail as i32) {
+        value *= pwr * p.perlin_signed() + 1.0;
+        pwr *= roughness;
+        p = p.scaled(lacunarity);
+    }
+    let rmd = detail - detail.floor();
+    if rmd != 0.0 {
+        value *= rmd * pwr * p.perlin_signed() + 1.0;
+    }
+    value
+}
+
+pub fn hetero_terrain<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacunarity: f32, offset: f32) -> f32 {
+    let mut pwr = roughness;
+    let mut value = offset + p.perlin_signed();
+    p = p.scaled(lacunarity);
+    for _ in 1..=(detail as i32) {
+        let increment = (p.perlin_signed() + offset) * pwr * value;
+        value += increment;
+        pwr *= roughness;
+        p = p.scaled(lacunarity);
+    }
+    let rmd = detail - detail.floor();
+    if rmd != 0.0 {
+        let increment = (p.perlin_signed() + offset) * pwr * value;
+        value += rmd * increment;
+    }
+    value
+}
+
+pub fn hybrid_multi_fractal<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacunarity: f32, offset: f32, gain: f32) -> f32 {
+    let mut pwr = 1.0f32;
+    let mut value = 0.0f32;
+    let mut weight = 1.0f32;
+    let mut i = 0;
+    while weight > 0.001 && i <= detail as i32 {
+        if weight > 1.0 {
+            weight = 1.0;
+        }
+        let signal = (p.perlin_signed() + offset) * pwr;
+        pwr *= roughness;
+        value += weight * signal;
+        weight *= gain * signal;
+        p = p.scaled(lacunarity);
+        i += 1;
+    }
+    let rmd = detail - detail.floor();
+    if rmd != 0.0 && weight > 0.001 {
+        if weight > 1.0 {
+            weight = 1.0;
+        }
+        let signal = (p.perlin_signed() + offset) * pwr;
+        value += rmd * weight * signal;
+    }
+    value
+}
+
+pub fn ridged_multi_fractal<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacunarity: f32, offset: f32, gain: f32) -> f32 {
+    let mut pwr = roughness;
+    let mut signal = offset - p.perlin_signed().abs();
+    signal *= signal;
+    let mut value = signal;
+    for _ in 1..=(detail as i32) {
+        p = p.scaled(lacunarity);
+        let weight = (signal * gain).clamp(0.0, 1.0);
+        signal = offset - p.perlin_signed().abs();
+        signal *= signal;
+        signal *= weight;
+        value += signal * pwr;
+        pwr *= roughness;
+    }
+    value
+}
+
+/// The Noise Texture's `noise_type`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NoiseType {
+    MultiFractal,
+    Fbm,
+    HybridMultiFractal,
+    RidgedMultiFractal,
+    HeteroTerrain,
+}
+
+impl NoiseType {
+    pub fn from_blender(s: &str) -> Option<NoiseType> {
+        Some(match s {
+            "MULTIFRACTAL" => NoiseType::MultiFractal,
+            "FBM" => NoiseType::Fbm,
+            "HYBRID_MULTIFRACTAL" => NoiseType::HybridMultiFractal,
+            "RIDGED_MULTIFRACTAL" => NoiseType::RidgedMultiFractal,
+            "HETERO_TERRAIN" => NoiseType::HeteroTerrain,
+            _ => return None,
+        })
+    }
+}
+
+/// Noise settings after the node's clamping.
+#[derive(Debug, Clone, Copy)]
+pub struct NoiseParams {
+    pub kind: NoiseType,
+    pub normalize: bool,
+    pub detail: f32,
+    pub roughness: f32,
+    pub lacunarity: f32,
+    pub offset: f32,
+    pub gain: f32,
+    pub distortion: f32,
+}
+
+fn select<P: NoisePoint>(p: P, n: &NoiseParams) -> f32 {
+    match n.kind {
+        NoiseType::MultiFractal => multi_fractal(p, n.detail, n.roughness, n.lacunarity),
+        NoiseType::Fbm => fbm(p, n.detail, n.roughness, n.lacunarity, n.normalize),
+        NoiseType::HybridMultiFractal => hybrid_multi_fractal(p, n.detail, n.roughness, n.lacunarity, n.offset, n.gain),
+        NoiseType::RidgedMultiFractal => ridged_multi_fractal(p, n.detail, n.roughness, n.lacunarity, n.offset, n.gain),
+        NoiseType::HeteroTerrain => hetero_terrain(p, n.detail, n.roughness, n.lacunarity, n.offset),
+    }
+}
+
+/// `perlin_fractal_distorted`: the Fac output.
+pub fn fractal_distorted<P: NoisePoint>(p: P, n: &NoiseParams) -> f32 {
+    let p = p.plus(p.distortion(n.distortion));
+    select(p, n)
+}
+
+/// `perlin_float3_fractal_distorted`: the Color output (its first channel is Fac). The
+/// seeds of the two extra channels depend on the dimension, as in Blender.
+pub fn fractal_distorted_color<P: NoisePoint>(p: P, n: &NoiseParams, seeds: [f32; 2]) -> [f32; 3] {
+    let p = p.plus(p.distortion(n.distortion));
+    [select(p, n), select(p.plus(P::offset(seeds[0])), n), select(p.plus(P::offset(seeds[1])), n)]
+}
+
+/// The Noise Texture node on one point: `dimensions` 1-4 (`vector` used for 2-4, `w` for
+/// 1 and 4). Returns (Fac, Color).
+#[allow(clippy::too_many_arguments)]
+pub fn noise_texture(dimensions: u8, vector: [f32; 3], w: f32, scale: f32, params: NoiseParams, want_color: bool) -> (f32, [f32; 4]) {
+    let mut n = params;
+    n.detail = n.detail.clamp(0.0, 15.0);
+    n.roughness = n.roughness.max(0.0);
+    let v = [vector[0] * scale, vector[1] * scale, vector[2] * scale];
+    let ws = w * scale;
+    let c = if want_color {
+        match dimensions {
+            1 => fractal_distorted_color(ws, &n, [1.0, 2.0]),
+            2 => fractal_distorted_color([v[0], v[1]], &n, [2.0, 3.0]),
+            4 => fractal_distorted_color([v[0], v[1], v[2], ws], &n, [4.0, 5.0]),
+            _ => fractal_distorted_color(v, &n, [3.0, 4.0]),
+        }
+    } else {
+        let f = match dimensions {
+            1 => fractal_distorted(ws, &n),
+            2 => fractal_distorted([v[0], v[1]], &n),
+            4 => fractal_distorted([v[0], v[1], v[2], ws], &n),
+            _ => fractal_distorted(v, &n),
+        };
+        [f, 0.0, 0.0]
+    };
+    (c[0], [c[0], c[1], c[2], 1.0])
+}
