@@ -1,0 +1,184 @@
+//! Film colour management as Blender 4.5 applies it to the final image: exposure, look,
+//! view transform and display (read from the OpenColorIO config and LUT files that the
+//! exporter copies into `DIR/colormanagement/`), then gamma; plus atomic PNG/EXR writers.
+//!
+//! Blender builds one OCIO processor per view (intern/opencolorio `createDisplayProcessor`):
+//! scene linear -> exposure scale -> look (in the look's process space) -> the view's colour
+//! space on the display -> `pow(x, 1/gamma)`. `pipeline` re-creates that chain from the
+//! config without the OCIO library; alpha is divided out around it, as Blender does for
+//! premultiplied float buffers.
+
+mod config;
+mod lut;
+mod pipeline;
+mod tone;
+mod write;
+
+use std::path::{Path, PathBuf};
+
+pub use write::{write_exr, write_png};
+
+use crate::scene::Scene;
+
+#[derive(Debug, thiserror::Error)]
+pub enum ColorError {
+    #[error("{path}: {message}")]
+    Config { path: PathBuf, message: String },
+    #[error("{path}: {message}")]
+    Lut { path: PathBuf, message: String },
+    #[error("colour management: {0}")]
+    Settings(String),
+    #[error("{path}: {message}")]
+    Write { path: PathBuf, message: String },
+}
+
+/// The scene's colour-management settings that shape the final image.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ViewSettings {
+    pub display_device: String,
+    pub view_transform: String,
+    /// "None" (or empty) for no look.
+    pub look: String,
+    pub exposure: f32,
+    pub gamma: f32,
+}
+
+impl Default for ViewSettings {
+    fn default() -> Self {
+        ViewSettings { display_device: "sRGB".into(), view_transform: "Standard".into(), look: "None".into(), exposure: 0.0, gamma: 1.0 }
+    }
+}
+
+impl ViewSettings {
+    /// Reads `scene.view_settings` and `scene.display_settings`; settings blendsynth does not
+    /// reproduce (RGB curves, white balance) are reported as errors rather than ignored.
+    pub fn from_scene(scene: &Scene) -> Result<ViewSettings, ColorError> {
+        let s = &scene.file.scene;
+        let vs = &s.view_settings;
+        let text = |m: &serde_json::Map<String, serde_json::Value>, k: &str, d: &str| m.get(k).and_then(|v| v.as_str()).unwrap_or(d).to_string();
+        let num = |k: &str, d: f64| vs.get(k).and_then(|v| v.as_f64()).unwrap_or(d) as f32;
+        let flag = |k: &str| vs.get(k).and_then(|v| v.as_bool()).unwrap_or(false);
+        if flag("use_curve_mapping") {
+            return Err(ColorError::Settings("scene.view_settings.use_curve_mapping (RGB curves on the view) is not supported; turn it off in Blender".into()));
+        }
+        if flag("use_white_balance") {
+            return Err(ColorError::Settings("scene.view_settings.use_white_balance is not supported; turn it off in Blender".into()));
+        }
+        Ok(ViewSettings {
+            display_device: text(&s.display_settings, "display_device", "sRGB"),
+            view_transform: text(vs, "view_transform", "Standard"),
+            look: text(vs, "look", "None"),
+            exposure: num("exposure", 0.0),
+            gamma: num("gamma", 1.0),
+        })
+    }
+
+    fn has_look(&self) -> bool {
+        !self.look.is_empty() && self.look != "None"
+    }
+}
+
+/// A ready-to-apply display transform (LUTs loaded once; apply to any number of images).
+#[derive(Debug, Clone)]
+pub struct DisplayTransform {
+    ops: Vec<pipeline::Op>,
+}
+
+impl DisplayTransform {
+    /// Builds the transform for `settings` from the OCIO config at `config` (the export's
+    /// `colormanagement/config.ocio`). Without a config only what needs no LUT is possible:
+    /// Standard and Raw on the sRGB display.
+    pub fn new(settings: &ViewSettings, config: Option<&Path>) -> Result<DisplayTransform, ColorError> {
+        let exposure_scale = if settings.exposure == 0.0 { 1.0 } else { 2f32.powf(settings.exposure) };
+        let mut ops = Vec::new();
+        if exposure_scale != 1.0 {
+            ops.push(pipeline::Op::Affine { scale: [exposure_scale; 3], offset: [0.0; 3] });
+        }
+        match config {
+            Some(path) => {
+                let cfg = config::Config::load(path)?;
+                let mut b = pipeline::Builder::new(&cfg);
+                let mut space = "scene_linear".to_string();
+                if settings.has_look() {
+                    space = b.look(&space, &settings.look)?;
+                }
+                let view_space = cfg.view_space(&settings.display_device, &settings.view_transform).ok_or_else(|| {
+                    let views: Vec<String> = cfg
+                        .displays
+                        .iter()
+                        .map(|(d, v)| format!("{d}: {}", v.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>().join(", ")))
+                        .collect();
+                    ColorError::Config {
+                        path: path.to_path_buf(),
+                        message: format!("no view {:?} on display {:?} (the config has {})", settings.view_transform, settings.display_device, views.join("; ")),
+                    }
+                })?;
+                let view_space = view_space.to_string();
+                b.convert(&space, &view_space)?;
+                ops.extend(b.ops);
+            }
+            None => {
+                if settings.display_device != "sRGB" || settings.has_look() || !matches!(settings.view_transform.as_str(), "Standard" | "Raw") {
+                    return Err(ColorError::Settings(format!(
+                        "view {:?} / look {:?} on display {:?} needs Blender's OCIO config and LUTs, which this export lacks (re-export with `blendsynth convert`, which copies them to colormanagement/)",
+                        settings.view_transform, settings.look, settings.display_device
+                    )));
+                }
+                if settings.view_transform == "Standard" {
+                    // The sRGB colour space of Blender's config: the piecewise sRGB curve.
+                    ops.push(pipeline::Op::MonCurve { gamma: [2.4; 3], offset: [0.055; 3], encode: true });
+                }
+            }
+        }
+        if settings.gamma != 1.0 {
+            let e = 1.0 / settings.gamma.max(f32::EPSILON);
+            ops.push(pipeline::Op::Pow([e; 3]));
+        }
+        Ok(DisplayTransform { ops })
+    }
+
+    /// The scene's transform (its settings, its export's config).
+    pub fn from_scene(scene: &Scene) -> Result<DisplayTransform, ColorError> {
+        let settings = ViewSettings::from_scene(scene)?;
+        let config = match &scene.file.color_management.config {
+            Some(rel) => Some(scene.resolve(rel, "color_management.config").map_err(|e| ColorError::Settings(e.to_string()))?),
+            None => None,
+        };
+        DisplayTransform::new(&settings, config.as_deref())
+    }
+
+    /// Linear scene-referred premultiplied RGBA in, display-referred premultiplied RGBA out
+    /// (alpha unchanged). Colour is divided by alpha around the transform for partly
+    /// transparent pixels, as Blender does; non-finite results become 0.
+    pub fn apply(&self, pixels: &mut [[f32; 4]]) {
+        for px in pixels.iter_mut() {
+            let a = px[3];
+            let predivide = a != 1.0 && a != 0.0;
+            let mut rgb = [px[0], px[1], px[2]];
+            if predivide {
+                for v in rgb.iter_mut() {
+                    *v /= a;
+                }
+            }
+            for op in &self.ops {
+                op.apply(&mut rgb);
+            }
+            if predivide {
+                for v in rgb.iter_mut() {
+                    *v *= a;
+                }
+            }
+            for (d, v) in px.iter_mut().zip(rgb) {
+                *d = if v.is_finite() { v } else { 0.0 };
+            }
+        }
+    }
+}
+
+/// Exposure, view transform (Standard, Filmic, AgX, ... with look), gamma and display
+/// encoding as the scene's colour management says, in place. Input linear scene-referred
+/// (Linear Rec.709), output display-referred values (0..1 for the usual views).
+pub fn to_display(scene: &Scene, pixels: &mut [[f32; 4]]) -> Result<(), ColorError> {
+    DisplayTransform::from_scene(scene)?.apply(pixels);
+    Ok(())
+}

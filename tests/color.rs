@@ -1,0 +1,168 @@
+//! Colour management against Blender: fixtures/color/make_color_refs.py saved a linear
+//! test image through Blender 4.5's own colour management (OCIO) as 16-bit PNGs, one per
+//! view transform / look / exposure / gamma / display case. We apply ours to the same
+//! input, write it with our PNG writer, read both back and compare.
+//!
+//! Cases that need Blender's OCIO config read it from the bpy installation (skipped
+//! without one, failing in CI); Standard and Raw on sRGB need no config and always run.
+
+mod common;
+
+use std::path::{Path, PathBuf};
+
+use blendsynth::color::{self, DisplayTransform, ViewSettings};
+
+fn fixtures() -> PathBuf {
+    common::repo().join("fixtures/color")
+}
+
+fn load_input() -> (u32, u32, Vec<[f32; 4]>, serde_json::Value) {
+    let cases: serde_json::Value = serde_json::from_slice(&std::fs::read(fixtures().join("cases.json")).unwrap()).unwrap();
+    let (w, h) = (cases["width"].as_u64().unwrap() as u32, cases["height"].as_u64().unwrap() as u32);
+    let bytes = std::fs::read(fixtures().join("input.f32")).unwrap();
+    assert_eq!(bytes.len(), (w * h * 16) as usize);
+    let px: Vec<[f32; 4]> = bytes
+        .chunks_exact(16)
+        .map(|c| std::array::from_fn(|i| f32::from_le_bytes(c[i * 4..i * 4 + 4].try_into().unwrap())))
+        .collect();
+    (w, h, px, cases)
+}
+
+/// Blender's colour-management folder next to the bpy module of the test Python.
+fn blender_colormanagement() -> Option<PathBuf> {
+    let python = common::bpy_python()?;
+    let venv = python.parent()?.parent()?.to_path_buf();
+    let lib = venv.join("lib");
+    for py in std::fs::read_dir(&lib).ok()?.flatten() {
+        let bpy = py.path().join("site-packages/bpy");
+        for ver in std::fs::read_dir(&bpy).ok().into_iter().flatten().flatten() {
+            let cm = ver.path().join("datafiles/colormanagement/config.ocio");
+            if cm.is_file() {
+                return Some(cm);
+            }
+        }
+    }
+    None
+}
+
+fn settings(case: &serde_json::Value) -> ViewSettings {
+    ViewSettings {
+        display_device: case["display_device"].as_str().unwrap().into(),
+        view_transform: case["view_transform"].as_str().unwrap().into(),
+        look: case["look"].as_str().unwrap().into(),
+        exposure: case["exposure"].as_f64().unwrap() as f32,
+        gamma: case["gamma"].as_f64().unwrap() as f32,
+    }
+}
+
+struct Stats {
+    max_opaque: f64,
+    max_alpha_rows: f64,
+    mean: f64,
+}
+
+/// Our PNG (through `write_png`) against Blender's, in display units (0..1).
+fn compare(ours: &Path, theirs: &Path, w: u32, h: u32, opaque_rows: u32) -> Stats {
+    let a = image::open(ours).unwrap().to_rgba16();
+    let b = image::open(theirs).unwrap().to_rgba16();
+    assert_eq!(a.dimensions(), (w, h));
+    assert_eq!(b.dimensions(), (w, h));
+    let (mut max_opaque, mut max_alpha_rows, mut sum, mut n) = (0f64, 0f64, 0f64, 0usize);
+    for y in 0..h {
+        for x in 0..w {
+            let (pa, pb) = (a.get_pixel(x, y).0, b.get_pixel(x, y).0);
+            for c in 0..4 {
+                let d = (pa[c] as f64 - pb[c] as f64).abs() / 65535.0;
+                // A fully transparent pixel's colour is meaningless in a straight-alpha PNG.
+                if c < 3 && pb[3] == 0 {
+                    continue;
+                }
+                if y < opaque_rows {
+                    max_opaque = max_opaque.max(d);
+                } else {
+                    max_alpha_rows = max_alpha_rows.max(d);
+                }
+                sum += d;
+                n += 1;
+            }
+        }
+    }
+    Stats { max_opaque, max_alpha_rows, mean: sum / n as f64 }
+}
+
+fn run_case(case: &serde_json::Value, config: Option<&Path>, w: u32, h: u32, input: &[[f32; 4]], tmp: &Path) -> Stats {
+    let t = DisplayTransform::new(&settings(case), config).unwrap_or_else(|e| panic!("{}: {e}", case["name"]));
+    let mut px = input.to_vec();
+    t.apply(&mut px);
+    let out = tmp.join(format!("{}.png", case["name"].as_str().unwrap()));
+    color::write_png(&out, w, h, &px, true, true).unwrap();
+    compare(&out, &fixtures().join(case["png"].as_str().unwrap()), w, h, 60)
+}
+
+const LIMIT: f64 = 1.0 / 255.0;
+
+fn report(rows: &[(String, String, Stats)]) -> bool {
+    println!("{:<34} {:<22} {:>12} {:>12} {:>12}", "case", "view", "max(opaque)", "max(alpha)", "mean");
+    let mut ok = true;
+    for (name, view, s) in rows {
+        let pass = s.max_opaque <= LIMIT && s.max_alpha_rows <= LIMIT;
+        ok &= pass;
+        println!(
+            "{:<34} {:<22} {:>9.2}/255 {:>9.2}/255 {:>9.4}/255 {}",
+            name,
+            view,
+            s.max_opaque * 255.0,
+            s.max_alpha_rows * 255.0,
+            s.mean * 255.0,
+            if pass { "" } else { "FAIL" }
+        );
+    }
+    let mut views: Vec<&str> = rows.iter().map(|r| r.1.as_str()).collect();
+    views.sort();
+    views.dedup();
+    for v in views {
+        let worst = rows.iter().filter(|r| r.1 == v).map(|r| r.2.max_opaque.max(r.2.max_alpha_rows)).fold(0.0, f64::max);
+        println!("worst {v:<22} {:.3}/255 ({:.1}/65535)", worst * 255.0, worst * 65535.0);
+    }
+    ok
+}
+
+#[test]
+fn standard_and_raw_without_config_match_blender() {
+    let (w, h, input, cases) = load_input();
+    let tmp = tempfile::tempdir().unwrap();
+    let mut rows = Vec::new();
+    for case in cases["cases"].as_array().unwrap() {
+        let s = settings(case);
+        if s.display_device != "sRGB" || !matches!(s.view_transform.as_str(), "Standard" | "Raw") {
+            continue;
+        }
+        let st = run_case(case, None, w, h, &input, tmp.path());
+        rows.push((case["name"].as_str().unwrap().to_string(), s.view_transform.clone(), st));
+    }
+    assert!(rows.len() >= 4);
+    assert!(report(&rows), "some cases exceed 1/255");
+}
+
+#[test]
+fn every_view_transform_matches_blender() {
+    let Some(config) = common::require("Blender's colormanagement/config.ocio (bpy)", blender_colormanagement()) else { return };
+    let (w, h, input, cases) = load_input();
+    let tmp = tempfile::tempdir().unwrap();
+    let mut rows = Vec::new();
+    for case in cases["cases"].as_array().unwrap() {
+        let st = run_case(case, Some(&config), w, h, &input, tmp.path());
+        let s = settings(case);
+        rows.push((case["name"].as_str().unwrap().to_string(), format!("{} ({})", s.view_transform, s.display_device), st));
+    }
+    assert!(report(&rows), "some cases exceed 1/255");
+}
+
+#[test]
+fn missing_config_for_filmic_is_a_clear_error() {
+    let s = ViewSettings { view_transform: "Filmic".into(), ..ViewSettings::default() };
+    let e = DisplayTransform::new(&s, None).unwrap_err().to_string();
+    assert!(e.contains("Filmic") && e.contains("colormanagement"), "{e}");
+    let e = DisplayTransform::new(&s, Some(Path::new("/nonexistent/config.ocio"))).unwrap_err().to_string();
+    assert!(e.contains("/nonexistent/config.ocio"), "{e}");
+}
