@@ -91,13 +91,14 @@ impl DisplayTransform {
     pub fn new(settings: &ViewSettings, config: Option<&Path>) -> Result<DisplayTransform, ColorError> {
         let exposure_scale = if settings.exposure == 0.0 { 1.0 } else { 2f32.powf(settings.exposure) };
         let mut ops = Vec::new();
-        if exposure_scale != 1.0 {
-            ops.push(pipeline::Op::Affine { scale: [exposure_scale; 3], offset: [0.0; 3] });
-        }
         match config {
             Some(path) => {
                 let cfg = config::Config::load(path)?;
                 let mut b = pipeline::Builder::new(&cfg);
+                if exposure_scale != 1.0 {
+                    let s = exposure_scale as f64;
+                    b.push_matrix([[s, 0.0, 0.0], [0.0, s, 0.0], [0.0, 0.0, s]], [0.0; 3]);
+                }
                 let mut space = "scene_linear".to_string();
                 if settings.has_look() {
                     space = b.look(&space, &settings.look)?;
@@ -115,9 +116,12 @@ impl DisplayTransform {
                 })?;
                 let view_space = view_space.to_string();
                 b.convert(&space, &view_space)?;
-                ops.extend(b.ops);
+                ops.extend(b.finish());
             }
             None => {
+                if exposure_scale != 1.0 {
+                    ops.push(pipeline::Op::Affine { scale: [exposure_scale; 3], offset: [0.0; 3] });
+                }
                 if settings.display_device != "sRGB" || settings.has_look() || !matches!(settings.view_transform.as_str(), "Standard" | "Raw") {
                     return Err(ColorError::Settings(format!(
                         "view {:?} / look {:?} on display {:?} needs Blender's OCIO config and LUTs, which this export lacks (re-export with `blendsynth convert`, which copies them to colormanagement/)",

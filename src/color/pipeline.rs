@@ -39,7 +39,10 @@ pub enum Op {
 pub struct Builder<'a> {
     pub config: &'a Config,
     luts: HashMap<PathBuf, LutFile>,
-    pub ops: Vec<Op>,
+    ops: Vec<Op>,
+    /// Consecutive matrix-like ops are multiplied together in f64 (as OCIO's optimizer
+    /// does), so round trips through the reference space cancel exactly.
+    pending: Option<([[f64; 3]; 3], [f64; 3])>,
     depth: usize,
 }
 
@@ -67,15 +70,58 @@ fn f3(v: [f64; 3]) -> [f32; 3] {
 
 impl<'a> Builder<'a> {
     pub fn new(config: &'a Config) -> Self {
-        Builder { config, luts: HashMap::new(), ops: Vec::new(), depth: 0 }
+        Builder { config, luts: HashMap::new(), ops: Vec::new(), pending: None, depth: 0 }
     }
 
     fn cerr(&self, msg: impl std::fmt::Display) -> ColorError {
         ColorError::Config { path: self.config.path.clone(), message: msg.to_string() }
     }
 
-    fn push_matrix(&mut self, m: [[f64; 3]; 3], offset: [f64; 3]) {
-        self.ops.push(Op::Matrix { m: [f3(m[0]), f3(m[1]), f3(m[2])], offset: f3(offset) });
+    /// out = m * in + offset, fused with a preceding matrix.
+    pub fn push_matrix(&mut self, m: [[f64; 3]; 3], offset: [f64; 3]) {
+        self.pending = Some(match self.pending.take() {
+            None => (m, offset),
+            Some((a, ao)) => {
+                let mut p = [[0.0; 3]; 3];
+                let mut o = offset;
+                for i in 0..3 {
+                    for j in 0..3 {
+                        p[i][j] = (0..3).map(|k| m[i][k] * a[k][j]).sum();
+                        o[i] += m[i][j] * ao[j];
+                    }
+                }
+                (p, o)
+            }
+        });
+    }
+
+    fn push_scale_offset(&mut self, scale: f64, offset: f64) {
+        self.push_matrix([[scale, 0.0, 0.0], [0.0, scale, 0.0], [0.0, 0.0, scale]], [offset; 3]);
+    }
+
+    fn flush(&mut self) {
+        if let Some((m, o)) = self.pending.take() {
+            let identity = (0..3).all(|i| (0..3).all(|j| (m[i][j] - if i == j { 1.0 } else { 0.0 }).abs() < 1e-12) && o[i].abs() < 1e-12);
+            if !identity {
+                let diagonal = (0..3).all(|i| (0..3).all(|j| i == j || m[i][j] == 0.0));
+                self.ops.push(if diagonal {
+                    Op::Affine { scale: f3([m[0][0], m[1][1], m[2][2]]), offset: f3(o) }
+                } else {
+                    Op::Matrix { m: [f3(m[0]), f3(m[1]), f3(m[2])], offset: f3(o) }
+                });
+            }
+        }
+    }
+
+    fn push(&mut self, op: Op) {
+        self.flush();
+        self.ops.push(op);
+    }
+
+    /// The finished list of operations.
+    pub fn finish(mut self) -> Vec<Op> {
+        self.flush();
+        self.ops
     }
 
     /// Converts from colour space `src` to `dst` (names, aliases or roles).
@@ -176,39 +222,35 @@ impl<'a> Builder<'a> {
                 let (lo, hi) = if vars.len() >= 2 { (vars[0], vars[1]) } else if *lg2 { (-10.0, 6.0) } else { (0.0, 1.0) };
                 let lin_offset = if *lg2 && vars.len() >= 3 { vars[2] } else { 0.0 };
                 // Fit lo..hi to 0..1.
-                let fit = |fwd: bool| {
+                let fit = |b: &mut Self, fwd: bool| {
                     let s = 1.0 / (hi - lo);
-                    if fwd {
-                        Op::Affine { scale: [s as f32; 3], offset: [(-lo * s) as f32; 3] }
-                    } else {
-                        Op::Affine { scale: [(hi - lo) as f32; 3], offset: [lo as f32; 3] }
-                    }
+                    if fwd { b.push_scale_offset(s, -lo * s) } else { b.push_scale_offset(hi - lo, lo) }
                 };
                 if !*lg2 {
-                    self.ops.push(fit(fwd));
+                    fit(self, fwd);
                 } else if fwd {
                     if lin_offset != 0.0 {
-                        self.ops.push(Op::Affine { scale: [1.0; 3], offset: [lin_offset as f32; 3] });
+                        self.push_scale_offset(1.0, lin_offset);
                     }
-                    self.ops.push(Op::Log2);
-                    self.ops.push(fit(true));
+                    self.push(Op::Log2);
+                    fit(self, true);
                 } else {
-                    self.ops.push(fit(false));
-                    self.ops.push(Op::Exp2);
+                    fit(self, false);
+                    self.push(Op::Exp2);
                     if lin_offset != 0.0 {
-                        self.ops.push(Op::Affine { scale: [1.0; 3], offset: [-lin_offset as f32; 3] });
+                        self.push_scale_offset(1.0, -lin_offset);
                     }
                 }
             }
             Transform::File { src, tetrahedral, dir } => {
                 let fwd = outer.combine(*dir) == Dir::Forward;
                 match self.load_lut(src)? {
-                    LutFile::OneD(l) => self.ops.push(Op::Lut1D { lut: Arc::new(l), inverse: !fwd }),
+                    LutFile::OneD(l) => self.push(Op::Lut1D { lut: Arc::new(l), inverse: !fwd }),
                     LutFile::ThreeD(l) => {
                         if !fwd {
                             return Err(self.cerr(format!("inverse of the 3D LUT {src:?} is not supported")));
                         }
-                        self.ops.push(Op::Lut3D { lut: Arc::new(l), tetrahedral: *tetrahedral })
+                        self.push(Op::Lut3D { lut: Arc::new(l), tetrahedral: *tetrahedral })
                     }
                     LutFile::Matrix(m) => {
                         let t = Transform::Matrix {
@@ -223,11 +265,11 @@ impl<'a> Builder<'a> {
             Transform::Exponent { value, dir } => {
                 let fwd = outer.combine(*dir) == Dir::Forward;
                 let e = |v: f64| if fwd { v as f32 } else { (1.0 / v) as f32 };
-                self.ops.push(Op::Pow([e(value[0]), e(value[1]), e(value[2])]));
+                self.push(Op::Pow([e(value[0]), e(value[1]), e(value[2])]));
             }
             Transform::ExponentWithLinear { gamma, offset, dir } => {
                 let fwd = outer.combine(*dir) == Dir::Forward;
-                self.ops.push(Op::MonCurve {
+                self.push(Op::MonCurve {
                     gamma: f3([gamma[0], gamma[1], gamma[2]]),
                     offset: f3([offset[0], offset[1], offset[2]]),
                     encode: !fwd,
@@ -240,16 +282,16 @@ impl<'a> Builder<'a> {
                 if a_min != b_min || a_max != b_max {
                     return Err(self.cerr("RangeTransform that rescales is not supported"));
                 }
-                self.ops.push(Op::Clamp { min: a_min.map(|v| v as f32), max: a_max.map(|v| v as f32) });
+                self.push(Op::Clamp { min: a_min.map(|v| v as f32), max: a_max.map(|v| v as f32) });
             }
             Transform::Cdl { slope, offset, power, sat, dir } => {
                 let fwd = outer.combine(*dir) == Dir::Forward;
-                self.ops.push(Op::Cdl { slope: f3(*slope), offset: f3(*offset), power: f3(*power), sat: *sat as f32, inverse: !fwd });
+                self.push(Op::Cdl { slope: f3(*slope), offset: f3(*offset), power: f3(*power), sat: *sat as f32, inverse: !fwd });
             }
             Transform::GradingPrimaryLog { contrast, saturation, pivot, brightness, gamma, dir } => {
                 let fwd = outer.combine(*dir) == Dir::Forward;
                 let s = 6.25 / 1023.0;
-                self.ops.push(Op::GradingPrimaryLog {
+                self.push(Op::GradingPrimaryLog {
                     brightness: f3([brightness[0] * s, brightness[1] * s, brightness[2] * s]),
                     contrast: f3(*contrast),
                     gamma: f3([1.0 / gamma[0], 1.0 / gamma[1], 1.0 / gamma[2]]),
@@ -264,7 +306,7 @@ impl<'a> Builder<'a> {
                 if !fwd {
                     return Err(self.cerr("inverse GradingToneTransform is not supported"));
                 }
-                self.ops.push(Op::GradingTone(Box::new(super::tone::ToneOp::new(g).map_err(|m| self.cerr(m))?)));
+                self.push(Op::GradingTone(Box::new(super::tone::ToneOp::new(g).map_err(|m| self.cerr(m))?)));
             }
             Transform::Unsupported(what) => return Err(self.cerr(format!("{what} is not supported"))),
         }
