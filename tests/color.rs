@@ -178,3 +178,78 @@ fn missing_config_for_filmic_is_a_clear_error() {
     let e = DisplayTransform::new(&s, Some(Path::new("/nonexistent/config.ocio"))).unwrap_err().to_string();
     assert!(e.contains("/nonexistent/config.ocio"), "{e}");
 }
+
+/// 8-bit PNGs: Blender rounds float to byte (dither off); ours must land within one code.
+#[test]
+fn eight_bit_png_matches_blender() {
+    let config = blender_colormanagement();
+    let (w, h, input, cases) = load_input();
+    let tmp = tempfile::tempdir().unwrap();
+    let mut checked = 0;
+    for case in cases["cases"].as_array().unwrap() {
+        let Some(png8) = case["png8"].as_str() else { continue };
+        let s = settings(case);
+        let needs_config = s.view_transform != "Standard";
+        if needs_config && common::require("Blender's colormanagement/config.ocio (bpy)", config.as_ref()).is_none() {
+            continue;
+        }
+        let t = DisplayTransform::new(&s, if needs_config { config.as_deref() } else { None }).unwrap();
+        let mut px = input.clone();
+        t.apply(&mut px);
+        let out = tmp.path().join("o.png");
+        color::write_png(&out, w, h, &px, false, true).unwrap();
+        let a = image::open(&out).unwrap();
+        let b = image::open(fixtures().join(png8)).unwrap();
+        assert_eq!(a.color(), image::ColorType::Rgba8);
+        assert_eq!(b.color(), image::ColorType::Rgba8);
+        let (a, b) = (a.to_rgba8(), b.to_rgba8());
+        let mut worst = 0i32;
+        let mut differing = 0usize;
+        for (pa, pb) in a.pixels().zip(b.pixels()) {
+            if pb.0[3] == 0 {
+                continue;
+            }
+            let d = (0..4).map(|c| (pa.0[c] as i32 - pb.0[c] as i32).abs()).max().unwrap();
+            worst = worst.max(d);
+            differing += (d > 0) as usize;
+        }
+        println!("{:<20} 8-bit: worst {worst}/255, {differing} of {} pixels differ", case["name"].as_str().unwrap(), w * h);
+        assert!(worst <= 1, "{}: {worst}/255", case["name"]);
+        checked += 1;
+    }
+    assert!(checked >= 1);
+}
+
+#[test]
+fn writers_round_trip_and_are_atomic() {
+    let tmp = tempfile::tempdir().unwrap();
+    let px: Vec<[f32; 4]> = (0..12).map(|i| [i as f32 * 0.1, 2.5, -1.0, if i % 3 == 0 { 0.5 } else { 1.0 }]).collect();
+    // EXR keeps linear floats exactly (no clamping, no colour management).
+    let exr = tmp.path().join("a.exr");
+    color::write_exr(&exr, 4, 3, &px).unwrap();
+    let back = image::open(&exr).unwrap().to_rgba32f();
+    for (p, q) in px.iter().zip(back.pixels()) {
+        assert_eq!(*p, q.0);
+    }
+    // PNG without alpha: colour as is, clamped, rounded half up.
+    let png = tmp.path().join("a.png");
+    color::write_png(&png, 4, 3, &px, false, false).unwrap();
+    let b = image::open(&png).unwrap();
+    assert_eq!(b.color(), image::ColorType::Rgb8);
+    let b = b.to_rgb8();
+    assert_eq!(b.get_pixel(1, 0).0, [26, 255, 0]);
+    // 16-bit with alpha: straight alpha (colour divided by alpha).
+    color::write_png(&png, 4, 3, &px, true, true).unwrap();
+    let b = image::open(&png).unwrap().to_rgba16();
+    assert_eq!(b.get_pixel(3, 0).0, [39321, 65535, 0, 32768]); // (0.3, 2.5, -1) at alpha 0.5
+    // Bad sizes are errors and leave no file behind.
+    let bad = tmp.path().join("bad.png");
+    assert!(color::write_png(&bad, 5, 3, &px, false, false).is_err());
+    assert!(color::write_exr(&bad, 0, 3, &px).is_err());
+    assert!(!bad.exists());
+    let leftovers: Vec<_> = std::fs::read_dir(tmp.path()).unwrap().flatten().filter(|e| e.file_name().to_string_lossy().ends_with(".tmp")).collect();
+    assert!(leftovers.is_empty());
+    // A folder that does not exist is a clear error naming the file.
+    let e = color::write_png(&tmp.path().join("no/such/dir/x.png"), 4, 3, &px, false, false).unwrap_err().to_string();
+    assert!(e.contains("x.png"), "{e}");
+}
