@@ -253,3 +253,28 @@ fn writers_round_trip_and_are_atomic() {
     let e = color::write_png(&tmp.path().join("no/such/dir/x.png"), 4, 3, &px, false, false).unwrap_err().to_string();
     assert!(e.contains("x.png"), "{e}");
 }
+
+/// The contract entry point on an exported scene (Standard view: no config needed).
+#[test]
+fn to_display_reads_the_scene_settings() {
+    let mut scene = blendsynth::scene::Scene::load(&common::repo().join("fixtures/scenes/material_zoo")).unwrap();
+    let mut px = vec![[0.5f32, 0.0, 1.0, 1.0], [0.25, 0.25, 0.25, 0.5]];
+    color::to_display(&scene, &mut px).unwrap();
+    // sRGB encoding of 0.5 and of 0.25/0.5 (predivided), re-multiplied by alpha.
+    assert!((px[0][0] - 0.735_357).abs() < 1e-5, "{:?}", px[0]);
+    assert_eq!(px[0][1], 0.0);
+    assert!((px[0][2] - 1.0).abs() < 1e-6);
+    assert!((px[1][0] - 0.735_357 * 0.5).abs() < 1e-5 && px[1][3] == 0.5, "{:?}", px[1]);
+    // Exposure +1 doubles the linear value before the view.
+    scene.file.scene.view_settings.insert("exposure".into(), serde_json::json!(1.0));
+    let mut px = vec![[0.25f32, 0.25, 0.25, 1.0]];
+    color::to_display(&scene, &mut px).unwrap();
+    assert!((px[0][0] - 0.735_357).abs() < 1e-5, "{:?}", px[0]);
+    // A view that needs LUTs the export lacks is a clear error.
+    scene.file.scene.view_settings.insert("view_transform".into(), serde_json::json!("AgX"));
+    let e = color::to_display(&scene, &mut px).unwrap_err().to_string();
+    assert!(e.contains("AgX") && e.contains("convert"), "{e}");
+    scene.file.scene.view_settings.insert("use_white_balance".into(), serde_json::json!(true));
+    let e = color::to_display(&scene, &mut px).unwrap_err().to_string();
+    assert!(e.contains("white_balance"), "{e}");
+}
