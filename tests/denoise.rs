@@ -123,3 +123,21 @@ fn explicit_missing_library_is_an_error() {
     let e = Denoiser::load(Some(&fake)).unwrap_err().to_string();
     assert!(e.contains("cannot load"), "{e}");
 }
+
+/// The fixture camera (rotation X 1.1 rad) sees the floor (world +Z) with Cycles'
+/// denoising normal (0, 0.891, -0.454); `cycles_denoise_normal` must produce what the
+/// committed pass holds there.
+#[test]
+fn denoise_normal_convention_matches_cycles_pass() {
+    let exr = read_exr(&common::repo().join("fixtures/denoise/render.exr"));
+    let normal = exr.vec3("Denoising Normal", ["X", "Y", "Z"]);
+    let floor = normal[(exr.height - 3) * exr.width + exr.width / 2];
+    let (s, c) = (1.1f64.sin(), 1.1f64.cos());
+    let cam = [[1.0, 0.0, 0.0, 0.0], [0.0, c, -s, -6.0], [0.0, s, c, 3.2], [0.0, 0.0, 0.0, 1.0]];
+    let ours = blendsynth::denoise::cycles_denoise_normal([0.0, 0.0, 1.0], &cam);
+    for k in 0..3 {
+        assert!((ours[k] - floor[k]).abs() < 2e-3, "ours {ours:?} cycles {floor:?}");
+    }
+    // Background pixels have a zero normal.
+    assert_eq!(normal[2 * exr.width + 2], [0.0, 0.0, 0.0]);
+}

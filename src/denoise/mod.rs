@@ -8,6 +8,11 @@
 //! (High by default); with the Accurate prefilter (the default) each guide is first
 //! denoised by its own RT filter and the main filter gets `cleanAux` on; with the None
 //! prefilter `cleanAux` is on and guides are used as they are; with Fast it is off.
+//!
+//! The guides are Cycles' denoising passes ("Denoising Albedo", "Denoising Normal"): the
+//! normal is in Cycles' camera space (x right, y up, z forward away from the camera, see
+//! `cycles_denoise_normal`), (0, 0, 0) where the ray hits the background; the albedo there
+//! is the background colour. Images are row-major, top row first, like the renderer's.
 
 mod oidn;
 
@@ -66,6 +71,21 @@ impl DenoiseOptions {
             use_normal: !matches!(s("denoising_input_passes"), "RGB" | "RGB_ALBEDO"),
         }
     }
+}
+
+/// A world-space shading normal in the convention of Cycles' denoising normal pass:
+/// Cycles' camera space, which is Blender's camera frame with z flipped to point forward.
+/// `camera_matrix_world` is the camera object's world matrix (rows, translation in column 3).
+pub fn cycles_denoise_normal(world_normal: [f32; 3], camera_matrix_world: &[[f64; 4]; 4]) -> [f32; 3] {
+    let m = camera_matrix_world;
+    let axis = |c: usize| {
+        let v = [m[0][c], m[1][c], m[2][c]];
+        let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        if l > 0.0 { [v[0] / l, v[1] / l, v[2] / l] } else { v }
+    };
+    let n = world_normal.map(|v| v as f64);
+    let dot = |a: [f64; 3]| (a[0] * n[0] + a[1] * n[1] + a[2] * n[2]) as f32;
+    [dot(axis(0)), dot(axis(1)), -dot(axis(2))]
 }
 
 /// The loaded libOpenImageDenoise.
