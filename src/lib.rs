@@ -12,3 +12,5 @@ pub mod inspect;
 pub mod nodes;
 pub mod scene;
 pub mod shader;
+pub mod dataset;
+pub mod label;

@@ -1,0 +1,1 @@
+//! `blendsynth replicate --dataset doi-23843904`: placeholder, filled below.
