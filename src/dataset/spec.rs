@@ -605,8 +605,7 @@ fn support(d: &Dist) -> Result<Vec<(f64, f64)>, String> {
 const RNA_RANGES: &str = include_str!("rna_ranges.json");
 
 /// The hard [min, max] of the property at `path`, when known: a node-group interface
-/// socket (group input, modifier input) records its own; Factor sockets are [0, 1];
-/// RNA properties come from `RNA_RANGES`.
+/// socket (group input, modifier input) records its own; RNA properties come from `RNA_RANGES`.
 fn range_of(root: &Value, path: &str, chain: &[&Value]) -> Option<(f64, f64)> {
     let tokens = parse(path).ok()?;
     let slot_parent = chain.len().checked_sub(2).map(|i| chain[i]);
@@ -631,9 +630,9 @@ fn range_of(root: &Value, path: &str, chain: &[&Value]) -> Option<(f64, f64)> {
                 return Some(r);
             }
         }
-        if socket.get("bl_idname").and_then(Value::as_str) == Some("NodeSocketFloatFactor") {
-            return Some((0.0, 1.0));
-        }
+        // Built-in nodes declare their sockets' ranges in C++ and the exporter does not
+        // record them (a Factor subtype does not mean [0, 1]: Principled's Subsurface
+        // IOR is a Factor in [1.01, 3.8]), so those are not checked.
         return None;
     }
     // RNA properties: match the root collection and the trailing attribute names.
