@@ -256,10 +256,14 @@ fn crash_mid_frame_then_resume_equals_uninterrupted() {
 }
 
 fn cli_generate(out: &Path, extra: &[&str]) -> std::process::Command {
+    cli_generate_n(out, "300", "3", extra)
+}
+
+fn cli_generate_n(out: &Path, frames: &str, seed: &str, extra: &[&str]) -> std::process::Command {
     let repo = common::repo();
     let mut c = common::bin();
     c.args(["generate", repo.join("assets/doi-23843904/colonoscopy").to_str().unwrap(), "--spec", repo.join("assets/doi-23843904/colonoscopy.toml").to_str().unwrap()])
-        .args(["--frames", "300", "--seed", "3", "--split", "train=0.9,val=0.1", "--renderer", "bounds", "-o", out.to_str().unwrap()])
+        .args(["--frames", frames, "--seed", seed, "--split", "train=0.9,val=0.1", "--renderer", "bounds", "-o", out.to_str().unwrap()])
         .args(extra);
     c
 }
@@ -315,4 +319,44 @@ fn replicate_and_preview_through_the_cli() {
     let o = common::run(&["replicate", "--dataset", "doi-0", "-o", out.join("x").to_str().unwrap()], &[]);
     common::assert_clean_error(&o, 1, &["doi-0"]);
     std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// SLURM is up when `sinfo` reports a usable node. In CI (`.ci/run` starts a
+/// single-node cluster) a missing cluster is a failure; elsewhere the test skips.
+fn slurm_up() -> bool {
+    std::process::Command::new("sinfo").args(["-h", "-o", "%T"]).output().map(|o| o.status.success() && String::from_utf8_lossy(&o.stdout).lines().any(|l| ["idle", "mix", "alloc"].iter().any(|s| l.starts_with(s)))).unwrap_or(false)
+}
+
+#[test]
+fn slurm_job_array_and_merge_equal_a_single_run() {
+    if common::require("a running SLURM cluster (deploy/slurm/single-node.sh)", slurm_up().then_some(())).is_none() {
+        return;
+    }
+    let repo = common::repo();
+    let out = tmp("slurm");
+    std::fs::create_dir_all(&out).unwrap();
+    let bin = PathBuf::from(env!("CARGO_BIN_EXE_blendsynth"));
+    let o = std::process::Command::new("bash")
+        .arg(repo.join("deploy/slurm/submit.sh"))
+        .arg("--wait")
+        .env("SCENE", repo.join("assets/doi-23843904/colonoscopy"))
+        .env("SPEC", repo.join("assets/doi-23843904/colonoscopy.toml"))
+        .env("FRAMES", "40")
+        .env("SHARDS", "4")
+        .env("SEED", "5")
+        .env("OUT", &out)
+        .env("RENDERER", "bounds")
+        .env("BLENDSYNTH", &bin)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "sbatch: {}{}", common::stdout(&o), common::stderr(&o));
+    let single = tmp("slurm-single");
+    let o = cli_generate_n(&single, "40", "5", &[]).output().unwrap();
+    assert!(o.status.success(), "{}", common::stderr(&o));
+    for i in 0..4 {
+        assert!(out.join(format!("shard-{i}/manifest.json")).exists(), "array task {i} ran");
+    }
+    assert_same_tree(&single, &out.join("dataset"));
+    std::fs::remove_dir_all(&out).unwrap();
+    std::fs::remove_dir_all(&single).unwrap();
 }
