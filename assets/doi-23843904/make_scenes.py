@@ -99,7 +99,7 @@ def colonoscopy():
     s = reset("Colonoscopy")
     s.frame_start, s.frame_end, s.frame_current = 1, 1000, 1
     # Centre line: a meandering Bezier curve, ~0.5 m.
-    pts = [(0, 0, 0), (0.08, 0.03, 0.01), (0.16, -0.02, 0.03), (0.24, 0.04, 0.0), (0.33, 0.0, -0.03), (0.42, -0.05, 0.0), (0.5, 0.0, 0.02)]
+    pts = [(0, 0, 0), (0.08, 0.012, 0.004), (0.16, -0.008, 0.012), (0.24, 0.016, 0.0), (0.33, 0.0, -0.012), (0.42, -0.02, 0.0), (0.5, 0.0, 0.008)]
     cu = bpy.data.curves.new("Centreline", "CURVE")
     cu.dimensions = "3D"
     cu.resolution_u = 24
@@ -141,7 +141,7 @@ def colonoscopy():
         ring = []
         for j in range(n_ring):
             a = 2 * math.pi * j / n_ring
-            fold = 0.12 * max(0.0, math.sin(u * 2 * math.pi * 14)) ** 3  # haustral folds
+            fold = 0.3 * max(0.0, math.sin(u * 2 * math.pi * 14)) ** 4  # haustral folds
             r = radius * (1 - fold + 0.08 * smooth_noise(u, a, 3.0))
             ring.append(bm.verts.new(p + r * (math.cos(a) * x + math.sin(a) * y)))
         rings.append(ring)
@@ -277,8 +277,8 @@ def laparoscopy():
     s.camera = cam
     spot = bpy.data.lights.new("Spot", "SPOT")
     spot.energy = 2.0
-    spot.spot_size = math.radians(70)
-    spot.spot_blend = 0.3
+    spot.spot_size = math.radians(120)
+    spot.spot_blend = 0.5
     spot.shadow_soft_size = 0.003
     light = bpy.data.objects.new("Spot", spot)
     s.collection.objects.link(light)
