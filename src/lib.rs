@@ -14,3 +14,5 @@ pub mod scene;
 pub mod shader;
 pub mod color;
 pub mod denoise;
+pub mod dataset;
+pub mod label;

@@ -51,6 +51,141 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
+    /// Render a labelled dataset: frames with parameters drawn from a randomisation
+    /// spec, in parallel, resumable, optionally one shard of many.
+    Generate(GenerateArgs),
+    /// Join shard folders made by `generate --shard` into one dataset.
+    Merge {
+        /// Shard folders (all shards of one dataset).
+        #[arg(required = true)]
+        shards: Vec<PathBuf>,
+        /// Output folder (new or empty).
+        #[arg(short, long)]
+        output: PathBuf,
+    },
+    /// Draw a contact sheet of a dataset's frames with masks and boxes.
+    Preview {
+        /// A dataset folder written by `generate`, `merge` or `replicate`.
+        dir: PathBuf,
+        /// Output PNG.
+        #[arg(short, long)]
+        output: PathBuf,
+        /// How many frames (the first ones, in frame order).
+        #[arg(long, default_value_t = 16)]
+        count: usize,
+    },
+    /// Regenerate a published dataset with built-in scenes and specs.
+    Replicate(ReplicateArgs),
+}
+
+#[derive(Clone, Copy, PartialEq, clap::ValueEnum)]
+enum RendererKind {
+    /// The path tracer (the real images).
+    Path,
+    /// Debugging stand-in: each mesh object's projected bounding box as a flat
+    /// rectangle; checks a spec and the label pipeline in seconds. Not a render.
+    Bounds,
+}
+
+#[derive(clap::Args)]
+struct RunArgs {
+    /// Dataset seed: with the spec, fixes every frame's values.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// This run's slice, I/N with 0 <= I < N: frames with index % N == I.
+    #[arg(long)]
+    shard: Option<String>,
+    /// Finish a killed or partial run in OUT (same settings): finished frames are kept,
+    /// partial ones redone.
+    #[arg(long)]
+    resume: bool,
+    /// Frames rendered at once (default: the number of cores).
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// Which renderer makes the images and label passes.
+    #[arg(long, value_enum, default_value = "path")]
+    renderer: RendererKind,
+}
+
+#[derive(clap::Args)]
+struct GenerateArgs {
+    /// A scene folder written by `blendsynth convert`.
+    dir: PathBuf,
+    /// The randomisation spec (TOML; see README, "Randomisation spec").
+    #[arg(long)]
+    spec: PathBuf,
+    /// Number of frames in the dataset.
+    #[arg(long)]
+    frames: u64,
+    /// Output dataset folder.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Split fractions, NAME=FRACTION,... summing to 1 (exact counts per split).
+    #[arg(long, default_value = "train=1")]
+    split: String,
+    #[command(flatten)]
+    run: RunArgs,
+}
+
+#[derive(clap::Args)]
+struct ReplicateArgs {
+    /// The dataset to regenerate (doi-23843904: Dowrick et al., procedural colonoscopy
+    /// and laparoscopy, UCL 2023).
+    #[arg(long)]
+    dataset: String,
+    /// Which part (all: both, into OUT/colonoscopy and OUT/laparoscopy).
+    #[arg(long, value_enum, default_value = "all")]
+    part: blendsynth::dataset::replicate::Part,
+    /// Frames per part (the study: 50000, split 45000/5000).
+    #[arg(long, default_value_t = 50000)]
+    frames: u64,
+    /// Folder of a converted scene to use instead of the built-in one (a single part).
+    #[arg(long)]
+    assets: Option<PathBuf>,
+    /// Output folder.
+    #[arg(short, long)]
+    output: PathBuf,
+    #[command(flatten)]
+    run: RunArgs,
+}
+
+/// The path tracer as a dataset renderer. The render branch wires this at merge (see
+/// `dataset::renderer::path_tracer`).
+fn make_renderer(kind: RendererKind, scene: &Scene) -> Result<Box<dyn blendsynth::dataset::FrameRenderer>> {
+    match kind {
+        RendererKind::Path => blendsynth::dataset::renderer::path_tracer(scene).map_err(anyhow::Error::msg),
+        RendererKind::Bounds => Ok(Box::new(blendsynth::dataset::bounds::BoundsRenderer::new(scene).map_err(anyhow::Error::msg)?)),
+    }
+}
+
+fn generate_options(run: &RunArgs, frames: u64, split: Vec<(String, f64)>) -> Result<blendsynth::dataset::GenerateOptions> {
+    use blendsynth::dataset::generate::parse_shard;
+    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    if frames == 0 {
+        anyhow::bail!("--frames must be at least 1");
+    }
+    Ok(blendsynth::dataset::GenerateOptions {
+        frames,
+        seed: run.seed,
+        split,
+        shard: run.shard.as_deref().map(parse_shard).transpose().map_err(anyhow::Error::msg)?.unwrap_or((0, 1)),
+        resume: run.resume,
+        jobs: run.jobs.unwrap_or(cores).max(1),
+        threads_per_frame: 1,
+        progress: true,
+        after_write: None,
+    })
+}
+
+fn print_summary(s: &blendsynth::dataset::Summary) {
+    println!(
+        "dataset {}: {} frames rendered, {} already done, {:.1} s ({:.1} frames/hour)",
+        s.out.display(),
+        s.rendered,
+        s.skipped,
+        s.seconds,
+        if s.seconds > 0.0 { s.rendered as f64 * 3600.0 / s.seconds } else { 0.0 }
+    );
 }
 
 #[derive(clap::Args)]
@@ -123,6 +258,42 @@ fn run(cli: Cli) -> Result<Outcome> {
                 print!("{}", report.to_text());
             }
             Ok(if report.all_supported { Outcome::Done } else { Outcome::Unsupported })
+        }
+        Command::Generate(a) => {
+            use blendsynth::dataset::{generate, generate::parse_split, Spec};
+            let scene = Scene::load(&a.dir)?;
+            let spec = Spec::load(&a.spec)?;
+            let opts = generate_options(&a.run, a.frames, parse_split(&a.split).map_err(anyhow::Error::msg)?)?;
+            let renderer = make_renderer(a.run.renderer, &scene)?;
+            let s = generate(&scene, &spec, renderer.as_ref(), &a.output, &opts).map_err(anyhow::Error::msg)?;
+            print_summary(&s);
+            Ok(Outcome::Done)
+        }
+        Command::Merge { shards, output } => {
+            let n = blendsynth::dataset::merge(&shards, &output).map_err(anyhow::Error::msg)?;
+            println!("merged {} shard(s) into {}: {n} frames", shards.len(), output.display());
+            Ok(Outcome::Done)
+        }
+        Command::Preview { dir, output, count } => {
+            let n = blendsynth::dataset::preview::contact_sheet(&dir, &output, count).map_err(anyhow::Error::msg)?;
+            println!("preview of {n} frame(s) -> {}", output.display());
+            Ok(Outcome::Done)
+        }
+        Command::Replicate(a) => {
+            use blendsynth::dataset::replicate;
+            if a.dataset != replicate::DATASET {
+                anyhow::bail!("unknown dataset {:?} (known: {})", a.dataset, replicate::DATASET);
+            }
+            for part in a.part.parts() {
+                let (scene, spec) = replicate::scene_and_spec(part, a.assets.as_deref()).map_err(anyhow::Error::msg)?;
+                let out = if a.part.parts().len() > 1 { a.output.join(part.name()) } else { a.output.clone() };
+                let opts = generate_options(&a.run, a.frames, replicate::split())?;
+                let renderer = make_renderer(a.run.renderer, &scene)?;
+                let s = blendsynth::dataset::generate(&scene, &spec, renderer.as_ref(), &out, &opts).map_err(anyhow::Error::msg)?;
+                print_summary(&s);
+            }
+            println!("dataset written to {}", a.output.display());
+            Ok(Outcome::Done)
         }
     }
 }

@@ -1,0 +1,90 @@
+//! The dataset-wide files, written from the finished frames alone (so a dataset made
+//! by one process, by shards then `merge`, or by a resumed run is byte-identical):
+//! `frames.jsonl`, `annotations/instances_SPLIT.json` (COCO), `data.yaml` (YOLO).
+
+use std::path::{Path, PathBuf};
+
+use serde_json::Value;
+
+use super::layout::{self, write_atomic};
+use crate::label::coco;
+use crate::label::record::FrameRecord;
+use crate::label::yolo;
+
+fn read_record(out: &Path, i: u64) -> Result<FrameRecord, String> {
+    let p = layout::record_path(out, i);
+    let bytes = std::fs::read(&p).map_err(|e| format!("{}: {e}", p.display()))?;
+    serde_json::from_slice(&bytes).map_err(|e| format!("{}: {e}", p.display()))
+}
+
+/// Writes the dataset-wide files over frames `indices` (all must be finished).
+pub fn finalize(out: &Path, indices: &[u64], splits: &[String], class_names: &[String]) -> Result<(), String> {
+    let records = indices.iter().map(|&i| read_record(out, i)).collect::<Result<Vec<_>, _>>()?;
+    let mut jsonl = String::new();
+    for r in &records {
+        jsonl.push_str(&serde_json::to_string(r).unwrap());
+        jsonl.push('\n');
+    }
+    write_atomic(&out.join("frames.jsonl"), jsonl.as_bytes())?;
+    for s in splits {
+        let c = coco::instances(&records, s, class_names, "blendsynth generate");
+        write_atomic(&out.join("annotations").join(format!("instances_{s}.json")), serde_json::to_string(&c).unwrap().as_bytes())?;
+    }
+    write_atomic(&out.join("data.yaml"), yolo::data_yaml(splits, class_names).as_bytes())
+}
+
+fn read_manifest(dir: &Path) -> Result<Value, String> {
+    let p = dir.join("manifest.json");
+    let b = std::fs::read(&p).map_err(|e| format!("{}: {e} (not a blendsynth dataset?)", p.display()))?;
+    serde_json::from_slice(&b).map_err(|e| format!("{}: {e}", p.display()))
+}
+
+/// Joins shard folders into `out`: the manifests must agree (apart from the shard) and
+/// together hold every frame. The result equals a single run of all frames.
+pub fn merge(shards: &[PathBuf], out: &Path) -> Result<u64, String> {
+    if shards.is_empty() {
+        return Err("merge needs at least one dataset folder".into());
+    }
+    let mut manifest = read_manifest(&shards[0])?;
+    manifest["shard"] = Value::Null;
+    for s in &shards[1..] {
+        let mut m = read_manifest(s)?;
+        m["shard"] = Value::Null;
+        if m != manifest {
+            return Err(format!("{} was made with other settings than {} (scene, spec, seed, frames or split)", s.display(), shards[0].display()));
+        }
+    }
+    if out.join("manifest.json").exists() || out.exists() && std::fs::read_dir(out).map(|mut d| d.next().is_some()).unwrap_or(false) {
+        return Err(format!("{} is not empty; merge writes into a new folder", out.display()));
+    }
+    let frames = manifest["frames"].as_u64().ok_or("manifest has no frame count")?;
+    let splits: Vec<String> = manifest["split"].as_array().ok_or("manifest has no split")?.iter().filter_map(|s| s[0].as_str().map(String::from)).collect();
+    let classes: Vec<String> = manifest["classes"].as_array().ok_or("manifest has no classes")?.iter().filter_map(|s| s.as_str().map(String::from)).collect();
+    let mut missing = Vec::new();
+    for i in 0..frames {
+        let Some(src) = shards.iter().find(|s| layout::record_path(s, i).exists()) else {
+            missing.push(i);
+            continue;
+        };
+        let rec = read_record(src, i)?;
+        let files = [
+            (layout::image_path(src, &rec.split, i), layout::image_path(out, &rec.split, i)),
+            (layout::mask_path(src, &rec.split, i), layout::mask_path(out, &rec.split, i)),
+            (layout::label_path(src, &rec.split, i), layout::label_path(out, &rec.split, i)),
+            (layout::record_path(src, i), layout::record_path(out, i)),
+        ];
+        for (a, b) in files {
+            let bytes = std::fs::read(&a).map_err(|e| format!("{}: {e}", a.display()))?;
+            write_atomic(&b, &bytes)?;
+        }
+    }
+    if !missing.is_empty() {
+        let _ = std::fs::remove_dir_all(out);
+        let shown: Vec<String> = missing.iter().take(10).map(|i| i.to_string()).collect();
+        return Err(format!("{} of {frames} frames are in none of the shards (first: {}); finish them with generate --resume", missing.len(), shown.join(", ")));
+    }
+    write_atomic(&out.join("manifest.json"), format!("{}\n", serde_json::to_string_pretty(&manifest).unwrap()).as_bytes())?;
+    let all: Vec<u64> = (0..frames).collect();
+    finalize(out, &all, &splits, &classes)?;
+    Ok(frames)
+}

@@ -1,0 +1,85 @@
+//! The dataset folder and atomic writes.
+//!
+//! ```text
+//! OUT/manifest.json                     what made it (spec, seed, frames, split, shard)
+//! OUT/images/SPLIT/NNNNNNNNN.png        8-bit RGB image
+//! OUT/masks/SPLIT/NNNNNNNNN.png         semantic mask (0 background, else class id)
+//! OUT/labels/SPLIT/NNNNNNNNN.txt        YOLO boxes
+//! OUT/frames/NNNNNNNNN.json             per-frame record; written last: its presence
+//!                                       marks the frame finished
+//! OUT/annotations/instances_SPLIT.json  COCO (written when all frames are done)
+//! OUT/frames.jsonl                      every record, one per line, in frame order
+//! OUT/data.yaml                         Ultralytics dataset file
+//! ```
+//! Every file is written to `.NAME.partial` beside it and renamed into place, so a
+//! killed run leaves whole files or `.partial` leftovers that a resumed run deletes.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+pub fn frame_name(index: u64) -> String {
+    format!("{index:09}")
+}
+pub fn image_path(out: &Path, split: &str, index: u64) -> PathBuf {
+    out.join("images").join(split).join(format!("{}.png", frame_name(index)))
+}
+pub fn mask_path(out: &Path, split: &str, index: u64) -> PathBuf {
+    out.join("masks").join(split).join(format!("{}.png", frame_name(index)))
+}
+pub fn label_path(out: &Path, split: &str, index: u64) -> PathBuf {
+    out.join("labels").join(split).join(format!("{}.txt", frame_name(index)))
+}
+pub fn record_path(out: &Path, index: u64) -> PathBuf {
+    out.join("frames").join(format!("{}.json", frame_name(index)))
+}
+
+/// Writes `bytes` to `path` atomically (temp file beside it, fsync, rename).
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    let dir = path.parent().ok_or_else(|| format!("{}: no parent folder", path.display()))?;
+    std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
+    let name = path.file_name().unwrap().to_string_lossy();
+    let tmp = dir.join(format!(".{name}.partial"));
+    let mut f = std::fs::File::create(&tmp).map_err(|e| format!("{}: cannot write: {e}", tmp.display()))?;
+    f.write_all(&bytes).and_then(|_| f.sync_all()).map_err(|e| format!("{}: cannot write: {e}", tmp.display()))?;
+    drop(f);
+    std::fs::rename(&tmp, path).map_err(|e| format!("{}: cannot rename into place: {e}", path.display()))
+}
+
+/// Deletes `.partial` leftovers of a killed run.
+pub fn remove_partials(dir: &Path) -> std::io::Result<usize> {
+    let mut n = 0;
+    if !dir.is_dir() {
+        return Ok(0);
+    }
+    for e in std::fs::read_dir(dir)? {
+        let e = e?;
+        let p = e.path();
+        if e.file_type()?.is_dir() {
+            n += remove_partials(&p)?;
+        } else if p.file_name().is_some_and(|f| f.to_string_lossy().ends_with(".partial")) {
+            std::fs::remove_file(&p)?;
+            n += 1;
+        }
+    }
+    Ok(n)
+}
+
+/// PNG bytes of an 8-bit image (`channels` 1 = gray, 3 = RGB, 4 = RGBA).
+pub fn png_bytes(width: u32, height: u32, channels: u8, data: &[u8]) -> Result<Vec<u8>, String> {
+    use image::ImageEncoder;
+    let kind = match channels {
+        1 => image::ExtendedColorType::L8,
+        3 => image::ExtendedColorType::Rgb8,
+        4 => image::ExtendedColorType::Rgba8,
+        _ => return Err(format!("{channels} channels")),
+    };
+    let mut out = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut out).write_image(data, width, height, kind).map_err(|e| format!("PNG encode: {e}"))?;
+    Ok(out)
+}
+
+/// Display-referred [0, 1] RGBA to 8-bit RGB, rounded.
+pub fn to_rgb8(color: &[[f32; 4]]) -> Vec<u8> {
+    let q = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
+    color.iter().flat_map(|c| [q(c[0]), q(c[1]), q(c[2])]).collect()
+}
