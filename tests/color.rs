@@ -277,4 +277,13 @@ fn to_display_reads_the_scene_settings() {
     scene.file.scene.view_settings.insert("use_white_balance".into(), serde_json::json!(true));
     let e = color::to_display(&scene, &mut px).unwrap_err().to_string();
     assert!(e.contains("white_balance"), "{e}");
+    // The output format's override replaces the scene's settings (Standard, exposure 2 here).
+    let ims = scene.file.scene.render.get_mut("image_settings").unwrap().as_object_mut().unwrap();
+    ims.insert("color_management".into(), serde_json::json!("OVERRIDE"));
+    let vs = ims.get_mut("view_settings").unwrap().as_object_mut().unwrap();
+    vs.insert("exposure".into(), serde_json::json!(2.0));
+    vs.insert("view_transform".into(), serde_json::json!("Standard"));
+    let mut px = vec![[0.125f32, 0.125, 0.125, 1.0]];
+    color::to_display(&scene, &mut px).unwrap();
+    assert!((px[0][0] - 0.735_357).abs() < 1e-5, "{:?}", px[0]);
 }
