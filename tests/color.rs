@@ -287,3 +287,20 @@ fn to_display_reads_the_scene_settings() {
     color::to_display(&scene, &mut px).unwrap();
     assert!((px[0][0] - 0.735_357).abs() < 1e-5, "{:?}", px[0]);
 }
+
+#[test]
+fn write_render_follows_the_output_format() {
+    let scene = blendsynth::scene::Scene::load(&common::repo().join("fixtures/scenes/material_zoo")).unwrap();
+    let f = color::OutputFormat::from_scene(&scene);
+    assert_eq!(f, color::OutputFormat { sixteen_bit: false, alpha: true }); // PNG, 8 bit, RGBA
+    let tmp = tempfile::tempdir().unwrap();
+    let px = vec![[0.5f32, 0.25, 2.0, 1.0]; 6];
+    color::write_render(&scene, &tmp.path().join("a.png"), 3, 2, &px).unwrap();
+    let png = image::open(tmp.path().join("a.png")).unwrap();
+    assert_eq!(png.color(), image::ColorType::Rgba8);
+    assert_eq!(png.to_rgba8().get_pixel(2, 1).0, [188, 137, 255, 255]);
+    color::write_render(&scene, &tmp.path().join("a.exr"), 3, 2, &px).unwrap();
+    assert_eq!(image::open(tmp.path().join("a.exr")).unwrap().to_rgba32f().get_pixel(0, 0).0, [0.5, 0.25, 2.0, 1.0]);
+    let e = color::write_render(&scene, &tmp.path().join("a.tif"), 3, 2, &px).unwrap_err().to_string();
+    assert!(e.contains(".tif"), "{e}");
+}

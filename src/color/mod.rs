@@ -197,3 +197,38 @@ pub fn to_display(scene: &Scene, pixels: &mut [[f32; 4]]) -> Result<(), ColorErr
     DisplayTransform::from_scene(scene)?.apply(pixels);
     Ok(())
 }
+
+/// How the scene's output format (`render.image_settings`) stores the final image.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OutputFormat {
+    /// 16 bits per channel (PNG `color_depth` "16"); else 8.
+    pub sixteen_bit: bool,
+    /// An alpha channel (`color_mode` "RGBA").
+    pub alpha: bool,
+}
+
+impl OutputFormat {
+    pub fn from_scene(scene: &Scene) -> OutputFormat {
+        let ims = scene.file.scene.render.get("image_settings").and_then(|v| v.as_object());
+        let get = |k: &str| ims.and_then(|m| m.get(k)).and_then(|v| v.as_str()).unwrap_or("");
+        OutputFormat { sixteen_bit: get("color_depth") == "16", alpha: get("color_mode") == "RGBA" }
+    }
+}
+
+/// Writes a rendered frame as Blender would save it, choosing by `path`'s extension:
+/// `.exr` gets the linear scene-referred pixels as float RGBA (Blender applies no view
+/// transform to float formats); `.png` gets the scene's colour management and its
+/// output format's bit depth and alpha. `linear` is left untouched.
+pub fn write_render(scene: &Scene, path: &Path, width: u32, height: u32, linear: &[[f32; 4]]) -> Result<(), ColorError> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    match ext.as_str() {
+        "exr" => write_exr(path, width, height, linear),
+        "png" => {
+            let mut px = linear.to_vec();
+            to_display(scene, &mut px)?;
+            let f = OutputFormat::from_scene(scene);
+            write_png(path, width, height, &px, f.sixteen_bit, f.alpha)
+        }
+        _ => Err(ColorError::Write { path: path.to_path_buf(), message: format!("unsupported output type .{ext} (use .png or .exr)") }),
+    }
+}
