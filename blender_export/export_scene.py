@@ -732,8 +732,14 @@ def main():
               if im.source != "VIEWER" and im.type not in ("RENDER_RESULT", "COMPOSITING")]
 
     cm = {"dir": None, "config": None}
-    if scene.view_settings.view_transform not in ("Standard", "Raw"):
-        # Filmic, AgX, ... need the OCIO config and LUTs of the Blender that made the file.
+    ims = scene.render.image_settings
+    views = [(scene.view_settings, scene.display_settings)]
+    if ims.color_management == "OVERRIDE":
+        views.append((ims.view_settings, ims.display_settings))
+    # Everything but Standard/Raw on sRGB without a look needs Blender's OCIO config and
+    # LUTs (Filmic, AgX, looks, other displays); blendsynth reads them from the export.
+    if any(v.view_transform not in ("Standard", "Raw") or v.look not in ("None", "") or d.display_device != "sRGB"
+           for v, d in views):
         src = os.path.join(bpy.utils.resource_path("LOCAL"), "datafiles", "colormanagement")
         if os.path.isfile(os.path.join(src, "config.ocio")):
             shutil.copytree(src, os.path.join(out, "colormanagement"), dirs_exist_ok=True)

@@ -277,4 +277,30 @@ fn to_display_reads_the_scene_settings() {
     scene.file.scene.view_settings.insert("use_white_balance".into(), serde_json::json!(true));
     let e = color::to_display(&scene, &mut px).unwrap_err().to_string();
     assert!(e.contains("white_balance"), "{e}");
+    // The output format's override replaces the scene's settings (Standard, exposure 2 here).
+    let ims = scene.file.scene.render.get_mut("image_settings").unwrap().as_object_mut().unwrap();
+    ims.insert("color_management".into(), serde_json::json!("OVERRIDE"));
+    let vs = ims.get_mut("view_settings").unwrap().as_object_mut().unwrap();
+    vs.insert("exposure".into(), serde_json::json!(2.0));
+    vs.insert("view_transform".into(), serde_json::json!("Standard"));
+    let mut px = vec![[0.125f32, 0.125, 0.125, 1.0]];
+    color::to_display(&scene, &mut px).unwrap();
+    assert!((px[0][0] - 0.735_357).abs() < 1e-5, "{:?}", px[0]);
+}
+
+#[test]
+fn write_render_follows_the_output_format() {
+    let scene = blendsynth::scene::Scene::load(&common::repo().join("fixtures/scenes/material_zoo")).unwrap();
+    let f = color::OutputFormat::from_scene(&scene);
+    assert_eq!(f, color::OutputFormat { sixteen_bit: false, alpha: true }); // PNG, 8 bit, RGBA
+    let tmp = tempfile::tempdir().unwrap();
+    let px = vec![[0.5f32, 0.25, 2.0, 1.0]; 6];
+    color::write_render(&scene, &tmp.path().join("a.png"), 3, 2, &px).unwrap();
+    let png = image::open(tmp.path().join("a.png")).unwrap();
+    assert_eq!(png.color(), image::ColorType::Rgba8);
+    assert_eq!(png.to_rgba8().get_pixel(2, 1).0, [188, 137, 255, 255]);
+    color::write_render(&scene, &tmp.path().join("a.exr"), 3, 2, &px).unwrap();
+    assert_eq!(image::open(tmp.path().join("a.exr")).unwrap().to_rgba32f().get_pixel(0, 0).0, [0.5, 0.25, 2.0, 1.0]);
+    let e = color::write_render(&scene, &tmp.path().join("a.tif"), 3, 2, &px).unwrap_err().to_string();
+    assert!(e.contains(".tif"), "{e}");
 }

@@ -50,24 +50,35 @@ impl Default for ViewSettings {
 }
 
 impl ViewSettings {
-    /// Reads `scene.view_settings` and `scene.display_settings`; settings blendsynth does not
-    /// reproduce (RGB curves, white balance) are reported as errors rather than ignored.
+    /// Reads `scene.view_settings` and `scene.display_settings`, or the output format's own
+    /// (`render.image_settings.view_settings` / `display_settings`) when its colour
+    /// management is "OVERRIDE", as Blender does when saving a render. Settings blendsynth
+    /// does not reproduce (RGB curves, white balance) are reported as errors, not ignored.
     pub fn from_scene(scene: &Scene) -> Result<ViewSettings, ColorError> {
         let s = &scene.file.scene;
-        let vs = &s.view_settings;
+        let image = s.render.get("image_settings").and_then(|v| v.as_object());
+        let overridden = image.and_then(|i| i.get("color_management")).and_then(|v| v.as_str()) == Some("OVERRIDE");
+        let pick = |key: &str, scene_value: &'_ serde_json::Map<String, serde_json::Value>| -> serde_json::Map<String, serde_json::Value> {
+            match image.and_then(|i| i.get(key)).and_then(|v| v.as_object()) {
+                Some(m) if overridden => m.clone(),
+                _ => scene_value.clone(),
+            }
+        };
+        let (vs, ds) = (pick("view_settings", &s.view_settings), pick("display_settings", &s.display_settings));
+        let prefix = if overridden { "scene.render.image_settings.view_settings" } else { "scene.view_settings" };
         let text = |m: &serde_json::Map<String, serde_json::Value>, k: &str, d: &str| m.get(k).and_then(|v| v.as_str()).unwrap_or(d).to_string();
         let num = |k: &str, d: f64| vs.get(k).and_then(|v| v.as_f64()).unwrap_or(d) as f32;
         let flag = |k: &str| vs.get(k).and_then(|v| v.as_bool()).unwrap_or(false);
         if flag("use_curve_mapping") {
-            return Err(ColorError::Settings("scene.view_settings.use_curve_mapping (RGB curves on the view) is not supported; turn it off in Blender".into()));
+            return Err(ColorError::Settings(format!("{prefix}.use_curve_mapping (RGB curves on the view) is not supported; turn it off in Blender")));
         }
         if flag("use_white_balance") {
-            return Err(ColorError::Settings("scene.view_settings.use_white_balance is not supported; turn it off in Blender".into()));
+            return Err(ColorError::Settings(format!("{prefix}.use_white_balance is not supported; turn it off in Blender")));
         }
         Ok(ViewSettings {
-            display_device: text(&s.display_settings, "display_device", "sRGB"),
-            view_transform: text(vs, "view_transform", "Standard"),
-            look: text(vs, "look", "None"),
+            display_device: text(&ds, "display_device", "sRGB"),
+            view_transform: text(&vs, "view_transform", "Standard"),
+            look: text(&vs, "look", "None"),
             exposure: num("exposure", 0.0),
             gamma: num("gamma", 1.0),
         })
@@ -185,4 +196,39 @@ impl DisplayTransform {
 pub fn to_display(scene: &Scene, pixels: &mut [[f32; 4]]) -> Result<(), ColorError> {
     DisplayTransform::from_scene(scene)?.apply(pixels);
     Ok(())
+}
+
+/// How the scene's output format (`render.image_settings`) stores the final image.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OutputFormat {
+    /// 16 bits per channel (PNG `color_depth` "16"); else 8.
+    pub sixteen_bit: bool,
+    /// An alpha channel (`color_mode` "RGBA").
+    pub alpha: bool,
+}
+
+impl OutputFormat {
+    pub fn from_scene(scene: &Scene) -> OutputFormat {
+        let ims = scene.file.scene.render.get("image_settings").and_then(|v| v.as_object());
+        let get = |k: &str| ims.and_then(|m| m.get(k)).and_then(|v| v.as_str()).unwrap_or("");
+        OutputFormat { sixteen_bit: get("color_depth") == "16", alpha: get("color_mode") == "RGBA" }
+    }
+}
+
+/// Writes a rendered frame as Blender would save it, choosing by `path`'s extension:
+/// `.exr` gets the linear scene-referred pixels as float RGBA (Blender applies no view
+/// transform to float formats); `.png` gets the scene's colour management and its
+/// output format's bit depth and alpha. `linear` is left untouched.
+pub fn write_render(scene: &Scene, path: &Path, width: u32, height: u32, linear: &[[f32; 4]]) -> Result<(), ColorError> {
+    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    match ext.as_str() {
+        "exr" => write_exr(path, width, height, linear),
+        "png" => {
+            let mut px = linear.to_vec();
+            to_display(scene, &mut px)?;
+            let f = OutputFormat::from_scene(scene);
+            write_png(path, width, height, &px, f.sixteen_bit, f.alpha)
+        }
+        _ => Err(ColorError::Write { path: path.to_path_buf(), message: format!("unsupported output type .{ext} (use .png or .exr)") }),
+    }
 }

@@ -163,6 +163,7 @@ pub fn candidate_dirs() -> Vec<PathBuf> {
                 dirs.push(sp.join(pkg).join("lib"));
                 dirs.push(sp.join(pkg).join("libs"));
             }
+            dirs.push(sp.join("pyoidn/oidn/lib"));
             dirs.push(sp.join("pyoidn.libs"));
         }
     }
