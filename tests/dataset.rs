@@ -53,7 +53,7 @@ impl FrameRenderer for SquaresRenderer {
                 }
             }
         }
-        Ok(RenderedFrame { width: w, height: h, color, ids: FrameIds { width: w, height: h, instance_id: ids, depth: None, instances } })
+        Ok(RenderedFrame { width: w, height: h, color, ids: FrameIds { width: w, height: h, instance_id: ids, depth: None, normal: None, instances } })
     }
 }
 
@@ -359,4 +359,42 @@ fn slurm_job_array_and_merge_equal_a_single_run() {
     assert_same_tree(&single, &out.join("dataset"));
     std::fs::remove_dir_all(&out).unwrap();
     std::fs::remove_dir_all(&single).unwrap();
+}
+
+#[test]
+fn optional_depth_output_agrees_with_the_records() {
+    let scene = Scene::load(&common::repo().join("assets/doi-23843904/laparoscopy")).unwrap();
+    let base = std::fs::read_to_string(common::repo().join("assets/doi-23843904/laparoscopy.toml")).unwrap();
+    let spec = Spec::parse(&base.replace("[labels]\n", "[labels]\ndepth = true\n")).unwrap();
+    assert!(spec.labels.depth);
+    let renderer = blendsynth::dataset::bounds::BoundsRenderer::new(&scene).unwrap();
+    let out = tmp("depth");
+    generate(&scene, &spec, &renderer, &out, &GenerateOptions { frames: 3, ..Default::default() }).unwrap();
+    let mut checked = 0;
+    for line in std::fs::read_to_string(out.join("frames.jsonl")).unwrap().lines() {
+        let r: blendsynth::label::record::FrameRecord = serde_json::from_str(line).unwrap();
+        let img = image::open(out.join(format!("depth/train/{:09}.png", r.index))).unwrap();
+        let d = img.as_luma16().expect("16-bit depth").clone();
+        for a in &r.annotations {
+            let [x, y, w, h] = a.bbox;
+            let mut nearest = u16::MAX;
+            for yy in y..y + h {
+                for xx in x..x + w {
+                    let v = d.get_pixel(xx, yy).0[0];
+                    if v > 0 {
+                        nearest = nearest.min(v);
+                    }
+                }
+            }
+            let want = (a.nearest_depth.unwrap() * 1000.0).round() as u16;
+            assert!(nearest <= want && want > 0, "frame {} {}: depth image {nearest} mm, record {want} mm", r.index, a.object);
+            checked += 1;
+        }
+    }
+    assert!(checked > 0);
+    // Normals need a renderer that makes them.
+    let spec = Spec::parse(&base.replace("[labels]\n", "[labels]\nnormals = true\n")).unwrap();
+    let e = generate(&scene, &spec, &renderer, &tmp("normals"), &GenerateOptions { frames: 1, ..Default::default() }).unwrap_err();
+    assert!(e.contains("normals"), "{e}");
+    std::fs::remove_dir_all(&out).unwrap();
 }

@@ -89,7 +89,7 @@ fn boxes_masks_and_drop_rule() {
         4, 4, 0, 0, 0, 0, 0, 0,
         4, 0, 0, 0, 0, 0, 0, 0u32,
     ];
-    let frame = FrameIds { width: 8, height: 6, instance_id: ids, depth: None, instances: vec![inst("Liver"), inst("Gallbladder"), inst("Bowel.000"), inst("Liver"), inst("Gallbladder")] };
+    let frame = FrameIds { width: 8, height: 6, instance_id: ids, depth: None, normal: None, instances: vec![inst("Liver"), inst("Gallbladder"), inst("Bowel.000"), inst("Liver"), inst("Gallbladder")] };
     let labels = extract(&frame, &classes, 4).unwrap();
     assert_eq!(labels.len(), 2, "{labels:?}");
     assert_eq!((labels[0].instance, labels[0].class, labels[0].area, labels[0].bbox), (0, 0, 13, [1, 0, 5, 4]));

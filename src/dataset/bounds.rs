@@ -143,6 +143,6 @@ impl FrameRenderer for BoundsRenderer {
                 }
             }
         }
-        Ok(RenderedFrame { width: w, height: h, color, ids: FrameIds { width: w, height: h, instance_id: ids, depth: Some(depth), instances } })
+        Ok(RenderedFrame { width: w, height: h, color, ids: FrameIds { width: w, height: h, instance_id: ids, depth: Some(depth), normal: None, instances } })
     }
 }

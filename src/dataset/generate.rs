@@ -261,6 +261,20 @@ impl FrameContext<'_> {
         let mask = layout::mask_path(self.out, split, i);
         write_atomic(&mask, &layout::png_bytes(r.width, r.height, 1, &semantic(&r.ids, &labels))?)?;
         hook(&mask)?;
+        let labels_spec = &self.spec.labels;
+        if labels_spec.depth {
+            let d = r.ids.depth.as_ref().ok_or("the spec asks for depth but the renderer gave none")?;
+            let mm: Vec<u16> = d.iter().map(|z| if z.is_finite() { (*z as f64 * labels_spec.mm_per_unit).round().clamp(0.0, 65535.0) as u16 } else { 0 }).collect();
+            let p = layout::depth_path(self.out, split, i);
+            write_atomic(&p, &layout::png16_bytes(r.width, r.height, &mm)?)?;
+            hook(&p)?;
+        }
+        if labels_spec.normals {
+            let n = r.ids.normal.as_ref().ok_or("the spec asks for normals but the renderer gave none")?;
+            let p = layout::normal_path(self.out, split, i);
+            write_atomic(&p, &layout::exr_rgb_bytes(r.width, r.height, n)?)?;
+            hook(&p)?;
+        }
         let txt = layout::label_path(self.out, split, i);
         write_atomic(&txt, yolo::label_text(&anns, r.width, r.height).as_bytes())?;
         hook(&txt)?;
