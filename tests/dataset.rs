@@ -398,3 +398,27 @@ fn optional_depth_output_agrees_with_the_records() {
     assert!(e.contains("normals"), "{e}");
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+#[test]
+fn polyp_sizes_are_the_authored_sizes_times_the_drawn_scale() {
+    // make_scenes.py: Polyp.sessile.000 is a sphere of radius 6 mm flattened to 0.55 in
+    // its own z; Polyp.stalked.001 a stalk and head of size 5 mm, 5 * (1.5 + 0.6) tall.
+    let authored = [("Polyp.sessile.000", [12.0, 12.0, 6.6]), ("Polyp.stalked.001", [6.0, 6.0, 10.5])];
+    let out = tmp("sizes");
+    generate(&colon(), &colon_spec(), &SquaresRenderer, &out, &opts(40)).unwrap();
+    let mut checked = 0;
+    for line in std::fs::read_to_string(out.join("frames.jsonl")).unwrap().lines() {
+        let r: blendsynth::label::record::FrameRecord = serde_json::from_str(line).unwrap();
+        for a in &r.annotations {
+            let Some((_, dims)) = authored.iter().find(|(n, _)| *n == a.object) else { continue };
+            let scale = r.values[&format!("objects[\"{}\"].scale", a.object)].as_f64().unwrap();
+            for k in 0..3 {
+                assert!((a.size_mm[k] - dims[k] * scale).abs() < 1e-3, "{} frame {}: {:?} vs {dims:?} x {scale}", a.object, r.index, a.size_mm);
+            }
+            assert!((a.largest_mm - dims.iter().cloned().fold(0.0, f64::max) * scale).abs() < 1e-3);
+            checked += 1;
+        }
+    }
+    assert!(checked >= 2, "polyps seen: {checked}");
+    std::fs::remove_dir_all(&out).unwrap();
+}

@@ -120,6 +120,6 @@ fn classes_from_custom_property_and_patterns() {
 #[test]
 fn yolo_lines_are_normalised_centres() {
     use blendsynth::label::record::Annotation;
-    let a = Annotation { object: "P".into(), instance_index: None, class: "polyp".into(), category_id: 2, bbox: [10, 20, 30, 40], area: 1, rle: None, size: [0.0; 3], size_mm: [0.0; 3], distance: 0.0, distance_mm: 0.0, nearest_depth: None };
+    let a = Annotation { object: "P".into(), instance_index: None, class: "polyp".into(), category_id: 2, bbox: [10, 20, 30, 40], area: 1, rle: None, size: [0.0; 3], size_mm: [0.0; 3], largest_mm: 0.0, distance: 0.0, distance_mm: 0.0, nearest_depth: None };
     assert_eq!(blendsynth::label::yolo::label_text(&[a], 100, 200), "1 0.250000 0.200000 0.300000 0.200000\n");
 }

@@ -183,7 +183,7 @@ pub fn generate(scene: &Scene, spec: &Spec, renderer: &dyn FrameRenderer, out: &
     let skipped = (mine.len() - todo.len()) as u64;
 
     let scene_json = serde_json::to_value(&scene.file).map_err(|e| e.to_string())?;
-    let ctx = FrameContext { scene, scene_json: &scene_json, spec, renderer, classes: &classes, out, opts, splits: &splits };
+    let ctx = FrameContext { scene, scene_json: &scene_json, spec, renderer, classes: &classes, out, opts, splits: &splits, bounds: Mutex::new(std::collections::HashMap::new()) };
 
     let bar = if opts.progress {
         let b = indicatif::ProgressBar::new(todo.len() as u64);
@@ -238,9 +238,34 @@ struct FrameContext<'a> {
     out: &'a Path,
     opts: &'a GenerateOptions,
     splits: &'a [u16],
+    /// Mesh bounds in object space, by object name (meshes do not change per frame).
+    bounds: Mutex<std::collections::HashMap<String, Option<([f64; 3], [f64; 3])>>>,
 }
 
 impl FrameContext<'_> {
+    fn local_bounds(&self, object: &str) -> Option<([f64; 3], [f64; 3])> {
+        if let Some(b) = self.bounds.lock().unwrap().get(object) {
+            return *b;
+        }
+        let b = (|| {
+            let o = self.scene.object(object)?;
+            let mesh = o.data.as_deref().filter(|_| o.kind == "MESH")?;
+            let idx = self.scene.file.meshes.iter().position(|m| m.name == mesh)?;
+            let m = self.scene.load_mesh(idx).ok()?;
+            let mut lo = [f64::INFINITY; 3];
+            let mut hi = [f64::NEG_INFINITY; 3];
+            for p in &m.positions {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k] as f64);
+                    hi[k] = hi[k].max(p[k] as f64);
+                }
+            }
+            (!m.positions.is_empty()).then_some((lo, hi))
+        })();
+        self.bounds.lock().unwrap().insert(object.to_string(), b);
+        b
+    }
+
     fn frame(&self, i: u64) -> Result<(), String> {
         let opts = self.opts;
         let split = &opts.split[self.splits[i as usize] as usize].0;
@@ -252,7 +277,7 @@ impl FrameContext<'_> {
         }
         let labels = extract(&r.ids, self.classes, self.spec.labels.min_pixels)?;
         let camera = scene_camera(&scene, fv.frame as f64, r.width, r.height)?;
-        let anns = annotations(&r.ids, &labels, &self.classes.names, &camera, self.spec.labels.mm_per_unit);
+        let anns = annotations(&r.ids, &labels, &self.classes.names, &camera, self.spec.labels.mm_per_unit, &|o| self.local_bounds(o));
 
         let hook = |p: &Path| opts.after_write.map_or(Ok(()), |h| h(i, p));
         let img = layout::image_path(self.out, split, i);
