@@ -219,6 +219,16 @@ fn same_bytes_across_threads_shards_and_merge() {
     assert_eq!(merge(&shards, &merged).unwrap(), 24);
     assert_same_tree(&one, &merged);
 
+    // One frame regenerated alone (shard 17 of 24 is frame 17) is the same bytes.
+    let alone = tmp("alone");
+    generate(&scene, &spec, &SquaresRenderer, &alone, &GenerateOptions { shard: (17, 24), ..opts(24) }).unwrap();
+    let split = if one.join("images/train/000000017.png").exists() { "train" } else { "val" };
+    for f in [format!("images/{split}/000000017.png"), format!("masks/{split}/000000017.png"), format!("labels/{split}/000000017.txt"), "frames/000000017.json".to_string()] {
+        assert_eq!(std::fs::read(alone.join(&f)).unwrap(), std::fs::read(one.join(&f)).unwrap(), "{f}");
+    }
+    assert_eq!(std::fs::read_dir(alone.join("frames")).unwrap().count(), 1);
+    std::fs::remove_dir_all(&alone).unwrap();
+
     // Missing shards are an error naming the frames.
     let partial = tmp("partial");
     assert!(merge(&shards[..2], &partial).unwrap_err().contains("in none of the shards"));

@@ -18,9 +18,12 @@ use super::renderer::FrameRenderer;
 use super::rng;
 use super::spec::Spec;
 use crate::label::camera::{camera_info, CameraInfo};
-use crate::label::record::{annotations, FrameRecord};
+use crate::label::record::{annotations, Bounds, FrameRecord};
 use crate::label::{extract, instances::semantic, yolo, ClassMap};
 use crate::scene::Scene;
+
+/// See `GenerateOptions::after_write`.
+pub type WriteHook = fn(u64, &Path) -> Result<(), String>;
 
 #[derive(Debug, Clone)]
 pub struct GenerateOptions {
@@ -37,7 +40,7 @@ pub struct GenerateOptions {
     pub progress: bool,
     /// Test hook: called after each file of a frame is written, with the frame index
     /// and the file; an error stops the run there (a crash mid-frame).
-    pub after_write: Option<fn(u64, &Path) -> Result<(), String>>,
+    pub after_write: Option<WriteHook>,
 }
 
 impl Default for GenerateOptions {
@@ -211,7 +214,7 @@ pub fn generate(scene: &Scene, spec: &Spec, renderer: &dyn FrameRenderer, out: &
                     Err(e) => {
                         stop.store(true, Ordering::Relaxed);
                         let mut g = first_error.lock().unwrap();
-                        if g.as_ref().is_none_or(|(j, _)| i < *j) {
+                        if g.as_ref().map_or(true, |(j, _)| i < *j) {
                             *g = Some((i, e));
                         }
                         return;
@@ -239,11 +242,11 @@ struct FrameContext<'a> {
     opts: &'a GenerateOptions,
     splits: &'a [u16],
     /// Mesh bounds in object space, by object name (meshes do not change per frame).
-    bounds: Mutex<std::collections::HashMap<String, Option<([f64; 3], [f64; 3])>>>,
+    bounds: Mutex<std::collections::HashMap<String, Option<Bounds>>>,
 }
 
 impl FrameContext<'_> {
-    fn local_bounds(&self, object: &str) -> Option<([f64; 3], [f64; 3])> {
+    fn local_bounds(&self, object: &str) -> Option<Bounds> {
         if let Some(b) = self.bounds.lock().unwrap().get(object) {
             return *b;
         }

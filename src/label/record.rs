@@ -58,6 +58,9 @@ pub struct FrameRecord {
     pub annotations: Vec<Annotation>,
 }
 
+/// Axis-aligned bounds (min, max).
+pub type Bounds = ([f64; 3], [f64; 3]);
+
 /// Annotations of one frame from its labels. `local_bounds` gives an object's mesh
 /// bounds in its own space (None when unknown).
 pub fn annotations(
@@ -66,7 +69,7 @@ pub fn annotations(
     class_names: &[String],
     camera: &CameraInfo,
     mm_per_unit: f64,
-    local_bounds: &dyn Fn(&str) -> Option<([f64; 3], [f64; 3])>,
+    local_bounds: &dyn Fn(&str) -> Option<Bounds>,
 ) -> Vec<Annotation> {
     labels
         .iter()
