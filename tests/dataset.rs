@@ -53,7 +53,7 @@ impl FrameRenderer for SquaresRenderer {
                 }
             }
         }
-        Ok(RenderedFrame { width: w, height: h, color, ids: FrameIds { width: w, height: h, instance_id: ids, depth: None, instances } })
+        Ok(RenderedFrame { width: w, height: h, color, ids: FrameIds { width: w, height: h, instance_id: ids, depth: None, normal: None, instances } })
     }
 }
 
@@ -219,6 +219,16 @@ fn same_bytes_across_threads_shards_and_merge() {
     assert_eq!(merge(&shards, &merged).unwrap(), 24);
     assert_same_tree(&one, &merged);
 
+    // One frame regenerated alone (shard 17 of 24 is frame 17) is the same bytes.
+    let alone = tmp("alone");
+    generate(&scene, &spec, &SquaresRenderer, &alone, &GenerateOptions { shard: (17, 24), ..opts(24) }).unwrap();
+    let split = if one.join("images/train/000000017.png").exists() { "train" } else { "val" };
+    for f in [format!("images/{split}/000000017.png"), format!("masks/{split}/000000017.png"), format!("labels/{split}/000000017.txt"), "frames/000000017.json".to_string()] {
+        assert_eq!(std::fs::read(alone.join(&f)).unwrap(), std::fs::read(one.join(&f)).unwrap(), "{f}");
+    }
+    assert_eq!(std::fs::read_dir(alone.join("frames")).unwrap().count(), 1);
+    std::fs::remove_dir_all(&alone).unwrap();
+
     // Missing shards are an error naming the frames.
     let partial = tmp("partial");
     assert!(merge(&shards[..2], &partial).unwrap_err().contains("in none of the shards"));
@@ -359,4 +369,66 @@ fn slurm_job_array_and_merge_equal_a_single_run() {
     assert_same_tree(&single, &out.join("dataset"));
     std::fs::remove_dir_all(&out).unwrap();
     std::fs::remove_dir_all(&single).unwrap();
+}
+
+#[test]
+fn optional_depth_output_agrees_with_the_records() {
+    let scene = Scene::load(&common::repo().join("assets/doi-23843904/laparoscopy")).unwrap();
+    let base = std::fs::read_to_string(common::repo().join("assets/doi-23843904/laparoscopy.toml")).unwrap();
+    let spec = Spec::parse(&base.replace("[labels]\n", "[labels]\ndepth = true\n")).unwrap();
+    assert!(spec.labels.depth);
+    let renderer = blendsynth::dataset::bounds::BoundsRenderer::new(&scene).unwrap();
+    let out = tmp("depth");
+    generate(&scene, &spec, &renderer, &out, &GenerateOptions { frames: 3, ..Default::default() }).unwrap();
+    let mut checked = 0;
+    for line in std::fs::read_to_string(out.join("frames.jsonl")).unwrap().lines() {
+        let r: blendsynth::label::record::FrameRecord = serde_json::from_str(line).unwrap();
+        let img = image::open(out.join(format!("depth/train/{:09}.png", r.index))).unwrap();
+        let d = img.as_luma16().expect("16-bit depth").clone();
+        for a in &r.annotations {
+            let [x, y, w, h] = a.bbox;
+            let mut nearest = u16::MAX;
+            for yy in y..y + h {
+                for xx in x..x + w {
+                    let v = d.get_pixel(xx, yy).0[0];
+                    if v > 0 {
+                        nearest = nearest.min(v);
+                    }
+                }
+            }
+            let want = (a.nearest_depth.unwrap() * 1000.0).round() as u16;
+            assert!(nearest <= want && want > 0, "frame {} {}: depth image {nearest} mm, record {want} mm", r.index, a.object);
+            checked += 1;
+        }
+    }
+    assert!(checked > 0);
+    // Normals need a renderer that makes them.
+    let spec = Spec::parse(&base.replace("[labels]\n", "[labels]\nnormals = true\n")).unwrap();
+    let e = generate(&scene, &spec, &renderer, &tmp("normals"), &GenerateOptions { frames: 1, ..Default::default() }).unwrap_err();
+    assert!(e.contains("normals"), "{e}");
+    std::fs::remove_dir_all(&out).unwrap();
+}
+
+#[test]
+fn polyp_sizes_are_the_authored_sizes_times_the_drawn_scale() {
+    // make_scenes.py: Polyp.sessile.000 is a sphere of radius 6 mm flattened to 0.55 in
+    // its own z; Polyp.stalked.001 a stalk and head of size 5 mm, 5 * (1.5 + 0.6) tall.
+    let authored = [("Polyp.sessile.000", [12.0, 12.0, 6.6]), ("Polyp.stalked.001", [6.0, 6.0, 10.5])];
+    let out = tmp("sizes");
+    generate(&colon(), &colon_spec(), &SquaresRenderer, &out, &opts(40)).unwrap();
+    let mut checked = 0;
+    for line in std::fs::read_to_string(out.join("frames.jsonl")).unwrap().lines() {
+        let r: blendsynth::label::record::FrameRecord = serde_json::from_str(line).unwrap();
+        for a in &r.annotations {
+            let Some((_, dims)) = authored.iter().find(|(n, _)| *n == a.object) else { continue };
+            let scale = r.values[&format!("objects[\"{}\"].scale", a.object)].as_f64().unwrap();
+            for k in 0..3 {
+                assert!((a.size_mm[k] - dims[k] * scale).abs() < 1e-3, "{} frame {}: {:?} vs {dims:?} x {scale}", a.object, r.index, a.size_mm);
+            }
+            assert!((a.largest_mm - dims.iter().cloned().fold(0.0, f64::max) * scale).abs() < 1e-3);
+            checked += 1;
+        }
+    }
+    assert!(checked >= 2, "polyps seen: {checked}");
+    std::fs::remove_dir_all(&out).unwrap();
 }

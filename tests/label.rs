@@ -89,7 +89,7 @@ fn boxes_masks_and_drop_rule() {
         4, 4, 0, 0, 0, 0, 0, 0,
         4, 0, 0, 0, 0, 0, 0, 0u32,
     ];
-    let frame = FrameIds { width: 8, height: 6, instance_id: ids, depth: None, instances: vec![inst("Liver"), inst("Gallbladder"), inst("Bowel.000"), inst("Liver"), inst("Gallbladder")] };
+    let frame = FrameIds { width: 8, height: 6, instance_id: ids, depth: None, normal: None, instances: vec![inst("Liver"), inst("Gallbladder"), inst("Bowel.000"), inst("Liver"), inst("Gallbladder")] };
     let labels = extract(&frame, &classes, 4).unwrap();
     assert_eq!(labels.len(), 2, "{labels:?}");
     assert_eq!((labels[0].instance, labels[0].class, labels[0].area, labels[0].bbox), (0, 0, 13, [1, 0, 5, 4]));
@@ -120,6 +120,6 @@ fn classes_from_custom_property_and_patterns() {
 #[test]
 fn yolo_lines_are_normalised_centres() {
     use blendsynth::label::record::Annotation;
-    let a = Annotation { object: "P".into(), instance_index: None, class: "polyp".into(), category_id: 2, bbox: [10, 20, 30, 40], area: 1, rle: None, size: [0.0; 3], size_mm: [0.0; 3], distance: 0.0, distance_mm: 0.0, nearest_depth: None };
+    let a = Annotation { object: "P".into(), instance_index: None, class: "polyp".into(), category_id: 2, bbox: [10, 20, 30, 40], area: 1, rle: None, size: [0.0; 3], size_mm: [0.0; 3], largest_mm: 0.0, distance: 0.0, distance_mm: 0.0, nearest_depth: None };
     assert_eq!(blendsynth::label::yolo::label_text(&[a], 100, 200), "1 0.250000 0.200000 0.300000 0.200000\n");
 }

@@ -42,6 +42,7 @@ fn xform(m: &[[f64; 4]; 4], p: [f64; 3]) -> [f64; 3] {
     [0, 1, 2].map(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3])
 }
 
+#[allow(clippy::needless_range_loop)]
 /// Inverse of an affine matrix (rotation/scale/shear plus translation).
 fn affine_inverse(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
     let a = |r: usize, c: usize| m[r][c];
@@ -143,6 +144,6 @@ impl FrameRenderer for BoundsRenderer {
                 }
             }
         }
-        Ok(RenderedFrame { width: w, height: h, color, ids: FrameIds { width: w, height: h, instance_id: ids, depth: Some(depth), instances } })
+        Ok(RenderedFrame { width: w, height: h, color, ids: FrameIds { width: w, height: h, instance_id: ids, depth: Some(depth), normal: None, instances } })
     }
 }

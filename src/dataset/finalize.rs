@@ -70,10 +70,16 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<u64, String> {
         let files = [
             (layout::image_path(src, &rec.split, i), layout::image_path(out, &rec.split, i)),
             (layout::mask_path(src, &rec.split, i), layout::mask_path(out, &rec.split, i)),
+            (layout::depth_path(src, &rec.split, i), layout::depth_path(out, &rec.split, i)),
+            (layout::normal_path(src, &rec.split, i), layout::normal_path(out, &rec.split, i)),
             (layout::label_path(src, &rec.split, i), layout::label_path(out, &rec.split, i)),
             (layout::record_path(src, i), layout::record_path(out, i)),
         ];
-        for (a, b) in files {
+        for (k, (a, b)) in files.into_iter().enumerate() {
+            // Depth and normals are optional.
+            if (k == 2 || k == 3) && !a.exists() {
+                continue;
+            }
             let bytes = std::fs::read(&a).map_err(|e| format!("{}: {e}", a.display()))?;
             write_atomic(&b, &bytes)?;
         }

@@ -18,9 +18,12 @@ use super::renderer::FrameRenderer;
 use super::rng;
 use super::spec::Spec;
 use crate::label::camera::{camera_info, CameraInfo};
-use crate::label::record::{annotations, FrameRecord};
+use crate::label::record::{annotations, Bounds, FrameRecord};
 use crate::label::{extract, instances::semantic, yolo, ClassMap};
 use crate::scene::Scene;
+
+/// See `GenerateOptions::after_write`.
+pub type WriteHook = fn(u64, &Path) -> Result<(), String>;
 
 #[derive(Debug, Clone)]
 pub struct GenerateOptions {
@@ -37,7 +40,7 @@ pub struct GenerateOptions {
     pub progress: bool,
     /// Test hook: called after each file of a frame is written, with the frame index
     /// and the file; an error stops the run there (a crash mid-frame).
-    pub after_write: Option<fn(u64, &Path) -> Result<(), String>>,
+    pub after_write: Option<WriteHook>,
 }
 
 impl Default for GenerateOptions {
@@ -183,7 +186,7 @@ pub fn generate(scene: &Scene, spec: &Spec, renderer: &dyn FrameRenderer, out: &
     let skipped = (mine.len() - todo.len()) as u64;
 
     let scene_json = serde_json::to_value(&scene.file).map_err(|e| e.to_string())?;
-    let ctx = FrameContext { scene, scene_json: &scene_json, spec, renderer, classes: &classes, out, opts, splits: &splits };
+    let ctx = FrameContext { scene, scene_json: &scene_json, spec, renderer, classes: &classes, out, opts, splits: &splits, bounds: Mutex::new(std::collections::HashMap::new()) };
 
     let bar = if opts.progress {
         let b = indicatif::ProgressBar::new(todo.len() as u64);
@@ -211,7 +214,7 @@ pub fn generate(scene: &Scene, spec: &Spec, renderer: &dyn FrameRenderer, out: &
                     Err(e) => {
                         stop.store(true, Ordering::Relaxed);
                         let mut g = first_error.lock().unwrap();
-                        if g.as_ref().is_none_or(|(j, _)| i < *j) {
+                        if g.as_ref().map_or(true, |(j, _)| i < *j) {
                             *g = Some((i, e));
                         }
                         return;
@@ -238,9 +241,34 @@ struct FrameContext<'a> {
     out: &'a Path,
     opts: &'a GenerateOptions,
     splits: &'a [u16],
+    /// Mesh bounds in object space, by object name (meshes do not change per frame).
+    bounds: Mutex<std::collections::HashMap<String, Option<Bounds>>>,
 }
 
 impl FrameContext<'_> {
+    fn local_bounds(&self, object: &str) -> Option<Bounds> {
+        if let Some(b) = self.bounds.lock().unwrap().get(object) {
+            return *b;
+        }
+        let b = (|| {
+            let o = self.scene.object(object)?;
+            let mesh = o.data.as_deref().filter(|_| o.kind == "MESH")?;
+            let idx = self.scene.file.meshes.iter().position(|m| m.name == mesh)?;
+            let m = self.scene.load_mesh(idx).ok()?;
+            let mut lo = [f64::INFINITY; 3];
+            let mut hi = [f64::NEG_INFINITY; 3];
+            for p in &m.positions {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(p[k] as f64);
+                    hi[k] = hi[k].max(p[k] as f64);
+                }
+            }
+            (!m.positions.is_empty()).then_some((lo, hi))
+        })();
+        self.bounds.lock().unwrap().insert(object.to_string(), b);
+        b
+    }
+
     fn frame(&self, i: u64) -> Result<(), String> {
         let opts = self.opts;
         let split = &opts.split[self.splits[i as usize] as usize].0;
@@ -252,7 +280,7 @@ impl FrameContext<'_> {
         }
         let labels = extract(&r.ids, self.classes, self.spec.labels.min_pixels)?;
         let camera = scene_camera(&scene, fv.frame as f64, r.width, r.height)?;
-        let anns = annotations(&r.ids, &labels, &self.classes.names, &camera, self.spec.labels.mm_per_unit);
+        let anns = annotations(&r.ids, &labels, &self.classes.names, &camera, self.spec.labels.mm_per_unit, &|o| self.local_bounds(o));
 
         let hook = |p: &Path| opts.after_write.map_or(Ok(()), |h| h(i, p));
         let img = layout::image_path(self.out, split, i);
@@ -261,6 +289,20 @@ impl FrameContext<'_> {
         let mask = layout::mask_path(self.out, split, i);
         write_atomic(&mask, &layout::png_bytes(r.width, r.height, 1, &semantic(&r.ids, &labels))?)?;
         hook(&mask)?;
+        let labels_spec = &self.spec.labels;
+        if labels_spec.depth {
+            let d = r.ids.depth.as_ref().ok_or("the spec asks for depth but the renderer gave none")?;
+            let mm: Vec<u16> = d.iter().map(|z| if z.is_finite() { (*z as f64 * labels_spec.mm_per_unit).round().clamp(0.0, 65535.0) as u16 } else { 0 }).collect();
+            let p = layout::depth_path(self.out, split, i);
+            write_atomic(&p, &layout::png16_bytes(r.width, r.height, &mm)?)?;
+            hook(&p)?;
+        }
+        if labels_spec.normals {
+            let n = r.ids.normal.as_ref().ok_or("the spec asks for normals but the renderer gave none")?;
+            let p = layout::normal_path(self.out, split, i);
+            write_atomic(&p, &layout::exr_rgb_bytes(r.width, r.height, n)?)?;
+            hook(&p)?;
+        }
         let txt = layout::label_path(self.out, split, i);
         write_atomic(&txt, yolo::label_text(&anns, r.width, r.height).as_bytes())?;
         hook(&txt)?;

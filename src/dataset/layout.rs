@@ -5,6 +5,8 @@
 //! OUT/images/SPLIT/NNNNNNNNN.png        8-bit RGB image
 //! OUT/masks/SPLIT/NNNNNNNNN.png         semantic mask (0 background, else class id)
 //! OUT/labels/SPLIT/NNNNNNNNN.txt        YOLO boxes
+//! OUT/depth/SPLIT/NNNNNNNNN.png         optional: depth in mm, 16-bit (0: none/far)
+//! OUT/normals/SPLIT/NNNNNNNNN.exr       optional: world-space normals, float RGB
 //! OUT/frames/NNNNNNNNN.json             per-frame record; written last: its presence
 //!                                       marks the frame finished
 //! OUT/annotations/instances_SPLIT.json  COCO (written when all frames are done)
@@ -29,6 +31,12 @@ pub fn mask_path(out: &Path, split: &str, index: u64) -> PathBuf {
 pub fn label_path(out: &Path, split: &str, index: u64) -> PathBuf {
     out.join("labels").join(split).join(format!("{}.txt", frame_name(index)))
 }
+pub fn depth_path(out: &Path, split: &str, index: u64) -> PathBuf {
+    out.join("depth").join(split).join(format!("{}.png", frame_name(index)))
+}
+pub fn normal_path(out: &Path, split: &str, index: u64) -> PathBuf {
+    out.join("normals").join(split).join(format!("{}.exr", frame_name(index)))
+}
 pub fn record_path(out: &Path, index: u64) -> PathBuf {
     out.join("frames").join(format!("{}.json", frame_name(index)))
 }
@@ -40,7 +48,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
     let name = path.file_name().unwrap().to_string_lossy();
     let tmp = dir.join(format!(".{name}.partial"));
     let mut f = std::fs::File::create(&tmp).map_err(|e| format!("{}: cannot write: {e}", tmp.display()))?;
-    f.write_all(&bytes).and_then(|_| f.sync_all()).map_err(|e| format!("{}: cannot write: {e}", tmp.display()))?;
+    f.write_all(bytes).and_then(|_| f.sync_all()).map_err(|e| format!("{}: cannot write: {e}", tmp.display()))?;
     drop(f);
     std::fs::rename(&tmp, path).map_err(|e| format!("{}: cannot rename into place: {e}", path.display()))
 }
@@ -76,6 +84,25 @@ pub fn png_bytes(width: u32, height: u32, channels: u8, data: &[u8]) -> Result<V
     let mut out = Vec::new();
     image::codecs::png::PngEncoder::new(&mut out).write_image(data, width, height, kind).map_err(|e| format!("PNG encode: {e}"))?;
     Ok(out)
+}
+
+/// 16-bit grey PNG bytes.
+pub fn png16_bytes(width: u32, height: u32, data: &[u16]) -> Result<Vec<u8>, String> {
+    use image::ImageEncoder;
+    // The encoder takes native-endian samples (it writes PNG big-endian itself).
+    let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_ne_bytes()).collect();
+    let mut out = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut out).write_image(&bytes, width, height, image::ExtendedColorType::L16).map_err(|e| format!("PNG encode: {e}"))?;
+    Ok(out)
+}
+
+/// Float RGB OpenEXR bytes.
+pub fn exr_rgb_bytes(width: u32, height: u32, data: &[[f32; 3]]) -> Result<Vec<u8>, String> {
+    use image::ImageEncoder;
+    let bytes: Vec<u8> = data.iter().flat_map(|p| p.iter().flat_map(|v| v.to_ne_bytes())).collect();
+    let mut out = std::io::Cursor::new(Vec::new());
+    image::codecs::openexr::OpenExrEncoder::new(&mut out).write_image(&bytes, width, height, image::ExtendedColorType::Rgb32F).map_err(|e| format!("EXR encode: {e}"))?;
+    Ok(out.into_inner())
 }
 
 /// Display-referred [0, 1] RGBA to 8-bit RGB, rounded.

@@ -54,7 +54,7 @@ pub fn resolution(scene: &Scene, settings: &RenderSettings) -> (u32, u32) {
 ///             instance_index: i.instance_index, world_bounds: i.world_bounds, world_transform: i.world_transform }).collect();
 ///         Ok(RenderedFrame { width: out.width, height: out.height, color: out.color,
 ///             ids: crate::label::FrameIds { width: out.width, height: out.height, instance_id: p.instance_id,
-///                                           depth: Some(p.depth), instances } })
+///                                           depth: Some(p.depth), normal: Some(p.normal), instances } })
 ///     }
 /// }
 /// ```

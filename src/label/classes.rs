@@ -26,11 +26,14 @@ pub struct LabelSpec {
     pub min_pixels: u64,
     /// Millimetres per scene unit, for 3D sizes and distances.
     pub mm_per_unit: f64,
+    /// Also write depth (16-bit PNG, millimetres) and normals (float EXR).
+    pub depth: bool,
+    pub normals: bool,
 }
 
 impl Default for LabelSpec {
     fn default() -> Self {
-        LabelSpec { classes: Vec::new(), class_property: "class".into(), min_pixels: 16, mm_per_unit: 1000.0 }
+        LabelSpec { classes: Vec::new(), class_property: "class".into(), min_pixels: 16, mm_per_unit: 1000.0, depth: false, normals: false }
     }
 }
 
@@ -49,6 +52,8 @@ impl LabelSpec {
                         _ => return Err("mm_per_unit must be a positive number".into()),
                     }
                 }
+                "depth" => s.depth = x.as_bool().ok_or("depth must be true or false")?,
+                "normals" => s.normals = x.as_bool().ok_or("normals must be true or false")?,
                 "class" => {
                     for (i, c) in x.as_array().ok_or("class must be an array of tables ([[labels.class]])")?.iter().enumerate() {
                         let c = c.as_table().ok_or(format!("class[{i}] must be a table"))?;
@@ -75,7 +80,7 @@ impl LabelSpec {
                         s.classes.push(ClassSpec { name, objects, mask });
                     }
                 }
-                other => return Err(format!("unknown key {other:?} (expected class, class_property, min_pixels, mm_per_unit)")),
+                other => return Err(format!("unknown key {other:?} (expected class, class_property, min_pixels, mm_per_unit, depth, normals)")),
             }
         }
         Ok(s)

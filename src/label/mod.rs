@@ -40,6 +40,8 @@ pub struct FrameIds {
     pub instance_id: Vec<u32>,
     /// Camera-space Z distance per pixel (infinity for background), when rendered.
     pub depth: Option<Vec<f32>>,
+    /// World-space shading normal of the first hit, when rendered.
+    pub normal: Option<Vec<[f32; 3]>>,
     pub instances: Vec<Instance>,
 }
 
@@ -53,6 +55,11 @@ impl FrameIds {
         if let Some(d) = &self.depth {
             if d.len() != n {
                 return Err(format!("depth has {} pixels, expected {n}", d.len()));
+            }
+        }
+        if let Some(d) = &self.normal {
+            if d.len() != n {
+                return Err(format!("normal has {} pixels, expected {n}", d.len()));
             }
         }
         if let Some(bad) = self.instance_id.iter().find(|&&id| id as usize > self.instances.len()) {

@@ -22,9 +22,13 @@ pub struct Annotation {
     /// pycocotools compressed RLE (column-major), for classes with masks.
     #[serde(skip_serializing_if = "Option::is_none", default)]
     pub rle: Option<String>,
-    /// World-space extent of the instance's bounds, scene units and millimetres.
+    /// The instance's true 3D size in scene units and millimetres: its mesh's bounds
+    /// along the object's own axes, times the object's world scale (for Geometry
+    /// Nodes instances, whose mesh the scene does not hold, the world-space bounds).
     pub size: [f64; 3],
     pub size_mm: [f64; 3],
+    /// The largest of the three, in millimetres (a polyp's size as reported clinically).
+    pub largest_mm: f64,
     /// Distance from the camera to the centre of the instance's bounds.
     pub distance: f64,
     pub distance_mm: f64,
@@ -54,14 +58,30 @@ pub struct FrameRecord {
     pub annotations: Vec<Annotation>,
 }
 
-/// Annotations of one frame from its labels.
-pub fn annotations(ids: &FrameIds, labels: &[InstanceLabel], class_names: &[String], camera: &CameraInfo, mm_per_unit: f64) -> Vec<Annotation> {
+/// Axis-aligned bounds (min, max).
+pub type Bounds = ([f64; 3], [f64; 3]);
+
+/// Annotations of one frame from its labels. `local_bounds` gives an object's mesh
+/// bounds in its own space (None when unknown).
+pub fn annotations(
+    ids: &FrameIds,
+    labels: &[InstanceLabel],
+    class_names: &[String],
+    camera: &CameraInfo,
+    mm_per_unit: f64,
+    local_bounds: &dyn Fn(&str) -> Option<Bounds>,
+) -> Vec<Annotation> {
     labels
         .iter()
         .map(|l| {
             let inst = &ids.instances[l.instance];
             let (lo, hi) = inst.world_bounds;
-            let size = [0, 1, 2].map(|k| (hi[k] - lo[k]) as f64);
+            let m = &inst.world_transform;
+            let axis_len = |c: usize| ((0..3).map(|r| (m[r][c] as f64).powi(2)).sum::<f64>()).sqrt();
+            let size = match (inst.instance_index, local_bounds(&inst.object)) {
+                (None, Some((llo, lhi))) => [0, 1, 2].map(|k| (lhi[k] - llo[k]) * axis_len(k)),
+                _ => [0, 1, 2].map(|k| (hi[k] - lo[k]) as f64),
+            };
             let centre = [0, 1, 2].map(|k| (hi[k] as f64 + lo[k] as f64) / 2.0);
             let distance = (0..3).map(|k| (centre[k] - camera.location[k]).powi(2)).sum::<f64>().sqrt();
             Annotation {
@@ -74,6 +94,7 @@ pub fn annotations(ids: &FrameIds, labels: &[InstanceLabel], class_names: &[Stri
                 rle: l.rle.as_deref().map(super::rle::to_string),
                 size,
                 size_mm: size.map(|s| s * mm_per_unit),
+                largest_mm: size.iter().cloned().fold(0.0, f64::max) * mm_per_unit,
                 distance,
                 distance_mm: distance * mm_per_unit,
                 nearest_depth: l.nearest_depth.map(|d| d as f64),

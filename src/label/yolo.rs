@@ -14,13 +14,15 @@ pub fn label_text(annotations: &[Annotation], width: u32, height: u32) -> String
     s
 }
 
-/// `data.yaml` for Ultralytics: paths relative to the file's folder.
+/// `data.yaml` for Ultralytics: split folders relative to the file's folder. No `path`
+/// key: Ultralytics' `check_det_dataset` resolves a relative `path` (even `.`) against
+/// the working directory, but without one it uses the YAML file's own folder.
 pub fn data_yaml(splits: &[String], names: &[String]) -> String {
-    let mut s = String::from("# Ultralytics dataset: blendsynth generate\npath: .\n");
+    let mut s = String::from("# Ultralytics dataset written by blendsynth; paths are relative to this file's folder.\n");
     for sp in splits {
         s.push_str(&format!("{sp}: images/{sp}\n"));
     }
-    s.push_str("names:\n");
+    s.push_str(&format!("nc: {}\nnames:\n", names.len()));
     for (i, n) in names.iter().enumerate() {
         s.push_str(&format!("  {i}: {}\n", serde_json::to_string(n).unwrap()));
     }
