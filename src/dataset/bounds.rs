@@ -21,21 +21,25 @@ impl BoundsRenderer {
         let mut local = HashMap::new();
         for (i, m) in scene.file.meshes.iter().enumerate() {
             let mesh = scene.load_mesh(i).map_err(|e| e.to_string())?;
-            if mesh.positions.is_empty() {
-                continue;
+            if let Some(b) = positions_bounds(&mesh.positions) {
+                local.insert(m.name.clone(), b);
             }
-            let mut lo = [f64::INFINITY; 3];
-            let mut hi = [f64::NEG_INFINITY; 3];
-            for p in &mesh.positions {
-                for k in 0..3 {
-                    lo[k] = lo[k].min(p[k] as f64);
-                    hi[k] = hi[k].max(p[k] as f64);
-                }
-            }
-            local.insert(m.name.clone(), (lo, hi));
         }
         Ok(BoundsRenderer { local })
     }
+}
+
+/// Bounds of a set of points (None when empty).
+pub fn positions_bounds(positions: &[[f32; 3]]) -> Option<([f64; 3], [f64; 3])> {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in positions {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k] as f64);
+            hi[k] = hi[k].max(p[k] as f64);
+        }
+    }
+    (!positions.is_empty()).then_some((lo, hi))
 }
 
 fn xform(m: &[[f64; 4]; 4], p: [f64; 3]) -> [f64; 3] {

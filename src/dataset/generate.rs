@@ -254,16 +254,7 @@ impl FrameContext<'_> {
             let o = self.scene.object(object)?;
             let mesh = o.data.as_deref().filter(|_| o.kind == "MESH")?;
             let idx = self.scene.file.meshes.iter().position(|m| m.name == mesh)?;
-            let m = self.scene.load_mesh(idx).ok()?;
-            let mut lo = [f64::INFINITY; 3];
-            let mut hi = [f64::NEG_INFINITY; 3];
-            for p in &m.positions {
-                for k in 0..3 {
-                    lo[k] = lo[k].min(p[k] as f64);
-                    hi[k] = hi[k].max(p[k] as f64);
-                }
-            }
-            (!m.positions.is_empty()).then_some((lo, hi))
+            super::bounds::positions_bounds(&self.scene.load_mesh(idx).ok()?.positions)
         })();
         self.bounds.lock().unwrap().insert(object.to_string(), b);
         b
