@@ -2,6 +2,7 @@
 //! here is an error naming the tree and node: it is never evaluated as something else.
 
 pub mod attribute;
+pub mod curve;
 pub mod delete;
 pub mod distribute;
 pub mod extrude;
@@ -10,6 +11,7 @@ pub mod function;
 pub mod geometry_ops;
 pub mod input;
 pub mod primitives;
+pub mod proximity;
 pub mod subdivide;
 
 use super::error::GeometryError;
@@ -76,6 +78,11 @@ pub const SUPPORTED: &[&str] = &[
     "FunctionNodeRotationToEuler",
     "FunctionNodeInputRotation",
     "GeometryNodeExtrudeMesh",
+    "GeometryNodeResampleCurve",
+    "GeometryNodeSetCurveRadius",
+    "GeometryNodeSetCurveTilt",
+    "GeometryNodeCurveToMesh",
+    "GeometryNodeProximity",
 ];
 
 pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -139,6 +146,11 @@ pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "FunctionNodeRotationToEuler" => field_nodes::rotation_to_euler(ctx),
         "FunctionNodeInputRotation" => field_nodes::input_rotation(ctx),
         "GeometryNodeExtrudeMesh" => extrude::extrude_mesh(ctx),
+        "GeometryNodeResampleCurve" => curve::resample_curve(ctx),
+        "GeometryNodeSetCurveRadius" => curve::set_curve_radius(ctx),
+        "GeometryNodeSetCurveTilt" => curve::set_curve_tilt(ctx),
+        "GeometryNodeCurveToMesh" => curve::curve_to_mesh(ctx),
+        "GeometryNodeProximity" => proximity::geometry_proximity(ctx),
         _ => Err(ctx.err("this node type is not supported by blendsynth's Geometry Nodes evaluator")),
     }
 }
