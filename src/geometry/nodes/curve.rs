@@ -17,13 +17,16 @@ use super::geometry_ops::{eval_fields, geo, modify_geometry_sets};
 /// Segment index and factor of a sample at `len` along accumulated segment `lengths`
 /// (`length_parameterize::sample_at_length`).
 fn sample_at_length(lengths: &[f32], len: f32) -> (usize, f32) {
-    let idx = lengths.partition_point(|&l| l <= len);
-    if idx == lengths.len() {
+    let total = lengths[lengths.len() - 1];
+    if len >= total {
         return (lengths.len() - 1, 1.0);
     }
+    let idx = lengths.partition_point(|&l| l <= len);
     let start = if idx == 0 { 0.0 } else { lengths[idx - 1] };
     let seg = lengths[idx] - start;
-    (idx, if seg == 0.0 { 0.0 } else { (len - start) / seg })
+    // Blender multiplies by the inverse (bit for bit, that is not a division).
+    let inv = if seg == 0.0 { 0.0 } else { 1.0 / seg };
+    (idx, (len - start) * inv)
 }
 
 /// `count` uniform samples along accumulated `lengths` (`length_parameterize::sample_uniform`).
@@ -179,6 +182,13 @@ pub fn set_curve_tilt(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     set_point_float(ctx, "Tilt", "tilt", 0.0)
 }
 
+fn is_builtin_curve_attribute(n: &str) -> bool {
+    matches!(
+        n,
+        "position" | "radius" | "tilt" | "handle_left" | "handle_right" | "handle_type_left" | "handle_type_right" | "nurbs_weight" | "normal_mode" | "curve_type" | "cyclic" | "resolution" | "nurbs_order" | "knots_mode" | "custom_normal"
+    )
+}
+
 fn segments(n: usize, cyclic: bool) -> usize {
     if cyclic {
         n
@@ -297,6 +307,24 @@ fn sweep(main: &Curves, scale_field: &[f32], profile: Option<&Curves>, fill_caps
                 m.face_offsets.push(m.corner_verts.len() as u32);
             }
         }
+    }
+    // Main curves' own point attributes on the vertices of each ring (built-in curve
+    // attributes are not mesh attributes and stay behind, as in Blender).
+    for a in main.attributes.iter() {
+        if a.domain != Domain::Point || a.id.name().is_some_and(is_builtin_curve_attribute) {
+            continue;
+        }
+        let evaluated = mev.interpolate(main, &a.data);
+        let mut idx = Vec::with_capacity(m.vertex_count());
+        for im in 0..main.curve_count() {
+            for ip in 0..profile.curve_count() {
+                let pn = pev.range(ip).len();
+                for i in mev.range(im) {
+                    idx.extend(std::iter::repeat_n(i, pn));
+                }
+            }
+        }
+        m.attributes.set(a.id.clone(), Domain::Point, evaluated.gather(&idx));
     }
     if !sharp_faces.is_empty() {
         let mut e = vec![false; m.edge_count()];
