@@ -3,6 +3,7 @@
 
 pub mod attribute;
 pub mod curve;
+pub mod curve_primitives;
 pub mod delete;
 pub mod distribute;
 pub mod extrude;
@@ -83,6 +84,12 @@ pub const SUPPORTED: &[&str] = &[
     "GeometryNodeSetCurveTilt",
     "GeometryNodeCurveToMesh",
     "GeometryNodeProximity",
+    "GeometryNodeCurvePrimitiveLine",
+    "GeometryNodeCurvePrimitiveCircle",
+    "GeometryNodeCurveStar",
+    "GeometryNodeCurveSpiral",
+    "GeometryNodeCurvePrimitiveQuadrilateral",
+    "GeometryNodeCurvePrimitiveBezierSegment",
 ];
 
 pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -151,6 +158,12 @@ pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "GeometryNodeSetCurveTilt" => curve::set_curve_tilt(ctx),
         "GeometryNodeCurveToMesh" => curve::curve_to_mesh(ctx),
         "GeometryNodeProximity" => proximity::geometry_proximity(ctx),
+        "GeometryNodeCurvePrimitiveLine" => curve_primitives::line(ctx),
+        "GeometryNodeCurvePrimitiveCircle" => curve_primitives::circle(ctx),
+        "GeometryNodeCurveStar" => curve_primitives::star(ctx),
+        "GeometryNodeCurveSpiral" => curve_primitives::spiral(ctx),
+        "GeometryNodeCurvePrimitiveQuadrilateral" => curve_primitives::quadrilateral(ctx),
+        "GeometryNodeCurvePrimitiveBezierSegment" => curve_primitives::bezier_segment(ctx),
         _ => Err(ctx.err("this node type is not supported by blendsynth's Geometry Nodes evaluator")),
     }
 }
