@@ -21,6 +21,10 @@ struct Grid<'a> {
     pts: &'a [[f32; 3]],
 }
 
+fn k_coord(k: (i64, i64, i64), c: usize) -> i64 {
+    [k.0, k.1, k.2][c]
+}
+
 impl<'a> Grid<'a> {
     fn new(pts: &'a [[f32; 3]], cell: f64) -> Self {
         let mut cells: HashMap<(i64, i64, i64), Vec<u32>> = HashMap::new();
@@ -35,7 +39,22 @@ impl<'a> Grid<'a> {
     /// Distance to the nearest point if it is within one cell, else infinity.
     fn nearest_within_cell(&self, q: &[f32; 3]) -> f64 {
         let k = Self::key(q, self.cell);
-        let mut best = f64::INFINITY;
+        let dist = |i: u32| {
+            let p = &self.pts[i as usize];
+            (0..3).map(|c| (p[c] as f64 - q[c] as f64).powi(2)).sum::<f64>().sqrt()
+        };
+        // Own cell first: a point there nearer than any face of the cell is the nearest.
+        let mut best = self.cells.get(&k).map(|v| v.iter().map(|&i| dist(i)).fold(f64::INFINITY, f64::min)).unwrap_or(f64::INFINITY);
+        let to_face = (0..3)
+            .map(|c| {
+                let lo = k_coord(k, c) as f64 * self.cell;
+                let x = q[c] as f64;
+                (x - lo).min(lo + self.cell - x)
+            })
+            .fold(f64::INFINITY, f64::min);
+        if best <= to_face {
+            return best;
+        }
         for dx in -1..=1 {
             for dy in -1..=1 {
                 for dz in -1..=1 {
