@@ -129,6 +129,15 @@ impl Evaluated {
         Ok(Evaluated { offsets, cyclic, types, bezier_offsets })
     }
 
+    /// The evaluated point (within curve `i`) where control point `p` (within the curve)
+    /// lies.
+    pub fn control_point_evaluated(&self, i: usize, p: usize) -> usize {
+        match self.types[i] {
+            CURVE_TYPE_BEZIER => self.bezier_offsets[i][p] as usize,
+            _ => p,
+        }
+    }
+
     pub fn total(&self) -> usize {
         *self.offsets.last().unwrap_or(&0) as usize
     }
@@ -275,6 +284,10 @@ pub fn lerp_gather(data: &Array, a: &[usize], b: &[usize], f: &[f32]) -> Array {
         Array::Float2(v) => Array::Float2(lanes(v, a, b, f)),
         Array::Vector(v) => Array::Vector(lanes(v, a, b, f)),
         Array::Color(v) => Array::Color(lanes(v, a, b, f)),
+        // Blender's `mix2` for integers and booleans: the float mix, rounded / thresholded.
+        Array::Int(v) => Array::Int((0..a.len()).map(|i| ((1.0 - f[i]) * v[a[i]] as f32 + f[i] * v[b[i]] as f32).round() as i32).collect()),
+        Array::Int8(v) => Array::Int8((0..a.len()).map(|i| ((1.0 - f[i]) * v[a[i]] as f32 + f[i] * v[b[i]] as f32).round() as i8).collect()),
+        Array::Bool(v) => Array::Bool((0..a.len()).map(|i| (1.0 - f[i]) * v[a[i]] as u8 as f32 + f[i] * v[b[i]] as u8 as f32 >= 0.5).collect()),
         other => other.gather(a),
     }
 }

@@ -3,6 +3,7 @@
 
 pub mod attribute;
 pub mod curve;
+pub mod curve_fields;
 pub mod curve_primitives;
 pub mod delete;
 pub mod distribute;
@@ -90,6 +91,8 @@ pub const SUPPORTED: &[&str] = &[
     "GeometryNodeCurveSpiral",
     "GeometryNodeCurvePrimitiveQuadrilateral",
     "GeometryNodeCurvePrimitiveBezierSegment",
+    "GeometryNodeSplineParameter",
+    "GeometryNodeCurveLength",
 ];
 
 pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -164,6 +167,8 @@ pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "GeometryNodeCurveSpiral" => curve_primitives::spiral(ctx),
         "GeometryNodeCurvePrimitiveQuadrilateral" => curve_primitives::quadrilateral(ctx),
         "GeometryNodeCurvePrimitiveBezierSegment" => curve_primitives::bezier_segment(ctx),
+        "GeometryNodeSplineParameter" => curve_fields::spline_parameter(ctx),
+        "GeometryNodeCurveLength" => curve_fields::curve_length(ctx),
         _ => Err(ctx.err("this node type is not supported by blendsynth's Geometry Nodes evaluator")),
     }
 }
