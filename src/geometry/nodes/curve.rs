@@ -320,7 +320,7 @@ fn sweep(main: &Curves, scale_field: &[f32], profile: Option<&Curves>, fill_caps
             for ip in 0..profile.curve_count() {
                 let pn = pev.range(ip).len();
                 for i in mev.range(im) {
-                    idx.extend(std::iter::repeat_n(i, pn));
+                    idx.extend(std::iter::repeat(i).take(pn));
                 }
             }
         }

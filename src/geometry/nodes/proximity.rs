@@ -65,7 +65,7 @@ pub fn geometry_proximity(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         return Err(ctx.err(format!("target element {element} is not supported yet (only POINTS)")));
     }
     for id in ["Group ID", "Sample Group ID"] {
-        if ctx.has_input(id) && ctx.field(id, DataType::Int)?.as_constant().is_none_or(|v| v.as_int() != 0) {
+        if ctx.has_input(id) && ctx.field(id, DataType::Int)?.as_constant().map_or(true, |v| v.as_int() != 0) {
             return Err(ctx.err(format!("{id} is not supported yet")));
         }
     }
