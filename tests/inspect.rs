@@ -17,12 +17,18 @@ fn row<'a>(r: &'a Value, kind: &str) -> &'a Value {
 
 #[test]
 fn shared_maths_counts_only_where_an_evaluator_runs_it() {
-    // Math and Combine XYZ are proven for shaders, but this file uses them in a
-    // Geometry Nodes tree, which blendsynth does not evaluate yet.
+    // This file uses Math and Combine XYZ in a Geometry Nodes tree: they count because
+    // the geometry evaluator runs them (its world shader still makes the exit status 3).
     let (code, r) = report("fixtures/scenes/geonodes");
     assert_eq!(code, Some(3));
-    assert_eq!(row(&r, "ShaderNodeMath")["support"], "unsupported");
-    assert_eq!(row(&r, "ShaderNodeCombineXYZ")["support"], "unsupported");
+    assert_eq!(row(&r, "ShaderNodeMath")["support"], "supported");
+    assert_eq!(row(&r, "ShaderNodeCombineXYZ")["support"], "supported");
+    assert_eq!(row(&r, "ShaderNodeOutputWorld")["support"], "unsupported");
+    // In a Geometry Nodes tree only what the geometry evaluator implements counts.
+    use blendsynth::nodes::{support_in, Support};
+    assert!(matches!(support_in("GeometryNodeTree", "GeometryNodeCurveToMesh"), Support::Supported));
+    assert!(matches!(support_in("GeometryNodeTree", "GeometryNodeSubdivisionSurface"), Support::Unsupported));
+    assert!(matches!(support_in("GeometryNodeTree", "ShaderNodeBsdfPrincipled"), Support::Unsupported));
     let (_, r) = report("fixtures/bake/scenes/uv_math");
     assert_eq!(row(&r, "ShaderNodeMath")["support"], "supported");
 }

@@ -93,23 +93,7 @@ pub fn scene_at(scene: &Scene, frame: f64, overrides: &[(String, Value)]) -> Res
     Ok(Scene { dir: scene.dir.clone(), file })
 }
 
-/// Per node group, each link's `multi_input_sort_id` as scene.json holds it (0 when
-/// absent), read from the file because the typed `Link` does not keep it.
+/// Per node group, each link's `multi_input_sort_id` (0 when the export lacks it).
 pub fn link_sort_ids(scene: &Scene) -> Result<HashMap<String, Vec<i64>>, GeometryError> {
-    let mut out = HashMap::new();
-    let bytes = match std::fs::read(scene.json_path()) {
-        Ok(b) => b,
-        Err(_) => return Ok(out),
-    };
-    let v: Value = serde_json::from_slice(&bytes).map_err(|e| GeometryError::new(format!("{}: {e}", scene.json_path().display())))?;
-    for g in v.get("node_groups").and_then(Value::as_array).into_iter().flatten() {
-        let Some(name) = g.get("name").and_then(Value::as_str) else { continue };
-        let ids = g
-            .get("links")
-            .and_then(Value::as_array)
-            .map(|ls| ls.iter().map(|l| l.get("multi_input_sort_id").and_then(Value::as_i64).unwrap_or(0)).collect())
-            .unwrap_or_default();
-        out.insert(name.to_string(), ids);
-    }
-    Ok(out)
+    Ok(scene.file.node_groups.iter().map(|g| (g.name.clone(), g.links.iter().map(|l| l.multi_input_sort_id).collect())).collect())
 }

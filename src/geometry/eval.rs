@@ -62,6 +62,12 @@ impl<'s> Session<'s> {
                 let md = self.scene.load_mesh(index)?;
                 Ok(GeometrySet::from_mesh(Mesh::from_scene(&md, &self.scene.file.meshes[index].materials)))
             }
+            "CURVE" => {
+                let data = o.data.as_deref().ok_or_else(|| GeometryError::new(format!("{here}: curve object without curve data")))?;
+                let cu = self.scene.file.curves.iter().find(|c| c.name == data).ok_or_else(|| GeometryError::new(format!("{here}: curve {data:?} is not in the export")))?;
+                let curves = super::legacy_curve::to_curves(cu).map_err(|e| e.within(&here))?;
+                Ok(GeometrySet { curves: Some(std::sync::Arc::new(curves)), ..Default::default() })
+            }
             "EMPTY" | "CAMERA" | "LIGHT" | "LIGHT_PROBE" | "SPEAKER" => Ok(GeometrySet::default()),
             other => Err(GeometryError::new(format!("{here}: {other} objects cannot be evaluated as geometry yet"))),
         }

@@ -266,3 +266,32 @@ pub fn write_glb(path: &Path, m: &Mesh, name: &str) -> Result<(), GeometryError>
     out.extend_from_slice(&b.bin);
     std::fs::write(path, out).map_err(|e| io_err(path, e))
 }
+
+/// Writes `m` in the format `path`'s extension names (`glb`, `ply` or `obj`), through a
+/// temporary file in the same folder renamed into place, so a failure never leaves a
+/// half-written output.
+pub fn write_mesh(path: &Path, m: &Mesh, name: &str) -> Result<(), GeometryError> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
+    if !matches!(ext.as_str(), "glb" | "ply" | "obj") {
+        return Err(GeometryError::new(format!("{}: unknown mesh format (use .glb, .ply or .obj)", path.display())));
+    }
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        return Err(GeometryError::new(format!("{}: folder {} does not exist", path.display(), dir.display())));
+    }
+    let file_name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let tmp = dir.join(format!(".{file_name}.{}.part.{ext}", std::process::id()));
+    let written = match ext.as_str() {
+        "glb" => write_glb(&tmp, m, name),
+        "ply" => write_ply(&tmp, m),
+        _ => write_obj(&tmp, m),
+    };
+    if let Err(e) = written.and_then(|_| std::fs::rename(&tmp, path).map_err(|e| io_err(path, e))) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(e);
+    }
+    Ok(())
+}

@@ -24,7 +24,9 @@
 
 pub mod animated;
 pub mod attribute;
+pub mod curve_eval;
 pub mod curves;
+pub mod legacy_curve;
 pub mod error;
 pub mod eval;
 pub mod export;
@@ -35,13 +37,14 @@ pub mod math;
 pub mod mesh;
 pub mod nodes;
 pub mod pointcloud;
+pub mod polyfill;
 pub mod realize;
 pub mod set;
 pub mod types;
 pub mod value;
 
 pub use error::GeometryError;
-pub use export::{write_glb, write_obj, write_ply};
+pub use export::{write_glb, write_mesh, write_obj, write_ply};
 pub use mesh::Mesh;
 pub use set::GeometrySet;
 

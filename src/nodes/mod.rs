@@ -118,6 +118,10 @@ const SUPPORTED: &[&str] = &[
 /// tree type runs it. Geometry Nodes trees are not evaluated yet, so only their
 /// structure is supported there.
 pub fn support_in(tree: &str, bl_idname: &str) -> Support {
+    // Geometry Nodes trees: exactly what the geometry evaluator implements.
+    if tree == "GeometryNodeTree" && !STRUCTURAL.contains(&bl_idname) {
+        return if crate::geometry::supports_node(bl_idname) { Support::Supported } else { Support::Unsupported };
+    }
     match support(bl_idname) {
         Support::Supported if tree != "ShaderNodeTree" => Support::Unsupported,
         s => s,

@@ -419,6 +419,10 @@ pub struct Link {
     pub is_muted: bool,
     #[serde(default = "yes")]
     pub is_valid: bool,
+    /// Order of this link among the links into a multi-input socket (Join Geometry);
+    /// 0 when the exporter did not write it.
+    #[serde(default)]
+    pub multi_input_sort_id: i64,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -21,7 +21,8 @@ use super::super::value::SocketValue;
 use super::geometry_ops::{eval_fields, modify_geometry_sets};
 use crate::nodes::random::{hash2, hash3, hash_float_to_float3, Rng};
 
-/// Blender's loop triangles: triangles as they are, quads split (0,1,2) (0,2,3).
+/// Blender's loop triangles: triangles as they are, quads split (0,1,2) (0,2,3), n-gons
+/// by Blender's ear clipping (`polyfill`).
 pub fn corner_tris(m: &Mesh) -> Result<(Vec<[u32; 3]>, Vec<u32>), String> {
     let mut tris = Vec::new();
     let mut faces = Vec::new();
@@ -39,7 +40,15 @@ pub fn corner_tris(m: &Mesh) -> Result<(Vec<[u32; 3]>, Vec<u32>), String> {
                 faces.push(f as u32);
                 faces.push(f as u32);
             }
-            n => return Err(format!("face {f} has {n} corners: triangulating n-gons as Blender does (polyfill) is not supported yet")),
+            n => {
+                let normal = m.face_normal(f);
+                let co = super::super::polyfill::project(normal, r.clone().map(|c| m.positions[m.corner_verts[c] as usize]));
+                for t in super::super::polyfill::polyfill(&co) {
+                    tris.push([s + t[0], s + t[1], s + t[2]]);
+                    faces.push(f as u32);
+                }
+                let _ = n;
+            }
         }
     }
     Ok((tris, faces))
@@ -241,7 +250,8 @@ fn mix3(a: &Array, idx: [usize; 3], w: V3) -> Value {
     }
 }
 
-fn distribute_mesh(ctx: &NodeCtx, m: &Mesh, method: &str, sel: &Field, seed: i32, want_normal: Option<&AttrId>, want_rot: Option<&AttrId>) -> Result<Option<PointCloud>, String> {
+#[allow(clippy::too_many_arguments)]
+fn distribute_mesh(ctx: &NodeCtx, m: &Mesh, method: &str, sel: &Field, seed: i32, want_normal: Option<&AttrId>, want_rot: Option<&AttrId>, legacy: bool) -> Result<Option<PointCloud>, String> {
     let (tris, tri_faces) = corner_tris(m)?;
     let comp = ComponentRef::Mesh(m);
     let density_factors = |f: &Field| -> Result<Vec<f32>, String> {
@@ -313,7 +323,7 @@ fn distribute_mesh(ctx: &NodeCtx, m: &Mesh, method: &str, sel: &Field, seed: i32
         .collect();
     pc.attributes.set(AttrId::named("id"), Domain::Point, Array::Int(ids));
     if want_normal.is_some() || want_rot.is_some() {
-        let normals = sample_normals(m, &tris, &tri_faces, &s);
+        let normals = if legacy { legacy_normals(m, &tris, &s) } else { sample_normals(m, &tris, &tri_faces, &s) };
         if let Some(id) = want_normal {
             pc.attributes.set(id.clone(), Domain::Point, Array::Vector(normals.clone()));
         }
@@ -323,6 +333,22 @@ fn distribute_mesh(ctx: &NodeCtx, m: &Mesh, method: &str, sel: &Field, seed: i32
         }
     }
     Ok(Some(pc))
+}
+
+/// "Legacy Normal" (files from before 4.0): the normal of the triangle each point lies on
+/// (`normal_tri_v3`), whatever the shading.
+fn legacy_normals(m: &Mesh, tris: &[[u32; 3]], s: &Samples) -> Vec<V3> {
+    s.tri
+        .iter()
+        .map(|&t| {
+            let c = tris[t];
+            let p = |k: usize| m.positions[m.corner_verts[c[k] as usize] as usize];
+            let (a, b, d) = (p(0), p(1), p(2));
+            let n1 = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+            let n2 = [b[0] - d[0], b[1] - d[1], b[2] - d[2]];
+            normalize([n1[1] * n2[2] - n1[2] * n2[1], n1[2] * n2[0] - n1[0] * n2[2], n1[0] * n2[1] - n1[1] * n2[0]])
+        })
+        .collect()
 }
 
 /// The surface normal at each point, by the mesh's normal domain (face normals on flat
@@ -371,16 +397,14 @@ pub fn distribute_points_on_faces(ctx: &NodeCtx) -> Result<Outputs, GeometryErro
     if !matches!(method.as_str(), "RANDOM" | "POISSON") {
         return Err(ctx.err(format!("method {method} is not supported")));
     }
-    if ctx.prop_bool("use_legacy_normal").unwrap_or(false) {
-        return Err(ctx.err("legacy normals are not supported"));
-    }
+    let legacy = ctx.prop_bool("use_legacy_normal").unwrap_or(false);
     let seed = ctx.int("Seed")?.wrapping_mul(5383843);
     let sel = ctx.field("Selection", DataType::Bool)?;
     let rot_id = ctx.output_used("Rotation").then(|| AttrId::anonymous("Rotation"));
     let normal_id = ctx.output_used("Normal").then(|| AttrId::anonymous("Normal"));
     modify_geometry_sets(&mut g, &mut |s: &mut GeometrySet| {
         if let Some(m) = s.mesh.clone() {
-            let pc = distribute_mesh(ctx, &m, &method, &sel, seed, normal_id.as_ref(), rot_id.as_ref())?;
+            let pc = distribute_mesh(ctx, &m, &method, &sel, seed, normal_id.as_ref(), rot_id.as_ref(), legacy)?;
             s.points = pc.map(Arc::new);
         } else {
             s.points = None;

@@ -2,6 +2,9 @@
 //! here is an error naming the tree and node: it is never evaluated as something else.
 
 pub mod attribute;
+pub mod curve;
+pub mod curve_fields;
+pub mod curve_primitives;
 pub mod delete;
 pub mod distribute;
 pub mod extrude;
@@ -10,6 +13,7 @@ pub mod function;
 pub mod geometry_ops;
 pub mod input;
 pub mod primitives;
+pub mod proximity;
 pub mod subdivide;
 
 use super::error::GeometryError;
@@ -76,6 +80,19 @@ pub const SUPPORTED: &[&str] = &[
     "FunctionNodeRotationToEuler",
     "FunctionNodeInputRotation",
     "GeometryNodeExtrudeMesh",
+    "GeometryNodeResampleCurve",
+    "GeometryNodeSetCurveRadius",
+    "GeometryNodeSetCurveTilt",
+    "GeometryNodeCurveToMesh",
+    "GeometryNodeProximity",
+    "GeometryNodeCurvePrimitiveLine",
+    "GeometryNodeCurvePrimitiveCircle",
+    "GeometryNodeCurveStar",
+    "GeometryNodeCurveSpiral",
+    "GeometryNodeCurvePrimitiveQuadrilateral",
+    "GeometryNodeCurvePrimitiveBezierSegment",
+    "GeometryNodeSplineParameter",
+    "GeometryNodeCurveLength",
 ];
 
 pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -139,6 +156,19 @@ pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "FunctionNodeRotationToEuler" => field_nodes::rotation_to_euler(ctx),
         "FunctionNodeInputRotation" => field_nodes::input_rotation(ctx),
         "GeometryNodeExtrudeMesh" => extrude::extrude_mesh(ctx),
+        "GeometryNodeResampleCurve" => curve::resample_curve(ctx),
+        "GeometryNodeSetCurveRadius" => curve::set_curve_radius(ctx),
+        "GeometryNodeSetCurveTilt" => curve::set_curve_tilt(ctx),
+        "GeometryNodeCurveToMesh" => curve::curve_to_mesh(ctx),
+        "GeometryNodeProximity" => proximity::geometry_proximity(ctx),
+        "GeometryNodeCurvePrimitiveLine" => curve_primitives::line(ctx),
+        "GeometryNodeCurvePrimitiveCircle" => curve_primitives::circle(ctx),
+        "GeometryNodeCurveStar" => curve_primitives::star(ctx),
+        "GeometryNodeCurveSpiral" => curve_primitives::spiral(ctx),
+        "GeometryNodeCurvePrimitiveQuadrilateral" => curve_primitives::quadrilateral(ctx),
+        "GeometryNodeCurvePrimitiveBezierSegment" => curve_primitives::bezier_segment(ctx),
+        "GeometryNodeSplineParameter" => curve_fields::spline_parameter(ctx),
+        "GeometryNodeCurveLength" => curve_fields::curve_length(ctx),
         _ => Err(ctx.err("this node type is not supported by blendsynth's Geometry Nodes evaluator")),
     }
 }
