@@ -10,5 +10,6 @@ pub mod blender;
 pub mod geometry;
 pub mod inspect;
 pub mod nodes;
+pub mod render;
 pub mod scene;
 pub mod shader;
