@@ -78,10 +78,16 @@ impl LobeSet {
     }
 
     pub fn push(&mut self, kind: LobeKind, weight: V3, n: V3) {
+        self.push_scaled(kind, weight, n, 1.0);
+    }
+
+    /// `push` with the selection weight scaled by the lobe's estimated albedo, as Cycles
+    /// does for Fresnel-weighted microfacet closures (a dim specular layer is picked less).
+    pub fn push_scaled(&mut self, kind: LobeKind, weight: V3, n: V3, albedo: f32) {
         if !(weight.iter().all(|w| w.is_finite())) {
             return;
         }
-        let sw = weight[0].abs() + weight[1].abs() + weight[2].abs();
+        let sw = (weight[0].abs() + weight[1].abs() + weight[2].abs()) * albedo.clamp(0.0, 1.0);
         if sw <= 0.0 {
             return;
         }

@@ -26,7 +26,38 @@ pub struct Settings {
     pub min_light_bounces: u32,
 }
 
+/// Emissive triangles for light sampling: chosen by area times estimated emission.
+#[derive(Default)]
+pub struct MeshLights {
+    pub prims: Vec<u32>,
+    pub cdf: Vec<f32>,
+    /// Per scene triangle: selection probability over its area (0: not a light).
+    pub pdf_area: Vec<f32>,
+}
+
+impl MeshLights {
+    fn pick(&self, u: f32) -> usize {
+        let n = self.cdf.len();
+        let i = self.cdf.partition_point(|&c| c <= u);
+        i.min(n - 1)
+    }
+}
+
+#[inline]
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    if a.is_infinite() {
+        return 1.0;
+    }
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 > 0.0 {
+        a2 / (a2 + b2)
+    } else {
+        0.0
+    }
+}
+
 pub struct Scene<'a> {
+    pub mesh_lights: &'a MeshLights,
     pub accel: &'a dyn Accel,
     pub geo: &'a Geometry,
     pub materials: &'a [Material],
@@ -40,12 +71,13 @@ pub struct Scene<'a> {
 pub struct Scratch {
     pub stacks: Vec<Vec<f32>>,
     pub lobes: LobeSet,
+    pub light_lobes: LobeSet,
     pub rays: u64,
 }
 
 impl Scratch {
     pub fn new(n_materials: usize) -> Scratch {
-        Scratch { stacks: vec![Vec::new(); n_materials + 1], lobes: LobeSet::default(), rays: 0 }
+        Scratch { stacks: vec![Vec::new(); n_materials + 1], lobes: LobeSet::default(), light_lobes: LobeSet::default(), rays: 0 }
     }
 }
 
@@ -58,6 +90,9 @@ pub struct SurfaceHit {
     pub material: Option<usize>,
     pub backfacing: bool,
 }
+
+/// Below this GGX alpha a vertex uses MIS toward lamps.
+const MIS_ALPHA: f32 = 0.05;
 
 fn clamp_contrib(l: V3, limit: f32) -> V3 {
     if limit > 0.0 {
@@ -118,17 +153,26 @@ impl Scene<'_> {
     }
 
     pub fn shade(&self, hit: &SurfaceHit, wo: V3, scratch: &mut Scratch) {
+        self.shade_into(hit, wo, &mut scratch.stacks, &mut scratch.lobes);
+    }
+
+    fn shade_into(&self, hit: &SurfaceHit, wo: V3, stacks: &mut [Vec<f32>], lobes: &mut LobeSet) {
         let ctx = Context { tables: self.tables, wo };
         match hit.material {
-            Some(mi) => {
-                let (stacks, lobes) = (&mut scratch.stacks, &mut scratch.lobes);
-                self.materials[mi].shade(&hit.sp, &mut stacks[mi], &ctx, lobes)
-            }
+            Some(mi) => self.materials[mi].shade(&hit.sp, &mut stacks[mi], &ctx, lobes),
             None => {
-                scratch.lobes.clear();
-                scratch.lobes.push(LobeKind::Diffuse, [0.8; 3], hit.sp.normal);
+                lobes.clear();
+                lobes.push(LobeKind::Diffuse, [0.8; 3], hit.sp.normal);
             }
         }
+    }
+
+    /// Emission of a surface point seen from direction `wo` (for building the mesh
+    /// light distribution and for light samples on emissive triangles).
+    pub fn emission_at(&self, prim: u32, u: f32, v: f32, wo: V3, scratch: &mut Scratch) -> V3 {
+        let hit = self.surface(prim, u, v, wo);
+        self.shade_into(&hit, wo, &mut scratch.stacks, &mut scratch.light_lobes);
+        scratch.light_lobes.emission
     }
 
     /// One path sample: radiance along the camera ray.
@@ -140,10 +184,37 @@ impl Scene<'_> {
         let (mut bounce, mut diffuse, mut glossy, mut transmission, mut transparent) = (0u32, 0u32, 0u32, 0u32, 0u32);
         let mut terminate_next = false;
         let mut set = 1u32;
+        // MIS state of the ray being traced: the BSDF pdf that chose it, or singular.
+        let mut prev_pdf = f32::INFINITY;
+        let mut prev_singular = true;
+        // Whether the vertex that sent the ray shares lamps between light and BSDF sampling.
+        let mut prev_mis_lamps = false;
         loop {
             scratch.rays += 1;
-            let Some(h) = self.accel.intersect(o, d, t0, t1) else {
-                let c = clamp_contrib(mul(throughput, self.background), if bounce == 0 { st.clamp_direct } else { st.clamp_indirect });
+            let hit_opt = self.accel.intersect(o, d, t0, t1);
+            // Emission reached by a ray clamps as the bounce before it (Cycles: light found
+            // after one bounce is direct light, like the light sample at that vertex).
+            let clamp_limit = if bounce <= 1 { st.clamp_direct } else { st.clamp_indirect };
+            // Lights are not in the BVH: a ray collects every light it passes before the surface.
+            let t_surface = hit_opt.map(|h| h.t).unwrap_or(if t1.is_finite() { t1 } else { f32::INFINITY });
+            for light in self.lights {
+                if let Some(lh) = light.intersect(o, d, t_surface) {
+                    let w = if prev_singular {
+                        1.0
+                    } else if prev_mis_lamps {
+                        power_heuristic(prev_pdf, lh.pdf)
+                    } else {
+                        // Light sampling alone covered this lamp at that vertex.
+                        continue;
+                    };
+                    let c = clamp_contrib(scale(mul(throughput, lh.radiance), w), clamp_limit);
+                    if finite(c) {
+                        l = add(l, c);
+                    }
+                }
+            }
+            let Some(h) = hit_opt else {
+                let c = clamp_contrib(mul(throughput, self.background), clamp_limit);
                 if finite(c) {
                     l = add(l, c);
                 }
@@ -154,14 +225,22 @@ impl Scene<'_> {
             self.shade(&hit, wo, scratch);
             let lobes = &scratch.lobes;
             if !is_zero(lobes.emission) {
-                let c = clamp_contrib(mul(throughput, lobes.emission), if bounce == 0 { st.clamp_direct } else { st.clamp_indirect });
+                let pa = self.mesh_lights.pdf_area.get(h.prim as usize).copied().unwrap_or(0.0);
+                let w = if prev_singular || pa <= 0.0 {
+                    1.0
+                } else {
+                    let cos_l = dot(hit.ng, wo).abs().max(1e-8);
+                    power_heuristic(prev_pdf, pa * h.t * h.t / cos_l)
+                };
+                let c = clamp_contrib(scale(mul(throughput, lobes.emission), w), clamp_limit);
                 if finite(c) {
                     l = add(l, c);
                 }
             }
             let u_bsdf = rng.get4(index, set);
             let u_light = rng.get4(index, set + 1);
-            set += 2;
+            let u_mesh = rng.get4(index, set + 2);
+            set += 3;
             if terminate_next {
                 // Only transparent surfaces let such a path continue (Cycles'
                 // TERMINATE_AFTER_TRANSPARENT).
@@ -185,16 +264,21 @@ impl Scene<'_> {
                     madd(hit.p, hit.ng, -eps)
                 }
             };
+            // Lamps are shared with BSDF sampling (MIS) only at vertices with a sharp
+            // glossy lobe, where light sampling alone is noisy; elsewhere light sampling
+            // alone has less variance than MIS with our area-uniform lamp sampling.
+            let mis_lamps = lobes.lobes[..lobes.len].iter().any(|l| matches!(l.kind, LobeKind::Glossy { alpha, .. } if alpha < MIS_ALPHA));
             // Next-event estimation toward every light.
             if !terminate_next && lobes.len > 0 {
                 for (li, light) in self.lights.iter().enumerate() {
                     let uu = if li == 0 { [u_light[0], u_light[1]] } else { let r = rng.get4(index, 0x4000_0000 + set * 64 + li as u32); [r[0], r[1]] };
                     let Some(ls) = light.sample(hit.p, uu) else { continue };
-                    let (f, _pdf) = lobes.eval(wo, ls.wi, hit.ng, self.tables);
+                    let (f, pdf_b) = lobes.eval(wo, ls.wi, hit.ng, self.tables);
                     if is_zero(f) {
                         continue;
                     }
-                    let c = mul(mul(throughput, f), ls.value);
+                    let w = if mis_lamps { power_heuristic(ls.pdf, pdf_b) } else { 1.0 };
+                    let c = scale(mul(mul(throughput, f), ls.value), w);
                     if is_zero(c) || !finite(c) {
                         continue;
                     }
@@ -206,9 +290,38 @@ impl Scene<'_> {
                     l = add(l, clamp_contrib(c, if bounce == 0 { st.clamp_direct } else { st.clamp_indirect }));
                 }
             }
-            if terminate_next && !is_zero(lobes.transparent) {
-                // Only continue through the transparent part.
+            // One light sample on an emissive triangle.
+            if !terminate_next && scratch.lobes.len > 0 && !self.mesh_lights.prims.is_empty() {
+                let k = self.mesh_lights.pick(u_mesh[2]);
+                let prim = self.mesh_lights.prims[k];
+                let tri = &self.geo.tris[prim as usize];
+                let su = u_mesh[0].sqrt();
+                let (b1, b2) = (su * (1.0 - u_mesh[1]), su * u_mesh[1]);
+                let q = add(add(scale(tri[0], 1.0 - b1 - b2), scale(tri[1], b1)), scale(tri[2], b2));
+                let to = sub(q, hit.p);
+                let d2 = dot(to, to);
+                let dist = d2.sqrt();
+                let wi = scale(to, 1.0 / dist.max(1e-12));
+                let ng_l = normalize(cross(sub(tri[1], tri[0]), sub(tri[2], tri[0])));
+                let cos_l = dot(ng_l, wi).abs();
+                if d2 > 0.0 && cos_l > 1e-6 && prim != h.prim {
+                    let (f, pdf_b) = scratch.lobes.eval(wo, wi, hit.ng, self.tables);
+                    if !is_zero(f) {
+                        let pdf_l = self.mesh_lights.pdf_area[prim as usize] * d2 / cos_l;
+                        let start = p_off(wi);
+                        scratch.rays += 1;
+                        if pdf_l > 0.0 && !self.accel.occluded(start, wi, 0.0, dist * (1.0 - 1e-4)) {
+                            let le = self.emission_at(prim, b1, b2, neg(wi), scratch);
+                            let w = power_heuristic(pdf_l, pdf_b);
+                            let c = scale(mul(mul(throughput, f), le), w / pdf_l);
+                            if finite(c) {
+                                l = add(l, clamp_contrib(c, if bounce == 0 { st.clamp_direct } else { st.clamp_indirect }));
+                            }
+                        }
+                    }
+                }
             }
+            let lobes = &scratch.lobes;
             let Some(bs) = lobes.sample(wo, hit.ng, [u_bsdf[0], u_bsdf[1], u_bsdf[2]], self.tables) else { break };
             if !finite(bs.weight) || is_zero(bs.weight) {
                 break;
@@ -253,6 +366,9 @@ impl Scene<'_> {
                 terminate_next = true;
             }
             bounce += 1;
+            prev_pdf = bs.pdf;
+            prev_singular = bs.singular;
+            prev_mis_lamps = mis_lamps;
             o = p_off(bs.wi);
             d = bs.wi;
             t0 = 0.0;

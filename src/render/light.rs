@@ -41,6 +41,16 @@ pub struct LightSample {
     pub dist: f32,
     /// Radiance times cosine at the light over pdf, before the BSDF.
     pub value: V3,
+    /// Solid-angle pdf of the sample (infinite for delta lights: no MIS).
+    pub pdf: f32,
+}
+
+/// A light found by a BSDF ray: distance, radiance, and the pdf with which light
+/// sampling would have chosen that direction.
+pub struct LightHit {
+    pub t: f32,
+    pub radiance: V3,
+    pub pdf: f32,
 }
 
 fn num(p: &serde_json::Map<String, Value>, k: &str, d: f64) -> f32 {
@@ -140,7 +150,7 @@ impl Light {
                 if *radius <= 0.0 {
                     // Intensity power / (4 pi) over squared distance.
                     let v = scale(self.strength, atten / (4.0 * PI * d2));
-                    return Some(LightSample { wi: w, dist: d, value: v });
+                    return Some(LightSample { wi: w, dist: d, value: v, pdf: f32::INFINITY });
                 }
                 // A disk of the sphere's radius facing the shading point.
                 let disk = super::camera::concentric_disk(u);
@@ -154,7 +164,8 @@ impl Light {
                 let radiance = 1.0 / (4.0 * PI * PI * radius * radius);
                 // value = L * cos_l * A / d^2
                 let v = scale(self.strength, atten * radiance * cos_l * PI * radius * radius / dq2);
-                Some(LightSample { wi, dist: dq, value: v })
+                let pdf = dq2 / (cos_l.max(1e-8) * PI * radius * radius);
+                Some(LightSample { wi, dist: dq, value: v, pdf })
             }
             Shape::Area { u: au, v: av, ellipse, area } => {
                 let (a, b) = if *ellipse {
@@ -177,12 +188,12 @@ impl Light {
                 }
                 let radiance = 1.0 / (PI * area);
                 let v = scale(self.strength, radiance * cos_l * area / d2);
-                Some(LightSample { wi, dist: d, value: v })
+                Some(LightSample { wi, dist: d, value: v, pdf: d2 / (cos_l * area) })
             }
             Shape::Sun { half_angle } => {
                 let toward = neg(self.dir);
                 if *half_angle <= 0.0 {
-                    return Some(LightSample { wi: toward, dist: f32::INFINITY, value: self.strength });
+                    return Some(LightSample { wi: toward, dist: f32::INFINITY, value: self.strength, pdf: f32::INFINITY });
                 }
                 let cos_max = half_angle.cos();
                 let z = 1.0 - u[0] * (1.0 - cos_max);
@@ -193,7 +204,74 @@ impl Light {
                 let s = half_angle.sin();
                 let radiance = 1.0 / (PI * s * s);
                 let pdf = 1.0 / (2.0 * PI * (1.0 - cos_max));
-                Some(LightSample { wi, dist: f32::INFINITY, value: scale(self.strength, radiance / pdf) })
+                Some(LightSample { wi, dist: f32::INFINITY, value: scale(self.strength, radiance / pdf), pdf })
+            }
+        }
+    }
+
+    /// Where a ray from `o` along unit `d` meets this light before `tmax` (suns: only
+    /// rays that leave the scene, `tmax` infinite).
+    pub fn intersect(&self, o: V3, d: V3, tmax: f32) -> Option<LightHit> {
+        match &self.shape {
+            Shape::Point { radius, spot } => {
+                if *radius <= 0.0 {
+                    return None;
+                }
+                // The disk through the light's centre facing the ray origin.
+                let to = sub(self.pos, o);
+                let dist2 = dot(to, to);
+                let n = normalize(neg(to));
+                let denom = dot(d, n);
+                if denom >= 0.0 {
+                    return None;
+                }
+                let t = dot(sub(self.pos, o), n) / denom;
+                if !(t > 0.0 && t < tmax) {
+                    return None;
+                }
+                let q = madd(o, d, t);
+                if dot(sub(q, self.pos), sub(q, self.pos)) > radius * radius {
+                    return None;
+                }
+                let mut atten = 1.0;
+                if let Some(s) = spot {
+                    let r = neg(normalize(to));
+                    let sr = normalize([dot(r, s.u), dot(r, s.v), dot(r, s.w)]);
+                    atten = if s.smooth.is_finite() { smoothstep((sr[2] - s.cos_half) * s.smooth) } else if sr[2] > s.cos_half { 1.0 } else { 0.0 };
+                }
+                let _ = dist2;
+                let radiance = scale(self.strength, atten / (4.0 * PI * PI * radius * radius));
+                let cos_l = -denom;
+                Some(LightHit { t, radiance, pdf: t * t / (cos_l.max(1e-8) * PI * radius * radius) })
+            }
+            Shape::Area { u, v, ellipse, area } => {
+                let cos_l = -dot(d, self.dir);
+                if cos_l <= 0.0 {
+                    return None;
+                }
+                let t = dot(sub(self.pos, o), self.dir) / dot(d, self.dir);
+                if !(t > 0.0 && t < tmax) {
+                    return None;
+                }
+                let q = sub(madd(o, d, t), self.pos);
+                let a = dot(q, *u) / dot(*u, *u);
+                let b = dot(q, *v) / dot(*v, *v);
+                let inside = if *ellipse { a * a + b * b <= 0.25 } else { a.abs() <= 0.5 && b.abs() <= 0.5 };
+                if !inside {
+                    return None;
+                }
+                Some(LightHit { t, radiance: scale(self.strength, 1.0 / (PI * area)), pdf: t * t / (cos_l * area) })
+            }
+            Shape::Sun { half_angle } => {
+                if tmax.is_finite() || *half_angle <= 0.0 {
+                    return None;
+                }
+                let cos_max = half_angle.cos();
+                if dot(d, neg(self.dir)) < cos_max {
+                    return None;
+                }
+                let s = half_angle.sin();
+                Some(LightHit { t: f32::INFINITY, radiance: scale(self.strength, 1.0 / (PI * s * s)), pdf: 1.0 / (2.0 * PI * (1.0 - cos_max)) })
             }
         }
     }

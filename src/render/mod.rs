@@ -161,7 +161,8 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     };
     let exposure = 1.0f32;
     let build_seconds = start.elapsed().as_secs_f64();
-    let tracer = integrator::Scene { accel: &bvh, geo: &geo, materials: &materials, lights: &lights, background, tables, settings };
+    let mesh_lights = mesh_lights(&geo, &materials, &bvh, &lights, background, tables, settings);
+    let tracer = integrator::Scene { mesh_lights: &mesh_lights, accel: &bvh, geo: &geo, materials: &materials, lights: &lights, background, tables, settings };
 
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);
@@ -278,6 +279,63 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         passes,
         stats: RenderStats { samples, wall_seconds: start.elapsed().as_secs_f64(), rays, triangles: geo.tris.len(), build_seconds },
     })
+}
+
+/// The emissive triangles, weighted by area times the luminance of their emission at
+/// the centroid (Cycles weights by an emission estimate too).
+fn mesh_lights(
+    geo: &build::Geometry,
+    materials: &[shade::Material],
+    bvh: &Bvh,
+    lights: &[light::Light],
+    background: V3,
+    tables: &tables::Tables,
+    settings: Settings,
+) -> integrator::MeshLights {
+    use crate::shader::program::Closure;
+    let empty = integrator::MeshLights::default();
+    let probe = integrator::Scene { mesh_lights: &empty, accel: bvh, geo, materials, lights, background, tables, settings };
+    let emissive: Vec<bool> = materials
+        .iter()
+        .map(|m| m.program.as_ref().is_some_and(|p| p.closures.iter().any(|c| matches!(c, Closure::Emission { .. } | Closure::Bsdf { emission: Some(_) }))))
+        .collect();
+    let mut scratch = Scratch::new(materials.len());
+    let mut prims = Vec::new();
+    let mut weights = Vec::new();
+    let mut areas = Vec::new();
+    for (prim, r) in geo.refs.iter().enumerate() {
+        let inst = &geo.instances[r.inst as usize];
+        let face = inst.mesh.triangle_faces[r.tri as usize] as usize;
+        let slot = inst.face_slot.get(face).copied().unwrap_or(0) as usize;
+        let Some(mi) = inst.slots.get(slot).copied().flatten() else { continue };
+        if !emissive[mi] {
+            continue;
+        }
+        let t = &geo.tris[prim];
+        let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+        let area = 0.5 * len(n);
+        if area <= 0.0 {
+            continue;
+        }
+        let e = probe.emission_at(prim as u32, 1.0 / 3.0, 1.0 / 3.0, normalize(n), &mut scratch);
+        let lum = 0.2126 * e[0].abs() + 0.7152 * e[1].abs() + 0.0722 * e[2].abs();
+        if !(lum > 0.0) || !lum.is_finite() {
+            continue;
+        }
+        prims.push(prim as u32);
+        weights.push(area * lum);
+        areas.push(area);
+    }
+    let total: f64 = weights.iter().map(|&w| w as f64).sum();
+    let mut pdf_area = vec![0.0f32; geo.tris.len()];
+    let mut cdf = Vec::with_capacity(prims.len());
+    let mut acc = 0.0f64;
+    for (k, &p) in prims.iter().enumerate() {
+        acc += weights[k] as f64;
+        cdf.push((acc / total) as f32);
+        pdf_area[p as usize] = (weights[k] as f64 / total) as f32 / areas[k];
+    }
+    integrator::MeshLights { prims, cdf, pdf_area }
 }
 
 #[derive(Default)]

@@ -204,7 +204,9 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
             let schlick = base[k] + (1.0 - base[k]) * f.powi(5);
             bb[k] = schlick * (1.0 - spec_tint[k]) * 7.0 / f6;
         }
-        out.push(LobeKind::Glossy { alpha: a, fresnel: Fresnel::F82 { f0: base, b: bb }, energy }, scale(weight, metallic), n);
+        let avg_f0 = (base[0] + base[1] + base[2]) / 3.0;
+        let albedo = (avg_f0 + (1.0 - avg_f0) / 21.0).clamp(0.0, 1.0);
+        out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::F82 { f0: base, b: bb }, energy }, scale(weight, metallic), n, albedo.max(1e-3));
         weight = scale(weight, 1.0 - metallic);
     }
     if transmission > 0.0 {
@@ -222,9 +224,9 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         }
     }
     if spec_level > 0.0 && max3(weight) > 0.0 {
-        out.push(LobeKind::Glossy { alpha: a, fresnel: Fresnel::Dielectric { eta }, energy }, mul(weight, spec_tint), n);
-        // Attenuate the layers below by the specular layer's albedo.
         let e = (ctx.tables.dielectric_e(mu, roughness, eta) * energy).clamp(0.0, 1.0);
+        out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::Dielectric { eta }, energy }, mul(weight, spec_tint), n, e.max(1e-3));
+        // Attenuate the layers below by the specular layer's albedo.
         let albedo = scale(spec_tint, e);
         weight = scale(weight, (1.0 - max3(albedo)).clamp(0.0, 1.0));
     }
