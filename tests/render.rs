@@ -22,6 +22,7 @@ const ASSERTED: &[&str] = &[
 
 /// Scenes that do not pass yet, with the reason.
 const KNOWN_FAILURES: &[(&str, &str)] = &[
+    ("glass", "ratio ~1.9 (means match to 0.2%): caustics through the sphere; Cycles' Filter Glossy roughens glass after a diffuse bounce and rough glass is not implemented yet"),
     ("mix_shader", "ratio ~1.25: diffuse+glossy mix under a small point light is noisier than Cycles (means match to 0.03%)"),
     ("principled", "ratio ~1.17: lamp sampling is area-uniform, not Cycles' solid-angle rectangle sampling (means match to 0.1%)"),
     ("translucent", "ratio ~1.15, on the limit: light through a translucent sheet is slightly noisier than Cycles (means match to 0.03%)"),

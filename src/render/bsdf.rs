@@ -23,6 +23,9 @@ pub enum LobeKind {
     Translucent,
     Glossy { alpha: f32, fresnel: Fresnel, energy: f32 },
     Transparent,
+    /// Smooth dielectric interface (Glass BSDF, Principled transmission): reflects or
+    /// refracts by Fresnel; `eta` is the relative IOR across the surface as hit.
+    Glass { eta: f32, refract_only: bool },
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -135,8 +138,8 @@ impl LobeSet {
         }
         let l = &self.lobes[pick];
         let (wi, singular) = sample_lobe(l, wo, ng, [u[0], u[1]])?;
-        let glossy = matches!(l.kind, LobeKind::Glossy { .. });
-        let transmit = matches!(l.kind, LobeKind::Translucent | LobeKind::Transparent);
+        let glossy = matches!(l.kind, LobeKind::Glossy { .. }) || (matches!(l.kind, LobeKind::Glass { .. }) && dot(wi, ng) > 0.0);
+        let transmit = matches!(l.kind, LobeKind::Translucent | LobeKind::Transparent) || (matches!(l.kind, LobeKind::Glass { .. }) && dot(wi, ng) < 0.0);
         if singular {
             // Mirror or pass-through: only this lobe contributes, with its discrete probability.
             let sel = l.sample_weight / total;
@@ -264,7 +267,7 @@ fn eval_lobe(l: &Lobe, wo: V3, wi: V3, ng: V3, _tables: &Tables) -> (V3, f32) {
                 ([0.0; 3], 0.0)
             }
         }
-        LobeKind::Transparent => ([0.0; 3], 0.0),
+        LobeKind::Transparent | LobeKind::Glass { .. } => ([0.0; 3], 0.0),
         LobeKind::Glossy { alpha, fresnel, energy } => {
             if alpha < SINGULAR_ALPHA || !same_side || cos_i <= 0.0 {
                 return ([0.0; 3], 0.0);
@@ -299,6 +302,24 @@ fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
             Some((wi, false))
         }
         LobeKind::Transparent => Some((neg(wo), true)),
+        LobeKind::Glass { eta, refract_only } => {
+            // Fresnel picks reflection or refraction, so the weight stays the colour.
+            let n = l.n;
+            let c = dot(n, wo).clamp(-1.0, 1.0);
+            let f = fresnel_dielectric(c, eta);
+            let reflect = sub(scale(n, 2.0 * c), wo);
+            let k = 1.0 - (1.0 - c * c) / (eta * eta);
+            if k <= 0.0 {
+                // Total internal reflection.
+                return Some((reflect, true));
+            }
+            if !refract_only && u[0] < f {
+                return Some((reflect, true));
+            }
+            let t = sub(scale(n, c / eta - k.sqrt()), scale(wo, 1.0 / eta));
+            let _ = ng;
+            Some((normalize(t), true))
+        }
         LobeKind::Glossy { alpha, .. } => {
             if alpha < SINGULAR_ALPHA {
                 let wi = sub(scale(l.n, 2.0 * dot(l.n, wo)), wo);

@@ -157,7 +157,7 @@ impl Scene<'_> {
     }
 
     fn shade_into(&self, hit: &SurfaceHit, wo: V3, stacks: &mut [Vec<f32>], lobes: &mut LobeSet) {
-        let ctx = Context { tables: self.tables, wo };
+        let ctx = Context { tables: self.tables, wo, backfacing: hit.backfacing };
         match hit.material {
             Some(mi) => self.materials[mi].shade(&hit.sp, &mut stacks[mi], &ctx, lobes),
             None => {
@@ -360,8 +360,20 @@ impl Scene<'_> {
                     }
                     glossy += 1;
                 }
+                LobeKind::Glass { .. } => {
+                    if bs.transmit {
+                        if transmission >= st.max_transmission {
+                            terminate_next = true;
+                        }
+                        transmission += 1;
+                    } else {
+                        if glossy >= st.max_glossy {
+                            terminate_next = true;
+                        }
+                        glossy += 1;
+                    }
+                }
             }
-            let _ = &mut transmission;
             if bounce >= st.max_bounces {
                 terminate_next = true;
             }

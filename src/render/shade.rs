@@ -43,6 +43,8 @@ pub struct Context<'a> {
     pub tables: &'a Tables,
     /// Unit direction toward the viewer.
     pub wo: V3,
+    /// The ray hit the back of the surface (normals are already flipped to face it).
+    pub backfacing: bool,
 }
 
 fn v3(s: &[f32], at: u32) -> V3 {
@@ -169,6 +171,14 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             out.push(LobeKind::Glossy { alpha: r * r, fresnel: Fresnel::Constant, energy }, scale(c, w), n);
         }
         "ShaderNodeBsdfPrincipled" => principled(b, w, s, sp, ctx, out),
+        // Rough glass is rendered as smooth glass for now (documented).
+        "ShaderNodeBsdfGlass" | "ShaderNodeBsdfRefraction" => {
+            let c = input_c(b, s, "Color", [1.0; 3]);
+            let ior = input_f(b, s, "IOR", 1.45).max(1e-4);
+            let eta = if ctx.backfacing { 1.0 / ior } else { ior };
+            let refract_only = b.bl_idname == "ShaderNodeBsdfRefraction";
+            out.push(LobeKind::Glass { eta, refract_only }, scale(c, w), input_n(b, s, "Normal", sp));
+        }
         // Unsupported closures fall back to a diffuse of their colour (documented).
         _ => {
             let c = input_c(b, s, "Color", [0.8; 3]);
@@ -210,7 +220,10 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         weight = scale(weight, 1.0 - metallic);
     }
     if transmission > 0.0 {
-        // Glass transmission is not implemented: its share goes to the dielectric below.
+        // Smooth glass tinted by the base colour (rough transmission is not implemented).
+        let eta = if ctx.backfacing { 1.0 / ior } else { ior };
+        out.push(LobeKind::Glass { eta, refract_only: false }, scale(mul(weight, base), transmission), n);
+        weight = scale(weight, 1.0 - transmission);
     }
     // Dielectric specular: IOR adjusted by the specular IOR level as Cycles does.
     let mut eta = ior;
