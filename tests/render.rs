@@ -17,14 +17,12 @@ const MAX_MEAN_REL: f64 = 0.01;
 
 /// Scenes that must pass.
 const ASSERTED: &[&str] = &[
-    "area_disk", "area_square", "diffuse_point", "diffuse_sun", "dof", "emission_mesh", "glossy", "metallic", "ortho_flat", "shift_clip", "spot", "world_light",
+    "area_disk", "area_square", "diffuse_point", "diffuse_sun", "dof", "emission_mesh", "glossy", "metallic", "mix_shader", "ortho_flat", "principled", "shift_clip", "spot", "world_light",
 ];
 
 /// Scenes that do not pass yet, with the reason.
 const KNOWN_FAILURES: &[(&str, &str)] = &[
     ("glass", "ratio ~1.9 (means match to 0.2%): caustics through the sphere; Cycles' Filter Glossy roughens glass after a diffuse bounce and rough glass is not implemented yet"),
-    ("mix_shader", "ratio ~1.25: diffuse+glossy mix under a small point light is noisier than Cycles (means match to 0.03%)"),
-    ("principled", "ratio ~1.17: lamp sampling is area-uniform, not Cycles' solid-angle rectangle sampling (means match to 0.1%)"),
     ("translucent", "ratio ~1.15, on the limit: light through a translucent sheet is slightly noisier than Cycles (means match to 0.03%)"),
 ];
 

@@ -24,6 +24,8 @@ pub struct Settings {
     pub clamp_direct: f32,
     pub clamp_indirect: f32,
     pub min_light_bounces: u32,
+    /// Cycles' Filter Glossy (`blur_glossy`).
+    pub filter_glossy: f32,
 }
 
 /// Emissive triangles for light sampling: chosen by area times estimated emission.
@@ -189,6 +191,8 @@ impl Scene<'_> {
         let mut prev_singular = true;
         // Whether the vertex that sent the ray shares lamps between light and BSDF sampling.
         let mut prev_mis_lamps = false;
+        // Smallest pdf of the non-singular bounces so far (Cycles' min_ray_pdf).
+        let mut min_ray_pdf = f32::INFINITY;
         loop {
             scratch.rays += 1;
             let hit_opt = self.accel.intersect(o, d, t0, t1);
@@ -223,6 +227,19 @@ impl Scene<'_> {
             let wo = neg(d);
             let hit = self.surface(h.prim, h.u, h.v, wo);
             self.shade(&hit, wo, scratch);
+            // Filter Glossy: after diffuse-like bounces, glossy lobes are roughened.
+            if st.filter_glossy > 0.0 && min_ray_pdf.is_finite() {
+                let blur_pdf = st.filter_glossy * min_ray_pdf;
+                if blur_pdf < 1.0 {
+                    let blur = (1.0 - blur_pdf).sqrt() * 0.5;
+                    let n = scratch.lobes.len;
+                    for lobe in &mut scratch.lobes.lobes[..n] {
+                        if let LobeKind::Glossy { alpha, .. } = &mut lobe.kind {
+                            *alpha = alpha.max(blur);
+                        }
+                    }
+                }
+            }
             let lobes = &scratch.lobes;
             if !is_zero(lobes.emission) {
                 let pa = self.mesh_lights.pdf_area.get(h.prim as usize).copied().unwrap_or(0.0);
@@ -381,6 +398,9 @@ impl Scene<'_> {
             prev_pdf = bs.pdf;
             prev_singular = bs.singular;
             prev_mis_lamps = mis_lamps;
+            if !bs.singular {
+                min_ray_pdf = min_ray_pdf.min(bs.pdf);
+            }
             o = p_off(bs.wi);
             d = bs.wi;
             t0 = 0.0;

@@ -158,6 +158,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         clamp_direct: rna_f(cy, "sample_clamp_direct").unwrap_or(0.0) as f32,
         clamp_indirect: rna_f(cy, "sample_clamp_indirect").unwrap_or(10.0) as f32,
         min_light_bounces: gi("min_light_bounces", 0.0),
+        filter_glossy: rna_f(cy, "blur_glossy").unwrap_or(1.0) as f32,
     };
     let exposure = 1.0f32;
     let build_seconds = start.elapsed().as_secs_f64();
