@@ -164,3 +164,15 @@ fn label_passes_from_the_pixel_centre() {
         }
     }
 }
+
+#[test]
+fn non_finite_samples_never_poison_pixels() {
+    // An emission strength beyond f32 range is infinite in the shader program; closure
+    // inputs that are not finite read as 0 (documented fallback) and non-finite samples
+    // are dropped, so every pixel stays finite.
+    let dir = common::repo().join("fixtures/render/scenes/emission_mesh");
+    let o = blendsynth::scene::Override::parse("materials[\"Glow\"].node_tree.nodes[\"Emission\"].inputs[1].default_value=1e39").unwrap();
+    let scene = Scene::load(&dir).unwrap().with_overrides(&[o]).unwrap();
+    let out = render(&scene, &RenderOptions { samples: Some(4), resolution: Some((32, 32)), ..Default::default() }).unwrap();
+    assert!(out.color.iter().all(|p| p.iter().all(|v| v.is_finite())));
+}
