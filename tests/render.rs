@@ -176,3 +176,45 @@ fn non_finite_samples_never_poison_pixels() {
     let out = render(&scene, &RenderOptions { samples: Some(4), resolution: Some((32, 32)), ..Default::default() }).unwrap();
     assert!(out.color.iter().all(|p| p.iter().all(|v| v.is_finite())));
 }
+
+#[test]
+fn geometry_nodes_instances_keep_their_own_ids() {
+    // The geonodes fixture instances cubes on points: each instance is its own render
+    // instance (own id, own transform) sharing its reference's mesh.
+    let dir = common::repo().join("fixtures/scenes/geonodes");
+    let scene = Scene::load(&dir).unwrap();
+    let eval = blendsynth::anim::evaluate_scene(&scene, scene.file.scene.frame_current as f64).unwrap();
+    let geo = blendsynth::render::build::build(&scene, &eval, &[]).unwrap();
+    let inst: Vec<_> = geo.instances.iter().filter(|i| i.instance_index.is_some()).collect();
+    assert!(inst.len() > 1, "expected several GN instances, found {}", inst.len());
+    let mut idx: Vec<u32> = inst.iter().map(|i| i.instance_index.unwrap()).collect();
+    idx.dedup();
+    assert_eq!(idx.len(), inst.len(), "instance indices are distinct");
+    assert!(inst.windows(2).all(|w| std::sync::Arc::ptr_eq(&w[0].mesh, &w[1].mesh) || w[0].mesh.name == w[1].mesh.name));
+    assert!(inst.windows(2).any(|w| w[0].to_world != w[1].to_world));
+    // Together they are Blender's evaluated mesh: same triangle count, same world bounds.
+    let reference = scene.load_evaluated(0).unwrap();
+    let obj = scene.file.evaluated[0].object.clone();
+    let ours: Vec<_> = geo.instances.iter().filter(|i| i.name == obj).collect();
+    assert_eq!(ours.iter().map(|i| i.mesh.triangles.len()).sum::<usize>(), reference.triangles.len());
+    let oi = scene.file.objects.iter().position(|o| o.name == obj).unwrap();
+    let m = eval.world_matrices[oi];
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for p in &reference.positions {
+        for r in 0..3 {
+            let w = (m[r][0] * p[0] as f64 + m[r][1] * p[1] as f64 + m[r][2] * p[2] as f64 + m[r][3]) as f32;
+            lo[r] = lo[r].min(w);
+            hi[r] = hi[r].max(w);
+        }
+    }
+    let (mut olo, mut ohi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for i in &ours {
+        for r in 0..3 {
+            olo[r] = olo[r].min(i.world_bounds.0[r]);
+            ohi[r] = ohi[r].max(i.world_bounds.1[r]);
+        }
+    }
+    for r in 0..3 {
+        assert!((lo[r] - olo[r]).abs() < 1e-4 && (hi[r] - ohi[r]).abs() < 1e-4, "bounds {olo:?}..{ohi:?} vs Blender {lo:?}..{hi:?}");
+    }
+}
