@@ -10,6 +10,7 @@ pub mod blender;
 pub mod geometry;
 pub mod inspect;
 pub mod nodes;
+pub mod render;
 pub mod scene;
 pub mod shader;
 pub mod color;

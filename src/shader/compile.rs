@@ -14,7 +14,7 @@ use crate::nodes::ramp::{ColorBand, HueInterpolation, RampColorMode, RampInterpo
 use crate::nodes::sepcomb::ColorMode;
 use crate::scene::{Scene, Socket};
 
-use super::program::{Closure, Kind, Op, Program, Slot};
+use super::program::{BsdfNode, Closure, Kind, Op, Program, Slot};
 
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct CompileError(pub String);
@@ -47,6 +47,7 @@ struct Compiler<'g, 'a> {
     /// Per flat node: the closure its (single) shader output makes.
     closure_of: Vec<Option<u32>>,
     surface: Option<u32>,
+    bsdfs: Vec<BsdfNode>,
 }
 
 fn kind_of(socket_type: &str) -> Option<Kind> {
@@ -105,6 +106,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
             values: vec![Vec::new(); g.nodes.len()],
             closure_of: vec![None; g.nodes.len()],
             surface: None,
+            bsdfs: Vec::new(),
         }
     }
 
@@ -366,11 +368,13 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 "ShaderNodeBsdfPrincipled" => {
                     let (color, strength) = (self.input(n, "Emission Color", C)?, self.input(n, "Emission Strength", F)?);
                     self.closure(i, Closure::Bsdf { emission: Some((color, strength)) });
+                    self.record_bsdf(i)?;
                 }
                 "ShaderNodeBsdfDiffuse" | "ShaderNodeBsdfGlossy" | "ShaderNodeBsdfAnisotropic" | "ShaderNodeBsdfGlass" | "ShaderNodeBsdfRefraction"
                 | "ShaderNodeBsdfTransparent" | "ShaderNodeBsdfTranslucent" | "ShaderNodeSubsurfaceScattering" | "ShaderNodeBsdfSheen" | "ShaderNodeHoldout" => {
                     // No emission; their scattering parameters are compiled with the renderer.
                     self.closure(i, Closure::Bsdf { emission: None });
+                    self.record_bsdf(i)?;
                 }
                 "ShaderNodeMixShader" => {
                     let fac = self.input(n, "Fac", F)?;
@@ -390,7 +394,26 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 other => return Err(CompileError(format!("node {:?}: {other} is not supported yet", n.path))),
             }
         }
-        Ok(Program { ops: self.ops, initial: self.initial, ramps: self.ramps, closures: self.closures, surface: self.surface })
+        Ok(Program { ops: self.ops, initial: self.initial, ramps: self.ramps, closures: self.closures, surface: self.surface, bsdfs: self.bsdfs })
+    }
+
+    /// Records a BSDF node's value inputs and enum properties for the renderer.
+    fn record_bsdf(&mut self, i: usize) -> Result<(), CompileError> {
+        let n = &self.g.nodes[i];
+        let closure = self.closures.len() as u32 - 1;
+        let mut inputs = Vec::new();
+        for sock in n.node.inputs.iter().filter(|s| s.enabled) {
+            let Some(kind) = kind_of(&sock.kind) else { continue };
+            if n.input(&sock.identifier).is_none() {
+                continue;
+            }
+            let linked = n.input(&sock.identifier).is_some_and(|inp| matches!(inp.sources.first(), Some(Source::Link { .. })));
+            let slot = self.input(n, &sock.identifier, kind)?;
+            inputs.push((sock.identifier.clone(), slot, linked));
+        }
+        let properties = n.node.properties.iter().filter_map(|(k, v)| v.as_str().map(|s| (k.clone(), s.to_string()))).collect();
+        self.bsdfs.push(BsdfNode { closure, bl_idname: n.node.bl_idname.clone(), inputs, properties });
+        Ok(())
     }
 
     /// An input that may be unavailable for the node's mode (then a zero constant).

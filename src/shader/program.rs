@@ -85,6 +85,29 @@ pub struct Program {
     pub closures: Vec<Closure>,
     /// The closure plugged into the Material Output's Surface.
     pub surface: Option<u32>,
+    /// Every BSDF node's inputs, for the renderer to build its closures from.
+    pub bsdfs: Vec<BsdfNode>,
+}
+
+/// A BSDF node as the renderer sees it: which closure it is, its type, and where each
+/// of its (non-shader) inputs lives on the stack after `run`.
+#[derive(Debug, Clone)]
+pub struct BsdfNode {
+    pub closure: u32,
+    pub bl_idname: String,
+    /// (socket identifier, slot, linked): an unlinked Normal means the shading normal.
+    pub inputs: Vec<(String, Slot, bool)>,
+    /// The node's enum properties (distribution, subsurface method, ...).
+    pub properties: Vec<(String, String)>,
+}
+
+impl BsdfNode {
+    pub fn input(&self, id: &str) -> Option<(Slot, bool)> {
+        self.inputs.iter().find(|i| i.0 == id).map(|i| (i.1, i.2))
+    }
+    pub fn property(&self, key: &str) -> Option<&str> {
+        self.properties.iter().find(|p| p.0 == key).map(|p| p.1.as_str())
+    }
 }
 
 fn v3(s: &[f32], at: Slot) -> Vec3 {

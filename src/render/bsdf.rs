@@ -1,0 +1,343 @@
+//! Scattering closures with light transport, as Cycles defines them: Lambert diffuse,
+//! translucent, GGX microfacet reflection (with Cycles' multiple-scattering energy
+//! compensation), Fresnel models (constant colour, dielectric, F82-tinted Schlick),
+//! transparent. `eval` returns BSDF times the cosine, as Cycles' closures do.
+
+use super::math::*;
+use super::tables::Tables;
+use std::f32::consts::PI;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Fresnel {
+    /// Glossy BSDF: the colour is the reflectance at every angle.
+    Constant,
+    /// Dielectric with relative IOR `eta`, tinted.
+    Dielectric { eta: f32 },
+    /// Metals: F0 colour, F82 tint factor `b` (precomputed).
+    F82 { f0: V3, b: V3 },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum LobeKind {
+    Diffuse,
+    Translucent,
+    Glossy { alpha: f32, fresnel: Fresnel, energy: f32 },
+    Transparent,
+    /// Smooth dielectric interface (Glass BSDF, Principled transmission): reflects or
+    /// refracts by Fresnel; `eta` is the relative IOR across the surface as hit.
+    Glass { eta: f32, refract_only: bool },
+}
+
+#[derive(Debug, Clone, Copy)]
+pub struct Lobe {
+    pub kind: LobeKind,
+    pub weight: V3,
+    pub n: V3,
+    /// Selection weight (Cycles' `sample_weight`: the sum of |weight|).
+    pub sample_weight: f32,
+}
+
+pub const MAX_LOBES: usize = 8;
+
+/// The closures of one shading point, fixed size (no allocation per hit).
+#[derive(Clone)]
+pub struct LobeSet {
+    pub lobes: [Lobe; MAX_LOBES],
+    pub len: usize,
+    pub emission: V3,
+    pub holdout: V3,
+    pub transparent: V3,
+}
+
+pub struct BsdfSample {
+    pub wi: V3,
+    /// eval / pdf (already weighted by the closure's weight).
+    pub weight: V3,
+    pub pdf: f32,
+    pub singular: bool,
+    pub glossy: bool,
+    pub transmit: bool,
+    /// Closure kind label for bounce limits.
+    pub kind: LobeKind,
+}
+
+const EMPTY: Lobe = Lobe { kind: LobeKind::Diffuse, weight: [0.0; 3], n: [0.0, 0.0, 1.0], sample_weight: 0.0 };
+
+impl Default for LobeSet {
+    fn default() -> Self {
+        LobeSet { lobes: [EMPTY; MAX_LOBES], len: 0, emission: [0.0; 3], holdout: [0.0; 3], transparent: [0.0; 3] }
+    }
+}
+
+/// Singular (mirror) below this alpha, as Cycles treats very low roughness.
+const SINGULAR_ALPHA: f32 = 1e-4;
+
+impl LobeSet {
+    pub fn clear(&mut self) {
+        self.len = 0;
+        self.emission = [0.0; 3];
+        self.holdout = [0.0; 3];
+        self.transparent = [0.0; 3];
+    }
+
+    pub fn push(&mut self, kind: LobeKind, weight: V3, n: V3) {
+        self.push_scaled(kind, weight, n, 1.0);
+    }
+
+    /// `push` with the selection weight scaled by the lobe's estimated albedo, as Cycles
+    /// does for Fresnel-weighted microfacet closures (a dim specular layer is picked less).
+    pub fn push_scaled(&mut self, kind: LobeKind, weight: V3, n: V3, albedo: f32) {
+        if !(weight.iter().all(|w| w.is_finite())) {
+            return;
+        }
+        let sw = (weight[0].abs() + weight[1].abs() + weight[2].abs()) * albedo.clamp(0.0, 1.0);
+        if sw <= 0.0 {
+            return;
+        }
+        if let LobeKind::Transparent = kind {
+            self.transparent = add(self.transparent, weight);
+        }
+        if self.len < MAX_LOBES {
+            self.lobes[self.len] = Lobe { kind, weight, n, sample_weight: sw };
+            self.len += 1;
+        }
+    }
+
+    /// Sum of the closures' BSDF times cosine toward `wi`, and the combined pdf, for a
+    /// viewer in direction `wo`; `ng` is the geometric normal facing the viewer.
+    pub fn eval(&self, wo: V3, wi: V3, ng: V3, tables: &Tables) -> (V3, f32) {
+        let mut f = [0.0; 3];
+        let mut pdf = 0.0;
+        let mut total = 0.0;
+        for l in &self.lobes[..self.len] {
+            total += l.sample_weight;
+            let (e, p) = eval_lobe(l, wo, wi, ng, tables);
+            f = add(f, mul(e, l.weight));
+            pdf += p * l.sample_weight;
+        }
+        if total > 0.0 {
+            pdf /= total;
+        }
+        (f, pdf)
+    }
+
+    pub fn sample(&self, wo: V3, ng: V3, u: [f32; 3], tables: &Tables) -> Option<BsdfSample> {
+        let total: f32 = self.lobes[..self.len].iter().map(|l| l.sample_weight).sum();
+        if total <= 0.0 {
+            return None;
+        }
+        // Pick a lobe by sample weight, reusing the rest of u[2].
+        let mut x = u[2] * total;
+        let mut pick = self.len - 1;
+        for (i, l) in self.lobes[..self.len].iter().enumerate() {
+            if x < l.sample_weight {
+                pick = i;
+                break;
+            }
+            x -= l.sample_weight;
+        }
+        let l = &self.lobes[pick];
+        let (wi, singular) = sample_lobe(l, wo, ng, [u[0], u[1]])?;
+        let glossy = matches!(l.kind, LobeKind::Glossy { .. }) || (matches!(l.kind, LobeKind::Glass { .. }) && dot(wi, ng) > 0.0);
+        let transmit = matches!(l.kind, LobeKind::Translucent | LobeKind::Transparent) || (matches!(l.kind, LobeKind::Glass { .. }) && dot(wi, ng) < 0.0);
+        if singular {
+            // Mirror or pass-through: only this lobe contributes, with its discrete probability.
+            let sel = l.sample_weight / total;
+            let w = match l.kind {
+                LobeKind::Glossy { fresnel, energy, .. } => {
+                    let h = l.n;
+                    scale(fresnel_eval(fresnel, dot(wo, h), l.weight), energy)
+                }
+                _ => l.weight,
+            };
+            let wgt = scale(match l.kind {
+                LobeKind::Glossy { fresnel: Fresnel::Constant, .. } => w,
+                LobeKind::Glossy { .. } => w,
+                _ => w,
+            }, 1.0 / sel);
+            return Some(BsdfSample { wi, weight: wgt, pdf: f32::INFINITY, singular: true, glossy, transmit, kind: l.kind });
+        }
+        let (f, pdf) = self.eval(wo, wi, ng, tables);
+        if !(pdf > 0.0) || !pdf.is_finite() {
+            return None;
+        }
+        Some(BsdfSample { wi, weight: scale(f, 1.0 / pdf), pdf, singular: false, glossy, transmit, kind: l.kind })
+    }
+
+    /// Diffuse-like albedo of the closures (for the albedo pass).
+    pub fn albedo(&self) -> V3 {
+        let mut a = [0.0; 3];
+        for l in &self.lobes[..self.len] {
+            a = add(a, l.weight);
+        }
+        a
+    }
+}
+
+pub fn fresnel_dielectric(cosi: f32, eta: f32) -> f32 {
+    let c = cosi.abs();
+    let g2 = eta * eta - 1.0 + c * c;
+    if g2 < 0.0 {
+        return 1.0;
+    }
+    let g = g2.sqrt();
+    let a = (g - c) / (g + c);
+    let b = (c * (g + c) - 1.0) / (c * (g - c) + 1.0);
+    0.5 * a * a * (1.0 + b * b)
+}
+
+fn fresnel_eval(f: Fresnel, cos_h: f32, tint: V3) -> V3 {
+    match f {
+        Fresnel::Constant => tint,
+        Fresnel::Dielectric { eta } => scale(tint, fresnel_dielectric(cos_h, eta)),
+        Fresnel::F82 { f0, b } => {
+            let c = cos_h.clamp(0.0, 1.0);
+            let m = 1.0 - c;
+            let m5 = m * m * m * m * m;
+            let mut out = [0.0; 3];
+            for k in 0..3 {
+                let s = f0[k] + (1.0 - f0[k]) * m5;
+                out[k] = (s - b[k] * c * m5 * m).clamp(0.0, 1.0) * tint[k];
+            }
+            out
+        }
+    }
+}
+
+#[inline]
+pub fn ggx_d(cos_h: f32, a2: f32) -> f32 {
+    let c2 = cos_h * cos_h;
+    let d = c2 * (a2 - 1.0) + 1.0;
+    a2 / (PI * d * d)
+}
+
+#[inline]
+pub fn ggx_lambda(cos: f32, a2: f32) -> f32 {
+    let c2 = cos * cos;
+    if c2 >= 1.0 {
+        return 0.0;
+    }
+    let t2 = (1.0 - c2) / c2.max(1e-12);
+    0.5 * (-1.0 + (1.0 + a2 * t2).sqrt())
+}
+
+/// Visible-normal sampling of isotropic GGX (Heitz 2018), local frame with N = +z.
+pub fn sample_vndf(v: V3, alpha: f32, u: [f32; 2]) -> V3 {
+    let vh = normalize([alpha * v[0], alpha * v[1], v[2]]);
+    let lensq = vh[0] * vh[0] + vh[1] * vh[1];
+    let t1 = if lensq > 0.0 { scale([-vh[1], vh[0], 0.0], 1.0 / lensq.sqrt()) } else { [1.0, 0.0, 0.0] };
+    let t2 = cross(vh, t1);
+    let r = u[0].sqrt();
+    let phi = 2.0 * PI * u[1];
+    let p1 = r * phi.cos();
+    let mut p2 = r * phi.sin();
+    let s = 0.5 * (1.0 + vh[2]);
+    p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * p2;
+    let nh = add(add(scale(t1, p1), scale(t2, p2)), scale(vh, (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt()));
+    normalize([alpha * nh[0], alpha * nh[1], nh[2].max(0.0)])
+}
+
+fn to_local(n: V3, v: V3) -> V3 {
+    let (t, b) = basis(n);
+    [dot(v, t), dot(v, b), dot(v, n)]
+}
+fn from_local(n: V3, v: V3) -> V3 {
+    let (t, b) = basis(n);
+    add(add(scale(t, v[0]), scale(b, v[1])), scale(n, v[2]))
+}
+
+/// (BSDF * cos without the closure weight, pdf) of one lobe.
+fn eval_lobe(l: &Lobe, wo: V3, wi: V3, ng: V3, _tables: &Tables) -> (V3, f32) {
+    let cos_i = dot(l.n, wi);
+    let same_side = dot(ng, wi) > 0.0;
+    match l.kind {
+        LobeKind::Diffuse => {
+            if cos_i > 0.0 && same_side {
+                let v = cos_i / PI;
+                ([v; 3], v)
+            } else {
+                ([0.0; 3], 0.0)
+            }
+        }
+        LobeKind::Translucent => {
+            if cos_i < 0.0 && !same_side {
+                let v = -cos_i / PI;
+                ([v; 3], v)
+            } else {
+                ([0.0; 3], 0.0)
+            }
+        }
+        LobeKind::Transparent | LobeKind::Glass { .. } => ([0.0; 3], 0.0),
+        LobeKind::Glossy { alpha, fresnel, energy } => {
+            if alpha < SINGULAR_ALPHA || !same_side || cos_i <= 0.0 {
+                return ([0.0; 3], 0.0);
+            }
+            let cos_o = dot(l.n, wo);
+            if cos_o <= 0.0 {
+                return ([0.0; 3], 0.0);
+            }
+            let h = normalize(add(wo, wi));
+            let cos_h = dot(l.n, h);
+            let a2 = alpha * alpha;
+            let d = ggx_d(cos_h, a2);
+            let lo = ggx_lambda(cos_o, a2);
+            let li = ggx_lambda(cos_i, a2);
+            let g2 = 1.0 / (1.0 + lo + li);
+            let g1 = 1.0 / (1.0 + lo);
+            let f = fresnel_eval(fresnel, dot(wo, h), [1.0; 3]);
+            let common = d * g2 / (4.0 * cos_o) * energy;
+            let pdf = g1 * d / (4.0 * cos_o);
+            (scale(f, common), pdf)
+        }
+    }
+}
+
+fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
+    match l.kind {
+        LobeKind::Diffuse | LobeKind::Translucent => {
+            let d = super::camera::concentric_disk(u);
+            let z = (1.0 - d[0] * d[0] - d[1] * d[1]).max(0.0).sqrt();
+            let n = if let LobeKind::Translucent = l.kind { neg(l.n) } else { l.n };
+            let wi = from_local(n, [d[0], d[1], z]);
+            Some((wi, false))
+        }
+        LobeKind::Transparent => Some((neg(wo), true)),
+        LobeKind::Glass { eta, refract_only } => {
+            // Fresnel picks reflection or refraction, so the weight stays the colour.
+            let n = l.n;
+            let c = dot(n, wo).clamp(-1.0, 1.0);
+            let f = fresnel_dielectric(c, eta);
+            let reflect = sub(scale(n, 2.0 * c), wo);
+            let k = 1.0 - (1.0 - c * c) / (eta * eta);
+            if k <= 0.0 {
+                // Total internal reflection.
+                return Some((reflect, true));
+            }
+            if !refract_only && u[0] < f {
+                return Some((reflect, true));
+            }
+            let t = sub(scale(n, c / eta - k.sqrt()), scale(wo, 1.0 / eta));
+            let _ = ng;
+            Some((normalize(t), true))
+        }
+        LobeKind::Glossy { alpha, .. } => {
+            if alpha < SINGULAR_ALPHA {
+                let wi = sub(scale(l.n, 2.0 * dot(l.n, wo)), wo);
+                if dot(wi, ng) <= 0.0 {
+                    return None;
+                }
+                return Some((wi, true));
+            }
+            let v = to_local(l.n, wo);
+            if v[2] <= 0.0 {
+                return None;
+            }
+            let h = sample_vndf(v, alpha, u);
+            let wi_l = sub(scale(h, 2.0 * dot(v, h)), v);
+            if wi_l[2] <= 0.0 {
+                return None;
+            }
+            Some((from_local(l.n, wi_l), false))
+        }
+    }
+}

@@ -1,0 +1,211 @@
+//! The scene at one frame as the renderer needs it: mesh objects (their exported
+//! meshes, or Geometry Nodes output realised) with world transforms, material slots,
+//! and every triangle in world space for the acceleration structure.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use crate::anim::EvaluatedScene;
+use crate::scene::{AttributeData, MeshData, Scene};
+
+use super::math::*;
+use super::RenderError;
+
+/// One renderable mesh instance.
+pub struct MeshInstance {
+    pub object: usize,
+    pub name: String,
+    pub instance_index: Option<u32>,
+    pub mesh: Arc<MeshData>,
+    pub to_world: Affine,
+    pub to_object: Affine,
+    /// Global material index per slot (None: no material, Cycles' default surface).
+    pub slots: Vec<Option<usize>>,
+    /// Per face: slot index.
+    pub face_slot: Vec<u32>,
+    /// Active render UV map, per corner.
+    pub uv: Option<Arc<Vec<[f32; 2]>>>,
+    pub tex_loc: V3,
+    pub tex_size: V3,
+    pub world_bounds: (V3, V3),
+}
+
+/// Per triangle: which instance and which of its mesh's triangles.
+#[derive(Debug, Clone, Copy)]
+pub struct TriRef {
+    pub inst: u32,
+    pub tri: u32,
+}
+
+pub struct Geometry {
+    pub instances: Vec<MeshInstance>,
+    pub tris: Vec<[V3; 3]>,
+    pub refs: Vec<TriRef>,
+}
+
+fn material_index(scene: &Scene, name: &Option<String>) -> Option<usize> {
+    name.as_ref().and_then(|n| scene.file.materials.iter().position(|m| &m.name == n))
+}
+
+pub fn build(scene: &Scene, eval: &EvaluatedScene, overrides: &[(String, serde_json::Value)]) -> Result<Geometry, RenderError> {
+    let mut cache: HashMap<usize, Arc<MeshData>> = HashMap::new();
+    let mut instances = Vec::new();
+    for (oi, obj) in eval.data.objects.iter().enumerate() {
+        if obj.kind != "MESH" || obj.hide_render {
+            continue;
+        }
+        let Some(mesh_name) = obj.data.as_deref() else { continue };
+        let Some(mi) = scene.file.meshes.iter().position(|m| m.name == mesh_name) else {
+            return Err(RenderError(format!("object {:?}: mesh {mesh_name:?} is not in the export", obj.name)));
+        };
+        let info = &scene.file.meshes[mi];
+        let has_gn = obj.modifiers.iter().any(|m| m.kind == "NODES" && m.show_render);
+        let other_mods: Vec<&str> = obj.modifiers.iter().filter(|m| m.kind != "NODES" && m.show_render).map(|m| m.kind.as_str()).collect();
+        if !other_mods.is_empty() {
+            return Err(RenderError(format!("object {:?}: modifier(s) {other_mods:?} are not supported by the renderer", obj.name)));
+        }
+        let to_world = Affine::from_rows(&eval.world_matrices[oi]);
+        if has_gn {
+            let set = crate::geometry::evaluate_object(scene, &obj.name, eval.frame, overrides).map_err(|e| RenderError(format!("object {:?}: geometry nodes: {e}", obj.name)))?;
+            // Top-level instances stay separate, each with its own id, sharing the
+            // realised mesh of its reference; the rest of the set is one mesh.
+            let mut rest = set.clone();
+            let instances_component = rest.instances.take();
+            let realise = |g: &crate::geometry::GeometrySet| -> Result<(Arc<MeshData>, Vec<Option<String>>), RenderError> {
+                let m = crate::geometry::realize_to_mesh(g).map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))?;
+                let mats = if m.materials.is_empty() { info.materials.clone() } else { m.materials.clone() };
+                Ok((Arc::new(m.to_scene(&obj.name)), mats))
+            };
+            let (mesh, mats) = realise(&rest)?;
+            push_instance(&mut instances, scene, oi, obj, info, mesh, &mats, to_world, None, false)?;
+            if let Some(inst) = instances_component {
+                let mut by_handle: HashMap<u32, (Arc<MeshData>, Vec<Option<String>>)> = HashMap::new();
+                for (i, (&h, t)) in inst.handles.iter().zip(&inst.transforms).enumerate() {
+                    let Some(g) = inst.references.get(h as usize).and_then(|r| r.geometry()) else { continue };
+                    let (mesh, mats) = match by_handle.get(&h) {
+                        Some(x) => x.clone(),
+                        None => {
+                            let x = realise(g)?;
+                            by_handle.insert(h, x.clone());
+                            x
+                        }
+                    };
+                    // Instance transforms are column-major (`m[col][row]`).
+                    let mut local = Affine { m: [[0.0; 4]; 3] };
+                    for r in 0..3 {
+                        for c in 0..4 {
+                            local.m[r][c] = t[c][r];
+                        }
+                    }
+                    let world = compose(&to_world, &local);
+                    push_instance(&mut instances, scene, oi, obj, info, mesh, &mats, world, Some(i as u32), false)?;
+                }
+            }
+        } else {
+            let m = match cache.get(&mi) {
+                Some(m) => m.clone(),
+                None => {
+                    let m = Arc::new(scene.load_mesh(mi).map_err(|e| RenderError(e.to_string()))?);
+                    cache.insert(mi, m.clone());
+                    m
+                }
+            };
+            push_instance(&mut instances, scene, oi, obj, info, m, &info.materials.clone(), to_world, None, true)?;
+        }
+    }
+    let mut tris = Vec::new();
+    let mut refs = Vec::new();
+    for (ii, inst) in instances.iter().enumerate() {
+        let m = &inst.mesh;
+        let world: Vec<V3> = m.positions.iter().map(|p| inst.to_world.point(*p)).collect();
+        for (t, tri) in m.triangles.iter().enumerate() {
+            let v = tri.map(|c| world[m.corner_verts[c as usize] as usize]);
+            if v.iter().any(|p| !p.iter().all(|x| x.is_finite())) {
+                continue;
+            }
+            tris.push(v);
+            refs.push(TriRef { inst: ii as u32, tri: t as u32 });
+        }
+    }
+    Ok(Geometry { instances, tris, refs })
+}
+
+fn compose(a: &Affine, b: &Affine) -> Affine {
+    let mut o = Affine { m: [[0.0; 4]; 3] };
+    for r in 0..3 {
+        for c in 0..4 {
+            let mut v = a.m[r][0] * b.m[0][c] + a.m[r][1] * b.m[1][c] + a.m[r][2] * b.m[2][c];
+            if c == 3 {
+                v += a.m[r][3];
+            }
+            o.m[r][c] = v;
+        }
+    }
+    o
+}
+
+#[allow(clippy::too_many_arguments)]
+fn push_instance(
+    instances: &mut Vec<MeshInstance>,
+    scene: &Scene,
+    oi: usize,
+    obj: &crate::scene::Object,
+    info: &crate::scene::MeshRef,
+    mesh: Arc<MeshData>,
+    mesh_materials: &[Option<String>],
+    to_world: Affine,
+    instance_index: Option<u32>,
+    exported_texspace: bool,
+) -> Result<(), RenderError> {
+    if mesh.triangles.is_empty() {
+        return Ok(());
+    }
+    // Object-linked slots override the mesh's materials (Blender's slot link).
+    let nslots = mesh_materials.len().max(obj.material_slots.len()).max(1);
+    let slots: Vec<Option<usize>> = (0..nslots)
+        .map(|s| {
+            let from_obj = obj.material_slots.get(s).filter(|sl| sl.link.as_deref() == Some("OBJECT")).map(|sl| sl.material.clone());
+            let name = from_obj.unwrap_or_else(|| mesh_materials.get(s).cloned().flatten().or_else(|| obj.material_slots.get(s).and_then(|sl| sl.material.clone())));
+            material_index(scene, &name)
+        })
+        .collect();
+    let face_slot: Vec<u32> = match mesh.attribute("material_index").map(|a| &a.data) {
+        Some(AttributeData::Int(v)) if v.len() == mesh.face_count() => v.iter().map(|&i| (i.max(0) as u32).min(nslots as u32 - 1)).collect(),
+        _ => vec![0; mesh.face_count()],
+    };
+    let uv_name = info.active_render_uv.clone().or_else(|| info.uv_layers.first().cloned());
+    let uv = uv_name.as_deref().and_then(|n| mesh.attribute(n)).and_then(|a| match &a.data {
+        AttributeData::Float2(v) if v.len() == mesh.corner_count() => Some(Arc::new(v.clone())),
+        _ => None,
+    });
+    let to_object = to_world.inverse().ok_or_else(|| RenderError(format!("object {:?} has a singular transform", obj.name)))?;
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    let (mut wlo, mut whi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for p in &mesh.positions {
+        lo = vmin(lo, *p);
+        hi = vmax(hi, *p);
+        let w = to_world.point(*p);
+        wlo = vmin(wlo, w);
+        whi = vmax(whi, w);
+    }
+    // The exported texture space for plain meshes; the bounds for generated geometry.
+    let (tex_loc, tex_size) = match (info.texspace_location, info.texspace_size, exported_texspace) {
+        (Some(l), Some(s), true) => (l.map(|x| x as f32), s.map(|x| x as f32)),
+        _ => (scale(add(lo, hi), 0.5), scale(sub(hi, lo), 0.5).map(|x| if x == 0.0 { 1.0 } else { x })),
+    };
+    instances.push(MeshInstance {
+        object: oi,
+        name: obj.name.clone(),
+        instance_index,
+        mesh,
+        to_world,
+        to_object,
+        slots,
+        face_slot,
+        uv,
+        tex_loc,
+        tex_size,
+        world_bounds: (wlo, whi),
+    });
+    Ok(())
+}

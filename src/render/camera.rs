@@ -1,0 +1,204 @@
+//! Blender's camera as Cycles builds it: sensor fit, shift, clipping (planar, along the
+//! view axis), perspective and orthographic projection, thin-lens depth of field with
+//! f-stop, focus distance or focus object, aperture blades and rotation.
+
+use serde_json::Value;
+
+use super::math::*;
+use super::RenderError;
+use crate::anim::EvaluatedScene;
+use crate::scene::Scene;
+
+#[derive(Debug, Clone)]
+pub struct Camera {
+    pub ortho: bool,
+    /// Viewplane bounds (Cycles' `viewplane`), already shifted.
+    left: f32,
+    right: f32,
+    bottom: f32,
+    top: f32,
+    /// tan(fov/2) for perspective; 1 for orthographic (the viewplane is in metres).
+    tan_half: f32,
+    pub clip_start: f32,
+    pub clip_end: f32,
+    /// Camera to world, scale removed; camera looks down -Z, +Y up.
+    pub to_world: Affine,
+    aperture: f32,
+    focus: f32,
+    blades: u32,
+    rotation: f32,
+    ratio: f32,
+    pub width: u32,
+    pub height: u32,
+}
+
+fn num(p: &serde_json::Map<String, Value>, key: &str, default: f64) -> f64 {
+    p.get(key).and_then(Value::as_f64).unwrap_or(default)
+}
+
+impl Camera {
+    pub fn new(scene: &Scene, eval: &EvaluatedScene, width: u32, height: u32) -> Result<Camera, RenderError> {
+        let cam_name = scene.file.scene.camera.as_deref().ok_or_else(|| RenderError("the scene has no active camera (scene.camera is empty)".into()))?;
+        let oi = eval.data.objects.iter().position(|o| o.name == cam_name).ok_or_else(|| RenderError(format!("camera object {cam_name:?} is not in the export")))?;
+        let obj = &eval.data.objects[oi];
+        let data = obj.data.as_deref().unwrap_or(cam_name);
+        let cam = eval.data.cameras.iter().find(|c| c.name == data).ok_or_else(|| RenderError(format!("camera object {cam_name:?}: camera data {data:?} is not in the export")))?;
+        let p = &cam.properties;
+        let kind = p.get("type").and_then(Value::as_str).unwrap_or("PERSP");
+        if kind == "PANO" {
+            return Err(RenderError(format!("camera {data:?}: panoramic cameras are not supported yet")));
+        }
+        let ortho = kind == "ORTHO";
+        let r = &scene.file.scene.render;
+        let (pax, pay) = (num(r, "pixel_aspect_x", 1.0) as f32, num(r, "pixel_aspect_y", 1.0) as f32);
+        let xratio = width as f32 * pax;
+        let yratio = height as f32 * pay;
+        let fit = p.get("sensor_fit").and_then(Value::as_str).unwrap_or("AUTO");
+        let (horizontal, sensor) = match fit {
+            "HORIZONTAL" => (true, num(p, "sensor_width", 36.0)),
+            "VERTICAL" => (false, num(p, "sensor_height", 24.0)),
+            _ => (xratio > yratio, num(p, "sensor_width", 36.0)),
+        };
+        let sensor = sensor as f32;
+        let (mut aspect, mut xaspect, mut yaspect) = if horizontal { (xratio / yratio, xratio / yratio, 1.0) } else { (yratio / xratio, 1.0, yratio / xratio) };
+        let ortho_scale = num(p, "ortho_scale", 6.0) as f32;
+        if ortho {
+            xaspect = xaspect * ortho_scale / (aspect * 2.0);
+            yaspect = yaspect * ortho_scale / (aspect * 2.0);
+            aspect = ortho_scale / 2.0;
+        }
+        let (sx, sy) = (num(p, "shift_x", 0.0) as f32, num(p, "shift_y", 0.0) as f32);
+        let dx = 2.0 * aspect * sx;
+        let dy = 2.0 * aspect * sy;
+        let lens = num(p, "lens", 50.0) as f32;
+        let tan_half = if ortho { 1.0 } else { (0.5 * sensor) / lens / aspect };
+        // Camera transform without scale (Cycles clears it).
+        let m = Affine::from_rows(&eval.world_matrices[oi]);
+        let mut to_world = m;
+        for c in 0..3 {
+            let l = len(m.column(c));
+            if l > 0.0 {
+                for r in 0..3 {
+                    to_world.m[r][c] /= l;
+                }
+            }
+        }
+        let dof = p.get("dof").and_then(Value::as_object);
+        let use_dof = dof.and_then(|d| d.get("use_dof")).and_then(Value::as_bool).unwrap_or(false);
+        let (mut aperture, mut focus, mut blades, mut rotation, mut ratio) = (0.0f32, 10.0f32, 0u32, 0.0f32, 1.0f32);
+        if let (true, Some(d)) = (use_dof, dof) {
+            let fstop = num(d, "aperture_fstop", 2.8) as f32;
+            // Cycles: lens in mm to a radius in metres; orthographic uses 1/(2 f-stop).
+            aperture = if fstop <= 0.0 { 0.0 } else if ortho { 1.0 / (2.0 * fstop) } else { (lens * 1e-3) / (2.0 * fstop) };
+            // Blender's unit scale applies to the lens; scene scale is 1 in our fixtures.
+            blades = num(d, "aperture_blades", 0.0) as u32;
+            rotation = num(d, "aperture_rotation", 0.0) as f32;
+            ratio = num(d, "aperture_ratio", 1.0) as f32;
+            focus = num(d, "focus_distance", 10.0) as f32;
+            if let Some(fo) = d.get("focus_object").and_then(Value::as_str) {
+                if let Some(fi) = eval.data.objects.iter().position(|o| o.name == fo) {
+                    // Distance along the view axis to the focus object's origin.
+                    let t = eval.world_matrices[fi];
+                    let pos = [t[0][3] as f32, t[1][3] as f32, t[2][3] as f32];
+                    let view = neg(normalize(to_world.column(2)));
+                    focus = dot(sub(pos, to_world.column(3)), view).abs();
+                }
+            }
+            focus = focus.max(1e-5);
+        }
+        let clip_start = num(p, "clip_start", 0.1) as f32;
+        let clip_end = num(p, "clip_end", 100.0) as f32;
+        Ok(Camera {
+            ortho,
+            left: -xaspect + dx,
+            right: xaspect + dx,
+            bottom: -yaspect + dy,
+            top: yaspect + dy,
+            tan_half,
+            clip_start,
+            clip_end,
+            to_world,
+            aperture,
+            focus,
+            blades,
+            rotation,
+            ratio,
+            width,
+            height,
+        })
+    }
+
+    /// A camera ray through raster position (x right, y down from the top-left corner,
+    /// in pixels): origin, unit direction, tmin, tmax. `lens` is a 2D sample.
+    pub fn ray(&self, x: f32, y: f32, lens: [f32; 2]) -> (V3, V3, f32, f32) {
+        let vx = self.left + (self.right - self.left) * (x / self.width as f32);
+        let vy = self.top - (self.top - self.bottom) * (y / self.height as f32);
+        // Camera space, looking down -Z.
+        let (mut p, mut d) = if self.ortho { ([vx, vy, 0.0], [0.0, 0.0, -1.0]) } else { ([0.0; 3], normalize([vx * self.tan_half, vy * self.tan_half, -1.0])) };
+        let tmin;
+        let tmax;
+        if self.aperture > 0.0 {
+            let mut uv = self.sample_aperture(lens);
+            uv[0] *= self.aperture;
+            uv[1] *= self.aperture;
+            // Point on the plane of focus, then the ray from the lens point through it.
+            let ft = self.focus / -d[2];
+            let focus_p = add(p, scale(d, ft));
+            let lp = [p[0] + uv[0], p[1] + uv[1], p[2]];
+            d = normalize(sub(focus_p, lp));
+            p = lp;
+        }
+        // Clipping planes are planar, along the view axis.
+        let zinv = 1.0 / (-d[2]).max(1e-8);
+        if self.ortho {
+            tmin = self.clip_start;
+            tmax = self.clip_end;
+        } else {
+            p = add(p, scale(d, self.clip_start * zinv));
+            tmin = 0.0;
+            tmax = (self.clip_end - self.clip_start) * zinv;
+        }
+        let wo = self.to_world.point(p);
+        let wd = normalize(self.to_world.vector(d));
+        (wo, wd, tmin, tmax)
+    }
+
+    fn sample_aperture(&self, u: [f32; 2]) -> [f32; 2] {
+        let mut p = if self.blades < 3 { concentric_disk(u) } else { regular_polygon(self.blades, self.rotation, u) };
+        // Anamorphic ratio stretches the bokeh as Cycles does.
+        p[0] *= self.ratio.sqrt().max(1e-6);
+        p[1] /= self.ratio.sqrt().max(1e-6);
+        p
+    }
+
+    /// The camera-space Z distance of a world point (for the depth pass).
+    pub fn depth(&self, w: V3) -> f32 {
+        let view = neg(self.to_world.column(2));
+        dot(sub(w, self.to_world.column(3)), view)
+    }
+}
+
+pub fn concentric_disk(u: [f32; 2]) -> [f32; 2] {
+    let a = 2.0 * u[0] - 1.0;
+    let b = 2.0 * u[1] - 1.0;
+    if a == 0.0 && b == 0.0 {
+        return [0.0, 0.0];
+    }
+    let (r, phi) = if a * a > b * b { (a, std::f32::consts::FRAC_PI_4 * (b / a)) } else { (b, std::f32::consts::FRAC_PI_2 - std::f32::consts::FRAC_PI_4 * (a / b)) };
+    [r * phi.cos(), r * phi.sin()]
+}
+
+/// Uniform point in a regular polygon inscribed in the unit circle.
+fn regular_polygon(blades: u32, rotation: f32, u: [f32; 2]) -> [f32; 2] {
+    let n = blades as f32;
+    let k = ((u[0] * n) as u32).min(blades - 1);
+    let u0 = u[0] * n - k as f32;
+    let step = 2.0 * std::f32::consts::PI / n;
+    let a0 = rotation + k as f32 * step;
+    let a1 = a0 + step;
+    let (p1, p2) = ([a0.cos(), a0.sin()], [a1.cos(), a1.sin()]);
+    // Uniform in the triangle (centre, p1, p2).
+    let s = u0.sqrt();
+    let (b1, b2) = (s * (1.0 - u[1]), s * u[1]);
+    [p1[0] * b1 + p2[0] * b2, p1[1] * b1 + p2[1] * b2]
+}

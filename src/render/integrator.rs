@@ -1,0 +1,411 @@
+//! The path tracer: next-event estimation toward light objects, BSDF sampling for
+//! emissive surfaces and the world, Cycles' per-type bounce limits (terminating after
+//! the next surface, as Cycles does), Russian roulette on sqrt of throughput, and
+//! Cycles' clamping (direct and indirect limits on the sum of a contribution).
+
+use crate::shader::ShadingPoint;
+
+use super::accel::Accel;
+use super::bsdf::{LobeKind, LobeSet};
+use super::build::Geometry;
+use super::light::Light;
+use super::math::*;
+use super::sampler::PixelSampler;
+use super::shade::{Context, Material};
+use super::tables::Tables;
+
+#[derive(Debug, Clone, Copy)]
+pub struct Settings {
+    pub max_bounces: u32,
+    pub max_diffuse: u32,
+    pub max_glossy: u32,
+    pub max_transmission: u32,
+    pub max_transparent: u32,
+    pub clamp_direct: f32,
+    pub clamp_indirect: f32,
+    pub min_light_bounces: u32,
+    /// Cycles' Filter Glossy (`blur_glossy`).
+    pub filter_glossy: f32,
+}
+
+/// Emissive triangles for light sampling: chosen by area times estimated emission.
+#[derive(Default)]
+pub struct MeshLights {
+    pub prims: Vec<u32>,
+    pub cdf: Vec<f32>,
+    /// Per scene triangle: selection probability over its area (0: not a light).
+    pub pdf_area: Vec<f32>,
+}
+
+impl MeshLights {
+    fn pick(&self, u: f32) -> usize {
+        let n = self.cdf.len();
+        let i = self.cdf.partition_point(|&c| c <= u);
+        i.min(n - 1)
+    }
+}
+
+#[inline]
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    if a.is_infinite() {
+        return 1.0;
+    }
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 > 0.0 {
+        a2 / (a2 + b2)
+    } else {
+        0.0
+    }
+}
+
+pub struct Scene<'a> {
+    pub mesh_lights: &'a MeshLights,
+    pub accel: &'a dyn Accel,
+    pub geo: &'a Geometry,
+    pub materials: &'a [Material],
+    pub lights: &'a [Light],
+    pub background: V3,
+    pub tables: &'a Tables,
+    pub settings: Settings,
+}
+
+/// Per-thread scratch, reused across samples (no allocation per ray).
+pub struct Scratch {
+    pub stacks: Vec<Vec<f32>>,
+    pub lobes: LobeSet,
+    pub light_lobes: LobeSet,
+    pub rays: u64,
+}
+
+impl Scratch {
+    pub fn new(n_materials: usize) -> Scratch {
+        Scratch { stacks: vec![Vec::new(); n_materials + 1], lobes: LobeSet::default(), light_lobes: LobeSet::default(), rays: 0 }
+    }
+}
+
+/// A surface hit, resolved for shading.
+pub struct SurfaceHit {
+    pub p: V3,
+    pub ng: V3,
+    pub sp: ShadingPoint,
+    pub inst: u32,
+    pub material: Option<usize>,
+    pub backfacing: bool,
+}
+
+/// Below this GGX alpha a vertex uses MIS toward lamps.
+const MIS_ALPHA: f32 = 0.05;
+
+fn clamp_contrib(l: V3, limit: f32) -> V3 {
+    if limit > 0.0 {
+        let s = l[0].abs() + l[1].abs() + l[2].abs();
+        if s > limit {
+            return scale(l, limit / s);
+        }
+    }
+    l
+}
+
+fn finite(v: V3) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+impl Scene<'_> {
+    pub fn surface(&self, prim: u32, u: f32, v: f32, wo: V3) -> SurfaceHit {
+        let r = self.geo.refs[prim as usize];
+        let inst = &self.geo.instances[r.inst as usize];
+        let m = &inst.mesh;
+        let c = m.triangles[r.tri as usize].map(|c| c as usize);
+        let w0 = 1.0 - u - v;
+        let tri = &self.geo.tris[prim as usize];
+        let p = add(add(scale(tri[0], w0), scale(tri[1], u)), scale(tri[2], v));
+        let mut ng = normalize(cross(sub(tri[1], tri[0]), sub(tri[2], tri[0])));
+        let lp = c.map(|c| m.positions[m.corner_verts[c] as usize]);
+        let local = add(add(scale(lp[0], w0), scale(lp[1], u)), scale(lp[2], v));
+        let mut n_obj = if m.corner_normals.len() == m.corner_verts.len() {
+            let cn = c.map(|c| m.corner_normals[c]);
+            normalize(add(add(scale(cn[0], w0), scale(cn[1], u)), scale(cn[2], v)))
+        } else {
+            normalize(cross(sub(lp[1], lp[0]), sub(lp[2], lp[0])))
+        };
+        let mut n = normalize(Affine::normal_by_inverse(&inst.to_object, n_obj));
+        if !finite(n) || is_zero(n) {
+            n = ng;
+        }
+        let backfacing = dot(ng, wo) < 0.0;
+        if backfacing {
+            ng = neg(ng);
+            n = neg(n);
+            n_obj = neg(n_obj);
+        }
+        let face = m.triangle_faces[r.tri as usize] as usize;
+        let slot = inst.face_slot.get(face).copied().unwrap_or(0) as usize;
+        let material = inst.slots.get(slot).copied().flatten();
+        let mut sp = ShadingPoint::default();
+        sp.position = p;
+        sp.normal = n;
+        sp.object_position = local;
+        sp.object_normal = n_obj;
+        sp.generated = [0, 1, 2].map(|k| (local[k] - inst.tex_loc[k]) / (2.0 * inst.tex_size[k]) + 0.5);
+        if let Some(uv) = &inst.uv {
+            let t = c.map(|c| uv[c]);
+            sp.uv = [t[0][0] * w0 + t[1][0] * u + t[2][0] * v, t[0][1] * w0 + t[1][1] * u + t[2][1] * v, 0.0];
+        }
+        SurfaceHit { p, ng, sp, inst: r.inst, material, backfacing }
+    }
+
+    pub fn shade(&self, hit: &SurfaceHit, wo: V3, scratch: &mut Scratch) {
+        self.shade_into(hit, wo, &mut scratch.stacks, &mut scratch.lobes);
+    }
+
+    fn shade_into(&self, hit: &SurfaceHit, wo: V3, stacks: &mut [Vec<f32>], lobes: &mut LobeSet) {
+        let ctx = Context { tables: self.tables, wo, backfacing: hit.backfacing };
+        match hit.material {
+            Some(mi) => self.materials[mi].shade(&hit.sp, &mut stacks[mi], &ctx, lobes),
+            None => {
+                lobes.clear();
+                lobes.push(LobeKind::Diffuse, [0.8; 3], hit.sp.normal);
+            }
+        }
+    }
+
+    /// Emission of a surface point seen from direction `wo` (for building the mesh
+    /// light distribution and for light samples on emissive triangles).
+    pub fn emission_at(&self, prim: u32, u: f32, v: f32, wo: V3, scratch: &mut Scratch) -> V3 {
+        let hit = self.surface(prim, u, v, wo);
+        self.shade_into(&hit, wo, &mut scratch.stacks, &mut scratch.light_lobes);
+        scratch.light_lobes.emission
+    }
+
+    /// One path sample: radiance along the camera ray.
+    pub fn radiance(&self, org: V3, dir: V3, tmin: f32, tmax: f32, rng: &PixelSampler, index: u32, scratch: &mut Scratch) -> V3 {
+        let st = &self.settings;
+        let mut l = [0.0f32; 3];
+        let mut throughput = [1.0f32; 3];
+        let (mut o, mut d, mut t0, mut t1) = (org, dir, tmin, tmax);
+        let (mut bounce, mut diffuse, mut glossy, mut transmission, mut transparent) = (0u32, 0u32, 0u32, 0u32, 0u32);
+        let mut terminate_next = false;
+        let mut set = 1u32;
+        // MIS state of the ray being traced: the BSDF pdf that chose it, or singular.
+        let mut prev_pdf = f32::INFINITY;
+        let mut prev_singular = true;
+        // Whether the vertex that sent the ray shares lamps between light and BSDF sampling.
+        let mut prev_mis_lamps = false;
+        // Smallest pdf of the non-singular bounces so far (Cycles' min_ray_pdf).
+        let mut min_ray_pdf = f32::INFINITY;
+        loop {
+            scratch.rays += 1;
+            let hit_opt = self.accel.intersect(o, d, t0, t1);
+            // Emission reached by a ray clamps as the bounce before it (Cycles: light found
+            // after one bounce is direct light, like the light sample at that vertex).
+            let clamp_limit = if bounce <= 1 { st.clamp_direct } else { st.clamp_indirect };
+            // Lights are not in the BVH: a ray collects every light it passes before the surface.
+            let t_surface = hit_opt.map(|h| h.t).unwrap_or(if t1.is_finite() { t1 } else { f32::INFINITY });
+            for light in self.lights {
+                if let Some(lh) = light.intersect(o, d, t_surface) {
+                    let w = if prev_singular {
+                        1.0
+                    } else if prev_mis_lamps {
+                        power_heuristic(prev_pdf, lh.pdf)
+                    } else {
+                        // Light sampling alone covered this lamp at that vertex.
+                        continue;
+                    };
+                    let c = clamp_contrib(scale(mul(throughput, lh.radiance), w), clamp_limit);
+                    if finite(c) {
+                        l = add(l, c);
+                    }
+                }
+            }
+            let Some(h) = hit_opt else {
+                let c = clamp_contrib(mul(throughput, self.background), clamp_limit);
+                if finite(c) {
+                    l = add(l, c);
+                }
+                break;
+            };
+            let wo = neg(d);
+            let hit = self.surface(h.prim, h.u, h.v, wo);
+            self.shade(&hit, wo, scratch);
+            // Filter Glossy: after diffuse-like bounces, glossy lobes are roughened.
+            if st.filter_glossy > 0.0 && min_ray_pdf.is_finite() {
+                let blur_pdf = st.filter_glossy * min_ray_pdf;
+                if blur_pdf < 1.0 {
+                    let blur = (1.0 - blur_pdf).sqrt() * 0.5;
+                    let n = scratch.lobes.len;
+                    for lobe in &mut scratch.lobes.lobes[..n] {
+                        if let LobeKind::Glossy { alpha, .. } = &mut lobe.kind {
+                            *alpha = alpha.max(blur);
+                        }
+                    }
+                }
+            }
+            let lobes = &scratch.lobes;
+            if !is_zero(lobes.emission) {
+                let pa = self.mesh_lights.pdf_area.get(h.prim as usize).copied().unwrap_or(0.0);
+                let w = if prev_singular || pa <= 0.0 {
+                    1.0
+                } else {
+                    let cos_l = dot(hit.ng, wo).abs().max(1e-8);
+                    power_heuristic(prev_pdf, pa * h.t * h.t / cos_l)
+                };
+                let c = clamp_contrib(scale(mul(throughput, lobes.emission), w), clamp_limit);
+                if finite(c) {
+                    l = add(l, c);
+                }
+            }
+            let u_bsdf = rng.get4(index, set);
+            let u_light = rng.get4(index, set + 1);
+            let u_mesh = rng.get4(index, set + 2);
+            set += 3;
+            if terminate_next {
+                // Only transparent surfaces let such a path continue (Cycles'
+                // TERMINATE_AFTER_TRANSPARENT).
+                if is_zero(lobes.transparent) {
+                    break;
+                }
+            }
+            // Russian roulette, as Cycles: none up to the minimum bounce, then sqrt of throughput.
+            if bounce > st.min_light_bounces {
+                let q = max3(throughput.map(f32::abs)).sqrt().min(1.0);
+                if q <= 0.0 || u_light[3] >= q {
+                    break;
+                }
+                throughput = scale(throughput, 1.0 / q);
+            }
+            let p_off = |dir: V3| {
+                let eps = 1e-5 * (1.0 + max3(hit.p.map(f32::abs)));
+                if dot(dir, hit.ng) >= 0.0 {
+                    madd(hit.p, hit.ng, eps)
+                } else {
+                    madd(hit.p, hit.ng, -eps)
+                }
+            };
+            // Lamps are shared with BSDF sampling (MIS) only at vertices with a sharp
+            // glossy lobe, where light sampling alone is noisy; elsewhere light sampling
+            // alone has less variance than MIS with our area-uniform lamp sampling.
+            let mis_lamps = lobes.lobes[..lobes.len].iter().any(|l| matches!(l.kind, LobeKind::Glossy { alpha, .. } if alpha < MIS_ALPHA));
+            // Next-event estimation toward every light.
+            if !terminate_next && lobes.len > 0 {
+                for (li, light) in self.lights.iter().enumerate() {
+                    let uu = if li == 0 { [u_light[0], u_light[1]] } else { let r = rng.get4(index, 0x4000_0000 + set * 64 + li as u32); [r[0], r[1]] };
+                    let Some(ls) = light.sample(hit.p, uu) else { continue };
+                    let (f, pdf_b) = lobes.eval(wo, ls.wi, hit.ng, self.tables);
+                    if is_zero(f) {
+                        continue;
+                    }
+                    let w = if mis_lamps { power_heuristic(ls.pdf, pdf_b) } else { 1.0 };
+                    let c = scale(mul(mul(throughput, f), ls.value), w);
+                    if is_zero(c) || !finite(c) {
+                        continue;
+                    }
+                    let start = p_off(ls.wi);
+                    scratch.rays += 1;
+                    if light.cast_shadow && self.accel.occluded(start, ls.wi, 0.0, if ls.dist.is_finite() { ls.dist * (1.0 - 1e-4) } else { f32::INFINITY }) {
+                        continue;
+                    }
+                    l = add(l, clamp_contrib(c, if bounce == 0 { st.clamp_direct } else { st.clamp_indirect }));
+                }
+            }
+            // One light sample on an emissive triangle.
+            if !terminate_next && scratch.lobes.len > 0 && !self.mesh_lights.prims.is_empty() {
+                let k = self.mesh_lights.pick(u_mesh[2]);
+                let prim = self.mesh_lights.prims[k];
+                let tri = &self.geo.tris[prim as usize];
+                let su = u_mesh[0].sqrt();
+                let (b1, b2) = (su * (1.0 - u_mesh[1]), su * u_mesh[1]);
+                let q = add(add(scale(tri[0], 1.0 - b1 - b2), scale(tri[1], b1)), scale(tri[2], b2));
+                let to = sub(q, hit.p);
+                let d2 = dot(to, to);
+                let dist = d2.sqrt();
+                let wi = scale(to, 1.0 / dist.max(1e-12));
+                let ng_l = normalize(cross(sub(tri[1], tri[0]), sub(tri[2], tri[0])));
+                let cos_l = dot(ng_l, wi).abs();
+                if d2 > 0.0 && cos_l > 1e-6 && prim != h.prim {
+                    let (f, pdf_b) = scratch.lobes.eval(wo, wi, hit.ng, self.tables);
+                    if !is_zero(f) {
+                        let pdf_l = self.mesh_lights.pdf_area[prim as usize] * d2 / cos_l;
+                        let start = p_off(wi);
+                        scratch.rays += 1;
+                        if pdf_l > 0.0 && !self.accel.occluded(start, wi, 0.0, dist * (1.0 - 1e-4)) {
+                            let le = self.emission_at(prim, b1, b2, neg(wi), scratch);
+                            let w = power_heuristic(pdf_l, pdf_b);
+                            let c = scale(mul(mul(throughput, f), le), w / pdf_l);
+                            if finite(c) {
+                                l = add(l, clamp_contrib(c, if bounce == 0 { st.clamp_direct } else { st.clamp_indirect }));
+                            }
+                        }
+                    }
+                }
+            }
+            let lobes = &scratch.lobes;
+            let Some(bs) = lobes.sample(wo, hit.ng, [u_bsdf[0], u_bsdf[1], u_bsdf[2]], self.tables) else { break };
+            if !finite(bs.weight) || is_zero(bs.weight) {
+                break;
+            }
+            if terminate_next && !matches!(bs.kind, LobeKind::Transparent) {
+                break;
+            }
+            throughput = mul(throughput, bs.weight);
+            match bs.kind {
+                LobeKind::Transparent => {
+                    transparent += 1;
+                    if transparent > st.max_transparent {
+                        break;
+                    }
+                    // Transparent bounces keep the bounce count and continue from the hit.
+                    o = p_off(d);
+                    t0 = 0.0;
+                    t1 = f32::INFINITY;
+                    continue;
+                }
+                LobeKind::Diffuse => {
+                    if diffuse >= st.max_diffuse {
+                        terminate_next = true;
+                    }
+                    diffuse += 1;
+                }
+                LobeKind::Translucent => {
+                    if diffuse >= st.max_diffuse {
+                        terminate_next = true;
+                    }
+                    diffuse += 1;
+                }
+                LobeKind::Glossy { .. } => {
+                    if glossy >= st.max_glossy {
+                        terminate_next = true;
+                    }
+                    glossy += 1;
+                }
+                LobeKind::Glass { .. } => {
+                    if bs.transmit {
+                        if transmission >= st.max_transmission {
+                            terminate_next = true;
+                        }
+                        transmission += 1;
+                    } else {
+                        if glossy >= st.max_glossy {
+                            terminate_next = true;
+                        }
+                        glossy += 1;
+                    }
+                }
+            }
+            if bounce >= st.max_bounces {
+                terminate_next = true;
+            }
+            bounce += 1;
+            prev_pdf = bs.pdf;
+            prev_singular = bs.singular;
+            prev_mis_lamps = mis_lamps;
+            if !bs.singular {
+                min_ray_pdf = min_ray_pdf.min(bs.pdf);
+            }
+            o = p_off(bs.wi);
+            d = bs.wi;
+            t0 = 0.0;
+            t1 = f32::INFINITY;
+        }
+        l
+    }
+}

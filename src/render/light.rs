@@ -1,0 +1,278 @@
+//! Light objects with Cycles' units: point and spot (W; sphere of `shadow_soft_size`
+//! radius, radiance = power / (4 pi^2 r^2)), area (W; one-sided square, rectangle, disk
+//! or ellipse, radiance = power / (pi A)), sun (W/m^2; cone of `angle`).
+//! Sampling returns direction, distance and the contribution divided by the pdf.
+
+use serde_json::Value;
+use std::f32::consts::PI;
+
+use super::math::*;
+use crate::anim::EvaluatedScene;
+
+#[derive(Debug, Clone)]
+pub enum Shape {
+    Point { radius: f32, spot: Option<Spot> },
+    Area { u: V3, v: V3, ellipse: bool, area: f32 },
+    Sun { half_angle: f32 },
+}
+
+#[derive(Debug, Clone, Copy)]
+pub struct Spot {
+    pub cos_half: f32,
+    pub smooth: f32,
+    /// Axes scaled as Cycles does, for non-uniformly scaled spot cones.
+    pub u: V3,
+    pub v: V3,
+    pub w: V3,
+}
+
+#[derive(Debug, Clone)]
+pub struct Light {
+    pub shape: Shape,
+    pub strength: V3,
+    pub pos: V3,
+    /// Emission direction (-Z of the object), unit.
+    pub dir: V3,
+    pub cast_shadow: bool,
+}
+
+pub struct LightSample {
+    pub wi: V3,
+    pub dist: f32,
+    /// Radiance times cosine at the light over pdf, before the BSDF.
+    pub value: V3,
+    /// Solid-angle pdf of the sample (infinite for delta lights: no MIS).
+    pub pdf: f32,
+}
+
+/// A light found by a BSDF ray: distance, radiance, and the pdf with which light
+/// sampling would have chosen that direction.
+pub struct LightHit {
+    pub t: f32,
+    pub radiance: V3,
+    pub pdf: f32,
+}
+
+fn num(p: &serde_json::Map<String, Value>, k: &str, d: f64) -> f32 {
+    p.get(k).and_then(Value::as_f64).unwrap_or(d) as f32
+}
+
+pub fn collect(eval: &EvaluatedScene) -> Vec<Light> {
+    let mut out = Vec::new();
+    for (oi, obj) in eval.data.objects.iter().enumerate() {
+        if obj.kind != "LIGHT" || obj.hide_render {
+            continue;
+        }
+        let Some(data) = obj.data.as_deref() else { continue };
+        let Some(l) = eval.data.lights.iter().find(|l| l.name == data) else { continue };
+        let p = &l.properties;
+        let m = Affine::from_rows(&eval.world_matrices[oi]);
+        let color = p.get("color").and_then(Value::as_array).map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(1.0) as f32)).unwrap_or([1.0; 3]);
+        let energy = num(p, "energy", 10.0);
+        let exposure = num(p, "exposure", 0.0);
+        let strength = scale(color, energy * 2f32.powf(exposure));
+        let pos = m.column(3);
+        let dir = normalize(neg(m.column(2)));
+        let cast_shadow = p.get("cycles").and_then(|c| c.get("cast_shadow")).and_then(Value::as_bool).unwrap_or(true);
+        let shape = match l.kind.as_str() {
+            "POINT" | "SPOT" => {
+                let radius = num(p, "shadow_soft_size", 0.25);
+                let spot = if l.kind == "SPOT" {
+                    let size = num(p, "spot_size", 0.785398);
+                    let blend = num(p, "spot_blend", 0.15);
+                    let cos_half = (size * 0.5).cos();
+                    let smooth = if blend > 0.0 { 1.0 / ((1.0 - cos_half) * blend) } else { f32::INFINITY };
+                    // Cycles divides by the axes' squared lengths so scale shapes the cone.
+                    let inv = |a: V3| {
+                        let l2 = dot(a, a);
+                        if l2 > 0.0 {
+                            scale(a, 1.0 / l2)
+                        } else {
+                            a
+                        }
+                    };
+                    Some(Spot { cos_half, smooth, u: inv(m.column(0)), v: inv(m.column(1)), w: inv(neg(m.column(2))) })
+                } else {
+                    None
+                };
+                Shape::Point { radius, spot }
+            }
+            "AREA" => {
+                let size = num(p, "size", 1.0);
+                let shape = p.get("shape").and_then(Value::as_str).unwrap_or("SQUARE");
+                let size_y = if shape == "RECTANGLE" || shape == "ELLIPSE" { num(p, "size_y", 1.0) } else { size };
+                let u = scale(m.column(0), size);
+                let v = scale(m.column(1), size_y);
+                let ellipse = shape == "DISK" || shape == "ELLIPSE";
+                let mut area = len(u) * len(v);
+                if ellipse {
+                    area *= PI / 4.0;
+                }
+                if area <= 0.0 {
+                    continue;
+                }
+                Shape::Area { u, v, ellipse, area }
+            }
+            "SUN" => Shape::Sun { half_angle: num(p, "angle", 0.00918) * 0.5 },
+            _ => continue,
+        };
+        out.push(Light { shape, strength, pos, dir, cast_shadow });
+    }
+    out
+}
+
+#[inline]
+fn smoothstep(x: f32) -> f32 {
+    let x = x.clamp(0.0, 1.0);
+    x * x * (3.0 - 2.0 * x)
+}
+
+impl Light {
+    pub fn sample(&self, p: V3, u: [f32; 2]) -> Option<LightSample> {
+        match &self.shape {
+            Shape::Point { radius, spot } => {
+                let to = sub(self.pos, p);
+                let d2 = dot(to, to);
+                if d2 <= 0.0 {
+                    return None;
+                }
+                let d = d2.sqrt();
+                let w = scale(to, 1.0 / d);
+                let mut atten = 1.0;
+                if let Some(s) = spot {
+                    let r = neg(w);
+                    let sr = normalize([dot(r, s.u), dot(r, s.v), dot(r, s.w)]);
+                    atten = if s.smooth.is_finite() { smoothstep((sr[2] - s.cos_half) * s.smooth) } else if sr[2] > s.cos_half { 1.0 } else { 0.0 };
+                    if atten <= 0.0 {
+                        return None;
+                    }
+                }
+                if *radius <= 0.0 {
+                    // Intensity power / (4 pi) over squared distance.
+                    let v = scale(self.strength, atten / (4.0 * PI * d2));
+                    return Some(LightSample { wi: w, dist: d, value: v, pdf: f32::INFINITY });
+                }
+                // A disk of the sphere's radius facing the shading point.
+                let disk = super::camera::concentric_disk(u);
+                let (t, b) = basis(w);
+                let q = add(self.pos, add(scale(t, disk[0] * radius), scale(b, disk[1] * radius)));
+                let to = sub(q, p);
+                let dq2 = dot(to, to);
+                let dq = dq2.sqrt();
+                let wi = scale(to, 1.0 / dq);
+                let cos_l = dot(w, wi).abs();
+                let radiance = 1.0 / (4.0 * PI * PI * radius * radius);
+                // value = L * cos_l * A / d^2
+                let v = scale(self.strength, atten * radiance * cos_l * PI * radius * radius / dq2);
+                let pdf = dq2 / (cos_l.max(1e-8) * PI * radius * radius);
+                Some(LightSample { wi, dist: dq, value: v, pdf })
+            }
+            Shape::Area { u: au, v: av, ellipse, area } => {
+                let (a, b) = if *ellipse {
+                    let d = super::camera::concentric_disk(u);
+                    (d[0] * 0.5, d[1] * 0.5)
+                } else {
+                    (u[0] - 0.5, u[1] - 0.5)
+                };
+                let q = add(self.pos, add(scale(*au, a), scale(*av, b)));
+                let to = sub(q, p);
+                let d2 = dot(to, to);
+                if d2 <= 0.0 {
+                    return None;
+                }
+                let d = d2.sqrt();
+                let wi = scale(to, 1.0 / d);
+                let cos_l = -dot(self.dir, wi);
+                if cos_l <= 0.0 {
+                    return None;
+                }
+                let radiance = 1.0 / (PI * area);
+                let v = scale(self.strength, radiance * cos_l * area / d2);
+                Some(LightSample { wi, dist: d, value: v, pdf: d2 / (cos_l * area) })
+            }
+            Shape::Sun { half_angle } => {
+                let toward = neg(self.dir);
+                if *half_angle <= 0.0 {
+                    return Some(LightSample { wi: toward, dist: f32::INFINITY, value: self.strength, pdf: f32::INFINITY });
+                }
+                let cos_max = half_angle.cos();
+                let z = 1.0 - u[0] * (1.0 - cos_max);
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                let phi = 2.0 * PI * u[1];
+                let (t, b) = basis(toward);
+                let wi = add(add(scale(t, r * phi.cos()), scale(b, r * phi.sin())), scale(toward, z));
+                let s = half_angle.sin();
+                let radiance = 1.0 / (PI * s * s);
+                let pdf = 1.0 / (2.0 * PI * (1.0 - cos_max));
+                Some(LightSample { wi, dist: f32::INFINITY, value: scale(self.strength, radiance / pdf), pdf })
+            }
+        }
+    }
+
+    /// Where a ray from `o` along unit `d` meets this light before `tmax` (suns: only
+    /// rays that leave the scene, `tmax` infinite).
+    pub fn intersect(&self, o: V3, d: V3, tmax: f32) -> Option<LightHit> {
+        match &self.shape {
+            Shape::Point { radius, spot } => {
+                if *radius <= 0.0 {
+                    return None;
+                }
+                // The disk through the light's centre facing the ray origin.
+                let to = sub(self.pos, o);
+                let dist2 = dot(to, to);
+                let n = normalize(neg(to));
+                let denom = dot(d, n);
+                if denom >= 0.0 {
+                    return None;
+                }
+                let t = dot(sub(self.pos, o), n) / denom;
+                if !(t > 0.0 && t < tmax) {
+                    return None;
+                }
+                let q = madd(o, d, t);
+                if dot(sub(q, self.pos), sub(q, self.pos)) > radius * radius {
+                    return None;
+                }
+                let mut atten = 1.0;
+                if let Some(s) = spot {
+                    let r = neg(normalize(to));
+                    let sr = normalize([dot(r, s.u), dot(r, s.v), dot(r, s.w)]);
+                    atten = if s.smooth.is_finite() { smoothstep((sr[2] - s.cos_half) * s.smooth) } else if sr[2] > s.cos_half { 1.0 } else { 0.0 };
+                }
+                let _ = dist2;
+                let radiance = scale(self.strength, atten / (4.0 * PI * PI * radius * radius));
+                let cos_l = -denom;
+                Some(LightHit { t, radiance, pdf: t * t / (cos_l.max(1e-8) * PI * radius * radius) })
+            }
+            Shape::Area { u, v, ellipse, area } => {
+                let cos_l = -dot(d, self.dir);
+                if cos_l <= 0.0 {
+                    return None;
+                }
+                let t = dot(sub(self.pos, o), self.dir) / dot(d, self.dir);
+                if !(t > 0.0 && t < tmax) {
+                    return None;
+                }
+                let q = sub(madd(o, d, t), self.pos);
+                let a = dot(q, *u) / dot(*u, *u);
+                let b = dot(q, *v) / dot(*v, *v);
+                let inside = if *ellipse { a * a + b * b <= 0.25 } else { a.abs() <= 0.5 && b.abs() <= 0.5 };
+                if !inside {
+                    return None;
+                }
+                Some(LightHit { t, radiance: scale(self.strength, 1.0 / (PI * area)), pdf: t * t / (cos_l * area) })
+            }
+            Shape::Sun { half_angle } => {
+                if tmax.is_finite() || *half_angle <= 0.0 {
+                    return None;
+                }
+                let cos_max = half_angle.cos();
+                if dot(d, neg(self.dir)) < cos_max {
+                    return None;
+                }
+                let s = half_angle.sin();
+                Some(LightHit { t: f32::INFINITY, radiance: scale(self.strength, 1.0 / (PI * s * s)), pdf: 1.0 / (2.0 * PI * (1.0 - cos_max)) })
+            }
+        }
+    }
+}

@@ -1,0 +1,397 @@
+//! Rendering an exported scene with a Cycles-compatible path tracer.
+//!
+//! One idea per file: `build` (the scene at a frame as triangles and instances),
+//! `accel` (ray queries: trait and BVH), `camera`, `sampler` (Owen-scrambled Sobol),
+//! `filter` (Blackman-Harris importance sampling), `bsdf` (closures), `tables` (GGX
+//! albedo tables), `shade` (materials to closures), `light`, `world`, `integrator`.
+//! The film (tiles, passes, progress) is here.
+//!
+//! Determinism: every random number comes from (pixel, sample index, seed), tiles are
+//! independent, and pixels are summed in sample order, so the image has the same bits
+//! for any thread count.
+
+pub mod accel;
+pub mod bsdf;
+pub mod build;
+pub mod camera;
+pub mod filter;
+pub mod integrator;
+pub mod light;
+pub mod math;
+pub mod sampler;
+pub mod shade;
+pub mod tables;
+pub mod world;
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+use serde_json::Value;
+
+use crate::scene::Scene;
+use accel::{Accel, Bvh};
+use integrator::{Scratch, Settings};
+use math::*;
+use sampler::PixelSampler;
+
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct RenderError(pub String);
+
+impl std::fmt::Display for RenderError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+impl std::error::Error for RenderError {}
+
+#[derive(Debug, Clone, Default)]
+pub struct RenderOptions {
+    pub frame: Option<f64>,
+    pub samples: Option<u32>,
+    pub threshold: Option<f32>,
+    pub resolution: Option<(u32, u32)>,
+    pub seed: Option<u32>,
+    pub threads: Option<usize>,
+    pub progress: bool,
+}
+
+#[derive(Debug, Clone, Default)]
+pub struct RenderStats {
+    pub samples: u32,
+    pub wall_seconds: f64,
+    pub rays: u64,
+    pub triangles: usize,
+    pub build_seconds: f64,
+}
+
+#[derive(Debug, Clone)]
+pub struct RenderOutput {
+    pub width: u32,
+    pub height: u32,
+    pub color: Vec<[f32; 4]>,
+    pub passes: Passes,
+    pub stats: RenderStats,
+}
+
+#[derive(Debug, Clone, Default)]
+pub struct Passes {
+    pub depth: Vec<f32>,
+    pub object_index: Vec<u32>,
+    pub instance_id: Vec<u32>,
+    pub material_index: Vec<u32>,
+    pub normal: Vec<[f32; 3]>,
+    pub albedo: Vec<[f32; 3]>,
+    pub denoise_normal: Vec<[f32; 3]>,
+    pub uv: Vec<[f32; 2]>,
+    pub instances: Vec<InstanceInfo>,
+}
+
+#[derive(Debug, Clone)]
+pub struct InstanceInfo {
+    pub object: String,
+    pub instance_index: Option<u32>,
+    pub world_bounds: ([f32; 3], [f32; 3]),
+    pub world_transform: [[f32; 4]; 4],
+}
+
+/// Largest accepted image side, so a typo cannot ask for terabytes.
+pub const MAX_SIDE: u32 = 16384;
+const TILE: u32 = 16;
+
+fn rna_f(m: &crate::scene::Rna, k: &str) -> Option<f64> {
+    m.get(k).and_then(Value::as_f64)
+}
+
+/// Renders `scene` (overrides already applied) at the options' frame.
+pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput, RenderError> {
+    render_with_overrides(scene, opts, &[])
+}
+
+/// `render`, also passing data-path overrides to Geometry Nodes evaluation.
+pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(String, Value)]) -> Result<RenderOutput, RenderError> {
+    let start = Instant::now();
+    let s = &scene.file.scene;
+    let (cy, r) = (&s.cycles, &s.render);
+    let (w, h) = match opts.resolution {
+        Some(res) => res,
+        None => {
+            let pct = rna_f(r, "resolution_percentage").unwrap_or(100.0);
+            let rx = rna_f(r, "resolution_x").unwrap_or(1920.0);
+            let ry = rna_f(r, "resolution_y").unwrap_or(1080.0);
+            (((rx * pct / 100.0) as u32).max(1), ((ry * pct / 100.0) as u32).max(1))
+        }
+    };
+    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
+        return Err(RenderError(format!("resolution {w}x{h}: each side must be 1 to {MAX_SIDE}")));
+    }
+    let samples = opts.samples.unwrap_or_else(|| rna_f(cy, "samples").unwrap_or(128.0) as u32);
+    if samples == 0 {
+        return Err(RenderError("samples must be at least 1".into()));
+    }
+    let seed = opts.seed.unwrap_or_else(|| rna_f(cy, "seed").unwrap_or(0.0) as u32);
+    let frame = opts.frame.unwrap_or(s.frame_current as f64);
+    if !frame.is_finite() {
+        return Err(RenderError(format!("frame {frame} is not finite")));
+    }
+    let eval = crate::anim::evaluate_scene(scene, frame).map_err(|e| RenderError(format!("evaluating the scene at frame {frame}: {e}")))?;
+    let camera = camera::Camera::new(scene, &eval, w, h)?;
+    let geo = build::build(scene, &eval, overrides)?;
+    let mut used = vec![false; scene.file.materials.len()];
+    for inst in &geo.instances {
+        for m in inst.slots.iter().flatten() {
+            used[*m] = true;
+        }
+    }
+    let materials = shade::compile_all(scene, &used)?;
+    let lights = light::collect(&eval);
+    let background = world::background(scene)?;
+    let tables = tables::Tables::shared();
+    let bvh = Bvh::build(&geo.tris);
+    let filter = filter::FilterTable::blackman_harris(rna_f(cy, "filter_width").or_else(|| rna_f(r, "filter_size")).unwrap_or(1.5) as f32);
+    let gi = |k: &str, d: f64| rna_f(cy, k).unwrap_or(d) as u32;
+    let settings = Settings {
+        max_bounces: gi("max_bounces", 12.0),
+        max_diffuse: gi("diffuse_bounces", 4.0),
+        max_glossy: gi("glossy_bounces", 4.0),
+        max_transmission: gi("transmission_bounces", 12.0),
+        max_transparent: gi("transparent_max_bounces", 8.0),
+        clamp_direct: rna_f(cy, "sample_clamp_direct").unwrap_or(0.0) as f32,
+        clamp_indirect: rna_f(cy, "sample_clamp_indirect").unwrap_or(10.0) as f32,
+        min_light_bounces: gi("min_light_bounces", 0.0),
+        filter_glossy: rna_f(cy, "blur_glossy").unwrap_or(1.0) as f32,
+    };
+    let exposure = 1.0f32;
+    let build_seconds = start.elapsed().as_secs_f64();
+    let mesh_lights = mesh_lights(&geo, &materials, &bvh, &lights, background, tables, settings);
+    let tracer = integrator::Scene { mesh_lights: &mesh_lights, accel: &bvh, geo: &geo, materials: &materials, lights: &lights, background, tables, settings };
+
+    let tiles_x = w.div_ceil(TILE);
+    let tiles_y = h.div_ceil(TILE);
+    let n_tiles = (tiles_x * tiles_y) as usize;
+    let bar = if opts.progress {
+        let b = indicatif::ProgressBar::new(n_tiles as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} tiles  ETA {eta}  {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        Some(b)
+    } else {
+        None
+    };
+    let render_start = Instant::now();
+    let nmat = materials.len();
+    let run = || -> Vec<(Vec<[f32; 4]>, TilePasses, u64)> {
+        (0..n_tiles)
+            .into_par_iter()
+            .map_init(
+                || Scratch::new(nmat),
+                |scratch, t| {
+                    let tx = (t as u32 % tiles_x) * TILE;
+                    let ty = (t as u32 / tiles_x) * TILE;
+                    let tw = TILE.min(w - tx);
+                    let th = TILE.min(h - ty);
+                    let rays0 = scratch.rays;
+                    let mut color = Vec::with_capacity((tw * th) as usize);
+                    let mut passes = TilePasses::default();
+                    for y in ty..ty + th {
+                        for x in tx..tx + tw {
+                            let rng = PixelSampler::new(x, y, seed);
+                            let mut sum = [0.0f64; 3];
+                            for i in 0..samples {
+                                let u = rng.get4(i, 0);
+                                let fx = x as f32 + 0.5 + filter.sample(u[0]);
+                                let fy = y as f32 + 0.5 + filter.sample(u[1]);
+                                let (o, d, t0, t1) = camera.ray(fx, fy, [u[2], u[3]]);
+                                let c = tracer.radiance(o, d, t0, t1, &rng, i, scratch);
+                                // A NaN or infinite sample is dropped, never averaged in.
+                                if c.iter().all(|v| v.is_finite()) {
+                                    for k in 0..3 {
+                                        sum[k] += c[k] as f64;
+                                    }
+                                }
+                            }
+                            let inv = exposure as f64 / samples as f64;
+                            color.push([(sum[0] * inv) as f32, (sum[1] * inv) as f32, (sum[2] * inv) as f32, 1.0]);
+                            primary_passes(&tracer, &camera, x, y, scratch, &mut passes);
+                        }
+                    }
+                    if let Some(b) = &bar {
+                        b.inc(1);
+                        let secs = render_start.elapsed().as_secs_f64().max(1e-6);
+                        let done = b.position() as f64 * (TILE * TILE) as f64 * samples as f64;
+                        b.set_message(format!("{:.2} M samples/s", done / secs / 1e6));
+                    }
+                    (color, passes, scratch.rays - rays0)
+                },
+            )
+            .collect()
+    };
+    let results = match opts.threads {
+        Some(n) => rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build().map_err(|e| RenderError(format!("thread pool: {e}")))?.install(run),
+        None => run(),
+    };
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let npix = (w * h) as usize;
+    let mut color = vec![[0.0f32; 4]; npix];
+    let mut passes = Passes {
+        depth: vec![f32::INFINITY; npix],
+        object_index: vec![0; npix],
+        instance_id: vec![0; npix],
+        material_index: vec![0; npix],
+        normal: vec![[0.0; 3]; npix],
+        albedo: vec![[0.0; 3]; npix],
+        denoise_normal: vec![[0.0; 3]; npix],
+        uv: vec![[0.0; 2]; npix],
+        instances: geo
+            .instances
+            .iter()
+            .map(|i| InstanceInfo { object: i.name.clone(), instance_index: i.instance_index, world_bounds: i.world_bounds, world_transform: i.to_world.to_rows() })
+            .collect(),
+    };
+    let mut rays = 0;
+    for (t, (c, p, r)) in results.into_iter().enumerate() {
+        rays += r;
+        let tx = (t as u32 % tiles_x) * TILE;
+        let ty = (t as u32 / tiles_x) * TILE;
+        let tw = TILE.min(w - tx);
+        let mut k = 0;
+        for y in ty..(ty + TILE).min(h) {
+            for x in tx..tx + tw {
+                let i = (y * w + x) as usize;
+                color[i] = c[k];
+                passes.depth[i] = p.depth[k];
+                passes.object_index[i] = p.object_index[k];
+                passes.instance_id[i] = p.instance_id[k];
+                passes.material_index[i] = p.material_index[k];
+                passes.normal[i] = p.normal[k];
+                passes.albedo[i] = p.albedo[k];
+                passes.denoise_normal[i] = p.normal[k];
+                passes.uv[i] = p.uv[k];
+                k += 1;
+            }
+        }
+    }
+    Ok(RenderOutput {
+        width: w,
+        height: h,
+        color,
+        passes,
+        stats: RenderStats { samples, wall_seconds: start.elapsed().as_secs_f64(), rays, triangles: geo.tris.len(), build_seconds },
+    })
+}
+
+/// The emissive triangles, weighted by area times the luminance of their emission at
+/// the centroid (Cycles weights by an emission estimate too).
+fn mesh_lights(
+    geo: &build::Geometry,
+    materials: &[shade::Material],
+    bvh: &Bvh,
+    lights: &[light::Light],
+    background: V3,
+    tables: &tables::Tables,
+    settings: Settings,
+) -> integrator::MeshLights {
+    use crate::shader::program::Closure;
+    let empty = integrator::MeshLights::default();
+    let probe = integrator::Scene { mesh_lights: &empty, accel: bvh, geo, materials, lights, background, tables, settings };
+    let emissive: Vec<bool> = materials
+        .iter()
+        .map(|m| m.program.as_ref().is_some_and(|p| p.closures.iter().any(|c| matches!(c, Closure::Emission { .. } | Closure::Bsdf { emission: Some(_) }))))
+        .collect();
+    let mut scratch = Scratch::new(materials.len());
+    let mut prims = Vec::new();
+    let mut weights = Vec::new();
+    let mut areas = Vec::new();
+    for (prim, r) in geo.refs.iter().enumerate() {
+        let inst = &geo.instances[r.inst as usize];
+        let face = inst.mesh.triangle_faces[r.tri as usize] as usize;
+        let slot = inst.face_slot.get(face).copied().unwrap_or(0) as usize;
+        let Some(mi) = inst.slots.get(slot).copied().flatten() else { continue };
+        if !emissive[mi] {
+            continue;
+        }
+        let t = &geo.tris[prim];
+        let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+        let area = 0.5 * len(n);
+        if area <= 0.0 {
+            continue;
+        }
+        let e = probe.emission_at(prim as u32, 1.0 / 3.0, 1.0 / 3.0, normalize(n), &mut scratch);
+        let lum = 0.2126 * e[0].abs() + 0.7152 * e[1].abs() + 0.0722 * e[2].abs();
+        if !(lum > 0.0) || !lum.is_finite() {
+            continue;
+        }
+        prims.push(prim as u32);
+        weights.push(area * lum);
+        areas.push(area);
+    }
+    let total: f64 = weights.iter().map(|&w| w as f64).sum();
+    let mut pdf_area = vec![0.0f32; geo.tris.len()];
+    let mut cdf = Vec::with_capacity(prims.len());
+    let mut acc = 0.0f64;
+    for (k, &p) in prims.iter().enumerate() {
+        acc += weights[k] as f64;
+        cdf.push((acc / total) as f32);
+        pdf_area[p as usize] = (weights[k] as f64 / total) as f32 / areas[k];
+    }
+    integrator::MeshLights { prims, cdf, pdf_area }
+}
+
+#[derive(Default)]
+struct TilePasses {
+    depth: Vec<f32>,
+    object_index: Vec<u32>,
+    instance_id: Vec<u32>,
+    material_index: Vec<u32>,
+    normal: Vec<[f32; 3]>,
+    albedo: Vec<[f32; 3]>,
+    uv: Vec<[f32; 2]>,
+}
+
+/// Label passes from the primary ray through the pixel centre (exact ids, unfiltered).
+fn primary_passes(tracer: &integrator::Scene, camera: &camera::Camera, x: u32, y: u32, scratch: &mut Scratch, out: &mut TilePasses) {
+    let (o, d, t0, t1) = camera.ray(x as f32 + 0.5, y as f32 + 0.5, [0.5, 0.5]);
+    match tracer.accel.intersect(o, d, t0, t1) {
+        Some(h) => {
+            let wo = neg(d);
+            let hit = tracer.surface(h.prim, h.u, h.v, wo);
+            tracer.shade(&hit, wo, scratch);
+            let inst = &tracer.geo.instances[hit.inst as usize];
+            out.depth.push(camera.depth(hit.p));
+            out.object_index.push(inst.object as u32 + 1);
+            out.instance_id.push(hit.inst + 1);
+            out.material_index.push(hit.material.map(|m| m as u32 + 1).unwrap_or(0));
+            out.normal.push(hit.sp.normal);
+            out.albedo.push(scratch.lobes.albedo());
+            out.uv.push([hit.sp.uv[0], hit.sp.uv[1]]);
+        }
+        None => {
+            out.depth.push(f32::INFINITY);
+            out.object_index.push(0);
+            out.instance_id.push(0);
+            out.material_index.push(0);
+            out.normal.push([0.0; 3]);
+            out.albedo.push(tracer.background.map(|c| c.clamp(0.0, 1.0)));
+            out.uv.push([0.0; 2]);
+        }
+    }
+}
+
+/// Writes linear RGBA to a float EXR atomically (temp file + rename).
+pub fn write_exr(path: &std::path::Path, width: u32, height: u32, pixels: &[[f32; 4]]) -> Result<(), RenderError> {
+    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+    let mut buf = Vec::with_capacity(pixels.len() * 4);
+    for p in pixels {
+        buf.extend_from_slice(p);
+    }
+    let img = image::Rgba32FImage::from_raw(width, height, buf).ok_or_else(|| RenderError("image buffer size mismatch".into()))?;
+    let tmp = tempfile::Builder::new().suffix(".exr").tempfile_in(dir).map_err(|e| RenderError(format!("{}: {e}", dir.display())))?;
+    image::DynamicImage::ImageRgba32F(img).save_with_format(tmp.path(), image::ImageFormat::OpenExr).map_err(|e| RenderError(format!("{}: {e}", path.display())))?;
+    tmp.persist(path).map_err(|e| RenderError(format!("{}: {e}", path.display())))?;
+    Ok(())
+}
+
+#[doc(hidden)]
+pub fn _assert_accel_object_safe(_: &dyn Accel) {}

@@ -1,0 +1,247 @@
+//! Materials as the renderer runs them: each compiled once with `shader::compile`, run
+//! per hit on a reused stack, and its closure tree turned into weighted lobes the way
+//! Cycles' SVM builds closures (Mix Shader factors clamped, Principled BSDF layered).
+
+use crate::scene::Scene;
+use crate::shader::program::{BsdfNode, Closure, Program};
+use crate::shader::{compile_material, ShadingPoint};
+
+use super::bsdf::{Fresnel, LobeKind, LobeSet};
+use super::math::*;
+use super::tables::Tables;
+use super::RenderError;
+
+pub struct Material {
+    pub program: Option<Program>,
+    /// Per closure: index into `program.bsdfs`.
+    bsdf_of: Vec<Option<u32>>,
+    pub name: String,
+}
+
+/// Every material of the scene, in `scene.file.materials` order.
+pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, RenderError> {
+    let mut out = Vec::new();
+    for (i, m) in scene.file.materials.iter().enumerate() {
+        if !used.get(i).copied().unwrap_or(false) {
+            out.push(Material { program: None, bsdf_of: Vec::new(), name: m.name.clone() });
+            continue;
+        }
+        let p = compile_material(scene, &m.name).map_err(|e| RenderError(format!("{e}")))?;
+        let mut bsdf_of = vec![None; p.closures.len()];
+        for (bi, b) in p.bsdfs.iter().enumerate() {
+            if let Some(slot) = bsdf_of.get_mut(b.closure as usize) {
+                *slot = Some(bi as u32);
+            }
+        }
+        out.push(Material { program: Some(p), bsdf_of, name: m.name.clone() });
+    }
+    Ok(out)
+}
+
+/// What the shading of one hit needs besides the shading point.
+pub struct Context<'a> {
+    pub tables: &'a Tables,
+    /// Unit direction toward the viewer.
+    pub wo: V3,
+    /// The ray hit the back of the surface (normals are already flipped to face it).
+    pub backfacing: bool,
+}
+
+fn v3(s: &[f32], at: u32) -> V3 {
+    let i = at as usize;
+    [s[i], s[i + 1], s[i + 2]]
+}
+
+fn finite_or(v: f32, d: f32) -> f32 {
+    if v.is_finite() {
+        v
+    } else {
+        d
+    }
+}
+fn finite3(v: V3) -> V3 {
+    v.map(|x| if x.is_finite() { x } else { 0.0 })
+}
+
+impl Material {
+    /// Runs the material at `sp` and fills `out`. A material without a program is
+    /// Cycles' default surface (diffuse grey 0.8).
+    pub fn shade(&self, sp: &ShadingPoint, stack: &mut Vec<f32>, ctx: &Context, out: &mut LobeSet) {
+        out.clear();
+        let Some(p) = &self.program else {
+            out.push(LobeKind::Diffuse, [0.8; 3], sp.normal);
+            return;
+        };
+        if stack.len() != p.initial.len() {
+            stack.clear();
+            stack.extend_from_slice(&p.initial);
+        }
+        p.run(sp, stack);
+        if let Some(c) = p.surface {
+            self.closure(p, c, 1.0, stack, sp, ctx, out);
+        }
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn closure(&self, p: &Program, c: u32, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet) {
+        match p.closures[c as usize] {
+            Closure::Emission { color, strength } => {
+                let e = scale(v3(s, color), finite_or(s[strength as usize], 0.0) * w);
+                out.emission = add(out.emission, finite3(e));
+            }
+            Closure::Mix { fac, a, b } => {
+                let f = finite_or(s[fac as usize], 0.0).clamp(0.0, 1.0);
+                if let Some(a) = a {
+                    if w * (1.0 - f) > 0.0 {
+                        self.closure(p, a, w * (1.0 - f), s, sp, ctx, out);
+                    }
+                }
+                if let Some(b) = b {
+                    if w * f > 0.0 {
+                        self.closure(p, b, w * f, s, sp, ctx, out);
+                    }
+                }
+            }
+            Closure::Add { a, b } => {
+                if let Some(a) = a {
+                    self.closure(p, a, w, s, sp, ctx, out);
+                }
+                if let Some(b) = b {
+                    self.closure(p, b, w, s, sp, ctx, out);
+                }
+            }
+            Closure::Bsdf { .. } => {
+                if let Some(bi) = self.bsdf_of.get(c as usize).copied().flatten() {
+                    bsdf(&p.bsdfs[bi as usize], w, s, sp, ctx, out);
+                }
+            }
+        }
+    }
+}
+
+fn input_f(b: &BsdfNode, s: &[f32], id: &str, d: f32) -> f32 {
+    b.input(id).map(|(slot, _)| finite_or(s[slot as usize], d)).unwrap_or(d)
+}
+fn input_c(b: &BsdfNode, s: &[f32], id: &str, d: V3) -> V3 {
+    b.input(id).map(|(slot, _)| finite3(v3(s, slot))).unwrap_or(d)
+}
+fn input_n(b: &BsdfNode, s: &[f32], id: &str, sp: &ShadingPoint) -> V3 {
+    match b.input(id) {
+        Some((slot, true)) => {
+            let n = normalize(finite3(v3(s, slot)));
+            if is_zero(n) {
+                sp.normal
+            } else {
+                n
+            }
+        }
+        _ => sp.normal,
+    }
+}
+
+fn multiscatter_energy(tables: &Tables, mu: f32, roughness: f32) -> f32 {
+    let e = tables.ggx_e(mu, roughness).max(1e-3);
+    1.0 / e
+}
+
+fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet) {
+    match b.bl_idname.as_str() {
+        "ShaderNodeBsdfDiffuse" => {
+            let c = input_c(b, s, "Color", [0.8; 3]);
+            out.push(LobeKind::Diffuse, scale(c, w), input_n(b, s, "Normal", sp));
+        }
+        "ShaderNodeBsdfTranslucent" => {
+            let c = input_c(b, s, "Color", [0.8; 3]);
+            out.push(LobeKind::Translucent, scale(c, w), input_n(b, s, "Normal", sp));
+        }
+        "ShaderNodeBsdfTransparent" => {
+            let c = input_c(b, s, "Color", [1.0; 3]);
+            out.push(LobeKind::Transparent, scale(c, w), sp.normal);
+        }
+        "ShaderNodeHoldout" => {
+            out.holdout = add(out.holdout, [w; 3]);
+        }
+        "ShaderNodeBsdfAnisotropic" | "ShaderNodeBsdfGlossy" => {
+            let c = input_c(b, s, "Color", [0.8; 3]);
+            let r = input_f(b, s, "Roughness", 0.5).clamp(0.0, 1.0);
+            let n = input_n(b, s, "Normal", sp);
+            let multi = b.property("distribution") == Some("MULTI_GGX");
+            let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
+            let energy = if multi { multiscatter_energy(ctx.tables, mu, r) } else { 1.0 };
+            out.push(LobeKind::Glossy { alpha: r * r, fresnel: Fresnel::Constant, energy }, scale(c, w), n);
+        }
+        "ShaderNodeBsdfPrincipled" => principled(b, w, s, sp, ctx, out),
+        // Rough glass is rendered as smooth glass for now (documented).
+        "ShaderNodeBsdfGlass" | "ShaderNodeBsdfRefraction" => {
+            let c = input_c(b, s, "Color", [1.0; 3]);
+            let ior = input_f(b, s, "IOR", 1.45).max(1e-4);
+            let eta = if ctx.backfacing { 1.0 / ior } else { ior };
+            let refract_only = b.bl_idname == "ShaderNodeBsdfRefraction";
+            out.push(LobeKind::Glass { eta, refract_only }, scale(c, w), input_n(b, s, "Normal", sp));
+        }
+        // Unsupported closures fall back to a diffuse of their colour (documented).
+        _ => {
+            let c = input_c(b, s, "Color", [0.8; 3]);
+            out.push(LobeKind::Diffuse, scale(c, w), sp.normal);
+        }
+    }
+}
+
+fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet) {
+    let base = input_c(b, s, "Base Color", [0.8; 3]).map(|x| x.max(0.0));
+    let metallic = input_f(b, s, "Metallic", 0.0).clamp(0.0, 1.0);
+    let roughness = input_f(b, s, "Roughness", 0.5).clamp(0.0, 1.0);
+    let ior = input_f(b, s, "IOR", 1.5).max(1e-5);
+    let alpha = input_f(b, s, "Alpha", 1.0).clamp(0.0, 1.0);
+    let transmission = input_f(b, s, "Transmission Weight", 0.0).clamp(0.0, 1.0);
+    let spec_level = input_f(b, s, "Specular IOR Level", 0.5).max(0.0);
+    let spec_tint = input_c(b, s, "Specular Tint", [1.0; 3]).map(|x| x.max(0.0));
+    let n = input_n(b, s, "Normal", sp);
+    let mut weight = [w; 3];
+    if alpha < 1.0 {
+        out.push(LobeKind::Transparent, [w * (1.0 - alpha); 3], sp.normal);
+        weight = scale(weight, alpha);
+    }
+    let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
+    let energy = multiscatter_energy(ctx.tables, mu, roughness);
+    let a = roughness * roughness;
+    if metallic > 0.0 {
+        // F82-tint Schlick: b chosen so F(acos 1/7) = Schlick * tint.
+        let f = 6.0f32 / 7.0;
+        let f6 = f.powi(6);
+        let mut bb = [0.0; 3];
+        for k in 0..3 {
+            let schlick = base[k] + (1.0 - base[k]) * f.powi(5);
+            bb[k] = schlick * (1.0 - spec_tint[k]) * 7.0 / f6;
+        }
+        let avg_f0 = (base[0] + base[1] + base[2]) / 3.0;
+        let albedo = (avg_f0 + (1.0 - avg_f0) / 21.0).clamp(0.0, 1.0);
+        out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::F82 { f0: base, b: bb }, energy }, scale(weight, metallic), n, albedo.max(1e-3));
+        weight = scale(weight, 1.0 - metallic);
+    }
+    if transmission > 0.0 {
+        // Smooth glass tinted by the base colour (rough transmission is not implemented).
+        let eta = if ctx.backfacing { 1.0 / ior } else { ior };
+        out.push(LobeKind::Glass { eta, refract_only: false }, scale(mul(weight, base), transmission), n);
+        weight = scale(weight, 1.0 - transmission);
+    }
+    // Dielectric specular: IOR adjusted by the specular IOR level as Cycles does.
+    let mut eta = ior;
+    if spec_level != 0.5 {
+        let r = (ior - 1.0) / (ior + 1.0);
+        let f0 = (r * r * 2.0 * spec_level).min(0.9999);
+        let sq = f0.sqrt();
+        eta = (1.0 + sq) / (1.0 - sq);
+        if ior < 1.0 {
+            eta = 1.0 / eta;
+        }
+    }
+    if spec_level > 0.0 && max3(weight) > 0.0 {
+        let e = (ctx.tables.dielectric_e(mu, roughness, eta) * energy).clamp(0.0, 1.0);
+        out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::Dielectric { eta }, energy }, mul(weight, spec_tint), n, e.max(1e-3));
+        // Attenuate the layers below by the specular layer's albedo.
+        let albedo = scale(spec_tint, e);
+        weight = scale(weight, (1.0 - max3(albedo)).clamp(0.0, 1.0));
+    }
+    out.push(LobeKind::Diffuse, mul(weight, base), n);
+}

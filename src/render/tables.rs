@@ -1,0 +1,124 @@
+//! Directional albedo tables of GGX, integrated here at start-up (as Cycles precomputes
+//! its own): E(mu, roughness) with Fresnel one, for multiple-scattering energy
+//! compensation, and the dielectric-Fresnel albedo E(mu, roughness, ior) for layering
+//! Principled's specular over its diffuse base.
+
+use super::bsdf::{fresnel_dielectric, ggx_lambda, sample_vndf};
+use super::sampler::PixelSampler;
+
+const N1: usize = 32;
+const N3: usize = 16;
+
+pub struct Tables {
+    ggx_e: Vec<f32>,
+    ggx_e_avg: Vec<f32>,
+    dielectric_e: Vec<f32>,
+}
+
+/// Mean of F * G2/G1 over VNDF samples: the single-scattering albedo.
+fn albedo(mu: f32, alpha: f32, eta: Option<f32>, n: u32) -> f32 {
+    let mu = mu.max(1e-4);
+    let v = [(1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu];
+    let a2 = alpha * alpha;
+    let s = PixelSampler::new(7, 11, 13);
+    let mut sum = 0.0f64;
+    for i in 0..n {
+        let u = s.get4(i, 0);
+        let h = sample_vndf(v, alpha, [u[0], u[1]]);
+        let vh = v[0] * h[0] + v[1] * h[1] + v[2] * h[2];
+        let wi = [2.0 * vh * h[0] - v[0], 2.0 * vh * h[1] - v[1], 2.0 * vh * h[2] - v[2]];
+        if wi[2] <= 0.0 {
+            continue;
+        }
+        let lo = ggx_lambda(mu, a2);
+        let li = ggx_lambda(wi[2], a2);
+        let g = (1.0 + lo) / (1.0 + lo + li);
+        let f = eta.map(|e| fresnel_dielectric(vh, e)).unwrap_or(1.0);
+        sum += (g * f) as f64;
+    }
+    (sum / n as f64) as f32
+}
+
+fn rough_to_alpha(r: f32) -> f32 {
+    (r * r).max(1e-4)
+}
+
+static SHARED: std::sync::OnceLock<Tables> = std::sync::OnceLock::new();
+
+impl Tables {
+    /// The tables, integrated once per process.
+    pub fn shared() -> &'static Tables {
+        SHARED.get_or_init(Tables::new)
+    }
+
+    pub fn new() -> Tables {
+        let mut ggx_e = vec![0.0; N1 * N1];
+        let mut ggx_e_avg = vec![0.0; N1];
+        for ri in 0..N1 {
+            let alpha = rough_to_alpha(ri as f32 / (N1 - 1) as f32);
+            let mut avg = 0.0;
+            for mi in 0..N1 {
+                let mu = mi as f32 / (N1 - 1) as f32;
+                let e = albedo(mu, alpha, None, 256);
+                ggx_e[ri * N1 + mi] = e;
+                avg += 2.0 * e * mu.max(1e-4) / N1 as f32;
+            }
+            ggx_e_avg[ri] = avg;
+        }
+        let mut dielectric_e = vec![0.0; N3 * N3 * N3];
+        for zi in 0..N3 {
+            let z = (zi as f32 / (N3 - 1) as f32).max(0.01);
+            let r = z * z;
+            let eta = ((1.0 + r) / (1.0 - r).max(1e-4)).min(1e4);
+            for ri in 0..N3 {
+                let alpha = rough_to_alpha(ri as f32 / (N3 - 1) as f32);
+                for mi in 0..N3 {
+                    let mu = mi as f32 / (N3 - 1) as f32;
+                    dielectric_e[(zi * N3 + ri) * N3 + mi] = albedo(mu, alpha, Some(eta), 128);
+                }
+            }
+        }
+        Tables { ggx_e, ggx_e_avg, dielectric_e }
+    }
+
+    /// Single-scattering albedo of GGX with Fresnel one; `roughness` = sqrt(alpha).
+    pub fn ggx_e(&self, mu: f32, roughness: f32) -> f32 {
+        lerp2(&self.ggx_e, N1, roughness, mu)
+    }
+
+    pub fn ggx_e_avg(&self, roughness: f32) -> f32 {
+        let x = roughness.clamp(0.0, 1.0) * (N1 - 1) as f32;
+        let i = (x as usize).min(N1 - 2);
+        let t = x - i as f32;
+        self.ggx_e_avg[i] * (1.0 - t) + self.ggx_e_avg[i + 1] * t
+    }
+
+    /// Single-scattering albedo of dielectric GGX reflection for relative IOR `eta` >= 1.
+    pub fn dielectric_e(&self, mu: f32, roughness: f32, eta: f32) -> f32 {
+        let eta = if eta < 1.0 { 1.0 / eta } else { eta };
+        let z = ((eta - 1.0) / (eta + 1.0)).abs().sqrt().clamp(0.0, 1.0);
+        let x = z * (N3 - 1) as f32;
+        let i = (x as usize).min(N3 - 2);
+        let t = x - i as f32;
+        let a = lerp2(&self.dielectric_e[i * N3 * N3..(i + 1) * N3 * N3], N3, roughness, mu);
+        let b = lerp2(&self.dielectric_e[(i + 1) * N3 * N3..(i + 2) * N3 * N3], N3, roughness, mu);
+        a * (1.0 - t) + b * t
+    }
+}
+
+impl Default for Tables {
+    fn default() -> Self {
+        Tables::new()
+    }
+}
+
+fn lerp2(t: &[f32], n: usize, y: f32, x: f32) -> f32 {
+    let fx = x.clamp(0.0, 1.0) * (n - 1) as f32;
+    let fy = y.clamp(0.0, 1.0) * (n - 1) as f32;
+    let (ix, iy) = ((fx as usize).min(n - 2), (fy as usize).min(n - 2));
+    let (tx, ty) = (fx - ix as f32, fy - iy as f32);
+    let at = |i: usize, j: usize| t[j * n + i];
+    let a = at(ix, iy) * (1.0 - tx) + at(ix + 1, iy) * tx;
+    let b = at(ix, iy + 1) * (1.0 - tx) + at(ix + 1, iy + 1) * tx;
+    a * (1.0 - ty) + b * ty
+}

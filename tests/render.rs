@@ -1,0 +1,220 @@
+//! Render parity against Cycles: each scene under fixtures/render/scenes (authored and
+//! rendered by fixtures/render/make_render_refs.py with bpy 4.5.4, two seeds A and B)
+//! is rendered by blendsynth at the same size and sample count. A scene passes when
+//! RMSE(ours, A) / RMSE(B, A) <= 1.15 and every channel mean is within 1% of A's.
+//! Scenes that do not pass yet are named in KNOWN_FAILURES with the reason, and their
+//! figures are printed; a scene in neither list fails the test.
+
+mod common;
+
+use std::path::Path;
+
+use blendsynth::render::{render, RenderError, RenderOptions};
+use blendsynth::scene::Scene;
+
+const MAX_RATIO: f64 = 1.15;
+const MAX_MEAN_REL: f64 = 0.01;
+
+/// Scenes that must pass.
+const ASSERTED: &[&str] = &[
+    "area_disk", "area_square", "diffuse_point", "diffuse_sun", "dof", "emission_mesh", "glossy", "metallic", "mix_shader", "ortho_flat", "principled", "shift_clip", "spot", "world_light",
+];
+
+/// Scenes that do not pass yet, with the reason.
+const KNOWN_FAILURES: &[(&str, &str)] = &[
+    ("glass", "ratio ~1.9 (means match to 0.2%): caustics through the sphere; Cycles' Filter Glossy roughens glass after a diffuse bounce and rough glass is not implemented yet"),
+    ("translucent", "ratio ~1.15, on the limit: light through a translucent sheet is slightly noisier than Cycles (means match to 0.03%)"),
+];
+
+fn read_exr(p: &Path) -> Vec<[f32; 3]> {
+    let img = image::open(p).unwrap_or_else(|e| panic!("{}: {e}", p.display())).to_rgba32f();
+    img.pixels().map(|p| [p[0], p[1], p[2]]).collect()
+}
+
+fn rmse(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
+    let mut s = 0.0f64;
+    for (x, y) in a.iter().zip(b) {
+        for k in 0..3 {
+            let d = x[k] as f64 - y[k] as f64;
+            s += d * d;
+        }
+    }
+    (s / (a.len() * 3) as f64).sqrt()
+}
+
+fn means(a: &[[f32; 3]]) -> [f64; 3] {
+    let mut m = [0.0f64; 3];
+    for x in a {
+        for k in 0..3 {
+            m[k] += x[k] as f64;
+        }
+    }
+    m.map(|v| v / a.len() as f64)
+}
+
+struct Row {
+    name: String,
+    ratio: f64,
+    worst_mean: f64,
+    ours: [f64; 3],
+    cycles: [f64; 3],
+    seconds: f64,
+}
+
+fn evaluate(dir: &Path) -> Row {
+    let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+    let meta: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("render.json")).unwrap()).unwrap();
+    let samples = meta["samples"].as_u64().unwrap() as u32;
+    let res = meta["resolution"].as_array().unwrap();
+    let (w, h) = (res[0].as_u64().unwrap() as u32, res[1].as_u64().unwrap() as u32);
+    let a = read_exr(&dir.join("cycles_a.exr"));
+    let b = read_exr(&dir.join("cycles_b.exr"));
+    let scene = Scene::load(dir).unwrap();
+    let opts = RenderOptions { samples: Some(samples), resolution: Some((w, h)), seed: Some(0), ..Default::default() };
+    let out = render(&scene, &opts).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let ours: Vec<[f32; 3]> = out.color.iter().map(|p| [p[0], p[1], p[2]]).collect();
+    assert_eq!(ours.len(), a.len(), "{name}: size");
+    let ratio = rmse(&ours, &a) / rmse(&b, &a).max(1e-12);
+    let (mo, ma) = (means(&ours), means(&a));
+    let worst_mean = (0..3).map(|k| (mo[k] - ma[k]).abs() / ma[k].abs().max(1e-6)).fold(0.0, f64::max);
+    Row { name, ratio, worst_mean, ours: mo, cycles: ma, seconds: out.stats.wall_seconds }
+}
+
+#[test]
+fn parity_with_cycles() {
+    let root = common::repo().join("fixtures/render/scenes");
+    let mut dirs: Vec<_> = std::fs::read_dir(&root).expect("fixtures/render/scenes").map(|e| e.unwrap().path()).filter(|p| p.join("scene.json").exists()).collect();
+    dirs.sort();
+    assert!(dirs.len() >= 12, "expected at least 12 parity scenes, found {}", dirs.len());
+    let mut failures = Vec::new();
+    println!("{:<16} {:>7} {:>8}  {:<26} {:<26} {:>6}  status", "scene", "ratio", "mean err", "mean ours (RGB)", "mean Cycles A (RGB)", "secs");
+    for d in &dirs {
+        let r = evaluate(d);
+        let pass = r.ratio <= MAX_RATIO && r.worst_mean <= MAX_MEAN_REL;
+        let known = KNOWN_FAILURES.iter().find(|k| k.0 == r.name);
+        let status = match (pass, ASSERTED.contains(&r.name.as_str()), known) {
+            (true, true, _) => "pass".to_string(),
+            (false, true, _) => {
+                failures.push(format!("{}: ratio {:.3}, worst channel mean error {:.2}%", r.name, r.ratio, 100.0 * r.worst_mean));
+                "FAIL".to_string()
+            }
+            (p, false, Some((_, why))) => format!("known failure ({why}){}", if p { " -- now passes: move it to ASSERTED" } else { "" }),
+            (_, false, None) => {
+                failures.push(format!("{}: in neither ASSERTED nor KNOWN_FAILURES (ratio {:.3}, mean error {:.2}%)", r.name, r.ratio, 100.0 * r.worst_mean));
+                "UNLISTED".to_string()
+            }
+        };
+        let f = |m: [f64; 3]| format!("{:.4} {:.4} {:.4}", m[0], m[1], m[2]);
+        println!("{:<16} {:>7.3} {:>7.2}%  {:<26} {:<26} {:>6.2}  {status}", r.name, r.ratio, 100.0 * r.worst_mean, f(r.ours), f(r.cycles), r.seconds);
+    }
+    assert!(failures.is_empty(), "parity failures:\n{}", failures.join("\n"));
+}
+
+#[test]
+fn same_bits_for_any_thread_count() {
+    let dir = common::repo().join("fixtures/render/scenes/diffuse_point");
+    let scene = Scene::load(&dir).unwrap();
+    let opts = |t| RenderOptions { samples: Some(4), resolution: Some((40, 32)), seed: Some(3), threads: Some(t), ..Default::default() };
+    let a = render(&scene, &opts(1)).unwrap();
+    let b = render(&scene, &opts(2)).unwrap();
+    let bits = |o: &blendsynth::render::RenderOutput| o.color.iter().flat_map(|p| p.map(f32::to_bits)).collect::<Vec<_>>();
+    assert_eq!(bits(&a), bits(&b));
+    // And a different seed changes the noise.
+    let c = render(&scene, &RenderOptions { seed: Some(4), ..opts(2) }).unwrap();
+    assert_ne!(bits(&a), bits(&c));
+}
+
+#[test]
+fn bad_input_is_a_clear_error() {
+    let dir = common::repo().join("fixtures/render/scenes/diffuse_point");
+    let scene = Scene::load(&dir).unwrap();
+    let err = |o: RenderOptions| render(&scene, &o).err().map(|RenderError(m)| m).unwrap_or_default();
+    assert!(err(RenderOptions { resolution: Some((0, 10)), ..Default::default() }).contains("resolution 0x10"));
+    assert!(err(RenderOptions { resolution: Some((100_000, 10)), ..Default::default() }).contains("each side must be"));
+    assert!(err(RenderOptions { samples: Some(0), resolution: Some((8, 8)), ..Default::default() }).contains("samples must be at least 1"));
+    assert!(err(RenderOptions { frame: Some(f64::NAN), samples: Some(1), resolution: Some((8, 8)), ..Default::default() }).contains("not finite"));
+    let mut no_cam = scene.clone();
+    no_cam.file.scene.camera = None;
+    assert!(err(RenderOptions { samples: Some(1), resolution: Some((8, 8)), ..Default::default() }.clone()).is_empty());
+    let m = render(&no_cam, &RenderOptions { samples: Some(1), resolution: Some((8, 8)), ..Default::default() }).err().unwrap().0;
+    assert!(m.contains("no active camera"), "{m}");
+}
+
+#[test]
+fn label_passes_from_the_pixel_centre() {
+    let dir = common::repo().join("fixtures/render/scenes/diffuse_point");
+    let scene = Scene::load(&dir).unwrap();
+    let out = render(&scene, &RenderOptions { samples: Some(1), resolution: Some((64, 64)), ..Default::default() }).unwrap();
+    let p = &out.passes;
+    // Each object seen gets its own id; names resolve through `instances`.
+    let mut seen: Vec<u32> = p.instance_id.clone();
+    seen.sort();
+    seen.dedup();
+    let names: Vec<&str> = seen.iter().filter(|&&i| i > 0).map(|&i| p.instances[i as usize - 1].object.as_str()).collect();
+    for want in ["Floor", "Sphere", "Cube"] {
+        assert!(names.contains(&want), "{names:?}");
+    }
+    // Depth is finite on geometry, infinite on background, positive along the view axis.
+    for i in 0..p.depth.len() {
+        assert_eq!(p.instance_id[i] == 0, p.depth[i].is_infinite());
+        if p.instance_id[i] > 0 {
+            assert!(p.depth[i] > 0.0);
+            let n = p.normal[i];
+            assert!(((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() - 1.0).abs() < 1e-3);
+        }
+    }
+}
+
+#[test]
+fn non_finite_samples_never_poison_pixels() {
+    // An emission strength beyond f32 range is infinite in the shader program; closure
+    // inputs that are not finite read as 0 (documented fallback) and non-finite samples
+    // are dropped, so every pixel stays finite.
+    let dir = common::repo().join("fixtures/render/scenes/emission_mesh");
+    let o = blendsynth::scene::Override::parse("materials[\"Glow\"].node_tree.nodes[\"Emission\"].inputs[1].default_value=1e39").unwrap();
+    let scene = Scene::load(&dir).unwrap().with_overrides(&[o]).unwrap();
+    let out = render(&scene, &RenderOptions { samples: Some(4), resolution: Some((32, 32)), ..Default::default() }).unwrap();
+    assert!(out.color.iter().all(|p| p.iter().all(|v| v.is_finite())));
+}
+
+#[test]
+fn geometry_nodes_instances_keep_their_own_ids() {
+    // The geonodes fixture instances cubes on points: each instance is its own render
+    // instance (own id, own transform) sharing its reference's mesh.
+    let dir = common::repo().join("fixtures/scenes/geonodes");
+    let scene = Scene::load(&dir).unwrap();
+    let eval = blendsynth::anim::evaluate_scene(&scene, scene.file.scene.frame_current as f64).unwrap();
+    let geo = blendsynth::render::build::build(&scene, &eval, &[]).unwrap();
+    let inst: Vec<_> = geo.instances.iter().filter(|i| i.instance_index.is_some()).collect();
+    assert!(inst.len() > 1, "expected several GN instances, found {}", inst.len());
+    let mut idx: Vec<u32> = inst.iter().map(|i| i.instance_index.unwrap()).collect();
+    idx.dedup();
+    assert_eq!(idx.len(), inst.len(), "instance indices are distinct");
+    assert!(inst.windows(2).all(|w| std::sync::Arc::ptr_eq(&w[0].mesh, &w[1].mesh) || w[0].mesh.name == w[1].mesh.name));
+    assert!(inst.windows(2).any(|w| w[0].to_world != w[1].to_world));
+    // Together they are Blender's evaluated mesh: same triangle count, same world bounds.
+    let reference = scene.load_evaluated(0).unwrap();
+    let obj = scene.file.evaluated[0].object.clone();
+    let ours: Vec<_> = geo.instances.iter().filter(|i| i.name == obj).collect();
+    assert_eq!(ours.iter().map(|i| i.mesh.triangles.len()).sum::<usize>(), reference.triangles.len());
+    let oi = scene.file.objects.iter().position(|o| o.name == obj).unwrap();
+    let m = eval.world_matrices[oi];
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for p in &reference.positions {
+        for r in 0..3 {
+            let w = (m[r][0] * p[0] as f64 + m[r][1] * p[1] as f64 + m[r][2] * p[2] as f64 + m[r][3]) as f32;
+            lo[r] = lo[r].min(w);
+            hi[r] = hi[r].max(w);
+        }
+    }
+    let (mut olo, mut ohi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for i in &ours {
+        for r in 0..3 {
+            olo[r] = olo[r].min(i.world_bounds.0[r]);
+            ohi[r] = ohi[r].max(i.world_bounds.1[r]);
+        }
+    }
+    for r in 0..3 {
+        assert!((lo[r] - olo[r]).abs() < 1e-4 && (hi[r] - ohi[r]).abs() < 1e-4, "bounds {olo:?}..{ohi:?} vs Blender {lo:?}..{hi:?}");
+    }
+}
