@@ -128,6 +128,8 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeTexMagic",
     "ShaderNodeTexWhiteNoise",
     "ShaderNodeTexChecker",
+    // mapping.rs
+    "ShaderNodeMapping",
 ];
 
 /// Support for a node inside a tree of type `tree` (`ShaderNodeTree`,
