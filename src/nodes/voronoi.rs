@@ -55,6 +55,10 @@ pub struct VoronoiOutput {
 trait Cell<const N: usize> {
     fn jitter(cell: [f32; N]) -> [f32; N];
     fn color(cell: [f32; N]) -> Vec3;
+    /// The cell's colour given its jitter hash (in 3D both are the same hash).
+    fn color_with(cell: [f32; N], _jitter: [f32; N]) -> Vec3 {
+        Self::color(cell)
+    }
     /// Cycles' `voronoi_position`: where the N components land in (x, y, z, w).
     fn position(p: [f32; N]) -> [f32; 4];
 }
@@ -87,6 +91,9 @@ impl Cell<3> for D {
     }
     fn color(c: [f32; 3]) -> Vec3 {
         hash_f3_to_f3(c)
+    }
+    fn color_with(_: [f32; 3], jitter: [f32; 3]) -> Vec3 {
+        jitter
     }
     fn position(p: [f32; 3]) -> [f32; 4] {
         [p[0], p[1], p[2], 0.0]
@@ -213,13 +220,14 @@ where
     let mut sp = [0.0f32; N];
     let mut h = -1.0f32;
     for_cells(2, |off: [f32; N]| {
-        let point = add(off, scale(D::jitter(add(cell, off)), p.randomness));
+        let jitter = D::jitter(add(cell, off));
+        let point = add(off, scale(jitter, p.randomness));
         let d = metric_distance(point, local, p);
         h = if h == -1.0 { 1.0 } else { smoothstep(0.5 + 0.5 * (sd - d) / p.smoothness) };
         let mut corr = p.smoothness * h * (1.0 - h);
         sd = mix1(sd, d, h) - corr;
         corr /= 1.0 + 3.0 * p.smoothness;
-        let c = D::color(add(cell, off));
+        let c = D::color_with(add(cell, off), jitter);
         sc = mixn(sc, c, h).map(|x| x - corr);
         sp = mixn(sp, point, h).map(|x| x - corr);
     });
