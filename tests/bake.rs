@@ -9,6 +9,8 @@ use blendsynth::shader::bake::{bake_emission, BakeOptions};
 
 /// Arithmetic and colour nodes only: Cycles and blendsynth run the same float maths.
 const TOL: f32 = 1e-5;
+/// The project bound for texture nodes.
+const TEXTURE_TOL: f32 = 1e-4;
 
 fn compare(case: &str) -> f32 {
     compare_in(&repo().join("fixtures/bake/scenes"), case)
@@ -53,6 +55,12 @@ fn closure_weights_match_cycles() {
     assert!(compare("closures") <= TOL);
 }
 
+/// Mapping, 6-octave Noise, Voronoi, Wave, Magic, Gradient and Checker in one material.
+#[test]
+fn texture_material_matches_cycles() {
+    assert!(compare("textures") <= TEXTURE_TOL);
+}
+
 #[test]
 fn cli_writes_the_same_values_as_an_exr() {
     let dir = repo().join("fixtures/bake/scenes/closures");
@@ -93,4 +101,5 @@ fn fresh_cycles_bakes_match() {
     for case in ["uv_math", "structure", "closures"] {
         assert!(compare_in(t.path(), case) <= TOL, "{case}");
     }
+    assert!(compare_in(t.path(), "textures") <= TEXTURE_TOL, "textures");
 }

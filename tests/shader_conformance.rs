@@ -32,15 +32,41 @@ use blendsynth::nodes::ramp::{
 };
 use blendsynth::nodes::sepcomb::{combine_color, separate_color, ColorMode};
 use blendsynth::nodes::wavelength::wavelength;
+use blendsynth::nodes::checker::checker_texture;
+use blendsynth::nodes::gradient::{gradient, GradientType};
+use blendsynth::nodes::magic::magic;
+use blendsynth::nodes::mapping::{mapping, MappingType};
+use blendsynth::nodes::noise::{noise_texture_cycles, NoiseParams, NoiseType};
+use blendsynth::nodes::voronoi::{voronoi_texture, VoronoiFeature, VoronoiMetric, VoronoiParams};
+use blendsynth::nodes::wave::{wave, BandsDirection, RingsDirection, WaveProfile, WaveSettings, WaveType};
+use blendsynth::nodes::white_noise::white_noise;
 use blendsynth::nodes::{support, Support};
 use serde_json::Value;
 
 /// The project's bound for arithmetic and colour nodes.
 const TOLERANCE: f64 = 1e-5;
 
+/// The project's bound for texture nodes.
+const TEXTURE_TOLERANCE: f64 = 1e-4;
+
+fn is_texture(node: &str) -> bool {
+    node.starts_with("ShaderNodeTex")
+}
+
 /// Cases that cannot meet `TOLERANCE`: (case name, bound, why). Empty while every case
 /// passes; an entry here is reported, never silently skipped.
-const ALLOWED: &[(&str, f64, &str)] = &[];
+const ALLOWED: &[(&str, f64, &str)] = &[
+    // One texel, (14, 18): W = 0.72, Scale 3.7, Lacunarity 3.3, Roughness 1, Detail 8.3,
+    // Distortion 2.5, so the top octaves sample 1D Perlin noise near 7e4 where an f32's
+    // fraction has steps of 0.008 and every octave weighs 1: Cycles' scalar 1D kernel
+    // rounds differently there (its 2D-4D kernels match to 1e-6 on the same texel).
+    // Every other texel of these cases is within 1e-4.
+    ("noise_1d_fbm", 1.5e-4, ONE_D_NOISE),
+    ("noise_1d_fbm_unnormalized", 3e-3, ONE_D_NOISE),
+    ("noise_1d_multifractal", 2e-3, ONE_D_NOISE),
+    ("noise_1d_hetero_terrain", 5e-3, ONE_D_NOISE),
+];
+const ONE_D_NOISE: &str = "one texel (14, 18) with unattenuated octaves near 7e4 (see above); all others <= 1e-4";
 
 type V3 = [f32; 3];
 
@@ -50,6 +76,10 @@ struct Refs {
 }
 
 fn refs_dir() -> PathBuf {
+    // A freshly generated set can be tried before it replaces the committed one.
+    if let Some(dir) = std::env::var_os("BLENDSYNTH_CONFORMANCE_REFS") {
+        return PathBuf::from(dir);
+    }
     Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/shader_conformance/refs")
 }
 
@@ -357,7 +387,118 @@ fn evaluator<'a>(c: &'a Case<'a>) -> Eval<'a> {
         "ShaderNodeWavelength" => {
             Box::new(|t| vec![("Color", wavelength(t.f("Wavelength"), &LINEAR_REC709))])
         }
+        "ShaderNodeTexNoise" => {
+            let dims = dimensions(c, "noise_dimensions");
+            let kind = parse(c, "noise_type", c.prop("noise_type"), NoiseType::from_blender);
+            let normalize = c.flag("normalize");
+            Box::new(move |t| {
+                let params = NoiseParams {
+                    kind,
+                    normalize,
+                    detail: t.f("Detail"),
+                    roughness: t.f("Roughness"),
+                    lacunarity: t.f("Lacunarity"),
+                    offset: t.f("Offset"),
+                    gain: t.f("Gain"),
+                    distortion: t.f("Distortion"),
+                };
+                let (fac, col) = noise_texture_cycles(dims, t.v3("Vector"), t.f("W"), t.f("Scale"), params);
+                vec![("Fac", f1(fac)), ("Color", col)]
+            })
+        }
+        "ShaderNodeTexVoronoi" => {
+            let dims = dimensions(c, "voronoi_dimensions");
+            let feature = parse(c, "feature", c.prop("feature"), VoronoiFeature::from_blender);
+            let metric = parse(c, "distance", c.prop("distance"), VoronoiMetric::from_blender);
+            let normalize = c.flag("normalize");
+            Box::new(move |t| {
+                let p = VoronoiParams::new(
+                    feature,
+                    metric,
+                    normalize,
+                    t.f("Scale"),
+                    t.f("Detail"),
+                    t.f("Roughness"),
+                    t.f("Lacunarity"),
+                    t.f("Smoothness"),
+                    t.f("Exponent"),
+                    t.f("Randomness"),
+                );
+                let o = voronoi_texture(dims, t.v3("Vector"), t.f("W"), p);
+                vec![
+                    ("Distance", f1(o.distance)),
+                    ("Color", o.color),
+                    ("Position", o.position),
+                    ("W", f1(o.w)),
+                    ("Radius", f1(o.radius)),
+                ]
+            })
+        }
+        "ShaderNodeTexWave" => {
+            let s = WaveSettings {
+                kind: parse(c, "wave_type", c.prop("wave_type"), WaveType::from_blender),
+                bands: c.props.get("bands_direction").and_then(Value::as_str).and_then(BandsDirection::from_blender).unwrap_or(BandsDirection::X),
+                rings: c.props.get("rings_direction").and_then(Value::as_str).and_then(RingsDirection::from_blender).unwrap_or(RingsDirection::X),
+                profile: parse(c, "wave_profile", c.prop("wave_profile"), WaveProfile::from_blender),
+            };
+            Box::new(move |t| {
+                let f = wave(
+                    s,
+                    t.v3("Vector"),
+                    t.f("Scale"),
+                    t.f("Distortion"),
+                    t.f("Detail"),
+                    t.f("Detail Scale"),
+                    t.f("Detail Roughness"),
+                    t.f("Phase Offset"),
+                );
+                vec![("Fac", f1(f)), ("Color", [f; 3])]
+            })
+        }
+        "ShaderNodeTexGradient" => {
+            let kind = parse(c, "gradient_type", c.prop("gradient_type"), GradientType::from_blender);
+            Box::new(move |t| {
+                let f = gradient(kind, t.v3("Vector"));
+                vec![("Fac", f1(f)), ("Color", [f; 3])]
+            })
+        }
+        "ShaderNodeTexMagic" => {
+            let depth = c.props["turbulence_depth"].as_i64().expect("turbulence_depth") as i32;
+            Box::new(move |t| {
+                let (col, fac) = magic(t.v3("Vector"), t.f("Scale"), depth, t.f("Distortion"));
+                vec![("Fac", f1(fac)), ("Color", col)]
+            })
+        }
+        "ShaderNodeTexWhiteNoise" => {
+            let dims = dimensions(c, "noise_dimensions");
+            Box::new(move |t| {
+                let (v, col) = white_noise(dims, t.v3("Vector"), t.f("W"));
+                vec![("Value", f1(v)), ("Color", col)]
+            })
+        }
+        "ShaderNodeMapping" => {
+            let kind = parse(c, "vector_type", c.prop("vector_type"), MappingType::from_blender);
+            Box::new(move |t| {
+                let r = mapping(kind, t.v3("Vector"), t.v3("Location"), t.v3("Rotation"), t.v3("Scale"));
+                vec![("Vector", r)]
+            })
+        }
+        "ShaderNodeTexChecker" => Box::new(|t| {
+            let (col, fac) = checker_texture(t.v3("Vector"), t.v3("Color1"), t.v3("Color2"), t.f("Scale"));
+            vec![("Fac", f1(fac)), ("Color", col)]
+        }),
         other => panic!("{}: no evaluator for node type {other}", c.name),
+    }
+}
+
+/// "1D".."4D" as a number.
+fn dimensions(c: &Case, key: &str) -> u8 {
+    match c.prop(key) {
+        "1D" => 1,
+        "2D" => 2,
+        "3D" => 3,
+        "4D" => 4,
+        other => panic!("{}: {key} {other:?}", c.name),
     }
 }
 
@@ -421,6 +562,8 @@ struct CaseResult {
     worst: f64,
     worst_at: String,
     bound: f64,
+    /// Texels over the node family's bound.
+    over: usize,
 }
 
 fn run_case<'a>(refs: &'a Refs, case: &'a Value, texels: usize) -> CaseResult {
@@ -462,7 +605,10 @@ fn run_case<'a>(refs: &'a Refs, case: &'a Value, texels: usize) -> CaseResult {
         .collect();
     let mut worst = 0.0f64;
     let mut worst_at = String::new();
+    let texture = is_texture(c.node);
+    let mut over = 0usize;
     for k in 0..texels {
+        let mut texel_over = false;
         let texel = Texel { case: &c, k };
         let got = eval(&texel);
         for &(socket, ch, data) in &outputs {
@@ -476,7 +622,11 @@ fn run_case<'a>(refs: &'a Refs, case: &'a Value, texels: usize) -> CaseResult {
             let ours = ours.map(|x| if x.is_finite() { x } else { 0.0 });
             for i in 0..ch {
                 let err = (ours[i] as f64 - cycles[i] as f64).abs();
+                // Fractal textures reach values in the thousands, where one f32 ulp
+                // exceeds 1e-4: above magnitude 1 their error is relative.
+                let err = if texture { err / (cycles[i].abs() as f64).max(1.0) } else { err };
                 let err = if err.is_nan() { f64::INFINITY } else { err };
+                texel_over |= err > if texture { TEXTURE_TOLERANCE } else { TOLERANCE };
                 if err > worst {
                     worst = err;
                     worst_at = format!(
@@ -489,17 +639,19 @@ fn run_case<'a>(refs: &'a Refs, case: &'a Value, texels: usize) -> CaseResult {
                 }
             }
         }
+        over += texel_over as usize;
     }
     let bound = ALLOWED
         .iter()
         .find(|a| a.0 == name)
-        .map_or(TOLERANCE, |a| a.1);
+        .map_or(if is_texture(c.node) { TEXTURE_TOLERANCE } else { TOLERANCE }, |a| a.1);
     CaseResult {
         name: name.to_string(),
         node: c.node.to_string(),
         worst,
         worst_at,
         bound,
+        over,
     }
 }
 
@@ -555,8 +707,8 @@ fn shader_nodes_match_cycles() {
         let flag = if r.worst <= r.bound { "ok  " } else { "FAIL" };
         let _ = writeln!(
             report,
-            "{flag} {:<44} {:>12.3e}  {}",
-            r.name, r.worst, r.worst_at
+            "{flag} {:<44} {:>12.3e} {:>5} over  {}",
+            r.name, r.worst, r.over, r.worst_at
         );
     }
     print!("{report}");
@@ -565,10 +717,10 @@ fn shader_nodes_match_cycles() {
     }
 
     for (name, _, _) in ALLOWED {
-        assert!(
-            results.iter().any(|r| r.name == *name),
-            "ALLOWED names a missing case {name}"
-        );
+        let r = results.iter().find(|r| r.name == *name);
+        assert!(r.is_some(), "ALLOWED names a missing case {name}");
+        // The allowance is for the one texel named in the reason, not for the case.
+        assert!(r.unwrap().over <= 1, "{name}: {} texels over the family bound", r.unwrap().over);
     }
     // Written so that a NaN error counts as a failure.
     #[allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -653,6 +805,16 @@ fn assert_modes_covered(cases: &[Value]) {
                 }
             }
             "ShaderNodeSeparateColor" | "ShaderNodeCombineColor" => s("mode"),
+            "ShaderNodeTexNoise" => format!("{} {} {}", s("noise_dimensions"), s("noise_type"), b("normalize")),
+            "ShaderNodeTexVoronoi" => format!("{} {} {} {}", s("voronoi_dimensions"), s("feature"), s("distance"), b("normalize")),
+            "ShaderNodeTexWave" => {
+                let dir = if s("wave_type") == "BANDS" { s("bands_direction") } else { s("rings_direction") };
+                format!("{} {dir} {}", s("wave_type"), s("wave_profile"))
+            }
+            "ShaderNodeTexGradient" => s("gradient_type"),
+            "ShaderNodeMapping" => s("vector_type"),
+            "ShaderNodeTexMagic" => p["turbulence_depth"].to_string(),
+            "ShaderNodeTexWhiteNoise" => s("noise_dimensions"),
             _ => String::new(),
         };
         seen.insert(format!("{node} {key}"));
@@ -706,6 +868,50 @@ fn assert_modes_covered(cases: &[Value]) {
     for m in ColorMode::ALL {
         want.push(format!("ShaderNodeSeparateColor {}", m.blender_name()));
         want.push(format!("ShaderNodeCombineColor {}", m.blender_name()));
+    }
+    let dims = ["1D", "2D", "3D", "4D"];
+    for d in dims {
+        for t in ["FBM", "MULTIFRACTAL", "HYBRID_MULTIFRACTAL", "RIDGED_MULTIFRACTAL", "HETERO_TERRAIN"] {
+            want.push(format!("ShaderNodeTexNoise {d} {t} true"));
+        }
+        want.push(format!("ShaderNodeTexNoise {d} FBM false"));
+        want.push(format!("ShaderNodeTexWhiteNoise {d}"));
+        // The metric only matters for F1, F2 and Smooth F1 beyond 1D.
+        let metrics: &[VoronoiMetric] = if d == "1D" { &[VoronoiMetric::Euclidean] } else { VoronoiMetric::ALL };
+        for f in VoronoiFeature::ALL {
+            let ms: &[VoronoiMetric] = match f {
+                VoronoiFeature::DistanceToEdge | VoronoiFeature::NSphereRadius => &[VoronoiMetric::Euclidean],
+                _ => metrics,
+            };
+            for m in ms {
+                want.push(format!("ShaderNodeTexVoronoi {d} {} {} false", f.blender_name(), m.blender_name()));
+            }
+            if *f != VoronoiFeature::NSphereRadius {
+                let m = ms.last().unwrap();
+                want.push(format!("ShaderNodeTexVoronoi {d} {} {} true", f.blender_name(), m.blender_name()));
+            }
+        }
+    }
+    for t in WaveType::ALL {
+        for p in WaveProfile::ALL {
+            let dirs: Vec<&str> = match t {
+                WaveType::Bands => BandsDirection::ALL.iter().map(|d| d.blender_name()).collect(),
+                WaveType::Rings => RingsDirection::ALL.iter().map(|d| d.blender_name()).collect(),
+            };
+            for d in dirs {
+                want.push(format!("ShaderNodeTexWave {} {d} {}", t.blender_name(), p.blender_name()));
+            }
+        }
+    }
+    for g in GradientType::ALL {
+        want.push(format!("ShaderNodeTexGradient {}", g.blender_name()));
+    }
+    for depth in 0..=10 {
+        want.push(format!("ShaderNodeTexMagic {depth}"));
+    }
+    want.push("ShaderNodeTexChecker ".to_string());
+    for m in MappingType::ALL {
+        want.push(format!("ShaderNodeMapping {}", m.blender_name()));
     }
     let missing: Vec<&String> = want.iter().filter(|w| !seen.contains(*w)).collect();
     assert!(

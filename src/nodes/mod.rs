@@ -47,6 +47,14 @@ pub mod random;
 pub mod ramp;
 pub mod sepcomb;
 pub mod wavelength;
+// Textures.
+pub mod checker;
+pub mod gradient;
+pub mod magic;
+pub mod mapping;
+pub mod voronoi;
+pub mod wave;
+pub mod white_noise;
 
 /// How blendsynth handles a node type (by its `bl_idname`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -111,6 +119,17 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeMixShader",
     "ShaderNodeAddShader",
     "ShaderNodeOutputMaterial",
+    // noise.rs (Cycles flavour), voronoi.rs, wave.rs, gradient.rs, magic.rs,
+    // white_noise.rs, checker.rs: every mode in tests/shader_conformance.rs.
+    "ShaderNodeTexNoise",
+    "ShaderNodeTexVoronoi",
+    "ShaderNodeTexWave",
+    "ShaderNodeTexGradient",
+    "ShaderNodeTexMagic",
+    "ShaderNodeTexWhiteNoise",
+    "ShaderNodeTexChecker",
+    // mapping.rs
+    "ShaderNodeMapping",
 ];
 
 /// Support for a node inside a tree of type `tree` (`ShaderNodeTree`,

@@ -150,6 +150,32 @@ pub trait NoisePoint: Copy {
     fn offset(seed: f32) -> Self;
     /// `perlin_distortion(p, strength)`.
     fn distortion(self, strength: f32) -> Self;
+    /// `p + distortion(p, strength)`.
+    fn distorted(self, strength: f32) -> Self {
+        self.plus(self.distortion(strength))
+    }
+    /// Whether `a * b + c` is one fused operation, as in Cycles' FMA-built CPU kernels
+    /// (GCC contracts them); Blender's own CPU code is built without FMA.
+    const FUSED: bool = false;
+}
+
+#[inline]
+fn madd<P: NoisePoint>(a: f32, b: f32, c: f32) -> f32 {
+    if P::FUSED {
+        a.mul_add(b, c)
+    } else {
+        a * b + c
+    }
+}
+
+/// Linear blend: Cycles' `a + t * (b - a)` (fused) or Blender's `interpf`.
+#[inline]
+fn blend<P: NoisePoint>(a: f32, b: f32, t: f32) -> f32 {
+    if P::FUSED {
+        t.mul_add(b - a, a)
+    } else {
+        lerp(a, b, t)
+    }
 }
 
 fn correction(v: f32) -> f32 {
@@ -264,7 +290,7 @@ pub fn fbm<P: NoisePoint>(p: P, detail: f32, roughness: f32, lacunarity: f32, no
     let mut sum = 0.0f32;
     for _ in 0..=(detail as i32) {
         let t = p.scaled(fscale).perlin_signed();
-        sum += t * amp;
+        sum = madd::<P>(t, amp, sum);
         maxamp += amp;
         amp *= roughness;
         fscale *= lacunarity;
@@ -272,11 +298,11 @@ pub fn fbm<P: NoisePoint>(p: P, detail: f32, roughness: f32, lacunarity: f32, no
     let rmd = detail - detail.floor();
     if rmd != 0.0 {
         let t = p.scaled(fscale).perlin_signed();
-        let sum2 = sum + t * amp;
+        let sum2 = madd::<P>(t, amp, sum);
         return if normalize {
-            lerp(0.5 * sum / maxamp + 0.5, 0.5 * sum2 / (maxamp + amp) + 0.5, rmd)
+            blend::<P>(0.5 * sum / maxamp + 0.5, 0.5 * sum2 / (maxamp + amp) + 0.5, rmd)
         } else {
-            lerp(sum, sum2, rmd)
+            blend::<P>(sum, sum2, rmd)
         };
     }
     if normalize {
@@ -290,13 +316,13 @@ pub fn multi_fractal<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacun
     let mut value = 1.0f32;
     let mut pwr = 1.0f32;
     for _ in 0..=(detail as i32) {
-        value *= pwr * p.perlin_signed() + 1.0;
+        value *= madd::<P>(pwr, p.perlin_signed(), 1.0);
         pwr *= roughness;
         p = p.scaled(lacunarity);
     }
     let rmd = detail - detail.floor();
     if rmd != 0.0 {
-        value *= rmd * pwr * p.perlin_signed() + 1.0;
+        value *= madd::<P>(rmd * pwr, p.perlin_signed(), 1.0);
     }
     value
 }
@@ -306,15 +332,14 @@ pub fn hetero_terrain<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacu
     let mut value = offset + p.perlin_signed();
     p = p.scaled(lacunarity);
     for _ in 1..=(detail as i32) {
-        let increment = (p.perlin_signed() + offset) * pwr * value;
-        value += increment;
+        value = madd::<P>((p.perlin_signed() + offset) * pwr, value, value);
         pwr *= roughness;
         p = p.scaled(lacunarity);
     }
     let rmd = detail - detail.floor();
     if rmd != 0.0 {
         let increment = (p.perlin_signed() + offset) * pwr * value;
-        value += rmd * increment;
+        value = madd::<P>(rmd, increment, value);
     }
     value
 }
@@ -330,7 +355,7 @@ pub fn hybrid_multi_fractal<P: NoisePoint>(mut p: P, detail: f32, roughness: f32
         }
         let signal = (p.perlin_signed() + offset) * pwr;
         pwr *= roughness;
-        value += weight * signal;
+        value = madd::<P>(weight, signal, value);
         weight *= gain * signal;
         p = p.scaled(lacunarity);
         i += 1;
@@ -341,7 +366,7 @@ pub fn hybrid_multi_fractal<P: NoisePoint>(mut p: P, detail: f32, roughness: f32
             weight = 1.0;
         }
         let signal = (p.perlin_signed() + offset) * pwr;
-        value += rmd * weight * signal;
+        value = madd::<P>(rmd * weight, signal, value);
     }
     value
 }
@@ -357,7 +382,7 @@ pub fn ridged_multi_fractal<P: NoisePoint>(mut p: P, detail: f32, roughness: f32
         signal = offset - p.perlin_signed().abs();
         signal *= signal;
         signal *= weight;
-        value += signal * pwr;
+        value = madd::<P>(signal, pwr, value);
         pwr *= roughness;
     }
     value
@@ -411,14 +436,14 @@ fn select<P: NoisePoint>(p: P, n: &NoiseParams) -> f32 {
 
 /// `perlin_fractal_distorted`: the Fac output.
 pub fn fractal_distorted<P: NoisePoint>(p: P, n: &NoiseParams) -> f32 {
-    let p = p.plus(p.distortion(n.distortion));
+    let p = p.distorted(n.distortion);
     select(p, n)
 }
 
 /// `perlin_float3_fractal_distorted`: the Color output (its first channel is Fac). The
 /// seeds of the two extra channels depend on the dimension, as in Blender.
 pub fn fractal_distorted_color<P: NoisePoint>(p: P, n: &NoiseParams, seeds: [f32; 2]) -> [f32; 3] {
-    let p = p.plus(p.distortion(n.distortion));
+    let p = p.distorted(n.distortion);
     [select(p, n), select(p.plus(P::offset(seeds[0])), n), select(p.plus(P::offset(seeds[1])), n)]
 }
 
@@ -448,4 +473,198 @@ pub fn noise_texture(dimensions: u8, vector: [f32; 3], w: f32, scale: f32, param
         [f, 0.0, 0.0]
     };
     (c[0], [c[0], c[1], c[2], 1.0])
+}
+
+// --- Cycles' kernel flavour -------------------------------------------------------------
+//
+// Cycles (`kernel/svm/noise.h`) computes the same Perlin noise with its own arithmetic:
+// `fade` in single precision, linear blends as `a + t * (b - a)`, and, in its SSE/AVX
+// CPU kernels, the blends in a fixed axis order (2D and 3D: x, then y, then z; 4D: w
+// first, then x, y, z). At fine scales times many octaves the coordinates are large and
+// these rounding differences grow past 1e-4, so shaders use this flavour; Geometry
+// Nodes keep Blender's CPU version above.
+
+#[inline]
+fn cy_mix(a: f32, b: f32, t: f32) -> f32 {
+    t.mul_add(b - a, a)
+}
+
+#[inline]
+fn cy_fade(t: f32) -> f32 {
+    let a = t.mul_add(6.0, -15.0);
+    let b = t.mul_add(a, 10.0);
+    (t * t) * (t * b)
+}
+
+fn cy_perlin1(p: f32) -> f32 {
+    let (x, fx) = floor_fraction(p);
+    let u = t_fade1(fx);
+    cy_mix(grad1(hash1(x as u32), fx), grad1(hash1(x.wrapping_add(1) as u32), fx - 1.0), u)
+}
+
+/// The scalar 1D kernel's fade: `t * t * t * (t * (t * 6 - 15) + 10)`.
+#[inline]
+fn t_fade1(t: f32) -> f32 {
+    t * t * t * t.mul_add(t.mul_add(6.0, -15.0), 10.0)
+}
+
+fn cy_perlin2(p: [f32; 2]) -> f32 {
+    let (x, fx) = floor_fraction(p[0]);
+    let (y, fy) = floor_fraction(p[1]);
+    let (u, v) = (cy_fade(fx), cy_fade(fy));
+    let h = |dx: i32, dy: i32| hash2(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32);
+    let g0 = cy_mix(grad2(h(0, 0), fx, fy), grad2(h(1, 0), fx - 1.0, fy), u);
+    let g1 = cy_mix(grad2(h(0, 1), fx, fy - 1.0), grad2(h(1, 1), fx - 1.0, fy - 1.0), u);
+    cy_mix(g0, g1, v)
+}
+
+/// Gradients at the 8 corners (index bit 0: x, bit 1: y, bit 2: z) blended x, y, z.
+#[inline]
+fn cy_tri(g: impl Fn(i32, i32, i32) -> f32, u: f32, v: f32, w: f32) -> f32 {
+    let x00 = cy_mix(g(0, 0, 0), g(1, 0, 0), u);
+    let x10 = cy_mix(g(0, 1, 0), g(1, 1, 0), u);
+    let x01 = cy_mix(g(0, 0, 1), g(1, 0, 1), u);
+    let x11 = cy_mix(g(0, 1, 1), g(1, 1, 1), u);
+    cy_mix(cy_mix(x00, x10, v), cy_mix(x01, x11, v), w)
+}
+
+fn cy_perlin3(p: [f32; 3]) -> f32 {
+    let (x, fx) = floor_fraction(p[0]);
+    let (y, fy) = floor_fraction(p[1]);
+    let (z, fz) = floor_fraction(p[2]);
+    let g = |dx: i32, dy: i32, dz: i32| {
+        grad3(
+            hash3(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32, z.wrapping_add(dz) as u32),
+            fx - dx as f32,
+            fy - dy as f32,
+            fz - dz as f32,
+        )
+    };
+    cy_tri(g, cy_fade(fx), cy_fade(fy), cy_fade(fz))
+}
+
+fn cy_perlin4(p: [f32; 4]) -> f32 {
+    let (x, fx) = floor_fraction(p[0]);
+    let (y, fy) = floor_fraction(p[1]);
+    let (z, fz) = floor_fraction(p[2]);
+    let (w, fw) = floor_fraction(p[3]);
+    let s = cy_fade(fw);
+    let g = |dx: i32, dy: i32, dz: i32| {
+        let at = |dw: i32| {
+            grad4(
+                hash4(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32, z.wrapping_add(dz) as u32, w.wrapping_add(dw) as u32),
+                fx - dx as f32,
+                fy - dy as f32,
+                fz - dz as f32,
+                fw - dw as f32,
+            )
+        };
+        cy_mix(at(0), at(1), s)
+    };
+    cy_tri(g, cy_fade(fx), cy_fade(fy), cy_fade(fz))
+}
+
+/// A point evaluated with Cycles' kernel arithmetic (see above).
+#[derive(Debug, Clone, Copy)]
+pub struct Cycles<P>(pub P);
+
+macro_rules! cycles_point {
+    ($t:ty, $perlin:ident, $scale:expr) => {
+        impl NoisePoint for Cycles<$t> {
+            fn perlin_signed(self) -> f32 {
+                // Repeats every 100000 with Blender's half-cell shift beyond 1e6.
+                let p = cycles_fmod(self.0);
+                $perlin(p) * $scale
+            }
+            fn scaled(self, s: f32) -> Self {
+                Cycles(self.0.scaled(s))
+            }
+            fn plus(self, o: Self) -> Self {
+                Cycles(self.0.plus(o.0))
+            }
+            fn offset(seed: f32) -> Self {
+                Cycles(<$t>::offset(seed))
+            }
+            fn distortion(self, strength: f32) -> Self {
+                let mut out = self.0;
+                let n = std::mem::size_of::<$t>() / 4;
+                for i in 0..n {
+                    let o = Cycles(<$t>::offset(i as f32));
+                    set(&mut out, i, self.plus(o).perlin_signed() * strength);
+                }
+                Cycles(out)
+            }
+            fn distorted(self, strength: f32) -> Self {
+                if std::mem::size_of::<$t>() == 4 {
+                    // The scalar kernel contracts `p += snoise(..) * distortion`.
+                    let mut out = self.0;
+                    let d = self.plus(Cycles(<$t>::offset(0.0))).perlin_signed();
+                    set(&mut out, 0, d.mul_add(strength, get(self.0)));
+                    Cycles(out)
+                } else {
+                    self.plus(self.distortion(strength))
+                }
+            }
+            const FUSED: bool = true;
+        }
+    };
+}
+
+trait Comps: Copy {
+    fn map_c(self, f: impl Fn(f32) -> f32) -> Self;
+    fn set_c(&mut self, i: usize, v: f32);
+    fn first_c(self) -> f32;
+}
+impl Comps for f32 {
+    fn map_c(self, f: impl Fn(f32) -> f32) -> Self {
+        f(self)
+    }
+    fn set_c(&mut self, _: usize, v: f32) {
+        *self = v;
+    }
+    fn first_c(self) -> f32 {
+        self
+    }
+}
+impl<const N: usize> Comps for [f32; N] {
+    fn map_c(self, f: impl Fn(f32) -> f32) -> Self {
+        self.map(f)
+    }
+    fn set_c(&mut self, i: usize, v: f32) {
+        self[i] = v;
+    }
+    fn first_c(self) -> f32 {
+        self[0]
+    }
+}
+fn cycles_fmod<T: Comps>(p: T) -> T {
+    p.map_c(|x| x % 100000.0 + correction(x))
+}
+fn get<T: Comps>(p: T) -> f32 {
+    p.first_c()
+}
+fn set<T: Comps>(p: &mut T, i: usize, v: f32) {
+    p.set_c(i, v)
+}
+
+cycles_point!(f32, cy_perlin1, 0.25);
+cycles_point!([f32; 2], cy_perlin2, 0.6616);
+cycles_point!([f32; 3], cy_perlin3, 0.9820);
+cycles_point!([f32; 4], cy_perlin4, 0.8344);
+
+/// The Noise Texture node as Cycles' shader kernel evaluates it: (Fac, Color).
+#[allow(clippy::too_many_arguments)]
+pub fn noise_texture_cycles(dimensions: u8, vector: [f32; 3], w: f32, scale: f32, params: NoiseParams) -> (f32, [f32; 3]) {
+    let mut n = params;
+    n.detail = n.detail.clamp(0.0, 15.0);
+    n.roughness = n.roughness.max(0.0);
+    let v = [vector[0] * scale, vector[1] * scale, vector[2] * scale];
+    let ws = w * scale;
+    let c = match dimensions {
+        1 => fractal_distorted_color(Cycles(ws), &n, [1.0, 2.0]),
+        2 => fractal_distorted_color(Cycles([v[0], v[1]]), &n, [2.0, 3.0]),
+        4 => fractal_distorted_color(Cycles([v[0], v[1], v[2], ws]), &n, [4.0, 5.0]),
+        _ => fractal_distorted_color(Cycles(v), &n, [3.0, 4.0]),
+    };
+    (c[0], c)
 }

@@ -12,6 +12,11 @@ use crate::nodes::math::{MathOp, VectorMathOp};
 use crate::nodes::mix::MixBlend;
 use crate::nodes::ramp::{ColorBand, HueInterpolation, RampColorMode, RampInterpolation, RampStop, RampTable};
 use crate::nodes::sepcomb::ColorMode;
+use crate::nodes::gradient::GradientType;
+use crate::nodes::mapping::MappingType;
+use crate::nodes::noise::NoiseType;
+use crate::nodes::voronoi::{VoronoiFeature, VoronoiMetric};
+use crate::nodes::wave::{BandsDirection, RingsDirection, WaveProfile, WaveSettings, WaveType};
 use crate::scene::{Scene, Socket};
 
 use super::program::{BsdfNode, Closure, Kind, Op, Program, Slot};
@@ -93,6 +98,28 @@ fn floats(v: &Value) -> [f32; 4] {
         }
         _ => [0.0, 0.0, 0.0, 1.0],
     }
+}
+
+fn dimensions(n: &FlatNode, key: &str) -> Result<u8, CompileError> {
+    match prop_str(n, key)? {
+        "1D" => Ok(1),
+        "2D" => Ok(2),
+        "3D" => Ok(3),
+        "4D" => Ok(4),
+        other => Err(CompileError(format!("node {:?}: {key} {other:?} is not supported", n.path))),
+    }
+}
+
+fn linked(n: &FlatNode, id: &str) -> bool {
+    n.input(id).is_some_and(|i| matches!(i.sources.first(), Some(Source::Link { .. })))
+}
+
+/// True when a texture node's `texture_mapping` leaves coordinates unchanged.
+fn identity_mapping(m: &Value) -> bool {
+    let v3 = |k: &str, want: f64| m.get(k).and_then(Value::as_array).map_or(true, |a| a.iter().all(|x| x.as_f64() == Some(want)));
+    let b = |k: &str| m.get(k).and_then(Value::as_bool).unwrap_or(false);
+    let s = |k: &str, want: &str| m.get(k).and_then(Value::as_str).map_or(true, |x| x == want);
+    v3("translation", 0.0) && v3("rotation", 0.0) && v3("scale", 1.0) && !b("use_min") && !b("use_max") && s("mapping_x", "X") && s("mapping_y", "Y") && s("mapping_z", "Z")
 }
 
 impl<'g, 'a> Compiler<'g, 'a> {
@@ -361,6 +388,89 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     self.ops.push(Op::Wavelength { wavelength, dst: d });
                     self.outputs(i, n, &[("Color", d, C)]);
                 }
+                "ShaderNodeMapping" => {
+                    let kind = mode(n, "vector_type", MappingType::from_blender)?;
+                    let vector = self.input(n, "Vector", V)?;
+                    // Location is hidden (and unused) for Vector and Normal mappings.
+                    let location = self.opt_input(n, "Location", V)?;
+                    let rotation = self.input(n, "Rotation", V)?;
+                    let scale = self.input(n, "Scale", V)?;
+                    let d = self.alloc(V);
+                    self.ops.push(Op::Mapping { kind, vector, location, rotation, scale, dst: d });
+                    self.outputs(i, n, &[("Vector", d, V)]);
+                }
+                "ShaderNodeTexNoise" => {
+                    let (dims, vector, w) = self.texture_point(n, Some("noise_dimensions"))?;
+                    let kind = mode(n, "noise_type", NoiseType::from_blender)?;
+                    let normalize = prop_bool(n, "normalize")?;
+                    let ids = ["Scale", "Detail", "Roughness", "Lacunarity", "Offset", "Gain", "Distortion"];
+                    let args = self.inputs_n(n, ids, F)?;
+                    let (fac, color) = (self.alloc(F), self.alloc(C));
+                    self.ops.push(Op::TexNoise { dims, kind, normalize, vector, w, args, fac, color });
+                    self.outputs(i, n, &[("Fac", fac, F), ("Color", color, C)]);
+                }
+                "ShaderNodeTexVoronoi" => {
+                    let (dims, vector, w) = self.texture_point(n, Some("voronoi_dimensions"))?;
+                    let feature = mode(n, "feature", VoronoiFeature::from_blender)?;
+                    let metric = mode(n, "distance", VoronoiMetric::from_blender)?;
+                    let normalize = prop_bool(n, "normalize")?;
+                    let ids = ["Scale", "Detail", "Roughness", "Lacunarity", "Smoothness", "Exponent", "Randomness"];
+                    let args = self.inputs_n(n, ids, F)?;
+                    let (distance, color, position, w_out, radius) = (self.alloc(F), self.alloc(C), self.alloc(V), self.alloc(F), self.alloc(F));
+                    self.ops.push(Op::TexVoronoi { dims, feature, metric, normalize, vector, w, args, distance, color, position, w_out, radius });
+                    self.outputs(i, n, &[("Distance", distance, F), ("Color", color, C), ("Position", position, V), ("W", w_out, F), ("Radius", radius, F)]);
+                }
+                "ShaderNodeTexWave" => {
+                    let (_, vector, _) = self.texture_point(n, None)?;
+                    let settings = WaveSettings {
+                        kind: mode(n, "wave_type", WaveType::from_blender)?,
+                        bands: mode(n, "bands_direction", BandsDirection::from_blender)?,
+                        rings: mode(n, "rings_direction", RingsDirection::from_blender)?,
+                        profile: mode(n, "wave_profile", WaveProfile::from_blender)?,
+                    };
+                    let ids = ["Scale", "Distortion", "Detail", "Detail Scale", "Detail Roughness", "Phase Offset"];
+                    let args = self.inputs_n(n, ids, F)?;
+                    let (fac, color) = (self.alloc(F), self.alloc(C));
+                    self.ops.push(Op::TexWave { settings, vector, args, fac, color });
+                    self.outputs(i, n, &[("Fac", fac, F), ("Color", color, C)]);
+                }
+                "ShaderNodeTexGradient" => {
+                    let (_, vector, _) = self.texture_point(n, None)?;
+                    let kind = mode(n, "gradient_type", GradientType::from_blender)?;
+                    let (fac, color) = (self.alloc(F), self.alloc(C));
+                    self.ops.push(Op::TexGradient { kind, vector, fac, color });
+                    self.outputs(i, n, &[("Fac", fac, F), ("Color", color, C)]);
+                }
+                "ShaderNodeTexMagic" => {
+                    let (_, vector, _) = self.texture_point(n, None)?;
+                    let depth = prop(n, "turbulence_depth")?.as_i64().ok_or_else(|| CompileError(format!("node {:?}: turbulence_depth is not an integer", n.path)))? as i32;
+                    let (scale, distortion) = (self.input(n, "Scale", F)?, self.input(n, "Distortion", F)?);
+                    let (fac, color) = (self.alloc(F), self.alloc(C));
+                    self.ops.push(Op::TexMagic { depth, vector, scale, distortion, fac, color });
+                    self.outputs(i, n, &[("Fac", fac, F), ("Color", color, C)]);
+                }
+                "ShaderNodeTexWhiteNoise" => {
+                    let dims = dimensions(n, "noise_dimensions")?;
+                    // An unlinked White Noise vector is the world position, not Generated.
+                    let vector = if linked(n, "Vector") {
+                        self.input(n, "Vector", V)?
+                    } else {
+                        let d = self.alloc(V);
+                        self.ops.push(Op::Position { dst: d });
+                        d
+                    };
+                    let w = self.opt_input(n, "W", F)?;
+                    let (value, color) = (self.alloc(F), self.alloc(C));
+                    self.ops.push(Op::TexWhiteNoise { dims, vector, w, value, color });
+                    self.outputs(i, n, &[("Value", value, F), ("Color", color, C)]);
+                }
+                "ShaderNodeTexChecker" => {
+                    let (_, vector, _) = self.texture_point(n, None)?;
+                    let (color1, color2, scale) = (self.input(n, "Color1", C)?, self.input(n, "Color2", C)?, self.input(n, "Scale", F)?);
+                    let (fac, color) = (self.alloc(F), self.alloc(C));
+                    self.ops.push(Op::TexChecker { vector, color1, color2, scale, fac, color });
+                    self.outputs(i, n, &[("Fac", fac, F), ("Color", color, C)]);
+                }
                 "ShaderNodeEmission" => {
                     let (color, strength) = (self.input(n, "Color", C)?, self.input(n, "Strength", F)?);
                     self.closure(i, Closure::Emission { color, strength });
@@ -423,6 +533,40 @@ impl<'g, 'a> Compiler<'g, 'a> {
         } else {
             Ok(self.constant(want, [0.0; 3]))
         }
+    }
+
+    fn inputs_n<const K: usize>(&mut self, n: &FlatNode<'a>, ids: [&str; K], want: Kind) -> Result<[Slot; K], CompileError> {
+        let mut out = [0; K];
+        for (o, id) in out.iter_mut().zip(ids) {
+            *o = self.opt_input(n, id, want)?;
+        }
+        Ok(out)
+    }
+
+    /// A texture node's dimensions (if it has them), its Vector (Generated coordinates
+    /// when unlinked, as Cycles does) and W. Only the identity texture mapping is
+    /// supported: Cycles then adds no mapping step.
+    fn texture_point(&mut self, n: &FlatNode<'a>, dims_key: Option<&str>) -> Result<(u8, Slot, Slot), CompileError> {
+        let dims = match dims_key {
+            Some(k) => dimensions(n, k)?,
+            None => 3,
+        };
+        if let Some(m) = n.property("texture_mapping") {
+            if !identity_mapping(m) {
+                return Err(CompileError(format!("node {:?}: a non-identity texture_mapping is not supported yet", n.path)));
+            }
+        }
+        let vector = if dims == 1 {
+            self.constant(Kind::Vector, [0.0; 3])
+        } else if linked(n, "Vector") {
+            self.input(n, "Vector", Kind::Vector)?
+        } else {
+            let d = self.alloc(Kind::Vector);
+            self.ops.push(Op::TexCoord { generated: Some(d), normal: None, uv: None, object: None });
+            d
+        };
+        let w = if n.input("W").is_some() { self.input(n, "W", Kind::Float)? } else { self.constant(Kind::Float, [0.0; 3]) };
+        Ok((dims, vector, w))
     }
 
     fn inputs6(&mut self, n: &FlatNode<'a>, ids: [&str; 6], want: Kind) -> Result<[Slot; 6], CompileError> {

@@ -9,6 +9,14 @@ use crate::nodes::mix::{mix_color, mix_float, mix_rgb, mix_vector, mix_vector_no
 use crate::nodes::ramp::RampTable;
 use crate::nodes::sepcomb::{combine_color, separate_color, ColorMode};
 use crate::nodes::{blackbody, wavelength};
+use crate::nodes::checker::checker_texture;
+use crate::nodes::gradient::{gradient, GradientType};
+use crate::nodes::magic::magic;
+use crate::nodes::mapping::{mapping, MappingType};
+use crate::nodes::noise::{noise_texture_cycles, NoiseParams, NoiseType};
+use crate::nodes::voronoi::{voronoi_texture, VoronoiFeature, VoronoiMetric, VoronoiParams};
+use crate::nodes::wave::{wave, WaveSettings};
+use crate::nodes::white_noise::white_noise;
 
 use super::point::ShadingPoint;
 
@@ -63,6 +71,17 @@ pub enum Op {
     CombineColor { mode: ColorMode, a: Slot, b: Slot, c: Slot, dst: Slot },
     Blackbody { temperature: Slot, dst: Slot },
     Wavelength { wavelength: Slot, dst: Slot },
+    /// World-space position (unlinked White Noise vectors).
+    Position { dst: Slot },
+    /// Textures: inputs in socket order after Vector; outputs Fac/Distance first.
+    TexNoise { dims: u8, kind: NoiseType, normalize: bool, vector: Slot, w: Slot, args: [Slot; 7], fac: Slot, color: Slot },
+    TexVoronoi { dims: u8, feature: VoronoiFeature, metric: VoronoiMetric, normalize: bool, vector: Slot, w: Slot, args: [Slot; 7], distance: Slot, color: Slot, position: Slot, w_out: Slot, radius: Slot },
+    TexWave { settings: WaveSettings, vector: Slot, args: [Slot; 6], fac: Slot, color: Slot },
+    TexGradient { kind: GradientType, vector: Slot, fac: Slot, color: Slot },
+    TexMagic { depth: i32, vector: Slot, scale: Slot, distortion: Slot, fac: Slot, color: Slot },
+    TexWhiteNoise { dims: u8, vector: Slot, w: Slot, value: Slot, color: Slot },
+    TexChecker { vector: Slot, color1: Slot, color2: Slot, scale: Slot, fac: Slot, color: Slot },
+    Mapping { kind: MappingType, vector: Slot, location: Slot, rotation: Slot, scale: Slot, dst: Slot },
 }
 
 /// The shader part of a material: closures as a small tree over stack values.
@@ -235,6 +254,54 @@ impl Program {
                 Op::Wavelength { wavelength: w, dst } => {
                     let r = wavelength::wavelength(s[w as usize], &LINEAR_REC709);
                     put3(s, dst, r)
+                }
+                Op::Position { dst } => put3(s, dst, sp.position),
+                Op::TexNoise { dims, kind, normalize, vector, w, args, fac, color } => {
+                    let a = args.map(|i| s[i as usize]);
+                    let params = NoiseParams { kind, normalize, detail: a[1], roughness: a[2], lacunarity: a[3], offset: a[4], gain: a[5], distortion: a[6] };
+                    let (f, c) = noise_texture_cycles(dims, v3(s, vector), s[w as usize], a[0], params);
+                    s[fac as usize] = f;
+                    put3(s, color, c);
+                }
+                Op::TexVoronoi { dims, feature, metric, normalize, vector, w, args, distance, color, position, w_out, radius } => {
+                    let a = args.map(|i| s[i as usize]);
+                    let p = VoronoiParams::new(feature, metric, normalize, a[0], a[1], a[2], a[3], a[4], a[5], a[6]);
+                    let o = voronoi_texture(dims, v3(s, vector), s[w as usize], p);
+                    s[distance as usize] = o.distance;
+                    put3(s, color, o.color);
+                    put3(s, position, o.position);
+                    s[w_out as usize] = o.w;
+                    s[radius as usize] = o.radius;
+                }
+                Op::TexWave { settings, vector, args, fac, color } => {
+                    let a = args.map(|i| s[i as usize]);
+                    let f = wave(settings, v3(s, vector), a[0], a[1], a[2], a[3], a[4], a[5]);
+                    s[fac as usize] = f;
+                    put3(s, color, [f; 3]);
+                }
+                Op::TexGradient { kind, vector, fac, color } => {
+                    let f = gradient(kind, v3(s, vector));
+                    s[fac as usize] = f;
+                    put3(s, color, [f; 3]);
+                }
+                Op::TexMagic { depth, vector, scale, distortion, fac, color } => {
+                    let (c, f) = magic(v3(s, vector), s[scale as usize], depth, s[distortion as usize]);
+                    s[fac as usize] = f;
+                    put3(s, color, c);
+                }
+                Op::TexWhiteNoise { dims, vector, w, value, color } => {
+                    let (v, c) = white_noise(dims, v3(s, vector), s[w as usize]);
+                    s[value as usize] = v;
+                    put3(s, color, c);
+                }
+                Op::Mapping { kind, vector, location, rotation, scale, dst } => {
+                    let r = mapping(kind, v3(s, vector), v3(s, location), v3(s, rotation), v3(s, scale));
+                    put3(s, dst, r);
+                }
+                Op::TexChecker { vector, color1, color2, scale, fac, color } => {
+                    let (c, f) = checker_texture(v3(s, vector), v3(s, color1), v3(s, color2), s[scale as usize]);
+                    s[fac as usize] = f;
+                    put3(s, color, c);
                 }
             }
         }
