@@ -260,9 +260,23 @@ struct RenderArgs {
     /// Folder for label passes (depth, ids, normal, uv, albedo) as float EXRs.
     #[arg(long)]
     passes: Option<PathBuf>,
-    /// Output image (linear float EXR).
+    /// Denoise with Open Image Denoise as Cycles does (default: the scene's setting).
+    #[arg(long, value_enum)]
+    denoise: Option<OnOff>,
+    /// libOpenImageDenoise to use (file or folder; default: $BLENDSYNTH_OIDN, the bpy or
+    /// Blender installation, or the pyoidn wheel).
+    #[arg(long)]
+    oidn: Option<PathBuf>,
+    /// Output image: .png through the scene's colour management (view transform, look,
+    /// exposure, gamma; its bit depth and alpha), or .exr linear float RGBA.
     #[arg(short, long)]
     output: PathBuf,
+}
+
+#[derive(Clone, Copy, PartialEq, clap::ValueEnum)]
+enum OnOff {
+    On,
+    Off,
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
@@ -277,8 +291,22 @@ fn run_render(a: RenderArgs) -> Result<()> {
     let overrides = a.set.iter().map(|s| Override::parse(s)).collect::<Result<Vec<_>, _>>().map_err(anyhow::Error::msg)?;
     let scene = Scene::load(&a.dir)?.with_overrides(&overrides)?;
     let opts = render::RenderOptions { frame: a.frame, samples: a.samples, threshold: a.threshold, resolution: a.resolution, seed: a.seed, threads: a.threads, progress: true };
-    let out = render::render(&scene, &opts).map_err(|e| anyhow::anyhow!("render {}: {e}", a.dir.display()))?;
-    render::write_exr(&a.output, out.width, out.height, &out.color).map_err(anyhow::Error::msg)?;
+    let ext = a.output.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    if ext != "png" && ext != "exr" {
+        anyhow::bail!("{}: the output must be a .png or .exr file", a.output.display());
+    }
+    // Find the denoiser before spending the render time.
+    let want_denoise = a.denoise.map_or_else(|| blendsynth::denoise::scene_wants_denoising(&scene), |d| d == OnOff::On);
+    let denoiser = if want_denoise { blendsynth::denoise::Denoiser::load(a.oidn.as_deref())? } else { None };
+    if want_denoise && denoiser.is_none() {
+        eprintln!("notice: no Open Image Denoise library found (--oidn, $BLENDSYNTH_OIDN, a bpy/Blender install or the pyoidn wheel); writing the noisy image");
+    }
+    let mut out = render::render(&scene, &opts).map_err(|e| anyhow::anyhow!("render {}: {e}", a.dir.display()))?;
+    if let Some(d) = &denoiser {
+        let frame = a.frame.unwrap_or(scene.file.scene.frame_current as f64);
+        blendsynth::denoise::denoise_render(d, &scene, frame, &mut out).map_err(|e| anyhow::anyhow!("denoising: {e}"))?;
+    }
+    blendsynth::color::write_render(&scene, &a.output, out.width, out.height, &out.color)?;
     if let Some(dir) = &a.passes {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
         let p = &out.passes;

@@ -38,38 +38,51 @@ pub fn resolution(scene: &Scene, settings: &RenderSettings) -> (u32, u32) {
     (((g("resolution_x", 1920) * pct) / 100).max(1) as u32, ((g("resolution_y", 1080) * pct) / 100).max(1) as u32)
 }
 
-/// The path tracer as a `FrameRenderer`. Until the render branch is merged this build
-/// has none; at merge the lead replaces this function with an adapter over
-/// `render::render` (CONTRACT.md), for example:
-///
-/// ```ignore
-/// struct PathTracer { denoiser: Option<crate::denoise::Denoiser> }
-/// impl FrameRenderer for PathTracer {
-///     fn render(&self, scene: &Scene, frame: f64, seed: u32, s: &RenderSettings, threads: usize) -> Result<RenderedFrame, String> {
-///         let opts = crate::render::RenderOptions { frame: Some(frame), samples: s.samples, threshold: s.threshold,
-///             resolution: s.resolution, seed: Some(seed), threads: Some(threads), progress: false };
-///         let mut out = crate::render::render(scene, &opts).map_err(|e| e.to_string())?;
-///         let p = out.passes;
-///         let denoise = s.denoise.unwrap_or_else(|| scene.file.scene.cycles.get("use_denoising").and_then(|v| v.as_bool()).unwrap_or(false));
-///         if let (true, Some(d)) = (denoise, &self.denoiser) {
-///             d.denoise(out.width, out.height, &mut out.color, &p.albedo, &p.denoise_normal).map_err(|e| e.to_string())?;
-///         }
-///         crate::color::to_display(scene, &mut out.color).map_err(|e| e.to_string())?;
-///         let instances = p.instances.into_iter().map(|i| crate::label::Instance { object: i.object,
-///             instance_index: i.instance_index, world_bounds: i.world_bounds, world_transform: i.world_transform }).collect();
-///         Ok(RenderedFrame { width: out.width, height: out.height, color: out.color,
-///             ids: crate::label::FrameIds { width: out.width, height: out.height, instance_id: p.instance_id,
-///                 depth: Some(p.depth), normal: Some(p.normal), instances } })
-///     }
-/// }
-/// pub fn path_tracer(_scene: &Scene) -> Result<Box<dyn FrameRenderer>, String> {
-///     let denoiser = crate::denoise::Denoiser::load(None).map_err(|e| e.to_string())?;
-///     if denoiser.is_none() { eprintln!("notice: no OpenImageDenoise found; frames are not denoised"); }
-///     Ok(Box::new(PathTracer { denoiser }))
-/// }
-/// ```
-/// (`Denoiser` must be `Sync` for frames to render in parallel; otherwise keep one per
-/// thread.)
+/// The path tracer as a `FrameRenderer`: render, denoise when the spec or the scene asks
+/// for it (as Cycles does after the last sample), then the scene's view transform.
+struct PathTracer {
+    denoiser: Option<crate::denoise::Denoiser>,
+}
+
+impl FrameRenderer for PathTracer {
+    fn render(&self, scene: &Scene, frame: f64, seed: u32, s: &RenderSettings, threads: usize) -> Result<RenderedFrame, String> {
+        let opts = crate::render::RenderOptions {
+            frame: Some(frame),
+            samples: s.samples,
+            threshold: s.threshold,
+            resolution: Some(resolution(scene, s)),
+            seed: Some(seed),
+            threads: Some(threads.max(1)),
+            progress: false,
+        };
+        let mut out = crate::render::render(scene, &opts).map_err(|e| e.to_string())?;
+        if s.denoise.unwrap_or_else(|| crate::denoise::scene_wants_denoising(scene)) {
+            if let Some(d) = &self.denoiser {
+                crate::denoise::denoise_render(d, scene, frame, &mut out).map_err(|e| format!("denoising: {e}"))?;
+            }
+        }
+        crate::color::to_display(scene, &mut out.color).map_err(|e| e.to_string())?;
+        let p = out.passes;
+        let instances = p
+            .instances
+            .into_iter()
+            .map(|i| crate::label::Instance { object: i.object, instance_index: i.instance_index, world_bounds: i.world_bounds, world_transform: i.world_transform })
+            .collect();
+        Ok(RenderedFrame {
+            width: out.width,
+            height: out.height,
+            color: out.color,
+            ids: crate::label::FrameIds { width: out.width, height: out.height, instance_id: p.instance_id, depth: Some(p.depth), normal: Some(p.normal), instances },
+        })
+    }
+}
+
+/// The path tracer, with Open Image Denoise when one can be found (a notice otherwise:
+/// frames are then written noisy).
 pub fn path_tracer(_scene: &Scene) -> Result<Box<dyn FrameRenderer>, String> {
-    Err("this build has no path tracer yet (src/render is not merged); use --renderer bounds to check a spec and the labels".into())
+    let denoiser = crate::denoise::Denoiser::load(None).map_err(|e| e.to_string())?;
+    if denoiser.is_none() {
+        eprintln!("notice: no Open Image Denoise library found ($BLENDSYNTH_OIDN, a bpy/Blender install or the pyoidn wheel); frames that ask for denoising are written noisy");
+    }
+    Ok(Box::new(PathTracer { denoiser }))
 }

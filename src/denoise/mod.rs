@@ -300,3 +300,26 @@ impl Denoiser {
         Ok(())
     }
 }
+
+/// Denoises a finished render in place as Cycles does after its last sample: the
+/// renderer's world-space guide normals are first turned into Cycles' camera-space
+/// convention (background stays zero) using the scene camera at `frame`.
+pub fn denoise_render(denoiser: &Denoiser, scene: &crate::scene::Scene, frame: f64, out: &mut crate::render::RenderOutput) -> Result<(), DenoiseError> {
+    let cam_name = scene.file.scene.camera.as_deref().ok_or_else(|| DenoiseError::Input("the scene has no camera".into()))?;
+    let idx = scene.file.objects.iter().position(|o| o.name == cam_name).ok_or_else(|| DenoiseError::Input(format!("camera object {cam_name:?} not found")))?;
+    let mats = crate::anim::evaluate_transforms(scene, frame).map_err(|e| DenoiseError::Input(format!("camera at frame {frame}: {e}")))?;
+    let cam = mats[idx];
+    let p = &out.passes;
+    let normal: Vec<[f32; 3]> = p
+        .denoise_normal
+        .iter()
+        .zip(&p.instance_id)
+        .map(|(n, &id)| if id == 0 { [0.0; 3] } else { cycles_denoise_normal(*n, &cam) })
+        .collect();
+    denoiser.denoise_with(out.width, out.height, &mut out.color, &p.albedo, &normal, &DenoiseOptions::from_scene(scene))
+}
+
+/// Whether the scene asks for denoising of the final render (`cycles.use_denoising`).
+pub fn scene_wants_denoising(scene: &crate::scene::Scene) -> bool {
+    scene.file.scene.cycles.get("use_denoising").and_then(|v| v.as_bool()).unwrap_or(false)
+}
