@@ -17,7 +17,7 @@ const MAX_MEAN_REL: f64 = 0.01;
 
 /// Scenes that must pass.
 const ASSERTED: &[&str] = &[
-    "area_disk", "area_square", "diffuse_point", "diffuse_sun", "dof", "emission_mesh", "glossy", "metallic", "mix_shader", "ortho_flat", "principled", "shift_clip", "spot", "world_light",
+    "adaptive", "area_disk", "area_square", "diffuse_point", "diffuse_sun", "dof", "emission_mesh", "glossy", "metallic", "mix_shader", "ortho_flat", "principled", "shift_clip", "spot", "world_light",
 ];
 
 /// Scenes that do not pass yet, with the reason.
@@ -59,6 +59,8 @@ struct Row {
     ours: [f64; 3],
     cycles: [f64; 3],
     seconds: f64,
+    /// Mean samples per pixel: ours, and Cycles' (seed A) when the fixture recorded it.
+    spp: (f64, Option<f64>),
 }
 
 fn evaluate(dir: &Path) -> Row {
@@ -77,7 +79,8 @@ fn evaluate(dir: &Path) -> Row {
     let ratio = rmse(&ours, &a) / rmse(&b, &a).max(1e-12);
     let (mo, ma) = (means(&ours), means(&a));
     let worst_mean = (0..3).map(|k| (mo[k] - ma[k]).abs() / ma[k].abs().max(1e-6)).fold(0.0, f64::max);
-    Row { name, ratio, worst_mean, ours: mo, cycles: ma, seconds: out.stats.wall_seconds }
+    let spp = (out.stats.samples_taken as f64 / (w * h) as f64, meta["mean_samples_a"].as_f64());
+    Row { name, ratio, worst_mean, ours: mo, cycles: ma, seconds: out.stats.wall_seconds, spp }
 }
 
 #[test]
@@ -88,6 +91,7 @@ fn parity_with_cycles() {
     assert!(dirs.len() >= 12, "expected at least 12 parity scenes, found {}", dirs.len());
     let mut failures = Vec::new();
     println!("{:<16} {:>7} {:>8}  {:<26} {:<26} {:>6}  status", "scene", "ratio", "mean err", "mean ours (RGB)", "mean Cycles A (RGB)", "secs");
+    println!("(spp: mean samples per pixel, ours / Cycles A, for adaptive scenes)");
     for d in &dirs {
         let r = evaluate(d);
         let pass = r.ratio <= MAX_RATIO && r.worst_mean <= MAX_MEAN_REL;
@@ -105,7 +109,8 @@ fn parity_with_cycles() {
             }
         };
         let f = |m: [f64; 3]| format!("{:.4} {:.4} {:.4}", m[0], m[1], m[2]);
-        println!("{:<16} {:>7.3} {:>7.2}%  {:<26} {:<26} {:>6.2}  {status}", r.name, r.ratio, 100.0 * r.worst_mean, f(r.ours), f(r.cycles), r.seconds);
+        let spp = r.spp.1.map(|c| format!("  spp {:.1} / {c:.1}", r.spp.0)).unwrap_or_default();
+        println!("{:<16} {:>7.3} {:>7.2}%  {:<26} {:<26} {:>6.2}  {status}{spp}", r.name, r.ratio, 100.0 * r.worst_mean, f(r.ours), f(r.cycles), r.seconds);
     }
     assert!(failures.is_empty(), "parity failures:\n{}", failures.join("\n"));
 }
@@ -217,4 +222,24 @@ fn geometry_nodes_instances_keep_their_own_ids() {
     for r in 0..3 {
         assert!((lo[r] - olo[r]).abs() < 1e-4 && (hi[r] - ohi[r]).abs() < 1e-4, "bounds {olo:?}..{ohi:?} vs Blender {lo:?}..{hi:?}");
     }
+}
+
+#[test]
+fn adaptive_sampling_is_deterministic_and_stops_early() {
+    // The adaptive fixture (threshold 0.05, automatic min samples 40): the check after
+    // 48 samples stops the plain background, whatever the thread count.
+    let dir = common::repo().join("fixtures/render/scenes/adaptive");
+    let scene = Scene::load(&dir).unwrap();
+    let opts = |t| RenderOptions { samples: Some(64), resolution: Some((40, 32)), seed: Some(3), threads: Some(t), ..Default::default() };
+    let a = render(&scene, &opts(1)).unwrap();
+    let b = render(&scene, &opts(2)).unwrap();
+    let bits = |o: &blendsynth::render::RenderOutput| o.color.iter().flat_map(|p| p.map(f32::to_bits)).collect::<Vec<_>>();
+    assert_eq!(bits(&a), bits(&b));
+    assert_eq!(a.passes.sample_count, b.passes.sample_count);
+    let n = a.passes.sample_count.len() as u64;
+    assert!(a.passes.sample_count.iter().all(|&c| c == 48 || c == 64), "samples are taken up to a check");
+    assert!(a.stats.samples_taken < 64 * n && a.stats.samples_taken > 48 * n, "{}", a.stats.samples_taken);
+    // A threshold of 0 from the command line turns it off.
+    let off = render(&scene, &RenderOptions { threshold: Some(0.0), ..opts(2) }).unwrap();
+    assert_eq!(off.stats.samples_taken, 64 * n);
 }

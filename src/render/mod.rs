@@ -11,6 +11,7 @@
 //! for any thread count.
 
 pub mod accel;
+pub mod adaptive;
 pub mod bsdf;
 pub mod build;
 pub mod camera;
@@ -58,6 +59,9 @@ pub struct RenderOptions {
 #[derive(Debug, Clone, Default)]
 pub struct RenderStats {
     pub samples: u32,
+    /// Camera samples actually traced over all pixels (fewer than pixels x samples when
+    /// adaptive sampling stops converged pixels early).
+    pub samples_taken: u64,
     pub wall_seconds: f64,
     pub rays: u64,
     pub triangles: usize,
@@ -83,6 +87,8 @@ pub struct Passes {
     pub albedo: Vec<[f32; 3]>,
     pub denoise_normal: Vec<[f32; 3]>,
     pub uv: Vec<[f32; 2]>,
+    /// Samples taken per pixel (Cycles' Debug Sample Count pass, unnormalised).
+    pub sample_count: Vec<u32>,
     pub instances: Vec<InstanceInfo>,
 }
 
@@ -165,13 +171,14 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     let mesh_lights = mesh_lights(&geo, &materials, &bvh, &lights, background, tables, settings);
     let tracer = integrator::Scene { mesh_lights: &mesh_lights, accel: &bvh, geo: &geo, materials: &materials, lights: &lights, background, tables, settings };
 
+    let adaptive = adaptive::Adaptive::from_scene(cy, samples, opts.threshold);
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);
     let n_tiles = (tiles_x * tiles_y) as usize;
     let bar = if opts.progress {
-        let b = indicatif::ProgressBar::new(n_tiles as u64);
+        let b = indicatif::ProgressBar::new(samples as u64);
         b.set_style(
-            indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} tiles  ETA {eta}  {msg}")
+            indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} samples  ETA {eta}  {msg}")
                 .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
         Some(b)
@@ -180,61 +187,107 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     };
     let render_start = Instant::now();
     let nmat = materials.len();
-    let run = || -> Vec<(Vec<[f32; 4]>, TilePasses, u64)> {
-        (0..n_tiles)
-            .into_par_iter()
-            .map_init(
+    let npix = (w * h) as usize;
+    // Per-pixel accumulators live in image order; tiles read and write disjoint pixels.
+    let mut film = adaptive::Film::new(npix);
+    let mut tiles: Vec<TileWork> = (0..n_tiles)
+        .map(|t| {
+            let tx = (t as u32 % tiles_x) * TILE;
+            let ty = (t as u32 / tiles_x) * TILE;
+            TileWork { tx, ty, tw: TILE.min(w - tx), th: TILE.min(h - ty), acc: Vec::new(), passes: TilePasses::default(), rays: 0 }
+        })
+        .collect();
+    let mut start_sample = 0u32;
+    let mut taken = 0u64;
+    let pool = match opts.threads {
+        Some(n) => Some(rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build().map_err(|e| RenderError(format!("thread pool: {e}")))?),
+        None => None,
+    };
+    while start_sample < samples {
+        // Sample ranges end where Cycles would run its convergence check, so the
+        // check sees the same sample counts whatever the thread count or timing.
+        let n = adaptive.align_samples(start_sample, samples - start_sample);
+        let end_sample = start_sample + n;
+        let first = start_sample == 0;
+        for t in tiles.iter_mut() {
+            t.acc.clear();
+            for y in t.ty..t.ty + t.th {
+                for x in t.tx..t.tx + t.tw {
+                    t.acc.push(film.pixel((y * w + x) as usize));
+                }
+            }
+        }
+        let run = |tiles: &mut Vec<TileWork>| {
+            tiles.par_iter_mut().for_each_init(
                 || Scratch::new(nmat),
-                |scratch, t| {
-                    let tx = (t as u32 % tiles_x) * TILE;
-                    let ty = (t as u32 / tiles_x) * TILE;
-                    let tw = TILE.min(w - tx);
-                    let th = TILE.min(h - ty);
+                |scratch, tile| {
                     let rays0 = scratch.rays;
-                    let mut color = Vec::with_capacity((tw * th) as usize);
-                    let mut passes = TilePasses::default();
-                    for y in ty..ty + th {
-                        for x in tx..tx + tw {
+                    let mut k = 0;
+                    for y in tile.ty..tile.ty + tile.th {
+                        for x in tile.tx..tile.tx + tile.tw {
+                            let px = &mut tile.acc[k];
+                            k += 1;
+                            if first {
+                                primary_passes(&tracer, &camera, x, y, scratch, &mut tile.passes);
+                            }
+                            if px.converged {
+                                continue;
+                            }
                             let rng = PixelSampler::new(x, y, seed);
-                            let mut sum = [0.0f64; 3];
-                            for i in 0..samples {
+                            // Like Cycles with a sample count pass, a pixel's sample
+                            // index is its own count, so a pixel resumed by dilation
+                            // continues its sequence.
+                            for _ in start_sample..end_sample {
+                                let i = px.count;
                                 let u = rng.get4(i, 0);
                                 let fx = x as f32 + 0.5 + filter.sample(u[0]);
                                 let fy = y as f32 + 0.5 + filter.sample(u[1]);
                                 let (o, d, t0, t1) = camera.ray(fx, fy, [u[2], u[3]]);
                                 let c = tracer.radiance(o, d, t0, t1, &rng, i, scratch);
-                                // A NaN or infinite sample is dropped, never averaged in.
-                                if c.iter().all(|v| v.is_finite()) {
-                                    for k in 0..3 {
-                                        sum[k] += c[k] as f64;
-                                    }
-                                }
+                                px.add(i, c);
                             }
-                            let inv = exposure as f64 / samples as f64;
-                            color.push([(sum[0] * inv) as f32, (sum[1] * inv) as f32, (sum[2] * inv) as f32, 1.0]);
-                            primary_passes(&tracer, &camera, x, y, scratch, &mut passes);
                         }
                     }
-                    if let Some(b) = &bar {
-                        b.inc(1);
-                        let secs = render_start.elapsed().as_secs_f64().max(1e-6);
-                        let done = b.position() as f64 * (TILE * TILE) as f64 * samples as f64;
-                        b.set_message(format!("{:.2} M samples/s", done / secs / 1e6));
-                    }
-                    (color, passes, scratch.rays - rays0)
+                    tile.rays += scratch.rays - rays0;
                 },
             )
-            .collect()
-    };
-    let results = match opts.threads {
-        Some(n) => rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build().map_err(|e| RenderError(format!("thread pool: {e}")))?.install(run),
-        None => run(),
-    };
+        };
+        match &pool {
+            Some(p) => p.install(|| run(&mut tiles)),
+            None => run(&mut tiles),
+        }
+        for t in &tiles {
+            let mut k = 0;
+            for y in t.ty..t.ty + t.th {
+                for x in t.tx..t.tx + t.tw {
+                    let i = (y * w + x) as usize;
+                    taken += (t.acc[k].count - film.pixel(i).count) as u64;
+                    film.set(i, t.acc[k]);
+                    k += 1;
+                }
+            }
+        }
+        start_sample = end_sample;
+        if let Some(b) = &bar {
+            b.set_position(end_sample as u64);
+            let secs = render_start.elapsed().as_secs_f64().max(1e-6);
+            b.set_message(format!("{:.2} M samples/s", taken as f64 / secs / 1e6));
+        }
+        if adaptive.need_filter(end_sample - 1) && film.converge_and_dilate(&adaptive, exposure, w as usize, h as usize) == 0 {
+            break;
+        }
+    }
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let npix = (w * h) as usize;
     let mut color = vec![[0.0f32; 4]; npix];
+    let mut sample_count = vec![0u32; npix];
+    for i in 0..npix {
+        let p = film.pixel(i);
+        let inv = exposure as f64 / p.count.max(1) as f64;
+        color[i] = [(p.sum[0] * inv) as f32, (p.sum[1] * inv) as f32, (p.sum[2] * inv) as f32, 1.0];
+        sample_count[i] = p.count;
+    }
     let mut passes = Passes {
         depth: vec![f32::INFINITY; npix],
         object_index: vec![0; npix],
@@ -244,6 +297,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         albedo: vec![[0.0; 3]; npix],
         denoise_normal: vec![[0.0; 3]; npix],
         uv: vec![[0.0; 2]; npix],
+        sample_count,
         instances: geo
             .instances
             .iter()
@@ -251,16 +305,13 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
             .collect(),
     };
     let mut rays = 0;
-    for (t, (c, p, r)) in results.into_iter().enumerate() {
-        rays += r;
-        let tx = (t as u32 % tiles_x) * TILE;
-        let ty = (t as u32 / tiles_x) * TILE;
-        let tw = TILE.min(w - tx);
+    for t in &tiles {
+        rays += t.rays;
+        let p = &t.passes;
         let mut k = 0;
-        for y in ty..(ty + TILE).min(h) {
-            for x in tx..tx + tw {
+        for y in t.ty..t.ty + t.th {
+            for x in t.tx..t.tx + t.tw {
                 let i = (y * w + x) as usize;
-                color[i] = c[k];
                 passes.depth[i] = p.depth[k];
                 passes.object_index[i] = p.object_index[k];
                 passes.instance_id[i] = p.instance_id[k];
@@ -278,7 +329,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         height: h,
         color,
         passes,
-        stats: RenderStats { samples, wall_seconds: start.elapsed().as_secs_f64(), rays, triangles: geo.tris.len(), build_seconds },
+        stats: RenderStats { samples, samples_taken: taken, wall_seconds: start.elapsed().as_secs_f64(), rays, triangles: geo.tris.len(), build_seconds },
     })
 }
 
@@ -337,6 +388,18 @@ fn mesh_lights(
         pdf_area[p as usize] = (weights[k] as f64 / total) as f32 / areas[k];
     }
     integrator::MeshLights { prims, cdf, pdf_area }
+}
+
+/// One tile's share of the work: its rectangle, a copy of its pixels' accumulators
+/// for the current sample range, and its label passes.
+struct TileWork {
+    tx: u32,
+    ty: u32,
+    tw: u32,
+    th: u32,
+    acc: Vec<adaptive::PixelAcc>,
+    passes: TilePasses,
+    rays: u64,
 }
 
 #[derive(Default)]
