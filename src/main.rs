@@ -242,7 +242,8 @@ struct RenderArgs {
     /// Samples per pixel (default: the scene's Cycles samples).
     #[arg(long)]
     samples: Option<u32>,
-    /// Adaptive sampling noise threshold (accepted; adaptive sampling is not implemented yet).
+    /// Adaptive sampling noise threshold: T > 0 turns Cycles' adaptive sampling on with T,
+    /// 0 turns it off (default: the scene's setting).
     #[arg(long)]
     threshold: Option<f32>,
     /// Image size WxH (default: the scene's resolution times its percentage).
