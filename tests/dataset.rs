@@ -323,9 +323,6 @@ fn replicate_and_preview_through_the_cli() {
     // Laparoscopy: livers carry masks (RLE), and boxes come with them.
     let lap: serde_json::Value = serde_json::from_slice(&std::fs::read(out.join("laparoscopy/annotations/instances_train.json")).unwrap()).unwrap();
     assert!(lap["annotations"].as_array().unwrap().iter().any(|a| a["segmentation"]["counts"].is_string()));
-    // The path tracer is not in this build: a clear error, not a panic.
-    let o = common::run(&["replicate", "--dataset", "doi-23843904", "--frames", "1", "-o", out.join("pt").to_str().unwrap()], &[]);
-    common::assert_clean_error(&o, 1, &["path tracer"]);
     let o = common::run(&["replicate", "--dataset", "doi-0", "-o", out.join("x").to_str().unwrap()], &[]);
     common::assert_clean_error(&o, 1, &["doi-0"]);
     std::fs::remove_dir_all(&out).unwrap();
@@ -470,4 +467,23 @@ fn coco_files_load_in_pycocotools() {
         assert_eq!(common::stdout(&o).lines().filter(|l| l.contains("images")).count(), 2, "{}", common::stdout(&o));
     }
     std::fs::remove_dir_all(&out).unwrap();
+}
+
+/// The production renderer behind `generate`/`replicate`: the path tracer renders a
+/// built-in frame (small and few samples, to stay quick) whose instance pass sees the
+/// colon wall and at least one polyp, and whose image is display-referred and not flat.
+#[test]
+fn path_tracer_renders_a_labelled_builtin_frame() {
+    use blendsynth::dataset::{renderer::path_tracer, replicate, spec::RenderSettings};
+    let (scene, _spec) = replicate::scene_and_spec(replicate::Part::Colonoscopy, None).unwrap();
+    let r = path_tracer(&scene).unwrap();
+    let settings = RenderSettings { resolution: Some((64, 64)), samples: Some(8), threshold: Some(0.0), denoise: Some(false) };
+    let f = r.render(&scene, scene.file.scene.frame_current as f64, 0, &settings, 2).unwrap();
+    assert_eq!((f.width, f.height, f.color.len()), (64, 64, 64 * 64));
+    assert!(f.color.iter().all(|p| p.iter().all(|c| c.is_finite() && (0.0..=1.0).contains(c))));
+    let mean = f.color.iter().map(|p| p[0] as f64).sum::<f64>() / f.color.len() as f64;
+    let var = f.color.iter().map(|p| (p[0] as f64 - mean).powi(2)).sum::<f64>() / f.color.len() as f64;
+    assert!(mean > 0.02 && var > 1e-5, "image is flat: mean {mean}, variance {var}");
+    let seen: std::collections::BTreeSet<&str> = f.ids.instance_id.iter().filter(|&&i| i > 0).map(|&i| f.ids.instances[i as usize - 1].object.as_str()).collect();
+    assert!(seen.iter().any(|o| o.starts_with("Colon")), "no colon wall in the instance pass: {seen:?}");
 }
