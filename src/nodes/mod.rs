@@ -38,6 +38,7 @@ macro_rules! blender_enum {
 pub mod blackbody;
 pub mod clamp;
 pub mod color;
+pub mod curves;
 pub mod graph;
 pub mod map_range;
 pub mod math;
@@ -94,6 +95,10 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeMixRGB",
     // ramp.rs
     "ShaderNodeValToRGB",
+    // curves.rs
+    "ShaderNodeRGBCurve",
+    "ShaderNodeVectorCurve",
+    "ShaderNodeFloatCurve",
     // color.rs
     "ShaderNodeInvert",
     "ShaderNodeGamma",

@@ -6,6 +6,7 @@ use crate::nodes::color::{bright_contrast, gamma, hue_saturation, invert, rgb_to
 use crate::nodes::map_range::{map_range_float, map_range_vector, MapRangeInterpolation};
 use crate::nodes::math::{math_node, vector_math, MathOp, Vec3, VectorMathOp};
 use crate::nodes::mix::{mix_color, mix_float, mix_rgb, mix_vector, mix_vector_non_uniform, MixBlend};
+use crate::nodes::curves::CurveTable;
 use crate::nodes::ramp::RampTable;
 use crate::nodes::sepcomb::{combine_color, separate_color, ColorMode};
 use crate::nodes::{blackbody, wavelength};
@@ -60,6 +61,10 @@ pub enum Op {
     MixColor { blend: MixBlend, clamp_factor: bool, clamp_result: bool, factor: Slot, a: Slot, b: Slot, dst: Slot },
     MixRgb { blend: MixBlend, clamp: bool, factor: Slot, a: Slot, b: Slot, dst: Slot },
     Ramp { table: u32, fac: Slot, color: Slot, alpha: Slot },
+    /// RGB Curves / Vector Curves: `curves[table]` per channel.
+    Curves3 { table: u32, fac: Slot, v: Slot, dst: Slot },
+    /// Float Curve.
+    Curve1 { table: u32, fac: Slot, v: Slot, dst: Slot },
     Invert { fac: Slot, color: Slot, dst: Slot },
     Gamma { color: Slot, gamma: Slot, dst: Slot },
     BrightContrast { color: Slot, bright: Slot, contrast: Slot, dst: Slot },
@@ -101,6 +106,8 @@ pub struct Program {
     /// The stack as it starts: constants in place, the rest zero.
     pub initial: Vec<f32>,
     pub ramps: Vec<RampTable>,
+    /// Lookup tables of RGB/Vector/Float Curve nodes.
+    pub curves: Vec<CurveTable>,
     pub closures: Vec<Closure>,
     /// The closure plugged into the Material Output's Surface.
     pub surface: Option<u32>,
@@ -209,6 +216,13 @@ impl Program {
                     let (c, a) = self.ramps[table as usize].color_ramp(s[fac as usize]);
                     put3(s, color, c);
                     s[alpha as usize] = a;
+                }
+                Op::Curves3 { table, fac, v, dst } => {
+                    let r = self.curves[table as usize].eval3(s[fac as usize], v3(s, v));
+                    put3(s, dst, r)
+                }
+                Op::Curve1 { table, fac, v, dst } => {
+                    s[dst as usize] = self.curves[table as usize].eval1(s[fac as usize], s[v as usize]);
                 }
                 Op::Invert { fac, color, dst } => {
                     let r = invert(s[fac as usize], v3(s, color));
