@@ -18,6 +18,7 @@ use std::path::{Path, PathBuf};
 
 use blendsynth::nodes::blackbody::blackbody;
 use blendsynth::nodes::curves::{mapping_from_json, CurveKind, CurveTable};
+use blendsynth::nodes::vector_rotate::{vector_rotate, VectorRotateType};
 use blendsynth::nodes::clamp::{clamp_node, ClampType};
 use blendsynth::nodes::color::{
     bright_contrast, gamma, hue_saturation, invert, rgb_to_bw, LINEAR_REC709,
@@ -337,6 +338,13 @@ fn evaluator<'a>(c: &'a Case<'a>) -> Eval<'a> {
                 CurveKind::Vector => Box::new(move |t| vec![("Vector", table.eval3(t.f("Fac"), t.v3("Vector")))]),
                 CurveKind::Float => Box::new(move |t| vec![("Value", f1(table.eval1(t.f("Factor"), t.f("Value"))))]),
             }
+        }
+        "ShaderNodeVectorRotate" => {
+            let kind = parse(c, "rotation_type", c.prop("rotation_type"), VectorRotateType::from_blender);
+            let invert = c.flag("invert");
+            Box::new(move |t| {
+                vec![("Vector", vector_rotate(kind, invert, t.v3("Vector"), t.v3("Center"), t.v3("Axis"), t.f("Angle"), t.v3("Rotation")))]
+            })
         }
         "ShaderNodeInvert" => Box::new(|t| vec![("Color", invert(t.f("Fac"), t.v3("Color")))]),
         "ShaderNodeGamma" => Box::new(|t| vec![("Color", gamma(t.v3("Color"), t.f("Gamma")))]),
@@ -828,6 +836,7 @@ fn assert_modes_covered(cases: &[Value]) {
             }
             "ShaderNodeTexGradient" => s("gradient_type"),
             "ShaderNodeMapping" => s("vector_type"),
+            "ShaderNodeVectorRotate" => format!("{} {}", s("rotation_type"), b("invert")),
             "ShaderNodeTexMagic" => p["turbulence_depth"].to_string(),
             "ShaderNodeTexWhiteNoise" => s("noise_dimensions"),
             "ShaderNodeRGBCurve" | "ShaderNodeVectorCurve" | "ShaderNodeFloatCurve" => {
@@ -936,6 +945,11 @@ fn assert_modes_covered(cases: &[Value]) {
     want.push("ShaderNodeTexChecker ".to_string());
     for m in MappingType::ALL {
         want.push(format!("ShaderNodeMapping {}", m.blender_name()));
+    }
+    for r in VectorRotateType::ALL {
+        for inv in bools {
+            want.push(format!("ShaderNodeVectorRotate {} {inv}", r.blender_name()));
+        }
     }
     // Curves: both extend modes, each with a layout mixing every handle type.
     for node in ["ShaderNodeRGBCurve", "ShaderNodeVectorCurve", "ShaderNodeFloatCurve"] {

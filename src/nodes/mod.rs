@@ -53,6 +53,7 @@ pub mod checker;
 pub mod gradient;
 pub mod magic;
 pub mod mapping;
+pub mod vector_rotate;
 pub mod voronoi;
 pub mod wave;
 pub mod white_noise;
@@ -135,6 +136,8 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeTexChecker",
     // mapping.rs
     "ShaderNodeMapping",
+    // vector_rotate.rs
+    "ShaderNodeVectorRotate",
 ];
 
 /// Support for a node inside a tree of type `tree` (`ShaderNodeTree`,

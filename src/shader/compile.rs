@@ -10,6 +10,7 @@ use crate::nodes::graph::{active_output, flatten, FlatGraph, FlatNode, Source};
 use crate::nodes::map_range::MapRangeInterpolation;
 use crate::nodes::math::{MathOp, VectorMathOp};
 use crate::nodes::mix::MixBlend;
+use crate::nodes::vector_rotate::VectorRotateType;
 use crate::nodes::curves::{mapping_from_json, CurveKind, CurveTable};
 use crate::nodes::ramp::{ColorBand, HueInterpolation, RampColorMode, RampInterpolation, RampStop, RampTable};
 use crate::nodes::sepcomb::ColorMode;
@@ -405,6 +406,19 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     let d = self.alloc(C);
                     self.ops.push(Op::Wavelength { wavelength, dst: d });
                     self.outputs(i, n, &[("Color", d, C)]);
+                }
+                "ShaderNodeVectorRotate" => {
+                    let kind = mode(n, "rotation_type", VectorRotateType::from_blender)?;
+                    let invert = prop_bool(n, "invert")?;
+                    let vector = self.input(n, "Vector", V)?;
+                    let center = self.input(n, "Center", V)?;
+                    // Inputs the rotation type hides are unused.
+                    let axis = self.opt_input(n, "Axis", V)?;
+                    let angle = self.opt_input(n, "Angle", F)?;
+                    let rotation = self.opt_input(n, "Rotation", V)?;
+                    let d = self.alloc(V);
+                    self.ops.push(Op::VectorRotate { kind, invert, vector, center, axis, angle, rotation, dst: d });
+                    self.outputs(i, n, &[("Vector", d, V)]);
                 }
                 "ShaderNodeMapping" => {
                     let kind = mode(n, "vector_type", MappingType::from_blender)?;

@@ -7,6 +7,7 @@ use crate::nodes::map_range::{map_range_float, map_range_vector, MapRangeInterpo
 use crate::nodes::math::{math_node, vector_math, MathOp, Vec3, VectorMathOp};
 use crate::nodes::mix::{mix_color, mix_float, mix_rgb, mix_vector, mix_vector_non_uniform, MixBlend};
 use crate::nodes::curves::CurveTable;
+use crate::nodes::vector_rotate::{vector_rotate, VectorRotateType};
 use crate::nodes::ramp::RampTable;
 use crate::nodes::sepcomb::{combine_color, separate_color, ColorMode};
 use crate::nodes::{blackbody, wavelength};
@@ -86,6 +87,7 @@ pub enum Op {
     TexMagic { depth: i32, vector: Slot, scale: Slot, distortion: Slot, fac: Slot, color: Slot },
     TexWhiteNoise { dims: u8, vector: Slot, w: Slot, value: Slot, color: Slot },
     TexChecker { vector: Slot, color1: Slot, color2: Slot, scale: Slot, fac: Slot, color: Slot },
+    VectorRotate { kind: VectorRotateType, invert: bool, vector: Slot, center: Slot, axis: Slot, angle: Slot, rotation: Slot, dst: Slot },
     Mapping { kind: MappingType, vector: Slot, location: Slot, rotation: Slot, scale: Slot, dst: Slot },
 }
 
@@ -307,6 +309,10 @@ impl Program {
                     let (v, c) = white_noise(dims, v3(s, vector), s[w as usize]);
                     s[value as usize] = v;
                     put3(s, color, c);
+                }
+                Op::VectorRotate { kind, invert, vector, center, axis, angle, rotation, dst } => {
+                    let r = vector_rotate(kind, invert, v3(s, vector), v3(s, center), v3(s, axis), s[angle as usize], v3(s, rotation));
+                    put3(s, dst, r);
                 }
                 Op::Mapping { kind, vector, location, rotation, scale, dst } => {
                     let r = mapping(kind, v3(s, vector), v3(s, location), v3(s, rotation), v3(s, scale));
