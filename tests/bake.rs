@@ -61,6 +61,12 @@ fn texture_material_matches_cycles() {
     assert!(compare("textures") <= TEXTURE_TOL);
 }
 
+/// Vector Rotate, Vector/RGB/Float Curves as exported and compiled.
+#[test]
+fn curves_material_matches_cycles() {
+    assert!(compare("curves") <= TOL);
+}
+
 #[test]
 fn cli_writes_the_same_values_as_an_exr() {
     let dir = repo().join("fixtures/bake/scenes/closures");
@@ -98,7 +104,7 @@ fn fresh_cycles_bakes_match() {
     let Some(py) = require("a Python with bpy 4.5.4", bpy_python()) else { return };
     let t = tempfile::tempdir().unwrap();
     run_python(&py, &repo().join("fixtures/bake/make_bake_refs.py"), &["--out", t.path().to_str().unwrap()]);
-    for case in ["uv_math", "structure", "closures"] {
+    for case in ["uv_math", "structure", "closures", "curves"] {
         assert!(compare_in(t.path(), case) <= TOL, "{case}");
     }
     assert!(compare_in(t.path(), "textures") <= TEXTURE_TOL, "textures");

@@ -17,6 +17,8 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use blendsynth::nodes::blackbody::blackbody;
+use blendsynth::nodes::curves::{mapping_from_json, CurveKind, CurveTable};
+use blendsynth::nodes::vector_rotate::{vector_rotate, VectorRotateType};
 use blendsynth::nodes::clamp::{clamp_node, ClampType};
 use blendsynth::nodes::color::{
     bright_contrast, gamma, hue_saturation, invert, rgb_to_bw, LINEAR_REC709,
@@ -321,6 +323,27 @@ fn evaluator<'a>(c: &'a Case<'a>) -> Eval<'a> {
             Box::new(move |t| {
                 let (rgb, alpha) = table.color_ramp(t.f("Fac"));
                 vec![("Color", rgb), ("Alpha", f1(alpha))]
+            })
+        }
+        "ShaderNodeRGBCurve" | "ShaderNodeVectorCurve" | "ShaderNodeFloatCurve" => {
+            let m = mapping_from_json(&c.case["mapping"]).unwrap_or_else(|e| panic!("{}: {}", c.name, e.0));
+            let kind = match c.node {
+                "ShaderNodeRGBCurve" => CurveKind::Rgb,
+                "ShaderNodeVectorCurve" => CurveKind::Vector,
+                _ => CurveKind::Float,
+            };
+            let table = CurveTable::new(&m, kind).unwrap_or_else(|e| panic!("{}: {}", c.name, e.0));
+            match kind {
+                CurveKind::Rgb => Box::new(move |t| vec![("Color", table.eval3(t.f("Fac"), t.v3("Color")))]),
+                CurveKind::Vector => Box::new(move |t| vec![("Vector", table.eval3(t.f("Fac"), t.v3("Vector")))]),
+                CurveKind::Float => Box::new(move |t| vec![("Value", f1(table.eval1(t.f("Factor"), t.f("Value"))))]),
+            }
+        }
+        "ShaderNodeVectorRotate" => {
+            let kind = parse(c, "rotation_type", c.prop("rotation_type"), VectorRotateType::from_blender);
+            let invert = c.flag("invert");
+            Box::new(move |t| {
+                vec![("Vector", vector_rotate(kind, invert, t.v3("Vector"), t.v3("Center"), t.v3("Axis"), t.f("Angle"), t.v3("Rotation")))]
             })
         }
         "ShaderNodeInvert" => Box::new(|t| vec![("Color", invert(t.f("Fac"), t.v3("Color")))]),
@@ -813,8 +836,18 @@ fn assert_modes_covered(cases: &[Value]) {
             }
             "ShaderNodeTexGradient" => s("gradient_type"),
             "ShaderNodeMapping" => s("vector_type"),
+            "ShaderNodeVectorRotate" => format!("{} {}", s("rotation_type"), b("invert")),
             "ShaderNodeTexMagic" => p["turbulence_depth"].to_string(),
             "ShaderNodeTexWhiteNoise" => s("noise_dimensions"),
+            "ShaderNodeRGBCurve" | "ShaderNodeVectorCurve" | "ShaderNodeFloatCurve" => {
+                let m = &c["mapping"];
+                let mut handles: Vec<&str> = m["curves"].as_array().unwrap().iter()
+                    .flat_map(|cu| cu["points"].as_array().unwrap().iter().map(|p| p["handle_type"].as_str().unwrap()))
+                    .collect();
+                handles.sort();
+                handles.dedup();
+                format!("{} {}", m["extend"].as_str().unwrap(), handles.join(","))
+            }
             _ => String::new(),
         };
         seen.insert(format!("{node} {key}"));
@@ -912,6 +945,17 @@ fn assert_modes_covered(cases: &[Value]) {
     want.push("ShaderNodeTexChecker ".to_string());
     for m in MappingType::ALL {
         want.push(format!("ShaderNodeMapping {}", m.blender_name()));
+    }
+    for r in VectorRotateType::ALL {
+        for inv in bools {
+            want.push(format!("ShaderNodeVectorRotate {} {inv}", r.blender_name()));
+        }
+    }
+    // Curves: both extend modes, each with a layout mixing every handle type.
+    for node in ["ShaderNodeRGBCurve", "ShaderNodeVectorCurve", "ShaderNodeFloatCurve"] {
+        for ext in ["EXTRAPOLATED", "HORIZONTAL"] {
+            want.push(format!("{node} {ext} AUTO,AUTO_CLAMPED,VECTOR"));
+        }
     }
     let missing: Vec<&String> = want.iter().filter(|w| !seen.contains(*w)).collect();
     assert!(

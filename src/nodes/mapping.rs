@@ -13,7 +13,7 @@ blender_enum! {
 }
 
 /// Rows of Cycles' `euler_to_transform` (rotation part).
-fn euler_rows(e: Vec3) -> [Vec3; 3] {
+pub(crate) fn euler_rows(e: Vec3) -> [Vec3; 3] {
     let (cx, cy, cz) = (e[0].cos(), e[1].cos(), e[2].cos());
     let (sx, sy, sz) = (e[0].sin(), e[1].sin(), e[2].sin());
     [
@@ -27,11 +27,11 @@ fn dot(a: Vec3, b: Vec3) -> f32 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
-fn rotate(r: &[Vec3; 3], a: Vec3) -> Vec3 {
+pub(crate) fn rotate(r: &[Vec3; 3], a: Vec3) -> Vec3 {
     [dot(a, r[0]), dot(a, r[1]), dot(a, r[2])]
 }
 
-fn rotate_transposed(r: &[Vec3; 3], a: Vec3) -> Vec3 {
+pub(crate) fn rotate_transposed(r: &[Vec3; 3], a: Vec3) -> Vec3 {
     let col = |i: usize| [r[0][i], r[1][i], r[2][i]];
     [dot(a, col(0)), dot(a, col(1)), dot(a, col(2))]
 }

@@ -38,6 +38,7 @@ macro_rules! blender_enum {
 pub mod blackbody;
 pub mod clamp;
 pub mod color;
+pub mod curves;
 pub mod graph;
 pub mod map_range;
 pub mod math;
@@ -52,6 +53,7 @@ pub mod checker;
 pub mod gradient;
 pub mod magic;
 pub mod mapping;
+pub mod vector_rotate;
 pub mod voronoi;
 pub mod wave;
 pub mod white_noise;
@@ -94,6 +96,10 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeMixRGB",
     // ramp.rs
     "ShaderNodeValToRGB",
+    // curves.rs
+    "ShaderNodeRGBCurve",
+    "ShaderNodeVectorCurve",
+    "ShaderNodeFloatCurve",
     // color.rs
     "ShaderNodeInvert",
     "ShaderNodeGamma",
@@ -130,6 +136,8 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeTexChecker",
     // mapping.rs
     "ShaderNodeMapping",
+    // vector_rotate.rs
+    "ShaderNodeVectorRotate",
 ];
 
 /// Support for a node inside a tree of type `tree` (`ShaderNodeTree`,

@@ -10,6 +10,8 @@ use crate::nodes::graph::{active_output, flatten, FlatGraph, FlatNode, Source};
 use crate::nodes::map_range::MapRangeInterpolation;
 use crate::nodes::math::{MathOp, VectorMathOp};
 use crate::nodes::mix::MixBlend;
+use crate::nodes::vector_rotate::VectorRotateType;
+use crate::nodes::curves::{mapping_from_json, CurveKind, CurveTable};
 use crate::nodes::ramp::{ColorBand, HueInterpolation, RampColorMode, RampInterpolation, RampStop, RampTable};
 use crate::nodes::sepcomb::ColorMode;
 use crate::nodes::gradient::GradientType;
@@ -46,6 +48,7 @@ struct Compiler<'g, 'a> {
     initial: Vec<f32>,
     ops: Vec<Op>,
     ramps: Vec<RampTable>,
+    curves: Vec<CurveTable>,
     closures: Vec<Closure>,
     /// Per flat node, per output index: where its value lives.
     values: Vec<Vec<Option<(Slot, Kind)>>>,
@@ -129,6 +132,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
             initial: Vec::new(),
             ops: Vec::new(),
             ramps: Vec::new(),
+            curves: Vec::new(),
             closures: Vec::new(),
             values: vec![Vec::new(); g.nodes.len()],
             closure_of: vec![None; g.nodes.len()],
@@ -308,6 +312,21 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     self.ops.push(Op::Ramp { table, fac, color, alpha });
                     self.outputs(i, n, &[("Color", color, C), ("Alpha", alpha, F)]);
                 }
+                "ShaderNodeRGBCurve" | "ShaderNodeVectorCurve" => {
+                    let (kind, sock, k) = if n.node.bl_idname == "ShaderNodeRGBCurve" { (CurveKind::Rgb, "Color", C) } else { (CurveKind::Vector, "Vector", V) };
+                    let table = self.curve_table(n, kind)?;
+                    let (fac, v) = (self.input(n, "Fac", F)?, self.input(n, sock, k)?);
+                    let d = self.alloc(k);
+                    self.ops.push(Op::Curves3 { table, fac, v, dst: d });
+                    self.outputs(i, n, &[(sock, d, k)]);
+                }
+                "ShaderNodeFloatCurve" => {
+                    let table = self.curve_table(n, CurveKind::Float)?;
+                    let (fac, v) = (self.input(n, "Factor", F)?, self.input(n, "Value", F)?);
+                    let d = self.alloc(F);
+                    self.ops.push(Op::Curve1 { table, fac, v, dst: d });
+                    self.outputs(i, n, &[("Value", d, F)]);
+                }
                 "ShaderNodeInvert" => {
                     let (fac, color) = (self.input(n, "Fac", F)?, self.input(n, "Color", C)?);
                     let d = self.alloc(C);
@@ -387,6 +406,19 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     let d = self.alloc(C);
                     self.ops.push(Op::Wavelength { wavelength, dst: d });
                     self.outputs(i, n, &[("Color", d, C)]);
+                }
+                "ShaderNodeVectorRotate" => {
+                    let kind = mode(n, "rotation_type", VectorRotateType::from_blender)?;
+                    let invert = prop_bool(n, "invert")?;
+                    let vector = self.input(n, "Vector", V)?;
+                    let center = self.input(n, "Center", V)?;
+                    // Inputs the rotation type hides are unused.
+                    let axis = self.opt_input(n, "Axis", V)?;
+                    let angle = self.opt_input(n, "Angle", F)?;
+                    let rotation = self.opt_input(n, "Rotation", V)?;
+                    let d = self.alloc(V);
+                    self.ops.push(Op::VectorRotate { kind, invert, vector, center, axis, angle, rotation, dst: d });
+                    self.outputs(i, n, &[("Vector", d, V)]);
                 }
                 "ShaderNodeMapping" => {
                     let kind = mode(n, "vector_type", MappingType::from_blender)?;
@@ -504,7 +536,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 other => return Err(CompileError(format!("node {:?}: {other} is not supported yet", n.path))),
             }
         }
-        Ok(Program { ops: self.ops, initial: self.initial, ramps: self.ramps, closures: self.closures, surface: self.surface, bsdfs: self.bsdfs })
+        Ok(Program { ops: self.ops, initial: self.initial, ramps: self.ramps, curves: self.curves, closures: self.closures, surface: self.surface, bsdfs: self.bsdfs })
     }
 
     /// Records a BSDF node's value inputs and enum properties for the renderer.
@@ -616,6 +648,14 @@ impl<'g, 'a> Compiler<'g, 'a> {
             other => return Err(CompileError(format!("node {:?}: Mix data type {other:?} is not supported", n.path))),
         }
         Ok(())
+    }
+
+    /// The node's curve mapping, baked into the lookup table Cycles builds from it.
+    fn curve_table(&mut self, n: &FlatNode, kind: CurveKind) -> Result<u32, CompileError> {
+        let m = mapping_from_json(prop(n, "mapping")?).map_err(|e| CompileError(format!("node {:?}: {}", n.path, e.0)))?;
+        let t = CurveTable::new(&m, kind).map_err(|e| CompileError(format!("node {:?}: {}", n.path, e.0)))?;
+        self.curves.push(t);
+        Ok(self.curves.len() as u32 - 1)
     }
 
     /// The node's colour band, sampled into a lookup table as Blender hands it to Cycles.

@@ -6,6 +6,8 @@ use crate::nodes::color::{bright_contrast, gamma, hue_saturation, invert, rgb_to
 use crate::nodes::map_range::{map_range_float, map_range_vector, MapRangeInterpolation};
 use crate::nodes::math::{math_node, vector_math, MathOp, Vec3, VectorMathOp};
 use crate::nodes::mix::{mix_color, mix_float, mix_rgb, mix_vector, mix_vector_non_uniform, MixBlend};
+use crate::nodes::curves::CurveTable;
+use crate::nodes::vector_rotate::{vector_rotate, VectorRotateType};
 use crate::nodes::ramp::RampTable;
 use crate::nodes::sepcomb::{combine_color, separate_color, ColorMode};
 use crate::nodes::{blackbody, wavelength};
@@ -60,6 +62,10 @@ pub enum Op {
     MixColor { blend: MixBlend, clamp_factor: bool, clamp_result: bool, factor: Slot, a: Slot, b: Slot, dst: Slot },
     MixRgb { blend: MixBlend, clamp: bool, factor: Slot, a: Slot, b: Slot, dst: Slot },
     Ramp { table: u32, fac: Slot, color: Slot, alpha: Slot },
+    /// RGB Curves / Vector Curves: `curves[table]` per channel.
+    Curves3 { table: u32, fac: Slot, v: Slot, dst: Slot },
+    /// Float Curve.
+    Curve1 { table: u32, fac: Slot, v: Slot, dst: Slot },
     Invert { fac: Slot, color: Slot, dst: Slot },
     Gamma { color: Slot, gamma: Slot, dst: Slot },
     BrightContrast { color: Slot, bright: Slot, contrast: Slot, dst: Slot },
@@ -81,6 +87,7 @@ pub enum Op {
     TexMagic { depth: i32, vector: Slot, scale: Slot, distortion: Slot, fac: Slot, color: Slot },
     TexWhiteNoise { dims: u8, vector: Slot, w: Slot, value: Slot, color: Slot },
     TexChecker { vector: Slot, color1: Slot, color2: Slot, scale: Slot, fac: Slot, color: Slot },
+    VectorRotate { kind: VectorRotateType, invert: bool, vector: Slot, center: Slot, axis: Slot, angle: Slot, rotation: Slot, dst: Slot },
     Mapping { kind: MappingType, vector: Slot, location: Slot, rotation: Slot, scale: Slot, dst: Slot },
 }
 
@@ -101,6 +108,8 @@ pub struct Program {
     /// The stack as it starts: constants in place, the rest zero.
     pub initial: Vec<f32>,
     pub ramps: Vec<RampTable>,
+    /// Lookup tables of RGB/Vector/Float Curve nodes.
+    pub curves: Vec<CurveTable>,
     pub closures: Vec<Closure>,
     /// The closure plugged into the Material Output's Surface.
     pub surface: Option<u32>,
@@ -210,6 +219,13 @@ impl Program {
                     put3(s, color, c);
                     s[alpha as usize] = a;
                 }
+                Op::Curves3 { table, fac, v, dst } => {
+                    let r = self.curves[table as usize].eval3(s[fac as usize], v3(s, v));
+                    put3(s, dst, r)
+                }
+                Op::Curve1 { table, fac, v, dst } => {
+                    s[dst as usize] = self.curves[table as usize].eval1(s[fac as usize], s[v as usize]);
+                }
                 Op::Invert { fac, color, dst } => {
                     let r = invert(s[fac as usize], v3(s, color));
                     put3(s, dst, r)
@@ -293,6 +309,10 @@ impl Program {
                     let (v, c) = white_noise(dims, v3(s, vector), s[w as usize]);
                     s[value as usize] = v;
                     put3(s, color, c);
+                }
+                Op::VectorRotate { kind, invert, vector, center, axis, angle, rotation, dst } => {
+                    let r = vector_rotate(kind, invert, v3(s, vector), v3(s, center), v3(s, axis), s[angle as usize], v3(s, rotation));
+                    put3(s, dst, r);
                 }
                 Op::Mapping { kind, vector, location, rotation, scale, dst } => {
                     let r = mapping(kind, v3(s, vector), v3(s, location), v3(s, rotation), v3(s, scale));
