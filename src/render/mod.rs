@@ -130,6 +130,11 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
         return Err(RenderError(format!("resolution {w}x{h}: each side must be 1 to {MAX_SIDE}")));
     }
+    // Motion blur is not rendered yet; say so once per process rather than pretend.
+    if r.get("use_motion_blur").and_then(Value::as_bool) == Some(true) {
+        static WARN: std::sync::Once = std::sync::Once::new();
+        WARN.call_once(|| eprintln!("warning: the scene has motion blur on; blendsynth does not render motion blur yet (frames are sharp)"));
+    }
     let samples = opts.samples.unwrap_or_else(|| rna_f(cy, "samples").unwrap_or(128.0) as u32);
     if samples == 0 {
         return Err(RenderError("samples must be at least 1".into()));
