@@ -280,6 +280,11 @@ enum OnOff {
     Off,
 }
 
+/// `--set PATH=VALUE` arguments, as `bake`, `mesh` and `render` take them.
+fn parse_overrides(set: &[String]) -> Result<Vec<Override>> {
+    set.iter().map(|s| Override::parse(s)).collect::<Result<Vec<_>, _>>().map_err(anyhow::Error::msg)
+}
+
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     let (a, b) = s.split_once(['x', 'X']).ok_or_else(|| format!("{s:?}: expected WxH, e.g. 640x480"))?;
     let w = a.trim().parse::<u32>().map_err(|e| format!("{s:?}: width: {e}"))?;
@@ -289,7 +294,7 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
 
 fn run_render(a: RenderArgs) -> Result<()> {
     use blendsynth::render;
-    let overrides = a.set.iter().map(|s| Override::parse(s)).collect::<Result<Vec<_>, _>>().map_err(anyhow::Error::msg)?;
+    let overrides = parse_overrides(&a.set)?;
     let scene = Scene::load(&a.dir)?.with_overrides(&overrides)?;
     let opts = render::RenderOptions { frame: a.frame, samples: a.samples, threshold: a.threshold, resolution: a.resolution, seed: a.seed, threads: a.threads, progress: true };
     let ext = a.output.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
@@ -372,7 +377,7 @@ fn run(cli: Cli) -> Result<Outcome> {
             Ok(Outcome::Done)
         }
         Command::Bake(a) => {
-            let overrides = a.set.iter().map(|s| Override::parse(s)).collect::<Result<Vec<_>, _>>().map_err(anyhow::Error::msg)?;
+            let overrides = parse_overrides(&a.set)?;
             let scene = Scene::load(&a.dir)?.with_overrides(&overrides)?;
             let opts = BakeOptions { object: a.object.clone(), uv: a.uv, size: a.size };
             let start = std::time::Instant::now();
@@ -435,7 +440,7 @@ fn run(cli: Cli) -> Result<Outcome> {
             Ok(Outcome::Done)
         }
         Command::Mesh(a) => {
-            let overrides = a.set.iter().map(|s| Override::parse(s)).collect::<Result<Vec<_>, _>>().map_err(anyhow::Error::msg)?;
+            let overrides = parse_overrides(&a.set)?;
             let overrides: Vec<(String, serde_json::Value)> = overrides.into_iter().map(|o| (o.path, o.value)).collect();
             let scene = Scene::load(&a.dir)?;
             let frame = a.frame.unwrap_or(scene.file.scene.frame_current as f64);
