@@ -30,6 +30,8 @@ pub struct Camera {
     ratio: f32,
     pub width: u32,
     pub height: u32,
+    /// Camera-to-world at the motion steps across the shutter, when motion blur is on.
+    motion: Option<Vec<super::motion::Decomposed>>,
 }
 
 fn num(p: &serde_json::Map<String, Value>, key: &str, default: f64) -> f64 {
@@ -73,16 +75,7 @@ impl Camera {
         let lens = num(p, "lens", 50.0) as f32;
         let tan_half = if ortho { 1.0 } else { (0.5 * sensor) / lens / aspect };
         // Camera transform without scale (Cycles clears it).
-        let m = Affine::from_rows(&eval.world_matrices[oi]);
-        let mut to_world = m;
-        for c in 0..3 {
-            let l = len(m.column(c));
-            if l > 0.0 {
-                for r in 0..3 {
-                    to_world.m[r][c] /= l;
-                }
-            }
-        }
+        let to_world = without_scale(&Affine::from_rows(&eval.world_matrices[oi]));
         let dof = p.get("dof").and_then(Value::as_object);
         let use_dof = dof.and_then(|d| d.get("use_dof")).and_then(Value::as_bool).unwrap_or(false);
         let (mut aperture, mut focus, mut blades, mut rotation, mut ratio) = (0.0f32, 10.0f32, 0u32, 0.0f32, 1.0f32);
@@ -125,12 +118,36 @@ impl Camera {
             ratio,
             width,
             height,
+            motion: None,
         })
+    }
+
+    /// Gives the camera its transforms at the shutter's motion steps (scale removed as
+    /// for the centre transform); rays then take a time.
+    pub fn set_motion(&mut self, steps: &[Affine]) {
+        let unscaled: Vec<Affine> = steps.iter().map(without_scale).collect();
+        self.motion = Some(super::motion::decompose(&unscaled));
+    }
+
+    pub fn has_motion(&self) -> bool {
+        self.motion.is_some()
+    }
+
+    /// `ray` at shutter time `time` in [0, 1] (ignored without motion blur).
+    pub fn ray_at(&self, x: f32, y: f32, lens: [f32; 2], time: f32) -> (V3, V3, f32, f32) {
+        match &self.motion {
+            Some(steps) => self.ray_with(&super::motion::interpolate(steps, time), x, y, lens),
+            None => self.ray(x, y, lens),
+        }
     }
 
     /// A camera ray through raster position (x right, y down from the top-left corner,
     /// in pixels): origin, unit direction, tmin, tmax. `lens` is a 2D sample.
     pub fn ray(&self, x: f32, y: f32, lens: [f32; 2]) -> (V3, V3, f32, f32) {
+        self.ray_with(&self.to_world, x, y, lens)
+    }
+
+    fn ray_with(&self, to_world: &Affine, x: f32, y: f32, lens: [f32; 2]) -> (V3, V3, f32, f32) {
         let vx = self.left + (self.right - self.left) * (x / self.width as f32);
         let vy = self.top - (self.top - self.bottom) * (y / self.height as f32);
         // Camera space, looking down -Z.
@@ -158,8 +175,8 @@ impl Camera {
             tmin = 0.0;
             tmax = (self.clip_end - self.clip_start) * zinv;
         }
-        let wo = self.to_world.point(p);
-        let wd = normalize(self.to_world.vector(d));
+        let wo = to_world.point(p);
+        let wd = normalize(to_world.vector(d));
         (wo, wd, tmin, tmax)
     }
 
@@ -176,6 +193,20 @@ impl Camera {
         let view = neg(self.to_world.column(2));
         dot(sub(w, self.to_world.column(3)), view)
     }
+}
+
+/// The transform with its axes normalised (Cycles clears camera scale).
+fn without_scale(m: &Affine) -> Affine {
+    let mut o = *m;
+    for c in 0..3 {
+        let l = len(m.column(c));
+        if l > 0.0 {
+            for r in 0..3 {
+                o.m[r][c] /= l;
+            }
+        }
+    }
+    o
 }
 
 pub fn concentric_disk(u: [f32; 2]) -> [f32; 2] {

@@ -19,6 +19,7 @@ pub mod filter;
 pub mod integrator;
 pub mod light;
 pub mod math;
+pub mod motion;
 pub mod sampler;
 pub mod shade;
 pub mod tables;
@@ -103,6 +104,21 @@ pub struct InstanceInfo {
 /// Largest accepted image side, so a typo cannot ask for terabytes.
 pub const MAX_SIDE: u32 = 16384;
 const TILE: u32 = 16;
+/// Sample dimension set of the shutter time (apart from the sets paths use).
+const TIME_SET: u32 = 0x7000_0000;
+
+/// Says once per process that moving objects are rendered sharp (only the camera's
+/// motion is blurred so far).
+fn warn_object_motion(scene: &Scene, centre: &crate::anim::EvaluatedScene, other: &crate::anim::EvaluatedScene) {
+    let cam = scene.file.scene.camera.as_deref();
+    let moved = centre.data.objects.iter().enumerate().any(|(i, o)| {
+        Some(o.name.as_str()) != cam && matches!(o.kind.as_str(), "MESH" | "CURVE") && centre.world_matrices[i] != other.world_matrices[i]
+    });
+    if moved {
+        static WARN: std::sync::Once = std::sync::Once::new();
+        WARN.call_once(|| eprintln!("warning: objects move within the shutter; blendsynth blurs camera motion only, moving objects are rendered at the shutter's centre"));
+    }
+}
 
 fn rna_f(m: &crate::scene::Rna, k: &str) -> Option<f64> {
     m.get(k).and_then(Value::as_f64)
@@ -130,11 +146,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
         return Err(RenderError(format!("resolution {w}x{h}: each side must be 1 to {MAX_SIDE}")));
     }
-    // Motion blur is not rendered yet; say so once per process rather than pretend.
-    if r.get("use_motion_blur").and_then(Value::as_bool) == Some(true) {
-        static WARN: std::sync::Once = std::sync::Once::new();
-        WARN.call_once(|| eprintln!("warning: the scene has motion blur on; blendsynth does not render motion blur yet (frames are sharp)"));
-    }
+    let shutter = motion::Shutter::from_render(r).map_err(RenderError)?;
     let samples = opts.samples.unwrap_or_else(|| rna_f(cy, "samples").unwrap_or(128.0) as u32);
     if samples == 0 {
         return Err(RenderError("samples must be at least 1".into()));
@@ -144,8 +156,23 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     if !frame.is_finite() {
         return Err(RenderError(format!("frame {frame} is not finite")));
     }
-    let eval = crate::anim::evaluate_scene(scene, frame).map_err(|e| RenderError(format!("evaluating the scene at frame {frame}: {e}")))?;
-    let camera = camera::Camera::new(scene, &eval, w, h)?;
+    // With motion blur Cycles syncs the scene at the shutter's centre (START and END
+    // positions move it off the frame), and the camera at the shutter's ends too.
+    let centre = frame + shutter.as_ref().map_or(0.0, |s| s.centre_delta);
+    let eval = crate::anim::evaluate_scene(scene, centre).map_err(|e| RenderError(format!("evaluating the scene at frame {centre}: {e}")))?;
+    let mut camera = camera::Camera::new(scene, &eval, w, h)?;
+    if let Some(sh) = &shutter {
+        let mut steps = Vec::new();
+        for (k, f) in sh.step_frames(frame).into_iter().enumerate() {
+            let e = if k == 1 { None } else { Some(crate::anim::evaluate_scene(scene, f).map_err(|e| RenderError(format!("evaluating the scene at frame {f} (motion blur): {e}")))?) };
+            let at = e.as_ref().unwrap_or(&eval);
+            steps.push(camera::Camera::new(scene, at, w, h)?.to_world);
+            if let Some(e) = &e {
+                warn_object_motion(scene, &eval, e);
+            }
+        }
+        camera.set_motion(&steps);
+    }
     let geo = build::build(scene, &eval, overrides)?;
     let mut used = vec![false; scene.file.materials.len()];
     for inst in &geo.instances {
@@ -247,7 +274,10 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
                                 let u = rng.get4(i, 0);
                                 let fx = x as f32 + 0.5 + filter.sample(u[0]);
                                 let fy = y as f32 + 0.5 + filter.sample(u[1]);
-                                let (o, d, t0, t1) = camera.ray(fx, fy, [u[2], u[3]]);
+                                let (o, d, t0, t1) = match &shutter {
+                                    Some(sh) => camera.ray_at(fx, fy, [u[2], u[3]], sh.time(rng.get4(i, TIME_SET)[0])),
+                                    None => camera.ray(fx, fy, [u[2], u[3]]),
+                                };
                                 let c = tracer.radiance(o, d, t0, t1, &rng, i, scratch);
                                 px.add(i, c);
                             }
