@@ -109,3 +109,26 @@ fn fresh_cycles_bakes_match() {
     }
     assert!(compare_in(t.path(), "textures") <= TEXTURE_TOL, "textures");
 }
+
+/// Blender-side, with the published colon scene: its tissue material "Fat.001", baked by
+/// Cycles and by blendsynth on the same UV-mapped plane, output by output (the colour
+/// reaching the Principled BSDF, the bumped normal it shades with, with and without the
+/// displacement, and the displacement), at the file's settings and at one draw of the
+/// authors' randomised inputs (fixtures/bake/make_fat001_refs.py; exports go to a
+/// temporary folder, never the repository).
+#[test]
+fn published_fat001_matches_cycles() {
+    let Some(py) = require("a Python with bpy 4.5.4", bpy_python()) else { return };
+    let Some(blend) = require("../shared/published/colon_nodes.blend", published_colon()) else { return };
+    let t = tempfile::tempdir().unwrap();
+    run_python(&py, &repo().join("fixtures/bake/make_fat001_refs.py"), &["--blend", blend.to_str().unwrap(), "--out", t.path().to_str().unwrap()]);
+    let mut failed = Vec::new();
+    for case in ["color", "normal", "normal_bump_only", "displacement", "color_random", "normal_random", "normal_bump_only_random", "displacement_random"] {
+        let worst = compare_in(t.path(), case);
+        eprintln!("Fat.001 {case}: worst abs error {worst:.2e}");
+        if worst > TEXTURE_TOL {
+            failed.push(format!("{case}: {worst:.2e}"));
+        }
+    }
+    assert!(failed.is_empty(), "Fat.001 outputs beyond {TEXTURE_TOL}: {failed:?}");
+}
