@@ -3,8 +3,9 @@
 //!
 //! Materials: the bake-parity fixtures (fixtures/bake/scenes). `textures` is Mapping, a
 //! 6-octave fBm Noise, Smooth-F1 Voronoi (2 octaves), Wave, Magic, Gradient and Checker.
-//! Fat.001 and a noise + bump material need Bump, Displacement, RGB Curves and Layer
-//! Weight, which are not implemented yet.
+//! With `BLENDSYNTH_COLON_EXPORT=DIR` (a `blendsynth convert` of
+//! ../shared/published/colon_nodes.blend, which is never copied into the repository)
+//! it also measures the published tissue material "Fat.001".
 
 use std::hint::black_box;
 use std::path::Path;
@@ -15,9 +16,15 @@ use blendsynth::shader::{compile_material, ShadingPoint};
 
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/bake/scenes");
-    for case in ["uv_math", "structure", "closures", "textures"] {
-        let scene = Scene::load(&root.join(case)).expect("fixture scene");
-        let material = scene.file.materials[0].name.clone();
+    let mut cases: Vec<(String, std::path::PathBuf, Option<&str>)> =
+        ["uv_math", "structure", "closures", "textures"].iter().map(|c| (c.to_string(), root.join(c), None)).collect();
+    match std::env::var_os("BLENDSYNTH_COLON_EXPORT") {
+        Some(dir) => cases.push(("Fat.001".into(), dir.into(), Some("Fat.001"))),
+        None => println!("shading Fat.001: skipped (set BLENDSYNTH_COLON_EXPORT to a converted colon_nodes.blend)"),
+    }
+    for (case, dir, name) in &cases {
+        let scene = Scene::load(dir).expect("scene");
+        let material = name.map(str::to_string).unwrap_or_else(|| scene.file.materials[0].name.clone());
         let program = compile_material(&scene, &material).expect("compiles");
         let mut stack = program.new_stack();
         let n = 2_000_000u32;
@@ -34,6 +41,7 @@ fn main() {
                 object_normal: [0.0, 0.0, 1.0],
                 generated: [u, v, 0.5],
                 uv: [u, v, 0.0],
+                ..Default::default()
             };
             program.run(black_box(&sp), &mut stack);
             acc += program.surface_emission(&stack)[0];

@@ -71,8 +71,11 @@ fn evaluate(dir: &Path) -> Row {
     let (w, h) = (res[0].as_u64().unwrap() as u32, res[1].as_u64().unwrap() as u32);
     let a = read_exr(&dir.join("cycles_a.exr"));
     let b = read_exr(&dir.join("cycles_b.exr"));
-    let scene = Scene::load(dir).unwrap();
-    let opts = RenderOptions { samples: Some(samples), resolution: Some((w, h)), seed: Some(0), ..Default::default() };
+    // A reference may share an export with others ("scene": relative folder) and name a frame.
+    let scene_dir = meta["scene"].as_str().map(|s| dir.join(s)).unwrap_or_else(|| dir.to_path_buf());
+    let scene = Scene::load(&scene_dir).unwrap();
+    let frame = meta["frame"].as_f64();
+    let opts = RenderOptions { samples: Some(samples), resolution: Some((w, h)), seed: Some(0), frame, ..Default::default() };
     let out = render(&scene, &opts).unwrap_or_else(|e| panic!("{name}: {e}"));
     let ours: Vec<[f32; 3]> = out.color.iter().map(|p| [p[0], p[1], p[2]]).collect();
     assert_eq!(ours.len(), a.len(), "{name}: size");
@@ -242,4 +245,24 @@ fn adaptive_sampling_is_deterministic_and_stops_early() {
     // A threshold of 0 from the command line turns it off.
     let off = render(&scene, &RenderOptions { threshold: Some(0.0), ..opts(2) }).unwrap();
     assert_eq!(off.stats.samples_taken, 64 * n);
+}
+
+/// Blender-side, with the published colon scene: frames 50 and 11595 at 256x256 with
+/// denoising off and the file's other settings, Cycles with two seeds against blendsynth
+/// (fixtures/render/make_published_refs.py; everything is written to a temporary folder).
+#[test]
+fn published_colon_parity() {
+    let Some(py) = common::require("a Python with bpy 4.5.4", common::bpy_python()) else { return };
+    let Some(blend) = common::require("../shared/published/colon_nodes.blend", common::published_colon()) else { return };
+    let t = tempfile::tempdir().unwrap();
+    common::run_python(&py, &common::repo().join("fixtures/render/make_published_refs.py"), &["--blend", blend.to_str().unwrap(), "--out", t.path().to_str().unwrap()]);
+    let mut failures = Vec::new();
+    for f in ["frame_50", "frame_11595"] {
+        let r = evaluate(&t.path().join(f));
+        println!("colon {f}: ratio {:.3}, worst channel mean error {:.2}%, ours {:?}, Cycles {:?}, {:.1} s", r.ratio, 100.0 * r.worst_mean, r.ours, r.cycles, r.seconds);
+        if r.ratio > MAX_RATIO || r.worst_mean > MAX_MEAN_REL {
+            failures.push(format!("{f}: ratio {:.3}, mean error {:.2}%", r.ratio, 100.0 * r.worst_mean));
+        }
+    }
+    assert!(failures.is_empty(), "published colon parity: {failures:?}");
 }
