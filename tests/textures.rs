@@ -14,7 +14,18 @@ use blendsynth::shader::bake::{bake_emission, BakeOptions};
 const TOL: f32 = 1e-4;
 
 /// Cases that cannot meet TOL, with the bound they meet and why.
-const LOOSER: &[(&str, f32, &str)] = &[];
+const LOOSER: &[(&str, f32, &str)] = &[
+    (
+        "img_jpeg",
+        2e-2,
+        "the image crate's JPEG decoder (zune-jpeg) rounds its IDCT and chroma upsampling differently from OIIO's libjpeg-turbo: decoded bytes differ by up to 2/255 (measured on this file), which no sampling can undo",
+    ),
+    (
+        "brick_offset_squash",
+        1e-3,
+        "a smooth mortar edge of slope 1/(size * smooth) = 500 per unit amplifies a few-ulp difference in Object coordinates (3.6e-4 measured); the other brick cases meet 1e-4",
+    ),
+];
 
 /// Worst absolute error of every case in the export at `dir`: (object, what, worst, texel).
 fn compare_all(dir: &Path) -> Vec<(String, String, f32, usize)> {
