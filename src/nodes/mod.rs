@@ -57,6 +57,9 @@ pub mod vector_rotate;
 pub mod voronoi;
 pub mod wave;
 pub mod white_noise;
+// Brick, Image and Environment Textures.
+pub mod brick;
+pub mod image;
 
 /// How blendsynth handles a node type (by its `bl_idname`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]

@@ -67,6 +67,8 @@ pub struct Scene<'a> {
     pub background: V3,
     pub tables: &'a Tables,
     pub settings: Settings,
+    /// The world's node program when it varies with direction (else `background`).
+    pub world: Option<&'a super::world::WorldShader>,
 }
 
 /// Per-thread scratch, reused across samples (no allocation per ray).
@@ -218,7 +220,7 @@ impl Scene<'_> {
                 }
             }
             let Some(h) = hit_opt else {
-                let c = clamp_contrib(mul(throughput, self.background), clamp_limit);
+                let c = clamp_contrib(mul(throughput, self.background_toward(d, scratch)), clamp_limit);
                 if finite(c) {
                     l = add(l, c);
                 }
@@ -407,5 +409,16 @@ impl Scene<'_> {
             t1 = f32::INFINITY;
         }
         l
+    }
+}
+
+impl Scene<'_> {
+    /// Radiance from the world along a ray leaving the scene in direction `d`. The world
+    /// program runs on the scratch's spare stack (the one after the materials').
+    pub fn background_toward(&self, d: V3, scratch: &mut Scratch) -> V3 {
+        match (self.world, scratch.stacks.last_mut()) {
+            (Some(w), Some(stack)) => w.eval(d, stack),
+            _ => self.background,
+        }
     }
 }

@@ -183,6 +183,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     let materials = shade::compile_all(scene, &used)?;
     let lights = light::collect(&eval);
     let background = world::background(scene)?;
+    let world_shader = world::shader(scene)?;
     let tables = tables::Tables::shared();
     let bvh = Bvh::build(&geo.tris);
     let filter = filter::FilterTable::blackman_harris(rna_f(cy, "filter_width").or_else(|| rna_f(r, "filter_size")).unwrap_or(1.5) as f32);
@@ -201,7 +202,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     let exposure = 1.0f32;
     let build_seconds = start.elapsed().as_secs_f64();
     let mesh_lights = mesh_lights(&geo, &materials, &bvh, &lights, background, tables, settings);
-    let tracer = integrator::Scene { mesh_lights: &mesh_lights, accel: &bvh, geo: &geo, materials: &materials, lights: &lights, background, tables, settings };
+    let tracer = integrator::Scene { mesh_lights: &mesh_lights, accel: &bvh, geo: &geo, materials: &materials, lights: &lights, background, tables, settings, world: world_shader.as_ref() };
 
     let adaptive = adaptive::Adaptive::from_scene(cy, samples, opts.threshold);
     let tiles_x = w.div_ceil(TILE);
@@ -381,7 +382,7 @@ fn mesh_lights(
 ) -> integrator::MeshLights {
     use crate::shader::program::Closure;
     let empty = integrator::MeshLights::default();
-    let probe = integrator::Scene { mesh_lights: &empty, accel: bvh, geo, materials, lights, background, tables, settings };
+    let probe = integrator::Scene { mesh_lights: &empty, accel: bvh, geo, materials, lights, background, tables, settings, world: None };
     let emissive: Vec<bool> = materials
         .iter()
         .map(|m| m.program.as_ref().is_some_and(|p| p.closures.iter().any(|c| matches!(c, Closure::Emission { .. } | Closure::Bsdf { emission: Some(_) }))))
@@ -471,7 +472,7 @@ fn primary_passes(tracer: &integrator::Scene, camera: &camera::Camera, x: u32, y
             out.instance_id.push(0);
             out.material_index.push(0);
             out.normal.push([0.0; 3]);
-            out.albedo.push(tracer.background.map(|c| c.clamp(0.0, 1.0)));
+            out.albedo.push(tracer.background_toward(d, scratch).map(|c| c.clamp(0.0, 1.0)));
             out.uv.push([0.0; 2]);
         }
     }

@@ -1,5 +1,7 @@
 //! The world background: a Background node's colour times strength feeding the World
-//! Output (constant), or the world's viewport colour without nodes.
+//! Output (constant), the world's viewport colour without nodes, or, for any other
+//! world node graph (environment images, gradients by direction), the compiled world
+//! program run per escaping ray (`WorldShader`).
 
 use serde_json::Value;
 
@@ -14,6 +16,10 @@ pub fn background(scene: &Scene) -> Result<V3, RenderError> {
         (Some(t), true) => t,
         _ => return Ok(w.color.map(|c| c.map(|x| x as f32)).unwrap_or([0.05; 3])),
     };
+    if !is_constant(tree) {
+        // Varies with direction: `shader` evaluates it per ray.
+        return Ok([0.0; 3]);
+    }
     let out = tree
         .nodes
         .iter()
@@ -35,4 +41,56 @@ pub fn background(scene: &Scene) -> Result<V3, RenderError> {
     let color = input("Color")?.and_then(Value::as_array).map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(0.0) as f32)).unwrap_or([0.8; 3]);
     let strength = input("Strength")?.and_then(Value::as_f64).unwrap_or(1.0) as f32;
     Ok(color.map(|c| c * strength))
+}
+
+/// A world whose surface varies with direction (an Environment Texture, a Texture
+/// Coordinate, any linked Background input): its compiled node program, run per ray
+/// that leaves the scene.
+pub struct WorldShader {
+    pub program: crate::shader::Program,
+}
+
+impl WorldShader {
+    /// Radiance arriving along `-d` from the world (`d`: the ray's unit direction), as
+    /// Cycles shades the background with the ray direction as position.
+    pub fn eval(&self, d: V3, stack: &mut Vec<f32>) -> V3 {
+        let p = &self.program;
+        if stack.len() != p.initial.len() {
+            stack.clear();
+            stack.extend_from_slice(&p.initial);
+        }
+        p.run(&crate::shader::compile::world_point(d), stack);
+        p.surface_emission(stack)
+    }
+}
+
+/// The scene world's shader when it is not a constant colour (None: `background`
+/// gives its constant radiance).
+pub fn shader(scene: &Scene) -> Result<Option<WorldShader>, RenderError> {
+    let Some(name) = scene.file.scene.world.as_deref() else { return Ok(None) };
+    let Some(w) = scene.file.worlds.iter().find(|w| w.name == name) else { return Ok(None) };
+    let tree = match (&w.node_tree, w.use_nodes) {
+        (Some(t), true) => t,
+        _ => return Ok(None),
+    };
+    if is_constant(tree) {
+        return Ok(None);
+    }
+    let program = crate::shader::compile::compile_world(scene, name).map_err(|e| RenderError(e.to_string()))?;
+    Ok(Some(WorldShader { program }))
+}
+
+/// True when the world output is fed by a Background or Emission node with unlinked
+/// inputs (or by nothing): `background` handles that without a program.
+fn is_constant(tree: &crate::scene::NodeTree) -> bool {
+    let out = tree
+        .nodes
+        .iter()
+        .filter(|n| n.bl_idname == "ShaderNodeOutputWorld")
+        .find(|n| n.properties.get("is_active_output").and_then(Value::as_bool).unwrap_or(true))
+        .or_else(|| tree.nodes.iter().find(|n| n.bl_idname == "ShaderNodeOutputWorld"));
+    let Some(out) = out else { return true };
+    let Some(link) = tree.links.iter().find(|l| l.to_node == out.name && l.to_socket == "Surface" && !l.is_muted) else { return true };
+    let Some(node) = tree.nodes.iter().find(|n| n.name == link.from_node) else { return true };
+    (node.bl_idname == "ShaderNodeBackground" || node.bl_idname == "ShaderNodeEmission") && !node.mute && !tree.links.iter().any(|l| l.to_node == node.name && !l.is_muted)
 }

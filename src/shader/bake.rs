@@ -98,12 +98,16 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
                 // Cycles moves vertices to world space and derives object coordinates back
                 // through the inverse transform; doing the same keeps its rounding.
                 let position = lerp(c.map(|c| transform_point(&world, mesh.positions[mesh.corner_verts[c] as usize])));
-                let local_n = normalize3(lerp(c.map(|c| mesh.corner_normals.get(c).copied().unwrap_or([0.0, 0.0, 1.0]))));
+                // Cycles applies the object transform to a single-user mesh: vertex normals
+                // go to world space (normalised) before interpolation, and the object-space
+                // normal (Texture Coordinate > Normal, box projection) comes back through
+                // the transpose.
+                let world_n = normalize3(lerp(c.map(|c| normalize3(mul3x3(&normal_matrix, mesh.corner_normals.get(c).copied().unwrap_or([0.0, 0.0, 1.0]))))));
                 let sp = ShadingPoint {
                     position,
-                    normal: normalize3(mul3x3(&normal_matrix, local_n)),
+                    normal: world_n,
                     object_position: transform_point(&inverse, position),
-                    object_normal: local_n,
+                    object_normal: normalize3(mul3x3_transposed(&world, world_n)),
                     generated: std::array::from_fn(|k| ((local[k] as f64 - tex_loc[k]) / (2.0 * tex_size[k]) + 0.5) as f32),
                     uv: { let u = lerp(c.map(|c| [uvs[c][0], uvs[c][1], 0.0])); [u[0], u[1], 0.0] },
                 };
@@ -183,4 +187,9 @@ pub fn write_exr(b: &Baked, path: &Path) -> Result<(), String> {
     img.save_with_format(tmp.path(), image::ImageFormat::OpenExr).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     tmp.persist(path).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     Ok(())
+}
+
+/// The transpose of the 3x3 part of `m` times `v` (world to object for normals).
+fn mul3x3_transposed(m: &[[f64; 4]; 4], v: Vec3) -> Vec3 {
+    std::array::from_fn(|c| (m[0][c] * v[0] as f64 + m[1][c] * v[1] as f64 + m[2][c] * v[2] as f64) as f32)
 }

@@ -40,7 +40,9 @@ pub fn compile_material(scene: &Scene, name: &str) -> Result<Program, CompileErr
     let out = active_output(tree, "ShaderNodeOutputMaterial", "CYCLES")
         .ok_or_else(|| CompileError(format!("material {name:?} has no Material Output for Cycles")))?;
     let graph = flatten(tree, &scene.file.node_groups, &out.name).map_err(|e| CompileError(format!("material {name:?}: {e}")))?;
-    Compiler::new(&graph).run().map_err(|e| CompileError(format!("material {name:?}: {}", e.0)))
+    let mut c = Compiler::new(&graph);
+    c.scene = Some(scene);
+    c.run().map_err(|e| CompileError(format!("material {name:?}: {}", e.0)))
 }
 
 struct Compiler<'g, 'a> {
@@ -56,6 +58,8 @@ struct Compiler<'g, 'a> {
     closure_of: Vec<Option<u32>>,
     surface: Option<u32>,
     bsdfs: Vec<BsdfNode>,
+    /// The scene, for the images texture nodes name (None: no images available).
+    scene: Option<&'a Scene>,
 }
 
 fn kind_of(socket_type: &str) -> Option<Kind> {
@@ -138,6 +142,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
             closure_of: vec![None; g.nodes.len()],
             surface: None,
             bsdfs: Vec::new(),
+            scene: None,
         }
     }
 
@@ -533,6 +538,15 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     }
                     self.surface = self.closure_input(n, "Surface")?;
                 }
+                "ShaderNodeTexBrick" => self.brick(i)?,
+                "ShaderNodeTexImage" => self.image_texture(i)?,
+                "ShaderNodeTexEnvironment" => self.environment_texture(i)?,
+                "ShaderNodeBackground" => {
+                    // A world's Background is emission seen along the ray.
+                    let (color, strength) = (self.input(n, "Color", C)?, self.input(n, "Strength", F)?);
+                    self.closure(i, Closure::Emission { color, strength });
+                }
+                "ShaderNodeOutputWorld" => self.surface = self.closure_input(n, "Surface")?,
                 other => return Err(CompileError(format!("node {:?}: {other} is not supported yet", n.path))),
             }
         }
@@ -676,5 +690,115 @@ impl<'g, 'a> Compiler<'g, 'a> {
         let band = ColorBand::new(&stops, interp, cm, hue).ok_or_else(|| bad("needs 1 to 32 elements"))?;
         self.ramps.push(RampTable::from_band(&band));
         Ok(self.ramps.len() as u32 - 1)
+    }
+}
+
+/// Compiles the Cycles surface of world `name`: Background closures as emission, and
+/// texture coordinates read from the ray direction (`world_point`).
+pub fn compile_world(scene: &Scene, name: &str) -> Result<Program, CompileError> {
+    let world = scene.file.worlds.iter().find(|w| w.name == name).ok_or_else(|| CompileError(format!("no world {name:?}")))?;
+    let tree = world.node_tree.as_ref().ok_or_else(|| CompileError(format!("world {name:?} has no node tree")))?;
+    let out = active_output(tree, "ShaderNodeOutputWorld", "CYCLES").ok_or_else(|| CompileError(format!("world {name:?} has no World Output")))?;
+    let graph = flatten(tree, &scene.file.node_groups, &out.name).map_err(|e| CompileError(format!("world {name:?}: {e}")))?;
+    let mut c = Compiler::new(&graph);
+    c.scene = Some(scene);
+    c.run().map_err(|e| CompileError(format!("world {name:?}: {}", e.0)))
+}
+
+/// A world shading point for direction `d` (unit, world space), as Cycles sets up the
+/// background: position, Generated and Object coordinates are the direction, the
+/// normal faces back along the ray, no UV.
+pub fn world_point(d: crate::nodes::math::Vec3) -> super::point::ShadingPoint {
+    let n = [-d[0], -d[1], -d[2]];
+    super::point::ShadingPoint { position: d, normal: n, object_position: d, object_normal: n, generated: d, ..Default::default() }
+}
+
+impl<'g, 'a> Compiler<'g, 'a> {
+    fn prop_f32(n: &FlatNode, key: &str) -> Result<f32, CompileError> {
+        prop(n, key)?.as_f64().map(|v| v as f32).ok_or_else(|| CompileError(format!("node {:?}: property {key:?} is not a number", n.path)))
+    }
+
+    /// Whether output `id` of flat node `i` feeds anything in the graph.
+    fn output_used(&self, i: usize, id: &str) -> bool {
+        let Some(k) = self.g.nodes[i].node.outputs.iter().position(|o| o.identifier == id) else { return false };
+        self.g.nodes.iter().any(|m| m.inputs.iter().any(|inp| inp.sources.iter().any(|s| matches!(s, Source::Link { node, output, .. } if *node == i && *output == k))))
+    }
+
+    fn brick(&mut self, i: usize) -> Result<(), CompileError> {
+        use crate::nodes::brick::BrickSettings;
+        let n = &self.g.nodes[i];
+        let (_, vector, _) = self.texture_point(n, None)?;
+        let int = |key: &str| -> Result<i32, CompileError> { prop(n, key)?.as_i64().map(|v| v as i32).ok_or_else(|| CompileError(format!("node {:?}: property {key:?} is not an integer", n.path))) };
+        let settings = BrickSettings { offset: Self::prop_f32(n, "offset")?, offset_frequency: int("offset_frequency")?, squash: Self::prop_f32(n, "squash")?, squash_frequency: int("squash_frequency")? };
+        let [c1, c2, m] = self.inputs_n(n, ["Color1", "Color2", "Mortar"], Kind::Color)?;
+        let [scale, size, smooth, bias, width, height] = self.inputs_n(n, ["Scale", "Mortar Size", "Mortar Smooth", "Bias", "Brick Width", "Row Height"], Kind::Float)?;
+        let (fac, color) = (self.alloc(Kind::Float), self.alloc(Kind::Color));
+        self.ops.push(Op::TexBrick { settings, vector, args: [c1, c2, m, scale, size, smooth, bias, width, height], fac, color });
+        self.outputs(i, n, &[("Fac", fac, Kind::Float), ("Color", color, Kind::Color)]);
+        Ok(())
+    }
+
+    /// The image an Image/Environment Texture node names (Cycles' magenta if none).
+    fn node_image(&self, n: &FlatNode) -> Result<std::sync::Arc<super::images::TexImage>, CompileError> {
+        let name = n.property("image").and_then(|v| v.get("name")).and_then(Value::as_str);
+        match (name, self.scene) {
+            (Some(name), Some(scene)) => super::images::scene_image(scene, name).map_err(|e| CompileError(format!("node {:?}: {e}", n.path))),
+            (Some(_), None) => Err(CompileError(format!("node {:?}: images need the scene", n.path))),
+            (None, _) => Ok(std::sync::Arc::new(super::images::TexImage::missing())),
+        }
+    }
+
+    fn image_texture(&mut self, i: usize) -> Result<(), CompileError> {
+        use crate::nodes::image::{Extension, Interpolation, Projection};
+        let n = &self.g.nodes[i];
+        let interpolation = mode(n, "interpolation", Interpolation::from_blender)?;
+        let extension = mode(n, "extension", Extension::from_blender)?;
+        let projection = mode(n, "projection", Projection::from_blender)?;
+        let blend = Self::prop_f32(n, "projection_blend")?;
+        if let Some(m) = n.property("texture_mapping") {
+            if !identity_mapping(m) {
+                return Err(CompileError(format!("node {:?}: a non-identity texture_mapping is not supported yet", n.path)));
+            }
+        }
+        let image = self.node_image(n)?;
+        // An unlinked Vector is the UV map (Cycles' LINK_TEXTURE_UV).
+        let vector = if linked(n, "Vector") {
+            self.input(n, "Vector", Kind::Vector)?
+        } else {
+            let d = self.alloc(Kind::Vector);
+            self.ops.push(Op::UvMap { dst: d });
+            d
+        };
+        let unassociate = self.output_used(i, "Alpha") && image.unassociates();
+        let (color, alpha) = (self.alloc(Kind::Color), self.alloc(Kind::Float));
+        self.ops.push(Op::TexImage { image, projection, blend, interpolation, extension, unassociate, vector, color, alpha });
+        self.outputs(i, n, &[("Color", color, Kind::Color), ("Alpha", alpha, Kind::Float)]);
+        Ok(())
+    }
+
+    fn environment_texture(&mut self, i: usize) -> Result<(), CompileError> {
+        use crate::nodes::image::{EnvProjection, Interpolation};
+        let n = &self.g.nodes[i];
+        let interpolation = mode(n, "interpolation", Interpolation::from_blender)?;
+        let projection = mode(n, "projection", EnvProjection::from_blender)?;
+        if let Some(m) = n.property("texture_mapping") {
+            if !identity_mapping(m) {
+                return Err(CompileError(format!("node {:?}: a non-identity texture_mapping is not supported yet", n.path)));
+            }
+        }
+        let image = self.node_image(n)?;
+        // An unlinked Vector is the position: for a world, the ray direction.
+        let vector = if linked(n, "Vector") {
+            self.input(n, "Vector", Kind::Vector)?
+        } else {
+            let d = self.alloc(Kind::Vector);
+            self.ops.push(Op::Position { dst: d });
+            d
+        };
+        let unassociate = self.output_used(i, "Alpha") && image.unassociates();
+        let (color, alpha) = (self.alloc(Kind::Color), self.alloc(Kind::Float));
+        self.ops.push(Op::TexEnvironment { image, projection, interpolation, unassociate, vector, color, alpha });
+        self.outputs(i, n, &[("Color", color, Kind::Color), ("Alpha", alpha, Kind::Float)]);
+        Ok(())
     }
 }

@@ -6,6 +6,7 @@ pub mod bake;
 pub mod compile;
 pub mod point;
 pub mod program;
+pub mod images;
 
 pub use compile::{compile_material, CompileError};
 pub use point::ShadingPoint;

@@ -20,6 +20,10 @@ use crate::nodes::voronoi::{voronoi_texture, VoronoiFeature, VoronoiMetric, Voro
 use crate::nodes::wave::{wave, WaveSettings};
 use crate::nodes::white_noise::white_noise;
 
+use crate::nodes::brick::{brick_texture, BrickSettings};
+use crate::nodes::image::{box_uvs, box_weights, direction_to_equirectangular, direction_to_mirrorball, project, safe_normalize, EnvProjection, Extension, Interpolation, Projection};
+
+use super::images::TexImage;
 use super::point::ShadingPoint;
 
 /// A float's position on the stack; vectors and colours take three in a row.
@@ -89,6 +93,13 @@ pub enum Op {
     TexChecker { vector: Slot, color1: Slot, color2: Slot, scale: Slot, fac: Slot, color: Slot },
     VectorRotate { kind: VectorRotateType, invert: bool, vector: Slot, center: Slot, axis: Slot, angle: Slot, rotation: Slot, dst: Slot },
     Mapping { kind: MappingType, vector: Slot, location: Slot, rotation: Slot, scale: Slot, dst: Slot },
+    /// Brick Texture: args are Color1, Color2, Mortar, Scale, Mortar Size, Mortar Smooth,
+    /// Bias, Brick Width, Row Height.
+    TexBrick { settings: BrickSettings, vector: Slot, args: [Slot; 9], fac: Slot, color: Slot },
+    /// Image Texture; `unassociate`: the Alpha output is used and the image is colour.
+    TexImage { image: std::sync::Arc<TexImage>, projection: Projection, blend: f32, interpolation: Interpolation, extension: Extension, unassociate: bool, vector: Slot, color: Slot, alpha: Slot },
+    /// Environment Texture (the vector is a direction).
+    TexEnvironment { image: std::sync::Arc<TexImage>, projection: EnvProjection, interpolation: Interpolation, unassociate: bool, vector: Slot, color: Slot, alpha: Slot },
 }
 
 /// The shader part of a material: closures as a small tree over stack values.
@@ -322,6 +333,45 @@ impl Program {
                     let (c, f) = checker_texture(v3(s, vector), v3(s, color1), v3(s, color2), s[scale as usize]);
                     s[fac as usize] = f;
                     put3(s, color, c);
+                }
+                Op::TexBrick { settings, vector, args, fac, color } => {
+                    let [c1, c2, m, scale, size, smooth, bias, width, height] = args;
+                    let (c, f) = brick_texture(v3(s, vector), v3(s, c1), v3(s, c2), v3(s, m), s[scale as usize], s[size as usize], s[smooth as usize], s[bias as usize], s[width as usize], s[height as usize], settings);
+                    s[fac as usize] = f;
+                    put3(s, color, c);
+                }
+                Op::TexImage { ref image, projection, blend, interpolation, extension, unassociate, vector, color, alpha } => {
+                    let co = v3(s, vector);
+                    let r = if projection == Projection::Box {
+                        // Cycles weighs the three axis images by the object-space normal.
+                        let n = sp.object_normal;
+                        let w = box_weights(n, blend);
+                        let uvs = box_uvs(n, co);
+                        let mut f = [0.0f32; 4];
+                        for k in 0..3 {
+                            if w[k] > 0.0 {
+                                let t = image.lookup(uvs[k][0], uvs[k][1], interpolation, extension, unassociate);
+                                f = std::array::from_fn(|c| f[c] + w[k] * t[c]);
+                            }
+                        }
+                        f
+                    } else {
+                        let uv = project(projection, co);
+                        image.lookup(uv[0], uv[1], interpolation, extension, unassociate)
+                    };
+                    put3(s, color, [r[0], r[1], r[2]]);
+                    s[alpha as usize] = r[3];
+                }
+                Op::TexEnvironment { ref image, projection, interpolation, unassociate, vector, color, alpha } => {
+                    let d = safe_normalize(v3(s, vector));
+                    let uv = match projection {
+                        EnvProjection::Equirectangular => direction_to_equirectangular(d),
+                        EnvProjection::MirrorBall => direction_to_mirrorball(d),
+                    };
+                    // Environment textures always repeat (Cycles' EXTENSION_REPEAT).
+                    let r = image.lookup(uv[0], uv[1], interpolation, Extension::Repeat, unassociate);
+                    put3(s, color, [r[0], r[1], r[2]]);
+                    s[alpha as usize] = r[3];
                 }
             }
         }
