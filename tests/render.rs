@@ -247,15 +247,15 @@ fn adaptive_sampling_is_deterministic_and_stops_early() {
     assert_eq!(off.stats.samples_taken, 64 * n);
 }
 
-/// Blender-side, with the published colon scene: frames 50 and 11595 at 256x256 with
-/// denoising off and the file's other settings, Cycles with two seeds against blendsynth
+/// Blender-side, with the published colon scene: frames 50 and 11595 at 256x256, 32
+/// samples (to keep CI short), denoising off and the file's other settings, Cycles with two seeds against blendsynth
 /// (fixtures/render/make_published_refs.py; everything is written to a temporary folder).
 #[test]
 fn published_colon_parity() {
     let Some(py) = common::require("a Python with bpy 4.5.4", common::bpy_python()) else { return };
     let Some(blend) = common::require("../shared/published/colon_nodes.blend", common::published_colon()) else { return };
     let t = tempfile::tempdir().unwrap();
-    common::run_python(&py, &common::repo().join("fixtures/render/make_published_refs.py"), &["--blend", blend.to_str().unwrap(), "--out", t.path().to_str().unwrap()]);
+    common::run_python(&py, &common::repo().join("fixtures/render/make_published_refs.py"), &["--blend", blend.to_str().unwrap(), "--out", t.path().to_str().unwrap(), "--samples", "32"]);
     let mut failures = Vec::new();
     for f in ["frame_50", "frame_11595"] {
         let r = evaluate(&t.path().join(f));
