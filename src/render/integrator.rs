@@ -229,13 +229,17 @@ impl Scene<'_> {
             self.shade(&hit, wo, scratch);
             // Filter Glossy: after diffuse-like bounces, glossy lobes are roughened.
             if st.filter_glossy > 0.0 && min_ray_pdf.is_finite() {
-                let blur_pdf = st.filter_glossy * min_ray_pdf;
+                // Cycles' kernel uses 1 / blur_glossy.
+                let blur_pdf = min_ray_pdf / st.filter_glossy;
                 if blur_pdf < 1.0 {
                     let blur = (1.0 - blur_pdf).sqrt() * 0.5;
                     let n = scratch.lobes.len;
                     for lobe in &mut scratch.lobes.lobes[..n] {
                         if let LobeKind::Glossy { alpha, .. } = &mut lobe.kind {
                             *alpha = alpha.max(blur);
+                        }
+                        if let LobeKind::Glass(g) = &mut lobe.kind {
+                            g.alpha = g.alpha.max(blur);
                         }
                     }
                 }

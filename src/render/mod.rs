@@ -19,6 +19,7 @@ pub mod filter;
 pub mod integrator;
 pub mod light;
 pub mod math;
+pub mod microfacet;
 pub mod sampler;
 pub mod shade;
 pub mod tables;

@@ -171,13 +171,14 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             out.push(LobeKind::Glossy { alpha: r * r, fresnel: Fresnel::Constant, energy }, scale(c, w), n);
         }
         "ShaderNodeBsdfPrincipled" => principled(b, w, s, sp, ctx, out),
-        // Rough glass is rendered as smooth glass for now (documented).
         "ShaderNodeBsdfGlass" | "ShaderNodeBsdfRefraction" => {
             let c = input_c(b, s, "Color", [1.0; 3]);
-            let ior = input_f(b, s, "IOR", 1.45).max(1e-4);
-            let eta = if ctx.backfacing { 1.0 / ior } else { ior };
+            let ior = input_f(b, s, "IOR", 1.45);
+            let r = input_f(b, s, "Roughness", 0.0);
+            let n = input_n(b, s, "Normal", sp);
             let refract_only = b.bl_idname == "ShaderNodeBsdfRefraction";
-            out.push(LobeKind::Glass { eta, refract_only }, scale(c, w), input_n(b, s, "Normal", sp));
+            let g = super::microfacet::glass_closure(ctx.tables, b.property("distribution"), refract_only, r, ior, ctx.backfacing, dot(n, ctx.wo));
+            out.push(LobeKind::Glass(g), scale(c, w), n);
         }
         // Unsupported closures fall back to a diffuse of their colour (documented).
         _ => {
@@ -220,9 +221,12 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         weight = scale(weight, 1.0 - metallic);
     }
     if transmission > 0.0 {
-        // Smooth glass tinted by the base colour (rough transmission is not implemented).
-        let eta = if ctx.backfacing { 1.0 / ior } else { ior };
-        out.push(LobeKind::Glass { eta, refract_only: false }, scale(mul(weight, base), transmission), n);
+        // Rough glass: reflection tinted by the specular tint, refraction by sqrt of the base
+        // colour (light crosses the surface twice), as Cycles' Principled sets it up.
+        let mut g = super::microfacet::glass_closure(ctx.tables, Some("MULTI_GGX"), false, roughness, ior, ctx.backfacing, mu);
+        g.tint_r = spec_tint;
+        g.tint_t = base.map(f32::sqrt);
+        out.push(LobeKind::Glass(g), scale(weight, transmission), n);
         weight = scale(weight, 1.0 - transmission);
     }
     // Dielectric specular: IOR adjusted by the specular IOR level as Cycles does.
