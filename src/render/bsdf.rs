@@ -5,6 +5,7 @@
 
 use super::math::*;
 use super::microfacet::Dielectric;
+use super::subsurface::Bssrdf;
 use super::tables::Tables;
 use std::f32::consts::PI;
 
@@ -27,6 +28,9 @@ pub enum LobeKind {
     /// Dielectric interface (Glass and Refraction BSDFs, Principled transmission), rough
     /// or sharp: reflects or refracts by Fresnel (see `microfacet`).
     Glass(Dielectric),
+    /// BSSRDF (random walk subsurface scattering): picked like a BSDF, never evaluated;
+    /// the integrator walks the medium (see `subsurface`).
+    Subsurface(Bssrdf),
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -140,6 +144,9 @@ impl LobeSet {
         }
         let l = &self.lobes[pick];
         let sel = l.sample_weight / total;
+        if let LobeKind::Subsurface(_) = l.kind {
+            return Some(BsdfSample { wi: l.n, weight: scale(l.weight, 1.0 / sel), pdf: 0.0, singular: false, glossy: false, transmit: true, kind: l.kind });
+        }
         if let LobeKind::Glass(g) = l.kind {
             let u3 = (x / l.sample_weight).clamp(0.0, 1.0 - f32::EPSILON);
             let ds = g.sample(l.n, wo, ng, [u[0], u[1], u3])?;
@@ -277,7 +284,7 @@ fn eval_lobe(l: &Lobe, wo: V3, wi: V3, ng: V3, _tables: &Tables) -> (V3, f32) {
                 ([0.0; 3], 0.0)
             }
         }
-        LobeKind::Transparent => ([0.0; 3], 0.0),
+        LobeKind::Transparent | LobeKind::Subsurface(_) => ([0.0; 3], 0.0),
         LobeKind::Glass(g) => g.eval(l.n, wo, wi, ng),
         LobeKind::Glossy { alpha, fresnel, energy } => {
             if alpha < SINGULAR_ALPHA || !same_side || cos_i <= 0.0 {
@@ -313,7 +320,7 @@ fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
             Some((wi, false))
         }
         LobeKind::Transparent => Some((neg(wo), true)),
-        LobeKind::Glass(_) => None, // sampled by `Dielectric::sample`
+        LobeKind::Glass(_) | LobeKind::Subsurface(_) => None, // sampled elsewhere
         LobeKind::Glossy { alpha, .. } => {
             if alpha < SINGULAR_ALPHA {
                 let wi = sub(scale(l.n, 2.0 * dot(l.n, wo)), wo);

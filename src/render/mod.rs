@@ -22,6 +22,7 @@ pub mod math;
 pub mod microfacet;
 pub mod sampler;
 pub mod shade;
+pub mod subsurface;
 pub mod tables;
 pub mod world;
 
