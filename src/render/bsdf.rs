@@ -4,6 +4,8 @@
 //! transparent. `eval` returns BSDF times the cosine, as Cycles' closures do.
 
 use super::math::*;
+use super::microfacet::Dielectric;
+use super::subsurface::Bssrdf;
 use super::tables::Tables;
 use std::f32::consts::PI;
 
@@ -23,9 +25,12 @@ pub enum LobeKind {
     Translucent,
     Glossy { alpha: f32, fresnel: Fresnel, energy: f32 },
     Transparent,
-    /// Smooth dielectric interface (Glass BSDF, Principled transmission): reflects or
-    /// refracts by Fresnel; `eta` is the relative IOR across the surface as hit.
-    Glass { eta: f32, refract_only: bool },
+    /// Dielectric interface (Glass and Refraction BSDFs, Principled transmission), rough
+    /// or sharp: reflects or refracts by Fresnel (see `microfacet`).
+    Glass(Dielectric),
+    /// BSSRDF (random walk subsurface scattering): picked like a BSDF, never evaluated;
+    /// the integrator walks the medium (see `subsurface`).
+    Subsurface(Bssrdf),
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -126,7 +131,8 @@ impl LobeSet {
         if total <= 0.0 {
             return None;
         }
-        // Pick a lobe by sample weight, reusing the rest of u[2].
+        // Pick a lobe by sample weight; the rest of u[2] (rescaled) is the lobe's own third
+        // number, as Cycles reuses it.
         let mut x = u[2] * total;
         let mut pick = self.len - 1;
         for (i, l) in self.lobes[..self.len].iter().enumerate() {
@@ -137,12 +143,28 @@ impl LobeSet {
             x -= l.sample_weight;
         }
         let l = &self.lobes[pick];
+        let sel = l.sample_weight / total;
+        if let LobeKind::Subsurface(_) = l.kind {
+            return Some(BsdfSample { wi: l.n, weight: scale(l.weight, 1.0 / sel), pdf: 0.0, singular: false, glossy: false, transmit: true, kind: l.kind });
+        }
+        if let LobeKind::Glass(g) = l.kind {
+            let u3 = (x / l.sample_weight).clamp(0.0, 1.0 - f32::EPSILON);
+            let ds = g.sample(l.n, wo, ng, [u[0], u[1], u3])?;
+            let (glossy, transmit) = (!ds.transmit, ds.transmit);
+            if ds.singular {
+                return Some(BsdfSample { wi: ds.l, weight: scale(mul(ds.weight, l.weight), 1.0 / sel), pdf: f32::INFINITY, singular: true, glossy, transmit, kind: l.kind });
+            }
+            let (f, pdf) = self.eval(wo, ds.l, ng, tables);
+            if !(pdf > 0.0) || !pdf.is_finite() {
+                return None;
+            }
+            return Some(BsdfSample { wi: ds.l, weight: scale(f, 1.0 / pdf), pdf, singular: false, glossy, transmit, kind: l.kind });
+        }
         let (wi, singular) = sample_lobe(l, wo, ng, [u[0], u[1]])?;
-        let glossy = matches!(l.kind, LobeKind::Glossy { .. }) || (matches!(l.kind, LobeKind::Glass { .. }) && dot(wi, ng) > 0.0);
-        let transmit = matches!(l.kind, LobeKind::Translucent | LobeKind::Transparent) || (matches!(l.kind, LobeKind::Glass { .. }) && dot(wi, ng) < 0.0);
+        let glossy = matches!(l.kind, LobeKind::Glossy { .. });
+        let transmit = matches!(l.kind, LobeKind::Translucent | LobeKind::Transparent);
         if singular {
             // Mirror or pass-through: only this lobe contributes, with its discrete probability.
-            let sel = l.sample_weight / total;
             let w = match l.kind {
                 LobeKind::Glossy { fresnel, energy, .. } => {
                     let h = l.n;
@@ -150,12 +172,7 @@ impl LobeSet {
                 }
                 _ => l.weight,
             };
-            let wgt = scale(match l.kind {
-                LobeKind::Glossy { fresnel: Fresnel::Constant, .. } => w,
-                LobeKind::Glossy { .. } => w,
-                _ => w,
-            }, 1.0 / sel);
-            return Some(BsdfSample { wi, weight: wgt, pdf: f32::INFINITY, singular: true, glossy, transmit, kind: l.kind });
+            return Some(BsdfSample { wi, weight: scale(w, 1.0 / sel), pdf: f32::INFINITY, singular: true, glossy, transmit, kind: l.kind });
         }
         let (f, pdf) = self.eval(wo, wi, ng, tables);
         if !(pdf > 0.0) || !pdf.is_finite() {
@@ -267,7 +284,8 @@ fn eval_lobe(l: &Lobe, wo: V3, wi: V3, ng: V3, _tables: &Tables) -> (V3, f32) {
                 ([0.0; 3], 0.0)
             }
         }
-        LobeKind::Transparent | LobeKind::Glass { .. } => ([0.0; 3], 0.0),
+        LobeKind::Transparent | LobeKind::Subsurface(_) => ([0.0; 3], 0.0),
+        LobeKind::Glass(g) => g.eval(l.n, wo, wi, ng),
         LobeKind::Glossy { alpha, fresnel, energy } => {
             if alpha < SINGULAR_ALPHA || !same_side || cos_i <= 0.0 {
                 return ([0.0; 3], 0.0);
@@ -302,24 +320,7 @@ fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
             Some((wi, false))
         }
         LobeKind::Transparent => Some((neg(wo), true)),
-        LobeKind::Glass { eta, refract_only } => {
-            // Fresnel picks reflection or refraction, so the weight stays the colour.
-            let n = l.n;
-            let c = dot(n, wo).clamp(-1.0, 1.0);
-            let f = fresnel_dielectric(c, eta);
-            let reflect = sub(scale(n, 2.0 * c), wo);
-            let k = 1.0 - (1.0 - c * c) / (eta * eta);
-            if k <= 0.0 {
-                // Total internal reflection.
-                return Some((reflect, true));
-            }
-            if !refract_only && u[0] < f {
-                return Some((reflect, true));
-            }
-            let t = sub(scale(n, c / eta - k.sqrt()), scale(wo, 1.0 / eta));
-            let _ = ng;
-            Some((normalize(t), true))
-        }
+        LobeKind::Glass(_) | LobeKind::Subsurface(_) => None, // sampled elsewhere
         LobeKind::Glossy { alpha, .. } => {
             if alpha < SINGULAR_ALPHA {
                 let wi = sub(scale(l.n, 2.0 * dot(l.n, wo)), wo);

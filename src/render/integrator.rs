@@ -195,15 +195,25 @@ impl Scene<'_> {
         let mut prev_mis_lamps = false;
         // Smallest pdf of the non-singular bounces so far (Cycles' min_ray_pdf).
         let mut min_ray_pdf = f32::INFINITY;
+        // Where a subsurface random walk left the object: the next vertex, shaded white
+        // diffuse (Cycles' subsurface_shader_data_setup); and whether the path has taken a
+        // diffuse bounce (a BSSRDF then falls back to diffuse, as in Cycles).
+        let mut sss_exit: Option<super::accel::Hit> = None;
+        let mut diffuse_ancestor = false;
         loop {
-            scratch.rays += 1;
-            let hit_opt = self.accel.intersect(o, d, t0, t1);
+            let from_sss = sss_exit.take();
+            let hit_opt = if from_sss.is_some() {
+                from_sss
+            } else {
+                scratch.rays += 1;
+                self.accel.intersect(o, d, t0, t1)
+            };
             // Emission reached by a ray clamps as the bounce before it (Cycles: light found
             // after one bounce is direct light, like the light sample at that vertex).
             let clamp_limit = if bounce <= 1 { st.clamp_direct } else { st.clamp_indirect };
             // Lights are not in the BVH: a ray collects every light it passes before the surface.
             let t_surface = hit_opt.map(|h| h.t).unwrap_or(if t1.is_finite() { t1 } else { f32::INFINITY });
-            for light in self.lights {
+            for light in self.lights.iter().filter(|_| from_sss.is_none()) {
                 if let Some(lh) = light.intersect(o, d, t_surface) {
                     let w = if prev_singular {
                         1.0
@@ -228,16 +238,28 @@ impl Scene<'_> {
             };
             let wo = neg(d);
             let hit = self.surface(h.prim, h.u, h.v, wo);
-            self.shade(&hit, wo, scratch);
+            if from_sss.is_some() {
+                scratch.lobes.clear();
+                scratch.lobes.push(LobeKind::Diffuse, [1.0; 3], hit.sp.normal);
+            } else {
+                self.shade(&hit, wo, scratch);
+            }
+            if diffuse_ancestor {
+                super::subsurface::to_diffuse(&mut scratch.lobes);
+            }
             // Filter Glossy: after diffuse-like bounces, glossy lobes are roughened.
             if st.filter_glossy > 0.0 && min_ray_pdf.is_finite() {
-                let blur_pdf = st.filter_glossy * min_ray_pdf;
+                // Cycles' kernel uses 1 / blur_glossy.
+                let blur_pdf = min_ray_pdf / st.filter_glossy;
                 if blur_pdf < 1.0 {
                     let blur = (1.0 - blur_pdf).sqrt() * 0.5;
                     let n = scratch.lobes.len;
                     for lobe in &mut scratch.lobes.lobes[..n] {
                         if let LobeKind::Glossy { alpha, .. } = &mut lobe.kind {
                             *alpha = alpha.max(blur);
+                        }
+                        if let LobeKind::Glass(g) = &mut lobe.kind {
+                            g.alpha = g.alpha.max(blur);
                         }
                     }
                 }
@@ -349,6 +371,14 @@ impl Scene<'_> {
                 break;
             }
             throughput = mul(throughput, bs.weight);
+            if let LobeKind::Subsurface(b) = bs.kind {
+                // Not a bounce of its own: the walk's exit is the next vertex.
+                let exit = super::subsurface::enter_and_walk(self, &b, &hit, wo, bs.wi, rng, index, set, &mut throughput, &mut scratch.rays);
+                let Some((exit_hit, dir)) = exit else { break };
+                sss_exit = Some(exit_hit);
+                d = neg(dir);
+                continue;
+            }
             match bs.kind {
                 LobeKind::Transparent => {
                     transparent += 1;
@@ -362,12 +392,14 @@ impl Scene<'_> {
                     continue;
                 }
                 LobeKind::Diffuse => {
+                    diffuse_ancestor = true;
                     if diffuse >= st.max_diffuse {
                         terminate_next = true;
                     }
                     diffuse += 1;
                 }
                 LobeKind::Translucent => {
+                    diffuse_ancestor = true;
                     if diffuse >= st.max_diffuse {
                         terminate_next = true;
                     }
@@ -392,6 +424,7 @@ impl Scene<'_> {
                         glossy += 1;
                     }
                 }
+                LobeKind::Subsurface(_) => {}
             }
             if bounce >= st.max_bounces {
                 terminate_next = true;

@@ -20,8 +20,10 @@ pub mod integrator;
 pub mod light;
 pub mod math;
 pub mod motion;
+pub mod microfacet;
 pub mod sampler;
 pub mod shade;
+pub mod subsurface;
 pub mod tables;
 pub mod world;
 

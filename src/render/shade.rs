@@ -9,6 +9,7 @@ use crate::shader::{compile_material, ShadingPoint};
 use super::bsdf::{Fresnel, LobeKind, LobeSet};
 use super::math::*;
 use super::tables::Tables;
+use super::subsurface::Method;
 use super::RenderError;
 
 pub struct Material {
@@ -171,13 +172,23 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             out.push(LobeKind::Glossy { alpha: r * r, fresnel: Fresnel::Constant, energy }, scale(c, w), n);
         }
         "ShaderNodeBsdfPrincipled" => principled(b, w, s, sp, ctx, out),
-        // Rough glass is rendered as smooth glass for now (documented).
         "ShaderNodeBsdfGlass" | "ShaderNodeBsdfRefraction" => {
             let c = input_c(b, s, "Color", [1.0; 3]);
-            let ior = input_f(b, s, "IOR", 1.45).max(1e-4);
-            let eta = if ctx.backfacing { 1.0 / ior } else { ior };
+            let ior = input_f(b, s, "IOR", 1.45);
+            let r = input_f(b, s, "Roughness", 0.0);
+            let n = input_n(b, s, "Normal", sp);
             let refract_only = b.bl_idname == "ShaderNodeBsdfRefraction";
-            out.push(LobeKind::Glass { eta, refract_only }, scale(c, w), input_n(b, s, "Normal", sp));
+            let g = super::microfacet::glass_closure(ctx.tables, b.property("distribution"), refract_only, r, ior, ctx.backfacing, dot(n, ctx.wo));
+            out.push(LobeKind::Glass(g), scale(c, w), n);
+        }
+        "ShaderNodeSubsurfaceScattering" => {
+            let c = input_c(b, s, "Color", [0.8; 3]);
+            let radius = scale(input_c(b, s, "Radius", [1.0, 0.2, 0.1]), input_f(b, s, "Scale", 0.05));
+            let method = Method::from_property(b.property("falloff"));
+            let ior = input_f(b, s, "IOR", 1.4);
+            let r = input_f(b, s, "Roughness", 1.0);
+            let aniso = input_f(b, s, "Anisotropy", 0.0);
+            push_bssrdf(out, scale(c, w), radius, c, aniso, ior, r, method, input_n(b, s, "Normal", sp));
         }
         // Unsupported closures fall back to a diffuse of their colour (documented).
         _ => {
@@ -220,9 +231,12 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         weight = scale(weight, 1.0 - metallic);
     }
     if transmission > 0.0 {
-        // Smooth glass tinted by the base colour (rough transmission is not implemented).
-        let eta = if ctx.backfacing { 1.0 / ior } else { ior };
-        out.push(LobeKind::Glass { eta, refract_only: false }, scale(mul(weight, base), transmission), n);
+        // Rough glass: reflection tinted by the specular tint, refraction by sqrt of the base
+        // colour (light crosses the surface twice), as Cycles' Principled sets it up.
+        let mut g = super::microfacet::glass_closure(ctx.tables, Some("MULTI_GGX"), false, roughness, ior, ctx.backfacing, mu);
+        g.tint_r = spec_tint;
+        g.tint_t = base.map(f32::sqrt);
+        out.push(LobeKind::Glass(g), scale(weight, transmission), n);
         weight = scale(weight, 1.0 - transmission);
     }
     // Dielectric specular: IOR adjusted by the specular IOR level as Cycles does.
@@ -243,5 +257,32 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         let albedo = scale(spec_tint, e);
         weight = scale(weight, (1.0 - max3(albedo)).clamp(0.0, 1.0));
     }
+    let ss = input_f(b, s, "Subsurface Weight", 0.0).clamp(0.0, 1.0);
+    if ss > 0.0 {
+        let radius = scale(input_c(b, s, "Subsurface Radius", [1.0, 0.2, 0.1]), input_f(b, s, "Subsurface Scale", 0.05));
+        let method = Method::from_property(b.property("subsurface_method"));
+        // Random Walk (Skin) has its own IOR input; the other methods use the BSDF's.
+        let ss_ior = if method == Method::RandomWalkSkin { input_f(b, s, "Subsurface IOR", 1.4) } else { ior };
+        let aniso = input_f(b, s, "Subsurface Anisotropy", 0.0);
+        push_bssrdf(out, scale(mul(weight, base), ss), radius, base, aniso, ss_ior, roughness, method, n);
+        weight = scale(weight, 1.0 - ss);
+    }
     out.push(LobeKind::Diffuse, mul(weight, base), n);
+}
+
+/// A BSSRDF closure after Cycles' `bssrdf_setup`: its selection weight counts every
+/// channel, channels with no radius become diffuse.
+#[allow(clippy::too_many_arguments)]
+fn push_bssrdf(out: &mut LobeSet, weight: V3, radius: V3, albedo: V3, aniso: f32, ior: f32, roughness: f32, method: Method, n: V3) {
+    let (bssrdf, diffuse, channels) = super::subsurface::setup(weight, radius, albedo, aniso, ior, roughness, method);
+    if !is_zero(diffuse) {
+        out.push(LobeKind::Diffuse, diffuse, n);
+    }
+    if let Some((b, w)) = bssrdf {
+        let before = out.len;
+        out.push(LobeKind::Subsurface(b), w, n);
+        if out.len > before {
+            out.lobes[before].sample_weight *= channels as f32;
+        }
+    }
 }

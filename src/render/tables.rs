@@ -13,6 +13,10 @@ pub struct Tables {
     ggx_e: Vec<f32>,
     ggx_e_avg: Vec<f32>,
     dielectric_e: Vec<f32>,
+    /// Glass albedo E(z, roughness, mu) for eta > 1 and for 1 / eta (Cycles' ggx_glass_E
+    /// and ggx_glass_inv_E), for Multiscatter GGX glass.
+    glass_e: Vec<f32>,
+    glass_inv_e: Vec<f32>,
 }
 
 /// Mean of F * G2/G1 over VNDF samples: the single-scattering albedo.
@@ -78,7 +82,8 @@ impl Tables {
                 }
             }
         }
-        Tables { ggx_e, ggx_e_avg, dielectric_e }
+        let (glass_e, glass_inv_e) = glass_tables();
+        Tables { ggx_e, ggx_e_avg, dielectric_e, glass_e, glass_inv_e }
     }
 
     /// Single-scattering albedo of GGX with Fresnel one; `roughness` = sqrt(alpha).
@@ -104,6 +109,46 @@ impl Tables {
         let b = lerp2(&self.dielectric_e[(i + 1) * N3 * N3..(i + 2) * N3 * N3], N3, roughness, mu);
         a * (1.0 - t) + b * t
     }
+}
+
+impl Tables {
+    /// Single-scattering albedo of GGX glass (reflection plus refraction) for relative
+    /// IOR `eta`; `roughness` = sqrt(alpha).
+    pub fn glass_e(&self, mu: f32, roughness: f32, eta: f32) -> f32 {
+        let (t, e) = if eta < 1.0 { (&self.glass_inv_e, 1.0 / eta) } else { (&self.glass_e, eta) };
+        let z = ((e - 1.0) / (e + 1.0)).abs().sqrt().clamp(0.0, 1.0);
+        let x = z * (N3 - 1) as f32;
+        let i = (x as usize).min(N3 - 2);
+        let f = x - i as f32;
+        let a = lerp2(&t[i * N3 * N3..(i + 1) * N3 * N3], N3, roughness, mu);
+        let b = lerp2(&t[(i + 1) * N3 * N3..(i + 2) * N3 * N3], N3, roughness, mu);
+        a * (1.0 - f) + b * f
+    }
+}
+
+fn glass_tables() -> (Vec<f32>, Vec<f32>) {
+    let s = PixelSampler::new(7, 11, 17);
+    let samples: Vec<[f32; 2]> = (0..128).map(|i| {
+        let u = s.get4(i, 0);
+        [u[0], u[1]]
+    }).collect();
+    let mut e = vec![0.0; N3 * N3 * N3];
+    let mut inv = vec![0.0; N3 * N3 * N3];
+    for zi in 0..N3 {
+        let z = (zi as f32 / (N3 - 1) as f32).max(0.01);
+        let r = z * z;
+        let eta = ((1.0 + r) / (1.0 - r).max(1e-4)).min(1e4);
+        for ri in 0..N3 {
+            let alpha = rough_to_alpha(ri as f32 / (N3 - 1) as f32);
+            for mi in 0..N3 {
+                let mu = mi as f32 / (N3 - 1) as f32;
+                let k = (zi * N3 + ri) * N3 + mi;
+                e[k] = super::microfacet::glass_albedo(mu, alpha, eta, &samples);
+                inv[k] = super::microfacet::glass_albedo(mu, alpha, 1.0 / eta, &samples);
+            }
+        }
+    }
+    (e, inv)
 }
 
 impl Default for Tables {
