@@ -7,6 +7,7 @@ use std::path::Path;
 use crate::nodes::math::{normalize3, Vec3};
 use crate::scene::{AttributeData, Scene};
 
+use super::bump::{attribute_differential, differential_dudv, differential_from_compact, differential_make_compact, ObjectTransform};
 use super::compile::compile_material;
 use super::point::ShadingPoint;
 use super::program::Program;
@@ -65,6 +66,8 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
     let inverse = invert4(&world).ok_or_else(|| format!("object {:?} has a singular transform", obj.name))?;
     let normal_matrix = inverse_transpose3(&world).ok_or_else(|| format!("object {:?} has a singular transform", obj.name))?;
     let (tex_loc, tex_size) = (info.texspace_location.unwrap_or([0.0; 3]), info.texspace_size.unwrap_or([1.0; 3]));
+    let f32_rows = |m: &[[f64; 4]; 4]| -> [[f32; 4]; 3] { std::array::from_fn(|r| std::array::from_fn(|k| m[r][k] as f32)) };
+    let transform = ObjectTransform { to_world: f32_rows(&world), to_object: f32_rows(&inverse) };
 
     let n = size as usize;
     let mut pixels = vec![[0.0f32; 4]; n * n];
@@ -83,6 +86,7 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
         if area == 0.0 {
             continue;
         }
+        let diff = TriangleDifferentials::new(&world, uv, size, c.map(|c| mesh.positions[mesh.corner_verts[c] as usize]), tex_loc, tex_size);
         for y in y0..y1 {
             for x in x0..x1 {
                 // Blender's bake rasteriser samples slightly off the texel centre
@@ -110,6 +114,7 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
                     object_normal: normalize3(mul3x3_transposed(&world, world_n)),
                     generated: std::array::from_fn(|k| ((local[k] as f64 - tex_loc[k]) / (2.0 * tex_size[k]) + 0.5) as f32),
                     uv: { let u = lerp(c.map(|c| [uvs[c][0], uvs[c][1], 0.0])); [u[0], u[1], 0.0] },
+                    ..diff.point(transform)
                 };
                 program.run(&sp, stack);
                 let e = program.surface_emission(stack);
@@ -192,4 +197,62 @@ pub fn write_exr(b: &Baked, path: &Path) -> Result<(), String> {
 /// The transpose of the 3x3 part of `m` times `v` (world to object for normals).
 fn mul3x3_transposed(m: &[[f64; 4]; 4], v: Vec3) -> Vec3 {
     std::array::from_fn(|c| (m[0][c] * v[0] as f64 + m[1][c] * v[1] as f64 + m[2][c] * v[2] as f64) as f32)
+}
+
+/// A bake triangle's ray differentials as Cycles gets them for a bake: Blender's
+/// bake_differentials (half-texel steps of the barycentrics), turned into dP/dx, dP/dy on
+/// the world-space triangle, compacted to one radius (init_from_bake.h) and expanded again
+/// around the geometric normal when shading, as every Cycles shading point is.
+struct TriangleDifferentials {
+    ng: Vec3,
+    dp: [Vec3; 2],
+    generated: [Vec3; 2],
+    uv: [Vec3; 2],
+}
+
+impl TriangleDifferentials {
+    fn new(world: &[[f64; 4]; 4], uv: [[f32; 2]; 3], size: u32, local: [Vec3; 3], tex_loc: [f64; 3], tex_size: [f64; 3]) -> Self {
+        let p = local.map(|l| transform_point(world, l));
+        let sub = |a: Vec3, b: Vec3| -> Vec3 { [a[0] - b[0], a[1] - b[1], a[2] - b[2]] };
+        let (dpdu, dpdv) = (sub(p[1], p[0]), sub(p[2], p[0]));
+        let ng = normalize3(crate::nodes::math::cross3(dpdu, dpdv));
+        // Blender's rasteriser coordinates (texel centres at integers).
+        let v = uv.map(|t| [t[0] * size as f32 - (0.5 + 0.001), t[1] * size as f32 - (0.5 + 0.002)]);
+        let mut a = (v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[2][0] - v[0][0]) * (v[1][1] - v[0][1]);
+        let (du_dx, dv_dx, du_dy, dv_dy) = if a.abs() > f32::EPSILON {
+            a = 0.5 / a;
+            ((v[1][1] - v[2][1]) * a, (v[2][1] - v[0][1]) * a, (v[2][0] - v[1][0]) * a, (v[0][0] - v[2][0]) * a)
+        } else {
+            (0.0, 0.0, 0.0, 0.0)
+        };
+        // Blender weighs (corner 0, 1, 2) by (u, v, 1-u-v); Cycles by (1-u-v, u, v).
+        let (cu_dx, cv_dx, cu_dy, cv_dy) = (dv_dx, -du_dx - dv_dx, dv_dy, -du_dy - dv_dy);
+        let lin = |a: Vec3, s: f32, b: Vec3, t: f32| -> Vec3 { std::array::from_fn(|k| a[k] * s + b[k] * t) };
+        let full = [lin(dpdu, cu_dx, dpdv, cv_dx), lin(dpdu, cu_dy, dpdv, cv_dy)];
+        let (dx, dy) = differential_from_compact(ng, differential_make_compact(full[0], full[1]));
+        let duv = differential_dudv(dpdu, dpdv, [dx, dy], ng);
+        let generated = local.map(|l| std::array::from_fn(|k| ((l[k] as f64 - tex_loc[k]) / (2.0 * tex_size[k]) + 0.5) as f32));
+        let uvs = uv.map(|t| [t[0], t[1], 0.0]);
+        TriangleDifferentials {
+            ng,
+            dp: [dx, dy],
+            generated: [attribute_differential(generated, duv[0]), attribute_differential(generated, duv[1])],
+            uv: [attribute_differential(uvs, duv[0]), attribute_differential(uvs, duv[1])],
+        }
+    }
+
+    /// The differential fields of a shading point on this triangle.
+    fn point(&self, transform: ObjectTransform) -> ShadingPoint {
+        ShadingPoint {
+            ng: self.ng,
+            dp_dx: self.dp[0],
+            dp_dy: self.dp[1],
+            generated_dx: self.generated[0],
+            generated_dy: self.generated[1],
+            uv_dx: self.uv[0],
+            uv_dy: self.uv[1],
+            transform,
+            ..ShadingPoint::default()
+        }
+    }
 }

@@ -22,6 +22,8 @@ use crate::nodes::wave::{BandsDirection, RingsDirection, WaveProfile, WaveSettin
 use crate::scene::{Scene, Socket};
 
 use super::program::{BsdfNode, Closure, Kind, Op, Program, Slot};
+use super::bump::{BumpSettings, MapSpace};
+use super::bump_graph::{self, Schedule, Step};
 
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct CompileError(pub String);
@@ -42,8 +44,29 @@ pub fn compile_material(scene: &Scene, name: &str) -> Result<Program, CompileErr
     let graph = flatten(tree, &scene.file.node_groups, &out.name).map_err(|e| CompileError(format!("material {name:?}: {e}")))?;
     let mut c = Compiler::new(&graph);
     c.scene = Some(scene);
+    c.displace = displacement_as_bump(name, mat.properties.get("displacement_method").and_then(Value::as_str));
     c.run().map_err(|e| CompileError(format!("material {name:?}: {}", e.0)))
 }
+
+/// How the Material Output's Displacement is compiled: as a bump of the shading normal
+/// (Cycles' default "Bump Only"); `Some(true)`: in object space, as Cycles' "Both" does.
+/// True displacement is not done: those methods are bumped too, with a warning.
+fn displacement_as_bump(material: &str, method: Option<&str>) -> Option<bool> {
+    match method.unwrap_or("BUMP") {
+        "BUMP" => Some(false),
+        "BOTH" => {
+            eprintln!("warning: material {material:?}: displacement method BOTH: true displacement is not done, only its bump");
+            Some(true)
+        }
+        other => {
+            eprintln!("warning: material {material:?}: displacement method {other}: true displacement is not done, rendered as a bump");
+            Some(false)
+        }
+    }
+}
+
+/// Per flat node, per output: where one copy of the graph keeps its values.
+type CopyValues = Vec<Vec<Option<(Slot, Kind)>>>;
 
 struct Compiler<'g, 'a> {
     g: &'g FlatGraph<'a>,
@@ -60,6 +83,13 @@ struct Compiler<'g, 'a> {
     bsdfs: Vec<BsdfNode>,
     /// The scene, for the images texture nodes name (None: no images available).
     scene: Option<&'a Scene>,
+    /// Displacement compiled as a bump (object space when true); None: not at all.
+    displace: Option<bool>,
+    /// Values of the graph copies not being compiled (see `bump_graph`), and which copy
+    /// `values` holds now.
+    copy_values: Vec<CopyValues>,
+    copy: usize,
+    displaced_normal: Option<Slot>,
 }
 
 fn kind_of(socket_type: &str) -> Option<Kind> {
@@ -143,6 +173,10 @@ impl<'g, 'a> Compiler<'g, 'a> {
             surface: None,
             bsdfs: Vec::new(),
             scene: None,
+            displace: None,
+            copy_values: Vec::new(),
+            copy: 0,
+            displaced_normal: None,
         }
     }
 
@@ -228,7 +262,10 @@ impl<'g, 'a> Compiler<'g, 'a> {
 
     fn run(mut self) -> Result<Program, CompileError> {
         use Kind::{Color as C, Float as F, Vector as V};
-        for i in 0..self.g.nodes.len() {
+        let schedule = bump_graph::schedule(self.g, self.displace.is_some()).map_err(CompileError)?;
+        self.copy_values = vec![vec![Vec::new(); self.g.nodes.len()]; schedule.copies.len()];
+        for step in &schedule.steps {
+            let Some(i) = self.enter_step(&schedule, *step)? else { continue };
             let n = &self.g.nodes[i];
             match n.node.bl_idname.as_str() {
                 "ShaderNodeValue" => {
@@ -533,7 +570,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     self.closure(i, Closure::Add { a, b });
                 }
                 "ShaderNodeOutputMaterial" => {
-                    if n.input("Displacement").is_some_and(|d| matches!(d.sources.first(), Some(Source::Link { .. }))) {
+                    if self.displace.is_none() && n.input("Displacement").is_some_and(|d| matches!(d.sources.first(), Some(Source::Link { .. }))) {
                         return Err(CompileError(format!("node {:?}: displacement is not supported yet", n.path)));
                     }
                     self.surface = self.closure_input(n, "Surface")?;
@@ -547,10 +584,56 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     self.closure(i, Closure::Emission { color, strength });
                 }
                 "ShaderNodeOutputWorld" => self.surface = self.closure_input(n, "Surface")?,
+                "ShaderNodeBump" => {
+                    let settings = BumpSettings { invert: prop_bool(n, "invert")?, object_space: false, filter_width: bump_graph::filter_width(self.g, i).map_err(CompileError)? };
+                    let (strength, distance) = (self.input(n, "Strength", F)?, self.input(n, "Distance", F)?);
+                    let normal = if linked(n, "Normal") { Some(self.input(n, "Normal", V)?) } else { None };
+                    let center = self.input(n, "Height", F)?;
+                    let (dx, dy) = match schedule.bump_copies[i] {
+                        Some((cx, cy)) => (self.input_in_copy(cx, i, "Height", F)?, self.input_in_copy(cy, i, "Height", F)?),
+                        None => (center, center),
+                    };
+                    let d = self.alloc(V);
+                    self.ops.push(Op::Bump { settings, normal, strength, distance, center, dx, dy, dst: d });
+                    self.outputs(i, n, &[("Normal", d, V)]);
+                }
+                "ShaderNodeDisplacement" => {
+                    let object_space = match prop_str(n, "space")? {
+                        "OBJECT" => true,
+                        "WORLD" => false,
+                        other => return Err(CompileError(format!("node {:?}: space {other:?} is not supported", n.path))),
+                    };
+                    let (height, midlevel, scale) = (self.input(n, "Height", F)?, self.input(n, "Midlevel", F)?, self.input(n, "Scale", F)?);
+                    let normal = if linked(n, "Normal") { Some(self.input(n, "Normal", V)?) } else { None };
+                    let d = self.alloc(V);
+                    self.ops.push(Op::Displacement { object_space, height, midlevel, scale, normal, dst: d });
+                    self.outputs(i, n, &[("Displacement", d, V)]);
+                }
+                "ShaderNodeVectorDisplacement" => {
+                    let space = mode(n, "space", MapSpace::from_blender)?;
+                    if space == MapSpace::Tangent {
+                        return Err(CompileError(format!("node {:?}: tangent-space Vector Displacement is not supported yet", n.path)));
+                    }
+                    let (vector, midlevel, scale) = (self.input(n, "Vector", V)?, self.input(n, "Midlevel", F)?, self.input(n, "Scale", F)?);
+                    let d = self.alloc(V);
+                    self.ops.push(Op::VectorDisplacement { space, vector, midlevel, scale, dst: d });
+                    self.outputs(i, n, &[("Displacement", d, V)]);
+                }
+                "ShaderNodeNormalMap" => {
+                    let space = mode(n, "space", MapSpace::from_blender)?;
+                    if space == MapSpace::Tangent {
+                        return Err(CompileError(format!("node {:?}: tangent-space Normal Map is not supported yet", n.path)));
+                    }
+                    let (color, strength) = (self.input(n, "Color", C)?, self.input(n, "Strength", F)?);
+                    let d = self.alloc(V);
+                    self.ops.push(Op::NormalMap { space, color, strength, dst: d });
+                    self.outputs(i, n, &[("Normal", d, V)]);
+                }
                 other => return Err(CompileError(format!("node {:?}: {other} is not supported yet", n.path))),
             }
         }
-        Ok(Program { ops: self.ops, initial: self.initial, ramps: self.ramps, curves: self.curves, closures: self.closures, surface: self.surface, bsdfs: self.bsdfs })
+        self.switch_copy(&schedule, 0);
+        Ok(Program { ops: self.ops, initial: self.initial, ramps: self.ramps, curves: self.curves, closures: self.closures, surface: self.surface, bsdfs: self.bsdfs, displaced_normal: self.displaced_normal })
     }
 
     /// Records a BSDF node's value inputs and enum properties for the renderer.
@@ -690,6 +773,53 @@ impl<'g, 'a> Compiler<'g, 'a> {
         let band = ColorBand::new(&stops, interp, cm, hue).ok_or_else(|| bad("needs 1 to 32 elements"))?;
         self.ramps.push(RampTable::from_band(&band));
         Ok(self.ramps.len() as u32 - 1)
+    }
+
+    /// Makes copy `c` of the graph current: its values in `values`, and an op moving the
+    /// shading point the following ops read.
+    fn switch_copy(&mut self, schedule: &Schedule, c: usize) {
+        if c == self.copy {
+            return;
+        }
+        std::mem::swap(&mut self.values, &mut self.copy_values[self.copy]);
+        std::mem::swap(&mut self.values, &mut self.copy_values[c]);
+        let (old, new) = (schedule.copies[self.copy], schedule.copies[c]);
+        if old.point != new.point || old.filter_width != new.filter_width {
+            self.ops.push(Op::BumpPoint { point: new.point, width: new.filter_width });
+        }
+        self.copy = c;
+    }
+
+    /// Prepares a schedule step; returns the node to compile, if it is one.
+    fn enter_step(&mut self, schedule: &Schedule, step: Step) -> Result<Option<usize>, CompileError> {
+        match step {
+            Step::Node { node, copy } => {
+                self.switch_copy(schedule, copy);
+                Ok(Some(node))
+            }
+            Step::DisplacementBump => {
+                let Some((c, x, y)) = schedule.displacement else { return Ok(None) };
+                self.switch_copy(schedule, 0);
+                let root = self.g.root;
+                let center = self.input_in_copy(c, root, "Displacement", Kind::Vector)?;
+                let dx = self.input_in_copy(x, root, "Displacement", Kind::Vector)?;
+                let dy = self.input_in_copy(y, root, "Displacement", Kind::Vector)?;
+                let d = self.alloc(Kind::Vector);
+                self.ops.push(Op::DisplacementBump { object_space: self.displace == Some(true), center, dx, dy, dst: d });
+                self.displaced_normal = Some(d);
+                Ok(None)
+            }
+        }
+    }
+
+    /// Input `id` of flat node `i` as copy `c` of the graph computed it.
+    fn input_in_copy(&mut self, c: usize, i: usize, id: &str, want: Kind) -> Result<Slot, CompileError> {
+        debug_assert_eq!(self.copy, 0);
+        std::mem::swap(&mut self.values, &mut self.copy_values[c]);
+        let n = &self.g.nodes[i];
+        let r = self.input(n, id, want);
+        std::mem::swap(&mut self.values, &mut self.copy_values[c]);
+        r
     }
 }
 

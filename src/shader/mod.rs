@@ -3,6 +3,8 @@
 //! map the way Cycles' EMIT bake does (`bake`).
 
 pub mod bake;
+pub mod bump;
+pub mod bump_graph;
 pub mod compile;
 pub mod point;
 pub mod program;

@@ -24,6 +24,7 @@ use crate::nodes::brick::{brick_texture, BrickSettings};
 use crate::nodes::image::{box_uvs, box_weights, direction_to_equirectangular, direction_to_mirrorball, project, safe_normalize, EnvProjection, Extension, Interpolation, Projection};
 
 use super::images::TexImage;
+use super::bump::{bump_normal, displacement, displacement_bump, normal_map, offset_point, vector_displacement, BumpPoint, BumpSettings, MapSpace};
 use super::point::ShadingPoint;
 
 /// A float's position on the stack; vectors and colours take three in a row.
@@ -100,6 +101,15 @@ pub enum Op {
     TexImage { image: std::sync::Arc<TexImage>, projection: Projection, blend: f32, interpolation: Interpolation, extension: Extension, unassociate: bool, vector: Slot, color: Slot, alpha: Slot },
     /// Environment Texture (the vector is a direction).
     TexEnvironment { image: std::sync::Arc<TexImage>, projection: EnvProjection, interpolation: Interpolation, unassociate: bool, vector: Slot, color: Slot, alpha: Slot },
+    /// The shading point the following ops read: a Bump height copy's offset point.
+    BumpPoint { point: BumpPoint, width: f32 },
+    /// Bump node; `normal` None: the shading normal.
+    Bump { settings: BumpSettings, normal: Option<Slot>, strength: Slot, distance: Slot, center: Slot, dx: Slot, dy: Slot, dst: Slot },
+    Displacement { object_space: bool, height: Slot, midlevel: Slot, scale: Slot, normal: Option<Slot>, dst: Slot },
+    VectorDisplacement { space: MapSpace, vector: Slot, midlevel: Slot, scale: Slot, dst: Slot },
+    /// Material Output's Displacement as a bump: sets the shading normal for all that follows.
+    DisplacementBump { object_space: bool, center: Slot, dx: Slot, dy: Slot, dst: Slot },
+    NormalMap { space: MapSpace, color: Slot, strength: Slot, dst: Slot },
 }
 
 /// The shader part of a material: closures as a small tree over stack values.
@@ -126,6 +136,9 @@ pub struct Program {
     pub surface: Option<u32>,
     /// Every BSDF node's inputs, for the renderer to build its closures from.
     pub bsdfs: Vec<BsdfNode>,
+    /// Where the normal bumped by the material's displacement lands after `run` (the
+    /// shading normal of every closure), when the material has one.
+    pub displaced_normal: Option<Slot>,
 }
 
 /// A BSDF node as the renderer sees it: which closure it is, its type, and where each
@@ -167,6 +180,9 @@ impl Program {
     /// Runs every operation for one shading point.
     pub fn run(&self, sp: &ShadingPoint, s: &mut [f32]) {
         s.copy_from_slice(&self.initial);
+        // `sp` is what the ops read: `base`, or a bump copy's offset point.
+        let mut base = *sp;
+        let mut sp = base;
         for op in &self.ops {
             match *op {
                 Op::VectorToFloat { src, dst } => {
@@ -372,6 +388,32 @@ impl Program {
                     let r = image.lookup(uv[0], uv[1], interpolation, Extension::Repeat, unassociate);
                     put3(s, color, [r[0], r[1], r[2]]);
                     s[alpha as usize] = r[3];
+                }
+                Op::BumpPoint { point, width } => sp = offset_point(&base, point, width),
+                Op::Bump { settings, normal, strength, distance, center, dx, dy, dst } => {
+                    let n = normal.map_or(sp.normal, |n| v3(s, n));
+                    let r = bump_normal(&sp, settings, n, s[strength as usize], s[distance as usize], s[center as usize], s[dx as usize], s[dy as usize]);
+                    put3(s, dst, r);
+                }
+                Op::Displacement { object_space, height, midlevel, scale, normal, dst } => {
+                    let n = normal.map_or(sp.normal, |n| v3(s, n));
+                    let r = displacement(&sp, object_space, s[height as usize], s[midlevel as usize], s[scale as usize], n);
+                    put3(s, dst, r);
+                }
+                Op::VectorDisplacement { space, vector, midlevel, scale, dst } => {
+                    let r = vector_displacement(&sp, space, v3(s, vector), s[midlevel as usize], s[scale as usize]);
+                    put3(s, dst, r);
+                }
+                Op::DisplacementBump { object_space, center, dx, dy, dst } => {
+                    let n = displacement_bump(&base, object_space, v3(s, center), v3(s, dx), v3(s, dy));
+                    base.normal = n;
+                    base.object_normal = base.transform.inverse_normal(n);
+                    sp = base;
+                    put3(s, dst, n);
+                }
+                Op::NormalMap { space, color, strength, dst } => {
+                    let r = normal_map(&sp, space, v3(s, color), s[strength as usize]);
+                    put3(s, dst, r);
                 }
             }
         }

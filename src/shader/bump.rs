@@ -1,0 +1,269 @@
+//! Bump mapping as Cycles does it: ray differentials around a shading point
+//! (`kernel/util/differential.h`), the points the Height subgraph is evaluated at for its
+//! dx/dy copies (the bump variants of the coordinate nodes), and the Bump, Displacement,
+//! Vector Displacement and Normal Map nodes (`kernel/svm/displace.h`, `tex_coord.h`).
+
+use crate::nodes::math::{add3, cross3, dot3, length3, scale3, sub3, Vec3};
+
+use super::point::ShadingPoint;
+
+/// An object's transform as a shading point needs it: rows of the 3x4 object-to-world
+/// and world-to-object matrices. The default is the identity.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObjectTransform {
+    pub to_world: [[f32; 4]; 3],
+    pub to_object: [[f32; 4]; 3],
+}
+
+const IDENTITY: [[f32; 4]; 3] = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]];
+
+impl Default for ObjectTransform {
+    fn default() -> Self {
+        ObjectTransform { to_world: IDENTITY, to_object: IDENTITY }
+    }
+}
+
+fn point(m: &[[f32; 4]; 3], p: Vec3) -> Vec3 {
+    std::array::from_fn(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3])
+}
+fn dir(m: &[[f32; 4]; 3], d: Vec3) -> Vec3 {
+    std::array::from_fn(|r| m[r][0] * d[0] + m[r][1] * d[1] + m[r][2] * d[2])
+}
+fn dir_transposed(m: &[[f32; 4]; 3], d: Vec3) -> Vec3 {
+    std::array::from_fn(|c| m[0][c] * d[0] + m[1][c] * d[1] + m[2][c] * d[2])
+}
+
+impl ObjectTransform {
+    /// Cycles' object_inverse_position_transform.
+    pub fn inverse_point(&self, p: Vec3) -> Vec3 {
+        point(&self.to_object, p)
+    }
+    /// object_dir_transform / object_inverse_dir_transform.
+    pub fn dir(&self, d: Vec3) -> Vec3 {
+        dir(&self.to_world, d)
+    }
+    pub fn inverse_dir(&self, d: Vec3) -> Vec3 {
+        dir(&self.to_object, d)
+    }
+    /// object_normal_transform: world normal from an object-space one.
+    pub fn normal(&self, n: Vec3) -> Vec3 {
+        normalize(dir_transposed(&self.to_object, n))
+    }
+    /// object_inverse_normal_transform: object-space normal from a world one.
+    pub fn inverse_normal(&self, n: Vec3) -> Vec3 {
+        normalize(dir_transposed(&self.to_world, n))
+    }
+}
+
+pub fn normalize(v: Vec3) -> Vec3 {
+    let l = length3(v);
+    [v[0] / l, v[1] / l, v[2] / l]
+}
+
+pub fn safe_normalize(v: Vec3) -> Vec3 {
+    let l = length3(v);
+    if l != 0.0 {
+        [v[0] / l, v[1] / l, v[2] / l]
+    } else {
+        [0.0; 3]
+    }
+}
+
+fn signf(x: f32) -> f32 {
+    if x < 0.0 {
+        -1.0
+    } else {
+        1.0
+    }
+}
+
+/// Two unit tangents completing `n` to an orthonormal frame (Cycles' make_orthonormals:
+/// (1,1,1) x N, or (-1,1,1) x N when N is on the diagonal), which decides the directions
+/// a compact differential expands to. Bump results depend on it to second order.
+pub fn make_orthonormals(n: Vec3) -> (Vec3, Vec3) {
+    let a = if n[0] != n[1] || n[0] != n[2] { [n[2] - n[1], n[0] - n[2], n[1] - n[0]] } else { [n[2] - n[1], n[0] + n[2], -n[1] - n[0]] };
+    let a = normalize(a);
+    (a, cross3(n, a))
+}
+
+/// A compact differential (a radius) as the two vectors Cycles expands it to around `d`.
+pub fn differential_from_compact(d: Vec3, radius: f32) -> (Vec3, Vec3) {
+    let (x, y) = make_orthonormals(d);
+    (scale3(x, radius), scale3(y, radius))
+}
+
+/// Cycles' differential_make_compact: the mean length of the two differentials.
+pub fn differential_make_compact(dx: Vec3, dy: Vec3) -> f32 {
+    0.5 * (length3(dx) + length3(dy))
+}
+
+/// Changes of the barycentric (u, v) of a triangle along `dp` (Cycles' differential_dudv,
+/// Cramer's rule after dropping the axis the normal is largest along). `dpdu`, `dpdv` are
+/// p1 - p0 and p2 - p0 (the point is (1-u-v) p0 + u p1 + v p2).
+pub fn differential_dudv(mut dpdu: Vec3, mut dpdv: Vec3, mut dp: [Vec3; 2], ng: Vec3) -> [[f32; 2]; 2] {
+    let (xn, yn, zn) = (ng[0].abs(), ng[1].abs(), ng[2].abs());
+    if zn < xn || zn < yn {
+        if yn < xn || yn < zn {
+            dpdu[0] = dpdu[1];
+            dpdv[0] = dpdv[1];
+            dp[0][0] = dp[0][1];
+            dp[1][0] = dp[1][1];
+        }
+        dpdu[1] = dpdu[2];
+        dpdv[1] = dpdv[2];
+        dp[0][1] = dp[0][2];
+        dp[1][1] = dp[1][2];
+    }
+    let mut det = dpdu[0] * dpdv[1] - dpdv[0] * dpdu[1];
+    if det != 0.0 {
+        det = 1.0 / det;
+    }
+    // [[du/dx, dv/dx], [du/dy, dv/dy]]
+    std::array::from_fn(|k| [(dp[k][0] * dpdv[1] - dp[k][1] * dpdv[0]) * det, (dp[k][1] * dpdu[0] - dp[k][0] * dpdu[1]) * det])
+}
+
+/// The change of a triangle attribute (values at corners `f`) for barycentric changes `d`.
+pub fn attribute_differential(f: [Vec3; 3], d: [f32; 2]) -> Vec3 {
+    add3(scale3(sub3(f[1], f[0]), d[0]), scale3(sub3(f[2], f[0]), d[1]))
+}
+
+/// Which of the three Height evaluations a bump program is running.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BumpPoint {
+    Center,
+    Dx,
+    Dy,
+}
+
+/// The shading point as the coordinate nodes of a Bump's dx/dy copy see it: position,
+/// object coordinates, Generated and UV moved by `width` times the differential (Cycles'
+/// svm_node_bump_P_dx and the attribute nodes' bump variants). The normal stays.
+pub fn offset_point(sp: &ShadingPoint, which: BumpPoint, width: f32) -> ShadingPoint {
+    let (dp, dg, duv) = match which {
+        BumpPoint::Center => return *sp,
+        BumpPoint::Dx => (sp.dp_dx, sp.generated_dx, sp.uv_dx),
+        BumpPoint::Dy => (sp.dp_dy, sp.generated_dy, sp.uv_dy),
+    };
+    let mut o = *sp;
+    o.position = add3(sp.position, scale3(dp, width));
+    o.object_position = sp.transform.inverse_point(o.position);
+    o.generated = add3(sp.generated, scale3(dg, width));
+    o.uv = add3(sp.uv, scale3(duv, width));
+    o
+}
+
+/// The Bump node's settings that are not stack values.
+#[derive(Debug, Clone, Copy)]
+pub struct BumpSettings {
+    pub invert: bool,
+    pub object_space: bool,
+    pub filter_width: f32,
+}
+
+/// Cycles' svm_node_set_bump: the normal perturbed by the finite differences of the
+/// height sampled at the centre and at the dx/dy points.
+#[allow(clippy::too_many_arguments)]
+pub fn bump_normal(sp: &ShadingPoint, set: BumpSettings, normal_in: Vec3, strength: f32, distance: f32, h_c: f32, h_x: f32, h_y: f32) -> Vec3 {
+    let (mut n, mut dx, mut dy) = (normal_in, sp.dp_dx, sp.dp_dy);
+    if set.object_space {
+        n = sp.transform.inverse_normal(n);
+        dx = sp.transform.inverse_dir(dx);
+        dy = sp.transform.inverse_dir(dy);
+    }
+    let rx = cross3(dy, n);
+    let ry = cross3(n, dx);
+    let det = dot3(dx, rx);
+    let surfgrad = add3(scale3(rx, h_x - h_c), scale3(ry, h_y - h_c));
+    let absdet = det.abs();
+    let scale = if set.invert { -distance } else { distance };
+    let strength = strength.max(0.0);
+    let mut out = safe_normalize(sub3(scale3(n, set.filter_width * absdet), scale3(surfgrad, scale * signf(det))));
+    if out == [0.0; 3] {
+        out = n;
+    } else {
+        out = normalize(add3(scale3(out, strength), scale3(n, 1.0 - strength)));
+    }
+    if set.object_space {
+        out = sp.transform.normal(out);
+    }
+    out
+}
+
+/// Displacement node: the offset along the normal, world or object space.
+pub fn displacement(sp: &ShadingPoint, object_space: bool, height: f32, midlevel: f32, scale: f32, normal: Vec3) -> Vec3 {
+    let k = (height - midlevel) * scale;
+    if object_space {
+        sp.transform.dir(scale3(sp.transform.inverse_normal(normal), k))
+    } else {
+        scale3(normal, k)
+    }
+}
+
+/// The spaces of the Vector Displacement and Normal Map nodes (Cycles' NodeNormalMapSpace).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MapSpace {
+    Tangent,
+    Object,
+    World,
+    BlenderObject,
+    BlenderWorld,
+}
+
+impl MapSpace {
+    pub fn from_blender(s: &str) -> Option<MapSpace> {
+        Some(match s {
+            "TANGENT" => MapSpace::Tangent,
+            "OBJECT" => MapSpace::Object,
+            "WORLD" => MapSpace::World,
+            "BLENDER_OBJECT" => MapSpace::BlenderObject,
+            "BLENDER_WORLD" => MapSpace::BlenderWorld,
+            _ => return None,
+        })
+    }
+}
+
+/// Vector Displacement in object or world space (tangent space needs tangents).
+pub fn vector_displacement(sp: &ShadingPoint, space: MapSpace, vector: Vec3, midlevel: f32, scale: f32) -> Vec3 {
+    let d = scale3(sub3(vector, [midlevel; 3]), scale);
+    match space {
+        MapSpace::World => d,
+        _ => sp.transform.dir(d),
+    }
+}
+
+/// Normal Map in the non-tangent spaces (Cycles' svm_node_normal_map): the colour read as
+/// a normal, then blended toward the shading normal by strength.
+pub fn normal_map(sp: &ShadingPoint, space: MapSpace, color: Vec3, strength: f32) -> Vec3 {
+    let mut c = scale3(sub3(color, [0.5; 3]), 2.0);
+    if matches!(space, MapSpace::BlenderObject | MapSpace::BlenderWorld) {
+        c[1] = -c[1];
+        c[2] = -c[2];
+    }
+    let mut n = match space {
+        MapSpace::Object | MapSpace::BlenderObject => sp.transform.normal(c),
+        _ => safe_normalize(c),
+    };
+    if sp.backfacing {
+        n = scale3(n, -1.0);
+    }
+    if strength != 1.0 {
+        let s = strength.max(0.0);
+        n = safe_normalize(add3(sp.normal, scale3(sub3(n, sp.normal), s)));
+    }
+    if n == [0.0; 3] || !n.iter().all(|x| x.is_finite()) {
+        n = sp.normal;
+    }
+    n
+}
+
+/// The normal the displacement bump gives every closure: heights are the displacement
+/// projected on the unperturbed normal (Cycles' bump_from_displacement: distance 1,
+/// strength 1, the Bump node's default filter width).
+pub fn displacement_bump(sp: &ShadingPoint, object_space: bool, d_c: Vec3, d_x: Vec3, d_y: Vec3) -> Vec3 {
+    let n = sp.normal;
+    let set = BumpSettings { invert: false, object_space, filter_width: DEFAULT_FILTER_WIDTH };
+    bump_normal(sp, set, n, 1.0, 1.0, dot3(d_c, n), dot3(d_x, n), dot3(d_y, n))
+}
+
+/// Cycles' BumpNode default filter width, used by the displacement bump.
+pub const DEFAULT_FILTER_WIDTH: f32 = 0.1;
