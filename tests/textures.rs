@@ -82,3 +82,38 @@ fn fresh_cycles_bakes_match() {
     run_python(&py, &repo().join("fixtures/textures/make_texture_refs.py"), &["--out", out.to_str().unwrap()]);
     check(&out);
 }
+
+/// An image colour space that needs an OpenColorIO conversion is an error naming the
+/// material, node and image, never a stand-in; the export is left untouched.
+#[test]
+fn unsupported_colour_space_is_a_clear_error() {
+    let t = tempfile::tempdir().unwrap();
+    let dir = t.path().join("scene");
+    copy_dir(&repo().join("fixtures/textures/scene"), &dir);
+    let path = dir.join("scene.json");
+    let mut json: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    for im in json["images"].as_array_mut().unwrap() {
+        if im["name"] == "rgb8_srgb" {
+            im["colorspace"] = "ACEScg".into();
+        }
+    }
+    std::fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+    let out = t.path().join("o.exr");
+    let o = run(&["bake", dir.to_str().unwrap(), "--object", "img_linear_repeat", "--size", "8", "-o", out.to_str().unwrap()], &[]);
+    assert_clean_error(&o, 1, &["img_linear_repeat", "Image Texture", "rgb8_srgb", "ACEScg"]);
+    assert!(!out.exists());
+}
+
+/// A missing image file renders magenta (Cycles' convention) with a warning naming it.
+#[test]
+fn missing_image_is_magenta_with_a_warning() {
+    let dir = repo().join("fixtures/textures/scene");
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("m.exr");
+    let o = run(&["bake", dir.to_str().unwrap(), "--object", "img_missing", "--size", "8", "-o", out.to_str().unwrap()], &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(stderr(&o).contains("\"missing\"") && stderr(&o).contains("magenta"), "{}", stderr(&o));
+    let img = image::open(&out).unwrap().into_rgba32f();
+    let p = img.get_pixel(4, 4).0;
+    assert_eq!([p[0], p[1], p[2]], [1.0, 0.0, 1.0]);
+}
