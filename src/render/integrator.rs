@@ -450,7 +450,7 @@ impl Scene<'_> {
         let Some(map) = self.world.and_then(|w| w.map.as_ref()) else { return [0.0; 3] };
         let Some((wi, pdf_l)) = map.sample(u) else { return [0.0; 3] };
         let (f, pdf_b) = scratch.lobes.eval(wo, wi, ng, self.tables);
-        if is_zero(f) || !(pdf_l > 0.0) {
+        if is_zero(f) || pdf_l.is_nan() || pdf_l <= 0.0 {
             return [0.0; 3];
         }
         let eps = 1e-5 * (1.0 + max3(p.map(f32::abs)));

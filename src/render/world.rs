@@ -150,7 +150,7 @@ impl WorldMap {
             }
         }
         let total: f64 = f.iter().sum();
-        if !(total > 0.0) || !total.is_finite() {
+        if !total.is_finite() || total <= 0.0 {
             return None;
         }
         let mut rows = Vec::with_capacity(h * (w + 1));
