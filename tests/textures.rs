@@ -82,3 +82,95 @@ fn fresh_cycles_bakes_match() {
     run_python(&py, &repo().join("fixtures/textures/make_texture_refs.py"), &["--out", out.to_str().unwrap()]);
     check(&out);
 }
+
+/// An image colour space that needs an OpenColorIO conversion is an error naming the
+/// material, node and image, never a stand-in; the export is left untouched.
+#[test]
+fn unsupported_colour_space_is_a_clear_error() {
+    let t = tempfile::tempdir().unwrap();
+    let dir = t.path().join("scene");
+    copy_dir(&repo().join("fixtures/textures/scene"), &dir);
+    let path = dir.join("scene.json");
+    let mut json: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    for im in json["images"].as_array_mut().unwrap() {
+        if im["name"] == "rgb8_srgb" {
+            im["colorspace"] = "ACEScg".into();
+        }
+    }
+    std::fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+    let out = t.path().join("o.exr");
+    let o = run(&["bake", dir.to_str().unwrap(), "--object", "img_linear_repeat", "--size", "8", "-o", out.to_str().unwrap()], &[]);
+    assert_clean_error(&o, 1, &["img_linear_repeat", "Image Texture", "rgb8_srgb", "ACEScg"]);
+    assert!(!out.exists());
+}
+
+/// A missing image file renders magenta (Cycles' convention) with a warning naming it.
+#[test]
+fn missing_image_is_magenta_with_a_warning() {
+    let dir = repo().join("fixtures/textures/scene");
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("m.exr");
+    let o = run(&["bake", dir.to_str().unwrap(), "--object", "img_missing", "--size", "8", "-o", out.to_str().unwrap()], &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    assert!(stderr(&o).contains("\"missing\"") && stderr(&o).contains("magenta"), "{}", stderr(&o));
+    let img = image::open(&out).unwrap().into_rgba32f();
+    let p = img.get_pixel(4, 4).0;
+    assert_eq!([p[0], p[1], p[2]], [1.0, 0.0, 1.0]);
+}
+
+/// The committed cases cover every mode the registry claims: each interpolation x
+/// extension pair, each projection, each environment projection, each alpha mode and
+/// image type, so a smaller regenerated case set cannot pass silently.
+#[test]
+fn cases_cover_every_mode() {
+    use blendsynth::nodes::image::{EnvProjection, Extension, Interpolation, Projection};
+    use std::collections::BTreeSet;
+    let scene = Scene::load(&repo().join("fixtures/textures/scene")).unwrap();
+    let (mut pairs, mut projections, mut envs, mut images) = (BTreeSet::new(), BTreeSet::new(), BTreeSet::new(), BTreeSet::new());
+    let mut brick_frequencies = BTreeSet::new();
+    for m in &scene.file.materials {
+        for n in &m.node_tree.as_ref().unwrap().nodes {
+            let p = |k: &str| n.properties.get(k).and_then(|v| v.as_str()).unwrap_or("").to_string();
+            match n.bl_idname.as_str() {
+                "ShaderNodeTexImage" => {
+                    pairs.insert((p("interpolation"), p("extension")));
+                    projections.insert(p("projection"));
+                    if let Some(name) = n.properties.get("image").and_then(|v| v.get("name")).and_then(|v| v.as_str()) {
+                        images.insert(name.to_string());
+                    }
+                }
+                "ShaderNodeTexEnvironment" => {
+                    envs.insert(p("projection"));
+                }
+                "ShaderNodeTexBrick" => {
+                    brick_frequencies.insert((n.properties["offset_frequency"].as_i64(), n.properties["squash_frequency"].as_i64()));
+                }
+                _ => {}
+            }
+        }
+    }
+    for i in Interpolation::ALL {
+        for e in Extension::ALL {
+            assert!(pairs.contains(&(i.blender_name().to_string(), e.blender_name().to_string())), "no case for {i:?} x {e:?}");
+        }
+    }
+    for p in Projection::ALL {
+        assert!(projections.contains(p.blender_name()), "no case for projection {p:?}");
+    }
+    for p in EnvProjection::ALL {
+        assert!(envs.contains(p.blender_name()), "no case for environment projection {p:?}");
+    }
+    let modes: BTreeSet<String> = scene.file.images.iter().filter(|i| images.contains(&i.name)).filter_map(|i| i.alpha_mode.clone()).collect();
+    for m in ["STRAIGHT", "PREMUL", "CHANNEL_PACKED", "NONE"] {
+        assert!(modes.contains(m), "no case for alpha mode {m}");
+    }
+    let spaces: BTreeSet<String> = scene.file.images.iter().filter(|i| images.contains(&i.name)).filter_map(|i| i.colorspace.clone()).collect();
+    for s in ["sRGB", "Non-Color", "Linear Rec.709"] {
+        assert!(spaces.contains(s), "no case for colour space {s}");
+    }
+    let files: BTreeSet<String> = scene.file.images.iter().filter_map(|i| i.file.as_deref().and_then(|f| f.rsplit('.').next()).map(str::to_string)).collect();
+    for ext in ["png", "jpg", "exr"] {
+        assert!(files.contains(ext), "no {ext} image");
+    }
+    assert!(brick_frequencies.len() >= 3, "brick cases should vary offset/squash frequencies: {brick_frequencies:?}");
+}

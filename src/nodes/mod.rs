@@ -141,6 +141,16 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeMapping",
     // vector_rotate.rs
     "ShaderNodeVectorRotate",
+    // brick.rs, image.rs (+ shader/images.rs): every interpolation, extension,
+    // projection and alpha mode in tests/textures.rs. Image colour spaces other than
+    // sRGB, Non-Color and Linear Rec.709, and sequences/UDIM, are compile errors naming
+    // the image, never stand-ins.
+    "ShaderNodeTexBrick",
+    "ShaderNodeTexImage",
+    "ShaderNodeTexEnvironment",
+    // World surfaces (render/world.rs): tests/world.rs.
+    "ShaderNodeBackground",
+    "ShaderNodeOutputWorld",
 ];
 
 /// Support for a node inside a tree of type `tree` (`ShaderNodeTree`,

@@ -230,7 +230,8 @@ impl Scene<'_> {
                 }
             }
             let Some(h) = hit_opt else {
-                let c = clamp_contrib(mul(throughput, self.background_toward(d, scratch)), clamp_limit);
+                let w = self.world_mis_weight(d, prev_singular, prev_pdf);
+                let c = clamp_contrib(scale(mul(throughput, self.background_toward(d, scratch)), w), clamp_limit);
                 if finite(c) {
                     l = add(l, c);
                 }
@@ -362,6 +363,15 @@ impl Scene<'_> {
                     }
                 }
             }
+            // One light sample toward the world, where it varies with direction.
+            if !terminate_next && scratch.lobes.len > 0 {
+                let u_world = rng.get4(index, 0x2000_0000 + set);
+                let c = self.world_light_sample(hit.p, hit.ng, wo, [u_world[0], u_world[1]], scratch);
+                let c = mul(throughput, c);
+                if finite(c) && !is_zero(c) {
+                    l = add(l, clamp_contrib(c, if bounce == 0 { st.clamp_direct } else { st.clamp_indirect }));
+                }
+            }
             let lobes = &scratch.lobes;
             let Some(bs) = lobes.sample(wo, hit.ng, [u_bsdf[0], u_bsdf[1], u_bsdf[2]], self.tables) else { break };
             if !finite(bs.weight) || is_zero(bs.weight) {
@@ -453,5 +463,36 @@ impl Scene<'_> {
             (Some(w), Some(stack)) => w.eval(d, stack),
             _ => self.background,
         }
+    }
+}
+
+impl Scene<'_> {
+    /// MIS weight of world radiance reached by a BSDF-sampled ray (1 when the world is
+    /// not light-sampled or the ray came from a singular lobe or the camera).
+    fn world_mis_weight(&self, d: V3, prev_singular: bool, prev_pdf: f32) -> f32 {
+        match self.world.and_then(|w| w.map.as_ref()) {
+            Some(map) if !prev_singular => power_heuristic(prev_pdf, map.pdf(d)),
+            _ => 1.0,
+        }
+    }
+
+    /// Next-event estimate toward the world from surface point `p` (BSDF in
+    /// `scratch.lobes`), MIS-weighted against BSDF sampling; zero if unoccluded paths
+    /// see nothing or the world is not light-sampled.
+    fn world_light_sample(&self, p: V3, ng: V3, wo: V3, u: [f32; 2], scratch: &mut Scratch) -> V3 {
+        let Some(map) = self.world.and_then(|w| w.map.as_ref()) else { return [0.0; 3] };
+        let Some((wi, pdf_l)) = map.sample(u) else { return [0.0; 3] };
+        let (f, pdf_b) = scratch.lobes.eval(wo, wi, ng, self.tables);
+        if is_zero(f) || pdf_l.is_nan() || pdf_l <= 0.0 {
+            return [0.0; 3];
+        }
+        let eps = 1e-5 * (1.0 + max3(p.map(f32::abs)));
+        let start = if dot(wi, ng) >= 0.0 { madd(p, ng, eps) } else { madd(p, ng, -eps) };
+        scratch.rays += 1;
+        if self.accel.occluded(start, wi, 0.0, f32::INFINITY) {
+            return [0.0; 3];
+        }
+        let le = self.background_toward(wi, scratch);
+        scale(mul(f, le), power_heuristic(pdf_l, pdf_b) / pdf_l)
     }
 }

@@ -48,6 +48,8 @@ pub fn background(scene: &Scene) -> Result<V3, RenderError> {
 /// that leaves the scene.
 pub struct WorldShader {
     pub program: crate::shader::Program,
+    /// Importance map for light sampling toward the world (None: black world).
+    pub map: Option<WorldMap>,
 }
 
 impl WorldShader {
@@ -77,8 +79,13 @@ pub fn shader(scene: &Scene) -> Result<Option<WorldShader>, RenderError> {
         return Ok(None);
     }
     let program = crate::shader::compile::compile_world(scene, name).map_err(|e| RenderError(e.to_string()))?;
-    Ok(Some(WorldShader { program }))
+    let mut shader = WorldShader { program, map: None };
+    shader.map = WorldMap::build(&shader, MAP_WIDTH, MAP_WIDTH / 2);
+    Ok(Some(shader))
 }
+
+/// Columns of the world importance map (rows: half as many).
+const MAP_WIDTH: usize = 512;
 
 /// True when the world output is fed by a Background or Emission node with unlinked
 /// inputs (or by nothing): `background` handles that without a program.
@@ -93,4 +100,106 @@ fn is_constant(tree: &crate::scene::NodeTree) -> bool {
     let Some(link) = tree.links.iter().find(|l| l.to_node == out.name && l.to_socket == "Surface" && !l.is_muted) else { return true };
     let Some(node) = tree.nodes.iter().find(|n| n.name == link.from_node) else { return true };
     (node.bl_idname == "ShaderNodeBackground" || node.bl_idname == "ShaderNodeEmission") && !node.mute && !tree.links.iter().any(|l| l.to_node == node.name && !l.is_muted)
+}
+
+/// Importance sampling of a world that varies with direction: a piecewise-constant
+/// distribution over the equirectangular square, each cell weighted by the luminance of
+/// the world at its centre times the cell's solid angle (sin theta), as Cycles builds
+/// its background map. The pdf is exact for the distribution it samples, so any map
+/// gives unbiased results; a better map only lowers noise.
+pub struct WorldMap {
+    w: usize,
+    h: usize,
+    /// Per row: the cumulative distribution over its columns (w + 1 entries).
+    rows: Vec<f32>,
+    /// Cumulative distribution over rows (h + 1 entries).
+    marginal: Vec<f32>,
+    /// Cell weights, normalised so that the mean is 1 (pdf over the unit square).
+    pdf: Vec<f32>,
+}
+
+fn equirect_direction(u: f32, v: f32) -> (V3, f32) {
+    use std::f32::consts::PI;
+    let phi = -2.0 * PI * u + PI;
+    let theta = -PI * v + PI;
+    let st = theta.sin();
+    ([st * phi.cos(), st * phi.sin(), theta.cos()], st)
+}
+
+/// Index of the bucket of `cdf` (ascending, 0..1) holding `x`, and the position in it.
+fn pick(cdf: &[f32], x: f32) -> (usize, f32) {
+    let n = cdf.len() - 1;
+    let i = cdf.partition_point(|&c| c <= x).saturating_sub(1).min(n - 1);
+    let width = cdf[i + 1] - cdf[i];
+    let t = if width > 0.0 { ((x - cdf[i]) / width).clamp(0.0, 1.0) } else { 0.5 };
+    (i, t)
+}
+
+impl WorldMap {
+    /// Builds the map by running the world program at every cell centre. None when the
+    /// world is black everywhere (nothing to sample).
+    pub fn build(shader: &WorldShader, w: usize, h: usize) -> Option<WorldMap> {
+        let mut stack = Vec::new();
+        let mut f = vec![0.0f64; w * h];
+        for j in 0..h {
+            for i in 0..w {
+                let (d, st) = equirect_direction((i as f32 + 0.5) / w as f32, (j as f32 + 0.5) / h as f32);
+                let c = shader.eval(d, &mut stack);
+                let lum = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+                f[j * w + i] = if lum.is_finite() && lum > 0.0 { lum as f64 * st as f64 } else { 0.0 };
+            }
+        }
+        let total: f64 = f.iter().sum();
+        if !total.is_finite() || total <= 0.0 {
+            return None;
+        }
+        let mut rows = Vec::with_capacity(h * (w + 1));
+        let mut marginal = Vec::with_capacity(h + 1);
+        marginal.push(0.0f32);
+        let mut acc_rows = 0.0f64;
+        for j in 0..h {
+            let row = &f[j * w..(j + 1) * w];
+            let sum: f64 = row.iter().sum();
+            let mut acc = 0.0f64;
+            rows.push(0.0f32);
+            for &x in row {
+                acc += x;
+                rows.push(if sum > 0.0 { (acc / sum) as f32 } else { 0.0 });
+            }
+            acc_rows += sum;
+            marginal.push((acc_rows / total) as f32);
+        }
+        let n = (w * h) as f64;
+        let pdf = f.iter().map(|&x| (x * n / total) as f32).collect();
+        Some(WorldMap { w, h, rows, marginal, pdf })
+    }
+
+    /// A direction drawn from the map and its solid-angle pdf.
+    pub fn sample(&self, u: [f32; 2]) -> Option<(V3, f32)> {
+        let (j, tv) = pick(&self.marginal, u[0]);
+        let row = &self.rows[j * (self.w + 1)..(j + 1) * (self.w + 1)];
+        let (i, tu) = pick(row, u[1]);
+        let p = self.pdf[j * self.w + i];
+        if p <= 0.0 {
+            return None;
+        }
+        let (d, st) = equirect_direction((i as f32 + tu) / self.w as f32, (j as f32 + tv) / self.h as f32);
+        if st <= 0.0 {
+            return None;
+        }
+        Some((d, p / (2.0 * std::f32::consts::PI * std::f32::consts::PI * st)))
+    }
+
+    /// The solid-angle pdf with which `sample` draws direction `d` (unit).
+    pub fn pdf(&self, d: V3) -> f32 {
+        let uv = crate::nodes::image::direction_to_equirectangular(d);
+        let u = uv[0] - uv[0].floor();
+        let i = ((u * self.w as f32) as usize).min(self.w - 1);
+        let j = ((uv[1].clamp(0.0, 1.0) * self.h as f32) as usize).min(self.h - 1);
+        let st = (1.0 - d[2] * d[2]).max(0.0).sqrt();
+        if st <= 0.0 {
+            return 0.0;
+        }
+        self.pdf[j * self.w + i] / (2.0 * std::f32::consts::PI * std::f32::consts::PI * st)
+    }
 }
