@@ -24,13 +24,13 @@ const ASSERTED: &[&str] = &[
     "glass_rough",
     "refraction",
     "sss_principled",
+    "oren_nayar",
+    "glossy_beckmann",
 ];
 
 /// Scenes that do not pass yet, with the reason.
 const KNOWN_FAILURES: &[(&str, &str)] = &[
     ("sss_node", "ratio ~1.21: the Burley method's disk projection is not implemented; it is rendered by the random walk with Burley's radius scaling"),
-    ("glossy_beckmann", "Beckmann Glossy not implemented yet (rendered as GGX)"),
-    ("oren_nayar", "Oren-Nayar diffuse not implemented yet (rendered as Lambert)"),
     ("sheen", "Sheen BSDF not implemented yet (falls back to diffuse)"),
     ("translucent", "ratio ~1.15, on the limit: light through a translucent sheet is slightly noisier than Cycles (means match to 0.03%)"),
 ];

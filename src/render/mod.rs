@@ -20,6 +20,7 @@ pub mod integrator;
 pub mod light;
 pub mod math;
 pub mod microfacet;
+pub mod oren_nayar;
 pub mod sampler;
 pub mod shade;
 pub mod subsurface;

@@ -149,7 +149,14 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
     match b.bl_idname.as_str() {
         "ShaderNodeBsdfDiffuse" => {
             let c = input_c(b, s, "Color", [0.8; 3]);
-            out.push(LobeKind::Diffuse, scale(c, w), input_n(b, s, "Normal", sp));
+            let n = input_n(b, s, "Normal", sp);
+            let r = input_f(b, s, "Roughness", 0.0);
+            if r >= 1e-5 {
+                let on = super::oren_nayar::OrenNayar::new(r, c, dot(n, ctx.wo));
+                out.push(LobeKind::OrenNayar(on), scale(c, w), n);
+            } else {
+                out.push(LobeKind::Diffuse, scale(c, w), n);
+            }
         }
         "ShaderNodeBsdfTranslucent" => {
             let c = input_c(b, s, "Color", [0.8; 3]);
@@ -166,6 +173,11 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             let c = input_c(b, s, "Color", [0.8; 3]);
             let r = input_f(b, s, "Roughness", 0.5).clamp(0.0, 1.0);
             let n = input_n(b, s, "Normal", sp);
+            if b.property("distribution") == Some("BECKMANN") {
+                let r = super::microfacet::Reflection { dist: super::microfacet::Distribution::Beckmann, alpha: r * r };
+                out.push(LobeKind::Reflection(r), scale(c, w), n);
+                return;
+            }
             let multi = b.property("distribution") == Some("MULTI_GGX");
             let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
             let energy = if multi { multiscatter_energy(ctx.tables, mu, r) } else { 1.0 };
@@ -266,6 +278,12 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         let aniso = input_f(b, s, "Subsurface Anisotropy", 0.0);
         push_bssrdf(out, scale(mul(weight, base), ss), radius, base, aniso, ss_ior, roughness, method, n);
         weight = scale(weight, 1.0 - ss);
+    }
+    let diffuse_roughness = input_f(b, s, "Diffuse Roughness", 0.0);
+    if diffuse_roughness >= 1e-5 {
+        let on = super::oren_nayar::OrenNayar::new(diffuse_roughness, base, dot(n, ctx.wo));
+        out.push(LobeKind::OrenNayar(on), mul(weight, base), n);
+        return;
     }
     out.push(LobeKind::Diffuse, mul(weight, base), n);
 }
