@@ -4,8 +4,9 @@
 //! transparent. `eval` returns BSDF times the cosine, as Cycles' closures do.
 
 use super::math::*;
-use super::microfacet::Dielectric;
+use super::microfacet::{Dielectric, Reflection};
 use super::subsurface::Bssrdf;
+use super::oren_nayar::OrenNayar;
 use super::tables::Tables;
 use std::f32::consts::PI;
 
@@ -31,6 +32,10 @@ pub enum LobeKind {
     /// BSSRDF (random walk subsurface scattering): picked like a BSDF, never evaluated;
     /// the integrator walks the medium (see `subsurface`).
     Subsurface(Bssrdf),
+    /// Oren-Nayar diffuse (Diffuse BSDF with roughness > 0).
+    OrenNayar(OrenNayar),
+    /// Glossy reflection with the Beckmann distribution.
+    Reflection(Reflection),
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -161,7 +166,7 @@ impl LobeSet {
             return Some(BsdfSample { wi: ds.l, weight: scale(f, 1.0 / pdf), pdf, singular: false, glossy, transmit, kind: l.kind });
         }
         let (wi, singular) = sample_lobe(l, wo, ng, [u[0], u[1]])?;
-        let glossy = matches!(l.kind, LobeKind::Glossy { .. });
+        let glossy = matches!(l.kind, LobeKind::Glossy { .. } | LobeKind::Reflection(_));
         let transmit = matches!(l.kind, LobeKind::Translucent | LobeKind::Transparent);
         if singular {
             // Mirror or pass-through: only this lobe contributes, with its discrete probability.
@@ -285,6 +290,17 @@ fn eval_lobe(l: &Lobe, wo: V3, wi: V3, ng: V3, _tables: &Tables) -> (V3, f32) {
             }
         }
         LobeKind::Transparent | LobeKind::Subsurface(_) => ([0.0; 3], 0.0),
+        LobeKind::Reflection(r) => {
+            let (f, p) = r.eval(l.n, wo, wi, ng);
+            ([f; 3], p)
+        }
+        LobeKind::OrenNayar(on) => {
+            if cos_i > 0.0 && same_side {
+                (on.eval(l.n, wo, wi), cos_i / PI)
+            } else {
+                ([0.0; 3], 0.0)
+            }
+        }
         LobeKind::Glass(g) => g.eval(l.n, wo, wi, ng),
         LobeKind::Glossy { alpha, fresnel, energy } => {
             if alpha < SINGULAR_ALPHA || !same_side || cos_i <= 0.0 {
@@ -312,7 +328,7 @@ fn eval_lobe(l: &Lobe, wo: V3, wi: V3, ng: V3, _tables: &Tables) -> (V3, f32) {
 
 fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
     match l.kind {
-        LobeKind::Diffuse | LobeKind::Translucent => {
+        LobeKind::Diffuse | LobeKind::Translucent | LobeKind::OrenNayar(_) => {
             let d = super::camera::concentric_disk(u);
             let z = (1.0 - d[0] * d[0] - d[1] * d[1]).max(0.0).sqrt();
             let n = if let LobeKind::Translucent = l.kind { neg(l.n) } else { l.n };
@@ -321,6 +337,7 @@ fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
         }
         LobeKind::Transparent => Some((neg(wo), true)),
         LobeKind::Glass(_) | LobeKind::Subsurface(_) => None, // sampled elsewhere
+        LobeKind::Reflection(r) => r.sample(l.n, wo, ng, u),
         LobeKind::Glossy { alpha, .. } => {
             if alpha < SINGULAR_ALPHA {
                 let wi = sub(scale(l.n, 2.0 * dot(l.n, wo)), wo);

@@ -262,6 +262,9 @@ impl Scene<'_> {
                         if let LobeKind::Glass(g) = &mut lobe.kind {
                             g.alpha = g.alpha.max(blur);
                         }
+                        if let LobeKind::Reflection(r) = &mut lobe.kind {
+                            r.alpha = r.alpha.max(blur);
+                        }
                     }
                 }
             }
@@ -435,6 +438,19 @@ impl Scene<'_> {
                     }
                 }
                 LobeKind::Subsurface(_) => {}
+                LobeKind::Reflection(_) => {
+                    if glossy >= st.max_glossy {
+                        terminate_next = true;
+                    }
+                    glossy += 1;
+                }
+                LobeKind::OrenNayar(_) => {
+                    diffuse_ancestor = true;
+                    if diffuse >= st.max_diffuse {
+                        terminate_next = true;
+                    }
+                    diffuse += 1;
+                }
             }
             if bounce >= st.max_bounces {
                 terminate_next = true;

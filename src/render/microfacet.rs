@@ -364,3 +364,54 @@ pub fn glass_closure(tables: &super::tables::Tables, distribution: Option<&str>,
     }
     g
 }
+
+/// Microfacet reflection without Fresnel (Glossy BSDF: the colour is the closure
+/// weight), for the Beckmann distribution (isotropic GGX keeps `LobeKind::Glossy`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reflection {
+    pub dist: Distribution,
+    pub alpha: f32,
+}
+
+impl Reflection {
+    pub fn singular(&self) -> bool {
+        self.alpha * self.alpha <= ROUGHNESS_SQ_THRESH
+    }
+
+    /// (BSDF * cos, pdf) toward `l`.
+    pub fn eval(&self, n: V3, v: V3, l: V3, ng: V3) -> (f32, f32) {
+        let cos_nv = dot(n, v);
+        let cos_nl = dot(n, l);
+        if cos_nv <= 0.0 || cos_nl <= 0.0 || dot(ng, l) <= 0.0 || self.singular() {
+            return (0.0, 0.0);
+        }
+        let h = normalize(add(v, l));
+        let a2 = self.alpha * self.alpha;
+        let dd = d(self.dist, a2, dot(n, h));
+        let lv = lambda(self.dist, a2, cos_nv);
+        let ll = lambda(self.dist, a2, cos_nl);
+        let common = dd / cos_nv * 0.25;
+        (common / (1.0 + lv + ll), common / (1.0 + lv))
+    }
+
+    /// A reflected direction from a visible normal (or the mirror direction), and whether
+    /// it is singular.
+    pub fn sample(&self, n: V3, v: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
+        let cos_nv = dot(n, v);
+        if cos_nv <= 0.0 {
+            return None;
+        }
+        let h = if self.singular() {
+            n
+        } else {
+            let (tx, ty) = basis(n);
+            let hl = sample_vndf(self.dist, [dot(v, tx), dot(v, ty), cos_nv], self.alpha, self.alpha, u);
+            add(add(scale(tx, hl[0]), scale(ty, hl[1])), scale(n, hl[2]))
+        };
+        let l = sub(scale(h, 2.0 * dot(h, v)), v);
+        if dot(ng, l) <= 0.0 || dot(n, l) <= 0.0 {
+            return None;
+        }
+        Some((l, self.singular()))
+    }
+}

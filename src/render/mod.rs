@@ -21,6 +21,7 @@ pub mod light;
 pub mod math;
 pub mod motion;
 pub mod microfacet;
+pub mod oren_nayar;
 pub mod sampler;
 pub mod shade;
 pub mod subsurface;

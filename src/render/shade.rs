@@ -149,7 +149,14 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
     match b.bl_idname.as_str() {
         "ShaderNodeBsdfDiffuse" => {
             let c = input_c(b, s, "Color", [0.8; 3]);
-            out.push(LobeKind::Diffuse, scale(c, w), input_n(b, s, "Normal", sp));
+            let n = input_n(b, s, "Normal", sp);
+            let r = input_f(b, s, "Roughness", 0.0);
+            if r >= 1e-5 {
+                let on = super::oren_nayar::OrenNayar::new(r, c, dot(n, ctx.wo));
+                out.push(LobeKind::OrenNayar(on), scale(c, w), n);
+            } else {
+                out.push(LobeKind::Diffuse, scale(c, w), n);
+            }
         }
         "ShaderNodeBsdfTranslucent" => {
             let c = input_c(b, s, "Color", [0.8; 3]);
@@ -166,6 +173,11 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             let c = input_c(b, s, "Color", [0.8; 3]);
             let r = input_f(b, s, "Roughness", 0.5).clamp(0.0, 1.0);
             let n = input_n(b, s, "Normal", sp);
+            if b.property("distribution") == Some("BECKMANN") {
+                let r = super::microfacet::Reflection { dist: super::microfacet::Distribution::Beckmann, alpha: r * r };
+                out.push(LobeKind::Reflection(r), scale(c, w), n);
+                return;
+            }
             let multi = b.property("distribution") == Some("MULTI_GGX");
             let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
             let energy = if multi { multiscatter_energy(ctx.tables, mu, r) } else { 1.0 };
@@ -216,6 +228,10 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
     let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
     let energy = multiscatter_energy(ctx.tables, mu, roughness);
     let a = roughness * roughness;
+    let coat = input_f(b, s, "Coat Weight", 0.0).clamp(0.0, 1.0);
+    if coat > 0.0 {
+        weight = principled_coat(b, s, sp, ctx, out, weight, coat);
+    }
     if metallic > 0.0 {
         // F82-tint Schlick: b chosen so F(acos 1/7) = Schlick * tint.
         let f = 6.0f32 / 7.0;
@@ -267,6 +283,12 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         push_bssrdf(out, scale(mul(weight, base), ss), radius, base, aniso, ss_ior, roughness, method, n);
         weight = scale(weight, 1.0 - ss);
     }
+    let diffuse_roughness = input_f(b, s, "Diffuse Roughness", 0.0);
+    if diffuse_roughness >= 1e-5 {
+        let on = super::oren_nayar::OrenNayar::new(diffuse_roughness, base, dot(n, ctx.wo));
+        out.push(LobeKind::OrenNayar(on), mul(weight, base), n);
+        return;
+    }
     out.push(LobeKind::Diffuse, mul(weight, base), n);
 }
 
@@ -285,4 +307,25 @@ fn push_bssrdf(out: &mut LobeSet, weight: V3, radius: V3, albedo: V3, aniso: f32
             out.lobes[before].sample_weight *= channels as f32;
         }
     }
+}
+
+/// Principled coat as Cycles 4.x layers it: a dielectric GGX lobe (Multiscatter) on top,
+/// the layers below attenuated by its albedo and by the coat tint along the refracted
+/// path (tint^(1 / cos) mixed by the coat weight). Returns the weight left for them.
+fn principled_coat(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet, weight: V3, coat: f32) -> V3 {
+    let rough = input_f(b, s, "Coat Roughness", 0.03).clamp(0.0, 1.0);
+    let coat_ior = input_f(b, s, "Coat IOR", 1.5).max(1.0);
+    let tint = input_c(b, s, "Coat Tint", [1.0; 3]).map(|x| x.max(0.0));
+    let n = input_n(b, s, "Coat Normal", sp);
+    let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
+    let energy = multiscatter_energy(ctx.tables, mu, rough);
+    let e = (ctx.tables.dielectric_e(mu, rough, coat_ior) * energy).clamp(0.0, 1.0);
+    out.push_scaled(LobeKind::Glossy { alpha: rough * rough, fresnel: Fresnel::Dielectric { eta: coat_ior }, energy }, scale(weight, coat), n, e.max(1e-3));
+    let mut below = scale(weight, (1.0 - coat * e).clamp(0.0, 1.0));
+    if tint != [1.0; 3] {
+        let cos_t = (1.0 - (1.0 - mu * mu) / (coat_ior * coat_ior)).max(1e-6).sqrt();
+        let depth = 1.0 / cos_t;
+        below = mul(below, tint.map(|t| 1.0 - coat + coat * t.powf(depth)));
+    }
+    below
 }

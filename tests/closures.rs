@@ -1,0 +1,101 @@
+//! Properties the closures must have whatever the scene: sampling agrees with
+//! evaluation (same value and pdf), and the energy-preserving closures keep a white
+//! furnace white (Cycles' Multiscatter GGX glass and its Oren-Nayar both promise this).
+
+use blendsynth::render::math::{basis, dot, normalize};
+use blendsynth::render::microfacet::{glass_closure, Distribution, Dielectric};
+use blendsynth::render::oren_nayar::OrenNayar;
+use blendsynth::render::sampler::PixelSampler;
+use blendsynth::render::tables::Tables;
+
+fn view(mu: f32) -> [f32; 3] {
+    [(1.0 - mu * mu).sqrt(), 0.0, mu]
+}
+
+const N: [f32; 3] = [0.0, 0.0, 1.0];
+
+#[test]
+fn rough_glass_sample_matches_eval() {
+    let s = PixelSampler::new(3, 5, 7);
+    for dist in [Distribution::Ggx, Distribution::Beckmann] {
+        for eta in [1.5f32, 1.0 / 1.5] {
+            let g = Dielectric { dist, alpha: 0.3, eta, refract_only: false, tint_r: [1.0; 3], tint_t: [1.0; 3], energy: 1.0 };
+            let v = view(0.6);
+            let mut checked = 0;
+            for i in 0..2000 {
+                let u = s.get4(i, 0);
+                let Some(ds) = g.sample(N, v, N, [u[0], u[1], u[2]]) else { continue };
+                let (f, pdf) = g.eval(N, v, ds.l, N);
+                assert!(!ds.singular);
+                let rel = (pdf - ds.pdf).abs() / pdf.max(1e-6);
+                assert!(rel < 2e-3, "{dist:?} eta {eta}: pdf {pdf} vs sampled {}", ds.pdf);
+                let w = f[0] / pdf;
+                assert!((w - ds.weight[0]).abs() <= 2e-3 * w.max(1.0), "{dist:?} eta {eta}: weight {w} vs {}", ds.weight[0]);
+                checked += 1;
+            }
+            assert!(checked > 1500, "{dist:?} eta {eta}: only {checked} valid samples");
+        }
+    }
+}
+
+/// Mean sampled weight of Multiscatter GGX glass: one (all light reflected or refracted).
+#[test]
+fn multiscatter_glass_is_white() {
+    let tables = Tables::shared();
+    let s = PixelSampler::new(9, 4, 2);
+    for (rough, ior, backfacing) in [(0.3f32, 1.5f32, false), (0.7, 1.45, false), (0.5, 1.33, true)] {
+        for mu in [0.3f32, 0.8] {
+            let g = glass_closure(tables, Some("MULTI_GGX"), false, rough, ior, backfacing, mu);
+            let v = view(mu);
+            let n = 20000;
+            let mut sum = 0.0f64;
+            for i in 0..n {
+                let u = s.get4(i, 1);
+                if let Some(ds) = g.sample(N, v, N, [u[0], u[1], u[2]]) {
+                    sum += ds.weight[0] as f64;
+                }
+            }
+            let e = sum / n as f64;
+            assert!((e - 1.0).abs() < 0.03, "roughness {rough} ior {ior} back {backfacing} mu {mu}: albedo {e}");
+        }
+    }
+    // Plain GGX glass (single scattering) loses energy at this roughness.
+    let g = glass_closure(tables, Some("GGX"), false, 0.7, 1.45, false, 0.3);
+    let n = 20000;
+    let sum: f64 = (0..n).filter_map(|i| {
+        let u = s.get4(i, 3);
+        g.sample(N, view(0.3), N, [u[0], u[1], u[2]]).map(|ds| ds.weight[0] as f64)
+    }).sum();
+    assert!(sum / (n as f64) < 0.97, "single-scattering GGX glass albedo {}", sum / n as f64);
+}
+
+/// Oren-Nayar of white albedo reflects everything (energy-preserving multiscatter term).
+#[test]
+fn oren_nayar_white_furnace() {
+    let s = PixelSampler::new(1, 2, 3);
+    for rough in [0.3f32, 1.0] {
+        for mu in [0.2f32, 0.9] {
+            let v = view(mu);
+            let on = OrenNayar::new(rough, [1.0; 3], mu);
+            let n = 20000;
+            let mut sum = 0.0f64;
+            for i in 0..n {
+                let u = s.get4(i, 2);
+                // Cosine-weighted direction: weight = eval / (cos / pi).
+                let r = u[0].sqrt();
+                let phi = 2.0 * std::f32::consts::PI * u[1];
+                let l = [r * phi.cos(), r * phi.sin(), (1.0 - u[0]).sqrt()];
+                let f = on.eval(N, v, l)[0];
+                sum += (f / (l[2] / std::f32::consts::PI)) as f64;
+            }
+            let e = sum / n as f64;
+            assert!((e - 1.0).abs() < 0.02, "roughness {rough} mu {mu}: albedo {e}");
+        }
+    }
+    // And single scattering alone loses energy at high roughness (the term matters).
+    let on = OrenNayar::new(1.0, [0.0; 3], 0.5);
+    let l = normalize([0.3, 0.2, 0.9]);
+    let (t, b) = basis(N);
+    assert!(dot(t, b).abs() < 1e-6);
+    assert!(on.eval(N, view(0.5), l)[0] < OrenNayar::new(1.0, [1.0; 3], 0.5).eval(N, view(0.5), l)[0]);
+}
