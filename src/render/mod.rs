@@ -248,6 +248,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
                                 let fx = x as f32 + 0.5 + filter.sample(u[0]);
                                 let fy = y as f32 + 0.5 + filter.sample(u[1]);
                                 let (o, d, t0, t1) = camera.ray(fx, fy, [u[2], u[3]]);
+                                (scratch.ray_dp, scratch.ray_dd) = camera.ray_differentials(fx, fy, [u[2], u[3]]);
                                 let c = tracer.radiance(o, d, t0, t1, &rng, i, scratch);
                                 px.add(i, c);
                             }
