@@ -5,6 +5,8 @@
 //! 6-octave fBm Noise, Smooth-F1 Voronoi (2 octaves), Wave, Magic, Gradient and Checker.
 //! Fat.001 and a noise + bump material need Bump, Displacement, RGB Curves and Layer
 //! Weight, which are not implemented yet.
+//! `noise6_bump` (fixtures/bake/bump) is a 6-octave fBm Noise into a Bump node: the
+//! height subgraph runs three times (centre, dx, dy) per point.
 
 use std::hint::black_box;
 use std::path::Path;
@@ -15,8 +17,10 @@ use blendsynth::shader::{compile_material, ShadingPoint};
 
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/bake/scenes");
-    for case in ["uv_math", "structure", "closures", "textures"] {
-        let scene = Scene::load(&root.join(case)).expect("fixture scene");
+    let bump_root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/bake/bump");
+    for case in ["uv_math", "structure", "closures", "textures", "noise6_bump"] {
+        let dir = if case == "noise6_bump" { bump_root.join(case) } else { root.join(case) };
+        let scene = Scene::load(&dir).expect("fixture scene");
         let material = scene.file.materials[0].name.clone();
         let program = compile_material(&scene, &material).expect("compiles");
         let mut stack = program.new_stack();
@@ -34,6 +38,7 @@ fn main() {
                 object_normal: [0.0, 0.0, 1.0],
                 generated: [u, v, 0.5],
                 uv: [u, v, 0.0],
+                ..bump_point()
             };
             program.run(black_box(&sp), &mut stack);
             acc += program.surface_emission(&stack)[0];
@@ -46,5 +51,20 @@ fn main() {
             n as f64 / secs / 1e6,
             secs * 1e9 / n as f64
         );
+    }
+}
+
+/// Ray differentials of a 1/1000 step on the unit square, so Bump nodes run their dx/dy
+/// copies as in a bake or a render (`noise6_bump`: 6-octave fBm Noise into a Bump).
+fn bump_point() -> ShadingPoint {
+    ShadingPoint {
+        ng: [0.0, 0.0, 1.0],
+        dp_dx: [1e-3, 0.0, 0.0],
+        dp_dy: [0.0, 1e-3, 0.0],
+        generated_dx: [1e-3, 0.0, 0.0],
+        generated_dy: [0.0, 1e-3, 0.0],
+        uv_dx: [1e-3, 0.0, 0.0],
+        uv_dy: [0.0, 1e-3, 0.0],
+        ..ShadingPoint::default()
     }
 }

@@ -45,6 +45,12 @@ fn bump_of_a_noise_height_matches_cycles() {
     assert!(compare("bump_noise") <= TOL);
 }
 
+/// The benchmark material (benches/shading.rs): a 6-octave Noise height.
+#[test]
+fn bump_of_a_six_octave_noise_matches_cycles() {
+    assert!(compare("noise6_bump") <= TOL);
+}
+
 #[test]
 fn bump_of_texture_coordinate_maths_matches_cycles() {
     assert!(compare("bump_texcoord_math") <= TOL);
