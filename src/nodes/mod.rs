@@ -138,6 +138,12 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeMapping",
     // vector_rotate.rs
     "ShaderNodeVectorRotate",
+    // shader/bump.rs, bump_graph.rs: tests/bump.rs. Tangent space (Normal Map, Vector
+    // Displacement) is refused per material by the compiler.
+    "ShaderNodeBump",
+    "ShaderNodeDisplacement",
+    "ShaderNodeVectorDisplacement",
+    "ShaderNodeNormalMap",
 ];
 
 /// Support for a node inside a tree of type `tree` (`ShaderNodeTree`,
