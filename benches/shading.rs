@@ -6,6 +6,8 @@
 //! With `BLENDSYNTH_COLON_EXPORT=DIR` (a `blendsynth convert` of
 //! ../shared/published/colon_nodes.blend, which is never copied into the repository)
 //! it also measures the published tissue material "Fat.001".
+//! `noise6_bump` (fixtures/bake/bump) is a 6-octave fBm Noise into a Bump node: the
+//! height subgraph runs three times (centre, dx, dy) per point.
 
 use std::hint::black_box;
 use std::path::Path;
@@ -16,8 +18,10 @@ use blendsynth::shader::{compile_material, ShadingPoint};
 
 fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/bake/scenes");
+    let bump_root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/bake/bump");
     let mut cases: Vec<(String, std::path::PathBuf, Option<&str>)> =
         ["uv_math", "structure", "closures", "textures"].iter().map(|c| (c.to_string(), root.join(c), None)).collect();
+    cases.push(("noise6_bump".into(), bump_root.join("noise6_bump"), None));
     match std::env::var_os("BLENDSYNTH_COLON_EXPORT") {
         Some(dir) => cases.push(("Fat.001".into(), dir.into(), Some("Fat.001"))),
         None => println!("shading Fat.001: skipped (set BLENDSYNTH_COLON_EXPORT to a converted colon_nodes.blend)"),
@@ -41,7 +45,7 @@ fn main() {
                 object_normal: [0.0, 0.0, 1.0],
                 generated: [u, v, 0.5],
                 uv: [u, v, 0.0],
-                ..Default::default()
+                ..bump_point()
             };
             program.run(black_box(&sp), &mut stack);
             acc += program.surface_emission(&stack)[0];
@@ -54,5 +58,20 @@ fn main() {
             n as f64 / secs / 1e6,
             secs * 1e9 / n as f64
         );
+    }
+}
+
+/// Ray differentials of a 1/1000 step on the unit square, so Bump nodes run their dx/dy
+/// copies as in a bake or a render (`noise6_bump`: 6-octave fBm Noise into a Bump).
+fn bump_point() -> ShadingPoint {
+    ShadingPoint {
+        ng: [0.0, 0.0, 1.0],
+        dp_dx: [1e-3, 0.0, 0.0],
+        dp_dy: [0.0, 1e-3, 0.0],
+        generated_dx: [1e-3, 0.0, 0.0],
+        generated_dy: [0.0, 1e-3, 0.0],
+        uv_dx: [1e-3, 0.0, 0.0],
+        uv_dy: [0.0, 1e-3, 0.0],
+        ..ShadingPoint::default()
     }
 }

@@ -151,6 +151,12 @@ const SUPPORTED: &[&str] = &[
     // World surfaces (render/world.rs): tests/world.rs.
     "ShaderNodeBackground",
     "ShaderNodeOutputWorld",
+    // shader/bump.rs, bump_graph.rs: tests/bump.rs. Tangent space (Normal Map, Vector
+    // Displacement) is refused per material by the compiler.
+    "ShaderNodeBump",
+    "ShaderNodeDisplacement",
+    "ShaderNodeVectorDisplacement",
+    "ShaderNodeNormalMap",
 ];
 
 /// Support for a node inside a tree of type `tree` (`ShaderNodeTree`,

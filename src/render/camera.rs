@@ -180,6 +180,16 @@ impl Camera {
         (wo, wd, tmin, tmax)
     }
 
+    /// Compact ray differentials (Cycles' ray.dP, ray.dD) of the ray through (x, y): the
+    /// mean change of its origin and direction one pixel right and one pixel down.
+    pub fn ray_differentials(&self, x: f32, y: f32, lens: [f32; 2]) -> (f32, f32) {
+        let (o, d, ..) = self.ray(x, y, lens);
+        let (ox, dx, ..) = self.ray(x + 1.0, y, lens);
+        let (oy, dy, ..) = self.ray(x, y + 1.0, lens);
+        let len = |v: V3| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        (0.5 * (len(sub(ox, o)) + len(sub(oy, o))), 0.5 * (len(sub(dx, d)) + len(sub(dy, d))))
+    }
+
     fn sample_aperture(&self, u: [f32; 2]) -> [f32; 2] {
         let mut p = if self.blades < 3 { concentric_disk(u) } else { regular_polygon(self.blades, self.rotation, u) };
         // Anamorphic ratio stretches the bokeh as Cycles does.

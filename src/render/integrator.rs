@@ -77,11 +77,15 @@ pub struct Scratch {
     pub lobes: LobeSet,
     pub light_lobes: LobeSet,
     pub rays: u64,
+    /// The camera ray's compact differentials (Cycles' ray.dP and ray.dD: spread of the
+    /// origin and of the direction per pixel), set by the caller before `radiance`.
+    pub ray_dp: f32,
+    pub ray_dd: f32,
 }
 
 impl Scratch {
     pub fn new(n_materials: usize) -> Scratch {
-        Scratch { stacks: vec![Vec::new(); n_materials + 1], lobes: LobeSet::default(), light_lobes: LobeSet::default(), rays: 0 }
+        Scratch { stacks: vec![Vec::new(); n_materials + 1], lobes: LobeSet::default(), light_lobes: LobeSet::default(), rays: 0, ray_dp: 0.0, ray_dd: 0.0 }
     }
 }
 
@@ -200,6 +204,9 @@ impl Scene<'_> {
         // diffuse bounce (a BSSRDF then falls back to diffuse, as in Cycles).
         let mut sss_exit: Option<super::accel::Hit> = None;
         let mut diffuse_ancestor = false;
+        // Ray differentials, carried through bounces as Cycles does: the next ray's dP is
+        // the hit's; dD stays (Cycles widens it by the BSDF roughness; not done here).
+        let (mut ray_dp, ray_dd) = (scratch.ray_dp, scratch.ray_dd);
         loop {
             let from_sss = sss_exit.take();
             let hit_opt = if from_sss.is_some() {
@@ -238,7 +245,9 @@ impl Scene<'_> {
                 break;
             };
             let wo = neg(d);
-            let hit = self.surface(h.prim, h.u, h.v, wo);
+            let mut hit = self.surface(h.prim, h.u, h.v, wo);
+            ray_dp += h.t * ray_dd;
+            self.fill_differentials(&mut hit, h.prim, ray_dp);
             if from_sss.is_some() {
                 scratch.lobes.clear();
                 scratch.lobes.push(LobeKind::Diffuse, [1.0; 3], hit.sp.normal);
@@ -510,5 +519,37 @@ impl Scene<'_> {
         }
         let le = self.background_toward(wi, scratch);
         scale(mul(f, le), power_heuristic(pdf_l, pdf_b) / pdf_l)
+    }
+}
+
+impl Scene<'_> {
+    /// Fills a hit's ray differentials from the compact differential `dp` at the hit, as
+    /// Cycles' shader_setup_from_ray: expanded around Ng, with the UV and Generated
+    /// attribute differentials the Bump node's coordinate copies read.
+    pub fn fill_differentials(&self, hit: &mut SurfaceHit, prim: u32, dp: f32) {
+        use crate::shader::bump::{attribute_differential, differential_dudv, differential_from_compact, ObjectTransform};
+        let r = self.geo.refs[prim as usize];
+        let inst = &self.geo.instances[r.inst as usize];
+        let m = &inst.mesh;
+        let c = m.triangles[r.tri as usize].map(|c| c as usize);
+        let tri = &self.geo.tris[prim as usize];
+        let (dpdu, dpdv) = (sub(tri[1], tri[0]), sub(tri[2], tri[0]));
+        let sp = &mut hit.sp;
+        sp.ng = hit.ng;
+        sp.backfacing = hit.backfacing;
+        sp.transform = ObjectTransform { to_world: inst.to_world.m, to_object: inst.to_object.m };
+        let (dx, dy) = differential_from_compact(hit.ng, dp);
+        sp.dp_dx = dx;
+        sp.dp_dy = dy;
+        let d = differential_dudv(dpdu, dpdv, [dx, dy], hit.ng);
+        let lp = c.map(|c| m.positions[m.corner_verts[c] as usize]);
+        let generated = lp.map(|l| [0, 1, 2].map(|k| (l[k] - inst.tex_loc[k]) / (2.0 * inst.tex_size[k]) + 0.5));
+        sp.generated_dx = attribute_differential(generated, d[0]);
+        sp.generated_dy = attribute_differential(generated, d[1]);
+        if let Some(uv) = &inst.uv {
+            let t = c.map(|c| [uv[c][0], uv[c][1], 0.0]);
+            sp.uv_dx = attribute_differential(t, d[0]);
+            sp.uv_dy = attribute_differential(t, d[1]);
+        }
     }
 }

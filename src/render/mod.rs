@@ -282,6 +282,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
                                     Some(sh) => camera.ray_at(fx, fy, [u[2], u[3]], sh.time(rng.get4(i, TIME_SET)[0])),
                                     None => camera.ray(fx, fy, [u[2], u[3]]),
                                 };
+                                (scratch.ray_dp, scratch.ray_dd) = camera.ray_differentials(fx, fy, [u[2], u[3]]);
                                 let c = tracer.radiance(o, d, t0, t1, &rng, i, scratch);
                                 px.add(i, c);
                             }

@@ -78,6 +78,15 @@ impl Material {
             stack.extend_from_slice(&p.initial);
         }
         p.run(sp, stack);
+        // The material's displacement, bumped, is the shading normal of every closure.
+        let bumped;
+        let sp = match p.displaced_normal {
+            Some(slot) => {
+                bumped = ShadingPoint { normal: v3(stack, slot), ..*sp };
+                &bumped
+            }
+            None => sp,
+        };
         if let Some(c) = p.surface {
             self.closure(p, c, 1.0, stack, sp, ctx, out);
         }
