@@ -57,6 +57,9 @@ pub mod vector_rotate;
 pub mod voronoi;
 pub mod wave;
 pub mod white_noise;
+// Input nodes that read the shading context.
+pub mod fresnel;
+pub mod light_falloff;
 
 /// How blendsynth handles a node type (by its `bl_idname`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -138,6 +141,19 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeMapping",
     // vector_rotate.rs
     "ShaderNodeVectorRotate",
+    // Input nodes reading the shading context (shader/inputs.rs; fresnel.rs,
+    // light_falloff.rs), proven by tests/inputs.rs against Cycles' EMIT bakes. The
+    // outputs they cannot give (Geometry Pointiness and Random Per Island, Tangent UV
+    // Map) are compile errors naming the node.
+    "ShaderNodeFresnel",
+    "ShaderNodeLayerWeight",
+    "ShaderNodeNewGeometry",
+    "ShaderNodeObjectInfo",
+    "ShaderNodeCameraData",
+    "ShaderNodeLightPath",
+    "ShaderNodeLightFalloff",
+    "ShaderNodeNormal",
+    "ShaderNodeTangent",
 ];
 
 /// Support for a node inside a tree of type `tree` (`ShaderNodeTree`,

@@ -66,6 +66,9 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
     let normal_matrix = inverse_transpose3(&world).ok_or_else(|| format!("object {:?} has a singular transform", obj.name))?;
     let (tex_loc, tex_size) = (info.texspace_location.unwrap_or([0.0; 3]), info.texspace_size.unwrap_or([1.0; 3]));
 
+    // What Cycles' EMIT bake gives the context-reading nodes: the scene camera, the object.
+    let view = super::view::scene_view(scene)?.unwrap_or_default();
+    let object = super::view::object_info(obj, &world);
     let n = size as usize;
     let mut pixels = vec![[0.0f32; 4]; n * n];
     let mut stacks: Vec<Vec<f32>> = programs.iter().map(|p| p.as_ref().map(Program::new_stack).unwrap_or_default()).collect();
@@ -98,15 +101,21 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
                 // Cycles moves vertices to world space and derives object coordinates back
                 // through the inverse transform; doing the same keeps its rounding.
                 let position = lerp(c.map(|c| transform_point(&world, mesh.positions[mesh.corner_verts[c] as usize])));
-                let local_n = normalize3(lerp(c.map(|c| mesh.corner_normals.get(c).copied().unwrap_or([0.0, 0.0, 1.0]))));
+                // Cycles applies the object transform to the mesh: vertex normals go to
+                // world space one by one, then interpolate; Texture Coordinate > Normal
+                // transforms the result back.
+                let world_n = normalize3(lerp(c.map(|c| normalize3(mul3x3(&normal_matrix, mesh.corner_normals.get(c).copied().unwrap_or([0.0, 0.0, 1.0]))))));
+                let local_n = normalize3(mul3x3(&transpose3(&world), world_n));
                 let sp = ShadingPoint {
                     position,
-                    normal: normalize3(mul3x3(&normal_matrix, local_n)),
+                    normal: world_n,
                     object_position: transform_point(&inverse, position),
                     object_normal: local_n,
                     generated: std::array::from_fn(|k| ((local[k] as f64 - tex_loc[k]) / (2.0 * tex_size[k]) + 0.5) as f32),
                     uv: { let u = lerp(c.map(|c| [uvs[c][0], uvs[c][1], 0.0])); [u[0], u[1], 0.0] },
+                    ..Default::default()
                 };
+                let sp = bake_context(sp, &view, object, c.map(|c| transform_point(&world, mesh.positions[mesh.corner_verts[c] as usize])), w);
                 program.run(&sp, stack);
                 let e = program.surface_emission(stack);
                 pixels[y * n + x] = [e[0], e[1], e[2], 1.0];
@@ -183,4 +192,35 @@ pub fn write_exr(b: &Baked, path: &Path) -> Result<(), String> {
     img.save_with_format(tmp.path(), image::ImageFormat::OpenExr).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     tmp.persist(path).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     Ok(())
+}
+
+/// The rest of the shading context as Cycles' EMIT bake sets it: a ray of length 1
+/// arriving along the shading normal (so Incoming is the normal), a camera ray's path
+/// state, the true normal of the world-space triangle, barycentrics as Cycles stores
+/// them, and the scene camera's view of the point.
+fn bake_context(mut sp: ShadingPoint, view: &super::view::View, object: super::point::ObjectInfo, tri: [Vec3; 3], w: [f32; 3]) -> ShadingPoint {
+    let e1: Vec3 = std::array::from_fn(|k| tri[1][k] - tri[0][k]);
+    let e2: Vec3 = std::array::from_fn(|k| tri[2][k] - tri[0][k]);
+    let ng = normalize3([e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]]);
+    sp.incoming = sp.normal;
+    sp.backfacing = ng[0] * sp.incoming[0] + ng[1] * sp.incoming[1] + ng[2] * sp.incoming[2] < 0.0;
+    if sp.backfacing {
+        sp.true_normal = ng.map(|x| -x);
+        sp.normal = sp.normal.map(|x| -x);
+    } else {
+        sp.true_normal = ng;
+    }
+    // Cycles' (u, v) are the weights of the triangle's second and third corners.
+    sp.parametric = [w[1], w[2]];
+    sp.ray_length = 1.0;
+    sp.path = super::point::PathState::CAMERA;
+    sp.camera_position = view.camera_space(sp.position);
+    sp.window = view.window(sp.camera_position);
+    sp.object = object;
+    sp
+}
+
+/// The transpose of an affine transform's 3x3 block (Cycles' `transform_direction_transposed`).
+fn transpose3(m: &[[f64; 4]; 4]) -> [[f64; 3]; 3] {
+    std::array::from_fn(|r| std::array::from_fn(|c| m[c][r]))
 }

@@ -23,6 +23,9 @@ use crate::scene::{Scene, Socket};
 
 use super::program::{BsdfNode, Closure, Kind, Op, Program, Slot};
 
+/// Compiling the input nodes that read the shading context.
+mod inputs;
+
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct CompileError(pub String);
 
@@ -40,7 +43,10 @@ pub fn compile_material(scene: &Scene, name: &str) -> Result<Program, CompileErr
     let out = active_output(tree, "ShaderNodeOutputMaterial", "CYCLES")
         .ok_or_else(|| CompileError(format!("material {name:?} has no Material Output for Cycles")))?;
     let graph = flatten(tree, &scene.file.node_groups, &out.name).map_err(|e| CompileError(format!("material {name:?}: {e}")))?;
-    Compiler::new(&graph).run().map_err(|e| CompileError(format!("material {name:?}: {}", e.0)))
+    let mut compiler = Compiler::new(&graph);
+    compiler.scene = Some(scene);
+    compiler.material_pass_index = mat.pass_index as f32;
+    compiler.run().map_err(|e| CompileError(format!("material {name:?}: {}", e.0)))
 }
 
 struct Compiler<'g, 'a> {
@@ -56,6 +62,10 @@ struct Compiler<'g, 'a> {
     closure_of: Vec<Option<u32>>,
     surface: Option<u32>,
     bsdfs: Vec<BsdfNode>,
+    /// The scene the material belongs to (other objects' transforms) and the material's
+    /// pass index (Object Info > Material Index).
+    scene: Option<&'a Scene>,
+    material_pass_index: f32,
 }
 
 fn kind_of(socket_type: &str) -> Option<Kind> {
@@ -138,6 +148,8 @@ impl<'g, 'a> Compiler<'g, 'a> {
             closure_of: vec![None; g.nodes.len()],
             surface: None,
             bsdfs: Vec::new(),
+            scene: None,
+            material_pass_index: 0.0,
         }
     }
 
@@ -239,8 +251,8 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 "ShaderNodeTexCoord" => {
                     let (g, nn, uv, ob) = (self.alloc(V), self.alloc(V), self.alloc(V), self.alloc(V));
                     self.ops.push(Op::TexCoord { generated: Some(g), normal: Some(nn), uv: Some(uv), object: Some(ob) });
-                    // Camera, Window and Reflection need a camera: left unset, so a use is an error.
                     self.outputs(i, n, &[("Generated", g, V), ("Normal", nn, V), ("UV", uv, V), ("Object", ob, V)]);
+                    self.tex_coord_more(i)?;
                 }
                 "ShaderNodeUVMap" => {
                     if !prop_str(n, "uv_map")?.is_empty() {
@@ -533,6 +545,8 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     }
                     self.surface = self.closure_input(n, "Surface")?;
                 }
+                "ShaderNodeFresnel" | "ShaderNodeLayerWeight" | "ShaderNodeNewGeometry" | "ShaderNodeObjectInfo" | "ShaderNodeCameraData" | "ShaderNodeLightPath"
+                | "ShaderNodeLightFalloff" | "ShaderNodeNormal" | "ShaderNodeTangent" => self.input_node(i)?,
                 other => return Err(CompileError(format!("node {:?}: {other} is not supported yet", n.path))),
             }
         }

@@ -6,6 +6,8 @@ pub mod bake;
 pub mod compile;
 pub mod point;
 pub mod program;
+pub mod inputs;
+pub mod view;
 
 pub use compile::{compile_material, CompileError};
 pub use point::ShadingPoint;
