@@ -75,3 +75,67 @@ fn fresh_cycles_input_bakes_match() {
     run_python(&py, &repo().join("fixtures/bake/make_input_refs.py"), &["--out", t.path().to_str().unwrap()]);
     check(&compare_all(t.path()));
 }
+
+/// View-dependent outputs (Fresnel, Layer Weight, Camera Data, Light Path Ray Length,
+/// Incoming, Window, Reflection): blendsynth's camera render of emission-only
+/// materials against Cycles' at a 0.01 px pixel filter
+/// (fixtures/render_inputs/make_view_refs.py). Per pixel, excluding silhouette pixels
+/// (any 3x3 neighbour sees another object or the background): there the 0.005 px
+/// filter jitter of either renderer can cross an edge. Also excluded: the few pixels
+/// where Cycles itself sampled off the pixel centre, found from its own Window render
+/// (which depends on nothing but the sample position; same camera, seed and samples in
+/// every case): where that differs from the exact centre by more than 1e-4
+/// (measured: 6 of 1280 pixels, up to 3.7e-3, i.e. 0.12 px; median 2.4e-5).
+/// The bound asserted is 1e-3, not the 1e-4 aimed for: measured worst 2.2e-4 (Layer
+/// Weight), 1.1e-4 (Window), 6.9e-4 (Reflection on the 32-segment sphere); the
+/// remaining difference is not yet explained (suspected: Cycles' residual sample
+/// jitter times steep gradients), so this test bounds it rather than hides it.
+const VIEW_TOL: f32 = 1e-3;
+
+#[test]
+fn view_dependent_inputs_match_cycles_renders() {
+    use blendsynth::render::{render, RenderOptions};
+    let root = repo().join("fixtures/render_inputs");
+    let mut failures = Vec::new();
+    let probe: Vec<f32> = std::fs::read(root.join("window/cycles.f32")).unwrap().chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+    for case in ["facing", "camera", "incoming", "window", "reflection"] {
+        let dir = root.join(case);
+        let meta: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("view.json")).unwrap()).unwrap();
+        let (w, h) = (meta["width"].as_u64().unwrap() as usize, meta["height"].as_u64().unwrap() as usize);
+        let reference: Vec<f32> = std::fs::read(dir.join("cycles.f32")).unwrap().chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+        let scene = Scene::load(&dir).unwrap();
+        let opts = RenderOptions { samples: Some(meta["samples"].as_u64().unwrap() as u32), resolution: Some((w as u32, h as u32)), seed: Some(0), threads: Some(1), ..Default::default() };
+        let out = render(&scene, &opts).unwrap_or_else(|e| panic!("{case}: {e}"));
+        let ids = &out.passes.object_index;
+        let (mut worst, mut at, mut compared) = (0.0f32, (0, 0, 0), 0);
+        for y in 0..h {
+            for x in 0..w {
+                let id = ids[y * w + x];
+                let edge = id == 0 || (-1..=1).any(|dy: i64| (-1..=1).any(|dx: i64| {
+                    let (nx, ny) = (x as i64 + dx, y as i64 + dy);
+                    nx >= 0 && ny >= 0 && (nx as usize) < w && (ny as usize) < h && ids[ny as usize * w + nx as usize] != id
+                }));
+                let centre = [(x as f32 + 0.5) / w as f32, 1.0 - (y as f32 + 0.5) / h as f32];
+                let off_centre = (0..2).any(|k| (probe[(y * w + x) * 4 + k] - centre[k]).abs() > 1e-4);
+                if edge || off_centre {
+                    continue;
+                }
+                compared += 1;
+                for c in 0..3 {
+                    let d = (out.color[y * w + x][c] - reference[(y * w + x) * 4 + c]).abs();
+                    if !(d <= worst) {
+                        worst = if d.is_nan() { f32::INFINITY } else { d };
+                        at = (x, y, c);
+                    }
+                }
+            }
+        }
+        let (x, y, c) = at;
+        eprintln!("render {case:12} {w}x{h}: {compared} interior pixels, worst abs error {worst:.2e} at ({x},{y}) channel {c}: ours {} Cycles {}", out.color[y * w + x][c], reference[(y * w + x) * 4 + c]);
+        assert!(compared > w * h / 2, "{case}: most pixels are compared");
+        if !(worst <= VIEW_TOL) {
+            failures.push((case, worst));
+        }
+    }
+    assert!(failures.is_empty(), "over {VIEW_TOL:e}: {failures:?}");
+}
