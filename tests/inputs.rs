@@ -140,3 +140,33 @@ fn view_dependent_inputs_match_cycles_renders() {
     }
     assert!(failures.is_empty(), "over {VIEW_TOL:e}: {failures:?}");
 }
+
+/// Light Path in a path tracer: the emitter is red to camera rays, green to the rest,
+/// blue by Ray Depth, with Light Falloff on its strength; the floor sees it only
+/// through light samples and diffuse bounces (fixtures/render_inputs/make_light_path_ref.py).
+/// As tests/render.rs: RMSE against Cycles A over Cycles B's RMSE against A.
+#[test]
+fn light_path_render_matches_cycles() {
+    use blendsynth::render::{render, RenderOptions};
+    let dir = repo().join("fixtures/render_inputs/light_path");
+    let meta: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("view.json")).unwrap()).unwrap();
+    let (w, h) = (meta["width"].as_u64().unwrap() as u32, meta["height"].as_u64().unwrap() as u32);
+    let load = |f: &str| -> Vec<f32> { std::fs::read(dir.join(f)).unwrap().chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect() };
+    let (a, b) = (load("cycles_a.f32"), load("cycles_b.f32"));
+    let scene = Scene::load(&dir).unwrap();
+    let opts = RenderOptions { samples: Some(meta["samples"].as_u64().unwrap() as u32), resolution: Some((w, h)), seed: Some(0), ..Default::default() };
+    let out = render(&scene, &opts).unwrap();
+    let ours: Vec<f32> = out.color.iter().flat_map(|p| [p[0], p[1], p[2], p[3]]).collect();
+    let rmse = |x: &[f32], y: &[f32]| -> f64 {
+        let s: f64 = x.chunks(4).zip(y.chunks(4)).map(|(p, q)| (0..3).map(|k| (p[k] as f64 - q[k] as f64).powi(2)).sum::<f64>()).sum();
+        (s / (x.len() / 4 * 3) as f64).sqrt()
+    };
+    let mean = |x: &[f32], k: usize| x.chunks(4).map(|p| p[k] as f64).sum::<f64>() / (x.len() / 4) as f64;
+    let ratio = rmse(&ours, &a) / rmse(&b, &a).max(1e-12);
+    let means: Vec<(f64, f64)> = (0..3).map(|k| (mean(&ours, k), mean(&a, k))).collect();
+    eprintln!("light_path render {w}x{h}: RMSE ratio {ratio:.3}; means ours/Cycles {means:?}");
+    for (k, (o, c)) in means.iter().enumerate() {
+        assert!((o - c).abs() <= 0.01 * c.abs().max(1e-3), "channel {k}: mean {o} vs Cycles {c}");
+    }
+    assert!(ratio <= 1.15, "RMSE ratio {ratio}");
+}
