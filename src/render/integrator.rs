@@ -132,6 +132,14 @@ impl Scene<'_> {
             normalize(cross(sub(lp[1], lp[0]), sub(lp[2], lp[0])))
         };
         let mut n = normalize(Affine::normal_by_inverse(&inst.to_object, n_obj));
+        // Cycles applies the object transform to the mesh: each vertex normal goes to world
+        // space before interpolation (it differs under non-uniform scale), and Texture
+        // Coordinate > Normal transforms the result back.
+        if m.corner_normals.len() == m.corner_verts.len() {
+            let cn = c.map(|c| normalize(Affine::normal_by_inverse(&inst.to_object, m.corner_normals[c])));
+            n = normalize(add(add(scale(cn[0], w0), scale(cn[1], u)), scale(cn[2], v)));
+            n_obj = normalize(Affine::normal_by_inverse(&inst.to_world, n));
+        }
         if !finite(n) || is_zero(n) {
             n = ng;
         }
