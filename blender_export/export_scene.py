@@ -517,6 +517,7 @@ def object_entry(o, view_layer):
         "hide_render": o.hide_render, "hide_viewport": o.hide_viewport,
         "visible": o.visible_get(view_layer=view_layer) if view_layer.objects.get(o.name) else False,
         "pass_index": o.pass_index, "collections": [c.name for c in o.users_collection],
+        "color": vec(o.color),
         "material_slots": [{"material": s.material.name if s.material else None, "link": s.link} for s in o.material_slots],
         "modifiers": [modifier_entry(m, f"{w}.modifiers[{q(m.name)}]") for m in o.modifiers],
         "constraints": [{"name": c.name, "type": c.type, "mute": c.mute, "influence": c.influence,

@@ -60,6 +60,9 @@ pub mod white_noise;
 // Brick, Image and Environment Textures.
 pub mod brick;
 pub mod image;
+// Input nodes that read the shading context.
+pub mod fresnel;
+pub mod light_falloff;
 
 /// How blendsynth handles a node type (by its `bl_idname`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
@@ -157,6 +160,19 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeDisplacement",
     "ShaderNodeVectorDisplacement",
     "ShaderNodeNormalMap",
+    // Input nodes reading the shading context (shader/inputs.rs; fresnel.rs,
+    // light_falloff.rs), proven by tests/inputs.rs against Cycles' EMIT bakes. The
+    // outputs they cannot give (Geometry Pointiness and Random Per Island, Tangent UV
+    // Map) are compile errors naming the node.
+    "ShaderNodeFresnel",
+    "ShaderNodeLayerWeight",
+    "ShaderNodeNewGeometry",
+    "ShaderNodeObjectInfo",
+    "ShaderNodeCameraData",
+    "ShaderNodeLightPath",
+    "ShaderNodeLightFalloff",
+    "ShaderNodeNormal",
+    "ShaderNodeTangent",
 ];
 
 /// Support for a node inside a tree of type `tree` (`ShaderNodeTree`,

@@ -28,6 +28,8 @@ pub struct MeshInstance {
     pub tex_loc: V3,
     pub tex_size: V3,
     pub world_bounds: (V3, V3),
+    /// Object Info values and the world-to-object transform the shader reads.
+    pub info: crate::shader::point::ObjectInfo,
 }
 
 /// Per triangle: which instance and which of its mesh's triangles.
@@ -206,6 +208,11 @@ fn push_instance(
         tex_loc,
         tex_size,
         world_bounds: (wlo, whi),
+        info: {
+            let m = to_world.m;
+            let rows: [[f64; 4]; 4] = std::array::from_fn(|r| if r < 3 { m[r].map(|x| x as f64) } else { [0.0, 0.0, 0.0, 1.0] });
+            crate::shader::view::object_info(obj, &rows)
+        },
     });
     Ok(())
 }

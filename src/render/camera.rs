@@ -243,3 +243,11 @@ fn regular_polygon(blades: u32, rotation: f32, u: [f32; 2]) -> [f32; 2] {
     let (b1, b2) = (s * (1.0 - u[1]), s * u[1]);
     [p1[0] * b1 + p2[0] * b2, p1[1] * b1 + p2[1] * b2]
 }
+
+impl Camera {
+    /// The camera as the shader's texture-coordinate nodes see it (Cycles' world to
+    /// camera and world to NDC transforms).
+    pub fn view(&self) -> crate::shader::view::View {
+        crate::shader::view::View::new(&self.to_world.m, self.ortho, self.tan_half, [self.left, self.right, self.bottom, self.top])
+    }
+}

@@ -4,6 +4,7 @@
 //! Cycles' clamping (direct and indirect limits on the sum of a contribution).
 
 use crate::shader::ShadingPoint;
+use crate::shader::point::{ray, PathState};
 
 use super::accel::Accel;
 use super::bsdf::{LobeKind, LobeSet};
@@ -69,6 +70,8 @@ pub struct Scene<'a> {
     pub settings: Settings,
     /// The world's node program when it varies with direction (else `background`).
     pub world: Option<&'a super::world::WorldShader>,
+    /// The camera as Texture Coordinate > Camera/Window and Camera Data see it.
+    pub view: crate::shader::view::View,
 }
 
 /// Per-thread scratch, reused across samples (no allocation per ray).
@@ -135,6 +138,14 @@ impl Scene<'_> {
             normalize(cross(sub(lp[1], lp[0]), sub(lp[2], lp[0])))
         };
         let mut n = normalize(Affine::normal_by_inverse(&inst.to_object, n_obj));
+        // Cycles applies the object transform to the mesh: each vertex normal goes to world
+        // space before interpolation (it differs under non-uniform scale), and Texture
+        // Coordinate > Normal transforms the result back.
+        if m.corner_normals.len() == m.corner_verts.len() {
+            let cn = c.map(|c| normalize(Affine::normal_by_inverse(&inst.to_object, m.corner_normals[c])));
+            n = normalize(add(add(scale(cn[0], w0), scale(cn[1], u)), scale(cn[2], v)));
+            n_obj = normalize(Affine::normal_by_inverse(&inst.to_world, n));
+        }
         if !finite(n) || is_zero(n) {
             n = ng;
         }
@@ -157,6 +168,7 @@ impl Scene<'_> {
             let t = c.map(|c| uv[c]);
             sp.uv = [t[0][0] * w0 + t[1][0] * u + t[2][0] * v, t[0][1] * w0 + t[1][1] * u + t[2][1] * v, 0.0];
         }
+        self.fill_context(&mut sp, inst, wo, ng, backfacing, u, v);
         SurfaceHit { p, ng, sp, inst: r.inst, material, backfacing }
     }
 
@@ -191,6 +203,8 @@ impl Scene<'_> {
         let (mut o, mut d, mut t0, mut t1) = (org, dir, tmin, tmax);
         let (mut bounce, mut diffuse, mut glossy, mut transmission, mut transparent) = (0u32, 0u32, 0u32, 0u32, 0u32);
         let mut terminate_next = false;
+        // Cycles' path flags of the ray being traced (Light Path node).
+        let mut flags = ray::CAMERA;
         let mut set = 1u32;
         // MIS state of the ray being traced: the BSDF pdf that chose it, or singular.
         let mut prev_pdf = f32::INFINITY;
@@ -246,6 +260,8 @@ impl Scene<'_> {
             };
             let wo = neg(d);
             let mut hit = self.surface(h.prim, h.u, h.v, wo);
+            hit.sp.ray_length = h.t;
+            hit.sp.path = PathState { flags, bounce, diffuse, glossy, transmission, transparent };
             ray_dp += h.t * ray_dd;
             self.fill_differentials(&mut hit, h.prim, ray_dp);
             if from_sss.is_some() {
@@ -365,7 +381,7 @@ impl Scene<'_> {
                         let start = p_off(wi);
                         scratch.rays += 1;
                         if pdf_l > 0.0 && !self.accel.occluded(start, wi, 0.0, dist * (1.0 - 1e-4)) {
-                            let le = self.emission_at(prim, b1, b2, neg(wi), scratch);
+                            let le = self.light_emission(prim, b1, b2, neg(wi), dist, bounce, scratch);
                             let w = power_heuristic(pdf_l, pdf_b);
                             let c = scale(mul(mul(throughput, f), le), w / pdf_l);
                             if finite(c) {
@@ -404,6 +420,7 @@ impl Scene<'_> {
             match bs.kind {
                 LobeKind::Transparent => {
                     transparent += 1;
+                    flags |= ray::TRANSPARENT;
                     if transparent > st.max_transparent {
                         break;
                     }
@@ -465,6 +482,7 @@ impl Scene<'_> {
                 terminate_next = true;
             }
             bounce += 1;
+            flags = bounce_flags(bs.kind, bs.transmit, bs.singular);
             prev_pdf = bs.pdf;
             prev_singular = bs.singular;
             prev_mis_lamps = mis_lamps;
@@ -551,5 +569,51 @@ impl Scene<'_> {
             sp.uv_dx = attribute_differential(t, d[0]);
             sp.uv_dy = attribute_differential(t, d[1]);
         }
+    }
+}
+
+/// Cycles' path flags after a non-transparent bounce of lobe `kind`.
+fn bounce_flags(kind: LobeKind, transmit: bool, singular: bool) -> u32 {
+    let mut f = match kind {
+        LobeKind::Diffuse => ray::DIFFUSE | ray::REFLECT,
+        LobeKind::Translucent => ray::DIFFUSE | ray::TRANSMIT,
+        LobeKind::Glossy { .. } => ray::GLOSSY | ray::REFLECT,
+        LobeKind::Glass { .. } => ray::GLOSSY | if transmit { ray::TRANSMIT } else { ray::REFLECT },
+        LobeKind::Transparent => ray::TRANSPARENT,
+        // The walk's exit scatters diffusely, as Cycles' subsurface exit closure does.
+        LobeKind::OrenNayar(_) | LobeKind::Subsurface(_) => ray::DIFFUSE | ray::REFLECT,
+        LobeKind::Reflection(_) => ray::GLOSSY | ray::REFLECT,
+    };
+    if singular {
+        f |= ray::SINGULAR;
+    }
+    f
+}
+
+impl Scene<'_> {
+    /// The shading context besides position, normals and UV: what the input nodes read
+    /// (incoming direction, true normal, barycentrics in Cycles' convention, camera and
+    /// window coordinates, object). Path state and ray length are the caller's.
+    fn fill_context(&self, sp: &mut ShadingPoint, inst: &super::build::MeshInstance, wo: V3, ng: V3, backfacing: bool, u: f32, v: f32) {
+        sp.incoming = wo;
+        sp.true_normal = ng;
+        sp.backfacing = backfacing;
+        sp.parametric = [u, v];
+        sp.camera_position = self.view.camera_space(sp.position);
+        sp.window = self.view.window(sp.camera_position);
+        sp.object = inst.info;
+        sp.path = PathState::CAMERA;
+        sp.ray_length = 1.0;
+    }
+
+    /// Emission of an emissive triangle for a light sample from a vertex at depth
+    /// `bounce`, `dist` away: Cycles evaluates it with only PATH_RAY_EMISSION set (so
+    /// Ray Depth reads one more) and the sample distance as the ray length.
+    pub fn light_emission(&self, prim: u32, u: f32, v: f32, wo: V3, dist: f32, bounce: u32, scratch: &mut Scratch) -> V3 {
+        let mut hit = self.surface(prim, u, v, wo);
+        hit.sp.ray_length = dist;
+        hit.sp.path = PathState { flags: ray::EMISSION, bounce, ..PathState::default() };
+        self.shade_into(&hit, wo, &mut scratch.stacks, &mut scratch.light_lobes);
+        scratch.light_lobes.emission
     }
 }

@@ -205,7 +205,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     let exposure = 1.0f32;
     let build_seconds = start.elapsed().as_secs_f64();
     let mesh_lights = mesh_lights(&geo, &materials, &bvh, &lights, background, tables, settings);
-    let tracer = integrator::Scene { mesh_lights: &mesh_lights, accel: &bvh, geo: &geo, materials: &materials, lights: &lights, background, tables, settings, world: world_shader.as_ref() };
+    let tracer = integrator::Scene { mesh_lights: &mesh_lights, accel: &bvh, geo: &geo, materials: &materials, lights: &lights, background, tables, settings, world: world_shader.as_ref(), view: camera.view() };
 
     let adaptive = adaptive::Adaptive::from_scene(cy, samples, opts.threshold);
     let tiles_x = w.div_ceil(TILE);
@@ -386,7 +386,7 @@ fn mesh_lights(
 ) -> integrator::MeshLights {
     use crate::shader::program::Closure;
     let empty = integrator::MeshLights::default();
-    let probe = integrator::Scene { mesh_lights: &empty, accel: bvh, geo, materials, lights, background, tables, settings, world: None };
+    let probe = integrator::Scene { mesh_lights: &empty, accel: bvh, geo, materials, lights, background, tables, settings, world: None, view: Default::default() };
     let emissive: Vec<bool> = materials
         .iter()
         .map(|m| m.program.as_ref().is_some_and(|p| p.closures.iter().any(|c| matches!(c, Closure::Emission { .. } | Closure::Bsdf { emission: Some(_) }))))

@@ -149,6 +149,9 @@ pub struct Object {
     pub instance_type: Option<String>,
     #[serde(default)]
     pub instance_collection: Option<String>,
+    /// Object colour RGBA (Object Info > Color and Alpha); absent in older exports.
+    #[serde(default)]
+    pub color: Option<[f64; 4]>,
 }
 
 fn yes() -> bool {

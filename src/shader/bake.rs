@@ -69,6 +69,9 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
     let f32_rows = |m: &[[f64; 4]; 4]| -> [[f32; 4]; 3] { std::array::from_fn(|r| std::array::from_fn(|k| m[r][k] as f32)) };
     let transform = ObjectTransform { to_world: f32_rows(&world), to_object: f32_rows(&inverse) };
 
+    // What Cycles' EMIT bake gives the context-reading nodes: the scene camera, the object.
+    let view = super::view::scene_view(scene)?.unwrap_or_default();
+    let object = super::view::object_info(obj, &world);
     let n = size as usize;
     let mut pixels = vec![[0.0f32; 4]; n * n];
     let mut stacks: Vec<Vec<f32>> = programs.iter().map(|p| p.as_ref().map(Program::new_stack).unwrap_or_default()).collect();
@@ -116,6 +119,7 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
                     uv: { let u = lerp(c.map(|c| [uvs[c][0], uvs[c][1], 0.0])); [u[0], u[1], 0.0] },
                     ..diff.point(transform)
                 };
+                let sp = bake_context(sp, &view, object, c.map(|c| transform_point(&world, mesh.positions[mesh.corner_verts[c] as usize])), w);
                 program.run(&sp, stack);
                 let e = program.surface_emission(stack);
                 pixels[y * n + x] = [e[0], e[1], e[2], 1.0];
@@ -255,4 +259,30 @@ impl TriangleDifferentials {
             ..ShadingPoint::default()
         }
     }
+}
+
+/// The rest of the shading context as Cycles' EMIT bake sets it: a ray of length 1
+/// arriving along the shading normal (so Incoming is the normal), a camera ray's path
+/// state, the true normal of the world-space triangle, barycentrics as Cycles stores
+/// them, and the scene camera's view of the point.
+fn bake_context(mut sp: ShadingPoint, view: &super::view::View, object: super::point::ObjectInfo, tri: [Vec3; 3], w: [f32; 3]) -> ShadingPoint {
+    let e1: Vec3 = std::array::from_fn(|k| tri[1][k] - tri[0][k]);
+    let e2: Vec3 = std::array::from_fn(|k| tri[2][k] - tri[0][k]);
+    let ng = normalize3([e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]]);
+    sp.incoming = sp.normal;
+    sp.backfacing = ng[0] * sp.incoming[0] + ng[1] * sp.incoming[1] + ng[2] * sp.incoming[2] < 0.0;
+    if sp.backfacing {
+        sp.true_normal = ng.map(|x| -x);
+        sp.normal = sp.normal.map(|x| -x);
+    } else {
+        sp.true_normal = ng;
+    }
+    // Cycles' (u, v) are the weights of the triangle's second and third corners.
+    sp.parametric = [w[1], w[2]];
+    sp.ray_length = 1.0;
+    sp.path = super::point::PathState::CAMERA;
+    sp.camera_position = view.camera_space(sp.position);
+    sp.window = view.window(sp.camera_position);
+    sp.object = object;
+    sp
 }

@@ -25,6 +25,9 @@ use super::program::{BsdfNode, Closure, Kind, Op, Program, Slot};
 use super::bump::{BumpSettings, MapSpace};
 use super::bump_graph::{self, Schedule, Step};
 
+/// Compiling the input nodes that read the shading context.
+mod inputs;
+
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct CompileError(pub String);
 
@@ -45,6 +48,7 @@ pub fn compile_material(scene: &Scene, name: &str) -> Result<Program, CompileErr
     let mut c = Compiler::new(&graph);
     c.scene = Some(scene);
     c.displace = displacement_as_bump(name, mat.properties.get("displacement_method").and_then(Value::as_str));
+    c.material_pass_index = mat.pass_index as f32;
     c.run().map_err(|e| CompileError(format!("material {name:?}: {}", e.0)))
 }
 
@@ -90,6 +94,8 @@ struct Compiler<'g, 'a> {
     copy_values: Vec<CopyValues>,
     copy: usize,
     displaced_normal: Option<Slot>,
+    /// The material's pass index (Object Info > Material Index).
+    material_pass_index: f32,
 }
 
 fn kind_of(socket_type: &str) -> Option<Kind> {
@@ -177,6 +183,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
             copy_values: Vec::new(),
             copy: 0,
             displaced_normal: None,
+            material_pass_index: 0.0,
         }
     }
 
@@ -281,8 +288,8 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 "ShaderNodeTexCoord" => {
                     let (g, nn, uv, ob) = (self.alloc(V), self.alloc(V), self.alloc(V), self.alloc(V));
                     self.ops.push(Op::TexCoord { generated: Some(g), normal: Some(nn), uv: Some(uv), object: Some(ob) });
-                    // Camera, Window and Reflection need a camera: left unset, so a use is an error.
                     self.outputs(i, n, &[("Generated", g, V), ("Normal", nn, V), ("UV", uv, V), ("Object", ob, V)]);
+                    self.tex_coord_more(i)?;
                 }
                 "ShaderNodeUVMap" => {
                     if !prop_str(n, "uv_map")?.is_empty() {
@@ -629,6 +636,8 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     self.ops.push(Op::NormalMap { space, color, strength, dst: d });
                     self.outputs(i, n, &[("Normal", d, V)]);
                 }
+                "ShaderNodeFresnel" | "ShaderNodeLayerWeight" | "ShaderNodeNewGeometry" | "ShaderNodeObjectInfo" | "ShaderNodeCameraData" | "ShaderNodeLightPath"
+                | "ShaderNodeLightFalloff" | "ShaderNodeNormal" | "ShaderNodeTangent" => self.input_node(i)?,
                 other => return Err(CompileError(format!("node {:?}: {other} is not supported yet", n.path))),
             }
         }

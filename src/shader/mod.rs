@@ -9,6 +9,8 @@ pub mod compile;
 pub mod point;
 pub mod program;
 pub mod images;
+pub mod inputs;
+pub mod view;
 
 pub use compile::{compile_material, CompileError};
 pub use point::ShadingPoint;

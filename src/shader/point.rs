@@ -34,4 +34,86 @@ pub struct ShadingPoint {
     pub transform: ObjectTransform,
     /// The ray hit the back of the surface (normals already flipped toward it).
     pub backfacing: bool,
+    /// Unit vector from the point back along the ray that reached it (Cycles' `sd->wi`,
+    /// Geometry > Incoming). An EMIT bake sets it to the shading normal.
+    pub incoming: Vec3,
+    /// World-space geometric normal (Geometry > True Normal), flipped with `normal`
+    /// when the ray hit the back of the surface.
+    pub true_normal: Vec3,
+    /// Cycles' barycentric (u, v) in its triangle: Geometry > Parametric is (1-u-v, u, 0).
+    pub parametric: [f32; 2],
+    /// Length of the ray segment that reached the point (Light Path > Ray Length; 1 in a bake).
+    pub ray_length: f32,
+    /// What kind of ray reached the point, and the path's bounce counts (Light Path).
+    pub path: PathState,
+    /// Position in Cycles' camera space: x right, y up, z forward (Texture Coordinate >
+    /// Camera, Camera Data).
+    pub camera_position: Vec3,
+    /// Position in the camera's normalised frame, 0..1 over the image, z = 0
+    /// (Texture Coordinate > Window).
+    pub window: Vec3,
+    /// The shaded object (Object Info, object-space transforms).
+    pub object: ObjectInfo,
+}
+
+/// Cycles' path flags (`PATH_RAY_*`) that the Light Path node reads.
+pub mod ray {
+    pub const CAMERA: u32 = 1 << 0;
+    pub const REFLECT: u32 = 1 << 1;
+    pub const TRANSMIT: u32 = 1 << 2;
+    pub const DIFFUSE: u32 = 1 << 3;
+    pub const GLOSSY: u32 = 1 << 4;
+    pub const SINGULAR: u32 = 1 << 5;
+    pub const TRANSPARENT: u32 = 1 << 6;
+    pub const SHADOW: u32 = 1 << 7;
+    /// Emission evaluated for a light sample (Cycles counts it one bounce further).
+    pub const EMISSION: u32 = 1 << 8;
+    /// Never set: blendsynth has no volumes (Is Volume Scatter Ray reads 0, as Cycles
+    /// does for surfaces reached without volume scattering).
+    pub const VOLUME_SCATTER: u32 = 1 << 9;
+}
+
+/// The path state a Light Path node reads: flags from `ray` and bounce counts so far.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PathState {
+    pub flags: u32,
+    /// Non-transparent bounces (Ray Depth, before Cycles' +1 for shadow and emission rays).
+    pub bounce: u32,
+    pub diffuse: u32,
+    pub glossy: u32,
+    pub transmission: u32,
+    pub transparent: u32,
+}
+
+impl PathState {
+    /// A camera ray, as Cycles' EMIT bake and camera rays start.
+    pub const CAMERA: PathState = PathState { flags: ray::CAMERA, bounce: 0, diffuse: 0, glossy: 0, transmission: 0, transparent: 0 };
+}
+
+/// The object a shading point belongs to, as Cycles' Object Info node and object-space
+/// transforms see it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ObjectInfo {
+    /// World-space origin of the object.
+    pub location: Vec3,
+    /// Object colour (RGBA; Alpha is the fourth).
+    pub color: [f32; 4],
+    /// Object pass index (Object Index).
+    pub pass_index: f32,
+    /// Cycles' per-object random number in [0, 1] (hash of the object name).
+    pub random: f32,
+    /// World to object transform, rows of an affine 3x4 matrix.
+    pub world_to_object: [[f32; 4]; 3],
+}
+
+impl Default for ObjectInfo {
+    fn default() -> Self {
+        ObjectInfo {
+            location: [0.0; 3],
+            color: [1.0; 4],
+            pass_index: 0.0,
+            random: 0.0,
+            world_to_object: [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]],
+        }
+    }
 }

@@ -26,6 +26,7 @@ use crate::nodes::image::{box_uvs, box_weights, direction_to_equirectangular, di
 use super::images::TexImage;
 use super::bump::{bump_normal, displacement, displacement_bump, normal_map, offset_point, vector_displacement, BumpPoint, BumpSettings, MapSpace};
 use super::point::ShadingPoint;
+use super::inputs::{self, Input};
 
 /// A float's position on the stack; vectors and colours take three in a row.
 pub type Slot = u32;
@@ -110,6 +111,20 @@ pub enum Op {
     /// Material Output's Displacement as a bump: sets the shading normal for all that follows.
     DisplacementBump { object_space: bool, center: Slot, dx: Slot, dy: Slot, dst: Slot },
     NormalMap { space: MapSpace, color: Slot, strength: Slot, dst: Slot },
+    /// A value of the shading context (Geometry, Object Info, Camera Data, Light Path,
+    /// Texture Coordinate's Camera/Window/Reflection).
+    Input { what: Input, dst: Slot },
+    /// Fresnel / Layer Weight: `normal` is None when unlinked (the shading normal).
+    Fresnel { ior: Slot, normal: Option<Slot>, dst: Slot },
+    LayerWeight { blend: Slot, normal: Option<Slot>, fresnel: Slot, facing: Slot },
+    /// Light Falloff: Quadratic, Linear, Constant.
+    LightFalloff { strength: Slot, smooth: Slot, dst: [Slot; 3] },
+    /// Normal node's Dot output (its Normal output is a constant).
+    NormalDot { direction: Vec3, normal: Slot, dst: Slot },
+    /// Texture Coordinate > Object relative to another object (its world-to-object).
+    ObjectSpace { to_object: [[f32; 4]; 3], dst: Slot },
+    /// Tangent node, radial mode around axis 0/1/2 (X/Y/Z).
+    TangentRadial { axis: u8, dst: Slot },
 }
 
 /// The shader part of a material: closures as a small tree over stack values.
@@ -415,6 +430,22 @@ impl Program {
                     let r = normal_map(&sp, space, v3(s, color), s[strength as usize]);
                     put3(s, dst, r);
                 }
+                Op::Input { what, dst } => inputs::read(what, &sp, s, dst),
+                Op::Fresnel { ior, normal, dst } => s[dst as usize] = inputs::fresnel_node(&sp, s[ior as usize], normal.map(|n| v3(s, n))),
+                Op::LayerWeight { blend, normal, fresnel, facing } => {
+                    let (f, g) = inputs::layer_weight_node(&sp, s[blend as usize], normal.map(|n| v3(s, n)));
+                    s[fresnel as usize] = f;
+                    s[facing as usize] = g;
+                }
+                Op::LightFalloff { strength, smooth, dst } => {
+                    let r = inputs::light_falloff_node(&sp, s[strength as usize], s[smooth as usize]);
+                    for (d, v) in dst.iter().zip(r) {
+                        s[*d as usize] = v;
+                    }
+                }
+                Op::NormalDot { direction, normal, dst } => s[dst as usize] = inputs::normal_dot(direction, v3(s, normal)),
+                Op::ObjectSpace { to_object, dst } => put3(s, dst, inputs::transform_point(&to_object, sp.position)),
+                Op::TangentRadial { axis, dst } => put3(s, dst, inputs::radial_tangent(&sp, axis)),
             }
         }
     }

@@ -1,0 +1,185 @@
+//! Input nodes that read the shading context rather than other nodes (Cycles'
+//! svm/geometry.h, camera.h, tex_coord.h, light_path.h, fresnel.h, normal.h,
+//! tangent.h): what each output reads from the `ShadingPoint`.
+
+use crate::nodes::fresnel::{fresnel, layer_weight};
+use crate::nodes::light_falloff::light_falloff;
+use crate::nodes::math::Vec3;
+
+use super::point::{ray, ShadingPoint};
+
+/// One value a shading point provides, as an input node's output reads it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Input {
+    // Geometry.
+    Position,
+    Normal,
+    /// Cycles' radial tangent around the object's Z axis, from Generated coordinates.
+    Tangent,
+    TrueNormal,
+    Incoming,
+    Parametric,
+    Backfacing,
+    // Object Info.
+    ObjectLocation,
+    ObjectColor,
+    ObjectAlpha,
+    ObjectIndex,
+    ObjectRandom,
+    // Camera Data.
+    ViewVector,
+    ViewZDepth,
+    ViewDistance,
+    // Texture Coordinate.
+    Camera,
+    Window,
+    Reflection,
+    // Light Path: a flag of `ray`, or a count.
+    RayFlag(u32),
+    RayLength,
+    RayDepth,
+    DiffuseDepth,
+    GlossyDepth,
+    TransparentDepth,
+    TransmissionDepth,
+}
+
+impl Input {
+    /// True when the value is a vector (three slots), false for a float.
+    pub fn is_vector(self) -> bool {
+        use Input::*;
+        matches!(self, Position | Normal | Tangent | TrueNormal | Incoming | Parametric | ObjectLocation | ObjectColor | ViewVector | Camera | Window | Reflection)
+    }
+
+    /// The Light Path output with socket identifier `id`.
+    pub fn light_path(id: &str) -> Option<Input> {
+        Some(match id {
+            "Is Camera Ray" => Input::RayFlag(ray::CAMERA),
+            "Is Shadow Ray" => Input::RayFlag(ray::SHADOW),
+            "Is Diffuse Ray" => Input::RayFlag(ray::DIFFUSE),
+            "Is Glossy Ray" => Input::RayFlag(ray::GLOSSY),
+            "Is Singular Ray" => Input::RayFlag(ray::SINGULAR),
+            "Is Reflection Ray" => Input::RayFlag(ray::REFLECT),
+            "Is Transmission Ray" => Input::RayFlag(ray::TRANSMIT),
+            "Is Volume Scatter Ray" => Input::RayFlag(ray::VOLUME_SCATTER),
+            "Ray Length" => Input::RayLength,
+            "Ray Depth" => Input::RayDepth,
+            "Diffuse Depth" => Input::DiffuseDepth,
+            "Glossy Depth" => Input::GlossyDepth,
+            "Transparent Depth" => Input::TransparentDepth,
+            "Transmission Depth" => Input::TransmissionDepth,
+            _ => return None,
+        })
+    }
+}
+
+fn dot(a: Vec3, b: Vec3) -> f32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+fn cross(a: Vec3, b: Vec3) -> Vec3 {
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+/// Cycles' `normalize`: no guard, a zero vector gives NaNs as it does there.
+fn normalize(v: Vec3) -> Vec3 {
+    let l = dot(v, v).sqrt();
+    [v[0] / l, v[1] / l, v[2] / l]
+}
+fn len(v: Vec3) -> f32 {
+    dot(v, v).sqrt()
+}
+
+/// An object-space direction to world space the way Cycles transforms normals
+/// (`object_normal_transform`: by the transposed world-to-object matrix).
+pub fn object_normal_to_world(sp: &ShadingPoint, n: Vec3) -> Vec3 {
+    let m = &sp.object.world_to_object;
+    std::array::from_fn(|c| m[0][c] * n[0] + m[1][c] * n[1] + m[2][c] * n[2])
+}
+
+/// Tangent node, radial mode, around `axis` (0 = X, 1 = Y, 2 = Z) of Generated
+/// coordinates; also Geometry > Tangent (axis Z).
+pub fn radial_tangent(sp: &ShadingPoint, axis: u8) -> Vec3 {
+    let g = sp.generated;
+    let t = match axis {
+        0 => [0.0, -(g[2] - 0.5), g[1] - 0.5],
+        1 => [-(g[2] - 0.5), 0.0, g[0] - 0.5],
+        _ => [-(g[1] - 0.5), g[0] - 0.5, 0.0],
+    };
+    let t = object_normal_to_world(sp, t);
+    cross(sp.normal, normalize(cross(t, sp.normal)))
+}
+
+/// Writes input `what` of `sp` to the stack at `dst` (three slots for a vector).
+#[inline]
+pub fn read(what: Input, sp: &ShadingPoint, s: &mut [f32], dst: u32) {
+    let d = dst as usize;
+    let path = &sp.path;
+    let f = |b: bool| if b { 1.0 } else { 0.0 };
+    let v: Vec3 = match what {
+        Input::Position => sp.position,
+        Input::Normal => sp.normal,
+        Input::Tangent => radial_tangent(sp, 2),
+        Input::TrueNormal => sp.true_normal,
+        Input::Incoming => sp.incoming,
+        Input::Parametric => [1.0 - sp.parametric[0] - sp.parametric[1], sp.parametric[0], 0.0],
+        Input::ObjectLocation => sp.object.location,
+        Input::ObjectColor => [sp.object.color[0], sp.object.color[1], sp.object.color[2]],
+        Input::ViewVector => normalize(sp.camera_position),
+        Input::Camera => sp.camera_position,
+        Input::Window => sp.window,
+        Input::Reflection => {
+            let k = 2.0 * dot(sp.normal, sp.incoming);
+            [k * sp.normal[0] - sp.incoming[0], k * sp.normal[1] - sp.incoming[1], k * sp.normal[2] - sp.incoming[2]]
+        }
+        scalar => {
+            s[d] = match scalar {
+                Input::Backfacing => f(sp.backfacing),
+                Input::ObjectAlpha => sp.object.color[3],
+                Input::ObjectIndex => sp.object.pass_index,
+                Input::ObjectRandom => sp.object.random,
+                Input::ViewZDepth => sp.camera_position[2],
+                Input::ViewDistance => len(sp.camera_position),
+                Input::RayFlag(flag) => f(path.flags & flag != 0),
+                Input::RayLength => sp.ray_length,
+                // Shadow rays and light emission are one bounce further (Cycles).
+                Input::RayDepth => path.bounce as f32 + f(path.flags & (ray::SHADOW | ray::EMISSION) != 0),
+                Input::DiffuseDepth => path.diffuse as f32,
+                Input::GlossyDepth => path.glossy as f32,
+                Input::TransparentDepth => path.transparent as f32,
+                Input::TransmissionDepth => path.transmission as f32,
+                _ => 0.0,
+            };
+            return;
+        }
+    };
+    s[d..d + 3].copy_from_slice(&v);
+}
+
+/// Fresnel node; `normal` is the linked Normal input, or the shading normal.
+#[inline]
+pub fn fresnel_node(sp: &ShadingPoint, ior: f32, normal: Option<Vec3>) -> f32 {
+    fresnel(ior, sp.incoming, normal.unwrap_or(sp.normal), sp.backfacing)
+}
+
+/// Layer Weight node: (Fresnel, Facing).
+#[inline]
+pub fn layer_weight_node(sp: &ShadingPoint, blend: f32, normal: Option<Vec3>) -> (f32, f32) {
+    layer_weight(blend, sp.incoming, normal.unwrap_or(sp.normal), sp.backfacing)
+}
+
+/// Light Falloff node: (Quadratic, Linear, Constant).
+#[inline]
+pub fn light_falloff_node(sp: &ShadingPoint, strength: f32, smooth: f32) -> [f32; 3] {
+    light_falloff(strength, smooth, sp.ray_length)
+}
+
+/// Normal node's Dot output: its (normalised) direction against the normalised input.
+#[inline]
+pub fn normal_dot(direction: Vec3, normal: Vec3) -> f32 {
+    dot(direction, normalize(normal))
+}
+
+/// Texture Coordinate > Object relative to another object: its world-to-object transform.
+#[inline]
+pub fn transform_point(m: &[[f32; 4]; 3], p: Vec3) -> Vec3 {
+    std::array::from_fn(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3])
+}
