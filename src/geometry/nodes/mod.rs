@@ -15,6 +15,7 @@ pub mod input;
 pub mod primitives;
 pub mod proximity;
 pub mod subdivide;
+pub mod subdivision_surface;
 
 use super::error::GeometryError;
 use super::eval::{NodeCtx, Outputs};
@@ -93,6 +94,7 @@ pub const SUPPORTED: &[&str] = &[
     "GeometryNodeCurvePrimitiveBezierSegment",
     "GeometryNodeSplineParameter",
     "GeometryNodeCurveLength",
+    "GeometryNodeSubdivisionSurface",
 ];
 
 pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -169,6 +171,7 @@ pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "GeometryNodeCurvePrimitiveBezierSegment" => curve_primitives::bezier_segment(ctx),
         "GeometryNodeSplineParameter" => curve_fields::spline_parameter(ctx),
         "GeometryNodeCurveLength" => curve_fields::curve_length(ctx),
+        "GeometryNodeSubdivisionSurface" => subdivision_surface::subdivision_surface_node(ctx),
         _ => Err(ctx.err("this node type is not supported by blendsynth's Geometry Nodes evaluator")),
     }
 }
