@@ -8,7 +8,10 @@
 //! mesh is isolated adaptively to the same level; the grid points then fall on B-spline
 //! patches (exact limit surface) or on the corners of end-cap patches (limit points), so
 //! every grid point is the limit position of the refined vertex: the limit mask applied to
-//! the uniformly refined mesh gives the same points.
+//! the uniformly refined mesh gives the same points. Two exceptions measured against
+//! Blender: sharpness still left on the last level does not count in the limit (only
+//! infinite creases do), and a boundary vertex of a single face stays where the deepest
+//! isolation level puts it (the end-cap corner).
 //!
 //! Rules (`opensubdiv/sdc/catmarkScheme.h`, `crease.h`): an edge point is the smooth
 //! average of the edge ends and face points, the midpoint when the edge stays sharp, and a
@@ -491,13 +494,14 @@ fn limit_positions(lv: &Level, adj: &Adjacency) -> Vec<[f64; 3]> {
             if faces.len() <= 1 {
                 return p;
             }
-            let rule = rule_of(lv.vert_sharp[v], edges.iter().map(|&e| lv.edge_sharp[e as usize]));
+            let inf = |s: f32| if s >= INFINITE { s } else { 0.0 };
+            let rule = rule_of(inf(lv.vert_sharp[v]), edges.iter().map(|&e| inf(lv.edge_sharp[e as usize])));
             match rule {
                 Rule::Corner => p,
                 Rule::Crease => {
                     let mut q = [0.0; 3];
                     for &e in edges {
-                        if lv.edge_sharp[e as usize] > 0.0 {
+                        if lv.edge_sharp[e as usize] >= INFINITE {
                             let o = lv.pos[other_end(lv.edges[e as usize], v as u32)];
                             for k in 0..3 {
                                 q[k] += o[k];
