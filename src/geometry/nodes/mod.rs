@@ -11,6 +11,7 @@ pub mod distribute;
 pub mod extrude;
 pub mod field_nodes;
 pub mod flip_faces;
+pub mod float_curve;
 pub mod function;
 pub mod geometry_ops;
 pub mod input;
@@ -108,6 +109,7 @@ pub const SUPPORTED: &[&str] = &[
     "FunctionNodeRotateRotation",
     "FunctionNodeAlignEulerToVector",
     "FunctionNodeAlignRotationToVector",
+    "ShaderNodeFloatCurve",
 ];
 
 pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -194,6 +196,7 @@ pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "FunctionNodeRotateRotation" => rotation::rotate_rotation(ctx),
         "FunctionNodeAlignEulerToVector" => rotation::align_euler_to_vector(ctx),
         "FunctionNodeAlignRotationToVector" => rotation::align_rotation_to_vector(ctx),
+        "ShaderNodeFloatCurve" => float_curve::float_curve(ctx),
         _ => Err(ctx.err("this node type is not supported by blendsynth's Geometry Nodes evaluator")),
     }
 }
