@@ -128,7 +128,7 @@ impl Target {
             let mut out: Option<(V3, f32)> = None;
             for p in it {
                 let d = dist2(p, q);
-                if out.is_none_or(|(_, b)| d < b) {
+                if out.map_or(true, |(_, b)| d < b) {
                     out = Some((p, d));
                 }
             }
