@@ -97,8 +97,12 @@ impl<'s> Session<'s> {
                 continue;
             }
             let here = format!("objects[{}].modifiers[{}]", quote(&o.name), quote(&m.name));
+            if m.kind == "SUBSURF" {
+                g = super::nodes::subdivision_surface::subsurf_modifier(&m.properties, g).map_err(|e| GeometryError::new(format!("{here}: {e}")))?;
+                continue;
+            }
             if m.kind != "NODES" {
-                return Err(GeometryError::new(format!("{here}: {} modifiers are not supported (only Geometry Nodes)", m.kind)));
+                return Err(GeometryError::new(format!("{here}: {} modifiers are not supported (only Geometry Nodes and Subdivision Surface)", m.kind)));
             }
             g = self.evaluate_modifier(o, m, g).map_err(|e| e.within(&here))?;
         }

@@ -517,3 +517,27 @@ pub fn mapping_from_json(v: &serde_json::Value) -> Result<CurveMapping, CurveErr
         .collect::<Result<Vec<_>, _>>()?;
     Ok(CurveMapping { extrapolate, use_clip, clip, curves })
 }
+
+/// One curve of a mapping as Blender itself evaluates it (`BKE_curvemapping_evaluateF`,
+/// what Geometry Nodes' Float Curve uses): the curve's own table, then the clip range on
+/// the output when clipping is on.
+pub struct BlenderCurve {
+    table: CurveMapTable,
+    extrapolate: bool,
+    clip_y: Option<[f32; 2]>,
+}
+
+impl BlenderCurve {
+    pub fn new(m: &CurveMapping, index: usize) -> Result<Self, CurveError> {
+        let c = m.curves.get(index).filter(|c| !c.is_empty()).ok_or_else(|| CurveError(format!("mapping has no curve {index} with points")))?;
+        let table = m.make_table(&m.prepared(c));
+        Ok(BlenderCurve { table, extrapolate: m.extrapolate, clip_y: m.use_clip.then_some([m.clip[2], m.clip[3]]) })
+    }
+    pub fn eval(&self, x: f32) -> f32 {
+        let v = evaluate(self.extrapolate, &self.table, x);
+        match self.clip_y {
+            Some([lo, hi]) => v.clamp(lo, hi),
+            None => v,
+        }
+    }
+}

@@ -2,6 +2,7 @@
 //! here is an error naming the tree and node: it is never evaluated as something else.
 
 pub mod attribute;
+pub mod bounding_box;
 pub mod curve;
 pub mod curve_fields;
 pub mod curve_primitives;
@@ -9,12 +10,17 @@ pub mod delete;
 pub mod distribute;
 pub mod extrude;
 pub mod field_nodes;
+pub mod flip_faces;
+pub mod float_curve;
 pub mod function;
 pub mod geometry_ops;
 pub mod input;
+pub mod instance_transform;
 pub mod primitives;
 pub mod proximity;
+pub mod rotation;
 pub mod subdivide;
+pub mod subdivision_surface;
 
 use super::error::GeometryError;
 use super::eval::{NodeCtx, Outputs};
@@ -93,6 +99,17 @@ pub const SUPPORTED: &[&str] = &[
     "GeometryNodeCurvePrimitiveBezierSegment",
     "GeometryNodeSplineParameter",
     "GeometryNodeCurveLength",
+    "GeometryNodeSubdivisionSurface",
+    "GeometryNodeFlipFaces",
+    "GeometryNodeBoundBox",
+    "GeometryNodeTranslateInstances",
+    "GeometryNodeRotateInstances",
+    "GeometryNodeScaleInstances",
+    "FunctionNodeAxisAngleToRotation",
+    "FunctionNodeRotateRotation",
+    "FunctionNodeAlignEulerToVector",
+    "FunctionNodeAlignRotationToVector",
+    "ShaderNodeFloatCurve",
 ];
 
 pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -169,6 +186,17 @@ pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "GeometryNodeCurvePrimitiveBezierSegment" => curve_primitives::bezier_segment(ctx),
         "GeometryNodeSplineParameter" => curve_fields::spline_parameter(ctx),
         "GeometryNodeCurveLength" => curve_fields::curve_length(ctx),
+        "GeometryNodeSubdivisionSurface" => subdivision_surface::subdivision_surface_node(ctx),
+        "GeometryNodeFlipFaces" => flip_faces::flip_faces(ctx),
+        "GeometryNodeBoundBox" => bounding_box::bounding_box(ctx),
+        "GeometryNodeTranslateInstances" => instance_transform::translate_instances(ctx),
+        "GeometryNodeRotateInstances" => instance_transform::rotate_instances(ctx),
+        "GeometryNodeScaleInstances" => instance_transform::scale_instances(ctx),
+        "FunctionNodeAxisAngleToRotation" => rotation::axis_angle_to_rotation(ctx),
+        "FunctionNodeRotateRotation" => rotation::rotate_rotation(ctx),
+        "FunctionNodeAlignEulerToVector" => rotation::align_euler_to_vector(ctx),
+        "FunctionNodeAlignRotationToVector" => rotation::align_rotation_to_vector(ctx),
+        "ShaderNodeFloatCurve" => float_curve::float_curve(ctx),
         _ => Err(ctx.err("this node type is not supported by blendsynth's Geometry Nodes evaluator")),
     }
 }

@@ -1103,3 +1103,24 @@ pub fn ico_sphere(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let extra = with_uv(ctx, &mut m, |_| ICO_UVS.to_vec());
     Ok(mesh_out(m, extra))
 }
+
+/// Blender's `create_cuboid_mesh` without a UV map (Bounding Box uses it): `size`
+/// centred on the origin, at least two vertices along each axis.
+pub fn cuboid_mesh(size: V3, vx: usize, vy: usize, vz: usize) -> Mesh {
+    let c = Cuboid { size, vx, vy, vz, ex: vx - 1, ey: vy - 1, ez: vz - 1 };
+    let mut m = Mesh::new();
+    m.positions = cuboid_positions(&c);
+    for q in cuboid_faces(&c) {
+        m.corner_verts.extend(q);
+        m.face_offsets.push(m.corner_verts.len() as u32);
+    }
+    m.calc_edges(false);
+    m.set_smooth(false);
+    m.materials = vec![None];
+    m
+}
+
+/// The UV map of a 2x2x2-vertex cuboid of `size` (Bounding Box's "uv_map").
+pub fn cuboid_uvs_for(size: V3) -> Vec<[f32; 2]> {
+    cuboid_uvs(&Cuboid { size, vx: 2, vy: 2, vz: 2, ex: 1, ey: 1, ez: 1 })
+}

@@ -165,6 +165,17 @@ struct Build {
     /// Per new corner: weights over coarse corners.
     corner_src: Vec<Weights>,
     face_src: Vec<usize>,
+    /// Per new vertex: where it lies on the coarse mesh (for smooth schemes).
+    vert_loc: Vec<Loc>,
+}
+
+/// Where a vertex of the subdivided mesh lies: a coarse vertex, the `i`-th inner point of
+/// a coarse edge (from its first vertex), or grid point (x, y) of a ptex patch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Loc {
+    Vertex(usize),
+    Edge(usize, usize),
+    Ptex(usize, usize, usize),
 }
 
 fn blend(m: &Mesh, w: &[(usize, f64)]) -> [f32; 3] {
@@ -178,6 +189,12 @@ fn blend(m: &Mesh, w: &[(usize, f64)]) -> [f32; 3] {
 }
 
 pub fn subdivide_mesh(m: &Mesh, level: u32) -> Mesh {
+    subdivide_with_locations(m, level).0
+}
+
+/// Simple subdivision, and where each new vertex lies on the coarse mesh (Blender's
+/// Subdivision Surface uses the same topology and moves the vertices).
+pub fn subdivide_with_locations(m: &Mesh, level: u32) -> (Mesh, Vec<Loc>) {
     let ctx = Ctx::new(m, level);
     let res = ctx.res;
     let per_edge = res - 2;
@@ -191,16 +208,20 @@ pub fn subdivide_mesh(m: &Mesh, level: u32) -> Mesh {
         corner_edges: vec![0; ctx.n_faces * 4],
         corner_src: vec![Vec::new(); ctx.n_faces * 4],
         face_src: vec![0; ctx.n_faces],
+        vert_loc: vec![Loc::Vertex(0); ctx.n_verts],
     };
     // Coarse vertices, then vertices along coarse edges (linear from edge[0]).
     for v in 0..m.vertex_count() {
         b.vert_src[v] = vec![(v, 1.0)];
+        b.vert_loc[v] = Loc::Vertex(v);
     }
     let inv = 1.0 / (res - 1) as f64;
     for (e, ev) in m.edges.iter().enumerate() {
         for i in 0..per_edge {
             let t = (i + 1) as f64 * inv;
-            b.vert_src[(ctx.vertices_edge_offset + e as i64 * per_edge + i) as usize] = vec![(ev[0] as usize, 1.0 - t), (ev[1] as usize, t)];
+            let idx = (ctx.vertices_edge_offset + e as i64 * per_edge + i) as usize;
+            b.vert_src[idx] = vec![(ev[0] as usize, 1.0 - t), (ev[1] as usize, t)];
+            b.vert_loc[idx] = Loc::Edge(e, i as usize);
         }
     }
     let corner_to_vert = |w: &Weights| -> Vec<(usize, f64)> { w.iter().map(|&(c, x)| (m.corner_verts[c] as usize, x)).collect() };
@@ -214,6 +235,7 @@ pub fn subdivide_mesh(m: &Mesh, level: u32) -> Mesh {
                 for x in 1..res - 1 {
                     let (_, w) = ctx.weights(ptex, x as f64 * inv, y as f64 * inv);
                     b.vert_src[idx] = corner_to_vert(&w);
+                    b.vert_loc[idx] = Loc::Ptex(ptex, x as usize, y as usize);
                     idx += 1;
                 }
             }
@@ -222,12 +244,14 @@ pub fn subdivide_mesh(m: &Mesh, level: u32) -> Mesh {
             let pinv = 1.0 / (pr - 1) as f64;
             let (_, w) = ctx.weights(ptex, 1.0, 1.0);
             b.vert_src[idx] = corner_to_vert(&w);
+            b.vert_loc[idx] = Loc::Ptex(ptex, (pr - 1) as usize, (pr - 1) as usize);
             idx += 1;
             for c in 0..size {
                 for y in 1..pr - 1 {
                     for x in 1..pr {
                         let (_, w) = ctx.weights(ptex + c, x as f64 * pinv, y as f64 * pinv);
                         b.vert_src[idx] = corner_to_vert(&w);
+                        b.vert_loc[idx] = Loc::Ptex(ptex + c, x as usize, y as usize);
                         idx += 1;
                     }
                 }
@@ -268,7 +292,7 @@ pub fn subdivide_mesh(m: &Mesh, level: u32) -> Mesh {
     out.corner_edges = b.corner_edges;
     out.materials = m.materials.clone();
     out.attributes = interpolate_attributes(m, &b.vert_src, &b.edge_src, &b.corner_src, &b.face_src);
-    out
+    (out, b.vert_loc)
 }
 
 fn mix_array(src: &Array, weights: &[Vec<(usize, f64)>]) -> Array {

@@ -1,0 +1,168 @@
+//! Rotation function nodes: Axis Angle to Rotation, Rotate Rotation, Align Rotation to
+//! Vector and Align Euler to Vector (`function/nodes/node_fn_*`).
+
+use super::super::error::GeometryError;
+use super::super::eval::{outputs, NodeCtx, Outputs};
+use super::super::field::Field;
+use super::super::math::{euler_to_mat3, mat3_normalized_to_quat, mat3_to_euler, normalize, quat_to_mat3, Mat3f, V3};
+use super::super::types::{Array, DataType};
+use super::super::value::SocketValue;
+use super::instance_transform::{axis_angle_mat3, mat3_mul};
+
+/// Hamilton product `a * b` (w, x, y, z): `b` applied first.
+pub fn quat_mul(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
+    [
+        a[0] * b[0] - a[1] * b[1] - a[2] * b[2] - a[3] * b[3],
+        a[0] * b[1] + a[1] * b[0] + a[2] * b[3] - a[3] * b[2],
+        a[0] * b[2] + a[2] * b[0] + a[3] * b[1] - a[1] * b[3],
+        a[0] * b[3] + a[3] * b[0] + a[1] * b[2] - a[2] * b[1],
+    ]
+}
+
+pub fn axis_angle_to_rotation(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
+    let axis = ctx.field("Axis", DataType::Vector)?;
+    let angle = ctx.field("Angle", DataType::Float)?;
+    let f = Field::op1("Axis Angle to Rotation", vec![axis, angle], DataType::Quaternion, |_, x| {
+        let (ax, an) = (x[0].as_vector(), x[1].as_float());
+        Ok(Array::Quaternion(
+            ax.iter()
+                .zip(an.iter())
+                .map(|(a, t)| {
+                    let n = normalize(*a);
+                    let (s, c) = (t * 0.5).sin_cos();
+                    [c, n[0] * s, n[1] * s, n[2] * s]
+                })
+                .collect(),
+        ))
+    })
+    .map_err(|e| ctx.err(e))?;
+    Ok(outputs([("Rotation", SocketValue::Field(f))]))
+}
+
+pub fn rotate_rotation(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
+    let local = ctx.prop("rotation_space").and_then(|v| v.as_str()) == Some("LOCAL");
+    let r = ctx.field("Rotation", DataType::Quaternion)?;
+    let by = ctx.field("Rotate By", DataType::Quaternion)?;
+    let f = Field::op1("Rotate Rotation", vec![r, by], DataType::Quaternion, move |_, x| {
+        let (r, by) = (x[0].as_quat(), x[1].as_quat());
+        Ok(Array::Quaternion(r.iter().zip(by.iter()).map(|(r, b)| if local { quat_mul(*r, *b) } else { quat_mul(*b, *r) }).collect()))
+    })
+    .map_err(|e| ctx.err(e))?;
+    Ok(outputs([("Rotation", SocketValue::Field(f))]))
+}
+
+fn axis_vector(name: &str) -> Option<V3> {
+    match name {
+        "X" => Some([1.0, 0.0, 0.0]),
+        "Y" => Some([0.0, 1.0, 0.0]),
+        "Z" => Some([0.0, 0.0, 1.0]),
+        _ => None,
+    }
+}
+
+fn mat3_vec(m: &Mat3f, v: V3) -> V3 {
+    [0, 1, 2].map(|i| m[0][i] * v[0] + m[1][i] * v[1] + m[2][i] * v[2])
+}
+
+/// `angle_normalized_v3v3`: the angle between unit vectors, accurate near 0 and pi.
+fn angle_normalized(a: V3, b: V3) -> f32 {
+    let d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let len = |v: V3| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    if d >= 0.0 {
+        2.0 * (len([a[0] - b[0], a[1] - b[1], a[2] - b[2]]) / 2.0).asin()
+    } else {
+        std::f32::consts::PI - 2.0 * (len([a[0] + b[0], a[1] + b[1], a[2] + b[2]]) / 2.0).asin()
+    }
+}
+
+fn cross_f64(a: V3, b: V3) -> V3 {
+    let (a, b) = (a.map(|x| x as f64), b.map(|x| x as f64));
+    [(a[1] * b[2] - a[2] * b[1]) as f32, (a[2] * b[0] - a[0] * b[2]) as f32, (a[0] * b[1] - a[1] * b[0]) as f32]
+}
+
+fn is_zero(v: V3) -> bool {
+    v == [0.0; 3]
+}
+
+/// `project_plane_normalized_v3_v3v3`: `v` minus its part along unit `n`.
+fn project_plane(v: V3, n: V3) -> V3 {
+    let d = v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
+    [v[0] - n[0] * d, v[1] - n[1] * d, v[2] - n[2] * d]
+}
+
+/// `angle_signed_on_axis_v3v3_v3`: the angle from `v2` to `v1` about `axis`, in [0, 2 pi).
+fn angle_signed_on_axis(v1: V3, v2: V3, axis: V3) -> f32 {
+    let (p1, p2) = (project_plane(v1, axis), project_plane(v2, axis));
+    let angle = angle_normalized(normalize(p1), normalize(p2));
+    let t = cross_f64(p2, p1);
+    if t[0] * axis[0] + t[1] * axis[1] + t[2] * axis[2] < 0.0 {
+        std::f32::consts::PI * 2.0 - angle
+    } else {
+        angle
+    }
+}
+
+/// The new rotation matrix aligning `main` of `old` to `vector` by `factor`
+/// (`align_rotations_auto_pivot` / `align_rotations_fixed_pivot`); None keeps `old`.
+fn align(old: &Mat3f, vector: V3, factor: f32, main: V3, pivot: Option<V3>) -> Option<Mat3f> {
+    if is_zero(vector) {
+        return None;
+    }
+    let old_axis = mat3_vec(old, main);
+    let rot = match pivot {
+        None => {
+            let new_axis = normalize(vector);
+            let mut axis = cross_f64(old_axis, new_axis);
+            if is_zero(axis) {
+                axis = cross_f64(old_axis, [1.0, 0.0, 0.0]);
+                if is_zero(axis) {
+                    axis = cross_f64(old_axis, [0.0, 1.0, 0.0]);
+                }
+            }
+            axis_angle_mat3(axis, factor * angle_normalized(old_axis, new_axis))
+        }
+        Some(p) => {
+            if p == main {
+                return None;
+            }
+            let pivot_axis = mat3_vec(old, p);
+            let mut full = angle_signed_on_axis(vector, old_axis, pivot_axis);
+            if full > std::f32::consts::PI {
+                full -= 2.0 * std::f32::consts::PI;
+            }
+            axis_angle_mat3(pivot_axis, factor * full)
+        }
+    };
+    Some(mat3_mul(&rot, old))
+}
+
+fn align_settings(ctx: &NodeCtx) -> Result<(V3, Option<V3>), GeometryError> {
+    let main = axis_vector(ctx.prop_str("axis")?).ok_or_else(|| ctx.err("unknown axis"))?;
+    let pivot = match ctx.prop_str("pivot_axis")? {
+        "AUTO" => None,
+        other => Some(axis_vector(other).ok_or_else(|| ctx.err("unknown pivot axis"))?),
+    };
+    Ok((main, pivot))
+}
+
+pub fn align_euler_to_vector(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
+    let (main, pivot) = align_settings(ctx)?;
+    let ins = vec![ctx.field("Rotation", DataType::Vector)?, ctx.field("Factor", DataType::Float)?, ctx.field("Vector", DataType::Vector)?];
+    let f = Field::op1("Align Euler to Vector", ins, DataType::Vector, move |_, x| {
+        let (r, fac, v) = (x[0].as_vector(), x[1].as_float(), x[2].as_vector());
+        Ok(Array::Vector((0..r.len()).map(|i| align(&euler_to_mat3(r[i]), v[i], fac[i], main, pivot).map_or(r[i], |m| mat3_to_euler(&m))).collect()))
+    })
+    .map_err(|e| ctx.err(e))?;
+    Ok(outputs([("Rotation", SocketValue::Field(f))]))
+}
+
+pub fn align_rotation_to_vector(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
+    let (main, pivot) = align_settings(ctx)?;
+    let ins = vec![ctx.field("Rotation", DataType::Quaternion)?, ctx.field("Factor", DataType::Float)?, ctx.field("Vector", DataType::Vector)?];
+    let f = Field::op1("Align Rotation to Vector", ins, DataType::Quaternion, move |_, x| {
+        let (r, fac, v) = (x[0].as_quat(), x[1].as_float(), x[2].as_vector());
+        Ok(Array::Quaternion((0..r.len()).map(|i| align(&quat_to_mat3(r[i]), v[i], fac[i], main, pivot).map_or(r[i], |m| mat3_normalized_to_quat(&m))).collect()))
+    })
+    .map_err(|e| ctx.err(e))?;
+    Ok(outputs([("Rotation", SocketValue::Field(f))]))
+}
