@@ -28,7 +28,8 @@ fn shared_maths_counts_only_where_an_evaluator_runs_it() {
     // In a Geometry Nodes tree only what the geometry evaluator implements counts.
     use blendsynth::nodes::{support_in, Support};
     assert!(matches!(support_in("GeometryNodeTree", "GeometryNodeCurveToMesh"), Support::Supported));
-    assert!(matches!(support_in("GeometryNodeTree", "GeometryNodeSubdivisionSurface"), Support::Unsupported));
+    assert!(matches!(support_in("GeometryNodeTree", "GeometryNodeSubdivisionSurface"), Support::Supported));
+    assert!(matches!(support_in("GeometryNodeTree", "GeometryNodeMergeByDistance"), Support::Unsupported));
     assert!(matches!(support_in("GeometryNodeTree", "ShaderNodeBsdfPrincipled"), Support::Unsupported));
     let (_, r) = report("fixtures/bake/scenes/uv_math");
     assert_eq!(row(&r, "ShaderNodeMath")["support"], "supported");
