@@ -173,6 +173,24 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeLightFalloff",
     "ShaderNodeNormal",
     "ShaderNodeTangent",
+    // Constant and coordinate inputs (shader/compile.rs), proven by tests/bake.rs and
+    // tests/inputs.rs.
+    "ShaderNodeValue",
+    "ShaderNodeRGB",
+    "ShaderNodeTexCoord",
+    "ShaderNodeUVMap",
+    // Closures the renderer gives light transport, each with a Cycles parity scene in
+    // tests/render.rs (Anisotropic is the 3.x name of Glossy).
+    "ShaderNodeBsdfDiffuse",
+    "ShaderNodeBsdfGlossy",
+    "ShaderNodeBsdfAnisotropic",
+    "ShaderNodeBsdfGlass",
+    "ShaderNodeBsdfRefraction",
+    "ShaderNodeBsdfTranslucent",
+    "ShaderNodeBsdfTransparent",
+    "ShaderNodeBsdfPrincipled",
+    "ShaderNodeSubsurfaceScattering",
+    "ShaderNodeHoldout",
 ];
 
 /// Support for a node inside a tree of type `tree` (`ShaderNodeTree`,
