@@ -16,7 +16,7 @@ use super::geometry_ops::{eval_fields, geo, modify_geometry_sets};
 
 /// Segment index and factor of a sample at `len` along accumulated segment `lengths`
 /// (`length_parameterize::sample_at_length`).
-fn sample_at_length(lengths: &[f32], len: f32) -> (usize, f32) {
+pub fn sample_at_length(lengths: &[f32], len: f32) -> (usize, f32) {
     let total = lengths[lengths.len() - 1];
     if len >= total {
         return (lengths.len() - 1, 1.0);

@@ -20,6 +20,7 @@ pub mod merge_by_distance;
 pub mod curve_to_points;
 pub mod mesh_to_curve;
 pub mod dual_mesh;
+pub mod sample_curve;
 pub mod primitives;
 pub mod proximity;
 pub mod rotation;
@@ -118,6 +119,7 @@ pub const SUPPORTED: &[&str] = &[
     "GeometryNodeCurveToPoints",
     "GeometryNodeMeshToCurve",
     "GeometryNodeDualMesh",
+    "GeometryNodeSampleCurve",
 ];
 
 pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -209,6 +211,7 @@ pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "GeometryNodeCurveToPoints" => curve_to_points::curve_to_points(ctx),
         "GeometryNodeMeshToCurve" => mesh_to_curve::mesh_to_curve(ctx),
         "GeometryNodeDualMesh" => dual_mesh::dual_mesh(ctx),
+        "GeometryNodeSampleCurve" => sample_curve::sample_curve(ctx),
         _ => Err(ctx.err("this node type is not supported by blendsynth's Geometry Nodes evaluator")),
     }
 }
