@@ -2,7 +2,8 @@
 //! curves. Runs start at every vertex without exactly two selected edges (in vertex
 //! order, each unused edge in the order the edges list it) and follow two-edge vertices
 //! until a vertex with another count; what is left are closed loops, cyclic curves
-//! started at their lowest vertex. Point attributes follow the vertices.
+//! started at their lowest vertex. Point attributes follow the vertices. In Faces mode
+//! every selected face becomes a cyclic curve (`mesh_faces_to_curves`).
 
 use std::sync::Arc;
 
@@ -115,21 +116,63 @@ pub fn mesh_edges_to_curves(m: &Mesh, edges: &[[u32; 2]]) -> Curves {
     c
 }
 
+/// `mesh_faces_to_curves_convert`: each selected face a cyclic poly curve through its
+/// corners' vertices; point and edge attributes follow the vertices, corner attributes
+/// the corners, face attributes go to the curves.
+pub fn mesh_faces_to_curves(m: &Mesh, faces: &[usize]) -> Curves {
+    let mut offsets = vec![0u32];
+    let mut corners: Vec<usize> = Vec::new();
+    for &f in faces {
+        corners.extend(m.face(f));
+        offsets.push(corners.len() as u32);
+    }
+    let verts: Vec<usize> = corners.iter().map(|&c| m.corner_verts[c] as usize).collect();
+    let n = faces.len();
+    let mut c = Curves { positions: verts.iter().map(|&v| m.positions[v]).collect(), curve_offsets: offsets, ..Default::default() };
+    c.attributes.set(AttrId::named("curve_type"), Domain::Curve, Array::Int8(vec![CURVE_TYPE_POLY; n]));
+    c.attributes.set(AttrId::named("cyclic"), Domain::Curve, Array::Bool(vec![true; n]));
+    for a in m.attributes.iter() {
+        if a.id.name().is_some_and(|x| x.starts_with('.') || matches!(x, "sharp_face" | "sharp_edge")) {
+            continue;
+        }
+        match a.domain {
+            Domain::Point | Domain::Edge => {
+                let on_points = ComponentRef::Mesh(m).adapt(&a.data, a.domain, Domain::Point);
+                c.attributes.set(a.id.clone(), Domain::Point, on_points.gather(&verts));
+            }
+            Domain::Corner => c.attributes.set(a.id.clone(), Domain::Point, a.data.gather(&corners)),
+            Domain::Face => c.attributes.set(a.id.clone(), Domain::Curve, a.data.gather(faces)),
+            _ => {}
+        }
+    }
+    c.materials = m.materials.clone();
+    c
+}
+
 pub fn mesh_to_curve(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let mut g = ctx.geometry("Mesh")?;
     let sel = ctx.field("Selection", DataType::Bool)?;
-    let mode = ctx.prop_str("mode").unwrap_or("EDGES").to_string();
-    if mode != "EDGES" {
-        return Err(ctx.err(format!("mode {mode} is not supported yet (only Edges)")));
-    }
+    let faces_mode = match ctx.prop_str("mode").unwrap_or("EDGES") {
+        "EDGES" => false,
+        "FACES" => true,
+        other => return Err(ctx.err(format!("mode {other} is not a Mesh to Curve mode"))),
+    };
     modify_geometry_sets(&mut g, &mut |s| {
         let Some(m) = s.mesh.clone() else { return Ok(()) };
-        let r = eval_fields(ComponentRef::Mesh(&m), Domain::Edge, &[(&sel, DataType::Bool)])?;
-        let sel = r[0].as_bool();
-        let edges: Vec<[u32; 2]> = (0..m.edge_count()).filter(|&e| sel[e]).map(|e| m.edges[e]).collect();
+        let curves = if faces_mode {
+            let r = eval_fields(ComponentRef::Mesh(&m), Domain::Face, &[(&sel, DataType::Bool)])?;
+            let sel = r[0].as_bool();
+            let faces: Vec<usize> = (0..m.face_count()).filter(|&f| sel[f]).collect();
+            (!faces.is_empty()).then(|| mesh_faces_to_curves(&m, &faces))
+        } else {
+            let r = eval_fields(ComponentRef::Mesh(&m), Domain::Edge, &[(&sel, DataType::Bool)])?;
+            let sel = r[0].as_bool();
+            let edges: Vec<[u32; 2]> = (0..m.edge_count()).filter(|&e| sel[e]).map(|e| m.edges[e]).collect();
+            (!edges.is_empty()).then(|| mesh_edges_to_curves(&m, &edges))
+        };
         s.mesh = None;
         s.points = None;
-        s.curves = if edges.is_empty() { None } else { Some(Arc::new(mesh_edges_to_curves(&m, &edges))) };
+        s.curves = curves.map(Arc::new);
         Ok(())
     })
     .map_err(|e| ctx.err(e))?;
