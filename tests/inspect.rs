@@ -31,7 +31,8 @@ fn shared_maths_counts_only_where_an_evaluator_runs_it() {
     use blendsynth::nodes::{support_in, Support};
     assert!(matches!(support_in("GeometryNodeTree", "GeometryNodeCurveToMesh"), Support::Supported));
     assert!(matches!(support_in("GeometryNodeTree", "GeometryNodeSubdivisionSurface"), Support::Supported));
-    assert!(matches!(support_in("GeometryNodeTree", "GeometryNodeMergeByDistance"), Support::Unsupported));
+    assert!(matches!(support_in("GeometryNodeTree", "GeometryNodeMergeByDistance"), Support::Supported));
+    assert!(matches!(support_in("GeometryNodeTree", "GeometryNodeConvexHull"), Support::Unsupported));
     assert!(matches!(support_in("GeometryNodeTree", "ShaderNodeBsdfPrincipled"), Support::Unsupported));
     let (_, r) = report("fixtures/bake/scenes/uv_math");
     assert_eq!(row(&r, "ShaderNodeMath")["support"], "supported");

@@ -174,6 +174,29 @@ pub fn quat_to_euler(q: [f32; 4]) -> V3 {
 
 /// `mat3_normalized_to_quat_fast` followed by a normalize.
 pub fn mat3_normalized_to_quat(m: &Mat3f) -> [f32; 4] {
+    normalize_quat(mat3_to_quat_raw(m))
+}
+
+/// `math::to_quaternion(float3x3)` (`normalized_to_quat_with_checks`): no column
+/// normalization, a negative matrix negated, and the result normalized only when its
+/// squared length is off by 0.0006 or more (so a slightly sheared frame keeps its scale).
+pub fn mat3_to_quat_checked(m: &Mat3f) -> [f32; 4] {
+    let det = m[0][0] * (m[1][1] * m[2][2] - m[2][1] * m[1][2]) - m[1][0] * (m[0][1] * m[2][2] - m[2][1] * m[0][2]) + m[2][0] * (m[0][1] * m[1][2] - m[1][1] * m[0][2]);
+    if !det.is_finite() {
+        return [1.0, 0.0, 0.0, 0.0];
+    }
+    let m = if det < 0.0 { m.map(|c| c.map(|x| -x)) } else { *m };
+    let q = mat3_to_quat_raw(&m);
+    let len_sq = q[1] * q[1] + q[2] * q[2] + q[3] * q[3] + q[0] * q[0];
+    if (len_sq - 1.0).abs() >= 0.0002 * 3.0 {
+        let inv = (1.0 / (len_sq as f64).sqrt()) as f32;
+        return q.map(|x| x * inv);
+    }
+    q
+}
+
+/// Mike Day's matrix to quaternion (w, x, y, z), unnormalized.
+fn mat3_to_quat_raw(m: &Mat3f) -> [f32; 4] {
     let mut q = [0.0f32; 4];
     if m[2][2] < 0.0 {
         if m[0][0] > m[1][1] {
@@ -231,7 +254,7 @@ pub fn mat3_normalized_to_quat(m: &Mat3f) -> [f32; 4] {
             q[0] = 1.0;
         }
     }
-    normalize_quat(q)
+    q
 }
 
 pub fn normalize_quat(q: [f32; 4]) -> [f32; 4] {

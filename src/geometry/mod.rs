@@ -43,6 +43,7 @@ pub mod realize;
 pub mod set;
 pub mod types;
 pub mod value;
+pub mod weld;
 
 pub use error::GeometryError;
 pub use export::{write_glb, write_mesh, write_obj, write_ply};

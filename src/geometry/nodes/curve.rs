@@ -16,7 +16,7 @@ use super::geometry_ops::{eval_fields, geo, modify_geometry_sets};
 
 /// Segment index and factor of a sample at `len` along accumulated segment `lengths`
 /// (`length_parameterize::sample_at_length`).
-fn sample_at_length(lengths: &[f32], len: f32) -> (usize, f32) {
+pub fn sample_at_length(lengths: &[f32], len: f32) -> (usize, f32) {
     let total = lengths[lengths.len() - 1];
     if len >= total {
         return (lengths.len() - 1, 1.0);
@@ -45,7 +45,7 @@ fn sample_uniform(lengths: &[f32], include_last: bool, count: usize, idx: &mut V
     }
 }
 
-enum ResampleMode {
+pub enum ResampleMode {
     Count(Vec<i32>),
     Length(Vec<f32>),
     Evaluated,
@@ -53,6 +53,19 @@ enum ResampleMode {
 
 /// Resamples every curve to poly curves (all curves selected).
 fn resample(c: &Curves, mode: ResampleMode) -> Result<Curves, String> {
+    Ok(resample_indexed(c, mode)?.0)
+}
+
+/// Samples of a resampling: for each new point, the two evaluated points it lies between
+/// and the factor.
+pub struct Samples {
+    pub a: Vec<usize>,
+    pub b: Vec<usize>,
+    pub factor: Vec<f32>,
+}
+
+/// `resample` with where each new point came from (for tangents and normals).
+pub fn resample_indexed(c: &Curves, mode: ResampleMode) -> Result<(Curves, Samples, Evaluated), String> {
     let ev = Evaluated::new(c)?;
     let eval_pos = ev.positions(c);
     let mut out = Curves { curve_offsets: vec![0], ..Default::default() };
@@ -110,7 +123,7 @@ fn resample(c: &Curves, mode: ResampleMode) -> Result<Curves, String> {
         out.attributes.set(AttrId::named("curve_type"), Domain::Curve, Array::Int8(vec![CURVE_TYPE_POLY; c.curve_count()]));
     }
     out.materials = c.materials.clone();
-    Ok(out)
+    Ok((out, Samples { a: ia, b: ib, factor: fac }, ev))
 }
 
 fn lerp3(a: V3, b: V3, t: f32) -> V3 {

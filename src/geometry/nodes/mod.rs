@@ -16,6 +16,11 @@ pub mod function;
 pub mod geometry_ops;
 pub mod input;
 pub mod instance_transform;
+pub mod merge_by_distance;
+pub mod curve_to_points;
+pub mod mesh_to_curve;
+pub mod dual_mesh;
+pub mod sample_curve;
 pub mod primitives;
 pub mod proximity;
 pub mod rotation;
@@ -110,6 +115,11 @@ pub const SUPPORTED: &[&str] = &[
     "FunctionNodeAlignEulerToVector",
     "FunctionNodeAlignRotationToVector",
     "ShaderNodeFloatCurve",
+    "GeometryNodeMergeByDistance",
+    "GeometryNodeCurveToPoints",
+    "GeometryNodeMeshToCurve",
+    "GeometryNodeDualMesh",
+    "GeometryNodeSampleCurve",
 ];
 
 pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -197,6 +207,11 @@ pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "FunctionNodeAlignEulerToVector" => rotation::align_euler_to_vector(ctx),
         "FunctionNodeAlignRotationToVector" => rotation::align_rotation_to_vector(ctx),
         "ShaderNodeFloatCurve" => float_curve::float_curve(ctx),
+        "GeometryNodeMergeByDistance" => merge_by_distance::merge_by_distance(ctx),
+        "GeometryNodeCurveToPoints" => curve_to_points::curve_to_points(ctx),
+        "GeometryNodeMeshToCurve" => mesh_to_curve::mesh_to_curve(ctx),
+        "GeometryNodeDualMesh" => dual_mesh::dual_mesh(ctx),
+        "GeometryNodeSampleCurve" => sample_curve::sample_curve(ctx),
         _ => Err(ctx.err("this node type is not supported by blendsynth's Geometry Nodes evaluator")),
     }
 }
