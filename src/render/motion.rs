@@ -284,17 +284,30 @@ mod tests {
 
     #[test]
     fn scale_and_shear_survive_decomposition() {
-        // A rotated, non-uniformly scaled, sheared and mirrored transform recomposes exactly.
+        // Rotated, non-uniformly scaled and sheared transforms recompose exactly, and so
+        // do mirrored ones without shear. (Cycles folds a mirror into the scale only, not
+        // the shear, so a mirrored sheared transform does not survive there either.)
         let (c, s) = (0.6f32.cos(), 0.6f32.sin());
         let rot = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
-        let sm = [[2.0, 0.3, -0.2], [0.0, 0.5, 0.1], [0.0, 0.0, -1.5]];
-        let m = Affine { m: std::array::from_fn(|i| [0, 1, 2, 3].map(|j| if j == 3 { [1.0, -2.0, 3.0][i] } else { (0..3).map(|k| rot[i][k] * sm[k][j]).sum() })) };
-        let steps = decompose(&[m, m]);
-        let back = interpolate(&steps, 0.3);
-        for r in 0..3 {
-            for c in 0..4 {
-                assert!((back.m[r][c] - m.m[r][c]).abs() < 1e-5, "{:?} vs {:?}", back.m, m.m);
+        for sm in [[[2.0, 0.3, -0.2], [0.0, 0.5, 0.1], [0.0, 0.0, 1.5]], [[2.0, 0.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.0, -1.5]]] {
+            let m = Affine { m: std::array::from_fn(|i| [0, 1, 2, 3].map(|j| if j == 3 { [1.0, -2.0, 3.0][i] } else { (0..3).map(|k| rot[i][k] * sm[k][j]).sum() })) };
+            let steps = decompose(&[m, m]);
+            let back = interpolate(&steps, 0.3);
+            for r in 0..3 {
+                for c in 0..4 {
+                    assert!((back.m[r][c] - m.m[r][c]).abs() < 1e-5, "{:?} vs {:?}", back.m, m.m);
+                }
             }
+        }
+    }
+
+    #[test]
+    fn scale_interpolates_linearly() {
+        // Cycles interpolates the scale matrix linearly between steps.
+        let sx = |k: f32| Affine { m: [[k, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]] };
+        let steps = decompose(&[sx(1.0), sx(2.0), sx(4.0)]);
+        for (time, want) in [(0.25, 1.5f32), (0.5, 2.0), (0.75, 3.0)] {
+            assert!((interpolate(&steps, time).m[0][0] - want).abs() < 1e-6);
         }
     }
 }

@@ -167,17 +167,8 @@ impl MotionAccel {
                     ohi = vmax(ohi, *p);
                 }
             }
-            let c = scale(add(olo, ohi), 0.5);
-            let r = 0.5 * len(sub(ohi, olo));
-            // Translation is linear between steps and the rest reaches no farther than
-            // at a step, so the steps' translations grown by the largest reach bound it.
-            let reach = motion.steps.iter().map(|s| s.reach(c, r)).fold(0.0f32, f32::max) * (1.0 + 1e-5) + 1e-6;
-            let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-            for s in &motion.steps {
-                lo = vmin(lo, s.translation());
-                hi = vmax(hi, s.translation());
-            }
-            movers.push(Mover { bvh: Bvh::build(&tris), prims, motion: motion.clone(), lo: lo.map(|v| v - reach), hi: hi.map(|v| v + reach) });
+            let (lo, hi) = reach_bounds(&motion.steps, olo, ohi);
+            movers.push(Mover { bvh: Bvh::build(&tris), prims, motion: motion.clone(), lo, hi });
         }
         MotionAccel { fixed: Bvh::build(&fixed_tris), fixed_prims, movers }
     }
@@ -186,6 +177,21 @@ impl MotionAccel {
     pub fn movers(&self) -> usize {
         self.movers.len()
     }
+}
+
+/// A world box holding the object-space box (olo, ohi) at every time across the steps.
+/// Translation is linear between steps and the rest reaches no farther than at a step,
+/// so the steps' translations grown by the largest reach bound it.
+fn reach_bounds(steps: &[Decomposed], olo: V3, ohi: V3) -> (V3, V3) {
+    let c = scale(add(olo, ohi), 0.5);
+    let r = 0.5 * len(sub(ohi, olo));
+    let reach = steps.iter().map(|s| s.reach(c, r)).fold(0.0f32, f32::max) * (1.0 + 1e-5) + 1e-6;
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for s in steps {
+        lo = vmin(lo, s.translation());
+        hi = vmax(hi, s.translation());
+    }
+    (lo.map(|v| v - reach), hi.map(|v| v + reach))
 }
 
 /// Whether the ray meets the box within [tmin, tmax].
@@ -262,5 +268,25 @@ mod tests {
         assert!(meets_box([-1.0; 3], [1.0; 3], [0.0, 0.0, -5.0], [0.0, 0.0, 1.0], 0.0, f32::INFINITY));
         assert!(!meets_box([-1.0; 3], [1.0; 3], [2.0, 0.0, -5.0], [0.0, 0.0, 1.0], 0.0, f32::INFINITY));
         assert!(!meets_box([-1.0; 3], [1.0; 3], [0.0, 0.0, -5.0], [0.0, 0.0, 1.0], 0.0, 3.0));
+    }
+
+    #[test]
+    fn reach_bounds_hold_the_object_at_every_time() {
+        // A box off its origin, turning half a turn, growing and moving: its corners at
+        // many times between the steps stay inside the bound.
+        let step = |a: f32, k: f32, t: V3| {
+            let (c, s) = (a.cos(), a.sin());
+            Affine { m: [[c * k, -s, 0.0, t[0]], [s * k, c, 0.0, t[1]], [0.0, 0.0, 1.0 + 0.5 * k, t[2]]] }
+        };
+        let steps = decompose(&[step(0.0, 1.0, [0.0; 3]), step(1.6, 2.0, [1.0, 0.5, 0.0]), step(3.1, 0.5, [3.0, -1.0, 2.0])]);
+        let (olo, ohi) = ([1.0, 2.0, -0.5], [2.0, 3.0, 0.5]);
+        let (lo, hi) = reach_bounds(&steps, olo, ohi);
+        for i in 0..=200 {
+            let m = interpolate(&steps, i as f32 / 200.0);
+            for k in 0..8 {
+                let p = m.point([0, 1, 2].map(|a| if k >> a & 1 == 1 { ohi[a] } else { olo[a] }));
+                assert!((0..3).all(|a| p[a] >= lo[a] && p[a] <= hi[a]), "time {}: {p:?} outside {lo:?}..{hi:?}", i as f32 / 200.0);
+            }
+        }
     }
 }
