@@ -152,8 +152,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     let centre = frame + shutter.as_ref().map_or(0.0, |s| s.centre_delta);
     let eval = crate::anim::evaluate_scene(scene, centre).map_err(|e| RenderError(format!("evaluating the scene at frame {centre}: {e}")))?;
     let mut camera = camera::Camera::new(scene, &eval, w, h)?;
-    // Objects' world matrices at the motion steps (Cycles' default of one step each side
-    // of the centre, as for the camera).
+    // Objects' world matrices at the motion steps (`object_motion::evaluate_steps`).
     let mut object_steps: Vec<Vec<crate::anim::Mat4>> = Vec::new();
     if let Some(sh) = &shutter {
         let mut steps = Vec::new();
@@ -161,13 +160,13 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
             let e = if k == 1 { None } else { Some(crate::anim::evaluate_scene(scene, f).map_err(|e| RenderError(format!("evaluating the scene at frame {f} (motion blur): {e}")))?) };
             let at = e.as_ref().unwrap_or(&eval);
             steps.push(camera::Camera::new(scene, at, w, h)?.to_world);
-            object_steps.push(at.world_matrices.clone());
         }
+        object_steps = object_motion::evaluate_steps(scene, &eval, sh)?;
         object_motion::warn_deformation(&eval);
         camera.set_motion(&steps);
     }
     let mut geo = build::build(scene, &eval, overrides)?;
-    let moving = object_motion::attach(&mut geo, &eval.world_matrices, &object_steps);
+    let moving = object_motion::attach(&mut geo, &eval.data.objects, &eval.world_matrices, &object_steps);
     let mut used = vec![false; scene.file.materials.len()];
     for inst in &geo.instances {
         for m in inst.slots.iter().flatten() {

@@ -79,17 +79,58 @@ fn affine_mul(a: &Affine, b: &Affine) -> Affine {
     o
 }
 
+/// Cycles' motion step count of an object (BlenderSync::object_motion_steps): none
+/// when its motion blur is off, else 2^(motion_steps - 1) * 2 + 1 (the default 1 gives
+/// 3), so objects with fewer steps are sampled at a subset of the others' times.
+pub fn step_count(obj: &crate::scene::Object) -> usize {
+    let get = |k: &str| obj.cycles.as_ref().and_then(|c| c.get(k));
+    if get("use_motion_blur").and_then(serde_json::Value::as_bool) == Some(false) {
+        return 0;
+    }
+    let steps = get("motion_steps").and_then(serde_json::Value::as_i64).unwrap_or(1).clamp(1, 7);
+    ((2usize << (steps - 1)) + 1).min(MAX_MOTION_STEPS)
+}
+
+/// Cycles' Object::MAX_MOTION_STEPS.
+const MAX_MOTION_STEPS: usize = 129;
+
+/// The objects' world matrices at the motion steps of the object with the most of
+/// them, spread evenly over the shutter in time order (the synced centre among them),
+/// as Cycles syncs motion: frame = centre + relative time x shutter / 2. Empty when no
+/// rendered mesh object blurs.
+pub fn evaluate_steps(scene: &crate::scene::Scene, centre: &crate::anim::EvaluatedScene, shutter: &super::motion::Shutter) -> Result<Vec<Vec<Mat4>>, super::RenderError> {
+    let n = centre.data.objects.iter().filter(|o| o.kind == "MESH" && !o.hide_render).map(step_count).max().unwrap_or(0);
+    if n < 3 {
+        return Ok(Vec::new());
+    }
+    (0..n)
+        .map(|k| {
+            let rel = 2.0 * k as f64 / (n - 1) as f64 - 1.0;
+            if 2 * k == n - 1 {
+                return Ok(centre.world_matrices.clone());
+            }
+            let f = centre.frame + rel * 0.5 * shutter.length;
+            crate::anim::evaluate_scene(scene, f).map(|e| e.world_matrices).map_err(|e| super::RenderError(format!("evaluating the scene at frame {f} (motion blur): {e}")))
+        })
+        .collect()
+}
+
 /// Gives every instance whose object moves within the shutter its motion. `steps` holds
-/// the objects' world matrices at each motion step in time order (the centre among
-/// them); `centre` those the geometry was built with. Returns how many instances move.
-/// Cycles keeps an object's motion only when some step differs from the centre.
-pub fn attach(geo: &mut Geometry, centre: &[Mat4], steps: &[Vec<Mat4>]) -> usize {
-    if steps.len() < 2 {
+/// the objects' world matrices at each motion step in time order (`evaluate_steps`);
+/// `centre` those the geometry was built with; `objects` the objects' settings. Returns
+/// how many instances move. Cycles keeps an object's motion only when some step
+/// differs from the centre.
+pub fn attach(geo: &mut Geometry, objects: &[crate::scene::Object], centre: &[Mat4], all_steps: &[Vec<Mat4>]) -> usize {
+    if all_steps.len() < 3 {
         return 0;
     }
     let mut moving = 0;
     for inst in geo.instances.iter_mut() {
         let oi = inst.object;
+        let Some(count) = objects.get(oi).map(step_count).filter(|&c| c >= 3) else { continue };
+        // This object's steps are every stride-th of the finest set.
+        let stride = (all_steps.len() - 1) / (count - 1);
+        let steps: Vec<&Vec<Mat4>> = all_steps.iter().step_by(stride.max(1)).collect();
         if steps.iter().all(|s| s.get(oi) == centre.get(oi)) {
             continue;
         }
@@ -250,9 +291,10 @@ impl Accel for MotionAccel {
 
 /// Says once per process that mesh changes within the shutter are not blurred, when
 /// motion blur is on and a rendered object's mesh comes from Geometry Nodes (whose
-/// output can change over time).
+/// output can change over time) with Cycles' deformation blur on.
 pub fn warn_deformation(eval: &crate::anim::EvaluatedScene) {
-    let generated = eval.data.objects.iter().any(|o| o.kind == "MESH" && !o.hide_render && o.modifiers.iter().any(|m| m.kind == "NODES" && m.show_render));
+    let deform = |o: &crate::scene::Object| o.cycles.as_ref().and_then(|c| c.get("use_deform_motion")).and_then(serde_json::Value::as_bool) != Some(false);
+    let generated = eval.data.objects.iter().any(|o| o.kind == "MESH" && !o.hide_render && step_count(o) > 0 && deform(o) && o.modifiers.iter().any(|m| m.kind == "NODES" && m.show_render));
     if generated {
         static WARN: std::sync::Once = std::sync::Once::new();
         WARN.call_once(|| eprintln!("warning: motion blur: objects are blurred by their transforms only; deformation motion blur (a mesh that changes within the shutter) is not rendered, meshes are taken at the shutter's centre"));
