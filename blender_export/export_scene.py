@@ -527,6 +527,9 @@ def object_entry(o, view_layer):
         "track_axis": o.track_axis, "up_axis": o.up_axis,
         "instance_type": o.instance_type,
         "instance_collection": o.instance_collection.name if o.instance_collection else None,
+        # Cycles' per-object motion blur settings (Object Properties > Motion Blur).
+        "cycles": {"use_motion_blur": o.cycles.use_motion_blur, "use_deform_motion": o.cycles.use_deform_motion,
+                   "motion_steps": o.cycles.motion_steps} if hasattr(o, "cycles") else None,
     }
 
 

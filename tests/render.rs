@@ -27,6 +27,9 @@ const ASSERTED: &[&str] = &[
     "oren_nayar",
     "glossy_beckmann",
     "coat",
+    // Object motion blur: a cube moving and turning (centred shutter, and START).
+    "object_motion",
+    "object_motion_start",
 ];
 
 /// Scenes that do not pass yet, with the reason.
@@ -295,5 +298,28 @@ fn subsurface_and_rough_glass_same_bits_for_any_thread_count() {
         let b = render(&scene, &opts(2)).unwrap();
         let bits = |o: &blendsynth::render::RenderOutput| o.color.iter().flat_map(|p| p.map(f32::to_bits)).collect::<Vec<_>>();
         assert_eq!(bits(&a), bits(&b), "{scene_name}");
+    }
+}
+
+#[test]
+fn object_motion_blur_matches_cycles_and_discriminates() {
+    // The parity figures of the moving-cube scenes, and the same scenes rendered with
+    // motion blur off (the cube sharp at the shutter's centre): far off Cycles, so the
+    // parity test can tell blur from none.
+    for name in ["object_motion", "object_motion_start"] {
+        let dir = common::repo().join("fixtures/render/scenes").join(name);
+        let r = evaluate(&dir);
+        println!("{name}: ratio {:.3}, worst channel mean error {:.2}%", r.ratio, 100.0 * r.worst_mean);
+        assert!(r.ratio <= MAX_RATIO && r.worst_mean <= MAX_MEAN_REL, "{name}: ratio {:.3}, mean error {:.2}%", r.ratio, 100.0 * r.worst_mean);
+        let mut scene = Scene::load(&dir).unwrap();
+        scene.file.scene.render.insert("use_motion_blur".into(), serde_json::Value::Bool(false));
+        let opts = RenderOptions { samples: Some(64), resolution: Some((128, 128)), seed: Some(0), ..Default::default() };
+        let sharp = render(&scene, &opts).unwrap();
+        let sharp: Vec<[f32; 3]> = sharp.color.iter().map(|p| [p[0], p[1], p[2]]).collect();
+        let a = read_exr(&dir.join("cycles_a.exr"));
+        let b = read_exr(&dir.join("cycles_b.exr"));
+        let ratio = rmse(&sharp, &a) / rmse(&b, &a);
+        println!("{name} without motion blur: ratio {ratio:.3}");
+        assert!(ratio > 2.0 * MAX_RATIO, "{name}: without blur the ratio is only {ratio:.3}");
     }
 }

@@ -18,6 +18,14 @@ pub struct Hit {
 pub trait Accel: Sync {
     fn intersect(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> Option<Hit>;
     fn occluded(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> bool;
+    /// `intersect` at shutter time `time` in [0, 1] (only moving objects care).
+    fn intersect_at(&self, org: V3, dir: V3, tmin: f32, tmax: f32, _time: f32) -> Option<Hit> {
+        self.intersect(org, dir, tmin, tmax)
+    }
+    /// `occluded` at shutter time `time` in [0, 1].
+    fn occluded_at(&self, org: V3, dir: V3, tmin: f32, tmax: f32, _time: f32) -> bool {
+        self.occluded(org, dir, tmin, tmax)
+    }
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -313,5 +321,13 @@ mod tests {
             let s = i as f32 / 1000.0;
             assert!(bvh.intersect([s, s, 1.0], [0.0, 0.0, -1.0], 0.0, f32::INFINITY).is_some(), "miss at {s}");
         }
+    }
+}
+
+impl Bvh {
+    /// The nearest hit (`ANY` false) or any hit (`ANY` true), for structures built of BVHs.
+    #[inline(always)]
+    pub fn intersect_or_occluded<const ANY: bool>(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> Option<Hit> {
+        self.traverse::<ANY>(org, dir, tmin, tmax)
     }
 }

@@ -30,6 +30,8 @@ pub struct MeshInstance {
     pub world_bounds: (V3, V3),
     /// Object Info values and the world-to-object transform the shader reads.
     pub info: crate::shader::point::ObjectInfo,
+    /// Transforms across the shutter when the object moves within it (`object_motion`).
+    pub motion: Option<Arc<super::object_motion::ObjectMotion>>,
 }
 
 /// Per triangle: which instance and which of its mesh's triangles.
@@ -213,6 +215,7 @@ fn push_instance(
             let rows: [[f64; 4]; 4] = std::array::from_fn(|r| if r < 3 { m[r].map(|x| x as f64) } else { [0.0, 0.0, 0.0, 1.0] });
             crate::shader::view::object_info(obj, &rows)
         },
+        motion: None,
     });
     Ok(())
 }

@@ -84,11 +84,14 @@ pub struct Scratch {
     /// origin and of the direction per pixel), set by the caller before `radiance`.
     pub ray_dp: f32,
     pub ray_dd: f32,
+    /// The camera ray's shutter time in [0, 1], shared by every ray of its path (set by
+    /// the caller before `radiance`, like the differentials).
+    pub time: f32,
 }
 
 impl Scratch {
     pub fn new(n_materials: usize) -> Scratch {
-        Scratch { stacks: vec![Vec::new(); n_materials + 1], lobes: LobeSet::default(), light_lobes: LobeSet::default(), rays: 0, ray_dp: 0.0, ray_dd: 0.0 }
+        Scratch { stacks: vec![Vec::new(); n_materials + 1], lobes: LobeSet::default(), light_lobes: LobeSet::default(), rays: 0, ray_dp: 0.0, ray_dd: 0.0, time: super::object_motion::CENTRE_TIME }
     }
 }
 
@@ -100,6 +103,8 @@ pub struct SurfaceHit {
     pub inst: u32,
     pub material: Option<usize>,
     pub backfacing: bool,
+    /// The shutter time the hit's object was posed at.
+    pub time: f32,
 }
 
 /// Below this GGX alpha a vertex uses MIS toward lamps.
@@ -121,12 +126,18 @@ fn finite(v: V3) -> bool {
 
 impl Scene<'_> {
     pub fn surface(&self, prim: u32, u: f32, v: f32, wo: V3) -> SurfaceHit {
+        self.surface_at(prim, u, v, wo, super::object_motion::CENTRE_TIME)
+    }
+
+    /// `surface` with a moving object posed at shutter time `time`.
+    pub fn surface_at(&self, prim: u32, u: f32, v: f32, wo: V3, time: f32) -> SurfaceHit {
         let r = self.geo.refs[prim as usize];
         let inst = &self.geo.instances[r.inst as usize];
         let m = &inst.mesh;
         let c = m.triangles[r.tri as usize].map(|c| c as usize);
         let w0 = 1.0 - u - v;
-        let tri = &self.geo.tris[prim as usize];
+        let (to_world, to_object) = inst.pose_at(time);
+        let tri = &inst.posed_triangle(&self.geo.tris[prim as usize], r.tri, &to_world);
         let p = add(add(scale(tri[0], w0), scale(tri[1], u)), scale(tri[2], v));
         let mut ng = normalize(cross(sub(tri[1], tri[0]), sub(tri[2], tri[0])));
         let lp = c.map(|c| m.positions[m.corner_verts[c] as usize]);
@@ -137,14 +148,14 @@ impl Scene<'_> {
         } else {
             normalize(cross(sub(lp[1], lp[0]), sub(lp[2], lp[0])))
         };
-        let mut n = normalize(Affine::normal_by_inverse(&inst.to_object, n_obj));
+        let mut n = normalize(Affine::normal_by_inverse(&to_object, n_obj));
         // Cycles applies the object transform to the mesh: each vertex normal goes to world
         // space before interpolation (it differs under non-uniform scale), and Texture
         // Coordinate > Normal transforms the result back.
         if m.corner_normals.len() == m.corner_verts.len() {
-            let cn = c.map(|c| normalize(Affine::normal_by_inverse(&inst.to_object, m.corner_normals[c])));
+            let cn = c.map(|c| normalize(Affine::normal_by_inverse(&to_object, m.corner_normals[c])));
             n = normalize(add(add(scale(cn[0], w0), scale(cn[1], u)), scale(cn[2], v)));
-            n_obj = normalize(Affine::normal_by_inverse(&inst.to_world, n));
+            n_obj = normalize(Affine::normal_by_inverse(&to_world, n));
         }
         if !finite(n) || is_zero(n) {
             n = ng;
@@ -169,7 +180,12 @@ impl Scene<'_> {
             sp.uv = [t[0][0] * w0 + t[1][0] * u + t[2][0] * v, t[0][1] * w0 + t[1][1] * u + t[2][1] * v, 0.0];
         }
         self.fill_context(&mut sp, inst, wo, ng, backfacing, u, v);
-        SurfaceHit { p, ng, sp, inst: r.inst, material, backfacing }
+        if inst.motion.is_some() {
+            // Object Info reads the object's transform at the ray's time, as in Cycles.
+            sp.object.location = to_world.column(3);
+            sp.object.world_to_object = to_object.m;
+        }
+        SurfaceHit { p, ng, sp, inst: r.inst, material, backfacing, time }
     }
 
     pub fn shade(&self, hit: &SurfaceHit, wo: V3, scratch: &mut Scratch) {
@@ -227,7 +243,7 @@ impl Scene<'_> {
                 from_sss
             } else {
                 scratch.rays += 1;
-                self.accel.intersect(o, d, t0, t1)
+                self.accel.intersect_at(o, d, t0, t1, scratch.time)
             };
             // Emission reached by a ray clamps as the bounce before it (Cycles: light found
             // after one bounce is direct light, like the light sample at that vertex).
@@ -259,7 +275,7 @@ impl Scene<'_> {
                 break;
             };
             let wo = neg(d);
-            let mut hit = self.surface(h.prim, h.u, h.v, wo);
+            let mut hit = self.surface_at(h.prim, h.u, h.v, wo, scratch.time);
             hit.sp.ray_length = h.t;
             hit.sp.path = PathState { flags, bounce, diffuse, glossy, transmission, transparent };
             ray_dp += h.t * ray_dd;
@@ -354,7 +370,7 @@ impl Scene<'_> {
                     }
                     let start = p_off(ls.wi);
                     scratch.rays += 1;
-                    if light.cast_shadow && self.accel.occluded(start, ls.wi, 0.0, if ls.dist.is_finite() { ls.dist * (1.0 - 1e-4) } else { f32::INFINITY }) {
+                    if light.cast_shadow && self.accel.occluded_at(start, ls.wi, 0.0, if ls.dist.is_finite() { ls.dist * (1.0 - 1e-4) } else { f32::INFINITY }, scratch.time) {
                         continue;
                     }
                     l = add(l, clamp_contrib(c, if bounce == 0 { st.clamp_direct } else { st.clamp_indirect }));
@@ -380,7 +396,7 @@ impl Scene<'_> {
                         let pdf_l = self.mesh_lights.pdf_area[prim as usize] * d2 / cos_l;
                         let start = p_off(wi);
                         scratch.rays += 1;
-                        if pdf_l > 0.0 && !self.accel.occluded(start, wi, 0.0, dist * (1.0 - 1e-4)) {
+                        if pdf_l > 0.0 && !self.accel.occluded_at(start, wi, 0.0, dist * (1.0 - 1e-4), scratch.time) {
                             let le = self.light_emission(prim, b1, b2, neg(wi), dist, bounce, scratch);
                             let w = power_heuristic(pdf_l, pdf_b);
                             let c = scale(mul(mul(throughput, f), le), w / pdf_l);
@@ -532,7 +548,7 @@ impl Scene<'_> {
         let eps = 1e-5 * (1.0 + max3(p.map(f32::abs)));
         let start = if dot(wi, ng) >= 0.0 { madd(p, ng, eps) } else { madd(p, ng, -eps) };
         scratch.rays += 1;
-        if self.accel.occluded(start, wi, 0.0, f32::INFINITY) {
+        if self.accel.occluded_at(start, wi, 0.0, f32::INFINITY, scratch.time) {
             return [0.0; 3];
         }
         let le = self.background_toward(wi, scratch);
@@ -550,12 +566,13 @@ impl Scene<'_> {
         let inst = &self.geo.instances[r.inst as usize];
         let m = &inst.mesh;
         let c = m.triangles[r.tri as usize].map(|c| c as usize);
-        let tri = &self.geo.tris[prim as usize];
+        let (to_world, to_object) = inst.pose_at(hit.time);
+        let tri = &inst.posed_triangle(&self.geo.tris[prim as usize], r.tri, &to_world);
         let (dpdu, dpdv) = (sub(tri[1], tri[0]), sub(tri[2], tri[0]));
         let sp = &mut hit.sp;
         sp.ng = hit.ng;
         sp.backfacing = hit.backfacing;
-        sp.transform = ObjectTransform { to_world: inst.to_world.m, to_object: inst.to_object.m };
+        sp.transform = ObjectTransform { to_world: to_world.m, to_object: to_object.m };
         let (dx, dy) = differential_from_compact(hit.ng, dp);
         sp.dp_dx = dx;
         sp.dp_dy = dy;

@@ -20,6 +20,7 @@ pub mod integrator;
 pub mod light;
 pub mod math;
 pub mod motion;
+pub mod object_motion;
 pub mod microfacet;
 pub mod oren_nayar;
 pub mod sampler;
@@ -110,19 +111,6 @@ const TILE: u32 = 16;
 /// Sample dimension set of the shutter time (apart from the sets paths use).
 const TIME_SET: u32 = 0x7000_0000;
 
-/// Says once per process that moving objects are rendered sharp (only the camera's
-/// motion is blurred so far).
-fn warn_object_motion(scene: &Scene, centre: &crate::anim::EvaluatedScene, other: &crate::anim::EvaluatedScene) {
-    let cam = scene.file.scene.camera.as_deref();
-    let moved = centre.data.objects.iter().enumerate().any(|(i, o)| {
-        Some(o.name.as_str()) != cam && matches!(o.kind.as_str(), "MESH" | "CURVE") && centre.world_matrices[i] != other.world_matrices[i]
-    });
-    if moved {
-        static WARN: std::sync::Once = std::sync::Once::new();
-        WARN.call_once(|| eprintln!("warning: objects move within the shutter; blendsynth blurs camera motion only, moving objects are rendered at the shutter's centre"));
-    }
-}
-
 fn rna_f(m: &crate::scene::Rna, k: &str) -> Option<f64> {
     m.get(k).and_then(Value::as_f64)
 }
@@ -164,19 +152,21 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     let centre = frame + shutter.as_ref().map_or(0.0, |s| s.centre_delta);
     let eval = crate::anim::evaluate_scene(scene, centre).map_err(|e| RenderError(format!("evaluating the scene at frame {centre}: {e}")))?;
     let mut camera = camera::Camera::new(scene, &eval, w, h)?;
+    // Objects' world matrices at the motion steps (`object_motion::evaluate_steps`).
+    let mut object_steps: Vec<Vec<crate::anim::Mat4>> = Vec::new();
     if let Some(sh) = &shutter {
         let mut steps = Vec::new();
         for (k, f) in sh.step_frames(frame).into_iter().enumerate() {
             let e = if k == 1 { None } else { Some(crate::anim::evaluate_scene(scene, f).map_err(|e| RenderError(format!("evaluating the scene at frame {f} (motion blur): {e}")))?) };
             let at = e.as_ref().unwrap_or(&eval);
             steps.push(camera::Camera::new(scene, at, w, h)?.to_world);
-            if let Some(e) = &e {
-                warn_object_motion(scene, &eval, e);
-            }
         }
+        object_steps = object_motion::evaluate_steps(scene, &eval, sh)?;
+        object_motion::warn_deformation(&eval);
         camera.set_motion(&steps);
     }
-    let geo = build::build(scene, &eval, overrides)?;
+    let mut geo = build::build(scene, &eval, overrides)?;
+    let moving = object_motion::attach(&mut geo, &eval.data.objects, &eval.world_matrices, &object_steps);
     let mut used = vec![false; scene.file.materials.len()];
     for inst in &geo.instances {
         for m in inst.slots.iter().flatten() {
@@ -188,7 +178,9 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     let background = world::background(scene)?;
     let world_shader = world::shader(scene)?;
     let tables = tables::Tables::shared();
-    let bvh = Bvh::build(&geo.tris);
+    // With moving objects the static rest goes in a BVH of its own (`object_motion`).
+    let motion_accel = (moving > 0).then(|| object_motion::MotionAccel::build(&geo));
+    let bvh = if motion_accel.is_some() { Bvh::build(&[]) } else { Bvh::build(&geo.tris) };
     let filter = filter::FilterTable::blackman_harris(rna_f(cy, "filter_width").or_else(|| rna_f(r, "filter_size")).unwrap_or(1.5) as f32);
     let gi = |k: &str, d: f64| rna_f(cy, k).unwrap_or(d) as u32;
     let settings = Settings {
@@ -205,7 +197,11 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     let exposure = 1.0f32;
     let build_seconds = start.elapsed().as_secs_f64();
     let mesh_lights = mesh_lights(&geo, &materials, &bvh, &lights, background, tables, settings);
-    let tracer = integrator::Scene { mesh_lights: &mesh_lights, accel: &bvh, geo: &geo, materials: &materials, lights: &lights, background, tables, settings, world: world_shader.as_ref(), view: camera.view() };
+    let accel: &dyn Accel = match &motion_accel {
+        Some(m) => m,
+        None => &bvh,
+    };
+    let tracer = integrator::Scene { mesh_lights: &mesh_lights, accel, geo: &geo, materials: &materials, lights: &lights, background, tables, settings, world: world_shader.as_ref(), view: camera.view() };
 
     let adaptive = adaptive::Adaptive::from_scene(cy, samples, opts.threshold);
     let tiles_x = w.div_ceil(TILE);
@@ -278,8 +274,9 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
                                 let u = rng.get4(i, 0);
                                 let fx = x as f32 + 0.5 + filter.sample(u[0]);
                                 let fy = y as f32 + 0.5 + filter.sample(u[1]);
+                                scratch.time = shutter.as_ref().map_or(object_motion::CENTRE_TIME, |sh| sh.time(rng.get4(i, TIME_SET)[0]));
                                 let (o, d, t0, t1) = match &shutter {
-                                    Some(sh) => camera.ray_at(fx, fy, [u[2], u[3]], sh.time(rng.get4(i, TIME_SET)[0])),
+                                    Some(_) => camera.ray_at(fx, fy, [u[2], u[3]], scratch.time),
                                     None => camera.ray(fx, fy, [u[2], u[3]]),
                                 };
                                 (scratch.ray_dp, scratch.ray_dd) = camera.ray_differentials(fx, fy, [u[2], u[3]]);
@@ -397,6 +394,11 @@ fn mesh_lights(
     let mut areas = Vec::new();
     for (prim, r) in geo.refs.iter().enumerate() {
         let inst = &geo.instances[r.inst as usize];
+        // A moving emitter is found by BSDF sampling alone (its pdf_area stays 0, so
+        // the MIS weight is 1): light samples on it would need its pose at the ray's time.
+        if inst.motion.is_some() {
+            continue;
+        }
         let face = inst.mesh.triangle_faces[r.tri as usize] as usize;
         let slot = inst.face_slot.get(face).copied().unwrap_or(0) as usize;
         let Some(mi) = inst.slots.get(slot).copied().flatten() else { continue };
@@ -453,7 +455,9 @@ struct TilePasses {
     uv: Vec<[f32; 2]>,
 }
 
-/// Label passes from the primary ray through the pixel centre (exact ids, unfiltered).
+/// Label passes from the primary ray through the pixel centre (exact ids, unfiltered), at
+/// the shutter's centre: with motion blur the labels show moving objects where the scene
+/// was synced (the frame for a centred shutter), sharp, not blurred as in the image.
 fn primary_passes(tracer: &integrator::Scene, camera: &camera::Camera, x: u32, y: u32, scratch: &mut Scratch, out: &mut TilePasses) {
     let (o, d, t0, t1) = camera.ray(x as f32 + 0.5, y as f32 + 0.5, [0.5, 0.5]);
     match tracer.accel.intersect(o, d, t0, t1) {

@@ -4,8 +4,8 @@
 //! shutter curve, at which the camera transform is interpolated (rotation by slerp,
 //! translation linearly).
 //!
-//! Object motion blur needs per-instance transforms in the acceleration structure; it is
-//! not rendered yet, and a render says so when objects move within the shutter.
+//! Objects use the same decomposition and interpolation (`object_motion` keeps moving
+//! objects in object space and moves each ray into it at the ray's time).
 
 use serde_json::Value;
 
@@ -111,11 +111,14 @@ fn inverted_cdf(curve: &[f32]) -> Vec<f32> {
         .collect()
 }
 
-/// A rigid transform split for interpolation: unit quaternion (x, y, z, w) and translation.
+/// An affine transform split for interpolation as Cycles' DecomposedTransform: unit
+/// quaternion (x, y, z, w), translation, and the upper-triangular scale/shear matrix S
+/// (the transform is R S plus translation) as s00, s01, s02, s11, s12, s22.
 #[derive(Debug, Clone, Copy)]
 pub struct Decomposed {
     q: [f32; 4],
     t: V3,
+    s: [f32; 6],
 }
 
 /// Rotation part of an affine transform (scale already removed) as a quaternion.
@@ -139,19 +142,60 @@ fn quat_from(m: &Affine) -> [f32; 4] {
     [(q[0] / n) as f32, (q[1] / n) as f32, (q[2] / n) as f32, (q[3] / n) as f32]
 }
 
+/// Cycles' transform_decompose: scale and shear by Gram-Schmidt on the columns, a
+/// negative determinant folded into the scale, the orthonormal rest as a quaternion.
+fn decompose_one(m: &Affine) -> Decomposed {
+    let col = |i: usize| [m.m[0][i], m.m[1][i], m.m[2][i]];
+    let div = |v: V3, d: f32| if d != 0.0 { scale(v, 1.0 / d) } else { [0.0; 3] };
+    let (mut cx, mut cy, mut cz) = (col(0), col(1), col(2));
+    let sx = len(cx);
+    cx = div(cx, sx);
+    let shz = dot(cx, cy);
+    cy = sub(cy, scale(cx, shz));
+    let sy = len(cy);
+    cy = div(cy, sy);
+    let shy = dot(cx, cz);
+    cz = sub(cz, scale(cx, shy));
+    let shx = dot(cy, cz);
+    cz = sub(cz, scale(cy, shx));
+    let sz = len(cz);
+    cz = div(cz, sz);
+    let mut r = Affine { m: std::array::from_fn(|i| [cx[i], cy[i], cz[i], 0.0]) };
+    let mut sc = [sx, sy, sz];
+    if dot(cross(cx, cy), cz) < 0.0 {
+        sc = sc.map(|v| -v);
+        for row in r.m.iter_mut() {
+            for v in row.iter_mut().take(3) {
+                *v = -*v;
+            }
+        }
+    }
+    Decomposed { q: quat_from(&r), t: m.column(3), s: [sc[0], shz, shy, sc[1], shx, sc[2]] }
+}
+
 /// Decomposes the motion steps, flipping quaternions onto one hemisphere so slerp takes
-/// the short way (as Cycles' transform_motion_decompose does).
+/// the short way (as Cycles' transform_motion_decompose does), and giving a step whose
+/// scale is zero its neighbour's rotation.
 pub fn decompose(steps: &[Affine]) -> Vec<Decomposed> {
     let mut out: Vec<Decomposed> = Vec::with_capacity(steps.len());
     for m in steps {
-        let mut q = quat_from(m);
+        let mut d = decompose_one(m);
         if let Some(prev) = out.last() {
-            let d = q[0] * prev.q[0] + q[1] * prev.q[1] + q[2] * prev.q[2] + q[3] * prev.q[3];
-            if d < 0.0 {
-                q = q.map(|c| -c);
+            let c = d.q[0] * prev.q[0] + d.q[1] * prev.q[1] + d.q[2] * prev.q[2] + d.q[3] * prev.q[3];
+            if c < 0.0 {
+                d.q = d.q.map(|c| -c);
             }
         }
-        out.push(Decomposed { q, t: m.column(3) });
+        out.push(d);
+    }
+    for i in 0..out.len() {
+        if out[i].s[0] == 0.0 && out[i].s[3] == 0.0 && out[i].s[5] == 0.0 {
+            if i > 0 {
+                out[i].q = out[i - 1].q;
+            } else if i + 1 < out.len() {
+                out[i].q = out[i + 1].q;
+            }
+        }
     }
     out
 }
@@ -171,15 +215,16 @@ fn quat_interpolate(a: [f32; 4], b: [f32; 4], t: f32) -> [f32; 4] {
     std::array::from_fn(|i| a[i] * tp.cos() + perp[i] * tp.sin())
 }
 
-fn compose(q: [f32; 4], t: V3) -> Affine {
+/// R S plus translation (Cycles' transform_compose).
+fn compose(q: [f32; 4], t: V3, s: &[f32; 6]) -> Affine {
     let [x, y, z, w] = q;
-    Affine {
-        m: [
-            [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w), t[0]],
-            [2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w), t[1]],
-            [2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y), t[2]],
-        ],
-    }
+    let r = [
+        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)],
+        [2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)],
+        [2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)],
+    ];
+    let sm = [[s[0], s[1], s[2]], [0.0, s[3], s[4]], [0.0, 0.0, s[5]]];
+    Affine { m: std::array::from_fn(|i| [0, 1, 2, 3].map(|j| if j == 3 { t[i] } else { r[i][0] * sm[0][j] + r[i][1] * sm[1][j] + r[i][2] * sm[2][j] })) }
 }
 
 /// The transform at `time` in [0, 1] across the motion steps.
@@ -189,7 +234,24 @@ pub fn interpolate(steps: &[Decomposed], time: f32) -> Affine {
     let i = (x as usize).min(max - 1);
     let t = x - i as f32;
     let (a, b) = (&steps[i], &steps[i + 1]);
-    compose(quat_interpolate(a.q, b.q, t), std::array::from_fn(|k| (1.0 - t) * a.t[k] + t * b.t[k]))
+    let lerp = |x: f32, y: f32| (1.0 - t) * x + t * y;
+    compose(quat_interpolate(a.q, b.q, t), std::array::from_fn(|k| lerp(a.t[k], b.t[k])), &std::array::from_fn(|k| lerp(a.s[k], b.s[k])))
+}
+
+impl Decomposed {
+    pub fn translation(&self) -> V3 {
+        self.t
+    }
+
+    /// An upper bound of |R S p| for every p within `r` of `c`: how far the object's
+    /// points reach from its origin at this step. S is interpolated linearly, so between
+    /// two steps the reach stays below the larger of theirs.
+    pub fn reach(&self, c: V3, r: f32) -> f32 {
+        let s = &self.s;
+        let sc = [s[0] * c[0] + s[1] * c[1] + s[2] * c[2], s[3] * c[1] + s[4] * c[2], s[5] * c[2]];
+        let frobenius = s.iter().map(|v| v * v).sum::<f32>().sqrt();
+        len(sc) + r * frobenius
+    }
 }
 
 #[cfg(test)]
@@ -217,6 +279,35 @@ mod tests {
                     assert!((m.m[r][c] - want.m[r][c]).abs() < 1e-5, "time {time}: {:?} vs {:?}", m.m, want.m);
                 }
             }
+        }
+    }
+
+    #[test]
+    fn scale_and_shear_survive_decomposition() {
+        // Rotated, non-uniformly scaled and sheared transforms recompose exactly, and so
+        // do mirrored ones without shear. (Cycles folds a mirror into the scale only, not
+        // the shear, so a mirrored sheared transform does not survive there either.)
+        let (c, s) = (0.6f32.cos(), 0.6f32.sin());
+        let rot = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
+        for sm in [[[2.0, 0.3, -0.2], [0.0, 0.5, 0.1], [0.0, 0.0, 1.5]], [[2.0, 0.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.0, -1.5]]] {
+            let m = Affine { m: std::array::from_fn(|i| [0, 1, 2, 3].map(|j| if j == 3 { [1.0, -2.0, 3.0][i] } else { (0..3).map(|k| rot[i][k] * sm[k][j]).sum() })) };
+            let steps = decompose(&[m, m]);
+            let back = interpolate(&steps, 0.3);
+            for r in 0..3 {
+                for c in 0..4 {
+                    assert!((back.m[r][c] - m.m[r][c]).abs() < 1e-5, "{:?} vs {:?}", back.m, m.m);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn scale_interpolates_linearly() {
+        // Cycles interpolates the scale matrix linearly between steps.
+        let sx = |k: f32| Affine { m: [[k, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]] };
+        let steps = decompose(&[sx(1.0), sx(2.0), sx(4.0)]);
+        for (time, want) in [(0.25, 1.5f32), (0.5, 2.0), (0.75, 3.0)] {
+            assert!((interpolate(&steps, time).m[0][0] - want).abs() < 1e-6);
         }
     }
 }

@@ -342,6 +342,8 @@ pub fn to_diffuse(lobes: &mut super::bsdf::LobeSet) {
 struct Local<'a, 'b> {
     scene: &'a super::integrator::Scene<'b>,
     rays: u64,
+    /// The path's shutter time (moving objects are posed at it).
+    time: f32,
 }
 
 impl LocalTrace for Local<'_, '_> {
@@ -350,7 +352,7 @@ impl LocalTrace for Local<'_, '_> {
         // Skip hits on other objects (Cycles' local intersection sees one object only).
         for _ in 0..64 {
             self.rays += 1;
-            let h = self.scene.accel.intersect(org, dir, t0, tmax)?;
+            let h = self.scene.accel.intersect_at(org, dir, t0, tmax, self.time)?;
             if self.scene.geo.refs[h.prim as usize].inst == inst {
                 return Some((h.t, h.prim, h.u, h.v));
             }
@@ -389,7 +391,7 @@ pub fn enter_and_walk(
         let c = rng.get4(index, base.wrapping_add(2 + 2 * bounce));
         [a[0], a[1], a[2], a[3], c[0], c[1], c[2], c[3]]
     };
-    let mut local = Local { scene, rays: 0 };
+    let mut local = Local { scene, rays: 0, time: hit.time };
     let exit = random_walk(b, start, n, d0, hit.inst, throughput, &mut local, &rand);
     *rays += local.rays;
     let e = exit?;

@@ -152,6 +152,10 @@ pub struct Object {
     /// Object colour RGBA (Object Info > Color and Alpha); absent in older exports.
     #[serde(default)]
     pub color: Option<[f64; 4]>,
+    /// Cycles' object settings (`use_motion_blur`, `use_deform_motion`, `motion_steps`);
+    /// absent in older exports.
+    #[serde(default)]
+    pub cycles: Option<Rna>,
 }
 
 fn yes() -> bool {
