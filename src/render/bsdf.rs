@@ -36,6 +36,10 @@ pub enum LobeKind {
     OrenNayar(OrenNayar),
     /// Glossy reflection with the Beckmann distribution.
     Reflection(Reflection),
+    /// Microfiber sheen (Sheen BSDF, Principled sheen); scatters like diffuse.
+    Sheen(super::sheen::Sheen),
+    /// Ashikhmin velvet (Sheen BSDF, Ashikhmin distribution); scatters like diffuse.
+    Velvet(super::sheen::Velvet),
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -323,6 +327,14 @@ fn eval_lobe(l: &Lobe, wo: V3, wi: V3, ng: V3, _tables: &Tables) -> (V3, f32) {
             let pdf = g1 * d / (4.0 * cos_o);
             (scale(f, common), pdf)
         }
+        LobeKind::Sheen(sh) => {
+            let (f, p) = sh.eval(l.n, wi, ng);
+            ([f; 3], p)
+        }
+        LobeKind::Velvet(ve) => {
+            let (f, p) = ve.eval(l.n, wo, wi, ng);
+            ([f; 3], p)
+        }
     }
 }
 
@@ -357,5 +369,7 @@ fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
             }
             Some((from_local(l.n, wi_l), false))
         }
+        LobeKind::Sheen(sh) => sh.sample(l.n, ng, u).map(|wi| (wi, false)),
+        LobeKind::Velvet(ve) => ve.sample(l.n, ng, u).map(|wi| (wi, false)),
     }
 }

@@ -477,6 +477,14 @@ impl Scene<'_> {
                     }
                     diffuse += 1;
                 }
+                // Cycles labels sheen REFLECT | DIFFUSE: a diffuse bounce.
+                LobeKind::Sheen(_) | LobeKind::Velvet(_) => {
+                    diffuse_ancestor = true;
+                    if diffuse >= st.max_diffuse {
+                        terminate_next = true;
+                    }
+                    diffuse += 1;
+                }
             }
             if bounce >= st.max_bounces {
                 terminate_next = true;
@@ -583,6 +591,7 @@ fn bounce_flags(kind: LobeKind, transmit: bool, singular: bool) -> u32 {
         // The walk's exit scatters diffusely, as Cycles' subsurface exit closure does.
         LobeKind::OrenNayar(_) | LobeKind::Subsurface(_) => ray::DIFFUSE | ray::REFLECT,
         LobeKind::Reflection(_) => ray::GLOSSY | ray::REFLECT,
+        LobeKind::Sheen(_) | LobeKind::Velvet(_) => ray::DIFFUSE | ray::REFLECT,
     };
     if singular {
         f |= ray::SINGULAR;

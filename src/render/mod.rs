@@ -24,6 +24,8 @@ pub mod microfacet;
 pub mod oren_nayar;
 pub mod sampler;
 pub mod shade;
+pub mod sheen;
+pub mod sheen_ltc;
 pub mod subsurface;
 pub mod tables;
 pub mod world;

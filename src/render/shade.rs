@@ -211,6 +211,12 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             let aniso = input_f(b, s, "Anisotropy", 0.0);
             push_bssrdf(out, scale(c, w), radius, c, aniso, ior, r, method, input_n(b, s, "Normal", sp));
         }
+        "ShaderNodeBsdfSheen" => {
+            let c = input_c(b, s, "Color", [0.8; 3]);
+            let r = input_f(b, s, "Roughness", 0.5);
+            let n = input_n(b, s, "Normal", sp);
+            push_sheen_node(out, b.property("distribution"), scale(c, w), r, n, ctx.wo);
+        }
         // Unsupported closures fall back to a diffuse of their colour (documented).
         _ => {
             let c = input_c(b, s, "Color", [0.8; 3]);
@@ -238,6 +244,7 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
     let energy = multiscatter_energy(ctx.tables, mu, roughness);
     let a = roughness * roughness;
     let coat = input_f(b, s, "Coat Weight", 0.0).clamp(0.0, 1.0);
+    weight = principled_sheen(b, s, sp, ctx, out, weight, n, coat);
     if coat > 0.0 {
         weight = principled_coat(b, s, sp, ctx, out, weight, coat);
     }
@@ -337,4 +344,40 @@ fn principled_coat(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, ctx: &Context, ou
         below = mul(below, tint.map(|t| 1.0 - coat + coat * t.powf(depth)));
     }
     below
+}
+
+/// The Sheen BSDF node: microfiber sheen (the default) or Ashikhmin velvet.
+fn push_sheen_node(out: &mut LobeSet, distribution: Option<&str>, weight: V3, roughness: f32, n: V3, wo: V3) {
+    let r = roughness.clamp(0.0, 1.0);
+    if distribution == Some("ASHIKHMIN") {
+        out.push(LobeKind::Velvet(super::sheen::Velvet::new(r)), weight, n);
+        return;
+    }
+    let (sheen, albedo) = super::sheen::Sheen::new(n, wo, r);
+    out.push(LobeKind::Sheen(sheen), scale(weight, albedo), n);
+}
+
+/// Principled sheen as Cycles 4.x layers it: the first layer, a microfiber sheen of
+/// weight x tint about the normal leaned toward the coat normal by the coat weight; the
+/// layers below are scaled by 1 - max(its albedo). Returns the weight left for them.
+#[allow(clippy::too_many_arguments)]
+fn principled_sheen(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet, weight: V3, n: V3, coat: f32) -> V3 {
+    let sheen_w = input_f(b, s, "Sheen Weight", 0.0).max(0.0);
+    if sheen_w <= 1e-5 {
+        return weight;
+    }
+    let tint = input_c(b, s, "Sheen Tint", [1.0; 3]).map(|x| x.max(0.0));
+    let r = input_f(b, s, "Sheen Roughness", 0.5).clamp(0.0, 1.0);
+    let coat_n = input_n(b, s, "Coat Normal", sp);
+    let sn = normalize(add(scale(n, 1.0 - coat), scale(coat_n, coat)));
+    let sn = if is_zero(sn) || !sn.iter().all(|x| x.is_finite()) { n } else { sn };
+    let lobe_w = mul(scale(weight, sheen_w), tint);
+    if lobe_w[0].abs() + lobe_w[1].abs() + lobe_w[2].abs() <= 1e-5 {
+        return weight;
+    }
+    let (sheen, albedo) = super::sheen::Sheen::new(sn, ctx.wo, r);
+    out.push(LobeKind::Sheen(sheen), scale(lobe_w, albedo), sn);
+    // Cycles' closure_layering_weight: albedo over weight is sheen weight x tint x albedo.
+    let layer = scale(tint, sheen_w * albedo);
+    scale(weight, (1.0 - max3(layer)).clamp(0.0, 1.0))
 }
