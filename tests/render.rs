@@ -29,6 +29,11 @@ const ASSERTED: &[&str] = &[
     "coat",
     // Sheen helper: microfiber sheen (Sheen BSDF), LTC table from Cycles.
     "sheen",
+    "principled_sheen",
+    "sheen_ashikhmin",
+    // Anisotropic GGX: Glossy BSDF (default radial tangent), Principled (linked tangent).
+    "anisotropic",
+    "principled_aniso",
 ];
 
 /// Scenes that do not pass yet, with the reason.

@@ -40,6 +40,8 @@ pub enum LobeKind {
     Sheen(super::sheen::Sheen),
     /// Ashikhmin velvet (Sheen BSDF, Ashikhmin distribution); scatters like diffuse.
     Velvet(super::sheen::Velvet),
+    /// Anisotropic GGX reflection (Glossy BSDF anisotropy, Principled anisotropic).
+    GlossyAniso { lobe: super::anisotropic::AnisoGgx, fresnel: Fresnel, energy: f32 },
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -171,6 +173,7 @@ impl LobeSet {
         }
         let (wi, singular) = sample_lobe(l, wo, ng, [u[0], u[1]])?;
         let glossy = matches!(l.kind, LobeKind::Glossy { .. } | LobeKind::Reflection(_));
+        let glossy = glossy || matches!(l.kind, LobeKind::GlossyAniso { .. });
         let transmit = matches!(l.kind, LobeKind::Translucent | LobeKind::Transparent);
         if singular {
             // Mirror or pass-through: only this lobe contributes, with its discrete probability.
@@ -335,6 +338,13 @@ fn eval_lobe(l: &Lobe, wo: V3, wi: V3, ng: V3, _tables: &Tables) -> (V3, f32) {
             let (f, p) = ve.eval(l.n, wo, wi, ng);
             ([f; 3], p)
         }
+        LobeKind::GlossyAniso { lobe, fresnel, energy } => {
+            let (f, p, cos_hv) = lobe.eval(l.n, wo, wi, ng);
+            if !(p > 0.0) {
+                return ([0.0; 3], 0.0);
+            }
+            (scale(fresnel_eval(fresnel, cos_hv, [1.0; 3]), f * energy), p)
+        }
     }
 }
 
@@ -371,5 +381,6 @@ fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
         }
         LobeKind::Sheen(sh) => sh.sample(l.n, ng, u).map(|wi| (wi, false)),
         LobeKind::Velvet(ve) => ve.sample(l.n, ng, u).map(|wi| (wi, false)),
+        LobeKind::GlossyAniso { lobe, .. } => lobe.sample(l.n, wo, ng, u).map(|wi| (wi, false)),
     }
 }

@@ -290,6 +290,10 @@ impl Scene<'_> {
                         if let LobeKind::Reflection(r) = &mut lobe.kind {
                             r.alpha = r.alpha.max(blur);
                         }
+                        if let LobeKind::GlossyAniso { lobe: a, .. } = &mut lobe.kind {
+                            a.alpha_x = a.alpha_x.max(blur);
+                            a.alpha_y = a.alpha_y.max(blur);
+                        }
                     }
                 }
             }
@@ -338,6 +342,7 @@ impl Scene<'_> {
             // glossy lobe, where light sampling alone is noisy; elsewhere light sampling
             // alone has less variance than MIS with our area-uniform lamp sampling.
             let mis_lamps = lobes.lobes[..lobes.len].iter().any(|l| matches!(l.kind, LobeKind::Glossy { alpha, .. } if alpha < MIS_ALPHA));
+            let mis_lamps = mis_lamps || lobes.lobes[..lobes.len].iter().any(|l| matches!(l.kind, LobeKind::GlossyAniso { lobe, .. } if lobe.alpha_x.min(lobe.alpha_y) < MIS_ALPHA));
             // Next-event estimation toward every light.
             if !terminate_next && lobes.len > 0 {
                 for (li, light) in self.lights.iter().enumerate() {
@@ -485,6 +490,12 @@ impl Scene<'_> {
                     }
                     diffuse += 1;
                 }
+                LobeKind::GlossyAniso { .. } => {
+                    if glossy >= st.max_glossy {
+                        terminate_next = true;
+                    }
+                    glossy += 1;
+                }
             }
             if bounce >= st.max_bounces {
                 terminate_next = true;
@@ -592,6 +603,7 @@ fn bounce_flags(kind: LobeKind, transmit: bool, singular: bool) -> u32 {
         LobeKind::OrenNayar(_) | LobeKind::Subsurface(_) => ray::DIFFUSE | ray::REFLECT,
         LobeKind::Reflection(_) => ray::GLOSSY | ray::REFLECT,
         LobeKind::Sheen(_) | LobeKind::Velvet(_) => ray::DIFFUSE | ray::REFLECT,
+        LobeKind::GlossyAniso { .. } => ray::GLOSSY | ray::REFLECT,
     };
     if singular {
         f |= ray::SINGULAR;

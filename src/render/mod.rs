@@ -12,6 +12,7 @@
 
 pub mod accel;
 pub mod adaptive;
+pub mod anisotropic;
 pub mod bsdf;
 pub mod build;
 pub mod camera;

@@ -189,6 +189,13 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             }
             let multi = b.property("distribution") == Some("MULTI_GGX");
             let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
+            let aniso = input_f(b, s, "Anisotropy", 0.0).clamp(-0.99, 0.99);
+            if aniso.abs() > 1e-4 {
+                let (ax, ay) = super::anisotropic::glossy_alphas(r, aniso);
+                let t = tangent_input(b, s, sp, "Tangent", input_f(b, s, "Rotation", 0.0), n);
+                push_glossy(out, ctx, ax, ay, t, Fresnel::Constant, multi, scale(c, w), n, 1.0);
+                return;
+            }
             let energy = if multi { multiscatter_energy(ctx.tables, mu, r) } else { 1.0 };
             out.push(LobeKind::Glossy { alpha: r * r, fresnel: Fresnel::Constant, energy }, scale(c, w), n);
         }
@@ -243,6 +250,9 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
     let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
     let energy = multiscatter_energy(ctx.tables, mu, roughness);
     let a = roughness * roughness;
+    // Anisotropic metallic and specular layers (alphas stretched along the tangent).
+    let (ax, ay) = super::anisotropic::principled_alphas(roughness, input_f(b, s, "Anisotropic", 0.0));
+    let tangent = if ax != ay { tangent_input(b, s, sp, "Tangent", input_f(b, s, "Anisotropic Rotation", 0.0), n) } else { [0.0; 3] };
     let coat = input_f(b, s, "Coat Weight", 0.0).clamp(0.0, 1.0);
     weight = principled_sheen(b, s, sp, ctx, out, weight, n, coat);
     if coat > 0.0 {
@@ -259,7 +269,11 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         }
         let avg_f0 = (base[0] + base[1] + base[2]) / 3.0;
         let albedo = (avg_f0 + (1.0 - avg_f0) / 21.0).clamp(0.0, 1.0);
-        out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::F82 { f0: base, b: bb }, energy }, scale(weight, metallic), n, albedo.max(1e-3));
+        if ax != ay {
+            push_glossy(out, ctx, ax, ay, tangent, Fresnel::F82 { f0: base, b: bb }, true, scale(weight, metallic), n, albedo.max(1e-3));
+        } else {
+            out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::F82 { f0: base, b: bb }, energy }, scale(weight, metallic), n, albedo.max(1e-3));
+        }
         weight = scale(weight, 1.0 - metallic);
     }
     if transmission > 0.0 {
@@ -284,7 +298,18 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
     }
     if spec_level > 0.0 && max3(weight) > 0.0 {
         let e = (ctx.tables.dielectric_e(mu, roughness, eta) * energy).clamp(0.0, 1.0);
-        out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::Dielectric { eta }, energy }, mul(weight, spec_tint), n, e.max(1e-3));
+        // Anisotropic: the albedo tables at Cycles' equivalent roughness (alpha_x alpha_y)^(1/4).
+        let e = if ax != ay {
+            let r4 = (ax * ay).sqrt().sqrt();
+            (ctx.tables.dielectric_e(mu, r4, eta) * multiscatter_energy(ctx.tables, mu, r4)).clamp(0.0, 1.0)
+        } else {
+            e
+        };
+        if ax != ay {
+            push_glossy(out, ctx, ax, ay, tangent, Fresnel::Dielectric { eta }, true, mul(weight, spec_tint), n, e.max(1e-3));
+        } else {
+            out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::Dielectric { eta }, energy }, mul(weight, spec_tint), n, e.max(1e-3));
+        }
         // Attenuate the layers below by the specular layer's albedo.
         let albedo = scale(spec_tint, e);
         weight = scale(weight, (1.0 - max3(albedo)).clamp(0.0, 1.0));
@@ -380,4 +405,33 @@ fn principled_sheen(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, ctx: &Context, o
     // Cycles' closure_layering_weight: albedo over weight is sheen weight x tint x albedo.
     let layer = scale(tint, sheen_w * albedo);
     scale(weight, (1.0 - max3(layer)).clamp(0.0, 1.0))
+}
+
+/// The tangent of an anisotropic closure: the node's Tangent input when linked, else
+/// Cycles' default (Geometry > Tangent: radial about the object's Z), rotated about the
+/// closure normal `n` by `rotation` turns.
+fn tangent_input(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, id: &str, rotation: f32, n: V3) -> V3 {
+    let t = match b.input(id) {
+        Some((slot, true)) => finite3(v3(s, slot)),
+        _ => crate::shader::inputs::radial_tangent(sp, 2),
+    };
+    if rotation != 0.0 {
+        super::anisotropic::rotate_around_axis(t, n, rotation * std::f32::consts::TAU)
+    } else {
+        t
+    }
+}
+
+/// A GGX reflection lobe with alphas (`ax`, `ay`) along tangent `t`: anisotropic unless
+/// singular, Multiscatter energy from the isotropic table at (ax ay)^(1/4) when `multi`.
+#[allow(clippy::too_many_arguments)]
+fn push_glossy(out: &mut LobeSet, ctx: &Context, ax: f32, ay: f32, t: V3, fresnel: Fresnel, multi: bool, weight: V3, n: V3, albedo: f32) {
+    let lobe = super::anisotropic::AnisoGgx::new(n, t, ax, ay);
+    let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
+    let energy = if multi { multiscatter_energy(ctx.tables, mu, lobe.table_roughness()) } else { 1.0 };
+    if lobe.singular() {
+        out.push_scaled(LobeKind::Glossy { alpha: (ax * ay).sqrt(), fresnel, energy }, weight, n, albedo);
+    } else {
+        out.push_scaled(LobeKind::GlossyAniso { lobe, fresnel, energy }, weight, n, albedo);
+    }
 }
