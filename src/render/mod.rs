@@ -28,6 +28,7 @@ pub mod shade;
 pub mod sheen;
 pub mod sheen_ltc;
 pub mod subsurface;
+pub mod subsurface_disk;
 pub mod tables;
 pub mod world;
 
