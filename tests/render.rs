@@ -296,3 +296,16 @@ fn subsurface_and_rough_glass_same_bits_for_any_thread_count() {
         assert_eq!(bits(&a), bits(&b), "{scene_name}");
     }
 }
+
+#[test]
+fn sheen_anisotropic_and_burley_same_bits_for_any_thread_count() {
+    for scene_name in ["principled_sheen", "principled_aniso", "sss_node"] {
+        let dir = common::repo().join("fixtures/render/scenes").join(scene_name);
+        let scene = Scene::load(&dir).unwrap();
+        let opts = |t| RenderOptions { samples: Some(4), resolution: Some((40, 32)), seed: Some(3), threads: Some(t), ..Default::default() };
+        let a = render(&scene, &opts(1)).unwrap();
+        let b = render(&scene, &opts(2)).unwrap();
+        let bits = |o: &blendsynth::render::RenderOutput| o.color.iter().flat_map(|p| p.map(f32::to_bits)).collect::<Vec<_>>();
+        assert_eq!(bits(&a), bits(&b), "{scene_name}");
+    }
+}
