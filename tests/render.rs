@@ -30,12 +30,19 @@ const ASSERTED: &[&str] = &[
     // Object motion blur: a cube moving and turning (centred shutter, and START).
     "object_motion",
     "object_motion_start",
+    // Sheen helper: microfiber sheen (Sheen BSDF), LTC table from Cycles.
+    "sheen",
+    "principled_sheen",
+    "sheen_ashikhmin",
+    // Anisotropic GGX: Glossy BSDF (default radial tangent), Principled (linked tangent).
+    "anisotropic",
+    "principled_aniso",
+    // Subsurface Scattering node, Burley method: disk projection (render/subsurface_disk.rs).
+    "sss_node",
 ];
 
 /// Scenes that do not pass yet, with the reason.
 const KNOWN_FAILURES: &[(&str, &str)] = &[
-    ("sss_node", "ratio ~1.21: the Burley method's disk projection is not implemented; it is rendered by the random walk with Burley's radius scaling"),
-    ("sheen", "Sheen BSDF not implemented yet (falls back to diffuse)"),
     ("translucent", "ratio ~1.151, on the limit, means match to 0.03% (variance, not bias): the excess is in the sun-lit floor (ratio 1.20 there, half the squared error) whose noise is indirect light via the sheet's underside; the sheet itself is at 1.10"),
 ];
 
@@ -321,5 +328,18 @@ fn object_motion_blur_matches_cycles_and_discriminates() {
         let ratio = rmse(&sharp, &a) / rmse(&b, &a);
         println!("{name} without motion blur: ratio {ratio:.3}");
         assert!(ratio > 2.0 * MAX_RATIO, "{name}: without blur the ratio is only {ratio:.3}");
+    }
+}
+
+#[test]
+fn sheen_anisotropic_and_burley_same_bits_for_any_thread_count() {
+    for scene_name in ["principled_sheen", "principled_aniso", "sss_node"] {
+        let dir = common::repo().join("fixtures/render/scenes").join(scene_name);
+        let scene = Scene::load(&dir).unwrap();
+        let opts = |t| RenderOptions { samples: Some(4), resolution: Some((40, 32)), seed: Some(3), threads: Some(t), ..Default::default() };
+        let a = render(&scene, &opts(1)).unwrap();
+        let b = render(&scene, &opts(2)).unwrap();
+        let bits = |o: &blendsynth::render::RenderOutput| o.color.iter().flat_map(|p| p.map(f32::to_bits)).collect::<Vec<_>>();
+        assert_eq!(bits(&a), bits(&b), "{scene_name}");
     }
 }

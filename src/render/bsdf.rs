@@ -36,6 +36,12 @@ pub enum LobeKind {
     OrenNayar(OrenNayar),
     /// Glossy reflection with the Beckmann distribution.
     Reflection(Reflection),
+    /// Microfiber sheen (Sheen BSDF, Principled sheen); scatters like diffuse.
+    Sheen(super::sheen::Sheen),
+    /// Ashikhmin velvet (Sheen BSDF, Ashikhmin distribution); scatters like diffuse.
+    Velvet(super::sheen::Velvet),
+    /// Anisotropic GGX reflection (Glossy BSDF anisotropy, Principled anisotropic).
+    GlossyAniso { lobe: super::anisotropic::AnisoGgx, fresnel: Fresnel, energy: f32 },
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -167,6 +173,7 @@ impl LobeSet {
         }
         let (wi, singular) = sample_lobe(l, wo, ng, [u[0], u[1]])?;
         let glossy = matches!(l.kind, LobeKind::Glossy { .. } | LobeKind::Reflection(_));
+        let glossy = glossy || matches!(l.kind, LobeKind::GlossyAniso { .. });
         let transmit = matches!(l.kind, LobeKind::Translucent | LobeKind::Transparent);
         if singular {
             // Mirror or pass-through: only this lobe contributes, with its discrete probability.
@@ -323,6 +330,21 @@ fn eval_lobe(l: &Lobe, wo: V3, wi: V3, ng: V3, _tables: &Tables) -> (V3, f32) {
             let pdf = g1 * d / (4.0 * cos_o);
             (scale(f, common), pdf)
         }
+        LobeKind::Sheen(sh) => {
+            let (f, p) = sh.eval(l.n, wi, ng);
+            ([f; 3], p)
+        }
+        LobeKind::Velvet(ve) => {
+            let (f, p) = ve.eval(l.n, wo, wi, ng);
+            ([f; 3], p)
+        }
+        LobeKind::GlossyAniso { lobe, fresnel, energy } => {
+            let (f, p, cos_hv) = lobe.eval(l.n, wo, wi, ng);
+            if !(p > 0.0) {
+                return ([0.0; 3], 0.0);
+            }
+            (scale(fresnel_eval(fresnel, cos_hv, [1.0; 3]), f * energy), p)
+        }
     }
 }
 
@@ -357,5 +379,8 @@ fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
             }
             Some((from_local(l.n, wi_l), false))
         }
+        LobeKind::Sheen(sh) => sh.sample(l.n, ng, u).map(|wi| (wi, false)),
+        LobeKind::Velvet(ve) => ve.sample(l.n, ng, u).map(|wi| (wi, false)),
+        LobeKind::GlossyAniso { lobe, .. } => lobe.sample(l.n, wo, ng, u).map(|wi| (wi, false)),
     }
 }

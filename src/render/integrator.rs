@@ -306,6 +306,10 @@ impl Scene<'_> {
                         if let LobeKind::Reflection(r) = &mut lobe.kind {
                             r.alpha = r.alpha.max(blur);
                         }
+                        if let LobeKind::GlossyAniso { lobe: a, .. } = &mut lobe.kind {
+                            a.alpha_x = a.alpha_x.max(blur);
+                            a.alpha_y = a.alpha_y.max(blur);
+                        }
                     }
                 }
             }
@@ -354,6 +358,7 @@ impl Scene<'_> {
             // glossy lobe, where light sampling alone is noisy; elsewhere light sampling
             // alone has less variance than MIS with our area-uniform lamp sampling.
             let mis_lamps = lobes.lobes[..lobes.len].iter().any(|l| matches!(l.kind, LobeKind::Glossy { alpha, .. } if alpha < MIS_ALPHA));
+            let mis_lamps = mis_lamps || lobes.lobes[..lobes.len].iter().any(|l| matches!(l.kind, LobeKind::GlossyAniso { lobe, .. } if lobe.alpha_x.min(lobe.alpha_y) < MIS_ALPHA));
             // Next-event estimation toward every light.
             if !terminate_next && lobes.len > 0 {
                 for (li, light) in self.lights.iter().enumerate() {
@@ -493,6 +498,20 @@ impl Scene<'_> {
                     }
                     diffuse += 1;
                 }
+                // Cycles labels sheen REFLECT | DIFFUSE: a diffuse bounce.
+                LobeKind::Sheen(_) | LobeKind::Velvet(_) => {
+                    diffuse_ancestor = true;
+                    if diffuse >= st.max_diffuse {
+                        terminate_next = true;
+                    }
+                    diffuse += 1;
+                }
+                LobeKind::GlossyAniso { .. } => {
+                    if glossy >= st.max_glossy {
+                        terminate_next = true;
+                    }
+                    glossy += 1;
+                }
             }
             if bounce >= st.max_bounces {
                 terminate_next = true;
@@ -600,6 +619,8 @@ fn bounce_flags(kind: LobeKind, transmit: bool, singular: bool) -> u32 {
         // The walk's exit scatters diffusely, as Cycles' subsurface exit closure does.
         LobeKind::OrenNayar(_) | LobeKind::Subsurface(_) => ray::DIFFUSE | ray::REFLECT,
         LobeKind::Reflection(_) => ray::GLOSSY | ray::REFLECT,
+        LobeKind::Sheen(_) | LobeKind::Velvet(_) => ray::DIFFUSE | ray::REFLECT,
+        LobeKind::GlossyAniso { .. } => ray::GLOSSY | ray::REFLECT,
     };
     if singular {
         f |= ray::SINGULAR;

@@ -12,6 +12,7 @@
 
 pub mod accel;
 pub mod adaptive;
+pub mod anisotropic;
 pub mod bsdf;
 pub mod build;
 pub mod camera;
@@ -25,7 +26,10 @@ pub mod microfacet;
 pub mod oren_nayar;
 pub mod sampler;
 pub mod shade;
+pub mod sheen;
+pub mod sheen_ltc;
 pub mod subsurface;
+pub mod subsurface_disk;
 pub mod tables;
 pub mod world;
 

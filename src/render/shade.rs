@@ -189,6 +189,13 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             }
             let multi = b.property("distribution") == Some("MULTI_GGX");
             let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
+            let aniso = input_f(b, s, "Anisotropy", 0.0).clamp(-0.99, 0.99);
+            if aniso.abs() > 1e-4 {
+                let (ax, ay) = super::anisotropic::glossy_alphas(r, aniso);
+                let t = tangent_input(b, s, sp, "Tangent", input_f(b, s, "Rotation", 0.0), n);
+                push_glossy(out, ctx, ax, ay, t, Fresnel::Constant, multi, scale(c, w), n, 1.0);
+                return;
+            }
             let energy = if multi { multiscatter_energy(ctx.tables, mu, r) } else { 1.0 };
             out.push(LobeKind::Glossy { alpha: r * r, fresnel: Fresnel::Constant, energy }, scale(c, w), n);
         }
@@ -210,6 +217,12 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             let r = input_f(b, s, "Roughness", 1.0);
             let aniso = input_f(b, s, "Anisotropy", 0.0);
             push_bssrdf(out, scale(c, w), radius, c, aniso, ior, r, method, input_n(b, s, "Normal", sp));
+        }
+        "ShaderNodeBsdfSheen" => {
+            let c = input_c(b, s, "Color", [0.8; 3]);
+            let r = input_f(b, s, "Roughness", 0.5);
+            let n = input_n(b, s, "Normal", sp);
+            push_sheen_node(out, b.property("distribution"), scale(c, w), r, n, ctx.wo);
         }
         // Unsupported closures fall back to a diffuse of their colour (documented).
         _ => {
@@ -237,7 +250,11 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
     let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
     let energy = multiscatter_energy(ctx.tables, mu, roughness);
     let a = roughness * roughness;
+    // Anisotropic metallic and specular layers (alphas stretched along the tangent).
+    let (ax, ay) = super::anisotropic::principled_alphas(roughness, input_f(b, s, "Anisotropic", 0.0));
+    let tangent = if ax != ay { tangent_input(b, s, sp, "Tangent", input_f(b, s, "Anisotropic Rotation", 0.0), n) } else { [0.0; 3] };
     let coat = input_f(b, s, "Coat Weight", 0.0).clamp(0.0, 1.0);
+    weight = principled_sheen(b, s, sp, ctx, out, weight, n, coat);
     if coat > 0.0 {
         weight = principled_coat(b, s, sp, ctx, out, weight, coat);
     }
@@ -252,7 +269,11 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         }
         let avg_f0 = (base[0] + base[1] + base[2]) / 3.0;
         let albedo = (avg_f0 + (1.0 - avg_f0) / 21.0).clamp(0.0, 1.0);
-        out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::F82 { f0: base, b: bb }, energy }, scale(weight, metallic), n, albedo.max(1e-3));
+        if ax != ay {
+            push_glossy(out, ctx, ax, ay, tangent, Fresnel::F82 { f0: base, b: bb }, true, scale(weight, metallic), n, albedo.max(1e-3));
+        } else {
+            out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::F82 { f0: base, b: bb }, energy }, scale(weight, metallic), n, albedo.max(1e-3));
+        }
         weight = scale(weight, 1.0 - metallic);
     }
     if transmission > 0.0 {
@@ -277,7 +298,18 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
     }
     if spec_level > 0.0 && max3(weight) > 0.0 {
         let e = (ctx.tables.dielectric_e(mu, roughness, eta) * energy).clamp(0.0, 1.0);
-        out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::Dielectric { eta }, energy }, mul(weight, spec_tint), n, e.max(1e-3));
+        // Anisotropic: the albedo tables at Cycles' equivalent roughness (alpha_x alpha_y)^(1/4).
+        let e = if ax != ay {
+            let r4 = (ax * ay).sqrt().sqrt();
+            (ctx.tables.dielectric_e(mu, r4, eta) * multiscatter_energy(ctx.tables, mu, r4)).clamp(0.0, 1.0)
+        } else {
+            e
+        };
+        if ax != ay {
+            push_glossy(out, ctx, ax, ay, tangent, Fresnel::Dielectric { eta }, true, mul(weight, spec_tint), n, e.max(1e-3));
+        } else {
+            out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::Dielectric { eta }, energy }, mul(weight, spec_tint), n, e.max(1e-3));
+        }
         // Attenuate the layers below by the specular layer's albedo.
         let albedo = scale(spec_tint, e);
         weight = scale(weight, (1.0 - max3(albedo)).clamp(0.0, 1.0));
@@ -337,4 +369,69 @@ fn principled_coat(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, ctx: &Context, ou
         below = mul(below, tint.map(|t| 1.0 - coat + coat * t.powf(depth)));
     }
     below
+}
+
+/// The Sheen BSDF node: microfiber sheen (the default) or Ashikhmin velvet.
+fn push_sheen_node(out: &mut LobeSet, distribution: Option<&str>, weight: V3, roughness: f32, n: V3, wo: V3) {
+    let r = roughness.clamp(0.0, 1.0);
+    if distribution == Some("ASHIKHMIN") {
+        out.push(LobeKind::Velvet(super::sheen::Velvet::new(r)), weight, n);
+        return;
+    }
+    let (sheen, albedo) = super::sheen::Sheen::new(n, wo, r);
+    out.push(LobeKind::Sheen(sheen), scale(weight, albedo), n);
+}
+
+/// Principled sheen as Cycles 4.x layers it: the first layer, a microfiber sheen of
+/// weight x tint about the normal leaned toward the coat normal by the coat weight; the
+/// layers below are scaled by 1 - max(its albedo). Returns the weight left for them.
+#[allow(clippy::too_many_arguments)]
+fn principled_sheen(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet, weight: V3, n: V3, coat: f32) -> V3 {
+    let sheen_w = input_f(b, s, "Sheen Weight", 0.0).max(0.0);
+    if sheen_w <= 1e-5 {
+        return weight;
+    }
+    let tint = input_c(b, s, "Sheen Tint", [1.0; 3]).map(|x| x.max(0.0));
+    let r = input_f(b, s, "Sheen Roughness", 0.5).clamp(0.0, 1.0);
+    let coat_n = input_n(b, s, "Coat Normal", sp);
+    let sn = normalize(add(scale(n, 1.0 - coat), scale(coat_n, coat)));
+    let sn = if is_zero(sn) || !sn.iter().all(|x| x.is_finite()) { n } else { sn };
+    let lobe_w = mul(scale(weight, sheen_w), tint);
+    if lobe_w[0].abs() + lobe_w[1].abs() + lobe_w[2].abs() <= 1e-5 {
+        return weight;
+    }
+    let (sheen, albedo) = super::sheen::Sheen::new(sn, ctx.wo, r);
+    out.push(LobeKind::Sheen(sheen), scale(lobe_w, albedo), sn);
+    // Cycles' closure_layering_weight: albedo over weight is sheen weight x tint x albedo.
+    let layer = scale(tint, sheen_w * albedo);
+    scale(weight, (1.0 - max3(layer)).clamp(0.0, 1.0))
+}
+
+/// The tangent of an anisotropic closure: the node's Tangent input when linked, else
+/// Cycles' default (Geometry > Tangent: radial about the object's Z), rotated about the
+/// closure normal `n` by `rotation` turns.
+fn tangent_input(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, id: &str, rotation: f32, n: V3) -> V3 {
+    let t = match b.input(id) {
+        Some((slot, true)) => finite3(v3(s, slot)),
+        _ => crate::shader::inputs::radial_tangent(sp, 2),
+    };
+    if rotation != 0.0 {
+        super::anisotropic::rotate_around_axis(t, n, rotation * std::f32::consts::TAU)
+    } else {
+        t
+    }
+}
+
+/// A GGX reflection lobe with alphas (`ax`, `ay`) along tangent `t`: anisotropic unless
+/// singular, Multiscatter energy from the isotropic table at (ax ay)^(1/4) when `multi`.
+#[allow(clippy::too_many_arguments)]
+fn push_glossy(out: &mut LobeSet, ctx: &Context, ax: f32, ay: f32, t: V3, fresnel: Fresnel, multi: bool, weight: V3, n: V3, albedo: f32) {
+    let lobe = super::anisotropic::AnisoGgx::new(n, t, ax, ay);
+    let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
+    let energy = if multi { multiscatter_energy(ctx.tables, mu, lobe.table_roughness()) } else { 1.0 };
+    if lobe.singular() {
+        out.push_scaled(LobeKind::Glossy { alpha: (ax * ay).sqrt(), fresnel, energy }, weight, n, albedo);
+    } else {
+        out.push_scaled(LobeKind::GlossyAniso { lobe, fresnel, energy }, weight, n, albedo);
+    }
 }

@@ -6,8 +6,8 @@
 //! Dwivedi-guided directions and spectral MIS over the channels, and leaves where it
 //! next meets the same object, continuing from there with a white diffuse closure.
 //!
-//! Not done: the Burley method's disk projection (rendered by the same random walk), the
-//! quarter-pixel radius fallback (needs ray differentials).
+//! The Burley method samples by disk projection instead (`subsurface_disk`). Not done:
+//! the quarter-pixel radius fallback (needs ray differentials).
 
 use super::math::*;
 use super::microfacet::sample_ggx_vndf;
@@ -377,6 +377,10 @@ pub fn enter_and_walk(
     throughput: &mut V3,
     rays: &mut u64,
 ) -> Option<(super::accel::Hit, V3)> {
+    // The Burley method samples by disk projection instead of walking.
+    if b.method == Method::Burley {
+        return super::subsurface_disk::disk_exit(scene, b, hit, rng, index, set, throughput, rays);
+    }
     // Random numbers of this vertex's walk: a dimension range apart from the path's own.
     let base = 0x2000_0000u32.wrapping_add(set.wrapping_mul(4096));
     let ue = rng.get4(index, base);
