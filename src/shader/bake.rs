@@ -74,6 +74,13 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
     let object = super::view::object_info(obj, &world);
     let n = size as usize;
     let mut pixels = vec![[0.0f32; 4]; n * n];
+    let bound = programs
+        .iter()
+        .map(|p| match p {
+            Some(p) => super::attributes::BoundAttributes::bind(&mesh, &p.attributes, info.active_render_uv.as_deref(), info.default_color_attribute.as_deref()).map_err(|e| format!("mesh {mesh_name:?}: {e}")),
+            None => Ok(Default::default()),
+        })
+        .collect::<Result<Vec<_>, String>>()?;
     let mut stacks: Vec<Vec<f32>> = programs.iter().map(|p| p.as_ref().map(Program::new_stack).unwrap_or_default()).collect();
     for (t, tri) in mesh.triangles.iter().enumerate() {
         let face = mesh.triangle_faces[t] as usize;
@@ -119,7 +126,8 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
                     uv: { let u = lerp(c.map(|c| [uvs[c][0], uvs[c][1], 0.0])); [u[0], u[1], 0.0] },
                     ..diff.point(transform)
                 };
-                let sp = bake_context(sp, &view, object, c.map(|c| transform_point(&world, mesh.positions[mesh.corner_verts[c] as usize])), w);
+                let mut sp = bake_context(sp, &view, object, c.map(|c| transform_point(&world, mesh.positions[mesh.corner_verts[c] as usize])), w);
+                bound[slot].fill(&mesh, t, c, face, w, &mut sp);
                 program.run(&sp, stack);
                 let e = program.surface_emission(stack);
                 pixels[y * n + x] = [e[0], e[1], e[2], 1.0];
