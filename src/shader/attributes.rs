@@ -131,7 +131,9 @@ impl BoundAttributes {
                         Some(AttributeData::Bool(v)) => v.clone(),
                         _ => vec![false; mesh.face_count()],
                     };
-                    Bound { values: Values::MapNormal { normals: mesh.corner_normals.clone(), flat }, fac: FacMode::Average }
+                    let vn = super::tangent::vertex_normals(mesh);
+                    let normals = mesh.corner_verts.iter().map(|&v| vn[v as usize]).collect();
+                    Bound { values: Values::MapNormal { normals, flat }, fac: FacMode::Average }
                 }
             });
         }
