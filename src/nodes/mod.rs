@@ -173,6 +173,11 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeLightFalloff",
     "ShaderNodeNormal",
     "ShaderNodeTangent",
+    // Mesh attributes and tangent space (shader/attributes.rs, tangent.rs), proven by
+    // tests/attributes.rs: in bakes; the renderer refuses materials that read them.
+    // Attribute types Object/Instancer/View Layer are compile errors naming the node.
+    "ShaderNodeAttribute",
+    "ShaderNodeVertexColor",
 ];
 
 /// Support for a node inside a tree of type `tree` (`ShaderNodeTree`,
