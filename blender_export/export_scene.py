@@ -719,7 +719,8 @@ def main():
                        "attributes": [{"name": a.name, "domain": a.domain, "data_type": a.data_type}
                                       for a in me.attributes if not a.name.startswith(".")],
                        "texspace_location": vec(me.texspace_location), "texspace_size": vec(me.texspace_size),
-                       "use_auto_texspace": me.use_auto_texspace})
+                       "use_auto_texspace": me.use_auto_texspace,
+                       "default_color_attribute": getattr(me.attributes, "default_color_name", None) or None})
 
     evaluated = []
     if not args.no_evaluated:

@@ -44,8 +44,9 @@ fn materials_report_whether_they_compile() {
     let m = &r["material_status"][0];
     assert_eq!(m["name"], "Structure");
     assert!(m["error"].is_null(), "{m}");
-    let (code, r) = report("fixtures/scenes/material_zoo");
-    assert_eq!(code, Some(3));
-    let e = r["material_status"][0]["error"].as_str().expect("the zoo uses unsupported nodes");
-    assert!(e.contains("is not supported yet"), "{e}");
+    // The zoo's last unsupported node (tangent-space Normal Map) is supported now: it
+    // compiles; tests/bake.rs covers an unsupported node's error.
+    let (_, r) = report("fixtures/scenes/material_zoo");
+    let m = &r["material_status"][0];
+    assert!(m["error"].is_null(), "{m}");
 }

@@ -191,6 +191,12 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeBsdfPrincipled",
     "ShaderNodeSubsurfaceScattering",
     "ShaderNodeHoldout",
+    "ShaderNodeBsdfSheen",
+    // Mesh attributes and tangent space (shader/attributes.rs, tangent.rs), proven by
+    // tests/attributes.rs: in bakes; the renderer refuses materials that read them.
+    // Attribute types Object/Instancer/View Layer are compile errors naming the node.
+    "ShaderNodeAttribute",
+    "ShaderNodeVertexColor",
 ];
 
 /// Support for a node inside a tree of type `tree` (`ShaderNodeTree`,

@@ -28,6 +28,11 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
             continue;
         }
         let p = compile_material(scene, &m.name).map_err(|e| RenderError(format!("{e}")))?;
+        if !p.attributes.is_empty() {
+            // The renderer's hit points do not carry mesh attributes yet: refuse rather
+            // than shade with zeros.
+            return Err(RenderError(format!("material {:?} reads mesh attributes or tangents ({:?}), which the renderer does not provide yet (blendsynth bake does)", m.name, p.attributes)));
+        }
         let mut bsdf_of = vec![None; p.closures.len()];
         for (bi, b) in p.bsdfs.iter().enumerate() {
             if let Some(slot) = bsdf_of.get_mut(b.closure as usize) {

@@ -223,6 +223,10 @@ pub struct MeshRef {
     pub texspace_size: Option<[f64; 3]>,
     #[serde(default)]
     pub use_auto_texspace: Option<bool>,
+    /// The colour attribute a Color Attribute node without a name reads (Blender's
+    /// default colour attribute).
+    #[serde(default)]
+    pub default_color_attribute: Option<String>,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]

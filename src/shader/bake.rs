@@ -52,6 +52,21 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
         _ => vec![0; mesh.face_count()],
     };
 
+    let flat: Vec<bool> = match mesh.attribute("sharp_face").map(|a| &a.data) {
+        Some(AttributeData::Bool(v)) => v.clone(),
+        _ => vec![false; mesh.face_count()],
+    };
+    // Cycles shades smooth triangles with Blender's vertex normals, unless the mesh has
+    // custom normals (then its corner normals).
+    let vertex_normals = super::tangent::vertex_normals(&mesh);
+    let custom = mesh.attribute("custom_normal").is_some();
+    let smooth_normal = |c: usize| -> Vec3 {
+        if custom {
+            mesh.corner_normals.get(c).copied().unwrap_or([0.0, 0.0, 1.0])
+        } else {
+            vertex_normals[mesh.corner_verts[c] as usize]
+        }
+    };
     // One program per material slot; a face without a material emits nothing.
     let mut programs: Vec<Option<Program>> = Vec::new();
     let slots = if obj.material_slots.is_empty() { info.materials.clone() } else { obj.material_slots.iter().map(|s| s.material.clone()).collect() };
@@ -74,6 +89,13 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
     let object = super::view::object_info(obj, &world);
     let n = size as usize;
     let mut pixels = vec![[0.0f32; 4]; n * n];
+    let bound = programs
+        .iter()
+        .map(|p| match p {
+            Some(p) => super::attributes::BoundAttributes::bind(&mesh, &p.attributes, info.active_render_uv.as_deref(), info.default_color_attribute.as_deref()).map_err(|e| format!("mesh {mesh_name:?}: {e}")),
+            None => Ok(Default::default()),
+        })
+        .collect::<Result<Vec<_>, String>>()?;
     let mut stacks: Vec<Vec<f32>> = programs.iter().map(|p| p.as_ref().map(Program::new_stack).unwrap_or_default()).collect();
     for (t, tri) in mesh.triangles.iter().enumerate() {
         let face = mesh.triangle_faces[t] as usize;
@@ -109,7 +131,10 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
                 // go to world space (normalised) before interpolation, and the object-space
                 // normal (Texture Coordinate > Normal, box projection) comes back through
                 // the transpose.
-                let world_n = normalize3(lerp(c.map(|c| normalize3(mul3x3(&normal_matrix, mesh.corner_normals.get(c).copied().unwrap_or([0.0, 0.0, 1.0]))))));
+                let world_n = normalize3(lerp(c.map(|c| normalize3(mul3x3(&normal_matrix, smooth_normal(c))))));
+                // A flat face shades with its triangle's normal (Cycles' sd->N = Ng), which
+                // differs from Blender's face normal where a quad is not planar.
+                let world_n = if flat[face] { flat_normal(c.map(|c| transform_point(&world, mesh.positions[mesh.corner_verts[c] as usize]))) } else { world_n };
                 let sp = ShadingPoint {
                     position,
                     normal: world_n,
@@ -119,7 +144,8 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
                     uv: { let u = lerp(c.map(|c| [uvs[c][0], uvs[c][1], 0.0])); [u[0], u[1], 0.0] },
                     ..diff.point(transform)
                 };
-                let sp = bake_context(sp, &view, object, c.map(|c| transform_point(&world, mesh.positions[mesh.corner_verts[c] as usize])), w);
+                let mut sp = bake_context(sp, &view, object, c.map(|c| transform_point(&world, mesh.positions[mesh.corner_verts[c] as usize])), w);
+                bound[slot].fill(&mesh, t, c, face, w, &mut sp);
                 program.run(&sp, stack);
                 let e = program.surface_emission(stack);
                 pixels[y * n + x] = [e[0], e[1], e[2], 1.0];
@@ -285,4 +311,11 @@ fn bake_context(mut sp: ShadingPoint, view: &super::view::View, object: super::p
     sp.window = view.window(sp.camera_position);
     sp.object = object;
     sp
+}
+
+/// The unit normal of a triangle (corners counter-clockwise).
+fn flat_normal(p: [Vec3; 3]) -> Vec3 {
+    let e1: Vec3 = std::array::from_fn(|k| p[1][k] - p[0][k]);
+    let e2: Vec3 = std::array::from_fn(|k| p[2][k] - p[0][k]);
+    normalize3(crate::nodes::math::cross3(e1, e2))
 }

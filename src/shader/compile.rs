@@ -27,6 +27,8 @@ use super::bump_graph::{self, Schedule, Step};
 
 /// Compiling the input nodes that read the shading context.
 mod inputs;
+/// Compiling the nodes that read mesh attributes and tangents.
+mod attributes;
 
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct CompileError(pub String);
@@ -96,6 +98,10 @@ struct Compiler<'g, 'a> {
     displaced_normal: Option<Slot>,
     /// The material's pass index (Object Info > Material Index).
     material_pass_index: f32,
+    /// Mesh attributes the program reads (`Program::attributes`).
+    attributes: Vec<super::attributes::AttributeRequest>,
+    /// The current graph copy evaluates at a bump offset point (dx or dy).
+    offset_copy: bool,
 }
 
 fn kind_of(socket_type: &str) -> Option<Kind> {
@@ -184,6 +190,8 @@ impl<'g, 'a> Compiler<'g, 'a> {
             copy: 0,
             displaced_normal: None,
             material_pass_index: 0.0,
+            attributes: Vec::new(),
+            offset_copy: false,
         }
     }
 
@@ -291,10 +299,8 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     self.outputs(i, n, &[("Generated", g, V), ("Normal", nn, V), ("UV", uv, V), ("Object", ob, V)]);
                     self.tex_coord_more(i)?;
                 }
+                "ShaderNodeUVMap" if !prop_str(n, "uv_map")?.is_empty() || n.property("from_instancer").and_then(Value::as_bool) == Some(true) => self.named_uv(i)?,
                 "ShaderNodeUVMap" => {
-                    if !prop_str(n, "uv_map")?.is_empty() {
-                        return Err(CompileError(format!("node {:?}: a named UV map is not supported yet (only the active render UV)", n.path)));
-                    }
                     let d = self.alloc(V);
                     self.ops.push(Op::UvMap { dst: d });
                     self.outputs(i, n, &[("UV", d, V)]);
@@ -619,7 +625,8 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 "ShaderNodeVectorDisplacement" => {
                     let space = mode(n, "space", MapSpace::from_blender)?;
                     if space == MapSpace::Tangent {
-                        return Err(CompileError(format!("node {:?}: tangent-space Vector Displacement is not supported yet", n.path)));
+                        self.vector_displacement_tangent(i)?;
+                        continue;
                     }
                     let (vector, midlevel, scale) = (self.input(n, "Vector", V)?, self.input(n, "Midlevel", F)?, self.input(n, "Scale", F)?);
                     let d = self.alloc(V);
@@ -629,7 +636,8 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 "ShaderNodeNormalMap" => {
                     let space = mode(n, "space", MapSpace::from_blender)?;
                     if space == MapSpace::Tangent {
-                        return Err(CompileError(format!("node {:?}: tangent-space Normal Map is not supported yet", n.path)));
+                        self.normal_map_tangent(i)?;
+                        continue;
                     }
                     let (color, strength) = (self.input(n, "Color", C)?, self.input(n, "Strength", F)?);
                     let d = self.alloc(V);
@@ -638,11 +646,12 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 }
                 "ShaderNodeFresnel" | "ShaderNodeLayerWeight" | "ShaderNodeNewGeometry" | "ShaderNodeObjectInfo" | "ShaderNodeCameraData" | "ShaderNodeLightPath"
                 | "ShaderNodeLightFalloff" | "ShaderNodeNormal" | "ShaderNodeTangent" => self.input_node(i)?,
+                "ShaderNodeAttribute" | "ShaderNodeVertexColor" => self.attribute_node(i)?,
                 other => return Err(CompileError(format!("node {:?}: {other} is not supported yet", n.path))),
             }
         }
         self.switch_copy(&schedule, 0);
-        Ok(Program { ops: self.ops, initial: self.initial, ramps: self.ramps, curves: self.curves, closures: self.closures, surface: self.surface, bsdfs: self.bsdfs, displaced_normal: self.displaced_normal })
+        Ok(Program { ops: self.ops, initial: self.initial, ramps: self.ramps, curves: self.curves, closures: self.closures, surface: self.surface, bsdfs: self.bsdfs, displaced_normal: self.displaced_normal, attributes: self.attributes })
     }
 
     /// Records a BSDF node's value inputs and enum properties for the renderer.
@@ -797,6 +806,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
             self.ops.push(Op::BumpPoint { point: new.point, width: new.filter_width });
         }
         self.copy = c;
+        self.offset_copy = new.point != super::bump::BumpPoint::Center;
     }
 
     /// Prepares a schedule step; returns the node to compile, if it is one.

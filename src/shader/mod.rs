@@ -11,6 +11,8 @@ pub mod program;
 pub mod images;
 pub mod inputs;
 pub mod view;
+pub mod attributes;
+pub mod tangent;
 
 pub use compile::{compile_material, CompileError};
 pub use point::ShadingPoint;

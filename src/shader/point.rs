@@ -54,6 +54,13 @@ pub struct ShadingPoint {
     pub window: Vec3,
     /// The shaded object (Object Info, object-space transforms).
     pub object: ObjectInfo,
+    /// Mesh attribute values the program requested (`Program::attributes`, in order), as
+    /// (x, y, z, alpha); filled by `attributes::BoundAttributes::fill`.
+    pub attrs: [[f32; 4]; super::attributes::MAX_ATTRIBUTES],
+    /// The Attribute node's Fac of each (x for 2D values, else the mean of x, y, z).
+    pub attr_fac: [f32; super::attributes::MAX_ATTRIBUTES],
+    /// Bit i set: request i is not on the mesh (Cycles' "attribute not found").
+    pub attr_missing: u32,
 }
 
 /// Cycles' path flags (`PATH_RAY_*`) that the Light Path node reads.

@@ -125,6 +125,18 @@ pub enum Op {
     ObjectSpace { to_object: [[f32; 4]; 3], dst: Slot },
     /// Tangent node, radial mode around axis 0/1/2 (X/Y/Z).
     TangentRadial { axis: u8, dst: Slot },
+    /// Attribute node (Geometry type): request `attr` as Color/Vector, Fac, Alpha.
+    Attribute { attr: u8, vector: Slot, fac: Slot, alpha: Slot },
+    /// Color Attribute node: request `attr` as Color, Alpha (0 when missing, as Cycles).
+    ColorAttribute { attr: u8, color: Slot, alpha: Slot },
+    /// UV Map node with a named map: request `attr` as (u, v, 0).
+    NamedUv { attr: u8, dst: Slot },
+    /// Normal Map in tangent space: `tangent` and `normal` are requests (Tangent, MapNormal).
+    NormalMapTangent { tangent: u8, normal: u8, color: Slot, strength: Slot, dst: Slot },
+    /// Vector Displacement in tangent space.
+    VectorDisplacementTangent { tangent: u8, vector: Slot, midlevel: Slot, scale: Slot, dst: Slot },
+    /// Tangent node, UV Map mode.
+    TangentUv { tangent: u8, dst: Slot },
 }
 
 /// The shader part of a material: closures as a small tree over stack values.
@@ -154,6 +166,8 @@ pub struct Program {
     /// Where the normal bumped by the material's displacement lands after `run` (the
     /// shading normal of every closure), when the material has one.
     pub displaced_normal: Option<Slot>,
+    /// The mesh attributes the ops read (`ShadingPoint::attrs`, in this order).
+    pub attributes: Vec<super::attributes::AttributeRequest>,
 }
 
 /// A BSDF node as the renderer sees it: which closure it is, its type, and where each
@@ -446,6 +460,37 @@ impl Program {
                 Op::NormalDot { direction, normal, dst } => s[dst as usize] = inputs::normal_dot(direction, v3(s, normal)),
                 Op::ObjectSpace { to_object, dst } => put3(s, dst, inputs::transform_point(&to_object, sp.position)),
                 Op::TangentRadial { axis, dst } => put3(s, dst, inputs::radial_tangent(&sp, axis)),
+                Op::Attribute { attr, vector, fac, alpha } => {
+                    let (a, missing) = (sp.attrs[attr as usize], sp.attr_missing & (1 << attr) != 0);
+                    put3(s, vector, [a[0], a[1], a[2]]);
+                    s[fac as usize] = sp.attr_fac[attr as usize];
+                    // Cycles reads a missing attribute's Alpha as 1 (its float3 fallback).
+                    s[alpha as usize] = if missing { 1.0 } else { a[3] };
+                }
+                Op::ColorAttribute { attr, color, alpha } => {
+                    let a = sp.attrs[attr as usize];
+                    put3(s, color, [a[0], a[1], a[2]]);
+                    s[alpha as usize] = a[3];
+                }
+                Op::NamedUv { attr, dst } => {
+                    let a = sp.attrs[attr as usize];
+                    put3(s, dst, [a[0], a[1], 0.0]);
+                }
+                Op::NormalMapTangent { tangent, normal, color, strength, dst } => {
+                    let t = (sp.attr_missing & (1 << tangent) == 0).then_some(sp.attrs[tangent as usize]);
+                    let n = sp.attrs[normal as usize];
+                    let r = super::tangent::normal_map_tangent(&sp, t, [n[0], n[1], n[2]], v3(s, color), s[strength as usize]);
+                    put3(s, dst, r);
+                }
+                Op::VectorDisplacementTangent { tangent, vector, midlevel, scale, dst } => {
+                    let t = (sp.attr_missing & (1 << tangent) == 0).then_some(sp.attrs[tangent as usize]);
+                    let r = super::tangent::vector_displacement_tangent(&sp, t, v3(s, vector), s[midlevel as usize], s[scale as usize]);
+                    put3(s, dst, r);
+                }
+                Op::TangentUv { tangent, dst } => {
+                    let t = (sp.attr_missing & (1 << tangent) == 0).then_some(sp.attrs[tangent as usize]);
+                    put3(s, dst, super::tangent::tangent_uv(&sp, t));
+                }
             }
         }
     }

@@ -120,7 +120,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
             }
             "ShaderNodeTangent" => {
                 if prop_str(n, "direction_type")? != "RADIAL" {
-                    return Err(CompileError(format!("node {:?}: Tangent direction UV Map is not supported yet (needs MikkTSpace tangents)", n.path)));
+                    return self.tangent_uv(i);
                 }
                 let axis = match prop_str(n, "axis")? {
                     "X" => 0,

@@ -1,0 +1,118 @@
+//! Compiling the nodes that read mesh attributes (Attribute, Color Attribute, a named UV
+//! Map) and tangent space (Normal Map and Vector Displacement in tangent space, Tangent
+//! in UV Map mode): each becomes an op reading an `AttributeRequest` the program lists.
+
+use serde_json::Value;
+
+use crate::shader::attributes::{AttributeRequest, MAX_ATTRIBUTES};
+
+use super::{prop_str, CompileError, Compiler, Kind, Op};
+
+/// Attribute names Cycles resolves to built-in data rather than to a mesh attribute.
+const STANDARD_NAMES: [&str; 12] = ["generated", "uv", "tangent", "N", "Ng", "undeformed", "undisplaced", "pointiness", "random_per_island", "vertex_color", "ptex_face_id", "ptex_uv"];
+
+impl<'g, 'a> Compiler<'g, 'a> {
+    /// The index of request `r`, added when new.
+    fn request(&mut self, path: &str, r: AttributeRequest) -> Result<u8, CompileError> {
+        if let Some(k) = self.attributes.iter().position(|x| *x == r) {
+            return Ok(k as u8);
+        }
+        if self.attributes.len() == MAX_ATTRIBUTES {
+            return Err(CompileError(format!("node {path:?}: the material reads more than {MAX_ATTRIBUTES} mesh attributes")));
+        }
+        self.attributes.push(r);
+        Ok(self.attributes.len() as u8 - 1)
+    }
+
+    /// Attribute values at a bump's offset points need attribute differentials.
+    fn no_offset(&self, path: &str, what: &str) -> Result<(), CompileError> {
+        if self.offset_copy {
+            return Err(CompileError(format!("node {path:?}: {what} inside a Bump height or displacement is not supported yet (needs attribute differentials)")));
+        }
+        Ok(())
+    }
+
+    /// The tangent request of a node's `uv_map` (empty: the active render UV map).
+    fn tangent_request(&mut self, i: usize, uv_key: Option<&str>) -> Result<u8, CompileError> {
+        let n = &self.g.nodes[i];
+        let uv = match uv_key {
+            Some(k) => prop_str(n, k)?,
+            None => "",
+        };
+        let r = AttributeRequest::Tangent((!uv.is_empty()).then(|| uv.to_string()));
+        self.request(&n.path, r)
+    }
+
+    pub(super) fn attribute_node(&mut self, i: usize) -> Result<(), CompileError> {
+        use Kind::{Color as C, Float as F, Vector as V};
+        let n = &self.g.nodes[i];
+        self.no_offset(&n.path, &n.node.bl_idname)?;
+        if n.node.bl_idname == "ShaderNodeVertexColor" {
+            let name = prop_str(n, "layer_name")?;
+            let r = if name.is_empty() { AttributeRequest::DefaultColor } else { AttributeRequest::Named(name.to_string()) };
+            let attr = self.request(&n.path, r)?;
+            let (color, alpha) = (self.alloc(C), self.alloc(F));
+            self.ops.push(Op::ColorAttribute { attr, color, alpha });
+            self.outputs(i, n, &[("Color", color, C), ("Alpha", alpha, F)]);
+            return Ok(());
+        }
+        let kind = prop_str(n, "attribute_type")?;
+        if kind != "GEOMETRY" {
+            return Err(CompileError(format!("node {:?}: Attribute type {kind} is not supported (only Geometry: object and instancer custom properties are not exported)", n.path)));
+        }
+        let name = prop_str(n, "attribute_name")?;
+        if STANDARD_NAMES.contains(&name) {
+            return Err(CompileError(format!("node {:?}: Attribute name {name:?} is Cycles built-in data, not supported yet", n.path)));
+        }
+        let attr = self.request(&n.path, AttributeRequest::Named(name.to_string()))?;
+        let (vector, fac, alpha) = (self.alloc(V), self.alloc(F), self.alloc(F));
+        self.ops.push(Op::Attribute { attr, vector, fac, alpha });
+        self.outputs(i, n, &[("Color", vector, C), ("Vector", vector, V), ("Fac", fac, F), ("Alpha", alpha, F)]);
+        Ok(())
+    }
+
+    pub(super) fn named_uv(&mut self, i: usize) -> Result<(), CompileError> {
+        let n = &self.g.nodes[i];
+        if n.property("from_instancer").and_then(Value::as_bool) == Some(true) {
+            return Err(CompileError(format!("node {:?}: UV Map 'From Instancer' is not supported yet", n.path)));
+        }
+        self.no_offset(&n.path, "a named UV Map")?;
+        let name = prop_str(n, "uv_map")?.to_string();
+        let attr = self.request(&n.path, AttributeRequest::Named(name))?;
+        let dst = self.alloc(Kind::Vector);
+        self.ops.push(Op::NamedUv { attr, dst });
+        self.outputs(i, n, &[("UV", dst, Kind::Vector)]);
+        Ok(())
+    }
+
+    pub(super) fn normal_map_tangent(&mut self, i: usize) -> Result<(), CompileError> {
+        let tangent = self.tangent_request(i, Some("uv_map"))?;
+        let n = &self.g.nodes[i];
+        let normal = self.request(&n.path, AttributeRequest::MapNormal)?;
+        let (color, strength) = (self.input(n, "Color", Kind::Color)?, self.input(n, "Strength", Kind::Float)?);
+        let dst = self.alloc(Kind::Vector);
+        self.ops.push(Op::NormalMapTangent { tangent, normal, color, strength, dst });
+        self.outputs(i, n, &[("Normal", dst, Kind::Vector)]);
+        Ok(())
+    }
+
+    /// Cycles' Vector Displacement reads the active render UV map's tangents.
+    pub(super) fn vector_displacement_tangent(&mut self, i: usize) -> Result<(), CompileError> {
+        let tangent = self.tangent_request(i, None)?;
+        let n = &self.g.nodes[i];
+        let (vector, midlevel, scale) = (self.input(n, "Vector", Kind::Vector)?, self.input(n, "Midlevel", Kind::Float)?, self.input(n, "Scale", Kind::Float)?);
+        let dst = self.alloc(Kind::Vector);
+        self.ops.push(Op::VectorDisplacementTangent { tangent, vector, midlevel, scale, dst });
+        self.outputs(i, n, &[("Displacement", dst, Kind::Vector)]);
+        Ok(())
+    }
+
+    pub(super) fn tangent_uv(&mut self, i: usize) -> Result<(), CompileError> {
+        let tangent = self.tangent_request(i, Some("uv_map"))?;
+        let n = &self.g.nodes[i];
+        let dst = self.alloc(Kind::Vector);
+        self.ops.push(Op::TangentUv { tangent, dst });
+        self.outputs(i, n, &[("Tangent", dst, Kind::Vector)]);
+        Ok(())
+    }
+}

@@ -1,0 +1,161 @@
+//! Tangent space as Cycles builds it: MikkTSpace tangents per corner of the mesh's
+//! triangles (Cycles runs MikkTSpace on its triangles, not on Blender's faces), and the
+//! nodes that use them: Normal Map and Vector Displacement in tangent space, Tangent in
+//! UV Map mode.
+
+use crate::nodes::math::{add3, cross3, normalize3, safe_normalize3, scale3, sub3, Vec3};
+use crate::scene::{AttributeData, MeshData};
+
+use super::point::ShadingPoint;
+
+struct MikkMesh<'a> {
+    mesh: &'a MeshData,
+    uvs: &'a [[f32; 2]],
+    flat: Vec<bool>,
+    vertex_normals: Vec<Vec3>,
+    out: Vec<[f32; 4]>,
+}
+
+impl MikkMesh<'_> {
+    fn corner(&self, face: usize, vert: usize) -> usize {
+        self.mesh.triangles[face][vert] as usize
+    }
+    fn pos(&self, face: usize, vert: usize) -> [f32; 3] {
+        self.mesh.positions[self.mesh.corner_verts[self.corner(face, vert)] as usize]
+    }
+}
+
+impl mikktspace::Geometry for MikkMesh<'_> {
+    fn num_faces(&self) -> usize {
+        self.mesh.triangles.len()
+    }
+    fn num_vertices_of_face(&self, _face: usize) -> usize {
+        3
+    }
+    fn position(&self, face: usize, vert: usize) -> [f32; 3] {
+        self.pos(face, vert)
+    }
+    fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
+        // Cycles: the vertex normal on a smooth face, the triangle's normal on a flat one.
+        if self.flat[self.mesh.triangle_faces[face] as usize] {
+            let p = [self.pos(face, 0), self.pos(face, 1), self.pos(face, 2)];
+            normalize3(cross3(sub3(p[1], p[0]), sub3(p[2], p[0])))
+        } else {
+            self.vertex_normals[self.mesh.corner_verts[self.corner(face, vert)] as usize]
+        }
+    }
+    fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
+        self.uvs[self.corner(face, vert)]
+    }
+    fn set_tangent_encoded(&mut self, t: [f32; 4], face: usize, vert: usize) {
+        self.out[3 * face + vert] = t;
+    }
+}
+
+/// MikkTSpace tangents (x, y, z, bitangent sign) for UV map `uvs`, per corner of each
+/// triangle (index 3 * triangle + k), object space.
+pub fn mikk_tangents(mesh: &MeshData, uvs: &[[f32; 2]]) -> Vec<[f32; 4]> {
+    let flat = match mesh.attribute("sharp_face").map(|a| &a.data) {
+        Some(AttributeData::Bool(v)) => v.clone(),
+        _ => vec![false; mesh.face_count()],
+    };
+    let mut m = MikkMesh { mesh, uvs, flat, vertex_normals: vertex_normals(mesh), out: vec![[0.0; 4]; mesh.triangles.len() * 3] };
+    mikktspace::generate_tangents(&mut m);
+    m.out
+}
+
+/// Normal Map, tangent space (Cycles' svm_node_normal_map): `tangent` is the interpolated
+/// (x, y, z, sign), `normal` the interpolated object-space normal (see
+/// `AttributeRequest::MapNormal`); None when the mesh has no such UV map, then the
+/// unperturbed normal.
+pub fn normal_map_tangent(sp: &ShadingPoint, tangent: Option<[f32; 4]>, normal: Vec3, color: Vec3, strength: f32) -> Vec3 {
+    let Some(t4) = tangent else { return sp.normal };
+    let mut c = scale3(sub3(color, [0.5; 3]), 2.0);
+    // Tangent space scales the map's x and y by strength instead of blending normals.
+    c[0] *= strength;
+    c[1] *= strength;
+    c[2] = 1.0 + (c[2] - 1.0) * strength.clamp(0.0, 1.0);
+    let t = [t4[0], t4[1], t4[2]];
+    let b = scale3(cross3(normal, t), t4[3]);
+    let local = safe_normalize3(add3(add3(scale3(t, c[0]), scale3(b, c[1])), scale3(normal, c[2])));
+    let mut n = sp.transform.normal(local);
+    if sp.backfacing {
+        n = scale3(n, -1.0);
+    }
+    if n == [0.0; 3] {
+        n = sp.normal;
+    }
+    n
+}
+
+/// Vector Displacement, tangent space (Cycles' svm_node_vector_displacement): x along the
+/// tangent, y along the normal, z along the bitangent, then to world space. Without the
+/// UV map Cycles uses dPdu, which a bake does not have: None is then zero.
+pub fn vector_displacement_tangent(sp: &ShadingPoint, tangent: Option<[f32; 4]>, vector: Vec3, midlevel: f32, scale: f32) -> Vec3 {
+    let Some(t4) = tangent else { return [0.0; 3] };
+    let d = scale3(sub3(vector, [midlevel; 3]), scale);
+    let normal = sp.transform.inverse_normal(sp.normal);
+    let t = [t4[0], t4[1], t4[2]];
+    let b = scale3(safe_normalize3(cross3(normal, t)), t4[3]);
+    let local = add3(add3(scale3(t, d[0]), scale3(normal, d[1])), scale3(b, d[2]));
+    sp.transform.dir(local)
+}
+
+/// Tangent node, UV Map mode: the interpolated tangent to world space, made orthogonal to
+/// the shading normal; zero without the UV map.
+pub fn tangent_uv(sp: &ShadingPoint, tangent: Option<[f32; 4]>) -> Vec3 {
+    let Some(t4) = tangent else { return [0.0; 3] };
+    let t = sp.transform.normal([t4[0], t4[1], t4[2]]);
+    let n = sp.normal;
+    cross3(n, normalize3(cross3(t, n)))
+}
+
+/// Blender's vertex normals (what Cycles' smooth triangles and MikkTSpace read): each
+/// face's normal weighted by its corner angle at the vertex, summed and normalised.
+pub fn vertex_normals(mesh: &MeshData) -> Vec<Vec3> {
+    // Without sharp faces, sharp edges or custom normals Blender's corner normals are its
+    // vertex normals: take them as Blender rounded them.
+    let any = |name: &str| matches!(mesh.attribute(name).map(|a| &a.data), Some(AttributeData::Bool(v)) if v.iter().any(|&b| b));
+    if !any("sharp_face") && !any("sharp_edge") && mesh.attribute("custom_normal").is_none() && mesh.corner_normals.len() == mesh.corner_count() {
+        let mut out = vec![[0.0f32; 3]; mesh.vertex_count()];
+        for (c, &v) in mesh.corner_verts.iter().enumerate() {
+            out[v as usize] = mesh.corner_normals[c];
+        }
+        return out;
+    }
+    let mut acc = vec![[0.0f32; 3]; mesh.vertex_count()];
+    let pos = |c: usize| mesh.positions[mesh.corner_verts[c] as usize];
+    for f in 0..mesh.face_count() {
+        let (a, b) = (mesh.face_offsets[f] as usize, mesh.face_offsets[f + 1] as usize);
+        let n = b - a;
+        if n < 3 {
+            continue;
+        }
+        let fno = match n {
+            3 => normalize3(cross3(sub3(pos(a), pos(a + 1)), sub3(pos(a + 1), pos(a + 2)))),
+            4 => normalize3(cross3(sub3(pos(a), pos(a + 2)), sub3(pos(a + 1), pos(a + 3)))),
+            _ => {
+                // Newell's method.
+                let mut s = [0.0f32; 3];
+                for k in 0..n {
+                    let (p, q) = (pos(a + k), pos(a + (k + 1) % n));
+                    s[0] += (p[1] - q[1]) * (p[2] + q[2]);
+                    s[1] += (p[2] - q[2]) * (p[0] + q[0]);
+                    s[2] += (p[0] - q[0]) * (p[1] + q[1]);
+                }
+                normalize3(s)
+            }
+        };
+        for k in 0..n {
+            let c = a + k;
+            let prev = a + (k + n - 1) % n;
+            let next = a + (k + 1) % n;
+            let d1 = safe_normalize3(sub3(pos(prev), pos(c)));
+            let d2 = safe_normalize3(sub3(pos(next), pos(c)));
+            let angle = (d1[0] * d2[0] + d1[1] * d2[1] + d1[2] * d2[2]).clamp(-1.0, 1.0).acos();
+            let v = mesh.corner_verts[c] as usize;
+            acc[v] = add3(acc[v], scale3(fno, angle));
+        }
+    }
+    acc.into_iter().map(safe_normalize3).collect()
+}
