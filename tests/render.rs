@@ -315,8 +315,8 @@ fn published_colon_parity() {
 }
 
 #[test]
-fn subsurface_and_rough_glass_same_bits_for_any_thread_count() {
-    for scene_name in ["sss_principled", "glass_rough"] {
+fn closures_same_bits_for_any_thread_count() {
+    for scene_name in ["sss_principled", "glass_rough", "principled_sheen", "principled_aniso", "sss_node"] {
         let dir = common::repo().join("fixtures/render/scenes").join(scene_name);
         let scene = Scene::load(&dir).unwrap();
         let opts = |t| RenderOptions { samples: Some(4), resolution: Some((40, 32)), seed: Some(3), threads: Some(t), ..Default::default() };
@@ -347,18 +347,5 @@ fn object_motion_blur_matches_cycles_and_discriminates() {
         let ratio = rmse(&sharp, &a) / rmse(&b, &a);
         println!("{name} without motion blur: ratio {ratio:.3}");
         assert!(ratio > 2.0 * MAX_RATIO, "{name}: without blur the ratio is only {ratio:.3}");
-    }
-}
-
-#[test]
-fn sheen_anisotropic_and_burley_same_bits_for_any_thread_count() {
-    for scene_name in ["principled_sheen", "principled_aniso", "sss_node"] {
-        let dir = common::repo().join("fixtures/render/scenes").join(scene_name);
-        let scene = Scene::load(&dir).unwrap();
-        let opts = |t| RenderOptions { samples: Some(4), resolution: Some((40, 32)), seed: Some(3), threads: Some(t), ..Default::default() };
-        let a = render(&scene, &opts(1)).unwrap();
-        let b = render(&scene, &opts(2)).unwrap();
-        let bits = |o: &blendsynth::render::RenderOutput| o.color.iter().flat_map(|p| p.map(f32::to_bits)).collect::<Vec<_>>();
-        assert_eq!(bits(&a), bits(&b), "{scene_name}");
     }
 }

@@ -136,3 +136,32 @@ pub fn export_counts(s: &blendsynth::scene::Scene) -> serde_json::Value {
     }
     serde_json::json!({"node_trees": trees, "objects": objects, "animation": anim})
 }
+
+/// EMIT-bake parity fixtures (cases.json + CASE.f32 written by a fixtures/bake script):
+/// blendsynth's bake of every case against Cycles', the worst absolute error by case name.
+pub fn bake_cases_worst(dir: &Path) -> Vec<(String, f32)> {
+    let scene = blendsynth::scene::Scene::load(dir).unwrap();
+    let meta: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("cases.json")).unwrap()).unwrap();
+    let size = meta["size"].as_u64().unwrap() as u32;
+    let mut out = Vec::new();
+    for (case, object) in meta["cases"].as_object().unwrap() {
+        let reference: Vec<f32> = std::fs::read(dir.join(format!("{case}.f32"))).unwrap().chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+        assert_eq!(reference.len(), (size * size * 4) as usize);
+        let ours = blendsynth::shader::bake::bake_emission(&scene, &blendsynth::shader::bake::BakeOptions { object: object.as_str().unwrap().into(), uv: None, size }).unwrap_or_else(|e| panic!("{case}: {e}"));
+        let (mut worst, mut at) = (0.0f32, (0, 0));
+        for (i, p) in ours.pixels.iter().enumerate() {
+            assert_eq!(p[3], reference[i * 4 + 3], "{case}: texel {i} coverage differs");
+            for c in 0..3 {
+                let d = (p[c] - reference[i * 4 + c]).abs();
+                if !(d <= worst) {
+                    worst = if d.is_nan() { f32::INFINITY } else { d };
+                    at = (i, c);
+                }
+            }
+        }
+        let (i, c) = at;
+        eprintln!("{case:24} {size}x{size}: worst abs error {worst:.2e} (texel {i} channel {c}: ours {} Cycles {})", ours.pixels[i][c], reference[i * 4 + c]);
+        out.push((case.clone(), worst));
+    }
+    out
+}
