@@ -23,16 +23,22 @@ const COLLAPSED: i32 = -2;
 /// every unmerged selected vertex within `distance`. Returns the destination map (-1 for
 /// vertices left alone, the vertex itself for cluster targets) and the number merged away.
 pub fn duplicates_all(positions: &[[f32; 3]], selection: &[bool], distance: f32) -> (Vec<i32>, usize) {
-    let n = positions.len();
-    let mut dest = vec![OUT; n];
+    let order: Vec<usize> = (0..positions.len()).filter(|&i| selection[i]).collect();
+    duplicates_in_order(positions, &order, distance)
+}
+
+/// The shared search: targets are tried in `order` (the selected vertices); each one not
+/// yet merged takes every unmerged vertex of `order` within `distance`.
+fn duplicates_in_order(positions: &[[f32; 3]], order: &[usize], distance: f32) -> (Vec<i32>, usize) {
+    let mut dest = vec![OUT; positions.len()];
     let range_sq = distance * distance;
     // Candidates sorted by x, so each search scans a slab only.
-    let mut by_x: Vec<usize> = (0..n).filter(|&i| selection[i]).collect();
+    let mut by_x: Vec<usize> = order.to_vec();
     by_x.sort_by(|&a, &b| positions[a][0].total_cmp(&positions[b][0]).then(a.cmp(&b)));
     let xs: Vec<f32> = by_x.iter().map(|&i| positions[i][0]).collect();
     let mut found = 0;
-    for i in 0..n {
-        if !selection[i] || !(dest[i] == OUT || dest[i] == i as i32) {
+    for &i in order {
+        if !(dest[i] == OUT || dest[i] == i as i32) {
             continue;
         }
         let p = positions[i];
@@ -390,37 +396,7 @@ fn kdtree_balanced_order(positions: &[[f32; 3]], nodes: &mut [usize], axis: usiz
 /// `kdtree_calc_duplicates_fast` without index order (as point clouds merge): targets are
 /// tried in the balanced tree's node order.
 pub fn duplicates_tree_order(positions: &[[f32; 3]], selection: &[bool], distance: f32) -> (Vec<i32>, usize) {
-    let n = positions.len();
-    let mut order: Vec<usize> = (0..n).filter(|&i| selection[i]).collect();
+    let mut order: Vec<usize> = (0..positions.len()).filter(|&i| selection[i]).collect();
     kdtree_balanced_order(positions, &mut order, 0);
-    let mut dest = vec![OUT; n];
-    let range_sq = distance * distance;
-    let mut by_x: Vec<usize> = order.clone();
-    by_x.sort_by(|&a, &b| positions[a][0].total_cmp(&positions[b][0]).then(a.cmp(&b)));
-    let xs: Vec<f32> = by_x.iter().map(|&i| positions[i][0]).collect();
-    let mut found = 0;
-    for &i in &order {
-        if !(dest[i] == OUT || dest[i] == i as i32) {
-            continue;
-        }
-        let p = positions[i];
-        let lo = xs.partition_point(|&x| x < p[0] - distance);
-        let hi = xs.partition_point(|&x| x <= p[0] + distance);
-        let before = found;
-        for &j in &by_x[lo..hi] {
-            if j == i || dest[j] != OUT {
-                continue;
-            }
-            let q = positions[j];
-            let (dx, dy, dz) = (q[0] - p[0], q[1] - p[1], q[2] - p[2]);
-            if dx * dx + dy * dy + dz * dz <= range_sq {
-                dest[j] = i as i32;
-                found += 1;
-            }
-        }
-        if found != before {
-            dest[i] = i as i32;
-        }
-    }
-    (dest, found)
+    duplicates_in_order(positions, &order, distance)
 }
