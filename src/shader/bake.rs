@@ -78,7 +78,7 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
     }
 
     let world = obj.matrix_world;
-    let inverse = invert4(&world).ok_or_else(|| format!("object {:?} has a singular transform", obj.name))?;
+    let inverse = crate::shader::view::invert_affine(&world).ok_or_else(|| format!("object {:?} has a singular transform", obj.name))?;
     let normal_matrix = inverse_transpose3(&world).ok_or_else(|| format!("object {:?} has a singular transform", obj.name))?;
     let (tex_loc, tex_size) = (info.texspace_location.unwrap_or([0.0; 3]), info.texspace_size.unwrap_or([1.0; 3]));
     let f32_rows = |m: &[[f64; 4]; 4]| -> [[f32; 4]; 3] { std::array::from_fn(|r| std::array::from_fn(|k| m[r][k] as f32)) };
@@ -176,34 +176,10 @@ fn mul3x3(m: &[[f64; 3]; 3], v: Vec3) -> Vec3 {
     std::array::from_fn(|r| (m[r][0] * v[0] as f64 + m[r][1] * v[1] as f64 + m[r][2] * v[2] as f64) as f32)
 }
 
-/// The inverse of an affine transform (rows; last row 0 0 0 1).
-fn invert4(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
-    let it = inverse_transpose3(m)?;
-    // The inverse's 3x3 block is the transpose of the inverse transpose.
-    let r: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| it[j][i]));
-    let t = [m[0][3], m[1][3], m[2][3]];
-    let mut out = [[0.0; 4]; 4];
-    for i in 0..3 {
-        out[i][..3].copy_from_slice(&r[i]);
-        out[i][3] = -(r[i][0] * t[0] + r[i][1] * t[1] + r[i][2] * t[2]);
-    }
-    out[3][3] = 1.0;
-    Some(out)
-}
-
 fn inverse_transpose3(m: &[[f64; 4]; 4]) -> Option<[[f64; 3]; 3]> {
-    let a = |r: usize, c: usize| m[r][c];
-    let cof = |r: usize, c: usize| {
-        let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
-        let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
-        a(r1, c1) * a(r2, c2) - a(r1, c2) * a(r2, c1)
-    };
-    let det = a(0, 0) * cof(0, 0) + a(0, 1) * cof(0, 1) + a(0, 2) * cof(0, 2);
-    if det.abs() < 1e-30 {
-        return None;
-    }
-    // The inverse transpose is the cofactor matrix over the determinant.
-    Some(std::array::from_fn(|r| std::array::from_fn(|c| cof(r, c) / det)))
+    // The transposed upper 3x3 of the inverse (the same cofactors over the same determinant).
+    let inv = crate::shader::view::invert_affine(m)?;
+    Some(std::array::from_fn(|r| std::array::from_fn(|c| inv[c][r])))
 }
 
 /// Writes a baked image as a 32-bit float RGBA EXR (top row first, as image files are),
