@@ -381,8 +381,7 @@ pub fn enter_and_walk(
     if b.method == Method::Burley {
         return super::subsurface_disk::disk_exit(scene, b, hit, rng, index, set, throughput, rays);
     }
-    // Random numbers of this vertex's walk: a dimension range apart from the path's own.
-    let base = 0x2000_0000u32.wrapping_add(set.wrapping_mul(4096));
+    let base = bssrdf_dimensions(set);
     let ue = rng.get4(index, base);
     let d0 = entry_direction(b, n, wo, [ue[0], ue[1]])?;
     if dot(hit.ng, d0) >= 0.0 {
@@ -400,4 +399,10 @@ pub fn enter_and_walk(
     *rays += local.rays;
     let e = exit?;
     Some((super::accel::Hit { t: 0.0, prim: e.prim, u: e.u, v: e.v }, e.dir))
+}
+
+/// First sampler dimension of a subsurface bounce's random numbers (walk or disk probe):
+/// a range apart from the path's own dimensions, one range per bounce `set`.
+pub fn bssrdf_dimensions(set: u32) -> u32 {
+    0x2000_0000u32.wrapping_add(set.wrapping_mul(4096))
 }

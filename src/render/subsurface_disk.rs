@@ -107,7 +107,7 @@ pub fn disk_exit(
     throughput: &mut V3,
     rays: &mut u64,
 ) -> Option<(super::accel::Hit, V3)> {
-    let base = 0x2000_0000u32.wrapping_add(set.wrapping_mul(4096));
+    let base = super::subsurface::bssrdf_dimensions(set);
     let u = rng.get4(index, base);
     let (xi_r, mut xi_axis, xi_resample) = (u[0], u[1], u[2]);
     // Axis: the normal with probability 1/2, each tangent 1/4.
