@@ -32,6 +32,9 @@ pub struct MeshInstance {
     pub info: crate::shader::point::ObjectInfo,
     /// Transforms across the shutter when the object moves within it (`object_motion`).
     pub motion: Option<Arc<super::object_motion::ObjectMotion>>,
+    /// Object-space vertex positions before true displacement (`displace`), which
+    /// Generated coordinates and the displacement bump read.
+    pub undisplaced: Option<Arc<Vec<V3>>>,
 }
 
 /// Per triangle: which instance and which of its mesh's triangles.
@@ -117,6 +120,12 @@ pub fn build(scene: &Scene, eval: &EvaluatedScene, overrides: &[(String, serde_j
             push_instance(&mut instances, scene, oi, obj, info, m, &info.materials.clone(), to_world, None, true)?;
         }
     }
+    let (tris, refs) = world_triangles(&instances);
+    Ok(Geometry { instances, tris, refs })
+}
+
+/// Every instance's triangles in world space, skipping those with non-finite corners.
+pub fn world_triangles(instances: &[MeshInstance]) -> (Vec<[V3; 3]>, Vec<TriRef>) {
     let mut tris = Vec::new();
     let mut refs = Vec::new();
     for (ii, inst) in instances.iter().enumerate() {
@@ -131,7 +140,7 @@ pub fn build(scene: &Scene, eval: &EvaluatedScene, overrides: &[(String, serde_j
             refs.push(TriRef { inst: ii as u32, tri: t as u32 });
         }
     }
-    Ok(Geometry { instances, tris, refs })
+    (tris, refs)
 }
 
 fn compose(a: &Affine, b: &Affine) -> Affine {
@@ -216,6 +225,7 @@ fn push_instance(
             crate::shader::view::object_info(obj, &rows)
         },
         motion: None,
+        undisplaced: None,
     });
     Ok(())
 }

@@ -4,7 +4,7 @@
 //! Cycles' clamping (direct and indirect limits on the sum of a contribution).
 
 use crate::shader::ShadingPoint;
-use crate::shader::point::{ray, PathState};
+use crate::shader::point::{ray, PathState, Undisplaced};
 
 use super::accel::Accel;
 use super::bsdf::{LobeKind, LobeSet};
@@ -174,7 +174,17 @@ impl Scene<'_> {
         sp.normal = n;
         sp.object_position = local;
         sp.object_normal = n_obj;
-        sp.generated = [0, 1, 2].map(|k| (local[k] - inst.tex_loc[k]) / (2.0 * inst.tex_size[k]) + 0.5);
+        // Generated coordinates (and a displacement bump) read the mesh before true
+        // displacement moved it.
+        let before = inst.undisplaced.as_ref().map(|orig| {
+            let up = c.map(|c| orig[m.corner_verts[c] as usize]);
+            add(add(scale(up[0], w0), scale(up[1], u)), scale(up[2], v))
+        });
+        let orco = before.unwrap_or(local);
+        sp.generated = [0, 1, 2].map(|k| (orco[k] - inst.tex_loc[k]) / (2.0 * inst.tex_size[k]) + 0.5);
+        if let Some(b) = before {
+            sp.undisplaced = Some(Undisplaced { position: to_world.point(b), object_position: b, ..Undisplaced::default() });
+        }
         if let Some(uv) = &inst.uv {
             let t = c.map(|c| uv[c]);
             sp.uv = [t[0][0] * w0 + t[1][0] * u + t[2][0] * v, t[0][1] * w0 + t[1][1] * u + t[2][1] * v, 0.0];
@@ -596,7 +606,17 @@ impl Scene<'_> {
         sp.dp_dx = dx;
         sp.dp_dy = dy;
         let d = differential_dudv(dpdu, dpdv, [dx, dy], hit.ng);
-        let lp = c.map(|c| m.positions[m.corner_verts[c] as usize]);
+        let lp = match &inst.undisplaced {
+            Some(u) => c.map(|c| u[m.corner_verts[c] as usize]),
+            None => c.map(|c| m.positions[m.corner_verts[c] as usize]),
+        };
+        if let Some(und) = &mut sp.undisplaced {
+            // The undisplaced position's differentials: the hit's barycentric ones
+            // applied to the triangle before displacement (Cycles' attribute dx/dy).
+            let w = lp.map(|l| to_world.point(l));
+            und.dp_dx = attribute_differential(w, d[0]);
+            und.dp_dy = attribute_differential(w, d[1]);
+        }
         let generated = lp.map(|l| [0, 1, 2].map(|k| (l[k] - inst.tex_loc[k]) / (2.0 * inst.tex_size[k]) + 0.5));
         sp.generated_dx = attribute_differential(generated, d[0]);
         sp.generated_dy = attribute_differential(generated, d[1]);

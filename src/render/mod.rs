@@ -16,6 +16,7 @@ pub mod anisotropic;
 pub mod bsdf;
 pub mod build;
 pub mod camera;
+pub mod displace;
 pub mod filter;
 pub mod integrator;
 pub mod light;
@@ -170,7 +171,6 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         camera.set_motion(&steps);
     }
     let mut geo = build::build(scene, &eval, overrides)?;
-    let moving = object_motion::attach(&mut geo, &eval.data.objects, &eval.world_matrices, &object_steps);
     let mut used = vec![false; scene.file.materials.len()];
     for inst in &geo.instances {
         for m in inst.slots.iter().flatten() {
@@ -178,6 +178,10 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         }
     }
     let materials = shade::compile_all(scene, &used)?;
+    if displace::apply(&mut geo, &materials) > 0 {
+        (geo.tris, geo.refs) = build::world_triangles(&geo.instances);
+    }
+    let moving = object_motion::attach(&mut geo, &eval.data.objects, &eval.world_matrices, &object_steps);
     let lights = light::collect(&eval);
     let background = world::background(scene)?;
     let world_shader = world::shader(scene)?;
@@ -385,13 +389,9 @@ fn mesh_lights(
     tables: &tables::Tables,
     settings: Settings,
 ) -> integrator::MeshLights {
-    use crate::shader::program::Closure;
     let empty = integrator::MeshLights::default();
     let probe = integrator::Scene { mesh_lights: &empty, accel: bvh, geo, materials, lights, background, tables, settings, world: None, view: Default::default() };
-    let emissive: Vec<bool> = materials
-        .iter()
-        .map(|m| m.program.as_ref().is_some_and(|p| p.closures.iter().any(|c| matches!(c, Closure::Emission { .. } | Closure::Bsdf { emission: Some(_) }))))
-        .collect();
+    let emissive: Vec<bool> = materials.iter().map(|m| m.program.as_ref().is_some_and(|p| light_sampled(p, &m.sampling))).collect();
     let mut scratch = Scratch::new(materials.len());
     let mut prims = Vec::new();
     let mut weights = Vec::new();
@@ -434,6 +434,21 @@ fn mesh_lights(
         pdf_area[p as usize] = (weights[k] as f64 / total) as f32 / areas[k];
     }
     integrator::MeshLights { prims, cdf, pdf_area }
+}
+
+/// Whether Cycles light-samples a material's emitting triangles (Shader::estimate_emission):
+/// never when its emission estimate is zero; with "Auto" only when the estimate's largest
+/// channel exceeds 0.5 (weaker emitters are found by BSDF rays alone).
+fn light_sampled(p: &crate::shader::program::Program, sampling: &str) -> bool {
+    let e = p.emission_estimate;
+    if e.iter().all(|&x| x == 0.0) {
+        return false;
+    }
+    match sampling {
+        "NONE" => false,
+        "AUTO" => e.iter().any(|x| x.abs() > 0.5),
+        _ => true,
+    }
 }
 
 /// One tile's share of the work: its rectangle, a copy of its pixels' accumulators

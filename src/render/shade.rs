@@ -17,6 +17,8 @@ pub struct Material {
     /// Per closure: index into `program.bsdfs`.
     bsdf_of: Vec<Option<u32>>,
     pub name: String,
+    /// The material's emission sampling setting (Cycles' AUTO, NONE, FRONT, BACK, FRONT_BACK).
+    pub sampling: String,
 }
 
 /// Every material of the scene, in `scene.file.materials` order.
@@ -24,7 +26,7 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
     let mut out = Vec::new();
     for (i, m) in scene.file.materials.iter().enumerate() {
         if !used.get(i).copied().unwrap_or(false) {
-            out.push(Material { program: None, bsdf_of: Vec::new(), name: m.name.clone() });
+            out.push(Material { program: None, bsdf_of: Vec::new(), name: m.name.clone(), sampling: String::new() });
             continue;
         }
         let p = compile_material(scene, &m.name).map_err(|e| RenderError(format!("{e}")))?;
@@ -39,7 +41,8 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
                 *slot = Some(bi as u32);
             }
         }
-        out.push(Material { program: Some(p), bsdf_of, name: m.name.clone() });
+        let sampling = m.properties.get("cycles").and_then(|c| c.get("emission_sampling")).and_then(|v| v.as_str()).unwrap_or("AUTO").to_string();
+        out.push(Material { program: Some(p), bsdf_of, name: m.name.clone(), sampling });
     }
     Ok(out)
 }

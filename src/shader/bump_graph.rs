@@ -21,6 +21,8 @@ pub enum Step {
     Node { node: usize, copy: usize },
     /// The displacement's three copies are compiled: bump the shading normal.
     DisplacementBump,
+    /// The displacement's centre copy is compiled: its value moves the vertices.
+    DisplacementValue,
 }
 
 #[derive(Debug, Clone)]
@@ -31,6 +33,8 @@ pub struct Schedule {
     pub bump_copies: Vec<Option<(usize, usize)>>,
     /// The displacement's (centre, dx, dy) copies, when it is bumped.
     pub displacement: Option<(usize, usize, usize)>,
+    /// The copy whose Displacement is the value vertices move by (true displacement).
+    pub displacement_value: Option<usize>,
 }
 
 fn linked_node(g: &FlatGraph, node: usize, input: &str) -> Option<usize> {
@@ -88,20 +92,30 @@ fn add_copies(g: &FlatGraph, s: &mut Schedule, deps: &[bool], points: &[BumpPoin
     Ok(out)
 }
 
-/// The compile order. `displace`: the Material Output's Displacement is bumped.
-pub fn schedule(g: &FlatGraph, displace: bool) -> Result<Schedule, String> {
+/// The compile order. `bump`: the Material Output's Displacement is bumped; `value`: it
+/// is also a value of its own (true displacement). The centre copy's ops come first, so
+/// the renderer can run them alone at a vertex.
+pub fn schedule(g: &FlatGraph, bump: bool, value: bool) -> Result<Schedule, String> {
     let mut s = Schedule {
         copies: vec![GraphCopy { point: BumpPoint::Center, filter_width: 0.0 }],
         steps: Vec::new(),
         bump_copies: vec![None; g.nodes.len()],
         displacement: None,
+        displacement_value: None,
     };
-    if displace {
+    if bump || value {
         if let Some(d) = linked_node(g, g.root, "Displacement") {
             let deps = dependencies(g, d);
-            let c = add_copies(g, &mut s, &deps, &[BumpPoint::Center, BumpPoint::Dx, BumpPoint::Dy], DEFAULT_FILTER_WIDTH)?;
-            s.displacement = Some((c[0], c[1], c[2]));
-            s.steps.push(Step::DisplacementBump);
+            let c = add_copies(g, &mut s, &deps, &[BumpPoint::Center], DEFAULT_FILTER_WIDTH)?[0];
+            if value {
+                s.displacement_value = Some(c);
+                s.steps.push(Step::DisplacementValue);
+            }
+            if bump {
+                let xy = add_copies(g, &mut s, &deps, &[BumpPoint::Dx, BumpPoint::Dy], DEFAULT_FILTER_WIDTH)?;
+                s.displacement = Some((c, xy[0], xy[1]));
+                s.steps.push(Step::DisplacementBump);
+            }
         }
     }
     for i in 0..g.nodes.len() {

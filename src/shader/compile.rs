@@ -49,25 +49,21 @@ pub fn compile_material(scene: &Scene, name: &str) -> Result<Program, CompileErr
     let graph = flatten(tree, &scene.file.node_groups, &out.name).map_err(|e| CompileError(format!("material {name:?}: {e}")))?;
     let mut c = Compiler::new(&graph);
     c.scene = Some(scene);
-    c.displace = displacement_as_bump(name, mat.properties.get("displacement_method").and_then(Value::as_str));
+    (c.displace, c.true_displacement) = displacement_method(name, mat.properties.get("displacement_method").and_then(Value::as_str))?;
     c.material_pass_index = mat.pass_index as f32;
     c.run().map_err(|e| CompileError(format!("material {name:?}: {}", e.0)))
 }
 
-/// How the Material Output's Displacement is compiled: as a bump of the shading normal
-/// (Cycles' default "Bump Only"); `Some(true)`: in object space, as Cycles' "Both" does.
-/// True displacement is not done: those methods are bumped too, with a warning.
-fn displacement_as_bump(material: &str, method: Option<&str>) -> Option<bool> {
+/// How the Material Output's Displacement is compiled, after Cycles' displacement methods:
+/// a bump of the shading normal (`Some(object_space)`; "Bump Only" in world space, "Both"
+/// in object space, as Cycles' bump_from_displacement), and/or a value the renderer moves
+/// the mesh's vertices by before tracing ("Displacement Only" and "Both").
+fn displacement_method(material: &str, method: Option<&str>) -> Result<(Option<bool>, bool), CompileError> {
     match method.unwrap_or("BUMP") {
-        "BUMP" => Some(false),
-        "BOTH" => {
-            eprintln!("warning: material {material:?}: displacement method BOTH: true displacement is not done, only its bump");
-            Some(true)
-        }
-        other => {
-            eprintln!("warning: material {material:?}: displacement method {other}: true displacement is not done, rendered as a bump");
-            Some(false)
-        }
+        "BUMP" => Ok((Some(false), false)),
+        "BOTH" => Ok((Some(true), true)),
+        "DISPLACEMENT" => Ok((None, true)),
+        other => Err(CompileError(format!("material {material:?}: displacement method {other:?} is not supported"))),
     }
 }
 
@@ -91,6 +87,11 @@ struct Compiler<'g, 'a> {
     scene: Option<&'a Scene>,
     /// Displacement compiled as a bump (object space when true); None: not at all.
     displace: Option<bool>,
+    /// Displacement also compiled as a value to move vertices by (`Program::displacement`).
+    true_displacement: bool,
+    displacement: Option<super::program::TrueDisplacement>,
+    /// Slots `constant` filled (unlinked or constant-folded values).
+    constants: Vec<Slot>,
     /// Values of the graph copies not being compiled (see `bump_graph`), and which copy
     /// `values` holds now.
     copy_values: Vec<CopyValues>,
@@ -186,6 +187,9 @@ impl<'g, 'a> Compiler<'g, 'a> {
             bsdfs: Vec::new(),
             scene: None,
             displace: None,
+            true_displacement: false,
+            displacement: None,
+            constants: Vec::new(),
             copy_values: Vec::new(),
             copy: 0,
             displaced_normal: None,
@@ -205,7 +209,48 @@ impl<'g, 'a> Compiler<'g, 'a> {
         let s = self.alloc(kind);
         let w = kind.width() as usize;
         self.initial[s as usize..s as usize + w].copy_from_slice(&v[..w]);
+        self.constants.push(s);
         s
+    }
+
+    /// Cycles' output_estimate_emission over the compiled closure tree: constant
+    /// colours and strengths as they are, anything computed as one (it may emit).
+    fn emission_estimate(&self, c: Option<u32>) -> [f32; 3] {
+        let Some(c) = c else { return [0.0; 3] };
+        let value = |slot: Slot, width: usize| -> [f32; 3] {
+            if self.constants.contains(&slot) {
+                let i = slot as usize;
+                if width == 1 {
+                    [self.initial[i]; 3]
+                } else {
+                    [self.initial[i], self.initial[i + 1], self.initial[i + 2]]
+                }
+            } else {
+                [1.0; 3]
+            }
+        };
+        let emitter = |color: Slot, strength: Slot| {
+            let (c, s) = (value(color, 3), value(strength, 1));
+            [c[0] * s[0], c[1] * s[1], c[2] * s[2]]
+        };
+        match self.closures[c as usize] {
+            Closure::Emission { color, strength } => emitter(color, strength),
+            Closure::Bsdf { emission: Some((color, strength)) } => emitter(color, strength),
+            Closure::Bsdf { emission: None } => [0.0; 3],
+            Closure::Add { a, b } => {
+                let (x, y) = (self.emission_estimate(a), self.emission_estimate(b));
+                [x[0] + y[0], x[1] + y[1], x[2] + y[2]]
+            }
+            Closure::Mix { fac, a, b } => {
+                let (x, y) = (self.emission_estimate(a), self.emission_estimate(b));
+                if self.constants.contains(&fac) {
+                    let f = self.initial[fac as usize];
+                    [(1.0 - f) * x[0] + f * y[0], (1.0 - f) * x[1] + f * y[1], (1.0 - f) * x[2] + f * y[2]]
+                } else {
+                    [x[0] + y[0], x[1] + y[1], x[2] + y[2]]
+                }
+            }
+        }
     }
 
     /// A socket's default converted to `want`, as Blender converts unlinked values.
@@ -277,7 +322,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
 
     fn run(mut self) -> Result<Program, CompileError> {
         use Kind::{Color as C, Float as F, Vector as V};
-        let schedule = bump_graph::schedule(self.g, self.displace.is_some()).map_err(CompileError)?;
+        let schedule = bump_graph::schedule(self.g, self.displace.is_some(), self.true_displacement).map_err(CompileError)?;
         self.copy_values = vec![vec![Vec::new(); self.g.nodes.len()]; schedule.copies.len()];
         for step in &schedule.steps {
             let Some(i) = self.enter_step(&schedule, *step)? else { continue };
@@ -583,7 +628,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     self.closure(i, Closure::Add { a, b });
                 }
                 "ShaderNodeOutputMaterial" => {
-                    if self.displace.is_none() && n.input("Displacement").is_some_and(|d| matches!(d.sources.first(), Some(Source::Link { .. }))) {
+                    if self.displace.is_none() && !self.true_displacement && n.input("Displacement").is_some_and(|d| matches!(d.sources.first(), Some(Source::Link { .. }))) {
                         return Err(CompileError(format!("node {:?}: displacement is not supported yet", n.path)));
                     }
                     self.surface = self.closure_input(n, "Surface")?;
@@ -651,7 +696,8 @@ impl<'g, 'a> Compiler<'g, 'a> {
             }
         }
         self.switch_copy(&schedule, 0);
-        Ok(Program { ops: self.ops, initial: self.initial, ramps: self.ramps, curves: self.curves, closures: self.closures, surface: self.surface, bsdfs: self.bsdfs, displaced_normal: self.displaced_normal, attributes: self.attributes })
+        let emission_estimate = self.emission_estimate(self.surface);
+        Ok(Program { ops: self.ops, initial: self.initial, ramps: self.ramps, curves: self.curves, closures: self.closures, surface: self.surface, bsdfs: self.bsdfs, displaced_normal: self.displaced_normal, attributes: self.attributes, displacement: self.displacement, emission_estimate })
     }
 
     /// Records a BSDF node's value inputs and enum properties for the renderer.
@@ -826,6 +872,16 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 let d = self.alloc(Kind::Vector);
                 self.ops.push(Op::DisplacementBump { object_space: self.displace == Some(true), center, dx, dy, dst: d });
                 self.displaced_normal = Some(d);
+                if let Some(t) = &mut self.displacement {
+                    t.bump_end = Some(self.ops.len());
+                }
+                Ok(None)
+            }
+            Step::DisplacementValue => {
+                let Some(c) = schedule.displacement_value else { return Ok(None) };
+                self.switch_copy(schedule, 0);
+                let value = self.input_in_copy(c, self.g.root, "Displacement", Kind::Vector)?;
+                self.displacement = Some(super::program::TrueDisplacement { center_end: self.ops.len(), value, bump_end: None });
                 Ok(None)
             }
         }

@@ -61,6 +61,19 @@ pub struct ShadingPoint {
     pub attr_fac: [f32; super::attributes::MAX_ATTRIBUTES],
     /// Bit i set: request i is not on the mesh (Cycles' "attribute not found").
     pub attr_missing: u32,
+    /// On a truly displaced mesh: the point before displacement, which the material's
+    /// displacement bump reads ("Both").
+    pub undisplaced: Option<Undisplaced>,
+}
+
+/// A shading point's position and differentials before true displacement (Cycles'
+/// undisplaced position attribute, interpolated with the hit's barycentrics).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Undisplaced {
+    pub position: Vec3,
+    pub object_position: Vec3,
+    pub dp_dx: Vec3,
+    pub dp_dy: Vec3,
 }
 
 /// Cycles' path flags (`PATH_RAY_*`) that the Light Path node reads.

@@ -168,6 +168,23 @@ pub struct Program {
     pub displaced_normal: Option<Slot>,
     /// The mesh attributes the ops read (`ShadingPoint::attrs`, in this order).
     pub attributes: Vec<super::attributes::AttributeRequest>,
+    /// True displacement ("Displacement Only" or "Both"): where its ops end.
+    pub displacement: Option<TrueDisplacement>,
+    /// Cycles' emission estimate of the surface (Shader::estimate_emission): zero means
+    /// the material never emits; its size decides whether emitters are light-sampled.
+    pub emission_estimate: [f32; 3],
+}
+
+/// Where a material's true displacement lives in its program. Ops `..center_end`
+/// compute the displacement vector (world space) into `value`: the renderer runs them
+/// alone at each vertex. With "Both", ops `..bump_end` are Cycles' separate bump shader,
+/// which runs at the undisplaced surface (`ShadingPoint::undisplaced`) before the
+/// surface ops; with "Displacement Only" shading skips the displacement ops.
+#[derive(Debug, Clone, Copy)]
+pub struct TrueDisplacement {
+    pub center_end: usize,
+    pub value: Slot,
+    pub bump_end: Option<usize>,
 }
 
 /// A BSDF node as the renderer sees it: which closure it is, its type, and where each
@@ -206,13 +223,42 @@ impl Program {
         self.initial.clone()
     }
 
-    /// Runs every operation for one shading point.
+    /// Runs the program for one shading point.
     pub fn run(&self, sp: &ShadingPoint, s: &mut [f32]) {
         s.copy_from_slice(&self.initial);
+        let Some(d) = self.displacement else {
+            self.exec(*sp, s, &self.ops);
+            return;
+        };
+        match (d.bump_end, self.displaced_normal) {
+            (Some(end), Some(normal)) => {
+                // Cycles' bump shader of a displaced mesh reads the surface as it was
+                // before displacement (svm_node_enter_bump_eval), then the surface ops
+                // read the displaced point with the bumped normal.
+                let before = sp.undisplaced.map_or(*sp, |u| ShadingPoint { position: u.position, object_position: u.object_position, dp_dx: u.dp_dx, dp_dy: u.dp_dy, ..*sp });
+                self.exec(before, s, &self.ops[..end]);
+                let n = v3(s, normal);
+                let after = ShadingPoint { normal: n, object_normal: sp.transform.inverse_normal(n), ..*sp };
+                self.exec(after, s, &self.ops[end..]);
+            }
+            _ => self.exec(*sp, s, &self.ops[d.center_end..]),
+        }
+    }
+
+    /// The world-space vector true displacement moves the vertex at `sp` by (None: the
+    /// material has no true displacement).
+    pub fn displacement_at(&self, sp: &ShadingPoint, s: &mut [f32]) -> Option<Vec3> {
+        let d = self.displacement?;
+        s.copy_from_slice(&self.initial);
+        self.exec(*sp, s, &self.ops[..d.center_end]);
+        Some(v3(s, d.value))
+    }
+
+    fn exec(&self, sp: ShadingPoint, s: &mut [f32], ops: &[Op]) {
         // `sp` is what the ops read: `base`, or a bump copy's offset point.
-        let mut base = *sp;
+        let mut base = sp;
         let mut sp = base;
-        for op in &self.ops {
+        for op in ops {
             match *op {
                 Op::VectorToFloat { src, dst } => {
                     let v = v3(s, src);

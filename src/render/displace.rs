@@ -1,0 +1,186 @@
+//! True displacement, as Cycles does it for the "Displacement Only" and "Both" methods
+//! (scene/mesh_displace.cpp, kernel/bake/bake.h kernel_displace): before the scene is
+//! traced, each vertex of a mesh whose material displaces moves by the material's
+//! Displacement evaluated there. The shading point at a vertex is that of the first
+//! triangle (in order) using it, at its corner, with the vertex normal (Cycles forces
+//! smooth shading there) and no differentials. "Both" keeps the vertex normals as they
+//! were (its bump supplies the detail, read at the undisplaced surface); "Displacement
+//! Only" recomputes them from the moved triangles. The mesh is displaced once, with the
+//! first instance's transform, and shared by every instance of it, as in Cycles.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use rayon::prelude::*;
+
+use crate::scene::{AttributeData, MeshData};
+use crate::shader::bump::ObjectTransform;
+use crate::shader::ShadingPoint;
+
+use super::build::{Geometry, MeshInstance};
+use super::math::*;
+use super::shade::Material;
+
+/// Displaces every mesh that uses a truly displacing material; returns how many vertices
+/// moved. The caller rebuilds the world triangles afterwards.
+pub fn apply(geo: &mut Geometry, materials: &[Material]) -> usize {
+    let displacing = |m: &Option<usize>| m.and_then(|m| materials[m].program.as_ref()).is_some_and(|p| p.displacement.is_some());
+    let mut done: HashMap<*const MeshData, (Arc<MeshData>, Arc<Vec<V3>>)> = HashMap::new();
+    let mut moved = 0;
+    for inst in &mut geo.instances {
+        if !inst.slots.iter().any(displacing) {
+            continue;
+        }
+        let key = Arc::as_ptr(&inst.mesh);
+        if !done.contains_key(&key) {
+            let (mesh, n) = displace(inst, materials);
+            moved += n;
+            done.insert(key, (Arc::new(mesh), Arc::new(inst.mesh.positions.clone())));
+        }
+        let (mesh, undisplaced) = done[&key].clone();
+        inst.mesh = mesh;
+        inst.undisplaced = Some(undisplaced);
+        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for p in &inst.mesh.positions {
+            let w = inst.to_world.point(*p);
+            lo = vmin(lo, w);
+            hi = vmax(hi, w);
+        }
+        inst.world_bounds = (lo, hi);
+    }
+    moved
+}
+
+/// The material program of triangle `t` of `inst`, if it truly displaces.
+fn program_of<'m>(inst: &MeshInstance, materials: &'m [Material], t: usize) -> Option<(usize, &'m crate::shader::program::Program)> {
+    let face = inst.mesh.triangle_faces[t] as usize;
+    let slot = inst.face_slot.get(face).copied().unwrap_or(0) as usize;
+    let mi = inst.slots.get(slot).copied().flatten()?;
+    let p = materials[mi].program.as_ref()?;
+    p.displacement.map(|_| (mi, p))
+}
+
+fn displace(inst: &MeshInstance, materials: &[Material]) -> (MeshData, usize) {
+    let m = &inst.mesh;
+    // Per vertex: the first displacing triangle corner that uses it (3 * triangle + k).
+    let mut owner = vec![u32::MAX; m.vertex_count()];
+    let mut recompute = vec![false; m.triangles.len()];
+    for (t, tri) in m.triangles.iter().enumerate() {
+        let Some((_, p)) = program_of(inst, materials, t) else { continue };
+        // "Displacement Only" triangles get new normals; "Both" keeps the old ones.
+        recompute[t] = p.displacement.is_some_and(|d| d.bump_end.is_none());
+        for (k, &c) in tri.iter().enumerate() {
+            let v = m.corner_verts[c as usize] as usize;
+            if owner[v] == u32::MAX {
+                owner[v] = (3 * t + k) as u32;
+            }
+        }
+    }
+    let vertex_normals = crate::shader::tangent::vertex_normals(m);
+    let jobs: Vec<(u32, u32)> = owner.iter().enumerate().filter(|(_, o)| **o != u32::MAX).map(|(v, o)| (v as u32, *o)).collect();
+    let transform = ObjectTransform { to_world: inst.to_world.m, to_object: inst.to_object.m };
+    let offsets: Vec<V3> = jobs
+        .par_iter()
+        .map_init(
+            || vec![Vec::new(); materials.len()],
+            |stacks, &(v, o)| {
+                let (t, k) = ((o / 3) as usize, (o % 3) as usize);
+                let Some((mi, p)) = program_of(inst, materials, t) else { return [0.0; 3] };
+                let sp = vertex_point(inst, &vertex_normals, transform, t, k, v as usize);
+                let stack = &mut stacks[mi];
+                if stack.len() != p.initial.len() {
+                    *stack = p.new_stack();
+                }
+                let d = p.displacement_at(&sp, stack).unwrap_or([0.0; 3]);
+                // Cycles' ensure_finite, then back to object space (the mesh's).
+                inst.to_object.vector(d.map(|x| if x.is_finite() { x } else { 0.0 }))
+            },
+        )
+        .collect();
+    let mut out = MeshData::clone(m);
+    for (&(v, _), d) in jobs.iter().zip(&offsets) {
+        out.positions[v as usize] = add(out.positions[v as usize], *d);
+    }
+    if recompute.iter().any(|&r| r) {
+        recompute_normals(&mut out, &recompute);
+    }
+    (out, jobs.len())
+}
+
+/// The shading point Cycles' displacement shader sees at vertex `v`, corner `k` of
+/// triangle `t` (shader_setup_from_displace).
+fn vertex_point(inst: &MeshInstance, vertex_normals: &[V3], transform: ObjectTransform, t: usize, k: usize, v: usize) -> ShadingPoint {
+    let m = &inst.mesh;
+    let tri = m.triangles[t];
+    let local = m.positions[v];
+    let world = inst.to_world.point(local);
+    let wv = tri.map(|c| inst.to_world.point(m.positions[m.corner_verts[c as usize] as usize]));
+    let ng = normalize(cross(sub(wv[1], wv[0]), sub(wv[2], wv[0])));
+    let n_obj = normalize(vertex_normals[v]);
+    let mut n = normalize(Affine::normal_by_inverse(&inst.to_object, n_obj));
+    if !n.iter().all(|x| x.is_finite()) || is_zero(n) {
+        n = ng;
+    }
+    let mut sp = ShadingPoint::default();
+    sp.position = world;
+    sp.normal = n;
+    sp.object_position = local;
+    sp.object_normal = n_obj;
+    sp.generated = [0, 1, 2].map(|a| (local[a] - inst.tex_loc[a]) / (2.0 * inst.tex_size[a]) + 0.5);
+    if let Some(uv) = &inst.uv {
+        let c = tri[k] as usize;
+        sp.uv = [uv[c][0], uv[c][1], 0.0];
+    }
+    sp.ng = ng;
+    sp.true_normal = ng;
+    // Cycles gives the displacement shader an incoming direction along the normal.
+    sp.incoming = n;
+    sp.parametric = [[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]][k];
+    sp.transform = transform;
+    sp.object = inst.info;
+    sp
+}
+
+/// "Displacement Only": corner normals of the moved triangles from the new geometry,
+/// as Cycles' compute_vertex_normals (unit triangle normals summed per vertex); flat
+/// faces take their triangle's normal.
+fn recompute_normals(m: &mut MeshData, recompute: &[bool]) {
+    let mut acc = vec![[0.0f32; 3]; m.vertex_count()];
+    let tri_normal = |m: &MeshData, tri: &[u32; 3]| {
+        let p = tri.map(|c| m.positions[m.corner_verts[c as usize] as usize]);
+        let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
+        if is_zero(n) {
+            [1.0, 0.0, 0.0]
+        } else {
+            normalize(n)
+        }
+    };
+    for (t, tri) in m.triangles.iter().enumerate() {
+        if recompute[t] {
+            let n = tri_normal(m, tri);
+            for &c in tri {
+                let v = m.corner_verts[c as usize] as usize;
+                acc[v] = add(acc[v], n);
+            }
+        }
+    }
+    let flat = match m.attribute("sharp_face").map(|a| &a.data) {
+        Some(AttributeData::Bool(v)) => v.clone(),
+        _ => Vec::new(),
+    };
+    if m.corner_normals.len() != m.corner_count() {
+        m.corner_normals = vec![[0.0, 0.0, 1.0]; m.corner_count()];
+    }
+    for t in 0..m.triangles.len() {
+        if !recompute[t] {
+            continue;
+        }
+        let tri = m.triangles[t];
+        let is_flat = flat.get(m.triangle_faces[t] as usize).copied().unwrap_or(false);
+        let fno = tri_normal(m, &tri);
+        for &c in &tri {
+            let v = m.corner_verts[c as usize] as usize;
+            m.corner_normals[c as usize] = if is_flat { fno } else { normalize(acc[v]) };
+        }
+    }
+}
