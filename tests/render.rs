@@ -39,6 +39,9 @@ const ASSERTED: &[&str] = &[
     "principled_aniso",
     // Subsurface Scattering node, Burley method: disk projection (render/subsurface_disk.rs).
     "sss_node",
+    // The colon's material in small: Principled Burley under a strong bump in a Mix with a
+    // sharp Glossy (bump map correction, bumped BSSRDF exit normal, bump shadowing term).
+    "sss_burley_bump",
 ];
 
 /// Scenes that do not pass yet, with the reason.
