@@ -42,6 +42,10 @@ const ASSERTED: &[&str] = &[
     // The colon's material in small: Principled Burley under a strong bump in a Mix with a
     // sharp Glossy (bump map correction, bumped BSSRDF exit normal, bump shadowing term).
     "sss_burley_bump",
+    // Spots with a radius near the lit surface: the cone weighs each sampled direction
+    // (Soft Falloff's facing disk, and the sphere light with it off).
+    "spot_radius",
+    "spot_sphere",
 ];
 
 /// Scenes that do not pass yet, with the reason.
