@@ -39,6 +39,13 @@ const ASSERTED: &[&str] = &[
     "principled_aniso",
     // Subsurface Scattering node, Burley method: disk projection (render/subsurface_disk.rs).
     "sss_node",
+    // The colon's material in small: Principled Burley under a strong bump in a Mix with a
+    // sharp Glossy (bump map correction, bumped BSSRDF exit normal, bump shadowing term).
+    "sss_burley_bump",
+    // Spots with a radius near the lit surface: the cone weighs each sampled direction
+    // (Soft Falloff's facing disk, and the sphere light with it off).
+    "spot_radius",
+    "spot_sphere",
 ];
 
 /// Scenes that do not pass yet, with the reason.

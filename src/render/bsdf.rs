@@ -63,6 +63,11 @@ pub struct LobeSet {
     pub emission: V3,
     pub holdout: V3,
     pub transparent: V3,
+    /// The smooth shading normal (Cycles' sd->N, after the displacement's bump): lobes
+    /// bumped away from it get Cycles' bump shadowing term. Zero when unset.
+    pub smooth_n: V3,
+    /// The material's bump map correction, which also softens diffuse bump shadows.
+    pub bump_correction: bool,
 }
 
 pub struct BsdfSample {
@@ -81,7 +86,7 @@ const EMPTY: Lobe = Lobe { kind: LobeKind::Diffuse, weight: [0.0; 3], n: [0.0, 0
 
 impl Default for LobeSet {
     fn default() -> Self {
-        LobeSet { lobes: [EMPTY; MAX_LOBES], len: 0, emission: [0.0; 3], holdout: [0.0; 3], transparent: [0.0; 3] }
+        LobeSet { lobes: [EMPTY; MAX_LOBES], len: 0, emission: [0.0; 3], holdout: [0.0; 3], transparent: [0.0; 3], smooth_n: [0.0; 3], bump_correction: true }
     }
 }
 
@@ -94,6 +99,8 @@ impl LobeSet {
         self.emission = [0.0; 3];
         self.holdout = [0.0; 3];
         self.transparent = [0.0; 3];
+        self.smooth_n = [0.0; 3];
+        self.bump_correction = true;
     }
 
     pub fn push(&mut self, kind: LobeKind, weight: V3, n: V3) {
@@ -127,7 +134,17 @@ impl LobeSet {
         let mut total = 0.0;
         for l in &self.lobes[..self.len] {
             total += l.sample_weight;
+            let bump = if is_zero(self.smooth_n) {
+                1.0
+            } else {
+                let diffuse = matches!(l.kind, LobeKind::Diffuse | LobeKind::OrenNayar(_) | LobeKind::Translucent);
+                super::bump_correction::bump_shadowing_term(self.smooth_n, l.n, wi, diffuse, self.bump_correction)
+            };
+            if bump == 0.0 {
+                continue;
+            }
             let (e, p) = eval_lobe(l, wo, wi, ng, tables);
+            let e = scale(e, bump);
             f = add(f, mul(e, l.weight));
             pdf += p * l.sample_weight;
         }

@@ -203,7 +203,7 @@ impl Scene<'_> {
     }
 
     fn shade_into(&self, hit: &SurfaceHit, wo: V3, stacks: &mut [Vec<f32>], lobes: &mut LobeSet) {
-        let ctx = Context { tables: self.tables, wo, backfacing: hit.backfacing };
+        let ctx = Context { tables: self.tables, wo, backfacing: hit.backfacing, bump_correction: true };
         match hit.material {
             Some(mi) => self.materials[mi].shade(&hit.sp, &mut stacks[mi], &ctx, lobes),
             None => {
@@ -291,8 +291,21 @@ impl Scene<'_> {
             ray_dp += h.t * ray_dd;
             self.fill_differentials(&mut hit, h.prim, ray_dp);
             if from_sss.is_some() {
+                // With a bumped BSSRDF Cycles runs the material at the exit and lights
+                // with the BSSRDF's normal there (corrected as seen along the true normal).
+                let (n, smooth) = match hit.material {
+                    Some(mi) if self.materials[mi].bssrdf_bump => {
+                        self.shade(&hit, wo, scratch);
+                        let smooth = scratch.lobes.smooth_n;
+                        (super::subsurface::exit_normal(&scratch.lobes, smooth), smooth)
+                    }
+                    _ => (hit.sp.normal, hit.sp.normal),
+                };
+                let correction = hit.material.map(|mi| self.materials[mi].bump_correction).unwrap_or(true);
                 scratch.lobes.clear();
-                scratch.lobes.push(LobeKind::Diffuse, [1.0; 3], hit.sp.normal);
+                scratch.lobes.smooth_n = smooth;
+                scratch.lobes.bump_correction = correction;
+                scratch.lobes.push(LobeKind::Diffuse, [1.0; 3], n);
             } else {
                 self.shade(&hit, wo, scratch);
             }

@@ -11,7 +11,9 @@ use crate::anim::EvaluatedScene;
 
 #[derive(Debug, Clone)]
 pub enum Shape {
-    Point { radius: f32, spot: Option<Spot> },
+    /// `sphere`: Cycles' sphere light (Soft Falloff off); otherwise a disk of the radius
+    /// facing the shading point (Soft Falloff on, Blender's default).
+    Point { radius: f32, spot: Option<Spot>, sphere: bool },
     Area { u: V3, v: V3, ellipse: bool, area: f32 },
     Sun { half_angle: f32 },
 }
@@ -95,7 +97,8 @@ pub fn collect(eval: &EvaluatedScene) -> Vec<Light> {
                 } else {
                     None
                 };
-                Shape::Point { radius, spot }
+                let sphere = !p.get("use_soft_falloff").and_then(Value::as_bool).unwrap_or(true);
+                Shape::Point { radius, spot, sphere }
             }
             "AREA" => {
                 let size = num(p, "size", 1.0);
@@ -121,6 +124,53 @@ pub fn collect(eval: &EvaluatedScene) -> Vec<Light> {
     out
 }
 
+impl Spot {
+    /// Cycles' spot attenuation of light leaving along `ray` (from the light outward).
+    fn attenuation(&self, ray: V3) -> f32 {
+        let sr = normalize([dot(ray, self.u), dot(ray, self.v), dot(ray, self.w)]);
+        if self.smooth.is_finite() {
+            smoothstep((sr[2] - self.cos_half) * self.smooth)
+        } else if sr[2] > self.cos_half {
+            1.0
+        } else {
+            0.0
+        }
+    }
+}
+
+/// 1 - cos of the angle whose squared sine is `s2`, accurate for small angles.
+fn one_minus_cos_from_sin2(s2: f32) -> f32 {
+    if s2 < 0.0004 {
+        0.5 * s2 + 0.125 * s2 * s2
+    } else {
+        1.0 - (1.0 - s2).max(0.0).sqrt()
+    }
+}
+
+/// A direction uniform in the cone about `axis` with 1 - cos(half angle) = `omc`
+/// (Cycles' concentric cone mapping), and its cosine to the axis.
+fn sample_cone(axis: V3, omc: f32, u: [f32; 2]) -> (V3, f32) {
+    let xy = super::camera::concentric_disk(u);
+    let r2 = xy[0] * xy[0] + xy[1] * xy[1];
+    let cos_theta = 1.0 - r2 * omc;
+    let k = (omc * (2.0 - omc * r2)).max(0.0).sqrt();
+    let (t, b) = basis(axis);
+    (add(add(scale(t, xy[0] * k), scale(b, xy[1] * k)), scale(axis, cos_theta)), cos_theta)
+}
+
+/// Nearest positive distance along unit `d` from `o` to the sphere, if any.
+fn ray_sphere(o: V3, d: V3, c: V3, r: f32) -> Option<f32> {
+    let oc = sub(c, o);
+    let tc = dot(oc, d);
+    let h2 = r * r - (dot(oc, oc) - tc * tc);
+    if h2 < 0.0 {
+        return None;
+    }
+    let h = h2.sqrt();
+    let t = if tc - h > 0.0 { tc - h } else { tc + h };
+    (t > 0.0).then_some(t)
+}
+
 #[inline]
 fn smoothstep(x: f32) -> f32 {
     let x = x.clamp(0.0, 1.0);
@@ -130,7 +180,7 @@ fn smoothstep(x: f32) -> f32 {
 impl Light {
     pub fn sample(&self, p: V3, u: [f32; 2]) -> Option<LightSample> {
         match &self.shape {
-            Shape::Point { radius, spot } => {
+            Shape::Point { radius, spot, sphere } => {
                 let to = sub(self.pos, p);
                 let d2 = dot(to, to);
                 if d2 <= 0.0 {
@@ -138,34 +188,69 @@ impl Light {
                 }
                 let d = d2.sqrt();
                 let w = scale(to, 1.0 / d);
-                let mut atten = 1.0;
-                if let Some(s) = spot {
-                    let r = neg(w);
-                    let sr = normalize([dot(r, s.u), dot(r, s.v), dot(r, s.w)]);
-                    atten = if s.smooth.is_finite() { smoothstep((sr[2] - s.cos_half) * s.smooth) } else if sr[2] > s.cos_half { 1.0 } else { 0.0 };
+                if *radius <= 0.0 {
+                    let atten = match spot {
+                        Some(s) => s.attenuation(neg(w)),
+                        None => 1.0,
+                    };
                     if atten <= 0.0 {
                         return None;
                     }
-                }
-                if *radius <= 0.0 {
                     // Intensity power / (4 pi) over squared distance.
                     let v = scale(self.strength, atten / (4.0 * PI * d2));
                     return Some(LightSample { wi: w, dist: d, value: v, pdf: f32::INFINITY });
                 }
-                // A disk of the sphere's radius facing the shading point.
-                let disk = super::camera::concentric_disk(u);
-                let (t, b) = basis(w);
-                let q = add(self.pos, add(scale(t, disk[0] * radius), scale(b, disk[1] * radius)));
-                let to = sub(q, p);
-                let dq2 = dot(to, to);
-                let dq = dq2.sqrt();
-                let wi = scale(to, 1.0 / dq);
-                let cos_l = dot(w, wi).abs();
-                let radiance = 1.0 / (4.0 * PI * PI * radius * radius);
-                // value = L * cos_l * A / d^2
-                let v = scale(self.strength, atten * radiance * cos_l * PI * radius * radius / dq2);
-                let pdf = dq2 / (cos_l.max(1e-8) * PI * radius * radius);
-                Some(LightSample { wi, dist: dq, value: v, pdf })
+                let r2 = radius * radius;
+                let radiance = 1.0 / (4.0 * PI * PI * r2);
+                if !*sphere || d2 <= r2 {
+                    // Cycles' soft-falloff point light: a disk of the radius facing the
+                    // point, the spot cone weighing the sampled direction. (Inside a sphere
+                    // light Cycles samples the hemisphere, unweighted by the cone; rare,
+                    // done here as the disk.)
+                    let disk = super::camera::concentric_disk(u);
+                    let (t, b) = basis(w);
+                    let q = add(self.pos, add(scale(t, disk[0] * radius), scale(b, disk[1] * radius)));
+                    let to = sub(q, p);
+                    let dq2 = dot(to, to);
+                    let dq = dq2.sqrt();
+                    let wi = scale(to, 1.0 / dq);
+                    let cos_l = dot(w, wi).abs();
+                    let atten = match spot {
+                        Some(s) if !*sphere => s.attenuation(neg(wi)),
+                        _ => 1.0,
+                    };
+                    if atten <= 0.0 {
+                        return None;
+                    }
+                    let v = scale(self.strength, atten * radiance * cos_l * PI * r2 / dq2);
+                    let pdf = dq2 / (cos_l.max(1e-8) * PI * r2);
+                    return Some(LightSample { wi, dist: dq, value: v, pdf });
+                }
+                // Cycles' sphere light (light/point.h, spot.h): a direction uniform in the
+                // cone the sphere subtends or, for a spot narrower than that, in the spot's
+                // spread cone about its axis; the spot cone weighs each sampled direction.
+                let cap = one_minus_cos_from_sin2(r2 / d2);
+                let spread = spot.map(|s| 1.0 - s.cos_half).unwrap_or(f32::INFINITY);
+                let (axis, omc) = if cap < spread { (w, cap) } else { (neg(self.dir), spread) };
+                let (wi, cos_theta) = sample_cone(axis, omc, u);
+                let dist = if cap < spread {
+                    // Law of cosines: the nearer crossing of the sphere along the cone's ray.
+                    let cos_w = dot(wi, w);
+                    d * cos_w - (r2 - d2 + d2 * cos_w * cos_w).max(0.0).sqrt()
+                } else {
+                    let _ = cos_theta;
+                    ray_sphere(p, wi, self.pos, *radius)?
+                };
+                let atten = match spot {
+                    Some(s) => s.attenuation(neg(wi)),
+                    None => 1.0,
+                };
+                if atten <= 0.0 {
+                    return None;
+                }
+                let pdf = 1.0 / (2.0 * PI * omc);
+                let v = scale(self.strength, atten * radiance / pdf);
+                Some(LightSample { wi, dist, value: v, pdf })
             }
             Shape::Area { u: au, v: av, ellipse, area } => {
                 let (a, b) = if *ellipse {
@@ -213,36 +298,51 @@ impl Light {
     /// rays that leave the scene, `tmax` infinite).
     pub fn intersect(&self, o: V3, d: V3, tmax: f32) -> Option<LightHit> {
         match &self.shape {
-            Shape::Point { radius, spot } => {
+            Shape::Point { radius, spot, sphere } => {
                 if *radius <= 0.0 {
                     return None;
                 }
-                // The disk through the light's centre facing the ray origin.
+                // Rays leaving a spot are not lit by it (Cycles' one-sided test).
+                if spot.is_some() && dot(d, sub(o, self.pos)) >= 0.0 {
+                    return None;
+                }
+                if !*sphere {
+                    // The disk through the light's centre facing the ray origin.
+                    let to = sub(self.pos, o);
+                    let n = normalize(neg(to));
+                    let denom = dot(d, n);
+                    if denom >= 0.0 {
+                        return None;
+                    }
+                    let t = dot(to, n) / denom;
+                    if !(t > 0.0 && t < tmax) {
+                        return None;
+                    }
+                    let q = sub(madd(o, d, t), self.pos);
+                    if dot(q, q) > radius * radius {
+                        return None;
+                    }
+                    let atten = spot.map(|s| s.attenuation(neg(d))).unwrap_or(1.0);
+                    let radiance = scale(self.strength, atten / (4.0 * PI * PI * radius * radius));
+                    return Some(LightHit { t, radiance, pdf: t * t / ((-denom).max(1e-8) * PI * radius * radius) });
+                }
+                let t = ray_sphere(o, d, self.pos, *radius)?;
+                if t >= tmax {
+                    return None;
+                }
                 let to = sub(self.pos, o);
-                let dist2 = dot(to, to);
-                let n = normalize(neg(to));
-                let denom = dot(d, n);
-                if denom >= 0.0 {
-                    return None;
-                }
-                let t = dot(sub(self.pos, o), n) / denom;
-                if !(t > 0.0 && t < tmax) {
-                    return None;
-                }
-                let q = madd(o, d, t);
-                if dot(sub(q, self.pos), sub(q, self.pos)) > radius * radius {
-                    return None;
-                }
+                let (d2, r2) = (dot(to, to), radius * radius);
                 let mut atten = 1.0;
-                if let Some(s) = spot {
-                    let r = neg(normalize(to));
-                    let sr = normalize([dot(r, s.u), dot(r, s.v), dot(r, s.w)]);
-                    atten = if s.smooth.is_finite() { smoothstep((sr[2] - s.cos_half) * s.smooth) } else if sr[2] > s.cos_half { 1.0 } else { 0.0 };
+                let mut omc = 2.0;
+                if d2 > r2 {
+                    omc = one_minus_cos_from_sin2(r2 / d2);
+                    if let Some(s) = spot {
+                        atten = s.attenuation(neg(d));
+                        omc = omc.min(1.0 - s.cos_half);
+                    }
                 }
-                let _ = dist2;
-                let radiance = scale(self.strength, atten / (4.0 * PI * PI * radius * radius));
-                let cos_l = -denom;
-                Some(LightHit { t, radiance, pdf: t * t / (cos_l.max(1e-8) * PI * radius * radius) })
+                let radiance = scale(self.strength, atten / (4.0 * PI * PI * r2));
+                Some(LightHit { t, radiance, pdf: 1.0 / (2.0 * PI * omc) })
             }
             Shape::Area { u, v, ellipse, area } => {
                 let cos_l = -dot(d, self.dir);

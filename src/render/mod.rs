@@ -15,6 +15,7 @@ pub mod adaptive;
 pub mod anisotropic;
 pub mod bsdf;
 pub mod build;
+pub mod bump_correction;
 pub mod camera;
 pub mod displace;
 pub mod filter;

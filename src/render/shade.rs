@@ -19,6 +19,11 @@ pub struct Material {
     pub name: String,
     /// The material's emission sampling setting (Cycles' AUTO, NONE, FRONT, BACK, FRONT_BACK).
     pub sampling: String,
+    /// Cycles' "Bump Map Correction" (material setting, on by default).
+    pub bump_correction: bool,
+    /// Cycles' SD_HAS_BSSRDF_BUMP: a subsurface exit on this material lights with the
+    /// BSSRDF's (bumped) normal, so the material runs there (see `subsurface::exit_normal`).
+    pub bssrdf_bump: bool,
 }
 
 /// Every material of the scene, in `scene.file.materials` order.
@@ -26,7 +31,7 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
     let mut out = Vec::new();
     for (i, m) in scene.file.materials.iter().enumerate() {
         if !used.get(i).copied().unwrap_or(false) {
-            out.push(Material { program: None, bsdf_of: Vec::new(), name: m.name.clone(), sampling: String::new() });
+            out.push(Material { program: None, bsdf_of: Vec::new(), name: m.name.clone(), sampling: String::new(), bump_correction: true, bssrdf_bump: false });
             continue;
         }
         let p = compile_material(scene, &m.name).map_err(|e| RenderError(format!("{e}")))?;
@@ -42,9 +47,30 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
             }
         }
         let sampling = m.properties.get("cycles").and_then(|c| c.get("emission_sampling")).and_then(|v| v.as_str()).unwrap_or("AUTO").to_string();
-        out.push(Material { program: Some(p), bsdf_of, name: m.name.clone(), sampling });
+        let bump_correction = m.properties.get("cycles").and_then(|c| c.get("use_bump_map_correction")).and_then(|v| v.as_bool()).unwrap_or(true);
+        let bssrdf_bump = has_bssrdf_bump(&p);
+        out.push(Material { program: Some(p), bsdf_of, name: m.name.clone(), sampling, bump_correction, bssrdf_bump });
     }
     Ok(out)
+}
+
+/// Cycles' `has_bssrdf_bump` (svm.cpp: the displacement's bump, or a BSSRDF node whose
+/// Normal is linked; a Principled BSDF counts as BSSRDF when its Subsurface Weight is
+/// linked or above the closure cutoff).
+fn has_bssrdf_bump(p: &Program) -> bool {
+    p.displaced_normal.is_some()
+        || p.bsdfs.iter().any(|b| {
+            let bssrdf = match b.bl_idname.as_str() {
+                "ShaderNodeSubsurfaceScattering" => true,
+                "ShaderNodeBsdfPrincipled" => match b.input("Subsurface Weight") {
+                    Some((_, true)) => true,
+                    Some((slot, false)) => p.initial.get(slot as usize).is_some_and(|w| *w > 1e-5),
+                    None => false,
+                },
+                _ => false,
+            };
+            bssrdf && matches!(b.input("Normal"), Some((_, true)))
+        })
 }
 
 /// What the shading of one hit needs besides the shading point.
@@ -54,6 +80,19 @@ pub struct Context<'a> {
     pub wo: V3,
     /// The ray hit the back of the surface (normals are already flipped to face it).
     pub backfacing: bool,
+    /// The material's Bump Map Correction (set by `Material::shade`).
+    pub bump_correction: bool,
+}
+
+/// Cycles' `maybe_ensure_valid_specular_reflection`: the normal of the closures whose
+/// mirror direction must stay above the surface (microfacet, glass, translucent, BSSRDF),
+/// raised toward the true normal when the material's Bump Map Correction is on.
+fn valid_n(sp: &ShadingPoint, ctx: &Context, n: V3) -> V3 {
+    if ctx.bump_correction && n != sp.true_normal {
+        super::bump_correction::ensure_valid_specular_reflection(sp.true_normal, ctx.wo, n)
+    } else {
+        n
+    }
 }
 
 fn v3(s: &[f32], at: u32) -> V3 {
@@ -86,6 +125,7 @@ impl Material {
             stack.extend_from_slice(&p.initial);
         }
         p.run(sp, stack);
+        let ctx = &Context { bump_correction: self.bump_correction, ..*ctx };
         // The material's displacement, bumped, is the shading normal of every closure.
         let bumped;
         let sp = match p.displaced_normal {
@@ -95,6 +135,8 @@ impl Material {
             }
             None => sp,
         };
+        out.smooth_n = sp.normal;
+        out.bump_correction = self.bump_correction;
         if let Some(c) = p.surface {
             self.closure(p, c, 1.0, stack, sp, ctx, out);
         }
@@ -177,7 +219,7 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
         }
         "ShaderNodeBsdfTranslucent" => {
             let c = input_c(b, s, "Color", [0.8; 3]);
-            out.push(LobeKind::Translucent, scale(c, w), input_n(b, s, "Normal", sp));
+            out.push(LobeKind::Translucent, scale(c, w), valid_n(sp, ctx, input_n(b, s, "Normal", sp)));
         }
         "ShaderNodeBsdfTransparent" => {
             let c = input_c(b, s, "Color", [1.0; 3]);
@@ -189,7 +231,7 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
         "ShaderNodeBsdfAnisotropic" | "ShaderNodeBsdfGlossy" => {
             let c = input_c(b, s, "Color", [0.8; 3]);
             let r = input_f(b, s, "Roughness", 0.5).clamp(0.0, 1.0);
-            let n = input_n(b, s, "Normal", sp);
+            let n = valid_n(sp, ctx, input_n(b, s, "Normal", sp));
             if b.property("distribution") == Some("BECKMANN") {
                 let r = super::microfacet::Reflection { dist: super::microfacet::Distribution::Beckmann, alpha: r * r };
                 out.push(LobeKind::Reflection(r), scale(c, w), n);
@@ -212,7 +254,7 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             let c = input_c(b, s, "Color", [1.0; 3]);
             let ior = input_f(b, s, "IOR", 1.45);
             let r = input_f(b, s, "Roughness", 0.0);
-            let n = input_n(b, s, "Normal", sp);
+            let n = valid_n(sp, ctx, input_n(b, s, "Normal", sp));
             let refract_only = b.bl_idname == "ShaderNodeBsdfRefraction";
             let g = super::microfacet::glass_closure(ctx.tables, b.property("distribution"), refract_only, r, ior, ctx.backfacing, dot(n, ctx.wo));
             out.push(LobeKind::Glass(g), scale(c, w), n);
@@ -224,7 +266,7 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             let ior = input_f(b, s, "IOR", 1.4);
             let r = input_f(b, s, "Roughness", 1.0);
             let aniso = input_f(b, s, "Anisotropy", 0.0);
-            push_bssrdf(out, scale(c, w), radius, c, aniso, ior, r, method, input_n(b, s, "Normal", sp));
+            push_bssrdf(out, scale(c, w), radius, c, aniso, ior, r, method, valid_n(sp, ctx, input_n(b, s, "Normal", sp)));
         }
         "ShaderNodeBsdfSheen" => {
             let c = input_c(b, s, "Color", [0.8; 3]);
@@ -250,12 +292,15 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
     let spec_level = input_f(b, s, "Specular IOR Level", 0.5).max(0.0);
     let spec_tint = input_c(b, s, "Specular Tint", [1.0; 3]).map(|x| x.max(0.0));
     let n = input_n(b, s, "Normal", sp);
+    // The reflecting layers and the BSSRDF use the bump-corrected normal; diffuse and
+    // sheen the normal as given (Cycles' valid_reflection_N).
+    let vn = valid_n(sp, ctx, n);
     let mut weight = [w; 3];
     if alpha < 1.0 {
         out.push(LobeKind::Transparent, [w * (1.0 - alpha); 3], sp.normal);
         weight = scale(weight, alpha);
     }
-    let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
+    let mu = dot(vn, ctx.wo).clamp(0.0, 1.0);
     let energy = multiscatter_energy(ctx.tables, mu, roughness);
     let a = roughness * roughness;
     // Anisotropic metallic and specular layers (alphas stretched along the tangent).
@@ -278,9 +323,9 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         let avg_f0 = (base[0] + base[1] + base[2]) / 3.0;
         let albedo = (avg_f0 + (1.0 - avg_f0) / 21.0).clamp(0.0, 1.0);
         if ax != ay {
-            push_glossy(out, ctx, ax, ay, tangent, Fresnel::F82 { f0: base, b: bb }, true, scale(weight, metallic), n, albedo.max(1e-3));
+            push_glossy(out, ctx, ax, ay, tangent, Fresnel::F82 { f0: base, b: bb }, true, scale(weight, metallic), vn, albedo.max(1e-3));
         } else {
-            out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::F82 { f0: base, b: bb }, energy }, scale(weight, metallic), n, albedo.max(1e-3));
+            out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::F82 { f0: base, b: bb }, energy }, scale(weight, metallic), vn, albedo.max(1e-3));
         }
         weight = scale(weight, 1.0 - metallic);
     }
@@ -290,7 +335,7 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         let mut g = super::microfacet::glass_closure(ctx.tables, Some("MULTI_GGX"), false, roughness, ior, ctx.backfacing, mu);
         g.tint_r = spec_tint;
         g.tint_t = base.map(f32::sqrt);
-        out.push(LobeKind::Glass(g), scale(weight, transmission), n);
+        out.push(LobeKind::Glass(g), scale(weight, transmission), vn);
         weight = scale(weight, 1.0 - transmission);
     }
     // Dielectric specular: IOR adjusted by the specular IOR level as Cycles does.
@@ -314,9 +359,9 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
             e
         };
         if ax != ay {
-            push_glossy(out, ctx, ax, ay, tangent, Fresnel::Dielectric { eta }, true, mul(weight, spec_tint), n, e.max(1e-3));
+            push_glossy(out, ctx, ax, ay, tangent, Fresnel::Dielectric { eta }, true, mul(weight, spec_tint), vn, e.max(1e-3));
         } else {
-            out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::Dielectric { eta }, energy }, mul(weight, spec_tint), n, e.max(1e-3));
+            out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::Dielectric { eta }, energy }, mul(weight, spec_tint), vn, e.max(1e-3));
         }
         // Attenuate the layers below by the specular layer's albedo.
         let albedo = scale(spec_tint, e);
@@ -329,7 +374,7 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         // Random Walk (Skin) has its own IOR input; the other methods use the BSDF's.
         let ss_ior = if method == Method::RandomWalkSkin { input_f(b, s, "Subsurface IOR", 1.4) } else { ior };
         let aniso = input_f(b, s, "Subsurface Anisotropy", 0.0);
-        push_bssrdf(out, scale(mul(weight, base), ss), radius, base, aniso, ss_ior, roughness, method, n);
+        push_bssrdf(out, scale(mul(weight, base), ss), radius, base, aniso, ss_ior, roughness, method, vn);
         weight = scale(weight, 1.0 - ss);
     }
     let diffuse_roughness = input_f(b, s, "Diffuse Roughness", 0.0);
@@ -365,7 +410,7 @@ fn principled_coat(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, ctx: &Context, ou
     let rough = input_f(b, s, "Coat Roughness", 0.03).clamp(0.0, 1.0);
     let coat_ior = input_f(b, s, "Coat IOR", 1.5).max(1.0);
     let tint = input_c(b, s, "Coat Tint", [1.0; 3]).map(|x| x.max(0.0));
-    let n = input_n(b, s, "Coat Normal", sp);
+    let n = valid_n(sp, ctx, input_n(b, s, "Coat Normal", sp));
     let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
     let energy = multiscatter_energy(ctx.tables, mu, rough);
     let e = (ctx.tables.dielectric_e(mu, rough, coat_ior) * energy).clamp(0.0, 1.0);

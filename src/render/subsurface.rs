@@ -327,6 +327,25 @@ pub fn random_walk(b: &Bssrdf, p: V3, n: V3, d0: V3, inst: u32, throughput: &mut
     Some(exit)
 }
 
+/// The normal a subsurface exit lights with when its material has a bumped BSSRDF
+/// (Cycles' `surface_shader_bssrdf_normal`): the BSSRDF closures' normals (already bump
+/// corrected for the exit, whose incoming direction is the true normal) weighted by
+/// their mean weight; `fallback` (the shading normal) when there is none.
+pub fn exit_normal(lobes: &super::bsdf::LobeSet, fallback: V3) -> V3 {
+    let mut n = [0.0; 3];
+    for l in &lobes.lobes[..lobes.len] {
+        if let super::bsdf::LobeKind::Subsurface(_) = l.kind {
+            let w = ((l.weight[0] + l.weight[1] + l.weight[2]) / 3.0).abs();
+            n = madd(n, l.n, w);
+        }
+    }
+    if is_zero(n) || !n.iter().all(|x| x.is_finite()) {
+        fallback
+    } else {
+        normalize(n)
+    }
+}
+
 /// After a diffuse bounce Cycles replaces every BSSRDF by a diffuse closure of its weight.
 pub fn to_diffuse(lobes: &mut super::bsdf::LobeSet) {
     let n = lobes.len;
