@@ -50,6 +50,12 @@ const ASSERTED: &[&str] = &[
 
 /// Scenes that do not pass yet, with the reason.
 const KNOWN_FAILURES: &[(&str, &str)] = &[
+    // True displacement (render/displace.rs): the relief and its silhouette match and the
+    // channel means agree to 0.05%, but these sun-lit diffuse scenes are almost noise-free
+    // (Cycles A and B differ very little), so a small structured shading difference along
+    // the relief's sharp features dominates the ratio.
+    ("displace_both", "ratio ~2.4 (Displacement and Bump), means within 0.05%: structured error at the relief's creases, not yet explained"),
+    ("displace_true", "ratio ~1.37 (Displacement Only), means within 0.2%: structured error at the relief's creases, not yet explained"),
     ("translucent", "ratio ~1.151, on the limit, means match to 0.03% (variance, not bias): the excess is in the sun-lit floor (ratio 1.20 there, half the squared error) whose noise is indirect light via the sheet's underside; the sheet itself is at 1.10"),
 ];
 
@@ -355,4 +361,46 @@ fn object_motion_blur_matches_cycles_and_discriminates() {
         println!("{name} without motion blur: ratio {ratio:.3}");
         assert!(ratio > 2.0 * MAX_RATIO, "{name}: without blur the ratio is only {ratio:.3}");
     }
+}
+
+#[test]
+fn true_displacement_moves_the_relief_as_cycles() {
+    // The displaced grids against Cycles: channel means within 1%, and an error far below
+    // that of the same scene with its displacement only bumped (vertices left in place),
+    // so the test tells moved vertices from none. The ratio itself is a known failure
+    // (KNOWN_FAILURES: structured error at creases of a noise-free scene).
+    for (name, max_ratio) in [("displace_both", 3.0), ("displace_true", 1.6)] {
+        let dir = common::repo().join("fixtures/render/scenes").join(name);
+        let r = evaluate(&dir);
+        println!("{name}: ratio {:.3}, worst channel mean error {:.3}%", r.ratio, 100.0 * r.worst_mean);
+        assert!(r.ratio <= max_ratio && r.worst_mean <= MAX_MEAN_REL, "{name}: ratio {:.3}, mean error {:.3}%", r.ratio, 100.0 * r.worst_mean);
+        let mut scene = Scene::load(&dir).unwrap();
+        for m in &mut scene.file.materials {
+            m.properties.insert("displacement_method".into(), serde_json::Value::String("BUMP".into()));
+        }
+        let opts = RenderOptions { samples: Some(64), resolution: Some((128, 128)), seed: Some(0), ..Default::default() };
+        let flat = render(&scene, &opts).unwrap();
+        let flat: Vec<[f32; 3]> = flat.color.iter().map(|p| [p[0], p[1], p[2]]).collect();
+        let a = read_exr(&dir.join("cycles_a.exr"));
+        let b = read_exr(&dir.join("cycles_b.exr"));
+        let ratio = rmse(&flat, &a) / rmse(&b, &a);
+        println!("{name} with the displacement only bumped: ratio {ratio:.3}");
+        assert!(ratio > 3.0 * r.ratio, "{name}: bump-only ratio {ratio:.3} is not far above the displaced {:.3}", r.ratio);
+    }
+}
+
+#[test]
+fn emission_estimate_follows_cycles() {
+    // Cycles' Shader::estimate_emission: constant colour times strength through the
+    // closure tree (Mix Shader by its factor); zero means the material never emits and its
+    // triangles are no light. Principled's default Emission Strength is 0.
+    let program = |scene: &str, material: &str| {
+        let scene = Scene::load(&common::repo().join("fixtures/render/scenes").join(scene)).unwrap();
+        blendsynth::shader::compile_material(&scene, material).unwrap()
+    };
+    let glow = program("emission_mesh", "Glow").emission_estimate;
+    for (got, want) in glow.iter().zip([8.0, 7.2, 5.6]) {
+        assert!((got - want).abs() < 1e-5, "Glow estimate {glow:?}");
+    }
+    assert_eq!(program("principled", "Plastic").emission_estimate, [0.0; 3]);
 }
