@@ -1,5 +1,5 @@
 //! Shading-point throughput of compiled materials, single-threaded (points per second
-//! per core). `cargo bench --bench shading`.
+//! per core). `cargo bench --bench shading [CASE...]` (all cases when none is named).
 //!
 //! Materials: the bake-parity fixtures (fixtures/bake/scenes). `textures` is Mapping, a
 //! 6-octave fBm Noise, Smooth-F1 Voronoi (2 octaves), Wave, Magic, Gradient and Checker.
@@ -26,12 +26,17 @@ fn main() {
         Some(dir) => cases.push(("Fat.001".into(), dir.into(), Some("Fat.001"))),
         None => println!("shading Fat.001: skipped (set BLENDSYNTH_COLON_EXPORT to a converted colon_nodes.blend)"),
     }
+    let only: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
     for (case, dir, name) in &cases {
+        if !only.is_empty() && !only.iter().any(|o| o == case) {
+            continue;
+        }
         let scene = Scene::load(dir).expect("scene");
         let material = name.map(str::to_string).unwrap_or_else(|| scene.file.materials[0].name.clone());
         let program = compile_material(&scene, &material).expect("compiles");
         let mut stack = program.new_stack();
-        let n = 2_000_000u32;
+        // BLENDSYNTH_BENCH_POINTS=N (a multiple of 1000) shortens the slow materials' runs.
+        let n: u32 = std::env::var("BLENDSYNTH_BENCH_POINTS").ok().and_then(|s| s.parse().ok()).unwrap_or(2_000_000);
         let start = Instant::now();
         let mut acc = 0.0f32;
         for i in 0..n {
