@@ -194,42 +194,47 @@ fn reduce_add<const N: usize>(v: [f32; N]) -> f32 {
     }
 }
 
-/// N coordinates of M cells, one array per axis.
-type Soa<const N: usize, const M: usize> = [[f32; M]; N];
+/// N coordinates of P cells, one array per axis. P is the cell count rounded up to a
+/// multiple of 8 (one AVX2 vector) so that the loops over cells vectorise without a
+/// scalar remainder; the padding cells are hashed but never read.
+type Soa<const N: usize, const P: usize> = [[f32; P]; N];
 
 #[inline(always)]
-fn at<const N: usize, const M: usize>(a: &Soa<N, M>, t: usize) -> [f32; N] {
+fn at<const N: usize, const P: usize>(a: &Soa<N, P>, t: usize) -> [f32; N] {
     std::array::from_fn(|i| a[i][t])
 }
 
-/// The M = (2r+1)^N cells around `cell`, x fastest (Cycles' loop nesting, which decides
+/// The (2r+1)^N cells around `cell`, x fastest (Cycles' loop nesting, which decides
 /// ties): their offsets `base + o` for o in [-r, r]^N, their jitter hashes and their
 /// jittered points relative to `cell`.
-struct Block<const N: usize, const M: usize> {
-    off: Soa<N, M>,
-    jitter: Soa<N, M>,
-    point: Soa<N, M>,
+struct Block<const N: usize, const P: usize> {
+    /// The number of real cells, (2r+1)^N <= P.
+    m: usize,
+    off: Soa<N, P>,
+    jitter: Soa<N, P>,
+    point: Soa<N, P>,
 }
 
-impl<const N: usize, const M: usize> Block<N, M>
+impl<const N: usize, const P: usize> Block<N, P>
 where
     D: Cell<N>,
 {
     #[inline(always)]
     fn new(cell: [f32; N], base: [f32; N], r: i32, randomness: f32) -> Self {
         let side = 2 * r + 1;
-        debug_assert_eq!(side.pow(N as u32) as usize, M);
-        let mut off = [[0.0f32; M]; N];
+        let m = side.pow(N as u32) as usize;
+        debug_assert!(m <= P && P % 8 == 0);
+        let mut off = [[0.0f32; P]; N];
         let mut stride = 1;
         for (i, axis) in off.iter_mut().enumerate() {
-            for (t, o) in axis.iter_mut().enumerate() {
+            for (t, o) in axis.iter_mut().enumerate().take(m) {
                 *o = base[i] + ((t as i32 / stride) % side - r) as f32;
             }
             stride *= side;
         }
-        let mut jitter = [[0.0f32; M]; N];
-        let mut point = [[0.0f32; M]; N];
-        for t in 0..M {
+        let mut jitter = [[0.0f32; P]; N];
+        let mut point = [[0.0f32; P]; N];
+        for t in 0..P {
             let o = at(&off, t);
             let j = D::jitter(add(cell, o));
             let q = add(o, scale(j, randomness));
@@ -238,13 +243,13 @@ where
                 point[i][t] = q[i];
             }
         }
-        Block { off, jitter, point }
+        Block { m, off, jitter, point }
     }
 
     /// `metric_distance(point, local)` of every cell.
     #[inline(always)]
-    fn distances(&self, local: [f32; N], p: &VoronoiParams) -> [f32; M] {
-        let mut d = [0.0f32; M];
+    fn distances(&self, local: [f32; N], p: &VoronoiParams) -> [f32; P] {
+        let mut d = [0.0f32; P];
         let pt = &self.point;
         // One loop per metric (not a match per cell) so each loop vectorises.
         if N == 1 {
@@ -255,19 +260,19 @@ where
             VoronoiMetric::Euclidean => d.iter_mut().enumerate().for_each(|(t, d)| *d = euclidean(at(pt, t), local)),
             VoronoiMetric::Manhattan => d.iter_mut().enumerate().for_each(|(t, d)| *d = manhattan(at(pt, t), local)),
             VoronoiMetric::Chebychev => d.iter_mut().enumerate().for_each(|(t, d)| *d = chebychev(at(pt, t), local)),
-            VoronoiMetric::Minkowski => d.iter_mut().enumerate().for_each(|(t, d)| *d = minkowski(at(pt, t), local, p.exponent)),
+            VoronoiMetric::Minkowski => d.iter_mut().take(self.m).enumerate().for_each(|(t, d)| *d = minkowski(at(pt, t), local, p.exponent)),
         }
         d
     }
 }
 
-/// The first index of the smallest value below `f32::MAX`, as a strict `<` scan in
-/// order finds it (NaN never wins).
+/// The first index among the first `m` of the smallest value below `f32::MAX`, as a
+/// strict `<` scan in order finds it (NaN never wins).
 #[inline(always)]
-fn first_min<const M: usize>(d: &[f32; M]) -> Option<usize> {
+fn first_min(d: &[f32], m: usize) -> Option<usize> {
     let mut min_d = f32::MAX;
     let mut best = None;
-    for (t, &x) in d.iter().enumerate() {
+    for (t, &x) in d[..m].iter().enumerate() {
         if x < min_d {
             min_d = x;
             best = Some(t);
@@ -288,14 +293,14 @@ fn split<const N: usize>(coord: [f32; N]) -> ([f32; N], [f32; N]) {
     (cell, sub(coord, cell))
 }
 
-fn f1<const N: usize, const M: usize>(p: &VoronoiParams, coord: [f32; N]) -> Octave
+fn f1<const N: usize, const P: usize>(p: &VoronoiParams, coord: [f32; N]) -> Octave
 where
     D: Cell<N>,
 {
     let (cell, local) = split(coord);
-    let b = Block::<N, M>::new(cell, [0.0; N], 1, p.randomness);
+    let b = Block::<N, P>::new(cell, [0.0; N], 1, p.randomness);
     let d = b.distances(local, p);
-    match first_min(&d) {
+    match first_min(&d, b.m) {
         Some(t) => {
             let target = add(cell, at(&b.off, t));
             Octave { distance: d[t], color: D::color_with(target, at(&b.jitter, t)), position: D::position(add(at(&b.point, t), cell)) }
@@ -305,15 +310,15 @@ where
     }
 }
 
-fn smooth_f1<const N: usize, const M: usize>(p: &VoronoiParams, coord: [f32; N]) -> Octave
+fn smooth_f1<const N: usize, const P: usize>(p: &VoronoiParams, coord: [f32; N]) -> Octave
 where
     D: Cell<N>,
 {
     let (cell, local) = split(coord);
-    let b = Block::<N, M>::new(cell, [0.0; N], 2, p.randomness);
+    let b = Block::<N, P>::new(cell, [0.0; N], 2, p.randomness);
     let dist = b.distances(local, p);
-    let mut color = [[0.0f32; M]; 3];
-    for t in 0..M {
+    let mut color = [[0.0f32; P]; 3];
+    for t in 0..P {
         let c = D::color_with(add(cell, at(&b.off, t)), at(&b.jitter, t));
         for k in 0..3 {
             color[k][t] = c[k];
@@ -322,15 +327,32 @@ where
     let mut sd = 0.0f32;
     let mut sc = [0.0f32; 3];
     let mut sp = [0.0f32; N];
-    let mut h = -1.0f32;
-    for t in 0..M {
+    // Cells with smoothstep argument x < 0 (h = 0, most of the 5^N) leave every sum
+    // unchanged, so they are skipped, which takes them off the serial dependency chain.
+    // Exactly unchanged: with h = 0 both corrections are +0 and each sum s becomes
+    // (s + 0 * (v - s)) - 0, which is s when v - s is finite (all distances are, and the
+    // colours, points and sums are bounded) and s is not -0.
+    let finite = dist[..b.m].iter().all(|d| d.abs() < 1e30);
+    let neg_zero = |x: f32| x.to_bits() == (-0.0f32).to_bits();
+    let mut any_neg_zero = false;
+    for t in 0..b.m {
         let d = dist[t];
-        h = if h == -1.0 { 1.0 } else { smoothstep(0.5 + 0.5 * (sd - d) / p.smoothness) };
+        // The first cell blends with h = 1; smoothstep never gives Cycles' marker -1.
+        let h = if t == 0 {
+            1.0
+        } else {
+            let x = 0.5 + 0.5 * (sd - d) / p.smoothness;
+            if x < 0.0 && finite && !any_neg_zero {
+                continue;
+            }
+            smoothstep(x)
+        };
         let mut corr = p.smoothness * h * (1.0 - h);
         sd = mix1(sd, d, h) - corr;
         corr /= 1.0 + 3.0 * p.smoothness;
         sc = mixn(sc, at(&color, t), h).map(|x| x - corr);
         sp = mixn(sp, at(&b.point, t), h).map(|x| x - corr);
+        any_neg_zero = neg_zero(sd) || sc.iter().any(|&x| neg_zero(x)) || sp.iter().any(|&x| neg_zero(x));
     }
     Octave { distance: sd, color: sc, position: D::position(add(cell, sp)) }
 }
@@ -346,16 +368,16 @@ fn smoothstep(x: f32) -> f32 {
     }
 }
 
-fn f2<const N: usize, const M: usize>(p: &VoronoiParams, coord: [f32; N]) -> Octave
+fn f2<const N: usize, const P: usize>(p: &VoronoiParams, coord: [f32; N]) -> Octave
 where
     D: Cell<N>,
 {
     let (cell, local) = split(coord);
-    let b = Block::<N, M>::new(cell, [0.0; N], 1, p.randomness);
+    let b = Block::<N, P>::new(cell, [0.0; N], 1, p.randomness);
     let dist = b.distances(local, p);
     let (mut d1, mut d2) = (f32::MAX, f32::MAX);
     let (mut t1, mut t2) = (None, None);
-    for (t, &d) in dist.iter().enumerate() {
+    for (t, &d) in dist[..b.m].iter().enumerate() {
         if d < d1 {
             d2 = d1;
             d1 = d;
@@ -379,7 +401,7 @@ where
     Octave { distance: d2, color, position: D::position(add(pos2, cell)) }
 }
 
-fn distance_to_edge<const N: usize, const M: usize>(p: &VoronoiParams, coord: [f32; N]) -> f32
+fn distance_to_edge<const N: usize, const P: usize>(p: &VoronoiParams, coord: [f32; N]) -> f32
 where
     D: Cell<N>,
 {
@@ -394,20 +416,20 @@ where
         return dl.min(dr);
     }
     // Both passes see the same cells: hash them once.
-    let b = Block::<N, M>::new(cell, [0.0; N], 1, p.randomness);
-    let mut v = [[0.0f32; M]; N];
-    let mut d = [0.0f32; M];
-    for t in 0..M {
+    let b = Block::<N, P>::new(cell, [0.0; N], 1, p.randomness);
+    let mut v = [[0.0f32; P]; N];
+    let mut d = [0.0f32; P];
+    for t in 0..P {
         let vt = sub(at(&b.point, t), local);
         d[t] = dot(vt, vt);
         for i in 0..N {
             v[i][t] = vt[i];
         }
     }
-    let closest = first_min(&d).map_or([0.0; N], |t| at(&v, t));
+    let closest = first_min(&d, b.m).map_or([0.0; N], |t| at(&v, t));
     // Distance to each bisector; cells too close to the nearest one give +inf, which
     // `min` passes over exactly as the skipped cell.
-    let mut e = [0.0f32; M];
+    let mut e = [0.0f32; P];
     for (t, e) in e.iter_mut().enumerate() {
         let vt = at(&v, t);
         let perp = sub(vt, closest);
@@ -419,30 +441,31 @@ where
             f32::INFINITY
         };
     }
-    e.iter().fold(f32::MAX, |m, &x| m.min(x))
+    e[..b.m].iter().fold(f32::MAX, |m, &x| m.min(x))
 }
 
-fn n_sphere_radius<const N: usize, const M: usize>(p: &VoronoiParams, coord: [f32; N]) -> f32
+fn n_sphere_radius<const N: usize, const P: usize>(p: &VoronoiParams, coord: [f32; N]) -> f32
 where
     D: Cell<N>,
 {
     let (cell, local) = split(coord);
-    let b = Block::<N, M>::new(cell, [0.0; N], 1, p.randomness);
-    let mut d = [0.0f32; M];
+    let b = Block::<N, P>::new(cell, [0.0; N], 1, p.randomness);
+    let mut d = [0.0f32; P];
     for (t, d) in d.iter_mut().enumerate() {
         *d = euclidean(at(&b.point, t), local);
     }
-    let (closest, closest_off) = first_min(&d).map_or(([0.0; N], [0.0; N]), |t| (at(&b.point, t), at(&b.off, t)));
+    let (closest, closest_off) = first_min(&d, b.m).map_or(([0.0; N], [0.0; N]), |t| (at(&b.point, t), at(&b.off, t)));
     // The cells around the closest one, except itself (the middle of the block).
-    let b2 = Block::<N, M>::new(cell, closest_off, 1, p.randomness);
+    let b2 = Block::<N, P>::new(cell, closest_off, 1, p.randomness);
     for (t, d) in d.iter_mut().enumerate() {
-        *d = if t == (M - 1) / 2 { f32::NAN } else { euclidean(closest, at(&b2.point, t)) };
+        *d = euclidean(closest, at(&b2.point, t));
     }
-    let next = first_min(&d).map_or([0.0; N], |t| at(&b2.point, t));
+    d[(b2.m - 1) / 2] = f32::NAN;
+    let next = first_min(&d, b2.m).map_or([0.0; N], |t| at(&b2.point, t));
     euclidean(next, closest) / 2.0
 }
 
-fn fractal_x_fx<const N: usize, const M3: usize, const M5: usize>(p: &VoronoiParams, coord: [f32; N]) -> Octave
+fn fractal_x_fx<const N: usize, const P3: usize, const P5: usize>(p: &VoronoiParams, coord: [f32; N]) -> Octave
 where
     D: Cell<N>,
 {
@@ -455,9 +478,9 @@ where
     while i as f32 <= p.detail.ceil() {
         let c = scale(coord, sc);
         let octave = match p.feature {
-            VoronoiFeature::F2 => f2::<N, M3>(p, c),
-            VoronoiFeature::SmoothF1 if p.smoothness != 0.0 => smooth_f1::<N, M5>(p, c),
-            _ => f1::<N, M3>(p, c),
+            VoronoiFeature::F2 => f2::<N, P3>(p, c),
+            VoronoiFeature::SmoothF1 if p.smoothness != 0.0 => smooth_f1::<N, P5>(p, c),
+            _ => f1::<N, P3>(p, c),
         };
         if zero_input {
             max_amplitude = 1.0;
@@ -491,7 +514,7 @@ where
     out
 }
 
-fn fractal_distance_to_edge<const N: usize, const M3: usize>(p: &VoronoiParams, coord: [f32; N]) -> f32
+fn fractal_distance_to_edge<const N: usize, const P3: usize>(p: &VoronoiParams, coord: [f32; N]) -> f32
 where
     D: Cell<N>,
 {
@@ -502,7 +525,7 @@ where
     let zero_input = p.detail == 0.0 || p.roughness == 0.0;
     let mut i = 0;
     while i as f32 <= p.detail.ceil() {
-        let od = distance_to_edge::<N, M3>(p, scale(coord, sc));
+        let od = distance_to_edge::<N, P3>(p, scale(coord, sc));
         if zero_input {
             distance = od;
             break;
@@ -549,22 +572,25 @@ impl VoronoiParams {
     }
 }
 
-/// `M3` = 3^N and `M5` = 5^N cells: the neighbourhoods of radius 1 and 2.
-fn run<const N: usize, const M3: usize, const M5: usize>(mut p: VoronoiParams, coord: [f32; N]) -> VoronoiOutput
+/// `P3` and `P5`: 3^N and 5^N cells (the neighbourhoods of radius 1 and 2) rounded up to
+/// a multiple of 8. Not inlined,
+/// so each dimension has a stack frame of its own size.
+#[inline(never)]
+fn run<const N: usize, const P3: usize, const P5: usize>(mut p: VoronoiParams, coord: [f32; N]) -> VoronoiOutput
 where
     D: Cell<N>,
 {
     match p.feature {
         VoronoiFeature::DistanceToEdge => {
             p.max_distance = 0.5 + 0.5 * p.randomness;
-            VoronoiOutput { distance: fractal_distance_to_edge::<N, M3>(&p, coord), ..Default::default() }
+            VoronoiOutput { distance: fractal_distance_to_edge::<N, P3>(&p, coord), ..Default::default() }
         }
-        VoronoiFeature::NSphereRadius => VoronoiOutput { radius: n_sphere_radius::<N, M3>(&p, coord), ..Default::default() },
+        VoronoiFeature::NSphereRadius => VoronoiOutput { radius: n_sphere_radius::<N, P3>(&p, coord), ..Default::default() },
         _ => {
             let f2_factor = if p.feature == VoronoiFeature::F2 { 2.0 } else { 1.0 };
             let half = 0.5 + 0.5 * p.randomness;
             p.max_distance = metric_distance([0.0; N], [half; N], &p) * f2_factor;
-            let o = fractal_x_fx::<N, M3, M5>(&p, coord);
+            let o = fractal_x_fx::<N, P3, P5>(&p, coord);
             VoronoiOutput { distance: o.distance, color: o.color, position: [o.position[0], o.position[1], o.position[2]], w: o.position[3], radius: 0.0 }
         }
     }
@@ -576,9 +602,9 @@ pub fn voronoi_texture(dimensions: u8, vector: Vec3, w: f32, p: VoronoiParams) -
     let v = vector.map(|x| x * p.scale);
     let w = w * p.scale;
     match dimensions {
-        1 => run::<1, 3, 5>(p, [w]),
-        2 => run::<2, 9, 25>(p, [v[0], v[1]]),
-        4 => run::<4, 81, 625>(p, [v[0], v[1], v[2], w]),
-        _ => run::<3, 27, 125>(p, v),
+        1 => run::<1, 8, 8>(p, [w]),
+        2 => run::<2, 16, 32>(p, [v[0], v[1]]),
+        4 => run::<4, 88, 632>(p, [v[0], v[1], v[2], w]),
+        _ => run::<3, 32, 128>(p, v),
     }
 }
