@@ -4,15 +4,16 @@
 //! Speed: these run for every cell a Voronoi texture visits (125 per Smooth F1 point in
 //! 3D), so they are forced inline: a loop over a block of cells then becomes one vector
 //! loop (8 cells per AVX2 instruction). The lookup3 core is therefore written here as
-//! `#[inline(always)]` functions of plain integers; it computes exactly what
+//! `#[inline(always)]` functions of plain integers (noise.rs uses them too); it computes exactly what
 //! `random::hash1..hash4` compute (tests/noise_speed.rs checks every output bit against
 //! the previous code). Hashes that share their inputs share work: `hash_float4_to_float`
 //! of (k, 1) and (k, 2) differ only after lookup3's `mix`, which runs once.
 
 use super::math::Vec3;
 
-/// Bob Jenkins' lookup3 (`final` and `mix`, the constants of Blender's `BLI_hash`).
-mod lookup3 {
+/// Bob Jenkins' lookup3 (`final` and `mix`, the constants of Blender's `BLI_hash`); the
+/// Perlin noise hashes its lattice corners with it too.
+pub(crate) mod lookup3 {
     const SEED: u32 = 0xdeadbeef;
 
     #[inline(always)]
