@@ -16,7 +16,7 @@
 //! bits. tests/noise_speed.rs checks every result against the previous code.
 
 use super::random::{hash_float_to_float1, hash_float_to_float2};
-use super::white_noise::lookup3::{hash1, hash2, hash3, hash4};
+use super::white_noise::lookup3::{hash1, hash2, hash3_x8, hash4};
 
 #[inline(always)]
 fn fade(t: f32) -> f32 {
@@ -119,12 +119,13 @@ fn corners3(p: [f32; 3]) -> ([f32; 8], [f32; 3]) {
     let (x, fx) = floor_fraction(p[0]);
     let (y, fy) = floor_fraction(p[1]);
     let (z, fz) = floor_fraction(p[2]);
-    let mut g = [0.0f32; 8];
-    for (i, g) in g.iter_mut().enumerate() {
-        let [dx, dy, dz] = [i & 1, i >> 1 & 1, i >> 2 & 1].map(|d| d as i32);
-        let h = hash3(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32, z.wrapping_add(dz) as u32);
-        *g = grad3(h, fx - dx as f32, fy - dy as f32, fz - dz as f32);
-    }
+    let d = |i: usize, bit: usize| (i >> bit & 1) as i32;
+    let h = hash3_x8(
+        std::array::from_fn(|i| x.wrapping_add(d(i, 0)) as u32),
+        std::array::from_fn(|i| y.wrapping_add(d(i, 1)) as u32),
+        std::array::from_fn(|i| z.wrapping_add(d(i, 2)) as u32),
+    );
+    let g = std::array::from_fn(|i| grad3(h[i], fx - d(i, 0) as f32, fy - d(i, 1) as f32, fz - d(i, 2) as f32));
     (g, [fx, fy, fz])
 }
 
