@@ -41,7 +41,7 @@ impl Rng {
             9 => self.range(-3e6, 3e6),
             10 => self.range(9e4, 1.1e5) * self.pick(&[1.0, -1.0]),
             11 => self.range(-1e-6, 1e-6),
-            12 => self.pick(&[0.0, -0.0, 1.0, -1.0, 0.5, 99999.5, 1e6, -1e6, 16777216.0]),
+            12 => self.pick(&[0.0, -0.0, 1.0, -1.0, 0.5, 99999.5, 1e5, -3e5, 1e6, -1e6, 16777215.0, 16777216.0]),
             13 => self.range(-1e9, 1e9),
             14 => f32::from_bits(self.u64() as u32),
             _ => self.pick(&[f32::INFINITY, f32::NEG_INFINITY, f32::NAN, f32::MIN_POSITIVE, 3.4e38]),

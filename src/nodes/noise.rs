@@ -221,12 +221,25 @@ fn wrap(v: f32) -> f32 {
     }
 }
 
-/// Out of line: LLVM treats `%` as free of side effects and would otherwise compute it
-/// on both branches.
-#[cold]
+/// `v % 100000` for |v| >= 100000, out of line (LLVM treats `%` as free of side effects
+/// and would otherwise compute it on both branches of `wrap`). Below 2^24 it is computed
+/// exactly in f64 instead of by the libm loop: the quotient's truncation is exact there
+/// (a float at least 1e5 in size is a multiple of 1e5 or at least 2^-7 away from one), so
+/// are the product and the difference, and the remainder fits an f32; fmod gives a zero
+/// the sign of v.
 #[inline(never)]
 fn fmod_period(v: f32) -> f32 {
-    v % 100000.0
+    if v.abs() < 16_777_216.0 {
+        let x = v as f64;
+        let r = x - (x / 100000.0).trunc() * 100000.0;
+        if r == 0.0 {
+            0.0f32.copysign(v)
+        } else {
+            r as f32
+        }
+    } else {
+        v % 100000.0
+    }
 }
 
 /// `p.distorted(strength)`, skipping the noise where it cannot change p: with strength

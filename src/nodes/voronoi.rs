@@ -224,26 +224,25 @@ where
         let side = 2 * r + 1;
         let m = side.pow(N as u32) as usize;
         debug_assert!(m <= P && P % 8 == 0);
-        let mut off = [[0.0f32; P]; N];
+        // Filled in place: building the arrays apart and moving them in costs a copy.
+        let mut b = Block { m, off: [[0.0f32; P]; N], jitter: [[0.0f32; P]; N], point: [[0.0f32; P]; N] };
         let mut stride = 1;
-        for (i, axis) in off.iter_mut().enumerate() {
+        for (i, axis) in b.off.iter_mut().enumerate() {
             for (t, o) in axis.iter_mut().enumerate().take(m) {
                 *o = base[i] + ((t as i32 / stride) % side - r) as f32;
             }
             stride *= side;
         }
-        let mut jitter = [[0.0f32; P]; N];
-        let mut point = [[0.0f32; P]; N];
         for t in 0..P {
-            let o = at(&off, t);
+            let o = at(&b.off, t);
             let j = D::jitter(add(cell, o));
             let q = add(o, scale(j, randomness));
             for i in 0..N {
-                jitter[i][t] = j[i];
-                point[i][t] = q[i];
+                b.jitter[i][t] = j[i];
+                b.point[i][t] = q[i];
             }
         }
-        Block { m, off, jitter, point }
+        b
     }
 
     /// `metric_distance(point, local)` of every cell.
