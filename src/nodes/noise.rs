@@ -47,6 +47,8 @@ fn grad2(hash: u32, x: f32, y: f32) -> f32 {
     negate_if(u, h & 1) + negate_if(v, h & 2)
 }
 
+/// The scalar gradient; AVX2 builds use `grad3_x8` instead.
+#[cfg_attr(all(target_arch = "x86_64", target_feature = "avx2"), allow(dead_code))]
 #[inline(always)]
 fn grad3(hash: u32, x: f32, y: f32, z: f32) -> f32 {
     let h = hash & 15;
@@ -54,6 +56,37 @@ fn grad3(hash: u32, x: f32, y: f32, z: f32) -> f32 {
     let vt = if h == 12 || h == 14 { x } else { z };
     let v = if h < 4 { y } else { vt };
     negate_if(u, h & 1) + negate_if(v, h & 2)
+}
+
+/// `grad3` of 8 corners at once: written out for AVX2, like the corner hashes, because
+/// the compiler unrolls the 8 corners and then moves each hash to a scalar register.
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+#[inline(always)]
+fn grad3_x8(hash: [u32; 8], x: [f32; 8], y: [f32; 8], z: [f32; 8]) -> [f32; 8] {
+    use std::arch::x86_64::*;
+    // SAFETY: AVX2 is enabled for the whole build (the cfg above); loads and stores are
+    // unaligned ones of whole 8-lane arrays.
+    unsafe {
+        let (x, y, z) = (_mm256_loadu_ps(x.as_ptr()), _mm256_loadu_ps(y.as_ptr()), _mm256_loadu_ps(z.as_ptr()));
+        let h = _mm256_and_si256(_mm256_loadu_si256(hash.as_ptr().cast()), _mm256_set1_epi32(15));
+        let is = |k: i32| _mm256_castsi256_ps(_mm256_cmpeq_epi32(h, _mm256_set1_epi32(k)));
+        let below = |k: i32| _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(k), h));
+        // blendv takes its second operand where the mask is set.
+        let u = _mm256_blendv_ps(y, x, below(8));
+        let vt = _mm256_blendv_ps(z, x, _mm256_or_ps(is(12), is(14)));
+        let v = _mm256_blendv_ps(vt, y, below(4));
+        // negate_if: flipping the sign bit is exactly negation.
+        let sign = |bit: i32, shift: i32| _mm256_castsi256_ps(_mm256_sllv_epi32(_mm256_and_si256(h, _mm256_set1_epi32(bit)), _mm256_set1_epi32(shift)));
+        let g = _mm256_add_ps(_mm256_xor_ps(u, sign(1, 31)), _mm256_xor_ps(v, sign(2, 30)));
+        let mut out = [0.0f32; 8];
+        _mm256_storeu_ps(out.as_mut_ptr(), g);
+        out
+    }
+}
+#[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+#[inline(always)]
+fn grad3_x8(hash: [u32; 8], x: [f32; 8], y: [f32; 8], z: [f32; 8]) -> [f32; 8] {
+    std::array::from_fn(|i| grad3(hash[i], x[i], y[i], z[i]))
 }
 
 #[inline(always)]
@@ -125,8 +158,8 @@ fn corners3(p: [f32; 3]) -> ([f32; 8], [f32; 3]) {
         std::array::from_fn(|i| y.wrapping_add(d(i, 1)) as u32),
         std::array::from_fn(|i| z.wrapping_add(d(i, 2)) as u32),
     );
-    let g = std::array::from_fn(|i| grad3(h[i], fx - d(i, 0) as f32, fy - d(i, 1) as f32, fz - d(i, 2) as f32));
-    (g, [fx, fy, fz])
+    let at = |f: f32, bit: usize| std::array::from_fn(|i| f - d(i, bit) as f32);
+    (grad3_x8(h, at(fx, 0), at(fy, 1), at(fz, 2)), [fx, fy, fz])
 }
 
 /// The gradients at the 16 corners of the 4D lattice cell of `p` (index bits 0-3: x, y,
