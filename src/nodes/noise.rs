@@ -8,15 +8,22 @@
 //! evaluated in double (their literals are doubles), everything else in single precision.
 //! Cycles' SVM kernel computes the same functions but `fade` in single precision (and with
 //! SSE/AVX variants), so its values may differ from these in the last bit.
+//!
+//! Speed: the 2^N lattice corners of a point are hashed and their gradients taken in one
+//! loop without dependencies between corners, which the compiler turns into AVX2
+//! vector code (8 corners per instruction); the period wrap skips `fmod` for the
+//! coordinates that do not need it; zero distortion is skipped where that gives the same
+//! bits. tests/noise_speed.rs checks every result against the previous code.
 
-use super::random::{hash1, hash2, hash3, hash4, hash_float_to_float1, hash_float_to_float2};
+use super::random::{hash_float_to_float1, hash_float_to_float2};
+use super::white_noise::lookup3::{hash1, hash2, hash3_x8, hash4};
 
-#[inline]
+#[inline(always)]
 fn fade(t: f32) -> f32 {
     ((t * t * t) as f64 * (t as f64 * (t as f64 * 6.0 - 15.0) + 10.0)) as f32
 }
 
-#[inline]
+#[inline(always)]
 fn negate_if(v: f32, cond: u32) -> f32 {
     if cond != 0 {
         -v
@@ -25,14 +32,14 @@ fn negate_if(v: f32, cond: u32) -> f32 {
     }
 }
 
-#[inline]
+#[inline(always)]
 fn grad1(hash: u32, x: f32) -> f32 {
     let h = hash & 15;
     let g = (1 + (h & 7)) as f32;
     negate_if(g, h & 8) * x
 }
 
-#[inline]
+#[inline(always)]
 fn grad2(hash: u32, x: f32, y: f32) -> f32 {
     let h = hash & 7;
     let u = if h < 4 { x } else { y };
@@ -40,7 +47,9 @@ fn grad2(hash: u32, x: f32, y: f32) -> f32 {
     negate_if(u, h & 1) + negate_if(v, h & 2)
 }
 
-#[inline]
+/// The scalar gradient; AVX2 builds use `grad3_x8` instead.
+#[cfg_attr(all(target_arch = "x86_64", target_feature = "avx2"), allow(dead_code))]
+#[inline(always)]
 fn grad3(hash: u32, x: f32, y: f32, z: f32) -> f32 {
     let h = hash & 15;
     let u = if h < 8 { x } else { y };
@@ -49,7 +58,38 @@ fn grad3(hash: u32, x: f32, y: f32, z: f32) -> f32 {
     negate_if(u, h & 1) + negate_if(v, h & 2)
 }
 
-#[inline]
+/// `grad3` of 8 corners at once: written out for AVX2, like the corner hashes, because
+/// the compiler unrolls the 8 corners and then moves each hash to a scalar register.
+#[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+#[inline(always)]
+fn grad3_x8(hash: [u32; 8], x: [f32; 8], y: [f32; 8], z: [f32; 8]) -> [f32; 8] {
+    use std::arch::x86_64::*;
+    // SAFETY: AVX2 is enabled for the whole build (the cfg above); loads and stores are
+    // unaligned ones of whole 8-lane arrays.
+    unsafe {
+        let (x, y, z) = (_mm256_loadu_ps(x.as_ptr()), _mm256_loadu_ps(y.as_ptr()), _mm256_loadu_ps(z.as_ptr()));
+        let h = _mm256_and_si256(_mm256_loadu_si256(hash.as_ptr().cast()), _mm256_set1_epi32(15));
+        let is = |k: i32| _mm256_castsi256_ps(_mm256_cmpeq_epi32(h, _mm256_set1_epi32(k)));
+        let below = |k: i32| _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(k), h));
+        // blendv takes its second operand where the mask is set.
+        let u = _mm256_blendv_ps(y, x, below(8));
+        let vt = _mm256_blendv_ps(z, x, _mm256_or_ps(is(12), is(14)));
+        let v = _mm256_blendv_ps(vt, y, below(4));
+        // negate_if: flipping the sign bit is exactly negation.
+        let sign = |bit: i32, shift: i32| _mm256_castsi256_ps(_mm256_sllv_epi32(_mm256_and_si256(h, _mm256_set1_epi32(bit)), _mm256_set1_epi32(shift)));
+        let g = _mm256_add_ps(_mm256_xor_ps(u, sign(1, 31)), _mm256_xor_ps(v, sign(2, 30)));
+        let mut out = [0.0f32; 8];
+        _mm256_storeu_ps(out.as_mut_ptr(), g);
+        out
+    }
+}
+#[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+#[inline(always)]
+fn grad3_x8(hash: [u32; 8], x: [f32; 8], y: [f32; 8], z: [f32; 8]) -> [f32; 8] {
+    std::array::from_fn(|i| grad3(hash[i], x[i], y[i], z[i]))
+}
+
+#[inline(always)]
 fn grad4(hash: u32, x: f32, y: f32, z: f32, w: f32) -> f32 {
     let h = hash & 31;
     let u = if h < 24 { x } else { y };
@@ -58,7 +98,7 @@ fn grad4(hash: u32, x: f32, y: f32, z: f32, w: f32) -> f32 {
     negate_if(u, h & 1) + negate_if(v, h & 2) + negate_if(s, h & 4)
 }
 
-#[inline]
+#[inline(always)]
 fn lerp(v0: f32, v1: f32, x: f32) -> f32 {
     (1.0 - x) * v0 + x * v1
 }
@@ -78,7 +118,7 @@ fn tri_mix(v: [f32; 8], x: f32, y: f32, z: f32) -> f32 {
     z1 * (y1 * (v[0] * x1 + v[1] * x) + y * (v[2] * x1 + v[3] * x)) + z * (y1 * (v[4] * x1 + v[5] * x) + y * (v[6] * x1 + v[7] * x))
 }
 
-#[inline]
+#[inline(always)]
 fn floor_fraction(x: f32) -> (i32, f32) {
     let f = x.floor();
     (f as i32, x - f)
@@ -105,39 +145,57 @@ fn perlin_noise2(p: [f32; 2]) -> f32 {
     )
 }
 
-fn perlin_noise3(p: [f32; 3]) -> f32 {
+/// The gradients at the 8 corners of the lattice cell of `p` (corner index bit 0: x + 1,
+/// bit 1: y + 1, bit 2: z + 1) and the position in the cell.
+#[inline(always)]
+fn corners3(p: [f32; 3]) -> ([f32; 8], [f32; 3]) {
     let (x, fx) = floor_fraction(p[0]);
     let (y, fy) = floor_fraction(p[1]);
     let (z, fz) = floor_fraction(p[2]);
-    let (u, v, w) = (fade(fx), fade(fy), fade(fz));
-    let g = |dx: i32, dy: i32, dz: i32| {
-        grad3(
-            hash3(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32, z.wrapping_add(dz) as u32),
-            fx - dx as f32,
-            fy - dy as f32,
-            fz - dz as f32,
-        )
-    };
-    tri_mix([g(0, 0, 0), g(1, 0, 0), g(0, 1, 0), g(1, 1, 0), g(0, 0, 1), g(1, 0, 1), g(0, 1, 1), g(1, 1, 1)], u, v, w)
+    let d = |i: usize, bit: usize| (i >> bit & 1) as i32;
+    let h = hash3_x8(
+        std::array::from_fn(|i| x.wrapping_add(d(i, 0)) as u32),
+        std::array::from_fn(|i| y.wrapping_add(d(i, 1)) as u32),
+        std::array::from_fn(|i| z.wrapping_add(d(i, 2)) as u32),
+    );
+    let at = |f: f32, bit: usize| std::array::from_fn(|i| f - d(i, bit) as f32);
+    (grad3_x8(h, at(fx, 0), at(fy, 1), at(fz, 2)), [fx, fy, fz])
 }
 
-fn perlin_noise4(p: [f32; 4]) -> f32 {
+/// The gradients at the 16 corners of the 4D lattice cell of `p` (index bits 0-3: x, y,
+/// z, w + 1) and the position in the cell.
+#[inline(always)]
+fn corners4(p: [f32; 4]) -> ([f32; 16], [f32; 4]) {
     let (x, fx) = floor_fraction(p[0]);
     let (y, fy) = floor_fraction(p[1]);
     let (z, fz) = floor_fraction(p[2]);
     let (w, fw) = floor_fraction(p[3]);
+    let mut g = [0.0f32; 16];
+    for (i, g) in g.iter_mut().enumerate() {
+        let [dx, dy, dz, dw] = [i & 1, i >> 1 & 1, i >> 2 & 1, i >> 3 & 1].map(|d| d as i32);
+        let h = hash4(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32, z.wrapping_add(dz) as u32, w.wrapping_add(dw) as u32);
+        *g = grad4(h, fx - dx as f32, fy - dy as f32, fz - dz as f32, fw - dw as f32);
+    }
+    (g, [fx, fy, fz, fw])
+}
+
+#[inline(always)]
+fn half(g: &[f32; 16], from: usize) -> [f32; 8] {
+    std::array::from_fn(|i| g[from + i])
+}
+
+#[inline(always)]
+fn perlin_noise3(p: [f32; 3]) -> f32 {
+    let (g, [fx, fy, fz]) = corners3(p);
+    tri_mix(g, fade(fx), fade(fy), fade(fz))
+}
+
+#[inline(always)]
+fn perlin_noise4(p: [f32; 4]) -> f32 {
+    let (g, [fx, fy, fz, fw]) = corners4(p);
     let (u, v, t, s) = (fade(fx), fade(fy), fade(fz), fade(fw));
-    let g = |dx: i32, dy: i32, dz: i32, dw: i32| {
-        grad4(
-            hash4(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32, z.wrapping_add(dz) as u32, w.wrapping_add(dw) as u32),
-            fx - dx as f32,
-            fy - dy as f32,
-            fz - dz as f32,
-            fw - dw as f32,
-        )
-    };
-    let a = tri_mix([g(0, 0, 0, 0), g(1, 0, 0, 0), g(0, 1, 0, 0), g(1, 1, 0, 0), g(0, 0, 1, 0), g(1, 0, 1, 0), g(0, 1, 1, 0), g(1, 1, 1, 0)], u, v, t);
-    let b = tri_mix([g(0, 0, 0, 1), g(1, 0, 0, 1), g(0, 1, 0, 1), g(1, 1, 0, 1), g(0, 0, 1, 1), g(1, 0, 1, 1), g(0, 1, 1, 1), g(1, 1, 1, 1)], u, v, t);
+    let a = tri_mix(half(&g, 0), u, v, t);
+    let b = tri_mix(half(&g, 8), u, v, t);
     lerp(a, b, s)
 }
 
@@ -154,6 +212,8 @@ pub trait NoisePoint: Copy {
     fn distorted(self, strength: f32) -> Self {
         self.plus(self.distortion(strength))
     }
+    /// Whether every component satisfies `f`.
+    fn all(self, f: impl Fn(f32) -> bool) -> bool;
     /// Whether `a * b + c` is one fused operation, as in Cycles' FMA-built CPU kernels
     /// (GCC contracts them); Blender's own CPU code is built without FMA.
     const FUSED: bool = false;
@@ -178,13 +238,59 @@ fn blend<P: NoisePoint>(a: f32, b: f32, t: f32) -> f32 {
     }
 }
 
+#[inline(always)]
 fn correction(v: f32) -> f32 {
     0.5 * (v.abs() >= 1_000_000.0) as u8 as f32
 }
 
+/// `v % 100000`, calling `fmod` only where it changes `v` (it returns any |v| < 100000,
+/// signed zeros included, unchanged).
+#[inline(always)]
+fn wrap(v: f32) -> f32 {
+    if v.abs() < 100000.0 {
+        v
+    } else {
+        fmod_period(v)
+    }
+}
+
+/// `v % 100000` for |v| >= 100000, out of line (LLVM treats `%` as free of side effects
+/// and would otherwise compute it on both branches of `wrap`). Below 2^24 it is computed
+/// exactly in f64 instead of by the libm loop: the quotient's truncation is exact there
+/// (a float at least 1e5 in size is a multiple of 1e5 or at least 2^-7 away from one), so
+/// are the product and the difference, and the remainder fits an f32; fmod gives a zero
+/// the sign of v.
+#[inline(never)]
+fn fmod_period(v: f32) -> f32 {
+    if v.abs() < 16_777_216.0 {
+        let x = v as f64;
+        let r = x - (x / 100000.0).trunc() * 100000.0;
+        if r == 0.0 {
+            0.0f32.copysign(v)
+        } else {
+            r as f32
+        }
+    } else {
+        v % 100000.0
+    }
+}
+
+/// `p.distorted(strength)`, skipping the noise where it cannot change p: with strength
+/// 0, p + noise * 0 is p when p is finite (then so is its noise) and not -0 (-0 + +0 is
+/// +0).
+#[inline(always)]
+fn distorted<P: NoisePoint>(p: P, strength: f32) -> P {
+    if strength == 0.0 && p.all(|x| x.is_finite() && x.to_bits() != (-0.0f32).to_bits()) {
+        p
+    } else {
+        p.distorted(strength)
+    }
+}
+
 impl NoisePoint for f32 {
+    #[inline]
     fn perlin_signed(self) -> f32 {
-        let p = self % 100000.0 + correction(self);
+        let p = wrap(self) + correction(self);
         perlin_noise1(p) * 0.25
     }
     fn scaled(self, s: f32) -> Self {
@@ -199,6 +305,9 @@ impl NoisePoint for f32 {
     fn distortion(self, strength: f32) -> Self {
         (self + Self::offset(0.0)).perlin_signed() * strength
     }
+    fn all(self, f: impl Fn(f32) -> bool) -> bool {
+        f(self)
+    }
 }
 
 fn offset_component(seed: f32, k: f32) -> f32 {
@@ -206,8 +315,12 @@ fn offset_component(seed: f32, k: f32) -> f32 {
 }
 
 impl NoisePoint for [f32; 2] {
+    fn all(self, f: impl Fn(f32) -> bool) -> bool {
+        self.iter().all(|&x| f(x))
+    }
+    #[inline]
     fn perlin_signed(self) -> f32 {
-        let p = [self[0] % 100000.0 + correction(self[0]), self[1] % 100000.0 + correction(self[1])];
+        let p = [wrap(self[0]) + correction(self[0]), wrap(self[1]) + correction(self[1])];
         perlin_noise2(p) * 0.6616
     }
     fn scaled(self, s: f32) -> Self {
@@ -225,12 +338,12 @@ impl NoisePoint for [f32; 2] {
 }
 
 impl NoisePoint for [f32; 3] {
+    fn all(self, f: impl Fn(f32) -> bool) -> bool {
+        self.iter().all(|&x| f(x))
+    }
+    #[inline]
     fn perlin_signed(self) -> f32 {
-        let p = [
-            self[0] % 100000.0 + correction(self[0]),
-            self[1] % 100000.0 + correction(self[1]),
-            self[2] % 100000.0 + correction(self[2]),
-        ];
+        let p = self.map(|v| wrap(v) + correction(v));
         perlin_noise3(p) * 0.9820
     }
     fn scaled(self, s: f32) -> Self {
@@ -252,11 +365,12 @@ impl NoisePoint for [f32; 3] {
 }
 
 impl NoisePoint for [f32; 4] {
+    fn all(self, f: impl Fn(f32) -> bool) -> bool {
+        self.iter().all(|&x| f(x))
+    }
+    #[inline]
     fn perlin_signed(self) -> f32 {
-        let mut p = [0.0; 4];
-        for i in 0..4 {
-            p[i] = self[i] % 100000.0 + correction(self[i]);
-        }
+        let p = self.map(|v| wrap(v) + correction(v));
         perlin_noise4(p) * 0.8344
     }
     fn scaled(self, s: f32) -> Self {
@@ -436,14 +550,14 @@ fn select<P: NoisePoint>(p: P, n: &NoiseParams) -> f32 {
 
 /// `perlin_fractal_distorted`: the Fac output.
 pub fn fractal_distorted<P: NoisePoint>(p: P, n: &NoiseParams) -> f32 {
-    let p = p.distorted(n.distortion);
+    let p = distorted(p, n.distortion);
     select(p, n)
 }
 
 /// `perlin_float3_fractal_distorted`: the Color output (its first channel is Fac). The
 /// seeds of the two extra channels depend on the dimension, as in Blender.
 pub fn fractal_distorted_color<P: NoisePoint>(p: P, n: &NoiseParams, seeds: [f32; 2]) -> [f32; 3] {
-    let p = p.distorted(n.distortion);
+    let p = distorted(p, n.distortion);
     [select(p, n), select(p.plus(P::offset(seeds[0])), n), select(p.plus(P::offset(seeds[1])), n)]
 }
 
@@ -484,12 +598,12 @@ pub fn noise_texture(dimensions: u8, vector: [f32; 3], w: f32, scale: f32, param
 // these rounding differences grow past 1e-4, so shaders use this flavour; Geometry
 // Nodes keep Blender's CPU version above.
 
-#[inline]
+#[inline(always)]
 fn cy_mix(a: f32, b: f32, t: f32) -> f32 {
     t.mul_add(b - a, a)
 }
 
-#[inline]
+#[inline(always)]
 fn cy_fade(t: f32) -> f32 {
     let a = t.mul_add(6.0, -15.0);
     let b = t.mul_add(a, 10.0);
@@ -503,7 +617,7 @@ fn cy_perlin1(p: f32) -> f32 {
 }
 
 /// The scalar 1D kernel's fade: `t * t * t * (t * (t * 6 - 15) + 10)`.
-#[inline]
+#[inline(always)]
 fn t_fade1(t: f32) -> f32 {
     t * t * t * t.mul_add(t.mul_add(6.0, -15.0), 10.0)
 }
@@ -519,48 +633,27 @@ fn cy_perlin2(p: [f32; 2]) -> f32 {
 }
 
 /// Gradients at the 8 corners (index bit 0: x, bit 1: y, bit 2: z) blended x, y, z.
-#[inline]
-fn cy_tri(g: impl Fn(i32, i32, i32) -> f32, u: f32, v: f32, w: f32) -> f32 {
-    let x00 = cy_mix(g(0, 0, 0), g(1, 0, 0), u);
-    let x10 = cy_mix(g(0, 1, 0), g(1, 1, 0), u);
-    let x01 = cy_mix(g(0, 0, 1), g(1, 0, 1), u);
-    let x11 = cy_mix(g(0, 1, 1), g(1, 1, 1), u);
+#[inline(always)]
+fn cy_tri(g: [f32; 8], u: f32, v: f32, w: f32) -> f32 {
+    let x00 = cy_mix(g[0], g[1], u);
+    let x10 = cy_mix(g[2], g[3], u);
+    let x01 = cy_mix(g[4], g[5], u);
+    let x11 = cy_mix(g[6], g[7], u);
     cy_mix(cy_mix(x00, x10, v), cy_mix(x01, x11, v), w)
 }
 
+#[inline(always)]
 fn cy_perlin3(p: [f32; 3]) -> f32 {
-    let (x, fx) = floor_fraction(p[0]);
-    let (y, fy) = floor_fraction(p[1]);
-    let (z, fz) = floor_fraction(p[2]);
-    let g = |dx: i32, dy: i32, dz: i32| {
-        grad3(
-            hash3(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32, z.wrapping_add(dz) as u32),
-            fx - dx as f32,
-            fy - dy as f32,
-            fz - dz as f32,
-        )
-    };
+    let (g, [fx, fy, fz]) = corners3(p);
     cy_tri(g, cy_fade(fx), cy_fade(fy), cy_fade(fz))
 }
 
+#[inline(always)]
 fn cy_perlin4(p: [f32; 4]) -> f32 {
-    let (x, fx) = floor_fraction(p[0]);
-    let (y, fy) = floor_fraction(p[1]);
-    let (z, fz) = floor_fraction(p[2]);
-    let (w, fw) = floor_fraction(p[3]);
+    let (g, [fx, fy, fz, fw]) = corners4(p);
     let s = cy_fade(fw);
-    let g = |dx: i32, dy: i32, dz: i32| {
-        let at = |dw: i32| {
-            grad4(
-                hash4(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32, z.wrapping_add(dz) as u32, w.wrapping_add(dw) as u32),
-                fx - dx as f32,
-                fy - dy as f32,
-                fz - dz as f32,
-                fw - dw as f32,
-            )
-        };
-        cy_mix(at(0), at(1), s)
-    };
+    // w first (Cycles' SSE order), then x, y, z.
+    let g: [f32; 8] = std::array::from_fn(|i| cy_mix(g[i], g[i + 8], s));
     cy_tri(g, cy_fade(fx), cy_fade(fy), cy_fade(fz))
 }
 
@@ -571,6 +664,10 @@ pub struct Cycles<P>(pub P);
 macro_rules! cycles_point {
     ($t:ty, $perlin:ident, $scale:expr) => {
         impl NoisePoint for Cycles<$t> {
+            fn all(self, f: impl Fn(f32) -> bool) -> bool {
+                self.0.all_c(f)
+            }
+            #[inline]
             fn perlin_signed(self) -> f32 {
                 // Repeats every 100000 with Blender's half-cell shift beyond 1e6.
                 let p = cycles_fmod(self.0);
@@ -612,11 +709,17 @@ macro_rules! cycles_point {
 
 trait Comps: Copy {
     fn map_c(self, f: impl Fn(f32) -> f32) -> Self;
+    fn all_c(self, f: impl Fn(f32) -> bool) -> bool;
     fn set_c(&mut self, i: usize, v: f32);
     fn first_c(self) -> f32;
 }
 impl Comps for f32 {
+    #[inline(always)]
     fn map_c(self, f: impl Fn(f32) -> f32) -> Self {
+        f(self)
+    }
+    #[inline(always)]
+    fn all_c(self, f: impl Fn(f32) -> bool) -> bool {
         f(self)
     }
     fn set_c(&mut self, _: usize, v: f32) {
@@ -627,8 +730,13 @@ impl Comps for f32 {
     }
 }
 impl<const N: usize> Comps for [f32; N] {
+    #[inline(always)]
     fn map_c(self, f: impl Fn(f32) -> f32) -> Self {
         self.map(f)
+    }
+    #[inline(always)]
+    fn all_c(self, f: impl Fn(f32) -> bool) -> bool {
+        self.iter().all(|&x| f(x))
     }
     fn set_c(&mut self, i: usize, v: f32) {
         self[i] = v;
@@ -637,8 +745,9 @@ impl<const N: usize> Comps for [f32; N] {
         self[0]
     }
 }
+#[inline(always)]
 fn cycles_fmod<T: Comps>(p: T) -> T {
-    p.map_c(|x| x % 100000.0 + correction(x))
+    p.map_c(|x| wrap(x) + correction(x))
 }
 fn get<T: Comps>(p: T) -> f32 {
     p.first_c()
