@@ -192,6 +192,8 @@ fn noise_texture_matches_the_old_code_in_both_flavours() {
         let (f, c) = noise::noise_texture_cycles(dims, v, w, scale, params);
         let (of, oc) = old::noise::noise_texture_cycles(dims, v, w, scale, params);
         check("noise_texture_cycles", &[f, c[0], c[1], c[2]], &[of, oc[0], oc[1], oc[2]], &(dims, v, w, scale, params));
+        // Fac alone (Color unlinked) is the same bits as the full node's Fac.
+        check("noise_texture_cycles_fac", &[noise::noise_texture_cycles_fac(dims, v, w, scale, params)], &[of], &(dims, v, w, scale, params));
         let want_color = r.u64() % 2 == 0;
         let (f, c) = noise::noise_texture(dims, v, w, scale, params, want_color);
         let (of, oc) = old::noise::noise_texture(dims, v, w, scale, params, want_color);

@@ -777,3 +777,19 @@ pub fn noise_texture_cycles(dimensions: u8, vector: [f32; 3], w: f32, scale: f32
     };
     (c[0], c)
 }
+
+/// `noise_texture_cycles` when only Fac is read: the same bits as its Fac, without the
+/// Color output's two extra fractals (Cycles skips them too when Color is unlinked).
+pub fn noise_texture_cycles_fac(dimensions: u8, vector: [f32; 3], w: f32, scale: f32, params: NoiseParams) -> f32 {
+    let mut n = params;
+    n.detail = n.detail.clamp(0.0, 15.0);
+    n.roughness = n.roughness.max(0.0);
+    let v = [vector[0] * scale, vector[1] * scale, vector[2] * scale];
+    let ws = w * scale;
+    match dimensions {
+        1 => fractal_distorted(Cycles(ws), &n),
+        2 => fractal_distorted(Cycles([v[0], v[1]]), &n),
+        4 => fractal_distorted(Cycles([v[0], v[1], v[2], ws]), &n),
+        _ => fractal_distorted(Cycles(v), &n),
+    }
+}

@@ -538,7 +538,9 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     let ids = ["Scale", "Detail", "Roughness", "Lacunarity", "Offset", "Gain", "Distortion"];
                     let args = self.inputs_n(n, ids, F)?;
                     let (fac, color) = (self.alloc(F), self.alloc(C));
-                    self.ops.push(Op::TexNoise { dims, kind, normalize, vector, w, args, fac, color });
+                    // Without a link from Color only Fac is computed (as Cycles does).
+                    let want_color = self.output_used(i, "Color");
+                    self.ops.push(Op::TexNoise { dims, kind, normalize, vector, w, args, fac, color, want_color });
                     self.outputs(i, n, &[("Fac", fac, F), ("Color", color, C)]);
                 }
                 "ShaderNodeTexVoronoi" => {

@@ -15,7 +15,7 @@ use crate::nodes::checker::checker_texture;
 use crate::nodes::gradient::{gradient, GradientType};
 use crate::nodes::magic::magic;
 use crate::nodes::mapping::{mapping, MappingType};
-use crate::nodes::noise::{noise_texture_cycles, NoiseParams, NoiseType};
+use crate::nodes::noise::{noise_texture_cycles, noise_texture_cycles_fac, NoiseParams, NoiseType};
 use crate::nodes::voronoi::{voronoi_texture, VoronoiFeature, VoronoiMetric, VoronoiParams};
 use crate::nodes::wave::{wave, WaveSettings};
 use crate::nodes::white_noise::white_noise;
@@ -86,7 +86,7 @@ pub enum Op {
     /// World-space position (unlinked White Noise vectors).
     Position { dst: Slot },
     /// Textures: inputs in socket order after Vector; outputs Fac/Distance first.
-    TexNoise { dims: u8, kind: NoiseType, normalize: bool, vector: Slot, w: Slot, args: [Slot; 7], fac: Slot, color: Slot },
+    TexNoise { dims: u8, kind: NoiseType, normalize: bool, vector: Slot, w: Slot, args: [Slot; 7], fac: Slot, color: Slot, want_color: bool },
     TexVoronoi { dims: u8, feature: VoronoiFeature, metric: VoronoiMetric, normalize: bool, vector: Slot, w: Slot, args: [Slot; 7], distance: Slot, color: Slot, position: Slot, w_out: Slot, radius: Slot },
     TexWave { settings: WaveSettings, vector: Slot, args: [Slot; 6], fac: Slot, color: Slot },
     TexGradient { kind: GradientType, vector: Slot, fac: Slot, color: Slot },
@@ -374,12 +374,16 @@ impl Program {
                     put3(s, dst, r)
                 }
                 Op::Position { dst } => put3(s, dst, sp.position),
-                Op::TexNoise { dims, kind, normalize, vector, w, args, fac, color } => {
+                Op::TexNoise { dims, kind, normalize, vector, w, args, fac, color, want_color } => {
                     let a = args.map(|i| s[i as usize]);
                     let params = NoiseParams { kind, normalize, detail: a[1], roughness: a[2], lacunarity: a[3], offset: a[4], gain: a[5], distortion: a[6] };
-                    let (f, c) = noise_texture_cycles(dims, v3(s, vector), s[w as usize], a[0], params);
-                    s[fac as usize] = f;
-                    put3(s, color, c);
+                    if want_color {
+                        let (f, c) = noise_texture_cycles(dims, v3(s, vector), s[w as usize], a[0], params);
+                        s[fac as usize] = f;
+                        put3(s, color, c);
+                    } else {
+                        s[fac as usize] = noise_texture_cycles_fac(dims, v3(s, vector), s[w as usize], a[0], params);
+                    }
                 }
                 Op::TexVoronoi { dims, feature, metric, normalize, vector, w, args, distance, color, position, w_out, radius } => {
                     let a = args.map(|i| s[i as usize]);
