@@ -285,14 +285,14 @@ fn adaptive_sampling_is_deterministic_and_stops_early() {
 /// two seeds against blendsynth (fixtures/render/make_published_refs.py; everything is
 /// written to a temporary folder).
 ///
-/// Known failure, channel means: blendsynth's image is darker (about half of Cycles' mean
-/// on 2026-11-23). Measured causes, by Cycles renders of edited copies at 64x64: Fat.001
-/// uses displacement method "Displacement and Bump", and true displacement is not done
-/// (fixtures/render/colon_variants.py: Cycles' own render of the file with "Bump Only" is 27-32% darker than with it, and
-/// blendsynth matches that bump-only render within 6% on red and green with subsurface
-/// off); with subsurface on, the Burley disk projection on this open tube gives less
-/// light than Cycles' (not yet explained). So the RMSE ratio is asserted and the means
-/// are bounded to the measured deficit, so that any other regression fails.
+/// Known failure, channel means: blendsynth's image is 3-4% darker than Cycles' (measured
+/// 2026-11-23 against 32-sample references: frame 50 ours 0.241/0.288/0.154 vs Cycles
+/// 0.250/0.294/0.159, frame 11595 0.178/0.220/0.108 vs 0.185/0.224/0.111; it was about
+/// half before true displacement, bump map correction, the bump shadowing term, the
+/// BSSRDF exit normal and the per-direction spot cone). Edited copies of the scene
+/// (fixtures/render/colon_variants.py) show the rest is in indirect light on the strongly
+/// bumped walls (one bounce gives less than Cycles'). So the RMSE ratio is asserted and
+/// the means are bounded to 0.92..1.04 of Cycles', so that any regression fails.
 #[test]
 fn published_colon_parity() {
     let Some(py) = common::require("a Python with bpy 4.5.4", common::bpy_python()) else { return };
@@ -316,8 +316,8 @@ fn published_colon_parity() {
         }
         for c in 0..3 {
             let q = r.ours[c] / r.cycles[c];
-            if !(0.3..=1.0 + MAX_MEAN_REL).contains(&q) {
-                failures.push(format!("{f}: channel {c} mean is {q:.3} of Cycles' (known deficit bounded to 0.3..1.01)"));
+            if !(0.92..=1.04).contains(&q) {
+                failures.push(format!("{f}: channel {c} mean is {q:.3} of Cycles' (known deficit bounded to 0.92..1.04)"));
             }
         }
         if r.worst_mean <= MAX_MEAN_REL {
