@@ -37,6 +37,25 @@ pub struct MeshInstance {
     pub undisplaced: Option<Arc<Vec<V3>>>,
 }
 
+impl MeshInstance {
+    /// Texture Coordinate > Generated of object-space point `local`: 0..1 over the
+    /// instance's texture space.
+    pub fn generated(&self, local: V3) -> V3 {
+        [0, 1, 2].map(|k| (local[k] - self.tex_loc[k]) / (2.0 * self.tex_size[k]) + 0.5)
+    }
+}
+
+/// World-space bounds of `positions` placed by `to_world`.
+pub fn world_bounds(positions: &[V3], to_world: &Affine) -> (V3, V3) {
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for p in positions {
+        let w = to_world.point(*p);
+        lo = vmin(lo, w);
+        hi = vmax(hi, w);
+    }
+    (lo, hi)
+}
+
 /// Per triangle: which instance and which of its mesh's triangles.
 #[derive(Debug, Clone, Copy)]
 pub struct TriRef {
@@ -193,14 +212,11 @@ fn push_instance(
     });
     let to_object = to_world.inverse().ok_or_else(|| RenderError(format!("object {:?} has a singular transform", obj.name)))?;
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    let (mut wlo, mut whi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for p in &mesh.positions {
         lo = vmin(lo, *p);
         hi = vmax(hi, *p);
-        let w = to_world.point(*p);
-        wlo = vmin(wlo, w);
-        whi = vmax(whi, w);
     }
+    let (wlo, whi) = world_bounds(&mesh.positions, &to_world);
     // The exported texture space for plain meshes; the bounds for generated geometry.
     let (tex_loc, tex_size) = match (info.texspace_location, info.texspace_size, exported_texspace) {
         (Some(l), Some(s), true) => (l.map(|x| x as f32), s.map(|x| x as f32)),

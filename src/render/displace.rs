@@ -40,13 +40,7 @@ pub fn apply(geo: &mut Geometry, materials: &[Material]) -> usize {
         let (mesh, undisplaced) = done[&key].clone();
         inst.mesh = mesh;
         inst.undisplaced = Some(undisplaced);
-        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-        for p in &inst.mesh.positions {
-            let w = inst.to_world.point(*p);
-            lo = vmin(lo, w);
-            hi = vmax(hi, w);
-        }
-        inst.world_bounds = (lo, hi);
+        inst.world_bounds = super::build::world_bounds(&inst.mesh.positions, &inst.to_world);
     }
     moved
 }
@@ -126,7 +120,7 @@ fn vertex_point(inst: &MeshInstance, vertex_normals: &[V3], transform: ObjectTra
     sp.normal = n;
     sp.object_position = local;
     sp.object_normal = n_obj;
-    sp.generated = [0, 1, 2].map(|a| (local[a] - inst.tex_loc[a]) / (2.0 * inst.tex_size[a]) + 0.5);
+    sp.generated = inst.generated(local);
     if let Some(uv) = &inst.uv {
         let c = tri[k] as usize;
         sp.uv = [uv[c][0], uv[c][1], 0.0];

@@ -181,7 +181,7 @@ impl Scene<'_> {
             add(add(scale(up[0], w0), scale(up[1], u)), scale(up[2], v))
         });
         let orco = before.unwrap_or(local);
-        sp.generated = [0, 1, 2].map(|k| (orco[k] - inst.tex_loc[k]) / (2.0 * inst.tex_size[k]) + 0.5);
+        sp.generated = inst.generated(orco);
         if let Some(b) = before {
             sp.undisplaced = Some(Undisplaced { position: to_world.point(b), object_position: b, ..Undisplaced::default() });
         }
@@ -630,7 +630,7 @@ impl Scene<'_> {
             und.dp_dx = attribute_differential(w, d[0]);
             und.dp_dy = attribute_differential(w, d[1]);
         }
-        let generated = lp.map(|l| [0, 1, 2].map(|k| (l[k] - inst.tex_loc[k]) / (2.0 * inst.tex_size[k]) + 0.5));
+        let generated = lp.map(|l| inst.generated(l));
         sp.generated_dx = attribute_differential(generated, d[0]);
         sp.generated_dy = attribute_differential(generated, d[1]);
         if let Some(uv) = &inst.uv {
