@@ -310,12 +310,8 @@ pub fn denoise_render(denoiser: &Denoiser, scene: &crate::scene::Scene, frame: f
     let mats = crate::anim::evaluate_transforms(scene, frame).map_err(|e| DenoiseError::Input(format!("camera at frame {frame}: {e}")))?;
     let cam = mats[idx];
     let p = &out.passes;
-    let normal: Vec<[f32; 3]> = p
-        .denoise_normal
-        .iter()
-        .zip(&p.instance_id)
-        .map(|(n, &id)| if id == 0 { [0.0; 3] } else { cycles_denoise_normal(*n, &cam) })
-        .collect();
+    // The guide is already zero where every sample saw the background.
+    let normal: Vec<[f32; 3]> = p.denoise_normal.iter().map(|n| cycles_denoise_normal(*n, &cam)).collect();
     denoiser.denoise_with(out.width, out.height, &mut out.color, &p.albedo, &normal, &DenoiseOptions::from_scene(scene))
 }
 

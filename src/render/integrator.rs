@@ -87,11 +87,13 @@ pub struct Scratch {
     /// The camera ray's shutter time in [0, 1], shared by every ray of its path (set by
     /// the caller before `radiance`, like the differentials).
     pub time: f32,
+    /// The denoiser's guides of the sample `radiance` last traced.
+    pub features: super::denoise_features::Features,
 }
 
 impl Scratch {
     pub fn new(n_materials: usize) -> Scratch {
-        Scratch { stacks: vec![Vec::new(); n_materials + 1], lobes: LobeSet::default(), light_lobes: LobeSet::default(), rays: 0, ray_dp: 0.0, ray_dd: 0.0, time: super::object_motion::CENTRE_TIME }
+        Scratch { stacks: vec![Vec::new(); n_materials + 1], lobes: LobeSet::default(), light_lobes: LobeSet::default(), rays: 0, ray_dp: 0.0, ray_dd: 0.0, time: super::object_motion::CENTRE_TIME, features: Default::default() }
     }
 }
 
@@ -226,6 +228,7 @@ impl Scene<'_> {
         let st = &self.settings;
         let mut l = [0.0f32; 3];
         let mut throughput = [1.0f32; 3];
+        scratch.features = Default::default();
         let (mut o, mut d, mut t0, mut t1) = (org, dir, tmin, tmax);
         let (mut bounce, mut diffuse, mut glossy, mut transmission, mut transparent) = (0u32, 0u32, 0u32, 0u32, 0u32);
         let mut terminate_next = false;
@@ -270,6 +273,7 @@ impl Scene<'_> {
                         // Light sampling alone covered this lamp at that vertex.
                         continue;
                     };
+                    scratch.features.add_emission(scale(mul(throughput, lh.radiance), w));
                     let c = clamp_contrib(scale(mul(throughput, lh.radiance), w), clamp_limit);
                     if finite(c) {
                         l = add(l, c);
@@ -278,7 +282,9 @@ impl Scene<'_> {
             }
             let Some(h) = hit_opt else {
                 let w = self.world_mis_weight(d, prev_singular, prev_pdf);
-                let c = clamp_contrib(scale(mul(throughput, self.background_toward(d, scratch)), w), clamp_limit);
+                let bg = scale(mul(throughput, self.background_toward(d, scratch)), w);
+                scratch.features.add_emission(bg);
+                let c = clamp_contrib(bg, clamp_limit);
                 if finite(c) {
                     l = add(l, c);
                 }
@@ -345,10 +351,16 @@ impl Scene<'_> {
                     let cos_l = dot(hit.ng, wo).abs().max(1e-8);
                     power_heuristic(prev_pdf, pa * h.t * h.t / cos_l)
                 };
+                scratch.features.add_emission(scale(mul(throughput, lobes.emission), w));
                 let c = clamp_contrib(scale(mul(throughput, lobes.emission), w), clamp_limit);
                 if finite(c) {
                     l = add(l, c);
                 }
+            }
+            // A subsurface exit is not a surface the camera path saw (Cycles writes no
+            // guides there).
+            if from_sss.is_none() {
+                scratch.features.surface(lobes);
             }
             let u_bsdf = rng.get4(index, set);
             let u_light = rng.get4(index, set + 1);

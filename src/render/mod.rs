@@ -17,6 +17,7 @@ pub mod bsdf;
 pub mod build;
 pub mod bump_correction;
 pub mod camera;
+pub mod denoise_features;
 pub mod displace;
 pub mod filter;
 pub mod integrator;
@@ -95,6 +96,9 @@ pub struct Passes {
     pub instance_id: Vec<u32>,
     pub material_index: Vec<u32>,
     pub normal: Vec<[f32; 3]>,
+    /// The denoiser's guides, averaged over each pixel's samples as Cycles' "Denoising
+    /// Albedo" and "Denoising Normal" passes are (`denoise_features`); the normal in world
+    /// space (the denoiser turns it into Cycles' camera space).
     pub albedo: Vec<[f32; 3]>,
     pub denoise_normal: Vec<[f32; 3]>,
     pub uv: Vec<[f32; 2]>,
@@ -291,6 +295,9 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
                                 (scratch.ray_dp, scratch.ray_dd) = camera.ray_differentials(fx, fy, [u[2], u[3]]);
                                 let c = tracer.radiance(o, d, t0, t1, &rng, i, scratch);
                                 px.add(i, c);
+                                let f = &scratch.features;
+                                tile.passes.feature_normal[k - 1] = add(tile.passes.feature_normal[k - 1], f.normal);
+                                tile.passes.feature_albedo[k - 1] = add(tile.passes.feature_albedo[k - 1], f.albedo);
                             }
                         }
                     }
@@ -363,8 +370,10 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
                 passes.instance_id[i] = p.instance_id[k];
                 passes.material_index[i] = p.material_index[k];
                 passes.normal[i] = p.normal[k];
-                passes.albedo[i] = p.albedo[k];
-                passes.denoise_normal[i] = p.normal[k];
+                // The guides average the pixel's samples, as Cycles' passes do.
+                let inv = 1.0 / passes.sample_count[i].max(1) as f32;
+                passes.albedo[i] = scale(p.feature_albedo[k], inv);
+                passes.denoise_normal[i] = scale(p.feature_normal[k], inv);
                 passes.uv[i] = p.uv[k];
                 k += 1;
             }
@@ -471,14 +480,18 @@ struct TilePasses {
     instance_id: Vec<u32>,
     material_index: Vec<u32>,
     normal: Vec<[f32; 3]>,
-    albedo: Vec<[f32; 3]>,
     uv: Vec<[f32; 2]>,
+    /// Sums over the pixel's samples of the denoiser's guides (`denoise_features`).
+    feature_normal: Vec<[f32; 3]>,
+    feature_albedo: Vec<[f32; 3]>,
 }
 
 /// Label passes from the primary ray through the pixel centre (exact ids, unfiltered), at
 /// the shutter's centre: with motion blur the labels show moving objects where the scene
 /// was synced (the frame for a centred shutter), sharp, not blurred as in the image.
 fn primary_passes(tracer: &integrator::Scene, camera: &camera::Camera, x: u32, y: u32, scratch: &mut Scratch, out: &mut TilePasses) {
+    out.feature_normal.push([0.0; 3]);
+    out.feature_albedo.push([0.0; 3]);
     let (o, d, t0, t1) = camera.ray(x as f32 + 0.5, y as f32 + 0.5, [0.5, 0.5]);
     match tracer.accel.intersect(o, d, t0, t1) {
         Some(h) => {
@@ -491,7 +504,6 @@ fn primary_passes(tracer: &integrator::Scene, camera: &camera::Camera, x: u32, y
             out.instance_id.push(hit.inst + 1);
             out.material_index.push(hit.material.map(|m| m as u32 + 1).unwrap_or(0));
             out.normal.push(hit.sp.normal);
-            out.albedo.push(scratch.lobes.albedo());
             out.uv.push([hit.sp.uv[0], hit.sp.uv[1]]);
         }
         None => {
@@ -500,7 +512,6 @@ fn primary_passes(tracer: &integrator::Scene, camera: &camera::Camera, x: u32, y
             out.instance_id.push(0);
             out.material_index.push(0);
             out.normal.push([0.0; 3]);
-            out.albedo.push(tracer.background_toward(d, scratch).map(|c| c.clamp(0.0, 1.0)));
             out.uv.push([0.0; 2]);
         }
     }
