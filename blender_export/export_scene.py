@@ -517,6 +517,10 @@ def object_entry(o, view_layer):
         "hide_render": o.hide_render, "hide_viewport": o.hide_viewport,
         "visible": o.visible_get(view_layer=view_layer) if view_layer.objects.get(o.name) else False,
         "pass_index": o.pass_index, "collections": [c.name for c in o.users_collection],
+        # Cycles' ray visibility (Object > Visibility > Ray Visibility); light objects
+        # default to hidden from the camera in Blender 4.x.
+        "visibility": {k: getattr(o, "visible_" + k) for k in ("camera", "diffuse", "glossy", "transmission", "volume_scatter", "shadow")},
+        "is_holdout": o.is_holdout, "is_shadow_catcher": o.is_shadow_catcher,
         "color": vec(o.color),
         "material_slots": [{"material": s.material.name if s.material else None, "link": s.link} for s in o.material_slots],
         "modifiers": [modifier_entry(m, f"{w}.modifiers[{q(m.name)}]") for m in o.modifiers],

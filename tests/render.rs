@@ -46,6 +46,7 @@ const ASSERTED: &[&str] = &[
     // (Soft Falloff's facing disk, and the sphere light with it off).
     "spot_radius",
     "spot_sphere",
+    "light_visibility",
 ];
 
 /// Scenes that do not pass yet, with the reason.
@@ -403,4 +404,29 @@ fn emission_estimate_follows_cycles() {
         assert!((got - want).abs() < 1e-5, "Glow estimate {glow:?}");
     }
     assert_eq!(program("principled", "Plastic").emission_estimate, [0.0; 3]);
+}
+
+#[test]
+fn light_ray_visibility_follows_cycles() {
+    // Scene light_visibility (asserted in parity_with_cycles) with every light made
+    // visible to every ray: the point light in view appears, the panel lights diffuse
+    // closures and the key light gets a highlight, so the image is far from Cycles'.
+    // This tells the visibility flags from none.
+    let dir = common::repo().join("fixtures/render/scenes/light_visibility");
+    let mut scene = Scene::load(&dir).unwrap();
+    let mut hidden = 0;
+    for o in &mut scene.file.objects {
+        if let Some(v) = &mut o.visibility {
+            hidden += [v.camera, v.diffuse, v.glossy].iter().filter(|x| !**x).count();
+            (v.camera, v.diffuse, v.glossy) = (true, true, true);
+        }
+    }
+    assert!(hidden >= 3, "the export should carry the lights' ray visibility");
+    let opts = RenderOptions { samples: Some(64), resolution: Some((128, 128)), seed: Some(0), ..Default::default() };
+    let all: Vec<[f32; 3]> = render(&scene, &opts).unwrap().color.iter().map(|p| [p[0], p[1], p[2]]).collect();
+    let a = read_exr(&dir.join("cycles_a.exr"));
+    let b = read_exr(&dir.join("cycles_b.exr"));
+    let ratio = rmse(&all, &a) / rmse(&b, &a);
+    println!("light_visibility with every light visible to every ray: ratio {ratio:.3}");
+    assert!(ratio > 3.0, "ignoring ray visibility gives ratio {ratio:.3}, too close to Cycles for the test to tell");
 }

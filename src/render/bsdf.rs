@@ -90,6 +90,21 @@ impl Default for LobeSet {
     }
 }
 
+/// Whether a light hidden from these ray types (`ray::` flags) skips this closure in
+/// next-event estimation: Cycles' diffuse range (diffuse, Oren-Nayar, sheen,
+/// translucent), glossy range (microfacet reflection) and transmission range
+/// (translucent, refraction and glass).
+fn excluded(kind: &LobeKind, exclude: u32) -> bool {
+    use crate::shader::point::ray;
+    match kind {
+        LobeKind::Diffuse | LobeKind::OrenNayar(_) | LobeKind::Sheen(_) | LobeKind::Velvet(_) => exclude & ray::DIFFUSE != 0,
+        LobeKind::Translucent => exclude & (ray::DIFFUSE | ray::TRANSMIT) != 0,
+        LobeKind::Glossy { .. } | LobeKind::Reflection(_) | LobeKind::GlossyAniso { .. } => exclude & ray::GLOSSY != 0,
+        LobeKind::Glass(_) => exclude & ray::TRANSMIT != 0,
+        LobeKind::Transparent | LobeKind::Subsurface(_) => false,
+    }
+}
+
 /// Singular (mirror) below this alpha, as Cycles treats very low roughness.
 const SINGULAR_ALPHA: f32 = 1e-4;
 
@@ -129,11 +144,21 @@ impl LobeSet {
     /// Sum of the closures' BSDF times cosine toward `wi`, and the combined pdf, for a
     /// viewer in direction `wo`; `ng` is the geometric normal facing the viewer.
     pub fn eval(&self, wo: V3, wi: V3, ng: V3, tables: &Tables) -> (V3, f32) {
+        self.eval_excluding(wo, wi, ng, tables, 0)
+    }
+
+    /// `eval` toward a light that some ray types do not see (`exclude`, `ray::` flags):
+    /// the closures of those types give nothing but keep their share of the pdf, as in
+    /// Cycles' _surface_shader_exclude.
+    pub fn eval_excluding(&self, wo: V3, wi: V3, ng: V3, tables: &Tables, exclude: u32) -> (V3, f32) {
         let mut f = [0.0; 3];
         let mut pdf = 0.0;
         let mut total = 0.0;
         for l in &self.lobes[..self.len] {
             total += l.sample_weight;
+            if exclude != 0 && excluded(&l.kind, exclude) {
+                continue;
+            }
             let bump = if is_zero(self.smooth_n) {
                 1.0
             } else {

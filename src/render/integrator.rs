@@ -263,7 +263,7 @@ impl Scene<'_> {
             let clamp_limit = if bounce <= 1 { st.clamp_direct } else { st.clamp_indirect };
             // Lights are not in the BVH: a ray collects every light it passes before the surface.
             let t_surface = hit_opt.map(|h| h.t).unwrap_or(if t1.is_finite() { t1 } else { f32::INFINITY });
-            for light in self.lights.iter().filter(|_| from_sss.is_none()) {
+            for light in self.lights.iter().filter(|l| from_sss.is_none() && l.visible_to(flags)) {
                 if let Some(lh) = light.intersect(o, d, t_surface) {
                     let w = if prev_singular {
                         1.0
@@ -399,7 +399,7 @@ impl Scene<'_> {
                 for (li, light) in self.lights.iter().enumerate() {
                     let uu = if li == 0 { [u_light[0], u_light[1]] } else { let r = rng.get4(index, 0x4000_0000 + set * 64 + li as u32); [r[0], r[1]] };
                     let Some(ls) = light.sample(hit.p, uu) else { continue };
-                    let (f, pdf_b) = lobes.eval(wo, ls.wi, hit.ng, self.tables);
+                    let (f, pdf_b) = lobes.eval_excluding(wo, ls.wi, hit.ng, self.tables, light.exclude);
                     if is_zero(f) {
                         continue;
                     }

@@ -36,6 +36,37 @@ pub struct Light {
     /// Emission direction (-Z of the object), unit.
     pub dir: V3,
     pub cast_shadow: bool,
+    /// Ray types that do not see the light (`ray::` flags: CAMERA, DIFFUSE, GLOSSY,
+    /// TRANSMIT, VOLUME_SCATTER), from the object's ray visibility.
+    pub exclude: u32,
+}
+
+impl Light {
+    /// Cycles' is_light_shader_visible_to_path for a ray with these path flags.
+    #[inline]
+    pub fn visible_to(&self, flags: u32) -> bool {
+        use crate::shader::point::ray;
+        let x = self.exclude;
+        !((x & ray::DIFFUSE != 0 && flags & ray::DIFFUSE != 0)
+            || (x & ray::GLOSSY != 0 && flags & (ray::GLOSSY | ray::REFLECT) == ray::GLOSSY | ray::REFLECT)
+            || (x & ray::TRANSMIT != 0 && flags & ray::TRANSMIT != 0)
+            || (x & ray::CAMERA != 0 && flags & ray::CAMERA != 0)
+            || (x & ray::VOLUME_SCATTER != 0 && flags & ray::VOLUME_SCATTER != 0))
+    }
+}
+
+/// The ray types an object's ray visibility hides it from, as `ray::` flags; without the
+/// setting in the export, Blender 4.5's default for a light (hidden from the camera).
+pub fn excluded_rays(v: Option<&crate::scene::format::RayVisibility>) -> u32 {
+    use crate::shader::point::ray;
+    let Some(v) = v else { return ray::CAMERA };
+    let mut x = 0;
+    for (on, flag) in [(v.camera, ray::CAMERA), (v.diffuse, ray::DIFFUSE), (v.glossy, ray::GLOSSY), (v.transmission, ray::TRANSMIT), (v.volume_scatter, ray::VOLUME_SCATTER)] {
+        if !on {
+            x |= flag;
+        }
+    }
+    x
 }
 
 pub struct LightSample {
@@ -119,7 +150,8 @@ pub fn collect(eval: &EvaluatedScene) -> Vec<Light> {
             "SUN" => Shape::Sun { half_angle: num(p, "angle", 0.00918) * 0.5 },
             _ => continue,
         };
-        out.push(Light { shape, strength, pos, dir, cast_shadow });
+        let exclude = excluded_rays(obj.visibility.as_ref());
+        out.push(Light { shape, strength, pos, dir, cast_shadow, exclude });
     }
     out
 }

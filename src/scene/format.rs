@@ -90,6 +90,17 @@ fn one_f64() -> f64 {
     1.0
 }
 
+/// Which rays see an object (Blender's `visible_camera`, `visible_diffuse`, ...).
+#[derive(Debug, Clone, Copy, Serialize, Deserialize, PartialEq)]
+pub struct RayVisibility {
+    pub camera: bool,
+    pub diffuse: bool,
+    pub glossy: bool,
+    pub transmission: bool,
+    pub volume_scatter: bool,
+    pub shadow: bool,
+}
+
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Object {
     pub name: String,
@@ -127,6 +138,10 @@ pub struct Object {
     pub hide_viewport: bool,
     #[serde(default = "yes")]
     pub visible: bool,
+    /// Cycles' ray visibility; absent in exports made before it was written (then
+    /// Blender 4.5's defaults apply: everything visible but lights to the camera).
+    #[serde(default)]
+    pub visibility: Option<RayVisibility>,
     #[serde(default)]
     pub pass_index: i32,
     #[serde(default)]
