@@ -63,8 +63,9 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 self.ops.push(Op::LayerWeight { blend, normal, fresnel, facing });
                 self.outputs(i, n, &[("Fresnel", fresnel, F), ("Facing", facing, F)]);
             }
-            // Pointiness and Random Per Island are left unset: a use is an error.
-            "ShaderNodeNewGeometry" => self.input_outputs(i, |id| {
+            // Pointiness and Random Per Island read derived mesh attributes.
+            "ShaderNodeNewGeometry" => {
+                self.input_outputs(i, |id| {
                 Some(match id {
                     "Position" => Input::Position,
                     "Normal" => Input::Normal,
@@ -75,7 +76,9 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     "Backfacing" => Input::Backfacing,
                     _ => return None,
                 })
-            }),
+                });
+                self.geometry_derived(i)?;
+            }
             "ShaderNodeObjectInfo" => {
                 self.input_outputs(i, |id| {
                     Some(match id {
