@@ -46,6 +46,10 @@ const ASSERTED: &[&str] = &[
     // (Soft Falloff's facing disk, and the sphere light with it off).
     "spot_radius",
     "spot_sphere",
+    // Mesh attributes in the renderer: a tangent-space Normal Map from an image texture
+    // (MikkTSpace tangents), and corner colour / point float attributes as base colour.
+    "normal_map",
+    "attribute_color",
 ];
 
 /// Scenes that do not pass yet, with the reason.
@@ -125,6 +129,11 @@ fn parity_with_cycles() {
     let mut dirs: Vec<_> = std::fs::read_dir(&root).expect("fixtures/render/scenes").map(|e| e.unwrap().path()).filter(|p| p.join("scene.json").exists()).collect();
     dirs.sort();
     assert!(dirs.len() >= 12, "expected at least 12 parity scenes, found {}", dirs.len());
+    // BLENDSYNTH_PARITY_ONLY=a,b runs just those scenes (for a quick check of new ones).
+    if let Ok(only) = std::env::var("BLENDSYNTH_PARITY_ONLY") {
+        let only: Vec<&str> = only.split(',').collect();
+        dirs.retain(|d| only.iter().any(|o| d.file_name().is_some_and(|n| n == *o)));
+    }
     let mut failures = Vec::new();
     println!("{:<16} {:>7} {:>8}  {:<26} {:<26} {:>6}  status", "scene", "ratio", "mean err", "mean ours (RGB)", "mean Cycles A (RGB)", "secs");
     println!("(spp: mean samples per pixel, ours / Cycles A, for adaptive scenes)");
