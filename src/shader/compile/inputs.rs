@@ -66,16 +66,16 @@ impl<'g, 'a> Compiler<'g, 'a> {
             // Pointiness and Random Per Island read derived mesh attributes.
             "ShaderNodeNewGeometry" => {
                 self.input_outputs(i, |id| {
-                Some(match id {
-                    "Position" => Input::Position,
-                    "Normal" => Input::Normal,
-                    "Tangent" => Input::Tangent,
-                    "True Normal" => Input::TrueNormal,
-                    "Incoming" => Input::Incoming,
-                    "Parametric" => Input::Parametric,
-                    "Backfacing" => Input::Backfacing,
-                    _ => return None,
-                })
+                    Some(match id {
+                        "Position" => Input::Position,
+                        "Normal" => Input::Normal,
+                        "Tangent" => Input::Tangent,
+                        "True Normal" => Input::TrueNormal,
+                        "Incoming" => Input::Incoming,
+                        "Parametric" => Input::Parametric,
+                        "Backfacing" => Input::Backfacing,
+                        _ => return None,
+                    })
                 });
                 self.geometry_derived(i)?;
             }
