@@ -49,6 +49,7 @@ const ASSERTED: &[&str] = &[
     // Mesh attributes in the renderer: a tangent-space Normal Map from an image texture
     // (MikkTSpace tangents), and corner colour / point float attributes as base colour.
     "normal_map",
+    "normal_map_scaled",
     "attribute_color",
 ];
 
