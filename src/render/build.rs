@@ -7,6 +7,7 @@ use std::sync::Arc;
 
 use crate::anim::EvaluatedScene;
 use crate::scene::{AttributeData, MeshData, Scene};
+use crate::shader::attributes::BoundAttributes;
 
 use super::math::*;
 use super::RenderError;
@@ -35,6 +36,13 @@ pub struct MeshInstance {
     /// Object-space vertex positions before true displacement (`displace`), which
     /// Generated coordinates and the displacement bump read.
     pub undisplaced: Option<Arc<Vec<V3>>>,
+    /// The mesh's active render UV map and default colour attribute by name (what
+    /// tangents and Color Attribute without a name read).
+    pub uv_name: Option<String>,
+    pub default_color: Option<String>,
+    /// Per slot: the attributes its material reads, bound to this mesh (`bind_attributes`);
+    /// empty until then and for materials that read none.
+    pub attributes: Vec<Option<Arc<BoundAttributes>>>,
 }
 
 impl MeshInstance {
@@ -242,6 +250,46 @@ fn push_instance(
         },
         motion: None,
         undisplaced: None,
+        uv_name,
+        default_color: info.default_color_attribute.clone(),
+        attributes: Vec::new(),
     });
+    Ok(())
+}
+
+/// Binds, for every instance and slot, the mesh attributes its material reads (Cycles
+/// syncs them once per mesh): instances sharing a mesh and material share one binding.
+/// Call before true displacement, which Cycles also runs after the attributes are made.
+pub fn bind_attributes(geo: &mut Geometry, materials: &[super::shade::Material]) -> Result<(), RenderError> {
+    let mut done: HashMap<(*const MeshData, usize), Arc<BoundAttributes>> = HashMap::new();
+    for inst in &mut geo.instances {
+        let mut per_slot = Vec::with_capacity(inst.slots.len());
+        for slot in &inst.slots {
+            let Some((mi, p)) = slot.and_then(|mi| materials.get(mi).and_then(|m| m.program.as_ref()).map(|p| (mi, p))) else {
+                per_slot.push(None);
+                continue;
+            };
+            if p.attributes.is_empty() {
+                per_slot.push(None);
+                continue;
+            }
+            if super::shade::displacement_reads_attributes(p) {
+                return Err(RenderError(format!("object {:?}: material {:?} truly displaces by mesh attributes or tangents, which the renderer does not support yet", inst.name, materials[mi].name)));
+            }
+            let key = (Arc::as_ptr(&inst.mesh), mi);
+            let bound = match done.get(&key) {
+                Some(b) => b.clone(),
+                None => {
+                    let b = BoundAttributes::bind(&inst.mesh, &p.attributes, inst.uv_name.as_deref(), inst.default_color.as_deref())
+                        .map_err(|e| RenderError(format!("object {:?}, material {:?}: {e}", inst.name, materials[mi].name)))?;
+                    let b = Arc::new(b);
+                    done.insert(key, b.clone());
+                    b
+                }
+            };
+            per_slot.push(Some(bound));
+        }
+        inst.attributes = per_slot;
+    }
     Ok(())
 }

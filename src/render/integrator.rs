@@ -192,6 +192,11 @@ impl Scene<'_> {
             sp.uv = [t[0][0] * w0 + t[1][0] * u + t[2][0] * v, t[0][1] * w0 + t[1][1] * u + t[2][1] * v, 0.0];
         }
         self.fill_context(&mut sp, inst, wo, ng, backfacing, u, v);
+        // Tangent-space normal maps turn their normal to world space with it.
+        sp.transform = crate::shader::bump::ObjectTransform { to_world: to_world.m, to_object: to_object.m };
+        if let Some(Some(bound)) = inst.attributes.get(slot) {
+            bound.fill(m, r.tri as usize, c, face, [w0, u, v], &mut sp);
+        }
         if inst.motion.is_some() {
             // Object Info reads the object's transform at the ray's time, as in Cycles.
             sp.object.location = to_world.column(3);

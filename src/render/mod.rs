@@ -183,6 +183,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         }
     }
     let materials = shade::compile_all(scene, &used)?;
+    build::bind_attributes(&mut geo, &materials)?;
     if displace::apply(&mut geo, &materials) > 0 {
         (geo.tris, geo.refs) = build::world_triangles(&geo.instances);
     }

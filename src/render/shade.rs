@@ -35,11 +35,6 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
             continue;
         }
         let p = compile_material(scene, &m.name).map_err(|e| RenderError(format!("{e}")))?;
-        if !p.attributes.is_empty() {
-            // The renderer's hit points do not carry mesh attributes yet: refuse rather
-            // than shade with zeros.
-            return Err(RenderError(format!("material {:?} reads mesh attributes or tangents ({:?}), which the renderer does not provide yet (blendsynth bake does)", m.name, p.attributes)));
-        }
         let mut bsdf_of = vec![None; p.closures.len()];
         for (bi, b) in p.bsdfs.iter().enumerate() {
             if let Some(slot) = bsdf_of.get_mut(b.closure as usize) {
@@ -52,6 +47,14 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
         out.push(Material { program: Some(p), bsdf_of, name: m.name.clone(), sampling, bump_correction, bssrdf_bump });
     }
     Ok(out)
+}
+
+/// True when the ops of the material's true displacement read mesh attributes or
+/// tangents: the renderer's displacement points (`displace`) do not carry them.
+pub fn displacement_reads_attributes(p: &Program) -> bool {
+    use crate::shader::program::Op;
+    let Some(d) = p.displacement else { return false };
+    p.ops[..d.center_end.min(p.ops.len())].iter().any(|op| matches!(op, Op::Attribute { .. } | Op::ColorAttribute { .. } | Op::NamedUv { .. } | Op::NormalMapTangent { .. } | Op::VectorDisplacementTangent { .. } | Op::TangentUv { .. }))
 }
 
 /// Cycles' `has_bssrdf_bump` (svm.cpp: the displacement's bump, or a BSSRDF node whose

@@ -26,6 +26,12 @@ pub enum AttributeRequest {
     /// Cycles' normal for tangent-space maps, object space and unnormalised: the
     /// interpolated vertex normals of a smooth face, the triangle normal of a flat one.
     MapNormal,
+    /// Cycles' Pointiness (Geometry node, or an Attribute named "pointiness"): per
+    /// vertex, see `derived::pointiness`.
+    Pointiness,
+    /// Cycles' Random Per Island (Geometry node, or an Attribute named
+    /// "random_per_island"): per face, see `derived::random_per_island`.
+    RandomPerIsland,
 }
 
 /// How the Attribute node's Fac reads a value (Cycles: float2 gives x, wider types the
@@ -135,6 +141,12 @@ impl BoundAttributes {
                     let normals = mesh.corner_verts.iter().map(|&v| vn[v as usize]).collect();
                     Bound { values: Values::MapNormal { normals, flat }, fac: FacMode::Average }
                 }
+                // Float attributes: Fac is the value itself, Color (v, v, v), Alpha 1.
+                AttributeRequest::Pointiness => {
+                    let p = super::derived::pointiness(mesh, &super::tangent::vertex_normals(mesh));
+                    Bound { values: Values::Point(p.into_iter().map(to4_float).collect()), fac: FacMode::X }
+                }
+                AttributeRequest::RandomPerIsland => Bound { values: Values::Face(super::derived::random_per_island(mesh).into_iter().map(to4_float).collect()), fac: FacMode::X },
             });
         }
         if items.len() > MAX_ATTRIBUTES {

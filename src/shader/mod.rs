@@ -13,6 +13,7 @@ pub mod inputs;
 pub mod view;
 pub mod attributes;
 pub mod tangent;
+pub mod derived;
 
 pub use compile::{compile_material, CompileError};
 pub use point::ShadingPoint;

@@ -61,6 +61,18 @@ impl<'g, 'a> Compiler<'g, 'a> {
             return Err(CompileError(format!("node {:?}: Attribute type {kind} is not supported (only Geometry: object and instancer custom properties are not exported)", n.path)));
         }
         let name = prop_str(n, "attribute_name")?;
+        let derived = match name {
+            "pointiness" => Some(AttributeRequest::Pointiness),
+            "random_per_island" => Some(AttributeRequest::RandomPerIsland),
+            _ => None,
+        };
+        if let Some(r) = derived {
+            let attr = self.request(&n.path, r)?;
+            let (vector, fac, alpha) = (self.alloc(V), self.alloc(F), self.alloc(F));
+            self.ops.push(Op::Attribute { attr, vector, fac, alpha });
+            self.outputs(i, n, &[("Color", vector, C), ("Vector", vector, V), ("Fac", fac, F), ("Alpha", alpha, F)]);
+            return Ok(());
+        }
         if STANDARD_NAMES.contains(&name) {
             return Err(CompileError(format!("node {:?}: Attribute name {name:?} is Cycles built-in data, not supported yet", n.path)));
         }
@@ -68,6 +80,26 @@ impl<'g, 'a> Compiler<'g, 'a> {
         let (vector, fac, alpha) = (self.alloc(V), self.alloc(F), self.alloc(F));
         self.ops.push(Op::Attribute { attr, vector, fac, alpha });
         self.outputs(i, n, &[("Color", vector, C), ("Vector", vector, V), ("Fac", fac, F), ("Alpha", alpha, F)]);
+        Ok(())
+    }
+
+    /// Geometry > Pointiness and Random Per Island: Cycles compiles them as float
+    /// attribute reads of its derived mesh attributes.
+    pub(super) fn geometry_derived(&mut self, i: usize) -> Result<(), CompileError> {
+        for (id, r) in [("Pointiness", AttributeRequest::Pointiness), ("Random Per Island", AttributeRequest::RandomPerIsland)] {
+            let n = &self.g.nodes[i];
+            let Some(k) = n.node.outputs.iter().position(|o| o.identifier == id) else { continue };
+            // At a bump's offset points the output stays unset (a use there is an
+            // error): that needs attribute differentials.
+            if !self.output_used(i, id) || self.offset_copy {
+                continue;
+            }
+            let path = n.path.clone();
+            let attr = self.request(&path, r)?;
+            let (vector, fac, alpha) = (self.alloc(Kind::Vector), self.alloc(Kind::Float), self.alloc(Kind::Float));
+            self.ops.push(Op::Attribute { attr, vector, fac, alpha });
+            self.values[i][k] = Some((fac, Kind::Float));
+        }
         Ok(())
     }
 

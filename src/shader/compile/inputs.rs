@@ -63,19 +63,22 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 self.ops.push(Op::LayerWeight { blend, normal, fresnel, facing });
                 self.outputs(i, n, &[("Fresnel", fresnel, F), ("Facing", facing, F)]);
             }
-            // Pointiness and Random Per Island are left unset: a use is an error.
-            "ShaderNodeNewGeometry" => self.input_outputs(i, |id| {
-                Some(match id {
-                    "Position" => Input::Position,
-                    "Normal" => Input::Normal,
-                    "Tangent" => Input::Tangent,
-                    "True Normal" => Input::TrueNormal,
-                    "Incoming" => Input::Incoming,
-                    "Parametric" => Input::Parametric,
-                    "Backfacing" => Input::Backfacing,
-                    _ => return None,
-                })
-            }),
+            // Pointiness and Random Per Island read derived mesh attributes.
+            "ShaderNodeNewGeometry" => {
+                self.input_outputs(i, |id| {
+                    Some(match id {
+                        "Position" => Input::Position,
+                        "Normal" => Input::Normal,
+                        "Tangent" => Input::Tangent,
+                        "True Normal" => Input::TrueNormal,
+                        "Incoming" => Input::Incoming,
+                        "Parametric" => Input::Parametric,
+                        "Backfacing" => Input::Backfacing,
+                        _ => return None,
+                    })
+                });
+                self.geometry_derived(i)?;
+            }
             "ShaderNodeObjectInfo" => {
                 self.input_outputs(i, |id| {
                     Some(match id {
