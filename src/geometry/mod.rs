@@ -25,6 +25,7 @@
 pub mod animated;
 pub mod attribute;
 pub mod catmull_clark;
+pub mod cdt;
 pub mod curve_eval;
 pub mod curves;
 pub mod legacy_curve;

@@ -9,6 +9,7 @@ pub mod curve_primitives;
 pub mod delete;
 pub mod distribute;
 pub mod extrude;
+pub mod fill_curve;
 pub mod field_nodes;
 pub mod flip_faces;
 pub mod float_curve;
@@ -120,6 +121,7 @@ pub const SUPPORTED: &[&str] = &[
     "GeometryNodeMeshToCurve",
     "GeometryNodeDualMesh",
     "GeometryNodeSampleCurve",
+    "GeometryNodeFillCurve",
 ];
 
 pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -212,6 +214,7 @@ pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "GeometryNodeMeshToCurve" => mesh_to_curve::mesh_to_curve(ctx),
         "GeometryNodeDualMesh" => dual_mesh::dual_mesh(ctx),
         "GeometryNodeSampleCurve" => sample_curve::sample_curve(ctx),
+        "GeometryNodeFillCurve" => fill_curve::fill_curve(ctx),
         _ => Err(ctx.err("this node type is not supported by blendsynth's Geometry Nodes evaluator")),
     }
 }

@@ -162,8 +162,10 @@ struct Build {
     edge_src: Vec<Option<usize>>,
     corner_verts: Vec<u32>,
     corner_edges: Vec<u32>,
-    /// Per new corner: weights over coarse corners.
+    /// Per new corner: weights over coarse corners (left empty when the mesh has no
+    /// corner attributes to interpolate: a weight list per corner is most of the time).
     corner_src: Vec<Weights>,
+    corner_weights: bool,
     face_src: Vec<usize>,
     /// Per new vertex: where it lies on the coarse mesh (for smooth schemes).
     vert_loc: Vec<Loc>,
@@ -207,6 +209,7 @@ pub fn subdivide_with_locations(m: &Mesh, level: u32) -> (Mesh, Vec<Loc>) {
         corner_verts: vec![0; ctx.n_faces * 4],
         corner_edges: vec![0; ctx.n_faces * 4],
         corner_src: vec![Vec::new(); ctx.n_faces * 4],
+        corner_weights: m.attributes.on(Domain::Corner).next().is_some(),
         face_src: vec![0; ctx.n_faces],
         vert_loc: vec![Loc::Vertex(0); ctx.n_verts],
     };
@@ -533,7 +536,9 @@ fn face(ctx: &Ctx, b: &mut Build, loop_start: i64, ptex: usize, rot: usize, v: [
     for k in 0..4 {
         b.corner_verts[l + k] = v[k] as u32;
         b.corner_edges[l + k] = e[k] as u32;
-        b.corner_src[l + k] = ctx.weights(ptex, uv[k].0, uv[k].1).1;
+        if b.corner_weights {
+            b.corner_src[l + k] = ctx.weights(ptex, uv[k].0, uv[k].1).1;
+        }
     }
 }
 
@@ -804,7 +809,8 @@ pub fn subdivide_node(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         modify_geometry_sets(&mut g, &mut |s: &mut GeometrySet| {
             if let Some(m) = s.mesh.clone() {
                 if m.face_count() > 0 {
-                    *s.mesh_mut().unwrap() = subdivide_mesh(&m, level);
+                    // A new Arc: `mesh_mut` would first deep-copy the shared input.
+                    s.mesh = Some(std::sync::Arc::new(subdivide_mesh(&m, level)));
                 }
             }
             Ok(())
