@@ -161,9 +161,8 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeVectorDisplacement",
     "ShaderNodeNormalMap",
     // Input nodes reading the shading context (shader/inputs.rs; fresnel.rs,
-    // light_falloff.rs), proven by tests/inputs.rs against Cycles' EMIT bakes. The
-    // outputs they cannot give (Geometry Pointiness and Random Per Island, Tangent UV
-    // Map) are compile errors naming the node.
+    // light_falloff.rs), proven by tests/inputs.rs against Cycles' EMIT bakes; Geometry
+    // Pointiness and Random Per Island come from the mesh (shader/derived.rs).
     "ShaderNodeFresnel",
     "ShaderNodeLayerWeight",
     "ShaderNodeNewGeometry",
