@@ -55,6 +55,10 @@ const ASSERTED: &[&str] = &[
     "attribute_color",
     // Geometry Pointiness and Random Per Island as base colour on a mesh of four islands.
     "pointiness_islands",
+    // Mesh objects' ray visibility (camera, shadow, glossy, and an emitter hidden from
+    // diffuse rays), and holdout objects (one opaque, one half transparent).
+    "object_visibility",
+    "holdout_object",
 ];
 
 /// Scenes that do not pass yet, with the reason.
@@ -442,4 +446,33 @@ fn light_ray_visibility_follows_cycles() {
     let ratio = rmse(&all, &a) / rmse(&b, &a);
     println!("light_visibility with every light visible to every ray: ratio {ratio:.3}");
     assert!(ratio > 3.0, "ignoring ray visibility gives ratio {ratio:.3}, too close to Cycles for the test to tell");
+}
+
+#[test]
+fn object_ray_visibility_and_holdout_follow_cycles() {
+    // Scenes object_visibility and holdout_object (asserted in parity_with_cycles) with
+    // every object visible to every ray and no holdout: the hidden sphere, the cube's
+    // shadow, the post's reflection, the emitter's diffuse light and the holdout objects
+    // all come back, so the image is far from Cycles'. This tells the flags from none.
+    for (name, min_ratio) in [("object_visibility", 2.0), ("holdout_object", 2.0)] {
+        let dir = common::repo().join("fixtures/render/scenes").join(name);
+        let mut scene = Scene::load(&dir).unwrap();
+        let mut flagged = 0;
+        for o in scene.file.objects.iter_mut().filter(|o| o.kind == "MESH") {
+            if let Some(v) = &mut o.visibility {
+                flagged += [v.camera, v.diffuse, v.glossy, v.shadow].iter().filter(|x| !**x).count();
+                (v.camera, v.diffuse, v.glossy, v.shadow) = (true, true, true, true);
+            }
+            flagged += o.is_holdout as usize;
+            o.is_holdout = false;
+        }
+        assert!(flagged >= 2, "{name}: the export should carry the objects' ray visibility or holdout");
+        let opts = RenderOptions { samples: Some(64), resolution: Some((128, 128)), seed: Some(0), ..Default::default() };
+        let all: Vec<[f32; 3]> = render(&scene, &opts).unwrap().color.iter().map(|p| [p[0], p[1], p[2]]).collect();
+        let a = read_exr(&dir.join("cycles_a.exr"));
+        let b = read_exr(&dir.join("cycles_b.exr"));
+        let ratio = rmse(&all, &a) / rmse(&b, &a);
+        println!("{name} with every object visible to every ray and no holdout: ratio {ratio:.3}");
+        assert!(ratio > min_ratio, "{name}: ignoring the flags gives ratio {ratio:.3}, too close to Cycles for the test to tell");
+    }
 }

@@ -26,6 +26,44 @@ pub trait Accel: Sync {
     fn occluded_at(&self, org: V3, dir: V3, tmin: f32, tmax: f32, _time: f32) -> bool {
         self.occluded(org, dir, tmin, tmax)
     }
+    /// `intersect_at` seeing only objects visible to a ray of visibility `mask` (Cycles'
+    /// ray visibility: `ray::` bits, see `visibility`); others are passed through, as
+    /// Cycles' BVH skips primitives whose visibility lacks the ray's. The default ignores
+    /// the mask (every object visible to every ray).
+    fn intersect_vis(&self, org: V3, dir: V3, tmin: f32, tmax: f32, time: f32, _mask: u32) -> Option<Hit> {
+        self.intersect_at(org, dir, tmin, tmax, time)
+    }
+    /// `occluded_at` by objects visible to a ray of visibility `mask`.
+    fn occluded_vis(&self, org: V3, dir: V3, tmin: f32, tmax: f32, time: f32, _mask: u32) -> bool {
+        self.occluded_at(org, dir, tmin, tmax, time)
+    }
+}
+
+/// Visibility masks: an object's is the `ray::` bits of the rays that see it, a ray's the
+/// bits of its type; the object is hit when they share a bit (Cycles' PATH_RAY_* masks).
+pub mod visibility {
+    use crate::shader::point::ray;
+
+    /// Every ray type an object can be hidden from.
+    pub const ALL: u32 = ray::CAMERA | ray::DIFFUSE | ray::GLOSSY | ray::TRANSMIT | ray::SHADOW | ray::VOLUME_SCATTER;
+
+    /// The mask of a shadow ray (next-event estimation).
+    pub const SHADOW: u32 = ray::SHADOW;
+
+    /// A camera or bounce ray's mask from its path flags, as Cycles'
+    /// path_state_ray_visibility: diffuse and glossy count for reflection only, so a
+    /// transmitted ray is seen by objects visible to transmission.
+    #[inline]
+    pub fn of_path(flags: u32) -> u32 {
+        let mut v = flags & (ray::CAMERA | ray::DIFFUSE | ray::GLOSSY | ray::TRANSMIT | ray::VOLUME_SCATTER);
+        if v & ray::TRANSMIT != 0 {
+            v &= !(ray::DIFFUSE | ray::GLOSSY);
+        }
+        if flags & ray::VOLUME_SCATTER != 0 {
+            v |= ray::DIFFUSE;
+        }
+        v
+    }
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -43,6 +81,9 @@ pub struct Bvh {
     /// Triangles in leaf order, with their index in the caller's list.
     tris: Vec<[V3; 3]>,
     ids: Vec<u32>,
+    /// Per triangle in leaf order: the visibility mask of its object; empty when every
+    /// triangle is visible to every ray (then no test is made).
+    masks: Vec<u32>,
 }
 
 const BINS: usize = 16;
@@ -57,6 +98,16 @@ fn area(min: V3, max: V3) -> f32 {
 }
 
 impl Bvh {
+    /// A BVH whose triangle `i` is seen only by rays sharing a bit with `masks[i]`
+    /// (`visibility`); `masks` empty, or every mask `visibility::ALL`, means all visible.
+    pub fn build_masked(tris: &[[V3; 3]], masks: &[u32]) -> Bvh {
+        let mut bvh = Bvh::build(tris);
+        if masks.len() == tris.len() && masks.iter().any(|&m| m & visibility::ALL != visibility::ALL) {
+            bvh.masks = bvh.ids.iter().map(|&i| masks[i as usize]).collect();
+        }
+        bvh
+    }
+
     pub fn build(tris: &[[V3; 3]]) -> Bvh {
         let n = tris.len();
         let mut ids: Vec<u32> = (0..n as u32).collect();
@@ -152,14 +203,16 @@ impl Bvh {
             stack.push(left + 1);
         }
         let tris_sorted = ids.iter().map(|&i| tris[i as usize]).collect();
-        Bvh { nodes, tris: tris_sorted, ids }
+        Bvh { nodes, tris: tris_sorted, ids, masks: Vec::new() }
     }
 
     #[inline(always)]
-    fn traverse<const ANY: bool>(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> Option<Hit> {
+    fn traverse<const ANY: bool>(&self, org: V3, dir: V3, tmin: f32, tmax: f32, mask: u32) -> Option<Hit> {
         if self.tris.is_empty() {
             return None;
         }
+        // Only a scene with hidden objects and a ray some of them hide from tests masks.
+        let filter = !self.masks.is_empty() && mask & visibility::ALL != visibility::ALL;
         let inv = [1.0 / dir[0], 1.0 / dir[1], 1.0 / dir[2]];
         let wt = Watertight::new(dir);
         let mut best: Option<Hit> = None;
@@ -171,6 +224,9 @@ impl Bvh {
             let node = &self.nodes[ni as usize];
             if node.count > 0 {
                 for i in node.start..node.start + node.count {
+                    if filter && self.masks[i as usize] & mask == 0 {
+                        continue;
+                    }
                     if let Some((t, u, v)) = wt.intersect(org, &self.tris[i as usize], tmin, tfar) {
                         tfar = t;
                         best = Some(Hit { t, prim: self.ids[i as usize], u, v });
@@ -217,10 +273,16 @@ impl Bvh {
 
 impl Accel for Bvh {
     fn intersect(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.traverse::<false>(org, dir, tmin, tmax)
+        self.traverse::<false>(org, dir, tmin, tmax, visibility::ALL)
     }
     fn occluded(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> bool {
-        self.traverse::<true>(org, dir, tmin, tmax).is_some()
+        self.traverse::<true>(org, dir, tmin, tmax, visibility::ALL).is_some()
+    }
+    fn intersect_vis(&self, org: V3, dir: V3, tmin: f32, tmax: f32, _time: f32, mask: u32) -> Option<Hit> {
+        self.traverse::<false>(org, dir, tmin, tmax, mask)
+    }
+    fn occluded_vis(&self, org: V3, dir: V3, tmin: f32, tmax: f32, _time: f32, mask: u32) -> bool {
+        self.traverse::<true>(org, dir, tmin, tmax, mask).is_some()
     }
 }
 
@@ -322,12 +384,33 @@ mod tests {
             assert!(bvh.intersect([s, s, 1.0], [0.0, 0.0, -1.0], 0.0, f32::INFINITY).is_some(), "miss at {s}");
         }
     }
+
+    #[test]
+    fn masked_triangles_are_passed_through() {
+        use crate::shader::point::ray;
+        // Two stacked quads' worth of triangles: the near one hidden from the camera and
+        // shadow rays, the far one visible to all.
+        let near = [[-1.0, -1.0, 1.0], [1.0, -1.0, 1.0], [0.0, 1.0, 1.0]];
+        let far = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]];
+        let bvh = Bvh::build_masked(&[near, far], &[visibility::ALL & !(ray::CAMERA | ray::SHADOW), visibility::ALL]);
+        let (o, d) = ([0.0, 0.0, 5.0], [0.0, 0.0, -1.0]);
+        let cam = bvh.intersect_vis(o, d, 0.0, f32::INFINITY, 0.5, visibility::of_path(ray::CAMERA)).unwrap();
+        assert_eq!(cam.prim, 1);
+        assert!((cam.t - 5.0).abs() < 1e-5);
+        let diffuse = bvh.intersect_vis(o, d, 0.0, f32::INFINITY, 0.5, visibility::of_path(ray::DIFFUSE | ray::REFLECT)).unwrap();
+        assert_eq!(diffuse.prim, 0);
+        assert!(!bvh.occluded_vis(o, d, 0.0, 4.5, 0.5, visibility::SHADOW));
+        assert!(bvh.occluded_vis(o, d, 0.0, 4.5, 0.5, visibility::of_path(ray::GLOSSY | ray::REFLECT)));
+        // A transmitted glossy ray is seen as transmission only.
+        assert_eq!(visibility::of_path(ray::GLOSSY | ray::TRANSMIT), ray::TRANSMIT);
+        assert_eq!(bvh.intersect(o, d, 0.0, f32::INFINITY).unwrap().prim, 0);
+    }
 }
 
 impl Bvh {
     /// The nearest hit (`ANY` false) or any hit (`ANY` true), for structures built of BVHs.
     #[inline(always)]
-    pub fn intersect_or_occluded<const ANY: bool>(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.traverse::<ANY>(org, dir, tmin, tmax)
+    pub fn intersect_or_occluded<const ANY: bool>(&self, org: V3, dir: V3, tmin: f32, tmax: f32, mask: u32) -> Option<Hit> {
+        self.traverse::<ANY>(org, dir, tmin, tmax, mask)
     }
 }

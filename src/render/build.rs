@@ -43,6 +43,11 @@ pub struct MeshInstance {
     /// Per slot: the attributes its material reads, bound to this mesh (`bind_attributes`);
     /// empty until then and for materials that read none.
     pub attributes: Vec<Option<Arc<BoundAttributes>>>,
+    /// The rays that see the instance, as `accel::visibility` bits (its object's Cycles
+    /// ray visibility).
+    pub visibility: u32,
+    /// Object > Visibility > Holdout: a hole in the film for camera rays.
+    pub holdout: bool,
 }
 
 impl MeshInstance {
@@ -89,6 +94,13 @@ pub fn build(scene: &Scene, eval: &EvaluatedScene, overrides: &[(String, serde_j
             continue;
         }
         let Some(mesh_name) = obj.data.as_deref() else { continue };
+        // Cycles does not sync an object no ray can see.
+        if object_visibility(obj) == 0 {
+            continue;
+        }
+        if obj.is_shadow_catcher {
+            warn_shadow_catcher(&obj.name);
+        }
         let Some(mi) = scene.file.meshes.iter().position(|m| m.name == mesh_name) else {
             return Err(RenderError(format!("object {:?}: mesh {mesh_name:?} is not in the export", obj.name)));
         };
@@ -149,6 +161,28 @@ pub fn build(scene: &Scene, eval: &EvaluatedScene, overrides: &[(String, serde_j
     }
     let (tris, refs) = world_triangles(&instances);
     Ok(Geometry { instances, tris, refs })
+}
+
+/// The `accel::visibility` mask of an object: the ray types its Cycles ray visibility
+/// shows it to (Cycles' object_ray_visibility); everything without the setting.
+pub fn object_visibility(obj: &crate::scene::Object) -> u32 {
+    use crate::shader::point::ray;
+    let Some(v) = &obj.visibility else { return super::accel::visibility::ALL };
+    [(v.camera, ray::CAMERA), (v.diffuse, ray::DIFFUSE), (v.glossy, ray::GLOSSY), (v.transmission, ray::TRANSMIT), (v.shadow, ray::SHADOW), (v.volume_scatter, ray::VOLUME_SCATTER)]
+        .iter()
+        .filter(|(on, _)| *on)
+        .fold(0, |m, (_, bit)| m | bit)
+}
+
+/// Per scene triangle: its instance's visibility mask (for `Bvh::build_masked`).
+pub fn triangle_masks(geo: &Geometry) -> Vec<u32> {
+    geo.refs.iter().map(|r| geo.instances[r.inst as usize].visibility).collect()
+}
+
+/// Says once per process that shadow catchers are rendered as ordinary objects.
+fn warn_shadow_catcher(name: &str) {
+    static WARN: std::sync::Once = std::sync::Once::new();
+    WARN.call_once(|| eprintln!("warning: object {name:?} is a shadow catcher, which the renderer does not support: it is rendered as an ordinary object"));
 }
 
 /// Every instance's triangles in world space, skipping those with non-finite corners.
@@ -253,6 +287,8 @@ fn push_instance(
         uv_name,
         default_color: info.default_color_attribute.clone(),
         attributes: Vec::new(),
+        visibility: object_visibility(obj),
+        holdout: obj.is_holdout,
     });
     Ok(())
 }

@@ -6,7 +6,7 @@
 use crate::shader::ShadingPoint;
 use crate::shader::point::{ray, PathState, Undisplaced};
 
-use super::accel::Accel;
+use super::accel::{visibility, Accel};
 use super::bsdf::{LobeKind, LobeSet};
 use super::build::Geometry;
 use super::light::Light;
@@ -261,7 +261,7 @@ impl Scene<'_> {
                 from_sss
             } else {
                 scratch.rays += 1;
-                self.accel.intersect_at(o, d, t0, t1, scratch.time)
+                self.accel.intersect_vis(o, d, t0, t1, scratch.time, visibility::of_path(flags))
             };
             // Emission reached by a ray clamps as the bounce before it (Cycles: light found
             // after one bounce is direct light, like the light sample at that vertex).
@@ -319,6 +319,12 @@ impl Scene<'_> {
                 scratch.lobes.push(LobeKind::Diffuse, [1.0; 3], n);
             } else {
                 self.shade(&hit, wo, scratch);
+                // A holdout object seen by the camera (directly or through transparent
+                // surfaces: Cycles' PATH_RAY_TRANSPARENT_BACKGROUND) keeps only its
+                // transparency; the rest is a hole in the film.
+                if bounce == 0 && self.geo.instances[hit.inst as usize].holdout && !holdout_keep_transparent(&mut scratch.lobes) {
+                    break;
+                }
             }
             if diffuse_ancestor {
                 super::subsurface::to_diffuse(&mut scratch.lobes);
@@ -415,7 +421,7 @@ impl Scene<'_> {
                     }
                     let start = p_off(ls.wi);
                     scratch.rays += 1;
-                    if light.cast_shadow && self.accel.occluded_at(start, ls.wi, 0.0, if ls.dist.is_finite() { ls.dist * (1.0 - 1e-4) } else { f32::INFINITY }, scratch.time) {
+                    if light.cast_shadow && self.accel.occluded_vis(start, ls.wi, 0.0, if ls.dist.is_finite() { ls.dist * (1.0 - 1e-4) } else { f32::INFINITY }, scratch.time, visibility::SHADOW) {
                         continue;
                     }
                     l = add(l, clamp_contrib(c, if bounce == 0 { st.clamp_direct } else { st.clamp_indirect }));
@@ -436,12 +442,16 @@ impl Scene<'_> {
                 let ng_l = normalize(cross(sub(tri[1], tri[0]), sub(tri[2], tri[0])));
                 let cos_l = dot(ng_l, wi).abs();
                 if d2 > 0.0 && cos_l > 1e-6 && prim != h.prim {
-                    let (f, pdf_b) = scratch.lobes.eval(wo, wi, hit.ng, self.tables);
+                    // The emitter's object hidden from some ray types lights only the
+                    // closures of the others (Cycles' SHADER_EXCLUDE_* of mesh lights).
+                    let seen_by = self.geo.instances[self.geo.refs[prim as usize].inst as usize].visibility;
+                    let exclude = !seen_by & (ray::DIFFUSE | ray::GLOSSY | ray::TRANSMIT | ray::VOLUME_SCATTER);
+                    let (f, pdf_b) = if exclude == 0 { scratch.lobes.eval(wo, wi, hit.ng, self.tables) } else { scratch.lobes.eval_excluding(wo, wi, hit.ng, self.tables, exclude) };
                     if !is_zero(f) {
                         let pdf_l = self.mesh_lights.pdf_area[prim as usize] * d2 / cos_l;
                         let start = p_off(wi);
                         scratch.rays += 1;
-                        if pdf_l > 0.0 && !self.accel.occluded_at(start, wi, 0.0, dist * (1.0 - 1e-4), scratch.time) {
+                        if pdf_l > 0.0 && !self.accel.occluded_vis(start, wi, 0.0, dist * (1.0 - 1e-4), scratch.time, visibility::SHADOW) {
                             let le = self.light_emission(prim, b1, b2, neg(wi), dist, bounce, scratch);
                             let w = power_heuristic(pdf_l, pdf_b);
                             let c = scale(mul(mul(throughput, f), le), w / pdf_l);
@@ -607,7 +617,7 @@ impl Scene<'_> {
         let eps = 1e-5 * (1.0 + max3(p.map(f32::abs)));
         let start = if dot(wi, ng) >= 0.0 { madd(p, ng, eps) } else { madd(p, ng, -eps) };
         scratch.rays += 1;
-        if self.accel.occluded_at(start, wi, 0.0, f32::INFINITY, scratch.time) {
+        if self.accel.occluded_vis(start, wi, 0.0, f32::INFINITY, scratch.time, visibility::SHADOW) {
             return [0.0; 3];
         }
         let le = self.background_toward(wi, scratch);
@@ -656,6 +666,25 @@ impl Scene<'_> {
             sp.uv_dy = attribute_differential(t, d[1]);
         }
     }
+}
+
+/// Cycles' surface_shader_apply_holdout for a holdout object: keeps only the transparent
+/// closures (no emission); false when nothing is transparent and the path ends.
+fn holdout_keep_transparent(lobes: &mut LobeSet) -> bool {
+    lobes.emission = [0.0; 3];
+    if is_zero(lobes.transparent) {
+        lobes.len = 0;
+        return false;
+    }
+    let mut k = 0;
+    for i in 0..lobes.len {
+        if matches!(lobes.lobes[i].kind, LobeKind::Transparent) {
+            lobes.lobes[k] = lobes.lobes[i];
+            k += 1;
+        }
+    }
+    lobes.len = k;
+    true
 }
 
 /// Cycles' path flags after a non-transparent bounce of lobe `kind`.

@@ -194,7 +194,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     let tables = tables::Tables::shared();
     // With moving objects the static rest goes in a BVH of its own (`object_motion`).
     let motion_accel = (moving > 0).then(|| object_motion::MotionAccel::build(&geo));
-    let bvh = if motion_accel.is_some() { Bvh::build(&[]) } else { Bvh::build(&geo.tris) };
+    let bvh = if motion_accel.is_some() { Bvh::build(&[]) } else { Bvh::build_masked(&geo.tris, &build::triangle_masks(&geo)) };
     let filter = filter::FilterTable::blackman_harris(rna_f(cy, "filter_width").or_else(|| rna_f(r, "filter_size")).unwrap_or(1.5) as f32);
     let gi = |k: &str, d: f64| rna_f(cy, k).unwrap_or(d) as u32;
     let settings = Settings {
@@ -494,7 +494,7 @@ fn primary_passes(tracer: &integrator::Scene, camera: &camera::Camera, x: u32, y
     out.feature_normal.push([0.0; 3]);
     out.feature_albedo.push([0.0; 3]);
     let (o, d, t0, t1) = camera.ray(x as f32 + 0.5, y as f32 + 0.5, [0.5, 0.5]);
-    match tracer.accel.intersect(o, d, t0, t1) {
+    match tracer.accel.intersect_vis(o, d, t0, t1, object_motion::CENTRE_TIME, accel::visibility::of_path(crate::shader::point::ray::CAMERA)) {
         Some(h) => {
             let wo = neg(d);
             let hit = tracer.surface(h.prim, h.u, h.v, wo);

@@ -12,7 +12,7 @@
 
 use std::sync::Arc;
 
-use super::accel::{Accel, Bvh, Hit};
+use super::accel::{visibility, Accel, Bvh, Hit};
 use super::build::{Geometry, MeshInstance};
 use super::math::*;
 use super::motion::{decompose, interpolate, Decomposed};
@@ -168,6 +168,8 @@ struct Mover {
     motion: Arc<ObjectMotion>,
     lo: V3,
     hi: V3,
+    /// The instance's visibility mask (`accel::visibility`).
+    mask: u32,
 }
 
 /// The two-level structure: static triangles in world space, moving instances each in
@@ -182,12 +184,14 @@ impl MotionAccel {
     pub fn build(geo: &Geometry) -> MotionAccel {
         let mut fixed_tris = Vec::new();
         let mut fixed_prims = Vec::new();
+        let mut fixed_masks = Vec::new();
         let mut per_inst: Vec<(Vec<[V3; 3]>, Vec<u32>)> = geo.instances.iter().map(|_| (Vec::new(), Vec::new())).collect();
         for (prim, r) in geo.refs.iter().enumerate() {
             let inst = &geo.instances[r.inst as usize];
             if inst.motion.is_none() {
                 fixed_tris.push(geo.tris[prim]);
                 fixed_prims.push(prim as u32);
+                fixed_masks.push(inst.visibility);
             } else {
                 let m = &inst.mesh;
                 let tri = m.triangles[r.tri as usize].map(|c| m.positions[m.corner_verts[c as usize] as usize]);
@@ -209,9 +213,9 @@ impl MotionAccel {
                 }
             }
             let (lo, hi) = reach_bounds(&motion.steps, olo, ohi);
-            movers.push(Mover { bvh: Bvh::build(&tris), prims, motion: motion.clone(), lo, hi });
+            movers.push(Mover { bvh: Bvh::build(&tris), prims, motion: motion.clone(), lo, hi, mask: inst.visibility });
         }
-        MotionAccel { fixed: Bvh::build(&fixed_tris), fixed_prims, movers }
+        MotionAccel { fixed: Bvh::build_masked(&fixed_tris, &fixed_masks), fixed_prims, movers }
     }
 
     /// Moving instances (for the render summary and tests).
@@ -251,19 +255,22 @@ fn meets_box(lo: V3, hi: V3, org: V3, dir: V3, tmin: f32, tmax: f32) -> bool {
 
 impl MotionAccel {
     #[inline]
-    fn trace<const ANY: bool>(&self, org: V3, dir: V3, tmin: f32, tmax: f32, time: f32) -> Option<Hit> {
-        let mut best = self.fixed.intersect_or_occluded::<ANY>(org, dir, tmin, tmax).map(|h| Hit { prim: self.fixed_prims[h.prim as usize], ..h });
+    fn trace<const ANY: bool>(&self, org: V3, dir: V3, tmin: f32, tmax: f32, time: f32, mask: u32) -> Option<Hit> {
+        let mut best = self.fixed.intersect_or_occluded::<ANY>(org, dir, tmin, tmax, mask).map(|h| Hit { prim: self.fixed_prims[h.prim as usize], ..h });
         if ANY && best.is_some() {
             return best;
         }
         for mv in &self.movers {
+            if mv.mask & mask == 0 {
+                continue;
+            }
             let tfar = best.map_or(tmax, |h| h.t);
             if !meets_box(mv.lo, mv.hi, org, dir, tmin, tfar) {
                 continue;
             }
             let Some(to_object) = mv.motion.at(time).inverse() else { continue };
             let (o, d) = (to_object.point(org), to_object.vector(dir));
-            if let Some(h) = mv.bvh.intersect_or_occluded::<ANY>(o, d, tmin, tfar) {
+            if let Some(h) = mv.bvh.intersect_or_occluded::<ANY>(o, d, tmin, tfar, visibility::ALL) {
                 best = Some(Hit { prim: mv.prims[h.prim as usize], ..h });
                 if ANY {
                     return best;
@@ -276,16 +283,22 @@ impl MotionAccel {
 
 impl Accel for MotionAccel {
     fn intersect(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.trace::<false>(org, dir, tmin, tmax, CENTRE_TIME)
+        self.trace::<false>(org, dir, tmin, tmax, CENTRE_TIME, visibility::ALL)
     }
     fn occluded(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> bool {
-        self.trace::<true>(org, dir, tmin, tmax, CENTRE_TIME).is_some()
+        self.trace::<true>(org, dir, tmin, tmax, CENTRE_TIME, visibility::ALL).is_some()
     }
     fn intersect_at(&self, org: V3, dir: V3, tmin: f32, tmax: f32, time: f32) -> Option<Hit> {
-        self.trace::<false>(org, dir, tmin, tmax, time)
+        self.trace::<false>(org, dir, tmin, tmax, time, visibility::ALL)
     }
     fn occluded_at(&self, org: V3, dir: V3, tmin: f32, tmax: f32, time: f32) -> bool {
-        self.trace::<true>(org, dir, tmin, tmax, time).is_some()
+        self.trace::<true>(org, dir, tmin, tmax, time, visibility::ALL).is_some()
+    }
+    fn intersect_vis(&self, org: V3, dir: V3, tmin: f32, tmax: f32, time: f32, mask: u32) -> Option<Hit> {
+        self.trace::<false>(org, dir, tmin, tmax, time, mask)
+    }
+    fn occluded_vis(&self, org: V3, dir: V3, tmin: f32, tmax: f32, time: f32, mask: u32) -> bool {
+        self.trace::<true>(org, dir, tmin, tmax, time, mask).is_some()
     }
 }
 

@@ -171,6 +171,11 @@ pub struct Object {
     /// absent in older exports.
     #[serde(default)]
     pub cycles: Option<Rna>,
+    /// Object > Visibility > Holdout and Shadow Catcher; false in older exports.
+    #[serde(default)]
+    pub is_holdout: bool,
+    #[serde(default)]
+    pub is_shadow_catcher: bool,
 }
 
 fn yes() -> bool {
