@@ -454,7 +454,7 @@ fn object_ray_visibility_and_holdout_follow_cycles() {
     // every object visible to every ray and no holdout: the hidden sphere, the cube's
     // shadow, the post's reflection, the emitter's diffuse light and the holdout objects
     // all come back, so the image is far from Cycles'. This tells the flags from none.
-    for (name, min_ratio) in [("object_visibility", 2.0), ("holdout_object", 2.0)] {
+    for (name, min_ratio) in [("object_visibility", 5.0), ("holdout_object", 5.0)] {
         let dir = common::repo().join("fixtures/render/scenes").join(name);
         let mut scene = Scene::load(&dir).unwrap();
         let mut flagged = 0;
