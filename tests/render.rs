@@ -476,3 +476,22 @@ fn object_ray_visibility_and_holdout_follow_cycles() {
         assert!(ratio > min_ratio, "{name}: ignoring the flags gives ratio {ratio:.3}, too close to Cycles for the test to tell");
     }
 }
+
+#[test]
+fn moving_object_hidden_from_every_surface_ray_is_not_seen() {
+    // Scene object_motion with its moving cube visible to volume scattering only (so it
+    // is still synced and traced as a moving instance) renders the same bits as with the
+    // cube not rendered at all: no camera, bounce or shadow ray may meet it.
+    let dir = common::repo().join("fixtures/render/scenes/object_motion");
+    let scene = Scene::load(&dir).unwrap();
+    let opts = RenderOptions { samples: Some(4), resolution: Some((48, 48)), seed: Some(0), ..Default::default() };
+    let mut hidden = scene.clone();
+    let mut gone = scene.clone();
+    let cube = hidden.file.objects.iter_mut().find(|o| o.name == "Cube").expect("object_motion has a Cube");
+    cube.visibility = Some(blendsynth::scene::RayVisibility { camera: false, diffuse: false, glossy: false, transmission: false, volume_scatter: true, shadow: false });
+    gone.file.objects.iter_mut().find(|o| o.name == "Cube").unwrap().hide_render = true;
+    let bits = |s: &Scene| render(s, &opts).unwrap().color.iter().flat_map(|p| p.map(f32::to_bits)).collect::<Vec<_>>();
+    let (with_cube, hidden_bits, gone_bits) = (bits(&scene), bits(&hidden), bits(&gone));
+    assert_ne!(with_cube, gone_bits, "the cube should show when visible");
+    assert_eq!(hidden_bits, gone_bits, "a moving object hidden from every surface ray must not be met");
+}
