@@ -14,10 +14,6 @@
 use super::bsdf::{LobeKind, LobeSet};
 use super::math::*;
 
-fn finite(v: V3) -> bool {
-    v.iter().all(|x| x.is_finite())
-}
-
 /// One sample's guide values and the state of their path.
 #[derive(Debug, Clone, Copy)]
 pub struct Features {

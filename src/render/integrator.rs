@@ -122,10 +122,6 @@ fn clamp_contrib(l: V3, limit: f32) -> V3 {
     l
 }
 
-fn finite(v: V3) -> bool {
-    v.iter().all(|x| x.is_finite())
-}
-
 impl Scene<'_> {
     pub fn surface(&self, prim: u32, u: f32, v: f32, wo: V3) -> SurfaceHit {
         self.surface_at(prim, u, v, wo, super::object_motion::CENTRE_TIME)

@@ -51,6 +51,12 @@ pub fn madd(a: V3, b: V3, f: f32) -> V3 {
 pub fn max3(a: V3) -> f32 {
     a[0].max(a[1]).max(a[2])
 }
+/// Every component finite (no NaN or infinity).
+#[inline(always)]
+pub fn finite(v: V3) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
 #[inline(always)]
 pub fn is_zero(a: V3) -> bool {
     a[0] == 0.0 && a[1] == 0.0 && a[2] == 0.0
