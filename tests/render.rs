@@ -59,6 +59,9 @@ const ASSERTED: &[&str] = &[
     // diffuse rays), and holdout objects (one opaque, one half transparent).
     "object_visibility",
     "holdout_object",
+    // Film > Transparent: background, half-transparent surface, Holdout shader and holdout
+    // object as alpha (checked as a fourth channel).
+    "film_transparent",
 ];
 
 /// Scenes that do not pass yet, with the reason.
@@ -73,8 +76,17 @@ const KNOWN_FAILURES: &[(&str, &str)] = &[
 ];
 
 fn read_exr(p: &Path) -> Vec<[f32; 3]> {
+    read_exr_rgba(p).iter().map(|p| [p[0], p[1], p[2]]).collect()
+}
+
+fn read_exr_rgba(p: &Path) -> Vec<[f32; 4]> {
     let img = image::open(p).unwrap_or_else(|e| panic!("{}: {e}", p.display())).to_rgba32f();
-    img.pixels().map(|p| [p[0], p[1], p[2]]).collect()
+    img.pixels().map(|p| p.0).collect()
+}
+
+/// Alpha as a grey image, so `rmse` and `means` serve it too.
+fn alpha_of(px: &[[f32; 4]]) -> Vec<[f32; 3]> {
+    px.iter().map(|p| [p[3]; 3]).collect()
 }
 
 fn rmse(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
@@ -107,6 +119,15 @@ struct Row {
     seconds: f64,
     /// Mean samples per pixel: ours, and Cycles' (seed A) when the fixture recorded it.
     spp: (f64, Option<f64>),
+    /// The alpha channel's figures, for scenes whose Cycles film has alpha.
+    alpha: Option<Alpha>,
+}
+
+struct Alpha {
+    ratio: f64,
+    mean_err: f64,
+    ours: f64,
+    cycles: f64,
 }
 
 fn evaluate(dir: &Path) -> Row {
@@ -115,8 +136,9 @@ fn evaluate(dir: &Path) -> Row {
     let samples = meta["samples"].as_u64().unwrap() as u32;
     let res = meta["resolution"].as_array().unwrap();
     let (w, h) = (res[0].as_u64().unwrap() as u32, res[1].as_u64().unwrap() as u32);
-    let a = read_exr(&dir.join("cycles_a.exr"));
-    let b = read_exr(&dir.join("cycles_b.exr"));
+    let a4 = read_exr_rgba(&dir.join("cycles_a.exr"));
+    let b4 = read_exr_rgba(&dir.join("cycles_b.exr"));
+    let (a, b): (Vec<[f32; 3]>, Vec<[f32; 3]>) = (a4.iter().map(|p| [p[0], p[1], p[2]]).collect(), b4.iter().map(|p| [p[0], p[1], p[2]]).collect());
     // A reference may share an export with others ("scene": relative folder) and name a frame.
     let scene_dir = meta["scene"].as_str().map(|s| dir.join(s)).unwrap_or_else(|| dir.to_path_buf());
     let scene = Scene::load(&scene_dir).unwrap();
@@ -129,7 +151,17 @@ fn evaluate(dir: &Path) -> Row {
     let (mo, ma) = (means(&ours), means(&a));
     let worst_mean = (0..3).map(|k| (mo[k] - ma[k]).abs() / ma[k].abs().max(1e-6)).fold(0.0, f64::max);
     let spp = (out.stats.samples_taken as f64 / (w * h) as f64, meta["mean_samples_a"].as_f64());
-    Row { name, ratio, worst_mean, ours: mo, cycles: ma, seconds: out.stats.wall_seconds, spp }
+    // Where Cycles' film has alpha (transparent film, holdouts), alpha is compared as a
+    // fourth channel: the same ratio, and its mean within the same 1%.
+    let alpha = a4.iter().any(|p| p[3] != 1.0).then(|| {
+        let (oa, aa, ba) = (alpha_of(&out.color), alpha_of(&a4), alpha_of(&b4));
+        let ratio = rmse(&oa, &aa) / rmse(&ba, &aa).max(1e-12);
+        let (mo, ma) = (means(&oa)[0], means(&aa)[0]);
+        Alpha { ratio, mean_err: (mo - ma).abs() / ma.abs().max(1e-6), ours: mo, cycles: ma }
+    });
+    let ratio = ratio.max(alpha.as_ref().map_or(0.0, |a| a.ratio));
+    let worst_mean = worst_mean.max(alpha.as_ref().map_or(0.0, |a| a.mean_err));
+    Row { name, ratio, worst_mean, ours: mo, cycles: ma, seconds: out.stats.wall_seconds, spp, alpha }
 }
 
 #[test]
@@ -164,7 +196,8 @@ fn parity_with_cycles() {
         };
         let f = |m: [f64; 3]| format!("{:.4} {:.4} {:.4}", m[0], m[1], m[2]);
         let spp = r.spp.1.map(|c| format!("  spp {:.1} / {c:.1}", r.spp.0)).unwrap_or_default();
-        println!("{:<16} {:>7.3} {:>7.2}%  {:<26} {:<26} {:>6.2}  {status}{spp}", r.name, r.ratio, 100.0 * r.worst_mean, f(r.ours), f(r.cycles), r.seconds);
+        let alpha = r.alpha.as_ref().map(|a| format!("  alpha: ratio {:.3}, mean {:.4} / {:.4}", a.ratio, a.ours, a.cycles)).unwrap_or_default();
+        println!("{:<16} {:>7.3} {:>7.2}%  {:<26} {:<26} {:>6.2}  {status}{spp}{alpha}", r.name, r.ratio, 100.0 * r.worst_mean, f(r.ours), f(r.cycles), r.seconds);
     }
     assert!(failures.is_empty(), "parity failures:\n{}", failures.join("\n"));
 }

@@ -83,13 +83,19 @@ pub struct PixelAcc {
     pub aux: [f64; 3],
     pub count: u32,
     pub converged: bool,
+    /// Summed transparency (1 - alpha) of the samples; not part of the error estimate,
+    /// as in Cycles, whose convergence check reads only the colour.
+    pub transparent: f64,
 }
 
 impl PixelAcc {
     /// Adds sample `index`; a NaN or infinite sample counts but adds nothing.
     #[inline]
-    pub fn add(&mut self, index: u32, c: [f32; 3]) {
+    pub fn add(&mut self, index: u32, c: [f32; 3], transparent: f32) {
         self.count += 1;
+        if transparent.is_finite() {
+            self.transparent += transparent as f64;
+        }
         if !c.iter().all(|v| v.is_finite()) {
             return;
         }

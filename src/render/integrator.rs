@@ -27,6 +27,12 @@ pub struct Settings {
     pub min_light_bounces: u32,
     /// Cycles' Filter Glossy (`blur_glossy`).
     pub filter_glossy: f32,
+    /// Film > Transparent: the background seen by camera rays (directly or through
+    /// transparent surfaces) becomes alpha instead of colour.
+    pub film_transparent: bool,
+    /// Some material can be transparent: shadow rays then run the materials they pass
+    /// through (`shadow_transmittance`); otherwise any hit blocks them.
+    pub transparent_shadows: bool,
 }
 
 /// Emissive triangles for light sampling: chosen by area times estimated emission.
@@ -89,11 +95,15 @@ pub struct Scratch {
     pub time: f32,
     /// The denoiser's guides of the sample `radiance` last traced.
     pub features: super::denoise_features::Features,
+    /// The transparency (1 - alpha) of the sample `radiance` last traced: transparent
+    /// background and holdouts seen by the camera, as Cycles accumulates it in the
+    /// combined pass's alpha.
+    pub transparent: f32,
 }
 
 impl Scratch {
     pub fn new(n_materials: usize) -> Scratch {
-        Scratch { stacks: vec![Vec::new(); n_materials + 1], lobes: LobeSet::default(), light_lobes: LobeSet::default(), rays: 0, ray_dp: 0.0, ray_dd: 0.0, time: super::object_motion::CENTRE_TIME, features: Default::default() }
+        Scratch { stacks: vec![Vec::new(); n_materials + 1], lobes: LobeSet::default(), light_lobes: LobeSet::default(), rays: 0, ray_dp: 0.0, ray_dd: 0.0, time: super::object_motion::CENTRE_TIME, features: Default::default(), transparent: 0.0 }
     }
 }
 
@@ -230,6 +240,7 @@ impl Scene<'_> {
         let mut l = [0.0f32; 3];
         let mut throughput = [1.0f32; 3];
         scratch.features = Default::default();
+        scratch.transparent = 0.0;
         let (mut o, mut d, mut t0, mut t1) = (org, dir, tmin, tmax);
         let (mut bounce, mut diffuse, mut glossy, mut transmission, mut transparent) = (0u32, 0u32, 0u32, 0u32, 0u32);
         let mut terminate_next = false;
@@ -282,6 +293,12 @@ impl Scene<'_> {
                 }
             }
             let Some(h) = hit_opt else {
+                // Cycles' PATH_RAY_TRANSPARENT_BACKGROUND: camera rays, and their
+                // continuations through transparent surfaces, keep the bounce count at 0.
+                if st.film_transparent && bounce == 0 {
+                    scratch.transparent += average(throughput);
+                    break;
+                }
                 let w = self.world_mis_weight(d, prev_singular, prev_pdf);
                 let bg = scale(mul(throughput, self.background_toward(d, scratch)), w);
                 scratch.features.add_emission(bg);
@@ -318,8 +335,21 @@ impl Scene<'_> {
                 // A holdout object seen by the camera (directly or through transparent
                 // surfaces: Cycles' PATH_RAY_TRANSPARENT_BACKGROUND) keeps only its
                 // transparency; the rest is a hole in the film.
-                if bounce == 0 && self.geo.instances[hit.inst as usize].holdout && !holdout_keep_transparent(&mut scratch.lobes) {
-                    break;
+                if bounce == 0 && self.geo.instances[hit.inst as usize].holdout {
+                    // The holdout weight (Cycles' surface_shader_apply_holdout) is what
+                    // the object's transparency does not let through.
+                    let weight = sub([1.0; 3], scratch.lobes.transparent.map(|t| t.clamp(0.0, 1.0)));
+                    scratch.transparent += average(mul(weight, throughput));
+                    if !holdout_keep_transparent(&mut scratch.lobes) {
+                        break;
+                    }
+                } else if bounce == 0 && !is_zero(scratch.lobes.holdout) {
+                    // Holdout closures (the Holdout shader node) seen by the camera.
+                    let weight = scratch.lobes.holdout;
+                    scratch.transparent += average(mul(weight, throughput));
+                    if weight.iter().all(|&w| w == 1.0) {
+                        break;
+                    }
                 }
             }
             if diffuse_ancestor {
@@ -402,11 +432,11 @@ impl Scene<'_> {
             let mis_lamps = lobes.lobes[..lobes.len].iter().any(|l| matches!(l.kind, LobeKind::Glossy { alpha, .. } if alpha < MIS_ALPHA));
             let mis_lamps = mis_lamps || lobes.lobes[..lobes.len].iter().any(|l| matches!(l.kind, LobeKind::GlossyAniso { lobe, .. } if lobe.alpha_x.min(lobe.alpha_y) < MIS_ALPHA));
             // Next-event estimation toward every light.
-            if !terminate_next && lobes.len > 0 {
+            if !terminate_next && scratch.lobes.len > 0 {
                 for (li, light) in self.lights.iter().enumerate() {
                     let uu = if li == 0 { [u_light[0], u_light[1]] } else { let r = rng.get4(index, 0x4000_0000 + set * 64 + li as u32); [r[0], r[1]] };
                     let Some(ls) = light.sample(hit.p, uu) else { continue };
-                    let (f, pdf_b) = lobes.eval_excluding(wo, ls.wi, hit.ng, self.tables, light.exclude);
+                    let (f, pdf_b) = scratch.lobes.eval_excluding(wo, ls.wi, hit.ng, self.tables, light.exclude);
                     if is_zero(f) {
                         continue;
                     }
@@ -416,10 +446,15 @@ impl Scene<'_> {
                         continue;
                     }
                     let start = p_off(ls.wi);
-                    scratch.rays += 1;
-                    if light.cast_shadow && self.accel.occluded_vis(start, ls.wi, 0.0, if ls.dist.is_finite() { ls.dist * (1.0 - 1e-4) } else { f32::INFINITY }, scratch.time, visibility::SHADOW) {
-                        continue;
-                    }
+                    let c = if light.cast_shadow {
+                        let tr = self.shadow_transmittance(start, ls.wi, if ls.dist.is_finite() { ls.dist * (1.0 - 1e-4) } else { f32::INFINITY }, scratch);
+                        if is_zero(tr) {
+                            continue;
+                        }
+                        mul(c, tr)
+                    } else {
+                        c
+                    };
                     l = add(l, clamp_contrib(c, if bounce == 0 { st.clamp_direct } else { st.clamp_indirect }));
                 }
             }
@@ -446,11 +481,11 @@ impl Scene<'_> {
                     if !is_zero(f) {
                         let pdf_l = self.mesh_lights.pdf_area[prim as usize] * d2 / cos_l;
                         let start = p_off(wi);
-                        scratch.rays += 1;
-                        if pdf_l > 0.0 && !self.accel.occluded_vis(start, wi, 0.0, dist * (1.0 - 1e-4), scratch.time, visibility::SHADOW) {
+                        let tr = if pdf_l > 0.0 { self.shadow_transmittance(start, wi, dist * (1.0 - 1e-4), scratch) } else { [0.0; 3] };
+                        if !is_zero(tr) {
                             let le = self.light_emission(prim, b1, b2, neg(wi), dist, bounce, scratch);
                             let w = power_heuristic(pdf_l, pdf_b);
-                            let c = scale(mul(mul(throughput, f), le), w / pdf_l);
+                            let c = mul(scale(mul(mul(throughput, f), le), w / pdf_l), tr);
                             if finite(c) {
                                 l = add(l, clamp_contrib(c, if bounce == 0 { st.clamp_direct } else { st.clamp_indirect }));
                             }
@@ -612,12 +647,48 @@ impl Scene<'_> {
         }
         let eps = 1e-5 * (1.0 + max3(p.map(f32::abs)));
         let start = if dot(wi, ng) >= 0.0 { madd(p, ng, eps) } else { madd(p, ng, -eps) };
-        scratch.rays += 1;
-        if self.accel.occluded_vis(start, wi, 0.0, f32::INFINITY, scratch.time, visibility::SHADOW) {
+        let tr = self.shadow_transmittance(start, wi, f32::INFINITY, scratch);
+        if is_zero(tr) {
             return [0.0; 3];
         }
         let le = self.background_toward(wi, scratch);
-        scale(mul(f, le), power_heuristic(pdf_l, pdf_b) / pdf_l)
+        mul(scale(mul(f, le), power_heuristic(pdf_l, pdf_b) / pdf_l), tr)
+    }
+
+    /// What a shadow ray from `start` along `dir` (unit) lets through up to `tmax`: zero at
+    /// the first opaque surface; through surfaces whose material can be transparent, the
+    /// product of their transparent closures' weights (Cycles' transparent shadows), and
+    /// opaque past the transparent bounce limit.
+    fn shadow_transmittance(&self, start: V3, dir: V3, tmax: f32, scratch: &mut Scratch) -> V3 {
+        scratch.rays += 1;
+        if !self.settings.transparent_shadows {
+            let blocked = self.accel.occluded_vis(start, dir, 0.0, tmax, scratch.time, visibility::SHADOW);
+            return if blocked { [0.0; 3] } else { [1.0; 3] };
+        }
+        let mut through = [1.0f32; 3];
+        let (mut o, mut left) = (start, tmax);
+        for crossed in 0..=self.settings.max_transparent {
+            if crossed > 0 {
+                scratch.rays += 1;
+            }
+            let Some(h) = self.accel.intersect_vis(o, dir, 0.0, left, scratch.time, visibility::SHADOW) else { return through };
+            let mut hit = self.surface_at(h.prim, h.u, h.v, neg(dir), scratch.time);
+            match hit.material {
+                Some(mi) if self.materials[mi].transparent_shadow => {}
+                _ => return [0.0; 3],
+            }
+            hit.sp.ray_length = h.t;
+            hit.sp.path = PathState { flags: ray::SHADOW, ..Default::default() };
+            self.shade_into(&hit, neg(dir), &mut scratch.stacks, &mut scratch.light_lobes);
+            through = mul(through, scratch.light_lobes.transparent);
+            if is_zero(through) {
+                return [0.0; 3];
+            }
+            let eps = 1e-5 * (1.0 + max3(hit.p.map(f32::abs)));
+            o = if dot(dir, hit.ng) >= 0.0 { madd(hit.p, hit.ng, eps) } else { madd(hit.p, hit.ng, -eps) };
+            left -= h.t;
+        }
+        [0.0; 3]
     }
 }
 

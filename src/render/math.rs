@@ -18,6 +18,11 @@ pub fn mul(a: V3, b: V3) -> V3 {
 pub fn scale(a: V3, f: f32) -> V3 {
     [a[0] * f, a[1] * f, a[2] * f]
 }
+/// Cycles' `average`: the mean of the three channels.
+#[inline(always)]
+pub fn average(a: V3) -> f32 {
+    (a[0] + a[1] + a[2]) / 3.0
+}
 #[inline(always)]
 pub fn dot(a: V3, b: V3) -> f32 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]

@@ -200,10 +200,6 @@ pub struct Dielectric {
     pub energy: f32,
 }
 
-fn avg(v: V3) -> f32 {
-    (v[0] + v[1] + v[2]) / 3.0
-}
-
 /// Result of sampling a dielectric: direction, eval / pdf (without the closure weight)
 /// and pdf (infinite when singular).
 pub struct DielectricSample {
@@ -249,7 +245,7 @@ impl Dielectric {
         let h = scale(hu, 1.0 / hl);
         let cos_hv = dot(h, v);
         let (r, t, _) = self.fresnel(cos_hv);
-        let sum = avg(r) + avg(t);
+        let sum = average(r) + average(t);
         if !(sum > 0.0) {
             return ([0.0; 3], 0.0);
         }
@@ -258,7 +254,7 @@ impl Dielectric {
         let lv = lambda(self.dist, a2, cos_nv);
         let ll = lambda(self.dist, a2, cos_nl);
         let common = dd / cos_nv * if is_t { (self.eta / hl) * (self.eta / hl) * (cos_hv * dot(h, l)).abs() } else { 0.25 };
-        let p_r = avg(r) / sum;
+        let p_r = average(r) / sum;
         let lobe = if is_t { 1.0 - p_r } else { p_r };
         let pdf = common * lobe / (1.0 + lv);
         let f = scale(if is_t { t } else { r }, common / (1.0 + lv + ll) * self.energy);
@@ -282,11 +278,11 @@ impl Dielectric {
         };
         let cos_hv = dot(h, v);
         let (r, t, cos_ht) = self.fresnel(cos_hv);
-        let sum = avg(r) + avg(t);
+        let sum = average(r) + average(t);
         if !(sum > 0.0) {
             return None;
         }
-        let p_r = avg(r) / sum;
+        let p_r = average(r) / sum;
         let refract = u[2] >= p_r;
         let l = if refract {
             // Snell: tangential part scaled by 1/eta, normal part from cos_ht.

@@ -207,7 +207,12 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         clamp_indirect: rna_f(cy, "sample_clamp_indirect").unwrap_or(10.0) as f32,
         min_light_bounces: gi("min_light_bounces", 0.0),
         filter_glossy: rna_f(cy, "blur_glossy").unwrap_or(1.0) as f32,
+        film_transparent: r.get("film_transparent").and_then(Value::as_bool).unwrap_or(false),
+        transparent_shadows: materials.iter().any(|m| m.transparent_shadow),
     };
+    if settings.film_transparent && cy.get("film_transparent_glass").and_then(Value::as_bool).unwrap_or(false) {
+        eprintln!("notice: Film > Transparent Glass is not supported; glass stays opaque in the alpha channel");
+    }
     let exposure = 1.0f32;
     let build_seconds = start.elapsed().as_secs_f64();
     let mesh_lights = mesh_lights(&geo, &materials, &bvh, &lights, background, tables, settings);
@@ -295,7 +300,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
                                 };
                                 (scratch.ray_dp, scratch.ray_dd) = camera.ray_differentials(fx, fy, [u[2], u[3]]);
                                 let c = tracer.radiance(o, d, t0, t1, &rng, i, scratch);
-                                px.add(i, c);
+                                px.add(i, c, scratch.transparent);
                                 let f = &scratch.features;
                                 tile.passes.feature_normal[k - 1] = add(tile.passes.feature_normal[k - 1], f.normal);
                                 tile.passes.feature_albedo[k - 1] = add(tile.passes.feature_albedo[k - 1], f.albedo);
@@ -339,7 +344,10 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     for i in 0..npix {
         let p = film.pixel(i);
         let inv = exposure as f64 / p.count.max(1) as f64;
-        color[i] = [(p.sum[0] * inv) as f32, (p.sum[1] * inv) as f32, (p.sum[2] * inv) as f32, 1.0];
+        // Colour stays premultiplied (the background and holdouts added none); alpha is
+        // 1 - transparency, as Cycles' combined pass gives it.
+        let alpha = (1.0 - p.transparent / p.count.max(1) as f64).clamp(0.0, 1.0);
+        color[i] = [(p.sum[0] * inv) as f32, (p.sum[1] * inv) as f32, (p.sum[2] * inv) as f32, alpha as f32];
         sample_count[i] = p.count;
     }
     let mut passes = Passes {

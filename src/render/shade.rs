@@ -24,6 +24,10 @@ pub struct Material {
     /// Cycles' SD_HAS_BSSRDF_BUMP: a subsurface exit on this material lights with the
     /// BSSRDF's (bumped) normal, so the material runs there (see `subsurface::exit_normal`).
     pub bssrdf_bump: bool,
+    /// Cycles' SD_HAS_TRANSPARENT_SHADOW: the material can be transparent (a Transparent
+    /// BSDF, or a Principled BSDF whose Alpha is linked or below 1), so shadow rays run
+    /// it instead of stopping at it.
+    pub transparent_shadow: bool,
 }
 
 /// Every material of the scene, in `scene.file.materials` order.
@@ -31,7 +35,7 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
     let mut out = Vec::new();
     for (i, m) in scene.file.materials.iter().enumerate() {
         if !used.get(i).copied().unwrap_or(false) {
-            out.push(Material { program: None, bsdf_of: Vec::new(), name: m.name.clone(), sampling: String::new(), bump_correction: true, bssrdf_bump: false });
+            out.push(Material { program: None, bsdf_of: Vec::new(), name: m.name.clone(), sampling: String::new(), bump_correction: true, bssrdf_bump: false, transparent_shadow: false });
             continue;
         }
         let p = compile_material(scene, &m.name).map_err(|e| RenderError(format!("{e}")))?;
@@ -44,7 +48,8 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
         let sampling = m.properties.get("cycles").and_then(|c| c.get("emission_sampling")).and_then(|v| v.as_str()).unwrap_or("AUTO").to_string();
         let bump_correction = m.properties.get("cycles").and_then(|c| c.get("use_bump_map_correction")).and_then(|v| v.as_bool()).unwrap_or(true);
         let bssrdf_bump = has_bssrdf_bump(&p);
-        out.push(Material { program: Some(p), bsdf_of, name: m.name.clone(), sampling, bump_correction, bssrdf_bump });
+        let transparent_shadow = can_be_transparent(&p);
+        out.push(Material { program: Some(p), bsdf_of, name: m.name.clone(), sampling, bump_correction, bssrdf_bump, transparent_shadow });
     }
     Ok(out)
 }
@@ -55,6 +60,20 @@ pub fn displacement_reads_attributes(p: &Program) -> bool {
     use crate::shader::program::Op;
     let Some(d) = p.displacement else { return false };
     p.ops[..d.center_end.min(p.ops.len())].iter().any(|op| matches!(op, Op::Attribute { .. } | Op::ColorAttribute { .. } | Op::NamedUv { .. } | Op::NormalMapTangent { .. } | Op::VectorDisplacementTangent { .. } | Op::TangentUv { .. }))
+}
+
+/// Whether the material has a closure that can be transparent (Cycles marks such
+/// shaders for transparent shadows).
+fn can_be_transparent(p: &Program) -> bool {
+    p.bsdfs.iter().any(|b| match b.bl_idname.as_str() {
+        "ShaderNodeBsdfTransparent" => true,
+        "ShaderNodeBsdfPrincipled" => match b.input("Alpha") {
+            Some((_, true)) => true,
+            Some((slot, false)) => p.initial.get(slot as usize).is_some_and(|a| *a < 1.0),
+            None => false,
+        },
+        _ => false,
+    })
 }
 
 /// Cycles' `has_bssrdf_bump` (svm.cpp: the displacement's bump, or a BSSRDF node whose
