@@ -258,9 +258,18 @@ struct RenderArgs {
     /// Parameter override by Blender data path, PATH=VALUE (repeatable).
     #[arg(long = "set", value_name = "PATH=VALUE")]
     set: Vec<String>,
-    /// Folder for label passes (depth, ids, normal, uv, albedo) as float EXRs.
+    /// Folder for label passes from the pixel-centre ray: depth (Z) and distance,
+    /// object/instance/material ids, semantic class, normal, albedo, UV, and classes.json.
     #[arg(long)]
     passes: Option<PathBuf>,
+    /// File format of the passes: exr (float) or png (16-bit ids, depth in mm).
+    #[arg(long, value_enum, default_value = "exr")]
+    pass_format: PassFormatArg,
+    /// Class mapping for the semantic pass: a TOML file with a [labels] section as in a
+    /// dataset spec ([[labels.class]] name + objects patterns, class_property,
+    /// mm_per_unit). Without it, objects' custom property `class` names their class.
+    #[arg(long)]
+    classes: Option<PathBuf>,
     /// Denoise with Open Image Denoise as Cycles does (default: the scene's setting).
     #[arg(long, value_enum)]
     denoise: Option<OnOff>,
@@ -272,6 +281,12 @@ struct RenderArgs {
     /// exposure, gamma; its bit depth and alpha), or .exr linear float RGBA.
     #[arg(short, long)]
     output: PathBuf,
+}
+
+#[derive(Clone, Copy, PartialEq, clap::ValueEnum)]
+enum PassFormatArg {
+    Exr,
+    Png,
 }
 
 #[derive(Clone, Copy, PartialEq, clap::ValueEnum)]
@@ -314,24 +329,34 @@ fn run_render(a: RenderArgs) -> Result<()> {
     }
     blendsynth::color::write_render(&scene, &a.output, out.width, out.height, &out.color)?;
     if let Some(dir) = &a.passes {
-        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        use blendsynth::label::passes::{write_passes, PassFormat, PassImages};
+        let labels = match &a.classes {
+            Some(f) => {
+                let text = std::fs::read_to_string(f).with_context(|| format!("cannot read {}", f.display()))?;
+                let v: toml::Value = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", f.display()))?;
+                let l = v.get("labels").ok_or_else(|| anyhow::anyhow!("{}: no [labels] section", f.display()))?;
+                blendsynth::label::LabelSpec::from_toml(l).map_err(|e| anyhow::anyhow!("{}: [labels]: {e}", f.display()))?
+            }
+            None => blendsynth::label::LabelSpec::default(),
+        };
+        let classes = blendsynth::label::ClassMap::new(&labels, &scene);
         let p = &out.passes;
-        let grey = |v: &[f32]| v.iter().map(|&x| [x, x, x, 1.0]).collect::<Vec<_>>();
-        let ids = |v: &[u32]| v.iter().map(|&x| [x as f32, x as f32, x as f32, 1.0]).collect::<Vec<_>>();
-        let rgb = |v: &[[f32; 3]]| v.iter().map(|x| [x[0], x[1], x[2], 1.0]).collect::<Vec<_>>();
-        let depth: Vec<f32> = p.depth.iter().map(|&d| if d.is_finite() { d } else { 1e10 }).collect();
-        let files: [(&str, Vec<[f32; 4]>); 7] = [
-            ("depth.exr", grey(&depth)),
-            ("object_index.exr", ids(&p.object_index)),
-            ("instance_id.exr", ids(&p.instance_id)),
-            ("material_index.exr", ids(&p.material_index)),
-            ("normal.exr", rgb(&p.normal)),
-            ("albedo.exr", rgb(&p.albedo)),
-            ("uv.exr", p.uv.iter().map(|u| [u[0], u[1], 0.0, 1.0]).collect()),
-        ];
-        for (name, px) in files {
-            render::write_exr(&dir.join(name), out.width, out.height, &px).map_err(anyhow::Error::msg)?;
-        }
+        let objects: Vec<String> = p.instances.iter().map(|i| i.object.clone()).collect();
+        let images = PassImages {
+            width: out.width,
+            height: out.height,
+            depth: &p.depth,
+            distance: &p.distance,
+            object_index: &p.object_index,
+            instance_id: &p.instance_id,
+            material_index: &p.material_index,
+            normal: &p.normal,
+            albedo: &p.albedo,
+            uv: &p.uv,
+            instance_objects: &objects,
+        };
+        let format = if a.pass_format == PassFormatArg::Png { PassFormat::Png } else { PassFormat::Exr };
+        write_passes(dir, &images, &classes, format, labels.mm_per_unit).map_err(anyhow::Error::msg)?;
     }
     let s = &out.stats;
     println!(

@@ -528,3 +528,74 @@ fn moving_object_hidden_from_every_surface_ray_is_not_seen() {
     assert_ne!(with_cube, gone_bits, "the cube should show when visible");
     assert_eq!(hidden_bits, gone_bits, "a moving object hidden from every surface ray must not be met");
 }
+
+/// Cycles' Z and object index passes (one centred sample per pixel, made by
+/// fixtures/render/make_pass_refs.py) against `blendsynth render --passes`, in both file
+/// formats, with the semantic pass from a class mapping file.
+#[test]
+fn pass_refs_match_cycles() {
+    let bytes = std::fs::read(common::repo().join("fixtures/render/passes/diffuse_point.bin")).unwrap();
+    let (w, h) = (u32::from_le_bytes(bytes[0..4].try_into().unwrap()) as usize, u32::from_le_bytes(bytes[4..8].try_into().unwrap()) as usize);
+    let vals: Vec<f32> = bytes[8..].chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().unwrap())).collect();
+    assert_eq!(vals.len(), w * h * 2);
+    let (z_ref, id_ref): (Vec<f32>, Vec<u32>) = (vals.iter().step_by(2).copied().collect(), vals.iter().skip(1).step_by(2).map(|v| *v as u32).collect());
+    let tmp = tempfile::tempdir().unwrap();
+    let classes = tmp.path().join("classes.toml");
+    std::fs::write(&classes, "[labels]\n[[labels.class]]\nname = \"ball\"\nobjects = [\"Sph*\"]\n[[labels.class]]\nname = \"box\"\nobjects = [\"Cube\"]\n").unwrap();
+    let scene = common::repo().join("fixtures/render/scenes/diffuse_point");
+    for format in ["exr", "png"] {
+        let dir = tmp.path().join(format);
+        let st = std::process::Command::new(env!("CARGO_BIN_EXE_blendsynth"))
+            .args(["render", scene.to_str().unwrap(), "--samples", "1", "--resolution", &format!("{w}x{h}"), "--pass-format", format, "--classes", classes.to_str().unwrap(), "--passes", dir.to_str().unwrap(), "-o", tmp.path().join("img.exr").to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert!(st.status.success(), "{}", String::from_utf8_lossy(&st.stderr));
+        let meta: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("classes.json")).unwrap()).unwrap();
+        assert_eq!(meta["semantic"]["1"], "ball");
+        assert_eq!(meta["semantic"]["2"], "box");
+        // Our instance ids name objects; Cycles' reference used pass indices Floor 1, Sphere 2, Cube 3.
+        let pass_index = |id: u32| -> u32 {
+            if id == 0 {
+                return 0;
+            }
+            match meta["instance_id"][id.to_string()].as_str().unwrap() {
+                "Floor" => 1,
+                "Sphere" => 2,
+                "Cube" => 3,
+                o => panic!("unexpected object {o}"),
+            }
+        };
+        let grey = |name: &str| -> Vec<f32> {
+            let img = image::open(dir.join(format!("{name}.{format}"))).unwrap();
+            match format {
+                "exr" => img.to_rgba32f().pixels().map(|p| p[0]).collect(),
+                _ => img.as_luma16().unwrap().pixels().map(|p| p[0] as f32).collect(),
+            }
+        };
+        let (depth, distance, inst, sem) = (grey("depth"), grey("distance"), grey("instance_id"), grey("semantic"));
+        let (mut same_id, mut worst) = (0usize, 0f32);
+        for i in 0..w * h {
+            let ours = pass_index(inst[i] as u32);
+            if ours != id_ref[i] {
+                continue; // an edge pixel whose centre ray grazes another object
+            }
+            same_id += 1;
+            let want_sem = match ours {
+                2 => 1.0,
+                3 => 2.0,
+                _ => 0.0,
+            };
+            assert_eq!(sem[i], want_sem, "semantic at pixel {i}");
+            if ours == 0 {
+                assert_eq!(depth[i], if format == "exr" { 1e10 } else { 0.0 });
+                continue;
+            }
+            let err = if format == "exr" { (depth[i] - z_ref[i]).abs() / z_ref[i] } else { (depth[i] - (z_ref[i] * 1000.0).round()).abs() };
+            worst = worst.max(err);
+            assert!(distance[i] >= depth[i] - if format == "exr" { 1e-5 * depth[i] } else { 1.0 }, "distance below depth at {i}");
+        }
+        println!("{format}: ids agree on {same_id} of {} pixels; worst depth error {worst:e} ({})", w * h, if format == "exr" { "relative" } else { "mm" });
+        assert!(same_id as f64 >= 0.99 * (w * h) as f64, "{format}: ids agree on only {same_id} pixels");
+        assert!(worst <= if format == "exr" { 1e-4 } else { 1.0 }, "{format}: depth differs from Cycles' Z by {worst}");
+    }
+}

@@ -283,7 +283,7 @@ impl FrameContext<'_> {
         let labels_spec = &self.spec.labels;
         if labels_spec.depth {
             let d = r.ids.depth.as_ref().ok_or("the spec asks for depth but the renderer gave none")?;
-            let mm: Vec<u16> = d.iter().map(|z| if z.is_finite() { (*z as f64 * labels_spec.mm_per_unit).round().clamp(0.0, 65535.0) as u16 } else { 0 }).collect();
+            let mm: Vec<u16> = d.iter().map(|&z| crate::label::passes::depth_mm(z, labels_spec.mm_per_unit)).collect();
             let p = layout::depth_path(self.out, split, i);
             write_atomic(&p, &layout::png16_bytes(r.width, r.height, &mm)?)?;
             hook(&p)?;

@@ -6,13 +6,15 @@
 //!
 //! One idea per file: `classes` (which object is which class), `instances` (masks,
 //! boxes, the drop rule), `rle` (COCO's compressed RLE), `camera` (intrinsics, pose),
-//! `coco` and `yolo` (file formats), `record` (the per-frame JSON).
+//! `coco` and `yolo` (file formats), `record` (the per-frame JSON), `passes` (a render's
+//! label passes as image files).
 
 pub mod camera;
 pub mod classes;
 pub mod coco;
 pub mod instances;
 pub mod record;
+pub mod passes;
 pub mod rle;
 pub mod yolo;
 

@@ -203,6 +203,16 @@ impl Camera {
         let view = neg(self.to_world.column(2));
         dot(sub(w, self.to_world.column(3)), view)
     }
+
+    /// Distance of world point `w` from the camera along its ray: from the eye for a
+    /// perspective camera, from the view plane (the depth) for an orthographic one.
+    pub fn distance(&self, w: V3) -> f32 {
+        if self.ortho {
+            self.depth(w)
+        } else {
+            len(sub(w, self.to_world.column(3)))
+        }
+    }
 }
 
 /// The transform with its axes normalised (Cycles clears camera scale).

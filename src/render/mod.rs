@@ -91,7 +91,10 @@ pub struct RenderOutput {
 
 #[derive(Debug, Clone, Default)]
 pub struct Passes {
+    /// Camera-space depth (Z along the view axis) of the pixel centre's surface.
     pub depth: Vec<f32>,
+    /// Distance from the camera ray's origin to that surface (`depth` is Cycles' Z pass).
+    pub distance: Vec<f32>,
     pub object_index: Vec<u32>,
     pub instance_id: Vec<u32>,
     pub material_index: Vec<u32>,
@@ -352,6 +355,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     }
     let mut passes = Passes {
         depth: vec![f32::INFINITY; npix],
+        distance: vec![f32::INFINITY; npix],
         object_index: vec![0; npix],
         instance_id: vec![0; npix],
         material_index: vec![0; npix],
@@ -375,6 +379,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
             for x in t.tx..t.tx + t.tw {
                 let i = (y * w + x) as usize;
                 passes.depth[i] = p.depth[k];
+                passes.distance[i] = p.distance[k];
                 passes.object_index[i] = p.object_index[k];
                 passes.instance_id[i] = p.instance_id[k];
                 passes.material_index[i] = p.material_index[k];
@@ -485,6 +490,7 @@ struct TileWork {
 #[derive(Default)]
 struct TilePasses {
     depth: Vec<f32>,
+    distance: Vec<f32>,
     object_index: Vec<u32>,
     instance_id: Vec<u32>,
     material_index: Vec<u32>,
@@ -509,6 +515,7 @@ fn primary_passes(tracer: &integrator::Scene, camera: &camera::Camera, x: u32, y
             tracer.shade(&hit, wo, scratch);
             let inst = &tracer.geo.instances[hit.inst as usize];
             out.depth.push(camera.depth(hit.p));
+            out.distance.push(camera.distance(hit.p));
             out.object_index.push(inst.object as u32 + 1);
             out.instance_id.push(hit.inst + 1);
             out.material_index.push(hit.material.map(|m| m as u32 + 1).unwrap_or(0));
@@ -517,6 +524,7 @@ fn primary_passes(tracer: &integrator::Scene, camera: &camera::Camera, x: u32, y
         }
         None => {
             out.depth.push(f32::INFINITY);
+            out.distance.push(f32::INFINITY);
             out.object_index.push(0);
             out.instance_id.push(0);
             out.material_index.push(0);
