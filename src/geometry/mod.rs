@@ -37,6 +37,8 @@ pub mod instances;
 pub mod interpolate;
 pub mod math;
 pub mod mesh;
+pub mod mesh_sample;
+pub mod nearest;
 pub mod nodes;
 pub mod pointcloud;
 pub mod polyfill;
