@@ -7,7 +7,8 @@
 //! `mesh`, `curves`, `pointcloud`, `instances`, `set`, `interpolate` (domain
 //! interpolation), `field`, `value` (socket values), `eval` (modifier stacks and trees),
 //! `nodes/*` (node implementations), `realize` (join and realize), `export` (PLY, OBJ,
-//! glb), `animated` (overrides and animated node values), `math`.
+//! glb), `animated` (overrides and animated node values), `math`, `nearest` (nearest
+//! elements), `mesh_sample` (values at points on corner triangles).
 //!
 //! ```no_run
 //! use blendsynth::{geometry, scene::Scene};
@@ -37,6 +38,8 @@ pub mod instances;
 pub mod interpolate;
 pub mod math;
 pub mod mesh;
+pub mod mesh_sample;
+pub mod nearest;
 pub mod nodes;
 pub mod pointcloud;
 pub mod polyfill;

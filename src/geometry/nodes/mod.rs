@@ -22,8 +22,10 @@ pub mod curve_to_points;
 pub mod mesh_to_curve;
 pub mod dual_mesh;
 pub mod sample_curve;
+pub mod sample_nearest;
 pub mod primitives;
 pub mod proximity;
+pub mod raycast;
 pub mod rotation;
 pub mod subdivide;
 pub mod subdivision_surface;
@@ -122,6 +124,9 @@ pub const SUPPORTED: &[&str] = &[
     "GeometryNodeDualMesh",
     "GeometryNodeSampleCurve",
     "GeometryNodeFillCurve",
+    "GeometryNodeRaycast",
+    "GeometryNodeSampleNearestSurface",
+    "GeometryNodeSampleNearest",
 ];
 
 pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -215,6 +220,9 @@ pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "GeometryNodeDualMesh" => dual_mesh::dual_mesh(ctx),
         "GeometryNodeSampleCurve" => sample_curve::sample_curve(ctx),
         "GeometryNodeFillCurve" => fill_curve::fill_curve(ctx),
+        "GeometryNodeRaycast" => raycast::raycast(ctx),
+        "GeometryNodeSampleNearestSurface" => sample_nearest::sample_nearest_surface(ctx),
+        "GeometryNodeSampleNearest" => sample_nearest::sample_nearest(ctx),
         _ => Err(ctx.err("this node type is not supported by blendsynth's Geometry Nodes evaluator")),
     }
 }

@@ -1,11 +1,13 @@
 //! Geometry Proximity: distance to and position of the nearest target element: POINTS
 //! (mesh vertices and point cloud points), EDGES (mesh edges as segments) or FACES (mesh
-//! faces as Blender's corner triangles). Edges and faces are searched exhaustively.
+//! faces as Blender's corner triangles), searched with a bounding-box tree (`nearest`), the
+//! lowest index winning exact ties.
 
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::Field;
 use super::super::math::V3;
+use super::super::nearest::{bounds_of, closest_on_segment, closest_on_triangle, dist_sq, NearestTree};
 use super::super::realize::realize_instances;
 use super::super::types::{Array, DataType};
 use super::super::value::SocketValue;
@@ -80,7 +82,7 @@ pub fn geometry_proximity(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         }
         "EDGES" => {
             let segs = target.mesh.as_ref().map_or(Vec::new(), |m| m.edges.iter().map(|e| [m.positions[e[0] as usize], m.positions[e[1] as usize]]).collect());
-            Target::Edges(segs)
+            Target::edges(segs)
         }
         "FACES" => {
             let tris = match &target.mesh {
@@ -90,7 +92,7 @@ pub fn geometry_proximity(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
                 }
                 None => Vec::new(),
             };
-            Target::Faces(tris)
+            Target::faces(tris)
         }
         other => return Err(ctx.err(format!("target element {other} is not supported"))),
     };
@@ -118,99 +120,33 @@ pub fn geometry_proximity(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
 
 enum Target {
     Points(SortedPoints),
-    Edges(Vec<[V3; 2]>),
-    Faces(Vec<[V3; 3]>),
+    Edges(Vec<[V3; 2]>, NearestTree),
+    Faces(Vec<[V3; 3]>, NearestTree),
 }
 
 impl Target {
+    fn edges(segs: Vec<[V3; 2]>) -> Target {
+        let tree = NearestTree::build(&segs.iter().map(|s| bounds_of(s)).collect::<Vec<_>>());
+        Target::Edges(segs, tree)
+    }
+    fn faces(tris: Vec<[V3; 3]>) -> Target {
+        let tree = NearestTree::build(&tris.iter().map(|t| bounds_of(t)).collect::<Vec<_>>());
+        Target::Faces(tris, tree)
+    }
     fn nearest(&self, q: V3) -> Option<(V3, f32)> {
-        let best = |it: &mut dyn Iterator<Item = V3>| -> Option<(V3, f32)> {
-            let mut out: Option<(V3, f32)> = None;
-            for p in it {
-                let d = dist2(p, q);
-                if out.map_or(true, |(_, b)| d < b) {
-                    out = Some((p, d));
-                }
-            }
-            out.map(|(p, d)| (p, d.sqrt()))
+        let found = match self {
+            Target::Points(p) => return p.nearest(q),
+            Target::Edges(s, tree) => tree.nearest(q, |i| {
+                let [a, b] = s[i as usize];
+                let p = closest_on_segment(q, a, b);
+                (dist_sq(p, q), p)
+            }),
+            Target::Faces(t, tree) => tree.nearest(q, |i| {
+                let [a, b, c] = t[i as usize];
+                let p = closest_on_triangle(q, a, b, c);
+                (dist_sq(p, q), p)
+            }),
         };
-        match self {
-            Target::Points(p) => p.nearest(q),
-            Target::Edges(s) => best(&mut s.iter().map(|[a, b]| closest_on_segment(q, *a, *b))),
-            Target::Faces(t) => best(&mut t.iter().map(|[a, b, c]| closest_on_triangle(q, *a, *b, *c))),
-        }
+        found.map(|(_, d, p)| (p, d.sqrt()))
     }
-}
-
-fn dist2(a: V3, b: V3) -> f32 {
-    (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2])
-}
-
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: V3, b: V3) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn madd(a: V3, d: V3, t: f32) -> V3 {
-    [a[0] + d[0] * t, a[1] + d[1] * t, a[2] + d[2] * t]
-}
-
-/// `closest_to_line_segment_v3`.
-fn closest_on_segment(p: V3, a: V3, b: V3) -> V3 {
-    let d = sub(b, a);
-    let len2 = dot(d, d);
-    if len2 == 0.0 {
-        return a;
-    }
-    let t = dot(sub(p, a), d) / len2;
-    if t <= 0.0 {
-        a
-    } else if t >= 1.0 {
-        b
-    } else {
-        madd(a, d, t)
-    }
-}
-
-/// `closest_on_tri_to_point_v3` (the Voronoi-region walk of Ericson's book).
-fn closest_on_triangle(p: V3, a: V3, b: V3, c: V3) -> V3 {
-    let ab = sub(b, a);
-    let ac = sub(c, a);
-    let ap = sub(p, a);
-    let d1 = dot(ab, ap);
-    let d2 = dot(ac, ap);
-    if d1 <= 0.0 && d2 <= 0.0 {
-        return a;
-    }
-    let bp = sub(p, b);
-    let d3 = dot(ab, bp);
-    let d4 = dot(ac, bp);
-    if d3 >= 0.0 && d4 <= d3 {
-        return b;
-    }
-    let vc = d1 * d4 - d3 * d2;
-    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
-        return madd(a, ab, d1 / (d1 - d3));
-    }
-    let cp = sub(p, c);
-    let d5 = dot(ab, cp);
-    let d6 = dot(ac, cp);
-    if d6 >= 0.0 && d5 <= d6 {
-        return c;
-    }
-    let vb = d5 * d2 - d1 * d6;
-    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
-        return madd(a, ac, d2 / (d2 - d6));
-    }
-    let va = d3 * d6 - d5 * d4;
-    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
-        return madd(b, sub(c, b), (d4 - d3) / ((d4 - d3) + (d5 - d6)));
-    }
-    let denom = 1.0 / (va + vb + vc);
-    let v = vb * denom;
-    let w = vc * denom;
-    madd(madd(a, ab, v), ac, w)
 }
