@@ -684,6 +684,10 @@ def main():
     ap.add_argument("--frame", type=int, help="frame to evaluate at (default: the file's current frame)")
     ap.add_argument("--no-evaluated", action="store_true", help="skip the evaluated reference meshes")
     args = ap.parse_args(argv)
+    # Older Blenders keep nodes that 4.x's versioning rewrites on load (3.x's Musgrave
+    # Texture becomes a Noise Texture plus Math nodes in 4.1), and their sockets differ.
+    if tuple(bpy.app.version) < (4, 2, 0):
+        fail(f"Blender {bpy.app.version_string} is too old: the exporter needs Blender 4.2 LTS or newer")
     if args.input is None:
         # `blender -b --disable-autoexec FILE --python export_scene.py -- --out DIR`:
         # Blender opened FILE itself, safe only when started with --disable-autoexec.
