@@ -258,6 +258,17 @@ fn label_passes_from_the_pixel_centre() {
 }
 
 #[test]
+fn thin_film_is_refused_not_ignored() {
+    let dir = common::repo().join("fixtures/render/scenes/principled");
+    let o = blendsynth::scene::Override::parse("materials[\"Plastic\"].node_tree.nodes[\"Principled BSDF\"].inputs[\"Thin Film Thickness\"].default_value=300").unwrap();
+    let scene = Scene::load(&dir).unwrap().with_overrides(&[o]).unwrap();
+    let e = render(&scene, &RenderOptions { samples: Some(1), resolution: Some((8, 8)), ..Default::default() }).err().expect("thin film must be refused").0;
+    assert!(e.contains("Plastic") && e.contains("thin film"), "{e}");
+    // Without it the same scene renders.
+    assert!(render(&Scene::load(&dir).unwrap(), &RenderOptions { samples: Some(1), resolution: Some((8, 8)), ..Default::default() }).is_ok());
+}
+
+#[test]
 fn non_finite_samples_never_poison_pixels() {
     // An emission strength beyond f32 range is infinite in the shader program; closure
     // inputs that are not finite read as 0 (documented fallback) and non-finite samples

@@ -47,6 +47,7 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
         }
         let sampling = m.properties.get("cycles").and_then(|c| c.get("emission_sampling")).and_then(|v| v.as_str()).unwrap_or("AUTO").to_string();
         let bump_correction = m.properties.get("cycles").and_then(|c| c.get("use_bump_map_correction")).and_then(|v| v.as_bool()).unwrap_or(true);
+        refuse_thin_film(&p, &m.name)?;
         let bssrdf_bump = has_bssrdf_bump(&p);
         let transparent_shadow = can_be_transparent(&p);
         out.push(Material { program: Some(p), bsdf_of, name: m.name.clone(), sampling, bump_correction, bssrdf_bump, transparent_shadow });
@@ -60,6 +61,22 @@ pub fn displacement_reads_attributes(p: &Program) -> bool {
     use crate::shader::program::Op;
     let Some(d) = p.displacement else { return false };
     p.ops[..d.center_end.min(p.ops.len())].iter().any(|op| matches!(op, Op::Attribute { .. } | Op::ColorAttribute { .. } | Op::NamedUv { .. } | Op::NormalMapTangent { .. } | Op::VectorDisplacementTangent { .. } | Op::TangentUv { .. }))
+}
+
+/// The Principled BSDF's thin film (4.2+) is not rendered yet: a material that uses it
+/// (Thin Film Thickness linked or above 0) is an error, never rendered without it.
+fn refuse_thin_film(p: &Program, material: &str) -> Result<(), RenderError> {
+    for b in p.bsdfs.iter().filter(|b| b.bl_idname == "ShaderNodeBsdfPrincipled") {
+        let used = match b.input("Thin Film Thickness") {
+            Some((_, true)) => true,
+            Some((slot, false)) => p.initial.get(slot as usize).is_some_and(|t| *t > 0.0),
+            None => false,
+        };
+        if used {
+            return Err(RenderError(format!("material {material:?}: Principled BSDF thin film (Thin Film Thickness > 0) is not supported yet")));
+        }
+    }
+    Ok(())
 }
 
 /// Whether the material has a closure that can be transparent (Cycles marks such
