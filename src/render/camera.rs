@@ -1,6 +1,7 @@
 //! Blender's camera as Cycles builds it: sensor fit, shift, clipping (planar, along the
 //! view axis), perspective and orthographic projection, thin-lens depth of field with
-//! f-stop, focus distance or focus object, aperture blades and rotation.
+//! f-stop, focus distance or focus object, aperture blades and rotation; panoramic
+//! cameras (`panorama`: equirectangular, fisheyes, mirror ball, cube face, cylindrical).
 
 use serde_json::Value;
 
@@ -32,6 +33,8 @@ pub struct Camera {
     pub height: u32,
     /// Camera-to-world at the motion steps across the shutter, when motion blur is on.
     motion: Option<Vec<super::motion::Decomposed>>,
+    /// A panoramic camera's projection (viewplane [0, 1]^2 plus shift).
+    pub panorama: Option<super::panorama::Panorama>,
 }
 
 fn num(p: &serde_json::Map<String, Value>, key: &str, default: f64) -> f64 {
@@ -47,14 +50,15 @@ impl Camera {
         let cam = eval.data.cameras.iter().find(|c| c.name == data).ok_or_else(|| RenderError(format!("camera object {cam_name:?}: camera data {data:?} is not in the export")))?;
         let p = &cam.properties;
         let kind = p.get("type").and_then(Value::as_str).unwrap_or("PERSP");
-        if kind == "PANO" {
-            return Err(RenderError(format!("camera {data:?}: panoramic cameras are not supported yet")));
+        if !matches!(kind, "PERSP" | "ORTHO" | "PANO") {
+            return Err(RenderError(format!("camera {data:?}: camera type {kind:?} is not supported")));
         }
         let ortho = kind == "ORTHO";
         let r = &scene.file.scene.render;
         let (pax, pay) = (num(r, "pixel_aspect_x", 1.0) as f32, num(r, "pixel_aspect_y", 1.0) as f32);
         let xratio = width as f32 * pax;
         let yratio = height as f32 * pay;
+        let panorama = if kind == "PANO" { Some(super::panorama::Panorama::from_camera(p, xratio, yratio).map_err(|e| RenderError(format!("camera {data:?}: {e}")))?) } else { None };
         let fit = p.get("sensor_fit").and_then(Value::as_str).unwrap_or("AUTO");
         let (horizontal, sensor) = match fit {
             "HORIZONTAL" => (true, num(p, "sensor_width", 36.0)),
@@ -101,12 +105,14 @@ impl Camera {
         }
         let clip_start = num(p, "clip_start", 0.1) as f32;
         let clip_end = num(p, "clip_end", 100.0) as f32;
+        // A panoramic camera's viewplane is [0, 1]^2, moved by the shift as it is.
+        let (left, right, bottom, top) = if panorama.is_some() { (sx, 1.0 + sx, sy, 1.0 + sy) } else { (-xaspect + dx, xaspect + dx, -yaspect + dy, yaspect + dy) };
         Ok(Camera {
             ortho,
-            left: -xaspect + dx,
-            right: xaspect + dx,
-            bottom: -yaspect + dy,
-            top: yaspect + dy,
+            left,
+            right,
+            bottom,
+            top,
             tan_half,
             clip_start,
             clip_end,
@@ -119,6 +125,7 @@ impl Camera {
             width,
             height,
             motion: None,
+            panorama,
         })
     }
 
@@ -150,6 +157,9 @@ impl Camera {
     fn ray_with(&self, to_world: &Affine, x: f32, y: f32, lens: [f32; 2]) -> (V3, V3, f32, f32) {
         let vx = self.left + (self.right - self.left) * (x / self.width as f32);
         let vy = self.top - (self.top - self.bottom) * (y / self.height as f32);
+        if let Some(pano) = &self.panorama {
+            return self.panorama_ray(pano, to_world, vx, vy, lens);
+        }
         // Camera space, looking down -Z.
         let (mut p, mut d) = if self.ortho { ([vx, vy, 0.0], [0.0, 0.0, -1.0]) } else { ([0.0; 3], normalize([vx * self.tan_half, vy * self.tan_half, -1.0])) };
         let tmin;
@@ -180,6 +190,35 @@ impl Camera {
         (wo, wd, tmin, tmax)
     }
 
+    /// Cycles' camera_sample_panorama: the direction from the projection, a thin lens
+    /// across it, the near clip along the ray. Outside the lens: a zero direction and
+    /// tmax 0 (the sample sees nothing).
+    fn panorama_ray(&self, pano: &super::panorama::Panorama, to_world: &Affine, u: f32, v: f32, lens: [f32; 2]) -> (V3, V3, f32, f32) {
+        let mut d = pano.direction(u, v);
+        if d == [0.0; 3] {
+            return (to_world.column(3), [0.0; 3], 0.0, 0.0);
+        }
+        let mut p = [0.0f32; 3];
+        if self.aperture > 0.0 {
+            let mut uv = self.sample_aperture(lens);
+            uv[0] *= self.aperture;
+            uv[1] *= self.aperture;
+            let df = normalize(d);
+            let pf = scale(df, self.focus);
+            let mut a = sub([1.0, 0.0, 0.0], scale(df, df[0]));
+            if dot(a, a) < 1e-12 {
+                a = [0.0, 1.0, 0.0];
+            }
+            let a = normalize(a);
+            let b = normalize(cross(df, a));
+            p = add(scale(a, uv[0]), scale(b, uv[1]));
+            d = normalize(sub(pf, p));
+        }
+        let wo = to_world.point(pano.to_blender_camera(p));
+        let wd = normalize(to_world.vector(pano.to_blender_camera(d)));
+        (madd(wo, wd, self.clip_start), wd, 0.0, self.clip_end - self.clip_start)
+    }
+
     /// Compact ray differentials (Cycles' ray.dP, ray.dD) of the ray through (x, y): the
     /// mean change of its origin and direction one pixel right and one pixel down.
     pub fn ray_differentials(&self, x: f32, y: f32, lens: [f32; 2]) -> (f32, f32) {
@@ -200,6 +239,10 @@ impl Camera {
 
     /// The camera-space Z distance of a world point (for the depth pass).
     pub fn depth(&self, w: V3) -> f32 {
+        // Cycles' camera_z_depth: a panorama has no view axis, so its depth is the distance.
+        if self.panorama.is_some() {
+            return len(sub(w, self.to_world.column(3)));
+        }
         let view = neg(self.to_world.column(2));
         dot(sub(w, self.to_world.column(3)), view)
     }

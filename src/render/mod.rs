@@ -27,6 +27,7 @@ pub mod motion;
 pub mod object_motion;
 pub mod microfacet;
 pub mod oren_nayar;
+pub mod panorama;
 pub mod sampler;
 pub mod shade;
 pub mod sheen;
@@ -302,7 +303,14 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
                                     None => camera.ray(fx, fy, [u[2], u[3]]),
                                 };
                                 (scratch.ray_dp, scratch.ray_dd) = camera.ray_differentials(fx, fy, [u[2], u[3]]);
-                                let c = tracer.radiance(o, d, t0, t1, &rng, i, scratch);
+                                // A panoramic camera's sample outside the lens sees nothing (black, opaque).
+                                let c = if t1 > 0.0 {
+                                    tracer.radiance(o, d, t0, t1, &rng, i, scratch)
+                                } else {
+                                    scratch.transparent = 0.0;
+                                    scratch.features = Default::default();
+                                    [0.0; 3]
+                                };
                                 px.add(i, c, scratch.transparent);
                                 let f = &scratch.features;
                                 tile.passes.feature_normal[k - 1] = add(tile.passes.feature_normal[k - 1], f.normal);
