@@ -3,6 +3,7 @@
 
 pub mod attribute;
 pub mod bounding_box;
+pub mod color;
 pub mod curve;
 pub mod curve_fields;
 pub mod curve_primitives;
@@ -27,6 +28,7 @@ pub mod proximity;
 pub mod rotation;
 pub mod subdivide;
 pub mod subdivision_surface;
+pub mod texture;
 
 use super::error::GeometryError;
 use super::eval::{NodeCtx, Outputs};
@@ -122,6 +124,24 @@ pub const SUPPORTED: &[&str] = &[
     "GeometryNodeDualMesh",
     "GeometryNodeSampleCurve",
     "GeometryNodeFillCurve",
+    // texture.rs, color.rs: tests/geometry.rs, scene "textures".
+    "ShaderNodeTexVoronoi",
+    "ShaderNodeTexWhiteNoise",
+    "ShaderNodeTexGradient",
+    "ShaderNodeTexWave",
+    "ShaderNodeTexMagic",
+    "ShaderNodeTexChecker",
+    "ShaderNodeTexBrick",
+    "ShaderNodeValToRGB",
+    "ShaderNodeRGBCurve",
+    "ShaderNodeVectorCurve",
+    "FunctionNodeSeparateColor",
+    "FunctionNodeCombineColor",
+    "ShaderNodeMixRGB",
+    "ShaderNodeVectorRotate",
+    "FunctionNodeRotateVector",
+    "FunctionNodeFloatToInt",
+    "ShaderNodeBlackbody",
 ];
 
 pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -215,6 +235,23 @@ pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "GeometryNodeDualMesh" => dual_mesh::dual_mesh(ctx),
         "GeometryNodeSampleCurve" => sample_curve::sample_curve(ctx),
         "GeometryNodeFillCurve" => fill_curve::fill_curve(ctx),
+        "ShaderNodeTexVoronoi" => texture::voronoi(ctx),
+        "ShaderNodeTexWhiteNoise" => texture::white_noise_node(ctx),
+        "ShaderNodeTexGradient" => texture::gradient_node(ctx),
+        "ShaderNodeTexWave" => texture::wave_node(ctx),
+        "ShaderNodeTexMagic" => texture::magic_node(ctx),
+        "ShaderNodeTexChecker" => texture::checker_node(ctx),
+        "ShaderNodeTexBrick" => texture::brick_node(ctx),
+        "ShaderNodeValToRGB" => color::color_ramp(ctx),
+        "ShaderNodeRGBCurve" => color::rgb_curves(ctx),
+        "ShaderNodeVectorCurve" => color::vector_curves(ctx),
+        "FunctionNodeSeparateColor" => color::separate_color(ctx),
+        "FunctionNodeCombineColor" => color::combine_color(ctx),
+        "ShaderNodeMixRGB" => color::mix_rgb(ctx),
+        "ShaderNodeVectorRotate" => color::vector_rotate_node(ctx),
+        "FunctionNodeRotateVector" => color::rotate_vector(ctx),
+        "FunctionNodeFloatToInt" => color::float_to_int(ctx),
+        "ShaderNodeBlackbody" => color::blackbody_node(ctx),
         _ => Err(ctx.err("this node type is not supported by blendsynth's Geometry Nodes evaluator")),
     }
 }
