@@ -72,7 +72,7 @@ fn blend_in(fac: f32, input: f32, curve: f32) -> f32 {
 }
 
 /// RGB Curves: the combined curve then each channel's (`BKE_curvemapping_evaluateRGBF`,
-/// no clipping), mixed with the input by Fac; alpha passes through.
+/// no clipping), mixed with the input by Fac; the output's alpha is 1.
 pub fn rgb_curves(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let m = mapping_from_json(ctx.prop("mapping").ok_or_else(|| ctx.err("property \"mapping\" missing"))?).map_err(|e| ctx.err(e.0))?;
     let curves: Vec<BlenderCurve> = (0..4).map(|k| BlenderCurve::new(&m, k)).collect::<Result<_, _>>().map_err(|e| ctx.err(e.0))?;
@@ -84,7 +84,7 @@ pub fn rgb_curves(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
                 .map(|i| {
                     let c = col[i];
                     let ch = |k: usize| blend_in(fac[i], c[k], curves[k].eval_unclipped(curves[3].eval_unclipped(c[k])));
-                    [ch(0), ch(1), ch(2), c[3]]
+                    [ch(0), ch(1), ch(2), 1.0]
                 })
                 .collect(),
         ))
