@@ -25,7 +25,9 @@ use blendsynth::scene::{AttributeData, MeshData, Scene};
 const POS_TOL: f32 = 1e-5;
 /// Attributes of texture nodes (by the node part of NODE.CASE names).
 const TEXTURE_TOL: f64 = 1e-4;
-const TEXTURE_NODES: &[&str] = &["voronoi", "white_noise", "gradient", "wave", "magic", "checker", "brick"];
+/// (Image Texture: Blender turns sRGB texels linear with OpenColorIO's CPU exponent,
+/// about 2e-5 relative from the exact transfer function ours computes.)
+const TEXTURE_NODES: &[&str] = &["voronoi", "white_noise", "gradient", "wave", "magic", "checker", "brick", "image_texture"];
 /// Blackbody in Geometry Nodes goes through Blender's Rec.709 -> scene-linear matrix,
 /// derived from the OCIO config in float: identity to about 6e-6 relative (Cycles treats
 /// it as identity, and so do we), 3e-5 absolute on the fit's largest values (~5.4).

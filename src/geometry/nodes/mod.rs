@@ -16,6 +16,7 @@ pub mod flip_faces;
 pub mod float_curve;
 pub mod function;
 pub mod geometry_ops;
+pub mod image_texture;
 pub mod input;
 pub mod instance_transform;
 pub mod merge_by_distance;
@@ -142,6 +143,7 @@ pub const SUPPORTED: &[&str] = &[
     "FunctionNodeRotateVector",
     "FunctionNodeFloatToInt",
     "ShaderNodeBlackbody",
+    "GeometryNodeImageTexture",
 ];
 
 pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -252,6 +254,7 @@ pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "FunctionNodeRotateVector" => color::rotate_vector(ctx),
         "FunctionNodeFloatToInt" => color::float_to_int(ctx),
         "ShaderNodeBlackbody" => color::blackbody_node(ctx),
+        "GeometryNodeImageTexture" => image_texture::image_texture(ctx),
         _ => Err(ctx.err("this node type is not supported by blendsynth's Geometry Nodes evaluator")),
     }
 }
