@@ -213,12 +213,11 @@ pub fn rotate_vector(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     Ok(outputs([("Vector", f(out))]))
 }
 
-/// Float to Integer: Blender's rounding modes (round half away from zero is
-/// `floor(x + 0.5)`, as `round_fl_to_int`).
+/// Float to Integer: C's `round` (halves away from zero), `floor`, `ceil`, `trunc`.
 pub fn float_to_int(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let m = ctx.prop_str("rounding_mode")?;
     let round: fn(f32) -> f32 = match m {
-        "ROUND" => |x| (x + 0.5).floor(),
+        "ROUND" => f32::round,
         "FLOOR" => f32::floor,
         "CEILING" => f32::ceil,
         "TRUNCATE" => f32::trunc,
