@@ -39,6 +39,38 @@ fn shared_maths_counts_only_where_an_evaluator_runs_it() {
 }
 
 #[test]
+fn texture_and_colour_nodes_count_in_geometry_nodes_trees() {
+    // The textures parity scene (tests/geometry.rs) uses them only in Geometry Nodes trees.
+    let (code, r) = report("fixtures/geometry/scenes/textures");
+    assert_eq!(code, Some(0), "{r}");
+    for kind in [
+        "ShaderNodeTexVoronoi",
+        "ShaderNodeTexWhiteNoise",
+        "ShaderNodeTexGradient",
+        "ShaderNodeTexWave",
+        "ShaderNodeTexMagic",
+        "ShaderNodeTexChecker",
+        "ShaderNodeTexBrick",
+        "ShaderNodeValToRGB",
+        "ShaderNodeRGBCurve",
+        "ShaderNodeVectorCurve",
+        "FunctionNodeSeparateColor",
+        "FunctionNodeCombineColor",
+        "ShaderNodeMix",
+        "ShaderNodeMixRGB",
+        "ShaderNodeVectorRotate",
+        "FunctionNodeRotateVector",
+        "FunctionNodeFloatToInt",
+        "ShaderNodeBlackbody",
+    ] {
+        assert_eq!(row(&r, kind)["support"], "supported", "{kind}");
+    }
+    use blendsynth::nodes::{support_in, Support};
+    // Gabor has no implementation on either side yet.
+    assert!(matches!(support_in("GeometryNodeTree", "ShaderNodeTexGabor"), Support::Unsupported));
+}
+
+#[test]
 fn materials_report_whether_they_compile() {
     let (_, r) = report("fixtures/bake/scenes/structure");
     let m = &r["material_status"][0];

@@ -233,7 +233,7 @@ fn implicit_field(bl_idname: &str, identifier: &str) -> Option<Field> {
         | ("GeometryNodeMeshToPoints", "Position") => Some(Field::input(PositionInput)),
         // Texture nodes in Geometry Nodes read the position when their vector is unlinked.
         ("ShaderNodeTexNoise" | "ShaderNodeTexVoronoi" | "ShaderNodeTexWave" | "ShaderNodeTexGradient" | "ShaderNodeTexMagic"
-        | "ShaderNodeTexChecker" | "ShaderNodeTexBrick" | "ShaderNodeTexWhiteNoise" | "ShaderNodeTexMusgrave", "Vector") => {
+        | "ShaderNodeTexChecker" | "ShaderNodeTexBrick" | "ShaderNodeTexWhiteNoise" | "ShaderNodeTexMusgrave" | "GeometryNodeImageTexture", "Vector") => {
             Some(Field::input(PositionInput))
         }
         ("FunctionNodeRandomValue", "ID") => Some(Field::input(IdInput)),

@@ -272,10 +272,8 @@ impl Value {
             let c = self.convert(T::Color).as_color();
             return Value::ByteColor(byte_color_roundtrip(c));
         }
-        let lum = |c: [f32; 4]| {
-            let w = crate::nodes::color::LINEAR_REC709.rgb_to_y;
-            w[0] * c[0] + w[1] * c[1] + w[2] * c[2]
-        };
+        // BLI `rgb_to_grayscale`: fixed Rec.709 weights, not the colour config's.
+        let lum = |c: [f32; 4]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
         match *self {
             Value::Float(a) => match to {
                 T::Int => Value::Int(a as i32),

@@ -533,6 +533,11 @@ impl BlenderCurve {
         let table = m.make_table(&m.prepared(c));
         Ok(BlenderCurve { table, extrapolate: m.extrapolate, clip_y: m.use_clip.then_some([m.clip[2], m.clip[3]]) })
     }
+    /// `BKE_curvemap_evaluateF`: the curve alone, without the mapping's clipping (what
+    /// Geometry Nodes' RGB and Vector Curves use per channel).
+    pub fn eval_unclipped(&self, x: f32) -> f32 {
+        evaluate(self.extrapolate, &self.table, x)
+    }
     pub fn eval(&self, x: f32) -> f32 {
         let v = evaluate(self.extrapolate, &self.table, x);
         match self.clip_y {

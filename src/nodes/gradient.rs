@@ -1,4 +1,5 @@
-//! Gradient Texture (Cycles `svm_gradient`).
+//! Gradient Texture (Cycles `svm_gradient`; Geometry Nodes' multi-function is the same
+//! without the final clamp).
 
 use super::math::Vec3;
 
@@ -14,10 +15,16 @@ blender_enum! {
     }
 }
 
-/// Fac (the Color output is Fac in all three channels).
+/// Fac (the Color output is Fac in all three channels), clamped to [0, 1] as Cycles does.
 pub fn gradient(kind: GradientType, p: Vec3) -> f32 {
+    gradient_unclamped(kind, p).clamp(0.0, 1.0)
+}
+
+/// Fac before Cycles' clamp: what Geometry Nodes output (Linear, Quadratic and Diagonal
+/// leave [0, 1] there).
+pub fn gradient_unclamped(kind: GradientType, p: Vec3) -> f32 {
     let [x, y, z] = p;
-    let f = match kind {
+    match kind {
         GradientType::Linear => x,
         GradientType::Quadratic => {
             let r = x.max(0.0);
@@ -41,6 +48,5 @@ pub fn gradient(kind: GradientType, p: Vec3) -> f32 {
                 r * r
             }
         }
-    };
-    f.clamp(0.0, 1.0)
+    }
 }

@@ -148,6 +148,21 @@ impl<T: Texel> Pixels<'_, T> {
         }
     }
 
+    /// The lookup of Geometry Nodes' Image Texture (`node_geo_image_texture.cc`): Cycles'
+    /// except Closest with Clip, which is black only left of / below the image and more
+    /// than one texel right of / above it, and clamps to the edge in between.
+    pub fn interp_geometry_nodes(&self, x: f32, y: f32, interpolation: Interpolation, extension: Extension) -> [f32; 4] {
+        if interpolation == Interpolation::Closest && extension == Extension::Clip {
+            let (_, ix) = frac(x * self.width as f32);
+            let (_, iy) = frac(y * self.height as f32);
+            if ix < 0 || iy < 0 || ix > self.width || iy > self.height {
+                return [0.0; 4];
+            }
+            return self.read(wrap_clamp(ix, self.width), wrap_clamp(iy, self.height));
+        }
+        self.interp(x, y, interpolation, extension)
+    }
+
     fn closest(&self, x: f32, y: f32, ext: Extension) -> [f32; 4] {
         let (w, h) = (self.width, self.height);
         let (_, mut ix) = frac(x * w as f32);

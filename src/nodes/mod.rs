@@ -1,9 +1,12 @@
 //! Node-graph evaluation shared by shader graphs and Geometry Nodes.
 //!
 //! Each node family gets its own file here, named as Blender names it (math, noise,
-//! voronoi, ramp, ...). Until a family is implemented and proven against Blender's
-//! numbers, `support` reports it as unsupported: `blendsynth inspect` must never
-//! claim a node that would be evaluated as something else.
+//! voronoi, ramp, ...), used by the shader compiler (`shader/`) and by Geometry Nodes'
+//! field nodes (`geometry/nodes/function.rs`, `texture.rs`, `color.rs`). Where Blender's
+//! Geometry Nodes compute differently from Cycles (Gradient's clamp, the ramp's table,
+//! curve clipping) the family offers both as siblings. Until a family is implemented
+//! and proven against Blender's numbers, `support` reports it as unsupported:
+//! `blendsynth inspect` must never claim a node that would be evaluated as something else.
 
 /// Declares a node-mode enum together with the Blender RNA enum identifiers it is parsed
 /// from (`from_blender`) and printed as (`blender_name`), plus `ALL` in Blender's order.
@@ -200,8 +203,9 @@ const SUPPORTED: &[&str] = &[
 
 /// Support for a node inside a tree of type `tree` (`ShaderNodeTree`,
 /// `GeometryNodeTree`, ...): the shared maths only counts where an evaluator for that
-/// tree type runs it. Geometry Nodes trees are not evaluated yet, so only their
-/// structure is supported there.
+/// tree type runs it. In Geometry Nodes trees that is the geometry evaluator's own list
+/// (`geometry::nodes::SUPPORTED`: shader-named texture, ramp, curve and colour nodes
+/// count there once they run as fields with Blender's Geometry Nodes semantics).
 pub fn support_in(tree: &str, bl_idname: &str) -> Support {
     // Geometry Nodes trees: exactly what the geometry evaluator implements.
     if tree == "GeometryNodeTree" && !STRUCTURAL.contains(&bl_idname) {

@@ -12,7 +12,7 @@ use crate::nodes::math::{MathOp, VectorMathOp};
 use crate::nodes::mix::MixBlend;
 use crate::nodes::vector_rotate::VectorRotateType;
 use crate::nodes::curves::{mapping_from_json, CurveKind, CurveTable};
-use crate::nodes::ramp::{ColorBand, HueInterpolation, RampColorMode, RampInterpolation, RampStop, RampTable};
+use crate::nodes::ramp::{band_from_json, RampTable};
 use crate::nodes::sepcomb::ColorMode;
 use crate::nodes::gradient::GradientType;
 use crate::nodes::mapping::MappingType;
@@ -823,20 +823,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
 
     /// The node's colour band, sampled into a lookup table as Blender hands it to Cycles.
     fn ramp(&mut self, n: &FlatNode) -> Result<u32, CompileError> {
-        let bad = |m: &str| CompileError(format!("node {:?}: color_ramp {m}", n.path));
-        let r = prop(n, "color_ramp")?;
-        let elements = r.get("elements").and_then(Value::as_array).ok_or_else(|| bad("has no elements"))?;
-        let mut stops = Vec::with_capacity(elements.len());
-        for e in elements {
-            let pos = e.get("position").and_then(Value::as_f64).ok_or_else(|| bad("element without position"))? as f32;
-            let c = e.get("color").map(floats).ok_or_else(|| bad("element without color"))?;
-            stops.push(RampStop { position: pos, color: c });
-        }
-        let s = |k: &str| r.get(k).and_then(Value::as_str).unwrap_or("");
-        let interp = RampInterpolation::from_blender(s("interpolation")).ok_or_else(|| bad("interpolation not supported"))?;
-        let cm = RampColorMode::from_blender(s("color_mode")).ok_or_else(|| bad("color mode not supported"))?;
-        let hue = HueInterpolation::from_blender(s("hue_interpolation")).ok_or_else(|| bad("hue interpolation not supported"))?;
-        let band = ColorBand::new(&stops, interp, cm, hue).ok_or_else(|| bad("needs 1 to 32 elements"))?;
+        let band = band_from_json(prop(n, "color_ramp")?).map_err(|e| CompileError(format!("node {:?}: {e}", n.path)))?;
         self.ramps.push(RampTable::from_band(&band));
         Ok(self.ramps.len() as u32 - 1)
     }

@@ -103,19 +103,37 @@ fn cache() -> &'static Mutex<HashMap<Key, Weak<TexImage>>> {
 /// A missing or unreadable file gives Cycles' magenta image and a warning; an
 /// unsupported colour space is an error.
 pub fn scene_image(scene: &Scene, name: &str) -> Result<Arc<TexImage>, String> {
+    let Some(f) = image_file(scene, name)? else {
+        warn_missing(name, "its file was not exported (missing or generated)");
+        return Ok(Arc::new(TexImage::missing()));
+    };
+    Ok(load_shared(&f.path, name, &f.colorspace, &f.alpha_mode, f.encoding, f.is_data))
+}
+
+/// Where an image datablock's file is and how its values are to be read.
+pub struct ImageFile {
+    pub path: PathBuf,
+    pub colorspace: String,
+    pub alpha_mode: String,
+    pub encoding: Encoding,
+    pub is_data: bool,
+}
+
+/// The file of image `name` (None when it was not exported: missing or generated); an
+/// unsupported colour space or source is an error naming the image.
+pub fn image_file(scene: &Scene, name: &str) -> Result<Option<ImageFile>, String> {
     let im = scene.file.images.iter().find(|i| i.name == name).ok_or_else(|| format!("no image {name:?} in the scene"))?;
     let colorspace = im.colorspace.clone().unwrap_or_else(|| "sRGB".into());
     let alpha_mode = im.alpha_mode.clone().unwrap_or_else(|| "STRAIGHT".into());
     let (encoding, is_data) = encoding_of(&colorspace).map_err(|e| format!("image {name:?}: {e}"))?;
     let Some(rel) = im.file.as_deref().filter(|_| !im.missing) else {
-        warn_missing(name, "its file was not exported (missing or generated)");
-        return Ok(Arc::new(TexImage::missing()));
+        return Ok(None);
     };
     if matches!(im.source.as_deref(), Some("SEQUENCE" | "MOVIE" | "TILED")) {
         return Err(format!("image {name:?}: source {} (sequences, movies, UDIM tiles) is not supported yet", im.source.as_deref().unwrap_or("")));
     }
     let path = scene.resolve(rel, &format!("images[{name:?}].file")).map_err(|e| e.to_string())?;
-    Ok(load_shared(&path, name, &colorspace, &alpha_mode, encoding, is_data))
+    Ok(Some(ImageFile { path, colorspace, alpha_mode, encoding, is_data }))
 }
 
 fn warn_missing(name: &str, why: &str) {

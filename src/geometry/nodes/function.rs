@@ -486,6 +486,7 @@ pub fn mix(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             .map_err(|e| op_err(ctx, e))?;
             Ok(outputs([("Result_Vector", f(out))]))
         }
+        "RGBA" => super::color::mix_rgba(ctx),
         other => Err(ctx.err(format!("Mix of {other} is not supported in Geometry Nodes yet"))),
     }
 }

@@ -3,6 +3,7 @@
 
 pub mod attribute;
 pub mod bounding_box;
+pub mod color;
 pub mod curve;
 pub mod curve_fields;
 pub mod curve_primitives;
@@ -15,6 +16,7 @@ pub mod flip_faces;
 pub mod float_curve;
 pub mod function;
 pub mod geometry_ops;
+pub mod image_texture;
 pub mod input;
 pub mod instance_transform;
 pub mod merge_by_distance;
@@ -29,6 +31,7 @@ pub mod raycast;
 pub mod rotation;
 pub mod subdivide;
 pub mod subdivision_surface;
+pub mod texture;
 
 use super::error::GeometryError;
 use super::eval::{NodeCtx, Outputs};
@@ -127,6 +130,25 @@ pub const SUPPORTED: &[&str] = &[
     "GeometryNodeRaycast",
     "GeometryNodeSampleNearestSurface",
     "GeometryNodeSampleNearest",
+    // texture.rs, color.rs: tests/geometry.rs, scene "textures".
+    "ShaderNodeTexVoronoi",
+    "ShaderNodeTexWhiteNoise",
+    "ShaderNodeTexGradient",
+    "ShaderNodeTexWave",
+    "ShaderNodeTexMagic",
+    "ShaderNodeTexChecker",
+    "ShaderNodeTexBrick",
+    "ShaderNodeValToRGB",
+    "ShaderNodeRGBCurve",
+    "ShaderNodeVectorCurve",
+    "FunctionNodeSeparateColor",
+    "FunctionNodeCombineColor",
+    "ShaderNodeMixRGB",
+    "ShaderNodeVectorRotate",
+    "FunctionNodeRotateVector",
+    "FunctionNodeFloatToInt",
+    "ShaderNodeBlackbody",
+    "GeometryNodeImageTexture",
 ];
 
 pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -223,6 +245,24 @@ pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "GeometryNodeRaycast" => raycast::raycast(ctx),
         "GeometryNodeSampleNearestSurface" => sample_nearest::sample_nearest_surface(ctx),
         "GeometryNodeSampleNearest" => sample_nearest::sample_nearest(ctx),
+        "ShaderNodeTexVoronoi" => texture::voronoi(ctx),
+        "ShaderNodeTexWhiteNoise" => texture::white_noise_node(ctx),
+        "ShaderNodeTexGradient" => texture::gradient_node(ctx),
+        "ShaderNodeTexWave" => texture::wave_node(ctx),
+        "ShaderNodeTexMagic" => texture::magic_node(ctx),
+        "ShaderNodeTexChecker" => texture::checker_node(ctx),
+        "ShaderNodeTexBrick" => texture::brick_node(ctx),
+        "ShaderNodeValToRGB" => color::color_ramp(ctx),
+        "ShaderNodeRGBCurve" => color::rgb_curves(ctx),
+        "ShaderNodeVectorCurve" => color::vector_curves(ctx),
+        "FunctionNodeSeparateColor" => color::separate_color(ctx),
+        "FunctionNodeCombineColor" => color::combine_color(ctx),
+        "ShaderNodeMixRGB" => color::mix_rgb(ctx),
+        "ShaderNodeVectorRotate" => color::vector_rotate_node(ctx),
+        "FunctionNodeRotateVector" => color::rotate_vector(ctx),
+        "FunctionNodeFloatToInt" => color::float_to_int(ctx),
+        "ShaderNodeBlackbody" => color::blackbody_node(ctx),
+        "GeometryNodeImageTexture" => image_texture::image_texture(ctx),
         _ => Err(ctx.err("this node type is not supported by blendsynth's Geometry Nodes evaluator")),
     }
 }
