@@ -62,6 +62,10 @@ const ASSERTED: &[&str] = &[
     // Film > Transparent: background, half-transparent surface, Holdout shader and holdout
     // object as alpha (checked as a fourth channel).
     "film_transparent",
+    // Panoramic cameras: an endoscope-like equisolid fisheye, and a lens polynomial with
+    // vertical sensor fit.
+    "pano_fisheye_equisolid",
+    "pano_fisheye_polynomial",
 ];
 
 /// Scenes that do not pass yet, with the reason.
@@ -72,6 +76,7 @@ const KNOWN_FAILURES: &[(&str, &str)] = &[
     // the relief's sharp features dominates the ratio.
     ("displace_both", "ratio ~2.4 (Displacement and Bump), means within 0.05%: structured error at the relief's creases, not yet explained"),
     ("displace_true", "ratio ~1.37 (Displacement Only), means within 0.2%: structured error at the relief's creases, not yet explained"),
+    ("pano_equirectangular", "ratio ~1.17, means within 0.01%: variance, not bias (our own seed-to-seed RMSE is 1.32x Cycles' here, and the mean of two of our seeds is as far from the mean of A and B as that noise predicts); the wide pixels of the equirectangular view make the image's noise the antialiasing of edges, where our sampling is less stratified than Cycles'"),
     ("translucent", "ratio ~1.151, on the limit, means match to 0.03% (variance, not bias): the excess is in the sun-lit floor (ratio 1.20 there, half the squared error) whose noise is indirect light via the sheet's underside; the sheet itself is at 1.10"),
 ];
 
