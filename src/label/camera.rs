@@ -12,10 +12,15 @@ pub struct CameraInfo {
     pub sensor_width_mm: f64,
     pub sensor_height_mm: f64,
     pub sensor_fit: String,
+    /// Blender's camera type: "PERSP", "ORTHO", or "PANO:" and the panorama type (for
+    /// example "PANO:FISHEYE_EQUISOLID"). Records written before it read as "PERSP".
+    #[serde(default = "persp")]
+    pub projection: String,
     pub width: u32,
     pub height: u32,
-    /// Pinhole intrinsics in pixels (x right, y down, origin at the top-left corner of
-    /// the top-left pixel): fx, fy, cx, cy.
+    /// Intrinsics in pixels (x right, y down, origin at the top-left corner of the
+    /// top-left pixel): fx, fy, cx, cy. Pinhole for "PERSP"; for "ORTHO" fx and fy are
+    /// pixels per scene unit (u = cx + fx * x_camera); 0 for panoramas, which have none.
     pub fx: f64,
     pub fy: f64,
     pub cx: f64,
@@ -28,6 +33,10 @@ pub struct CameraInfo {
     pub matrix_world: [[f64; 4]; 4],
     /// Camera position in world space.
     pub location: [f64; 3],
+}
+
+fn persp() -> String {
+    "PERSP".into()
 }
 
 fn f(p: &Rna, k: &str, default: f64) -> f64 {
@@ -47,7 +56,12 @@ pub fn camera_info(name: &str, props: &Rna, matrix_world: [[f64; 4]; 4], width: 
         "VERTICAL" => (h, sh),
         _ => (w.max(h), sw),
     };
-    let focal = lens / sensor * side;
+    let kind = props.get("type").and_then(|v| v.as_str()).unwrap_or("PERSP");
+    let (projection, focal) = match kind {
+        "ORTHO" => ("ORTHO".to_string(), side / f(props, "ortho_scale", 6.0)),
+        "PANO" => (format!("PANO:{}", props.get("panorama_type").and_then(|v| v.as_str()).unwrap_or("FISHEYE_EQUISOLID")), 0.0),
+        other => (other.to_string(), lens / sensor * side),
+    };
     let dof = props.get("dof");
     let d = |k: &str| dof.and_then(|x| x.get(k)).and_then(|v| v.as_f64());
     CameraInfo {
@@ -56,6 +70,7 @@ pub fn camera_info(name: &str, props: &Rna, matrix_world: [[f64; 4]; 4], width: 
         sensor_width_mm: sw,
         sensor_height_mm: sh,
         sensor_fit: fit,
+        projection,
         width,
         height,
         fx: focal,
