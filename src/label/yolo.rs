@@ -22,9 +22,29 @@ pub fn data_yaml(splits: &[String], names: &[String]) -> String {
     for sp in splits {
         s.push_str(&format!("{sp}: images/{sp}\n"));
     }
+    // Ultralytics requires `train` and `val`; a dataset made without one of them (one
+    // split only) names its first split for it, so `check_det_dataset` accepts it.
+    for need in ["train", "val"] {
+        if let (false, Some(first)) = (splits.iter().any(|sp| sp == need), splits.first()) {
+            s.push_str(&format!("{need}: images/{first}  # no {need} split in this dataset\n"));
+        }
+    }
     s.push_str(&format!("nc: {}\nnames:\n", names.len()));
     for (i, n) in names.iter().enumerate() {
         s.push_str(&format!("  {i}: {}\n", serde_json::to_string(n).unwrap()));
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::data_yaml;
+
+    #[test]
+    fn a_single_split_also_serves_as_val() {
+        let y = data_yaml(&["train".into()], &["polyp".into()]);
+        assert!(y.contains("train: images/train\n") && y.contains("val: images/train "), "{y}");
+        let y = data_yaml(&["train".into(), "val".into()], &["polyp".into()]);
+        assert_eq!(y.matches("val:").count(), 1, "{y}");
+    }
 }
