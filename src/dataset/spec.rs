@@ -257,6 +257,9 @@ fn nums(v: &Toml) -> Option<Vec<f64>> {
 
 fn pair(v: Option<&Toml>, what: &str) -> Result<(f64, f64), SpecError> {
     let a = v.and_then(nums).filter(|a| a.len() == 2).ok_or_else(|| err("", format!("{what} must be [low, high]")))?;
+    if !(a[0].is_finite() && a[1].is_finite()) {
+        return Err(err("", format!("{what} must be finite numbers (got {}, {})", a[0], a[1])));
+    }
     if a[0] > a[1] {
         return Err(err("", format!("{what}: low {} > high {}", a[0], a[1])));
     }

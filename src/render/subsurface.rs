@@ -252,7 +252,9 @@ pub fn random_walk(b: &Bssrdf, p: V3, n: V3, d0: V3, inst: u32, throughput: &mut
             let guided = r[2] < guided_fraction;
             let mut guide_backward = false;
             if have_opposite {
-                let x = dot(sub(pos, p), neg(n)).clamp(0.0, opposite_distance);
+                // Cycles' clamp is min(max(x, 0), d): the opposite hit can sit a hair behind the
+                // entry plane (d slightly negative), where f32::clamp would panic.
+                let x = dot(sub(pos, p), neg(n)).max(0.0).min(opposite_distance);
                 backward_fraction = 1.0 / (1.0 + ((opposite_distance - 2.0 * x) / diffusion_length).exp());
                 guide_backward = r[3] < backward_fraction;
             }

@@ -319,10 +319,11 @@ fn smootherstep(e0: f32, e1: f32, x: f32) -> f32 {
     x * x * x * (x * (x * 6.0 - 15.0) + 10.0)
 }
 fn clamp_range(v: f32, a: f32, b: f32) -> f32 {
+    // max/min rather than f32::clamp, which panics on a NaN bound from the graph.
     if a < b {
-        v.clamp(a, b)
+        v.max(a).min(b)
     } else {
-        v.clamp(b, a)
+        v.max(b).min(a)
     }
 }
 

@@ -76,7 +76,7 @@ pub fn sample_curve(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
                 let ends = &src.curve_ends;
                 let total = *ends.last().unwrap();
                 let s = if factor_mode { len[i] * total } else { len[i] };
-                let (k, f) = sample_at_length(ends, s.clamp(0.0, total));
+                let (k, f) = sample_at_length(ends, s.max(0.0).min(total));
                 let start = if k == 0 { 0.0 } else { ends[k - 1] };
                 (k as i64, f * (ends[k] - start), false)
             } else {
@@ -92,7 +92,7 @@ pub fn sample_curve(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             }
             let total = *lengths.last().unwrap();
             let s = if factor { l * total } else { l };
-            let (seg, f) = sample_at_length(lengths, s.clamp(0.0, total));
+            let (seg, f) = sample_at_length(lengths, s.max(0.0).min(total));
             let r = src.ev.range(curve);
             let last = r.len() - 1;
             let (ia, ib) = if seg == last { (r.start + last, r.start) } else { (r.start + seg, r.start + seg + 1) };
