@@ -265,9 +265,9 @@ struct RenderArgs {
     /// File format of the passes: exr (float) or png (16-bit ids, depth in mm).
     #[arg(long, value_enum, default_value = "exr")]
     pass_format: PassFormatArg,
-    /// Class mapping for the semantic pass: a TOML file with a [labels] section as in a
-    /// dataset spec ([[labels.class]] name + objects patterns, class_property,
-    /// mm_per_unit). Without it, objects' custom property `class` names their class.
+    /// Class mapping for the semantic pass: a dataset spec (TOML); its [labels] section
+    /// ([[labels.class]] name + objects patterns, class_property, mm_per_unit) is used.
+    /// Without it, objects' custom property `class` names their class.
     #[arg(long)]
     classes: Option<PathBuf>,
     /// Denoise with Open Image Denoise as Cycles does (default: the scene's setting).
@@ -330,13 +330,9 @@ fn run_render(a: RenderArgs) -> Result<()> {
     blendsynth::color::write_render(&scene, &a.output, out.width, out.height, &out.color)?;
     if let Some(dir) = &a.passes {
         use blendsynth::label::passes::{write_passes, PassFormat, PassImages};
+        // A dataset spec file (its [labels] section), read as `generate` reads it.
         let labels = match &a.classes {
-            Some(f) => {
-                let text = std::fs::read_to_string(f).with_context(|| format!("cannot read {}", f.display()))?;
-                let v: toml::Value = toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", f.display()))?;
-                let l = v.get("labels").ok_or_else(|| anyhow::anyhow!("{}: no [labels] section", f.display()))?;
-                blendsynth::label::LabelSpec::from_toml(l).map_err(|e| anyhow::anyhow!("{}: [labels]: {e}", f.display()))?
-            }
+            Some(f) => blendsynth::dataset::spec::Spec::load(f)?.labels,
             None => blendsynth::label::LabelSpec::default(),
         };
         let classes = blendsynth::label::ClassMap::new(&labels, &scene);

@@ -397,7 +397,8 @@ fn srgb_to_linear(c: f32) -> f32 {
     }
 }
 
-fn unit_to_byte(f: f32) -> u8 {
+/// Blender's `unit_float_to_uchar_clamp`.
+pub(crate) fn unit_to_byte(f: f32) -> u8 {
     if f <= 0.0 {
         0
     } else if f > 1.0 - 0.5 / 255.0 {

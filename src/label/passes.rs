@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::dataset::layout::{exr_rgb_bytes, png16_bytes, write_atomic};
+use crate::dataset::layout::{exr_rgb_bytes, png16_bytes, png_bytes, write_atomic};
 use crate::label::ClassMap;
 
 /// How the passes are stored.
@@ -96,9 +96,9 @@ pub fn write_passes(dir: &Path, p: &PassImages, classes: &ClassMap, format: Pass
             }
             let q8 = |x: f32| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
             let normal: Vec<u8> = p.normal.iter().flat_map(|n| n.map(|c| q8(c * 0.5 + 0.5))).collect();
-            put("normal.png".into(), crate::dataset::layout::png_bytes(w, h, 3, &normal)?)?;
+            put("normal.png".into(), png_bytes(w, h, 3, &normal)?)?;
             let albedo: Vec<u8> = p.albedo.iter().flat_map(|a| a.map(q8)).collect();
-            put("albedo.png".into(), crate::dataset::layout::png_bytes(w, h, 3, &albedo)?)?;
+            put("albedo.png".into(), png_bytes(w, h, 3, &albedo)?)?;
             let q16 = |x: f32| (x.clamp(0.0, 1.0) * 65535.0 + 0.5) as u16;
             put("uv_u.png".into(), png16_bytes(w, h, &p.uv.iter().map(|u| q16(u[0])).collect::<Vec<_>>())?)?;
             put("uv_v.png".into(), png16_bytes(w, h, &p.uv.iter().map(|u| q16(u[1])).collect::<Vec<_>>())?)?;

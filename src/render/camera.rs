@@ -37,6 +37,17 @@ pub struct Camera {
     pub panorama: Option<super::panorama::Panorama>,
 }
 
+/// Blender's sensor fit for an image of (xratio, yratio) (pixel aspect included):
+/// whether the sensor spans the width, and the sensor size along that side in mm.
+pub(super) fn sensor_fit(p: &serde_json::Map<String, Value>, xratio: f32, yratio: f32) -> (bool, f32) {
+    let (horizontal, size) = match p.get("sensor_fit").and_then(Value::as_str).unwrap_or("AUTO") {
+        "HORIZONTAL" => (true, num(p, "sensor_width", 36.0)),
+        "VERTICAL" => (false, num(p, "sensor_height", 24.0)),
+        _ => (xratio > yratio, num(p, "sensor_width", 36.0)),
+    };
+    (horizontal, size as f32)
+}
+
 fn num(p: &serde_json::Map<String, Value>, key: &str, default: f64) -> f64 {
     p.get(key).and_then(Value::as_f64).unwrap_or(default)
 }
@@ -59,13 +70,7 @@ impl Camera {
         let xratio = width as f32 * pax;
         let yratio = height as f32 * pay;
         let panorama = if kind == "PANO" { Some(super::panorama::Panorama::from_camera(p, xratio, yratio).map_err(|e| RenderError(format!("camera {data:?}: {e}")))?) } else { None };
-        let fit = p.get("sensor_fit").and_then(Value::as_str).unwrap_or("AUTO");
-        let (horizontal, sensor) = match fit {
-            "HORIZONTAL" => (true, num(p, "sensor_width", 36.0)),
-            "VERTICAL" => (false, num(p, "sensor_height", 24.0)),
-            _ => (xratio > yratio, num(p, "sensor_width", 36.0)),
-        };
-        let sensor = sensor as f32;
+        let (horizontal, sensor) = sensor_fit(p, xratio, yratio);
         let (mut aspect, mut xaspect, mut yaspect) = if horizontal { (xratio / yratio, xratio / yratio, 1.0) } else { (yratio / xratio, 1.0, yratio / xratio) };
         let ortho_scale = num(p, "ortho_scale", 6.0) as f32;
         if ortho {

@@ -32,12 +32,7 @@ impl Panorama {
         let kind = p.get("panorama_type").and_then(Value::as_str).unwrap_or("FISHEYE_EQUISOLID");
         // Blender's sensor fit decides which side the sensor size spans (blender_camera_sync).
         let sensor = || {
-            let fit = p.get("sensor_fit").and_then(Value::as_str).unwrap_or("AUTO");
-            let (horizontal, size) = match fit {
-                "HORIZONTAL" => (true, num(p, "sensor_width", 36.0)),
-                "VERTICAL" => (false, num(p, "sensor_height", 24.0)),
-                _ => (xratio > yratio, num(p, "sensor_width", 36.0)),
-            };
+            let (horizontal, size) = super::camera::sensor_fit(p, xratio, yratio);
             if horizontal {
                 [size, size * yratio / xratio]
             } else {

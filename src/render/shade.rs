@@ -63,16 +63,21 @@ pub fn displacement_reads_attributes(p: &Program) -> bool {
     p.ops[..d.center_end.min(p.ops.len())].iter().any(|op| matches!(op, Op::Attribute { .. } | Op::ColorAttribute { .. } | Op::NamedUv { .. } | Op::NormalMapTangent { .. } | Op::VectorDisplacementTangent { .. } | Op::TangentUv { .. }))
 }
 
+/// Whether BSDF node `b`'s input `name` is linked, or unlinked with a constant for which
+/// `constant` holds (false when the node has no such input).
+fn linked_or_constant(p: &Program, b: &crate::shader::program::BsdfNode, name: &str, constant: impl Fn(f32) -> bool) -> bool {
+    match b.input(name) {
+        Some((_, true)) => true,
+        Some((slot, false)) => p.initial.get(slot as usize).is_some_and(|v| constant(*v)),
+        None => false,
+    }
+}
+
 /// The Principled BSDF's thin film (4.2+) is not rendered yet: a material that uses it
 /// (Thin Film Thickness linked or above 0) is an error, never rendered without it.
 fn refuse_thin_film(p: &Program, material: &str) -> Result<(), RenderError> {
     for b in p.bsdfs.iter().filter(|b| b.bl_idname == "ShaderNodeBsdfPrincipled") {
-        let used = match b.input("Thin Film Thickness") {
-            Some((_, true)) => true,
-            Some((slot, false)) => p.initial.get(slot as usize).is_some_and(|t| *t > 0.0),
-            None => false,
-        };
-        if used {
+        if linked_or_constant(p, b, "Thin Film Thickness", |t| t > 0.0) {
             return Err(RenderError(format!("material {material:?}: Principled BSDF thin film (Thin Film Thickness > 0) is not supported yet")));
         }
     }
@@ -84,11 +89,7 @@ fn refuse_thin_film(p: &Program, material: &str) -> Result<(), RenderError> {
 fn can_be_transparent(p: &Program) -> bool {
     p.bsdfs.iter().any(|b| match b.bl_idname.as_str() {
         "ShaderNodeBsdfTransparent" => true,
-        "ShaderNodeBsdfPrincipled" => match b.input("Alpha") {
-            Some((_, true)) => true,
-            Some((slot, false)) => p.initial.get(slot as usize).is_some_and(|a| *a < 1.0),
-            None => false,
-        },
+        "ShaderNodeBsdfPrincipled" => linked_or_constant(p, b, "Alpha", |a| a < 1.0),
         _ => false,
     })
 }
@@ -101,11 +102,7 @@ fn has_bssrdf_bump(p: &Program) -> bool {
         || p.bsdfs.iter().any(|b| {
             let bssrdf = match b.bl_idname.as_str() {
                 "ShaderNodeSubsurfaceScattering" => true,
-                "ShaderNodeBsdfPrincipled" => match b.input("Subsurface Weight") {
-                    Some((_, true)) => true,
-                    Some((slot, false)) => p.initial.get(slot as usize).is_some_and(|w| *w > 1e-5),
-                    None => false,
-                },
+                "ShaderNodeBsdfPrincipled" => linked_or_constant(p, b, "Subsurface Weight", |w| w > 1e-5),
                 _ => false,
             };
             bssrdf && matches!(b.input("Normal"), Some((_, true)))

@@ -11,6 +11,7 @@ use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::Field;
 use super::super::types::{Array, DataType};
 use super::super::value::SocketValue;
+use crate::geometry::types::unit_to_byte;
 use crate::nodes::image::{srgb_to_linear, Extension, Interpolation, Pixels};
 use crate::shader::images::{image_file, Encoding, ImageFile};
 
@@ -19,17 +20,6 @@ struct FloatImage {
     width: i32,
     height: i32,
     pixels: Vec<[f32; 4]>,
-}
-
-/// Blender's `unit_float_to_uchar_clamp`.
-fn unit_to_byte(v: f32) -> u8 {
-    if v <= 0.0 {
-        0
-    } else if v > 1.0 - 0.5 / 255.0 {
-        255
-    } else {
-        (255.0 * v + 0.5) as u8
-    }
 }
 
 /// The image as `BKE_image_acquire_ibuf` + `IMB_float_from_byte` leave it: alpha handled
