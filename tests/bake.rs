@@ -17,11 +17,40 @@ fn compare(case: &str) -> f32 {
 }
 
 fn compare_in(root: &std::path::Path, case: &str) -> f32 {
+    compare_stats(root, case).worst
+}
+
+/// How far one bake is from another: the worst and the root-mean-square difference over
+/// every texel's three channels.
+struct Diff {
+    worst: f32,
+    rms: f64,
+}
+
+fn diff(a: &[f32], b: &[f32]) -> Diff {
+    assert_eq!(a.len(), b.len());
+    let (mut worst, mut sum, mut n) = (0.0f32, 0.0f64, 0usize);
+    for (p, q) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
+        for c in 0..3 {
+            let d = (p[c] - q[c]).abs();
+            worst = if d.is_nan() { f32::INFINITY } else { worst.max(d) };
+            sum += (d as f64) * (d as f64);
+            n += 1;
+        }
+    }
+    Diff { worst, rms: (sum / n as f64).sqrt() }
+}
+
+fn read_f32(path: &std::path::Path) -> Vec<f32> {
+    std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect()
+}
+
+fn compare_stats(root: &std::path::Path, case: &str) -> Diff {
     let dir = root.join(case);
     let scene = Scene::load(&dir).unwrap();
     let meta: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("bake.json")).unwrap()).unwrap();
     let size = meta["size"].as_u64().unwrap() as u32;
-    let reference: Vec<f32> = std::fs::read(dir.join("blender_emit.f32")).unwrap().chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+    let reference = read_f32(&dir.join("blender_emit.f32"));
     assert_eq!(reference.len(), (size * size * 4) as usize);
     let ours = bake_emission(&scene, &BakeOptions { object: meta["object"].as_str().unwrap().into(), uv: None, size }).unwrap_or_else(|e| panic!("{case}: {e}"));
     let mut worst = 0.0f32;
@@ -40,8 +69,24 @@ fn compare_in(root: &std::path::Path, case: &str) -> f32 {
         }
         assert_eq!(p[3], reference[i * 4 + 3], "{case}: texel {i} coverage differs");
     }
-    eprintln!("bake {case}: {size}x{size}, worst abs error {worst:.2e} at texel {at}; {over} channel values beyond {TEXTURE_TOL:e}");
-    worst
+    let flat: Vec<f32> = ours.pixels.iter().flatten().copied().collect();
+    let d = diff(&flat, &reference);
+    eprintln!("bake {case}: {size}x{size}, worst abs error {worst:.2e} at texel {at}, rms {:.2e}; {over} channel values beyond {TEXTURE_TOL:e}", d.rms);
+    d
+}
+
+/// Cycles against itself: its bakes of the same plane moved by rounding-level distances
+/// (`cycles_moved.f32`, see make_fat001_refs.py), each compared with its unmoved bake.
+/// The worst and the pooled rms over all moves.
+fn cycles_self_spread(root: &std::path::Path, case: &str) -> Diff {
+    let dir = root.join(case);
+    let reference = read_f32(&dir.join("blender_emit.f32"));
+    let moved = read_f32(&dir.join("cycles_moved.f32"));
+    assert!(!moved.is_empty() && moved.len() % reference.len() == 0, "{case}: cycles_moved.f32 has {} values", moved.len());
+    let ds: Vec<Diff> = moved.chunks_exact(reference.len()).map(|m| diff(m, &reference)).collect();
+    let worst = ds.iter().map(|d| d.worst).fold(0.0, f32::max);
+    let rms = (ds.iter().map(|d| d.rms * d.rms).sum::<f64>() / ds.len() as f64).sqrt();
+    Diff { worst, rms }
 }
 
 #[test]
@@ -134,25 +179,36 @@ fn published_fat001_matches_cycles() {
     let Some(blend) = require("../shared/published/colon_nodes.blend", published_colon()) else { return };
     let t = tempfile::tempdir().unwrap();
     run_python(&py, &repo().join("fixtures/bake/make_fat001_refs.py"), &["--blend", blend.to_str().unwrap(), "--out", t.path().to_str().unwrap()]);
-    // Cases that miss 1e-4, with their own bound and why (measured: "normal" 2.2e-4 on 48
-    // of 6912 channel values, "normal_bump_only" 1.2e-4 on 4).
-    const ALLOWED: &[(&str, f32, &str)] = &[
-        ("normal", 3e-4, "two chained Bump nodes on top of the displacement bump: each divides height differences at offsets of about a texel by that offset, so last-bit differences in the offset positions grow ~1/offset"),
-        ("normal_bump_only", 2e-4, "the same finite-difference amplification through the two chained Bump nodes"),
-    ];
+    // The bumped normals are beyond 1e-4 in a few texels, and so is Cycles against itself:
+    // its Bump nodes divide height differences at offsets of a tenth of a texel (the
+    // displacement's bump) and a texel (Bump.001 over 10.7 octaves of noise) by those
+    // offsets, so the last-bit rounding of a position grows to ~1e-4 in the normal. Moving
+    // the plane by 1-10 micrometres, which leaves every texture coordinate the same but
+    // for rounding, changes Cycles' own bake by up to ~1.7e-4 (normal) and ~1.0e-4
+    // (normal_bump_only). These cases are held to Cycles' own spread, measured in this
+    // run: worst and rms error at most SELF_FACTOR times Cycles' worst and rms change
+    // (measured: 1.2-1.5 times; our positions cannot be bit-identical to Cycles', whose
+    // barycentrics come from Blender's scanline rasteriser).
+    const MOVED: &[&str] = &["normal", "normal_bump_only"];
+    const SELF_FACTOR: f64 = 2.0;
     let mut failed = Vec::new();
     for case in ["color", "normal", "normal_bump_only", "displacement", "color_random", "normal_random", "normal_bump_only_random", "displacement_random"] {
-        let worst = compare_in(t.path(), case);
-        let bound = match ALLOWED.iter().find(|a| a.0 == case) {
-            Some((_, b, why)) => {
-                eprintln!("Fat.001 {case}: allowed up to {b:e}: {why}");
-                *b
+        let ours = compare_stats(t.path(), case);
+        if MOVED.contains(&case) {
+            let own = cycles_self_spread(t.path(), case);
+            let worst_bound = (TEXTURE_TOL as f64).max(SELF_FACTOR * own.worst as f64);
+            eprintln!(
+                "Fat.001 {case}: worst {:.2e}, rms {:.2e}; Cycles against itself (plane moved 1-10 um): worst {:.2e}, rms {:.2e}; ratios {:.2} and {:.2} (bound {SELF_FACTOR})",
+                ours.worst, ours.rms, own.worst, own.rms, ours.worst as f64 / own.worst as f64, ours.rms / own.rms
+            );
+            if ours.worst as f64 > worst_bound || ours.rms > SELF_FACTOR * own.rms {
+                failed.push(format!("{case}: worst {:.2e} (bound {worst_bound:.2e}), rms {:.2e} (bound {:.2e})", ours.worst, ours.rms, SELF_FACTOR * own.rms));
             }
-            None => TEXTURE_TOL,
-        };
-        eprintln!("Fat.001 {case}: worst abs error {worst:.2e}");
-        if worst > bound {
-            failed.push(format!("{case}: {worst:.2e}"));
+        } else {
+            eprintln!("Fat.001 {case}: worst abs error {:.2e}", ours.worst);
+            if ours.worst > TEXTURE_TOL {
+                failed.push(format!("{case}: {:.2e}", ours.worst));
+            }
         }
     }
     assert!(failed.is_empty(), "Fat.001 outputs beyond their bound: {failed:?}");
