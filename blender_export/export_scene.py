@@ -521,6 +521,9 @@ def object_entry(o, view_layer):
         # default to hidden from the camera in Blender 4.x.
         "visibility": {k: getattr(o, "visible_" + k) for k in ("camera", "diffuse", "glossy", "transmission", "volume_scatter", "shadow")},
         "is_holdout": o.is_holdout, "is_shadow_catcher": o.is_shadow_catcher,
+        # Object > Shading > Shadow Terminator (Cycles' shadow ray and shading offsets).
+        "shadow_terminator_geometry_offset": o.shadow_terminator_geometry_offset,
+        "shadow_terminator_shading_offset": o.shadow_terminator_shading_offset,
         "color": vec(o.color),
         "material_slots": [{"material": s.material.name if s.material else None, "link": s.link} for s in o.material_slots],
         "modifiers": [modifier_entry(m, f"{w}.modifiers[{q(m.name)}]") for m in o.modifiers],

@@ -318,7 +318,13 @@ fn from_local(n: V3, v: V3) -> V3 {
 }
 
 /// (BSDF * cos without the closure weight, pdf) of one lobe.
-fn eval_lobe(l: &Lobe, wo: V3, wi: V3, ng: V3, _tables: &Tables) -> (V3, f32) {
+fn eval_lobe(l: &Lobe, wo: V3, wi: V3, _ng: V3, _tables: &Tables) -> (V3, f32) {
+    // Cycles checks directions against the true normal only when sampling, never when
+    // evaluating (bsdf_microfacet_sample: "required in order to avoid shadow terminator
+    // artifacts on smooth geometry"; the same for every closure): a light below a smooth
+    // triangle's plane but above its shading normal's horizon is lit if its shadow ray
+    // gets through. So evaluation sees only the closure's own normal.
+    let ng = l.n;
     let cos_i = dot(l.n, wi);
     let same_side = dot(ng, wi) > 0.0;
     match l.kind {

@@ -48,6 +48,8 @@ pub struct MeshInstance {
     pub visibility: u32,
     /// Object > Visibility > Holdout: a hole in the film for camera rays.
     pub holdout: bool,
+    /// Object > Shading > Shadow Terminator > Geometry Offset (`terminator`).
+    pub shadow_terminator: f32,
 }
 
 impl MeshInstance {
@@ -100,6 +102,9 @@ pub fn build(scene: &Scene, eval: &EvaluatedScene, overrides: &[(String, serde_j
         }
         if obj.is_shadow_catcher {
             warn_shadow_catcher(&obj.name);
+        }
+        if obj.shadow_terminator_shading_offset != 0.0 {
+            warn_shading_offset(&obj.name);
         }
         let Some(mi) = scene.file.meshes.iter().position(|m| m.name == mesh_name) else {
             return Err(RenderError(format!("object {:?}: mesh {mesh_name:?} is not in the export", obj.name)));
@@ -183,6 +188,11 @@ pub fn triangle_masks(geo: &Geometry) -> Vec<u32> {
 fn warn_shadow_catcher(name: &str) {
     static WARN: std::sync::Once = std::sync::Once::new();
     WARN.call_once(|| eprintln!("warning: object {name:?} is a shadow catcher, which the renderer does not support: it is rendered as an ordinary object"));
+}
+
+fn warn_shading_offset(name: &str) {
+    static WARN: std::sync::Once = std::sync::Once::new();
+    WARN.call_once(|| eprintln!("warning: object {name:?} has a shadow terminator shading offset, which the renderer does not support: it is rendered without it (the geometry offset is applied)"));
 }
 
 /// Every instance's triangles in world space, skipping those with non-finite corners.
@@ -289,6 +299,7 @@ fn push_instance(
         attributes: Vec::new(),
         visibility: object_visibility(obj),
         holdout: obj.is_holdout,
+        shadow_terminator: obj.shadow_terminator_geometry_offset,
     });
     Ok(())
 }

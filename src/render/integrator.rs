@@ -3,6 +3,7 @@
 //! the next surface, as Cycles does), Russian roulette on sqrt of throughput, and
 //! Cycles' clamping (direct and indirect limits on the sum of a contribution).
 
+use crate::scene::AttributeData;
 use crate::shader::ShadingPoint;
 use crate::shader::point::{ray, PathState, Undisplaced};
 
@@ -117,6 +118,9 @@ pub struct SurfaceHit {
     pub backfacing: bool,
     /// The shutter time the hit's object was posed at.
     pub time: f32,
+    /// The triangle and the weights of its corners 1 and 2 (shadow terminator offset).
+    pub prim: u32,
+    pub uv: [f32; 2],
 }
 
 /// Below this GGX alpha a vertex uses MIS toward lamps.
@@ -208,7 +212,7 @@ impl Scene<'_> {
             sp.object.location = to_world.column(3);
             sp.object.world_to_object = to_object.m;
         }
-        SurfaceHit { p, ng, sp, inst: r.inst, material, backfacing, time }
+        SurfaceHit { p, ng, sp, inst: r.inst, material, backfacing, time, prim, uv: [u, v] }
     }
 
     pub fn shade(&self, hit: &SurfaceHit, wo: V3, scratch: &mut Scratch) {
@@ -445,7 +449,7 @@ impl Scene<'_> {
                     if is_zero(c) || !finite(c) {
                         continue;
                     }
-                    let start = p_off(ls.wi);
+                    let start = self.shadow_origin(&hit, ls.wi);
                     let c = if light.cast_shadow {
                         let tr = self.shadow_transmittance(start, ls.wi, if ls.dist.is_finite() { ls.dist * (1.0 - 1e-4) } else { f32::INFINITY }, scratch);
                         if is_zero(tr) {
@@ -480,7 +484,7 @@ impl Scene<'_> {
                     let (f, pdf_b) = if exclude == 0 { scratch.lobes.eval(wo, wi, hit.ng, self.tables) } else { scratch.lobes.eval_excluding(wo, wi, hit.ng, self.tables, exclude) };
                     if !is_zero(f) {
                         let pdf_l = self.mesh_lights.pdf_area[prim as usize] * d2 / cos_l;
-                        let start = p_off(wi);
+                        let start = self.shadow_origin(&hit, wi);
                         let tr = if pdf_l > 0.0 { self.shadow_transmittance(start, wi, dist * (1.0 - 1e-4), scratch) } else { [0.0; 3] };
                         if !is_zero(tr) {
                             let le = self.light_emission(prim, b1, b2, neg(wi), dist, bounce, scratch);
@@ -496,7 +500,7 @@ impl Scene<'_> {
             // One light sample toward the world, where it varies with direction.
             if !terminate_next && scratch.lobes.len > 0 {
                 let u_world = rng.get4(index, 0x2000_0000 + set);
-                let c = self.world_light_sample(hit.p, hit.ng, wo, [u_world[0], u_world[1]], scratch);
+                let c = self.world_light_sample(&hit, wo, [u_world[0], u_world[1]], scratch);
                 let c = mul(throughput, c);
                 if finite(c) && !is_zero(c) {
                     l = add(l, clamp_contrib(c, if bounce == 0 { st.clamp_direct } else { st.clamp_indirect }));
@@ -638,21 +642,54 @@ impl Scene<'_> {
     /// Next-event estimate toward the world from surface point `p` (BSDF in
     /// `scratch.lobes`), MIS-weighted against BSDF sampling; zero if unoccluded paths
     /// see nothing or the world is not light-sampled.
-    fn world_light_sample(&self, p: V3, ng: V3, wo: V3, u: [f32; 2], scratch: &mut Scratch) -> V3 {
+    fn world_light_sample(&self, hit: &SurfaceHit, wo: V3, u: [f32; 2], scratch: &mut Scratch) -> V3 {
         let Some(map) = self.world.and_then(|w| w.map.as_ref()) else { return [0.0; 3] };
         let Some((wi, pdf_l)) = map.sample(u) else { return [0.0; 3] };
-        let (f, pdf_b) = scratch.lobes.eval(wo, wi, ng, self.tables);
+        let (f, pdf_b) = scratch.lobes.eval(wo, wi, hit.ng, self.tables);
         if is_zero(f) || pdf_l.is_nan() || pdf_l <= 0.0 {
             return [0.0; 3];
         }
-        let eps = 1e-5 * (1.0 + max3(p.map(f32::abs)));
-        let start = if dot(wi, ng) >= 0.0 { madd(p, ng, eps) } else { madd(p, ng, -eps) };
+        let start = self.shadow_origin(hit, wi);
         let tr = self.shadow_transmittance(start, wi, f32::INFINITY, scratch);
         if is_zero(tr) {
             return [0.0; 3];
         }
         let le = self.background_toward(wi, scratch);
         mul(scale(mul(f, le), power_heuristic(pdf_l, pdf_b) / pdf_l), tr)
+    }
+
+    /// Where a shadow ray from `hit` toward `wi` (unit) starts: just off the surface on the
+    /// light's side, lifted to the smooth surface of the vertex normals at grazing angles
+    /// (Cycles' shadow terminator geometry offset, `terminator`).
+    fn shadow_origin(&self, hit: &SurfaceHit, wi: V3) -> V3 {
+        let mut p = hit.p;
+        let inst = &self.geo.instances[hit.inst as usize];
+        let m = &inst.mesh;
+        if inst.shadow_terminator > 0.0 && m.corner_normals.len() == m.corner_verts.len() {
+            let (amount, ng) = super::terminator::amount(inst.shadow_terminator, hit.sp.normal, hit.ng, wi);
+            let r = self.geo.refs[hit.prim as usize];
+            let face = m.triangle_faces[r.tri as usize] as usize;
+            let flat = matches!(m.attribute("sharp_face").map(|a| &a.data), Some(AttributeData::Bool(f)) if f.get(face) == Some(&true));
+            if amount > 0.0 && !flat {
+                let (to_world, to_object) = inst.pose_at(hit.time);
+                let v = inst.posed_triangle(&self.geo.tris[hit.prim as usize], r.tri, &to_world);
+                let c = m.triangles[r.tri as usize];
+                // World-space vertex normals, as Cycles has them once it applied the
+                // object's transform (the same normals `surface_at` shades with).
+                let n = c.map(|c| normalize(Affine::normal_by_inverse(&to_object, m.corner_normals[c as usize])));
+                let [u, w] = hit.uv;
+                let lift = super::terminator::smooth_surface_offset(v, n, [1.0 - u - w, u, w], ng);
+                if finite(lift) {
+                    p = madd(p, lift, amount);
+                }
+            }
+        }
+        let eps = 1e-5 * (1.0 + max3(p.map(f32::abs)));
+        if dot(wi, hit.ng) >= 0.0 {
+            madd(p, hit.ng, eps)
+        } else {
+            madd(p, hit.ng, -eps)
+        }
     }
 
     /// What a shadow ray from `start` along `dir` (unit) lets through up to `tmax`: zero at

@@ -35,6 +35,7 @@ pub mod sheen_ltc;
 pub mod subsurface;
 pub mod subsurface_disk;
 pub mod tables;
+pub mod terminator;
 pub mod world;
 
 use std::time::Instant;

@@ -176,6 +176,17 @@ pub struct Object {
     pub is_holdout: bool,
     #[serde(default)]
     pub is_shadow_catcher: bool,
+    /// Object > Shading > Shadow Terminator > Geometry Offset; Blender's default 0.1 in
+    /// older exports.
+    #[serde(default = "default_terminator_offset")]
+    pub shadow_terminator_geometry_offset: f32,
+    /// Object > Shading > Shadow Terminator > Shading Offset (default 0).
+    #[serde(default)]
+    pub shadow_terminator_shading_offset: f32,
+}
+
+fn default_terminator_offset() -> f32 {
+    0.1
 }
 
 fn yes() -> bool {
