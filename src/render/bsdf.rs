@@ -214,6 +214,12 @@ impl LobeSet {
             return Some(BsdfSample { wi: ds.l, weight: scale(f, 1.0 / pdf), pdf, singular: false, glossy, transmit, kind: l.kind });
         }
         let (wi, singular) = sample_lobe(l, wo, ng, [u[0], u[1]])?;
+        // The true normal is checked here, when sampling, and not in `eval_lobe` (as
+        // Cycles): a reflection must leave above the surface, a translucent
+        // transmission below it.
+        if !singular && (dot(ng, wi) > 0.0) == matches!(l.kind, LobeKind::Translucent) {
+            return None;
+        }
         let glossy = matches!(l.kind, LobeKind::Glossy { .. } | LobeKind::Reflection(_));
         let glossy = glossy || matches!(l.kind, LobeKind::GlossyAniso { .. });
         let transmit = matches!(l.kind, LobeKind::Translucent | LobeKind::Transparent);

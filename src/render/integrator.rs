@@ -449,7 +449,7 @@ impl Scene<'_> {
                     if is_zero(c) || !finite(c) {
                         continue;
                     }
-                    let start = self.shadow_origin(&hit, ls.wi);
+                    let start = self.shadow_origin(&hit, scratch.lobes.smooth_n, ls.wi);
                     let c = if light.cast_shadow {
                         let tr = self.shadow_transmittance(start, ls.wi, if ls.dist.is_finite() { ls.dist * (1.0 - 1e-4) } else { f32::INFINITY }, scratch);
                         if is_zero(tr) {
@@ -484,7 +484,7 @@ impl Scene<'_> {
                     let (f, pdf_b) = if exclude == 0 { scratch.lobes.eval(wo, wi, hit.ng, self.tables) } else { scratch.lobes.eval_excluding(wo, wi, hit.ng, self.tables, exclude) };
                     if !is_zero(f) {
                         let pdf_l = self.mesh_lights.pdf_area[prim as usize] * d2 / cos_l;
-                        let start = self.shadow_origin(&hit, wi);
+                        let start = self.shadow_origin(&hit, scratch.lobes.smooth_n, wi);
                         let tr = if pdf_l > 0.0 { self.shadow_transmittance(start, wi, dist * (1.0 - 1e-4), scratch) } else { [0.0; 3] };
                         if !is_zero(tr) {
                             let le = self.light_emission(prim, b1, b2, neg(wi), dist, bounce, scratch);
@@ -649,7 +649,7 @@ impl Scene<'_> {
         if is_zero(f) || pdf_l.is_nan() || pdf_l <= 0.0 {
             return [0.0; 3];
         }
-        let start = self.shadow_origin(hit, wi);
+        let start = self.shadow_origin(hit, scratch.lobes.smooth_n, wi);
         let tr = self.shadow_transmittance(start, wi, f32::INFINITY, scratch);
         if is_zero(tr) {
             return [0.0; 3];
@@ -660,13 +660,18 @@ impl Scene<'_> {
 
     /// Where a shadow ray from `hit` toward `wi` (unit) starts: just off the surface on the
     /// light's side, lifted to the smooth surface of the vertex normals at grazing angles
-    /// (Cycles' shadow terminator geometry offset, `terminator`).
-    fn shadow_origin(&self, hit: &SurfaceHit, wi: V3) -> V3 {
+    /// (Cycles' shadow terminator geometry offset, `terminator`). A lifted ray toward a
+    /// light behind the true normal may hit its own triangle, as in Cycles ("otherwise
+    /// we're meant to hit this surface"): it then starts on the near side, so it does.
+    fn shadow_origin(&self, hit: &SurfaceHit, smooth_n: V3, wi: V3) -> V3 {
         let mut p = hit.p;
+        let mut skip_self = true;
         let inst = &self.geo.instances[hit.inst as usize];
         let m = &inst.mesh;
         if inst.shadow_terminator > 0.0 && m.corner_normals.len() == m.corner_verts.len() {
-            let (amount, ng) = super::terminator::amount(inst.shadow_terminator, hit.sp.normal, hit.ng, wi);
+            // Cycles' sd->N: the shading normal after the material's displacement bump.
+            let n = if is_zero(smooth_n) { hit.sp.normal } else { smooth_n };
+            let (amount, ng) = super::terminator::amount(inst.shadow_terminator, n, hit.ng, wi);
             let r = self.geo.refs[hit.prim as usize];
             let face = m.triangle_faces[r.tri as usize] as usize;
             let flat = matches!(m.attribute("sharp_face").map(|a| &a.data), Some(AttributeData::Bool(f)) if f.get(face) == Some(&true));
@@ -682,10 +687,13 @@ impl Scene<'_> {
                 if finite(lift) {
                     p = madd(p, lift, amount);
                 }
+                skip_self = dot(ng, wi) > 0.0;
             }
         }
         let eps = 1e-5 * (1.0 + max3(p.map(f32::abs)));
-        if dot(wi, hit.ng) >= 0.0 {
+        // Off the surface on the light's side (the ray leaves its own triangle), or, when
+        // it is meant to hit it, on the other side.
+        if (dot(wi, hit.ng) >= 0.0) == skip_self {
             madd(p, hit.ng, eps)
         } else {
             madd(p, hit.ng, -eps)

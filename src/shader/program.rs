@@ -24,7 +24,7 @@ use crate::nodes::brick::{brick_texture, BrickSettings};
 use crate::nodes::image::{box_uvs, box_weights, direction_to_equirectangular, direction_to_mirrorball, project, safe_normalize, EnvProjection, Extension, Interpolation, Projection};
 
 use super::images::TexImage;
-use super::bump::{bump_normal, displacement, displacement_bump, normal_map, offset_point, vector_displacement, BumpPoint, BumpSettings, MapSpace};
+use super::bump::{bump_normal, differential_from_compact, differential_make_compact, displacement, displacement_bump, normal_map, offset_point, vector_displacement, BumpPoint, BumpSettings, MapSpace};
 use super::point::ShadingPoint;
 use super::inputs::{self, Input};
 
@@ -234,8 +234,14 @@ impl Program {
             (Some(end), Some(normal)) => {
                 // Cycles' bump shader of a displaced mesh reads the surface as it was
                 // before displacement (svm_node_enter_bump_eval), then the surface ops
-                // read the displaced point with the bumped normal.
-                let before = sp.undisplaced.map_or(*sp, |u| ShadingPoint { position: u.position, object_position: u.object_position, dp_dx: u.dp_dx, dp_dy: u.dp_dy, ..*sp });
+                // read the displaced point with the bumped normal. There the coordinate
+                // copies move by the undisplaced differential in its compact form,
+                // expanded around the displaced true normal as always; only the bump
+                // itself takes the full undisplaced differential (`DisplacementBump`).
+                let before = sp.undisplaced.map_or(*sp, |u| {
+                    let (dp_dx, dp_dy) = differential_from_compact(sp.ng, differential_make_compact(u.dp_dx, u.dp_dy));
+                    ShadingPoint { position: u.position, object_position: u.object_position, dp_dx, dp_dy, ..*sp }
+                });
                 self.exec(before, s, &self.ops[..end]);
                 let n = v3(s, normal);
                 let after = ShadingPoint { normal: n, object_normal: sp.transform.inverse_normal(n), ..*sp };
@@ -484,7 +490,13 @@ impl Program {
                     put3(s, dst, r);
                 }
                 Op::DisplacementBump { object_space, center, dx, dy, dst } => {
-                    let n = displacement_bump(&base, object_space, v3(s, center), v3(s, dx), v3(s, dy));
+                    // At the undisplaced surface, Cycles' bump reads the full differential
+                    // svm_node_enter_bump_eval saved, not the compact one.
+                    let mut full = base;
+                    if let Some(u) = base.undisplaced {
+                        (full.dp_dx, full.dp_dy) = (u.dp_dx, u.dp_dy);
+                    }
+                    let n = displacement_bump(&full, object_space, v3(s, center), v3(s, dx), v3(s, dy));
                     base.normal = n;
                     base.object_normal = base.transform.inverse_normal(n);
                     sp = base;
