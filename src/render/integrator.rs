@@ -639,7 +639,7 @@ impl Scene<'_> {
         }
     }
 
-    /// Next-event estimate toward the world from surface point `p` (BSDF in
+    /// Next-event estimate toward the world from surface point `hit` (BSDF in
     /// `scratch.lobes`), MIS-weighted against BSDF sampling; zero if unoccluded paths
     /// see nothing or the world is not light-sampled.
     fn world_light_sample(&self, hit: &SurfaceHit, wo: V3, u: [f32; 2], scratch: &mut Scratch) -> V3 {
@@ -673,9 +673,11 @@ impl Scene<'_> {
             let n = if is_zero(smooth_n) { hit.sp.normal } else { smooth_n };
             let (amount, ng) = super::terminator::amount(inst.shadow_terminator, n, hit.ng, wi);
             let r = self.geo.refs[hit.prim as usize];
-            let face = m.triangle_faces[r.tri as usize] as usize;
-            let flat = matches!(m.attribute("sharp_face").map(|a| &a.data), Some(AttributeData::Bool(f)) if f.get(face) == Some(&true));
-            if amount > 0.0 && !flat {
+            let flat = || {
+                let face = m.triangle_faces[r.tri as usize] as usize;
+                matches!(m.attribute("sharp_face").map(|a| &a.data), Some(AttributeData::Bool(f)) if f.get(face) == Some(&true))
+            };
+            if amount > 0.0 && !flat() {
                 let (to_world, to_object) = inst.pose_at(hit.time);
                 let v = inst.posed_triangle(&self.geo.tris[hit.prim as usize], r.tri, &to_world);
                 let c = m.triangles[r.tri as usize];
