@@ -422,14 +422,7 @@ impl Scene<'_> {
                 }
                 throughput = scale(throughput, 1.0 / q);
             }
-            let p_off = |dir: V3| {
-                let eps = 1e-5 * (1.0 + max3(hit.p.map(f32::abs)));
-                if dot(dir, hit.ng) >= 0.0 {
-                    madd(hit.p, hit.ng, eps)
-                } else {
-                    madd(hit.p, hit.ng, -eps)
-                }
-            };
+            let p_off = |dir: V3| offset_origin(hit.p, hit.ng, dir);
             // Lamps are shared with BSDF sampling (MIS) only at vertices with a sharp
             // glossy lobe, where light sampling alone is noisy; elsewhere light sampling
             // alone has less variance than MIS with our area-uniform lamp sampling.
@@ -692,14 +685,9 @@ impl Scene<'_> {
                 skip_self = dot(ng, wi) > 0.0;
             }
         }
-        let eps = 1e-5 * (1.0 + max3(p.map(f32::abs)));
         // Off the surface on the light's side (the ray leaves its own triangle), or, when
         // it is meant to hit it, on the other side.
-        if (dot(wi, hit.ng) >= 0.0) == skip_self {
-            madd(p, hit.ng, eps)
-        } else {
-            madd(p, hit.ng, -eps)
-        }
+        offset_origin(p, hit.ng, if skip_self { wi } else { neg(wi) })
     }
 
     /// What a shadow ray from `start` along `dir` (unit) lets through up to `tmax`: zero at
@@ -731,8 +719,7 @@ impl Scene<'_> {
             if is_zero(through) {
                 return [0.0; 3];
             }
-            let eps = 1e-5 * (1.0 + max3(hit.p.map(f32::abs)));
-            o = if dot(dir, hit.ng) >= 0.0 { madd(hit.p, hit.ng, eps) } else { madd(hit.p, hit.ng, -eps) };
+            o = offset_origin(hit.p, hit.ng, dir);
             left -= h.t;
         }
         [0.0; 3]

@@ -52,6 +52,17 @@ pub fn neg(a: V3) -> V3 {
 pub fn madd(a: V3, b: V3, f: f32) -> V3 {
     [a[0] + b[0] * f, a[1] + b[1] * f, a[2] + b[2] * f]
 }
+/// A ray origin just off a surface at `p` (true normal `ng`), on the side `dir` leaves
+/// toward, so the ray does not hit the surface it starts on.
+#[inline]
+pub fn offset_origin(p: V3, ng: V3, dir: V3) -> V3 {
+    let eps = 1e-5 * (1.0 + max3(p.map(f32::abs)));
+    if dot(dir, ng) >= 0.0 {
+        madd(p, ng, eps)
+    } else {
+        madd(p, ng, -eps)
+    }
+}
 #[inline(always)]
 pub fn max3(a: V3) -> f32 {
     a[0].max(a[1]).max(a[2])

@@ -408,8 +408,8 @@ pub fn enter_and_walk(
     if dot(hit.ng, d0) >= 0.0 {
         return None;
     }
-    let eps = 1e-5 * (1.0 + max3(hit.p.map(f32::abs)));
-    let start = madd(hit.p, hit.ng, -eps);
+    // Into the surface: d0 points below the true normal.
+    let start = offset_origin(hit.p, hit.ng, d0);
     let rand = |bounce: u32| {
         let a = rng.get4(index, base.wrapping_add(1 + 2 * bounce));
         let c = rng.get4(index, base.wrapping_add(2 + 2 * bounce));
