@@ -165,14 +165,29 @@ fn load_shared(path: &Path, name: &str, colorspace: &str, alpha_mode: &str, enco
     img
 }
 
-/// Decodes `path` into Cycles' storage for an image with these settings.
-pub fn load(path: &Path, encoding: Encoding, is_data: bool, alpha_mode: &str) -> Result<TexImage, String> {
-    use image::DynamicImage as D;
-    let img = image::ImageReader::open(path)
+/// Reads and decodes an image file, whatever its format; errors name the file.
+pub fn decode(path: &Path) -> Result<image::DynamicImage, String> {
+    image::ImageReader::open(path)
         .and_then(|r| r.with_guessed_format())
         .map_err(|e| format!("cannot read {}: {e}", path.display()))?
         .decode()
-        .map_err(|e| format!("cannot decode {}: {e}", path.display()))?;
+        .map_err(|e| format!("cannot decode {}: {e}", path.display()))
+}
+
+/// `w` x `h` pixels reordered from the file's top-row-first to Blender's and Cycles'
+/// bottom-row-first.
+pub fn flip_rows<T: Copy>(px: &[T], w: usize, h: usize) -> Vec<T> {
+    let mut out = Vec::with_capacity(px.len());
+    for y in (0..h).rev() {
+        out.extend_from_slice(&px[y * w..(y + 1) * w]);
+    }
+    out
+}
+
+/// Decodes `path` into Cycles' storage for an image with these settings.
+pub fn load(path: &Path, encoding: Encoding, is_data: bool, alpha_mode: &str) -> Result<TexImage, String> {
+    use image::DynamicImage as D;
+    let img = decode(path)?;
     let (w, h) = (img.width() as usize, img.height() as usize);
     if w == 0 || h == 0 {
         return Err(format!("{} is empty", path.display()));
@@ -185,14 +200,6 @@ pub fn load(path: &Path, encoding: Encoding, is_data: bool, alpha_mode: &str) ->
     let associate = !(is_data || alpha_mode == "CHANNEL_PACKED" || alpha_mode == "NONE");
     let is_exr = matches!(img, D::ImageRgb32F(_) | D::ImageRgba32F(_));
     let ignore_alpha = alpha_mode == "NONE";
-    // Image files store the top row first; Cycles' rows start at the bottom.
-    fn flip<T: Copy>(px: Vec<T>, w: usize, h: usize) -> Vec<T> {
-        let mut out = Vec::with_capacity(px.len());
-        for y in (0..h).rev() {
-            out.extend_from_slice(&px[y * w..(y + 1) * w]);
-        }
-        out
-    }
     let texels = match img {
         D::ImageLuma8(_) | D::ImageLumaA8(_) | D::ImageRgb8(_) | D::ImageRgba8(_) => {
             let mut px: Vec<[u8; 4]> = img.to_rgba8().pixels().map(|p| p.0).collect();
@@ -206,7 +213,7 @@ pub fn load(path: &Path, encoding: Encoding, is_data: bool, alpha_mode: &str) ->
                     }
                 }
             }
-            Texels::Byte(flip(px, w, h))
+            Texels::Byte(flip_rows(&px, w, h))
         }
         D::ImageLuma16(_) | D::ImageLumaA16(_) | D::ImageRgb16(_) | D::ImageRgba16(_) => {
             let mut px: Vec<[u16; 4]> = img.to_rgba16().pixels().map(|p| p.0).collect();
@@ -220,7 +227,7 @@ pub fn load(path: &Path, encoding: Encoding, is_data: bool, alpha_mode: &str) ->
                     }
                 }
             }
-            Texels::Short(flip(px, w, h))
+            Texels::Short(flip_rows(&px, w, h))
         }
         _ => {
             let mut px: Vec<[f32; 4]> = img.to_rgba32f().pixels().map(|p| p.0).collect();
@@ -238,7 +245,7 @@ pub fn load(path: &Path, encoding: Encoding, is_data: bool, alpha_mode: &str) ->
                     *p = [0.0; 4];
                 }
             }
-            Texels::Float(flip(px, w, h))
+            Texels::Float(flip_rows(&px, w, h))
         }
     };
     Ok(TexImage { width: w as i32, height: h as i32, texels, encoding, single_channel: channels == 1, is_data, alpha_mode: alpha_mode.into() })

@@ -13,7 +13,7 @@ use super::super::types::{Array, DataType};
 use super::super::value::SocketValue;
 use crate::geometry::types::unit_to_byte;
 use crate::nodes::image::{srgb_to_linear, Extension, Interpolation, Pixels};
-use crate::shader::images::{image_file, Encoding, ImageFile};
+use crate::shader::images::{self, flip_rows, image_file, Encoding, ImageFile};
 
 /// An image's pixels as Blender's `ImBuf` float buffer: linear, rows bottom to top.
 struct FloatImage {
@@ -28,11 +28,7 @@ struct FloatImage {
 /// the channels are packed, associated.
 fn decode(f: &ImageFile) -> Result<FloatImage, String> {
     use image::DynamicImage as D;
-    let img = image::ImageReader::open(&f.path)
-        .and_then(|r| r.with_guessed_format())
-        .map_err(|e| format!("cannot read {}: {e}", f.path.display()))?
-        .decode()
-        .map_err(|e| format!("cannot decode {}: {e}", f.path.display()))?;
+    let img = images::decode(&f.path)?;
     let (w, h) = (img.width() as usize, img.height() as usize);
     let packed = f.is_data || f.alpha_mode == "CHANNEL_PACKED";
     let ignore = f.alpha_mode == "NONE" && !f.is_data;
@@ -114,12 +110,7 @@ fn decode(f: &ImageFile) -> Result<FloatImage, String> {
                 .collect()
         }
     };
-    // Files store the top row first; Blender's rows start at the bottom.
-    let mut pixels = Vec::with_capacity(rows.len());
-    for y in (0..h).rev() {
-        pixels.extend_from_slice(&rows[y * w..(y + 1) * w]);
-    }
-    Ok(FloatImage { width: w as i32, height: h as i32, pixels })
+    Ok(FloatImage { width: w as i32, height: h as i32, pixels: flip_rows(&rows, w, h) })
 }
 
 pub fn image_texture(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
