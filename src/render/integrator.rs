@@ -26,6 +26,7 @@ pub struct Settings {
     pub clamp_direct: f32,
     pub clamp_indirect: f32,
     pub min_light_bounces: u32,
+    pub min_transparent_bounces: u32,
     /// Cycles' Filter Glossy (`blur_glossy`).
     pub filter_glossy: f32,
     /// Film > Transparent: the background seen by camera rays (directly or through
@@ -414,8 +415,13 @@ impl Scene<'_> {
                     break;
                 }
             }
-            // Russian roulette, as Cycles: none up to the minimum bounce, then sqrt of throughput.
-            if bounce > st.min_light_bounces {
+            // Russian roulette as Cycles (path_state_continuation_probability): sqrt of the
+            // throughput, but never within the minimum bounces, which Cycles' kernel takes
+            // as the setting plus one (so the first indirect hit always continues),
+            // counted in transparent bounces when the ray just passed a transparent
+            // surface; and not again at a subsurface exit (decided at the entry).
+            let roulette = if flags & ray::TRANSPARENT != 0 { transparent > st.min_transparent_bounces + 1 } else { bounce > st.min_light_bounces + 1 };
+            if roulette && from_sss.is_none() {
                 let q = max3(throughput.map(f32::abs)).sqrt().min(1.0);
                 if q <= 0.0 || u_light[3] >= q {
                     break;

@@ -211,6 +211,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         clamp_direct: rna_f(cy, "sample_clamp_direct").unwrap_or(0.0) as f32,
         clamp_indirect: rna_f(cy, "sample_clamp_indirect").unwrap_or(10.0) as f32,
         min_light_bounces: gi("min_light_bounces", 0.0),
+        min_transparent_bounces: gi("min_transparent_bounces", 0.0),
         filter_glossy: rna_f(cy, "blur_glossy").unwrap_or(1.0) as f32,
         film_transparent: r.get("film_transparent").and_then(Value::as_bool).unwrap_or(false),
         transparent_shadows: materials.iter().any(|m| m.transparent_shadow),
