@@ -23,6 +23,8 @@ pub struct Settings {
     pub max_glossy: u32,
     pub max_transmission: u32,
     pub max_transparent: u32,
+    /// Limits on the sum of a contribution's three channels (Cycles' kernel values: the
+    /// per-channel settings times three; 0 is off).
     pub clamp_direct: f32,
     pub clamp_indirect: f32,
     pub min_light_bounces: u32,

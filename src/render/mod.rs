@@ -208,8 +208,10 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         max_glossy: gi("glossy_bounces", 4.0),
         max_transmission: gi("transmission_bounces", 12.0),
         max_transparent: gi("transparent_max_bounces", 8.0),
-        clamp_direct: rna_f(cy, "sample_clamp_direct").unwrap_or(0.0) as f32,
-        clamp_indirect: rna_f(cy, "sample_clamp_indirect").unwrap_or(10.0) as f32,
+        // The clamp compares the sum of the three channels, so Cycles (integrator.cpp)
+        // stores the per-channel setting times three; 0 stays off.
+        clamp_direct: 3.0 * rna_f(cy, "sample_clamp_direct").unwrap_or(0.0) as f32,
+        clamp_indirect: 3.0 * rna_f(cy, "sample_clamp_indirect").unwrap_or(10.0) as f32,
         min_light_bounces: gi("min_light_bounces", 0.0),
         min_transparent_bounces: gi("min_transparent_bounces", 0.0),
         filter_glossy: rna_f(cy, "blur_glossy").unwrap_or(1.0) as f32,
