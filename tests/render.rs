@@ -76,6 +76,10 @@ const ASSERTED: &[&str] = &[
     // indirect hit, as Cycles' kernel min_bounce (the setting plus one) does.
     "pano_equirectangular",
     "translucent",
+    // Principled thin film (render/thin_film.rs): over the dielectric specular layer, and over
+    // the transmission (glass).
+    "thin_film",
+    "thin_film_glass",
 ];
 
 /// Scenes that do not pass yet, with the reason.
