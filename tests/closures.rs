@@ -19,7 +19,7 @@ fn rough_glass_sample_matches_eval() {
     let s = PixelSampler::new(3, 5, 7);
     for dist in [Distribution::Ggx, Distribution::Beckmann] {
         for eta in [1.5f32, 1.0 / 1.5] {
-            let g = Dielectric { dist, alpha: 0.3, eta, refract_only: false, tint_r: [1.0; 3], tint_t: [1.0; 3], energy: 1.0 };
+            let g = Dielectric { dist, alpha: 0.3, eta, refract_only: false, tint_r: [1.0; 3], tint_t: [1.0; 3], energy: 1.0, film: None };
             let v = view(0.6);
             let mut checked = 0;
             for i in 0..2000 {

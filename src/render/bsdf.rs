@@ -1,7 +1,7 @@
 //! Scattering closures with light transport, as Cycles defines them: Lambert diffuse,
 //! translucent, GGX microfacet reflection (with Cycles' multiple-scattering energy
-//! compensation), Fresnel models (constant colour, dielectric, F82-tinted Schlick),
-//! transparent. `eval` returns BSDF times the cosine, as Cycles' closures do.
+//! compensation), Fresnel models (constant colour, dielectric, F82-tinted Schlick, thin
+//! film), transparent. `eval` returns BSDF times the cosine, as Cycles' closures do.
 
 use super::math::*;
 use super::microfacet::{Dielectric, Reflection};
@@ -18,6 +18,8 @@ pub enum Fresnel {
     Dielectric { eta: f32 },
     /// Metals: F0 colour, F82 tint factor `b` (precomputed).
     F82 { f0: V3, b: V3 },
+    /// Dielectric under a thin film (Principled specular layer): coloured by interference.
+    ThinFilm(super::thin_film::ThinFilm),
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -278,6 +280,7 @@ fn fresnel_eval(f: Fresnel, cos_h: f32, tint: V3) -> V3 {
             }
             out
         }
+        Fresnel::ThinFilm(tf) => mul(tint, tf.eval(cos_h)),
     }
 }
 

@@ -198,6 +198,9 @@ pub struct Dielectric {
     pub tint_t: V3,
     /// Multiple-scattering energy compensation (1 / single-scattering albedo).
     pub energy: f32,
+    /// Principled transmission's thin film: its reflectance replaces the bare Fresnel
+    /// (refraction takes the rest; the refracted direction is Snell's either way).
+    pub film: Option<super::thin_film::ThinFilm>,
 }
 
 /// Result of sampling a dielectric: direction, eval / pdf (without the closure weight)
@@ -225,6 +228,10 @@ impl Dielectric {
         if self.refract_only {
             // Cycles' Refraction BSDF has no Fresnel factor.
             return ([0.0; 3], self.tint_t, cos_ht);
+        }
+        if let Some(film) = &self.film {
+            let r = film.eval(cos_hv);
+            return (mul(self.tint_r, r), mul(self.tint_t, r.map(|x| 1.0 - x)), cos_ht);
         }
         (scale(self.tint_r, f), scale(self.tint_t, 1.0 - f), cos_ht)
     }
@@ -354,7 +361,7 @@ pub fn glass_closure(tables: &super::tables::Tables, distribution: Option<&str>,
     let ior = ior.max(1e-5);
     let eta = if backfacing { 1.0 / ior } else { ior };
     let dist = if distribution == Some("BECKMANN") { Distribution::Beckmann } else { Distribution::Ggx };
-    let mut g = Dielectric { dist, alpha: r * r, eta, refract_only, tint_r: [1.0; 3], tint_t: [1.0; 3], energy: 1.0 };
+    let mut g = Dielectric { dist, alpha: r * r, eta, refract_only, tint_r: [1.0; 3], tint_t: [1.0; 3], energy: 1.0, film: None };
     if !refract_only && distribution == Some("MULTI_GGX") && !g.singular() {
         g.energy = 1.0 / tables.glass_e(mu.clamp(0.0, 1.0), r, eta).max(1e-3);
     }

@@ -36,6 +36,7 @@ pub mod subsurface;
 pub mod subsurface_disk;
 pub mod tables;
 pub mod terminator;
+pub mod thin_film;
 pub mod world;
 
 use std::time::Instant;

@@ -47,7 +47,6 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
         }
         let sampling = m.properties.get("cycles").and_then(|c| c.get("emission_sampling")).and_then(|v| v.as_str()).unwrap_or("AUTO").to_string();
         let bump_correction = m.properties.get("cycles").and_then(|c| c.get("use_bump_map_correction")).and_then(|v| v.as_bool()).unwrap_or(true);
-        refuse_thin_film(&p, &m.name)?;
         let bssrdf_bump = has_bssrdf_bump(&p);
         let transparent_shadow = can_be_transparent(&p);
         out.push(Material { program: Some(p), bsdf_of, name: m.name.clone(), sampling, bump_correction, bssrdf_bump, transparent_shadow });
@@ -71,17 +70,6 @@ fn linked_or_constant(p: &Program, b: &crate::shader::program::BsdfNode, name: &
         Some((slot, false)) => p.initial.get(slot as usize).is_some_and(|v| constant(*v)),
         None => false,
     }
-}
-
-/// The Principled BSDF's thin film (4.2+) is not rendered yet: a material that uses it
-/// (Thin Film Thickness linked or above 0) is an error, never rendered without it.
-fn refuse_thin_film(p: &Program, material: &str) -> Result<(), RenderError> {
-    for b in p.bsdfs.iter().filter(|b| b.bl_idname == "ShaderNodeBsdfPrincipled") {
-        if linked_or_constant(p, b, "Thin Film Thickness", |t| t > 0.0) {
-            return Err(RenderError(format!("material {material:?}: Principled BSDF thin film (Thin Film Thickness > 0) is not supported yet")));
-        }
-    }
-    Ok(())
 }
 
 /// Whether the material has a closure that can be transparent (Cycles marks such
@@ -343,6 +331,11 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
     let (ax, ay) = super::anisotropic::principled_alphas(roughness, input_f(b, s, "Anisotropic", 0.0));
     let tangent = if ax != ay { tangent_input(b, s, sp, "Tangent", input_f(b, s, "Anisotropic Rotation", 0.0), n) } else { [0.0; 3] };
     let coat = input_f(b, s, "Coat Weight", 0.0).clamp(0.0, 1.0);
+    // Thin film (4.2+): on the dielectric specular layer and the transmission; Cycles 4.5
+    // leaves the metallic layer without it.
+    let film_thickness = input_f(b, s, "Thin Film Thickness", 0.0).max(1e-5);
+    let film_ior = input_f(b, s, "Thin Film IOR", 1.33).max(1e-5);
+    let film = film_thickness > super::thin_film::CUTOFF;
     weight = principled_sheen(b, s, sp, ctx, out, weight, n, coat);
     if coat > 0.0 {
         weight = principled_coat(b, s, sp, ctx, out, weight, coat);
@@ -371,6 +364,14 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         let mut g = super::microfacet::glass_closure(ctx.tables, Some("MULTI_GGX"), false, roughness, ior, ctx.backfacing, mu);
         g.tint_r = spec_tint;
         g.tint_t = base.map(f32::sqrt);
+        if film {
+            // Cycles' film IOR is relative to the side the light comes from: film / ior
+            // seen from inside. The specular tint scales the film's reflectance instead.
+            let f0 = super::thin_film::f0_from_ior(ior);
+            let film_eta = if ctx.backfacing { film_ior / ior } else { film_ior };
+            g.film = Some(super::thin_film::ThinFilm { thickness: film_thickness, ior: film_eta, eta: g.eta, f0_scale: spec_tint.map(|t| (f0 * t).min(1.0) / f0) });
+            g.tint_r = [1.0; 3];
+        }
         out.push(LobeKind::Glass(g), scale(weight, transmission), vn);
         weight = scale(weight, 1.0 - transmission);
     }
@@ -385,7 +386,9 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
             eta = 1.0 / eta;
         }
     }
-    if spec_level > 0.0 && max3(weight) > 0.0 {
+    if film && max3(weight) > 0.0 {
+        principled_film_specular(ctx, out, &mut weight, ior, eta, spec_level, spec_tint, (film_thickness, film_ior), (a, ax, ay, tangent, energy), vn, mu);
+    } else if spec_level > 0.0 && max3(weight) > 0.0 {
         let e = (ctx.tables.dielectric_e(mu, roughness, eta) * energy).clamp(0.0, 1.0);
         // Anisotropic: the albedo tables at Cycles' equivalent roughness (alpha_x alpha_y)^(1/4).
         let e = if ax != ay {
@@ -420,6 +423,27 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         return;
     }
     out.push(LobeKind::Diffuse, mul(weight, base), n);
+}
+
+/// The Principled dielectric specular layer under a thin film. Its Fresnel is the film's
+/// (f0 / F0 scaling for the Specular Tint and IOR Level, as Cycles' generalized Schlick);
+/// Cycles estimates its albedo, for the selection weight and for darkening the layers
+/// below, by the film's reflectance toward the viewer (no table fits iridescence), and
+/// keeps the film-free multiple-scattering compensation.
+#[allow(clippy::too_many_arguments)]
+fn principled_film_specular(ctx: &Context, out: &mut LobeSet, weight: &mut V3, ior: f32, eta: f32, spec_level: f32, spec_tint: V3, (thickness, film_ior): (f32, f32), (a, ax, ay, tangent, energy): (f32, f32, f32, V3, f32), vn: V3, mu: f32) {
+    let f0_real = super::thin_film::f0_from_ior(eta);
+    let f0 = super::thin_film::f0_from_ior(ior) * if spec_level != 0.5 { 2.0 * spec_level } else { 1.0 };
+    let f0_scale = if f0_real > 0.0 { spec_tint.map(|t| (f0 * t).clamp(0.0, 1.0) / f0_real) } else { [1.0; 3] };
+    let tf = super::thin_film::ThinFilm { thickness, ior: film_ior, eta, f0_scale };
+    let albedo = tf.eval(mu);
+    let sel = average(albedo).max(1e-3);
+    if ax != ay {
+        push_glossy(out, ctx, ax, ay, tangent, Fresnel::ThinFilm(tf), true, *weight, vn, sel);
+    } else {
+        out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::ThinFilm(tf), energy }, *weight, vn, sel);
+    }
+    *weight = scale(*weight, (1.0 - max3(albedo)).clamp(0.0, 1.0));
 }
 
 /// A BSSRDF closure after Cycles' `bssrdf_setup`: its selection weight counts every
