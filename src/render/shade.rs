@@ -389,11 +389,11 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
     if film && max3(weight) > 0.0 {
         principled_film_specular(ctx, out, &mut weight, ior, eta, spec_level, spec_tint, (film_thickness, film_ior), (a, ax, ay, tangent, energy), vn, mu);
     } else if spec_level > 0.0 && max3(weight) > 0.0 {
-        let e = (ctx.tables.dielectric_e(mu, roughness, eta) * energy).clamp(0.0, 1.0);
+        let e = ctx.tables.dielectric_fresnel_avg(mu, roughness, eta).clamp(0.0, 1.0);
         // Anisotropic: the albedo tables at Cycles' equivalent roughness (alpha_x alpha_y)^(1/4).
         let e = if ax != ay {
             let r4 = (ax * ay).sqrt().sqrt();
-            (ctx.tables.dielectric_e(mu, r4, eta) * multiscatter_energy(ctx.tables, mu, r4)).clamp(0.0, 1.0)
+            ctx.tables.dielectric_fresnel_avg(mu, r4, eta).clamp(0.0, 1.0)
         } else {
             e
         };
@@ -473,7 +473,7 @@ fn principled_coat(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, ctx: &Context, ou
     let n = valid_n(sp, ctx, input_n(b, s, "Coat Normal", sp));
     let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
     let energy = multiscatter_energy(ctx.tables, mu, rough);
-    let e = (ctx.tables.dielectric_e(mu, rough, coat_ior) * energy).clamp(0.0, 1.0);
+    let e = ctx.tables.dielectric_fresnel_avg(mu, rough, coat_ior).clamp(0.0, 1.0);
     out.push_scaled(LobeKind::Glossy { alpha: rough * rough, fresnel: Fresnel::Dielectric { eta: coat_ior }, energy }, scale(weight, coat), n, e.max(1e-3));
     let mut below = scale(weight, (1.0 - coat * e).clamp(0.0, 1.0));
     if tint != [1.0; 3] {

@@ -1,7 +1,8 @@
 //! Directional albedo tables of GGX, integrated here at start-up (as Cycles precomputes
 //! its own): E(mu, roughness) with Fresnel one, for multiple-scattering energy
-//! compensation, and the dielectric-Fresnel albedo E(mu, roughness, ior) for layering
-//! Principled's specular over its diffuse base.
+//! compensation, and the dielectric Fresnel average (Cycles' ggx_gen_schlick_ior_s, the
+//! Fresnel-weighted albedo over the Fresnel-one albedo, stored as a blend from F0 to 1)
+//! for layering Principled's specular and coat over what lies beneath.
 
 use super::bsdf::{fresnel_dielectric, ggx_lambda, sample_vndf};
 use super::sampler::PixelSampler;
@@ -12,20 +13,22 @@ const N3: usize = 16;
 pub struct Tables {
     ggx_e: Vec<f32>,
     ggx_e_avg: Vec<f32>,
-    dielectric_e: Vec<f32>,
+    dielectric_s: Vec<f32>,
     /// Glass albedo E(z, roughness, mu) for eta > 1 and for 1 / eta (Cycles' ggx_glass_E
     /// and ggx_glass_inv_E), for Multiscatter GGX glass.
     glass_e: Vec<f32>,
     glass_inv_e: Vec<f32>,
 }
 
-/// Mean of F * G2/G1 over VNDF samples: the single-scattering albedo.
-fn albedo(mu: f32, alpha: f32, eta: Option<f32>, n: u32) -> f32 {
+/// Means of F * G2/G1 (the single-scattering albedo) and of G2/G1 (the same with Fresnel
+/// one) over the same VNDF samples.
+fn albedo_parts(mu: f32, alpha: f32, eta: Option<f32>, n: u32) -> (f32, f32) {
     let mu = mu.max(1e-4);
     let v = [(1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu];
     let a2 = alpha * alpha;
     let s = PixelSampler::new(7, 11, 13);
     let mut sum = 0.0f64;
+    let mut sum_g = 0.0f64;
     for i in 0..n {
         let u = s.get4(i, 0);
         let h = sample_vndf(v, alpha, [u[0], u[1]]);
@@ -39,8 +42,15 @@ fn albedo(mu: f32, alpha: f32, eta: Option<f32>, n: u32) -> f32 {
         let g = (1.0 + lo) / (1.0 + lo + li);
         let f = eta.map(|e| fresnel_dielectric(vh, e)).unwrap_or(1.0);
         sum += (g * f) as f64;
+        sum_g += g as f64;
     }
-    (sum / n as f64) as f32
+    ((sum / n as f64) as f32, (sum_g / n as f64) as f32)
+}
+
+/// Fresnel reflectance at normal incidence for relative IOR `eta`.
+fn f0(eta: f32) -> f32 {
+    let r = (eta - 1.0) / (eta + 1.0);
+    r * r
 }
 
 fn rough_to_alpha(r: f32) -> f32 {
@@ -63,13 +73,13 @@ impl Tables {
             let mut avg = 0.0;
             for mi in 0..N1 {
                 let mu = mi as f32 / (N1 - 1) as f32;
-                let e = albedo(mu, alpha, None, 256);
+                let e = albedo_parts(mu, alpha, None, 256).0;
                 ggx_e[ri * N1 + mi] = e;
                 avg += 2.0 * e * mu.max(1e-4) / N1 as f32;
             }
             ggx_e_avg[ri] = avg;
         }
-        let mut dielectric_e = vec![0.0; N3 * N3 * N3];
+        let mut dielectric_s = vec![0.0; N3 * N3 * N3];
         for zi in 0..N3 {
             let z = (zi as f32 / (N3 - 1) as f32).max(0.01);
             let r = z * z;
@@ -78,12 +88,20 @@ impl Tables {
                 let alpha = rough_to_alpha(ri as f32 / (N3 - 1) as f32);
                 for mi in 0..N3 {
                     let mu = mi as f32 / (N3 - 1) as f32;
-                    dielectric_e[(zi * N3 + ri) * N3 + mi] = albedo(mu, alpha, Some(eta), 128);
+                    // As Cycles' ggx_gen_schlick_ior_s: the Fresnel-weighted albedo over
+                    // the lobe's own (F = 1) albedo, as a blend factor from F0 to 1.
+                    // Interpolating this normalised factor keeps the estimate exact at
+                    // normal incidence and going to 1 at grazing, where the two albedos
+                    // interpolated apart drift (and a near-mirror's masking is not lost).
+                    let (gf, g) = albedo_parts(mu, alpha, Some(eta), 128);
+                    let ratio = if g > 0.0 { gf / g } else { 1.0 };
+                    let f = f0(eta);
+                    dielectric_s[(zi * N3 + ri) * N3 + mi] = ((ratio - f) / (1.0 - f).max(1e-6)).clamp(0.0, 1.0);
                 }
             }
         }
         let (glass_e, glass_inv_e) = glass_tables();
-        Tables { ggx_e, ggx_e_avg, dielectric_e, glass_e, glass_inv_e }
+        Tables { ggx_e, ggx_e_avg, dielectric_s, glass_e, glass_inv_e }
     }
 
     /// Single-scattering albedo of GGX with Fresnel one; `roughness` = sqrt(alpha).
@@ -98,16 +116,20 @@ impl Tables {
         self.ggx_e_avg[i] * (1.0 - t) + self.ggx_e_avg[i + 1] * t
     }
 
-    /// Single-scattering albedo of dielectric GGX reflection for relative IOR `eta` >= 1.
-    pub fn dielectric_e(&self, mu: f32, roughness: f32, eta: f32) -> f32 {
+    /// Fresnel average of dielectric GGX reflection for relative IOR `eta`: its
+    /// single-scattering albedo over the albedo with Fresnel one (Cycles' estimate of a
+    /// specular layer's albedo once its energy compensation is applied).
+    pub fn dielectric_fresnel_avg(&self, mu: f32, roughness: f32, eta: f32) -> f32 {
         let eta = if eta < 1.0 { 1.0 / eta } else { eta };
         let z = ((eta - 1.0) / (eta + 1.0)).abs().sqrt().clamp(0.0, 1.0);
         let x = z * (N3 - 1) as f32;
         let i = (x as usize).min(N3 - 2);
         let t = x - i as f32;
-        let a = lerp2(&self.dielectric_e[i * N3 * N3..(i + 1) * N3 * N3], N3, roughness, mu);
-        let b = lerp2(&self.dielectric_e[(i + 1) * N3 * N3..(i + 2) * N3 * N3], N3, roughness, mu);
-        a * (1.0 - t) + b * t
+        let a = lerp2(&self.dielectric_s[i * N3 * N3..(i + 1) * N3 * N3], N3, roughness, mu);
+        let b = lerp2(&self.dielectric_s[(i + 1) * N3 * N3..(i + 2) * N3 * N3], N3, roughness, mu);
+        let s = a * (1.0 - t) + b * t;
+        let f = f0(eta);
+        f + (1.0 - f) * s
     }
 }
 
