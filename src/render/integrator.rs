@@ -129,6 +129,18 @@ pub struct SurfaceHit {
 /// Below this GGX alpha a vertex uses MIS toward lamps.
 const MIS_ALPHA: f32 = 0.05;
 
+/// Whether a lobe is sharp enough (GGX or Beckmann alpha below `MIS_ALPHA`) that its
+/// vertex shares lamps between light and BSDF sampling.
+fn sharp_lobe(kind: &LobeKind) -> bool {
+    match kind {
+        LobeKind::Glossy { alpha, .. } => *alpha < MIS_ALPHA,
+        LobeKind::GlossyAniso { lobe, .. } => lobe.alpha_x.min(lobe.alpha_y) < MIS_ALPHA,
+        LobeKind::Glass(g) => g.alpha < MIS_ALPHA,
+        LobeKind::Reflection(r) => r.alpha < MIS_ALPHA,
+        _ => false,
+    }
+}
+
 fn clamp_contrib(l: V3, limit: f32) -> V3 {
     if limit > 0.0 {
         let s = l[0].abs() + l[1].abs() + l[2].abs();
@@ -432,10 +444,10 @@ impl Scene<'_> {
             }
             let p_off = |dir: V3| offset_origin(hit.p, hit.ng, dir);
             // Lamps are shared with BSDF sampling (MIS) only at vertices with a sharp
-            // glossy lobe, where light sampling alone is noisy; elsewhere light sampling
-            // alone has less variance than MIS with our area-uniform lamp sampling.
-            let mis_lamps = lobes.lobes[..lobes.len].iter().any(|l| matches!(l.kind, LobeKind::Glossy { alpha, .. } if alpha < MIS_ALPHA));
-            let mis_lamps = mis_lamps || lobes.lobes[..lobes.len].iter().any(|l| matches!(l.kind, LobeKind::GlossyAniso { lobe, .. } if lobe.alpha_x.min(lobe.alpha_y) < MIS_ALPHA));
+            // glossy lobe (microfacet reflection, or glass reflecting and refracting),
+            // where light sampling alone is noisy; elsewhere light sampling alone has less
+            // variance than MIS with our area-uniform lamp sampling.
+            let mis_lamps = lobes.lobes[..lobes.len].iter().any(|l| sharp_lobe(&l.kind));
             // Next-event estimation toward every light.
             if !terminate_next && scratch.lobes.len > 0 {
                 for (li, light) in self.lights.iter().enumerate() {

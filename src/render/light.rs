@@ -190,6 +190,13 @@ fn sample_cone(axis: V3, omc: f32, u: [f32; 2]) -> (V3, f32) {
     (add(add(scale(t, xy[0] * k), scale(b, xy[1] * k)), scale(axis, cos_theta)), cos_theta)
 }
 
+/// 1 - cos(half angle) of a sun's cone, without the cancellation of `1.0 - cos` at
+/// small angles (Cycles passes one_minus_cos for the same reason).
+fn sun_one_minus_cos(half_angle: f32) -> f32 {
+    let s = (0.5 * half_angle).sin();
+    2.0 * s * s
+}
+
 /// Nearest positive distance along unit `d` from `o` to the sphere, if any.
 fn ray_sphere(o: V3, d: V3, c: V3, r: f32) -> Option<f32> {
     let oc = sub(c, o);
@@ -312,15 +319,15 @@ impl Light {
                 if *half_angle <= 0.0 {
                     return Some(LightSample { wi: toward, dist: f32::INFINITY, value: self.strength, pdf: f32::INFINITY });
                 }
-                let cos_max = half_angle.cos();
-                let z = 1.0 - u[0] * (1.0 - cos_max);
-                let r = (1.0 - z * z).max(0.0).sqrt();
-                let phi = 2.0 * PI * u[1];
-                let (t, b) = basis(toward);
-                let wi = add(add(scale(t, r * phi.cos()), scale(b, r * phi.sin())), scale(toward, z));
+                // Uniform in the cone by Cycles' concentric mapping (distant_light_sample:
+                // sample_uniform_cone), which keeps the sampler's 2D stratification: a polar
+                // mapping stretches strata into thin rings and wedges, noisy where a sharp
+                // lobe sees only part of the disk (a glint on rough glass).
+                let omc = sun_one_minus_cos(*half_angle);
+                let (wi, _) = sample_cone(toward, omc, u);
                 let s = half_angle.sin();
                 let radiance = 1.0 / (PI * s * s);
-                let pdf = 1.0 / (2.0 * PI * (1.0 - cos_max));
+                let pdf = 1.0 / (2.0 * PI * omc);
                 Some(LightSample { wi, dist: f32::INFINITY, value: scale(self.strength, radiance / pdf), pdf })
             }
         }
@@ -403,7 +410,7 @@ impl Light {
                     return None;
                 }
                 let s = half_angle.sin();
-                Some(LightHit { t: f32::INFINITY, radiance: scale(self.strength, 1.0 / (PI * s * s)), pdf: 1.0 / (2.0 * PI * (1.0 - cos_max)) })
+                Some(LightHit { t: f32::INFINITY, radiance: scale(self.strength, 1.0 / (PI * s * s)), pdf: 1.0 / (2.0 * PI * sun_one_minus_cos(*half_angle)) })
             }
         }
     }
