@@ -253,6 +253,12 @@ impl LobeSet {
     }
 }
 
+/// Fresnel reflectance at normal incidence for relative IOR `ior`.
+pub fn f0_from_ior(ior: f32) -> f32 {
+    let r = (ior - 1.0) / (ior + 1.0);
+    r * r
+}
+
 pub fn fresnel_dielectric(cosi: f32, eta: f32) -> f32 {
     let c = cosi.abs();
     let g2 = eta * eta - 1.0 + c * c;

@@ -367,7 +367,7 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         if film {
             // Cycles' film IOR is relative to the side the light comes from: film / ior
             // seen from inside. The specular tint scales the film's reflectance instead.
-            let f0 = super::thin_film::f0_from_ior(ior);
+            let f0 = super::bsdf::f0_from_ior(ior);
             let film_eta = if ctx.backfacing { film_ior / ior } else { film_ior };
             g.film = Some(super::thin_film::ThinFilm { thickness: film_thickness, ior: film_eta, eta: g.eta, f0_scale: spec_tint.map(|t| (f0 * t).min(1.0) / f0) });
             g.tint_r = [1.0; 3];
@@ -378,8 +378,7 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
     // Dielectric specular: IOR adjusted by the specular IOR level as Cycles does.
     let mut eta = ior;
     if spec_level != 0.5 {
-        let r = (ior - 1.0) / (ior + 1.0);
-        let f0 = (r * r * 2.0 * spec_level).min(0.9999);
+        let f0 = (super::bsdf::f0_from_ior(ior) * 2.0 * spec_level).min(0.9999);
         let sq = f0.sqrt();
         eta = (1.0 + sq) / (1.0 - sq);
         if ior < 1.0 {
@@ -389,14 +388,9 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
     if film && max3(weight) > 0.0 {
         principled_film_specular(ctx, out, &mut weight, ior, eta, spec_level, spec_tint, (film_thickness, film_ior), (a, ax, ay, tangent, energy), vn, mu);
     } else if spec_level > 0.0 && max3(weight) > 0.0 {
-        let e = ctx.tables.dielectric_fresnel_avg(mu, roughness, eta).clamp(0.0, 1.0);
         // Anisotropic: the albedo tables at Cycles' equivalent roughness (alpha_x alpha_y)^(1/4).
-        let e = if ax != ay {
-            let r4 = (ax * ay).sqrt().sqrt();
-            ctx.tables.dielectric_fresnel_avg(mu, r4, eta).clamp(0.0, 1.0)
-        } else {
-            e
-        };
+        let table_roughness = if ax != ay { (ax * ay).sqrt().sqrt() } else { roughness };
+        let e = ctx.tables.dielectric_fresnel_avg(mu, table_roughness, eta).clamp(0.0, 1.0);
         if ax != ay {
             push_glossy(out, ctx, ax, ay, tangent, Fresnel::Dielectric { eta }, true, mul(weight, spec_tint), vn, e.max(1e-3));
         } else {
@@ -432,8 +426,8 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
 /// keeps the film-free multiple-scattering compensation.
 #[allow(clippy::too_many_arguments)]
 fn principled_film_specular(ctx: &Context, out: &mut LobeSet, weight: &mut V3, ior: f32, eta: f32, spec_level: f32, spec_tint: V3, (thickness, film_ior): (f32, f32), (a, ax, ay, tangent, energy): (f32, f32, f32, V3, f32), vn: V3, mu: f32) {
-    let f0_real = super::thin_film::f0_from_ior(eta);
-    let f0 = super::thin_film::f0_from_ior(ior) * if spec_level != 0.5 { 2.0 * spec_level } else { 1.0 };
+    let f0_real = super::bsdf::f0_from_ior(eta);
+    let f0 = super::bsdf::f0_from_ior(ior) * 2.0 * spec_level;
     let f0_scale = if f0_real > 0.0 { spec_tint.map(|t| (f0 * t).clamp(0.0, 1.0) / f0_real) } else { [1.0; 3] };
     let tf = super::thin_film::ThinFilm { thickness, ior: film_ior, eta, f0_scale };
     let albedo = tf.eval(mu);

@@ -4,7 +4,7 @@
 //! Fresnel-weighted albedo over the Fresnel-one albedo, stored as a blend from F0 to 1)
 //! for layering Principled's specular and coat over what lies beneath.
 
-use super::bsdf::{fresnel_dielectric, ggx_lambda, sample_vndf};
+use super::bsdf::{f0_from_ior, fresnel_dielectric, ggx_lambda, sample_vndf};
 use super::sampler::PixelSampler;
 
 const N1: usize = 32;
@@ -47,11 +47,6 @@ fn albedo_parts(mu: f32, alpha: f32, eta: Option<f32>, n: u32) -> (f32, f32) {
     ((sum / n as f64) as f32, (sum_g / n as f64) as f32)
 }
 
-/// Fresnel reflectance at normal incidence for relative IOR `eta`.
-fn f0(eta: f32) -> f32 {
-    let r = (eta - 1.0) / (eta + 1.0);
-    r * r
-}
 
 fn rough_to_alpha(r: f32) -> f32 {
     (r * r).max(1e-4)
@@ -95,7 +90,7 @@ impl Tables {
                     // interpolated apart drift (and a near-mirror's masking is not lost).
                     let (gf, g) = albedo_parts(mu, alpha, Some(eta), 128);
                     let ratio = if g > 0.0 { gf / g } else { 1.0 };
-                    let f = f0(eta);
+                    let f = f0_from_ior(eta);
                     dielectric_s[(zi * N3 + ri) * N3 + mi] = ((ratio - f) / (1.0 - f).max(1e-6)).clamp(0.0, 1.0);
                 }
             }
@@ -128,7 +123,7 @@ impl Tables {
         let a = lerp2(&self.dielectric_s[i * N3 * N3..(i + 1) * N3 * N3], N3, roughness, mu);
         let b = lerp2(&self.dielectric_s[(i + 1) * N3 * N3..(i + 2) * N3 * N3], N3, roughness, mu);
         let s = a * (1.0 - t) + b * t;
-        let f = f0(eta);
+        let f = f0_from_ior(eta);
         f + (1.0 - f) * s
     }
 }

@@ -6,6 +6,7 @@
 //! it to the Principled dielectric specular layer and its transmission (glass), not to
 //! the metallic layer.
 
+use super::bsdf::f0_from_ior;
 use super::math::*;
 use std::f32::consts::PI;
 
@@ -46,11 +47,6 @@ impl ThinFilm {
         }
         f
     }
-}
-
-pub fn f0_from_ior(ior: f32) -> f32 {
-    let r = (ior - 1.0) / (ior + 1.0);
-    r * r
 }
 
 /// Fresnel of one interface split by polarization: (R_s, R_p), the cosine of the
