@@ -325,7 +325,11 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         weight = scale(weight, alpha);
     }
     let mu = dot(vn, ctx.wo).clamp(0.0, 1.0);
-    let energy = multiscatter_energy(ctx.tables, mu, roughness);
+    // The Principled's distribution: Multiscatter GGX (the default) compensates the
+    // metallic, specular and transmission lobes for energy lost between microfacets; GGX
+    // does not (Cycles' is_multiggx).
+    let multi = b.property("distribution") != Some("GGX");
+    let energy = if multi { multiscatter_energy(ctx.tables, mu, roughness) } else { 1.0 };
     let a = roughness * roughness;
     // Anisotropic metallic and specular layers (alphas stretched along the tangent).
     let (ax, ay) = super::anisotropic::principled_alphas(roughness, input_f(b, s, "Anisotropic", 0.0));
@@ -352,7 +356,7 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         let avg_f0 = (base[0] + base[1] + base[2]) / 3.0;
         let albedo = (avg_f0 + (1.0 - avg_f0) / 21.0).clamp(0.0, 1.0);
         if ax != ay {
-            push_glossy(out, ctx, ax, ay, tangent, Fresnel::F82 { f0: base, b: bb }, true, scale(weight, metallic), vn, albedo.max(1e-3));
+            push_glossy(out, ctx, ax, ay, tangent, Fresnel::F82 { f0: base, b: bb }, multi, scale(weight, metallic), vn, albedo.max(1e-3));
         } else {
             out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::F82 { f0: base, b: bb }, energy }, scale(weight, metallic), vn, albedo.max(1e-3));
         }
@@ -361,7 +365,7 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
     if transmission > 0.0 {
         // Rough glass: reflection tinted by the specular tint, refraction by sqrt of the base
         // colour (light crosses the surface twice), as Cycles' Principled sets it up.
-        let mut g = super::microfacet::glass_closure(ctx.tables, Some("MULTI_GGX"), false, roughness, ior, ctx.backfacing, mu);
+        let mut g = super::microfacet::glass_closure(ctx.tables, Some(if multi { "MULTI_GGX" } else { "GGX" }), false, roughness, ior, ctx.backfacing, mu);
         g.tint_r = spec_tint;
         g.tint_t = base.map(f32::sqrt);
         if film {
@@ -386,13 +390,13 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         }
     }
     if film && max3(weight) > 0.0 {
-        principled_film_specular(ctx, out, &mut weight, ior, eta, spec_level, spec_tint, (film_thickness, film_ior), (a, ax, ay, tangent, energy), vn, mu);
+        principled_film_specular(ctx, out, &mut weight, ior, eta, spec_level, spec_tint, (film_thickness, film_ior), (a, ax, ay, tangent, energy, multi), vn, mu);
     } else if spec_level > 0.0 && max3(weight) > 0.0 {
         // Anisotropic: the albedo tables at Cycles' equivalent roughness (alpha_x alpha_y)^(1/4).
         let table_roughness = if ax != ay { (ax * ay).sqrt().sqrt() } else { roughness };
         let e = ctx.tables.dielectric_fresnel_avg(mu, table_roughness, eta).clamp(0.0, 1.0);
         if ax != ay {
-            push_glossy(out, ctx, ax, ay, tangent, Fresnel::Dielectric { eta }, true, mul(weight, spec_tint), vn, e.max(1e-3));
+            push_glossy(out, ctx, ax, ay, tangent, Fresnel::Dielectric { eta }, multi, mul(weight, spec_tint), vn, e.max(1e-3));
         } else {
             out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::Dielectric { eta }, energy }, mul(weight, spec_tint), vn, e.max(1e-3));
         }
@@ -425,7 +429,7 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
 /// below, by the film's reflectance toward the viewer (no table fits iridescence), and
 /// keeps the film-free multiple-scattering compensation.
 #[allow(clippy::too_many_arguments)]
-fn principled_film_specular(ctx: &Context, out: &mut LobeSet, weight: &mut V3, ior: f32, eta: f32, spec_level: f32, spec_tint: V3, (thickness, film_ior): (f32, f32), (a, ax, ay, tangent, energy): (f32, f32, f32, V3, f32), vn: V3, mu: f32) {
+fn principled_film_specular(ctx: &Context, out: &mut LobeSet, weight: &mut V3, ior: f32, eta: f32, spec_level: f32, spec_tint: V3, (thickness, film_ior): (f32, f32), (a, ax, ay, tangent, energy, multi): (f32, f32, f32, V3, f32, bool), vn: V3, mu: f32) {
     let f0_real = super::bsdf::f0_from_ior(eta);
     let f0 = super::bsdf::f0_from_ior(ior) * 2.0 * spec_level;
     let f0_scale = if f0_real > 0.0 { spec_tint.map(|t| (f0 * t).clamp(0.0, 1.0) / f0_real) } else { [1.0; 3] };
@@ -433,7 +437,7 @@ fn principled_film_specular(ctx: &Context, out: &mut LobeSet, weight: &mut V3, i
     let albedo = tf.eval(mu);
     let sel = average(albedo).max(1e-3);
     if ax != ay {
-        push_glossy(out, ctx, ax, ay, tangent, Fresnel::ThinFilm(tf), true, *weight, vn, sel);
+        push_glossy(out, ctx, ax, ay, tangent, Fresnel::ThinFilm(tf), multi, *weight, vn, sel);
     } else {
         out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::ThinFilm(tf), energy }, *weight, vn, sel);
     }

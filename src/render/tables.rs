@@ -143,29 +143,33 @@ impl Tables {
     }
 }
 
+/// Directions per glass table entry. 128 left the albedo a few percent off at moderate
+/// roughness (a roughness 0.25 glass cube against a flat world rendered 1-2% bright next to
+/// Cycles, whose tables are precomputed offline); 1024 brings it within Cycles' own noise.
+const GLASS_TABLE_SAMPLES: u32 = 1024;
+
 fn glass_tables() -> (Vec<f32>, Vec<f32>) {
+    use rayon::prelude::*;
     let s = PixelSampler::new(7, 11, 17);
-    let samples: Vec<[f32; 2]> = (0..128).map(|i| {
+    let samples: Vec<[f32; 2]> = (0..GLASS_TABLE_SAMPLES).map(|i| {
         let u = s.get4(i, 0);
         [u[0], u[1]]
     }).collect();
-    let mut e = vec![0.0; N3 * N3 * N3];
-    let mut inv = vec![0.0; N3 * N3 * N3];
-    for zi in 0..N3 {
-        let z = (zi as f32 / (N3 - 1) as f32).max(0.01);
-        let r = z * z;
-        let eta = ((1.0 + r) / (1.0 - r).max(1e-4)).min(1e4);
-        for ri in 0..N3 {
+    // Each entry is a pure function of its grid point, so the parallel build gives the
+    // same bits on any thread count.
+    let entries: Vec<(f32, f32)> = (0..N3 * N3 * N3)
+        .into_par_iter()
+        .map(|k| {
+            let (zi, ri, mi) = (k / (N3 * N3), (k / N3) % N3, k % N3);
+            let z = (zi as f32 / (N3 - 1) as f32).max(0.01);
+            let r = z * z;
+            let eta = ((1.0 + r) / (1.0 - r).max(1e-4)).min(1e4);
             let alpha = rough_to_alpha(ri as f32 / (N3 - 1) as f32);
-            for mi in 0..N3 {
-                let mu = mi as f32 / (N3 - 1) as f32;
-                let k = (zi * N3 + ri) * N3 + mi;
-                e[k] = super::microfacet::glass_albedo(mu, alpha, eta, &samples);
-                inv[k] = super::microfacet::glass_albedo(mu, alpha, 1.0 / eta, &samples);
-            }
-        }
-    }
-    (e, inv)
+            let mu = mi as f32 / (N3 - 1) as f32;
+            (super::microfacet::glass_albedo(mu, alpha, eta, &samples), super::microfacet::glass_albedo(mu, alpha, 1.0 / eta, &samples))
+        })
+        .collect();
+    entries.into_iter().unzip()
 }
 
 impl Default for Tables {
