@@ -62,6 +62,9 @@ const ASSERTED: &[&str] = &[
     // Film > Transparent: background, half-transparent surface, Holdout shader and holdout
     // object as alpha (checked as a fourth channel).
     "film_transparent",
+    // Film > Transparent Glass: the world through sharp and slightly rough glass as alpha,
+    // through rougher transmission as colour; a holdout seen through glass is a hole.
+    "film_transparent_glass",
     // Panoramic cameras: an endoscope-like equisolid fisheye, and a lens polynomial with
     // vertical sensor fit.
     "pano_fisheye_equisolid",

@@ -34,6 +34,10 @@ pub struct Settings {
     /// Film > Transparent: the background seen by camera rays (directly or through
     /// transparent surfaces) becomes alpha instead of colour.
     pub film_transparent: bool,
+    /// Film > Transparent Glass: the bound on a refraction's alpha_x * alpha_y (Cycles'
+    /// `transparent_roughness_squared_threshold`) under which it keeps a camera path
+    /// transparent to the background; negative when off.
+    pub transparent_glass: f32,
     /// Some material can be transparent: shadow rays then run the materials they pass
     /// through (`shadow_transmittance`); otherwise any hit blocks them.
     pub transparent_shadows: bool,
@@ -278,6 +282,9 @@ impl Scene<'_> {
         // diffuse bounce (a BSSRDF then falls back to diffuse, as in Cycles).
         let mut sss_exit: Option<super::accel::Hit> = None;
         let mut diffuse_ancestor = false;
+        // Cycles' PATH_RAY_TRANSPARENT_BACKGROUND: camera rays, kept through transparent
+        // surfaces and (with Transparent Glass) through smooth enough refraction.
+        let mut transparent_bg = true;
         // Ray differentials, carried through bounces as Cycles does: the next ray's dP is
         // the hit's; dD stays (Cycles widens it by the BSDF roughness; not done here).
         let (mut ray_dp, ray_dd) = (scratch.ray_dp, scratch.ray_dd);
@@ -312,9 +319,7 @@ impl Scene<'_> {
                 }
             }
             let Some(h) = hit_opt else {
-                // Cycles' PATH_RAY_TRANSPARENT_BACKGROUND: camera rays, and their
-                // continuations through transparent surfaces, keep the bounce count at 0.
-                if st.film_transparent && bounce == 0 {
+                if st.film_transparent && transparent_bg {
                     scratch.transparent += average(throughput);
                     break;
                 }
@@ -354,7 +359,7 @@ impl Scene<'_> {
                 // A holdout object seen by the camera (directly or through transparent
                 // surfaces: Cycles' PATH_RAY_TRANSPARENT_BACKGROUND) keeps only its
                 // transparency; the rest is a hole in the film.
-                if bounce == 0 && self.geo.instances[hit.inst as usize].holdout {
+                if transparent_bg && self.geo.instances[hit.inst as usize].holdout {
                     // The holdout weight (Cycles' surface_shader_apply_holdout) is what
                     // the object's transparency does not let through.
                     let weight = sub([1.0; 3], scratch.lobes.transparent.map(|t| t.clamp(0.0, 1.0)));
@@ -362,7 +367,7 @@ impl Scene<'_> {
                     if !holdout_keep_transparent(&mut scratch.lobes) {
                         break;
                     }
-                } else if bounce == 0 && !is_zero(scratch.lobes.holdout) {
+                } else if transparent_bg && !is_zero(scratch.lobes.holdout) {
                     // Holdout closures (the Holdout shader node) seen by the camera.
                     let weight = scratch.lobes.holdout;
                     scratch.transparent += average(mul(weight, throughput));
@@ -611,6 +616,14 @@ impl Scene<'_> {
                     glossy += 1;
                 }
             }
+            // Cycles (bsdf_sample, path_state_next): only a refraction whose roughness
+            // squared (alpha_x * alpha_y) is within the threshold keeps the path
+            // transparent to the background; every other bounce ends that.
+            transparent_bg = transparent_bg
+                && match bs.kind {
+                    LobeKind::Glass(g) if bs.transmit => st.transparent_glass >= 0.0 && g.alpha * g.alpha <= st.transparent_glass,
+                    _ => false,
+                };
             if bounce >= st.max_bounces {
                 terminate_next = true;
             }

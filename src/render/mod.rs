@@ -131,6 +131,21 @@ fn rna_f(m: &crate::scene::Rna, k: &str) -> Option<f64> {
     m.get(k).and_then(Value::as_f64)
 }
 
+/// Cycles' `transparent_roughness_squared_threshold` (scene/background.cpp): with Film >
+/// Transparent and Transparent Glass, the Roughness Threshold to the fourth (squared once
+/// for the roughness-to-alpha convention, once to compare with alpha_x * alpha_y);
+/// otherwise -1.
+fn transparent_glass_threshold(render: &crate::scene::Rna, cycles: &crate::scene::Rna) -> f32 {
+    let on = render.get("film_transparent").and_then(Value::as_bool).unwrap_or(false)
+        && cycles.get("film_transparent_glass").and_then(Value::as_bool).unwrap_or(false);
+    if on {
+        let t = rna_f(cycles, "film_transparent_roughness").unwrap_or(0.1) as f32;
+        (t * t) * (t * t)
+    } else {
+        -1.0
+    }
+}
+
 /// Renders `scene` (overrides already applied) at the options' frame.
 pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput, RenderError> {
     render_with_overrides(scene, opts, &[])
@@ -218,10 +233,8 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         filter_glossy: rna_f(cy, "blur_glossy").unwrap_or(1.0) as f32,
         film_transparent: r.get("film_transparent").and_then(Value::as_bool).unwrap_or(false),
         transparent_shadows: materials.iter().any(|m| m.transparent_shadow),
+        transparent_glass: transparent_glass_threshold(r, cy),
     };
-    if settings.film_transparent && cy.get("film_transparent_glass").and_then(Value::as_bool).unwrap_or(false) {
-        eprintln!("notice: Film > Transparent Glass is not supported; glass stays opaque in the alpha channel");
-    }
     let exposure = 1.0f32;
     let build_seconds = start.elapsed().as_secs_f64();
     let mesh_lights = mesh_lights(&geo, &materials, &bvh, &lights, background, tables, settings);
