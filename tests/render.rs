@@ -65,6 +65,8 @@ const ASSERTED: &[&str] = &[
     // Film > Transparent Glass: the world through sharp and slightly rough glass as alpha,
     // through rougher transmission as colour; a holdout seen through glass is a hole.
     "film_transparent_glass",
+    // The Principled BSDF's GGX distribution: no multiple-scattering compensation.
+    "principled_ggx",
     // Panoramic cameras: an endoscope-like equisolid fisheye, and a lens polynomial with
     // vertical sensor fit.
     "pano_fisheye_equisolid",
