@@ -145,7 +145,9 @@ impl Tables {
 
 /// Directions per glass table entry. 128 left the albedo a few percent off at moderate
 /// roughness (a roughness 0.25 glass cube against a flat world rendered 1-2% bright next to
-/// Cycles, whose tables are precomputed offline); 1024 brings it within Cycles' own noise.
+/// Cycles, whose tables are precomputed offline). At 1024 the entries for light entering
+/// glass agree with Cycles' to about 1e-4 where compared; those for light leaving it (eta
+/// below one) still read 1-2% low at mid angles, for a reason not found yet.
 const GLASS_TABLE_SAMPLES: u32 = 1024;
 
 fn glass_tables() -> (Vec<f32>, Vec<f32>) {
