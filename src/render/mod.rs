@@ -213,6 +213,9 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     let background = world::background(scene)?;
     let world_shader = world::shader(scene)?;
     let tables = tables::Tables::shared();
+    if materials.iter().any(|m| m.multiscatter_glass) {
+        tables.warm_glass();
+    }
     // With moving objects the static rest goes in a BVH of its own (`object_motion`).
     let motion_accel = (moving > 0).then(|| object_motion::MotionAccel::build(&geo));
     let bvh = if motion_accel.is_some() { Bvh::build(&[]) } else { Bvh::build_masked(&geo.tris, &build::triangle_masks(&geo)) };

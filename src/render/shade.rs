@@ -28,6 +28,10 @@ pub struct Material {
     /// BSDF, or a Principled BSDF whose Alpha is linked or below 1), so shadow rays run
     /// it instead of stopping at it.
     pub transparent_shadow: bool,
+    /// The material can make a Multiscatter GGX glass closure (Glass BSDF, or a
+    /// Principled BSDF whose Transmission Weight is linked or above zero), which reads the
+    /// glass albedo table.
+    pub multiscatter_glass: bool,
 }
 
 /// Every material of the scene, in `scene.file.materials` order.
@@ -35,7 +39,7 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
     let mut out = Vec::new();
     for (i, m) in scene.file.materials.iter().enumerate() {
         if !used.get(i).copied().unwrap_or(false) {
-            out.push(Material { program: None, bsdf_of: Vec::new(), name: m.name.clone(), sampling: String::new(), bump_correction: true, bssrdf_bump: false, transparent_shadow: false });
+            out.push(Material { program: None, bsdf_of: Vec::new(), name: m.name.clone(), sampling: String::new(), bump_correction: true, bssrdf_bump: false, transparent_shadow: false, multiscatter_glass: false });
             continue;
         }
         let p = compile_material(scene, &m.name).map_err(|e| RenderError(format!("{e}")))?;
@@ -49,7 +53,8 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
         let bump_correction = m.properties.get("cycles").and_then(|c| c.get("use_bump_map_correction")).and_then(|v| v.as_bool()).unwrap_or(true);
         let bssrdf_bump = has_bssrdf_bump(&p);
         let transparent_shadow = can_be_transparent(&p);
-        out.push(Material { program: Some(p), bsdf_of, name: m.name.clone(), sampling, bump_correction, bssrdf_bump, transparent_shadow });
+        let multiscatter_glass = has_multiscatter_glass(&p);
+        out.push(Material { program: Some(p), bsdf_of, name: m.name.clone(), sampling, bump_correction, bssrdf_bump, transparent_shadow, multiscatter_glass });
     }
     Ok(out)
 }
@@ -70,6 +75,16 @@ fn linked_or_constant(p: &Program, b: &crate::shader::program::BsdfNode, name: &
         Some((slot, false)) => p.initial.get(slot as usize).is_some_and(|v| constant(*v)),
         None => false,
     }
+}
+
+/// Whether the material can make a Multiscatter GGX glass closure (see
+/// `Material::multiscatter_glass`).
+fn has_multiscatter_glass(p: &Program) -> bool {
+    p.bsdfs.iter().any(|b| match b.bl_idname.as_str() {
+        "ShaderNodeBsdfGlass" => b.property("distribution") == Some("MULTI_GGX"),
+        "ShaderNodeBsdfPrincipled" => b.property("distribution") != Some("GGX") && linked_or_constant(p, b, "Transmission Weight", |w| w > 0.0),
+        _ => false,
+    })
 }
 
 /// Whether the material has a closure that can be transparent (Cycles marks such

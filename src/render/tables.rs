@@ -15,9 +15,9 @@ pub struct Tables {
     ggx_e_avg: Vec<f32>,
     dielectric_s: Vec<f32>,
     /// Glass albedo E(z, roughness, mu) for eta > 1 and for 1 / eta (Cycles' ggx_glass_E
-    /// and ggx_glass_inv_E), for Multiscatter GGX glass.
-    glass_e: Vec<f32>,
-    glass_inv_e: Vec<f32>,
+    /// and ggx_glass_inv_E), for Multiscatter GGX glass: integrated on first use, since
+    /// most scenes have no rough glass and the table is the dearest to build.
+    glass: std::sync::OnceLock<(Vec<f32>, Vec<f32>)>,
 }
 
 /// Means of F * G2/G1 (the single-scattering albedo) and of G2/G1 (the same with Fresnel
@@ -95,8 +95,7 @@ impl Tables {
                 }
             }
         }
-        let (glass_e, glass_inv_e) = glass_tables();
-        Tables { ggx_e, ggx_e_avg, dielectric_s, glass_e, glass_inv_e }
+        Tables { ggx_e, ggx_e_avg, dielectric_s, glass: std::sync::OnceLock::new() }
     }
 
     /// Single-scattering albedo of GGX with Fresnel one; `roughness` = sqrt(alpha).
@@ -129,10 +128,25 @@ impl Tables {
 }
 
 impl Tables {
+    /// The glass tables, integrated on first use. Renders build them before their tiles
+    /// start (`warm_glass`); a first use inside a rayon worker builds them sequentially,
+    /// since a parallel build there could steal a render job that asks for the table
+    /// while it is being built (OnceLock re-entry).
+    fn glass(&self) -> &(Vec<f32>, Vec<f32>) {
+        self.glass.get_or_init(|| glass_tables(rayon::current_thread_index().is_none()))
+    }
+
+    /// Builds the glass tables now, on the calling thread (in parallel outside rayon's
+    /// pool), so that the render's first glass closure does not.
+    pub fn warm_glass(&self) {
+        let _ = self.glass();
+    }
+
     /// Single-scattering albedo of GGX glass (reflection plus refraction) for relative
     /// IOR `eta`; `roughness` = sqrt(alpha).
     pub fn glass_e(&self, mu: f32, roughness: f32, eta: f32) -> f32 {
-        let (t, e) = if eta < 1.0 { (&self.glass_inv_e, 1.0 / eta) } else { (&self.glass_e, eta) };
+        let (glass_e, glass_inv_e) = self.glass();
+        let (t, e) = if eta < 1.0 { (glass_inv_e, 1.0 / eta) } else { (glass_e, eta) };
         let z = ((e - 1.0) / (e + 1.0)).abs().sqrt().clamp(0.0, 1.0);
         let x = z * (N3 - 1) as f32;
         let i = (x as usize).min(N3 - 2);
@@ -150,18 +164,16 @@ impl Tables {
 /// below one) still read 1-2% low at mid angles, for a reason not found yet.
 const GLASS_TABLE_SAMPLES: u32 = 1024;
 
-fn glass_tables() -> (Vec<f32>, Vec<f32>) {
+fn glass_tables(parallel: bool) -> (Vec<f32>, Vec<f32>) {
     use rayon::prelude::*;
     let s = PixelSampler::new(7, 11, 17);
     let samples: Vec<[f32; 2]> = (0..GLASS_TABLE_SAMPLES).map(|i| {
         let u = s.get4(i, 0);
         [u[0], u[1]]
     }).collect();
-    // Each entry is a pure function of its grid point, so the parallel build gives the
-    // same bits on any thread count.
-    let entries: Vec<(f32, f32)> = (0..N3 * N3 * N3)
-        .into_par_iter()
-        .map(|k| {
+    // Each entry is a pure function of its grid point, so the parallel and the
+    // sequential build give the same bits on any thread count.
+    let entry = |k: usize| {
             let (zi, ri, mi) = (k / (N3 * N3), (k / N3) % N3, k % N3);
             let z = (zi as f32 / (N3 - 1) as f32).max(0.01);
             let r = z * z;
@@ -169,8 +181,8 @@ fn glass_tables() -> (Vec<f32>, Vec<f32>) {
             let alpha = rough_to_alpha(ri as f32 / (N3 - 1) as f32);
             let mu = mi as f32 / (N3 - 1) as f32;
             (super::microfacet::glass_albedo(mu, alpha, eta, &samples), super::microfacet::glass_albedo(mu, alpha, 1.0 / eta, &samples))
-        })
-        .collect();
+    };
+    let entries: Vec<(f32, f32)> = if parallel { (0..N3 * N3 * N3).into_par_iter().map(entry).collect() } else { (0..N3 * N3 * N3).map(entry).collect() };
     entries.into_iter().unzip()
 }
 
