@@ -135,10 +135,8 @@ fn rna_f(m: &crate::scene::Rna, k: &str) -> Option<f64> {
 /// Transparent and Transparent Glass, the Roughness Threshold to the fourth (squared once
 /// for the roughness-to-alpha convention, once to compare with alpha_x * alpha_y);
 /// otherwise -1.
-fn transparent_glass_threshold(render: &crate::scene::Rna, cycles: &crate::scene::Rna) -> f32 {
-    let on = render.get("film_transparent").and_then(Value::as_bool).unwrap_or(false)
-        && cycles.get("film_transparent_glass").and_then(Value::as_bool).unwrap_or(false);
-    if on {
+fn transparent_glass_threshold(film_transparent: bool, cycles: &crate::scene::Rna) -> f32 {
+    if film_transparent && cycles.get("film_transparent_glass").and_then(Value::as_bool).unwrap_or(false) {
         let t = rna_f(cycles, "film_transparent_roughness").unwrap_or(0.1) as f32;
         (t * t) * (t * t)
     } else {
@@ -221,6 +219,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     let bvh = if motion_accel.is_some() { Bvh::build(&[]) } else { Bvh::build_masked(&geo.tris, &build::triangle_masks(&geo)) };
     let filter = filter::FilterTable::blackman_harris(rna_f(cy, "filter_width").or_else(|| rna_f(r, "filter_size")).unwrap_or(1.5) as f32);
     let gi = |k: &str, d: f64| rna_f(cy, k).unwrap_or(d) as u32;
+    let film_transparent = r.get("film_transparent").and_then(Value::as_bool).unwrap_or(false);
     let settings = Settings {
         max_bounces: gi("max_bounces", 12.0),
         max_diffuse: gi("diffuse_bounces", 4.0),
@@ -234,9 +233,9 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         min_light_bounces: gi("min_light_bounces", 0.0),
         min_transparent_bounces: gi("min_transparent_bounces", 0.0),
         filter_glossy: rna_f(cy, "blur_glossy").unwrap_or(1.0) as f32,
-        film_transparent: r.get("film_transparent").and_then(Value::as_bool).unwrap_or(false),
+        film_transparent,
         transparent_shadows: materials.iter().any(|m| m.transparent_shadow),
-        transparent_glass: transparent_glass_threshold(r, cy),
+        transparent_glass: transparent_glass_threshold(film_transparent, cy),
     };
     let exposure = 1.0f32;
     let build_seconds = start.elapsed().as_secs_f64();

@@ -77,12 +77,22 @@ fn linked_or_constant(p: &Program, b: &crate::shader::program::BsdfNode, name: &
     }
 }
 
+/// Whether a microfacet node compensates multiple scattering (Cycles' is_multiggx): the
+/// Principled BSDF unless its distribution is GGX (Multiscatter GGX is its default), the
+/// other nodes only when theirs is Multiscatter GGX.
+fn is_multiggx(b: &BsdfNode) -> bool {
+    match b.bl_idname.as_str() {
+        "ShaderNodeBsdfPrincipled" => b.property("distribution") != Some("GGX"),
+        _ => b.property("distribution") == Some("MULTI_GGX"),
+    }
+}
+
 /// Whether the material can make a Multiscatter GGX glass closure (see
 /// `Material::multiscatter_glass`).
 fn has_multiscatter_glass(p: &Program) -> bool {
     p.bsdfs.iter().any(|b| match b.bl_idname.as_str() {
-        "ShaderNodeBsdfGlass" => b.property("distribution") == Some("MULTI_GGX"),
-        "ShaderNodeBsdfPrincipled" => b.property("distribution") != Some("GGX") && linked_or_constant(p, b, "Transmission Weight", |w| w > 0.0),
+        "ShaderNodeBsdfGlass" => is_multiggx(b),
+        "ShaderNodeBsdfPrincipled" => is_multiggx(b) && linked_or_constant(p, b, "Transmission Weight", |w| w > 0.0),
         _ => false,
     })
 }
@@ -276,7 +286,7 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
                 out.push(LobeKind::Reflection(r), scale(c, w), n);
                 return;
             }
-            let multi = b.property("distribution") == Some("MULTI_GGX");
+            let multi = is_multiggx(b);
             let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
             let aniso = input_f(b, s, "Anisotropy", 0.0).clamp(-0.99, 0.99);
             if aniso.abs() > 1e-4 {
@@ -343,7 +353,7 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
     // The Principled's distribution: Multiscatter GGX (the default) compensates the
     // metallic, specular and transmission lobes for energy lost between microfacets; GGX
     // does not (Cycles' is_multiggx).
-    let multi = b.property("distribution") != Some("GGX");
+    let multi = is_multiggx(b);
     let energy = if multi { multiscatter_energy(ctx.tables, mu, roughness) } else { 1.0 };
     let a = roughness * roughness;
     // Anisotropic metallic and specular layers (alphas stretched along the tangent).

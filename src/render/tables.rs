@@ -47,9 +47,16 @@ fn albedo_parts(mu: f32, alpha: f32, eta: Option<f32>, n: u32) -> (f32, f32) {
     ((sum / n as f64) as f32, (sum_g / n as f64) as f32)
 }
 
-
 fn rough_to_alpha(r: f32) -> f32 {
     (r * r).max(1e-4)
+}
+
+/// The IOR of the 3D tables' slice `zi`: z = sqrt(sqrt(F0)) on a uniform grid, as Cycles
+/// parametrises its glass and Schlick tables (lookups invert it from the IOR).
+fn grid_eta(zi: usize) -> f32 {
+    let z = (zi as f32 / (N3 - 1) as f32).max(0.01);
+    let r = z * z;
+    ((1.0 + r) / (1.0 - r).max(1e-4)).min(1e4)
 }
 
 static SHARED: std::sync::OnceLock<Tables> = std::sync::OnceLock::new();
@@ -76,9 +83,7 @@ impl Tables {
         }
         let mut dielectric_s = vec![0.0; N3 * N3 * N3];
         for zi in 0..N3 {
-            let z = (zi as f32 / (N3 - 1) as f32).max(0.01);
-            let r = z * z;
-            let eta = ((1.0 + r) / (1.0 - r).max(1e-4)).min(1e4);
+            let eta = grid_eta(zi);
             for ri in 0..N3 {
                 let alpha = rough_to_alpha(ri as f32 / (N3 - 1) as f32);
                 for mi in 0..N3 {
@@ -174,13 +179,11 @@ fn glass_tables(parallel: bool) -> (Vec<f32>, Vec<f32>) {
     // Each entry is a pure function of its grid point, so the parallel and the
     // sequential build give the same bits on any thread count.
     let entry = |k: usize| {
-            let (zi, ri, mi) = (k / (N3 * N3), (k / N3) % N3, k % N3);
-            let z = (zi as f32 / (N3 - 1) as f32).max(0.01);
-            let r = z * z;
-            let eta = ((1.0 + r) / (1.0 - r).max(1e-4)).min(1e4);
-            let alpha = rough_to_alpha(ri as f32 / (N3 - 1) as f32);
-            let mu = mi as f32 / (N3 - 1) as f32;
-            (super::microfacet::glass_albedo(mu, alpha, eta, &samples), super::microfacet::glass_albedo(mu, alpha, 1.0 / eta, &samples))
+        let (zi, ri, mi) = (k / (N3 * N3), (k / N3) % N3, k % N3);
+        let eta = grid_eta(zi);
+        let alpha = rough_to_alpha(ri as f32 / (N3 - 1) as f32);
+        let mu = mi as f32 / (N3 - 1) as f32;
+        (super::microfacet::glass_albedo(mu, alpha, eta, &samples), super::microfacet::glass_albedo(mu, alpha, 1.0 / eta, &samples))
     };
     let entries: Vec<(f32, f32)> = if parallel { (0..N3 * N3 * N3).into_par_iter().map(entry).collect() } else { (0..N3 * N3 * N3).map(entry).collect() };
     entries.into_iter().unzip()
