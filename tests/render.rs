@@ -42,6 +42,9 @@ const ASSERTED: &[&str] = &[
     // The colon's material in small: Principled Burley under a strong bump in a Mix with a
     // sharp Glossy (bump map correction, bumped BSSRDF exit normal, bump shadowing term).
     "sss_burley_bump",
+    // A bump that only rays other than camera rays see (Light Path > Is Camera Ray): the
+    // subsurface exit is not a camera ray.
+    "sss_exit_light_path",
     // Spots with a radius near the lit surface: the cone weighs each sampled direction
     // (Soft Falloff's facing disk, and the sphere light with it off).
     "spot_radius",

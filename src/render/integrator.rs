@@ -538,6 +538,9 @@ impl Scene<'_> {
                 let exit = super::subsurface::enter_and_walk(self, &b, &hit, wo, bs.wi, rng, index, set, &mut throughput, &mut scratch.rays);
                 let Some((exit_hit, dir)) = exit else { break };
                 sss_exit = Some(exit_hit);
+                // The exit is no longer a camera ray (Cycles' subsurface_bounce clears
+                // PATH_RAY_CAMERA): its Light Path node sees it so.
+                flags &= !ray::CAMERA;
                 d = neg(dir);
                 continue;
             }
