@@ -45,6 +45,9 @@ const ASSERTED: &[&str] = &[
     // A bump that only rays other than camera rays see (Light Path > Is Camera Ray): the
     // subsurface exit is not a camera ray.
     "sss_exit_light_path",
+    // Light that reaches a wall after a subsurface exit and a bounce off the far walls,
+    // whose bump only such rays see: the footprint no longer widens after the exit.
+    "sss_indirect_footprint",
     // Spots with a radius near the lit surface: the cone weighs each sampled direction
     // (Soft Falloff's facing disk, and the sphere light with it off).
     "spot_radius",

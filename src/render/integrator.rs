@@ -286,8 +286,8 @@ impl Scene<'_> {
         // surfaces and (with Transparent Glass) through smooth enough refraction.
         let mut transparent_bg = true;
         // Ray differentials, carried through bounces as Cycles does: the next ray's dP is
-        // the hit's; dD stays (Cycles widens it by the BSDF roughness; not done here).
-        let (mut ray_dp, ray_dd) = (scratch.ray_dp, scratch.ray_dd);
+        // the hit's; dD stays, except that a subsurface bounce zeroes it.
+        let (mut ray_dp, mut ray_dd) = (scratch.ray_dp, scratch.ray_dd);
         loop {
             let from_sss = sss_exit.take();
             let hit_opt = if from_sss.is_some() {
@@ -541,6 +541,10 @@ impl Scene<'_> {
                 // The exit is no longer a camera ray (Cycles' subsurface_bounce clears
                 // PATH_RAY_CAMERA): its Light Path node sees it so.
                 flags &= !ray::CAMERA;
+                // Cycles' probe and walk rays carry no direction differential, and the
+                // exit's bounce keeps that: from here on the footprint no longer widens
+                // with distance.
+                ray_dd = 0.0;
                 d = neg(dir);
                 continue;
             }
