@@ -48,6 +48,9 @@ const ASSERTED: &[&str] = &[
     // Light that reaches a wall after a subsurface exit and a bounce off the far walls,
     // whose bump only such rays see: the footprint no longer widens after the exit.
     "sss_indirect_footprint",
+    // Bumps read from UV and Generated coordinates on back faces (Cycles turns their
+    // differentials over with dPdu and dPdv).
+    "bump_backfacing_uv",
     // Spots with a radius near the lit surface: the cone weighs each sampled direction
     // (Soft Falloff's facing disk, and the sphere light with it off).
     "spot_radius",

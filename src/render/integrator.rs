@@ -778,7 +778,12 @@ impl Scene<'_> {
         let c = m.triangles[r.tri as usize].map(|c| c as usize);
         let (to_world, to_object) = inst.pose_at(hit.time);
         let tri = &inst.posed_triangle(&self.geo.tris[prim as usize], r.tri, &to_world);
-        let (dpdu, dpdv) = (sub(tri[1], tri[0]), sub(tri[2], tri[0]));
+        // Seen from the back, Cycles flips dPdu and dPdv with the normals, so every
+        // attribute differential (and the bump read from them) turns over too.
+        let (mut dpdu, mut dpdv) = (sub(tri[1], tri[0]), sub(tri[2], tri[0]));
+        if hit.backfacing {
+            (dpdu, dpdv) = (neg(dpdu), neg(dpdv));
+        }
         let sp = &mut hit.sp;
         sp.ng = hit.ng;
         sp.backfacing = hit.backfacing;
