@@ -384,11 +384,13 @@ fn adaptive_sampling_is_deterministic_and_stops_early() {
 /// without the true normal (checked only when sampling) and the "Both" bump read with
 /// Cycles' undisplaced differentials; then within 1.6%. Clamping as Cycles does (three
 /// times the setting on the channel sum) removed a cut of about 1% that had hidden an
-/// excess: now ours is 1.7-2.2% bright at frame 50 and 2.3-2.9% at frame 11595, from the
-/// Burley subsurface (+0.7-1.3% alone, growing with its radius) and the sharp specular
-/// layer under the strong bump (+1.2-1.8% alone), per fixtures/render/colon_variants.py.
-/// The RMSE ratio is asserted, and the means are bounded to 0.96..1.04 of Cycles', so
-/// that a regression fails.
+/// excess of 1.7-2.9%. Most of it was light bounced after a subsurface exit: Cycles'
+/// probe ray has no direction differential, so later hits read the bump with the
+/// entry's footprint (scene sss_indirect_footprint). Now ours is 0.8-1.5% bright at frame
+/// 50 and 1.4-1.8% at frame 11595; what is left comes from the sharp specular layer over
+/// the strong bump and the Burley exit (fixtures/render/colon_variants.py). The RMSE
+/// ratio is asserted, and the means are bounded to 0.97..1.03 of Cycles', so that a
+/// regression fails.
 #[test]
 fn published_colon_parity() {
     let Some(py) = common::require("a Python with bpy 4.5.4", common::bpy_python()) else { return };
@@ -412,8 +414,8 @@ fn published_colon_parity() {
         }
         for c in 0..3 {
             let q = r.ours[c] / r.cycles[c];
-            if !(0.96..=1.04).contains(&q) {
-                failures.push(format!("{f}: channel {c} mean is {q:.3} of Cycles' (bounded to 0.96..1.04)"));
+            if !(0.97..=1.03).contains(&q) {
+                failures.push(format!("{f}: channel {c} mean is {q:.3} of Cycles' (bounded to 0.97..1.03)"));
             }
         }
         if r.worst_mean <= MAX_MEAN_REL {
