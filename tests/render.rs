@@ -102,6 +102,16 @@ const ASSERTED: &[&str] = &[
     // Rough glass through the Principled BSDF (alpha 0.01) under a sun: its glint needs the sun
     // sampled by Cycles' concentric cone mapping (2.05 with a polar mapping).
     "principled_glass_rough",
+    // Area lights as Cycles samples them: Spread (the soft-box attenuation, and sampling of
+    // only the part of the light that reaches a point) on a rectangle, a disk and an
+    // ellipse, each alone (make_render_refs.py says why); a room under a large ceiling light with default clamping, and rough glossy
+    // reflections of a rectangle light, which need rectangles sampled by solid angle and
+    // lights shared with BSDF sampling (MIS) at every vertex.
+    "area_spread_rect",
+    "area_spread_disk",
+    "area_spread_ellipse",
+    "area_room_clamp",
+    "area_glossy_mis",
 ];
 
 /// Scenes that do not pass yet, with the reason.

@@ -1,5 +1,6 @@
-//! The path tracer: next-event estimation toward light objects, BSDF sampling for
-//! emissive surfaces and the world, Cycles' per-type bounce limits (terminating after
+//! The path tracer: next-event estimation toward light objects, emissive triangles and
+//! the world, combined with BSDF sampling by multiple importance sampling wherever Cycles
+//! combines them (every light with extent and Multiple Importance on), Cycles' per-type bounce limits (terminating after
 //! the next surface, as Cycles does), Russian roulette on sqrt of throughput, and
 //! Cycles' clamping (direct and indirect limits on the sum of a contribution).
 
@@ -130,21 +131,6 @@ pub struct SurfaceHit {
     pub uv: [f32; 2],
 }
 
-/// Below this GGX alpha a vertex uses MIS toward lamps.
-const MIS_ALPHA: f32 = 0.05;
-
-/// Whether a lobe is sharp enough (GGX or Beckmann alpha below `MIS_ALPHA`) that its
-/// vertex shares lamps between light and BSDF sampling.
-fn sharp_lobe(kind: &LobeKind) -> bool {
-    match kind {
-        LobeKind::Glossy { alpha, .. } => *alpha < MIS_ALPHA,
-        LobeKind::GlossyAniso { lobe, .. } => lobe.alpha_x.min(lobe.alpha_y) < MIS_ALPHA,
-        LobeKind::Glass(g) => g.alpha < MIS_ALPHA,
-        LobeKind::Reflection(r) => r.alpha < MIS_ALPHA,
-        _ => false,
-    }
-}
-
 fn clamp_contrib(l: V3, limit: f32) -> V3 {
     if limit > 0.0 {
         let s = l[0].abs() + l[1].abs() + l[2].abs();
@@ -273,8 +259,6 @@ impl Scene<'_> {
         // MIS state of the ray being traced: the BSDF pdf that chose it, or singular.
         let mut prev_pdf = f32::INFINITY;
         let mut prev_singular = true;
-        // Whether the vertex that sent the ray shares lamps between light and BSDF sampling.
-        let mut prev_mis_lamps = false;
         // Smallest pdf of the non-singular bounces so far (Cycles' min_ray_pdf).
         let mut min_ray_pdf = f32::INFINITY;
         // Where a subsurface random walk left the object: the next vertex, shaded white
@@ -302,15 +286,13 @@ impl Scene<'_> {
             // Lights are not in the BVH: a ray collects every light it passes before the surface.
             let t_surface = hit_opt.map(|h| h.t).unwrap_or(if t1.is_finite() { t1 } else { f32::INFINITY });
             for light in self.lights.iter().filter(|l| from_sss.is_none() && l.visible_to(flags)) {
+                // Rays other than the camera's see only lights shared with BSDF sampling
+                // (Cycles' lights_intersect skips those without SHADER_USE_MIS).
+                if !light.mis && flags & ray::CAMERA == 0 {
+                    continue;
+                }
                 if let Some(lh) = light.intersect(o, d, t_surface) {
-                    let w = if prev_singular {
-                        1.0
-                    } else if prev_mis_lamps {
-                        power_heuristic(prev_pdf, lh.pdf)
-                    } else {
-                        // Light sampling alone covered this lamp at that vertex.
-                        continue;
-                    };
+                    let w = if prev_singular { 1.0 } else { power_heuristic(prev_pdf, lh.pdf) };
                     scratch.features.add_emission(scale(mul(throughput, lh.radiance), w));
                     let c = clamp_contrib(scale(mul(throughput, lh.radiance), w), clamp_limit);
                     if finite(c) {
@@ -448,11 +430,6 @@ impl Scene<'_> {
                 throughput = scale(throughput, 1.0 / q);
             }
             let p_off = |dir: V3| offset_origin(hit.p, hit.ng, dir);
-            // Lamps are shared with BSDF sampling (MIS) only at vertices with a sharp
-            // glossy lobe (microfacet reflection, or glass reflecting and refracting),
-            // where light sampling alone is noisy; elsewhere light sampling alone has less
-            // variance than MIS with our area-uniform lamp sampling.
-            let mis_lamps = lobes.lobes[..lobes.len].iter().any(|l| sharp_lobe(&l.kind));
             // Next-event estimation toward every light.
             if !terminate_next && scratch.lobes.len > 0 {
                 for (li, light) in self.lights.iter().enumerate() {
@@ -462,7 +439,9 @@ impl Scene<'_> {
                     if is_zero(f) {
                         continue;
                     }
-                    let w = if mis_lamps { power_heuristic(ls.pdf, pdf_b) } else { 1.0 };
+                    // Lights with extent are shared with BSDF sampling at every vertex, as
+                    // Cycles does (light_sample_mis_weight_nee).
+                    let w = if light.mis { power_heuristic(ls.pdf, pdf_b) } else { 1.0 };
                     let c = scale(mul(mul(throughput, f), ls.value), w);
                     if is_zero(c) || !finite(c) {
                         continue;
@@ -638,7 +617,6 @@ impl Scene<'_> {
             flags = bounce_flags(bs.kind, bs.transmit, bs.singular);
             prev_pdf = bs.pdf;
             prev_singular = bs.singular;
-            prev_mis_lamps = mis_lamps;
             if !bs.singular {
                 min_ray_pdf = min_ray_pdf.min(bs.pdf);
             }

@@ -13,6 +13,7 @@
 pub mod accel;
 pub mod adaptive;
 pub mod anisotropic;
+pub mod area_light;
 pub mod bsdf;
 pub mod build;
 pub mod bump_correction;
