@@ -70,6 +70,9 @@ pub struct LobeSet {
     pub smooth_n: V3,
     /// The material's bump map correction, which also softens diffuse bump shadows.
     pub bump_correction: bool,
+    /// The object's shadow terminator shading offset as a frequency (1: none), set by the
+    /// integrator after shading.
+    pub terminator_frequency: f32,
 }
 
 pub struct BsdfSample {
@@ -88,7 +91,7 @@ const EMPTY: Lobe = Lobe { kind: LobeKind::Diffuse, weight: [0.0; 3], n: [0.0, 0
 
 impl Default for LobeSet {
     fn default() -> Self {
-        LobeSet { lobes: [EMPTY; MAX_LOBES], len: 0, emission: [0.0; 3], holdout: [0.0; 3], transparent: [0.0; 3], smooth_n: [0.0; 3], bump_correction: true }
+        LobeSet { lobes: [EMPTY; MAX_LOBES], len: 0, emission: [0.0; 3], holdout: [0.0; 3], transparent: [0.0; 3], smooth_n: [0.0; 3], bump_correction: true, terminator_frequency: 1.0 }
     }
 }
 
@@ -118,6 +121,7 @@ impl LobeSet {
         self.transparent = [0.0; 3];
         self.smooth_n = [0.0; 3];
         self.bump_correction = true;
+        self.terminator_frequency = 1.0;
     }
 
     pub fn push(&mut self, kind: LobeKind, weight: V3, n: V3) {
@@ -171,7 +175,13 @@ impl LobeSet {
                 continue;
             }
             let (e, p) = eval_lobe(l, wo, wi, ng, tables);
-            let e = scale(e, bump);
+            let mut e = scale(e, bump);
+            if self.terminator_frequency > 1.0 {
+                let c = dot(wi, l.n);
+                if c >= 0.0 {
+                    e = scale(e, super::terminator::shift_cos_in(c, self.terminator_frequency));
+                }
+            }
             f = add(f, mul(e, l.weight));
             pdf += p * l.sample_weight;
         }
@@ -207,7 +217,8 @@ impl LobeSet {
             let ds = g.sample(l.n, wo, ng, [u[0], u[1], u3])?;
             let (glossy, transmit) = (!ds.transmit, ds.transmit);
             if ds.singular {
-                return Some(BsdfSample { wi: ds.l, weight: scale(mul(ds.weight, l.weight), 1.0 / sel), pdf: f32::INFINITY, singular: true, glossy, transmit, kind: l.kind });
+                let shift = if self.terminator_frequency > 1.0 && !transmit { super::terminator::shift_cos_in(dot(ds.l, l.n), self.terminator_frequency) } else { 1.0 };
+                return Some(BsdfSample { wi: ds.l, weight: scale(mul(ds.weight, l.weight), shift / sel), pdf: f32::INFINITY, singular: true, glossy, transmit, kind: l.kind });
             }
             let (f, pdf) = self.eval(wo, ds.l, ng, tables);
             if !(pdf > 0.0) || !pdf.is_finite() {
@@ -234,6 +245,8 @@ impl LobeSet {
                 }
                 _ => l.weight,
             };
+            // Cycles' bsdf_sample shifts every sample that does not transmit.
+            let w = if self.terminator_frequency > 1.0 && !transmit { scale(w, super::terminator::shift_cos_in(dot(wi, l.n), self.terminator_frequency)) } else { w };
             return Some(BsdfSample { wi, weight: scale(w, 1.0 / sel), pdf: f32::INFINITY, singular: true, glossy, transmit, kind: l.kind });
         }
         let (f, pdf) = self.eval(wo, wi, ng, tables);

@@ -50,6 +50,9 @@ pub struct MeshInstance {
     pub holdout: bool,
     /// Object > Shading > Shadow Terminator > Geometry Offset (`terminator`).
     pub shadow_terminator: f32,
+    /// Cycles' shadow terminator shading offset as its kernel keeps it, 1 / (1 - offset / 2)
+    /// (1: none); see `terminator::shift_cos_in`.
+    pub terminator_frequency: f32,
 }
 
 impl MeshInstance {
@@ -102,9 +105,6 @@ pub fn build(scene: &Scene, eval: &EvaluatedScene, overrides: &[(String, serde_j
         }
         if obj.is_shadow_catcher {
             warn_shadow_catcher(&obj.name);
-        }
-        if obj.shadow_terminator_shading_offset != 0.0 {
-            warn_shading_offset(&obj.name);
         }
         let Some(mi) = scene.file.meshes.iter().position(|m| m.name == mesh_name) else {
             return Err(RenderError(format!("object {:?}: mesh {mesh_name:?} is not in the export", obj.name)));
@@ -188,11 +188,6 @@ pub fn triangle_masks(geo: &Geometry) -> Vec<u32> {
 fn warn_shadow_catcher(name: &str) {
     static WARN: std::sync::Once = std::sync::Once::new();
     WARN.call_once(|| eprintln!("warning: object {name:?} is a shadow catcher, which the renderer does not support: it is rendered as an ordinary object"));
-}
-
-fn warn_shading_offset(name: &str) {
-    static WARN: std::sync::Once = std::sync::Once::new();
-    WARN.call_once(|| eprintln!("warning: object {name:?} has a shadow terminator shading offset, which the renderer does not support: it is rendered without it (the geometry offset is applied)"));
 }
 
 /// Every instance's triangles in world space, skipping those with non-finite corners.
@@ -300,6 +295,8 @@ fn push_instance(
         visibility: object_visibility(obj),
         holdout: obj.is_holdout,
         shadow_terminator: obj.shadow_terminator_geometry_offset,
+        // Cycles' kernel keeps the shading offset as a frequency multiplier (object.cpp).
+        terminator_frequency: 1.0 / (1.0 - 0.5 * obj.shadow_terminator_shading_offset),
     });
     Ok(())
 }

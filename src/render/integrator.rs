@@ -358,6 +358,7 @@ impl Scene<'_> {
                     }
                 }
             }
+            scratch.lobes.terminator_frequency = self.geo.instances[hit.inst as usize].terminator_frequency;
             if diffuse_ancestor {
                 super::subsurface::to_diffuse(&mut scratch.lobes);
             }

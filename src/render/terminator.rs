@@ -8,6 +8,17 @@
 
 use super::math::*;
 
+/// Cycles' shadow terminator shading offset (Object > Shading > Shadow Terminator >
+/// Shading Offset; kernel/closure/bsdf.h, after appleseed): every closure's value toward a
+/// light or sampled direction on its front side is scaled by cos(angle x frequency) /
+/// cos(angle), pushing the terminator toward the light. `frequency` is
+/// 1 / (1 - offset / 2); `cos_in` is the direction's cosine to the closure's normal.
+#[inline]
+pub fn shift_cos_in(cos_in: f32, frequency: f32) -> f32 {
+    let c = cos_in.min(1.0);
+    (c.acos() * frequency).cos().max(0.0) / c
+}
+
 /// How much of the lift a shadow ray toward `l` (unit) gets: Cycles' blend over the 10-20%
 /// most grazing directions when `cutoff` is 0.1. `n` is the shading normal, `ng` the true
 /// normal on the ray's side of the surface. Returns (amount, the true normal on the
