@@ -114,6 +114,8 @@ const ASSERTED: &[&str] = &[
     "area_glossy_mis",
     // The shadow terminator shading offset on a coarse diffuse sphere and a rough metal cube.
     "terminator_shading_offset",
+    // Blender 4.5's light Temperature and Normalize (off) settings.
+    "light_temperature_normalize",
 ];
 
 /// Scenes that do not pass yet, with the reason.

@@ -110,7 +110,15 @@ pub fn collect(eval: &EvaluatedScene) -> Vec<Light> {
         let color = p.get("color").and_then(Value::as_array).map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(1.0) as f32)).unwrap_or([1.0; 3]);
         let energy = num(p, "energy", 10.0);
         let exposure = num(p, "exposure", 0.0);
-        let strength = scale(color, energy * 2f32.powf(exposure));
+        let mut strength = scale(color, energy * 2f32.powf(exposure));
+        // Blender 4.5's light temperature: the colour is multiplied by the blackbody colour
+        // Blender computed (`temperature_color`, in the scene's working space).
+        if p.get("use_temperature").and_then(Value::as_bool).unwrap_or(false) {
+            let t = p.get("temperature_color").and_then(Value::as_array).map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(1.0) as f32));
+            if let Some(t) = t {
+                strength = mul(strength, t);
+            }
+        }
         let pos = m.column(3);
         let dir = normalize(neg(m.column(2)));
         let cast_shadow = p.get("cycles").and_then(|c| c.get("cast_shadow")).and_then(Value::as_bool).unwrap_or(true);
@@ -157,6 +165,22 @@ pub fn collect(eval: &EvaluatedScene) -> Vec<Light> {
             "SUN" => Shape::Sun { half_angle: num(p, "angle", 0.00918) * 0.5 },
             _ => continue,
         };
+        // Normalize off (Blender 4.5): the power is not spread over the light's area, so the
+        // radiance is that many times higher (Cycles' Light::area: a point's sphere, 4 when
+        // its radius is 0; the rectangle or ellipse; the sun's disk, 1 when its angle is 0).
+        if !p.get("normalize").and_then(Value::as_bool).unwrap_or(true) {
+            let area = match &shape {
+                Shape::Point { radius, .. } => {
+                    let a = 4.0 * PI * radius * radius;
+                    if a == 0.0 { 4.0 } else { a }
+                }
+                Shape::Area { area, .. } => *area,
+                Shape::Sun { half_angle } => {
+                    if *half_angle > 0.0 { PI * half_angle.sin() * half_angle.sin() } else { 1.0 }
+                }
+            };
+            strength = scale(strength, area);
+        }
         let exclude = excluded_rays(obj.visibility.as_ref());
         let use_mis = p.get("cycles").and_then(|c| c.get("use_multiple_importance_sampling")).and_then(Value::as_bool).unwrap_or(true);
         let extent = match &shape {
