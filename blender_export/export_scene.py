@@ -793,6 +793,7 @@ def main():
         "cameras": [{"name": c.name, "properties": rna_value(c, 0, f"cameras[{q(c.name)}]", skip={"animation_data"})}
                     for c in data.cameras],
         "lights": [{"name": l.name, "type": l.type,
+                    "node_tree": node_tree_entry(l.node_tree, f"lights[{q(l.name)}].node_tree") if l.node_tree else None,
                     "properties": rna_value(l, 0, f"lights[{q(l.name)}]", skip={"node_tree", "animation_data"})}
                    for l in data.lights],
         "images": images,

@@ -116,6 +116,8 @@ const ASSERTED: &[&str] = &[
     "terminator_shading_offset",
     // Blender 4.5's light Temperature and Normalize (off) settings.
     "light_temperature_normalize",
+    // Light node trees: a constant Emission's colour and strength scale the light.
+    "light_nodes",
 ];
 
 /// Scenes that do not pass yet, with the reason.
@@ -276,6 +278,39 @@ fn bad_input_is_a_clear_error() {
     assert!(err(RenderOptions { samples: Some(1), resolution: Some((8, 8)), ..Default::default() }.clone()).is_empty());
     let m = render(&no_cam, &RenderOptions { samples: Some(1), resolution: Some((8, 8)), ..Default::default() }).err().unwrap().0;
     assert!(m.contains("no active camera"), "{m}");
+}
+
+/// A light node tree other than a constant Emission is refused by name, never rendered
+/// as if it were absent.
+#[test]
+fn varying_light_node_tree_is_a_clear_error() {
+    let dir = common::repo().join("fixtures/render/scenes/light_nodes");
+    let mut scene = Scene::load(&dir).unwrap();
+    let opts = RenderOptions { samples: Some(1), resolution: Some((8, 8)), ..Default::default() };
+    assert!(render(&scene, &opts).is_ok());
+    let light = scene.file.lights.iter_mut().find(|l| l.name == "NodeSpot").unwrap();
+    let tree = light.node_tree.as_mut().unwrap();
+    let mut link = tree.links[0].clone();
+    link.from_node = "Light Falloff".into();
+    link.from_socket = "Quadratic".into();
+    link.to_node = "Emission".into();
+    link.to_socket = "Strength".into();
+    tree.links.push(link);
+    let RenderError(m) = render(&scene, &opts).err().expect("a linked Emission input is refused");
+    assert!(m.contains("NodeSpot") && m.contains("Strength") && m.contains("Light Falloff"), "{m}");
+    // A muted Emission passes nothing (it has no closure input): the spot goes dark.
+    let opts = RenderOptions { samples: Some(8), resolution: Some((24, 24)), ..Default::default() };
+    let light = scene.file.lights.iter_mut().find(|l| l.name == "NodeSpot").unwrap();
+    light.node_tree.as_mut().unwrap().links.pop();
+    let mean = |o: &blendsynth::render::RenderOutput| o.color.iter().map(|p| p[0] as f64).sum::<f64>() / o.color.len() as f64;
+    let lit = mean(&render(&scene, &opts).unwrap());
+    let mut off = scene.clone();
+    off.file.lights.iter_mut().find(|l| l.name == "NodeSpot").unwrap().properties.insert("energy".into(), serde_json::json!(0.0));
+    let unlit = mean(&render(&off, &opts).unwrap());
+    let light = scene.file.lights.iter_mut().find(|l| l.name == "NodeSpot").unwrap();
+    light.node_tree.as_mut().unwrap().nodes.iter_mut().find(|n| n.name == "Emission").unwrap().mute = true;
+    let muted = mean(&render(&scene, &opts).unwrap());
+    assert!(unlit < 0.8 * lit && muted == unlit, "muted {muted}, no power {unlit}, lit {lit}");
 }
 
 #[test]

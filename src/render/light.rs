@@ -9,6 +9,7 @@ use std::f32::consts::PI;
 
 use super::area_light::{rect_solid_angle, Region, Spread};
 use super::math::*;
+use super::RenderError;
 use crate::anim::EvaluatedScene;
 
 #[derive(Debug, Clone)]
@@ -97,7 +98,37 @@ fn num(p: &serde_json::Map<String, Value>, k: &str, d: f64) -> f32 {
     p.get(k).and_then(Value::as_f64).unwrap_or(d) as f32
 }
 
-pub fn collect(eval: &EvaluatedScene) -> Vec<Light> {
+/// The factor a light's node tree puts on its colour and power: Cycles multiplies the
+/// light's strength by the emission its shader evaluates to. Only a tree that reduces to a
+/// constant (an Emission node with unlinked inputs into the active Light Output) is
+/// supported; any other is an error naming the light and node, never a stand-in.
+fn node_factor(l: &crate::scene::format::Light) -> Result<V3, RenderError> {
+    let use_nodes = l.properties.get("use_nodes").and_then(Value::as_bool).unwrap_or(false);
+    let Some(tree) = l.node_tree.as_ref().filter(|_| use_nodes) else { return Ok([1.0; 3]) };
+    let outputs = || tree.nodes.iter().filter(|n| n.bl_idname == "ShaderNodeOutputLight");
+    let active = outputs().find(|n| n.properties.get("is_active_output").and_then(Value::as_bool).unwrap_or(true)).or_else(|| outputs().next());
+    // No output, or nothing linked to it: Cycles renders the light black.
+    let Some(out) = active else { return Ok([0.0; 3]) };
+    let Some(link) = tree.links.iter().find(|k| k.to_node == out.name && k.to_socket == "Surface" && !k.is_muted) else { return Ok([0.0; 3]) };
+    let name = &l.name;
+    let node = tree.nodes.iter().find(|n| n.name == link.from_node).ok_or_else(|| RenderError(format!("light {name:?}: its node tree links from a missing node {:?}", link.from_node)))?;
+    // A muted Emission has no closure input to pass through: nothing reaches the output.
+    if node.bl_idname == "ShaderNodeEmission" && node.mute {
+        return Ok([0.0; 3]);
+    }
+    if node.bl_idname != "ShaderNodeEmission" {
+        return Err(RenderError(format!("light {name:?}: node {:?} ({}) feeding the Light Output is not supported yet (only a constant Emission)", node.name, node.bl_idname)));
+    }
+    if let Some(k) = tree.links.iter().find(|k| k.to_node == node.name && !k.is_muted) {
+        return Err(RenderError(format!("light {name:?}: the linked {:?} input of {:?} (from {:?}) is not supported yet (only a constant Emission)", k.to_socket, node.name, k.from_node)));
+    }
+    let input = |id: &str| node.inputs.iter().find(|s| s.identifier == id).and_then(|s| s.default_value.as_ref());
+    let color = input("Color").and_then(Value::as_array).map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(1.0) as f32)).unwrap_or([1.0; 3]);
+    let strength = input("Strength").and_then(Value::as_f64).unwrap_or(1.0) as f32;
+    Ok(scale(color, strength))
+}
+
+pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
     let mut out = Vec::new();
     for (oi, obj) in eval.data.objects.iter().enumerate() {
         if obj.kind != "LIGHT" || obj.hide_render {
@@ -110,7 +141,7 @@ pub fn collect(eval: &EvaluatedScene) -> Vec<Light> {
         let color = p.get("color").and_then(Value::as_array).map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(1.0) as f32)).unwrap_or([1.0; 3]);
         let energy = num(p, "energy", 10.0);
         let exposure = num(p, "exposure", 0.0);
-        let mut strength = scale(color, energy * 2f32.powf(exposure));
+        let mut strength = mul(scale(color, energy * 2f32.powf(exposure)), node_factor(l)?);
         // Blender 4.5's light temperature: the colour is multiplied by the blackbody colour
         // Blender computed (`temperature_color`, in the scene's working space).
         if p.get("use_temperature").and_then(Value::as_bool).unwrap_or(false) {
@@ -190,7 +221,7 @@ pub fn collect(eval: &EvaluatedScene) -> Vec<Light> {
         };
         out.push(Light { shape, strength, pos, dir, cast_shadow, mis: use_mis && extent, exclude });
     }
-    out
+    Ok(out)
 }
 
 impl Spot {

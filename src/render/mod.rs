@@ -208,7 +208,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         (geo.tris, geo.refs) = build::world_triangles(&geo.instances);
     }
     let moving = object_motion::attach(&mut geo, &eval.data.objects, &eval.world_matrices, &object_steps);
-    let lights = light::collect(&eval);
+    let lights = light::collect(&eval)?;
     let background = world::background(scene)?;
     let world_shader = world::shader(scene)?;
     let tables = tables::Tables::shared();

@@ -478,6 +478,9 @@ pub struct Light {
     pub name: String,
     #[serde(rename = "type")]
     pub kind: String,
+    /// The light's shader nodes (used when `properties.use_nodes`); absent in older exports.
+    #[serde(default)]
+    pub node_tree: Option<NodeTree>,
     pub properties: Rna,
 }
 
