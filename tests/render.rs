@@ -118,6 +118,8 @@ const ASSERTED: &[&str] = &[
     "light_temperature_normalize",
     // Light node trees: a constant Emission's colour and strength scale the light.
     "light_nodes",
+    // Per-light Max Bounces (light sampling only; BSDF rays still find the light).
+    "light_max_bounces",
 ];
 
 /// Scenes that do not pass yet, with the reason.

@@ -434,6 +434,9 @@ impl Scene<'_> {
             // Next-event estimation toward every light.
             if !terminate_next && scratch.lobes.len > 0 {
                 for (li, light) in self.lights.iter().enumerate() {
+                    if bounce > light.max_bounces {
+                        continue;
+                    }
                     let uu = if li == 0 { [u_light[0], u_light[1]] } else { let r = rng.get4(index, 0x4000_0000 + set * 64 + li as u32); [r[0], r[1]] };
                     let Some(ls) = light.sample(hit.p, uu) else { continue };
                     let (f, pdf_b) = scratch.lobes.eval_excluding(wo, ls.wi, hit.ng, self.tables, light.exclude);

@@ -44,6 +44,9 @@ pub struct Light {
     /// Importance on, and a light with extent); otherwise only light sampling and camera
     /// rays see it.
     pub mis: bool,
+    /// Cycles' per-light Max Bounces: light sampling skips the light at vertices past
+    /// this many bounces (light_select_reached_max_bounces).
+    pub max_bounces: u32,
     /// Ray types that do not see the light (`ray::` flags: CAMERA, DIFFUSE, GLOSSY,
     /// TRANSMIT, VOLUME_SCATTER), from the object's ray visibility.
     pub exclude: u32,
@@ -219,7 +222,8 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
             Shape::Area { spread, .. } => spread.is_none_or(|s| s.tan_half > 0.0),
             Shape::Sun { half_angle } => *half_angle > 0.0,
         };
-        out.push(Light { shape, strength, pos, dir, cast_shadow, mis: use_mis && extent, exclude });
+        let max_bounces = p.get("cycles").and_then(|c| c.get("max_bounces")).and_then(Value::as_u64).unwrap_or(1024).min(u32::MAX as u64) as u32;
+        out.push(Light { shape, strength, pos, dir, cast_shadow, mis: use_mis && extent, max_bounces, exclude });
     }
     Ok(out)
 }
@@ -540,7 +544,7 @@ mod tests {
             a *= PI / 4.0;
         }
         let spread = spread_deg.and_then(|d| Spread::new(d.to_radians()));
-        Light { shape: Shape::Area { u, v, ellipse, area: a, spread }, strength: [100.0; 3], pos: [0.0, 0.0, 2.0], dir: [0.0, 0.0, -1.0], cast_shadow: true, mis: true, exclude: 0 }
+        Light { shape: Shape::Area { u, v, ellipse, area: a, spread }, strength: [100.0; 3], pos: [0.0, 0.0, 2.0], dir: [0.0, 0.0, -1.0], cast_shadow: true, mis: true, max_bounces: 1024, exclude: 0 }
     }
 
     /// MIS needs the pdf of a light sample and the pdf a BSDF ray finds for the same
