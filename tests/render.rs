@@ -120,6 +120,8 @@ const ASSERTED: &[&str] = &[
     "light_nodes",
     // Per-light Max Bounces (light sampling only; BSDF rays still find the light).
     "light_max_bounces",
+    // Cast Shadow off (light.use_shadow in Blender 4.x).
+    "light_no_shadow",
 ];
 
 /// Scenes that do not pass yet, with the reason.

@@ -155,7 +155,9 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
         }
         let pos = m.column(3);
         let dir = normalize(neg(m.column(2)));
-        let cast_shadow = p.get("cycles").and_then(|c| c.get("cast_shadow")).and_then(Value::as_bool).unwrap_or(true);
+        // Blender 4.x keeps Cast Shadow as the light's `use_shadow` (Cycles syncs it from
+        // there); older files had it under `cycles.cast_shadow`.
+        let cast_shadow = p.get("use_shadow").or_else(|| p.get("cycles").and_then(|c| c.get("cast_shadow"))).and_then(Value::as_bool).unwrap_or(true);
         let shape = match l.kind.as_str() {
             "POINT" | "SPOT" => {
                 let radius = num(p, "shadow_soft_size", 0.25);
