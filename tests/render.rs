@@ -122,6 +122,10 @@ const ASSERTED: &[&str] = &[
     "light_max_bounces",
     // Cast Shadow off (light.use_shadow in Blender 4.x).
     "light_no_shadow",
+    // World ray visibility (hidden from camera and glossy rays), constant and sampled by
+    // its map.
+    "world_visibility",
+    "world_visibility_map",
 ];
 
 /// Scenes that do not pass yet, with the reason.

@@ -81,6 +81,8 @@ pub struct Scene<'a> {
     pub materials: &'a [Material],
     pub lights: &'a [Light],
     pub background: V3,
+    /// Ray types the world is hidden from (World > Ray Visibility, `ray::` flags).
+    pub world_exclude: u32,
     pub tables: &'a Tables,
     pub settings: Settings,
     /// The world's node program when it varies with direction (else `background`).
@@ -303,6 +305,11 @@ impl Scene<'_> {
             let Some(h) = hit_opt else {
                 if st.film_transparent && transparent_bg {
                     scratch.transparent += average(throughput);
+                    break;
+                }
+                // A world hidden from this ray type gives it nothing (Cycles'
+                // integrator_eval_background_shader).
+                if !super::light::visible_to(self.world_exclude, flags) {
                     break;
                 }
                 let w = self.world_mis_weight(d, prev_singular, prev_pdf);
@@ -660,7 +667,8 @@ impl Scene<'_> {
     fn world_light_sample(&self, hit: &SurfaceHit, wo: V3, u: [f32; 2], scratch: &mut Scratch) -> V3 {
         let Some(map) = self.world.and_then(|w| w.map.as_ref()) else { return [0.0; 3] };
         let Some((wi, pdf_l)) = map.sample(u) else { return [0.0; 3] };
-        let (f, pdf_b) = scratch.lobes.eval(wo, wi, hit.ng, self.tables);
+        // Closures of the ray types the world is hidden from do not see it.
+        let (f, pdf_b) = scratch.lobes.eval_excluding(wo, wi, hit.ng, self.tables, self.world_exclude);
         if is_zero(f) || pdf_l.is_nan() || pdf_l <= 0.0 {
             return [0.0; 3];
         }

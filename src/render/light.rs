@@ -56,14 +56,20 @@ impl Light {
     /// Cycles' is_light_shader_visible_to_path for a ray with these path flags.
     #[inline]
     pub fn visible_to(&self, flags: u32) -> bool {
-        use crate::shader::point::ray;
-        let x = self.exclude;
-        !((x & ray::DIFFUSE != 0 && flags & ray::DIFFUSE != 0)
-            || (x & ray::GLOSSY != 0 && flags & (ray::GLOSSY | ray::REFLECT) == ray::GLOSSY | ray::REFLECT)
-            || (x & ray::TRANSMIT != 0 && flags & ray::TRANSMIT != 0)
-            || (x & ray::CAMERA != 0 && flags & ray::CAMERA != 0)
-            || (x & ray::VOLUME_SCATTER != 0 && flags & ray::VOLUME_SCATTER != 0))
+        visible_to(self.exclude, flags)
     }
+}
+
+/// Whether an emitter hidden from the ray types `x` (`ray::` flags) is seen by a ray with
+/// path flags `flags` (Cycles' is_light_shader_visible_to_path; lights and the world).
+#[inline]
+pub fn visible_to(x: u32, flags: u32) -> bool {
+    use crate::shader::point::ray;
+    !((x & ray::DIFFUSE != 0 && flags & ray::DIFFUSE != 0)
+        || (x & ray::GLOSSY != 0 && flags & (ray::GLOSSY | ray::REFLECT) == ray::GLOSSY | ray::REFLECT)
+        || (x & ray::TRANSMIT != 0 && flags & ray::TRANSMIT != 0)
+        || (x & ray::CAMERA != 0 && flags & ray::CAMERA != 0)
+        || (x & ray::VOLUME_SCATTER != 0 && flags & ray::VOLUME_SCATTER != 0))
 }
 
 /// The ray types an object's ray visibility hides it from, as `ray::` flags; without the

@@ -245,7 +245,7 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         Some(m) => m,
         None => &bvh,
     };
-    let tracer = integrator::Scene { mesh_lights: &mesh_lights, accel, geo: &geo, materials: &materials, lights: &lights, background, tables, settings, world: world_shader.as_ref(), view: camera.view() };
+    let tracer = integrator::Scene { mesh_lights: &mesh_lights, accel, geo: &geo, materials: &materials, lights: &lights, background, world_exclude: world::excluded_rays(scene), tables, settings, world: world_shader.as_ref(), view: camera.view() };
 
     let adaptive = adaptive::Adaptive::from_scene(cy, samples, opts.threshold);
     let tiles_x = w.div_ceil(TILE);
@@ -443,7 +443,7 @@ fn mesh_lights(
     settings: Settings,
 ) -> integrator::MeshLights {
     let empty = integrator::MeshLights::default();
-    let probe = integrator::Scene { mesh_lights: &empty, accel: bvh, geo, materials, lights, background, tables, settings, world: None, view: Default::default() };
+    let probe = integrator::Scene { mesh_lights: &empty, accel: bvh, geo, materials, lights, background, world_exclude: 0, tables, settings, world: None, view: Default::default() };
     let emissive: Vec<bool> = materials.iter().map(|m| m.program.as_ref().is_some_and(|p| light_sampled(p, &m.sampling))).collect();
     let mut scratch = Scratch::new(materials.len());
     let mut prims = Vec::new();

@@ -43,6 +43,22 @@ pub fn background(scene: &Scene) -> Result<V3, RenderError> {
     Ok(color.map(|c| c * strength))
 }
 
+/// The ray types the scene's world is hidden from (World > Settings > Ray Visibility,
+/// exported as `cycles_visibility`), as `ray::` flags.
+pub fn excluded_rays(scene: &Scene) -> u32 {
+    use crate::shader::point::ray;
+    let Some(name) = scene.file.scene.world.as_deref() else { return 0 };
+    let Some(w) = scene.file.worlds.iter().find(|w| w.name == name) else { return 0 };
+    let Some(v) = w.properties.get("cycles_visibility") else { return 0 };
+    let mut x = 0;
+    for (key, flag) in [("camera", ray::CAMERA), ("diffuse", ray::DIFFUSE), ("glossy", ray::GLOSSY), ("transmission", ray::TRANSMIT), ("scatter", ray::VOLUME_SCATTER)] {
+        if v.get(key).and_then(Value::as_bool) == Some(false) {
+            x |= flag;
+        }
+    }
+    x
+}
+
 /// A world whose surface varies with direction (an Environment Texture, a Texture
 /// Coordinate, any linked Background input): its compiled node program, run per ray
 /// that leaves the scene.
