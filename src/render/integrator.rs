@@ -1,7 +1,7 @@
 //! The path tracer: next-event estimation toward light objects, emissive triangles and
 //! the world, combined with BSDF sampling by multiple importance sampling wherever Cycles
-//! combines them (every light with extent and Multiple Importance on), Cycles' per-type bounce limits (terminating after
-//! the next surface, as Cycles does), Russian roulette on sqrt of throughput, and
+//! combines them (every light with extent and Multiple Importance on), Cycles' per-type
+//! bounce limits (terminating after the next surface, as Cycles does), Russian roulette on sqrt of throughput, and
 //! Cycles' clamping (direct and indirect limits on the sum of a contribution).
 
 use crate::scene::AttributeData;
