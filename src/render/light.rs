@@ -188,6 +188,9 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
                 let sphere = !p.get("use_soft_falloff").and_then(Value::as_bool).unwrap_or(true);
                 Shape::Point { radius, spot, sphere }
             }
+            // A portal only guides Cycles' sampling of the world through it: it emits
+            // nothing, and the world is sampled by its own map here.
+            "AREA" if p.get("cycles").and_then(|c| c.get("is_portal")).and_then(Value::as_bool).unwrap_or(false) => continue,
             "AREA" => {
                 let size = num(p, "size", 1.0);
                 let shape = p.get("shape").and_then(Value::as_str).unwrap_or("SQUARE");
