@@ -103,6 +103,11 @@ pub struct LightHit {
     pub pdf: f32,
 }
 
+/// An RGB triple from an exported colour array (a missing channel reads 1).
+fn rgb(v: Option<&Value>) -> Option<V3> {
+    v.and_then(Value::as_array).map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(1.0) as f32))
+}
+
 fn num(p: &serde_json::Map<String, Value>, k: &str, d: f64) -> f32 {
     p.get(k).and_then(Value::as_f64).unwrap_or(d) as f32
 }
@@ -114,10 +119,8 @@ fn num(p: &serde_json::Map<String, Value>, k: &str, d: f64) -> f32 {
 fn node_factor(l: &crate::scene::format::Light) -> Result<V3, RenderError> {
     let use_nodes = l.properties.get("use_nodes").and_then(Value::as_bool).unwrap_or(false);
     let Some(tree) = l.node_tree.as_ref().filter(|_| use_nodes) else { return Ok([1.0; 3]) };
-    let outputs = || tree.nodes.iter().filter(|n| n.bl_idname == "ShaderNodeOutputLight");
-    let active = outputs().find(|n| n.properties.get("is_active_output").and_then(Value::as_bool).unwrap_or(true)).or_else(|| outputs().next());
     // No output, or nothing linked to it: Cycles renders the light black.
-    let Some(out) = active else { return Ok([0.0; 3]) };
+    let Some(out) = crate::nodes::graph::active_output(tree, "ShaderNodeOutputLight", "CYCLES") else { return Ok([0.0; 3]) };
     let Some(link) = tree.links.iter().find(|k| k.to_node == out.name && k.to_socket == "Surface" && !k.is_muted) else { return Ok([0.0; 3]) };
     let name = &l.name;
     let node = tree.nodes.iter().find(|n| n.name == link.from_node).ok_or_else(|| RenderError(format!("light {name:?}: its node tree links from a missing node {:?}", link.from_node)))?;
@@ -132,7 +135,7 @@ fn node_factor(l: &crate::scene::format::Light) -> Result<V3, RenderError> {
         return Err(RenderError(format!("light {name:?}: the linked {:?} input of {:?} (from {:?}) is not supported yet (only a constant Emission)", k.to_socket, node.name, k.from_node)));
     }
     let input = |id: &str| node.inputs.iter().find(|s| s.identifier == id).and_then(|s| s.default_value.as_ref());
-    let color = input("Color").and_then(Value::as_array).map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(1.0) as f32)).unwrap_or([1.0; 3]);
+    let color = rgb(input("Color")).unwrap_or([1.0; 3]);
     let strength = input("Strength").and_then(Value::as_f64).unwrap_or(1.0) as f32;
     Ok(scale(color, strength))
 }
@@ -147,15 +150,14 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
         let Some(l) = eval.data.lights.iter().find(|l| l.name == data) else { continue };
         let p = &l.properties;
         let m = Affine::from_rows(&eval.world_matrices[oi]);
-        let color = p.get("color").and_then(Value::as_array).map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(1.0) as f32)).unwrap_or([1.0; 3]);
+        let color = rgb(p.get("color")).unwrap_or([1.0; 3]);
         let energy = num(p, "energy", 10.0);
         let exposure = num(p, "exposure", 0.0);
         let mut strength = mul(scale(color, energy * 2f32.powf(exposure)), node_factor(l)?);
         // Blender 4.5's light temperature: the colour is multiplied by the blackbody colour
         // Blender computed (`temperature_color`, in the scene's working space).
         if p.get("use_temperature").and_then(Value::as_bool).unwrap_or(false) {
-            let t = p.get("temperature_color").and_then(Value::as_array).map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(1.0) as f32));
-            if let Some(t) = t {
+            if let Some(t) = rgb(p.get("temperature_color")) {
                 strength = mul(strength, t);
             }
         }
