@@ -17,7 +17,7 @@ const MAX_MEAN_REL: f64 = 0.01;
 
 /// Scenes that must pass.
 const ASSERTED: &[&str] = &[
-    "adaptive", "motion_blur", "motion_blur_start", "area_disk", "area_square", "diffuse_point", "diffuse_sun", "dof", "emission_mesh", "glossy", "metallic", "mix_shader", "ortho_flat", "principled", "shift_clip", "spot", "world_light",
+    "adaptive", "motion_blur", "motion_blur_start", "area_disk", "area_square", "diffuse_point", "diffuse_sun", "dof", "emission_mesh", "glossy", "metallic", "mix_shader", "ortho_flat", "principled", "principled_bright_base", "shift_clip", "spot", "world_light",
     // Closures helper: glass (rough after Filter Glossy), rough glass and refraction.
     "glass",
     "glass_beckmann",

@@ -340,6 +340,9 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
     let transmission = input_f(b, s, "Transmission Weight", 0.0).clamp(0.0, 1.0);
     let spec_level = input_f(b, s, "Specular IOR Level", 0.5).max(0.0);
     let spec_tint = input_c(b, s, "Specular Tint", [1.0; 3]).map(|x| x.max(0.0));
+    // Cycles clamps the base colour to 1 for the layers that must conserve energy
+    // (metallic F0, transmission tint, subsurface); only the diffuse takes it unclamped.
+    let clamped = base.map(|x| x.min(1.0));
     let n = input_n(b, s, "Normal", sp);
     // The reflecting layers and the BSSRDF use the bump-corrected normal; diffuse and
     // sheen the normal as given (Cycles' valid_reflection_N).
@@ -374,6 +377,7 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         let f = 6.0f32 / 7.0;
         let f6 = f.powi(6);
         let mut bb = [0.0; 3];
+        let base = clamped;
         for k in 0..3 {
             let schlick = base[k] + (1.0 - base[k]) * f.powi(5);
             bb[k] = schlick * (1.0 - spec_tint[k]) * 7.0 / f6;
@@ -392,7 +396,7 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         // colour (light crosses the surface twice), as Cycles' Principled sets it up.
         let mut g = super::microfacet::glass_closure(ctx.tables, Some(if multi { "MULTI_GGX" } else { "GGX" }), false, roughness, ior, ctx.backfacing, mu);
         g.tint_r = spec_tint;
-        g.tint_t = base.map(f32::sqrt);
+        g.tint_t = clamped.map(f32::sqrt);
         if film {
             // Cycles' film IOR is relative to the side the light comes from: film / ior
             // seen from inside. The specular tint scales the film's reflectance instead.
@@ -436,7 +440,7 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         // Random Walk (Skin) has its own IOR input; the other methods use the BSDF's.
         let ss_ior = if method == Method::RandomWalkSkin { input_f(b, s, "Subsurface IOR", 1.4) } else { ior };
         let aniso = input_f(b, s, "Subsurface Anisotropy", 0.0);
-        push_bssrdf(out, scale(mul(weight, base), ss), radius, base, aniso, ss_ior, roughness, method, vn);
+        push_bssrdf(out, scale(mul(weight, clamped), ss), radius, clamped, aniso, ss_ior, roughness, method, vn);
         weight = scale(weight, 1.0 - ss);
     }
     let diffuse_roughness = input_f(b, s, "Diffuse Roughness", 0.0);
