@@ -377,17 +377,16 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         let f = 6.0f32 / 7.0;
         let f6 = f.powi(6);
         let mut bb = [0.0; 3];
-        let base = clamped;
         for k in 0..3 {
-            let schlick = base[k] + (1.0 - base[k]) * f.powi(5);
+            let schlick = clamped[k] + (1.0 - clamped[k]) * f.powi(5);
             bb[k] = schlick * (1.0 - spec_tint[k]) * 7.0 / f6;
         }
-        let avg_f0 = (base[0] + base[1] + base[2]) / 3.0;
+        let avg_f0 = (clamped[0] + clamped[1] + clamped[2]) / 3.0;
         let albedo = (avg_f0 + (1.0 - avg_f0) / 21.0).clamp(0.0, 1.0);
         if ax != ay {
-            push_glossy(out, ctx, ax, ay, tangent, Fresnel::F82 { f0: base, b: bb }, multi, scale(weight, metallic), vn, albedo.max(1e-3));
+            push_glossy(out, ctx, ax, ay, tangent, Fresnel::F82 { f0: clamped, b: bb }, multi, scale(weight, metallic), vn, albedo.max(1e-3));
         } else {
-            out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::F82 { f0: base, b: bb }, energy }, scale(weight, metallic), vn, albedo.max(1e-3));
+            out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::F82 { f0: clamped, b: bb }, energy }, scale(weight, metallic), vn, albedo.max(1e-3));
         }
         weight = scale(weight, 1.0 - metallic);
     }
