@@ -131,7 +131,10 @@ const ASSERTED: &[&str] = &[
 ];
 
 /// Scenes that do not pass yet, with the reason.
-const KNOWN_FAILURES: &[(&str, &str)] = &[];
+const KNOWN_FAILURES: &[(&str, &str)] = &[(
+    "bump_on_displacement_bump",
+    "a Bump node stacked on the displacement's bump: ours 3-5% too bright (ratio 1.26, mean 4.9%); either bump alone matches Cycles",
+)];
 
 fn read_exr(p: &Path) -> Vec<[f32; 3]> {
     read_exr_rgba(p).iter().map(|p| [p[0], p[1], p[2]]).collect()
