@@ -438,6 +438,11 @@ fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
         LobeKind::Reflection(r) => r.sample(l.n, wo, ng, u),
         LobeKind::Glossy { alpha, .. } => {
             if alpha < SINGULAR_ALPHA {
+                // Cycles' bsdf_microfacet_sample rejects a view below the shading normal,
+                // which strong bumps make common; its mirror would reflect "through" N.
+                if dot(l.n, wo) <= 0.0 {
+                    return None;
+                }
                 let wi = sub(scale(l.n, 2.0 * dot(l.n, wo)), wo);
                 if dot(wi, ng) <= 0.0 {
                     return None;
