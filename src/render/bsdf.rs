@@ -437,21 +437,18 @@ fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
         LobeKind::Glass(_) | LobeKind::Subsurface(_) => None, // sampled elsewhere
         LobeKind::Reflection(r) => r.sample(l.n, wo, ng, u),
         LobeKind::Glossy { alpha, .. } => {
+            // Cycles' bsdf_microfacet_sample rejects a view below the shading normal, sharp
+            // or rough (strong bumps make it common: a mirror would reflect "through" N).
+            let v = to_local(l.n, wo);
+            if v[2] <= 0.0 {
+                return None;
+            }
             if alpha < SINGULAR_ALPHA {
-                // Cycles' bsdf_microfacet_sample rejects a view below the shading normal,
-                // which strong bumps make common; its mirror would reflect "through" N.
-                if dot(l.n, wo) <= 0.0 {
-                    return None;
-                }
-                let wi = sub(scale(l.n, 2.0 * dot(l.n, wo)), wo);
+                let wi = sub(scale(l.n, 2.0 * v[2]), wo);
                 if dot(wi, ng) <= 0.0 {
                     return None;
                 }
                 return Some((wi, true));
-            }
-            let v = to_local(l.n, wo);
-            if v[2] <= 0.0 {
-                return None;
             }
             let h = sample_vndf(v, alpha, u);
             let wi_l = sub(scale(h, 2.0 * dot(v, h)), v);
