@@ -255,6 +255,7 @@ impl Scene<'_> {
         let (mut o, mut d, mut t0, mut t1) = (org, dir, tmin, tmax);
         let (mut bounce, mut diffuse, mut glossy, mut transmission, mut transparent) = (0u32, 0u32, 0u32, 0u32, 0u32);
         let mut terminate_next = false;
+        let mut passed_light = false;
         // Cycles' path flags of the ray being traced (Light Path node).
         let mut flags = ray::CAMERA;
         let mut set = 1u32;
@@ -294,6 +295,7 @@ impl Scene<'_> {
                     continue;
                 }
                 if let Some(lh) = light.intersect(o, d, t_surface) {
+                    passed_light = true;
                     let w = if prev_singular { 1.0 } else { power_heuristic(prev_pdf, lh.pdf) };
                     scratch.features.add_emission(scale(mul(throughput, lh.radiance), w));
                     let c = clamp_contrib(scale(mul(throughput, lh.radiance), w), clamp_limit);
@@ -368,6 +370,12 @@ impl Scene<'_> {
             scratch.lobes.terminator_frequency = self.geo.instances[hit.inst as usize].terminator_frequency;
             if diffuse_ancestor {
                 super::subsurface::to_diffuse(&mut scratch.lobes);
+            }
+            // Cycles' surface_shader_prepare_closures: defensive sampling at the first
+            // surface (no bounce, no transparent pass yet), before Filter Glossy.
+            // (Cycles counts a light the ray passed through as a transparent bounce.)
+            if bounce == 0 && transparent == 0 && !passed_light && from_sss.is_none() {
+                scratch.lobes.defensive_sampling();
             }
             // Filter Glossy: after diffuse-like bounces, glossy lobes are roughened.
             if st.filter_glossy > 0.0 && min_ray_pdf.is_finite() {
