@@ -115,15 +115,15 @@ fn autorun_script_in_a_blend_never_runs() {
     assert!(!marker.exists(), "the .blend's auto-run script ran during convert");
 }
 
-/// The committed copy of Cycles' glass albedo tables (tests/closures.rs compares ours with
-/// it) is what this Blender's library holds.
+/// The committed copy of Cycles' albedo tables (tests/closures.rs compares ours with it)
+/// is what this Blender's library holds.
 #[test]
-fn committed_cycles_glass_tables_are_current() {
+fn committed_cycles_albedo_tables_are_current() {
     let Some(py) = require("a Python with bpy 4.5.4", bpy_python()) else { return };
     let t = tempfile::tempdir().unwrap();
     let out = t.path().join("tables.json");
-    run_python(&py, &repo().join("fixtures/render/cycles_glass_tables.py"), &["--out", out.to_str().unwrap()]);
+    run_python(&py, &repo().join("fixtures/render/cycles_albedo_tables.py"), &["--out", out.to_str().unwrap()]);
     let fresh: Value = serde_json::from_str(&std::fs::read_to_string(&out).unwrap()).unwrap();
-    let committed: Value = serde_json::from_str(&std::fs::read_to_string(repo().join("fixtures/render/cycles_glass_tables.json")).unwrap()).unwrap();
-    assert_eq!(fresh, committed, "fixtures/render/cycles_glass_tables.json is stale; run fixtures/render/cycles_glass_tables.py");
+    let committed: Value = serde_json::from_str(&std::fs::read_to_string(repo().join("fixtures/render/cycles_albedo_tables.json")).unwrap()).unwrap();
+    assert_eq!(fresh, committed, "fixtures/render/cycles_albedo_tables.json is stale; run fixtures/render/cycles_albedo_tables.py");
 }

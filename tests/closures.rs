@@ -104,14 +104,47 @@ fn oren_nayar_white_furnace() {
     assert!(on.eval(N, view(0.5), l)[0] < OrenNayar::new(1.0, [1.0; 3], 0.5).eval(N, view(0.5), l)[0]);
 }
 
-/// Our integrated glass albedo tables (render/tables.rs) against Cycles' own, read from
-/// bpy's library by fixtures/render/cycles_glass_tables.py: light entering glass
-/// (ggx_glass_E) and leaving it (ggx_glass_inv_E), at each grid point of the slices kept.
+/// Cycles' albedo tables, read from bpy's library by fixtures/render/cycles_albedo_tables.py.
+fn cycles_tables() -> serde_json::Value {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/render/cycles_albedo_tables.json");
+    serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap()
+}
+
+/// Our integrated GGX albedo table (Fresnel one) and its cosine-weighted mean against
+/// Cycles' ggx_E and ggx_Eavg, which Multiscatter GGX reflection scales by.
+#[test]
+fn ggx_albedo_tables_match_cycles() {
+    let v = cycles_tables();
+    let tables = Tables::shared();
+    let (mut worst, mut at, mut sum) = (0.0f32, String::new(), 0.0f64);
+    for (i, row) in v["tables"]["ggx_E"].as_array().unwrap().iter().enumerate() {
+        for (j, c) in row.as_array().unwrap().iter().enumerate() {
+            let c = c.as_f64().unwrap() as f32;
+            let ours = tables.ggx_e(i as f32 / 31.0, j as f32 / 31.0);
+            let d = (ours - c).abs();
+            sum += d as f64;
+            if d > worst {
+                worst = d;
+                at = format!("cos {i}/31 roughness {j}/31: ours {ours}, Cycles {c}");
+            }
+        }
+    }
+    let mean = sum / 1024.0;
+    eprintln!("ggx_E: worst {worst:.5} ({at}), mean {mean:.6}");
+    assert!(worst < 0.0025 && mean < 3e-4, "ggx_E: worst {worst} at {at}, mean {mean}");
+    for (j, c) in v["tables"]["ggx_Eavg"].as_array().unwrap().iter().enumerate() {
+        let c = c.as_f64().unwrap() as f32;
+        let ours = tables.ggx_e_avg(j as f32 / 31.0);
+        assert!((ours - c).abs() < 1e-3, "ggx_Eavg at roughness {j}/31: ours {ours}, Cycles {c}");
+    }
+}
+
+/// Our integrated glass albedo tables (render/tables.rs) against Cycles' own: light
+/// entering glass (ggx_glass_E) and leaving it (ggx_glass_inv_E), at each grid point of
+/// the slices kept.
 #[test]
 fn glass_albedo_tables_match_cycles() {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/render/cycles_glass_tables.json");
-    let text = std::fs::read_to_string(&path).unwrap();
-    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let v = cycles_tables();
     let slices: Vec<usize> = v["slices"].as_array().unwrap().iter().map(|s| s.as_u64().unwrap() as usize).collect();
     let tables = Tables::shared();
     for (name, leaving) in [("glass_E", false), ("glass_inv_E", true)] {
