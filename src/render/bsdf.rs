@@ -135,7 +135,7 @@ impl LobeSet {
             return;
         }
         // Cycles' bsdf_alloc drops closures whose mean weight is below CLOSURE_WEIGHT_CUTOFF
-        // (which matters beyond their light: defensive sampling counts closures).
+        // (which matters beyond their light: they would take a share of the selection).
         let mean = (weight[0] + weight[1] + weight[2]).abs() / 3.0;
         if !(mean >= 1e-5) {
             return;
@@ -150,20 +150,6 @@ impl LobeSet {
         if self.len < MAX_LOBES {
             self.lobes[self.len] = Lobe { kind, weight, n, sample_weight: sw };
             self.len += 1;
-        }
-    }
-
-    /// Cycles' defensive sampling at the first surface a camera ray meets: with several
-    /// closures, none is picked with less than 1/8 of the total selection weight, so a dim
-    /// mirror layer over a bright base is still sampled often enough (its rare, strong
-    /// highlights otherwise dominate the noise).
-    pub fn defensive_sampling(&mut self) {
-        if self.len <= 1 {
-            return;
-        }
-        let floor = 0.125 * self.lobes[..self.len].iter().map(|l| l.sample_weight).sum::<f32>();
-        for l in &mut self.lobes[..self.len] {
-            l.sample_weight = l.sample_weight.max(floor);
         }
     }
 

@@ -255,7 +255,6 @@ impl Scene<'_> {
         let (mut o, mut d, mut t0, mut t1) = (org, dir, tmin, tmax);
         let (mut bounce, mut diffuse, mut glossy, mut transmission, mut transparent) = (0u32, 0u32, 0u32, 0u32, 0u32);
         let mut terminate_next = false;
-        let mut passed_light = false;
         // Cycles' path flags of the ray being traced (Light Path node).
         let mut flags = ray::CAMERA;
         let mut set = 1u32;
@@ -295,7 +294,6 @@ impl Scene<'_> {
                     continue;
                 }
                 if let Some(lh) = light.intersect(o, d, t_surface) {
-                    passed_light = true;
                     let w = if prev_singular { 1.0 } else { power_heuristic(prev_pdf, lh.pdf) };
                     scratch.features.add_emission(scale(mul(throughput, lh.radiance), w));
                     let c = clamp_contrib(scale(mul(throughput, lh.radiance), w), clamp_limit);
@@ -371,13 +369,11 @@ impl Scene<'_> {
             if diffuse_ancestor {
                 super::subsurface::to_diffuse(&mut scratch.lobes);
             }
-            // Cycles' surface_shader_prepare_closures: defensive sampling at the first
-            // surface (no bounce, no transparent pass yet), before Filter Glossy.
-            // (Cycles counts a light the ray passed through as a transparent bounce.)
-            if bounce == 0 && transparent == 0 && !passed_light && from_sss.is_none() {
-                scratch.lobes.defensive_sampling();
-            }
-            // Filter Glossy: after diffuse-like bounces, glossy lobes are roughened.
+            // Cycles' surface_shader_prepare_closures. Its 3.x defensive sampling (a floor
+            // on each closure's selection weight at the first hit) is gone in 4.x: the
+            // firefly histograms of a sharp specular over a diffuse base match Cycles 4.5
+            // only without it. Filter Glossy: after diffuse-like bounces, glossy lobes are
+            // roughened.
             if st.filter_glossy > 0.0 && min_ray_pdf.is_finite() {
                 // Cycles' kernel uses 1 / blur_glossy.
                 let blur_pdf = min_ray_pdf / st.filter_glossy;
