@@ -104,7 +104,7 @@ const ASSERTED: &[&str] = &[
     "principled_glass_rough",
     // Area lights as Cycles samples them: Spread (the soft-box attenuation, and sampling of
     // only the part of the light that reaches a point) on a rectangle, a disk and an
-    // ellipse, each alone (make_render_refs.py says why); a room under a large ceiling light with default clamping, and rough glossy
+    // ellipse (many_lights_sky has one beside other lights); a room under a large ceiling light with default clamping, and rough glossy
     // reflections of a rectangle light, which need rectangles sampled by solid angle and
     // lights shared with BSDF sampling (MIS) at every vertex.
     "area_spread_rect",
@@ -131,6 +131,15 @@ const ASSERTED: &[&str] = &[
     // The published colon's two stacked bumps (the displacement's and a Bump node on it) on
     // a sharp Principled specular inside a tube.
     "bump_on_displacement_bump",
+    // Several emitters under the default indirect clamp: one light sample per vertex from
+    // the emitter Cycles' light tree picks (render/light_tree.rs), whose probability the
+    // clamp acts through. A closed room with an area, a point, a spot, a spread disk and an
+    // emissive panel; the stage under a sky sampled by its map, a sun, a point and a
+    // spread disk.
+    "many_lights_room",
+    "many_lights_sky",
+    // The room with Use Light Tree off: Cycles' flat light distribution.
+    "many_lights_room_flat",
 ];
 
 /// Scenes that do not pass yet, with the reason.

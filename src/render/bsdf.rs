@@ -114,6 +114,12 @@ fn excluded(kind: &LobeKind, exclude: u32) -> bool {
 const SINGULAR_ALPHA: f32 = 1e-4;
 
 impl LobeSet {
+    /// Cycles' SD_BSDF_HAS_TRANSMISSION: some closure transmits (translucent, refraction,
+    /// glass). Light selection then counts lights behind the surface too.
+    pub fn has_transmission(&self) -> bool {
+        self.lobes[..self.len].iter().any(|l| matches!(l.kind, LobeKind::Translucent | LobeKind::Glass(_)))
+    }
+
     pub fn clear(&mut self) {
         self.len = 0;
         self.emission = [0.0; 3];

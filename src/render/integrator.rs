@@ -1,6 +1,7 @@
-//! The path tracer: next-event estimation toward light objects, emissive triangles and
-//! the world, combined with BSDF sampling by multiple importance sampling wherever Cycles
-//! combines them (every light with extent and Multiple Importance on), Cycles' per-type
+//! The path tracer: next-event estimation toward one emitter per vertex (a light object,
+//! an emissive triangle or the world, picked as Cycles picks it: `light_tree`), combined
+//! with BSDF sampling by multiple importance sampling wherever Cycles combines them (every
+//! light with extent and Multiple Importance on), Cycles' per-type
 //! bounce limits (terminating after the next surface, as Cycles does), Russian roulette on sqrt of throughput, and
 //! Cycles' clamping (direct and indirect limits on the sum of a contribution).
 
@@ -12,6 +13,7 @@ use super::accel::{visibility, Accel};
 use super::bsdf::{LobeKind, LobeSet};
 use super::build::Geometry;
 use super::light::Light;
+use super::light_tree::{LightSelect, Pick};
 use super::math::*;
 use super::sampler::PixelSampler;
 use super::shade::{Context, Material};
@@ -44,23 +46,6 @@ pub struct Settings {
     pub transparent_shadows: bool,
 }
 
-/// Emissive triangles for light sampling: chosen by area times estimated emission.
-#[derive(Default)]
-pub struct MeshLights {
-    pub prims: Vec<u32>,
-    pub cdf: Vec<f32>,
-    /// Per scene triangle: selection probability over its area (0: not a light).
-    pub pdf_area: Vec<f32>,
-}
-
-impl MeshLights {
-    fn pick(&self, u: f32) -> usize {
-        let n = self.cdf.len();
-        let i = self.cdf.partition_point(|&c| c <= u);
-        i.min(n - 1)
-    }
-}
-
 #[inline]
 fn power_heuristic(a: f32, b: f32) -> f32 {
     if a.is_infinite() {
@@ -75,7 +60,8 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
 }
 
 pub struct Scene<'a> {
-    pub mesh_lights: &'a MeshLights,
+    /// How light sampling picks its emitter.
+    pub light_select: &'a LightSelect,
     pub accel: &'a dyn Accel,
     pub geo: &'a Geometry,
     pub materials: &'a [Material],
@@ -237,14 +223,6 @@ impl Scene<'_> {
         }
     }
 
-    /// Emission of a surface point seen from direction `wo` (for building the mesh
-    /// light distribution and for light samples on emissive triangles).
-    pub fn emission_at(&self, prim: u32, u: f32, v: f32, wo: V3, scratch: &mut Scratch) -> V3 {
-        let hit = self.surface(prim, u, v, wo);
-        self.shade_into(&hit, wo, &mut scratch.stacks, &mut scratch.light_lobes);
-        scratch.light_lobes.emission
-    }
-
     /// One path sample: radiance along the camera ray.
     pub fn radiance(&self, org: V3, dir: V3, tmin: f32, tmax: f32, rng: &PixelSampler, index: u32, scratch: &mut Scratch) -> V3 {
         let st = &self.settings;
@@ -263,6 +241,11 @@ impl Scene<'_> {
         let mut prev_singular = true;
         // Smallest pdf of the non-singular bounces so far (Cycles' min_ray_pdf).
         let mut min_ray_pdf = f32::INFINITY;
+        // Where the ray being traced was sampled, as light selection saw it (Cycles'
+        // mis_origin_n and PATH_RAY_MIS_HAD_TRANSMISSION): the probability of picking
+        // what the ray finds, for its MIS weight, is computed there.
+        let mut mis_n = [0.0f32; 3];
+        let mut mis_trans = false;
         // Where a subsurface random walk left the object: the next vertex, shaded white
         // diffuse (Cycles' subsurface_shader_data_setup); and whether the path has taken a
         // diffuse bounce (a BSSRDF then falls back to diffuse, as in Cycles).
@@ -287,14 +270,18 @@ impl Scene<'_> {
             let clamp_limit = if bounce <= 1 { st.clamp_direct } else { st.clamp_indirect };
             // Lights are not in the BVH: a ray collects every light it passes before the surface.
             let t_surface = hit_opt.map(|h| h.t).unwrap_or(if t1.is_finite() { t1 } else { f32::INFINITY });
-            for light in self.lights.iter().filter(|l| from_sss.is_none() && l.visible_to(flags)) {
+            for (li, light) in self.lights.iter().enumerate().filter(|(_, l)| from_sss.is_none() && l.visible_to(flags)) {
                 // Rays other than the camera's see only lights shared with BSDF sampling
                 // (Cycles' lights_intersect skips those without SHADER_USE_MIS).
                 if !light.mis && flags & ray::CAMERA == 0 {
                     continue;
                 }
                 if let Some(lh) = light.intersect(o, d, t_surface) {
-                    let w = if prev_singular { 1.0 } else { power_heuristic(prev_pdf, lh.pdf) };
+                    let w = if prev_singular {
+                        1.0
+                    } else {
+                        power_heuristic(prev_pdf, lh.pdf * self.light_select.pdf(o, mis_n, mis_trans, Pick::Lamp(li as u32)))
+                    };
                     scratch.features.add_emission(scale(mul(throughput, lh.radiance), w));
                     let c = clamp_contrib(scale(mul(throughput, lh.radiance), w), clamp_limit);
                     if finite(c) {
@@ -312,7 +299,7 @@ impl Scene<'_> {
                 if !super::light::visible_to(self.world_exclude, flags) {
                     break;
                 }
-                let w = self.world_mis_weight(d, prev_singular, prev_pdf);
+                let w = self.world_mis_weight(d, prev_singular, prev_pdf, o, mis_n, mis_trans);
                 let bg = scale(mul(throughput, self.background_toward(d, scratch)), w);
                 scratch.features.add_emission(bg);
                 let c = clamp_contrib(bg, clamp_limit);
@@ -399,12 +386,18 @@ impl Scene<'_> {
             }
             let lobes = &scratch.lobes;
             if !is_zero(lobes.emission) {
-                let pa = self.mesh_lights.pdf_area.get(h.prim as usize).copied().unwrap_or(0.0);
-                let w = if prev_singular || pa <= 0.0 {
+                let w = if prev_singular {
                     1.0
                 } else {
-                    let cos_l = dot(hit.ng, wo).abs().max(1e-8);
-                    power_heuristic(prev_pdf, pa * h.t * h.t / cos_l)
+                    let pick = self.light_select.pdf(o, mis_n, mis_trans, Pick::Triangle(h.prim));
+                    let t = &self.geo.tris[h.prim as usize];
+                    let area = 0.5 * len(cross(sub(t[1], t[0]), sub(t[2], t[0])));
+                    if pick > 0.0 && area > 0.0 {
+                        let cos_l = dot(hit.ng, wo).abs().max(1e-8);
+                        power_heuristic(prev_pdf, pick / area * h.t * h.t / cos_l)
+                    } else {
+                        1.0
+                    }
                 };
                 scratch.features.add_emission(scale(mul(throughput, lobes.emission), w));
                 let c = clamp_contrib(scale(mul(throughput, lobes.emission), w), clamp_limit);
@@ -419,7 +412,6 @@ impl Scene<'_> {
             }
             let u_bsdf = rng.get4(index, set);
             let u_light = rng.get4(index, set + 1);
-            let u_mesh = rng.get4(index, set + 2);
             set += 3;
             if terminate_next {
                 // Only transparent surfaces let such a path continue (Cycles'
@@ -442,81 +434,72 @@ impl Scene<'_> {
                 throughput = scale(throughput, 1.0 / q);
             }
             let p_off = |dir: V3| offset_origin(hit.p, hit.ng, dir);
-            // Next-event estimation toward every light.
-            if !terminate_next && scratch.lobes.len > 0 {
-                for (li, light) in self.lights.iter().enumerate() {
-                    if bounce > light.max_bounces {
-                        continue;
-                    }
-                    let uu = if li == 0 { [u_light[0], u_light[1]] } else { let r = rng.get4(index, 0x4000_0000 + set * 64 + li as u32); [r[0], r[1]] };
-                    let Some(ls) = light.sample(hit.p, uu) else { continue };
-                    let (f, pdf_b) = scratch.lobes.eval_excluding(wo, ls.wi, hit.ng, self.tables, light.exclude);
-                    if is_zero(f) {
-                        continue;
-                    }
-                    // Lights with extent are shared with BSDF sampling at every vertex, as
-                    // Cycles does (light_sample_mis_weight_nee).
-                    let w = if light.mis { power_heuristic(ls.pdf, pdf_b) } else { 1.0 };
-                    let c = scale(mul(mul(throughput, f), ls.value), w);
-                    if is_zero(c) || !finite(c) {
-                        continue;
-                    }
-                    let start = self.shadow_origin(&hit, scratch.lobes.smooth_n, ls.wi);
-                    let c = if light.cast_shadow {
-                        let tr = self.shadow_transmittance(start, ls.wi, if ls.dist.is_finite() { ls.dist * (1.0 - 1e-4) } else { f32::INFINITY }, scratch);
-                        if is_zero(tr) {
-                            continue;
-                        }
-                        mul(c, tr)
-                    } else {
-                        c
-                    };
-                    l = add(l, clamp_contrib(c, if bounce == 0 { st.clamp_direct } else { st.clamp_indirect }));
-                }
-            }
-            // One light sample on an emissive triangle.
-            if !terminate_next && scratch.lobes.len > 0 && !self.mesh_lights.prims.is_empty() {
-                let k = self.mesh_lights.pick(u_mesh[2]);
-                let prim = self.mesh_lights.prims[k];
-                let tri = &self.geo.tris[prim as usize];
-                let su = u_mesh[0].sqrt();
-                let (b1, b2) = (su * (1.0 - u_mesh[1]), su * u_mesh[1]);
-                let q = add(add(scale(tri[0], 1.0 - b1 - b2), scale(tri[1], b1)), scale(tri[2], b2));
-                let to = sub(q, hit.p);
-                let d2 = dot(to, to);
-                let dist = d2.sqrt();
-                let wi = scale(to, 1.0 / dist.max(1e-12));
-                let ng_l = normalize(cross(sub(tri[1], tri[0]), sub(tri[2], tri[0])));
-                let cos_l = dot(ng_l, wi).abs();
-                if d2 > 0.0 && cos_l > 1e-6 && prim != h.prim {
-                    // The emitter's object hidden from some ray types lights only the
-                    // closures of the others (Cycles' SHADER_EXCLUDE_* of mesh lights).
-                    let seen_by = self.geo.instances[self.geo.refs[prim as usize].inst as usize].visibility;
-                    let exclude = !seen_by & (ray::DIFFUSE | ray::GLOSSY | ray::TRANSMIT | ray::VOLUME_SCATTER);
-                    let (f, pdf_b) = if exclude == 0 { scratch.lobes.eval(wo, wi, hit.ng, self.tables) } else { scratch.lobes.eval_excluding(wo, wi, hit.ng, self.tables, exclude) };
-                    if !is_zero(f) {
-                        let pdf_l = self.mesh_lights.pdf_area[prim as usize] * d2 / cos_l;
-                        let start = self.shadow_origin(&hit, scratch.lobes.smooth_n, wi);
-                        let tr = if pdf_l > 0.0 { self.shadow_transmittance(start, wi, dist * (1.0 - 1e-4), scratch) } else { [0.0; 3] };
-                        if !is_zero(tr) {
-                            let le = self.light_emission(prim, b1, b2, neg(wi), dist, bounce, scratch);
-                            let w = power_heuristic(pdf_l, pdf_b);
-                            let c = mul(scale(mul(mul(throughput, f), le), w / pdf_l), tr);
-                            if finite(c) {
-                                l = add(l, clamp_contrib(c, if bounce == 0 { st.clamp_direct } else { st.clamp_indirect }));
+            // Next-event estimation: one emitter, picked as Cycles picks it at this point
+            // (its shading normal, and whether its BSDF transmits), the sample divided by
+            // the probability of the pick.
+            let n_sel = if is_zero(scratch.lobes.smooth_n) { hit.sp.normal } else { scratch.lobes.smooth_n };
+            let trans_sel = scratch.lobes.has_transmission();
+            let picked = if !terminate_next && scratch.lobes.len > 0 { self.light_select.select(hit.p, n_sel, trans_sel, u_light[2]) } else { None };
+            let clamp_nee = if bounce == 0 { st.clamp_direct } else { st.clamp_indirect };
+            match picked {
+                Some((Pick::Lamp(li), p_sel)) if bounce <= self.lights[li as usize].max_bounces => {
+                    let light = &self.lights[li as usize];
+                    if let Some(ls) = light.sample(hit.p, [u_light[0], u_light[1]]) {
+                        let (f, pdf_b) = scratch.lobes.eval_excluding(wo, ls.wi, hit.ng, self.tables, light.exclude);
+                        // Lights with extent are shared with BSDF sampling at every vertex, as
+                        // Cycles does (light_sample_mis_weight_nee).
+                        let w = if light.mis { power_heuristic(ls.pdf * p_sel, pdf_b) } else { 1.0 };
+                        let c = scale(mul(mul(throughput, f), ls.value), w / p_sel);
+                        if !is_zero(c) && finite(c) {
+                            let start = self.shadow_origin(&hit, scratch.lobes.smooth_n, ls.wi);
+                            let tr = if light.cast_shadow { self.shadow_transmittance(start, ls.wi, if ls.dist.is_finite() { ls.dist * (1.0 - 1e-4) } else { f32::INFINITY }, scratch) } else { [1.0; 3] };
+                            if !is_zero(tr) {
+                                l = add(l, clamp_contrib(mul(c, tr), clamp_nee));
                             }
                         }
                     }
                 }
-            }
-            // One light sample toward the world, where it varies with direction.
-            if !terminate_next && scratch.lobes.len > 0 {
-                let u_world = rng.get4(index, 0x2000_0000 + set);
-                let c = self.world_light_sample(&hit, wo, [u_world[0], u_world[1]], scratch);
-                let c = mul(throughput, c);
-                if finite(c) && !is_zero(c) {
-                    l = add(l, clamp_contrib(c, if bounce == 0 { st.clamp_direct } else { st.clamp_indirect }));
+                Some((Pick::Triangle(prim), p_sel)) if prim != h.prim => {
+                    let tri = &self.geo.tris[prim as usize];
+                    let su = u_light[0].sqrt();
+                    let (b1, b2) = (su * (1.0 - u_light[1]), su * u_light[1]);
+                    let q = add(add(scale(tri[0], 1.0 - b1 - b2), scale(tri[1], b1)), scale(tri[2], b2));
+                    let to = sub(q, hit.p);
+                    let d2 = dot(to, to);
+                    let dist = d2.sqrt();
+                    let wi = scale(to, 1.0 / dist.max(1e-12));
+                    let nl = cross(sub(tri[1], tri[0]), sub(tri[2], tri[0]));
+                    let area = 0.5 * len(nl);
+                    let cos_l = dot(normalize(nl), wi).abs();
+                    if d2 > 0.0 && cos_l > 1e-6 && area > 0.0 {
+                        // The emitter's object hidden from some ray types lights only the
+                        // closures of the others (Cycles' SHADER_EXCLUDE_* of mesh lights).
+                        let seen_by = self.geo.instances[self.geo.refs[prim as usize].inst as usize].visibility;
+                        let exclude = !seen_by & (ray::DIFFUSE | ray::GLOSSY | ray::TRANSMIT | ray::VOLUME_SCATTER);
+                        let (f, pdf_b) = if exclude == 0 { scratch.lobes.eval(wo, wi, hit.ng, self.tables) } else { scratch.lobes.eval_excluding(wo, wi, hit.ng, self.tables, exclude) };
+                        if !is_zero(f) {
+                            let pdf_l = p_sel / area * d2 / cos_l;
+                            let start = self.shadow_origin(&hit, scratch.lobes.smooth_n, wi);
+                            let tr = self.shadow_transmittance(start, wi, dist * (1.0 - 1e-4), scratch);
+                            if !is_zero(tr) {
+                                let le = self.light_emission(prim, b1, b2, neg(wi), dist, bounce, scratch);
+                                let w = power_heuristic(pdf_l, pdf_b);
+                                let c = mul(scale(mul(mul(throughput, f), le), w / pdf_l), tr);
+                                if finite(c) {
+                                    l = add(l, clamp_contrib(c, clamp_nee));
+                                }
+                            }
+                        }
+                    }
                 }
+                Some((Pick::World, p_sel)) => {
+                    let c = self.world_light_sample(&hit, wo, [u_light[0], u_light[1]], p_sel, scratch);
+                    let c = mul(throughput, c);
+                    if finite(c) && !is_zero(c) {
+                        l = add(l, clamp_contrib(c, clamp_nee));
+                    }
+                }
+                _ => {}
             }
             let lobes = &scratch.lobes;
             let Some(bs) = lobes.sample(wo, hit.ng, [u_bsdf[0], u_bsdf[1], u_bsdf[2]], self.tables) else { break };
@@ -630,6 +613,8 @@ impl Scene<'_> {
             }
             bounce += 1;
             flags = bounce_flags(bs.kind, bs.transmit, bs.singular);
+            mis_n = n_sel;
+            mis_trans = trans_sel;
             prev_pdf = bs.pdf;
             prev_singular = bs.singular;
             if !bs.singular {
@@ -658,9 +643,9 @@ impl Scene<'_> {
 impl Scene<'_> {
     /// MIS weight of world radiance reached by a BSDF-sampled ray (1 when the world is
     /// not light-sampled or the ray came from a singular lobe or the camera).
-    fn world_mis_weight(&self, d: V3, prev_singular: bool, prev_pdf: f32) -> f32 {
+    fn world_mis_weight(&self, d: V3, prev_singular: bool, prev_pdf: f32, o: V3, mis_n: V3, mis_trans: bool) -> f32 {
         match self.world.and_then(|w| w.map.as_ref()) {
-            Some(map) if !prev_singular => power_heuristic(prev_pdf, map.pdf(d)),
+            Some(map) if !prev_singular => power_heuristic(prev_pdf, map.pdf(d) * self.light_select.pdf(o, mis_n, mis_trans, Pick::World)),
             _ => 1.0,
         }
     }
@@ -668,9 +653,10 @@ impl Scene<'_> {
     /// Next-event estimate toward the world from surface point `hit` (BSDF in
     /// `scratch.lobes`), MIS-weighted against BSDF sampling; zero if unoccluded paths
     /// see nothing or the world is not light-sampled.
-    fn world_light_sample(&self, hit: &SurfaceHit, wo: V3, u: [f32; 2], scratch: &mut Scratch) -> V3 {
+    fn world_light_sample(&self, hit: &SurfaceHit, wo: V3, u: [f32; 2], p_sel: f32, scratch: &mut Scratch) -> V3 {
         let Some(map) = self.world.and_then(|w| w.map.as_ref()) else { return [0.0; 3] };
         let Some((wi, pdf_l)) = map.sample(u) else { return [0.0; 3] };
+        let pdf_l = pdf_l * p_sel;
         // Closures of the ray types the world is hidden from do not see it.
         let (f, pdf_b) = scratch.lobes.eval_excluding(wo, wi, hit.ng, self.tables, self.world_exclude);
         if is_zero(f) || pdf_l.is_nan() || pdf_l <= 0.0 {

@@ -50,6 +50,12 @@ pub struct Light {
     /// Ray types that do not see the light (`ray::` flags: CAMERA, DIFFUSE, GLOSSY,
     /// TRANSMIT, VOLUME_SCATTER), from the object's ray visibility.
     pub exclude: u32,
+    /// Cycles' light tree energy of the light: |mean of its strength| (power times colour,
+    /// before Normalize) times its eval_fac scale (1/4 for area lights, 1/(4 pi) for
+    /// points and spots, 1 for suns).
+    pub tree_energy: f32,
+    /// Area lights' Spread (radians; pi when not set).
+    pub spread: f32,
 }
 
 impl Light {
@@ -161,6 +167,13 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
                 strength = mul(strength, t);
             }
         }
+        let tree_energy = average(strength).abs()
+            * match l.kind.as_str() {
+                "AREA" => 0.25,
+                "SUN" => 1.0,
+                _ => 0.25 / PI,
+            };
+        let spread = num(p, "spread", std::f64::consts::PI);
         let pos = m.column(3);
         let dir = normalize(neg(m.column(2)));
         // Blender 4.x keeps Cast Shadow as the light's `use_shadow` (Cycles syncs it from
@@ -236,7 +249,7 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
             Shape::Sun { half_angle } => *half_angle > 0.0,
         };
         let max_bounces = p.get("cycles").and_then(|c| c.get("max_bounces")).and_then(Value::as_u64).unwrap_or(1024).min(u32::MAX as u64) as u32;
-        out.push(Light { shape, strength, pos, dir, cast_shadow, mis: use_mis && extent, max_bounces, exclude });
+        out.push(Light { shape, strength, pos, dir, cast_shadow, mis: use_mis && extent, max_bounces, exclude, tree_energy, spread });
     }
     Ok(out)
 }
@@ -557,7 +570,7 @@ mod tests {
             a *= PI / 4.0;
         }
         let spread = spread_deg.and_then(|d| Spread::new(d.to_radians()));
-        Light { shape: Shape::Area { u, v, ellipse, area: a, spread }, strength: [100.0; 3], pos: [0.0, 0.0, 2.0], dir: [0.0, 0.0, -1.0], cast_shadow: true, mis: true, max_bounces: 1024, exclude: 0 }
+        Light { shape: Shape::Area { u, v, ellipse, area: a, spread }, strength: [100.0; 3], pos: [0.0, 0.0, 2.0], dir: [0.0, 0.0, -1.0], cast_shadow: true, mis: true, max_bounces: 1024, exclude: 0, tree_energy: 25.0, spread: PI }
     }
 
     /// MIS needs the pdf of a light sample and the pdf a BSDF ray finds for the same

@@ -23,6 +23,7 @@ pub mod displace;
 pub mod filter;
 pub mod integrator;
 pub mod light;
+pub mod light_tree;
 pub mod math;
 pub mod motion;
 pub mod object_motion;
@@ -48,6 +49,7 @@ use serde_json::Value;
 use crate::scene::Scene;
 use accel::{Accel, Bvh};
 use integrator::{Scratch, Settings};
+use light_tree::LightSelect;
 use math::*;
 use sampler::PixelSampler;
 
@@ -240,12 +242,13 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     };
     let exposure = 1.0f32;
     let build_seconds = start.elapsed().as_secs_f64();
-    let mesh_lights = mesh_lights(&geo, &materials, &bvh, &lights, background, tables, settings);
+    let use_light_tree = cy.get("use_light_tree").and_then(Value::as_bool).unwrap_or(true);
+    let light_select = light_select(&geo, &materials, &lights, world_shader.as_ref(), use_light_tree);
     let accel: &dyn Accel = match &motion_accel {
         Some(m) => m,
         None => &bvh,
     };
-    let tracer = integrator::Scene { mesh_lights: &mesh_lights, accel, geo: &geo, materials: &materials, lights: &lights, background, world_exclude: world::excluded_rays(scene), tables, settings, world: world_shader.as_ref(), view: camera.view() };
+    let tracer = integrator::Scene { light_select: &light_select, accel, geo: &geo, materials: &materials, lights: &lights, background, world_exclude: world::excluded_rays(scene), tables, settings, world: world_shader.as_ref(), view: camera.view() };
 
     let adaptive = adaptive::Adaptive::from_scene(cy, samples, opts.threshold);
     let tiles_x = w.div_ceil(TILE);
@@ -431,62 +434,104 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     })
 }
 
-/// The emissive triangles, weighted by area times the luminance of their emission at
-/// the centroid (Cycles weights by an emission estimate too).
-fn mesh_lights(
-    geo: &build::Geometry,
-    materials: &[shade::Material],
-    bvh: &Bvh,
-    lights: &[light::Light],
-    background: V3,
-    tables: &tables::Tables,
-    settings: Settings,
-) -> integrator::MeshLights {
-    let empty = integrator::MeshLights::default();
-    let probe = integrator::Scene { mesh_lights: &empty, accel: bvh, geo, materials, lights, background, world_exclude: 0, tables, settings, world: None, view: Default::default() };
-    let emissive: Vec<bool> = materials.iter().map(|m| m.program.as_ref().is_some_and(|p| light_sampled(p, &m.sampling))).collect();
-    let mut scratch = Scratch::new(materials.len());
-    let mut prims = Vec::new();
-    let mut weights = Vec::new();
-    let mut areas = Vec::new();
+/// The emitters light sampling picks from, as Cycles collects them (LightManager): every
+/// light, the world when it varies with direction, and the triangles of materials whose
+/// emission Cycles light-samples; in its light tree, or in its flat distribution when the
+/// scene turns the tree off. Energies are Cycles' estimates (a triangle's area times the
+/// mean of its material's emission estimate), not the emission itself: they set the
+/// selection probabilities, which decide how clamping acts.
+fn light_select(geo: &build::Geometry, materials: &[shade::Material], lights: &[light::Light], world: Option<&world::WorldShader>, use_tree: bool) -> LightSelect {
+    use light_tree::{Cone, Emitter, Measure, Pick, Shape};
+    use std::f32::consts::{FRAC_PI_2, PI};
+    let mut local = Vec::new();
+    let mut distant = Vec::new();
+    let mut flat_lights = Vec::new();
+    for (li, l) in lights.iter().enumerate() {
+        if l.tree_energy == 0.0 || !l.tree_energy.is_finite() {
+            continue;
+        }
+        let pick = Some(Pick::Lamp(li as u32));
+        flat_lights.push(Pick::Lamp(li as u32));
+        match &l.shape {
+            light::Shape::Point { radius, spot, sphere } => {
+                let r = [*radius; 3];
+                let (cone, spot_smooth) = match spot {
+                    None => (Cone { axis: l.dir, theta_o: PI, theta_e: FRAC_PI_2 }, None),
+                    Some(s) => {
+                        // Cycles widens the cone by the light's scale (its axes).
+                        let (lu, lv, lw) = (len(s.u), len(s.v), len(s.w));
+                        let stretch = if lu > 0.0 && lv > 0.0 { lw / lu.min(lv) } else { 1.0 };
+                        let half = s.cos_half.clamp(-1.0, 1.0).acos();
+                        (Cone { axis: l.dir, theta_o: 0.0, theta_e: (half.tan() * stretch).atan() }, Some(s.smooth))
+                    }
+                };
+                let measure = Measure::new(&[sub(l.pos, r), add(l.pos, r)], cone, l.tree_energy);
+                local.push(Emitter { pick, shape: Shape::Point { pos: l.pos, radius: *radius, sphere: *sphere, spot_smooth }, centroid: l.pos, measure });
+            }
+            light::Shape::Area { u, v, .. } => {
+                let (hu, hv) = (scale(*u, 0.5), scale(*v, 0.5));
+                let corners = [add(add(l.pos, hu), hv), sub(add(l.pos, hu), hv), add(sub(l.pos, hu), hv), sub(sub(l.pos, hu), hv)];
+                let measure = Measure::new(&corners, Cone { axis: l.dir, theta_o: 0.0, theta_e: 0.5 * l.spread }, l.tree_energy);
+                local.push(Emitter { pick, shape: Shape::Area { pos: l.pos, eu: *u, ev: *v }, centroid: l.pos, measure });
+            }
+            light::Shape::Sun { half_angle } => {
+                let measure = Measure::new(&[], Cone { axis: l.dir, theta_o: 0.0, theta_e: *half_angle }, l.tree_energy);
+                distant.push(Emitter { pick, shape: Shape::Distant, centroid: l.dir, measure });
+            }
+        }
+    }
+    if let Some((w, map)) = world.and_then(|w| w.map.as_ref().map(|m| (w, m))) {
+        let energy = (average(w.program.emission_estimate) * map.average_radiance * PI).abs();
+        if energy > 0.0 && energy.is_finite() {
+            let measure = Measure::new(&[], Cone { axis: [0.0, 0.0, 1.0], theta_o: PI, theta_e: 0.0 }, energy);
+            distant.push(Emitter { pick: Some(Pick::World), shape: Shape::World, centroid: [0.0; 3], measure });
+            flat_lights.push(Pick::World);
+        }
+    }
+    let sampled: Vec<Option<f32>> = materials.iter().map(|m| m.program.as_ref().filter(|p| light_sampled(p, &m.sampling)).map(|p| average(p.emission_estimate))).collect();
+    let mut meshes: Vec<Vec<Emitter>> = Vec::new();
+    let mut flat_tris = Vec::new();
+    let mut last_inst = u32::MAX;
     for (prim, r) in geo.refs.iter().enumerate() {
         let inst = &geo.instances[r.inst as usize];
-        // A moving emitter is found by BSDF sampling alone (its pdf_area stays 0, so
-        // the MIS weight is 1): light samples on it would need its pose at the ray's time.
+        // A moving emitter is found by BSDF sampling alone (it is no emitter here, so the
+        // MIS weight is 1): light samples on it would need its pose at the ray's time.
         if inst.motion.is_some() {
             continue;
         }
         let face = inst.mesh.triangle_faces[r.tri as usize] as usize;
         let slot = inst.face_slot.get(face).copied().unwrap_or(0) as usize;
         let Some(mi) = inst.slots.get(slot).copied().flatten() else { continue };
-        if !emissive[mi] {
-            continue;
-        }
-        let t = &geo.tris[prim];
-        let n = cross(sub(t[1], t[0]), sub(t[2], t[0]));
+        let Some(estimate) = sampled[mi] else { continue };
+        let v = geo.tris[prim];
+        let n = cross(sub(v[1], v[0]), sub(v[2], v[0]));
         let area = 0.5 * len(n);
-        if area <= 0.0 {
+        if !(area > 0.0) {
             continue;
         }
-        let e = probe.emission_at(prim as u32, 1.0 / 3.0, 1.0 / 3.0, normalize(n), &mut scratch);
-        let lum = 0.2126 * e[0].abs() + 0.7152 * e[1].abs() + 0.0722 * e[2].abs();
-        if !(lum > 0.0) || !lum.is_finite() {
-            continue;
+        let cone = match materials[mi].sampling.as_str() {
+            "FRONT" => Cone { axis: normalize(n), theta_o: 0.0, theta_e: FRAC_PI_2 },
+            "BACK" => Cone { axis: neg(normalize(n)), theta_o: 0.0, theta_e: FRAC_PI_2 },
+            _ => Cone { axis: normalize(sub(v[0], v[1])), theta_o: FRAC_PI_2, theta_e: FRAC_PI_2 },
+        };
+        let centroid = scale(add(add(v[0], v[1]), v[2]), 1.0 / 3.0);
+        let e = Emitter { pick: Some(light_tree::Pick::Triangle(prim as u32)), shape: Shape::Triangle { v }, centroid, measure: Measure::new(&v, cone, area * estimate) };
+        // One subtree per object (an instance's triangles are consecutive).
+        if r.inst != last_inst || meshes.is_empty() {
+            meshes.push(Vec::new());
+            last_inst = r.inst;
         }
-        prims.push(prim as u32);
-        weights.push(area * lum);
-        areas.push(area);
+        meshes.last_mut().expect("pushed above").push(e);
+        flat_tris.push((prim as u32, area));
     }
-    let total: f64 = weights.iter().map(|&w| w as f64).sum();
-    let mut pdf_area = vec![0.0f32; geo.tris.len()];
-    let mut cdf = Vec::with_capacity(prims.len());
-    let mut acc = 0.0f64;
-    for (k, &p) in prims.iter().enumerate() {
-        acc += weights[k] as f64;
-        cdf.push((acc / total) as f32);
-        pdf_area[p as usize] = (weights[k] as f64 / total) as f32 / areas[k];
+    if local.is_empty() && distant.is_empty() && meshes.is_empty() {
+        return LightSelect::None;
     }
-    integrator::MeshLights { prims, cdf, pdf_area }
+    if use_tree {
+        LightSelect::Tree(light_tree::LightTree::build(local, distant, meshes))
+    } else {
+        LightSelect::Flat(light_tree::Distribution::build(&flat_tris, &flat_lights))
+    }
 }
 
 /// Whether Cycles light-samples a material's emitting triangles (Shader::estimate_emission):

@@ -132,6 +132,9 @@ pub struct WorldMap {
     marginal: Vec<f32>,
     /// Cell weights, normalised so that the mean is 1 (pdf over the unit square).
     pdf: Vec<f32>,
+    /// Cycles' average radiance of the map (its light tree energy of the world): the
+    /// mean over cells of the channels' mean times sin theta, times pi / 2.
+    pub average_radiance: f32,
 }
 
 fn equirect_direction(u: f32, v: f32) -> (V3, f32) {
@@ -157,11 +160,16 @@ impl WorldMap {
     pub fn build(shader: &WorldShader, w: usize, h: usize) -> Option<WorldMap> {
         let mut stack = Vec::new();
         let mut f = vec![0.0f64; w * h];
+        let mut radiance = 0.0f64;
         for j in 0..h {
             for i in 0..w {
                 let (d, st) = equirect_direction((i as f32 + 0.5) / w as f32, (j as f32 + 0.5) / h as f32);
                 let c = shader.eval(d, &mut stack);
                 let lum = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+                let mean = (c[0].abs() + c[1].abs() + c[2].abs()) / 3.0;
+                if mean.is_finite() {
+                    radiance += mean as f64 * st as f64;
+                }
                 f[j * w + i] = if lum.is_finite() && lum > 0.0 { lum as f64 * st as f64 } else { 0.0 };
             }
         }
@@ -187,7 +195,8 @@ impl WorldMap {
         }
         let n = (w * h) as f64;
         let pdf = f.iter().map(|&x| (x * n / total) as f32).collect();
-        Some(WorldMap { w, h, rows, marginal, pdf })
+        let average_radiance = (radiance / n * std::f64::consts::FRAC_PI_2) as f32;
+        Some(WorldMap { w, h, rows, marginal, pdf, average_radiance })
     }
 
     /// A direction drawn from the map and its solid-angle pdf.
