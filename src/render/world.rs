@@ -96,7 +96,12 @@ pub fn shader(scene: &Scene) -> Result<Option<WorldShader>, RenderError> {
     }
     let program = crate::shader::compile::compile_world(scene, name).map_err(|e| RenderError(e.to_string()))?;
     let mut shader = WorldShader { program, map: None };
-    shader.map = WorldMap::build(&shader, MAP_WIDTH, MAP_WIDTH / 2);
+    // World > Settings > Surface > Sampling "None": Cycles does not light-sample the world
+    // (its background light is off); BSDF rays alone find it.
+    let sampled = w.properties.get("cycles").and_then(|c| c.get("sampling_method")).and_then(Value::as_str) != Some("NONE");
+    if sampled {
+        shader.map = WorldMap::build(&shader, MAP_WIDTH, MAP_WIDTH / 2);
+    }
     Ok(Some(shader))
 }
 
