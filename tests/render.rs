@@ -140,6 +140,8 @@ const ASSERTED: &[&str] = &[
     "many_lights_sky",
     // The room with Use Light Tree off: Cycles' flat light distribution.
     "many_lights_room_flat",
+    // The sky scene with the world's Sampling set to None (not light-sampled).
+    "world_sampling_none",
 ];
 
 /// Scenes that do not pass yet, with the reason.
