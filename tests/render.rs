@@ -142,6 +142,11 @@ const ASSERTED: &[&str] = &[
     "many_lights_room_flat",
     // The sky scene with the world's Sampling set to None (not light-sampled).
     "world_sampling_none",
+    // Emissive triangles sampled as Cycles does (render/triangle_light.rs): by solid angle
+    // near a large panel, by area far from it, and only from the side its material's
+    // Emission Sampling names (Front here), under a direct clamp of 1 (ratio 1.67 with
+    // area sampling from both sides).
+    "emission_panel_clamp",
 ];
 
 /// Scenes that do not pass yet, with the reason.

@@ -386,15 +386,15 @@ impl Scene<'_> {
             }
             let lobes = &scratch.lobes;
             if !is_zero(lobes.emission) {
-                let w = if prev_singular {
+                // Only the sides light sampling draws from share the emission by MIS
+                // (Cycles' SD_MIS_FRONT / SD_MIS_BACK).
+                let (front, back) = self.emission_sides(h.prim);
+                let w = if prev_singular || !(if hit.backfacing { back } else { front }) {
                     1.0
                 } else {
                     let pick = self.light_select.pdf(o, mis_n, mis_trans, Pick::Triangle(h.prim));
-                    let t = &self.geo.tris[h.prim as usize];
-                    let area = 0.5 * len(cross(sub(t[1], t[0]), sub(t[2], t[0])));
-                    if pick > 0.0 && area > 0.0 {
-                        let cos_l = dot(hit.ng, wo).abs().max(1e-8);
-                        power_heuristic(prev_pdf, pick / area * h.t * h.t / cos_l)
+                    if pick > 0.0 {
+                        power_heuristic(prev_pdf, pick * super::triangle_light::pdf(&self.geo.tris[h.prim as usize], o, d, h.t))
                     } else {
                         1.0
                     }
@@ -460,29 +460,19 @@ impl Scene<'_> {
                     }
                 }
                 Some((Pick::Triangle(prim), p_sel)) if prim != h.prim => {
-                    let tri = &self.geo.tris[prim as usize];
-                    let su = u_light[0].sqrt();
-                    let (b1, b2) = (su * (1.0 - u_light[1]), su * u_light[1]);
-                    let q = add(add(scale(tri[0], 1.0 - b1 - b2), scale(tri[1], b1)), scale(tri[2], b2));
-                    let to = sub(q, hit.p);
-                    let d2 = dot(to, to);
-                    let dist = d2.sqrt();
-                    let wi = scale(to, 1.0 / dist.max(1e-12));
-                    let nl = cross(sub(tri[1], tri[0]), sub(tri[2], tri[0]));
-                    let area = 0.5 * len(nl);
-                    let cos_l = dot(normalize(nl), wi).abs();
-                    if d2 > 0.0 && cos_l > 1e-6 && area > 0.0 {
+                    let (front, back) = self.emission_sides(prim);
+                    if let Some(ts) = super::triangle_light::sample(&self.geo.tris[prim as usize], hit.p, [u_light[0], u_light[1]], front, back) {
                         // The emitter's object hidden from some ray types lights only the
                         // closures of the others (Cycles' SHADER_EXCLUDE_* of mesh lights).
                         let seen_by = self.geo.instances[self.geo.refs[prim as usize].inst as usize].visibility;
                         let exclude = !seen_by & (ray::DIFFUSE | ray::GLOSSY | ray::TRANSMIT | ray::VOLUME_SCATTER);
-                        let (f, pdf_b) = if exclude == 0 { scratch.lobes.eval(wo, wi, hit.ng, self.tables) } else { scratch.lobes.eval_excluding(wo, wi, hit.ng, self.tables, exclude) };
+                        let (f, pdf_b) = if exclude == 0 { scratch.lobes.eval(wo, ts.wi, hit.ng, self.tables) } else { scratch.lobes.eval_excluding(wo, ts.wi, hit.ng, self.tables, exclude) };
                         if !is_zero(f) {
-                            let pdf_l = p_sel / area * d2 / cos_l;
-                            let start = self.shadow_origin(&hit, scratch.lobes.smooth_n, wi);
-                            let tr = self.shadow_transmittance(start, wi, dist * (1.0 - 1e-4), scratch);
+                            let pdf_l = p_sel * ts.pdf;
+                            let start = self.shadow_origin(&hit, scratch.lobes.smooth_n, ts.wi);
+                            let tr = self.shadow_transmittance(start, ts.wi, ts.dist * (1.0 - 1e-4), scratch);
                             if !is_zero(tr) {
-                                let le = self.light_emission(prim, b1, b2, neg(wi), dist, bounce, scratch);
+                                let le = self.light_emission(prim, ts.b1, ts.b2, neg(ts.wi), ts.dist, bounce, scratch);
                                 let w = power_heuristic(pdf_l, pdf_b);
                                 let c = mul(scale(mul(mul(throughput, f), le), w / pdf_l), tr);
                                 if finite(c) {
@@ -852,6 +842,20 @@ impl Scene<'_> {
     /// Emission of an emissive triangle for a light sample from a vertex at depth
     /// `bounce`, `dist` away: Cycles evaluates it with only PATH_RAY_EMISSION set (so
     /// Ray Depth reads one more) and the sample distance as the ray length.
+    /// The sides of triangle `prim` light sampling draws from: its material's Emission
+    /// Sampling (Front, Back, or both for Auto and Front and Back).
+    fn emission_sides(&self, prim: u32) -> (bool, bool) {
+        let r = self.geo.refs[prim as usize];
+        let inst = &self.geo.instances[r.inst as usize];
+        let face = inst.mesh.triangle_faces[r.tri as usize] as usize;
+        let slot = inst.face_slot.get(face).copied().unwrap_or(0) as usize;
+        match inst.slots.get(slot).copied().flatten().map(|mi| self.materials[mi].sampling.as_str()) {
+            Some("FRONT") => (true, false),
+            Some("BACK") => (false, true),
+            _ => (true, true),
+        }
+    }
+
     pub fn light_emission(&self, prim: u32, u: f32, v: f32, wo: V3, dist: f32, bounce: u32, scratch: &mut Scratch) -> V3 {
         let mut hit = self.surface(prim, u, v, wo);
         hit.sp.ray_length = dist;

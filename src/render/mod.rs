@@ -39,6 +39,7 @@ pub mod subsurface_disk;
 pub mod tables;
 pub mod terminator;
 pub mod thin_film;
+pub mod triangle_light;
 pub mod world;
 
 use std::time::Instant;
