@@ -739,7 +739,7 @@ pub struct Distribution {
     pdf_triangles: f32,
     pdf_lights: f32,
     prim_area: std::collections::HashMap<u32, f32>,
-    num_lights: usize,
+    lights: Vec<Pick>,
 }
 
 impl Distribution {
@@ -764,7 +764,7 @@ impl Distribution {
         let both = tri_area > 0.0 && !lights.is_empty();
         let pdf_triangles = if tri_area > 0.0 { (1.0 / tri_area) as f32 * if both { 0.5 } else { 1.0 } } else { 0.0 };
         let pdf_lights = if lights.is_empty() { 0.0 } else { 1.0 / lights.len() as f32 * if both { 0.5 } else { 1.0 } };
-        Distribution { cdf, entries, pdf_triangles, pdf_lights, prim_area: triangles.iter().copied().collect(), num_lights: lights.len() }
+        Distribution { cdf, entries, pdf_triangles, pdf_lights, prim_area: triangles.iter().copied().collect(), lights: lights.to_vec() }
     }
 
     pub fn select(&self, rand: f32) -> Option<(Pick, f32)> {
@@ -779,7 +779,7 @@ impl Distribution {
     pub fn pdf(&self, k: Pick) -> f32 {
         match k {
             Pick::Triangle(p) => self.prim_area.get(&p).map(|a| a * self.pdf_triangles).unwrap_or(0.0),
-            _ if self.num_lights > 0 && self.entries.contains(&k) => self.pdf_lights,
+            _ if self.lights.contains(&k) => self.pdf_lights,
             _ => 0.0,
         }
     }
