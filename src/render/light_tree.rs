@@ -313,7 +313,7 @@ impl LightTree {
             let end = t.emitters.len();
             let root = t.recursive_build(start, end, 0, 0);
             let m = t.nodes[root as usize].m;
-            mesh_ranges.push((start, end));
+            mesh_ranges.push((root, start, end));
             top.push(Emitter { pick: None, shape: Shape::Mesh { root }, centroid: m.centre(), measure: m });
         }
         let start = t.emitters.len();
@@ -347,10 +347,11 @@ impl LightTree {
                 None => {}
             }
         }
-        let mesh_emitters: Vec<(u32, u32)> = t.emitters.iter().enumerate().filter_map(|(i, s)| if let Shape::Mesh { root } = s.e.shape { Some((root, i as u32)) } else { None }).collect();
-        for (k, &(s, e)) in mesh_ranges.iter().enumerate() {
-            let parent = mesh_emitters[k].1;
-            debug_assert!(matches!(t.emitters[parent as usize].e.shape, Shape::Mesh { .. }));
+        // Each object's triangles belong to the emitter of their subtree's root (the
+        // top-level build has reordered the object emitters).
+        let emitter_of_root: std::collections::HashMap<u32, u32> = t.emitters.iter().enumerate().filter_map(|(i, s)| if let Shape::Mesh { root } = s.e.shape { Some((root, i as u32)) } else { None }).collect();
+        for (root, s, e) in mesh_ranges {
+            let parent = emitter_of_root[&root];
             for st in &mut t.emitters[s..e] {
                 st.parent = parent;
             }
@@ -863,6 +864,31 @@ mod tests {
                 let got = *counts.get(&k).unwrap_or(&0) as f32 / draws as f32;
                 let want = t.pdf(p, n, trans, k);
                 assert!((got - want).abs() < 0.003 + 0.02 * want, "{k:?} at {p:?}: picked {got}, pdf {want}");
+            }
+        }
+    }
+
+    /// Several emissive objects, which the top-level build reorders: each triangle's pdf
+    /// goes through its own object's emitter, so the pdfs still sum to one and agree with
+    /// what `select` reports.
+    #[test]
+    fn triangles_of_several_objects() {
+        let mut meshes = Vec::new();
+        for m in 0..6u32 {
+            let x = 3.0 - m as f32;
+            meshes.push((0..4u32).map(|i| tri(10 * m + i, [[x, i as f32 * 0.3, 2.0], [x + 0.5, i as f32 * 0.3, 2.0], [x, i as f32 * 0.3 + 0.3, 2.4]])).collect::<Vec<_>>());
+        }
+        let t = LightTree::build(vec![point(0, [0.0, -2.0, 3.0], 2.0)], Vec::new(), meshes);
+        let mut picks = vec![Pick::Lamp(0)];
+        picks.extend((0..6u32).flat_map(|m| (0..4u32).map(move |i| Pick::Triangle(10 * m + i))));
+        for p in [[0.0f32, 0.0, 0.0], [2.0, 1.0, 0.5]] {
+            let n = [0.0, 0.0, 1.0];
+            let sum: f32 = picks.iter().map(|&k| t.pdf(p, n, false, k)).sum();
+            assert!((sum - 1.0).abs() < 1e-4, "pdfs sum to {sum}");
+            for i in 0..2000 {
+                let (k, pr) = t.select(p, n, false, (i as f32 + 0.5) / 2000.0).expect("a pick");
+                let want = t.pdf(p, n, false, k);
+                assert!((pr - want).abs() <= 1e-4 * want.max(1e-3), "{k:?}: select says {pr}, pdf {want}");
             }
         }
     }
