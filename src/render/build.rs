@@ -56,6 +56,15 @@ pub struct MeshInstance {
 }
 
 impl MeshInstance {
+    /// The material of triangle `tri` of the mesh: its face's slot (slot 0 without
+    /// per-face slots), None for an empty slot.
+    #[inline]
+    pub fn material_of(&self, tri: usize) -> Option<usize> {
+        let face = self.mesh.triangle_faces[tri] as usize;
+        let slot = self.face_slot.get(face).copied().unwrap_or(0) as usize;
+        self.slots.get(slot).copied().flatten()
+    }
+
     /// Texture Coordinate > Generated of object-space point `local`: 0..1 over the
     /// instance's texture space.
     pub fn generated(&self, local: V3) -> V3 {

@@ -47,9 +47,7 @@ pub fn apply(geo: &mut Geometry, materials: &[Material]) -> usize {
 
 /// The material program of triangle `t` of `inst`, if it truly displaces.
 fn program_of<'m>(inst: &MeshInstance, materials: &'m [Material], t: usize) -> Option<(usize, &'m crate::shader::program::Program)> {
-    let face = inst.mesh.triangle_faces[t] as usize;
-    let slot = inst.face_slot.get(face).copied().unwrap_or(0) as usize;
-    let mi = inst.slots.get(slot).copied().flatten()?;
+    let mi = inst.material_of(t)?;
     let p = materials[mi].program.as_ref()?;
     p.displacement.map(|_| (mi, p))
 }

@@ -846,10 +846,7 @@ impl Scene<'_> {
     /// Sampling (Front, Back, or both for Auto and Front and Back).
     fn emission_sides(&self, prim: u32) -> (bool, bool) {
         let r = self.geo.refs[prim as usize];
-        let inst = &self.geo.instances[r.inst as usize];
-        let face = inst.mesh.triangle_faces[r.tri as usize] as usize;
-        let slot = inst.face_slot.get(face).copied().unwrap_or(0) as usize;
-        match inst.slots.get(slot).copied().flatten().map(|mi| self.materials[mi].sampling.as_str()) {
+        match self.geo.instances[r.inst as usize].material_of(r.tri as usize).map(|mi| self.materials[mi].sampling.as_str()) {
             Some("FRONT") => (true, false),
             Some("BACK") => (false, true),
             _ => (true, true),

@@ -500,9 +500,7 @@ fn light_select(geo: &build::Geometry, materials: &[shade::Material], lights: &[
         if inst.motion.is_some() {
             continue;
         }
-        let face = inst.mesh.triangle_faces[r.tri as usize] as usize;
-        let slot = inst.face_slot.get(face).copied().unwrap_or(0) as usize;
-        let Some(mi) = inst.slots.get(slot).copied().flatten() else { continue };
+        let Some(mi) = inst.material_of(r.tri as usize) else { continue };
         let Some(estimate) = sampled[mi] else { continue };
         let v = geo.tris[prim];
         let n = cross(sub(v[1], v[0]), sub(v[2], v[0]));
