@@ -20,23 +20,34 @@ fn main() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/bake/scenes");
     let bump_root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/bake/bump");
     let mut cases: Vec<(String, std::path::PathBuf, Option<&str>)> =
-        ["uv_math", "structure", "closures", "textures"].iter().map(|c| (c.to_string(), root.join(c), None)).collect();
+        ["uv_math", "structure", "closures", "textures"]
+            .iter()
+            .map(|c| (c.to_string(), root.join(c), None))
+            .collect();
     cases.push(("noise6_bump".into(), bump_root.join("noise6_bump"), None));
     match std::env::var_os("BLENDSYNTH_COLON_EXPORT") {
         Some(dir) => cases.push(("Fat.001".into(), dir.into(), Some("Fat.001"))),
         None => println!("shading Fat.001: skipped (set BLENDSYNTH_COLON_EXPORT to a converted colon_nodes.blend)"),
     }
-    let only: Vec<String> = std::env::args().skip(1).filter(|a| !a.starts_with('-')).collect();
+    let only: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| !a.starts_with('-'))
+        .collect();
     for (case, dir, name) in &cases {
         if !only.is_empty() && !only.iter().any(|o| o == case) {
             continue;
         }
         let scene = Scene::load(dir).expect("scene");
-        let material = name.map(str::to_string).unwrap_or_else(|| scene.file.materials[0].name.clone());
+        let material = name
+            .map(str::to_string)
+            .unwrap_or_else(|| scene.file.materials[0].name.clone());
         let program = compile_material(&scene, &material).expect("compiles");
         let mut stack = program.new_stack();
         // BLENDSYNTH_BENCH_POINTS=N (a multiple of 1000) shortens the slow materials' runs.
-        let n: u32 = std::env::var("BLENDSYNTH_BENCH_POINTS").ok().and_then(|s| s.parse().ok()).unwrap_or(2_000_000);
+        let n: u32 = std::env::var("BLENDSYNTH_BENCH_POINTS")
+            .ok()
+            .and_then(|s| s.parse().ok())
+            .unwrap_or(2_000_000);
         let (start, cpu_start) = (Instant::now(), cpu_ns());
         let mut acc = 0.0f32;
         for i in 0..n {
@@ -56,7 +67,9 @@ fn main() {
             acc += program.surface_emission(&stack)[0];
         }
         let secs = start.elapsed().as_secs_f64();
-        let cpu = cpu_ns().zip(cpu_start).map_or(f64::NAN, |(b, a)| (b - a) as f64);
+        let cpu = cpu_ns()
+            .zip(cpu_start)
+            .map_or(f64::NAN, |(b, a)| (b - a) as f64);
         black_box(acc);
         println!(
             "shading {case:<10} {:>4} ops: {:>6.1} M points/s per core ({:.1} ns/point; cpu {:.1} ns/point)",
@@ -71,7 +84,12 @@ fn main() {
 /// This thread's CPU time in ns (Linux): on a shared machine, unlike wall time, it does
 /// not count time spent waiting for a core.
 fn cpu_ns() -> Option<u64> {
-    std::fs::read_to_string("/proc/thread-self/schedstat").ok()?.split_whitespace().next()?.parse().ok()
+    std::fs::read_to_string("/proc/thread-self/schedstat")
+        .ok()?
+        .split_whitespace()
+        .next()?
+        .parse()
+        .ok()
 }
 
 /// Ray differentials of a 1/1000 step on the unit square, so Bump nodes run their dx/dy

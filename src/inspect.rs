@@ -7,8 +7,8 @@ use std::fmt::Write;
 use serde::Serialize;
 
 use crate::nodes::{support_in, Support};
-use crate::shader::compile_material;
 use crate::scene::{quote, Rna, Scene};
+use crate::shader::compile_material;
 
 #[derive(Debug, Serialize)]
 pub struct Report {
@@ -155,7 +155,11 @@ pub fn report(scene: &Scene) -> Report {
             data: o.data.clone(),
             parent: o.parent.clone(),
             renders: !o.hide_render,
-            materials: o.material_slots.iter().map(|s| s.material.clone()).collect(),
+            materials: o
+                .material_slots
+                .iter()
+                .map(|s| s.material.clone())
+                .collect(),
             modifiers: o
                 .modifiers
                 .iter()
@@ -170,7 +174,12 @@ pub fn report(scene: &Scene) -> Report {
                 .map(|c| ConstraintSummary {
                     name: c.name.clone(),
                     kind: c.kind.clone(),
-                    target: c.properties.get("target").and_then(|t| t.get("name")).and_then(|n| n.as_str()).map(str::to_string),
+                    target: c
+                        .properties
+                        .get("target")
+                        .and_then(|t| t.get("name"))
+                        .and_then(|n| n.as_str())
+                        .map(str::to_string),
                     settings: constraint_settings(&c.properties),
                 })
                 .collect(),
@@ -179,8 +188,17 @@ pub fn report(scene: &Scene) -> Report {
 
     let mut animation = Vec::new();
     for a in &f.animation {
-        for (fc, driver) in a.fcurves.iter().map(|c| (c, false)).chain(a.drivers.iter().map(|c| (c, true))) {
-            let mut interps: Vec<String> = fc.keyframes.iter().map(|k| k.interpolation.clone()).collect();
+        for (fc, driver) in a
+            .fcurves
+            .iter()
+            .map(|c| (c, false))
+            .chain(a.drivers.iter().map(|c| (c, true)))
+        {
+            let mut interps: Vec<String> = fc
+                .keyframes
+                .iter()
+                .map(|k| k.interpolation.clone())
+                .collect();
             interps.sort();
             interps.dedup();
             animation.push(AnimSummary {
@@ -203,7 +221,9 @@ pub fn report(scene: &Scene) -> Report {
             .iter()
             .map(|n| {
                 let sup = support_in(&t.bl_idname, &n.bl_idname);
-                let e = coverage.entry(n.bl_idname.clone()).or_insert((0, Vec::new(), sup));
+                let e = coverage
+                    .entry(n.bl_idname.clone())
+                    .or_insert((0, Vec::new(), sup));
                 e.0 += 1;
                 if !e.1.contains(&path) {
                     e.1.push(path.clone());
@@ -222,11 +242,21 @@ pub fn report(scene: &Scene) -> Report {
                 }
             })
             .collect();
-        node_trees.push(TreeSummary { path, bl_idname: t.bl_idname.clone(), links: t.links.len(), nodes });
+        node_trees.push(TreeSummary {
+            path,
+            bl_idname: t.bl_idname.clone(),
+            links: t.links.len(),
+            nodes,
+        });
     }
     let coverage: Vec<CoverageRow> = coverage
         .into_iter()
-        .map(|(bl_idname, (count, used_in, support))| CoverageRow { support, bl_idname, count, used_in })
+        .map(|(bl_idname, (count, used_in, support))| CoverageRow {
+            support,
+            bl_idname,
+            count,
+            used_in,
+        })
         .collect();
     // Node types alone do not tell everything (an unsupported option, a Texture
     // Coordinate output, displacement): each material must also compile.
@@ -234,9 +264,15 @@ pub fn report(scene: &Scene) -> Report {
         .materials
         .iter()
         .filter(|m| m.node_tree.is_some())
-        .map(|m| MaterialStatus { name: m.name.clone(), error: compile_material(scene, &m.name).err().map(|e| e.to_string()) })
+        .map(|m| MaterialStatus {
+            name: m.name.clone(),
+            error: compile_material(scene, &m.name)
+                .err()
+                .map(|e| e.to_string()),
+        })
         .collect();
-    let all_supported = coverage.iter().all(|r| r.support != Support::Unsupported) && material_status.iter().all(|m| m.error.is_none());
+    let all_supported = coverage.iter().all(|r| r.support != Support::Unsupported)
+        && material_status.iter().all(|m| m.error.is_none());
 
     Report {
         source_file: f.source_file.clone(),
@@ -247,7 +283,15 @@ pub fn report(scene: &Scene) -> Report {
         animation,
         materials: f.materials.iter().map(|m| m.name.clone()).collect(),
         node_trees,
-        images: f.images.iter().map(|i| ImageSummary { name: i.name.clone(), file: i.file.clone(), missing: i.missing }).collect(),
+        images: f
+            .images
+            .iter()
+            .map(|i| ImageSummary {
+                name: i.name.clone(),
+                file: i.file.clone(),
+                missing: i.missing,
+            })
+            .collect(),
         coverage,
         material_status,
         all_supported,
@@ -265,11 +309,31 @@ fn string(m: &Rna, k: &str) -> Option<String> {
 /// The settings worth a glance, as `key=value`, for any constraint type: scalars only,
 /// skipping bookkeeping properties.
 fn constraint_settings(p: &Rna) -> Vec<String> {
-    const SKIP: &[&str] = &["name", "type", "show_expanded", "is_override_data", "active", "is_valid", "error_location", "error_rotation", "target", "enabled"];
+    const SKIP: &[&str] = &[
+        "name",
+        "type",
+        "show_expanded",
+        "is_override_data",
+        "active",
+        "is_valid",
+        "error_location",
+        "error_rotation",
+        "target",
+        "enabled",
+    ];
     p.iter()
-        .filter(|(k, v)| !SKIP.contains(&k.as_str()) && (v.is_boolean() || v.is_number() || v.is_string()))
+        .filter(|(k, v)| {
+            !SKIP.contains(&k.as_str()) && (v.is_boolean() || v.is_number() || v.is_string())
+        })
         .filter(|(_, v)| v.as_str() != Some(""))
-        .map(|(k, v)| format!("{k}={}", v.as_str().map(str::to_string).unwrap_or_else(|| v.to_string())))
+        .map(|(k, v)| {
+            format!(
+                "{k}={}",
+                v.as_str()
+                    .map(str::to_string)
+                    .unwrap_or_else(|| v.to_string())
+            )
+        })
         .collect()
 }
 
@@ -282,10 +346,31 @@ impl Report {
 
     fn write_text(&self, o: &mut String) -> std::fmt::Result {
         let s = &self.scene;
-        writeln!(o, "Scene {:?} from {} (saved by Blender {}, exported by Blender {})", s.name, self.source_file, dotted(&self.file_version), self.blender_version)?;
-        writeln!(o, "  frames {}..{} (current {}), camera {}, world {}", s.frame_start, s.frame_end, s.frame_current, opt(&s.camera), opt(&s.world))?;
+        writeln!(
+            o,
+            "Scene {:?} from {} (saved by Blender {}, exported by Blender {})",
+            s.name,
+            self.source_file,
+            dotted(&self.file_version),
+            self.blender_version
+        )?;
+        writeln!(
+            o,
+            "  frames {}..{} (current {}), camera {}, world {}",
+            s.frame_start,
+            s.frame_end,
+            s.frame_current,
+            opt(&s.camera),
+            opt(&s.world)
+        )?;
         if let Some([x, y]) = s.resolution {
-            write!(o, "  {}x{} at {}%", x, y, s.resolution_percentage.unwrap_or(100))?;
+            write!(
+                o,
+                "  {}x{} at {}%",
+                x,
+                y,
+                s.resolution_percentage.unwrap_or(100)
+            )?;
         }
         writeln!(
             o,
@@ -319,7 +404,14 @@ impl Report {
                 writeln!(o, "    modifier {m}")?;
             }
             for c in &ob.constraints {
-                writeln!(o, "    constraint {} {:?} target {}: {}", c.kind, c.name, opt(&c.target), c.settings.join(" "))?;
+                writeln!(
+                    o,
+                    "    constraint {} {:?} target {}: {}",
+                    c.kind,
+                    c.name,
+                    opt(&c.target),
+                    c.settings.join(" ")
+                )?;
             }
         }
 
@@ -332,16 +424,40 @@ impl Report {
                 a.array_index,
                 if a.driver { " (driver)" } else { "" },
                 a.keyframes,
-                if a.interpolations.is_empty() { "-".to_string() } else { a.interpolations.join("/") },
+                if a.interpolations.is_empty() {
+                    "-".to_string()
+                } else {
+                    a.interpolations.join("/")
+                },
                 a.extrapolation,
-                if a.modifiers.is_empty() { String::new() } else { format!(", modifiers {}", a.modifiers.join(", ")) }
+                if a.modifiers.is_empty() {
+                    String::new()
+                } else {
+                    format!(", modifiers {}", a.modifiers.join(", "))
+                }
             )?;
         }
 
-        writeln!(o, "\nMaterials ({}): {}", self.materials.len(), self.materials.iter().map(|m| quote(m)).collect::<Vec<_>>().join(", "))?;
+        writeln!(
+            o,
+            "\nMaterials ({}): {}",
+            self.materials.len(),
+            self.materials
+                .iter()
+                .map(|m| quote(m))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )?;
 
         for t in &self.node_trees {
-            writeln!(o, "\nNode tree {} [{}]: {} nodes, {} links", t.path, t.bl_idname, t.nodes.len(), t.links)?;
+            writeln!(
+                o,
+                "\nNode tree {} [{}]: {} nodes, {} links",
+                t.path,
+                t.bl_idname,
+                t.nodes.len(),
+                t.links
+            )?;
             for n in &t.nodes {
                 writeln!(
                     o,
@@ -351,7 +467,11 @@ impl Report {
                     n.inputs,
                     n.outputs,
                     if n.mute { "  muted" } else { "" },
-                    if n.support == Support::Unsupported { "  (unsupported)" } else { "" }
+                    if n.support == Support::Unsupported {
+                        "  (unsupported)"
+                    } else {
+                        ""
+                    }
                 )?;
             }
         }
@@ -359,20 +479,49 @@ impl Report {
         if !self.images.is_empty() {
             writeln!(o, "\nImages")?;
             for i in &self.images {
-                writeln!(o, "  {}: {}", i.name, if i.missing { "MISSING (not packed, file not found)".to_string() } else { opt(&i.file) })?;
+                writeln!(
+                    o,
+                    "  {}: {}",
+                    i.name,
+                    if i.missing {
+                        "MISSING (not packed, file not found)".to_string()
+                    } else {
+                        opt(&i.file)
+                    }
+                )?;
             }
         }
 
-        let unsupported = self.coverage.iter().filter(|r| r.support == Support::Unsupported).count();
-        writeln!(o, "\nNode coverage: {} node types used, {} unsupported", self.coverage.len(), unsupported)?;
-        writeln!(o, "  {:<40} {:>5}  {:<12} used in", "node type", "count", "support")?;
+        let unsupported = self
+            .coverage
+            .iter()
+            .filter(|r| r.support == Support::Unsupported)
+            .count();
+        writeln!(
+            o,
+            "\nNode coverage: {} node types used, {} unsupported",
+            self.coverage.len(),
+            unsupported
+        )?;
+        writeln!(
+            o,
+            "  {:<40} {:>5}  {:<12} used in",
+            "node type", "count", "support"
+        )?;
         for r in &self.coverage {
             let sup = match r.support {
                 Support::Supported => "yes",
                 Support::Structural => "structural",
                 Support::Unsupported => "NO",
             };
-            writeln!(o, "  {:<40} {:>5}  {:<12} {}", r.bl_idname, r.count, sup, r.used_in.join(", "))?;
+            writeln!(
+                o,
+                "  {:<40} {:>5}  {:<12} {}",
+                r.bl_idname,
+                r.count,
+                sup,
+                r.used_in.join(", ")
+            )?;
         }
         if !self.material_status.is_empty() {
             writeln!(o, "\nMaterials for the renderer")?;
@@ -395,5 +544,8 @@ fn opt(v: &Option<String>) -> String {
 }
 
 fn dotted(v: &[u32]) -> String {
-    v.iter().map(|x| x.to_string()).collect::<Vec<_>>().join(".")
+    v.iter()
+        .map(|x| x.to_string())
+        .collect::<Vec<_>>()
+        .join(".")
 }

@@ -7,13 +7,13 @@
 
 pub mod anim;
 pub mod blender;
+pub mod color;
+pub mod dataset;
+pub mod denoise;
 pub mod geometry;
 pub mod inspect;
+pub mod label;
 pub mod nodes;
 pub mod render;
 pub mod scene;
 pub mod shader;
-pub mod color;
-pub mod denoise;
-pub mod dataset;
-pub mod label;

@@ -13,7 +13,11 @@ use blendsynth::shader::bake::{bake_emission, write_exr, BakeOptions};
 use blendsynth::{blender, inspect, scene::Override, scene::Scene};
 
 #[derive(Parser)]
-#[command(name = "blendsynth", version, about = "Render Blender scenes without Blender, to make labelled synthetic training datasets")]
+#[command(
+    name = "blendsynth",
+    version,
+    about = "Render Blender scenes without Blender, to make labelled synthetic training datasets"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -156,16 +160,29 @@ struct ReplicateArgs {
 
 /// The path tracer as a dataset renderer. The render branch wires this at merge (see
 /// `dataset::renderer::path_tracer`).
-fn make_renderer(kind: RendererKind, scene: &Scene) -> Result<Box<dyn blendsynth::dataset::FrameRenderer>> {
+fn make_renderer(
+    kind: RendererKind,
+    scene: &Scene,
+) -> Result<Box<dyn blendsynth::dataset::FrameRenderer>> {
     match kind {
-        RendererKind::Path => blendsynth::dataset::renderer::path_tracer(scene).map_err(anyhow::Error::msg),
-        RendererKind::Bounds => Ok(Box::new(blendsynth::dataset::bounds::BoundsRenderer::new(scene).map_err(anyhow::Error::msg)?)),
+        RendererKind::Path => {
+            blendsynth::dataset::renderer::path_tracer(scene).map_err(anyhow::Error::msg)
+        }
+        RendererKind::Bounds => Ok(Box::new(
+            blendsynth::dataset::bounds::BoundsRenderer::new(scene).map_err(anyhow::Error::msg)?,
+        )),
     }
 }
 
-fn generate_options(run: &RunArgs, frames: u64, split: Vec<(String, f64)>) -> Result<blendsynth::dataset::GenerateOptions> {
+fn generate_options(
+    run: &RunArgs,
+    frames: u64,
+    split: Vec<(String, f64)>,
+) -> Result<blendsynth::dataset::GenerateOptions> {
     use blendsynth::dataset::generate::parse_shard;
-    let cores = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1);
+    let cores = std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1);
     if frames == 0 {
         anyhow::bail!("--frames must be at least 1");
     }
@@ -173,7 +190,13 @@ fn generate_options(run: &RunArgs, frames: u64, split: Vec<(String, f64)>) -> Re
         frames,
         seed: run.seed,
         split,
-        shard: run.shard.as_deref().map(parse_shard).transpose().map_err(anyhow::Error::msg)?.unwrap_or((0, 1)),
+        shard: run
+            .shard
+            .as_deref()
+            .map(parse_shard)
+            .transpose()
+            .map_err(anyhow::Error::msg)?
+            .unwrap_or((0, 1)),
         resume: run.resume,
         jobs: run.jobs.unwrap_or(cores).max(1),
         threads_per_frame: 1,
@@ -189,7 +212,11 @@ fn print_summary(s: &blendsynth::dataset::Summary) {
         s.rendered,
         s.skipped,
         s.seconds,
-        if s.seconds > 0.0 { s.rendered as f64 * 3600.0 / s.seconds } else { 0.0 }
+        if s.seconds > 0.0 {
+            s.rendered as f64 * 3600.0 / s.seconds
+        } else {
+            0.0
+        }
     );
 }
 
@@ -297,13 +324,24 @@ enum OnOff {
 
 /// `--set PATH=VALUE` arguments, as `bake`, `mesh` and `render` take them.
 fn parse_overrides(set: &[String]) -> Result<Vec<Override>> {
-    set.iter().map(|s| Override::parse(s)).collect::<Result<Vec<_>, _>>().map_err(anyhow::Error::msg)
+    set.iter()
+        .map(|s| Override::parse(s))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(anyhow::Error::msg)
 }
 
 fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
-    let (a, b) = s.split_once(['x', 'X']).ok_or_else(|| format!("{s:?}: expected WxH, e.g. 640x480"))?;
-    let w = a.trim().parse::<u32>().map_err(|e| format!("{s:?}: width: {e}"))?;
-    let h = b.trim().parse::<u32>().map_err(|e| format!("{s:?}: height: {e}"))?;
+    let (a, b) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("{s:?}: expected WxH, e.g. 640x480"))?;
+    let w = a
+        .trim()
+        .parse::<u32>()
+        .map_err(|e| format!("{s:?}: width: {e}"))?;
+    let h = b
+        .trim()
+        .parse::<u32>()
+        .map_err(|e| format!("{s:?}: height: {e}"))?;
     Ok((w, h))
 }
 
@@ -311,21 +349,46 @@ fn run_render(a: RenderArgs) -> Result<()> {
     use blendsynth::render;
     let overrides = parse_overrides(&a.set)?;
     let scene = Scene::load(&a.dir)?.with_overrides(&overrides)?;
-    let opts = render::RenderOptions { frame: a.frame, samples: a.samples, threshold: a.threshold, resolution: a.resolution, seed: a.seed, threads: a.threads, progress: true };
-    let ext = a.output.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let opts = render::RenderOptions {
+        frame: a.frame,
+        samples: a.samples,
+        threshold: a.threshold,
+        resolution: a.resolution,
+        seed: a.seed,
+        threads: a.threads,
+        progress: true,
+    };
+    let ext = a
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
     if ext != "png" && ext != "exr" {
-        anyhow::bail!("{}: the output must be a .png or .exr file", a.output.display());
+        anyhow::bail!(
+            "{}: the output must be a .png or .exr file",
+            a.output.display()
+        );
     }
     // Find the denoiser before spending the render time.
-    let want_denoise = a.denoise.map_or_else(|| blendsynth::denoise::scene_wants_denoising(&scene), |d| d == OnOff::On);
-    let denoiser = if want_denoise { blendsynth::denoise::Denoiser::load(a.oidn.as_deref())? } else { None };
+    let want_denoise = a.denoise.map_or_else(
+        || blendsynth::denoise::scene_wants_denoising(&scene),
+        |d| d == OnOff::On,
+    );
+    let denoiser = if want_denoise {
+        blendsynth::denoise::Denoiser::load(a.oidn.as_deref())?
+    } else {
+        None
+    };
     if want_denoise && denoiser.is_none() {
         eprintln!("notice: no Open Image Denoise library found (--oidn, $BLENDSYNTH_OIDN, a bpy/Blender install or the pyoidn wheel); writing the noisy image");
     }
-    let mut out = render::render(&scene, &opts).map_err(|e| anyhow::anyhow!("render {}: {e}", a.dir.display()))?;
+    let mut out = render::render(&scene, &opts)
+        .map_err(|e| anyhow::anyhow!("render {}: {e}", a.dir.display()))?;
     if let Some(d) = &denoiser {
         let frame = a.frame.unwrap_or(scene.file.scene.frame_current as f64);
-        blendsynth::denoise::denoise_render(d, &scene, frame, &mut out).map_err(|e| anyhow::anyhow!("denoising: {e}"))?;
+        blendsynth::denoise::denoise_render(d, &scene, frame, &mut out)
+            .map_err(|e| anyhow::anyhow!("denoising: {e}"))?;
     }
     blendsynth::color::write_render(&scene, &a.output, out.width, out.height, &out.color)?;
     if let Some(dir) = &a.passes {
@@ -351,8 +414,13 @@ fn run_render(a: RenderArgs) -> Result<()> {
             uv: &p.uv,
             instance_objects: &objects,
         };
-        let format = if a.pass_format == PassFormatArg::Png { PassFormat::Png } else { PassFormat::Exr };
-        write_passes(dir, &images, &classes, format, labels.mm_per_unit).map_err(anyhow::Error::msg)?;
+        let format = if a.pass_format == PassFormatArg::Png {
+            PassFormat::Png
+        } else {
+            PassFormat::Exr
+        };
+        write_passes(dir, &images, &classes, format, labels.mm_per_unit)
+            .map_err(anyhow::Error::msg)?;
     }
     let s = &out.stats;
     println!(
@@ -377,8 +445,18 @@ enum Outcome {
 
 fn run(cli: Cli) -> Result<Outcome> {
     match cli.command {
-        Command::Convert { input, output, blender, frame, no_evaluated } => {
-            let opts = blender::ConvertOptions { blender, frame, no_evaluated };
+        Command::Convert {
+            input,
+            output,
+            blender,
+            frame,
+            no_evaluated,
+        } => {
+            let opts = blender::ConvertOptions {
+                blender,
+                frame,
+                no_evaluated,
+            };
             let scene = blender::convert(&input, &output, &opts)?;
             let f = &scene.file;
             println!(
@@ -400,11 +478,23 @@ fn run(cli: Cli) -> Result<Outcome> {
         Command::Bake(a) => {
             let overrides = parse_overrides(&a.set)?;
             let scene = Scene::load(&a.dir)?.with_overrides(&overrides)?;
-            let opts = BakeOptions { object: a.object.clone(), uv: a.uv, size: a.size };
+            let opts = BakeOptions {
+                object: a.object.clone(),
+                uv: a.uv,
+                size: a.size,
+            };
             let start = std::time::Instant::now();
-            let baked = bake_emission(&scene, &opts).map_err(|e| anyhow::anyhow!("bake {:?}: {e}", a.object))?;
+            let baked = bake_emission(&scene, &opts)
+                .map_err(|e| anyhow::anyhow!("bake {:?}: {e}", a.object))?;
             write_exr(&baked, &a.output).map_err(anyhow::Error::msg)?;
-            println!("baked {} ({}x{}) -> {} in {:.2} s", a.object, a.size, a.size, a.output.display(), start.elapsed().as_secs_f64());
+            println!(
+                "baked {} ({}x{}) -> {} in {:.2} s",
+                a.object,
+                a.size,
+                a.size,
+                a.output.display(),
+                start.elapsed().as_secs_f64()
+            );
             Ok(Outcome::Done)
         }
         Command::Render(a) => {
@@ -418,43 +508,71 @@ fn run(cli: Cli) -> Result<Outcome> {
             }
             let report = inspect::report(&scene);
             if json {
-                println!("{}", serde_json::to_string_pretty(&report).context("cannot serialise the report")?);
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&report).context("cannot serialise the report")?
+                );
             } else {
                 print!("{}", report.to_text());
             }
-            Ok(if report.all_supported { Outcome::Done } else { Outcome::Unsupported })
+            Ok(if report.all_supported {
+                Outcome::Done
+            } else {
+                Outcome::Unsupported
+            })
         }
         Command::Generate(a) => {
             use blendsynth::dataset::{generate, generate::parse_split, Spec};
             let scene = Scene::load(&a.dir)?;
             let spec = Spec::load(&a.spec)?;
-            let opts = generate_options(&a.run, a.frames, parse_split(&a.split).map_err(anyhow::Error::msg)?)?;
+            let opts = generate_options(
+                &a.run,
+                a.frames,
+                parse_split(&a.split).map_err(anyhow::Error::msg)?,
+            )?;
             let renderer = make_renderer(a.run.renderer, &scene)?;
-            let s = generate(&scene, &spec, renderer.as_ref(), &a.output, &opts).map_err(anyhow::Error::msg)?;
+            let s = generate(&scene, &spec, renderer.as_ref(), &a.output, &opts)
+                .map_err(anyhow::Error::msg)?;
             print_summary(&s);
             Ok(Outcome::Done)
         }
         Command::Merge { shards, output } => {
             let n = blendsynth::dataset::merge(&shards, &output).map_err(anyhow::Error::msg)?;
-            println!("merged {} shard(s) into {}: {n} frames", shards.len(), output.display());
+            println!(
+                "merged {} shard(s) into {}: {n} frames",
+                shards.len(),
+                output.display()
+            );
             Ok(Outcome::Done)
         }
         Command::Preview { dir, output, count } => {
-            let n = blendsynth::dataset::preview::contact_sheet(&dir, &output, count).map_err(anyhow::Error::msg)?;
+            let n = blendsynth::dataset::preview::contact_sheet(&dir, &output, count)
+                .map_err(anyhow::Error::msg)?;
             println!("preview of {n} frame(s) -> {}", output.display());
             Ok(Outcome::Done)
         }
         Command::Replicate(a) => {
             use blendsynth::dataset::replicate;
             if a.dataset != replicate::DATASET {
-                anyhow::bail!("unknown dataset {:?} (known: {})", a.dataset, replicate::DATASET);
+                anyhow::bail!(
+                    "unknown dataset {:?} (known: {})",
+                    a.dataset,
+                    replicate::DATASET
+                );
             }
             for part in a.part.parts() {
-                let (scene, spec) = replicate::scene_and_spec(part, a.assets.as_deref()).map_err(anyhow::Error::msg)?;
-                let out = if a.part.parts().len() > 1 { a.output.join(part.name()) } else { a.output.clone() };
+                let (scene, spec) = replicate::scene_and_spec(part, a.assets.as_deref())
+                    .map_err(anyhow::Error::msg)?;
+                let out = if a.part.parts().len() > 1 {
+                    a.output.join(part.name())
+                } else {
+                    a.output.clone()
+                };
                 let opts = generate_options(&a.run, a.frames, replicate::split())?;
                 let renderer = make_renderer(a.run.renderer, &scene)?;
-                let s = blendsynth::dataset::generate(&scene, &spec, renderer.as_ref(), &out, &opts).map_err(anyhow::Error::msg)?;
+                let s =
+                    blendsynth::dataset::generate(&scene, &spec, renderer.as_ref(), &out, &opts)
+                        .map_err(anyhow::Error::msg)?;
                 print_summary(&s);
             }
             println!("dataset written to {}", a.output.display());
@@ -462,12 +580,15 @@ fn run(cli: Cli) -> Result<Outcome> {
         }
         Command::Mesh(a) => {
             let overrides = parse_overrides(&a.set)?;
-            let overrides: Vec<(String, serde_json::Value)> = overrides.into_iter().map(|o| (o.path, o.value)).collect();
+            let overrides: Vec<(String, serde_json::Value)> =
+                overrides.into_iter().map(|o| (o.path, o.value)).collect();
             let scene = Scene::load(&a.dir)?;
             let frame = a.frame.unwrap_or(scene.file.scene.frame_current as f64);
             let start = std::time::Instant::now();
-            let set = blendsynth::geometry::evaluate_object(&scene, &a.object, frame, &overrides).map_err(|e| anyhow::anyhow!("mesh {:?}: {e}", a.object))?;
-            let mesh = blendsynth::geometry::realize_to_mesh(&set).map_err(|e| anyhow::anyhow!("mesh {:?}: {e}", a.object))?;
+            let set = blendsynth::geometry::evaluate_object(&scene, &a.object, frame, &overrides)
+                .map_err(|e| anyhow::anyhow!("mesh {:?}: {e}", a.object))?;
+            let mesh = blendsynth::geometry::realize_to_mesh(&set)
+                .map_err(|e| anyhow::anyhow!("mesh {:?}: {e}", a.object))?;
             let seconds = start.elapsed().as_secs_f64();
             blendsynth::geometry::write_mesh(&a.output, &mesh, &a.object)?;
             println!(

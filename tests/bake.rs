@@ -33,26 +33,46 @@ fn diff(a: &[f32], b: &[f32]) -> Diff {
     for (p, q) in a.chunks_exact(4).zip(b.chunks_exact(4)) {
         for c in 0..3 {
             let d = (p[c] - q[c]).abs();
-            worst = if d.is_nan() { f32::INFINITY } else { worst.max(d) };
+            worst = if d.is_nan() {
+                f32::INFINITY
+            } else {
+                worst.max(d)
+            };
             sum += (d as f64) * (d as f64);
             n += 1;
         }
     }
-    Diff { worst, rms: (sum / n as f64).sqrt() }
+    Diff {
+        worst,
+        rms: (sum / n as f64).sqrt(),
+    }
 }
 
 fn read_f32(path: &std::path::Path) -> Vec<f32> {
-    std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display())).chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect()
+    std::fs::read(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect()
 }
 
 fn compare_stats(root: &std::path::Path, case: &str) -> Diff {
     let dir = root.join(case);
     let scene = Scene::load(&dir).unwrap();
-    let meta: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("bake.json")).unwrap()).unwrap();
+    let meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("bake.json")).unwrap()).unwrap();
     let size = meta["size"].as_u64().unwrap() as u32;
     let reference = read_f32(&dir.join("blender_emit.f32"));
     assert_eq!(reference.len(), (size * size * 4) as usize);
-    let ours = bake_emission(&scene, &BakeOptions { object: meta["object"].as_str().unwrap().into(), uv: None, size }).unwrap_or_else(|e| panic!("{case}: {e}"));
+    let ours = bake_emission(
+        &scene,
+        &BakeOptions {
+            object: meta["object"].as_str().unwrap().into(),
+            uv: None,
+            size,
+        },
+    )
+    .unwrap_or_else(|e| panic!("{case}: {e}"));
     let mut worst = 0.0f32;
     let mut at = 0;
     let mut over = 0;
@@ -67,7 +87,11 @@ fn compare_stats(root: &std::path::Path, case: &str) -> Diff {
                 at = i;
             }
         }
-        assert_eq!(p[3], reference[i * 4 + 3], "{case}: texel {i} coverage differs");
+        assert_eq!(
+            p[3],
+            reference[i * 4 + 3],
+            "{case}: texel {i} coverage differs"
+        );
     }
     let flat: Vec<f32> = ours.pixels.iter().flatten().copied().collect();
     let d = diff(&flat, &reference);
@@ -82,8 +106,15 @@ fn cycles_self_spread(root: &std::path::Path, case: &str) -> Diff {
     let dir = root.join(case);
     let reference = read_f32(&dir.join("blender_emit.f32"));
     let moved = read_f32(&dir.join("cycles_moved.f32"));
-    assert!(!moved.is_empty() && moved.len() % reference.len() == 0, "{case}: cycles_moved.f32 has {} values", moved.len());
-    let ds: Vec<Diff> = moved.chunks_exact(reference.len()).map(|m| diff(m, &reference)).collect();
+    assert!(
+        !moved.is_empty() && moved.len() % reference.len() == 0,
+        "{case}: cycles_moved.f32 has {} values",
+        moved.len()
+    );
+    let ds: Vec<Diff> = moved
+        .chunks_exact(reference.len())
+        .map(|m| diff(m, &reference))
+        .collect();
     let worst = ds.iter().map(|d| d.worst).fold(0.0, f32::max);
     let rms = (ds.iter().map(|d| d.rms * d.rms).sum::<f64>() / ds.len() as f64).sqrt();
     Diff { worst, rms }
@@ -121,17 +152,38 @@ fn cli_writes_the_same_values_as_an_exr() {
     let dir = repo().join("fixtures/bake/scenes/closures");
     let t = tempfile::tempdir().unwrap();
     let out = t.path().join("closures.exr");
-    let o = run(&["bake", dir.to_str().unwrap(), "--object", "Plane", "--size", "32", "-o", out.to_str().unwrap()], &[]);
+    let o = run(
+        &[
+            "bake",
+            dir.to_str().unwrap(),
+            "--object",
+            "Plane",
+            "--size",
+            "32",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let img = image::open(&out).unwrap().into_rgba32f();
-    let reference: Vec<f32> = std::fs::read(dir.join("blender_emit.f32")).unwrap().chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+    let reference: Vec<f32> = std::fs::read(dir.join("blender_emit.f32"))
+        .unwrap()
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
     // Image files store the top row first; Blender's pixels start at the bottom.
     for y in 0..32u32 {
         for x in 0..32u32 {
             let p = img.get_pixel(x, 31 - y).0;
             let i = ((y * 32 + x) * 4) as usize;
             for c in 0..3 {
-                assert!((p[c] - reference[i + c]).abs() <= TOL, "texel ({x},{y}) channel {c}: {} vs {}", p[c], reference[i + c]);
+                assert!(
+                    (p[c] - reference[i + c]).abs() <= TOL,
+                    "texel ({x},{y}) channel {c}: {} vs {}",
+                    p[c],
+                    reference[i + c]
+                );
             }
         }
     }
@@ -147,8 +199,24 @@ fn unsupported_nodes_are_errors_never_stand_ins() {
     copy_dir(&repo().join("fixtures/scenes/material_zoo"), &zoo);
     let json = std::fs::read_to_string(zoo.join("scene.json")).unwrap();
     assert!(json.contains("\"ShaderNodeNormalMap\""));
-    std::fs::write(zoo.join("scene.json"), json.replace("\"ShaderNodeNormalMap\"", "\"ShaderNodeVectorTransform\"")).unwrap();
-    let o = run(&["bake", zoo.to_str().unwrap(), "--object", "Plane", "--size", "8", "-o", out.to_str().unwrap()], &[]);
+    std::fs::write(
+        zoo.join("scene.json"),
+        json.replace("\"ShaderNodeNormalMap\"", "\"ShaderNodeVectorTransform\""),
+    )
+    .unwrap();
+    let o = run(
+        &[
+            "bake",
+            zoo.to_str().unwrap(),
+            "--object",
+            "Plane",
+            "--size",
+            "8",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
     assert_clean_error(&o, 1, &["material \"Zoo\"", "is not supported yet"]);
     assert!(!out.exists(), "no half-written output");
 }
@@ -157,9 +225,15 @@ fn unsupported_nodes_are_errors_never_stand_ins() {
 /// CI checks parity with the running Blender, not only with the committed references.
 #[test]
 fn fresh_cycles_bakes_match() {
-    let Some(py) = require("a Python with bpy 4.5.4", bpy_python()) else { return };
+    let Some(py) = require("a Python with bpy 4.5.4", bpy_python()) else {
+        return;
+    };
     let t = tempfile::tempdir().unwrap();
-    run_python(&py, &repo().join("fixtures/bake/make_bake_refs.py"), &["--out", t.path().to_str().unwrap()]);
+    run_python(
+        &py,
+        &repo().join("fixtures/bake/make_bake_refs.py"),
+        &["--out", t.path().to_str().unwrap()],
+    );
     for case in ["uv_math", "structure", "closures", "curves"] {
         assert!(compare_in(t.path(), case) <= TOL, "{case}");
     }
@@ -175,10 +249,23 @@ fn fresh_cycles_bakes_match() {
 /// temporary folder, never the repository).
 #[test]
 fn published_fat001_matches_cycles() {
-    let Some(py) = require("a Python with bpy 4.5.4", bpy_python()) else { return };
-    let Some(blend) = require("../shared/published/colon_nodes.blend", published_colon()) else { return };
+    let Some(py) = require("a Python with bpy 4.5.4", bpy_python()) else {
+        return;
+    };
+    let Some(blend) = require("../shared/published/colon_nodes.blend", published_colon()) else {
+        return;
+    };
     let t = tempfile::tempdir().unwrap();
-    run_python(&py, &repo().join("fixtures/bake/make_fat001_refs.py"), &["--blend", blend.to_str().unwrap(), "--out", t.path().to_str().unwrap()]);
+    run_python(
+        &py,
+        &repo().join("fixtures/bake/make_fat001_refs.py"),
+        &[
+            "--blend",
+            blend.to_str().unwrap(),
+            "--out",
+            t.path().to_str().unwrap(),
+        ],
+    );
     // The bumped normals are beyond 1e-4 in a few texels, and so is Cycles against itself:
     // its Bump nodes divide height differences at offsets of a tenth of a texel (the
     // displacement's bump) and a texel (Bump.001 over 10.7 octaves of noise) by those
@@ -192,7 +279,16 @@ fn published_fat001_matches_cycles() {
     const MOVED: &[&str] = &["normal", "normal_bump_only"];
     const SELF_FACTOR: f64 = 2.0;
     let mut failed = Vec::new();
-    for case in ["color", "normal", "normal_bump_only", "displacement", "color_random", "normal_random", "normal_bump_only_random", "displacement_random"] {
+    for case in [
+        "color",
+        "normal",
+        "normal_bump_only",
+        "displacement",
+        "color_random",
+        "normal_random",
+        "normal_bump_only_random",
+        "displacement_random",
+    ] {
         let ours = compare_stats(t.path(), case);
         if MOVED.contains(&case) {
             let own = cycles_self_spread(t.path(), case);
@@ -202,7 +298,12 @@ fn published_fat001_matches_cycles() {
                 ours.worst, ours.rms, own.worst, own.rms, ours.worst as f64 / own.worst as f64, ours.rms / own.rms
             );
             if ours.worst as f64 > worst_bound || ours.rms > SELF_FACTOR * own.rms {
-                failed.push(format!("{case}: worst {:.2e} (bound {worst_bound:.2e}), rms {:.2e} (bound {:.2e})", ours.worst, ours.rms, SELF_FACTOR * own.rms));
+                failed.push(format!(
+                    "{case}: worst {:.2e} (bound {worst_bound:.2e}), rms {:.2e} (bound {:.2e})",
+                    ours.worst,
+                    ours.rms,
+                    SELF_FACTOR * own.rms
+                ));
             }
         } else {
             eprintln!("Fat.001 {case}: worst abs error {:.2e}", ours.worst);
@@ -211,7 +312,10 @@ fn published_fat001_matches_cycles() {
             }
         }
     }
-    assert!(failed.is_empty(), "Fat.001 outputs beyond their bound: {failed:?}");
+    assert!(
+        failed.is_empty(),
+        "Fat.001 outputs beyond their bound: {failed:?}"
+    );
 }
 
 fn copy_dir(from: &std::path::Path, to: &std::path::Path) {

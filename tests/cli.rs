@@ -8,7 +8,12 @@ fn version_and_help() {
     let o = run(&["--version"], &[]);
     assert_eq!(o.status.code(), Some(0));
     assert!(stdout(&o).starts_with("blendsynth "), "{}", stdout(&o));
-    for sub in [vec!["--help"], vec!["convert", "--help"], vec!["inspect", "--help"], vec!["help", "convert"]] {
+    for sub in [
+        vec!["--help"],
+        vec!["convert", "--help"],
+        vec!["inspect", "--help"],
+        vec!["help", "convert"],
+    ] {
         let o = run(&sub, &[]);
         assert_eq!(o.status.code(), Some(0), "{sub:?}: {}", stderr(&o));
         assert!(stdout(&o).contains("Usage:"), "{sub:?}");
@@ -17,7 +22,13 @@ fn version_and_help() {
 
 #[test]
 fn bad_usage_exits_2() {
-    for args in [vec!["frobnicate"], vec!["convert"], vec!["inspect"], vec!["convert", "x.blend"], vec!["inspect", "d", "--bogus"]] {
+    for args in [
+        vec!["frobnicate"],
+        vec!["convert"],
+        vec!["inspect"],
+        vec!["convert", "x.blend"],
+        vec!["inspect", "d", "--bogus"],
+    ] {
         let o = run(&args, &[]);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {}", stderr(&o));
     }
@@ -27,7 +38,15 @@ fn bad_usage_exits_2() {
 fn convert_missing_input() {
     let t = tempfile::tempdir().unwrap();
     let out = t.path().join("out");
-    let o = run(&["convert", "/nonexistent/scene.blend", "-o", out.to_str().unwrap()], &[]);
+    let o = run(
+        &[
+            "convert",
+            "/nonexistent/scene.blend",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
     assert_clean_error(&o, 1, &["input file not found", "/nonexistent/scene.blend"]);
     assert!(!out.exists());
 }
@@ -37,7 +56,15 @@ fn convert_rejects_non_blend() {
     let t = tempfile::tempdir().unwrap();
     let f = t.path().join("fake.blend");
     std::fs::write(&f, b"this is not blender data").unwrap();
-    let o = run(&["convert", f.to_str().unwrap(), "-o", t.path().join("o").to_str().unwrap()], &[]);
+    let o = run(
+        &[
+            "convert",
+            f.to_str().unwrap(),
+            "-o",
+            t.path().join("o").to_str().unwrap(),
+        ],
+        &[],
+    );
     assert_clean_error(&o, 1, &["not a .blend file", "fake.blend"]);
 }
 
@@ -53,11 +80,17 @@ fn convert_without_blender_says_how_to_install() {
     let t = tempfile::tempdir().unwrap();
     let f = fake_blend(t.path());
     let out = t.path().join("out");
-    let o = run(&["convert", f.to_str().unwrap(), "-o", out.to_str().unwrap()], &[("PATH", "/nonexistent")]);
+    let o = run(
+        &["convert", f.to_str().unwrap(), "-o", out.to_str().unwrap()],
+        &[("PATH", "/nonexistent")],
+    );
     assert_clean_error(&o, 1, &["no Blender found", "--blender", "bpy==4.5.4"]);
     // Nothing half-written: neither the output nor a staging folder is left behind.
     assert!(!out.exists());
-    let left: Vec<_> = std::fs::read_dir(t.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    let left: Vec<_> = std::fs::read_dir(t.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
     assert_eq!(left.len(), 1, "left behind: {left:?}");
 }
 
@@ -65,7 +98,17 @@ fn convert_without_blender_says_how_to_install() {
 fn convert_blender_path_must_exist() {
     let t = tempfile::tempdir().unwrap();
     let f = fake_blend(t.path());
-    let o = run(&["convert", f.to_str().unwrap(), "-o", t.path().join("o").to_str().unwrap(), "--blender", "/no/such/blender"], &[]);
+    let o = run(
+        &[
+            "convert",
+            f.to_str().unwrap(),
+            "-o",
+            t.path().join("o").to_str().unwrap(),
+            "--blender",
+            "/no/such/blender",
+        ],
+        &[],
+    );
     assert_clean_error(&o, 1, &["--blender /no/such/blender", "no such file"]);
 }
 
@@ -74,10 +117,26 @@ fn convert_unwritable_output_folder() {
     let t = tempfile::tempdir().unwrap();
     let f = fake_blend(t.path());
     // procfs refuses new folders even to root, so this fails the same way everywhere.
-    let o = run(&["convert", f.to_str().unwrap(), "-o", "/proc/blendsynth-test/out"], &[]);
+    let o = run(
+        &[
+            "convert",
+            f.to_str().unwrap(),
+            "-o",
+            "/proc/blendsynth-test/out",
+        ],
+        &[],
+    );
     assert_clean_error(&o, 1, &["/proc/blendsynth-test"]);
     // An output path under a regular file.
-    let o = run(&["convert", f.to_str().unwrap(), "-o", f.join("out").to_str().unwrap()], &[]);
+    let o = run(
+        &[
+            "convert",
+            f.to_str().unwrap(),
+            "-o",
+            f.join("out").to_str().unwrap(),
+        ],
+        &[],
+    );
     assert_clean_error(&o, 1, &["scene.blend/out"]);
 }
 
@@ -88,7 +147,10 @@ fn convert_refuses_to_overwrite_a_foreign_folder() {
     let out = t.path().join("precious");
     std::fs::create_dir(&out).unwrap();
     std::fs::write(out.join("thesis.tex"), b"...").unwrap();
-    let o = run(&["convert", f.to_str().unwrap(), "-o", out.to_str().unwrap()], &[]);
+    let o = run(
+        &["convert", f.to_str().unwrap(), "-o", out.to_str().unwrap()],
+        &[],
+    );
     assert_clean_error(&o, 1, &["not a blendsynth export"]);
     assert!(out.join("thesis.tex").is_file());
 }

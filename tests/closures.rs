@@ -3,7 +3,7 @@
 //! furnace white (Cycles' Multiscatter GGX glass and its Oren-Nayar both promise this).
 
 use blendsynth::render::math::{basis, dot, normalize};
-use blendsynth::render::microfacet::{glass_closure, Distribution, Dielectric};
+use blendsynth::render::microfacet::{glass_closure, Dielectric, Distribution};
 use blendsynth::render::oren_nayar::OrenNayar;
 use blendsynth::render::sampler::PixelSampler;
 use blendsynth::render::tables::Tables;
@@ -19,21 +19,43 @@ fn rough_glass_sample_matches_eval() {
     let s = PixelSampler::new(3, 5, 7);
     for dist in [Distribution::Ggx, Distribution::Beckmann] {
         for eta in [1.5f32, 1.0 / 1.5] {
-            let g = Dielectric { dist, alpha: 0.3, eta, refract_only: false, tint_r: [1.0; 3], tint_t: [1.0; 3], energy: 1.0, film: None };
+            let g = Dielectric {
+                dist,
+                alpha: 0.3,
+                eta,
+                refract_only: false,
+                tint_r: [1.0; 3],
+                tint_t: [1.0; 3],
+                energy: 1.0,
+                film: None,
+            };
             let v = view(0.6);
             let mut checked = 0;
             for i in 0..2000 {
                 let u = s.get4(i, 0);
-                let Some(ds) = g.sample(N, v, N, [u[0], u[1], u[2]]) else { continue };
+                let Some(ds) = g.sample(N, v, N, [u[0], u[1], u[2]]) else {
+                    continue;
+                };
                 let (f, pdf) = g.eval(N, v, ds.l, N);
                 assert!(!ds.singular);
                 let rel = (pdf - ds.pdf).abs() / pdf.max(1e-6);
-                assert!(rel < 2e-3, "{dist:?} eta {eta}: pdf {pdf} vs sampled {}", ds.pdf);
+                assert!(
+                    rel < 2e-3,
+                    "{dist:?} eta {eta}: pdf {pdf} vs sampled {}",
+                    ds.pdf
+                );
                 let w = f[0] / pdf;
-                assert!((w - ds.weight[0]).abs() <= 2e-3 * w.max(1.0), "{dist:?} eta {eta}: weight {w} vs {}", ds.weight[0]);
+                assert!(
+                    (w - ds.weight[0]).abs() <= 2e-3 * w.max(1.0),
+                    "{dist:?} eta {eta}: weight {w} vs {}",
+                    ds.weight[0]
+                );
                 checked += 1;
             }
-            assert!(checked > 1500, "{dist:?} eta {eta}: only {checked} valid samples");
+            assert!(
+                checked > 1500,
+                "{dist:?} eta {eta}: only {checked} valid samples"
+            );
         }
     }
 }
@@ -47,7 +69,11 @@ fn multiscatter_glass_is_white() {
     // counts refractions that leave on the wrong side, so its glass is not white there
     // either (about 3% dark at roughness 0.5, cos 0.3); glass_albedo_tables_match_cycles
     // checks that table instead.
-    for (rough, ior, backfacing) in [(0.3f32, 1.5f32, false), (0.7, 1.45, false), (0.5, 1.33, false)] {
+    for (rough, ior, backfacing) in [
+        (0.3f32, 1.5f32, false),
+        (0.7, 1.45, false),
+        (0.5, 1.33, false),
+    ] {
         for mu in [0.3f32, 0.8] {
             let g = glass_closure(tables, Some("MULTI_GGX"), false, rough, ior, backfacing, mu);
             let v = view(mu);
@@ -60,17 +86,27 @@ fn multiscatter_glass_is_white() {
                 }
             }
             let e = sum / n as f64;
-            assert!((e - 1.0).abs() < 0.03, "roughness {rough} ior {ior} back {backfacing} mu {mu}: albedo {e}");
+            assert!(
+                (e - 1.0).abs() < 0.03,
+                "roughness {rough} ior {ior} back {backfacing} mu {mu}: albedo {e}"
+            );
         }
     }
     // Plain GGX glass (single scattering) loses energy at this roughness.
     let g = glass_closure(tables, Some("GGX"), false, 0.7, 1.45, false, 0.3);
     let n = 20000;
-    let sum: f64 = (0..n).filter_map(|i| {
-        let u = s.get4(i, 3);
-        g.sample(N, view(0.3), N, [u[0], u[1], u[2]]).map(|ds| ds.weight[0] as f64)
-    }).sum();
-    assert!(sum / (n as f64) < 0.97, "single-scattering GGX glass albedo {}", sum / n as f64);
+    let sum: f64 = (0..n)
+        .filter_map(|i| {
+            let u = s.get4(i, 3);
+            g.sample(N, view(0.3), N, [u[0], u[1], u[2]])
+                .map(|ds| ds.weight[0] as f64)
+        })
+        .sum();
+    assert!(
+        sum / (n as f64) < 0.97,
+        "single-scattering GGX glass albedo {}",
+        sum / n as f64
+    );
 }
 
 /// Oren-Nayar of white albedo reflects everything (energy-preserving multiscatter term).
@@ -93,7 +129,10 @@ fn oren_nayar_white_furnace() {
                 sum += (f / (l[2] / std::f32::consts::PI)) as f64;
             }
             let e = sum / n as f64;
-            assert!((e - 1.0).abs() < 0.02, "roughness {rough} mu {mu}: albedo {e}");
+            assert!(
+                (e - 1.0).abs() < 0.02,
+                "roughness {rough} mu {mu}: albedo {e}"
+            );
         }
     }
     // And single scattering alone loses energy at high roughness (the term matters).
@@ -101,12 +140,15 @@ fn oren_nayar_white_furnace() {
     let l = normalize([0.3, 0.2, 0.9]);
     let (t, b) = basis(N);
     assert!(dot(t, b).abs() < 1e-6);
-    assert!(on.eval(N, view(0.5), l)[0] < OrenNayar::new(1.0, [1.0; 3], 0.5).eval(N, view(0.5), l)[0]);
+    assert!(
+        on.eval(N, view(0.5), l)[0] < OrenNayar::new(1.0, [1.0; 3], 0.5).eval(N, view(0.5), l)[0]
+    );
 }
 
 /// Cycles' albedo tables, read from bpy's library by fixtures/render/cycles_albedo_tables.py.
 fn cycles_tables() -> serde_json::Value {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fixtures/render/cycles_albedo_tables.json");
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fixtures/render/cycles_albedo_tables.json");
     serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap()
 }
 
@@ -131,11 +173,22 @@ fn ggx_albedo_tables_match_cycles() {
     }
     let mean = sum / 1024.0;
     eprintln!("ggx_E: worst {worst:.5} ({at}), mean {mean:.6}");
-    assert!(worst < 0.0025 && mean < 3e-4, "ggx_E: worst {worst} at {at}, mean {mean}");
-    for (j, c) in v["tables"]["ggx_Eavg"].as_array().unwrap().iter().enumerate() {
+    assert!(
+        worst < 0.0025 && mean < 3e-4,
+        "ggx_E: worst {worst} at {at}, mean {mean}"
+    );
+    for (j, c) in v["tables"]["ggx_Eavg"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .enumerate()
+    {
         let c = c.as_f64().unwrap() as f32;
         let ours = tables.ggx_e_avg(j as f32 / 31.0);
-        assert!((ours - c).abs() < 1e-3, "ggx_Eavg at roughness {j}/31: ours {ours}, Cycles {c}");
+        assert!(
+            (ours - c).abs() < 1e-3,
+            "ggx_Eavg at roughness {j}/31: ours {ours}, Cycles {c}"
+        );
     }
 }
 
@@ -145,7 +198,12 @@ fn ggx_albedo_tables_match_cycles() {
 #[test]
 fn glass_albedo_tables_match_cycles() {
     let v = cycles_tables();
-    let slices: Vec<usize> = v["slices"].as_array().unwrap().iter().map(|s| s.as_u64().unwrap() as usize).collect();
+    let slices: Vec<usize> = v["slices"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|s| s.as_u64().unwrap() as usize)
+        .collect();
     let tables = Tables::shared();
     for (name, leaving) in [("glass_E", false), ("glass_inv_E", true)] {
         let t = v["tables"][name].as_array().unwrap();
@@ -154,7 +212,11 @@ fn glass_albedo_tables_match_cycles() {
             // The IOR whose lookup lands exactly on slice zi (the last slice is looked up
             // at z = 1, however large the IOR).
             let z = zi as f32 / 15.0;
-            let ior = if zi == 15 { 1e6 } else { (1.0 + z * z) / (1.0 - z * z) };
+            let ior = if zi == 15 {
+                1e6
+            } else {
+                (1.0 + z * z) / (1.0 - z * z)
+            };
             let eta = if leaving { 1.0 / ior } else { ior };
             for (i, row) in t[k].as_array().unwrap().iter().enumerate() {
                 for (j, c) in row.as_array().unwrap().iter().enumerate() {
@@ -165,13 +227,18 @@ fn glass_albedo_tables_match_cycles() {
                     n += 1;
                     if d > worst {
                         worst = d;
-                        at = format!("slice {zi} cos {i}/15 roughness {j}/15: ours {ours}, Cycles {c}");
+                        at = format!(
+                            "slice {zi} cos {i}/15 roughness {j}/15: ours {ours}, Cycles {c}"
+                        );
                     }
                 }
             }
         }
         let mean = sum / n as f64;
         eprintln!("{name}: worst {worst:.5} ({at}), mean {mean:.6}");
-        assert!(worst < 0.005 && mean < 6e-4, "{name}: worst {worst} at {at}, mean {mean}");
+        assert!(
+            worst < 0.005 && mean < 6e-4,
+            "{name}: worst {worst} at {at}, mean {mean}"
+        );
     }
 }

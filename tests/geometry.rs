@@ -27,7 +27,16 @@ const POS_TOL: f32 = 1e-5;
 const TEXTURE_TOL: f64 = 1e-4;
 /// (Image Texture: Blender turns sRGB texels linear with OpenColorIO's CPU exponent,
 /// about 2e-5 relative from the exact transfer function ours computes.)
-const TEXTURE_NODES: &[&str] = &["voronoi", "white_noise", "gradient", "wave", "magic", "checker", "brick", "image_texture"];
+const TEXTURE_NODES: &[&str] = &[
+    "voronoi",
+    "white_noise",
+    "gradient",
+    "wave",
+    "magic",
+    "checker",
+    "brick",
+    "image_texture",
+];
 /// Blackbody in Geometry Nodes goes through Blender's Rec.709 -> scene-linear matrix,
 /// derived from the OCIO config in float: identity to about 6e-6 relative (Cycles treats
 /// it as identity, and so do we), 3e-5 absolute on the fit's largest values (~5.4).
@@ -40,12 +49,23 @@ fn scenes_dir() -> PathBuf {
 
 /// Symmetric Hausdorff distance between two point sets (brute force: cases are small).
 fn hausdorff(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
-    let d = |p: &[f32; 3], q: &[f32; 3]| -> f64 { (0..3).map(|k| (p[k] as f64 - q[k] as f64).powi(2)).sum::<f64>().sqrt() };
+    let d = |p: &[f32; 3], q: &[f32; 3]| -> f64 {
+        (0..3)
+            .map(|k| (p[k] as f64 - q[k] as f64).powi(2))
+            .sum::<f64>()
+            .sqrt()
+    };
     let one = |x: &[[f32; 3]], y: &[[f32; 3]]| -> f64 {
-        x.iter().map(|p| y.iter().map(|q| d(p, q)).fold(f64::INFINITY, f64::min)).fold(0.0, f64::max)
+        x.iter()
+            .map(|p| y.iter().map(|q| d(p, q)).fold(f64::INFINITY, f64::min))
+            .fold(0.0, f64::max)
     };
     if a.is_empty() || b.is_empty() {
-        return if a.len() == b.len() { 0.0 } else { f64::INFINITY };
+        return if a.len() == b.len() {
+            0.0
+        } else {
+            f64::INFINITY
+        };
     }
     one(a, b).max(one(b, a))
 }
@@ -69,12 +89,27 @@ fn diagonal(p: &[[f32; 3]]) -> f64 {
 fn ref_values(d: &AttributeData) -> Vec<Vec<f64>> {
     match d {
         AttributeData::Float(v) => v.iter().map(|x| vec![*x as f64]).collect(),
-        AttributeData::Float2(v) => v.iter().map(|x| x.iter().map(|c| *c as f64).collect()).collect(),
-        AttributeData::Float3(v) => v.iter().map(|x| x.iter().map(|c| *c as f64).collect()).collect(),
-        AttributeData::Color(v) | AttributeData::Quaternion(v) => v.iter().map(|x| x.iter().map(|c| *c as f64).collect()).collect(),
-        AttributeData::Float4x4(v) => v.iter().map(|x| x.iter().map(|c| *c as f64).collect()).collect(),
+        AttributeData::Float2(v) => v
+            .iter()
+            .map(|x| x.iter().map(|c| *c as f64).collect())
+            .collect(),
+        AttributeData::Float3(v) => v
+            .iter()
+            .map(|x| x.iter().map(|c| *c as f64).collect())
+            .collect(),
+        AttributeData::Color(v) | AttributeData::Quaternion(v) => v
+            .iter()
+            .map(|x| x.iter().map(|c| *c as f64).collect())
+            .collect(),
+        AttributeData::Float4x4(v) => v
+            .iter()
+            .map(|x| x.iter().map(|c| *c as f64).collect())
+            .collect(),
         AttributeData::Int(v) => v.iter().map(|x| vec![*x as f64]).collect(),
-        AttributeData::Int2(v) => v.iter().map(|x| x.iter().map(|c| *c as f64).collect()).collect(),
+        AttributeData::Int2(v) => v
+            .iter()
+            .map(|x| x.iter().map(|c| *c as f64).collect())
+            .collect(),
         AttributeData::Int8(v) => v.iter().map(|x| vec![*x as f64]).collect(),
         AttributeData::Bool(v) => v.iter().map(|x| vec![*x as u8 as f64]).collect(),
     }
@@ -88,8 +123,12 @@ fn our_values(a: &Array) -> Vec<Vec<f64>> {
             geometry::types::Value::Bool(x) => vec![x as u8 as f64],
             geometry::types::Value::Float2(x) => x.iter().map(|c| *c as f64).collect(),
             geometry::types::Value::Vector(x) => x.iter().map(|c| *c as f64).collect(),
-            geometry::types::Value::Color(x) | geometry::types::Value::ByteColor(x) | geometry::types::Value::Quaternion(x) => x.iter().map(|c| *c as f64).collect(),
-            geometry::types::Value::Matrix(m) => m.iter().flat_map(|c| c.iter().map(|x| *x as f64)).collect(),
+            geometry::types::Value::Color(x)
+            | geometry::types::Value::ByteColor(x)
+            | geometry::types::Value::Quaternion(x) => x.iter().map(|c| *c as f64).collect(),
+            geometry::types::Value::Matrix(m) => {
+                m.iter().flat_map(|c| c.iter().map(|x| *x as f64)).collect()
+            }
             geometry::types::Value::Int8(x) => vec![x as f64],
             geometry::types::Value::Int2(x) => x.iter().map(|c| *c as f64).collect(),
         })
@@ -100,14 +139,27 @@ struct Report {
     lines: Vec<String>,
     failures: Vec<String>,
     /// Per node of NODE.CASE attributes: (cases, attributes, worst error, worst attribute).
-    per_node: std::collections::BTreeMap<String, (std::collections::BTreeSet<String>, usize, f64, String)>,
+    per_node: std::collections::BTreeMap<
+        String,
+        (std::collections::BTreeSet<String>, usize, f64, String),
+    >,
 }
 
 fn compare(case: &str, ours: &Mesh, theirs: &MeshData, r: &mut Report) {
     let mut fail = |m: String| r.failures.push(format!("{case}: {m}"));
     let counts = |v: usize, e: usize, f: usize, c: usize| format!("v{v} e{e} f{f} c{c}");
-    let oc = counts(ours.vertex_count(), ours.edge_count(), ours.face_count(), ours.corner_count());
-    let tc = counts(theirs.vertex_count(), theirs.edges.len(), theirs.face_count(), theirs.corner_count());
+    let oc = counts(
+        ours.vertex_count(),
+        ours.edge_count(),
+        ours.face_count(),
+        ours.corner_count(),
+    );
+    let tc = counts(
+        theirs.vertex_count(),
+        theirs.edges.len(),
+        theirs.face_count(),
+        theirs.corner_count(),
+    );
     if oc != tc {
         fail(format!("counts differ: blendsynth {oc}, Blender {tc}"));
         r.lines.push(format!("{case:28} FAIL counts {oc} vs {tc}"));
@@ -120,26 +172,53 @@ fn compare(case: &str, ours: &Mesh, theirs: &MeshData, r: &mut Report) {
         .map(|(a, b)| (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0f32, f32::max))
         .fold(0.0f32, f32::max);
     if max_err > POS_TOL {
-        let worst = ours.positions.iter().zip(&theirs.positions).enumerate().max_by(|x, y| {
-            let e = |(a, b): (&[f32; 3], &[f32; 3])| (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0f32, f32::max);
-            e(x.1).partial_cmp(&e(y.1)).unwrap()
-        });
+        let worst = ours
+            .positions
+            .iter()
+            .zip(&theirs.positions)
+            .enumerate()
+            .max_by(|x, y| {
+                let e = |(a, b): (&[f32; 3], &[f32; 3])| {
+                    (0..3).map(|k| (a[k] - b[k]).abs()).fold(0.0f32, f32::max)
+                };
+                e(x.1).partial_cmp(&e(y.1)).unwrap()
+            });
         let (i, (a, b)) = worst.unwrap();
-        fail(format!("max position error {max_err:.3e} > {POS_TOL:e} (vertex {i}: {a:?} vs {b:?})"));
+        fail(format!(
+            "max position error {max_err:.3e} > {POS_TOL:e} (vertex {i}: {a:?} vs {b:?})"
+        ));
     }
     let diag = diagonal(&theirs.positions);
     let h = hausdorff(&ours.positions, &theirs.positions);
     if h > HAUSDORFF_REL_TOL * diag.max(1e-9) {
-        fail(format!("Hausdorff distance {h:.3e} > {HAUSDORFF_REL_TOL:e} x diagonal {diag:.3}"));
+        fail(format!(
+            "Hausdorff distance {h:.3e} > {HAUSDORFF_REL_TOL:e} x diagonal {diag:.3}"
+        ));
     }
-    let offsets_ours: Vec<u32> = if ours.face_count() == 0 { vec![] } else { ours.face_offsets.clone() };
-    let offsets_theirs: Vec<u32> = if theirs.face_count() == 0 { vec![] } else { theirs.face_offsets.clone() };
+    let offsets_ours: Vec<u32> = if ours.face_count() == 0 {
+        vec![]
+    } else {
+        ours.face_offsets.clone()
+    };
+    let offsets_theirs: Vec<u32> = if theirs.face_count() == 0 {
+        vec![]
+    } else {
+        theirs.face_offsets.clone()
+    };
     if offsets_ours != offsets_theirs || ours.corner_verts != theirs.corner_verts {
-        let first = ours.corner_verts.iter().zip(&theirs.corner_verts).position(|(a, b)| a != b);
+        let first = ours
+            .corner_verts
+            .iter()
+            .zip(&theirs.corner_verts)
+            .position(|(a, b)| a != b);
         fail(format!("faces differ (first corner mismatch at {first:?})"));
     }
     if ours.edges != theirs.edges {
-        let first = ours.edges.iter().zip(&theirs.edges).position(|(a, b)| a != b);
+        let first = ours
+            .edges
+            .iter()
+            .zip(&theirs.edges)
+            .position(|(a, b)| a != b);
         fail(format!("edges differ (first at {first:?})"));
     } else if ours.corner_edges != theirs.corner_edges {
         fail("corner edges differ".into());
@@ -153,7 +232,12 @@ fn compare(case: &str, ours: &Mesh, theirs: &MeshData, r: &mut Report) {
         let got = match ours_attr {
             Some(a) => {
                 if a.domain.name() != ta.domain.name() {
-                    fail(format!("attribute {:?} on {} in Blender, {} here", ta.name, ta.domain.name(), a.domain.name()));
+                    fail(format!(
+                        "attribute {:?} on {} in Blender, {} here",
+                        ta.name,
+                        ta.domain.name(),
+                        a.domain.name()
+                    ));
                     continue;
                 }
                 our_values(&a.data)
@@ -163,7 +247,12 @@ fn compare(case: &str, ours: &Mesh, theirs: &MeshData, r: &mut Report) {
                 "material_index" => vec![vec![0.0]; expected.len()],
                 "sharp_face" | "sharp_edge" => vec![vec![0.0]; expected.len()],
                 _ => {
-                    fail(format!("attribute {:?} ({} {}) missing", ta.name, ta.domain.name(), ta.data_type));
+                    fail(format!(
+                        "attribute {:?} ({} {}) missing",
+                        ta.name,
+                        ta.domain.name(),
+                        ta.data_type
+                    ));
                     continue;
                 }
             },
@@ -171,10 +260,18 @@ fn compare(case: &str, ours: &Mesh, theirs: &MeshData, r: &mut Report) {
         let err = expected
             .iter()
             .zip(&got)
-            .map(|(e, g)| e.iter().zip(g).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max))
+            .map(|(e, g)| {
+                e.iter()
+                    .zip(g)
+                    .map(|(x, y)| (x - y).abs())
+                    .fold(0.0, f64::max)
+            })
             .fold(0.0, f64::max);
         let node = ta.name.split_once('.').map(|(node, _)| node);
-        let tol = if matches!(ta.data, AttributeData::Int(_) | AttributeData::Bool(_) | AttributeData::Int8(_)) {
+        let tol = if matches!(
+            ta.data,
+            AttributeData::Int(_) | AttributeData::Bool(_) | AttributeData::Int8(_)
+        ) {
             0.0
         } else if node.is_some_and(|n| TEXTURE_NODES.contains(&n)) {
             TEXTURE_TOL
@@ -185,11 +282,21 @@ fn compare(case: &str, ours: &Mesh, theirs: &MeshData, r: &mut Report) {
         };
         if got.len() != expected.len() || err > tol {
             let worst = expected.iter().zip(&got).enumerate().max_by(|x, y| {
-                let e = |(a, b): (&Vec<f64>, &Vec<f64>)| a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+                let e = |(a, b): (&Vec<f64>, &Vec<f64>)| {
+                    a.iter()
+                        .zip(b)
+                        .map(|(x, y)| (x - y).abs())
+                        .fold(0.0, f64::max)
+                };
                 e(x.1).total_cmp(&e(y.1))
             });
-            let at = worst.map(|(i, (e, g))| format!(" at element {i}: Blender {e:?}, blendsynth {g:?}")).unwrap_or_default();
-            fail(format!("attribute {:?} differs (max error {err:.3e} > {tol:e}){at}", ta.name));
+            let at = worst
+                .map(|(i, (e, g))| format!(" at element {i}: Blender {e:?}, blendsynth {g:?}"))
+                .unwrap_or_default();
+            fail(format!(
+                "attribute {:?} differs (max error {err:.3e} > {tol:e}){at}",
+                ta.name
+            ));
         }
         if let Some(node) = node {
             let case = ta.name.split('.').take(2).collect::<Vec<_>>().join(".");
@@ -209,7 +316,9 @@ fn compare(case: &str, ours: &Mesh, theirs: &MeshData, r: &mut Report) {
         if theirs.attribute(name).is_none() {
             if let Some(a) = ours.attributes.named(name) {
                 if our_values(&a.data).iter().any(|v| v[0] != 0.0) {
-                    fail(format!("attribute {name:?} is set here but absent (default) in Blender"));
+                    fail(format!(
+                        "attribute {name:?} is set here but absent (default) in Blender"
+                    ));
                 }
             }
         }
@@ -223,7 +332,9 @@ fn run_scene(dir: &Path, r: &mut Report) -> usize {
     for (i, e) in scene.file.evaluated.iter().enumerate() {
         let case = format!("{scene_name}/{}", e.object);
         let reference = scene.load_evaluated(i).unwrap_or_else(|e| panic!("{e}"));
-        match geometry::evaluate_object(&scene, &e.object, e.frame, &[]).and_then(|g| geometry::realize_to_mesh(&g)) {
+        match geometry::evaluate_object(&scene, &e.object, e.frame, &[])
+            .and_then(|g| geometry::realize_to_mesh(&g))
+        {
             Ok(m) => {
                 if let Err(err) = m.validate() {
                     r.failures.push(format!("{case}: invalid mesh: {err}"));
@@ -241,8 +352,16 @@ fn run_scene(dir: &Path, r: &mut Report) -> usize {
 
 #[test]
 fn geometry_nodes_match_blender() {
-    let mut r = Report { lines: Vec::new(), failures: Vec::new(), per_node: Default::default() };
-    let mut dirs: Vec<PathBuf> = std::fs::read_dir(scenes_dir()).expect("fixtures/geometry/scenes").map(|e| e.unwrap().path()).filter(|p| p.is_dir()).collect();
+    let mut r = Report {
+        lines: Vec::new(),
+        failures: Vec::new(),
+        per_node: Default::default(),
+    };
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(scenes_dir())
+        .expect("fixtures/geometry/scenes")
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_dir())
+        .collect();
     dirs.sort();
     // The fixture scene of the renderer tests: Grid, Subdivide, noise Set Position,
     // Poisson distribution, instanced Ico Spheres, Join, Set Material, Shade Smooth.
@@ -257,10 +376,17 @@ fn geometry_nodes_match_blender() {
     }
     println!("Per node (NODE.CASE attributes): cases, attributes, worst absolute error");
     for (node, (cases, attrs, worst, name)) in &r.per_node {
-        println!("  {node:16} {:3} cases {attrs:3} attrs  worst {worst:.2e} ({name})", cases.len());
+        println!(
+            "  {node:16} {:3} cases {attrs:3} attrs  worst {worst:.2e} ({name})",
+            cases.len()
+        );
     }
     if !r.failures.is_empty() {
-        panic!("{} mismatch(es):\n  {}", r.failures.len(), r.failures.join("\n  "));
+        panic!(
+            "{} mismatch(es):\n  {}",
+            r.failures.len(),
+            r.failures.join("\n  ")
+        );
     }
     assert!(n >= 30, "expected the parity fixtures, found {n} cases");
 }
@@ -270,17 +396,32 @@ fn load(name: &str) -> Scene {
 }
 
 fn evaluated(scene: &Scene, object: &str) -> MeshData {
-    let i = scene.file.evaluated.iter().position(|e| e.object == object).expect("reference");
+    let i = scene
+        .file
+        .evaluated
+        .iter()
+        .position(|e| e.object == object)
+        .expect("reference");
     scene.load_evaluated(i).unwrap()
 }
 
-fn mesh_of(scene: &Scene, object: &str, frame: f64, overrides: &[(String, serde_json::Value)]) -> Result<Mesh, String> {
-    geometry::evaluate_object(scene, object, frame, overrides).and_then(|g| geometry::realize_to_mesh(&g)).map_err(|e| e.to_string())
+fn mesh_of(
+    scene: &Scene,
+    object: &str,
+    frame: f64,
+    overrides: &[(String, serde_json::Value)],
+) -> Result<Mesh, String> {
+    geometry::evaluate_object(scene, object, frame, overrides)
+        .and_then(|g| geometry::realize_to_mesh(&g))
+        .map_err(|e| e.to_string())
 }
 
 fn max_diff(a: &[[f32; 3]], b: &[[f32; 3]]) -> f32 {
     assert_eq!(a.len(), b.len());
-    a.iter().zip(b).map(|(p, q)| (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0, f32::max)).fold(0.0, f32::max)
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| (0..3).map(|k| (p[k] - q[k]).abs()).fold(0.0, f32::max))
+        .fold(0.0, f32::max)
 }
 
 #[test]
@@ -289,28 +430,68 @@ fn overrides_reach_modifier_inputs_and_node_values() {
     let frame = scene.file.scene.frame_current as f64;
     // A modifier input set by data path gives what Blender gave the object that set it.
     let set = evaluated(&scene, "io_set");
-    let m = mesh_of(&scene, "io_default", frame, &[("objects[\"io_default\"].modifiers[\"io_default\"][\"Socket_2\"]".into(), serde_json::json!(1.75))]).unwrap();
-    assert!(max_diff(&m.positions, &set.positions) <= POS_TOL, "modifier input override");
+    let m = mesh_of(
+        &scene,
+        "io_default",
+        frame,
+        &[(
+            "objects[\"io_default\"].modifiers[\"io_default\"][\"Socket_2\"]".into(),
+            serde_json::json!(1.75),
+        )],
+    )
+    .unwrap();
+    assert!(
+        max_diff(&m.positions, &set.positions) <= POS_TOL,
+        "modifier input override"
+    );
     // A node socket value (here an animated one: the override wins over the F-curve).
     let base = mesh_of(&scene, "animated", frame, &[]).unwrap();
     let path = "bpy.data.node_groups[\"animated\"].nodes[\"Height\"].outputs[0].default_value";
-    let m = mesh_of(&scene, "animated", frame, &[(path.into(), serde_json::json!(3.0))]).unwrap();
-    assert!(m.positions.iter().all(|p| (p[2] - 3.0).abs() < 1e-6), "{:?}", m.positions);
+    let m = mesh_of(
+        &scene,
+        "animated",
+        frame,
+        &[(path.into(), serde_json::json!(3.0))],
+    )
+    .unwrap();
+    assert!(
+        m.positions.iter().all(|p| (p[2] - 3.0).abs() < 1e-6),
+        "{:?}",
+        m.positions
+    );
     assert!(base.positions.iter().all(|p| (p[2] - 3.0).abs() > 0.5));
     // The animation itself: at frame 11 the value is 1.2 and Scene Time says 11.
     let m = mesh_of(&scene, "animated", 11.0, &[]).unwrap();
-    assert!(m.positions.iter().all(|p| (p[2] - 1.2).abs() < 1e-6), "{:?}", m.positions);
+    assert!(
+        m.positions.iter().all(|p| (p[2] - 1.2).abs() < 1e-6),
+        "{:?}",
+        m.positions
+    );
     // Bad paths are errors naming the path.
-    let e = mesh_of(&scene, "io_default", frame, &[("node_groups[\"nope\"].nodes[\"x\"].outputs[0].default_value".into(), serde_json::json!(1))]).unwrap_err();
+    let e = mesh_of(
+        &scene,
+        "io_default",
+        frame,
+        &[(
+            "node_groups[\"nope\"].nodes[\"x\"].outputs[0].default_value".into(),
+            serde_json::json!(1),
+        )],
+    )
+    .unwrap_err();
     assert!(e.contains("nope"), "{e}");
 }
 
 #[test]
 fn unsupported_nodes_are_errors_naming_tree_and_node() {
-    let scene = Scene::load(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/scenes/geonodes")).unwrap();
+    let scene =
+        Scene::load(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/scenes/geonodes"))
+            .unwrap();
     let over = [("node_groups[\"Terrain Builder\"].nodes[\"Ico Sphere\"].inputs[\"Subdivisions\"].default_value".to_string(), serde_json::json!(3))];
     let e = mesh_of(&scene, "Terrain", 1.0, &over).unwrap_err();
-    assert!(e.contains("Terrain Builder") && e.contains("Ico Sphere"), "{e}");
+    assert!(
+        e.contains("Terrain Builder") && e.contains("Ico Sphere"),
+        "{e}"
+    );
     let e = mesh_of(&scene, "No Such Object", 1.0, &[]).unwrap_err();
     assert!(e.contains("No Such Object"), "{e}");
 }
@@ -330,22 +511,40 @@ fn exports_round_trip() {
     let ply = dir.path().join("m.ply");
     geometry::write_ply(&ply, &m).unwrap();
     let head = std::fs::read(&ply).unwrap();
-    assert!(String::from_utf8_lossy(&head[..200]).contains(&format!("element vertex {}", m.vertex_count())));
+    assert!(String::from_utf8_lossy(&head[..200])
+        .contains(&format!("element vertex {}", m.vertex_count())));
     let obj = dir.path().join("m.obj");
     geometry::write_obj(&obj, &m).unwrap();
     let o = blendsynth::scene::read_obj(&obj).unwrap();
     assert_eq!(o.vertex_count(), m.vertex_count());
     assert_eq!(o.face_count(), m.face_count());
     // (tobj renumbers vertices in order of use, so compare what each corner points at.)
-    let corner_pos = |p: &[[f32; 3]], cv: &[u32]| cv.iter().map(|&v| p[v as usize]).collect::<Vec<_>>();
-    assert_eq!(corner_pos(&o.positions, &o.corner_verts), corner_pos(&m.positions, &m.corner_verts));
+    let corner_pos =
+        |p: &[[f32; 3]], cv: &[u32]| cv.iter().map(|&v| p[v as usize]).collect::<Vec<_>>();
+    assert_eq!(
+        corner_pos(&o.positions, &o.corner_verts),
+        corner_pos(&m.positions, &m.corner_verts)
+    );
 }
 
 #[test]
 fn parity_fixtures_stay_small() {
     fn size(p: &Path) -> u64 {
-        std::fs::read_dir(p).unwrap().map(|e| e.unwrap().path()).map(|p| if p.is_dir() { size(&p) } else { p.metadata().unwrap().len() }).sum()
+        std::fs::read_dir(p)
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .map(|p| {
+                if p.is_dir() {
+                    size(&p)
+                } else {
+                    p.metadata().unwrap().len()
+                }
+            })
+            .sum()
     }
     let total = size(&scenes_dir());
-    assert!(total < 6_000_000, "fixtures/geometry/scenes holds {total} bytes; keep it under 6 MB");
+    assert!(
+        total < 6_000_000,
+        "fixtures/geometry/scenes holds {total} bytes; keep it under 6 MB"
+    );
 }

@@ -34,17 +34,28 @@ impl<'a> Grid<'a> {
         Grid { cell, cells, pts }
     }
     fn key(p: &[f32; 3], cell: f64) -> (i64, i64, i64) {
-        ((p[0] as f64 / cell).floor() as i64, (p[1] as f64 / cell).floor() as i64, (p[2] as f64 / cell).floor() as i64)
+        (
+            (p[0] as f64 / cell).floor() as i64,
+            (p[1] as f64 / cell).floor() as i64,
+            (p[2] as f64 / cell).floor() as i64,
+        )
     }
     /// Distance to the nearest point if it is within one cell, else infinity.
     fn nearest_within_cell(&self, q: &[f32; 3]) -> f64 {
         let k = Self::key(q, self.cell);
         let dist = |i: u32| {
             let p = &self.pts[i as usize];
-            (0..3).map(|c| (p[c] as f64 - q[c] as f64).powi(2)).sum::<f64>().sqrt()
+            (0..3)
+                .map(|c| (p[c] as f64 - q[c] as f64).powi(2))
+                .sum::<f64>()
+                .sqrt()
         };
         // Own cell first: a point there nearer than any face of the cell is the nearest.
-        let mut best = self.cells.get(&k).map(|v| v.iter().map(|&i| dist(i)).fold(f64::INFINITY, f64::min)).unwrap_or(f64::INFINITY);
+        let mut best = self
+            .cells
+            .get(&k)
+            .map(|v| v.iter().map(|&i| dist(i)).fold(f64::INFINITY, f64::min))
+            .unwrap_or(f64::INFINITY);
         let to_face = (0..3)
             .map(|c| {
                 let lo = k_coord(k, c) as f64 * self.cell;
@@ -61,7 +72,10 @@ impl<'a> Grid<'a> {
                     if let Some(v) = self.cells.get(&(k.0 + dx, k.1 + dy, k.2 + dz)) {
                         for &i in v {
                             let p = &self.pts[i as usize];
-                            let d = (0..3).map(|c| (p[c] as f64 - q[c] as f64).powi(2)).sum::<f64>().sqrt();
+                            let d = (0..3)
+                                .map(|c| (p[c] as f64 - q[c] as f64).powi(2))
+                                .sum::<f64>()
+                                .sqrt();
                             best = best.min(d);
                         }
                     }
@@ -108,27 +122,54 @@ fn diagonal(p: &[[f32; 3]]) -> f64 {
 
 #[test]
 fn colon_matches_blender_at_frames_and_parameter_sets() {
-    let Some(python) = common::require("bpy python", common::bpy_python()) else { return };
-    let Some(blend) = common::require("../shared/published/colon_nodes.blend", common::published_colon()) else { return };
+    let Some(python) = common::require("bpy python", common::bpy_python()) else {
+        return;
+    };
+    let Some(blend) = common::require(
+        "../shared/published/colon_nodes.blend",
+        common::published_colon(),
+    ) else {
+        return;
+    };
     let tmp = tempfile::tempdir().unwrap();
     let scene_dir = tmp.path().join("scene");
     let o = common::run(
-        &["convert", blend.to_str().unwrap(), "-o", scene_dir.to_str().unwrap(), "--no-evaluated", "--blender", python.to_str().unwrap()],
+        &[
+            "convert",
+            blend.to_str().unwrap(),
+            "-o",
+            scene_dir.to_str().unwrap(),
+            "--no-evaluated",
+            "--blender",
+            python.to_str().unwrap(),
+        ],
         &[],
     );
     assert!(o.status.success(), "convert: {}", common::stderr(&o));
     let refs = tmp.path().join("refs");
     let script = common::repo().join("fixtures/geometry/colon_refs.py");
-    let out = common::run_python(&python, &script, &[blend.to_str().unwrap(), refs.to_str().unwrap()]);
-    let doc: serde_json::Value = serde_json::from_str(out.lines().last().unwrap()).expect("colon_refs.py JSON");
+    let out = common::run_python(
+        &python,
+        &script,
+        &[blend.to_str().unwrap(), refs.to_str().unwrap()],
+    );
+    let doc: serde_json::Value =
+        serde_json::from_str(out.lines().last().unwrap()).expect("colon_refs.py JSON");
     let scene = Scene::load(&scene_dir).unwrap();
     let mut failures = Vec::new();
     for cfg in doc["configurations"].as_array().unwrap() {
         let name = cfg["name"].as_str().unwrap();
         let frame = cfg["frame"].as_f64().unwrap();
-        let overrides: Vec<(String, serde_json::Value)> = cfg["overrides"].as_object().unwrap().iter().map(|(k, v)| (k.clone(), serde_json::json!(v.as_f64().unwrap()))).collect();
+        let overrides: Vec<(String, serde_json::Value)> = cfg["overrides"]
+            .as_object()
+            .unwrap()
+            .iter()
+            .map(|(k, v)| (k.clone(), serde_json::json!(v.as_f64().unwrap())))
+            .collect();
         let start = std::time::Instant::now();
-        let mesh = match geometry::evaluate_object(&scene, "Colon", frame, &overrides).and_then(|g| geometry::realize_to_mesh(&g)) {
+        let mesh = match geometry::evaluate_object(&scene, "Colon", frame, &overrides)
+            .and_then(|g| geometry::realize_to_mesh(&g))
+        {
             Ok(m) => m,
             Err(e) => {
                 failures.push(format!("{name}: {e}"));
@@ -137,8 +178,14 @@ fn colon_matches_blender_at_frames_and_parameter_sets() {
         };
         let ours_s = start.elapsed().as_secs_f64();
         let bytes = std::fs::read(refs.join(format!("{name}.bin"))).unwrap();
-        let theirs: Vec<[f32; 3]> = bytes.chunks_exact(12).map(|c| [0, 1, 2].map(|k| f32::from_le_bytes(c[4 * k..4 * k + 4].try_into().unwrap()))).collect();
-        let (nv, nf) = (cfg["vertex_count"].as_u64().unwrap() as usize, cfg["face_count"].as_u64().unwrap() as usize);
+        let theirs: Vec<[f32; 3]> = bytes
+            .chunks_exact(12)
+            .map(|c| [0, 1, 2].map(|k| f32::from_le_bytes(c[4 * k..4 * k + 4].try_into().unwrap())))
+            .collect();
+        let (nv, nf) = (
+            cfg["vertex_count"].as_u64().unwrap() as usize,
+            cfg["face_count"].as_u64().unwrap() as usize,
+        );
         let diag = diagonal(&theirs);
         let tol = 1e-4 * diag;
         let (h1, far1) = directed(&mesh.positions, &theirs, tol);
@@ -151,11 +198,20 @@ fn colon_matches_blender_at_frames_and_parameter_sets() {
             h1.max(h2)
         );
         if mesh.vertex_count() != nv || mesh.face_count() != nf {
-            failures.push(format!("{name}: counts v{} f{} vs Blender v{nv} f{nf}", mesh.vertex_count(), mesh.face_count()));
+            failures.push(format!(
+                "{name}: counts v{} f{} vs Blender v{nv} f{nf}",
+                mesh.vertex_count(),
+                mesh.face_count()
+            ));
         }
         if far1 + far2 > 0 {
             failures.push(format!("{name}: {far1} of our vertices and {far2} of Blender's are farther than {tol:.3e} from the other mesh"));
         }
     }
-    assert!(failures.is_empty(), "{} mismatch(es):\n  {}", failures.len(), failures.join("\n  "));
+    assert!(
+        failures.is_empty(),
+        "{} mismatch(es):\n  {}",
+        failures.len(),
+        failures.join("\n  ")
+    );
 }

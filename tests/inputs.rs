@@ -26,22 +26,33 @@ fn tolerance(case: &str) -> f32 {
 }
 
 fn check(results: &[(String, f32)]) {
-    let bad: Vec<_> = results.iter().filter(|(c, w)| !(*w <= tolerance(c))).collect();
+    let bad: Vec<_> = results
+        .iter()
+        .filter(|(c, w)| !(*w <= tolerance(c)))
+        .collect();
     assert!(bad.is_empty(), "cases over their tolerance: {bad:?}");
     assert!(results.len() >= 26, "every case ran");
 }
 
 #[test]
 fn input_nodes_match_cycles_emit_bakes() {
-    check(&common::bake_cases_worst(&repo().join("fixtures/bake/inputs")));
+    check(&common::bake_cases_worst(
+        &repo().join("fixtures/bake/inputs"),
+    ));
 }
 
 /// Blender-side: bake the cases afresh with Cycles and compare against those bakes.
 #[test]
 fn fresh_cycles_input_bakes_match() {
-    let Some(py) = require("a Python with bpy 4.5.4", bpy_python()) else { return };
+    let Some(py) = require("a Python with bpy 4.5.4", bpy_python()) else {
+        return;
+    };
     let t = tempfile::tempdir().unwrap();
-    run_python(&py, &repo().join("fixtures/bake/make_input_refs.py"), &["--out", t.path().to_str().unwrap()]);
+    run_python(
+        &py,
+        &repo().join("fixtures/bake/make_input_refs.py"),
+        &["--out", t.path().to_str().unwrap()],
+    );
     check(&common::bake_cases_worst(t.path()));
 }
 
@@ -67,26 +78,55 @@ fn view_dependent_inputs_match_cycles_renders() {
     use blendsynth::render::{render, RenderOptions};
     let root = repo().join("fixtures/render_inputs");
     let mut failures = Vec::new();
-    let probe: Vec<f32> = std::fs::read(root.join("window/cycles.f32")).unwrap().chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+    let probe: Vec<f32> = std::fs::read(root.join("window/cycles.f32"))
+        .unwrap()
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
     for case in ["facing", "camera", "incoming", "window", "reflection"] {
         let dir = root.join(case);
-        let meta: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("view.json")).unwrap()).unwrap();
-        let (w, h) = (meta["width"].as_u64().unwrap() as usize, meta["height"].as_u64().unwrap() as usize);
-        let reference: Vec<f32> = std::fs::read(dir.join("cycles.f32")).unwrap().chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+        let meta: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.join("view.json")).unwrap()).unwrap();
+        let (w, h) = (
+            meta["width"].as_u64().unwrap() as usize,
+            meta["height"].as_u64().unwrap() as usize,
+        );
+        let reference: Vec<f32> = std::fs::read(dir.join("cycles.f32"))
+            .unwrap()
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+            .collect();
         let scene = Scene::load(&dir).unwrap();
-        let opts = RenderOptions { samples: Some(meta["samples"].as_u64().unwrap() as u32), resolution: Some((w as u32, h as u32)), seed: Some(0), threads: Some(1), ..Default::default() };
+        let opts = RenderOptions {
+            samples: Some(meta["samples"].as_u64().unwrap() as u32),
+            resolution: Some((w as u32, h as u32)),
+            seed: Some(0),
+            threads: Some(1),
+            ..Default::default()
+        };
         let out = render(&scene, &opts).unwrap_or_else(|e| panic!("{case}: {e}"));
         let ids = &out.passes.object_index;
         let (mut worst, mut at, mut compared) = (0.0f32, (0, 0, 0), 0);
         for y in 0..h {
             for x in 0..w {
                 let id = ids[y * w + x];
-                let edge = id == 0 || (-1..=1).any(|dy: i64| (-1..=1).any(|dx: i64| {
-                    let (nx, ny) = (x as i64 + dx, y as i64 + dy);
-                    nx >= 0 && ny >= 0 && (nx as usize) < w && (ny as usize) < h && ids[ny as usize * w + nx as usize] != id
-                }));
-                let centre = [(x as f32 + 0.5) / w as f32, 1.0 - (y as f32 + 0.5) / h as f32];
-                let off_centre = (0..2).any(|k| (probe[(y * w + x) * 4 + k] - centre[k]).abs() > 1e-4);
+                let edge = id == 0
+                    || (-1..=1).any(|dy: i64| {
+                        (-1..=1).any(|dx: i64| {
+                            let (nx, ny) = (x as i64 + dx, y as i64 + dy);
+                            nx >= 0
+                                && ny >= 0
+                                && (nx as usize) < w
+                                && (ny as usize) < h
+                                && ids[ny as usize * w + nx as usize] != id
+                        })
+                    });
+                let centre = [
+                    (x as f32 + 0.5) / w as f32,
+                    1.0 - (y as f32 + 0.5) / h as f32,
+                ];
+                let off_centre =
+                    (0..2).any(|k| (probe[(y * w + x) * 4 + k] - centre[k]).abs() > 1e-4);
                 if edge || off_centre {
                     continue;
                 }
@@ -118,24 +158,55 @@ fn view_dependent_inputs_match_cycles_renders() {
 fn light_path_render_matches_cycles() {
     use blendsynth::render::{render, RenderOptions};
     let dir = repo().join("fixtures/render_inputs/light_path");
-    let meta: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("view.json")).unwrap()).unwrap();
-    let (w, h) = (meta["width"].as_u64().unwrap() as u32, meta["height"].as_u64().unwrap() as u32);
-    let load = |f: &str| -> Vec<f32> { std::fs::read(dir.join(f)).unwrap().chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect() };
+    let meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("view.json")).unwrap()).unwrap();
+    let (w, h) = (
+        meta["width"].as_u64().unwrap() as u32,
+        meta["height"].as_u64().unwrap() as u32,
+    );
+    let load = |f: &str| -> Vec<f32> {
+        std::fs::read(dir.join(f))
+            .unwrap()
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+            .collect()
+    };
     let (a, b) = (load("cycles_a.f32"), load("cycles_b.f32"));
     let scene = Scene::load(&dir).unwrap();
-    let opts = RenderOptions { samples: Some(meta["samples"].as_u64().unwrap() as u32), resolution: Some((w, h)), seed: Some(0), ..Default::default() };
+    let opts = RenderOptions {
+        samples: Some(meta["samples"].as_u64().unwrap() as u32),
+        resolution: Some((w, h)),
+        seed: Some(0),
+        ..Default::default()
+    };
     let out = render(&scene, &opts).unwrap();
-    let ours: Vec<f32> = out.color.iter().flat_map(|p| [p[0], p[1], p[2], p[3]]).collect();
+    let ours: Vec<f32> = out
+        .color
+        .iter()
+        .flat_map(|p| [p[0], p[1], p[2], p[3]])
+        .collect();
     let rmse = |x: &[f32], y: &[f32]| -> f64 {
-        let s: f64 = x.chunks(4).zip(y.chunks(4)).map(|(p, q)| (0..3).map(|k| (p[k] as f64 - q[k] as f64).powi(2)).sum::<f64>()).sum();
+        let s: f64 = x
+            .chunks(4)
+            .zip(y.chunks(4))
+            .map(|(p, q)| {
+                (0..3)
+                    .map(|k| (p[k] as f64 - q[k] as f64).powi(2))
+                    .sum::<f64>()
+            })
+            .sum();
         (s / (x.len() / 4 * 3) as f64).sqrt()
     };
-    let mean = |x: &[f32], k: usize| x.chunks(4).map(|p| p[k] as f64).sum::<f64>() / (x.len() / 4) as f64;
+    let mean =
+        |x: &[f32], k: usize| x.chunks(4).map(|p| p[k] as f64).sum::<f64>() / (x.len() / 4) as f64;
     let ratio = rmse(&ours, &a) / rmse(&b, &a).max(1e-12);
     let means: Vec<(f64, f64)> = (0..3).map(|k| (mean(&ours, k), mean(&a, k))).collect();
     eprintln!("light_path render {w}x{h}: RMSE ratio {ratio:.3}; means ours/Cycles {means:?}");
     for (k, (o, c)) in means.iter().enumerate() {
-        assert!((o - c).abs() <= 0.01 * c.abs().max(1e-3), "channel {k}: mean {o} vs Cycles {c}");
+        assert!(
+            (o - c).abs() <= 0.01 * c.abs().max(1e-3),
+            "channel {k}: mean {o} vs Cycles {c}"
+        );
     }
     assert!(ratio <= 1.15, "RMSE ratio {ratio}");
 }

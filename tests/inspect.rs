@@ -7,12 +7,23 @@ use common::*;
 use serde_json::Value;
 
 fn report(dir: &str) -> (Option<i32>, Value) {
-    let o = run(&["inspect", "--json", repo().join(dir).to_str().unwrap()], &[]);
-    (o.status.code(), serde_json::from_slice(&o.stdout).expect("JSON report"))
+    let o = run(
+        &["inspect", "--json", repo().join(dir).to_str().unwrap()],
+        &[],
+    );
+    (
+        o.status.code(),
+        serde_json::from_slice(&o.stdout).expect("JSON report"),
+    )
 }
 
 fn row<'a>(r: &'a Value, kind: &str) -> &'a Value {
-    r["coverage"].as_array().unwrap().iter().find(|c| c["bl_idname"] == kind).unwrap_or_else(|| panic!("{kind} not in coverage"))
+    r["coverage"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["bl_idname"] == kind)
+        .unwrap_or_else(|| panic!("{kind} not in coverage"))
 }
 
 #[test]
@@ -29,11 +40,26 @@ fn shared_maths_counts_only_where_an_evaluator_runs_it() {
     assert_eq!(row(&r, "ShaderNodeOutputWorld")["support"], "supported");
     // In a Geometry Nodes tree only what the geometry evaluator implements counts.
     use blendsynth::nodes::{support_in, Support};
-    assert!(matches!(support_in("GeometryNodeTree", "GeometryNodeCurveToMesh"), Support::Supported));
-    assert!(matches!(support_in("GeometryNodeTree", "GeometryNodeSubdivisionSurface"), Support::Supported));
-    assert!(matches!(support_in("GeometryNodeTree", "GeometryNodeMergeByDistance"), Support::Supported));
-    assert!(matches!(support_in("GeometryNodeTree", "GeometryNodeConvexHull"), Support::Unsupported));
-    assert!(matches!(support_in("GeometryNodeTree", "ShaderNodeBsdfPrincipled"), Support::Unsupported));
+    assert!(matches!(
+        support_in("GeometryNodeTree", "GeometryNodeCurveToMesh"),
+        Support::Supported
+    ));
+    assert!(matches!(
+        support_in("GeometryNodeTree", "GeometryNodeSubdivisionSurface"),
+        Support::Supported
+    ));
+    assert!(matches!(
+        support_in("GeometryNodeTree", "GeometryNodeMergeByDistance"),
+        Support::Supported
+    ));
+    assert!(matches!(
+        support_in("GeometryNodeTree", "GeometryNodeConvexHull"),
+        Support::Unsupported
+    ));
+    assert!(matches!(
+        support_in("GeometryNodeTree", "ShaderNodeBsdfPrincipled"),
+        Support::Unsupported
+    ));
     let (_, r) = report("fixtures/bake/scenes/uv_math");
     assert_eq!(row(&r, "ShaderNodeMath")["support"], "supported");
 }
@@ -67,7 +93,10 @@ fn texture_and_colour_nodes_count_in_geometry_nodes_trees() {
     }
     use blendsynth::nodes::{support_in, Support};
     // Gabor has no implementation on either side yet.
-    assert!(matches!(support_in("GeometryNodeTree", "ShaderNodeTexGabor"), Support::Unsupported));
+    assert!(matches!(
+        support_in("GeometryNodeTree", "ShaderNodeTexGabor"),
+        Support::Unsupported
+    ));
 }
 
 #[test]

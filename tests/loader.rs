@@ -27,17 +27,25 @@ fn load_err(dir: &Path) -> String {
         Ok(_) => panic!("{} should have been rejected", dir.display()),
         Err(e) => {
             let s = e.to_string();
-            assert!(s.contains("scene.json") || s.contains(".glb"), "error must name the file: {s}");
+            assert!(
+                s.contains("scene.json") || s.contains(".glb"),
+                "error must name the file: {s}"
+            );
             s
         }
     }
 }
 
 fn first_tree_with_links(v: &mut Value) -> &mut Value {
-    v["materials"].as_array_mut().unwrap().iter_mut().find_map(|m| {
-        let t = &mut m["node_tree"];
-        (t.is_object() && !t["links"].as_array().unwrap().is_empty()).then_some(t)
-    }).expect("fixture has a material with links")
+    v["materials"]
+        .as_array_mut()
+        .unwrap()
+        .iter_mut()
+        .find_map(|m| {
+            let t = &mut m["node_tree"];
+            (t.is_object() && !t["links"].as_array().unwrap().is_empty()).then_some(t)
+        })
+        .expect("fixture has a material with links")
 }
 
 #[test]
@@ -49,9 +57,16 @@ fn fixture_loads_and_inspects() {
     }
     let o = run(&["inspect", repo().join(FIXTURE).to_str().unwrap()], &[]);
     // Nodes are not all supported yet, so inspect says so with status 3.
-    assert!(matches!(o.status.code(), Some(0) | Some(3)), "{}", stderr(&o));
+    assert!(
+        matches!(o.status.code(), Some(0) | Some(3)),
+        "{}",
+        stderr(&o)
+    );
     assert!(stdout(&o).contains("Node coverage"));
-    let o = run(&["inspect", "--json", repo().join(FIXTURE).to_str().unwrap()], &[]);
+    let o = run(
+        &["inspect", "--json", repo().join(FIXTURE).to_str().unwrap()],
+        &[],
+    );
     let v: Value = serde_json::from_slice(&o.stdout).expect("inspect --json is JSON");
     assert!(v["coverage"].as_array().unwrap().len() >= 20);
 }
@@ -69,10 +84,16 @@ fn unknown_fields_are_tolerated() {
 #[test]
 fn missing_required_field() {
     let (_t, dir) = broken(|v| {
-        v["objects"][0].as_object_mut().unwrap().remove("matrix_world");
+        v["objects"][0]
+            .as_object_mut()
+            .unwrap()
+            .remove("matrix_world");
     });
     let e = load_err(&dir);
-    assert!(e.contains("objects[0]") && e.contains("matrix_world"), "{e}");
+    assert!(
+        e.contains("objects[0]") && e.contains("matrix_world"),
+        "{e}"
+    );
 }
 
 #[test]
@@ -111,7 +132,10 @@ fn non_finite_numbers() {
     for word in ["NaN", "Infinity", "-Infinity"] {
         let (_t, dir) = with_token(word);
         let e = load_err(&dir);
-        assert!(e.contains("non-finite") && e.contains("line "), "{word}: {e}");
+        assert!(
+            e.contains("non-finite") && e.contains("line "),
+            "{word}: {e}"
+        );
     }
     let (_t, dir) = with_token("1e999");
     let e = load_err(&dir);
@@ -120,22 +144,37 @@ fn non_finite_numbers() {
 
 #[test]
 fn dangling_links() {
-    let (_t, dir) = broken(|v| first_tree_with_links(v)["links"][0]["from_node"] = Value::from("No Such Node"));
+    let (_t, dir) =
+        broken(|v| first_tree_with_links(v)["links"][0]["from_node"] = Value::from("No Such Node"));
     let e = load_err(&dir);
-    assert!(e.contains(".links[0].from_node") && e.contains("No Such Node") && e.contains("dangling"), "{e}");
-    let (_t, dir) = broken(|v| first_tree_with_links(v)["links"][0]["to_socket"] = Value::from("NoSocket"));
+    assert!(
+        e.contains(".links[0].from_node") && e.contains("No Such Node") && e.contains("dangling"),
+        "{e}"
+    );
+    let (_t, dir) =
+        broken(|v| first_tree_with_links(v)["links"][0]["to_socket"] = Value::from("NoSocket"));
     let e = load_err(&dir);
-    assert!(e.contains(".links[0].to_socket") && e.contains("NoSocket"), "{e}");
+    assert!(
+        e.contains(".links[0].to_socket") && e.contains("NoSocket"),
+        "{e}"
+    );
     let (_t, dir) = broken(|v| v["objects"][0]["parent"] = Value::from("Ghost"));
     assert!(load_err(&dir).contains("objects[0]"));
 }
 
 #[test]
 fn mesh_paths_stay_inside_the_scene_folder() {
-    for (path, why) in [("../../etc/passwd", "leaves the scene folder"), ("/etc/passwd", "absolute"), ("meshes\\a.glb", "separators")] {
+    for (path, why) in [
+        ("../../etc/passwd", "leaves the scene folder"),
+        ("/etc/passwd", "absolute"),
+        ("meshes\\a.glb", "separators"),
+    ] {
         let (_t, dir) = broken(|v| v["meshes"][0]["file"] = Value::from(path));
         let e = load_err(&dir);
-        assert!(e.contains("meshes[0].file") && e.contains(why), "{path}: {e}");
+        assert!(
+            e.contains("meshes[0].file") && e.contains(why),
+            "{path}: {e}"
+        );
     }
     // A symlink inside the folder that points outside it.
     let (t, dir) = broken(|v| v["meshes"][0]["file"] = Value::from("meshes/escape.glb"));
@@ -180,7 +219,8 @@ fn mesh_counts_must_match_scene_json() {
 
 #[test]
 fn cli_reports_bad_scene_in_one_line() {
-    let (_t, dir) = broken(|v| first_tree_with_links(v)["links"][0]["to_node"] = Value::from("Nowhere"));
+    let (_t, dir) =
+        broken(|v| first_tree_with_links(v)["links"][0]["to_node"] = Value::from("Nowhere"));
     let o = run(&["inspect", dir.to_str().unwrap()], &[]);
     assert_clean_error(&o, 1, &["scene.json", "to_node", "Nowhere"]);
 }
@@ -224,11 +264,25 @@ fn inspect_exits_0_when_every_node_is_supported() {
     let o = run(&["inspect", dir.to_str().unwrap()], &[]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     // The unmodified scene's world (Background, World Output) is evaluated too.
-    let o = run(&["inspect", repo().join("fixtures/scenes/animated_camera").to_str().unwrap()], &[]);
+    let o = run(
+        &[
+            "inspect",
+            repo()
+                .join("fixtures/scenes/animated_camera")
+                .to_str()
+                .unwrap(),
+        ],
+        &[],
+    );
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     // A world node blendsynth does not evaluate (Sky Texture) makes it exit 3, named.
-    let mut v: Value = serde_json::from_slice(&std::fs::read(repo().join("fixtures/scenes/animated_camera/scene.json")).unwrap()).unwrap();
-    let nodes = v["worlds"][0]["node_tree"]["nodes"].as_array_mut().expect("world nodes");
+    let mut v: Value = serde_json::from_slice(
+        &std::fs::read(repo().join("fixtures/scenes/animated_camera/scene.json")).unwrap(),
+    )
+    .unwrap();
+    let nodes = v["worlds"][0]["node_tree"]["nodes"]
+        .as_array_mut()
+        .expect("world nodes");
     let mut sky = nodes[0].clone();
     sky["name"] = Value::from("Sky");
     sky["bl_idname"] = Value::from("ShaderNodeTexSky");

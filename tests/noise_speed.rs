@@ -41,10 +41,18 @@ impl Rng {
             9 => self.range(-3e6, 3e6),
             10 => self.range(9e4, 1.1e5) * self.pick(&[1.0, -1.0]),
             11 => self.range(-1e-6, 1e-6),
-            12 => self.pick(&[0.0, -0.0, 1.0, -1.0, 0.5, 99999.5, 1e5, -3e5, 1e6, -1e6, 16777215.0, 16777216.0]),
+            12 => self.pick(&[
+                0.0, -0.0, 1.0, -1.0, 0.5, 99999.5, 1e5, -3e5, 1e6, -1e6, 16777215.0, 16777216.0,
+            ]),
             13 => self.range(-1e9, 1e9),
             14 => f32::from_bits(self.u64() as u32),
-            _ => self.pick(&[f32::INFINITY, f32::NEG_INFINITY, f32::NAN, f32::MIN_POSITIVE, 3.4e38]),
+            _ => self.pick(&[
+                f32::INFINITY,
+                f32::NEG_INFINITY,
+                f32::NAN,
+                f32::MIN_POSITIVE,
+                3.4e38,
+            ]),
         }
     }
     fn vec3(&mut self) -> [f32; 3] {
@@ -80,7 +88,12 @@ fn same(a: f32, b: f32) -> bool {
 fn check(what: &str, new: &[f32], old: &[f32], input: &dyn std::fmt::Debug) {
     assert_eq!(new.len(), old.len());
     for (i, (a, b)) in new.iter().zip(old).enumerate() {
-        assert!(same(*a, *b), "{what}[{i}]: new {a:e} ({:#010x}) != old {b:e} ({:#010x}) for {input:?}", a.to_bits(), b.to_bits());
+        assert!(
+            same(*a, *b),
+            "{what}[{i}]: new {a:e} ({:#010x}) != old {b:e} ({:#010x}) for {input:?}",
+            a.to_bits(),
+            b.to_bits()
+        );
     }
 }
 
@@ -92,16 +105,51 @@ fn cell_hashes_and_white_noise_match_the_old_code() {
         let k1 = v[0];
         let k2 = [v[0], v[1]];
         let k3 = [v[0], v[1], v[2]];
-        check("hash_f1_to_f3", &white_noise::hash_f1_to_f3(k1), &old::white_noise::hash_f1_to_f3(k1), &v);
-        check("hash_f2_to_f2", &white_noise::hash_f2_to_f2(k2), &old::white_noise::hash_f2_to_f2(k2), &v);
-        check("hash_f2_to_f3", &white_noise::hash_f2_to_f3(k2), &old::white_noise::hash_f2_to_f3(k2), &v);
-        check("hash_f3_to_f3", &white_noise::hash_f3_to_f3(k3), &old::white_noise::hash_f3_to_f3(k3), &v);
-        check("hash_f4_to_f4", &white_noise::hash_f4_to_f4(v), &old::white_noise::hash_f4_to_f4(v), &v);
-        check("hash_f4_to_f3", &white_noise::hash_f4_to_f3(v), &old::white_noise::hash_f4_to_f3(v), &v);
+        check(
+            "hash_f1_to_f3",
+            &white_noise::hash_f1_to_f3(k1),
+            &old::white_noise::hash_f1_to_f3(k1),
+            &v,
+        );
+        check(
+            "hash_f2_to_f2",
+            &white_noise::hash_f2_to_f2(k2),
+            &old::white_noise::hash_f2_to_f2(k2),
+            &v,
+        );
+        check(
+            "hash_f2_to_f3",
+            &white_noise::hash_f2_to_f3(k2),
+            &old::white_noise::hash_f2_to_f3(k2),
+            &v,
+        );
+        check(
+            "hash_f3_to_f3",
+            &white_noise::hash_f3_to_f3(k3),
+            &old::white_noise::hash_f3_to_f3(k3),
+            &v,
+        );
+        check(
+            "hash_f4_to_f4",
+            &white_noise::hash_f4_to_f4(v),
+            &old::white_noise::hash_f4_to_f4(v),
+            &v,
+        );
+        check(
+            "hash_f4_to_f3",
+            &white_noise::hash_f4_to_f3(v),
+            &old::white_noise::hash_f4_to_f3(v),
+            &v,
+        );
         for dims in 1..=4 {
             let (f, c) = white_noise::white_noise(dims, k3, v[3]);
             let (of, oc) = old::white_noise::white_noise(dims, k3, v[3]);
-            check("white_noise", &[f, c[0], c[1], c[2]], &[of, oc[0], oc[1], oc[2]], &(dims, v));
+            check(
+                "white_noise",
+                &[f, c[0], c[1], c[2]],
+                &[of, oc[0], oc[1], oc[2]],
+                &(dims, v),
+            );
         }
     }
 }
@@ -113,23 +161,56 @@ fn voronoi_case(r: &mut Rng) -> (voronoi::VoronoiParams, old::voronoi::VoronoiPa
     let normalize = r.u64() % 2 == 0;
     let scale = r.setting(-5.0, 30.0, &[0.0, 1.0, 5.0, 21.8, -1.0]);
     // Fractal octaves multiply the cost; most cases keep to one or two.
-    let detail = if r.u64() % 8 == 0 { r.setting(0.0, 15.0, &[15.0, 16.0, 2.5]) } else { r.setting(0.0, 2.0, &[0.0, 1.0, -1.0, 0.5]) };
+    let detail = if r.u64() % 8 == 0 {
+        r.setting(0.0, 15.0, &[15.0, 16.0, 2.5])
+    } else {
+        r.setting(0.0, 2.0, &[0.0, 1.0, -1.0, 0.5])
+    };
     let roughness = r.setting(0.0, 1.0, &[0.0, 1.0, -0.5, 1.5]);
     let lacunarity = r.setting(0.0, 4.0, &[0.0, 1.0, 2.0, -1.0]);
     let smoothness = r.setting(0.0, 1.0, &[0.0, 1.0, 2.0, -1.0, 1e-6]);
     let exponent = r.setting(0.1, 4.0, &[0.5, 1.0, 2.0, 0.0, -1.0]);
     let randomness = r.setting(0.0, 1.0, &[0.0, 1.0, 1.5, -0.5]);
-    let args = (feature, metric, normalize, scale, detail, roughness, lacunarity, smoothness, exponent, randomness);
-    let new = voronoi::VoronoiParams::new(feature, metric, normalize, scale, detail, roughness, lacunarity, smoothness, exponent, randomness);
-    let old = old::voronoi::VoronoiParams::new(feature, metric, normalize, scale, detail, roughness, lacunarity, smoothness, exponent, randomness);
+    let args = (
+        feature, metric, normalize, scale, detail, roughness, lacunarity, smoothness, exponent,
+        randomness,
+    );
+    let new = voronoi::VoronoiParams::new(
+        feature, metric, normalize, scale, detail, roughness, lacunarity, smoothness, exponent,
+        randomness,
+    );
+    let old = old::voronoi::VoronoiParams::new(
+        feature, metric, normalize, scale, detail, roughness, lacunarity, smoothness, exponent,
+        randomness,
+    );
     (new, old, format!("{args:?}"))
 }
 
 fn voronoi_outputs(o: voronoi::VoronoiOutput) -> [f32; 9] {
-    [o.distance, o.color[0], o.color[1], o.color[2], o.position[0], o.position[1], o.position[2], o.w, o.radius]
+    [
+        o.distance,
+        o.color[0],
+        o.color[1],
+        o.color[2],
+        o.position[0],
+        o.position[1],
+        o.position[2],
+        o.w,
+        o.radius,
+    ]
 }
 fn old_voronoi_outputs(o: old::voronoi::VoronoiOutput) -> [f32; 9] {
-    [o.distance, o.color[0], o.color[1], o.color[2], o.position[0], o.position[1], o.position[2], o.w, o.radius]
+    [
+        o.distance,
+        o.color[0],
+        o.color[1],
+        o.color[2],
+        o.position[0],
+        o.position[1],
+        o.position[2],
+        o.w,
+        o.radius,
+    ]
 }
 
 #[test]
@@ -138,7 +219,11 @@ fn voronoi_matches_the_old_code_for_every_feature_metric_and_dimension() {
     for i in 0..60_000 {
         let (new, old, args) = voronoi_case(&mut r);
         let dims = (i % 4 + 1) as u8;
-        let (v, w) = if r.u64() % 4 == 0 { (r.vec3(), r.coord()) } else { ([r.near(), r.near(), r.near()], r.near()) };
+        let (v, w) = if r.u64() % 4 == 0 {
+            (r.vec3(), r.coord())
+        } else {
+            ([r.near(), r.near(), r.near()], r.near())
+        };
         let a = voronoi_outputs(voronoi::voronoi_texture(dims, v, w, new));
         let b = old_voronoi_outputs(old::voronoi::voronoi_texture(dims, v, w, old));
         check("voronoi_texture", &a, &b, &(dims, v, w, &args));
@@ -157,22 +242,41 @@ fn voronoi_ties_match_the_old_code() {
         let metric = r.pick(VoronoiMetric::ALL);
         let randomness = r.pick(&[0.0, 0.0, 1.0, 0.5]);
         let smoothness = r.pick(&[0.0, 1.0, 0.25]);
-        let new = voronoi::VoronoiParams::new(feature, metric, false, 1.0, 0.0, 0.5, 2.0, smoothness, 1.0, randomness);
-        let old = old::voronoi::VoronoiParams::new(feature, metric, false, 1.0, 0.0, 0.5, 2.0, smoothness, 1.0, randomness);
+        let new = voronoi::VoronoiParams::new(
+            feature, metric, false, 1.0, 0.0, 0.5, 2.0, smoothness, 1.0, randomness,
+        );
+        let old = old::voronoi::VoronoiParams::new(
+            feature, metric, false, 1.0, 0.0, 0.5, 2.0, smoothness, 1.0, randomness,
+        );
         let mut c = || (r.range(-6.0, 6.0) * 2.0).round() / 2.0;
         let (v, w) = ([c(), c(), c()], c());
         let a = voronoi_outputs(voronoi::voronoi_texture(dims, v, w, new));
         let b = old_voronoi_outputs(old::voronoi::voronoi_texture(dims, v, w, old));
-        check("voronoi_texture (ties)", &a, &b, &(dims, v, w, feature, metric, randomness, smoothness));
+        check(
+            "voronoi_texture (ties)",
+            &a,
+            &b,
+            &(dims, v, w, feature, metric, randomness, smoothness),
+        );
     }
 }
 
 fn noise_params(r: &mut Rng) -> noise::NoiseParams {
     use noise::NoiseType::*;
     noise::NoiseParams {
-        kind: r.pick(&[MultiFractal, Fbm, HybridMultiFractal, RidgedMultiFractal, HeteroTerrain]),
+        kind: r.pick(&[
+            MultiFractal,
+            Fbm,
+            HybridMultiFractal,
+            RidgedMultiFractal,
+            HeteroTerrain,
+        ]),
         normalize: r.u64() % 2 == 0,
-        detail: if r.u64() % 4 == 0 { r.setting(0.0, 16.0, &[15.0, 16.0, 10.689_58]) } else { r.setting(0.0, 4.0, &[0.0, 1.0, 2.0, -1.0]) },
+        detail: if r.u64() % 4 == 0 {
+            r.setting(0.0, 16.0, &[15.0, 16.0, 10.689_58])
+        } else {
+            r.setting(0.0, 4.0, &[0.0, 1.0, 2.0, -1.0])
+        },
         roughness: r.setting(0.0, 1.0, &[0.0, 0.5, 1.0, -0.5]),
         lacunarity: r.setting(0.0, 4.0, &[2.0, 1.0, 0.0]),
         offset: r.setting(-1.0, 2.0, &[0.0, 1.0]),
@@ -187,17 +291,36 @@ fn noise_texture_matches_the_old_code_in_both_flavours() {
     for i in 0..60_000 {
         let params = noise_params(&mut r);
         let dims = (i % 4 + 1) as u8;
-        let (v, w) = if r.u64() % 4 == 0 { (r.vec3(), r.coord()) } else { ([r.near(), r.near(), r.near()], r.near()) };
+        let (v, w) = if r.u64() % 4 == 0 {
+            (r.vec3(), r.coord())
+        } else {
+            ([r.near(), r.near(), r.near()], r.near())
+        };
         let scale = r.setting(0.0, 30.0, &[0.0, 1.0, 11.438_896, -2.0]);
         let (f, c) = noise::noise_texture_cycles(dims, v, w, scale, params);
         let (of, oc) = old::noise::noise_texture_cycles(dims, v, w, scale, params);
-        check("noise_texture_cycles", &[f, c[0], c[1], c[2]], &[of, oc[0], oc[1], oc[2]], &(dims, v, w, scale, params));
+        check(
+            "noise_texture_cycles",
+            &[f, c[0], c[1], c[2]],
+            &[of, oc[0], oc[1], oc[2]],
+            &(dims, v, w, scale, params),
+        );
         // Fac alone (Color unlinked) is the same bits as the full node's Fac.
-        check("noise_texture_cycles_fac", &[noise::noise_texture_cycles_fac(dims, v, w, scale, params)], &[of], &(dims, v, w, scale, params));
+        check(
+            "noise_texture_cycles_fac",
+            &[noise::noise_texture_cycles_fac(dims, v, w, scale, params)],
+            &[of],
+            &(dims, v, w, scale, params),
+        );
         let want_color = r.u64() % 2 == 0;
         let (f, c) = noise::noise_texture(dims, v, w, scale, params, want_color);
         let (of, oc) = old::noise::noise_texture(dims, v, w, scale, params, want_color);
-        check("noise_texture", &[f, c[0], c[1], c[2], c[3]], &[of, oc[0], oc[1], oc[2], oc[3]], &(dims, v, w, scale, params, want_color));
+        check(
+            "noise_texture",
+            &[f, c[0], c[1], c[2], c[3]],
+            &[of, oc[0], oc[1], oc[2], oc[3]],
+            &(dims, v, w, scale, params, want_color),
+        );
     }
 }
 
@@ -208,7 +331,16 @@ fn perlin_matches_the_old_code_on_every_regime() {
     for _ in 0..300_000 {
         let v = r.vec4();
         let (a2, a3) = ([v[0], v[1]], [v[0], v[1], v[2]]);
-        let new = [perlin(v[0]), perlin(a2), perlin(a3), perlin(v), perlin(Cycles(v[0])), perlin(Cycles(a2)), perlin(Cycles(a3)), perlin(Cycles(v))];
+        let new = [
+            perlin(v[0]),
+            perlin(a2),
+            perlin(a3),
+            perlin(v),
+            perlin(Cycles(v[0])),
+            perlin(Cycles(a2)),
+            perlin(Cycles(a3)),
+            perlin(Cycles(v)),
+        ];
         use old::noise::Cycles as O;
         let old = [
             old::noise::perlin(v[0]),
@@ -235,7 +367,11 @@ fn wave_matches_the_old_code() {
             rings: r.pick(RingsDirection::ALL),
             profile: r.pick(WaveProfile::ALL),
         };
-        let v = if r.u64() % 4 == 0 { r.vec3() } else { [r.near(), r.near(), r.near()] };
+        let v = if r.u64() % 4 == 0 {
+            r.vec3()
+        } else {
+            [r.near(), r.near(), r.near()]
+        };
         let a = [
             r.setting(0.0, 30.0, &[0.0, 1.0, 19.33]),
             r.setting(-2.0, 8.0, &[0.0, 6.0, 2.0]),

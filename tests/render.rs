@@ -17,7 +17,24 @@ const MAX_MEAN_REL: f64 = 0.01;
 
 /// Scenes that must pass.
 const ASSERTED: &[&str] = &[
-    "adaptive", "motion_blur", "motion_blur_start", "area_disk", "area_square", "diffuse_point", "diffuse_sun", "dof", "emission_mesh", "glossy", "metallic", "mix_shader", "ortho_flat", "principled", "principled_bright_base", "shift_clip", "spot", "world_light",
+    "adaptive",
+    "motion_blur",
+    "motion_blur_start",
+    "area_disk",
+    "area_square",
+    "diffuse_point",
+    "diffuse_sun",
+    "dof",
+    "emission_mesh",
+    "glossy",
+    "metallic",
+    "mix_shader",
+    "ortho_flat",
+    "principled",
+    "principled_bright_base",
+    "shift_clip",
+    "spot",
+    "world_light",
     // Closures helper: glass (rough after Filter Glossy), rough glass and refraction.
     "glass",
     "glass_beckmann",
@@ -160,11 +177,16 @@ const OTHER_TESTS: &[(&str, &str)] = &[(
 )];
 
 fn read_exr(p: &Path) -> Vec<[f32; 3]> {
-    read_exr_rgba(p).iter().map(|p| [p[0], p[1], p[2]]).collect()
+    read_exr_rgba(p)
+        .iter()
+        .map(|p| [p[0], p[1], p[2]])
+        .collect()
 }
 
 fn read_exr_rgba(p: &Path) -> Vec<[f32; 4]> {
-    let img = image::open(p).unwrap_or_else(|e| panic!("{}: {e}", p.display())).to_rgba32f();
+    let img = image::open(p)
+        .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+        .to_rgba32f();
     img.pixels().map(|p| p.0).collect()
 }
 
@@ -216,51 +238,97 @@ struct Alpha {
 
 fn evaluate(dir: &Path) -> Row {
     let name = dir.file_name().unwrap().to_string_lossy().into_owned();
-    let meta: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("render.json")).unwrap()).unwrap();
+    let meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("render.json")).unwrap()).unwrap();
     let samples = meta["samples"].as_u64().unwrap() as u32;
     let res = meta["resolution"].as_array().unwrap();
-    let (w, h) = (res[0].as_u64().unwrap() as u32, res[1].as_u64().unwrap() as u32);
+    let (w, h) = (
+        res[0].as_u64().unwrap() as u32,
+        res[1].as_u64().unwrap() as u32,
+    );
     let a4 = read_exr_rgba(&dir.join("cycles_a.exr"));
     let b4 = read_exr_rgba(&dir.join("cycles_b.exr"));
-    let (a, b): (Vec<[f32; 3]>, Vec<[f32; 3]>) = (a4.iter().map(|p| [p[0], p[1], p[2]]).collect(), b4.iter().map(|p| [p[0], p[1], p[2]]).collect());
+    let (a, b): (Vec<[f32; 3]>, Vec<[f32; 3]>) = (
+        a4.iter().map(|p| [p[0], p[1], p[2]]).collect(),
+        b4.iter().map(|p| [p[0], p[1], p[2]]).collect(),
+    );
     // A reference may share an export with others ("scene": relative folder) and name a frame.
-    let scene_dir = meta["scene"].as_str().map(|s| dir.join(s)).unwrap_or_else(|| dir.to_path_buf());
+    let scene_dir = meta["scene"]
+        .as_str()
+        .map(|s| dir.join(s))
+        .unwrap_or_else(|| dir.to_path_buf());
     let scene = Scene::load(&scene_dir).unwrap();
     let frame = meta["frame"].as_f64();
-    let opts = RenderOptions { samples: Some(samples), resolution: Some((w, h)), seed: Some(0), frame, ..Default::default() };
+    let opts = RenderOptions {
+        samples: Some(samples),
+        resolution: Some((w, h)),
+        seed: Some(0),
+        frame,
+        ..Default::default()
+    };
     let out = render(&scene, &opts).unwrap_or_else(|e| panic!("{name}: {e}"));
     let ours: Vec<[f32; 3]> = out.color.iter().map(|p| [p[0], p[1], p[2]]).collect();
     assert_eq!(ours.len(), a.len(), "{name}: size");
     let ratio = rmse(&ours, &a) / rmse(&b, &a).max(1e-12);
     let (mo, ma) = (means(&ours), means(&a));
-    let worst_mean = (0..3).map(|k| (mo[k] - ma[k]).abs() / ma[k].abs().max(1e-6)).fold(0.0, f64::max);
-    let spp = (out.stats.samples_taken as f64 / (w * h) as f64, meta["mean_samples_a"].as_f64());
+    let worst_mean = (0..3)
+        .map(|k| (mo[k] - ma[k]).abs() / ma[k].abs().max(1e-6))
+        .fold(0.0, f64::max);
+    let spp = (
+        out.stats.samples_taken as f64 / (w * h) as f64,
+        meta["mean_samples_a"].as_f64(),
+    );
     // Where Cycles' film has alpha (transparent film, holdouts), alpha is compared as a
     // fourth channel: the same ratio, and its mean within the same 1%.
     let alpha = a4.iter().any(|p| p[3] != 1.0).then(|| {
         let (oa, aa, ba) = (alpha_of(&out.color), alpha_of(&a4), alpha_of(&b4));
         let ratio = rmse(&oa, &aa) / rmse(&ba, &aa).max(1e-12);
         let (mo, ma) = (means(&oa)[0], means(&aa)[0]);
-        Alpha { ratio, mean_err: (mo - ma).abs() / ma.abs().max(1e-6), ours: mo, cycles: ma }
+        Alpha {
+            ratio,
+            mean_err: (mo - ma).abs() / ma.abs().max(1e-6),
+            ours: mo,
+            cycles: ma,
+        }
     });
     let ratio = ratio.max(alpha.as_ref().map_or(0.0, |a| a.ratio));
     let worst_mean = worst_mean.max(alpha.as_ref().map_or(0.0, |a| a.mean_err));
-    Row { name, ratio, worst_mean, ours: mo, cycles: ma, seconds: out.stats.wall_seconds, spp, alpha }
+    Row {
+        name,
+        ratio,
+        worst_mean,
+        ours: mo,
+        cycles: ma,
+        seconds: out.stats.wall_seconds,
+        spp,
+        alpha,
+    }
 }
 
 #[test]
 fn parity_with_cycles() {
     let root = common::repo().join("fixtures/render/scenes");
-    let mut dirs: Vec<_> = std::fs::read_dir(&root).expect("fixtures/render/scenes").map(|e| e.unwrap().path()).filter(|p| p.join("scene.json").exists()).collect();
+    let mut dirs: Vec<_> = std::fs::read_dir(&root)
+        .expect("fixtures/render/scenes")
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.join("scene.json").exists())
+        .collect();
     dirs.sort();
-    assert!(dirs.len() >= 12, "expected at least 12 parity scenes, found {}", dirs.len());
+    assert!(
+        dirs.len() >= 12,
+        "expected at least 12 parity scenes, found {}",
+        dirs.len()
+    );
     // BLENDSYNTH_PARITY_ONLY=a,b runs just those scenes (for a quick check of new ones).
     if let Ok(only) = std::env::var("BLENDSYNTH_PARITY_ONLY") {
         let only: Vec<&str> = only.split(',').collect();
         dirs.retain(|d| only.iter().any(|o| d.file_name().is_some_and(|n| n == *o)));
     }
     let mut failures = Vec::new();
-    println!("{:<16} {:>7} {:>8}  {:<26} {:<26} {:>6}  status", "scene", "ratio", "mean err", "mean ours (RGB)", "mean Cycles A (RGB)", "secs");
+    println!(
+        "{:<16} {:>7} {:>8}  {:<26} {:<26} {:>6}  status",
+        "scene", "ratio", "mean err", "mean ours (RGB)", "mean Cycles A (RGB)", "secs"
+    );
     println!("(spp: mean samples per pixel, ours / Cycles A, for adaptive scenes)");
     for d in &dirs {
         let r = evaluate(d);
@@ -269,35 +337,98 @@ fn parity_with_cycles() {
         let status = match (pass, ASSERTED.contains(&r.name.as_str()), known) {
             (true, true, _) => "pass".to_string(),
             (false, true, _) => {
-                failures.push(format!("{}: ratio {:.3}, worst channel mean error {:.2}%", r.name, r.ratio, 100.0 * r.worst_mean));
+                failures.push(format!(
+                    "{}: ratio {:.3}, worst channel mean error {:.2}%",
+                    r.name,
+                    r.ratio,
+                    100.0 * r.worst_mean
+                ));
                 "FAIL".to_string()
             }
-            (p, false, Some((_, why))) => format!("known failure ({why}){}", if p { " -- now passes: move it to ASSERTED" } else { "" }),
-            (_, false, None) if OTHER_TESTS.iter().any(|o| o.0 == r.name) => format!("not asserted ({})", OTHER_TESTS.iter().find(|o| o.0 == r.name).unwrap().1),
+            (p, false, Some((_, why))) => format!(
+                "known failure ({why}){}",
+                if p {
+                    " -- now passes: move it to ASSERTED"
+                } else {
+                    ""
+                }
+            ),
+            (_, false, None) if OTHER_TESTS.iter().any(|o| o.0 == r.name) => format!(
+                "not asserted ({})",
+                OTHER_TESTS.iter().find(|o| o.0 == r.name).unwrap().1
+            ),
             (_, false, None) => {
-                failures.push(format!("{}: in neither ASSERTED nor KNOWN_FAILURES (ratio {:.3}, mean error {:.2}%)", r.name, r.ratio, 100.0 * r.worst_mean));
+                failures.push(format!(
+                    "{}: in neither ASSERTED nor KNOWN_FAILURES (ratio {:.3}, mean error {:.2}%)",
+                    r.name,
+                    r.ratio,
+                    100.0 * r.worst_mean
+                ));
                 "UNLISTED".to_string()
             }
         };
         let f = |m: [f64; 3]| format!("{:.4} {:.4} {:.4}", m[0], m[1], m[2]);
-        let spp = r.spp.1.map(|c| format!("  spp {:.1} / {c:.1}", r.spp.0)).unwrap_or_default();
-        let alpha = r.alpha.as_ref().map(|a| format!("  alpha: ratio {:.3}, mean {:.4} / {:.4}", a.ratio, a.ours, a.cycles)).unwrap_or_default();
-        println!("{:<16} {:>7.3} {:>7.2}%  {:<26} {:<26} {:>6.2}  {status}{spp}{alpha}", r.name, r.ratio, 100.0 * r.worst_mean, f(r.ours), f(r.cycles), r.seconds);
+        let spp = r
+            .spp
+            .1
+            .map(|c| format!("  spp {:.1} / {c:.1}", r.spp.0))
+            .unwrap_or_default();
+        let alpha = r
+            .alpha
+            .as_ref()
+            .map(|a| {
+                format!(
+                    "  alpha: ratio {:.3}, mean {:.4} / {:.4}",
+                    a.ratio, a.ours, a.cycles
+                )
+            })
+            .unwrap_or_default();
+        println!(
+            "{:<16} {:>7.3} {:>7.2}%  {:<26} {:<26} {:>6.2}  {status}{spp}{alpha}",
+            r.name,
+            r.ratio,
+            100.0 * r.worst_mean,
+            f(r.ours),
+            f(r.cycles),
+            r.seconds
+        );
     }
-    assert!(failures.is_empty(), "parity failures:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "parity failures:\n{}",
+        failures.join("\n")
+    );
 }
 
 #[test]
 fn same_bits_for_any_thread_count() {
     let dir = common::repo().join("fixtures/render/scenes/diffuse_point");
     let scene = Scene::load(&dir).unwrap();
-    let opts = |t| RenderOptions { samples: Some(4), resolution: Some((40, 32)), seed: Some(3), threads: Some(t), ..Default::default() };
+    let opts = |t| RenderOptions {
+        samples: Some(4),
+        resolution: Some((40, 32)),
+        seed: Some(3),
+        threads: Some(t),
+        ..Default::default()
+    };
     let a = render(&scene, &opts(1)).unwrap();
     let b = render(&scene, &opts(2)).unwrap();
-    let bits = |o: &blendsynth::render::RenderOutput| o.color.iter().flat_map(|p| p.map(f32::to_bits)).collect::<Vec<_>>();
+    let bits = |o: &blendsynth::render::RenderOutput| {
+        o.color
+            .iter()
+            .flat_map(|p| p.map(f32::to_bits))
+            .collect::<Vec<_>>()
+    };
     assert_eq!(bits(&a), bits(&b));
     // And a different seed changes the noise.
-    let c = render(&scene, &RenderOptions { seed: Some(4), ..opts(2) }).unwrap();
+    let c = render(
+        &scene,
+        &RenderOptions {
+            seed: Some(4),
+            ..opts(2)
+        },
+    )
+    .unwrap();
     assert_ne!(bits(&a), bits(&c));
 }
 
@@ -305,15 +436,55 @@ fn same_bits_for_any_thread_count() {
 fn bad_input_is_a_clear_error() {
     let dir = common::repo().join("fixtures/render/scenes/diffuse_point");
     let scene = Scene::load(&dir).unwrap();
-    let err = |o: RenderOptions| render(&scene, &o).err().map(|RenderError(m)| m).unwrap_or_default();
-    assert!(err(RenderOptions { resolution: Some((0, 10)), ..Default::default() }).contains("resolution 0x10"));
-    assert!(err(RenderOptions { resolution: Some((100_000, 10)), ..Default::default() }).contains("each side must be"));
-    assert!(err(RenderOptions { samples: Some(0), resolution: Some((8, 8)), ..Default::default() }).contains("samples must be at least 1"));
-    assert!(err(RenderOptions { frame: Some(f64::NAN), samples: Some(1), resolution: Some((8, 8)), ..Default::default() }).contains("not finite"));
+    let err = |o: RenderOptions| {
+        render(&scene, &o)
+            .err()
+            .map(|RenderError(m)| m)
+            .unwrap_or_default()
+    };
+    assert!(err(RenderOptions {
+        resolution: Some((0, 10)),
+        ..Default::default()
+    })
+    .contains("resolution 0x10"));
+    assert!(err(RenderOptions {
+        resolution: Some((100_000, 10)),
+        ..Default::default()
+    })
+    .contains("each side must be"));
+    assert!(err(RenderOptions {
+        samples: Some(0),
+        resolution: Some((8, 8)),
+        ..Default::default()
+    })
+    .contains("samples must be at least 1"));
+    assert!(err(RenderOptions {
+        frame: Some(f64::NAN),
+        samples: Some(1),
+        resolution: Some((8, 8)),
+        ..Default::default()
+    })
+    .contains("not finite"));
     let mut no_cam = scene.clone();
     no_cam.file.scene.camera = None;
-    assert!(err(RenderOptions { samples: Some(1), resolution: Some((8, 8)), ..Default::default() }.clone()).is_empty());
-    let m = render(&no_cam, &RenderOptions { samples: Some(1), resolution: Some((8, 8)), ..Default::default() }).err().unwrap().0;
+    assert!(err(RenderOptions {
+        samples: Some(1),
+        resolution: Some((8, 8)),
+        ..Default::default()
+    }
+    .clone())
+    .is_empty());
+    let m = render(
+        &no_cam,
+        &RenderOptions {
+            samples: Some(1),
+            resolution: Some((8, 8)),
+            ..Default::default()
+        },
+    )
+    .err()
+    .unwrap()
+    .0;
     assert!(m.contains("no active camera"), "{m}");
 }
 
@@ -323,9 +494,18 @@ fn bad_input_is_a_clear_error() {
 fn varying_light_node_tree_is_a_clear_error() {
     let dir = common::repo().join("fixtures/render/scenes/light_nodes");
     let mut scene = Scene::load(&dir).unwrap();
-    let opts = RenderOptions { samples: Some(1), resolution: Some((8, 8)), ..Default::default() };
+    let opts = RenderOptions {
+        samples: Some(1),
+        resolution: Some((8, 8)),
+        ..Default::default()
+    };
     assert!(render(&scene, &opts).is_ok());
-    let light = scene.file.lights.iter_mut().find(|l| l.name == "NodeSpot").unwrap();
+    let light = scene
+        .file
+        .lights
+        .iter_mut()
+        .find(|l| l.name == "NodeSpot")
+        .unwrap();
     let tree = light.node_tree.as_mut().unwrap();
     let mut link = tree.links[0].clone();
     link.from_node = "Light Falloff".into();
@@ -333,34 +513,84 @@ fn varying_light_node_tree_is_a_clear_error() {
     link.to_node = "Emission".into();
     link.to_socket = "Strength".into();
     tree.links.push(link);
-    let RenderError(m) = render(&scene, &opts).err().expect("a linked Emission input is refused");
-    assert!(m.contains("NodeSpot") && m.contains("Strength") && m.contains("Light Falloff"), "{m}");
+    let RenderError(m) = render(&scene, &opts)
+        .err()
+        .expect("a linked Emission input is refused");
+    assert!(
+        m.contains("NodeSpot") && m.contains("Strength") && m.contains("Light Falloff"),
+        "{m}"
+    );
     // A muted Emission passes nothing (it has no closure input): the spot goes dark.
-    let opts = RenderOptions { samples: Some(8), resolution: Some((24, 24)), ..Default::default() };
-    let light = scene.file.lights.iter_mut().find(|l| l.name == "NodeSpot").unwrap();
+    let opts = RenderOptions {
+        samples: Some(8),
+        resolution: Some((24, 24)),
+        ..Default::default()
+    };
+    let light = scene
+        .file
+        .lights
+        .iter_mut()
+        .find(|l| l.name == "NodeSpot")
+        .unwrap();
     light.node_tree.as_mut().unwrap().links.pop();
-    let mean = |o: &blendsynth::render::RenderOutput| o.color.iter().map(|p| p[0] as f64).sum::<f64>() / o.color.len() as f64;
+    let mean = |o: &blendsynth::render::RenderOutput| {
+        o.color.iter().map(|p| p[0] as f64).sum::<f64>() / o.color.len() as f64
+    };
     let lit = mean(&render(&scene, &opts).unwrap());
     let mut off = scene.clone();
-    off.file.lights.iter_mut().find(|l| l.name == "NodeSpot").unwrap().properties.insert("energy".into(), serde_json::json!(0.0));
+    off.file
+        .lights
+        .iter_mut()
+        .find(|l| l.name == "NodeSpot")
+        .unwrap()
+        .properties
+        .insert("energy".into(), serde_json::json!(0.0));
     let unlit = mean(&render(&off, &opts).unwrap());
-    let light = scene.file.lights.iter_mut().find(|l| l.name == "NodeSpot").unwrap();
-    light.node_tree.as_mut().unwrap().nodes.iter_mut().find(|n| n.name == "Emission").unwrap().mute = true;
+    let light = scene
+        .file
+        .lights
+        .iter_mut()
+        .find(|l| l.name == "NodeSpot")
+        .unwrap();
+    light
+        .node_tree
+        .as_mut()
+        .unwrap()
+        .nodes
+        .iter_mut()
+        .find(|n| n.name == "Emission")
+        .unwrap()
+        .mute = true;
     let muted = mean(&render(&scene, &opts).unwrap());
-    assert!(unlit < 0.8 * lit && muted == unlit, "muted {muted}, no power {unlit}, lit {lit}");
+    assert!(
+        unlit < 0.8 * lit && muted == unlit,
+        "muted {muted}, no power {unlit}, lit {lit}"
+    );
 }
 
 #[test]
 fn label_passes_from_the_pixel_centre() {
     let dir = common::repo().join("fixtures/render/scenes/diffuse_point");
     let scene = Scene::load(&dir).unwrap();
-    let out = render(&scene, &RenderOptions { samples: Some(1), resolution: Some((64, 64)), ..Default::default() }).unwrap();
+    let out = render(
+        &scene,
+        &RenderOptions {
+            samples: Some(1),
+            resolution: Some((64, 64)),
+            ..Default::default()
+        },
+    )
+    .unwrap();
     let p = &out.passes;
     // Each object seen gets its own id; names resolve through `instances`.
     let mut seen: Vec<u32> = p.instance_id.clone();
     seen.sort();
     seen.dedup();
-    let names: Vec<&str> = seen.iter().filter(|&&i| i > 0).map(|&i| p.instances[i as usize - 1].object.as_str()).collect();
+    let names: Vec<&str> = seen
+        .iter()
+        .filter(|&&i| i > 0)
+        .map(|&i| p.instances[i as usize - 1].object.as_str())
+        .collect();
     for want in ["Floor", "Sphere", "Cube"] {
         assert!(names.contains(&want), "{names:?}");
     }
@@ -380,8 +610,16 @@ fn thin_film_changes_the_render() {
     // Thin film was refused until it was rendered: it must now render, and not be ignored.
     let dir = common::repo().join("fixtures/render/scenes/principled");
     let o = blendsynth::scene::Override::parse("materials[\"Plastic\"].node_tree.nodes[\"Principled BSDF\"].inputs[\"Thin Film Thickness\"].default_value=300").unwrap();
-    let opts = RenderOptions { samples: Some(4), resolution: Some((16, 16)), ..Default::default() };
-    let film = render(&Scene::load(&dir).unwrap().with_overrides(&[o]).unwrap(), &opts).unwrap();
+    let opts = RenderOptions {
+        samples: Some(4),
+        resolution: Some((16, 16)),
+        ..Default::default()
+    };
+    let film = render(
+        &Scene::load(&dir).unwrap().with_overrides(&[o]).unwrap(),
+        &opts,
+    )
+    .unwrap();
     let bare = render(&Scene::load(&dir).unwrap(), &opts).unwrap();
     assert_ne!(film.color, bare.color);
 }
@@ -392,9 +630,20 @@ fn non_finite_samples_never_poison_pixels() {
     // inputs that are not finite read as 0 (documented fallback) and non-finite samples
     // are dropped, so every pixel stays finite.
     let dir = common::repo().join("fixtures/render/scenes/emission_mesh");
-    let o = blendsynth::scene::Override::parse("materials[\"Glow\"].node_tree.nodes[\"Emission\"].inputs[1].default_value=1e39").unwrap();
+    let o = blendsynth::scene::Override::parse(
+        "materials[\"Glow\"].node_tree.nodes[\"Emission\"].inputs[1].default_value=1e39",
+    )
+    .unwrap();
     let scene = Scene::load(&dir).unwrap().with_overrides(&[o]).unwrap();
-    let out = render(&scene, &RenderOptions { samples: Some(4), resolution: Some((32, 32)), ..Default::default() }).unwrap();
+    let out = render(
+        &scene,
+        &RenderOptions {
+            samples: Some(4),
+            resolution: Some((32, 32)),
+            ..Default::default()
+        },
+    )
+    .unwrap();
     assert!(out.color.iter().all(|p| p.iter().all(|v| v.is_finite())));
 }
 
@@ -404,26 +653,47 @@ fn geometry_nodes_instances_keep_their_own_ids() {
     // instance (own id, own transform) sharing its reference's mesh.
     let dir = common::repo().join("fixtures/scenes/geonodes");
     let scene = Scene::load(&dir).unwrap();
-    let eval = blendsynth::anim::evaluate_scene(&scene, scene.file.scene.frame_current as f64).unwrap();
+    let eval =
+        blendsynth::anim::evaluate_scene(&scene, scene.file.scene.frame_current as f64).unwrap();
     let geo = blendsynth::render::build::build(&scene, &eval, &[]).unwrap();
-    let inst: Vec<_> = geo.instances.iter().filter(|i| i.instance_index.is_some()).collect();
-    assert!(inst.len() > 1, "expected several GN instances, found {}", inst.len());
+    let inst: Vec<_> = geo
+        .instances
+        .iter()
+        .filter(|i| i.instance_index.is_some())
+        .collect();
+    assert!(
+        inst.len() > 1,
+        "expected several GN instances, found {}",
+        inst.len()
+    );
     let mut idx: Vec<u32> = inst.iter().map(|i| i.instance_index.unwrap()).collect();
     idx.dedup();
     assert_eq!(idx.len(), inst.len(), "instance indices are distinct");
-    assert!(inst.windows(2).all(|w| std::sync::Arc::ptr_eq(&w[0].mesh, &w[1].mesh) || w[0].mesh.name == w[1].mesh.name));
+    assert!(inst.windows(2).all(
+        |w| std::sync::Arc::ptr_eq(&w[0].mesh, &w[1].mesh) || w[0].mesh.name == w[1].mesh.name
+    ));
     assert!(inst.windows(2).any(|w| w[0].to_world != w[1].to_world));
     // Together they are Blender's evaluated mesh: same triangle count, same world bounds.
     let reference = scene.load_evaluated(0).unwrap();
     let obj = scene.file.evaluated[0].object.clone();
     let ours: Vec<_> = geo.instances.iter().filter(|i| i.name == obj).collect();
-    assert_eq!(ours.iter().map(|i| i.mesh.triangles.len()).sum::<usize>(), reference.triangles.len());
-    let oi = scene.file.objects.iter().position(|o| o.name == obj).unwrap();
+    assert_eq!(
+        ours.iter().map(|i| i.mesh.triangles.len()).sum::<usize>(),
+        reference.triangles.len()
+    );
+    let oi = scene
+        .file
+        .objects
+        .iter()
+        .position(|o| o.name == obj)
+        .unwrap();
     let m = eval.world_matrices[oi];
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for p in &reference.positions {
         for r in 0..3 {
-            let w = (m[r][0] * p[0] as f64 + m[r][1] * p[1] as f64 + m[r][2] * p[2] as f64 + m[r][3]) as f32;
+            let w =
+                (m[r][0] * p[0] as f64 + m[r][1] * p[1] as f64 + m[r][2] * p[2] as f64 + m[r][3])
+                    as f32;
             lo[r] = lo[r].min(w);
             hi[r] = hi[r].max(w);
         }
@@ -436,7 +706,10 @@ fn geometry_nodes_instances_keep_their_own_ids() {
         }
     }
     for r in 0..3 {
-        assert!((lo[r] - olo[r]).abs() < 1e-4 && (hi[r] - ohi[r]).abs() < 1e-4, "bounds {olo:?}..{ohi:?} vs Blender {lo:?}..{hi:?}");
+        assert!(
+            (lo[r] - olo[r]).abs() < 1e-4 && (hi[r] - ohi[r]).abs() < 1e-4,
+            "bounds {olo:?}..{ohi:?} vs Blender {lo:?}..{hi:?}"
+        );
     }
 }
 
@@ -446,17 +719,42 @@ fn adaptive_sampling_is_deterministic_and_stops_early() {
     // 48 samples stops the plain background, whatever the thread count.
     let dir = common::repo().join("fixtures/render/scenes/adaptive");
     let scene = Scene::load(&dir).unwrap();
-    let opts = |t| RenderOptions { samples: Some(64), resolution: Some((40, 32)), seed: Some(3), threads: Some(t), ..Default::default() };
+    let opts = |t| RenderOptions {
+        samples: Some(64),
+        resolution: Some((40, 32)),
+        seed: Some(3),
+        threads: Some(t),
+        ..Default::default()
+    };
     let a = render(&scene, &opts(1)).unwrap();
     let b = render(&scene, &opts(2)).unwrap();
-    let bits = |o: &blendsynth::render::RenderOutput| o.color.iter().flat_map(|p| p.map(f32::to_bits)).collect::<Vec<_>>();
+    let bits = |o: &blendsynth::render::RenderOutput| {
+        o.color
+            .iter()
+            .flat_map(|p| p.map(f32::to_bits))
+            .collect::<Vec<_>>()
+    };
     assert_eq!(bits(&a), bits(&b));
     assert_eq!(a.passes.sample_count, b.passes.sample_count);
     let n = a.passes.sample_count.len() as u64;
-    assert!(a.passes.sample_count.iter().all(|&c| c == 48 || c == 64), "samples are taken up to a check");
-    assert!(a.stats.samples_taken < 64 * n && a.stats.samples_taken > 48 * n, "{}", a.stats.samples_taken);
+    assert!(
+        a.passes.sample_count.iter().all(|&c| c == 48 || c == 64),
+        "samples are taken up to a check"
+    );
+    assert!(
+        a.stats.samples_taken < 64 * n && a.stats.samples_taken > 48 * n,
+        "{}",
+        a.stats.samples_taken
+    );
     // A threshold of 0 from the command line turns it off.
-    let off = render(&scene, &RenderOptions { threshold: Some(0.0), ..opts(2) }).unwrap();
+    let off = render(
+        &scene,
+        &RenderOptions {
+            threshold: Some(0.0),
+            ..opts(2)
+        },
+    )
+    .unwrap();
     assert_eq!(off.stats.samples_taken, 64 * n);
 }
 
@@ -483,15 +781,33 @@ fn adaptive_sampling_is_deterministic_and_stops_early() {
 /// the means are bounded to 0.97..1.03 of Cycles', so that a regression fails.
 #[test]
 fn published_colon_parity() {
-    let Some(py) = common::require("a Python with bpy 4.5.4", common::bpy_python()) else { return };
-    let Some(blend) = common::require("../shared/published/colon_nodes.blend", common::published_colon()) else { return };
+    let Some(py) = common::require("a Python with bpy 4.5.4", common::bpy_python()) else {
+        return;
+    };
+    let Some(blend) = common::require(
+        "../shared/published/colon_nodes.blend",
+        common::published_colon(),
+    ) else {
+        return;
+    };
     let t = tempfile::tempdir().unwrap();
     // BLENDSYNTH_PUBLISHED_REFS=DIR reuses references the script already wrote there
     // (Cycles takes minutes per frame); otherwise they are made afresh.
     let refs = match std::env::var_os("BLENDSYNTH_PUBLISHED_REFS") {
         Some(d) => std::path::PathBuf::from(d),
         None => {
-            common::run_python(&py, &common::repo().join("fixtures/render/make_published_refs.py"), &["--blend", blend.to_str().unwrap(), "--out", t.path().to_str().unwrap(), "--samples", "16"]);
+            common::run_python(
+                &py,
+                &common::repo().join("fixtures/render/make_published_refs.py"),
+                &[
+                    "--blend",
+                    blend.to_str().unwrap(),
+                    "--out",
+                    t.path().to_str().unwrap(),
+                    "--samples",
+                    "16",
+                ],
+            );
             t.path().to_path_buf()
         }
     };
@@ -505,7 +821,9 @@ fn published_colon_parity() {
         for c in 0..3 {
             let q = r.ours[c] / r.cycles[c];
             if !(0.97..=1.03).contains(&q) {
-                failures.push(format!("{f}: channel {c} mean is {q:.3} of Cycles' (bounded to 0.97..1.03)"));
+                failures.push(format!(
+                    "{f}: channel {c} mean is {q:.3} of Cycles' (bounded to 0.97..1.03)"
+                ));
             }
         }
         if r.worst_mean <= MAX_MEAN_REL {
@@ -517,13 +835,32 @@ fn published_colon_parity() {
 
 #[test]
 fn closures_same_bits_for_any_thread_count() {
-    for scene_name in ["sss_principled", "glass_rough", "principled_sheen", "principled_aniso", "sss_node"] {
-        let dir = common::repo().join("fixtures/render/scenes").join(scene_name);
+    for scene_name in [
+        "sss_principled",
+        "glass_rough",
+        "principled_sheen",
+        "principled_aniso",
+        "sss_node",
+    ] {
+        let dir = common::repo()
+            .join("fixtures/render/scenes")
+            .join(scene_name);
         let scene = Scene::load(&dir).unwrap();
-        let opts = |t| RenderOptions { samples: Some(4), resolution: Some((40, 32)), seed: Some(3), threads: Some(t), ..Default::default() };
+        let opts = |t| RenderOptions {
+            samples: Some(4),
+            resolution: Some((40, 32)),
+            seed: Some(3),
+            threads: Some(t),
+            ..Default::default()
+        };
         let a = render(&scene, &opts(1)).unwrap();
         let b = render(&scene, &opts(2)).unwrap();
-        let bits = |o: &blendsynth::render::RenderOutput| o.color.iter().flat_map(|p| p.map(f32::to_bits)).collect::<Vec<_>>();
+        let bits = |o: &blendsynth::render::RenderOutput| {
+            o.color
+                .iter()
+                .flat_map(|p| p.map(f32::to_bits))
+                .collect::<Vec<_>>()
+        };
         assert_eq!(bits(&a), bits(&b), "{scene_name}");
     }
 }
@@ -536,18 +873,39 @@ fn object_motion_blur_matches_cycles_and_discriminates() {
     for name in ["object_motion", "object_motion_start"] {
         let dir = common::repo().join("fixtures/render/scenes").join(name);
         let r = evaluate(&dir);
-        println!("{name}: ratio {:.3}, worst channel mean error {:.2}%", r.ratio, 100.0 * r.worst_mean);
-        assert!(r.ratio <= MAX_RATIO && r.worst_mean <= MAX_MEAN_REL, "{name}: ratio {:.3}, mean error {:.2}%", r.ratio, 100.0 * r.worst_mean);
+        println!(
+            "{name}: ratio {:.3}, worst channel mean error {:.2}%",
+            r.ratio,
+            100.0 * r.worst_mean
+        );
+        assert!(
+            r.ratio <= MAX_RATIO && r.worst_mean <= MAX_MEAN_REL,
+            "{name}: ratio {:.3}, mean error {:.2}%",
+            r.ratio,
+            100.0 * r.worst_mean
+        );
         let mut scene = Scene::load(&dir).unwrap();
-        scene.file.scene.render.insert("use_motion_blur".into(), serde_json::Value::Bool(false));
-        let opts = RenderOptions { samples: Some(64), resolution: Some((128, 128)), seed: Some(0), ..Default::default() };
+        scene
+            .file
+            .scene
+            .render
+            .insert("use_motion_blur".into(), serde_json::Value::Bool(false));
+        let opts = RenderOptions {
+            samples: Some(64),
+            resolution: Some((128, 128)),
+            seed: Some(0),
+            ..Default::default()
+        };
         let sharp = render(&scene, &opts).unwrap();
         let sharp: Vec<[f32; 3]> = sharp.color.iter().map(|p| [p[0], p[1], p[2]]).collect();
         let a = read_exr(&dir.join("cycles_a.exr"));
         let b = read_exr(&dir.join("cycles_b.exr"));
         let ratio = rmse(&sharp, &a) / rmse(&b, &a);
         println!("{name} without motion blur: ratio {ratio:.3}");
-        assert!(ratio > 2.0 * MAX_RATIO, "{name}: without blur the ratio is only {ratio:.3}");
+        assert!(
+            ratio > 2.0 * MAX_RATIO,
+            "{name}: without blur the ratio is only {ratio:.3}"
+        );
     }
 }
 
@@ -559,20 +917,41 @@ fn true_displacement_moves_the_relief_as_cycles() {
     for (name, max_ratio) in [("displace_both", MAX_RATIO), ("displace_true", MAX_RATIO)] {
         let dir = common::repo().join("fixtures/render/scenes").join(name);
         let r = evaluate(&dir);
-        println!("{name}: ratio {:.3}, worst channel mean error {:.3}%", r.ratio, 100.0 * r.worst_mean);
-        assert!(r.ratio <= max_ratio && r.worst_mean <= MAX_MEAN_REL, "{name}: ratio {:.3}, mean error {:.3}%", r.ratio, 100.0 * r.worst_mean);
+        println!(
+            "{name}: ratio {:.3}, worst channel mean error {:.3}%",
+            r.ratio,
+            100.0 * r.worst_mean
+        );
+        assert!(
+            r.ratio <= max_ratio && r.worst_mean <= MAX_MEAN_REL,
+            "{name}: ratio {:.3}, mean error {:.3}%",
+            r.ratio,
+            100.0 * r.worst_mean
+        );
         let mut scene = Scene::load(&dir).unwrap();
         for m in &mut scene.file.materials {
-            m.properties.insert("displacement_method".into(), serde_json::Value::String("BUMP".into()));
+            m.properties.insert(
+                "displacement_method".into(),
+                serde_json::Value::String("BUMP".into()),
+            );
         }
-        let opts = RenderOptions { samples: Some(64), resolution: Some((128, 128)), seed: Some(0), ..Default::default() };
+        let opts = RenderOptions {
+            samples: Some(64),
+            resolution: Some((128, 128)),
+            seed: Some(0),
+            ..Default::default()
+        };
         let flat = render(&scene, &opts).unwrap();
         let flat: Vec<[f32; 3]> = flat.color.iter().map(|p| [p[0], p[1], p[2]]).collect();
         let a = read_exr(&dir.join("cycles_a.exr"));
         let b = read_exr(&dir.join("cycles_b.exr"));
         let ratio = rmse(&flat, &a) / rmse(&b, &a);
         println!("{name} with the displacement only bumped: ratio {ratio:.3}");
-        assert!(ratio > 3.0 * r.ratio, "{name}: bump-only ratio {ratio:.3} is not far above the displaced {:.3}", r.ratio);
+        assert!(
+            ratio > 3.0 * r.ratio,
+            "{name}: bump-only ratio {ratio:.3} is not far above the displaced {:.3}",
+            r.ratio
+        );
     }
 }
 
@@ -582,7 +961,8 @@ fn emission_estimate_follows_cycles() {
     // closure tree (Mix Shader by its factor); zero means the material never emits and its
     // triangles are no light. Principled's default Emission Strength is 0.
     let program = |scene: &str, material: &str| {
-        let scene = Scene::load(&common::repo().join("fixtures/render/scenes").join(scene)).unwrap();
+        let scene =
+            Scene::load(&common::repo().join("fixtures/render/scenes").join(scene)).unwrap();
         blendsynth::shader::compile_material(&scene, material).unwrap()
     };
     let glow = program("emission_mesh", "Glow").emission_estimate;
@@ -603,18 +983,37 @@ fn light_ray_visibility_follows_cycles() {
     let mut hidden = 0;
     for o in &mut scene.file.objects {
         if let Some(v) = &mut o.visibility {
-            hidden += [v.camera, v.diffuse, v.glossy].iter().filter(|x| !**x).count();
+            hidden += [v.camera, v.diffuse, v.glossy]
+                .iter()
+                .filter(|x| !**x)
+                .count();
             (v.camera, v.diffuse, v.glossy) = (true, true, true);
         }
     }
-    assert!(hidden >= 3, "the export should carry the lights' ray visibility");
-    let opts = RenderOptions { samples: Some(64), resolution: Some((128, 128)), seed: Some(0), ..Default::default() };
-    let all: Vec<[f32; 3]> = render(&scene, &opts).unwrap().color.iter().map(|p| [p[0], p[1], p[2]]).collect();
+    assert!(
+        hidden >= 3,
+        "the export should carry the lights' ray visibility"
+    );
+    let opts = RenderOptions {
+        samples: Some(64),
+        resolution: Some((128, 128)),
+        seed: Some(0),
+        ..Default::default()
+    };
+    let all: Vec<[f32; 3]> = render(&scene, &opts)
+        .unwrap()
+        .color
+        .iter()
+        .map(|p| [p[0], p[1], p[2]])
+        .collect();
     let a = read_exr(&dir.join("cycles_a.exr"));
     let b = read_exr(&dir.join("cycles_b.exr"));
     let ratio = rmse(&all, &a) / rmse(&b, &a);
     println!("light_visibility with every light visible to every ray: ratio {ratio:.3}");
-    assert!(ratio > 3.0, "ignoring ray visibility gives ratio {ratio:.3}, too close to Cycles for the test to tell");
+    assert!(
+        ratio > 3.0,
+        "ignoring ray visibility gives ratio {ratio:.3}, too close to Cycles for the test to tell"
+    );
 }
 
 #[test]
@@ -629,15 +1028,31 @@ fn object_ray_visibility_and_holdout_follow_cycles() {
         let mut flagged = 0;
         for o in scene.file.objects.iter_mut().filter(|o| o.kind == "MESH") {
             if let Some(v) = &mut o.visibility {
-                flagged += [v.camera, v.diffuse, v.glossy, v.shadow].iter().filter(|x| !**x).count();
+                flagged += [v.camera, v.diffuse, v.glossy, v.shadow]
+                    .iter()
+                    .filter(|x| !**x)
+                    .count();
                 (v.camera, v.diffuse, v.glossy, v.shadow) = (true, true, true, true);
             }
             flagged += o.is_holdout as usize;
             o.is_holdout = false;
         }
-        assert!(flagged >= 2, "{name}: the export should carry the objects' ray visibility or holdout");
-        let opts = RenderOptions { samples: Some(64), resolution: Some((128, 128)), seed: Some(0), ..Default::default() };
-        let all: Vec<[f32; 3]> = render(&scene, &opts).unwrap().color.iter().map(|p| [p[0], p[1], p[2]]).collect();
+        assert!(
+            flagged >= 2,
+            "{name}: the export should carry the objects' ray visibility or holdout"
+        );
+        let opts = RenderOptions {
+            samples: Some(64),
+            resolution: Some((128, 128)),
+            seed: Some(0),
+            ..Default::default()
+        };
+        let all: Vec<[f32; 3]> = render(&scene, &opts)
+            .unwrap()
+            .color
+            .iter()
+            .map(|p| [p[0], p[1], p[2]])
+            .collect();
         let a = read_exr(&dir.join("cycles_a.exr"));
         let b = read_exr(&dir.join("cycles_b.exr"));
         let ratio = rmse(&all, &a) / rmse(&b, &a);
@@ -653,16 +1068,48 @@ fn moving_object_hidden_from_every_surface_ray_is_not_seen() {
     // cube not rendered at all: no camera, bounce or shadow ray may meet it.
     let dir = common::repo().join("fixtures/render/scenes/object_motion");
     let scene = Scene::load(&dir).unwrap();
-    let opts = RenderOptions { samples: Some(4), resolution: Some((48, 48)), seed: Some(0), ..Default::default() };
+    let opts = RenderOptions {
+        samples: Some(4),
+        resolution: Some((48, 48)),
+        seed: Some(0),
+        ..Default::default()
+    };
     let mut hidden = scene.clone();
     let mut gone = scene.clone();
-    let cube = hidden.file.objects.iter_mut().find(|o| o.name == "Cube").expect("object_motion has a Cube");
-    cube.visibility = Some(blendsynth::scene::RayVisibility { camera: false, diffuse: false, glossy: false, transmission: false, volume_scatter: true, shadow: false });
-    gone.file.objects.iter_mut().find(|o| o.name == "Cube").unwrap().hide_render = true;
-    let bits = |s: &Scene| render(s, &opts).unwrap().color.iter().flat_map(|p| p.map(f32::to_bits)).collect::<Vec<_>>();
+    let cube = hidden
+        .file
+        .objects
+        .iter_mut()
+        .find(|o| o.name == "Cube")
+        .expect("object_motion has a Cube");
+    cube.visibility = Some(blendsynth::scene::RayVisibility {
+        camera: false,
+        diffuse: false,
+        glossy: false,
+        transmission: false,
+        volume_scatter: true,
+        shadow: false,
+    });
+    gone.file
+        .objects
+        .iter_mut()
+        .find(|o| o.name == "Cube")
+        .unwrap()
+        .hide_render = true;
+    let bits = |s: &Scene| {
+        render(s, &opts)
+            .unwrap()
+            .color
+            .iter()
+            .flat_map(|p| p.map(f32::to_bits))
+            .collect::<Vec<_>>()
+    };
     let (with_cube, hidden_bits, gone_bits) = (bits(&scene), bits(&hidden), bits(&gone));
     assert_ne!(with_cube, gone_bits, "the cube should show when visible");
-    assert_eq!(hidden_bits, gone_bits, "a moving object hidden from every surface ray must not be met");
+    assert_eq!(
+        hidden_bits, gone_bits,
+        "a moving object hidden from every surface ray must not be met"
+    );
 }
 
 /// Cycles' Z and object index passes (one centred sample per pixel, made by
@@ -670,11 +1117,21 @@ fn moving_object_hidden_from_every_surface_ray_is_not_seen() {
 /// formats, with the semantic pass from a class mapping file.
 #[test]
 fn pass_refs_match_cycles() {
-    let bytes = std::fs::read(common::repo().join("fixtures/render/passes/diffuse_point.bin")).unwrap();
-    let (w, h) = (u32::from_le_bytes(bytes[0..4].try_into().unwrap()) as usize, u32::from_le_bytes(bytes[4..8].try_into().unwrap()) as usize);
-    let vals: Vec<f32> = bytes[8..].chunks_exact(4).map(|b| f32::from_le_bytes(b.try_into().unwrap())).collect();
+    let bytes =
+        std::fs::read(common::repo().join("fixtures/render/passes/diffuse_point.bin")).unwrap();
+    let (w, h) = (
+        u32::from_le_bytes(bytes[0..4].try_into().unwrap()) as usize,
+        u32::from_le_bytes(bytes[4..8].try_into().unwrap()) as usize,
+    );
+    let vals: Vec<f32> = bytes[8..]
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes(b.try_into().unwrap()))
+        .collect();
     assert_eq!(vals.len(), w * h * 2);
-    let (z_ref, id_ref): (Vec<f32>, Vec<u32>) = (vals.iter().step_by(2).copied().collect(), vals.iter().skip(1).step_by(2).map(|v| *v as u32).collect());
+    let (z_ref, id_ref): (Vec<f32>, Vec<u32>) = (
+        vals.iter().step_by(2).copied().collect(),
+        vals.iter().skip(1).step_by(2).map(|v| *v as u32).collect(),
+    );
     let tmp = tempfile::tempdir().unwrap();
     let classes = tmp.path().join("classes.toml");
     std::fs::write(&classes, "[labels]\n[[labels.class]]\nname = \"ball\"\nobjects = [\"Sph*\"]\n[[labels.class]]\nname = \"box\"\nobjects = [\"Cube\"]\n").unwrap();
@@ -682,11 +1139,31 @@ fn pass_refs_match_cycles() {
     for format in ["exr", "png"] {
         let dir = tmp.path().join(format);
         let st = std::process::Command::new(env!("CARGO_BIN_EXE_blendsynth"))
-            .args(["render", scene.to_str().unwrap(), "--samples", "1", "--resolution", &format!("{w}x{h}"), "--pass-format", format, "--classes", classes.to_str().unwrap(), "--passes", dir.to_str().unwrap(), "-o", tmp.path().join("img.exr").to_str().unwrap()])
+            .args([
+                "render",
+                scene.to_str().unwrap(),
+                "--samples",
+                "1",
+                "--resolution",
+                &format!("{w}x{h}"),
+                "--pass-format",
+                format,
+                "--classes",
+                classes.to_str().unwrap(),
+                "--passes",
+                dir.to_str().unwrap(),
+                "-o",
+                tmp.path().join("img.exr").to_str().unwrap(),
+            ])
             .output()
             .unwrap();
-        assert!(st.status.success(), "{}", String::from_utf8_lossy(&st.stderr));
-        let meta: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("classes.json")).unwrap()).unwrap();
+        assert!(
+            st.status.success(),
+            "{}",
+            String::from_utf8_lossy(&st.stderr)
+        );
+        let meta: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.join("classes.json")).unwrap()).unwrap();
         assert_eq!(meta["semantic"]["1"], "ball");
         assert_eq!(meta["semantic"]["2"], "box");
         // Our instance ids name objects; Cycles' reference used pass indices Floor 1, Sphere 2, Cube 3.
@@ -705,10 +1182,20 @@ fn pass_refs_match_cycles() {
             let img = image::open(dir.join(format!("{name}.{format}"))).unwrap();
             match format {
                 "exr" => img.to_rgba32f().pixels().map(|p| p[0]).collect(),
-                _ => img.as_luma16().unwrap().pixels().map(|p| p[0] as f32).collect(),
+                _ => img
+                    .as_luma16()
+                    .unwrap()
+                    .pixels()
+                    .map(|p| p[0] as f32)
+                    .collect(),
             }
         };
-        let (depth, distance, inst, sem) = (grey("depth"), grey("distance"), grey("instance_id"), grey("semantic"));
+        let (depth, distance, inst, sem) = (
+            grey("depth"),
+            grey("distance"),
+            grey("instance_id"),
+            grey("semantic"),
+        );
         let (mut same_id, mut worst) = (0usize, 0f32);
         for i in 0..w * h {
             let ours = pass_index(inst[i] as u32);
@@ -726,13 +1213,36 @@ fn pass_refs_match_cycles() {
                 assert_eq!(depth[i], if format == "exr" { 1e10 } else { 0.0 });
                 continue;
             }
-            let err = if format == "exr" { (depth[i] - z_ref[i]).abs() / z_ref[i] } else { (depth[i] - (z_ref[i] * 1000.0).round()).abs() };
+            let err = if format == "exr" {
+                (depth[i] - z_ref[i]).abs() / z_ref[i]
+            } else {
+                (depth[i] - (z_ref[i] * 1000.0).round()).abs()
+            };
             worst = worst.max(err);
-            assert!(distance[i] >= depth[i] - if format == "exr" { 1e-5 * depth[i] } else { 1.0 }, "distance below depth at {i}");
+            assert!(
+                distance[i]
+                    >= depth[i]
+                        - if format == "exr" {
+                            1e-5 * depth[i]
+                        } else {
+                            1.0
+                        },
+                "distance below depth at {i}"
+            );
         }
-        println!("{format}: ids agree on {same_id} of {} pixels; worst depth error {worst:e} ({})", w * h, if format == "exr" { "relative" } else { "mm" });
-        assert!(same_id as f64 >= 0.99 * (w * h) as f64, "{format}: ids agree on only {same_id} pixels");
-        assert!(worst <= if format == "exr" { 1e-4 } else { 1.0 }, "{format}: depth differs from Cycles' Z by {worst}");
+        println!(
+            "{format}: ids agree on {same_id} of {} pixels; worst depth error {worst:e} ({})",
+            w * h,
+            if format == "exr" { "relative" } else { "mm" }
+        );
+        assert!(
+            same_id as f64 >= 0.99 * (w * h) as f64,
+            "{format}: ids agree on only {same_id} pixels"
+        );
+        assert!(
+            worst <= if format == "exr" { 1e-4 } else { 1.0 },
+            "{format}: depth differs from Cycles' Z by {worst}"
+        );
     }
 }
 
@@ -758,20 +1268,39 @@ fn sharp_specular_fireflies_match_cycles() {
                 }
             }
         }
-        assert!(n >= 20, "only {n} fireflies: the scene no longer tells how the specular is picked");
+        assert!(
+            n >= 20,
+            "only {n} fireflies: the scene no longer tells how the specular is picked"
+        );
         high / all
     };
-    let cycles = [share(&read_exr(&dir.join("cycles_a.exr"))), share(&read_exr(&dir.join("cycles_b.exr")))];
+    let cycles = [
+        share(&read_exr(&dir.join("cycles_a.exr"))),
+        share(&read_exr(&dir.join("cycles_b.exr"))),
+    ];
     let scene = Scene::load(&dir).unwrap();
     let ours: Vec<f64> = [0u32, 1]
         .iter()
         .map(|&seed| {
-            let opts = RenderOptions { samples: Some(64), resolution: Some((128, 128)), seed: Some(seed), ..Default::default() };
+            let opts = RenderOptions {
+                samples: Some(64),
+                resolution: Some((128, 128)),
+                seed: Some(seed),
+                ..Default::default()
+            };
             let out = render(&scene, &opts).unwrap();
-            share(&out.color.iter().map(|p| [p[0], p[1], p[2]]).collect::<Vec<_>>())
+            share(
+                &out.color
+                    .iter()
+                    .map(|p| [p[0], p[1], p[2]])
+                    .collect::<Vec<_>>(),
+            )
         })
         .collect();
     println!("share of firefly energy in pixels >= 1.0: Cycles {cycles:.3?}, ours {ours:.3?}");
     let (c, o) = ((cycles[0] + cycles[1]) / 2.0, (ours[0] + ours[1]) / 2.0);
-    assert!((o - c).abs() < 0.12, "firefly share: ours {o:.3}, Cycles {c:.3}");
+    assert!(
+        (o - c).abs() < 0.12,
+        "firefly share: ours {o:.3}, Cycles {c:.3}"
+    );
 }

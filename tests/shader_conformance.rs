@@ -17,30 +17,32 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
 use blendsynth::nodes::blackbody::blackbody;
-use blendsynth::nodes::curves::{mapping_from_json, CurveKind, CurveTable};
-use blendsynth::nodes::vector_rotate::{vector_rotate, VectorRotateType};
+use blendsynth::nodes::checker::checker_texture;
 use blendsynth::nodes::clamp::{clamp_node, ClampType};
 use blendsynth::nodes::color::{
     bright_contrast, gamma, hue_saturation, invert, rgb_to_bw, LINEAR_REC709,
 };
+use blendsynth::nodes::curves::{mapping_from_json, CurveKind, CurveTable};
+use blendsynth::nodes::gradient::{gradient, GradientType};
+use blendsynth::nodes::magic::magic;
 use blendsynth::nodes::map_range::{map_range_float, map_range_vector, MapRangeInterpolation};
+use blendsynth::nodes::mapping::{mapping, MappingType};
 use blendsynth::nodes::math::{math_node, vector_math, MathOp, VectorMathOp};
 use blendsynth::nodes::mix::{
     mix_color, mix_float, mix_rgb, mix_vector, mix_vector_non_uniform, MixBlend, MixDataType,
     MixFactorMode,
 };
+use blendsynth::nodes::noise::{noise_texture_cycles, NoiseParams, NoiseType};
 use blendsynth::nodes::ramp::{
     ColorBand, HueInterpolation, RampColorMode, RampInterpolation, RampStop, RampTable,
 };
 use blendsynth::nodes::sepcomb::{combine_color, separate_color, ColorMode};
-use blendsynth::nodes::wavelength::wavelength;
-use blendsynth::nodes::checker::checker_texture;
-use blendsynth::nodes::gradient::{gradient, GradientType};
-use blendsynth::nodes::magic::magic;
-use blendsynth::nodes::mapping::{mapping, MappingType};
-use blendsynth::nodes::noise::{noise_texture_cycles, NoiseParams, NoiseType};
+use blendsynth::nodes::vector_rotate::{vector_rotate, VectorRotateType};
 use blendsynth::nodes::voronoi::{voronoi_texture, VoronoiFeature, VoronoiMetric, VoronoiParams};
-use blendsynth::nodes::wave::{wave, BandsDirection, RingsDirection, WaveProfile, WaveSettings, WaveType};
+use blendsynth::nodes::wave::{
+    wave, BandsDirection, RingsDirection, WaveProfile, WaveSettings, WaveType,
+};
+use blendsynth::nodes::wavelength::wavelength;
 use blendsynth::nodes::white_noise::white_noise;
 use blendsynth::nodes::{support, Support};
 use serde_json::Value;
@@ -68,7 +70,8 @@ const ALLOWED: &[(&str, f64, &str)] = &[
     ("noise_1d_multifractal", 2e-3, ONE_D_NOISE),
     ("noise_1d_hetero_terrain", 5e-3, ONE_D_NOISE),
 ];
-const ONE_D_NOISE: &str = "one texel (14, 18) with unattenuated octaves near 7e4 (see above); all others <= 1e-4";
+const ONE_D_NOISE: &str =
+    "one texel (14, 18) with unattenuated octaves near 7e4 (see above); all others <= 1e-4";
 
 type V3 = [f32; 3];
 
@@ -326,7 +329,8 @@ fn evaluator<'a>(c: &'a Case<'a>) -> Eval<'a> {
             })
         }
         "ShaderNodeRGBCurve" | "ShaderNodeVectorCurve" | "ShaderNodeFloatCurve" => {
-            let m = mapping_from_json(&c.case["mapping"]).unwrap_or_else(|e| panic!("{}: {}", c.name, e.0));
+            let m = mapping_from_json(&c.case["mapping"])
+                .unwrap_or_else(|e| panic!("{}: {}", c.name, e.0));
             let kind = match c.node {
                 "ShaderNodeRGBCurve" => CurveKind::Rgb,
                 "ShaderNodeVectorCurve" => CurveKind::Vector,
@@ -334,16 +338,38 @@ fn evaluator<'a>(c: &'a Case<'a>) -> Eval<'a> {
             };
             let table = CurveTable::new(&m, kind).unwrap_or_else(|e| panic!("{}: {}", c.name, e.0));
             match kind {
-                CurveKind::Rgb => Box::new(move |t| vec![("Color", table.eval3(t.f("Fac"), t.v3("Color")))]),
-                CurveKind::Vector => Box::new(move |t| vec![("Vector", table.eval3(t.f("Fac"), t.v3("Vector")))]),
-                CurveKind::Float => Box::new(move |t| vec![("Value", f1(table.eval1(t.f("Factor"), t.f("Value"))))]),
+                CurveKind::Rgb => {
+                    Box::new(move |t| vec![("Color", table.eval3(t.f("Fac"), t.v3("Color")))])
+                }
+                CurveKind::Vector => {
+                    Box::new(move |t| vec![("Vector", table.eval3(t.f("Fac"), t.v3("Vector")))])
+                }
+                CurveKind::Float => {
+                    Box::new(move |t| vec![("Value", f1(table.eval1(t.f("Factor"), t.f("Value"))))])
+                }
             }
         }
         "ShaderNodeVectorRotate" => {
-            let kind = parse(c, "rotation_type", c.prop("rotation_type"), VectorRotateType::from_blender);
+            let kind = parse(
+                c,
+                "rotation_type",
+                c.prop("rotation_type"),
+                VectorRotateType::from_blender,
+            );
             let invert = c.flag("invert");
             Box::new(move |t| {
-                vec![("Vector", vector_rotate(kind, invert, t.v3("Vector"), t.v3("Center"), t.v3("Axis"), t.f("Angle"), t.v3("Rotation")))]
+                vec![(
+                    "Vector",
+                    vector_rotate(
+                        kind,
+                        invert,
+                        t.v3("Vector"),
+                        t.v3("Center"),
+                        t.v3("Axis"),
+                        t.f("Angle"),
+                        t.v3("Rotation"),
+                    ),
+                )]
             })
         }
         "ShaderNodeInvert" => Box::new(|t| vec![("Color", invert(t.f("Fac"), t.v3("Color")))]),
@@ -412,7 +438,12 @@ fn evaluator<'a>(c: &'a Case<'a>) -> Eval<'a> {
         }
         "ShaderNodeTexNoise" => {
             let dims = dimensions(c, "noise_dimensions");
-            let kind = parse(c, "noise_type", c.prop("noise_type"), NoiseType::from_blender);
+            let kind = parse(
+                c,
+                "noise_type",
+                c.prop("noise_type"),
+                NoiseType::from_blender,
+            );
             let normalize = c.flag("normalize");
             Box::new(move |t| {
                 let params = NoiseParams {
@@ -425,14 +456,25 @@ fn evaluator<'a>(c: &'a Case<'a>) -> Eval<'a> {
                     gain: t.f("Gain"),
                     distortion: t.f("Distortion"),
                 };
-                let (fac, col) = noise_texture_cycles(dims, t.v3("Vector"), t.f("W"), t.f("Scale"), params);
+                let (fac, col) =
+                    noise_texture_cycles(dims, t.v3("Vector"), t.f("W"), t.f("Scale"), params);
                 vec![("Fac", f1(fac)), ("Color", col)]
             })
         }
         "ShaderNodeTexVoronoi" => {
             let dims = dimensions(c, "voronoi_dimensions");
-            let feature = parse(c, "feature", c.prop("feature"), VoronoiFeature::from_blender);
-            let metric = parse(c, "distance", c.prop("distance"), VoronoiMetric::from_blender);
+            let feature = parse(
+                c,
+                "feature",
+                c.prop("feature"),
+                VoronoiFeature::from_blender,
+            );
+            let metric = parse(
+                c,
+                "distance",
+                c.prop("distance"),
+                VoronoiMetric::from_blender,
+            );
             let normalize = c.flag("normalize");
             Box::new(move |t| {
                 let p = VoronoiParams::new(
@@ -460,9 +502,24 @@ fn evaluator<'a>(c: &'a Case<'a>) -> Eval<'a> {
         "ShaderNodeTexWave" => {
             let s = WaveSettings {
                 kind: parse(c, "wave_type", c.prop("wave_type"), WaveType::from_blender),
-                bands: c.props.get("bands_direction").and_then(Value::as_str).and_then(BandsDirection::from_blender).unwrap_or(BandsDirection::X),
-                rings: c.props.get("rings_direction").and_then(Value::as_str).and_then(RingsDirection::from_blender).unwrap_or(RingsDirection::X),
-                profile: parse(c, "wave_profile", c.prop("wave_profile"), WaveProfile::from_blender),
+                bands: c
+                    .props
+                    .get("bands_direction")
+                    .and_then(Value::as_str)
+                    .and_then(BandsDirection::from_blender)
+                    .unwrap_or(BandsDirection::X),
+                rings: c
+                    .props
+                    .get("rings_direction")
+                    .and_then(Value::as_str)
+                    .and_then(RingsDirection::from_blender)
+                    .unwrap_or(RingsDirection::X),
+                profile: parse(
+                    c,
+                    "wave_profile",
+                    c.prop("wave_profile"),
+                    WaveProfile::from_blender,
+                ),
             };
             Box::new(move |t| {
                 let f = wave(
@@ -479,14 +536,21 @@ fn evaluator<'a>(c: &'a Case<'a>) -> Eval<'a> {
             })
         }
         "ShaderNodeTexGradient" => {
-            let kind = parse(c, "gradient_type", c.prop("gradient_type"), GradientType::from_blender);
+            let kind = parse(
+                c,
+                "gradient_type",
+                c.prop("gradient_type"),
+                GradientType::from_blender,
+            );
             Box::new(move |t| {
                 let f = gradient(kind, t.v3("Vector"));
                 vec![("Fac", f1(f)), ("Color", [f; 3])]
             })
         }
         "ShaderNodeTexMagic" => {
-            let depth = c.props["turbulence_depth"].as_i64().expect("turbulence_depth") as i32;
+            let depth = c.props["turbulence_depth"]
+                .as_i64()
+                .expect("turbulence_depth") as i32;
             Box::new(move |t| {
                 let (col, fac) = magic(t.v3("Vector"), t.f("Scale"), depth, t.f("Distortion"));
                 vec![("Fac", f1(fac)), ("Color", col)]
@@ -500,14 +564,26 @@ fn evaluator<'a>(c: &'a Case<'a>) -> Eval<'a> {
             })
         }
         "ShaderNodeMapping" => {
-            let kind = parse(c, "vector_type", c.prop("vector_type"), MappingType::from_blender);
+            let kind = parse(
+                c,
+                "vector_type",
+                c.prop("vector_type"),
+                MappingType::from_blender,
+            );
             Box::new(move |t| {
-                let r = mapping(kind, t.v3("Vector"), t.v3("Location"), t.v3("Rotation"), t.v3("Scale"));
+                let r = mapping(
+                    kind,
+                    t.v3("Vector"),
+                    t.v3("Location"),
+                    t.v3("Rotation"),
+                    t.v3("Scale"),
+                );
                 vec![("Vector", r)]
             })
         }
         "ShaderNodeTexChecker" => Box::new(|t| {
-            let (col, fac) = checker_texture(t.v3("Vector"), t.v3("Color1"), t.v3("Color2"), t.f("Scale"));
+            let (col, fac) =
+                checker_texture(t.v3("Vector"), t.v3("Color1"), t.v3("Color2"), t.f("Scale"));
             vec![("Fac", f1(fac)), ("Color", col)]
         }),
         other => panic!("{}: no evaluator for node type {other}", c.name),
@@ -647,9 +723,18 @@ fn run_case<'a>(refs: &'a Refs, case: &'a Value, texels: usize) -> CaseResult {
                 let err = (ours[i] as f64 - cycles[i] as f64).abs();
                 // Fractal textures reach values in the thousands, where one f32 ulp
                 // exceeds 1e-4: above magnitude 1 their error is relative.
-                let err = if texture { err / (cycles[i].abs() as f64).max(1.0) } else { err };
+                let err = if texture {
+                    err / (cycles[i].abs() as f64).max(1.0)
+                } else {
+                    err
+                };
                 let err = if err.is_nan() { f64::INFINITY } else { err };
-                texel_over |= err > if texture { TEXTURE_TOLERANCE } else { TOLERANCE };
+                texel_over |= err
+                    > if texture {
+                        TEXTURE_TOLERANCE
+                    } else {
+                        TOLERANCE
+                    };
                 if err > worst {
                     worst = err;
                     worst_at = format!(
@@ -664,10 +749,14 @@ fn run_case<'a>(refs: &'a Refs, case: &'a Value, texels: usize) -> CaseResult {
         }
         over += texel_over as usize;
     }
-    let bound = ALLOWED
-        .iter()
-        .find(|a| a.0 == name)
-        .map_or(if is_texture(c.node) { TEXTURE_TOLERANCE } else { TOLERANCE }, |a| a.1);
+    let bound = ALLOWED.iter().find(|a| a.0 == name).map_or(
+        if is_texture(c.node) {
+            TEXTURE_TOLERANCE
+        } else {
+            TOLERANCE
+        },
+        |a| a.1,
+    );
     CaseResult {
         name: name.to_string(),
         node: c.node.to_string(),
@@ -743,7 +832,11 @@ fn shader_nodes_match_cycles() {
         let r = results.iter().find(|r| r.name == *name);
         assert!(r.is_some(), "ALLOWED names a missing case {name}");
         // The allowance is for the one texel named in the reason, not for the case.
-        assert!(r.unwrap().over <= 1, "{name}: {} texels over the family bound", r.unwrap().over);
+        assert!(
+            r.unwrap().over <= 1,
+            "{name}: {} texels over the family bound",
+            r.unwrap().over
+        );
     }
     // Written so that a NaN error counts as a failure.
     #[allow(clippy::neg_cmp_op_on_partial_ord)]
@@ -828,10 +921,25 @@ fn assert_modes_covered(cases: &[Value]) {
                 }
             }
             "ShaderNodeSeparateColor" | "ShaderNodeCombineColor" => s("mode"),
-            "ShaderNodeTexNoise" => format!("{} {} {}", s("noise_dimensions"), s("noise_type"), b("normalize")),
-            "ShaderNodeTexVoronoi" => format!("{} {} {} {}", s("voronoi_dimensions"), s("feature"), s("distance"), b("normalize")),
+            "ShaderNodeTexNoise" => format!(
+                "{} {} {}",
+                s("noise_dimensions"),
+                s("noise_type"),
+                b("normalize")
+            ),
+            "ShaderNodeTexVoronoi" => format!(
+                "{} {} {} {}",
+                s("voronoi_dimensions"),
+                s("feature"),
+                s("distance"),
+                b("normalize")
+            ),
             "ShaderNodeTexWave" => {
-                let dir = if s("wave_type") == "BANDS" { s("bands_direction") } else { s("rings_direction") };
+                let dir = if s("wave_type") == "BANDS" {
+                    s("bands_direction")
+                } else {
+                    s("rings_direction")
+                };
                 format!("{} {dir} {}", s("wave_type"), s("wave_profile"))
             }
             "ShaderNodeTexGradient" => s("gradient_type"),
@@ -841,8 +949,17 @@ fn assert_modes_covered(cases: &[Value]) {
             "ShaderNodeTexWhiteNoise" => s("noise_dimensions"),
             "ShaderNodeRGBCurve" | "ShaderNodeVectorCurve" | "ShaderNodeFloatCurve" => {
                 let m = &c["mapping"];
-                let mut handles: Vec<&str> = m["curves"].as_array().unwrap().iter()
-                    .flat_map(|cu| cu["points"].as_array().unwrap().iter().map(|p| p["handle_type"].as_str().unwrap()))
+                let mut handles: Vec<&str> = m["curves"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .flat_map(|cu| {
+                        cu["points"]
+                            .as_array()
+                            .unwrap()
+                            .iter()
+                            .map(|p| p["handle_type"].as_str().unwrap())
+                    })
                     .collect();
                 handles.sort();
                 handles.dedup();
@@ -904,35 +1021,65 @@ fn assert_modes_covered(cases: &[Value]) {
     }
     let dims = ["1D", "2D", "3D", "4D"];
     for d in dims {
-        for t in ["FBM", "MULTIFRACTAL", "HYBRID_MULTIFRACTAL", "RIDGED_MULTIFRACTAL", "HETERO_TERRAIN"] {
+        for t in [
+            "FBM",
+            "MULTIFRACTAL",
+            "HYBRID_MULTIFRACTAL",
+            "RIDGED_MULTIFRACTAL",
+            "HETERO_TERRAIN",
+        ] {
             want.push(format!("ShaderNodeTexNoise {d} {t} true"));
         }
         want.push(format!("ShaderNodeTexNoise {d} FBM false"));
         want.push(format!("ShaderNodeTexWhiteNoise {d}"));
         // The metric only matters for F1, F2 and Smooth F1 beyond 1D.
-        let metrics: &[VoronoiMetric] = if d == "1D" { &[VoronoiMetric::Euclidean] } else { VoronoiMetric::ALL };
+        let metrics: &[VoronoiMetric] = if d == "1D" {
+            &[VoronoiMetric::Euclidean]
+        } else {
+            VoronoiMetric::ALL
+        };
         for f in VoronoiFeature::ALL {
             let ms: &[VoronoiMetric] = match f {
-                VoronoiFeature::DistanceToEdge | VoronoiFeature::NSphereRadius => &[VoronoiMetric::Euclidean],
+                VoronoiFeature::DistanceToEdge | VoronoiFeature::NSphereRadius => {
+                    &[VoronoiMetric::Euclidean]
+                }
                 _ => metrics,
             };
             for m in ms {
-                want.push(format!("ShaderNodeTexVoronoi {d} {} {} false", f.blender_name(), m.blender_name()));
+                want.push(format!(
+                    "ShaderNodeTexVoronoi {d} {} {} false",
+                    f.blender_name(),
+                    m.blender_name()
+                ));
             }
             if *f != VoronoiFeature::NSphereRadius {
                 let m = ms.last().unwrap();
-                want.push(format!("ShaderNodeTexVoronoi {d} {} {} true", f.blender_name(), m.blender_name()));
+                want.push(format!(
+                    "ShaderNodeTexVoronoi {d} {} {} true",
+                    f.blender_name(),
+                    m.blender_name()
+                ));
             }
         }
     }
     for t in WaveType::ALL {
         for p in WaveProfile::ALL {
             let dirs: Vec<&str> = match t {
-                WaveType::Bands => BandsDirection::ALL.iter().map(|d| d.blender_name()).collect(),
-                WaveType::Rings => RingsDirection::ALL.iter().map(|d| d.blender_name()).collect(),
+                WaveType::Bands => BandsDirection::ALL
+                    .iter()
+                    .map(|d| d.blender_name())
+                    .collect(),
+                WaveType::Rings => RingsDirection::ALL
+                    .iter()
+                    .map(|d| d.blender_name())
+                    .collect(),
             };
             for d in dirs {
-                want.push(format!("ShaderNodeTexWave {} {d} {}", t.blender_name(), p.blender_name()));
+                want.push(format!(
+                    "ShaderNodeTexWave {} {d} {}",
+                    t.blender_name(),
+                    p.blender_name()
+                ));
             }
         }
     }
@@ -952,7 +1099,11 @@ fn assert_modes_covered(cases: &[Value]) {
         }
     }
     // Curves: both extend modes, each with a layout mixing every handle type.
-    for node in ["ShaderNodeRGBCurve", "ShaderNodeVectorCurve", "ShaderNodeFloatCurve"] {
+    for node in [
+        "ShaderNodeRGBCurve",
+        "ShaderNodeVectorCurve",
+        "ShaderNodeFloatCurve",
+    ] {
         for ext in ["EXTRAPOLATED", "HORIZONTAL"] {
             want.push(format!("{node} {ext} AUTO,AUTO_CLAMPED,VECTOR"));
         }

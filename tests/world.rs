@@ -10,12 +10,22 @@ use blendsynth::render::{render, RenderOptions};
 use blendsynth::scene::Scene;
 
 fn read_exr(p: &Path) -> Vec<[f32; 3]> {
-    let img = image::open(p).unwrap_or_else(|e| panic!("{}: {e}", p.display())).to_rgba32f();
+    let img = image::open(p)
+        .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+        .to_rgba32f();
     img.pixels().map(|p| [p[0], p[1], p[2]]).collect()
 }
 
 fn rmse(a: &[[f32; 3]], b: &[[f32; 3]]) -> f64 {
-    let s: f64 = a.iter().zip(b).map(|(x, y)| (0..3).map(|k| (x[k] as f64 - y[k] as f64).powi(2)).sum::<f64>()).sum();
+    let s: f64 = a
+        .iter()
+        .zip(b)
+        .map(|(x, y)| {
+            (0..3)
+                .map(|k| (x[k] as f64 - y[k] as f64).powi(2))
+                .sum::<f64>()
+        })
+        .sum();
     (s / (a.len() * 3) as f64).sqrt()
 }
 
@@ -37,39 +47,69 @@ fn environment_image_world_matches_cycles() {
 /// Blender-side: make the sky and both Cycles renders afresh with the running Blender.
 #[test]
 fn fresh_cycles_renders_match() {
-    let Some(py) = common::require("a Python with bpy 4.5.4", common::bpy_python()) else { return };
+    let Some(py) = common::require("a Python with bpy 4.5.4", common::bpy_python()) else {
+        return;
+    };
     let t = tempfile::tempdir().unwrap();
-    common::run_python(&py, &common::repo().join("fixtures/world/make_world_refs.py"), &["--out", t.path().to_str().unwrap()]);
+    common::run_python(
+        &py,
+        &common::repo().join("fixtures/world/make_world_refs.py"),
+        &["--out", t.path().to_str().unwrap()],
+    );
     check(&t.path().join("env_image"));
 }
 
 fn check(dir: &Path) {
-    let meta: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("render.json")).unwrap()).unwrap();
+    let meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("render.json")).unwrap()).unwrap();
     let samples = meta["samples"].as_u64().unwrap() as u32;
     let res = meta["resolution"].as_array().unwrap();
-    let (w, h) = (res[0].as_u64().unwrap() as u32, res[1].as_u64().unwrap() as u32);
+    let (w, h) = (
+        res[0].as_u64().unwrap() as u32,
+        res[1].as_u64().unwrap() as u32,
+    );
     let a = read_exr(&dir.join("cycles_a.exr"));
     let b = read_exr(&dir.join("cycles_b.exr"));
     let scene = Scene::load(dir).unwrap();
-    let opts = RenderOptions { samples: Some(samples), resolution: Some((w, h)), seed: Some(0), ..Default::default() };
+    let opts = RenderOptions {
+        samples: Some(samples),
+        resolution: Some((w, h)),
+        seed: Some(0),
+        ..Default::default()
+    };
     let out = render(&scene, &opts).unwrap();
     let ours: Vec<[f32; 3]> = out.color.iter().map(|p| [p[0], p[1], p[2]]).collect();
     let ratio = rmse(&ours, &a) / rmse(&b, &a).max(1e-12);
     let (mo, ma) = (means(&ours), means(&a));
-    let worst_mean = (0..3).map(|k| (mo[k] - ma[k]).abs() / ma[k].abs().max(1e-6)).fold(0.0, f64::max);
+    let worst_mean = (0..3)
+        .map(|k| (mo[k] - ma[k]).abs() / ma[k].abs().max(1e-6))
+        .fold(0.0, f64::max);
     println!("env_image: ratio {ratio:.3}, worst channel mean error {:.2}%, ours {mo:.4?}, Cycles A {ma:.4?}, {:.2} s", 100.0 * worst_mean, out.stats.wall_seconds);
     assert!(ratio <= 1.15, "ratio {ratio:.3}");
-    assert!(worst_mean <= 0.01, "channel mean error {:.2}%", 100.0 * worst_mean);
+    assert!(
+        worst_mean <= 0.01,
+        "channel mean error {:.2}%",
+        100.0 * worst_mean
+    );
 }
 
 #[test]
 fn textured_world_is_deterministic_across_thread_counts() {
     let scene = Scene::load(&common::repo().join("fixtures/world/scenes/env_image")).unwrap();
     let run = |threads| {
-        let opts = RenderOptions { samples: Some(4), resolution: Some((24, 24)), seed: Some(3), threads: Some(threads), ..Default::default() };
+        let opts = RenderOptions {
+            samples: Some(4),
+            resolution: Some((24, 24)),
+            seed: Some(3),
+            threads: Some(threads),
+            ..Default::default()
+        };
         render(&scene, &opts).unwrap().color
     };
     let (a, b) = (run(1), run(3));
-    assert!(a.iter().zip(&b).all(|(x, y)| x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits())));
+    assert!(a
+        .iter()
+        .zip(&b)
+        .all(|(x, y)| x.iter().zip(y).all(|(p, q)| p.to_bits() == q.to_bits())));
     assert!(a.iter().any(|p| p[2] > 0.1), "the sky is visible");
 }

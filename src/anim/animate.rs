@@ -10,9 +10,9 @@
 
 use serde_json::Value;
 
-use crate::scene::datapath::{parse, Token};
 use super::error::AnimError;
 use super::fcurve::{CompiledFCurve, ValueKind};
+use crate::scene::datapath::{parse, Token};
 use crate::scene::{quote, AnimData, Camera, Curve, FCurve, Light, Object, Rna, SceneFile};
 
 /// Datablocks animation can change, copied from the scene file.
@@ -26,7 +26,12 @@ pub struct Datablocks {
 
 impl Datablocks {
     pub fn from_file(f: &SceneFile) -> Self {
-        Datablocks { objects: f.objects.clone(), curves: f.curves.clone(), cameras: f.cameras.clone(), lights: f.lights.clone() }
+        Datablocks {
+            objects: f.objects.clone(),
+            curves: f.curves.clone(),
+            cameras: f.cameras.clone(),
+            lights: f.lights.clone(),
+        }
     }
 }
 
@@ -43,7 +48,11 @@ fn fcurve_label(ad: &AnimData, fc: &FCurve) -> String {
 
 /// Applies all animation in `anim` at `frame`. Returns the F-curves it could not map onto
 /// anything (as "id_path data_path[index]" strings).
-pub fn apply(anim: &[AnimData], frame: f64, data: &mut Datablocks) -> Result<Vec<String>, AnimError> {
+pub fn apply(
+    anim: &[AnimData],
+    frame: f64,
+    data: &mut Datablocks,
+) -> Result<Vec<String>, AnimError> {
     let t = ctime(frame);
     let mut unapplied = Vec::new();
     for ad in anim {
@@ -98,7 +107,9 @@ fn object_slot<'a>(o: &'a mut Object, name: &str) -> Option<&'a mut [f64]> {
         "scale" => &mut o.scale[..],
         "delta_location" => &mut o.delta_location.get_or_insert([0.0; 3])[..],
         "delta_rotation_euler" => &mut o.delta_rotation_euler.get_or_insert([0.0; 3])[..],
-        "delta_rotation_quaternion" => &mut o.delta_rotation_quaternion.get_or_insert([1.0, 0.0, 0.0, 0.0])[..],
+        "delta_rotation_quaternion" => &mut o
+            .delta_rotation_quaternion
+            .get_or_insert([1.0, 0.0, 0.0, 0.0])[..],
         "delta_scale" => &mut o.delta_scale.get_or_insert([1.0; 3])[..],
         _ => return None,
     })
@@ -110,7 +121,9 @@ fn kind_of_json(v: &Value) -> Option<ValueKind> {
 
 /// Follows `tokens` inside an RNA map (nested structs, arrays by `index`).
 fn rna_slot<'a>(map: &'a mut Rna, tokens: &[Token], index: usize) -> Option<&'a mut Value> {
-    let (Token::Prop(first), rest) = tokens.split_first()? else { return None };
+    let (Token::Prop(first), rest) = tokens.split_first()? else {
+        return None;
+    };
     let mut v = map.get_mut(first)?;
     for t in rest {
         v = match t {
@@ -130,12 +143,16 @@ fn rna_kind(map: &mut Rna, tokens: &[Token], index: usize) -> Option<ValueKind> 
 }
 
 fn rna_write(map: &mut Rna, tokens: &[Token], index: usize, v: f64) -> bool {
-    let Some(slot) = rna_slot(map, tokens, index) else { return false };
+    let Some(slot) = rna_slot(map, tokens, index) else {
+        return false;
+    };
     *slot = match slot {
         // Blender's ANIMSYS_FLOAT_AS_BOOL.
         Value::Bool(_) => Value::Bool(v as f32 > 1.0 - f32::EPSILON),
         Value::Number(n) if !n.is_f64() => Value::from(v as i64),
-        Value::Number(_) => serde_json::Number::from_f64(v).map(Value::Number).unwrap_or(Value::Null),
+        Value::Number(_) => serde_json::Number::from_f64(v)
+            .map(Value::Number)
+            .unwrap_or(Value::Null),
         _ => return false,
     };
     true
@@ -146,24 +163,43 @@ fn find<'a, T>(list: &'a mut [T], name: &str, get: impl Fn(&T) -> &str) -> Optio
 }
 
 /// The kind of value the target holds, or None when we cannot map the path.
-fn value_kind(ad: &AnimData, tokens: &[Token], index: usize, data: &mut Datablocks) -> Option<ValueKind> {
+fn value_kind(
+    ad: &AnimData,
+    tokens: &[Token],
+    index: usize,
+    data: &mut Datablocks,
+) -> Option<ValueKind> {
     match ad.id_type.as_str() {
         "OBJECT" => {
             let o = find(&mut data.objects, &ad.id_name, |o| &o.name)?;
             match tokens {
-                [Token::Prop(p)] if OBJECT_VECTORS.iter().any(|(n, len)| n == p && index < *len) => Some(ValueKind::default()),
-                [Token::Prop(p)] if p == "hide_render" || p == "hide_viewport" => Some(ValueKind { discrete: true, integer: true }),
+                [Token::Prop(p)]
+                    if OBJECT_VECTORS.iter().any(|(n, len)| n == p && index < *len) =>
+                {
+                    Some(ValueKind::default())
+                }
+                [Token::Prop(p)] if p == "hide_render" || p == "hide_viewport" => Some(ValueKind {
+                    discrete: true,
+                    integer: true,
+                }),
                 [Token::Prop(c), Token::Key(name), Token::Prop(p)] if c == "constraints" => {
                     let con = o.constraints.iter_mut().find(|c| &c.name == name)?;
                     match p.as_str() {
                         "influence" => Some(ValueKind::default()),
-                        "mute" => Some(ValueKind { discrete: true, integer: true }),
+                        "mute" => Some(ValueKind {
+                            discrete: true,
+                            integer: true,
+                        }),
                         _ => rna_kind(&mut con.properties, &tokens[2..], index),
                     }
                 }
                 [Token::Key(k)] => {
                     let v = o.custom_properties.get_mut(k)?;
-                    let v = if v.is_array() { v.as_array_mut()?.get_mut(index)? } else { v };
+                    let v = if v.is_array() {
+                        v.as_array_mut()?.get_mut(index)?
+                    } else {
+                        v
+                    };
                     kind_of_json(v)
                 }
                 _ => None,
@@ -172,14 +208,22 @@ fn value_kind(ad: &AnimData, tokens: &[Token], index: usize, data: &mut Databloc
         "CURVE" => {
             let c = find(&mut data.curves, &ad.id_name, |c| &c.name)?;
             match tokens {
-                [Token::Prop(s), Token::Index(i), Token::Prop(kind), Token::Index(j), Token::Prop(field)] if s == "splines" => {
+                [Token::Prop(s), Token::Index(i), Token::Prop(kind), Token::Index(j), Token::Prop(field)]
+                    if s == "splines" =>
+                {
                     let sp = c.splines.get(*i)?;
                     let ok = match kind.as_str() {
                         "bezier_points" => {
                             sp.bezier_points.get(*j).is_some()
-                                && matches!(field.as_str(), "co" | "handle_left" | "handle_right" | "radius" | "tilt")
+                                && matches!(
+                                    field.as_str(),
+                                    "co" | "handle_left" | "handle_right" | "radius" | "tilt"
+                                )
                         }
-                        "points" => sp.points.get(*j).is_some() && matches!(field.as_str(), "co" | "radius" | "tilt" | "weight"),
+                        "points" => {
+                            sp.points.get(*j).is_some()
+                                && matches!(field.as_str(), "co" | "radius" | "tilt" | "weight")
+                        }
                         _ => false,
                     };
                     ok.then(ValueKind::default)
@@ -187,8 +231,16 @@ fn value_kind(ad: &AnimData, tokens: &[Token], index: usize, data: &mut Databloc
                 _ => rna_kind(&mut c.properties, tokens, index),
             }
         }
-        "CAMERA" => rna_kind(&mut find(&mut data.cameras, &ad.id_name, |c| &c.name)?.properties, tokens, index),
-        "LIGHT" => rna_kind(&mut find(&mut data.lights, &ad.id_name, |c| &c.name)?.properties, tokens, index),
+        "CAMERA" => rna_kind(
+            &mut find(&mut data.cameras, &ad.id_name, |c| &c.name)?.properties,
+            tokens,
+            index,
+        ),
+        "LIGHT" => rna_kind(
+            &mut find(&mut data.lights, &ad.id_name, |c| &c.name)?.properties,
+            tokens,
+            index,
+        ),
         _ => None,
     }
 }
@@ -196,7 +248,9 @@ fn value_kind(ad: &AnimData, tokens: &[Token], index: usize, data: &mut Databloc
 fn write(ad: &AnimData, tokens: &[Token], index: usize, v: f64, data: &mut Datablocks) -> bool {
     match ad.id_type.as_str() {
         "OBJECT" => {
-            let Some(o) = find(&mut data.objects, &ad.id_name, |o| &o.name) else { return false };
+            let Some(o) = find(&mut data.objects, &ad.id_name, |o| &o.name) else {
+                return false;
+            };
             match tokens {
                 [Token::Prop(p)] if p == "hide_render" => {
                     o.hide_render = v as f32 > 1.0 - f32::EPSILON;
@@ -214,7 +268,9 @@ fn write(ad: &AnimData, tokens: &[Token], index: usize, v: f64, data: &mut Datab
                     None => false,
                 },
                 [Token::Prop(c), Token::Key(name), Token::Prop(p)] if c == "constraints" => {
-                    let Some(con) = o.constraints.iter_mut().find(|c| &c.name == name) else { return false };
+                    let Some(con) = o.constraints.iter_mut().find(|c| &c.name == name) else {
+                        return false;
+                    };
                     match p.as_str() {
                         // Blender clamps influence to its RNA range.
                         "influence" => {
@@ -229,7 +285,9 @@ fn write(ad: &AnimData, tokens: &[Token], index: usize, v: f64, data: &mut Datab
                     }
                 }
                 [Token::Key(k)] => {
-                    let Some(slot) = o.custom_properties.get_mut(k) else { return false };
+                    let Some(slot) = o.custom_properties.get_mut(k) else {
+                        return false;
+                    };
                     let slot = if slot.is_array() {
                         match slot.as_array_mut().and_then(|a| a.get_mut(index)) {
                             Some(s) => s,
@@ -241,7 +299,9 @@ fn write(ad: &AnimData, tokens: &[Token], index: usize, v: f64, data: &mut Datab
                     *slot = match slot {
                         Value::Bool(_) => Value::Bool(v as f32 > 1.0 - f32::EPSILON),
                         Value::Number(n) if !n.is_f64() => Value::from(v as i64),
-                        _ => serde_json::Number::from_f64(v).map(Value::Number).unwrap_or(Value::Null),
+                        _ => serde_json::Number::from_f64(v)
+                            .map(Value::Number)
+                            .unwrap_or(Value::Null),
                     };
                     true
                 }
@@ -249,12 +309,20 @@ fn write(ad: &AnimData, tokens: &[Token], index: usize, v: f64, data: &mut Datab
             }
         }
         "CURVE" => {
-            let Some(c) = find(&mut data.curves, &ad.id_name, |c| &c.name) else { return false };
+            let Some(c) = find(&mut data.curves, &ad.id_name, |c| &c.name) else {
+                return false;
+            };
             match tokens {
-                [Token::Prop(s), Token::Index(i), Token::Prop(kind), Token::Index(j), Token::Prop(field)] if s == "splines" => {
-                    let Some(sp) = c.splines.get_mut(*i) else { return false };
+                [Token::Prop(s), Token::Index(i), Token::Prop(kind), Token::Index(j), Token::Prop(field)]
+                    if s == "splines" =>
+                {
+                    let Some(sp) = c.splines.get_mut(*i) else {
+                        return false;
+                    };
                     if kind == "bezier_points" {
-                        let Some(p) = sp.bezier_points.get_mut(*j) else { return false };
+                        let Some(p) = sp.bezier_points.get_mut(*j) else {
+                            return false;
+                        };
                         let slot = match field.as_str() {
                             "co" => p.co.get_mut(index),
                             "handle_left" => p.handle_left.get_mut(index),
@@ -265,7 +333,9 @@ fn write(ad: &AnimData, tokens: &[Token], index: usize, v: f64, data: &mut Datab
                         };
                         slot.map(|s| *s = v).is_some()
                     } else {
-                        let Some(p) = sp.points.get_mut(*j) else { return false };
+                        let Some(p) = sp.points.get_mut(*j) else {
+                            return false;
+                        };
                         let slot = match field.as_str() {
                             "co" => p.co.get_mut(index),
                             "radius" => Some(&mut p.radius),
@@ -283,8 +353,10 @@ fn write(ad: &AnimData, tokens: &[Token], index: usize, v: f64, data: &mut Datab
                 _ => rna_write(&mut c.properties, tokens, index, v),
             }
         }
-        "CAMERA" => find(&mut data.cameras, &ad.id_name, |c| &c.name).is_some_and(|c| rna_write(&mut c.properties, tokens, index, v)),
-        "LIGHT" => find(&mut data.lights, &ad.id_name, |c| &c.name).is_some_and(|c| rna_write(&mut c.properties, tokens, index, v)),
+        "CAMERA" => find(&mut data.cameras, &ad.id_name, |c| &c.name)
+            .is_some_and(|c| rna_write(&mut c.properties, tokens, index, v)),
+        "LIGHT" => find(&mut data.lights, &ad.id_name, |c| &c.name)
+            .is_some_and(|c| rna_write(&mut c.properties, tokens, index, v)),
         _ => false,
     }
 }

@@ -9,9 +9,26 @@ use crate::scene::{Constraint, Curve, Rna};
 
 #[derive(Debug, Clone)]
 pub enum Kind {
-    FollowPath { target: String, use_follow: bool, use_radius: bool, fixed: bool, offset: f32, offset_factor: f32, forward: i32, up: i32 },
-    TrackTo { target: String, track: i32, up: i32, target_z: bool },
-    DampedTrack { target: String, track: i32 },
+    FollowPath {
+        target: String,
+        use_follow: bool,
+        use_radius: bool,
+        fixed: bool,
+        offset: f32,
+        offset_factor: f32,
+        forward: i32,
+        up: i32,
+    },
+    TrackTo {
+        target: String,
+        track: i32,
+        up: i32,
+        target_z: bool,
+    },
+    DampedTrack {
+        target: String,
+        track: i32,
+    },
 }
 
 /// A constraint ready to solve, with its influence.
@@ -24,19 +41,28 @@ pub struct Parsed {
 impl Parsed {
     pub fn target(&self) -> &str {
         match &self.kind {
-            Kind::FollowPath { target, .. } | Kind::TrackTo { target, .. } | Kind::DampedTrack { target, .. } => target,
+            Kind::FollowPath { target, .. }
+            | Kind::TrackTo { target, .. }
+            | Kind::DampedTrack { target, .. } => target,
         }
     }
 }
 
 fn s<'a>(p: &'a Rna, k: &str) -> Result<&'a str, AnimError> {
-    p.get(k).and_then(|v| v.as_str()).ok_or_else(|| AnimError::new(format!("properties.{k}"), "missing or not a string"))
+    p.get(k)
+        .and_then(|v| v.as_str())
+        .ok_or_else(|| AnimError::new(format!("properties.{k}"), "missing or not a string"))
 }
 fn f(p: &Rna, k: &str) -> Result<f32, AnimError> {
-    p.get(k).and_then(|v| v.as_f64()).map(|v| v as f32).ok_or_else(|| AnimError::new(format!("properties.{k}"), "missing or not a number"))
+    p.get(k)
+        .and_then(|v| v.as_f64())
+        .map(|v| v as f32)
+        .ok_or_else(|| AnimError::new(format!("properties.{k}"), "missing or not a number"))
 }
 fn b(p: &Rna, k: &str) -> Result<bool, AnimError> {
-    p.get(k).and_then(|v| v.as_bool()).ok_or_else(|| AnimError::new(format!("properties.{k}"), "missing or not a boolean"))
+    p.get(k)
+        .and_then(|v| v.as_bool())
+        .ok_or_else(|| AnimError::new(format!("properties.{k}"), "missing or not a boolean"))
 }
 
 /// The target object's name, None when unset (Blender then leaves the owner alone).
@@ -44,8 +70,14 @@ fn target(p: &Rna) -> Result<Option<String>, AnimError> {
     match p.get("target") {
         None | Some(serde_json::Value::Null) => Ok(None),
         Some(v) => {
-            let name = v.get("name").and_then(|n| n.as_str()).ok_or_else(|| AnimError::new("properties.target", "not an ID reference"))?;
-            if v.get("id_type").and_then(|t| t.as_str()).is_some_and(|t| t != "OBJECT") {
+            let name = v
+                .get("name")
+                .and_then(|n| n.as_str())
+                .ok_or_else(|| AnimError::new("properties.target", "not an ID reference"))?;
+            if v.get("id_type")
+                .and_then(|t| t.as_str())
+                .is_some_and(|t| t != "OBJECT")
+            {
                 return Err(AnimError::new("properties.target", "is not an object"));
             }
             Ok(Some(name.to_string()))
@@ -85,7 +117,10 @@ pub fn parse(c: &Constraint) -> Result<Option<Parsed>, AnimError> {
     for space in ["owner_space", "target_space"] {
         if let Some(sp) = p.get(space).and_then(|v| v.as_str()) {
             if sp != "WORLD" {
-                return Err(AnimError::new(format!("properties.{space}"), format!("{sp:?} space is not supported (only WORLD)")));
+                return Err(AnimError::new(
+                    format!("properties.{space}"),
+                    format!("{sp:?} space is not supported (only WORLD)"),
+                ));
             }
         }
     }
@@ -99,16 +134,24 @@ pub fn parse(c: &Constraint) -> Result<Option<Parsed>, AnimError> {
                 fixed: b(p, "use_fixed_location")?,
                 offset: f(p, "offset")?,
                 offset_factor: f(p, "offset_factor")?,
-                forward: track_axis(s(p, "forward_axis")?).map_err(|e| e.within("properties.forward_axis"))?,
+                forward: track_axis(s(p, "forward_axis")?)
+                    .map_err(|e| e.within("properties.forward_axis"))?,
                 up: up_axis(s(p, "up_axis")?).map_err(|e| e.within("properties.up_axis"))?,
             }
         }
         "TRACK_TO" | "DAMPED_TRACK" => {
             let Some(t) = target(p)? else { return Ok(None) };
-            if p.get("subtarget").and_then(|v| v.as_str()).is_some_and(|v| !v.is_empty()) {
-                return Err(AnimError::new("properties.subtarget", "bone or vertex group sub-targets are not supported"));
+            if p.get("subtarget")
+                .and_then(|v| v.as_str())
+                .is_some_and(|v| !v.is_empty())
+            {
+                return Err(AnimError::new(
+                    "properties.subtarget",
+                    "bone or vertex group sub-targets are not supported",
+                ));
             }
-            let track = track_axis(s(p, "track_axis")?).map_err(|e| e.within("properties.track_axis"))?;
+            let track =
+                track_axis(s(p, "track_axis")?).map_err(|e| e.within("properties.track_axis"))?;
             if c.kind == "TRACK_TO" {
                 Kind::TrackTo {
                     target: t,
@@ -120,25 +163,62 @@ pub fn parse(c: &Constraint) -> Result<Option<Parsed>, AnimError> {
                 Kind::DampedTrack { target: t, track }
             }
         }
-        other => return Err(AnimError::new("type", format!("constraint type {other:?} is not supported"))),
+        other => {
+            return Err(AnimError::new(
+                "type",
+                format!("constraint type {other:?} is not supported"),
+            ))
+        }
     };
-    Ok(Some(Parsed { kind, influence: c.influence }))
+    Ok(Some(Parsed {
+        kind,
+        influence: c.influence,
+    }))
 }
 
 /// The Follow Path target matrix: the curve object's world matrix times the point (and,
 /// with follow, the orientation; with radius, the scale) on its path.
-pub fn follow_path_target(kind: &Kind, curve: &Curve, curve_world: &Mat4, path: Option<&Path>) -> Mat4 {
-    let Kind::FollowPath { use_follow, use_radius, fixed, offset, offset_factor, forward, up, .. } = *kind else { return IDENTITY };
+pub fn follow_path_target(
+    kind: &Kind,
+    curve: &Curve,
+    curve_world: &Mat4,
+    path: Option<&Path>,
+) -> Mat4 {
+    let Kind::FollowPath {
+        use_follow,
+        use_radius,
+        fixed,
+        offset,
+        offset_factor,
+        forward,
+        up,
+        ..
+    } = *kind
+    else {
+        return IDENTITY;
+    };
     let Some(path) = path else { return IDENTITY };
     let ctime = if fixed {
         offset_factor
     } else {
-        let eval_time = curve.properties.get("eval_time").and_then(|v| v.as_f64()).unwrap_or(0.0) as f32;
+        let eval_time = curve
+            .properties
+            .get("eval_time")
+            .and_then(|v| v.as_f64())
+            .unwrap_or(0.0) as f32;
         // path_duration is a short in Blender: an integer divisor.
-        let pathlen = curve.properties.get("path_duration").and_then(|v| v.as_f64()).unwrap_or(100.0) as i32 as f32;
+        let pathlen = curve
+            .properties
+            .get("path_duration")
+            .and_then(|v| v.as_f64())
+            .unwrap_or(100.0) as i32 as f32;
         let mut t = (eval_time - offset) / pathlen;
         let first_cyclic = curve.splines.first().is_some_and(|s| s.use_cyclic_u);
-        let clamp = curve.properties.get("use_path_clamp").and_then(|v| v.as_bool()).unwrap_or(false);
+        let clamp = curve
+            .properties
+            .get("use_path_clamp")
+            .and_then(|v| v.as_bool())
+            .unwrap_or(false);
         if !first_cyclic && clamp {
             t = t.clamp(0.0, 1.0);
         }
@@ -148,7 +228,12 @@ pub fn follow_path_target(kind: &Kind, curve: &Curve, curve_world: &Mat4, path: 
     let mut tot = IDENTITY;
     if use_follow {
         let q = quat_apply_track(sample.quat, forward, up);
-        tot = mat3_to_mat4(&quat_to_mat3_64([q[0] as f64, q[1] as f64, q[2] as f64, q[3] as f64]));
+        tot = mat3_to_mat4(&quat_to_mat3_64([
+            q[0] as f64,
+            q[1] as f64,
+            q[2] as f64,
+            q[3] as f64,
+        ]));
         // Blender's quat_to_mat4 rounds to float.
         for row in tot.iter_mut().take(3) {
             for v in row.iter_mut().take(3) {
@@ -164,14 +249,27 @@ pub fn follow_path_target(kind: &Kind, curve: &Curve, curve_world: &Mat4, path: 
             }
         }
     }
-    set_translation(&mut tot, [sample.pos[0] as f64, sample.pos[1] as f64, sample.pos[2] as f64]);
+    set_translation(
+        &mut tot,
+        [
+            sample.pos[0] as f64,
+            sample.pos[1] as f64,
+            sample.pos[2] as f64,
+        ],
+    );
     mul(curve_world, &tot)
 }
 
 /// Blender's `followpath_evaluate`: applies the target matrix, then restores the owner's
 /// scale unless the curve radius is meant to scale it.
 pub fn follow_path(kind: &Kind, owner: &Mat4, target: &Mat4) -> Mat4 {
-    let use_radius = matches!(kind, Kind::FollowPath { use_radius: true, .. });
+    let use_radius = matches!(
+        kind,
+        Kind::FollowPath {
+            use_radius: true,
+            ..
+        }
+    );
     let size = [axis_len(owner, 0), axis_len(owner, 1), axis_len(owner, 2)];
     let mut m = mul(target, owner);
     if !use_radius {
@@ -236,7 +334,15 @@ fn premul_rotation(a: &Mat3, m: &Mat4) -> Mat4 {
 }
 
 pub fn track_to(kind: &Kind, owner: &Mat4, target: &Mat4) -> Mat4 {
-    let Kind::TrackTo { track, up, target_z, .. } = *kind else { return *owner };
+    let Kind::TrackTo {
+        track,
+        up,
+        target_z,
+        ..
+    } = *kind
+    else {
+        return *owner;
+    };
     let size = [axis_len(owner, 0), axis_len(owner, 1), axis_len(owner, 2)];
     // Clear the rotation, keep the (world) scale.
     let mut m = *owner;
@@ -250,7 +356,14 @@ pub fn track_to(kind: &Kind, owner: &Mat4, target: &Mat4) -> Mat4 {
     premul_rotation(&tot, &m)
 }
 
-const TRACK_DIRS: [[f64; 3]; 6] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, -1.0]];
+const TRACK_DIRS: [[f64; 3]; 6] = [
+    [1.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 0.0, 1.0],
+    [-1.0, 0.0, 0.0],
+    [0.0, -1.0, 0.0],
+    [0.0, 0.0, -1.0],
+];
 
 fn mul3v(m: &Mat4, v: [f64; 3]) -> [f64; 3] {
     [
@@ -270,13 +383,19 @@ fn axis_angle_normalized_to_mat3(axis: [f64; 3], angle: f64) -> Mat3 {
     let n02 = axis[0] * axis[2] * ico;
     let n12 = axis[1] * axis[2] * ico;
     let n22 = axis[2] * axis[2] * ico;
-    [[n00 + c, n01 - nsi[2], n02 + nsi[1]], [n01 + nsi[2], n11 + c, n12 - nsi[0]], [n02 - nsi[1], n12 + nsi[0], n22 + c]]
+    [
+        [n00 + c, n01 - nsi[2], n02 + nsi[1]],
+        [n01 + nsi[2], n11 + c, n12 - nsi[0]],
+        [n02 - nsi[1], n12 + nsi[0], n22 + c],
+    ]
 }
 
 /// Blender's `damptrack_do_transform`: the smallest rotation that points the track axis at
 /// the target.
 pub fn damped_track(kind: &Kind, owner: &Mat4, target: &Mat4) -> Mat4 {
-    let Kind::DampedTrack { track, .. } = *kind else { return *owner };
+    let Kind::DampedTrack { track, .. } = *kind else {
+        return *owner;
+    };
     let track = track as usize;
     let mut tarvec = sub64(translation(target), translation(owner));
     if normalize64(&mut tarvec) == 0.0 {
@@ -303,7 +422,11 @@ pub fn damped_track(kind: &Kind, owner: &Mat4, target: &Mat4) -> Mat4 {
         }
     } else if norm < 0.1 {
         // asin is more precise than acos near 0 and pi.
-        rangle = if rangle > std::f64::consts::FRAC_PI_2 { pi - norm.asin() } else { norm.asin() };
+        rangle = if rangle > std::f64::consts::FRAC_PI_2 {
+            pi - norm.asin()
+        } else {
+            norm.asin()
+        };
     }
     let rmat = axis_angle_normalized_to_mat3(raxis, rangle);
     premul_rotation(&rmat, owner)

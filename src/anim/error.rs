@@ -13,12 +13,19 @@ pub struct AnimError {
 
 impl AnimError {
     pub fn new(context: impl Into<String>, message: impl Into<String>) -> Self {
-        AnimError { context: context.into(), message: message.into() }
+        AnimError {
+            context: context.into(),
+            message: message.into(),
+        }
     }
 
     /// Prefixes an outer context (`objects["A"]` + `constraints["B"]`).
     pub fn within(mut self, outer: &str) -> Self {
-        self.context = if self.context.is_empty() { outer.to_string() } else { format!("{outer}.{}", self.context) };
+        self.context = if self.context.is_empty() {
+            outer.to_string()
+        } else {
+            format!("{outer}.{}", self.context)
+        };
         self
     }
 }

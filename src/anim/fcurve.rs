@@ -59,9 +59,15 @@ impl ValueKind {
     /// None for strings (enums), which a number cannot be written back into.
     pub fn of_json(v: &serde_json::Value) -> Option<ValueKind> {
         match v {
-            serde_json::Value::Bool(_) => Some(ValueKind { discrete: true, integer: true }),
+            serde_json::Value::Bool(_) => Some(ValueKind {
+                discrete: true,
+                integer: true,
+            }),
             serde_json::Value::Number(n) if n.is_f64() => Some(ValueKind::default()),
-            serde_json::Value::Number(_) => Some(ValueKind { discrete: false, integer: true }),
+            serde_json::Value::Number(_) => Some(ValueKind {
+                discrete: false,
+                integer: true,
+            }),
             _ => None,
         }
     }
@@ -98,7 +104,9 @@ fn ipo_of(s: &str) -> Option<Ipo> {
 
 fn key_of(k: &Keyframe, i: usize) -> Result<Key, AnimError> {
     let at = format!("keyframes[{i}]");
-    let ipo = ipo_of(&k.interpolation).ok_or_else(|| AnimError::new(&at, format!("unknown interpolation {:?}", k.interpolation)))?;
+    let ipo = ipo_of(&k.interpolation).ok_or_else(|| {
+        AnimError::new(&at, format!("unknown interpolation {:?}", k.interpolation))
+    })?;
     let ease = match k.easing.as_deref().unwrap_or("AUTO") {
         "AUTO" => Ease::Auto,
         "EASE_IN" => Ease::In,
@@ -123,14 +131,30 @@ fn key_of(k: &Keyframe, i: usize) -> Result<Key, AnimError> {
 
 impl CompiledFCurve {
     pub fn new(fc: &FCurve, kind: ValueKind) -> Result<Self, AnimError> {
-        let keys = fc.keyframes.iter().enumerate().map(|(i, k)| key_of(k, i)).collect::<Result<Vec<_>, _>>()?;
+        let keys = fc
+            .keyframes
+            .iter()
+            .enumerate()
+            .map(|(i, k)| key_of(k, i))
+            .collect::<Result<Vec<_>, _>>()?;
         let extrapolate_linear = match fc.extrapolation.as_str() {
             "CONSTANT" => false,
             "LINEAR" => true,
-            other => return Err(AnimError::new("extrapolation", format!("unknown extrapolation {other:?}"))),
+            other => {
+                return Err(AnimError::new(
+                    "extrapolation",
+                    format!("unknown extrapolation {other:?}"),
+                ))
+            }
         };
         let mods = fmodifier::compile(&fc.modifiers)?;
-        Ok(CompiledFCurve { keys, extrapolate_linear, mute: fc.mute, mods, kind })
+        Ok(CompiledFCurve {
+            keys,
+            extrapolate_linear,
+            mute: fc.mute,
+            mods,
+            kind,
+        })
     }
 
     /// Blender's `BKE_fcurve_is_empty`: no keys and no curve-generating modifier, so the
@@ -150,7 +174,11 @@ impl CompiledFCurve {
             Some(([a.x, a.y], [b.x, b.y]))
         };
         let (t, storage) = stack.time(first_last, frame);
-        let mut value = if self.keys.is_empty() { 0.0 } else { self.eval_keys(t) };
+        let mut value = if self.keys.is_empty() {
+            0.0
+        } else {
+            self.eval_keys(t)
+        };
         stack.value(&storage, &mut value, t);
         if self.kind.integer {
             value = (value + 0.5).floor();
@@ -284,7 +312,13 @@ impl CompiledFCurve {
 /// Blender's keyframe binary search: the index to insert `frame` at, and whether a key
 /// already sits within `threshold` of it.
 fn binary_search(k: &[Key], frame: f32, threshold: f32) -> (usize, bool) {
-    let eqt = |a: f32, b: f32| if a > b { a - b <= threshold } else { b - a <= threshold };
+    let eqt = |a: f32, b: f32| {
+        if a > b {
+            a - b <= threshold
+        } else {
+            b - a <= threshold
+        }
+    };
     let len = k.len() as isize;
     if eqt(frame, k[0].x) {
         return (0, true);
@@ -325,7 +359,10 @@ fn bezier_segment(prev: &Key, next: &Key, t: f32) -> f32 {
     let mut v2 = prev.hr;
     let mut v3 = next.hl;
     let v4 = [next.x, next.y];
-    if (v1[1] - v4[1]).abs() < f32::EPSILON && (v2[1] - v3[1]).abs() < f32::EPSILON && (v3[1] - v4[1]).abs() < f32::EPSILON {
+    if (v1[1] - v4[1]).abs() < f32::EPSILON
+        && (v2[1] - v3[1]).abs() < f32::EPSILON
+        && (v3[1] - v4[1]).abs() < f32::EPSILON
+    {
         return v1[1];
     }
     correct_bezpart(v1, &mut v2, &mut v3, v4);
@@ -540,7 +577,14 @@ mod ease {
 
     /// Near the crossing point Blender blends the sine in when the amplitude is smaller
     /// than the change, to avoid a sharp falloff.
-    fn elastic_blend(time: f32, change: f32, duration: f32, amplitude: f32, s: f32, mut f: f32) -> f32 {
+    fn elastic_blend(
+        time: f32,
+        change: f32,
+        duration: f32,
+        amplitude: f32,
+        s: f32,
+        mut f: f32,
+    ) -> f32 {
         if change != 0.0 {
             let t = s.abs();
             if amplitude != 0.0 {
@@ -556,7 +600,14 @@ mod ease {
         f
     }
 
-    pub fn elastic_in(time: f32, begin: f32, change: f32, duration: f32, mut amplitude: f32, mut period: f32) -> f32 {
+    pub fn elastic_in(
+        time: f32,
+        begin: f32,
+        change: f32,
+        duration: f32,
+        mut amplitude: f32,
+        mut period: f32,
+    ) -> f32 {
         let mut f = 1.0f32;
         if time == 0.0 {
             return begin;
@@ -577,10 +628,18 @@ mod ease {
         } else {
             s = period / (2.0 * PI) * (change / amplitude).asin();
         }
-        (-f * (amplitude * 2f32.powf(10.0 * t) * ((t * duration - s) * (2.0 * PI) / period).sin())) + begin
+        (-f * (amplitude * 2f32.powf(10.0 * t) * ((t * duration - s) * (2.0 * PI) / period).sin()))
+            + begin
     }
 
-    pub fn elastic_out(time: f32, begin: f32, change: f32, duration: f32, mut amplitude: f32, mut period: f32) -> f32 {
+    pub fn elastic_out(
+        time: f32,
+        begin: f32,
+        change: f32,
+        duration: f32,
+        mut amplitude: f32,
+        mut period: f32,
+    ) -> f32 {
         let mut f = 1.0f32;
         if time == 0.0 {
             return begin;
@@ -601,10 +660,19 @@ mod ease {
         } else {
             s = period / (2.0 * PI) * (change / amplitude).asin();
         }
-        (f * (amplitude * 2f32.powf(10.0 * t) * ((t * duration - s) * (2.0 * PI) / period).sin())) + change + begin
+        (f * (amplitude * 2f32.powf(10.0 * t) * ((t * duration - s) * (2.0 * PI) / period).sin()))
+            + change
+            + begin
     }
 
-    pub fn elastic_in_out(time: f32, begin: f32, change: f32, duration: f32, mut amplitude: f32, mut period: f32) -> f32 {
+    pub fn elastic_in_out(
+        time: f32,
+        begin: f32,
+        change: f32,
+        duration: f32,
+        mut amplitude: f32,
+        mut period: f32,
+    ) -> f32 {
         let mut f = 1.0f32;
         if time == 0.0 {
             return begin;
@@ -627,11 +695,17 @@ mod ease {
         }
         if t < 0.0 {
             f *= -0.5;
-            return (f * (amplitude * 2f32.powf(10.0 * t) * ((t * duration - s) * (2.0 * PI) / period).sin())) + begin;
+            return (f
+                * (amplitude
+                    * 2f32.powf(10.0 * t)
+                    * ((t * duration - s) * (2.0 * PI) / period).sin()))
+                + begin;
         }
         t = -t;
         f *= 0.5;
-        (f * (amplitude * 2f32.powf(10.0 * t) * ((t * duration - s) * (2.0 * PI) / period).sin())) + change + begin
+        (f * (amplitude * 2f32.powf(10.0 * t) * ((t * duration - s) * (2.0 * PI) / period).sin()))
+            + change
+            + begin
     }
 
     // Blender rescales the exponential so it starts and ends exactly on the keys.

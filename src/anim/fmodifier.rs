@@ -9,13 +9,54 @@ use crate::scene::{FModifier, Rna};
 
 #[derive(Debug, Clone)]
 enum Kind {
-    Generator { factorised: bool, order: i32, coeffs: Vec<f32>, additive: bool },
-    FnGenerator { func: Func, amplitude: f32, phase_mult: f32, phase_off: f32, value_off: f32, additive: bool },
-    Envelope { mid: f32, min: f32, max: f32, points: Vec<[f32; 3]> },
-    Cycles { before_mode: i32, before_cycles: i32, after_mode: i32, after_cycles: i32 },
-    Noise { size: f32, strength: f32, phase: f32, offset: f32, depth: i32, lacunarity: f32, roughness: f32, blend: NoiseBlend },
-    Limits { min_x: Option<f32>, max_x: Option<f32>, min_y: Option<f32>, max_y: Option<f32> },
-    Stepped { step: f32, offset: f32, start: Option<f32>, end: Option<f32> },
+    Generator {
+        factorised: bool,
+        order: i32,
+        coeffs: Vec<f32>,
+        additive: bool,
+    },
+    FnGenerator {
+        func: Func,
+        amplitude: f32,
+        phase_mult: f32,
+        phase_off: f32,
+        value_off: f32,
+        additive: bool,
+    },
+    Envelope {
+        mid: f32,
+        min: f32,
+        max: f32,
+        points: Vec<[f32; 3]>,
+    },
+    Cycles {
+        before_mode: i32,
+        before_cycles: i32,
+        after_mode: i32,
+        after_cycles: i32,
+    },
+    Noise {
+        size: f32,
+        strength: f32,
+        phase: f32,
+        offset: f32,
+        depth: i32,
+        lacunarity: f32,
+        roughness: f32,
+        blend: NoiseBlend,
+    },
+    Limits {
+        min_x: Option<f32>,
+        max_x: Option<f32>,
+        min_y: Option<f32>,
+        max_y: Option<f32>,
+    },
+    Stepped {
+        step: f32,
+        offset: f32,
+        start: Option<f32>,
+        end: Option<f32>,
+    },
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -50,7 +91,13 @@ impl FMod {
     /// Curve-generating types (Blender's `FMI_TYPE_GENERATE_CURVE`) make an F-curve with no
     /// keyframes count as animated.
     pub fn generates_curve(&self) -> bool {
-        matches!(self.kind, Kind::Generator { .. } | Kind::FnGenerator { .. } | Kind::Limits { .. } | Kind::Stepped { .. })
+        matches!(
+            self.kind,
+            Kind::Generator { .. }
+                | Kind::FnGenerator { .. }
+                | Kind::Limits { .. }
+                | Kind::Stepped { .. }
+        )
     }
 
     fn in_range(&self, t: f32) -> bool {
@@ -82,19 +129,30 @@ impl FMod {
 }
 
 fn prop<'a>(p: &'a Rna, key: &str) -> Result<&'a serde_json::Value, AnimError> {
-    p.get(key).ok_or_else(|| AnimError::new(format!("properties.{key}"), "missing"))
+    p.get(key)
+        .ok_or_else(|| AnimError::new(format!("properties.{key}"), "missing"))
 }
 fn num(p: &Rna, key: &str) -> Result<f32, AnimError> {
-    prop(p, key)?.as_f64().map(|v| v as f32).ok_or_else(|| AnimError::new(format!("properties.{key}"), "not a number"))
+    prop(p, key)?
+        .as_f64()
+        .map(|v| v as f32)
+        .ok_or_else(|| AnimError::new(format!("properties.{key}"), "not a number"))
 }
 fn int(p: &Rna, key: &str) -> Result<i32, AnimError> {
-    prop(p, key)?.as_f64().map(|v| v as i32).ok_or_else(|| AnimError::new(format!("properties.{key}"), "not a number"))
+    prop(p, key)?
+        .as_f64()
+        .map(|v| v as i32)
+        .ok_or_else(|| AnimError::new(format!("properties.{key}"), "not a number"))
 }
 fn flag(p: &Rna, key: &str) -> Result<bool, AnimError> {
-    prop(p, key)?.as_bool().ok_or_else(|| AnimError::new(format!("properties.{key}"), "not a boolean"))
+    prop(p, key)?
+        .as_bool()
+        .ok_or_else(|| AnimError::new(format!("properties.{key}"), "not a boolean"))
 }
 fn text<'a>(p: &'a Rna, key: &str) -> Result<&'a str, AnimError> {
-    prop(p, key)?.as_str().ok_or_else(|| AnimError::new(format!("properties.{key}"), "not a string"))
+    prop(p, key)?
+        .as_str()
+        .ok_or_else(|| AnimError::new(format!("properties.{key}"), "not a string"))
 }
 fn opt_flag(p: &Rna, key: &str) -> bool {
     p.get(key).and_then(|v| v.as_bool()).unwrap_or(false)
@@ -118,14 +176,28 @@ fn compile_one(m: &FModifier, first: bool) -> Result<FMod, AnimError> {
                 .as_array()
                 .ok_or_else(|| AnimError::new("properties.coefficients", "not a list"))?
                 .iter()
-                .map(|v| v.as_f64().map(|x| x as f32).ok_or_else(|| AnimError::new("properties.coefficients", "not a number")))
+                .map(|v| {
+                    v.as_f64()
+                        .map(|x| x as f32)
+                        .ok_or_else(|| AnimError::new("properties.coefficients", "not a number"))
+                })
                 .collect::<Result<_, _>>()?;
             let factorised = match text(p, "mode")? {
                 "POLYNOMIAL" => false,
                 "POLYNOMIAL_FACTORISED" => true,
-                other => return Err(AnimError::new("properties.mode", format!("unknown generator mode {other:?}"))),
+                other => {
+                    return Err(AnimError::new(
+                        "properties.mode",
+                        format!("unknown generator mode {other:?}"),
+                    ))
+                }
             };
-            Kind::Generator { factorised, order: int(p, "poly_order")?, coeffs, additive: flag(p, "use_additive")? }
+            Kind::Generator {
+                factorised,
+                order: int(p, "poly_order")?,
+                coeffs,
+                additive: flag(p, "use_additive")?,
+            }
         }
         "FNGENERATOR" => {
             let func = match text(p, "function_type")? {
@@ -135,7 +207,12 @@ fn compile_one(m: &FModifier, first: bool) -> Result<FMod, AnimError> {
                 "SQRT" => Func::Sqrt,
                 "LN" => Func::Ln,
                 "SINC" => Func::Sinc,
-                other => return Err(AnimError::new("properties.function_type", format!("unknown function {other:?}"))),
+                other => {
+                    return Err(AnimError::new(
+                        "properties.function_type",
+                        format!("unknown function {other:?}"),
+                    ))
+                }
             };
             Kind::FnGenerator {
                 func,
@@ -153,11 +230,18 @@ fn compile_one(m: &FModifier, first: bool) -> Result<FMod, AnimError> {
                 .iter()
                 .enumerate()
                 .map(|(i, cp)| {
-                    let cp = cp.as_object().ok_or_else(|| AnimError::new(format!("properties.control_points[{i}]"), "not an object"))?;
+                    let cp = cp.as_object().ok_or_else(|| {
+                        AnimError::new(format!("properties.control_points[{i}]"), "not an object")
+                    })?;
                     Ok([num(cp, "frame")?, num(cp, "min")?, num(cp, "max")?])
                 })
                 .collect::<Result<Vec<_>, AnimError>>()?;
-            Kind::Envelope { mid: num(p, "reference_value")?, min: num(p, "default_min")?, max: num(p, "default_max")?, points }
+            Kind::Envelope {
+                mid: num(p, "reference_value")?,
+                min: num(p, "default_min")?,
+                max: num(p, "default_max")?,
+                points,
+            }
         }
         "CYCLES" => Kind::Cycles {
             before_mode: cycle_mode(text(p, "mode_before")?)?,
@@ -178,7 +262,12 @@ fn compile_one(m: &FModifier, first: bool) -> Result<FMod, AnimError> {
                 "ADD" => NoiseBlend::Add,
                 "SUBTRACT" => NoiseBlend::Subtract,
                 "MULTIPLY" => NoiseBlend::Multiply,
-                other => return Err(AnimError::new("properties.blend_type", format!("unknown blend type {other:?}"))),
+                other => {
+                    return Err(AnimError::new(
+                        "properties.blend_type",
+                        format!("unknown blend type {other:?}"),
+                    ))
+                }
             };
             Kind::Noise {
                 size: num(p, "scale")?,
@@ -193,7 +282,11 @@ fn compile_one(m: &FModifier, first: bool) -> Result<FMod, AnimError> {
         }
         "LIMITS" => {
             let lim = |use_key: &str, key: &str| -> Result<Option<f32>, AnimError> {
-                Ok(if flag(p, use_key)? { Some(num(p, key)?) } else { None })
+                Ok(if flag(p, use_key)? {
+                    Some(num(p, key)?)
+                } else {
+                    None
+                })
             };
             Kind::Limits {
                 min_x: lim("use_min_x", "min_x")?,
@@ -211,24 +304,62 @@ fn compile_one(m: &FModifier, first: bool) -> Result<FMod, AnimError> {
                     "a Stepped modifier with a restricted frame range cannot be evaluated: its range is not exportable (RNA names clash with the step range)",
                 ));
             }
-            let start = if flag(p, "use_frame_start")? { Some(num(p, "frame_start")?) } else { None };
-            let end = if flag(p, "use_frame_end")? { Some(num(p, "frame_end")?) } else { None };
-            Kind::Stepped { step: num(p, "frame_step")?, offset: num(p, "frame_offset")?, start, end }
+            let start = if flag(p, "use_frame_start")? {
+                Some(num(p, "frame_start")?)
+            } else {
+                None
+            };
+            let end = if flag(p, "use_frame_end")? {
+                Some(num(p, "frame_end")?)
+            } else {
+                None
+            };
+            Kind::Stepped {
+                step: num(p, "frame_step")?,
+                offset: num(p, "frame_offset")?,
+                start,
+                end,
+            }
         }
-        other => return Err(AnimError::new("type", format!("F-modifier type {other:?} is not supported"))),
+        other => {
+            return Err(AnimError::new(
+                "type",
+                format!("F-modifier type {other:?} is not supported"),
+            ))
+        }
     };
     let range = if flag(p, "use_restricted_range")? {
-        Some([num(p, "frame_start")?, num(p, "frame_end")?, num(p, "blend_in")?, num(p, "blend_out")?])
+        Some([
+            num(p, "frame_start")?,
+            num(p, "frame_end")?,
+            num(p, "blend_in")?,
+            num(p, "blend_out")?,
+        ])
     } else {
         None
     };
-    let influence = if flag(p, "use_influence")? { Some(num(p, "influence")?) } else { None };
+    let influence = if flag(p, "use_influence")? {
+        Some(num(p, "influence")?)
+    } else {
+        None
+    };
     let disabled = matches!(kind, Kind::Cycles { .. }) && !first;
-    Ok(FMod { kind, mute: m.mute, disabled, range, influence })
+    Ok(FMod {
+        kind,
+        mute: m.mute,
+        disabled,
+        range,
+        influence,
+    })
 }
 
 pub fn compile(mods: &[FModifier]) -> Result<Vec<FMod>, AnimError> {
-    mods.iter().enumerate().map(|(i, m)| compile_one(m, i == 0).map_err(|e| e.within(&format!("modifiers[{i}] ({})", m.kind)))).collect()
+    mods.iter()
+        .enumerate()
+        .map(|(i, m)| {
+            compile_one(m, i == 0).map_err(|e| e.within(&format!("modifiers[{i}] ({})", m.kind)))
+        })
+        .collect()
 }
 
 /// Per-evaluation state: the Cycles y-offset found in the time pass, used in the value pass.
@@ -245,7 +376,11 @@ impl<'a> Stack<'a> {
 
     /// The time at which to sample the keyframes. `first_last` are the first and last keys
     /// (x, y) when the curve has any.
-    pub fn time(&self, first_last: Option<([f32; 2], [f32; 2])>, mut evaltime: f32) -> (f32, Storage) {
+    pub fn time(
+        &self,
+        first_last: Option<([f32; 2], [f32; 2])>,
+        mut evaltime: f32,
+    ) -> (f32, Storage) {
         let mut storage = Storage(vec![0.0; self.mods.len()]);
         for (i, m) in self.mods.iter().enumerate().rev() {
             if !m.in_range(evaltime) || m.mute || m.disabled {
@@ -262,7 +397,12 @@ impl<'a> Stack<'a> {
                         evaltime
                     }
                 }
-                Kind::Stepped { step, offset, start, end } => {
+                Kind::Stepped {
+                    step,
+                    offset,
+                    start,
+                    end,
+                } => {
                     if start.is_some_and(|s| evaltime < s) || end.is_some_and(|e| evaltime > e) {
                         evaltime
                     } else {
@@ -289,15 +429,54 @@ impl<'a> Stack<'a> {
             match &m.kind {
                 Kind::Stepped { .. } => continue,
                 Kind::Cycles { .. } => nval += storage.0[i],
-                Kind::Generator { factorised, order, coeffs, additive } => {
-                    generator(*factorised, *order, coeffs, *additive, &mut nval, evaltime)
-                }
-                Kind::FnGenerator { func, amplitude, phase_mult, phase_off, value_off, additive } => {
-                    fn_generator(*func, *amplitude, *phase_mult, *phase_off, *value_off, *additive, &mut nval, evaltime)
-                }
-                Kind::Envelope { mid, min, max, points } => envelope(*mid, *min, *max, points, &mut nval, evaltime),
-                Kind::Noise { size, strength, phase, offset, depth, lacunarity, roughness, blend } => {
-                    let n = noise_value(*size, *phase, *offset, *depth, *lacunarity, *roughness, evaltime);
+                Kind::Generator {
+                    factorised,
+                    order,
+                    coeffs,
+                    additive,
+                } => generator(*factorised, *order, coeffs, *additive, &mut nval, evaltime),
+                Kind::FnGenerator {
+                    func,
+                    amplitude,
+                    phase_mult,
+                    phase_off,
+                    value_off,
+                    additive,
+                } => fn_generator(
+                    *func,
+                    *amplitude,
+                    *phase_mult,
+                    *phase_off,
+                    *value_off,
+                    *additive,
+                    &mut nval,
+                    evaltime,
+                ),
+                Kind::Envelope {
+                    mid,
+                    min,
+                    max,
+                    points,
+                } => envelope(*mid, *min, *max, points, &mut nval, evaltime),
+                Kind::Noise {
+                    size,
+                    strength,
+                    phase,
+                    offset,
+                    depth,
+                    lacunarity,
+                    roughness,
+                    blend,
+                } => {
+                    let n = noise_value(
+                        *size,
+                        *phase,
+                        *offset,
+                        *depth,
+                        *lacunarity,
+                        *roughness,
+                        evaltime,
+                    );
                     nval = match blend {
                         NoiseBlend::Add => nval + n * strength,
                         NoiseBlend::Subtract => nval - n * strength,
@@ -329,7 +508,14 @@ fn interpf(target: f32, origin: f32, fac: f32) -> f32 {
     (fac * target) + (1.0 - fac) * origin
 }
 
-fn generator(factorised: bool, order: i32, coeffs: &[f32], additive: bool, cvalue: &mut f32, t: f32) {
+fn generator(
+    factorised: bool,
+    order: i32,
+    coeffs: &[f32],
+    additive: bool,
+    cvalue: &mut f32,
+    t: f32,
+) {
     let value = if !factorised {
         // Sum of c[i] * t^i with powers built up by repeated multiplication.
         let mut value = 0.0f32;
@@ -359,15 +545,32 @@ fn generator(factorised: bool, order: i32, coeffs: &[f32], additive: bool, cvalu
 }
 
 #[allow(clippy::too_many_arguments)]
-fn fn_generator(func: Func, amplitude: f32, phase_mult: f32, phase_off: f32, value_off: f32, additive: bool, cvalue: &mut f32, t: f32) {
+fn fn_generator(
+    func: Func,
+    amplitude: f32,
+    phase_mult: f32,
+    phase_off: f32,
+    value_off: f32,
+    additive: bool,
+    cvalue: &mut f32,
+    t: f32,
+) {
     let arg = (phase_mult * t + phase_off) as f64;
     let f: Option<fn(f64) -> f64> = match func {
         Func::Sin => Some(f64::sin),
         Func::Cos => Some(f64::cos),
-        Func::Sinc => Some(|x: f64| if x.abs() < 0.0001 { 1.0 } else { (std::f64::consts::PI * x).sin() / (std::f64::consts::PI * x) }),
+        Func::Sinc => Some(|x: f64| {
+            if x.abs() < 0.0001 {
+                1.0
+            } else {
+                (std::f64::consts::PI * x).sin() / (std::f64::consts::PI * x)
+            }
+        }),
         Func::Tan => {
             // On the discontinuities Blender writes 0 (unless additive).
-            if ((arg - std::f64::consts::FRAC_PI_2) % std::f64::consts::PI).abs() < f32::EPSILON as f64 {
+            if ((arg - std::f64::consts::FRAC_PI_2) % std::f64::consts::PI).abs()
+                < f32::EPSILON as f64
+            {
                 None
             } else {
                 Some(f64::tan)
@@ -423,9 +626,24 @@ fn envelope(mid: f32, emin: f32, emax: f32, points: &[[f32; 3]], cvalue: &mut f3
     *cvalue = min + fac * (max - min);
 }
 
-fn cycles_time(m: &FMod, first_last: Option<([f32; 2], [f32; 2])>, evaltime: f32, cycyofs_out: &mut f32) -> f32 {
-    let Kind::Cycles { before_mode, before_cycles, after_mode, after_cycles } = m.kind else { return evaltime };
-    let Some((prevkey, lastkey)) = first_last else { return evaltime };
+fn cycles_time(
+    m: &FMod,
+    first_last: Option<([f32; 2], [f32; 2])>,
+    evaltime: f32,
+    cycyofs_out: &mut f32,
+) -> f32 {
+    let Kind::Cycles {
+        before_mode,
+        before_cycles,
+        after_mode,
+        after_cycles,
+    } = m.kind
+    else {
+        return evaltime;
+    };
+    let Some((prevkey, lastkey)) = first_last else {
+        return evaltime;
+    };
     let (mut side, mut mode, mut cycles, mut ofs) = (0i32, 0i32, 0i32, 0.0f32);
     if evaltime < prevkey[0] {
         if before_mode != 0 {
@@ -456,7 +674,11 @@ fn cycles_time(m: &FMod, first_last: Option<([f32; 2], [f32; 2])>, evaltime: f32
     }
     let mut cycyofs = 0.0f32;
     if mode == 2 {
-        cycyofs = if side < 0 { ((evaltime - ofs) / cycdx).floor() } else { ((evaltime - ofs) / cycdx).ceil() };
+        cycyofs = if side < 0 {
+            ((evaltime - ofs) / cycdx).floor()
+        } else {
+            ((evaltime - ofs) / cycdx).ceil()
+        };
         cycyofs *= cycdy;
     }
     let mut t;
@@ -467,7 +689,11 @@ fn cycles_time(m: &FMod, first_last: Option<([f32; 2], [f32; 2])>, evaltime: f32
         }
     } else if mode == 3 && ((cycle + 1.0) as i32) % 2 != 0 {
         // Mirrored cycles play backwards on odd counts.
-        t = if side < 0 { prevkey[0] - cyct } else { lastkey[0] - cyct };
+        t = if side < 0 {
+            prevkey[0] - cyct
+        } else {
+            lastkey[0] - cyct
+        };
     } else {
         t = prevkey[0] + cyct;
     }
@@ -484,7 +710,15 @@ fn cycles_time(m: &FMod, first_last: Option<([f32; 2], [f32; 2])>, evaltime: f32
 /// noise along scaled time, `phase` picking the row; time is shifted by the golden ratio so
 /// integer frames do not land on the lattice, where Perlin noise is always zero. (The
 /// formula was fitted to Blender 4.5's output; see the modifiers fixture.)
-fn noise_value(size: f32, phase: f32, offset: f32, depth: i32, lacunarity: f32, roughness: f32, t: f32) -> f32 {
+fn noise_value(
+    size: f32,
+    phase: f32,
+    offset: f32,
+    depth: i32,
+    lacunarity: f32,
+    roughness: f32,
+    t: f32,
+) -> f32 {
     #[allow(clippy::excessive_precision)] // Blender's literal, rounded to f32 as in C.
     const GOLDEN: f32 = 0.618_033_988_74;
     // Blender multiplies by the reciprocal size (this rounds differently from dividing).

@@ -13,7 +13,12 @@ pub type Mat3 = [[f64; 3]; 3];
 pub type V3 = [f32; 3];
 pub type Quat = [f32; 4];
 
-pub const IDENTITY: Mat4 = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
+pub const IDENTITY: Mat4 = [
+    [1.0, 0.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0, 0.0],
+    [0.0, 0.0, 1.0, 0.0],
+    [0.0, 0.0, 0.0, 1.0],
+];
 
 pub fn mul(a: &Mat4, b: &Mat4) -> Mat4 {
     let mut r = [[0.0; 4]; 4];
@@ -66,7 +71,8 @@ pub fn transpose3(m: &Mat3) -> Mat3 {
 }
 
 pub fn det3(m: &Mat3) -> f64 {
-    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+    m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
         + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
 }
 
@@ -150,7 +156,11 @@ pub fn dot64(a: [f64; 3], b: [f64; 3]) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 pub fn cross64(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 pub fn sub64(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
@@ -180,7 +190,11 @@ pub fn quat_to_mat3_64(q: [f64; 4]) -> Mat3 {
     let (qaa, qab, qac) = (q1 * q1, q1 * q2, q1 * q3);
     let (qbb, qbc, qcc) = (q2 * q2, q2 * q3, q3 * q3);
     // Blender's C arrays are column-major; row i here is its [*][i].
-    [[1.0 - qbb - qcc, -qdc + qab, qdb + qac], [qdc + qab, 1.0 - qaa - qcc, -qda + qbc], [-qdb + qac, qda + qbc, 1.0 - qaa - qbb]]
+    [
+        [1.0 - qbb - qcc, -qdc + qab, qdb + qac],
+        [qdc + qab, 1.0 - qaa - qcc, -qda + qbc],
+        [-qdb + qac, qda + qbc, 1.0 - qaa - qbb],
+    ]
 }
 
 pub fn normalize_quat64(q: [f64; 4]) -> [f64; 4] {
@@ -208,7 +222,12 @@ pub fn slerp64(a: [f64; 4], b: [f64; 4], t: f64) -> [f64; 4] {
     } else {
         (1.0 - t, t)
     };
-    [w0 * qa[0] + w1 * b[0], w0 * qa[1] + w1 * b[1], w0 * qa[2] + w1 * b[2], w0 * qa[3] + w1 * b[3]]
+    [
+        w0 * qa[0] + w1 * b[0],
+        w0 * qa[1] + w1 * b[1],
+        w0 * qa[2] + w1 * b[2],
+        w0 * qa[3] + w1 * b[3],
+    ]
 }
 
 /// Quaternion of a rotation matrix (orthonormal, positive determinant).
@@ -217,18 +236,42 @@ pub fn mat3_to_quat64(m: &Mat3) -> [f64; 4] {
     let tr = m[0][0] + m[1][1] + m[2][2];
     let q = if tr > 0.0 {
         let s = (tr + 1.0).sqrt() * 2.0;
-        [0.25 * s, (m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s]
+        [
+            0.25 * s,
+            (m[2][1] - m[1][2]) / s,
+            (m[0][2] - m[2][0]) / s,
+            (m[1][0] - m[0][1]) / s,
+        ]
     } else if m[0][0] > m[1][1] && m[0][0] > m[2][2] {
         let s = (1.0 + m[0][0] - m[1][1] - m[2][2]).sqrt() * 2.0;
-        [(m[2][1] - m[1][2]) / s, 0.25 * s, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s]
+        [
+            (m[2][1] - m[1][2]) / s,
+            0.25 * s,
+            (m[0][1] + m[1][0]) / s,
+            (m[0][2] + m[2][0]) / s,
+        ]
     } else if m[1][1] > m[2][2] {
         let s = (1.0 + m[1][1] - m[0][0] - m[2][2]).sqrt() * 2.0;
-        [(m[0][2] - m[2][0]) / s, (m[0][1] + m[1][0]) / s, 0.25 * s, (m[1][2] + m[2][1]) / s]
+        [
+            (m[0][2] - m[2][0]) / s,
+            (m[0][1] + m[1][0]) / s,
+            0.25 * s,
+            (m[1][2] + m[2][1]) / s,
+        ]
     } else {
         let s = (1.0 + m[2][2] - m[0][0] - m[1][1]).sqrt() * 2.0;
-        [(m[1][0] - m[0][1]) / s, (m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, 0.25 * s]
+        [
+            (m[1][0] - m[0][1]) / s,
+            (m[0][2] + m[2][0]) / s,
+            (m[1][2] + m[2][1]) / s,
+            0.25 * s,
+        ]
     };
-    let q = if q[0] < 0.0 { [-q[0], -q[1], -q[2], -q[3]] } else { q };
+    let q = if q[0] < 0.0 {
+        [-q[0], -q[1], -q[2], -q[3]]
+    } else {
+        q
+    };
     normalize_quat64(q)
 }
 
@@ -307,7 +350,11 @@ pub fn scale(a: V3, f: f32) -> V3 {
     [a[0] * f, a[1] * f, a[2] * f]
 }
 pub fn cross(a: V3, b: V3) -> V3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 pub fn len(a: V3) -> f32 {
     dot(a, a).sqrt()
@@ -441,7 +488,12 @@ pub fn qslerp(a: Quat, b: Quat, t: f32) -> Quat {
     } else {
         (1.0 - t, t)
     };
-    [w0 * qa[0] + w1 * b[0], w0 * qa[1] + w1 * b[1], w0 * qa[2] + w1 * b[2], w0 * qa[3] + w1 * b[3]]
+    [
+        w0 * qa[0] + w1 * b[0],
+        w0 * qa[1] + w1 * b[1],
+        w0 * qa[2] + w1 * b[2],
+        w0 * qa[3] + w1 * b[3],
+    ]
 }
 
 /// Blender's `quat_to_mat3` (double internally), as a row-major f32 3x3.
@@ -464,7 +516,11 @@ pub fn vec_to_quat(vec: V3, axis: i32, upflag: i32) -> Quat {
     if l == 0.0 {
         return QUAT_IDENTITY;
     }
-    let (tvec, axis) = if axis > 2 { (vec, axis - 3) } else { ([-vec[0], -vec[1], -vec[2]], axis) };
+    let (tvec, axis) = if axis > 2 {
+        (vec, axis - 3)
+    } else {
+        ([-vec[0], -vec[1], -vec[2]], axis)
+    };
     let mut nor;
     let mut co;
     if axis == 0 {
@@ -522,8 +578,14 @@ pub fn vec_to_quat(vec: V3, axis: i32, upflag: i32) -> Quat {
 /// and `upflag` (0..2) is up.
 pub fn quat_apply_track(quat: Quat, axis: i32, upflag: i32) -> Quat {
     let s = std::f32::consts::FRAC_1_SQRT_2;
-    let track: [Quat; 6] =
-        [[s, 0.0, -s, 0.0], [0.5, 0.5, 0.5, 0.5], [s, 0.0, 0.0, s], [s, 0.0, s, 0.0], [0.5, -0.5, -0.5, 0.5], [0.0, s, s, 0.0]];
+    let track: [Quat; 6] = [
+        [s, 0.0, -s, 0.0],
+        [0.5, 0.5, 0.5, 0.5],
+        [s, 0.0, 0.0, s],
+        [s, 0.0, s, 0.0],
+        [0.5, -0.5, -0.5, 0.5],
+        [0.0, s, s, 0.0],
+    ];
     let mut q = qmul(quat, track[axis as usize]);
     let axis = if axis > 2 { axis - 3 } else { axis };
     if upflag != (2 - axis) >> 1 {
@@ -537,13 +599,18 @@ pub fn quat_apply_track(quat: Quat, axis: i32, upflag: i32) -> Quat {
 fn normal_tri(a: V3, b: V3, c: V3) -> (V3, f32) {
     let n1 = sub(a, b);
     let n2 = sub(b, c);
-    let mut n = [n1[1] * n2[2] - n1[2] * n2[1], n1[2] * n2[0] - n1[0] * n2[2], n1[0] * n2[1] - n1[1] * n2[0]];
+    let mut n = [
+        n1[1] * n2[2] - n1[2] * n2[1],
+        n1[2] * n2[0] - n1[0] * n2[2],
+        n1[0] * n2[1] - n1[1] * n2[0],
+    ];
     let l = normalize(&mut n);
     (n, l)
 }
 
 fn invert3_f32(m: [[f32; 3]; 3]) -> [[f32; 3]; 3] {
-    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
         + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
     let mut r = [[0.0f32; 3]; 3];
     for i in 0..3 {
@@ -578,7 +645,11 @@ pub fn tri_to_quat(a: V3, b: V3, c: V3) -> Quat {
     let q1 = [co, n[0] * si, n[1] * si, 0.0];
     let imat = invert3_f32(quat_to_mat3(q1));
     let d = sub(b, a);
-    let mut v = [imat[0][0] * d[0] + imat[0][1] * d[1] + imat[0][2] * d[2], imat[1][0] * d[0] + imat[1][1] * d[1] + imat[1][2] * d[2], 0.0];
+    let mut v = [
+        imat[0][0] * d[0] + imat[0][1] * d[1] + imat[0][2] * d[2],
+        imat[1][0] * d[0] + imat[1][1] * d[1] + imat[1][2] * d[2],
+        0.0,
+    ];
     normalize(&mut v);
     let angle = 0.5 * v[1].atan2(v[0]);
     let q2 = [angle.cos(), 0.0, 0.0, angle.sin()];
@@ -591,7 +662,12 @@ mod tests {
 
     #[test]
     fn inverse_roundtrip() {
-        let m = [[2.0, 0.5, 0.0, 1.0], [0.0, 1.0, 0.3, -2.0], [0.1, 0.0, 3.0, 0.5], [0.0, 0.0, 0.0, 1.0]];
+        let m = [
+            [2.0, 0.5, 0.0, 1.0],
+            [0.0, 1.0, 0.3, -2.0],
+            [0.1, 0.0, 3.0, 0.5],
+            [0.0, 0.0, 0.0, 1.0],
+        ];
         let p = mul(&m, &inverse(&m).unwrap());
         for i in 0..4 {
             for j in 0..4 {

@@ -84,15 +84,27 @@ pub fn evaluate_scene(scene: &Scene, frame: f64) -> Result<EvaluatedScene, AnimE
     evaluate_scene_with(scene, frame, EvalOptions::default())
 }
 
-pub fn evaluate_scene_with(scene: &Scene, frame: f64, opts: EvalOptions) -> Result<EvaluatedScene, AnimError> {
+pub fn evaluate_scene_with(
+    scene: &Scene,
+    frame: f64,
+    opts: EvalOptions,
+) -> Result<EvaluatedScene, AnimError> {
     if !frame.is_finite() {
-        return Err(AnimError::new("frame", format!("{frame} is not a finite frame")));
+        return Err(AnimError::new(
+            "frame",
+            format!("{frame} is not a finite frame"),
+        ));
     }
     let mut data = Datablocks::from_file(&scene.file);
     let unapplied = animate::apply(&scene.file.animation, frame, &mut data)?;
     let axes = track_axes(scene);
     let world_matrices = transform::Solver::new(&data, opts.for_render, &axes).solve_all()?;
-    Ok(EvaluatedScene { frame, data, world_matrices, unapplied })
+    Ok(EvaluatedScene {
+        frame,
+        data,
+        world_matrices,
+        unapplied,
+    })
 }
 
 /// Objects' `track_axis`/`up_axis` as indices (only children of following path curves

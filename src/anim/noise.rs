@@ -69,7 +69,12 @@ fn perlin2(px: f32, py: f32) -> f32 {
     let (fy, y) = floor_frac(py);
     let u = fade(fx);
     let v = fade(fy);
-    let (x0, x1, y0, y1) = (x as u32, x.wrapping_add(1) as u32, y as u32, y.wrapping_add(1) as u32);
+    let (x0, x1, y0, y1) = (
+        x as u32,
+        x.wrapping_add(1) as u32,
+        y as u32,
+        y.wrapping_add(1) as u32,
+    );
     let v0 = grad2(hash2(x0, y0), fx, fy);
     let v1 = grad2(hash2(x1, y0), fx - 1.0, fy);
     let v2 = grad2(hash2(x0, y1), fx, fy - 1.0);
@@ -91,7 +96,14 @@ pub fn perlin_signed2(x: f32, y: f32) -> f32 {
 }
 
 /// Fractal Brownian motion of 2D Perlin noise (Blender's `perlin_fbm<float2>`).
-pub fn perlin_fbm2(x: f32, y: f32, detail: f32, roughness: f32, lacunarity: f32, normalize: bool) -> f32 {
+pub fn perlin_fbm2(
+    x: f32,
+    y: f32,
+    detail: f32,
+    roughness: f32,
+    lacunarity: f32,
+    normalize: bool,
+) -> f32 {
     let mut fscale = 1.0f32;
     let mut amp = 1.0f32;
     let mut maxamp = 0.0f32;
@@ -109,7 +121,11 @@ pub fn perlin_fbm2(x: f32, y: f32, detail: f32, roughness: f32, lacunarity: f32,
         let t = perlin_signed2(fscale * x, fscale * y);
         let sum2 = sum + t * amp;
         if normalize {
-            mix(0.5 * sum / maxamp + 0.5, 0.5 * sum2 / (maxamp + amp) + 0.5, rmd)
+            mix(
+                0.5 * sum / maxamp + 0.5,
+                0.5 * sum2 / (maxamp + amp) + 0.5,
+                rmd,
+            )
         } else {
             mix(sum, sum2, rmd)
         }

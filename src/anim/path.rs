@@ -71,38 +71,64 @@ enum TwistMode {
 }
 
 fn rna_f(c: &Curve, key: &str, default: f64) -> f64 {
-    c.properties.get(key).and_then(|v| v.as_f64()).unwrap_or(default)
+    c.properties
+        .get(key)
+        .and_then(|v| v.as_f64())
+        .unwrap_or(default)
 }
 fn rna_s<'a>(c: &'a Curve, key: &str, default: &'a str) -> &'a str {
-    c.properties.get(key).and_then(|v| v.as_str()).unwrap_or(default)
+    c.properties
+        .get(key)
+        .and_then(|v| v.as_str())
+        .unwrap_or(default)
 }
 fn rna_b(c: &Curve, key: &str) -> bool {
-    c.properties.get(key).and_then(|v| v.as_bool()).unwrap_or(false)
+    c.properties
+        .get(key)
+        .and_then(|v| v.as_bool())
+        .unwrap_or(false)
 }
 
 fn settings(c: &Curve) -> Result<CurveSettings, AnimError> {
     let is_3d = match rna_s(c, "dimensions", "3D") {
         "3D" => true,
         "2D" => false,
-        other => return Err(AnimError::new("properties.dimensions", format!("unknown dimensions {other:?}"))),
+        other => {
+            return Err(AnimError::new(
+                "properties.dimensions",
+                format!("unknown dimensions {other:?}"),
+            ))
+        }
     };
     let twist_mode = match rna_s(c, "twist_mode", "MINIMUM") {
         "Z_UP" => TwistMode::ZUp,
         "MINIMUM" => TwistMode::Minimum,
         "TANGENT" => TwistMode::Tangent,
-        other => return Err(AnimError::new("properties.twist_mode", format!("unknown twist mode {other:?}"))),
+        other => {
+            return Err(AnimError::new(
+                "properties.twist_mode",
+                format!("unknown twist mode {other:?}"),
+            ))
+        }
     };
-    let has_bevel_object = c.properties.get("bevel_object").is_some_and(|v| !v.is_null());
+    let has_bevel_object = c
+        .properties
+        .get("bevel_object")
+        .is_some_and(|v| !v.is_null());
     // Blender's CU_DO_RADIUS: radius is only interpolated when something uses it.
-    let do_radius =
-        rna_b(c, "use_radius") || is_3d || has_bevel_object || rna_f(c, "extrude", 0.0) != 0.0 || rna_f(c, "bevel_depth", 0.0) != 0.0;
+    let do_radius = rna_b(c, "use_radius")
+        || is_3d
+        || has_bevel_object
+        || rna_f(c, "extrude", 0.0) != 0.0
+        || rna_f(c, "bevel_depth", 0.0) != 0.0;
     let maps_segments = |k: &str| matches!(rna_s(c, k, "RESOLUTION"), "SEGMENTS" | "SPLINE");
     Ok(CurveSettings {
         is_3d,
         do_radius,
         twist_mode,
         twist_smooth: rna_f(c, "twist_smooth", 0.0) as f32,
-        need_seglen: maps_segments("bevel_factor_mapping_start") || maps_segments("bevel_factor_mapping_end"),
+        need_seglen: maps_segments("bevel_factor_mapping_start")
+            || maps_segments("bevel_factor_mapping_end"),
         render_resolution: rna_f(c, "render_resolution_u", 0.0).max(0.0) as u32,
     })
 }
@@ -119,7 +145,12 @@ fn nurb_type(s: &Spline) -> Result<NurbType, AnimError> {
         "POLY" => NurbType::Poly,
         "BEZIER" => NurbType::Bezier,
         "NURBS" => NurbType::Nurbs,
-        other => return Err(AnimError::new("type", format!("unknown spline type {other:?}"))),
+        other => {
+            return Err(AnimError::new(
+                "type",
+                format!("unknown spline type {other:?}"),
+            ))
+        }
     })
 }
 
@@ -205,7 +236,12 @@ fn interp_kind(s: &Option<String>) -> Result<i32, AnimError> {
         "CARDINAL" => 1,
         "BSPLINE" => 2,
         "EASE" => 3,
-        other => return Err(AnimError::new("tilt/radius interpolation", format!("unknown interpolation {other:?}"))),
+        other => {
+            return Err(AnimError::new(
+                "tilt/radius interpolation",
+                format!("unknown interpolation {other:?}"),
+            ))
+        }
     })
 }
 
@@ -241,7 +277,11 @@ fn bezier_list(s: &Spline, cs: &CurveSettings, resolu: usize) -> Result<BevList,
     let mut p = vec![BevPoint::default(); segcount * resolu + 1];
     let has_seglen = cs.need_seglen && !cyclic;
     let vect = |h: &str| h == "VECTOR";
-    let (mut prev, mut cur, mut a) = if cyclic { (n - 1, 0usize, n) } else { (0usize, 1usize, n - 1) };
+    let (mut prev, mut cur, mut a) = if cyclic {
+        (n - 1, 0usize, n)
+    } else {
+        (0usize, 1usize, n - 1)
+    };
     p[0].dir = normalized(sub(f3(bz[prev].handle_right), f3(bz[prev].co)));
     let mut k = 0usize; // write cursor
     while a > 0 {
@@ -259,7 +299,9 @@ fn bezier_list(s: &Spline, cs: &CurveSettings, resolu: usize) -> Result<BevList,
         } else {
             let (q0, q1, q2, q3) = (f3(pb.co), f3(pb.handle_right), f3(b.handle_left), f3(b.co));
             for j in 0..3 {
-                forward_diff(q0[j], q1[j], q2[j], q3[j], resolu, &mut |i, v| p[k + i].vec[j] = v);
+                forward_diff(q0[j], q1[j], q2[j], q3[j], resolu, &mut |i, v| {
+                    p[k + i].vec[j] = v
+                });
             }
             // Tilt and radius between the two keys, using the neighbours for smooth kinds.
             let pprev = if prev == 0 {
@@ -280,8 +322,18 @@ fn bezier_list(s: &Spline, cs: &CurveSettings, resolu: usize) -> Result<BevList,
             } else {
                 cur + 1
             };
-            let (tp, t0, t1, tn) = (bz[pprev].tilt as f32, pb.tilt as f32, b.tilt as f32, bz[next].tilt as f32);
-            let (rp, r0, r1, rn) = (bz[pprev].radius as f32, pb.radius as f32, b.radius as f32, bz[next].radius as f32);
+            let (tp, t0, t1, tn) = (
+                bz[pprev].tilt as f32,
+                pb.tilt as f32,
+                b.tilt as f32,
+                bz[next].tilt as f32,
+            );
+            let (rp, r0, r1, rn) = (
+                bz[pprev].radius as f32,
+                pb.radius as f32,
+                b.radius as f32,
+                bz[next].radius as f32,
+            );
             let dfac = 1.0f32 / resolu as f32;
             let mut fac = 0.0f32;
             for i in 0..resolu {
@@ -308,7 +360,10 @@ fn bezier_list(s: &Spline, cs: &CurveSettings, resolu: usize) -> Result<BevList,
                     let t = i as f32 / resolu as f32;
                     let mut v = [0.0f32; 3];
                     for (j, vj) in v.iter_mut().enumerate() {
-                        *vj = (-6.0 * t + 6.0) * q0[j] + (18.0 * t - 12.0) * q1[j] + (-18.0 * t + 6.0) * q2[j] + (6.0 * t) * q3[j];
+                        *vj = (-6.0 * t + 6.0) * q0[j]
+                            + (18.0 * t - 12.0) * q1[j]
+                            + (-18.0 * t + 6.0) * q2[j]
+                            + (6.0 * t) * q3[j];
                     }
                     normalize(&mut v);
                     p[k + i].tan = v;
@@ -333,7 +388,12 @@ fn bezier_list(s: &Spline, cs: &CurveSettings, resolu: usize) -> Result<BevList,
         k += 1;
     }
     p.truncate(k);
-    Ok(BevList { p, cyclic, has_seglen, hole: false })
+    Ok(BevList {
+        p,
+        cyclic,
+        has_seglen,
+        hole: false,
+    })
 }
 
 fn poly_list(s: &Spline, cs: &CurveSettings) -> BevList {
@@ -357,7 +417,12 @@ fn poly_list(s: &Spline, cs: &CurveSettings) -> BevList {
     if !cyclic {
         firstlast_dir_from_points(s, &mut p);
     }
-    BevList { p, cyclic, has_seglen, hole: false }
+    BevList {
+        p,
+        cyclic,
+        has_seglen,
+        hole: false,
+    }
 }
 
 fn firstlast_dir_from_points(s: &Spline, p: &mut [BevPoint]) {
@@ -413,7 +478,13 @@ fn calc_knots(pnts: usize, order: usize, cyclic: bool, bezier: bool, endpoint: b
 }
 
 /// Blender's `basisNurb`: B-spline basis values at `t`, and the non-zero index range.
-fn basis_nurb(mut t: f32, order: usize, pnts: usize, knots: &[f32], basis: &mut [f32]) -> (usize, usize) {
+fn basis_nurb(
+    mut t: f32,
+    order: usize,
+    pnts: usize,
+    knots: &[f32],
+    basis: &mut [f32],
+) -> (usize, usize) {
     let opp = order + pnts;
     let opp2 = opp - 1;
     if t < knots[0] {
@@ -446,8 +517,16 @@ fn basis_nurb(mut t: f32, order: usize, pnts: usize, knots: &[f32], basis: &mut 
         }
         for ii in i1..=i2 {
             let ii = ii as usize;
-            let d = if basis[ii] != 0.0 { ((t - knots[ii]) * basis[ii]) / (knots[ii + j - 1] - knots[ii]) } else { 0.0 };
-            let e = if basis[ii + 1] != 0.0 { ((knots[ii + j] - t) * basis[ii + 1]) / (knots[ii + j] - knots[ii + 1]) } else { 0.0 };
+            let d = if basis[ii] != 0.0 {
+                ((t - knots[ii]) * basis[ii]) / (knots[ii + j - 1] - knots[ii])
+            } else {
+                0.0
+            };
+            let e = if basis[ii + 1] != 0.0 {
+                ((knots[ii + j] - t) * basis[ii + 1]) / (knots[ii + j] - knots[ii + 1])
+            } else {
+                0.0
+            };
             basis[ii] = d + e;
         }
     }
@@ -478,7 +557,11 @@ fn nurbs_list(s: &Spline, cs: &CurveSettings, resolu: usize) -> BevList {
     let total = resolu * segcount;
     if total > 0 {
         let ustart = knots[order - 1];
-        let uend = if cyclic { knots[pntsu + order - 1] } else { knots[pntsu] };
+        let uend = if cyclic {
+            knots[pntsu + order - 1]
+        } else {
+            knots[pntsu]
+        };
         let ustep = (uend - ustart) / (total as f32 - if cyclic { 0.0 } else { 1.0 });
         let cycl = if cyclic { order - 1 } else { 0 };
         let mut basis = vec![0.0f32; knots_len + 1];
@@ -526,7 +609,12 @@ fn nurbs_list(s: &Spline, cs: &CurveSettings, resolu: usize) -> BevList {
     if !cyclic {
         firstlast_dir_from_points(s, &mut p);
     }
-    BevList { p, cyclic, has_seglen, hole: false }
+    BevList {
+        p,
+        cyclic,
+        has_seglen,
+        hole: false,
+    }
 }
 
 // ---- orientation (Blender's make_bevel_list_* functions) ---------------------------------
@@ -655,8 +743,11 @@ fn list_smooth(l: &mut BevList, iterations: i32) {
     let n = l.p.len();
     for _ in 0..iterations {
         // Visit order of Blender's walk; non-cyclic lists skip the first and last point.
-        let visits: Vec<(usize, usize, usize)> =
-            if l.cyclic { (0..n).map(|k| ring(n, k)).collect() } else { (1..n - 1).map(|b| (b - 1, b, b + 1)).collect() };
+        let visits: Vec<(usize, usize, usize)> = if l.cyclic {
+            (0..n).map(|k| ring(n, k)).collect()
+        } else {
+            (1..n - 1).map(|b| (b - 1, b, b + 1)).collect()
+        };
         let mut prev_quat = l.p[visits[0].0].quat;
         for &(_, b, c) in &visits {
             let mut q = qslerp(prev_quat, l.p[c].quat, 0.5);
@@ -696,8 +787,11 @@ fn segment_3d(l: &mut BevList) {
 
 fn list_2d(l: &mut BevList) {
     let n = l.p.len();
-    let visits: Vec<(usize, usize, usize)> =
-        if l.cyclic { (0..n).map(|k| ring(n, k)).collect() } else { (1..n - 1).map(|b| (b - 1, b, b + 1)).collect() };
+    let visits: Vec<(usize, usize, usize)> = if l.cyclic {
+        (0..n).map(|k| ring(n, k)).collect()
+    } else {
+        (1..n - 1).map(|b| (b - 1, b, b + 1)).collect()
+    };
     for (a, b, c) in visits {
         l.p[b].dir = bisect(l.p[a].vec, l.p[b].vec, l.p[c].vec);
         l.p[b].quat = vec_to_quat(l.p[b].dir, 5, 1);
@@ -728,7 +822,8 @@ fn bevel_inside(outer: &BevList, inner: &BevList) -> bool {
             // Intersection of edge pv-cv with the ray (cu_isectLL on x/y).
             let deler = (pv[0] - cv[0]) * (h1[1] - h2[1]) - (h1[0] - h2[0]) * (pv[1] - cv[1]);
             if deler != 0.0 {
-                let mut lambda = (pv[1] - h1[1]) * (h1[0] - h2[0]) - (pv[0] - h1[0]) * (h1[1] - h2[1]);
+                let mut lambda =
+                    (pv[1] - h1[1]) * (h1[0] - h2[0]) - (pv[0] - h1[0]) * (h1[1] - h2[1]);
                 lambda = -(lambda / deler);
                 let x = lambda * (cv[0] - pv[0]) + pv[0];
                 if lambda != 0.0 {
@@ -748,7 +843,9 @@ fn bevel_inside(outer: &BevList, inner: &BevList) -> bool {
 /// 2D curves: holes are detected and polygon winding normalized, which can reverse a
 /// list (and so the direction of a path along a closed 2D curve).
 fn orient_2d_polys(lists: &mut [BevList]) {
-    let polys: Vec<usize> = (0..lists.len()).filter(|&i| !lists[i].p.is_empty() && lists[i].cyclic).collect();
+    let polys: Vec<usize> = (0..lists.len())
+        .filter(|&i| !lists[i].p.is_empty() && lists[i].cyclic)
+        .collect();
     if polys.is_empty() {
         return;
     }
@@ -804,9 +901,16 @@ pub fn build_path(curve: &Curve, for_render: bool) -> Result<Option<Path>, AnimE
             lists.push(BevList::default());
             continue;
         }
-        resolu = if for_render && cs.render_resolution != 0 { cs.render_resolution as usize } else { s.resolution_u as usize };
+        resolu = if for_render && cs.render_resolution != 0 {
+            cs.render_resolution as usize
+        } else {
+            s.resolution_u as usize
+        };
         if resolu == 0 {
-            return Err(AnimError::new(format!("splines[{si}].resolution_u"), "is 0"));
+            return Err(AnimError::new(
+                format!("splines[{si}].resolution_u"),
+                "is 0",
+            ));
         }
         let l = match t {
             NurbType::Poly => poly_list(s, &cs),
@@ -823,7 +927,11 @@ pub fn build_path(curve: &Curve, for_render: bool) -> Result<Option<Path>, AnimE
         if n == 0 {
             continue;
         }
-        let (mut b0, mut b1) = if l.cyclic { (n - 1, 0usize) } else { (0usize, 1usize) };
+        let (mut b0, mut b1) = if l.cyclic {
+            (n - 1, 0usize)
+        } else {
+            (0usize, 1usize)
+        };
         if !l.cyclic {
             l.p[0].offset = 0.0;
         }
@@ -848,7 +956,9 @@ pub fn build_path(curve: &Curve, for_render: bool) -> Result<Option<Path>, AnimE
         orient_2d_polys(&mut lists);
     }
     // Step 4: orientation of the first list (the only one the path uses).
-    let Some(first) = lists.first_mut() else { return Ok(None) };
+    let Some(first) = lists.first_mut() else {
+        return Ok(None);
+    };
     let n = first.p.len();
     if n < 2 {
         // Blender has no usable path then (it would not even build one for n == 0).
@@ -882,7 +992,11 @@ pub fn build_path(curve: &Curve, for_render: bool) -> Result<Option<Path>, AnimE
     if l.cyclic {
         accum[seg - 1] = prev_len + len_between(l.p[0].vec, l.p[n - 1].vec);
     }
-    Ok(Some(Path { points: l.p, cyclic: l.cyclic, accum }))
+    Ok(Some(Path {
+        points: l.p,
+        cyclic: l.cyclic,
+        accum,
+    }))
 }
 
 impl Path {
@@ -940,13 +1054,22 @@ impl Path {
         let (idx, frac) = if ctime <= 0.0 || ctime >= 1.0 {
             let clamp = ctime.clamp(0.0, 1.0);
             let idx = (clamp * (seg - 1) as f32) as usize;
-            let frac = if idx == 0 { goal / self.accum[0] } else { (goal - self.accum[idx - 1]) / (self.accum[idx] - self.accum[idx - 1]) };
+            let frac = if idx == 0 {
+                goal / self.accum[0]
+            } else {
+                (goal - self.accum[idx - 1]) / (self.accum[idx] - self.accum[idx - 1])
+            };
             (idx, frac)
         } else {
             self.search(goal)
         };
         let [i0, i1, i2, i3] = self.points_at(idx);
-        let (p0, p1, p2, p3) = (&self.points[i0], &self.points[i1], &self.points[i2], &self.points[i3]);
+        let (p0, p1, p2, p3) = (
+            &self.points[i0],
+            &self.points[i1],
+            &self.points[i2],
+            &self.points[i3],
+        );
         // Poly, Bezier and NURBS paths interpolate linearly between their points.
         let mut w = [0.0f32, -frac + 1.0, frac, 0.0];
         let mut pos = [0.0f32; 3];
@@ -958,11 +1081,23 @@ impl Path {
         }
         let eps = f32::EPSILON;
         let tot = w[0] + w[3];
-        let q1 = if tot > eps { qslerp(p0.quat, p3.quat, w[3] / tot) } else { p1.quat };
+        let q1 = if tot > eps {
+            qslerp(p0.quat, p3.quat, w[3] / tot)
+        } else {
+            p1.quat
+        };
         let tot = w[1] + w[2];
-        let q2 = if tot > eps { qslerp(p1.quat, p2.quat, w[2] / tot) } else { p3.quat };
+        let q2 = if tot > eps {
+            qslerp(p1.quat, p2.quat, w[2] / tot)
+        } else {
+            p3.quat
+        };
         let tot = w[0] + w[1] + w[2] + w[3];
-        let quat = if tot > eps { qslerp(q1, q2, (w[1] + w[2]) / tot) } else { q2 };
+        let quat = if tot > eps {
+            qslerp(q1, q2, (w[1] + w[2]) / tot)
+        } else {
+            q2
+        };
         let radius = w[0] * p0.radius + w[1] * p1.radius + w[2] * p2.radius + w[3] * p3.radius;
         PathSample { pos, quat, radius }
     }

@@ -28,7 +28,11 @@ fn euler_order(mode: &str) -> Option<([usize; 3], bool)> {
 /// Blender's `eulO_to_mat3`, as a row-major matrix.
 pub fn euler_to_mat3(e: [f64; 3], mode: &str) -> Option<Mat3> {
     let ([i, j, k], parity) = euler_order(mode)?;
-    let (ti, tj, th) = if parity { (-e[i], -e[j], -e[k]) } else { (e[i], e[j], e[k]) };
+    let (ti, tj, th) = if parity {
+        (-e[i], -e[j], -e[k])
+    } else {
+        (e[i], e[j], e[k])
+    };
     let (ci, cj, ch) = (ti.cos(), tj.cos(), th.cos());
     let (si, sj, sh) = (ti.sin(), tj.sin(), th.sin());
     let (cc, cs, sc, ss) = (ci * ch, ci * sh, si * ch, si * sh);
@@ -55,16 +59,32 @@ fn axis_angle_to_mat3(axis: [f64; 3], angle: f64) -> Mat3 {
     let ico = 1.0 - c;
     let nsi = [n[0] * s, n[1] * s, n[2] * s];
     [
-        [n[0] * n[0] * ico + c, n[0] * n[1] * ico - nsi[2], n[0] * n[2] * ico + nsi[1]],
-        [n[0] * n[1] * ico + nsi[2], n[1] * n[1] * ico + c, n[1] * n[2] * ico - nsi[0]],
-        [n[0] * n[2] * ico - nsi[1], n[1] * n[2] * ico + nsi[0], n[2] * n[2] * ico + c],
+        [
+            n[0] * n[0] * ico + c,
+            n[0] * n[1] * ico - nsi[2],
+            n[0] * n[2] * ico + nsi[1],
+        ],
+        [
+            n[0] * n[1] * ico + nsi[2],
+            n[1] * n[1] * ico + c,
+            n[1] * n[2] * ico - nsi[0],
+        ],
+        [
+            n[0] * n[2] * ico - nsi[1],
+            n[1] * n[2] * ico + nsi[0],
+            n[2] * n[2] * ico + c,
+        ],
     ]
 }
 
 /// The object's own transform (no parent, no constraints): `matrix_basis`.
 pub fn basis_matrix(o: &Object) -> Result<Mat4, AnimError> {
     let dscale = o.delta_scale.unwrap_or([1.0; 3]);
-    let size = [o.scale[0] * dscale[0], o.scale[1] * dscale[1], o.scale[2] * dscale[2]];
+    let size = [
+        o.scale[0] * dscale[0],
+        o.scale[1] * dscale[1],
+        o.scale[2] * dscale[2],
+    ];
     let (rmat, dmat) = match o.rotation_mode.as_str() {
         "QUATERNION" => {
             let q = normalize_quat64(o.rotation_quaternion);
@@ -75,20 +95,35 @@ pub fn basis_matrix(o: &Object) -> Result<Mat4, AnimError> {
             // RNA order is (angle, x, y, z); the delta axis-angle is not exposed in RNA
             // (it is identity unless set from C).
             let aa = o.rotation_axis_angle.unwrap_or([0.0, 0.0, 1.0, 0.0]);
-            (axis_angle_to_mat3([aa[1], aa[2], aa[3]], aa[0]), axis_angle_to_mat3([0.0, 1.0, 0.0], 0.0))
+            (
+                axis_angle_to_mat3([aa[1], aa[2], aa[3]], aa[0]),
+                axis_angle_to_mat3([0.0, 1.0, 0.0], 0.0),
+            )
         }
         mode => {
-            let r = euler_to_mat3(o.rotation_euler, mode)
-                .ok_or_else(|| AnimError::new("rotation_mode", format!("unknown rotation mode {mode:?}")))?;
+            let r = euler_to_mat3(o.rotation_euler, mode).ok_or_else(|| {
+                AnimError::new("rotation_mode", format!("unknown rotation mode {mode:?}"))
+            })?;
             let d = euler_to_mat3(o.delta_rotation_euler.unwrap_or([0.0; 3]), mode).unwrap();
             (r, d)
         }
     };
     let rot = mul3(&dmat, &rmat);
-    let smat = [[size[0], 0.0, 0.0], [0.0, size[1], 0.0], [0.0, 0.0, size[2]]];
+    let smat = [
+        [size[0], 0.0, 0.0],
+        [0.0, size[1], 0.0],
+        [0.0, 0.0, size[2]],
+    ];
     let mut m = mat3_to_mat4(&mul3(&rot, &smat));
     let dloc = o.delta_location.unwrap_or([0.0; 3]);
-    set_translation(&mut m, [o.location[0] + dloc[0], o.location[1] + dloc[1], o.location[2] + dloc[2]]);
+    set_translation(
+        &mut m,
+        [
+            o.location[0] + dloc[0],
+            o.location[1] + dloc[1],
+            o.location[2] + dloc[2],
+        ],
+    );
     Ok(m)
 }
 
@@ -113,10 +148,27 @@ pub struct Solver<'a> {
 }
 
 impl<'a> Solver<'a> {
-    pub fn new(data: &'a Datablocks, for_render: bool, track_axes: &'a HashMap<String, (i32, i32)>) -> Self {
-        let index = data.objects.iter().enumerate().map(|(i, o)| (o.name.as_str(), i)).collect();
+    pub fn new(
+        data: &'a Datablocks,
+        for_render: bool,
+        track_axes: &'a HashMap<String, (i32, i32)>,
+    ) -> Self {
+        let index = data
+            .objects
+            .iter()
+            .enumerate()
+            .map(|(i, o)| (o.name.as_str(), i))
+            .collect();
         let n = data.objects.len();
-        Solver { data, for_render, track_axes, index, state: vec![State::Todo; n], world: vec![IDENTITY; n], paths: HashMap::new() }
+        Solver {
+            data,
+            for_render,
+            track_axes,
+            index,
+            state: vec![State::Todo; n],
+            world: vec![IDENTITY; n],
+            paths: HashMap::new(),
+        }
     }
 
     pub fn solve_all(mut self) -> Result<Vec<Mat4>, AnimError> {
@@ -127,7 +179,12 @@ impl<'a> Solver<'a> {
     }
 
     fn object_index(&self, name: &str, context: &str) -> Result<usize, AnimError> {
-        self.index.get(name).copied().ok_or_else(|| AnimError::new(context, format!("names object {name:?}, which does not exist")))
+        self.index.get(name).copied().ok_or_else(|| {
+            AnimError::new(
+                context,
+                format!("names object {name:?}, which does not exist"),
+            )
+        })
     }
 
     fn path_of(&mut self, curve_name: &str) -> Result<Option<&Path>, AnimError> {
@@ -137,8 +194,11 @@ impl<'a> Solver<'a> {
                 .curves
                 .iter()
                 .find(|c| c.name == curve_name)
-                .ok_or_else(|| AnimError::new(format!("curves[{}]", quote(curve_name)), "not in the scene"))?;
-            let p = build_path(curve, self.for_render).map_err(|e| e.within(&format!("curves[{}]", quote(curve_name))))?;
+                .ok_or_else(|| {
+                    AnimError::new(format!("curves[{}]", quote(curve_name)), "not in the scene")
+                })?;
+            let p = build_path(curve, self.for_render)
+                .map_err(|e| e.within(&format!("curves[{}]", quote(curve_name))))?;
             self.paths.insert(curve_name.to_string(), p);
         }
         Ok(self.paths[curve_name].as_ref())
@@ -180,7 +240,12 @@ impl<'a> Solver<'a> {
                     },
                     // Armature/lattice deform parents move children like a plain parent.
                     "ARMATURE" | "LATTICE" => pw,
-                    other => return Err(AnimError::new("parent_type", format!("parent type {other:?} is not supported"))),
+                    other => {
+                        return Err(AnimError::new(
+                            "parent_type",
+                            format!("parent type {other:?} is not supported"),
+                        ))
+                    }
                 };
                 let inv = o.matrix_parent_inverse.unwrap_or(IDENTITY);
                 mul(&mul(&parent_mat, &inv), &local)
@@ -188,7 +253,9 @@ impl<'a> Solver<'a> {
         };
         for c in &o.constraints {
             let at = format!("constraints[{}]", quote(&c.name));
-            let Some(parsed) = constraint::parse(c).map_err(|e| e.within(&at))? else { continue };
+            let Some(parsed) = constraint::parse(c).map_err(|e| e.within(&at))? else {
+                continue;
+            };
             let t = self.object_index(parsed.target(), &format!("{at}.target"))?;
             let target_world = self.world(t)?;
             let old = m;
@@ -204,13 +271,20 @@ impl<'a> Solver<'a> {
                         None => constraint::follow_path(&parsed.kind, &m, &IDENTITY),
                         Some(curve) => {
                             let path = self.path_of(&curve.name).map_err(|e| e.within(&at))?;
-                            let tm = constraint::follow_path_target(&parsed.kind, curve, &target_world, path);
+                            let tm = constraint::follow_path_target(
+                                &parsed.kind,
+                                curve,
+                                &target_world,
+                                path,
+                            );
                             constraint::follow_path(&parsed.kind, &m, &tm)
                         }
                     }
                 }
                 Kind::TrackTo { .. } => constraint::track_to(&parsed.kind, &m, &target_world),
-                Kind::DampedTrack { .. } => constraint::damped_track(&parsed.kind, &m, &target_world),
+                Kind::DampedTrack { .. } => {
+                    constraint::damped_track(&parsed.kind, &m, &target_world)
+                }
             };
             // Influence blends in world space (Blender's interp_m4_m4m4).
             if parsed.influence < 1.0 {
@@ -225,17 +299,35 @@ impl<'a> Solver<'a> {
     fn parent_curve_offset(&mut self, o: &Object, p: usize) -> Result<Option<Mat4>, AnimError> {
         let data = self.data;
         let po = &data.objects[p];
-        let (true, Some(cname)) = (po.kind == "CURVE", &po.data) else { return Ok(None) };
-        let Some(curve) = data.curves.iter().find(|c| &c.name == cname) else { return Ok(None) };
-        let rb = |k: &str| curve.properties.get(k).and_then(|v| v.as_bool()).unwrap_or(false);
+        let (true, Some(cname)) = (po.kind == "CURVE", &po.data) else {
+            return Ok(None);
+        };
+        let Some(curve) = data.curves.iter().find(|c| &c.name == cname) else {
+            return Ok(None);
+        };
+        let rb = |k: &str| {
+            curve
+                .properties
+                .get(k)
+                .and_then(|v| v.as_bool())
+                .unwrap_or(false)
+        };
         if !rb("use_path") {
             return Ok(None);
         }
         let follow = rb("use_path_follow");
         let use_radius = rb("use_radius");
         let clamp = rb("use_path_clamp");
-        let eval_time = curve.properties.get("eval_time").and_then(|v| v.as_f64()).unwrap_or(0.0) as f32;
-        let pathlen = curve.properties.get("path_duration").and_then(|v| v.as_f64()).unwrap_or(100.0) as i32;
+        let eval_time = curve
+            .properties
+            .get("eval_time")
+            .and_then(|v| v.as_f64())
+            .unwrap_or(0.0) as f32;
+        let pathlen = curve
+            .properties
+            .get("path_duration")
+            .and_then(|v| v.as_f64())
+            .unwrap_or(100.0) as i32;
         let axes = if follow {
             Some(*self.track_axes.get(&o.name).ok_or_else(|| {
                 AnimError::new(
@@ -246,8 +338,14 @@ impl<'a> Solver<'a> {
         } else {
             None
         };
-        let Some(path) = self.path_of(cname)? else { return Ok(None) };
-        let mut ctime = if pathlen != 0 { eval_time / pathlen as f32 } else { eval_time };
+        let Some(path) = self.path_of(cname)? else {
+            return Ok(None);
+        };
+        let mut ctime = if pathlen != 0 {
+            eval_time / pathlen as f32
+        } else {
+            eval_time
+        };
         if clamp {
             ctime = ctime.clamp(0.0, 1.0);
         }

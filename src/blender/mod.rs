@@ -37,7 +37,14 @@ impl Runner {
         match self {
             Runner::Blender(b) => {
                 cmd = Command::new(b);
-                cmd.args(["-b", "--factory-startup", "--disable-autoexec", "--python-exit-code", "1", "--python"]);
+                cmd.args([
+                    "-b",
+                    "--factory-startup",
+                    "--disable-autoexec",
+                    "--python-exit-code",
+                    "1",
+                    "--python",
+                ]);
                 cmd.arg(script).arg("--");
             }
             Runner::BpyPython(py) => {
@@ -57,7 +64,10 @@ or install the bpy module (`python3.11 -m venv venv && venv/bin/pip install bpy=
 /// `BLENDSYNTH_BPY_PYTHON`, then `blender` on PATH.
 pub fn locate(explicit: Option<&Path>) -> Result<Runner> {
     let classify = |p: PathBuf| {
-        let name = p.file_name().map(|n| n.to_string_lossy().to_lowercase()).unwrap_or_default();
+        let name = p
+            .file_name()
+            .map(|n| n.to_string_lossy().to_lowercase())
+            .unwrap_or_default();
         if name.starts_with("python") {
             Runner::BpyPython(p)
         } else {
@@ -92,7 +102,9 @@ pub fn locate(explicit: Option<&Path>) -> Result<Runner> {
 
 fn find_on_path(name: &str) -> Option<PathBuf> {
     let path = std::env::var_os("PATH")?;
-    std::env::split_paths(&path).map(|d| d.join(name)).find(|p| p.is_file())
+    std::env::split_paths(&path)
+        .map(|d| d.join(name))
+        .find(|p| p.is_file())
 }
 
 /// Options of `blendsynth convert`.
@@ -112,22 +124,41 @@ pub fn convert(input: &Path, out: &Path, opts: &ConvertOptions) -> Result<Scene>
     check_blend_file(input)?;
     check_output_dir(out)?;
 
-    let parent = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    std::fs::create_dir_all(parent).with_context(|| format!("cannot create output folder {} (its parent {} cannot be created)", out.display(), parent.display()))?;
-    let stem = out.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_else(|| "export".into());
+    let parent = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    std::fs::create_dir_all(parent).with_context(|| {
+        format!(
+            "cannot create output folder {} (its parent {} cannot be created)",
+            out.display(),
+            parent.display()
+        )
+    })?;
+    let stem = out
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| "export".into());
     let staging = tempfile::Builder::new()
         .prefix(&format!(".{stem}.partial-"))
         .tempdir_in(parent)
         .with_context(|| format!("cannot write output folder {}", out.display()))?;
 
     let runner = locate(opts.blender.as_deref())?;
-    let script_dir = tempfile::tempdir().context("cannot create a temporary folder for the exporter script")?;
+    let script_dir =
+        tempfile::tempdir().context("cannot create a temporary folder for the exporter script")?;
     let script = script_dir.path().join("export_scene.py");
     std::fs::write(&script, EXPORT_SCRIPT).context("cannot write the exporter script")?;
 
-    let input_abs = std::fs::canonicalize(input).with_context(|| format!("cannot resolve {}", input.display()))?;
+    let input_abs = std::fs::canonicalize(input)
+        .with_context(|| format!("cannot resolve {}", input.display()))?;
     let frame_s = opts.frame.map(|f| f.to_string());
-    let mut args: Vec<&std::ffi::OsStr> = vec!["--in".as_ref(), input_abs.as_os_str(), "--out".as_ref(), staging.path().as_os_str()];
+    let mut args: Vec<&std::ffi::OsStr> = vec![
+        "--in".as_ref(),
+        input_abs.as_os_str(),
+        "--out".as_ref(),
+        staging.path().as_os_str(),
+    ];
     if let Some(f) = &frame_s {
         args.push("--frame".as_ref());
         args.push(f.as_ref());
@@ -162,9 +193,11 @@ pub fn convert(input: &Path, out: &Path, opts: &ConvertOptions) -> Result<Scene>
     }
     let staging_path = staging.keep();
     if out.exists() {
-        std::fs::remove_dir_all(out).with_context(|| format!("cannot replace {}", out.display()))?;
+        std::fs::remove_dir_all(out)
+            .with_context(|| format!("cannot replace {}", out.display()))?;
     }
-    std::fs::rename(&staging_path, out).with_context(|| format!("cannot move the export into {}", out.display()))?;
+    std::fs::rename(&staging_path, out)
+        .with_context(|| format!("cannot move the export into {}", out.display()))?;
     Ok(Scene::load(out)?)
 }
 
@@ -180,9 +213,14 @@ fn check_blend_file(input: &Path) -> Result<()> {
     }
     let mut head = [0u8; 7];
     let n = f.read(&mut head).unwrap_or(0);
-    let ok = &head[..n] == b"BLENDER" || head[..n].starts_with(&[0x28, 0xB5, 0x2F, 0xFD]) || head[..n].starts_with(&[0x1F, 0x8B]);
+    let ok = &head[..n] == b"BLENDER"
+        || head[..n].starts_with(&[0x28, 0xB5, 0x2F, 0xFD])
+        || head[..n].starts_with(&[0x1F, 0x8B]);
     if !ok {
-        bail!("{} is not a .blend file (no BLENDER header)", input.display());
+        bail!(
+            "{} is not a .blend file (no BLENDER header)",
+            input.display()
+        );
     }
     Ok(())
 }
@@ -193,7 +231,9 @@ fn check_output_dir(out: &Path) -> Result<()> {
         bail!("output {} is a file; give a folder", out.display());
     }
     if out.is_dir() {
-        let empty = std::fs::read_dir(out).map(|mut d| d.next().is_none()).unwrap_or(false);
+        let empty = std::fs::read_dir(out)
+            .map(|mut d| d.next().is_none())
+            .unwrap_or(false);
         if !empty && !out.join("scene.json").is_file() {
             bail!("output folder {} exists and is not a blendsynth export; choose another or remove it", out.display());
         }
@@ -203,7 +243,12 @@ fn check_output_dir(out: &Path) -> Result<()> {
 
 /// One line out of Blender's output that says what went wrong.
 fn last_error_line(stderr: &str, stdout: &str) -> String {
-    let lines: Vec<&str> = stderr.lines().chain(stdout.lines()).map(str::trim).filter(|l| !l.is_empty()).collect();
+    let lines: Vec<&str> = stderr
+        .lines()
+        .chain(stdout.lines())
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect();
     lines
         .iter()
         .rev()

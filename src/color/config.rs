@@ -18,7 +18,11 @@ pub enum Dir {
 
 impl Dir {
     pub fn combine(self, other: Dir) -> Dir {
-        if self == other { Dir::Forward } else { Dir::Inverse }
+        if self == other {
+            Dir::Forward
+        } else {
+            Dir::Inverse
+        }
     }
 }
 
@@ -26,15 +30,57 @@ impl Dir {
 #[derive(Debug, Clone)]
 pub enum Transform {
     Group(Vec<Transform>, Dir),
-    ColorSpace { src: String, dst: String, dir: Dir },
-    Matrix { m: [f64; 16], offset: [f64; 4], dir: Dir },
-    Allocation { lg2: bool, vars: Vec<f64>, dir: Dir },
-    File { src: String, tetrahedral: bool, dir: Dir },
-    Exponent { value: [f64; 4], dir: Dir },
-    ExponentWithLinear { gamma: [f64; 4], offset: [f64; 4], dir: Dir },
-    Range { min_in: Option<f64>, max_in: Option<f64>, min_out: Option<f64>, max_out: Option<f64>, dir: Dir },
-    Cdl { slope: [f64; 3], offset: [f64; 3], power: [f64; 3], sat: f64, dir: Dir },
-    GradingPrimaryLog { contrast: [f64; 3], saturation: f64, pivot: f64, brightness: [f64; 3], gamma: [f64; 3], dir: Dir },
+    ColorSpace {
+        src: String,
+        dst: String,
+        dir: Dir,
+    },
+    Matrix {
+        m: [f64; 16],
+        offset: [f64; 4],
+        dir: Dir,
+    },
+    Allocation {
+        lg2: bool,
+        vars: Vec<f64>,
+        dir: Dir,
+    },
+    File {
+        src: String,
+        tetrahedral: bool,
+        dir: Dir,
+    },
+    Exponent {
+        value: [f64; 4],
+        dir: Dir,
+    },
+    ExponentWithLinear {
+        gamma: [f64; 4],
+        offset: [f64; 4],
+        dir: Dir,
+    },
+    Range {
+        min_in: Option<f64>,
+        max_in: Option<f64>,
+        min_out: Option<f64>,
+        max_out: Option<f64>,
+        dir: Dir,
+    },
+    Cdl {
+        slope: [f64; 3],
+        offset: [f64; 3],
+        power: [f64; 3],
+        sat: f64,
+        dir: Dir,
+    },
+    GradingPrimaryLog {
+        contrast: [f64; 3],
+        saturation: f64,
+        pivot: f64,
+        brightness: [f64; 3],
+        gamma: [f64; 3],
+        dir: Dir,
+    },
     GradingTone(Box<GradingTone>),
     Unsupported(String),
 }
@@ -81,7 +127,10 @@ pub struct Config {
 }
 
 fn err(path: &Path, msg: impl std::fmt::Display) -> ColorError {
-    ColorError::Config { path: path.to_path_buf(), message: msg.to_string() }
+    ColorError::Config {
+        path: path.to_path_buf(),
+        message: msg.to_string(),
+    }
 }
 
 /// (tag name without `!<` `>`, inner value)
@@ -89,7 +138,11 @@ fn untag(v: &Value) -> (Option<String>, &Value) {
     match v {
         Value::Tagged(t) => {
             let s = t.tag.to_string();
-            let s = s.trim_start_matches('!').trim_start_matches('<').trim_end_matches('>').to_string();
+            let s = s
+                .trim_start_matches('!')
+                .trim_start_matches('<')
+                .trim_end_matches('>')
+                .to_string();
             (Some(s), &t.value)
         }
         _ => (None, v),
@@ -164,7 +217,9 @@ fn parse_transform(v: &Value) -> Transform {
             dir,
         },
         "MatrixTransform" => {
-            let mut m = [1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0];
+            let mut m = [
+                1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0,
+            ];
             let mv = f64s(get(inner, "matrix"));
             if mv.len() == 16 {
                 m.copy_from_slice(&mv);
@@ -203,7 +258,11 @@ fn parse_transform(v: &Value) -> Transform {
                 4 => [v[0], v[1], v[2], v[3]],
                 _ => [d; 4],
             };
-            Transform::ExponentWithLinear { gamma: four(g, 1.0), offset: four(o, 0.0), dir }
+            Transform::ExponentWithLinear {
+                gamma: four(g, 1.0),
+                offset: four(o, 0.0),
+                dir,
+            }
         }
         "RangeTransform" => Transform::Range {
             min_in: get(inner, "min_in_value").and_then(f64_of),
@@ -213,7 +272,13 @@ fn parse_transform(v: &Value) -> Transform {
             dir,
         },
         "CDLTransform" => {
-            let three = |v: Vec<f64>, d: f64| if v.len() == 3 { [v[0], v[1], v[2]] } else { [d; 3] };
+            let three = |v: Vec<f64>, d: f64| {
+                if v.len() == 3 {
+                    [v[0], v[1], v[2]]
+                } else {
+                    [d; 3]
+                }
+            };
             Transform::Cdl {
                 slope: three(f64s(get(inner, "slope")), 1.0),
                 offset: three(f64s(get(inner, "offset")), 0.0),
@@ -230,9 +295,18 @@ fn parse_transform(v: &Value) -> Transform {
             let c = rgbm(get(inner, "contrast"), 1.0);
             let b = rgbm(get(inner, "brightness"), 0.0);
             let g = rgbm(get(inner, "gamma"), 1.0);
-            let pivot = get(inner, "pivot").and_then(|p| get(p, "contrast")).and_then(f64_of).unwrap_or(0.0);
-            if get(inner, "clamp").is_some() || get(inner, "pivot").and_then(|p| get(p, "black").or(get(p, "white"))).is_some() {
-                return Transform::Unsupported("GradingPrimaryTransform with clamp or black/white pivots".into());
+            let pivot = get(inner, "pivot")
+                .and_then(|p| get(p, "contrast"))
+                .and_then(f64_of)
+                .unwrap_or(0.0);
+            if get(inner, "clamp").is_some()
+                || get(inner, "pivot")
+                    .and_then(|p| get(p, "black").or(get(p, "white")))
+                    .is_some()
+            {
+                return Transform::Unsupported(
+                    "GradingPrimaryTransform with clamp or black/white pivots".into(),
+                );
             }
             Transform::GradingPrimaryLog {
                 contrast: [c[0] * c[3], c[1] * c[3], c[2] * c[3]],
@@ -250,8 +324,14 @@ fn parse_transform(v: &Value) -> Transform {
             let zone = |key: &str, d: [f64; 2], names: [&str; 2]| -> [f64; 6] {
                 let z = get(inner, key);
                 let m = rgbm(z, 1.0);
-                let p0 = z.and_then(|z| get(z, names[0])).and_then(f64_of).unwrap_or(d[0]);
-                let p1 = z.and_then(|z| get(z, names[1])).and_then(f64_of).unwrap_or(d[1]);
+                let p0 = z
+                    .and_then(|z| get(z, names[0]))
+                    .and_then(f64_of)
+                    .unwrap_or(d[0]);
+                let p1 = z
+                    .and_then(|z| get(z, names[1]))
+                    .and_then(f64_of)
+                    .unwrap_or(d[1]);
                 [m[0], m[1], m[2], m[3], p0, p1]
             };
             Transform::GradingTone(Box::new(GradingTone {
@@ -276,7 +356,11 @@ fn verbatim_tags_to_local(text: &str) -> String {
         out.push_str(&rest[..i]);
         let after = &rest[i + 2..];
         match after.find('>') {
-            Some(j) if after[..j].chars().all(|c| c.is_ascii_alphanumeric() || c == '_') => {
+            Some(j)
+                if after[..j]
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '_') =>
+            {
                 out.push('!');
                 out.push_str(&after[..j]);
                 rest = &after[j + 1..];
@@ -293,10 +377,12 @@ fn verbatim_tags_to_local(text: &str) -> String {
 
 impl Config {
     pub fn load(path: &Path) -> Result<Config, ColorError> {
-        let text = std::fs::read_to_string(path).map_err(|e| err(path, format!("cannot read: {e}")))?;
+        let text =
+            std::fs::read_to_string(path).map_err(|e| err(path, format!("cannot read: {e}")))?;
         // serde_yaml drops verbatim tags (`!<ColorSpace>`); the local form (`!ColorSpace`) is kept.
         let text = verbatim_tags_to_local(&text);
-        let doc: Value = serde_yaml::from_str(&text).map_err(|e| err(path, format!("not a readable OCIO config: {e}")))?;
+        let doc: Value = serde_yaml::from_str(&text)
+            .map_err(|e| err(path, format!("not a readable OCIO config: {e}")))?;
         let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
         let search_dirs = string(get(&doc, "search_path"))
             .unwrap_or_default()
@@ -321,7 +407,9 @@ impl Config {
                 if let Value::Sequence(s) = v {
                     for view in s {
                         let (_, inner) = untag(view);
-                        if let (Some(n), Some(cs)) = (string(get(inner, "name")), string(get(inner, "colorspace"))) {
+                        if let (Some(n), Some(cs)) =
+                            (string(get(inner, "name")), string(get(inner, "colorspace")))
+                        {
                             views.push((n, cs));
                         }
                     }
@@ -337,9 +425,11 @@ impl Config {
                     Some(Value::Sequence(a)) => a.iter().filter_map(|x| string(Some(x))).collect(),
                     _ => vec![],
                 };
-                let tr = |keys: &[&str]| keys.iter().find_map(|k| get(inner, k)).map(parse_transform);
+                let tr =
+                    |keys: &[&str]| keys.iter().find_map(|k| get(inner, k)).map(parse_transform);
                 spaces.push(ColorSpace {
-                    name: string(get(inner, "name")).ok_or_else(|| err(path, "a colour space has no name"))?,
+                    name: string(get(inner, "name"))
+                        .ok_or_else(|| err(path, "a colour space has no name"))?,
                     aliases,
                     is_data: matches!(get(inner, "isdata"), Some(Value::Bool(true))),
                     to_ref: tr(&["to_scene_reference", "to_reference"]),
@@ -348,7 +438,10 @@ impl Config {
             }
         }
         if get(&doc, "display_colorspaces").is_some() {
-            return Err(err(path, "display-referred colour spaces (display_colorspaces) are not supported"));
+            return Err(err(
+                path,
+                "display-referred colour spaces (display_colorspaces) are not supported",
+            ));
         }
         let mut looks = Vec::new();
         if let Some(Value::Sequence(s)) = get(&doc, "looks") {
@@ -362,20 +455,38 @@ impl Config {
                 });
             }
         }
-        Ok(Config { path: path.to_path_buf(), search_dirs, roles, displays, spaces, looks })
+        Ok(Config {
+            path: path.to_path_buf(),
+            search_dirs,
+            roles,
+            displays,
+            spaces,
+            looks,
+        })
     }
 
     /// A colour space by name, alias or role (names compare case-insensitively, as OCIO does).
     pub fn space(&self, name: &str) -> Option<&ColorSpace> {
         let find = |n: &str| {
-            self.spaces.iter().find(|c| c.name.eq_ignore_ascii_case(n) || c.aliases.iter().any(|a| a.eq_ignore_ascii_case(n)))
+            self.spaces.iter().find(|c| {
+                c.name.eq_ignore_ascii_case(n)
+                    || c.aliases.iter().any(|a| a.eq_ignore_ascii_case(n))
+            })
         };
-        find(name).or_else(|| self.roles.iter().find(|(k, _)| k.eq_ignore_ascii_case(name)).and_then(|(_, v)| find(v)))
+        find(name).or_else(|| {
+            self.roles
+                .iter()
+                .find(|(k, _)| k.eq_ignore_ascii_case(name))
+                .and_then(|(_, v)| find(v))
+        })
     }
 
     pub fn view_space(&self, display: &str, view: &str) -> Option<&str> {
         let (_, views) = self.displays.iter().find(|(d, _)| d == display)?;
-        views.iter().find(|(v, _)| v == view).map(|(_, cs)| cs.as_str())
+        views
+            .iter()
+            .find(|(v, _)| v == view)
+            .map(|(_, cs)| cs.as_str())
     }
 
     pub fn look(&self, name: &str) -> Option<&Look> {
@@ -383,6 +494,9 @@ impl Config {
     }
 
     pub fn find_file(&self, name: &str) -> Option<PathBuf> {
-        self.search_dirs.iter().map(|d| d.join(name)).find(|p| p.is_file())
+        self.search_dirs
+            .iter()
+            .map(|d| d.join(name))
+            .find(|p| p.is_file())
     }
 }

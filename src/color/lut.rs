@@ -35,23 +35,40 @@ pub enum LutFile {
 }
 
 fn bad(path: &Path, msg: impl std::fmt::Display) -> ColorError {
-    ColorError::Lut { path: path.to_path_buf(), message: msg.to_string() }
+    ColorError::Lut {
+        path: path.to_path_buf(),
+        message: msg.to_string(),
+    }
 }
 
 pub fn load(path: &Path) -> Result<LutFile, ColorError> {
     let text = std::fs::read_to_string(path).map_err(|e| bad(path, format!("cannot read: {e}")))?;
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
     match ext.as_str() {
-        "spi1d" => parse_spi1d(&text).map(LutFile::OneD).map_err(|m| bad(path, m)),
+        "spi1d" => parse_spi1d(&text)
+            .map(LutFile::OneD)
+            .map_err(|m| bad(path, m)),
         "cube" => parse_cube(&text).map_err(|m| bad(path, m)),
-        "spi3d" => parse_spi3d(&text).map(LutFile::ThreeD).map_err(|m| bad(path, m)),
-        "spimtx" => parse_spimtx(&text).map(LutFile::Matrix).map_err(|m| bad(path, m)),
-        _ => Err(bad(path, format!("unsupported LUT format .{ext} (supported: spi1d, cube, spi3d, spimtx)"))),
+        "spi3d" => parse_spi3d(&text)
+            .map(LutFile::ThreeD)
+            .map_err(|m| bad(path, m)),
+        "spimtx" => parse_spimtx(&text)
+            .map(LutFile::Matrix)
+            .map_err(|m| bad(path, m)),
+        _ => Err(bad(
+            path,
+            format!("unsupported LUT format .{ext} (supported: spi1d, cube, spi3d, spimtx)"),
+        )),
     }
 }
 
 fn num(tok: &str) -> Result<f32, String> {
-    tok.parse::<f32>().map_err(|_| format!("not a number: {tok:?}"))
+    tok.parse::<f32>()
+        .map_err(|_| format!("not a number: {tok:?}"))
 }
 
 fn parse_spi1d(text: &str) -> Result<Lut1D, String> {
@@ -80,8 +97,21 @@ fn parse_spi1d(text: &str) -> Result<Lut1D, String> {
                 from = num(it.next().ok_or("From needs two numbers")?)?;
                 to = num(it.next().ok_or("From needs two numbers")?)?;
             }
-            Some("Length") => length = Some(it.next().ok_or("Length needs a number")?.parse::<usize>().map_err(|e| e.to_string())?),
-            Some("Components") => comps = it.next().ok_or("Components needs a number")?.parse::<usize>().map_err(|e| e.to_string())?,
+            Some("Length") => {
+                length = Some(
+                    it.next()
+                        .ok_or("Length needs a number")?
+                        .parse::<usize>()
+                        .map_err(|e| e.to_string())?,
+                )
+            }
+            Some("Components") => {
+                comps = it
+                    .next()
+                    .ok_or("Components needs a number")?
+                    .parse::<usize>()
+                    .map_err(|e| e.to_string())?
+            }
             Some("{") => in_body = true,
             Some(other) => return Err(format!("unexpected line starting with {other:?}")),
             None => {}
@@ -92,14 +122,24 @@ fn parse_spi1d(text: &str) -> Result<Lut1D, String> {
         return Err(format!("Components {comps} not supported"));
     }
     if n < 2 || values.len() != n * comps {
-        return Err(format!("expected {} values, found {}", n * comps, values.len()));
+        return Err(format!(
+            "expected {} values, found {}",
+            n * comps,
+            values.len()
+        ));
     }
     let tables = if comps == 1 {
         vec![values]
     } else {
-        (0..comps).map(|c| values.iter().skip(c).step_by(comps).copied().collect()).collect()
+        (0..comps)
+            .map(|c| values.iter().skip(c).step_by(comps).copied().collect())
+            .collect()
     };
-    Ok(Lut1D { from: [from; 3], to: [to; 3], tables })
+    Ok(Lut1D {
+        from: [from; 3],
+        to: [to; 3],
+        tables,
+    })
 }
 
 fn parse_cube(text: &str) -> Result<LutFile, String> {
@@ -115,11 +155,33 @@ fn parse_cube(text: &str) -> Result<LutFile, String> {
         let first = it.next().unwrap();
         match first {
             "TITLE" => {}
-            "LUT_3D_SIZE" => size3 = Some(it.next().ok_or("LUT_3D_SIZE needs a number")?.parse::<usize>().map_err(|e| e.to_string())?),
-            "LUT_1D_SIZE" => size1 = Some(it.next().ok_or("LUT_1D_SIZE needs a number")?.parse::<usize>().map_err(|e| e.to_string())?),
+            "LUT_3D_SIZE" => {
+                size3 = Some(
+                    it.next()
+                        .ok_or("LUT_3D_SIZE needs a number")?
+                        .parse::<usize>()
+                        .map_err(|e| e.to_string())?,
+                )
+            }
+            "LUT_1D_SIZE" => {
+                size1 = Some(
+                    it.next()
+                        .ok_or("LUT_1D_SIZE needs a number")?
+                        .parse::<usize>()
+                        .map_err(|e| e.to_string())?,
+                )
+            }
             "DOMAIN_MIN" | "DOMAIN_MAX" => {
-                let v = [num(it.next().ok_or("domain needs 3 numbers")?)?, num(it.next().ok_or("domain needs 3 numbers")?)?, num(it.next().ok_or("domain needs 3 numbers")?)?];
-                if first == "DOMAIN_MIN" { dmin = v } else { dmax = v }
+                let v = [
+                    num(it.next().ok_or("domain needs 3 numbers")?)?,
+                    num(it.next().ok_or("domain needs 3 numbers")?)?,
+                    num(it.next().ok_or("domain needs 3 numbers")?)?,
+                ];
+                if first == "DOMAIN_MIN" {
+                    dmin = v
+                } else {
+                    dmax = v
+                }
             }
             _ => {
                 let r = num(first)?;
@@ -132,16 +194,34 @@ fn parse_cube(text: &str) -> Result<LutFile, String> {
     match (size3, size1) {
         (Some(n), _) => {
             if n < 2 || rows.len() != n * n * n {
-                return Err(format!("LUT_3D_SIZE {n} needs {} rows, found {}", n * n * n, rows.len()));
+                return Err(format!(
+                    "LUT_3D_SIZE {n} needs {} rows, found {}",
+                    n * n * n,
+                    rows.len()
+                ));
             }
-            Ok(LutFile::ThreeD(Lut3D { size: n, min: dmin, max: dmax, data: rows }))
+            Ok(LutFile::ThreeD(Lut3D {
+                size: n,
+                min: dmin,
+                max: dmax,
+                data: rows,
+            }))
         }
         (None, Some(n)) => {
             if n < 2 || rows.len() != n {
-                return Err(format!("LUT_1D_SIZE {n} needs {n} rows, found {}", rows.len()));
+                return Err(format!(
+                    "LUT_1D_SIZE {n} needs {n} rows, found {}",
+                    rows.len()
+                ));
             }
-            let tables = (0..3).map(|c| rows.iter().map(|r| r[c]).collect()).collect();
-            Ok(LutFile::OneD(Lut1D { from: dmin, to: dmax, tables }))
+            let tables = (0..3)
+                .map(|c| rows.iter().map(|r| r[c]).collect())
+                .collect();
+            Ok(LutFile::OneD(Lut1D {
+                from: dmin,
+                to: dmax,
+                tables,
+            }))
         }
         _ => Err("neither LUT_3D_SIZE nor LUT_1D_SIZE given".into()),
     }
@@ -150,7 +230,12 @@ fn parse_cube(text: &str) -> Result<LutFile, String> {
 fn parse_spi3d(text: &str) -> Result<Lut3D, String> {
     let mut lines = text.lines().map(str::trim).filter(|l| !l.is_empty());
     let _header = lines.next().ok_or("empty file")?;
-    let sizes: Vec<usize> = lines.next().ok_or("missing size line")?.split_whitespace().map(|t| t.parse::<usize>().map_err(|e| e.to_string())).collect::<Result<_, _>>()?;
+    let sizes: Vec<usize> = lines
+        .next()
+        .ok_or("missing size line")?
+        .split_whitespace()
+        .map(|t| t.parse::<usize>().map_err(|e| e.to_string()))
+        .collect::<Result<_, _>>()?;
     if sizes.len() != 3 || sizes[0] != sizes[1] || sizes[1] != sizes[2] || sizes[0] < 2 {
         return Err(format!("unsupported spi3d sizes {sizes:?}"));
     }
@@ -162,7 +247,11 @@ fn parse_spi3d(text: &str) -> Result<Lut3D, String> {
         if t.len() != 6 {
             return Err(format!("spi3d row needs 6 fields: {line:?}"));
         }
-        let (i, j, k) = (t[0].parse::<usize>().map_err(|e| e.to_string())?, t[1].parse::<usize>().map_err(|e| e.to_string())?, t[2].parse::<usize>().map_err(|e| e.to_string())?);
+        let (i, j, k) = (
+            t[0].parse::<usize>().map_err(|e| e.to_string())?,
+            t[1].parse::<usize>().map_err(|e| e.to_string())?,
+            t[2].parse::<usize>().map_err(|e| e.to_string())?,
+        );
         if i >= n || j >= n || k >= n {
             return Err(format!("spi3d index out of range: {line:?}"));
         }
@@ -172,11 +261,19 @@ fn parse_spi3d(text: &str) -> Result<Lut3D, String> {
     if count != n * n * n {
         return Err(format!("expected {} rows, found {count}", n * n * n));
     }
-    Ok(Lut3D { size: n, min: [0.0; 3], max: [1.0; 3], data })
+    Ok(Lut3D {
+        size: n,
+        min: [0.0; 3],
+        max: [1.0; 3],
+        data,
+    })
 }
 
 fn parse_spimtx(text: &str) -> Result<[[f64; 4]; 3], String> {
-    let v: Vec<f64> = text.split_whitespace().map(|t| t.parse::<f64>().map_err(|_| format!("not a number: {t:?}"))).collect::<Result<_, _>>()?;
+    let v: Vec<f64> = text
+        .split_whitespace()
+        .map(|t| t.parse::<f64>().map_err(|_| format!("not a number: {t:?}")))
+        .collect::<Result<_, _>>()?;
     if v.len() != 12 {
         return Err(format!("spimtx needs 12 numbers, found {}", v.len()));
     }
@@ -191,7 +288,11 @@ fn parse_spimtx(text: &str) -> Result<[[f64; 4]; 3], String> {
 impl Lut1D {
     #[inline]
     fn table(&self, c: usize) -> &[f32] {
-        if self.tables.len() == 1 { &self.tables[0] } else { &self.tables[c.min(self.tables.len() - 1)] }
+        if self.tables.len() == 1 {
+            &self.tables[0]
+        } else {
+            &self.tables[c.min(self.tables.len() - 1)]
+        }
     }
 
     #[inline]
@@ -236,7 +337,11 @@ impl Lut1D {
             let (mut lo, mut hi) = (0usize, n - 1);
             while hi - lo > 1 {
                 let mid = (lo + hi) / 2;
-                if key(t[mid]) < yk { lo = mid } else { hi = mid }
+                if key(t[mid]) < yk {
+                    lo = mid
+                } else {
+                    hi = mid
+                }
             }
             let (a, b) = (key(t[lo]), key(t[hi]));
             lo as f32 + if b > a { (yk - a) / (b - a) } else { 0.0 }
@@ -286,38 +391,50 @@ impl Lut3D {
                 let c100 = self.at(i1[0], i0[1], i0[2]);
                 let c110 = self.at(i1[0], i1[1], i0[2]);
                 for k in 0..3 {
-                    out[k] = (1.0 - fr) * c000[k] + (fr - fg) * c100[k] + (fg - fb) * c110[k] + fb * c111[k];
+                    out[k] = (1.0 - fr) * c000[k]
+                        + (fr - fg) * c100[k]
+                        + (fg - fb) * c110[k]
+                        + fb * c111[k];
                 }
             } else if fr > fb {
                 let c100 = self.at(i1[0], i0[1], i0[2]);
                 let c101 = self.at(i1[0], i0[1], i1[2]);
                 for k in 0..3 {
-                    out[k] = (1.0 - fr) * c000[k] + (fr - fb) * c100[k] + (fb - fg) * c101[k] + fg * c111[k];
+                    out[k] = (1.0 - fr) * c000[k]
+                        + (fr - fb) * c100[k]
+                        + (fb - fg) * c101[k]
+                        + fg * c111[k];
                 }
             } else {
                 let c001 = self.at(i0[0], i0[1], i1[2]);
                 let c101 = self.at(i1[0], i0[1], i1[2]);
                 for k in 0..3 {
-                    out[k] = (1.0 - fb) * c000[k] + (fb - fr) * c001[k] + (fr - fg) * c101[k] + fg * c111[k];
+                    out[k] = (1.0 - fb) * c000[k]
+                        + (fb - fr) * c001[k]
+                        + (fr - fg) * c101[k]
+                        + fg * c111[k];
                 }
             }
         } else if fb > fg {
             let c001 = self.at(i0[0], i0[1], i1[2]);
             let c011 = self.at(i0[0], i1[1], i1[2]);
             for k in 0..3 {
-                out[k] = (1.0 - fb) * c000[k] + (fb - fg) * c001[k] + (fg - fr) * c011[k] + fr * c111[k];
+                out[k] =
+                    (1.0 - fb) * c000[k] + (fb - fg) * c001[k] + (fg - fr) * c011[k] + fr * c111[k];
             }
         } else if fb > fr {
             let c010 = self.at(i0[0], i1[1], i0[2]);
             let c011 = self.at(i0[0], i1[1], i1[2]);
             for k in 0..3 {
-                out[k] = (1.0 - fg) * c000[k] + (fg - fb) * c010[k] + (fb - fr) * c011[k] + fr * c111[k];
+                out[k] =
+                    (1.0 - fg) * c000[k] + (fg - fb) * c010[k] + (fb - fr) * c011[k] + fr * c111[k];
             }
         } else {
             let c010 = self.at(i0[0], i1[1], i0[2]);
             let c110 = self.at(i1[0], i1[1], i0[2]);
             for k in 0..3 {
-                out[k] = (1.0 - fg) * c000[k] + (fg - fr) * c010[k] + (fr - fb) * c110[k] + fb * c111[k];
+                out[k] =
+                    (1.0 - fg) * c000[k] + (fg - fr) * c010[k] + (fr - fb) * c110[k] + fb * c111[k];
             }
         }
         out
@@ -327,11 +444,33 @@ impl Lut3D {
     pub fn trilinear(&self, rgb: [f32; 3]) -> [f32; 3] {
         let (i0, i1, [fr, fg, fb]) = self.coords(rgb);
         let mut out = [0.0f32; 3];
-        let lerp = |a: [f32; 3], b: [f32; 3], t: f32| [a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]), a[2] + t * (b[2] - a[2])];
-        let c00 = lerp(self.at(i0[0], i0[1], i0[2]), self.at(i1[0], i0[1], i0[2]), fr);
-        let c10 = lerp(self.at(i0[0], i1[1], i0[2]), self.at(i1[0], i1[1], i0[2]), fr);
-        let c01 = lerp(self.at(i0[0], i0[1], i1[2]), self.at(i1[0], i0[1], i1[2]), fr);
-        let c11 = lerp(self.at(i0[0], i1[1], i1[2]), self.at(i1[0], i1[1], i1[2]), fr);
+        let lerp = |a: [f32; 3], b: [f32; 3], t: f32| {
+            [
+                a[0] + t * (b[0] - a[0]),
+                a[1] + t * (b[1] - a[1]),
+                a[2] + t * (b[2] - a[2]),
+            ]
+        };
+        let c00 = lerp(
+            self.at(i0[0], i0[1], i0[2]),
+            self.at(i1[0], i0[1], i0[2]),
+            fr,
+        );
+        let c10 = lerp(
+            self.at(i0[0], i1[1], i0[2]),
+            self.at(i1[0], i1[1], i0[2]),
+            fr,
+        );
+        let c01 = lerp(
+            self.at(i0[0], i0[1], i1[2]),
+            self.at(i1[0], i0[1], i1[2]),
+            fr,
+        );
+        let c11 = lerp(
+            self.at(i0[0], i1[1], i1[2]),
+            self.at(i1[0], i1[1], i1[2]),
+            fr,
+        );
         let c0 = lerp(c00, c10, fg);
         let c1 = lerp(c01, c11, fg);
         let c = lerp(c0, c1, fb);

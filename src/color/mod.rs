@@ -45,7 +45,13 @@ pub struct ViewSettings {
 
 impl Default for ViewSettings {
     fn default() -> Self {
-        ViewSettings { display_device: "sRGB".into(), view_transform: "Standard".into(), look: "None".into(), exposure: 0.0, gamma: 1.0 }
+        ViewSettings {
+            display_device: "sRGB".into(),
+            view_transform: "Standard".into(),
+            look: "None".into(),
+            exposure: 0.0,
+            gamma: 1.0,
+        }
     }
 }
 
@@ -57,23 +63,39 @@ impl ViewSettings {
     pub fn from_scene(scene: &Scene) -> Result<ViewSettings, ColorError> {
         let s = &scene.file.scene;
         let image = s.render.get("image_settings").and_then(|v| v.as_object());
-        let overridden = image.and_then(|i| i.get("color_management")).and_then(|v| v.as_str()) == Some("OVERRIDE");
-        let pick = |key: &str, scene_value: &'_ serde_json::Map<String, serde_json::Value>| -> serde_json::Map<String, serde_json::Value> {
+        let overridden = image
+            .and_then(|i| i.get("color_management"))
+            .and_then(|v| v.as_str())
+            == Some("OVERRIDE");
+        let pick = |key: &str,
+                    scene_value: &'_ serde_json::Map<String, serde_json::Value>|
+         -> serde_json::Map<String, serde_json::Value> {
             match image.and_then(|i| i.get(key)).and_then(|v| v.as_object()) {
                 Some(m) if overridden => m.clone(),
                 _ => scene_value.clone(),
             }
         };
-        let (vs, ds) = (pick("view_settings", &s.view_settings), pick("display_settings", &s.display_settings));
-        let prefix = if overridden { "scene.render.image_settings.view_settings" } else { "scene.view_settings" };
-        let text = |m: &serde_json::Map<String, serde_json::Value>, k: &str, d: &str| m.get(k).and_then(|v| v.as_str()).unwrap_or(d).to_string();
+        let (vs, ds) = (
+            pick("view_settings", &s.view_settings),
+            pick("display_settings", &s.display_settings),
+        );
+        let prefix = if overridden {
+            "scene.render.image_settings.view_settings"
+        } else {
+            "scene.view_settings"
+        };
+        let text = |m: &serde_json::Map<String, serde_json::Value>, k: &str, d: &str| {
+            m.get(k).and_then(|v| v.as_str()).unwrap_or(d).to_string()
+        };
         let num = |k: &str, d: f64| vs.get(k).and_then(|v| v.as_f64()).unwrap_or(d) as f32;
         let flag = |k: &str| vs.get(k).and_then(|v| v.as_bool()).unwrap_or(false);
         if flag("use_curve_mapping") {
             return Err(ColorError::Settings(format!("{prefix}.use_curve_mapping (RGB curves on the view) is not supported; turn it off in Blender")));
         }
         if flag("use_white_balance") {
-            return Err(ColorError::Settings(format!("{prefix}.use_white_balance is not supported; turn it off in Blender")));
+            return Err(ColorError::Settings(format!(
+                "{prefix}.use_white_balance is not supported; turn it off in Blender"
+            )));
         }
         Ok(ViewSettings {
             display_device: text(&ds, "display_device", "sRGB"),
@@ -99,8 +121,15 @@ impl DisplayTransform {
     /// Builds the transform for `settings` from the OCIO config at `config` (the export's
     /// `colormanagement/config.ocio`). Without a config only what needs no LUT is possible:
     /// Standard and Raw on the sRGB display.
-    pub fn new(settings: &ViewSettings, config: Option<&Path>) -> Result<DisplayTransform, ColorError> {
-        let exposure_scale = if settings.exposure == 0.0 { 1.0 } else { 2f32.powf(settings.exposure) };
+    pub fn new(
+        settings: &ViewSettings,
+        config: Option<&Path>,
+    ) -> Result<DisplayTransform, ColorError> {
+        let exposure_scale = if settings.exposure == 0.0 {
+            1.0
+        } else {
+            2f32.powf(settings.exposure)
+        };
         let mut ops = Vec::new();
         match config {
             Some(path) => {
@@ -114,26 +143,47 @@ impl DisplayTransform {
                 if settings.has_look() {
                     space = b.look(&space, &settings.look)?;
                 }
-                let view_space = cfg.view_space(&settings.display_device, &settings.view_transform).ok_or_else(|| {
-                    let views: Vec<String> = cfg
-                        .displays
-                        .iter()
-                        .map(|(d, v)| format!("{d}: {}", v.iter().map(|(n, _)| n.as_str()).collect::<Vec<_>>().join(", ")))
-                        .collect();
-                    ColorError::Config {
-                        path: path.to_path_buf(),
-                        message: format!("no view {:?} on display {:?} (the config has {})", settings.view_transform, settings.display_device, views.join("; ")),
-                    }
-                })?;
+                let view_space = cfg
+                    .view_space(&settings.display_device, &settings.view_transform)
+                    .ok_or_else(|| {
+                        let views: Vec<String> = cfg
+                            .displays
+                            .iter()
+                            .map(|(d, v)| {
+                                format!(
+                                    "{d}: {}",
+                                    v.iter()
+                                        .map(|(n, _)| n.as_str())
+                                        .collect::<Vec<_>>()
+                                        .join(", ")
+                                )
+                            })
+                            .collect();
+                        ColorError::Config {
+                            path: path.to_path_buf(),
+                            message: format!(
+                                "no view {:?} on display {:?} (the config has {})",
+                                settings.view_transform,
+                                settings.display_device,
+                                views.join("; ")
+                            ),
+                        }
+                    })?;
                 let view_space = view_space.to_string();
                 b.convert(&space, &view_space)?;
                 ops.extend(b.finish());
             }
             None => {
                 if exposure_scale != 1.0 {
-                    ops.push(pipeline::Op::Affine { scale: [exposure_scale; 3], offset: [0.0; 3] });
+                    ops.push(pipeline::Op::Affine {
+                        scale: [exposure_scale; 3],
+                        offset: [0.0; 3],
+                    });
                 }
-                if settings.display_device != "sRGB" || settings.has_look() || !matches!(settings.view_transform.as_str(), "Standard" | "Raw") {
+                if settings.display_device != "sRGB"
+                    || settings.has_look()
+                    || !matches!(settings.view_transform.as_str(), "Standard" | "Raw")
+                {
                     return Err(ColorError::Settings(format!(
                         "view {:?} / look {:?} on display {:?} needs Blender's OCIO config and LUTs, which this export lacks (re-export with `blendsynth convert`, which copies them to colormanagement/)",
                         settings.view_transform, settings.look, settings.display_device
@@ -141,7 +191,11 @@ impl DisplayTransform {
                 }
                 if settings.view_transform == "Standard" {
                     // The sRGB colour space of Blender's config: the piecewise sRGB curve.
-                    ops.push(pipeline::Op::MonCurve { gamma: [2.4; 3], offset: [0.055; 3], encode: true });
+                    ops.push(pipeline::Op::MonCurve {
+                        gamma: [2.4; 3],
+                        offset: [0.055; 3],
+                        encode: true,
+                    });
                 }
             }
         }
@@ -156,7 +210,11 @@ impl DisplayTransform {
     pub fn from_scene(scene: &Scene) -> Result<DisplayTransform, ColorError> {
         let settings = ViewSettings::from_scene(scene)?;
         let config = match &scene.file.color_management.config {
-            Some(rel) => Some(scene.resolve(rel, "color_management.config").map_err(|e| ColorError::Settings(e.to_string()))?),
+            Some(rel) => Some(
+                scene
+                    .resolve(rel, "color_management.config")
+                    .map_err(|e| ColorError::Settings(e.to_string()))?,
+            ),
             None => None,
         };
         DisplayTransform::new(&settings, config.as_deref())
@@ -209,9 +267,21 @@ pub struct OutputFormat {
 
 impl OutputFormat {
     pub fn from_scene(scene: &Scene) -> OutputFormat {
-        let ims = scene.file.scene.render.get("image_settings").and_then(|v| v.as_object());
-        let get = |k: &str| ims.and_then(|m| m.get(k)).and_then(|v| v.as_str()).unwrap_or("");
-        OutputFormat { sixteen_bit: get("color_depth") == "16", alpha: get("color_mode") == "RGBA" }
+        let ims = scene
+            .file
+            .scene
+            .render
+            .get("image_settings")
+            .and_then(|v| v.as_object());
+        let get = |k: &str| {
+            ims.and_then(|m| m.get(k))
+                .and_then(|v| v.as_str())
+                .unwrap_or("")
+        };
+        OutputFormat {
+            sixteen_bit: get("color_depth") == "16",
+            alpha: get("color_mode") == "RGBA",
+        }
     }
 }
 
@@ -219,8 +289,18 @@ impl OutputFormat {
 /// `.exr` gets the linear scene-referred pixels as float RGBA (Blender applies no view
 /// transform to float formats); `.png` gets the scene's colour management and its
 /// output format's bit depth and alpha. `linear` is left untouched.
-pub fn write_render(scene: &Scene, path: &Path, width: u32, height: u32, linear: &[[f32; 4]]) -> Result<(), ColorError> {
-    let ext = path.extension().and_then(|e| e.to_str()).unwrap_or("").to_ascii_lowercase();
+pub fn write_render(
+    scene: &Scene,
+    path: &Path,
+    width: u32,
+    height: u32,
+    linear: &[[f32; 4]],
+) -> Result<(), ColorError> {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or("")
+        .to_ascii_lowercase();
     match ext.as_str() {
         "exr" => write_exr(path, width, height, linear),
         "png" => {
@@ -229,6 +309,9 @@ pub fn write_render(scene: &Scene, path: &Path, width: u32, height: u32, linear:
             let f = OutputFormat::from_scene(scene);
             write_png(path, width, height, &px, f.sixteen_bit, f.alpha)
         }
-        _ => Err(ColorError::Write { path: path.to_path_buf(), message: format!("unsupported output type .{ext} (use .png or .exr)") }),
+        _ => Err(ColorError::Write {
+            path: path.to_path_buf(),
+            message: format!("unsupported output type .{ext} (use .png or .exr)"),
+        }),
     }
 }

@@ -16,23 +16,55 @@ use super::ColorError;
 #[derive(Debug, Clone)]
 pub enum Op {
     /// out = M * rgb + offset
-    Matrix { m: [[f32; 3]; 3], offset: [f32; 3] },
+    Matrix {
+        m: [[f32; 3]; 3],
+        offset: [f32; 3],
+    },
     /// out = rgb * scale + offset, per channel
-    Affine { scale: [f32; 3], offset: [f32; 3] },
+    Affine {
+        scale: [f32; 3],
+        offset: [f32; 3],
+    },
     /// log2(max(x, FLT_MIN))
     Log2,
     /// 2^x
     Exp2,
-    Lut1D { lut: Arc<Lut1D>, inverse: bool },
-    Lut3D { lut: Arc<Lut3D>, tetrahedral: bool },
+    Lut1D {
+        lut: Arc<Lut1D>,
+        inverse: bool,
+    },
+    Lut3D {
+        lut: Arc<Lut3D>,
+        tetrahedral: bool,
+    },
     /// pow(max(x, 0), e) per channel (ExponentTransform's default negative clamp)
     Pow([f32; 3]),
     /// Moncurve (ExponentWithLinearTransform): encode = linear to encoded (its inverse).
-    MonCurve { gamma: [f32; 3], offset: [f32; 3], encode: bool },
-    Clamp { min: Option<f32>, max: Option<f32> },
+    MonCurve {
+        gamma: [f32; 3],
+        offset: [f32; 3],
+        encode: bool,
+    },
+    Clamp {
+        min: Option<f32>,
+        max: Option<f32>,
+    },
     /// ASC CDL without clamping (OCIO v2's default style).
-    Cdl { slope: [f32; 3], offset: [f32; 3], power: [f32; 3], sat: f32, inverse: bool },
-    GradingPrimaryLog { brightness: [f32; 3], contrast: [f32; 3], gamma: [f32; 3], pivot: f32, saturation: f32, inverse: bool },
+    Cdl {
+        slope: [f32; 3],
+        offset: [f32; 3],
+        power: [f32; 3],
+        sat: f32,
+        inverse: bool,
+    },
+    GradingPrimaryLog {
+        brightness: [f32; 3],
+        contrast: [f32; 3],
+        gamma: [f32; 3],
+        pivot: f32,
+        saturation: f32,
+        inverse: bool,
+    },
     GradingTone(Box<super::tone::ToneOp>),
 }
 
@@ -51,16 +83,29 @@ fn mat4_to3(m: &[f64; 16]) -> [[f64; 3]; 3] {
 }
 
 fn invert3(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
-    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
         + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
     if det.abs() < 1e-300 {
         return None;
     }
     let d = 1.0 / det;
     Some([
-        [(m[1][1] * m[2][2] - m[1][2] * m[2][1]) * d, (m[0][2] * m[2][1] - m[0][1] * m[2][2]) * d, (m[0][1] * m[1][2] - m[0][2] * m[1][1]) * d],
-        [(m[1][2] * m[2][0] - m[1][0] * m[2][2]) * d, (m[0][0] * m[2][2] - m[0][2] * m[2][0]) * d, (m[0][2] * m[1][0] - m[0][0] * m[1][2]) * d],
-        [(m[1][0] * m[2][1] - m[1][1] * m[2][0]) * d, (m[0][1] * m[2][0] - m[0][0] * m[2][1]) * d, (m[0][0] * m[1][1] - m[0][1] * m[1][0]) * d],
+        [
+            (m[1][1] * m[2][2] - m[1][2] * m[2][1]) * d,
+            (m[0][2] * m[2][1] - m[0][1] * m[2][2]) * d,
+            (m[0][1] * m[1][2] - m[0][2] * m[1][1]) * d,
+        ],
+        [
+            (m[1][2] * m[2][0] - m[1][0] * m[2][2]) * d,
+            (m[0][0] * m[2][2] - m[0][2] * m[2][0]) * d,
+            (m[0][2] * m[1][0] - m[0][0] * m[1][2]) * d,
+        ],
+        [
+            (m[1][0] * m[2][1] - m[1][1] * m[2][0]) * d,
+            (m[0][1] * m[2][0] - m[0][0] * m[2][1]) * d,
+            (m[0][0] * m[1][1] - m[0][1] * m[1][0]) * d,
+        ],
     ])
 }
 
@@ -70,11 +115,20 @@ fn f3(v: [f64; 3]) -> [f32; 3] {
 
 impl<'a> Builder<'a> {
     pub fn new(config: &'a Config) -> Self {
-        Builder { config, luts: HashMap::new(), ops: Vec::new(), pending: None, depth: 0 }
+        Builder {
+            config,
+            luts: HashMap::new(),
+            ops: Vec::new(),
+            pending: None,
+            depth: 0,
+        }
     }
 
     fn cerr(&self, msg: impl std::fmt::Display) -> ColorError {
-        ColorError::Config { path: self.config.path.clone(), message: msg.to_string() }
+        ColorError::Config {
+            path: self.config.path.clone(),
+            message: msg.to_string(),
+        }
     }
 
     /// out = m * in + offset, fused with a preceding matrix.
@@ -96,18 +150,30 @@ impl<'a> Builder<'a> {
     }
 
     fn push_scale_offset(&mut self, scale: f64, offset: f64) {
-        self.push_matrix([[scale, 0.0, 0.0], [0.0, scale, 0.0], [0.0, 0.0, scale]], [offset; 3]);
+        self.push_matrix(
+            [[scale, 0.0, 0.0], [0.0, scale, 0.0], [0.0, 0.0, scale]],
+            [offset; 3],
+        );
     }
 
     fn flush(&mut self) {
         if let Some((m, o)) = self.pending.take() {
-            let identity = (0..3).all(|i| (0..3).all(|j| (m[i][j] - if i == j { 1.0 } else { 0.0 }).abs() < 1e-12) && o[i].abs() < 1e-12);
+            let identity = (0..3).all(|i| {
+                (0..3).all(|j| (m[i][j] - if i == j { 1.0 } else { 0.0 }).abs() < 1e-12)
+                    && o[i].abs() < 1e-12
+            });
             if !identity {
                 let diagonal = (0..3).all(|i| (0..3).all(|j| i == j || m[i][j] == 0.0));
                 self.ops.push(if diagonal {
-                    Op::Affine { scale: f3([m[0][0], m[1][1], m[2][2]]), offset: f3(o) }
+                    Op::Affine {
+                        scale: f3([m[0][0], m[1][1], m[2][2]]),
+                        offset: f3(o),
+                    }
                 } else {
-                    Op::Matrix { m: [f3(m[0]), f3(m[1]), f3(m[2])], offset: f3(o) }
+                    Op::Matrix {
+                        m: [f3(m[0]), f3(m[1]), f3(m[2])],
+                        offset: f3(o),
+                    }
                 });
             }
         }
@@ -127,8 +193,12 @@ impl<'a> Builder<'a> {
     /// Converts from colour space `src` to `dst` (names, aliases or roles).
     pub fn convert(&mut self, src: &str, dst: &str) -> Result<(), ColorError> {
         let cfg = self.config;
-        let s = cfg.space(src).ok_or_else(|| self.cerr(format!("unknown colour space {src:?}")))?;
-        let d = cfg.space(dst).ok_or_else(|| self.cerr(format!("unknown colour space {dst:?}")))?;
+        let s = cfg
+            .space(src)
+            .ok_or_else(|| self.cerr(format!("unknown colour space {src:?}")))?;
+        let d = cfg
+            .space(dst)
+            .ok_or_else(|| self.cerr(format!("unknown colour space {dst:?}")))?;
         if s.name == d.name || s.is_data || d.is_data {
             return Ok(());
         }
@@ -160,7 +230,10 @@ impl<'a> Builder<'a> {
     pub fn look(&mut self, src: &str, name: &str) -> Result<String, ColorError> {
         let look = self.config.look(name).ok_or_else(|| {
             let names: Vec<&str> = self.config.looks.iter().map(|l| l.name.as_str()).collect();
-            self.cerr(format!("unknown look {name:?} (the config has: {})", names.join(", ")))
+            self.cerr(format!(
+                "unknown look {name:?} (the config has: {})",
+                names.join(", ")
+            ))
         })?;
         let look = look.clone();
         self.convert(src, &look.process_space)?;
@@ -173,7 +246,11 @@ impl<'a> Builder<'a> {
     }
 
     fn load_lut(&mut self, name: &str) -> Result<LutFile, ColorError> {
-        let path = self.config.find_file(name).ok_or_else(|| self.cerr(format!("LUT file {name:?} not found in the config's search path")))?;
+        let path = self.config.find_file(name).ok_or_else(|| {
+            self.cerr(format!(
+                "LUT file {name:?} not found in the config's search path"
+            ))
+        })?;
         if let Some(l) = self.luts.get(&path) {
             return Ok(l.clone());
         }
@@ -208,7 +285,8 @@ impl<'a> Builder<'a> {
                 if outer.combine(*dir) == Dir::Forward {
                     self.push_matrix(m3, off);
                 } else {
-                    let inv = invert3(m3).ok_or_else(|| self.cerr("a MatrixTransform to invert is singular"))?;
+                    let inv = invert3(m3)
+                        .ok_or_else(|| self.cerr("a MatrixTransform to invert is singular"))?;
                     let o = [
                         -(inv[0][0] * off[0] + inv[0][1] * off[1] + inv[0][2] * off[2]),
                         -(inv[1][0] * off[0] + inv[1][1] * off[1] + inv[1][2] * off[2]),
@@ -219,12 +297,26 @@ impl<'a> Builder<'a> {
             }
             Transform::Allocation { lg2, vars, dir } => {
                 let fwd = outer.combine(*dir) == Dir::Forward;
-                let (lo, hi) = if vars.len() >= 2 { (vars[0], vars[1]) } else if *lg2 { (-10.0, 6.0) } else { (0.0, 1.0) };
-                let lin_offset = if *lg2 && vars.len() >= 3 { vars[2] } else { 0.0 };
+                let (lo, hi) = if vars.len() >= 2 {
+                    (vars[0], vars[1])
+                } else if *lg2 {
+                    (-10.0, 6.0)
+                } else {
+                    (0.0, 1.0)
+                };
+                let lin_offset = if *lg2 && vars.len() >= 3 {
+                    vars[2]
+                } else {
+                    0.0
+                };
                 // Fit lo..hi to 0..1.
                 let fit = |b: &mut Self, fwd: bool| {
                     let s = 1.0 / (hi - lo);
-                    if fwd { b.push_scale_offset(s, -lo * s) } else { b.push_scale_offset(hi - lo, lo) }
+                    if fwd {
+                        b.push_scale_offset(s, -lo * s)
+                    } else {
+                        b.push_scale_offset(hi - lo, lo)
+                    }
                 };
                 if !*lg2 {
                     fit(self, fwd);
@@ -242,19 +334,33 @@ impl<'a> Builder<'a> {
                     }
                 }
             }
-            Transform::File { src, tetrahedral, dir } => {
+            Transform::File {
+                src,
+                tetrahedral,
+                dir,
+            } => {
                 let fwd = outer.combine(*dir) == Dir::Forward;
                 match self.load_lut(src)? {
-                    LutFile::OneD(l) => self.push(Op::Lut1D { lut: Arc::new(l), inverse: !fwd }),
+                    LutFile::OneD(l) => self.push(Op::Lut1D {
+                        lut: Arc::new(l),
+                        inverse: !fwd,
+                    }),
                     LutFile::ThreeD(l) => {
                         if !fwd {
-                            return Err(self.cerr(format!("inverse of the 3D LUT {src:?} is not supported")));
+                            return Err(self
+                                .cerr(format!("inverse of the 3D LUT {src:?} is not supported")));
                         }
-                        self.push(Op::Lut3D { lut: Arc::new(l), tetrahedral: *tetrahedral })
+                        self.push(Op::Lut3D {
+                            lut: Arc::new(l),
+                            tetrahedral: *tetrahedral,
+                        })
                     }
                     LutFile::Matrix(m) => {
                         let t = Transform::Matrix {
-                            m: [m[0][0], m[0][1], m[0][2], 0.0, m[1][0], m[1][1], m[1][2], 0.0, m[2][0], m[2][1], m[2][2], 0.0, 0.0, 0.0, 0.0, 1.0],
+                            m: [
+                                m[0][0], m[0][1], m[0][2], 0.0, m[1][0], m[1][1], m[1][2], 0.0,
+                                m[2][0], m[2][1], m[2][2], 0.0, 0.0, 0.0, 0.0, 1.0,
+                            ],
                             offset: [m[0][3], m[1][3], m[2][3], 0.0],
                             dir: Dir::Forward,
                         };
@@ -275,20 +381,52 @@ impl<'a> Builder<'a> {
                     encode: !fwd,
                 });
             }
-            Transform::Range { min_in, max_in, min_out, max_out, dir } => {
+            Transform::Range {
+                min_in,
+                max_in,
+                min_out,
+                max_out,
+                dir,
+            } => {
                 let fwd = outer.combine(*dir) == Dir::Forward;
-                let (a_min, a_max, b_min, b_max) = if fwd { (min_in, max_in, min_out, max_out) } else { (min_out, max_out, min_in, max_in) };
+                let (a_min, a_max, b_min, b_max) = if fwd {
+                    (min_in, max_in, min_out, max_out)
+                } else {
+                    (min_out, max_out, min_in, max_in)
+                };
                 // Only the clamp-only form (in == out) is used by Blender's configs.
                 if a_min != b_min || a_max != b_max {
                     return Err(self.cerr("RangeTransform that rescales is not supported"));
                 }
-                self.push(Op::Clamp { min: a_min.map(|v| v as f32), max: a_max.map(|v| v as f32) });
+                self.push(Op::Clamp {
+                    min: a_min.map(|v| v as f32),
+                    max: a_max.map(|v| v as f32),
+                });
             }
-            Transform::Cdl { slope, offset, power, sat, dir } => {
+            Transform::Cdl {
+                slope,
+                offset,
+                power,
+                sat,
+                dir,
+            } => {
                 let fwd = outer.combine(*dir) == Dir::Forward;
-                self.push(Op::Cdl { slope: f3(*slope), offset: f3(*offset), power: f3(*power), sat: *sat as f32, inverse: !fwd });
+                self.push(Op::Cdl {
+                    slope: f3(*slope),
+                    offset: f3(*offset),
+                    power: f3(*power),
+                    sat: *sat as f32,
+                    inverse: !fwd,
+                });
             }
-            Transform::GradingPrimaryLog { contrast, saturation, pivot, brightness, gamma, dir } => {
+            Transform::GradingPrimaryLog {
+                contrast,
+                saturation,
+                pivot,
+                brightness,
+                gamma,
+                dir,
+            } => {
                 let fwd = outer.combine(*dir) == Dir::Forward;
                 let s = 6.25 / 1023.0;
                 self.push(Op::GradingPrimaryLog {
@@ -306,9 +444,13 @@ impl<'a> Builder<'a> {
                 if !fwd {
                     return Err(self.cerr("inverse GradingToneTransform is not supported"));
                 }
-                self.push(Op::GradingTone(Box::new(super::tone::ToneOp::new(g).map_err(|m| self.cerr(m))?)));
+                self.push(Op::GradingTone(Box::new(
+                    super::tone::ToneOp::new(g).map_err(|m| self.cerr(m))?,
+                )));
             }
-            Transform::Unsupported(what) => return Err(self.cerr(format!("{what} is not supported"))),
+            Transform::Unsupported(what) => {
+                return Err(self.cerr(format!("{what} is not supported")))
+            }
         }
         Ok(())
     }
@@ -343,18 +485,30 @@ impl Op {
             }
             Op::Lut1D { lut, inverse } => {
                 for (c, v) in p.iter_mut().enumerate() {
-                    *v = if *inverse { lut.eval_inverse(c, *v) } else { lut.eval(c, *v) };
+                    *v = if *inverse {
+                        lut.eval_inverse(c, *v)
+                    } else {
+                        lut.eval(c, *v)
+                    };
                 }
             }
             Op::Lut3D { lut, tetrahedral } => {
-                *p = if *tetrahedral { lut.tetrahedral(*p) } else { lut.trilinear(*p) };
+                *p = if *tetrahedral {
+                    lut.tetrahedral(*p)
+                } else {
+                    lut.trilinear(*p)
+                };
             }
             Op::Pow(e) => {
                 for i in 0..3 {
                     p[i] = p[i].max(0.0).powf(e[i]);
                 }
             }
-            Op::MonCurve { gamma, offset, encode } => {
+            Op::MonCurve {
+                gamma,
+                offset,
+                encode,
+            } => {
                 for i in 0..3 {
                     p[i] = moncurve(p[i], gamma[i], offset[i], *encode);
                 }
@@ -369,7 +523,13 @@ impl Op {
                     }
                 }
             }
-            Op::Cdl { slope, offset, power, sat, inverse } => {
+            Op::Cdl {
+                slope,
+                offset,
+                power,
+                sat,
+                inverse,
+            } => {
                 let pw = |x: f32, e: f32| if x > 0.0 { x.powf(e) } else { x };
                 let saturate = |p: &mut [f32; 3], s: f32| {
                     let l = LUMA[0] * p[0] + LUMA[1] * p[1] + LUMA[2] * p[2];
@@ -389,7 +549,14 @@ impl Op {
                     }
                 }
             }
-            Op::GradingPrimaryLog { brightness, contrast, gamma, pivot, saturation, inverse } => {
+            Op::GradingPrimaryLog {
+                brightness,
+                contrast,
+                gamma,
+                pivot,
+                saturation,
+                inverse,
+            } => {
                 let (black, white) = (0.0f32, 1.0f32);
                 let gam = |x: f32, g: f32| {
                     let d = x - black;
@@ -422,7 +589,8 @@ impl Op {
                         if gamma[i] != 1.0 {
                             v = gam(v, 1.0 / gamma[i]);
                         }
-                        v = (v - pivot) / if contrast[i] == 0.0 { 1.0 } else { contrast[i] } + pivot;
+                        v = (v - pivot) / if contrast[i] == 0.0 { 1.0 } else { contrast[i] }
+                            + pivot;
                         p[i] = v - brightness[i];
                     }
                 }
@@ -442,7 +610,11 @@ fn moncurve(x: f32, gamma: f32, offset: f32, encode: bool) -> f32 {
     let slope = brk_lin / brk_enc; // linear = encoded * slope below the break
     let x = x as f64;
     let y = if encode {
-        if x <= brk_lin { x / slope } else { (1.0 + a) * x.powf(1.0 / g) - a }
+        if x <= brk_lin {
+            x / slope
+        } else {
+            (1.0 + a) * x.powf(1.0 / g) - a
+        }
     } else if x <= brk_enc {
         x * slope
     } else {

@@ -28,11 +28,20 @@ impl ToneOp {
         if !g.log {
             return Err("GradingToneTransform styles other than log are not supported".into());
         }
-        if !identity_zone(&g.blacks) || !identity_zone(&g.midtones) || !identity_zone(&g.highlights) || !identity_zone(&g.whites) || g.s_contrast != 1.0 {
+        if !identity_zone(&g.blacks)
+            || !identity_zone(&g.midtones)
+            || !identity_zone(&g.highlights)
+            || !identity_zone(&g.whites)
+            || g.s_contrast != 1.0
+        {
             return Err("GradingToneTransform zones other than shadows are not supported".into());
         }
         let (start, pivot) = (g.shadows[4], g.shadows[5]);
-        let start = if start < pivot + 0.01 { pivot + 0.01 } else { start };
+        let start = if start < pivot + 0.01 {
+            pivot + 0.01
+        } else {
+            start
+        };
         let mut shadows = [None; 4];
         for (c, slot) in shadows.iter_mut().enumerate() {
             let val = g.shadows[c] as f32;
@@ -42,10 +51,22 @@ impl ToneOp {
             let (x0, x2) = (pivot as f32, start as f32);
             let x1 = x0 + (x2 - x0) * 0.5;
             let (y0, y2) = (x0, x2);
-            let m0 = if val < 1.0 { val.max(0.01) } else { (2.0 - val).max(0.01) };
+            let m0 = if val < 1.0 {
+                val.max(0.01)
+            } else {
+                (2.0 - val).max(0.01)
+            };
             let m2 = 1.0f32;
-            let y1 = (0.5 / (x2 - x0)) * ((2.0 * y0 + m0 * (x1 - x0)) * (x2 - x1) + (2.0 * y2 - m2 * (x2 - x1)) * (x1 - x0));
-            *slot = Some(Curve { x: [x0, x1, x2], y: [y0, y1, y2], m0, m2, reverse: val > 1.0 });
+            let y1 = (0.5 / (x2 - x0))
+                * ((2.0 * y0 + m0 * (x1 - x0)) * (x2 - x1)
+                    + (2.0 * y2 - m2 * (x2 - x1)) * (x1 - x0));
+            *slot = Some(Curve {
+                x: [x0, x1, x2],
+                y: [y0, y1, y2],
+                m0,
+                m2,
+                reverse: val > 1.0,
+            });
         }
         Ok(ToneOp { shadows })
     }
@@ -78,7 +99,9 @@ impl Curve {
             let tl = (t - x0) / (x1 - x0);
             let tr = (t - x1) / (x2 - x1);
             let fl = y0 * (1.0 - tl * tl) + y1 * tl * tl + m0 * (1.0 - tl) * tl * (x1 - x0);
-            let fr = y1 * (1.0 - tr) * (1.0 - tr) + y2 * (2.0 - tr) * tr + m2 * (tr - 1.0) * tr * (x2 - x1);
+            let fr = y1 * (1.0 - tr) * (1.0 - tr)
+                + y2 * (2.0 - tr) * tr
+                + m2 * (tr - 1.0) * tr * (x2 - x1);
             let mut res = if t < x1 { fl } else { fr };
             if t < x0 {
                 res = (t - x0) * m0 + y0;

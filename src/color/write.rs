@@ -10,26 +10,50 @@ use image::{ImageBuffer, ImageEncoder, Rgb, Rgba};
 use super::ColorError;
 
 fn werr(path: &Path, msg: impl std::fmt::Display) -> ColorError {
-    ColorError::Write { path: path.to_path_buf(), message: msg.to_string() }
+    ColorError::Write {
+        path: path.to_path_buf(),
+        message: msg.to_string(),
+    }
 }
 
 fn check(path: &Path, width: u32, height: u32, n: usize) -> Result<(), ColorError> {
     if width == 0 || height == 0 {
-        return Err(werr(path, format!("cannot write an empty {width}x{height} image")));
+        return Err(werr(
+            path,
+            format!("cannot write an empty {width}x{height} image"),
+        ));
     }
     if (width as usize) * (height as usize) != n {
-        return Err(werr(path, format!("{width}x{height} image needs {} pixels, got {n}", width as u64 * height as u64)));
+        return Err(werr(
+            path,
+            format!(
+                "{width}x{height} image needs {} pixels, got {n}",
+                width as u64 * height as u64
+            ),
+        ));
     }
     Ok(())
 }
 
 /// Writes through `f` into a temp file in the target's folder, then renames it over `path`.
-fn atomic(path: &Path, f: impl FnOnce(&mut BufWriter<&mut std::fs::File>) -> Result<(), String>) -> Result<(), ColorError> {
+fn atomic(
+    path: &Path,
+    f: impl FnOnce(&mut BufWriter<&mut std::fs::File>) -> Result<(), String>,
+) -> Result<(), ColorError> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::Builder::new().prefix(".blendsynth-").suffix(".tmp").tempfile_in(dir).map_err(|e| werr(path, format!("cannot create a temporary file in {}: {e}", dir.display())))?;
+    let mut tmp = tempfile::Builder::new()
+        .prefix(".blendsynth-")
+        .suffix(".tmp")
+        .tempfile_in(dir)
+        .map_err(|e| {
+            werr(
+                path,
+                format!("cannot create a temporary file in {}: {e}", dir.display()),
+            )
+        })?;
     {
         let mut w = BufWriter::new(tmp.as_file_mut());
         f(&mut w).map_err(|m| werr(path, m))?;
@@ -54,7 +78,14 @@ fn quantize(v: f32, max: f32) -> f32 {
 /// PNG, 8 or 16 bits per channel. `pixels` are display-referred premultiplied RGBA (as
 /// `to_display` leaves them); with `alpha` the colour is un-premultiplied, since PNG stores
 /// straight alpha, and without it the colour is written as is (over black).
-pub fn write_png(path: &Path, width: u32, height: u32, pixels: &[[f32; 4]], sixteen_bit: bool, alpha: bool) -> Result<(), ColorError> {
+pub fn write_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[[f32; 4]],
+    sixteen_bit: bool,
+    alpha: bool,
+) -> Result<(), ColorError> {
     check(path, width, height, pixels.len())?;
     let straight = |p: &[f32; 4]| -> [f32; 4] {
         if alpha && p[3] > 0.0 && p[3] != 1.0 {
@@ -68,36 +99,52 @@ pub fn write_png(path: &Path, width: u32, height: u32, pixels: &[[f32; 4]], sixt
         let max = if sixteen_bit { 65535.0 } else { 255.0 };
         match (sixteen_bit, alpha) {
             (true, true) => {
-                let img: ImageBuffer<Rgba<u16>, Vec<u16>> = ImageBuffer::from_fn(width, height, |x, y| {
-                    let p = straight(&pixels[(y * width + x) as usize]);
-                    Rgba(p.map(|v| quantize(v, max) as u16))
-                });
+                let img: ImageBuffer<Rgba<u16>, Vec<u16>> =
+                    ImageBuffer::from_fn(width, height, |x, y| {
+                        let p = straight(&pixels[(y * width + x) as usize]);
+                        Rgba(p.map(|v| quantize(v, max) as u16))
+                    });
                 img.write_with_encoder(enc).map_err(|e| e.to_string())
             }
             (true, false) => {
-                let img: ImageBuffer<Rgb<u16>, Vec<u16>> = ImageBuffer::from_fn(width, height, |x, y| {
-                    let p = pixels[(y * width + x) as usize];
-                    Rgb([p[0], p[1], p[2]].map(|v| quantize(v, max) as u16))
-                });
+                let img: ImageBuffer<Rgb<u16>, Vec<u16>> =
+                    ImageBuffer::from_fn(width, height, |x, y| {
+                        let p = pixels[(y * width + x) as usize];
+                        Rgb([p[0], p[1], p[2]].map(|v| quantize(v, max) as u16))
+                    });
                 img.write_with_encoder(enc).map_err(|e| e.to_string())
             }
             (false, true) => {
-                let buf: Vec<u8> = pixels.iter().flat_map(|p| straight(p).map(|v| quantize(v, max) as u8)).collect();
-                enc.write_image(&buf, width, height, image::ExtendedColorType::Rgba8).map_err(|e| e.to_string())
+                let buf: Vec<u8> = pixels
+                    .iter()
+                    .flat_map(|p| straight(p).map(|v| quantize(v, max) as u8))
+                    .collect();
+                enc.write_image(&buf, width, height, image::ExtendedColorType::Rgba8)
+                    .map_err(|e| e.to_string())
             }
             (false, false) => {
-                let buf: Vec<u8> = pixels.iter().flat_map(|p| [p[0], p[1], p[2]].map(|v| quantize(v, max) as u8)).collect();
-                enc.write_image(&buf, width, height, image::ExtendedColorType::Rgb8).map_err(|e| e.to_string())
+                let buf: Vec<u8> = pixels
+                    .iter()
+                    .flat_map(|p| [p[0], p[1], p[2]].map(|v| quantize(v, max) as u8))
+                    .collect();
+                enc.write_image(&buf, width, height, image::ExtendedColorType::Rgb8)
+                    .map_err(|e| e.to_string())
             }
         }
     })
 }
 
 /// Linear float RGBA OpenEXR (the pixels as given, no colour management).
-pub fn write_exr(path: &Path, width: u32, height: u32, pixels: &[[f32; 4]]) -> Result<(), ColorError> {
+pub fn write_exr(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[[f32; 4]],
+) -> Result<(), ColorError> {
     check(path, width, height, pixels.len())?;
     let buf: Vec<f32> = pixels.iter().flatten().copied().collect();
-    let img: ImageBuffer<Rgba<f32>, Vec<f32>> = ImageBuffer::from_raw(width, height, buf).ok_or_else(|| werr(path, "pixel buffer size mismatch"))?;
+    let img: ImageBuffer<Rgba<f32>, Vec<f32>> = ImageBuffer::from_raw(width, height, buf)
+        .ok_or_else(|| werr(path, "pixel buffer size mismatch"))?;
     atomic(path, |w| {
         let enc = image::codecs::openexr::OpenExrEncoder::new(w);
         img.write_with_encoder(enc).map_err(|e| e.to_string())

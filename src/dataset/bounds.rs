@@ -50,7 +50,9 @@ fn xform(m: &[[f64; 4]; 4], p: [f64; 3]) -> [f64; 3] {
 /// Inverse of an affine matrix (rotation/scale/shear plus translation).
 fn affine_inverse(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
     let a = |r: usize, c: usize| m[r][c];
-    let det = a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1)) - a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0)) + a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0));
+    let det = a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1))
+        - a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0))
+        + a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0));
     if det.abs() < 1e-300 {
         return None;
     }
@@ -75,7 +77,14 @@ fn colour(name: &str) -> [f32; 3] {
 }
 
 impl FrameRenderer for BoundsRenderer {
-    fn render(&self, scene: &Scene, frame: f64, _seed: u32, settings: &RenderSettings, _threads: usize) -> Result<RenderedFrame, String> {
+    fn render(
+        &self,
+        scene: &Scene,
+        frame: f64,
+        _seed: u32,
+        settings: &RenderSettings,
+        _threads: usize,
+    ) -> Result<RenderedFrame, String> {
         let (w, h) = resolution(scene, settings);
         let cam = super::generate::scene_camera(scene, frame, w, h)?;
         let world_to_cam = affine_inverse(&cam.matrix_world).ok_or("camera matrix is singular")?;
@@ -89,9 +98,18 @@ impl FrameRenderer for BoundsRenderer {
             if o.kind != "MESH" || o.hide_render {
                 continue;
             }
-            let Some(&(lo, hi)) = o.data.as_ref().and_then(|d| self.local.get(d)) else { continue };
+            let Some(&(lo, hi)) = o.data.as_ref().and_then(|d| self.local.get(d)) else {
+                continue;
+            };
             let m = ev.world_matrices[oi];
-            let corners: Vec<[f64; 3]> = (0..8).map(|c| xform(&m, [0, 1, 2].map(|k| if c >> k & 1 == 1 { hi[k] } else { lo[k] }))).collect();
+            let corners: Vec<[f64; 3]> = (0..8)
+                .map(|c| {
+                    xform(
+                        &m,
+                        [0, 1, 2].map(|k| if c >> k & 1 == 1 { hi[k] } else { lo[k] }),
+                    )
+                })
+                .collect();
             let mut wlo = [f64::INFINITY; 3];
             let mut whi = [f64::NEG_INFINITY; 3];
             for p in &corners {
@@ -148,6 +166,18 @@ impl FrameRenderer for BoundsRenderer {
                 }
             }
         }
-        Ok(RenderedFrame { width: w, height: h, color, ids: FrameIds { width: w, height: h, instance_id: ids, depth: Some(depth), normal: None, instances } })
+        Ok(RenderedFrame {
+            width: w,
+            height: h,
+            color,
+            ids: FrameIds {
+                width: w,
+                height: h,
+                instance_id: ids,
+                depth: Some(depth),
+                normal: None,
+                instances,
+            },
+        })
     }
 }

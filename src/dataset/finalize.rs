@@ -18,8 +18,16 @@ fn read_record(out: &Path, i: u64) -> Result<FrameRecord, String> {
 }
 
 /// Writes the dataset-wide files over frames `indices` (all must be finished).
-pub fn finalize(out: &Path, indices: &[u64], splits: &[String], class_names: &[String]) -> Result<(), String> {
-    let records = indices.iter().map(|&i| read_record(out, i)).collect::<Result<Vec<_>, _>>()?;
+pub fn finalize(
+    out: &Path,
+    indices: &[u64],
+    splits: &[String],
+    class_names: &[String],
+) -> Result<(), String> {
+    let records = indices
+        .iter()
+        .map(|&i| read_record(out, i))
+        .collect::<Result<Vec<_>, _>>()?;
     let mut jsonl = String::new();
     for r in &records {
         jsonl.push_str(&serde_json::to_string(r).unwrap());
@@ -28,14 +36,21 @@ pub fn finalize(out: &Path, indices: &[u64], splits: &[String], class_names: &[S
     write_atomic(&out.join("frames.jsonl"), jsonl.as_bytes())?;
     for s in splits {
         let c = coco::instances(&records, s, class_names, "blendsynth generate");
-        write_atomic(&out.join("annotations").join(format!("instances_{s}.json")), serde_json::to_string(&c).unwrap().as_bytes())?;
+        write_atomic(
+            &out.join("annotations").join(format!("instances_{s}.json")),
+            serde_json::to_string(&c).unwrap().as_bytes(),
+        )?;
     }
-    write_atomic(&out.join("data.yaml"), yolo::data_yaml(splits, class_names).as_bytes())
+    write_atomic(
+        &out.join("data.yaml"),
+        yolo::data_yaml(splits, class_names).as_bytes(),
+    )
 }
 
 fn read_manifest(dir: &Path) -> Result<Value, String> {
     let p = dir.join("manifest.json");
-    let b = std::fs::read(&p).map_err(|e| format!("{}: {e} (not a blendsynth dataset?)", p.display()))?;
+    let b = std::fs::read(&p)
+        .map_err(|e| format!("{}: {e} (not a blendsynth dataset?)", p.display()))?;
     serde_json::from_slice(&b).map_err(|e| format!("{}: {e}", p.display()))
 }
 
@@ -51,15 +66,39 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<u64, String> {
         let mut m = read_manifest(s)?;
         m["shard"] = Value::Null;
         if m != manifest {
-            return Err(format!("{} was made with other settings than {} (scene, spec, seed, frames or split)", s.display(), shards[0].display()));
+            return Err(format!(
+                "{} was made with other settings than {} (scene, spec, seed, frames or split)",
+                s.display(),
+                shards[0].display()
+            ));
         }
     }
-    if out.join("manifest.json").exists() || out.exists() && std::fs::read_dir(out).map(|mut d| d.next().is_some()).unwrap_or(false) {
-        return Err(format!("{} is not empty; merge writes into a new folder", out.display()));
+    if out.join("manifest.json").exists()
+        || out.exists()
+            && std::fs::read_dir(out)
+                .map(|mut d| d.next().is_some())
+                .unwrap_or(false)
+    {
+        return Err(format!(
+            "{} is not empty; merge writes into a new folder",
+            out.display()
+        ));
     }
-    let frames = manifest["frames"].as_u64().ok_or("manifest has no frame count")?;
-    let splits: Vec<String> = manifest["split"].as_array().ok_or("manifest has no split")?.iter().filter_map(|s| s[0].as_str().map(String::from)).collect();
-    let classes: Vec<String> = manifest["classes"].as_array().ok_or("manifest has no classes")?.iter().filter_map(|s| s.as_str().map(String::from)).collect();
+    let frames = manifest["frames"]
+        .as_u64()
+        .ok_or("manifest has no frame count")?;
+    let splits: Vec<String> = manifest["split"]
+        .as_array()
+        .ok_or("manifest has no split")?
+        .iter()
+        .filter_map(|s| s[0].as_str().map(String::from))
+        .collect();
+    let classes: Vec<String> = manifest["classes"]
+        .as_array()
+        .ok_or("manifest has no classes")?
+        .iter()
+        .filter_map(|s| s.as_str().map(String::from))
+        .collect();
     let mut missing = Vec::new();
     for i in 0..frames {
         let Some(src) = shards.iter().find(|s| layout::record_path(s, i).exists()) else {
@@ -68,11 +107,26 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<u64, String> {
         };
         let rec = read_record(src, i)?;
         let files = [
-            (layout::image_path(src, &rec.split, i), layout::image_path(out, &rec.split, i)),
-            (layout::mask_path(src, &rec.split, i), layout::mask_path(out, &rec.split, i)),
-            (layout::depth_path(src, &rec.split, i), layout::depth_path(out, &rec.split, i)),
-            (layout::normal_path(src, &rec.split, i), layout::normal_path(out, &rec.split, i)),
-            (layout::label_path(src, &rec.split, i), layout::label_path(out, &rec.split, i)),
+            (
+                layout::image_path(src, &rec.split, i),
+                layout::image_path(out, &rec.split, i),
+            ),
+            (
+                layout::mask_path(src, &rec.split, i),
+                layout::mask_path(out, &rec.split, i),
+            ),
+            (
+                layout::depth_path(src, &rec.split, i),
+                layout::depth_path(out, &rec.split, i),
+            ),
+            (
+                layout::normal_path(src, &rec.split, i),
+                layout::normal_path(out, &rec.split, i),
+            ),
+            (
+                layout::label_path(src, &rec.split, i),
+                layout::label_path(out, &rec.split, i),
+            ),
             (layout::record_path(src, i), layout::record_path(out, i)),
         ];
         for (k, (a, b)) in files.into_iter().enumerate() {
@@ -89,7 +143,10 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<u64, String> {
         let shown: Vec<String> = missing.iter().take(10).map(|i| i.to_string()).collect();
         return Err(format!("{} of {frames} frames are in none of the shards (first: {}); finish them with generate --resume", missing.len(), shown.join(", ")));
     }
-    write_atomic(&out.join("manifest.json"), format!("{}\n", serde_json::to_string_pretty(&manifest).unwrap()).as_bytes())?;
+    write_atomic(
+        &out.join("manifest.json"),
+        format!("{}\n", serde_json::to_string_pretty(&manifest).unwrap()).as_bytes(),
+    )?;
     let all: Vec<u64> = (0..frames).collect();
     finalize(out, &all, &splits, &classes)?;
     Ok(frames)

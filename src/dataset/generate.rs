@@ -63,12 +63,23 @@ impl Default for GenerateOptions {
 pub fn parse_split(s: &str) -> Result<Vec<(String, f64)>, String> {
     let mut out = Vec::new();
     for part in s.split(',') {
-        let (name, frac) = part.split_once('=').ok_or_else(|| format!("split {part:?} is not NAME=FRACTION"))?;
+        let (name, frac) = part
+            .split_once('=')
+            .ok_or_else(|| format!("split {part:?} is not NAME=FRACTION"))?;
         let name = name.trim();
-        if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-') {
-            return Err(format!("split name {name:?} must be letters, digits, '_' or '-'"));
+        if name.is_empty()
+            || !name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+        {
+            return Err(format!(
+                "split name {name:?} must be letters, digits, '_' or '-'"
+            ));
         }
-        let f: f64 = frac.trim().parse().map_err(|_| format!("split {name}: {frac:?} is not a number"))?;
+        let f: f64 = frac
+            .trim()
+            .parse()
+            .map_err(|_| format!("split {name}: {frac:?} is not a number"))?;
         if !(0.0..=1.0).contains(&f) {
             return Err(format!("split {name}: {f} is not within [0, 1]"));
         }
@@ -86,8 +97,13 @@ pub fn parse_split(s: &str) -> Result<Vec<(String, f64)>, String> {
 
 /// Parses `I/N` (0-based I).
 pub fn parse_shard(s: &str) -> Result<(u64, u64), String> {
-    let (i, n) = s.split_once('/').ok_or_else(|| format!("shard {s:?} is not I/N"))?;
-    let (i, n): (u64, u64) = (i.trim().parse().map_err(|_| format!("shard index {i:?}"))?, n.trim().parse().map_err(|_| format!("shard count {n:?}"))?);
+    let (i, n) = s
+        .split_once('/')
+        .ok_or_else(|| format!("shard {s:?} is not I/N"))?;
+    let (i, n): (u64, u64) = (
+        i.trim().parse().map_err(|_| format!("shard index {i:?}"))?,
+        n.trim().parse().map_err(|_| format!("shard count {n:?}"))?,
+    );
     if n == 0 || i >= n {
         return Err(format!("shard {i}/{n}: need 0 <= I < N (I is 0-based)"));
     }
@@ -156,7 +172,13 @@ pub struct Summary {
 
 /// Renders the frames of this shard that are not finished, then writes the COCO, YOLO
 /// and JSONL files over the finished frames.
-pub fn generate(scene: &Scene, spec: &Spec, renderer: &dyn FrameRenderer, out: &Path, opts: &GenerateOptions) -> Result<Summary, String> {
+pub fn generate(
+    scene: &Scene,
+    spec: &Spec,
+    renderer: &dyn FrameRenderer,
+    out: &Path,
+    opts: &GenerateOptions,
+) -> Result<Summary, String> {
     let start = Instant::now();
     for w in spec.validate(scene).map_err(|e| e.to_string())? {
         eprintln!("warning: {w}");
@@ -165,34 +187,67 @@ pub fn generate(scene: &Scene, spec: &Spec, renderer: &dyn FrameRenderer, out: &
     let man = manifest(scene, spec, opts, &classes);
     let man_path = out.join("manifest.json");
     if man_path.exists() {
-        let old: Value = serde_json::from_slice(&std::fs::read(&man_path).map_err(|e| format!("{}: {e}", man_path.display()))?)
-            .map_err(|e| format!("{}: {e}", man_path.display()))?;
+        let old: Value = serde_json::from_slice(
+            &std::fs::read(&man_path).map_err(|e| format!("{}: {e}", man_path.display()))?,
+        )
+        .map_err(|e| format!("{}: {e}", man_path.display()))?;
         if !opts.resume {
-            return Err(format!("{} already holds a dataset; pass --resume to finish it, or choose another folder", out.display()));
+            return Err(format!(
+                "{} already holds a dataset; pass --resume to finish it, or choose another folder",
+                out.display()
+            ));
         }
         if old != man {
             return Err(format!("{}: made with other settings (scene, spec, seed, frames, split or shard); --resume needs the same ones", man_path.display()));
         }
         layout::remove_partials(out).map_err(|e| format!("{}: {e}", out.display()))?;
     } else {
-        if out.exists() && std::fs::read_dir(out).map(|mut d| d.next().is_some()).unwrap_or(false) {
-            return Err(format!("{} exists and is not a blendsynth dataset; choose an empty or new folder", out.display()));
+        if out.exists()
+            && std::fs::read_dir(out)
+                .map(|mut d| d.next().is_some())
+                .unwrap_or(false)
+        {
+            return Err(format!(
+                "{} exists and is not a blendsynth dataset; choose an empty or new folder",
+                out.display()
+            ));
         }
-        write_atomic(&man_path, format!("{}\n", serde_json::to_string_pretty(&man).unwrap()).as_bytes())?;
+        write_atomic(
+            &man_path,
+            format!("{}\n", serde_json::to_string_pretty(&man).unwrap()).as_bytes(),
+        )?;
     }
     let splits = assign_splits(opts.frames, opts.seed, &opts.split);
-    let mine: Vec<u64> = (0..opts.frames).filter(|i| i % opts.shard.1 == opts.shard.0).collect();
-    let todo: Vec<u64> = mine.iter().copied().filter(|&i| !layout::record_path(out, i).exists()).collect();
+    let mine: Vec<u64> = (0..opts.frames)
+        .filter(|i| i % opts.shard.1 == opts.shard.0)
+        .collect();
+    let todo: Vec<u64> = mine
+        .iter()
+        .copied()
+        .filter(|&i| !layout::record_path(out, i).exists())
+        .collect();
     let skipped = (mine.len() - todo.len()) as u64;
 
     let scene_json = serde_json::to_value(&scene.file).map_err(|e| e.to_string())?;
-    let ctx = FrameContext { scene, scene_json: &scene_json, spec, renderer, classes: &classes, out, opts, splits: &splits, bounds: Mutex::new(std::collections::HashMap::new()) };
+    let ctx = FrameContext {
+        scene,
+        scene_json: &scene_json,
+        spec,
+        renderer,
+        classes: &classes,
+        out,
+        opts,
+        splits: &splits,
+        bounds: Mutex::new(std::collections::HashMap::new()),
+    };
 
     let bar = if opts.progress {
         let b = indicatif::ProgressBar::new(todo.len() as u64);
         b.set_style(
-            indicatif::ProgressStyle::with_template("{spinner} frames {pos}/{len} [{elapsed_precise} < {eta_precise}] {per_sec} {msg}")
-                .unwrap(),
+            indicatif::ProgressStyle::with_template(
+                "{spinner} frames {pos}/{len} [{elapsed_precise} < {eta_precise}] {per_sec} {msg}",
+            )
+            .unwrap(),
         );
         b
     } else {
@@ -225,11 +280,19 @@ pub fn generate(scene: &Scene, spec: &Spec, renderer: &dyn FrameRenderer, out: &
     });
     bar.finish_and_clear();
     if let Some((i, e)) = first_error.into_inner().unwrap() {
-        return Err(format!("frame {i}: {e} (finished frames are kept; rerun with --resume)"));
+        return Err(format!(
+            "frame {i}: {e} (finished frames are kept; rerun with --resume)"
+        ));
     }
     let names: Vec<String> = opts.split.iter().map(|(n, _)| n.clone()).collect();
     finalize::finalize(out, &mine, &names, &classes.names)?;
-    Ok(Summary { rendered: todo.len() as u64, skipped, seconds: start.elapsed().as_secs_f64(), out: out.to_path_buf(), complete: true })
+    Ok(Summary {
+        rendered: todo.len() as u64,
+        skipped,
+        seconds: start.elapsed().as_secs_f64(),
+        out: out.to_path_buf(),
+        complete: true,
+    })
 }
 
 struct FrameContext<'a> {
@@ -263,33 +326,84 @@ impl FrameContext<'_> {
     fn frame(&self, i: u64) -> Result<(), String> {
         let opts = self.opts;
         let split = &opts.split[self.splits[i as usize] as usize].0;
-        let fv = self.spec.frame_values(self.scene_json, self.scene.file.scene.frame_current as i64, opts.seed, i).map_err(|e| e.to_string())?;
-        let scene = self.scene.with_overrides(&fv.overrides).map_err(|e| e.to_string())?;
-        let r = self.renderer.render(&scene, fv.frame as f64, fv.render_seed, &self.spec.render, opts.threads_per_frame)?;
-        if r.color.len() != (r.width * r.height) as usize || r.ids.width != r.width || r.ids.height != r.height {
-            return Err(format!("renderer returned {}x{} with {} pixels and {}x{} ids", r.width, r.height, r.color.len(), r.ids.width, r.ids.height));
+        let fv = self
+            .spec
+            .frame_values(
+                self.scene_json,
+                self.scene.file.scene.frame_current as i64,
+                opts.seed,
+                i,
+            )
+            .map_err(|e| e.to_string())?;
+        let scene = self
+            .scene
+            .with_overrides(&fv.overrides)
+            .map_err(|e| e.to_string())?;
+        let r = self.renderer.render(
+            &scene,
+            fv.frame as f64,
+            fv.render_seed,
+            &self.spec.render,
+            opts.threads_per_frame,
+        )?;
+        if r.color.len() != (r.width * r.height) as usize
+            || r.ids.width != r.width
+            || r.ids.height != r.height
+        {
+            return Err(format!(
+                "renderer returned {}x{} with {} pixels and {}x{} ids",
+                r.width,
+                r.height,
+                r.color.len(),
+                r.ids.width,
+                r.ids.height
+            ));
         }
         let labels = extract(&r.ids, self.classes, self.spec.labels.min_pixels)?;
         let camera = scene_camera(&scene, fv.frame as f64, r.width, r.height)?;
-        let anns = annotations(&r.ids, &labels, &self.classes.names, &camera, self.spec.labels.mm_per_unit, &|o| self.local_bounds(o));
+        let anns = annotations(
+            &r.ids,
+            &labels,
+            &self.classes.names,
+            &camera,
+            self.spec.labels.mm_per_unit,
+            &|o| self.local_bounds(o),
+        );
 
         let hook = |p: &Path| opts.after_write.map_or(Ok(()), |h| h(i, p));
         let img = layout::image_path(self.out, split, i);
-        write_atomic(&img, &layout::png_bytes(r.width, r.height, 3, &layout::to_rgb8(&r.color))?)?;
+        write_atomic(
+            &img,
+            &layout::png_bytes(r.width, r.height, 3, &layout::to_rgb8(&r.color))?,
+        )?;
         hook(&img)?;
         let mask = layout::mask_path(self.out, split, i);
-        write_atomic(&mask, &layout::png_bytes(r.width, r.height, 1, &semantic(&r.ids, &labels))?)?;
+        write_atomic(
+            &mask,
+            &layout::png_bytes(r.width, r.height, 1, &semantic(&r.ids, &labels))?,
+        )?;
         hook(&mask)?;
         let labels_spec = &self.spec.labels;
         if labels_spec.depth {
-            let d = r.ids.depth.as_ref().ok_or("the spec asks for depth but the renderer gave none")?;
-            let mm: Vec<u16> = d.iter().map(|&z| crate::label::passes::depth_mm(z, labels_spec.mm_per_unit)).collect();
+            let d = r
+                .ids
+                .depth
+                .as_ref()
+                .ok_or("the spec asks for depth but the renderer gave none")?;
+            let mm: Vec<u16> = d
+                .iter()
+                .map(|&z| crate::label::passes::depth_mm(z, labels_spec.mm_per_unit))
+                .collect();
             let p = layout::depth_path(self.out, split, i);
             write_atomic(&p, &layout::png16_bytes(r.width, r.height, &mm)?)?;
             hook(&p)?;
         }
         if labels_spec.normals {
-            let n = r.ids.normal.as_ref().ok_or("the spec asks for normals but the renderer gave none")?;
+            let n = r
+                .ids
+                .normal
+                .as_ref()
+                .ok_or("the spec asks for normals but the renderer gave none")?;
             let p = layout::normal_path(self.out, split, i);
             write_atomic(&p, &layout::exr_rgb_bytes(r.width, r.height, n)?)?;
             hook(&p)?;
@@ -306,25 +420,58 @@ impl FrameContext<'_> {
             frame: fv.frame,
             seed: opts.seed,
             render_seed: fv.render_seed,
-            values: fv.overrides.iter().map(|o| (o.path.clone(), o.value.clone())).collect(),
+            values: fv
+                .overrides
+                .iter()
+                .map(|o| (o.path.clone(), o.value.clone()))
+                .collect(),
             drawn: fv.drawn.iter().cloned().collect(),
             camera,
             annotations: anns,
         };
         let rec = layout::record_path(self.out, i);
-        write_atomic(&rec, format!("{}\n", serde_json::to_string(&record).unwrap()).as_bytes())?;
+        write_atomic(
+            &rec,
+            format!("{}\n", serde_json::to_string(&record).unwrap()).as_bytes(),
+        )?;
         hook(&rec)
     }
 }
 
 /// The scene camera's intrinsics and pose at `frame` (animation and constraints
 /// evaluated; overrides already in `scene`).
-pub fn scene_camera(scene: &Scene, frame: f64, width: u32, height: u32) -> Result<CameraInfo, String> {
-    let name = scene.file.scene.camera.as_deref().ok_or("the scene has no camera")?;
-    let idx = scene.file.objects.iter().position(|o| o.name == name).ok_or_else(|| format!("scene camera {name:?} is not an object"))?;
+pub fn scene_camera(
+    scene: &Scene,
+    frame: f64,
+    width: u32,
+    height: u32,
+) -> Result<CameraInfo, String> {
+    let name = scene
+        .file
+        .scene
+        .camera
+        .as_deref()
+        .ok_or("the scene has no camera")?;
+    let idx = scene
+        .file
+        .objects
+        .iter()
+        .position(|o| o.name == name)
+        .ok_or_else(|| format!("scene camera {name:?} is not an object"))?;
     let ev = crate::anim::evaluate_scene(scene, frame).map_err(|e| e.to_string())?;
     let obj = &ev.data.objects[idx];
     let data = obj.data.as_deref().unwrap_or(name);
-    let cam = ev.data.cameras.iter().find(|c| c.name == data).ok_or_else(|| format!("camera data {data:?} of {name:?} not found"))?;
-    Ok(camera_info(name, &cam.properties, ev.world_matrices[idx], width, height))
+    let cam = ev
+        .data
+        .cameras
+        .iter()
+        .find(|c| c.name == data)
+        .ok_or_else(|| format!("camera data {data:?} of {name:?} not found"))?;
+    Ok(camera_info(
+        name,
+        &cam.properties,
+        ev.world_matrices[idx],
+        width,
+        height,
+    ))
 }

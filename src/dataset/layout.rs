@@ -23,34 +23,51 @@ pub fn frame_name(index: u64) -> String {
     format!("{index:09}")
 }
 pub fn image_path(out: &Path, split: &str, index: u64) -> PathBuf {
-    out.join("images").join(split).join(format!("{}.png", frame_name(index)))
+    out.join("images")
+        .join(split)
+        .join(format!("{}.png", frame_name(index)))
 }
 pub fn mask_path(out: &Path, split: &str, index: u64) -> PathBuf {
-    out.join("masks").join(split).join(format!("{}.png", frame_name(index)))
+    out.join("masks")
+        .join(split)
+        .join(format!("{}.png", frame_name(index)))
 }
 pub fn label_path(out: &Path, split: &str, index: u64) -> PathBuf {
-    out.join("labels").join(split).join(format!("{}.txt", frame_name(index)))
+    out.join("labels")
+        .join(split)
+        .join(format!("{}.txt", frame_name(index)))
 }
 pub fn depth_path(out: &Path, split: &str, index: u64) -> PathBuf {
-    out.join("depth").join(split).join(format!("{}.png", frame_name(index)))
+    out.join("depth")
+        .join(split)
+        .join(format!("{}.png", frame_name(index)))
 }
 pub fn normal_path(out: &Path, split: &str, index: u64) -> PathBuf {
-    out.join("normals").join(split).join(format!("{}.exr", frame_name(index)))
+    out.join("normals")
+        .join(split)
+        .join(format!("{}.exr", frame_name(index)))
 }
 pub fn record_path(out: &Path, index: u64) -> PathBuf {
-    out.join("frames").join(format!("{}.json", frame_name(index)))
+    out.join("frames")
+        .join(format!("{}.json", frame_name(index)))
 }
 
 /// Writes `bytes` to `path` atomically (temp file beside it, fsync, rename).
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
-    let dir = path.parent().ok_or_else(|| format!("{}: no parent folder", path.display()))?;
+    let dir = path
+        .parent()
+        .ok_or_else(|| format!("{}: no parent folder", path.display()))?;
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
     let name = path.file_name().unwrap().to_string_lossy();
     let tmp = dir.join(format!(".{name}.partial"));
-    let mut f = std::fs::File::create(&tmp).map_err(|e| format!("{}: cannot write: {e}", tmp.display()))?;
-    f.write_all(bytes).and_then(|_| f.sync_all()).map_err(|e| format!("{}: cannot write: {e}", tmp.display()))?;
+    let mut f =
+        std::fs::File::create(&tmp).map_err(|e| format!("{}: cannot write: {e}", tmp.display()))?;
+    f.write_all(bytes)
+        .and_then(|_| f.sync_all())
+        .map_err(|e| format!("{}: cannot write: {e}", tmp.display()))?;
     drop(f);
-    std::fs::rename(&tmp, path).map_err(|e| format!("{}: cannot rename into place: {e}", path.display()))
+    std::fs::rename(&tmp, path)
+        .map_err(|e| format!("{}: cannot rename into place: {e}", path.display()))
 }
 
 /// Deletes `.partial` leftovers of a killed run.
@@ -64,7 +81,10 @@ pub fn remove_partials(dir: &Path) -> std::io::Result<usize> {
         let p = e.path();
         if e.file_type()?.is_dir() {
             n += remove_partials(&p)?;
-        } else if p.file_name().is_some_and(|f| f.to_string_lossy().ends_with(".partial")) {
+        } else if p
+            .file_name()
+            .is_some_and(|f| f.to_string_lossy().ends_with(".partial"))
+        {
             std::fs::remove_file(&p)?;
             n += 1;
         }
@@ -82,7 +102,9 @@ pub fn png_bytes(width: u32, height: u32, channels: u8, data: &[u8]) -> Result<V
         _ => return Err(format!("{channels} channels")),
     };
     let mut out = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut out).write_image(data, width, height, kind).map_err(|e| format!("PNG encode: {e}"))?;
+    image::codecs::png::PngEncoder::new(&mut out)
+        .write_image(data, width, height, kind)
+        .map_err(|e| format!("PNG encode: {e}"))?;
     Ok(out)
 }
 
@@ -92,21 +114,31 @@ pub fn png16_bytes(width: u32, height: u32, data: &[u16]) -> Result<Vec<u8>, Str
     // The encoder takes native-endian samples (it writes PNG big-endian itself).
     let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_ne_bytes()).collect();
     let mut out = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut out).write_image(&bytes, width, height, image::ExtendedColorType::L16).map_err(|e| format!("PNG encode: {e}"))?;
+    image::codecs::png::PngEncoder::new(&mut out)
+        .write_image(&bytes, width, height, image::ExtendedColorType::L16)
+        .map_err(|e| format!("PNG encode: {e}"))?;
     Ok(out)
 }
 
 /// Float RGB OpenEXR bytes.
 pub fn exr_rgb_bytes(width: u32, height: u32, data: &[[f32; 3]]) -> Result<Vec<u8>, String> {
     use image::ImageEncoder;
-    let bytes: Vec<u8> = data.iter().flat_map(|p| p.iter().flat_map(|v| v.to_ne_bytes())).collect();
+    let bytes: Vec<u8> = data
+        .iter()
+        .flat_map(|p| p.iter().flat_map(|v| v.to_ne_bytes()))
+        .collect();
     let mut out = std::io::Cursor::new(Vec::new());
-    image::codecs::openexr::OpenExrEncoder::new(&mut out).write_image(&bytes, width, height, image::ExtendedColorType::Rgb32F).map_err(|e| format!("EXR encode: {e}"))?;
+    image::codecs::openexr::OpenExrEncoder::new(&mut out)
+        .write_image(&bytes, width, height, image::ExtendedColorType::Rgb32F)
+        .map_err(|e| format!("EXR encode: {e}"))?;
     Ok(out.into_inner())
 }
 
 /// Display-referred [0, 1] RGBA to 8-bit RGB, rounded.
 pub fn to_rgb8(color: &[[f32; 4]]) -> Vec<u8> {
     let q = |v: f32| (v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
-    color.iter().flat_map(|c| [q(c[0]), q(c[1]), q(c[2])]).collect()
+    color
+        .iter()
+        .flat_map(|c| [q(c[0]), q(c[1]), q(c[2])])
+        .collect()
 }

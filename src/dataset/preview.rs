@@ -7,14 +7,28 @@ use std::path::Path;
 use super::layout::{self, write_atomic};
 use crate::label::record::FrameRecord;
 
-const PALETTE: [[u8; 3]; 6] = [[255, 60, 60], [60, 220, 60], [60, 120, 255], [255, 200, 0], [255, 0, 255], [0, 230, 230]];
+const PALETTE: [[u8; 3]; 6] = [
+    [255, 60, 60],
+    [60, 220, 60],
+    [60, 120, 255],
+    [255, 200, 0],
+    [255, 0, 255],
+    [0, 230, 230],
+];
 const THUMB: u32 = 256;
 const GAP: u32 = 4;
 
 fn records(dir: &Path, count: usize) -> Result<Vec<FrameRecord>, String> {
     let jsonl = dir.join("frames.jsonl");
-    let text = std::fs::read_to_string(&jsonl).map_err(|e| format!("{}: {e} (not a finished dataset?)", jsonl.display()))?;
-    text.lines().take(count).enumerate().map(|(n, l)| serde_json::from_str(l).map_err(|e| format!("{} line {}: {e}", jsonl.display(), n + 1))).collect()
+    let text = std::fs::read_to_string(&jsonl)
+        .map_err(|e| format!("{}: {e} (not a finished dataset?)", jsonl.display()))?;
+    text.lines()
+        .take(count)
+        .enumerate()
+        .map(|(n, l)| {
+            serde_json::from_str(l).map_err(|e| format!("{} line {}: {e}", jsonl.display(), n + 1))
+        })
+        .collect()
 }
 
 /// Writes the sheet; returns how many frames it shows.
@@ -29,12 +43,22 @@ pub fn contact_sheet(dir: &Path, output: &Path, count: usize) -> Result<usize, S
     let mut sheet = vec![40u8; (sw * sh * 3) as usize];
     for (n, r) in recs.iter().enumerate() {
         let img_path = dir.join(&r.image);
-        let img = image::open(&img_path).map_err(|e| format!("{}: {e}", img_path.display()))?.to_rgb8();
+        let img = image::open(&img_path)
+            .map_err(|e| format!("{}: {e}", img_path.display()))?
+            .to_rgb8();
         let mask_path = layout::mask_path(dir, &r.split, r.index);
-        let mask = image::open(&mask_path).map_err(|e| format!("{}: {e}", mask_path.display()))?.to_luma8();
+        let mask = image::open(&mask_path)
+            .map_err(|e| format!("{}: {e}", mask_path.display()))?
+            .to_luma8();
         let scale = THUMB as f64 / r.width.max(r.height) as f64;
-        let (tw, th) = (((r.width as f64) * scale) as u32, ((r.height as f64) * scale) as u32);
-        let (ox, oy) = (GAP + (n as u32 % cols) * (THUMB + GAP), GAP + (n as u32 / cols) * (THUMB + GAP));
+        let (tw, th) = (
+            ((r.width as f64) * scale) as u32,
+            ((r.height as f64) * scale) as u32,
+        );
+        let (ox, oy) = (
+            GAP + (n as u32 % cols) * (THUMB + GAP),
+            GAP + (n as u32 / cols) * (THUMB + GAP),
+        );
         let mut put = |x: u32, y: u32, c: [u8; 3]| {
             if x < tw && y < th {
                 let p = (((oy + y) * sw + ox + x) * 3) as usize;
@@ -43,7 +67,10 @@ pub fn contact_sheet(dir: &Path, output: &Path, count: usize) -> Result<usize, S
         };
         for y in 0..th {
             for x in 0..tw {
-                let (sx, sy) = (((x as f64 + 0.5) / scale) as u32, ((y as f64 + 0.5) / scale) as u32);
+                let (sx, sy) = (
+                    ((x as f64 + 0.5) / scale) as u32,
+                    ((y as f64 + 0.5) / scale) as u32,
+                );
                 let (sx, sy) = (sx.min(r.width - 1), sy.min(r.height - 1));
                 let mut c = img.get_pixel(sx, sy).0;
                 let m = mask.get_pixel(sx, sy).0[0];
@@ -59,8 +86,12 @@ pub fn contact_sheet(dir: &Path, output: &Path, count: usize) -> Result<usize, S
             let [bx, by, bw, bh] = a.bbox;
             let x0 = (bx as f64 * scale) as u32;
             let y0 = (by as f64 * scale) as u32;
-            let x1 = (((bx + bw) as f64 * scale) as u32).saturating_sub(1).max(x0);
-            let y1 = (((by + bh) as f64 * scale) as u32).saturating_sub(1).max(y0);
+            let x1 = (((bx + bw) as f64 * scale) as u32)
+                .saturating_sub(1)
+                .max(x0);
+            let y1 = (((by + bh) as f64 * scale) as u32)
+                .saturating_sub(1)
+                .max(y0);
             for x in x0..=x1 {
                 put(x, y0, t);
                 put(x, y1, t);

@@ -23,7 +23,14 @@ pub trait FrameRenderer: Sync {
     /// Renders `scene` at `frame` with Cycles seed `seed`. `settings` are the spec's
     /// (None: the scene's own). `threads` is how many threads this frame may use; the
     /// result must not depend on it.
-    fn render(&self, scene: &Scene, frame: f64, seed: u32, settings: &RenderSettings, threads: usize) -> Result<RenderedFrame, String>;
+    fn render(
+        &self,
+        scene: &Scene,
+        frame: f64,
+        seed: u32,
+        settings: &RenderSettings,
+        threads: usize,
+    ) -> Result<RenderedFrame, String>;
 }
 
 /// The output resolution: the spec's, else the scene's resolution x percentage / 100
@@ -35,7 +42,10 @@ pub fn resolution(scene: &Scene, settings: &RenderSettings) -> (u32, u32) {
     let r = &scene.file.scene.render;
     let g = |k: &str, d: i64| r.get(k).and_then(|v| v.as_i64()).unwrap_or(d);
     let pct = g("resolution_percentage", 100);
-    (((g("resolution_x", 1920) * pct) / 100).max(1) as u32, ((g("resolution_y", 1080) * pct) / 100).max(1) as u32)
+    (
+        ((g("resolution_x", 1920) * pct) / 100).max(1) as u32,
+        ((g("resolution_y", 1080) * pct) / 100).max(1) as u32,
+    )
 }
 
 /// The path tracer as a `FrameRenderer`: render, denoise when the spec or the scene asks
@@ -45,7 +55,14 @@ struct PathTracer {
 }
 
 impl FrameRenderer for PathTracer {
-    fn render(&self, scene: &Scene, frame: f64, seed: u32, s: &RenderSettings, threads: usize) -> Result<RenderedFrame, String> {
+    fn render(
+        &self,
+        scene: &Scene,
+        frame: f64,
+        seed: u32,
+        s: &RenderSettings,
+        threads: usize,
+    ) -> Result<RenderedFrame, String> {
         let opts = crate::render::RenderOptions {
             frame: Some(frame),
             samples: s.samples,
@@ -56,9 +73,12 @@ impl FrameRenderer for PathTracer {
             progress: false,
         };
         let mut out = crate::render::render(scene, &opts).map_err(|e| e.to_string())?;
-        if s.denoise.unwrap_or_else(|| crate::denoise::scene_wants_denoising(scene)) {
+        if s.denoise
+            .unwrap_or_else(|| crate::denoise::scene_wants_denoising(scene))
+        {
             if let Some(d) = &self.denoiser {
-                crate::denoise::denoise_render(d, scene, frame, &mut out).map_err(|e| format!("denoising: {e}"))?;
+                crate::denoise::denoise_render(d, scene, frame, &mut out)
+                    .map_err(|e| format!("denoising: {e}"))?;
             }
         }
         crate::color::to_display(scene, &mut out.color).map_err(|e| e.to_string())?;
@@ -66,13 +86,25 @@ impl FrameRenderer for PathTracer {
         let instances = p
             .instances
             .into_iter()
-            .map(|i| crate::label::Instance { object: i.object, instance_index: i.instance_index, world_bounds: i.world_bounds, world_transform: i.world_transform })
+            .map(|i| crate::label::Instance {
+                object: i.object,
+                instance_index: i.instance_index,
+                world_bounds: i.world_bounds,
+                world_transform: i.world_transform,
+            })
             .collect();
         Ok(RenderedFrame {
             width: out.width,
             height: out.height,
             color: out.color,
-            ids: crate::label::FrameIds { width: out.width, height: out.height, instance_id: p.instance_id, depth: Some(p.depth), normal: Some(p.normal), instances },
+            ids: crate::label::FrameIds {
+                width: out.width,
+                height: out.height,
+                instance_id: p.instance_id,
+                depth: Some(p.depth),
+                normal: Some(p.normal),
+                instances,
+            },
         })
     }
 }

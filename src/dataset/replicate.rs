@@ -45,7 +45,9 @@ pub fn split() -> Vec<(String, f64)> {
 
 /// Where the built-in scenes and specs are.
 pub fn assets_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("assets").join(DATASET)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("assets")
+        .join(DATASET)
 }
 
 /// The scene and spec of one part: built-in, or a converted scene given by `--assets`.
@@ -56,7 +58,11 @@ pub fn scene_and_spec(part: Part, assets: Option<&Path>) -> Result<(Scene, Spec)
         None => root.join(part.name()),
     };
     let scene = Scene::load(&scene_dir).map_err(|e| e.to_string())?;
-    let spec_name = if scene.file.source_file == "colon_nodes.blend" { "colon_nodes.toml".to_string() } else { format!("{}.toml", part.name()) };
+    let spec_name = if scene.file.source_file == "colon_nodes.blend" {
+        "colon_nodes.toml".to_string()
+    } else {
+        format!("{}.toml", part.name())
+    };
     let spec = Spec::load(&root.join(spec_name)).map_err(|e| e.to_string())?;
     Ok((scene, spec))
 }

@@ -31,7 +31,10 @@ impl std::fmt::Display for SpecError {
 impl std::error::Error for SpecError {}
 
 fn err(at: impl Into<String>, message: impl Into<String>) -> SpecError {
-    SpecError { at: at.into(), message: message.into() }
+    SpecError {
+        at: at.into(),
+        message: message.into(),
+    }
 }
 
 /// Render settings the spec fixes for every frame (None: the scene's own).
@@ -70,14 +73,25 @@ pub enum Dist {
     /// Uniform integer in [min, max], both included.
     UniformInt { min: i64, max: i64 },
     /// Normal, optionally clamped to [lo, hi].
-    Normal { mean: f64, std: f64, clamp: Option<(f64, f64)> },
+    Normal {
+        mean: f64,
+        std: f64,
+        clamp: Option<(f64, f64)>,
+    },
     /// Log-uniform in [min, max), min > 0.
     LogUniform { min: f64, max: f64 },
     /// One of `values`, with optional weights.
-    Choice { values: Vec<Value>, weights: Option<Vec<f64>> },
+    Choice {
+        values: Vec<Value>,
+        weights: Option<Vec<f64>>,
+    },
     /// A colour from HSV components each uniform in its range, converted to RGB as
     /// Python's colorsys does (what the study's script did). Alpha is kept.
-    Hsv { h: (f64, f64), s: (f64, f64), v: (f64, f64) },
+    Hsv {
+        h: (f64, f64),
+        s: (f64, f64),
+        v: (f64, f64),
+    },
     /// A colour with each RGB channel uniform between `min` and `max`. Alpha is kept.
     Color { min: [f64; 3], max: [f64; 3] },
 }
@@ -118,15 +132,24 @@ pub struct FrameValues {
 
 impl Spec {
     pub fn load(path: &Path) -> Result<Spec, SpecError> {
-        let text = std::fs::read_to_string(path).map_err(|e| err(path.display().to_string(), format!("cannot read: {e}")))?;
-        Spec::parse(&text).map_err(|e| SpecError { at: format!("{}: {}", path.display(), e.at), message: e.message })
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| err(path.display().to_string(), format!("cannot read: {e}")))?;
+        Spec::parse(&text).map_err(|e| SpecError {
+            at: format!("{}: {}", path.display(), e.at),
+            message: e.message,
+        })
     }
 
     pub fn parse(text: &str) -> Result<Spec, SpecError> {
-        let root: toml::Table = toml::from_str(text).map_err(|e| err("TOML", e.to_string().replace('\n', " ")))?;
+        let root: toml::Table =
+            toml::from_str(text).map_err(|e| err("TOML", e.to_string().replace('\n', " ")))?;
         let mut spec = Spec {
             render: RenderSettings::default(),
-            frames: FrameSchedule { start: None, step: 1, modulo: None },
+            frames: FrameSchedule {
+                start: None,
+                step: 1,
+                modulo: None,
+            },
             labels: LabelSpec::default(),
             params: Vec::new(),
             source: text.to_string(),
@@ -137,12 +160,25 @@ impl Spec {
                 "frames" => spec.frames = parse_frames(v)?,
                 "labels" => spec.labels = LabelSpec::from_toml(v).map_err(|m| err("labels", m))?,
                 "param" => {
-                    let Toml::Array(items) = v else { return Err(err("param", "must be an array of tables ([[param]])")) };
+                    let Toml::Array(items) = v else {
+                        return Err(err("param", "must be an array of tables ([[param]])"));
+                    };
                     for (i, item) in items.iter().enumerate() {
-                        spec.params.push(parse_param(item).map_err(|e| if e.at.is_empty() { err(format!("param[{i}]"), e.message) } else { e })?);
+                        spec.params.push(parse_param(item).map_err(|e| {
+                            if e.at.is_empty() {
+                                err(format!("param[{i}]"), e.message)
+                            } else {
+                                e
+                            }
+                        })?);
                     }
                 }
-                other => return Err(err(other, "unknown section (expected render, frames, labels, param)")),
+                other => {
+                    return Err(err(
+                        other,
+                        "unknown section (expected render, frames, labels, param)",
+                    ))
+                }
             }
         }
         let mut seen = std::collections::HashSet::new();
@@ -155,19 +191,38 @@ impl Spec {
     }
 
     /// The values of dataset frame `index`: a pure function of (spec, scene, seed, index).
-    pub fn frame_values(&self, scene_json: &Value, scene_current: i64, seed: u64, index: u64) -> Result<FrameValues, SpecError> {
+    pub fn frame_values(
+        &self,
+        scene_json: &Value,
+        scene_current: i64,
+        seed: u64,
+        index: u64,
+    ) -> Result<FrameValues, SpecError> {
         let mut drawn = Vec::with_capacity(self.params.len());
         let mut overrides = Vec::with_capacity(self.params.len());
         for p in &self.params {
             let key = rng::key(&p.path);
             let v = sample(&p.dist, seed, index, key);
             let slot = lookup(scene_json, &p.path).map_err(|m| err(&p.path, m))?;
-            let applied = if p.offset { add_offset(slot, &v).map_err(|m| err(&p.path, m))? } else { fit_colour(slot, v.clone()) };
+            let applied = if p.offset {
+                add_offset(slot, &v).map_err(|m| err(&p.path, m))?
+            } else {
+                fit_colour(slot, v.clone())
+            };
             drawn.push((p.path.clone(), v));
-            overrides.push(Override { path: p.path.clone(), value: applied });
+            overrides.push(Override {
+                path: p.path.clone(),
+                value: applied,
+            });
         }
         let render_seed = rng::bits(seed, index, rng::key("#render_seed"), 0) as u32;
-        Ok(FrameValues { index, frame: self.frames.frame(scene_current, index), render_seed, drawn, overrides })
+        Ok(FrameValues {
+            index,
+            frame: self.frames.frame(scene_current, index),
+            render_seed,
+            drawn,
+            overrides,
+        })
     }
 
     /// Checks every parameter against the scene before anything renders: the path
@@ -182,12 +237,20 @@ impl Spec {
             let slot = *chain.last().unwrap();
             check_type(slot, &p.dist, p.offset).map_err(|m| err(&p.path, m))?;
             if let Some((lo, hi)) = range_of(&root, &p.path, &chain) {
-                let support = support(&p.dist).map_err(|m| err(&p.path, format!("{m}; the property's range is [{lo}, {hi}]")))?;
+                let support = support(&p.dist).map_err(|m| {
+                    err(
+                        &p.path,
+                        format!("{m}; the property's range is [{lo}, {hi}]"),
+                    )
+                })?;
                 for (i, (a, b)) in support.iter().enumerate() {
                     let base = if p.offset { component(slot, i) } else { 0.0 };
                     let (a, b) = (a + base, b + base);
                     if a < lo || b > hi {
-                        return Err(err(&p.path, format!("values [{a}, {b}] leave the property's range [{lo}, {hi}]")));
+                        return Err(err(
+                            &p.path,
+                            format!("values [{a}, {b}] leave the property's range [{lo}, {hi}]"),
+                        ));
                     }
                 }
             }
@@ -197,38 +260,83 @@ impl Spec {
         }
         // Values of the first frame must apply (types the typed scene enforces too).
         let fv = self.frame_values(&root, scene.file.scene.frame_current as i64, 0, 0)?;
-        scene.with_overrides(&fv.overrides).map_err(|e| err("param", e.to_string()))?;
+        scene
+            .with_overrides(&fv.overrides)
+            .map_err(|e| err("param", e.to_string()))?;
         Ok(warnings)
     }
 }
 
 fn parse_render(v: &Toml) -> Result<RenderSettings, SpecError> {
-    let t = v.as_table().ok_or_else(|| err("render", "must be a table"))?;
+    let t = v
+        .as_table()
+        .ok_or_else(|| err("render", "must be a table"))?;
     let mut r = RenderSettings::default();
     for (k, x) in t {
         let at = format!("render.{k}");
         match k.as_str() {
             "resolution" => {
-                let a = x.as_array().filter(|a| a.len() == 2).ok_or_else(|| err(&at, "must be [width, height]"))?;
-                let w = a[0].as_integer().filter(|w| *w > 0).ok_or_else(|| err(&at, "width must be a positive integer"))?;
-                let h = a[1].as_integer().filter(|h| *h > 0).ok_or_else(|| err(&at, "height must be a positive integer"))?;
+                let a = x
+                    .as_array()
+                    .filter(|a| a.len() == 2)
+                    .ok_or_else(|| err(&at, "must be [width, height]"))?;
+                let w = a[0]
+                    .as_integer()
+                    .filter(|w| *w > 0)
+                    .ok_or_else(|| err(&at, "width must be a positive integer"))?;
+                let h = a[1]
+                    .as_integer()
+                    .filter(|h| *h > 0)
+                    .ok_or_else(|| err(&at, "height must be a positive integer"))?;
                 r.resolution = Some((w as u32, h as u32));
             }
-            "samples" => r.samples = Some(x.as_integer().filter(|s| *s > 0).ok_or_else(|| err(&at, "must be a positive integer"))? as u32),
-            "threshold" => r.threshold = Some(num(x).filter(|t| *t >= 0.0).ok_or_else(|| err(&at, "must be a number >= 0"))? as f32),
-            "denoise" => r.denoise = Some(x.as_bool().ok_or_else(|| err(&at, "must be true or false"))?),
-            _ => return Err(err(&at, "unknown key (expected resolution, samples, threshold, denoise)")),
+            "samples" => {
+                r.samples = Some(
+                    x.as_integer()
+                        .filter(|s| *s > 0)
+                        .ok_or_else(|| err(&at, "must be a positive integer"))?
+                        as u32,
+                )
+            }
+            "threshold" => {
+                r.threshold = Some(
+                    num(x)
+                        .filter(|t| *t >= 0.0)
+                        .ok_or_else(|| err(&at, "must be a number >= 0"))?
+                        as f32,
+                )
+            }
+            "denoise" => {
+                r.denoise = Some(
+                    x.as_bool()
+                        .ok_or_else(|| err(&at, "must be true or false"))?,
+                )
+            }
+            _ => {
+                return Err(err(
+                    &at,
+                    "unknown key (expected resolution, samples, threshold, denoise)",
+                ))
+            }
         }
     }
     Ok(r)
 }
 
 fn parse_frames(v: &Toml) -> Result<FrameSchedule, SpecError> {
-    let t = v.as_table().ok_or_else(|| err("frames", "must be a table"))?;
-    let mut f = FrameSchedule { start: None, step: 1, modulo: None };
+    let t = v
+        .as_table()
+        .ok_or_else(|| err("frames", "must be a table"))?;
+    let mut f = FrameSchedule {
+        start: None,
+        step: 1,
+        modulo: None,
+    };
     for (k, x) in t {
         let at = format!("frames.{k}");
-        let i = x.as_integer().ok_or_else(|| err(&at, "must be an integer"))?;
+        let i = x
+            .as_integer()
+            .ok_or_else(|| err(&at, "must be an integer"))?;
         match k.as_str() {
             "start" => f.start = Some(i),
             "step" => f.step = i,
@@ -256,9 +364,15 @@ fn nums(v: &Toml) -> Option<Vec<f64>> {
 }
 
 fn pair(v: Option<&Toml>, what: &str) -> Result<(f64, f64), SpecError> {
-    let a = v.and_then(nums).filter(|a| a.len() == 2).ok_or_else(|| err("", format!("{what} must be [low, high]")))?;
+    let a = v
+        .and_then(nums)
+        .filter(|a| a.len() == 2)
+        .ok_or_else(|| err("", format!("{what} must be [low, high]")))?;
     if !(a[0].is_finite() && a[1].is_finite()) {
-        return Err(err("", format!("{what} must be finite numbers (got {}, {})", a[0], a[1])));
+        return Err(err(
+            "",
+            format!("{what} must be finite numbers (got {}, {})", a[0], a[1]),
+        ));
     }
     if a[0] > a[1] {
         return Err(err("", format!("{what}: low {} > high {}", a[0], a[1])));
@@ -273,20 +387,29 @@ fn toml_to_json(v: &Toml) -> Value {
         Toml::Float(f) => Value::from(*f),
         Toml::Boolean(b) => Value::Bool(*b),
         Toml::Array(a) => Value::Array(a.iter().map(toml_to_json).collect()),
-        Toml::Table(t) => Value::Object(t.iter().map(|(k, v)| (k.clone(), toml_to_json(v))).collect()),
+        Toml::Table(t) => Value::Object(
+            t.iter()
+                .map(|(k, v)| (k.clone(), toml_to_json(v)))
+                .collect(),
+        ),
         Toml::Datetime(d) => Value::String(d.to_string()),
     }
 }
 
 fn parse_param(v: &Toml) -> Result<Param, SpecError> {
     let t = v.as_table().ok_or_else(|| err("", "must be a table"))?;
-    let path = t.get("path").and_then(Toml::as_str).ok_or_else(|| err("", "missing path = \"...\""))?;
+    let path = t
+        .get("path")
+        .and_then(Toml::as_str)
+        .ok_or_else(|| err("", "missing path = \"...\""))?;
     let path = path.strip_prefix("bpy.data.").unwrap_or(path).to_string();
     parse(&path).map_err(|m| err(&path, m))?;
     let at = |m: String| err(&path, m);
     let offset = match t.get("offset") {
         None => false,
-        Some(x) => x.as_bool().ok_or_else(|| at("offset must be true or false".into()))?,
+        Some(x) => x
+            .as_bool()
+            .ok_or_else(|| at("offset must be true or false".into()))?,
     };
     let kind = t.get("dist").and_then(Toml::as_str).ok_or_else(|| at("missing dist = \"uniform\" | \"uniform_int\" | \"normal\" | \"log_uniform\" | \"choice\" | \"hsv\" | \"color\"".into()))?;
     let allowed: &[&str] = match kind {
@@ -298,26 +421,41 @@ fn parse_param(v: &Toml) -> Result<Param, SpecError> {
     };
     for k in t.keys() {
         if !["path", "offset", "dist"].contains(&k.as_str()) && !allowed.contains(&k.as_str()) {
-            return Err(at(format!("unknown key {k:?} for dist {kind:?} (expected {})", allowed.join(", "))));
+            return Err(at(format!(
+                "unknown key {k:?} for dist {kind:?} (expected {})",
+                allowed.join(", ")
+            )));
         }
     }
-    let get = |k: &str| t.get(k).ok_or_else(|| at(format!("dist {kind:?} needs {k}")));
+    let get = |k: &str| {
+        t.get(k)
+            .ok_or_else(|| at(format!("dist {kind:?} needs {k}")))
+    };
     let with_path = |e: SpecError| at(e.message);
     let dist = match kind {
         "uniform" => {
-            let min = nums(get("min")?).ok_or_else(|| at("min must be a number or a list of numbers".into()))?;
-            let max = nums(get("max")?).ok_or_else(|| at("max must be a number or a list of numbers".into()))?;
+            let min = nums(get("min")?)
+                .ok_or_else(|| at("min must be a number or a list of numbers".into()))?;
+            let max = nums(get("max")?)
+                .ok_or_else(|| at("max must be a number or a list of numbers".into()))?;
             if min.len() != max.len() || min.is_empty() {
                 return Err(at("min and max must have the same length".into()));
             }
             if let Some(i) = (0..min.len()).find(|&i| min[i] > max[i]) {
-                return Err(at(format!("min {} > max {} (component {i})", min[i], max[i])));
+                return Err(at(format!(
+                    "min {} > max {} (component {i})",
+                    min[i], max[i]
+                )));
             }
             Dist::Uniform { min, max }
         }
         "uniform_int" => {
-            let min = get("min")?.as_integer().ok_or_else(|| at("min must be an integer".into()))?;
-            let max = get("max")?.as_integer().ok_or_else(|| at("max must be an integer".into()))?;
+            let min = get("min")?
+                .as_integer()
+                .ok_or_else(|| at("min must be an integer".into()))?;
+            let max = get("max")?
+                .as_integer()
+                .ok_or_else(|| at("max must be an integer".into()))?;
             if min > max {
                 return Err(at(format!("min {min} > max {max}")));
             }
@@ -333,7 +471,9 @@ fn parse_param(v: &Toml) -> Result<Param, SpecError> {
         }
         "normal" => {
             let mean = num(get("mean")?).ok_or_else(|| at("mean must be a number".into()))?;
-            let std = num(get("std")?).filter(|s| *s >= 0.0).ok_or_else(|| at("std must be a number >= 0".into()))?;
+            let std = num(get("std")?)
+                .filter(|s| *s >= 0.0)
+                .ok_or_else(|| at("std must be a number >= 0".into()))?;
             let clamp = match t.get("clamp") {
                 None => None,
                 Some(c) => Some(pair(Some(c), "clamp").map_err(with_path)?),
@@ -341,15 +481,23 @@ fn parse_param(v: &Toml) -> Result<Param, SpecError> {
             Dist::Normal { mean, std, clamp }
         }
         "choice" => {
-            let values: Vec<Value> = get("values")?.as_array().ok_or_else(|| at("values must be a list".into()))?.iter().map(toml_to_json).collect();
+            let values: Vec<Value> = get("values")?
+                .as_array()
+                .ok_or_else(|| at("values must be a list".into()))?
+                .iter()
+                .map(toml_to_json)
+                .collect();
             if values.is_empty() {
                 return Err(at("values is empty".into()));
             }
             let weights = match t.get("weights") {
                 None => None,
                 Some(w) => {
-                    let w = nums(w).filter(|w| w.len() == values.len()).ok_or_else(|| at("weights must be a list as long as values".into()))?;
-                    if w.iter().any(|x| *x < 0.0 || !x.is_finite()) || w.iter().sum::<f64>() <= 0.0 {
+                    let w = nums(w)
+                        .filter(|w| w.len() == values.len())
+                        .ok_or_else(|| at("weights must be a list as long as values".into()))?;
+                    if w.iter().any(|x| *x < 0.0 || !x.is_finite()) || w.iter().sum::<f64>() <= 0.0
+                    {
                         return Err(at("weights must be >= 0 with a positive sum".into()));
                     }
                     Some(w)
@@ -357,10 +505,18 @@ fn parse_param(v: &Toml) -> Result<Param, SpecError> {
             };
             Dist::Choice { values, weights }
         }
-        "hsv" => Dist::Hsv { h: pair(t.get("h"), "h").map_err(with_path)?, s: pair(t.get("s"), "s").map_err(with_path)?, v: pair(t.get("v"), "v").map_err(with_path)? },
+        "hsv" => Dist::Hsv {
+            h: pair(t.get("h"), "h").map_err(with_path)?,
+            s: pair(t.get("s"), "s").map_err(with_path)?,
+            v: pair(t.get("v"), "v").map_err(with_path)?,
+        },
         "color" => {
             let three = |k: &str| -> Result<[f64; 3], SpecError> {
-                let a = t.get(k).and_then(nums).filter(|a| a.len() == 3).ok_or_else(|| at(format!("{k} must be [r, g, b]")))?;
+                let a = t
+                    .get(k)
+                    .and_then(nums)
+                    .filter(|a| a.len() == 3)
+                    .ok_or_else(|| at(format!("{k} must be [r, g, b]")))?;
                 Ok([a[0], a[1], a[2]])
             };
             let (min, max) = (three("min")?, three("max")?);
@@ -371,8 +527,15 @@ fn parse_param(v: &Toml) -> Result<Param, SpecError> {
         }
         _ => unreachable!("checked above"),
     };
-    if offset && matches!(dist, Dist::Choice { .. } | Dist::Hsv { .. } | Dist::Color { .. }) {
-        return Err(at(format!("offset = true needs a numeric distribution, not {kind:?}")));
+    if offset
+        && matches!(
+            dist,
+            Dist::Choice { .. } | Dist::Hsv { .. } | Dist::Color { .. }
+        )
+    {
+        return Err(at(format!(
+            "offset = true needs a numeric distribution, not {kind:?}"
+        )));
     }
     Ok(Param { path, offset, dist })
 }
@@ -386,10 +549,16 @@ pub fn sample(d: &Dist, seed: u64, frame: u64, key: u64) -> Value {
             if min.len() == 1 {
                 Value::from(lerp(min[0], max[0], u(0)))
             } else {
-                Value::from((0..min.len()).map(|k| lerp(min[k], max[k], u(k as u64))).collect::<Vec<f64>>())
+                Value::from(
+                    (0..min.len())
+                        .map(|k| lerp(min[k], max[k], u(k as u64)))
+                        .collect::<Vec<f64>>(),
+                )
             }
         }
-        Dist::UniformInt { min, max } => Value::from(rng::int_inclusive(seed, frame, key, 0, *min, *max)),
+        Dist::UniformInt { min, max } => {
+            Value::from(rng::int_inclusive(seed, frame, key, 0, *min, *max))
+        }
         Dist::Normal { mean, std, clamp } => {
             // Box-Muller; 1 - u keeps the logarithm's argument in (0, 1].
             let r = (-2.0 * (1.0 - u(0)).ln()).sqrt();
@@ -399,10 +568,14 @@ pub fn sample(d: &Dist, seed: u64, frame: u64, key: u64) -> Value {
                 None => x,
             })
         }
-        Dist::LogUniform { min, max } => Value::from((min.ln() + (max.ln() - min.ln()) * u(0)).exp()),
+        Dist::LogUniform { min, max } => {
+            Value::from((min.ln() + (max.ln() - min.ln()) * u(0)).exp())
+        }
         Dist::Choice { values, weights } => {
             let i = match weights {
-                None => rng::int_inclusive(seed, frame, key, 0, 0, values.len() as i64 - 1) as usize,
+                None => {
+                    rng::int_inclusive(seed, frame, key, 0, 0, values.len() as i64 - 1) as usize
+                }
                 Some(w) => {
                     let total: f64 = w.iter().sum();
                     let mut x = u(0) * total;
@@ -420,10 +593,18 @@ pub fn sample(d: &Dist, seed: u64, frame: u64, key: u64) -> Value {
             values[i].clone()
         }
         Dist::Hsv { h, s, v } => {
-            let rgb = hsv_to_rgb(lerp(h.0, h.1, u(0)), lerp(s.0, s.1, u(1)), lerp(v.0, v.1, u(2)));
+            let rgb = hsv_to_rgb(
+                lerp(h.0, h.1, u(0)),
+                lerp(s.0, s.1, u(1)),
+                lerp(v.0, v.1, u(2)),
+            );
             Value::from(rgb.to_vec())
         }
-        Dist::Color { min, max } => Value::from((0..3).map(|k| lerp(min[k], max[k], u(k as u64))).collect::<Vec<f64>>()),
+        Dist::Color { min, max } => Value::from(
+            (0..3)
+                .map(|k| lerp(min[k], max[k], u(k as u64)))
+                .collect::<Vec<f64>>(),
+        ),
     }
 }
 
@@ -459,7 +640,11 @@ fn fit_colour(slot: &Value, v: Value) -> Value {
 
 fn component(slot: &Value, i: usize) -> f64 {
     match slot {
-        Value::Array(a) => a.get(i).or(a.first()).and_then(Value::as_f64).unwrap_or(0.0),
+        Value::Array(a) => a
+            .get(i)
+            .or(a.first())
+            .and_then(Value::as_f64)
+            .unwrap_or(0.0),
         x => x.as_f64().unwrap_or(0.0),
     }
 }
@@ -475,8 +660,17 @@ fn add_offset(slot: &Value, off: &Value) -> Result<Value, String> {
                 Err(format!("cannot add {o} to the integer {b}"))
             }
         }
-        (Value::Array(b), Value::Number(_)) => Ok(Value::Array(b.iter().map(|x| add_offset(x, off)).collect::<Result<_, _>>()?)),
-        (Value::Array(b), Value::Array(o)) if b.len() == o.len() => Ok(Value::Array(b.iter().zip(o).map(|(x, y)| add_offset(x, y)).collect::<Result<_, _>>()?)),
+        (Value::Array(b), Value::Number(_)) => Ok(Value::Array(
+            b.iter()
+                .map(|x| add_offset(x, off))
+                .collect::<Result<_, _>>()?,
+        )),
+        (Value::Array(b), Value::Array(o)) if b.len() == o.len() => Ok(Value::Array(
+            b.iter()
+                .zip(o)
+                .map(|(x, y)| add_offset(x, y))
+                .collect::<Result<_, _>>()?,
+        )),
         (b, o) => Err(format!("cannot add offset {o} to {b}")),
     }
 }
@@ -489,21 +683,43 @@ pub fn lookup<'a>(root: &'a Value, path: &str) -> Result<&'a Value, String> {
 /// Read-only walk of a data path with the rules of `scene::overrides::set`, returning
 /// every value passed through (the last is the addressed one).
 fn walk<'a>(root: &'a Value, path: &str) -> Result<Vec<&'a Value>, String> {
-    const COLLECTIONS: &[&str] = &["objects", "meshes", "curves", "materials", "worlds", "node_groups", "cameras", "lights", "images"];
+    const COLLECTIONS: &[&str] = &[
+        "objects",
+        "meshes",
+        "curves",
+        "materials",
+        "worlds",
+        "node_groups",
+        "cameras",
+        "lights",
+        "images",
+    ];
     let tokens = parse(path)?;
     let mut it = tokens.iter();
     let mut chain = Vec::new();
     let first = match it.next() {
         Some(Token::Prop(c)) if c == "scenes" => {
-            let Some(Token::Key(name)) = it.next() else { return Err("expected scenes[\"NAME\"]".into()) };
+            let Some(Token::Key(name)) = it.next() else {
+                return Err("expected scenes[\"NAME\"]".into());
+            };
             let s = &root["scene"];
             if s["name"].as_str() != Some(name.as_str()) {
-                return Err(format!("no scene named {name:?} (the export holds {})", s["name"]));
+                return Err(format!(
+                    "no scene named {name:?} (the export holds {})",
+                    s["name"]
+                ));
             }
             s
         }
-        Some(Token::Prop(c)) if COLLECTIONS.contains(&c.as_str()) => root.get(c.as_str()).ok_or_else(|| format!("the export has no {c}"))?,
-        Some(t) => return Err(format!("{t:?} is not a bpy.data collection this format holds ({})", COLLECTIONS.join(", "))),
+        Some(Token::Prop(c)) if COLLECTIONS.contains(&c.as_str()) => root
+            .get(c.as_str())
+            .ok_or_else(|| format!("the export has no {c}"))?,
+        Some(t) => {
+            return Err(format!(
+                "{t:?} is not a bpy.data collection this format holds ({})",
+                COLLECTIONS.join(", ")
+            ))
+        }
         None => return Err("empty path".into()),
     };
     chain.push(first);
@@ -511,7 +727,9 @@ fn walk<'a>(root: &'a Value, path: &str) -> Result<Vec<&'a Value>, String> {
     for t in it {
         cur = match t {
             Token::Prop(p) => {
-                let map = cur.as_object().ok_or_else(|| format!("no property {p:?} (not a structure)"))?;
+                let map = cur
+                    .as_object()
+                    .ok_or_else(|| format!("no property {p:?} (not a structure)"))?;
                 map.get(p.as_str())
                     .or_else(|| map.get("properties").and_then(|x| x.get(p.as_str())))
                     .ok_or_else(|| format!("no property {p:?}"))?
@@ -520,7 +738,11 @@ fn walk<'a>(root: &'a Value, path: &str) -> Result<Vec<&'a Value>, String> {
                 Value::Array(items) => items
                     .iter()
                     .find(|x| x.get("identifier").and_then(Value::as_str) == Some(k.as_str()))
-                    .or_else(|| items.iter().find(|x| x.get("name").and_then(Value::as_str) == Some(k.as_str())))
+                    .or_else(|| {
+                        items
+                            .iter()
+                            .find(|x| x.get("name").and_then(Value::as_str) == Some(k.as_str()))
+                    })
                     .ok_or_else(|| format!("nothing named {k:?}"))?,
                 Value::Object(map) => ["inputs", "custom_properties"]
                     .iter()
@@ -528,7 +750,10 @@ fn walk<'a>(root: &'a Value, path: &str) -> Result<Vec<&'a Value>, String> {
                     .ok_or_else(|| format!("no input or custom property {k:?}"))?,
                 _ => return Err(format!("cannot look up [{k:?}] here")),
             },
-            Token::Index(i) => cur.as_array().and_then(|a| a.get(*i)).ok_or_else(|| format!("index {i} out of range"))?,
+            Token::Index(i) => cur
+                .as_array()
+                .and_then(|a| a.get(*i))
+                .ok_or_else(|| format!("index {i} out of range"))?,
         };
         chain.push(cur);
     }
@@ -585,18 +810,31 @@ fn support(d: &Dist) -> Result<Vec<(f64, f64)>, String> {
         Dist::Uniform { min, max } => min.iter().zip(max).map(|(a, b)| (*a, *b)).collect(),
         Dist::UniformInt { min, max } => vec![(*min as f64, *max as f64)],
         Dist::Normal { clamp: Some(c), .. } => vec![*c],
-        Dist::Normal { clamp: None, .. } => return Err("a normal distribution without clamp = [low, high] can leave the range".into()),
+        Dist::Normal { clamp: None, .. } => {
+            return Err(
+                "a normal distribution without clamp = [low, high] can leave the range".into(),
+            )
+        }
         Dist::LogUniform { min, max } => vec![(*min, *max)],
         Dist::Choice { values, .. } => {
-            let xs: Vec<f64> = values.iter().flat_map(|v| v.as_array().cloned().unwrap_or_else(|| vec![v.clone()])).filter_map(|v| v.as_f64()).collect();
+            let xs: Vec<f64> = values
+                .iter()
+                .flat_map(|v| v.as_array().cloned().unwrap_or_else(|| vec![v.clone()]))
+                .filter_map(|v| v.as_f64())
+                .collect();
             if xs.is_empty() {
                 return Ok(vec![]);
             }
-            vec![(xs.iter().cloned().fold(f64::INFINITY, f64::min), xs.iter().cloned().fold(f64::NEG_INFINITY, f64::max))]
+            vec![(
+                xs.iter().cloned().fold(f64::INFINITY, f64::min),
+                xs.iter().cloned().fold(f64::NEG_INFINITY, f64::max),
+            )]
         }
         Dist::Hsv { .. } => {
             // colorsys keeps RGB within [v * (1 - s), v].
-            let Dist::Hsv { s, v, .. } = d else { unreachable!() };
+            let Dist::Hsv { s, v, .. } = d else {
+                unreachable!()
+            };
             vec![(v.0 * (1.0 - s.1), v.1); 3]
         }
         Dist::Color { min, max } => (0..3).map(|k| (min[k], max[k])).collect(),
@@ -614,7 +852,10 @@ fn range_of(root: &Value, path: &str, chain: &[&Value]) -> Option<(f64, f64)> {
     let slot_parent = chain.len().checked_sub(2).map(|i| chain[i]);
     // An interface item itself (node_groups["G"].interface[i].default_value).
     if let Some(p) = slot_parent {
-        if let (Some(lo), Some(hi)) = (p.get("min_value").and_then(Value::as_f64), p.get("max_value").and_then(Value::as_f64)) {
+        if let (Some(lo), Some(hi)) = (
+            p.get("min_value").and_then(Value::as_f64),
+            p.get("max_value").and_then(Value::as_f64),
+        ) {
             return Some((lo, hi));
         }
     }
@@ -628,7 +869,10 @@ fn range_of(root: &Value, path: &str, chain: &[&Value]) -> Option<(f64, f64)> {
     if matches!(tokens.last(), Some(Token::Prop(p)) if p == "default_value") && chain.len() >= 4 {
         let socket = chain[chain.len() - 2];
         let node = chain[chain.len() - 4];
-        if let (Some(group), Some(id)) = (node.get("node_tree").and_then(Value::as_str), socket.get("identifier").and_then(Value::as_str)) {
+        if let (Some(group), Some(id)) = (
+            node.get("node_tree").and_then(Value::as_str),
+            socket.get("identifier").and_then(Value::as_str),
+        ) {
             if let Some(r) = interface_range(root, group, id) {
                 return Some(r);
             }
@@ -643,7 +887,16 @@ fn range_of(root: &Value, path: &str, chain: &[&Value]) -> Option<(f64, f64)> {
         Some(Token::Prop(r)) => r.as_str(),
         _ => return None,
     };
-    let props: Vec<&str> = tokens.iter().filter_map(|t| if let Token::Prop(p) = t { Some(p.as_str()) } else { None }).collect();
+    let props: Vec<&str> = tokens
+        .iter()
+        .filter_map(|t| {
+            if let Token::Prop(p) = t {
+                Some(p.as_str())
+            } else {
+                None
+            }
+        })
+        .collect();
     let table: Value = serde_json::from_str(RNA_RANGES).ok()?;
     for r in table["ranges"].as_array()? {
         let suffix: Vec<&str> = r["suffix"].as_str()?.split('.').collect();
@@ -656,9 +909,18 @@ fn range_of(root: &Value, path: &str, chain: &[&Value]) -> Option<(f64, f64)> {
 }
 
 fn interface_range(root: &Value, group: &str, identifier: &str) -> Option<(f64, f64)> {
-    let g = root["node_groups"].as_array()?.iter().find(|g| g["name"] == group)?;
-    let item = g["interface"].as_array()?.iter().find(|i| i["identifier"] == identifier)?;
-    Some((item.get("min_value")?.as_f64()?, item.get("max_value")?.as_f64()?))
+    let g = root["node_groups"]
+        .as_array()?
+        .iter()
+        .find(|g| g["name"] == group)?;
+    let item = g["interface"]
+        .as_array()?
+        .iter()
+        .find(|i| i["identifier"] == identifier)?;
+    Some((
+        item.get("min_value")?.as_f64()?,
+        item.get("max_value")?.as_f64()?,
+    ))
 }
 
 /// Whether an F-curve animates the property (its override would be replaced).

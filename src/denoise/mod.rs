@@ -46,7 +46,12 @@ pub struct DenoiseOptions {
 impl Default for DenoiseOptions {
     /// Cycles 4.5's defaults.
     fn default() -> Self {
-        DenoiseOptions { prefilter: Prefilter::Accurate, quality: Quality::High, use_albedo: true, use_normal: true }
+        DenoiseOptions {
+            prefilter: Prefilter::Accurate,
+            quality: Quality::High,
+            use_albedo: true,
+            use_normal: true,
+        }
     }
 }
 
@@ -76,12 +81,19 @@ impl DenoiseOptions {
 /// A world-space shading normal in the convention of Cycles' denoising normal pass:
 /// Cycles' camera space, which is Blender's camera frame with z flipped to point forward.
 /// `camera_matrix_world` is the camera object's world matrix (rows, translation in column 3).
-pub fn cycles_denoise_normal(world_normal: [f32; 3], camera_matrix_world: &[[f64; 4]; 4]) -> [f32; 3] {
+pub fn cycles_denoise_normal(
+    world_normal: [f32; 3],
+    camera_matrix_world: &[[f64; 4]; 4],
+) -> [f32; 3] {
     let m = camera_matrix_world;
     let axis = |c: usize| {
         let v = [m[0][c], m[1][c], m[2][c]];
         let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        if l > 0.0 { [v[0] / l, v[1] / l, v[2] / l] } else { v }
+        if l > 0.0 {
+            [v[0] / l, v[1] / l, v[2] / l]
+        } else {
+            v
+        }
     };
     let n = world_normal.map(|v| v as f64);
     let dot = |a: [f64; 3]| (a[0] * n[0] + a[1] * n[1] + a[2] * n[2]) as f32;
@@ -96,11 +108,19 @@ pub struct Denoiser {
 
 impl std::fmt::Debug for Denoiser {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Denoiser").field("path", &self.path).finish()
+        f.debug_struct("Denoiser")
+            .field("path", &self.path)
+            .finish()
     }
 }
 
-const LIB_NAMES: &[&str] = &["libOpenImageDenoise.so.2", "libOpenImageDenoise.so", "libOpenImageDenoise.2.dylib", "libOpenImageDenoise.dylib", "OpenImageDenoise.dll"];
+const LIB_NAMES: &[&str] = &[
+    "libOpenImageDenoise.so.2",
+    "libOpenImageDenoise.so",
+    "libOpenImageDenoise.2.dylib",
+    "libOpenImageDenoise.dylib",
+    "OpenImageDenoise.dll",
+];
 
 /// The library file in `dir`, if any.
 fn lib_in(dir: &Path) -> Option<PathBuf> {
@@ -135,7 +155,15 @@ fn site_packages(env: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
     for lib in ["lib", "lib64"] {
         if let Ok(rd) = std::fs::read_dir(env.join(lib)) {
-            let mut dirs: Vec<PathBuf> = rd.flatten().map(|e| e.path()).filter(|p| p.file_name().and_then(|n| n.to_str()).is_some_and(|n| n.starts_with("python3"))).collect();
+            let mut dirs: Vec<PathBuf> = rd
+                .flatten()
+                .map(|e| e.path())
+                .filter(|p| {
+                    p.file_name()
+                        .and_then(|n| n.to_str())
+                        .is_some_and(|n| n.starts_with("python3"))
+                })
+                .collect();
             dirs.sort();
             for d in dirs {
                 for sp in ["site-packages", "dist-packages"] {
@@ -196,9 +224,17 @@ impl Denoiser {
     /// none is found (the caller prints a notice and keeps the noisy image); an error when
     /// a library is named or found but cannot be used.
     pub fn load(explicit: Option<&Path>) -> Result<Option<Denoiser>, DenoiseError> {
-        let named = explicit.map(Path::to_path_buf).or_else(|| std::env::var_os("BLENDSYNTH_OIDN").filter(|p| !p.is_empty()).map(PathBuf::from));
+        let named = explicit.map(Path::to_path_buf).or_else(|| {
+            std::env::var_os("BLENDSYNTH_OIDN")
+                .filter(|p| !p.is_empty())
+                .map(PathBuf::from)
+        });
         if let Some(p) = named {
-            let file = if p.is_dir() { lib_in(&p).ok_or_else(|| DenoiseError::NotFound(p.clone()))? } else { p.clone() };
+            let file = if p.is_dir() {
+                lib_in(&p).ok_or_else(|| DenoiseError::NotFound(p.clone()))?
+            } else {
+                p.clone()
+            };
             if !file.is_file() {
                 return Err(DenoiseError::NotFound(file));
             }
@@ -213,7 +249,10 @@ impl Denoiser {
     }
 
     fn open(file: &Path) -> Result<Denoiser, DenoiseError> {
-        Ok(Denoiser { lib: oidn::Lib::open(file)?, path: file.to_path_buf() })
+        Ok(Denoiser {
+            lib: oidn::Lib::open(file)?,
+            path: file.to_path_buf(),
+        })
     }
 
     /// The library file in use.
@@ -222,24 +261,55 @@ impl Denoiser {
     }
 
     /// Cycles' default: RT filter, hdr, albedo + normal guides (prefiltered as Cycles does).
-    pub fn denoise(&self, width: u32, height: u32, color: &mut [[f32; 4]], albedo: &[[f32; 3]], normal: &[[f32; 3]]) -> Result<(), DenoiseError> {
-        self.denoise_with(width, height, color, albedo, normal, &DenoiseOptions::default())
+    pub fn denoise(
+        &self,
+        width: u32,
+        height: u32,
+        color: &mut [[f32; 4]],
+        albedo: &[[f32; 3]],
+        normal: &[[f32; 3]],
+    ) -> Result<(), DenoiseError> {
+        self.denoise_with(
+            width,
+            height,
+            color,
+            albedo,
+            normal,
+            &DenoiseOptions::default(),
+        )
     }
 
     /// As `denoise`, with the scene's prefilter / quality / guide choice. Alpha is kept.
-    pub fn denoise_with(&self, width: u32, height: u32, color: &mut [[f32; 4]], albedo: &[[f32; 3]], normal: &[[f32; 3]], opts: &DenoiseOptions) -> Result<(), DenoiseError> {
+    pub fn denoise_with(
+        &self,
+        width: u32,
+        height: u32,
+        color: &mut [[f32; 4]],
+        albedo: &[[f32; 3]],
+        normal: &[[f32; 3]],
+        opts: &DenoiseOptions,
+    ) -> Result<(), DenoiseError> {
         let n = width as usize * height as usize;
         if width == 0 || height == 0 {
             return Err(DenoiseError::Input(format!("empty {width}x{height} image")));
         }
         if color.len() != n {
-            return Err(DenoiseError::Input(format!("colour has {} pixels, {width}x{height} needs {n}", color.len())));
+            return Err(DenoiseError::Input(format!(
+                "colour has {} pixels, {width}x{height} needs {n}",
+                color.len()
+            )));
         }
         if opts.use_albedo && albedo.len() != n {
-            return Err(DenoiseError::Input(format!("albedo guide has {} pixels, {width}x{height} needs {n}", albedo.len())));
+            return Err(DenoiseError::Input(format!(
+                "albedo guide has {} pixels, {width}x{height} needs {n}",
+                albedo.len()
+            )));
         }
         if opts.use_normal && normal.len() != n {
-            return Err(DenoiseError::Input(format!("normal guide has {} pixels, {width}x{height} needs {n}", normal.len())));
+            return Err(DenoiseError::Input(format!(
+                "normal guide has {} pixels, {width}x{height} needs {n}",
+                normal.len()
+            )));
         }
         // OIDN reads and writes packed float3 buffers; non-finite input would spread, so
         // it is zeroed first (Cycles' passes are finite by construction). Rows go bottom-up,
@@ -248,9 +318,20 @@ impl Denoiser {
         let finite = |v: f32| if v.is_finite() { v } else { 0.0 };
         let w = width as usize;
         let bottom_up = |i: usize| (height as usize - 1 - i / w) * w + i % w;
-        let mut rgb: Vec<[f32; 3]> = (0..n).map(|i| color[bottom_up(i)]).map(|p| [finite(p[0]), finite(p[1]), finite(p[2])]).collect();
-        let mut alb: Vec<[f32; 3]> = if opts.use_albedo { (0..n).map(|i| albedo[bottom_up(i)].map(finite)).collect() } else { Vec::new() };
-        let mut nrm: Vec<[f32; 3]> = if opts.use_normal { (0..n).map(|i| normal[bottom_up(i)].map(finite)).collect() } else { Vec::new() };
+        let mut rgb: Vec<[f32; 3]> = (0..n)
+            .map(|i| color[bottom_up(i)])
+            .map(|p| [finite(p[0]), finite(p[1]), finite(p[2])])
+            .collect();
+        let mut alb: Vec<[f32; 3]> = if opts.use_albedo {
+            (0..n).map(|i| albedo[bottom_up(i)].map(finite)).collect()
+        } else {
+            Vec::new()
+        };
+        let mut nrm: Vec<[f32; 3]> = if opts.use_normal {
+            (0..n).map(|i| normal[bottom_up(i)].map(finite)).collect()
+        } else {
+            Vec::new()
+        };
         let mut out = vec![[0.0f32; 3]; n];
         let quality = match opts.quality {
             Quality::Fast => oidn::QUALITY_FAST,
@@ -279,7 +360,9 @@ impl Denoiser {
         }
         if !nrm.is_empty() {
             if alb.is_empty() {
-                return Err(DenoiseError::Input("OIDN needs the albedo guide when the normal guide is given".into()));
+                return Err(DenoiseError::Input(
+                    "OIDN needs the albedo guide when the normal guide is given".into(),
+                ));
             }
             f.image("normal", nrm.as_mut_ptr().cast(), width, height)?;
         }
@@ -287,7 +370,9 @@ impl Denoiser {
         f.set_bool("hdr", true);
         f.set_bool("srgb", false);
         f.set_int("quality", quality);
-        if matches!(opts.prefilter, Prefilter::None | Prefilter::Accurate) && (!alb.is_empty() || !nrm.is_empty()) {
+        if matches!(opts.prefilter, Prefilter::None | Prefilter::Accurate)
+            && (!alb.is_empty() || !nrm.is_empty())
+        {
             f.set_bool("cleanAux", true);
         }
         f.run()?;
@@ -304,18 +389,51 @@ impl Denoiser {
 /// Denoises a finished render in place as Cycles does after its last sample: the
 /// renderer's world-space guide normals are first turned into Cycles' camera-space
 /// convention (background stays zero) using the scene camera at `frame`.
-pub fn denoise_render(denoiser: &Denoiser, scene: &crate::scene::Scene, frame: f64, out: &mut crate::render::RenderOutput) -> Result<(), DenoiseError> {
-    let cam_name = scene.file.scene.camera.as_deref().ok_or_else(|| DenoiseError::Input("the scene has no camera".into()))?;
-    let idx = scene.file.objects.iter().position(|o| o.name == cam_name).ok_or_else(|| DenoiseError::Input(format!("camera object {cam_name:?} not found")))?;
-    let mats = crate::anim::evaluate_transforms(scene, frame).map_err(|e| DenoiseError::Input(format!("camera at frame {frame}: {e}")))?;
+pub fn denoise_render(
+    denoiser: &Denoiser,
+    scene: &crate::scene::Scene,
+    frame: f64,
+    out: &mut crate::render::RenderOutput,
+) -> Result<(), DenoiseError> {
+    let cam_name = scene
+        .file
+        .scene
+        .camera
+        .as_deref()
+        .ok_or_else(|| DenoiseError::Input("the scene has no camera".into()))?;
+    let idx = scene
+        .file
+        .objects
+        .iter()
+        .position(|o| o.name == cam_name)
+        .ok_or_else(|| DenoiseError::Input(format!("camera object {cam_name:?} not found")))?;
+    let mats = crate::anim::evaluate_transforms(scene, frame)
+        .map_err(|e| DenoiseError::Input(format!("camera at frame {frame}: {e}")))?;
     let cam = mats[idx];
     let p = &out.passes;
     // The guide is already zero where every sample saw the background.
-    let normal: Vec<[f32; 3]> = p.denoise_normal.iter().map(|n| cycles_denoise_normal(*n, &cam)).collect();
-    denoiser.denoise_with(out.width, out.height, &mut out.color, &p.albedo, &normal, &DenoiseOptions::from_scene(scene))
+    let normal: Vec<[f32; 3]> = p
+        .denoise_normal
+        .iter()
+        .map(|n| cycles_denoise_normal(*n, &cam))
+        .collect();
+    denoiser.denoise_with(
+        out.width,
+        out.height,
+        &mut out.color,
+        &p.albedo,
+        &normal,
+        &DenoiseOptions::from_scene(scene),
+    )
 }
 
 /// Whether the scene asks for denoising of the final render (`cycles.use_denoising`).
 pub fn scene_wants_denoising(scene: &crate::scene::Scene) -> bool {
-    scene.file.scene.cycles.get("use_denoising").and_then(|v| v.as_bool()).unwrap_or(false)
+    scene
+        .file
+        .scene
+        .cycles
+        .get("use_denoising")
+        .and_then(|v| v.as_bool())
+        .unwrap_or(false)
 }

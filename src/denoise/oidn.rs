@@ -21,7 +21,11 @@ pub enum DenoiseError {
     #[error("cannot load Open Image Denoise from {path}: {message}")]
     Load { path: PathBuf, message: String },
     #[error("Open Image Denoise error ({code}) in {during}: {message}")]
-    Oidn { code: i32, during: String, message: String },
+    Oidn {
+        code: i32,
+        during: String,
+        message: String,
+    },
     #[error("denoise: {0}")]
     Input(String),
 }
@@ -33,7 +37,17 @@ struct Api {
     get_device_error: unsafe extern "C" fn(Handle, *mut *const c_char) -> c_int,
     release_device: unsafe extern "C" fn(Handle),
     new_filter: unsafe extern "C" fn(Handle, *const c_char) -> Handle,
-    set_shared_filter_image: unsafe extern "C" fn(Handle, *const c_char, *mut c_void, c_int, usize, usize, usize, usize, usize),
+    set_shared_filter_image: unsafe extern "C" fn(
+        Handle,
+        *const c_char,
+        *mut c_void,
+        c_int,
+        usize,
+        usize,
+        usize,
+        usize,
+        usize,
+    ),
     set_filter_bool: unsafe extern "C" fn(Handle, *const c_char, bool),
     set_filter_int: unsafe extern "C" fn(Handle, *const c_char, c_int),
     commit_filter: unsafe extern "C" fn(Handle),
@@ -49,13 +63,17 @@ pub struct Lib {
 
 impl Lib {
     pub fn open(path: &Path) -> Result<Lib, DenoiseError> {
-        let err = |m: String| DenoiseError::Load { path: path.to_path_buf(), message: m };
+        let err = |m: String| DenoiseError::Load {
+            path: path.to_path_buf(),
+            message: m,
+        };
         // SAFETY: loading a shared library runs its initialisers; OIDN's are benign.
         let lib = unsafe { libloading::Library::new(path) }.map_err(|e| err(e.to_string()))?;
         macro_rules! sym {
             ($name:literal) => {
                 // SAFETY: the symbol's type is the one declared in OIDN 2's oidn.h.
-                *unsafe { lib.get(concat!($name, "\0").as_bytes()) }.map_err(|e| err(format!("{} (needs Open Image Denoise 2.x): {e}", $name)))?
+                *unsafe { lib.get(concat!($name, "\0").as_bytes()) }
+                    .map_err(|e| err(format!("{} (needs Open Image Denoise 2.x): {e}", $name)))?
             };
         }
         let api = Api {
@@ -80,7 +98,11 @@ impl Lib {
         // SAFETY: plain C calls on a handle we own.
         let h = unsafe { (self.api.new_device)(DEVICE_TYPE_CPU) };
         if h.is_null() {
-            return Err(DenoiseError::Oidn { code: -1, during: "oidnNewDevice(CPU)".into(), message: "no device created".into() });
+            return Err(DenoiseError::Oidn {
+                code: -1,
+                during: "oidnNewDevice(CPU)".into(),
+                message: "no device created".into(),
+            });
         }
         let d = Device { lib: self, h };
         let name = CString::new("setAffinity").unwrap();
@@ -112,8 +134,18 @@ impl<'a> Device<'a> {
         if code == ERROR_NONE {
             return Ok(());
         }
-        let message = if msg.is_null() { String::new() } else { unsafe { CStr::from_ptr(msg) }.to_string_lossy().into_owned() };
-        Err(DenoiseError::Oidn { code, during: during.into(), message })
+        let message = if msg.is_null() {
+            String::new()
+        } else {
+            unsafe { CStr::from_ptr(msg) }
+                .to_string_lossy()
+                .into_owned()
+        };
+        Err(DenoiseError::Oidn {
+            code,
+            during: during.into(),
+            message,
+        })
     }
 
     pub fn filter(&self, kind: &str) -> Result<Filter<'_, 'a>, DenoiseError> {
@@ -121,7 +153,11 @@ impl<'a> Device<'a> {
         let h = unsafe { (self.lib.api.new_filter)(self.h, k.as_ptr()) };
         self.check(&format!("creating filter {kind}"))?;
         if h.is_null() {
-            return Err(DenoiseError::Oidn { code: -1, during: format!("creating filter {kind}"), message: "no filter created".into() });
+            return Err(DenoiseError::Oidn {
+                code: -1,
+                during: format!("creating filter {kind}"),
+                message: "no filter created".into(),
+            });
         }
         Ok(Filter { dev: self, h })
     }
@@ -141,9 +177,27 @@ impl Drop for Filter<'_, '_> {
 impl Filter<'_, '_> {
     /// Shares a packed float3 buffer of width*height pixels under `name` (the caller keeps
     /// it alive and unmoved until `run` returns).
-    pub fn image(&self, name: &str, ptr: *mut c_void, width: u32, height: u32) -> Result<(), DenoiseError> {
+    pub fn image(
+        &self,
+        name: &str,
+        ptr: *mut c_void,
+        width: u32,
+        height: u32,
+    ) -> Result<(), DenoiseError> {
         let n = CString::new(name).unwrap();
-        unsafe { (self.dev.lib.api.set_shared_filter_image)(self.h, n.as_ptr(), ptr, FORMAT_FLOAT3, width as usize, height as usize, 0, 0, 0) };
+        unsafe {
+            (self.dev.lib.api.set_shared_filter_image)(
+                self.h,
+                n.as_ptr(),
+                ptr,
+                FORMAT_FLOAT3,
+                width as usize,
+                height as usize,
+                0,
+                0,
+                0,
+            )
+        };
         self.dev.check(&format!("setting image {name}"))
     }
 

@@ -23,13 +23,22 @@ fn get<'a>(root: &'a Value, path: &str) -> Option<&'a Value> {
     };
     for t in it {
         cur = match t {
-            Token::Prop(p) => cur.get(p.as_str()).or_else(|| cur.get("properties").and_then(|x| x.get(p.as_str())))?,
+            Token::Prop(p) => cur
+                .get(p.as_str())
+                .or_else(|| cur.get("properties").and_then(|x| x.get(p.as_str())))?,
             Token::Key(k) => match cur {
                 Value::Array(items) => items
                     .iter()
                     .find(|x| x.get("identifier").and_then(Value::as_str) == Some(k.as_str()))
-                    .or_else(|| items.iter().find(|x| x.get("name").and_then(Value::as_str) == Some(k.as_str())))?,
-                Value::Object(m) => m.get("inputs").and_then(|i| i.get(k.as_str())).or_else(|| m.get("custom_properties").and_then(|i| i.get(k.as_str())))?,
+                    .or_else(|| {
+                        items
+                            .iter()
+                            .find(|x| x.get("name").and_then(Value::as_str) == Some(k.as_str()))
+                    })?,
+                Value::Object(m) => m
+                    .get("inputs")
+                    .and_then(|i| i.get(k.as_str()))
+                    .or_else(|| m.get("custom_properties").and_then(|i| i.get(k.as_str())))?,
                 _ => return None,
             },
             Token::Index(i) => cur.get(*i)?,
@@ -51,7 +60,10 @@ fn animated_paths(file: &SceneFile) -> Result<Vec<(String, &crate::scene::FCurve
         }
         if node_group {
             if let Some(d) = ad.drivers.iter().find(|d| !d.mute) {
-                return Err(GeometryError::new(format!("{}: driver on {} is not supported", ad.id_path, d.data_path)));
+                return Err(GeometryError::new(format!(
+                    "{}: driver on {} is not supported",
+                    ad.id_path, d.data_path
+                )));
             }
         }
     }
@@ -59,19 +71,29 @@ fn animated_paths(file: &SceneFile) -> Result<Vec<(String, &crate::scene::FCurve
 }
 
 /// A copy of `scene` with animation at `frame` and then `overrides` written in.
-pub fn scene_at(scene: &Scene, frame: f64, overrides: &[(String, Value)]) -> Result<Scene, GeometryError> {
+pub fn scene_at(
+    scene: &Scene,
+    frame: f64,
+    overrides: &[(String, Value)],
+) -> Result<Scene, GeometryError> {
     let anim = animated_paths(&scene.file)?;
     if anim.is_empty() && overrides.is_empty() {
         return Ok(scene.clone());
     }
-    let mut root = serde_json::to_value(&scene.file).map_err(|e| GeometryError::new(e.to_string()))?;
+    let mut root =
+        serde_json::to_value(&scene.file).map_err(|e| GeometryError::new(e.to_string()))?;
     for (path, fc) in anim {
         if fc.mute || fc.keyframes.is_empty() && fc.modifiers.is_empty() {
             continue;
         }
-        let target = get(&root, &path).ok_or_else(|| GeometryError::new(format!("animated property {path} is not in the export")))?;
+        let target = get(&root, &path).ok_or_else(|| {
+            GeometryError::new(format!("animated property {path} is not in the export"))
+        })?;
         let (full, current) = match target {
-            Value::Array(a) => (format!("{path}[{}]", fc.array_index), a.get(fc.array_index).cloned().unwrap_or(Value::Null)),
+            Value::Array(a) => (
+                format!("{path}[{}]", fc.array_index),
+                a.get(fc.array_index).cloned().unwrap_or(Value::Null),
+            ),
             v => (path.clone(), v.clone()),
         };
         let kind = ValueKind::of_json(&current).unwrap_or_default();
@@ -83,17 +105,33 @@ pub fn scene_at(scene: &Scene, frame: f64, overrides: &[(String, Value)]) -> Res
         } else {
             Value::from(v)
         };
-        set(&mut root, &full, &json).map_err(|m| GeometryError::new(format!("animating {full}: {m}")))?;
+        set(&mut root, &full, &json)
+            .map_err(|m| GeometryError::new(format!("animating {full}: {m}")))?;
     }
     for (path, value) in overrides {
         let path = path.strip_prefix("bpy.data.").unwrap_or(path);
-        set(&mut root, path, value).map_err(|m| GeometryError::new(format!("override {path}: {m}")))?;
+        set(&mut root, path, value)
+            .map_err(|m| GeometryError::new(format!("override {path}: {m}")))?;
     }
-    let file: SceneFile = serde_json::from_value(root).map_err(|e| GeometryError::new(format!("after overrides: {e}")))?;
-    Ok(Scene { dir: scene.dir.clone(), file })
+    let file: SceneFile = serde_json::from_value(root)
+        .map_err(|e| GeometryError::new(format!("after overrides: {e}")))?;
+    Ok(Scene {
+        dir: scene.dir.clone(),
+        file,
+    })
 }
 
 /// Per node group, each link's `multi_input_sort_id` (0 when the export lacks it).
 pub fn link_sort_ids(scene: &Scene) -> Result<HashMap<String, Vec<i64>>, GeometryError> {
-    Ok(scene.file.node_groups.iter().map(|g| (g.name.clone(), g.links.iter().map(|l| l.multi_input_sort_id).collect())).collect())
+    Ok(scene
+        .file
+        .node_groups
+        .iter()
+        .map(|g| {
+            (
+                g.name.clone(),
+                g.links.iter().map(|l| l.multi_input_sort_id).collect(),
+            )
+        })
+        .collect())
 }

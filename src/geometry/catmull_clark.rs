@@ -118,11 +118,34 @@ impl Level {
     fn adjacency(&self) -> Adjacency {
         let nv = self.pos.len();
         let ne = self.edges.len();
-        let (vert_edge_off, vert_edges) = rows(nv, self.edges.iter().enumerate().flat_map(|(e, v)| [(v[0] as usize, e as u32), (v[1] as usize, e as u32)]));
-        let faces_of_corners = (0..self.face_count()).flat_map(|f| (self.face_offsets[f]..self.face_offsets[f + 1]).map(move |c| (c, f as u32)));
-        let (vert_face_off, vert_faces) = rows(nv, faces_of_corners.clone().map(|(c, f)| (self.corner_verts[c] as usize, f)));
-        let (edge_face_off, edge_faces) = rows(ne, faces_of_corners.map(|(c, f)| (self.corner_edges[c] as usize, f)));
-        Adjacency { vert_edge_off, vert_edges, vert_face_off, vert_faces, edge_face_off, edge_faces }
+        let (vert_edge_off, vert_edges) = rows(
+            nv,
+            self.edges
+                .iter()
+                .enumerate()
+                .flat_map(|(e, v)| [(v[0] as usize, e as u32), (v[1] as usize, e as u32)]),
+        );
+        let faces_of_corners = (0..self.face_count()).flat_map(|f| {
+            (self.face_offsets[f]..self.face_offsets[f + 1]).map(move |c| (c, f as u32))
+        });
+        let (vert_face_off, vert_faces) = rows(
+            nv,
+            faces_of_corners
+                .clone()
+                .map(|(c, f)| (self.corner_verts[c] as usize, f)),
+        );
+        let (edge_face_off, edge_faces) = rows(
+            ne,
+            faces_of_corners.map(|(c, f)| (self.corner_edges[c] as usize, f)),
+        );
+        Adjacency {
+            vert_edge_off,
+            vert_edges,
+            vert_face_off,
+            vert_faces,
+            edge_face_off,
+            edge_faces,
+        }
     }
 }
 
@@ -131,7 +154,11 @@ fn other_end(e: [u32; 2], v: u32) -> usize {
 }
 
 fn lerp3(a: [f64; 3], b: [f64; 3], t: f64) -> [f64; 3] {
-    [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t]
+    [
+        a[0] + (b[0] - a[0]) * t,
+        a[1] + (b[1] - a[1]) * t,
+        a[2] + (b[2] - a[2]) * t,
+    ]
 }
 
 /// The refined mesh seen through the coarse one: coarse vertices, coarse-edge chains and
@@ -164,11 +191,26 @@ impl Refined {
 /// is deeper: the limit surface is isolated that far, which moves the corners of
 /// single-face boundary vertices. `edge_sharpness` and `vert_sharpness` are OpenSubdiv
 /// sharpness per coarse edge and vertex.
-pub fn refine(m: &Mesh, level: u32, isolation: u32, edge_sharpness: &[f32], vert_sharpness: &[f32], opts: Options) -> Refined {
-    let depth = if opts.limit { level.max(isolation) } else { level };
+pub fn refine(
+    m: &Mesh,
+    level: u32,
+    isolation: u32,
+    edge_sharpness: &[f32],
+    vert_sharpness: &[f32],
+    opts: Options,
+) -> Refined {
+    let depth = if opts.limit {
+        level.max(isolation)
+    } else {
+        level
+    };
     let stride = 1usize << (depth - level);
     let mut lv = Level {
-        pos: m.positions.iter().map(|p| [p[0] as f64, p[1] as f64, p[2] as f64]).collect(),
+        pos: m
+            .positions
+            .iter()
+            .map(|p| [p[0] as f64, p[1] as f64, p[2] as f64])
+            .collect(),
         face_offsets: m.face_offsets.iter().map(|&o| o as usize).collect(),
         corner_verts: m.corner_verts.clone(),
         corner_edges: m.corner_edges.clone(),
@@ -189,9 +231,14 @@ pub fn refine(m: &Mesh, level: u32, isolation: u32, edge_sharpness: &[f32], vert
     for v in 0..lv.pos.len() {
         let r = adj.vert_edge_off[v]..adj.vert_edge_off[v + 1];
         if r.len() == 2 {
-            let (e0, e1) = (adj.vert_edges[r.start] as usize, adj.vert_edges[r.start + 1] as usize);
+            let (e0, e1) = (
+                adj.vert_edges[r.start] as usize,
+                adj.vert_edges[r.start + 1] as usize,
+            );
             let add = |s: f32| if s < 1e-6 { 0.0 } else { s };
-            lv.vert_sharp[v] = (lv.vert_sharp[v] + add(edge_sharpness[e0]).min(add(edge_sharpness[e1]))).min(INFINITE);
+            lv.vert_sharp[v] = (lv.vert_sharp[v]
+                + add(edge_sharpness[e0]).min(add(edge_sharpness[e1])))
+            .min(INFINITE);
         }
     }
     if opts.boundary_corners {
@@ -233,7 +280,11 @@ pub fn refine(m: &Mesh, level: u32, isolation: u32, edge_sharpness: &[f32], vert
             let mut c = Vec::with_capacity(chain.len() * 2 - 1);
             for k in 0..chain.len() - 1 {
                 let (a, b) = (chain[k], chain[k + 1]);
-                let edge = if step == 0 { e } else { map.edge_between(&lv, &adj, a, b) };
+                let edge = if step == 0 {
+                    e
+                } else {
+                    map.edge_between(&lv, &adj, a, b)
+                };
                 c.push(map.vert_child(a as usize));
                 c.push(map.edge_child(edge));
             }
@@ -256,8 +307,14 @@ pub fn refine(m: &Mesh, level: u32, isolation: u32, edge_sharpness: &[f32], vert
                         let s = lv.face_offsets[f];
                         let prev = s + (c + n - 1) % n;
                         grids[ptex] = vec![
-                            vec![map.vert_child(lv.corner_verts[s + c] as usize), map.edge_child(lv.corner_edges[s + c] as usize)],
-                            vec![map.edge_child(lv.corner_edges[prev] as usize), map.face_child(f)],
+                            vec![
+                                map.vert_child(lv.corner_verts[s + c] as usize),
+                                map.edge_child(lv.corner_edges[s + c] as usize),
+                            ],
+                            vec![
+                                map.edge_child(lv.corner_edges[prev] as usize),
+                                map.face_child(f),
+                            ],
                         ];
                         face_grids[ptex] = vec![vec![(s + c) as u32]];
                     } else {
@@ -272,8 +329,18 @@ pub fn refine(m: &Mesh, level: u32, isolation: u32, edge_sharpness: &[f32], vert
         lv = next;
         adj = lv.adjacency();
     }
-    let positions = if opts.limit { limit_positions(&lv, &adj) } else { lv.pos.clone() };
-    Refined { positions, vertex, stride, chains, grids }
+    let positions = if opts.limit {
+        limit_positions(&lv, &adj)
+    } else {
+        lv.pos.clone()
+    };
+    Refined {
+        positions,
+        vertex,
+        stride,
+        chains,
+        grids,
+    }
 }
 
 /// Index layout of a refined level: face points, then edge points, then vertex points;
@@ -296,11 +363,21 @@ impl ChildMap {
     }
     fn edge_between(&self, lv: &Level, adj: &Adjacency, a: u32, b: u32) -> usize {
         let r = adj.vert_edge_off[a as usize]..adj.vert_edge_off[a as usize + 1];
-        adj.vert_edges[r].iter().map(|&e| e as usize).find(|&e| other_end(lv.edges[e], a) == b as usize).expect("grid edge exists")
+        adj.vert_edges[r]
+            .iter()
+            .map(|&e| e as usize)
+            .find(|&e| other_end(lv.edges[e], a) == b as usize)
+            .expect("grid edge exists")
     }
 }
 
-fn refine_grid(lv: &Level, adj: &Adjacency, map: &ChildMap, g: &[Vec<u32>], fg: &[Vec<u32>]) -> (Vec<Vec<u32>>, Vec<Vec<u32>>) {
+fn refine_grid(
+    lv: &Level,
+    adj: &Adjacency,
+    map: &ChildMap,
+    g: &[Vec<u32>],
+    fg: &[Vec<u32>],
+) -> (Vec<Vec<u32>>, Vec<Vec<u32>>) {
     let n = g.len();
     let mut out = vec![vec![0u32; 2 * n - 1]; 2 * n - 1];
     let mut fout = vec![vec![0u32; 2 * n - 2]; 2 * n - 2];
@@ -308,10 +385,12 @@ fn refine_grid(lv: &Level, adj: &Adjacency, map: &ChildMap, g: &[Vec<u32>], fg: 
         for x in 0..n {
             out[2 * y][2 * x] = map.vert_child(g[y][x] as usize);
             if x + 1 < n {
-                out[2 * y][2 * x + 1] = map.edge_child(map.edge_between(lv, adj, g[y][x], g[y][x + 1]));
+                out[2 * y][2 * x + 1] =
+                    map.edge_child(map.edge_between(lv, adj, g[y][x], g[y][x + 1]));
             }
             if y + 1 < n {
-                out[2 * y + 1][2 * x] = map.edge_child(map.edge_between(lv, adj, g[y][x], g[y + 1][x]));
+                out[2 * y + 1][2 * x] =
+                    map.edge_child(map.edge_between(lv, adj, g[y][x], g[y + 1][x]));
             }
             if x + 1 < n && y + 1 < n {
                 let f = fg[y][x] as usize;
@@ -320,7 +399,10 @@ fn refine_grid(lv: &Level, adj: &Adjacency, map: &ChildMap, g: &[Vec<u32>], fg: 
                 let r = lv.face_offsets[f]..lv.face_offsets[f + 1];
                 for (dy, dx) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
                     let v = g[y + dy][x + dx];
-                    let c = r.clone().find(|&c| lv.corner_verts[c] == v).expect("cell corner in face");
+                    let c = r
+                        .clone()
+                        .find(|&c| lv.corner_verts[c] == v)
+                        .expect("cell corner in face");
                     fout[2 * y + dy][2 * x + dx] = c as u32;
                 }
             }
@@ -438,7 +520,11 @@ fn refine_once(lv: &Level, adj: &Adjacency) -> (Level, ChildMap) {
                 sum += pe(i);
             }
         }
-        let w = if count == 0 { 0.0 } else { (sum / count as f32).min(1.0) as f64 };
+        let w = if count == 0 {
+            0.0
+        } else {
+            (sum / count as f32).min(1.0) as f64
+        };
         pos[nf + ne + v] = lerp3(child, parent, w);
     }
 
@@ -455,11 +541,15 @@ fn refine_once(lv: &Level, adj: &Adjacency) -> (Level, ChildMap) {
     }
     for f in 0..nf {
         for c in lv.face_offsets[f]..lv.face_offsets[f + 1] {
-            edges.push([map.edge_child(lv.corner_edges[c] as usize), map.face_child(f)]);
+            edges.push([
+                map.edge_child(lv.corner_edges[c] as usize),
+                map.face_child(f),
+            ]);
             edge_sharp.push(0.0);
         }
     }
-    let half = |e: usize, v: u32| -> u32 { (2 * e + if lv.edges[e][0] == v { 0 } else { 1 }) as u32 };
+    let half =
+        |e: usize, v: u32| -> u32 { (2 * e + if lv.edges[e][0] == v { 0 } else { 1 }) as u32 };
     let mut corner_verts = Vec::with_capacity(4 * lv.corner_verts.len());
     let mut corner_edges = Vec::with_capacity(4 * lv.corner_verts.len());
     for f in 0..nf {
@@ -470,8 +560,18 @@ fn refine_once(lv: &Level, adj: &Adjacency) -> (Level, ChildMap) {
             let prev = r.start + (k + n - 1) % n;
             let v = lv.corner_verts[c];
             let (e_next, e_prev) = (lv.corner_edges[c] as usize, lv.corner_edges[prev] as usize);
-            corner_verts.extend([map.vert_child(v as usize), map.edge_child(e_next), map.face_child(f), map.edge_child(e_prev)]);
-            corner_edges.extend([half(e_next, v), (2 * ne + c) as u32, (2 * ne + prev) as u32, half(e_prev, v)]);
+            corner_verts.extend([
+                map.vert_child(v as usize),
+                map.edge_child(e_next),
+                map.face_child(f),
+                map.edge_child(e_prev),
+            ]);
+            corner_edges.extend([
+                half(e_next, v),
+                (2 * ne + c) as u32,
+                (2 * ne + prev) as u32,
+                half(e_prev, v),
+            ]);
         }
     }
     let mut vert_sharp = vec![0.0f32; nf + ne + nv];
@@ -479,7 +579,18 @@ fn refine_once(lv: &Level, adj: &Adjacency) -> (Level, ChildMap) {
         vert_sharp[nf + ne + v] = decay(lv.vert_sharp[v]);
     }
     let face_offsets = (0..=lv.corner_verts.len()).map(|i| 4 * i).collect();
-    (Level { pos, face_offsets, corner_verts, corner_edges, edges, edge_sharp, vert_sharp }, map)
+    (
+        Level {
+            pos,
+            face_offsets,
+            corner_verts,
+            corner_edges,
+            edges,
+            edge_sharp,
+            vert_sharp,
+        },
+        map,
+    )
 }
 
 /// Limit positions of a level's vertices (OpenSubdiv's Catmark limit masks).
@@ -495,7 +606,10 @@ fn limit_positions(lv: &Level, adj: &Adjacency) -> Vec<[f64; 3]> {
                 return p;
             }
             let inf = |s: f32| if s >= INFINITE { s } else { 0.0 };
-            let rule = rule_of(inf(lv.vert_sharp[v]), edges.iter().map(|&e| inf(lv.edge_sharp[e as usize])));
+            let rule = rule_of(
+                inf(lv.vert_sharp[v]),
+                edges.iter().map(|&e| inf(lv.edge_sharp[e as usize])),
+            );
             match rule {
                 Rule::Corner => p,
                 Rule::Crease => {
@@ -522,7 +636,9 @@ fn limit_positions(lv: &Level, adj: &Adjacency) -> Vec<[f64; 3]> {
                     // Every face is a quad here: add the corner opposite the vertex.
                     for &f in faces {
                         let s = lv.face_offsets[f as usize];
-                        let i = (0..4).find(|&i| lv.corner_verts[s + i] as usize == v).unwrap();
+                        let i = (0..4)
+                            .find(|&i| lv.corner_verts[s + i] as usize == v)
+                            .unwrap();
                         let o = lv.pos[lv.corner_verts[s + (i + 2) % 4] as usize];
                         for k in 0..3 {
                             q[k] += o[k];

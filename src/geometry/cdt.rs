@@ -63,14 +63,21 @@ fn find(parent: &mut [usize], mut i: usize) -> usize {
 
 /// Triangulates `verts` with the closed polygons `faces` (indices into `verts`) as
 /// constraints.
-pub fn triangulate(verts: &[[f64; 2]], faces: &[Vec<u32>], output: Output) -> Result<CdtResult, String> {
-    let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> = ConstrainedDelaunayTriangulation::new();
+pub fn triangulate(
+    verts: &[[f64; 2]],
+    faces: &[Vec<u32>],
+    output: Output,
+) -> Result<CdtResult, String> {
+    let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> =
+        ConstrainedDelaunayTriangulation::new();
     let mut handle = Vec::with_capacity(verts.len());
     for (i, p) in verts.iter().enumerate() {
         if !p[0].is_finite() || !p[1].is_finite() {
             return Err(format!("point {i} ({}, {}) is not finite", p[0], p[1]));
         }
-        let h = cdt.insert(Point2::new(coordinate(p[0]), coordinate(p[1]))).map_err(|e| format!("point {i} ({}, {}): {e:?}", p[0], p[1]))?;
+        let h = cdt
+            .insert(Point2::new(coordinate(p[0]), coordinate(p[1])))
+            .map_err(|e| format!("point {i} ({}, {}): {e:?}", p[0], p[1]))?;
         handle.push(h);
     }
     for f in faces {
@@ -85,7 +92,10 @@ pub fn triangulate(verts: &[[f64; 2]], faces: &[Vec<u32>], output: Output) -> Re
         }
     }
 
-    let out_verts: Vec<[f64; 2]> = cdt.vertices().map(|v| [v.position().x, v.position().y]).collect();
+    let out_verts: Vec<[f64; 2]> = cdt
+        .vertices()
+        .map(|v| [v.position().x, v.position().y])
+        .collect();
     let edges: Vec<[u32; 2]> = cdt
         .undirected_edges()
         .filter(|e| cdt.is_constraint_edge(e.fix()))
@@ -100,7 +110,11 @@ pub fn triangulate(verts: &[[f64; 2]], faces: &[Vec<u32>], output: Output) -> Re
     let mut tris: Vec<Option<Tri>> = (0..nf).map(|_| None).collect();
     for f in cdt.inner_faces() {
         let es = f.adjacent_edges();
-        let mut t = Tri { v: [0; 3], nb: [0; 3], constraint: [false; 3] };
+        let mut t = Tri {
+            v: [0; 3],
+            nb: [0; 3],
+            constraint: [false; 3],
+        };
         for (k, e) in es.iter().enumerate() {
             t.v[k] = e.from().fix().index() as u32;
             t.nb[k] = e.rev().face().fix().index();
@@ -175,16 +189,27 @@ pub fn triangulate(verts: &[[f64; 2]], faces: &[Vec<u32>], output: Output) -> Re
     let kept = |f: usize| f != 0 && tris[f].is_some() && parity[region[f]] == 1;
 
     let faces_out = match output {
-        Output::InsideWithHoles => (1..nf).filter(|&f| kept(f)).map(|f| tris[f].as_ref().unwrap().v.to_vec()).collect(),
+        Output::InsideWithHoles => (1..nf)
+            .filter(|&f| kept(f))
+            .map(|f| tris[f].as_ref().unwrap().v.to_vec())
+            .collect(),
         Output::ValidBmeshWithHoles => dissolve(&tris, &out_verts, &kept),
     };
-    Ok(CdtResult { verts: out_verts, edges, faces: faces_out })
+    Ok(CdtResult {
+        verts: out_verts,
+        edges,
+        faces: faces_out,
+    })
 }
 
 /// `remove_non_constraint_edges_leave_valid_bmesh` on the kept triangles: edges by
 /// increasing length, each dissolved unless its two faces share another edge or another
 /// vertex; then each face's boundary as one counter-clockwise loop.
-fn dissolve(tris: &[Option<Tri>], verts: &[[f64; 2]], kept: &dyn Fn(usize) -> bool) -> Vec<Vec<u32>> {
+fn dissolve(
+    tris: &[Option<Tri>],
+    verts: &[[f64; 2]],
+    kept: &dyn Fn(usize) -> bool,
+) -> Vec<Vec<u32>> {
     let nf = tris.len();
     let mut candidates: Vec<(f64, usize, usize)> = Vec::new();
     let mut adj: Vec<HashMap<usize, u32>> = vec![HashMap::new(); nf];
@@ -216,8 +241,15 @@ fn dissolve(tris: &[Option<Tri>], verts: &[[f64; 2]], kept: &dyn Fn(usize) -> bo
         if a == b || adj[a].get(&b).copied().unwrap_or(0) > 1 {
             continue;
         }
-        let (small, large) = if face_verts[a].len() < face_verts[b].len() { (a, b) } else { (b, a) };
-        let shared = face_verts[small].iter().filter(|v| face_verts[large].contains(v)).count();
+        let (small, large) = if face_verts[a].len() < face_verts[b].len() {
+            (a, b)
+        } else {
+            (b, a)
+        };
+        let shared = face_verts[small]
+            .iter()
+            .filter(|v| face_verts[large].contains(v))
+            .count();
         if shared > 2 {
             continue;
         }
@@ -304,7 +336,11 @@ mod tests {
             .faces
             .iter()
             .map(|f| {
-                let (a, b, c) = (t.verts[f[0] as usize], t.verts[f[1] as usize], t.verts[f[2] as usize]);
+                let (a, b, c) = (
+                    t.verts[f[0] as usize],
+                    t.verts[f[1] as usize],
+                    t.verts[f[2] as usize],
+                );
                 ((b[0] - a[0]) * (c[1] - a[1]) - (c[0] - a[0]) * (b[1] - a[1])) / 2.0
             })
             .sum();

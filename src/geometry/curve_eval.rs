@@ -111,7 +111,8 @@ impl Evaluated {
                             acc += 1;
                             continue;
                         }
-                        let vector = hr[pts.start + s] == HANDLE_VECTOR && hl[pts.start + next] == HANDLE_VECTOR;
+                        let vector = hr[pts.start + s] == HANDLE_VECTOR
+                            && hl[pts.start + next] == HANDLE_VECTOR;
                         acc += if vector { 1 } else { r };
                     }
                     offs.push(acc);
@@ -122,11 +123,21 @@ impl Evaluated {
                         acc as usize
                     }
                 }
-                t => return Err(format!("curve {i}: {} curves are not supported yet (only Bezier and poly)", type_name(t))),
+                t => {
+                    return Err(format!(
+                        "curve {i}: {} curves are not supported yet (only Bezier and poly)",
+                        type_name(t)
+                    ))
+                }
             };
             offsets.push(offsets[i] + count as u32);
         }
-        Ok(Evaluated { offsets, cyclic, types, bezier_offsets })
+        Ok(Evaluated {
+            offsets,
+            cyclic,
+            types,
+            bezier_offsets,
+        })
     }
 
     /// The evaluated point (within curve `i`) where control point `p` (within the curve)
@@ -189,7 +200,11 @@ impl Evaluated {
             let start = out.len();
             out.extend(tangents(&evaluated[r.clone()], self.cyclic[i]));
             let pts = c.points(i);
-            if self.types[i] == CURVE_TYPE_BEZIER && !self.cyclic[i] && !r.is_empty() && !pts.is_empty() {
+            if self.types[i] == CURVE_TYPE_BEZIER
+                && !self.cyclic[i]
+                && !r.is_empty()
+                && !pts.is_empty()
+            {
                 let (f, l) = (pts.start, pts.end - 1);
                 if !almost_equal_relative(hr[f], c.positions[f], 1e-6) {
                     out[start] = normalize(sub(hr[f], c.positions[f]));
@@ -206,14 +221,21 @@ impl Evaluated {
     /// Evaluated normals of every curve (normal mode per curve, tilt interpolated).
     pub fn normals(&self, c: &Curves, tangents_all: &[V3]) -> Vec<V3> {
         let tilt = match c.attributes.named("tilt") {
-            Some(a) if a.domain == Domain::Point => self.interpolate(c, &a.data).as_float().into_owned(),
+            Some(a) if a.domain == Domain::Point => {
+                self.interpolate(c, &a.data).as_float().into_owned()
+            }
             _ => vec![0.0; self.total()],
         };
         let modes = normal_modes(c);
         let mut out = Vec::with_capacity(self.total());
         for i in 0..c.curve_count() {
             let r = self.range(i);
-            out.extend(normals(&tangents_all[r.clone()], self.cyclic[i], modes[i], &tilt[r]));
+            out.extend(normals(
+                &tangents_all[r.clone()],
+                self.cyclic[i],
+                modes[i],
+                &tilt[r],
+            ));
         }
         out
     }
@@ -280,14 +302,30 @@ pub fn lerp_gather(data: &Array, a: &[usize], b: &[usize], f: &[f32]) -> Array {
             .collect()
     }
     match data {
-        Array::Float(v) => Array::Float((0..a.len()).map(|i| v[a[i]] * (1.0 - f[i]) + v[b[i]] * f[i]).collect()),
+        Array::Float(v) => Array::Float(
+            (0..a.len())
+                .map(|i| v[a[i]] * (1.0 - f[i]) + v[b[i]] * f[i])
+                .collect(),
+        ),
         Array::Float2(v) => Array::Float2(lanes(v, a, b, f)),
         Array::Vector(v) => Array::Vector(lanes(v, a, b, f)),
         Array::Color(v) => Array::Color(lanes(v, a, b, f)),
         // Blender's `mix2` for integers and booleans: the float mix, rounded / thresholded.
-        Array::Int(v) => Array::Int((0..a.len()).map(|i| ((1.0 - f[i]) * v[a[i]] as f32 + f[i] * v[b[i]] as f32).round() as i32).collect()),
-        Array::Int8(v) => Array::Int8((0..a.len()).map(|i| ((1.0 - f[i]) * v[a[i]] as f32 + f[i] * v[b[i]] as f32).round() as i8).collect()),
-        Array::Bool(v) => Array::Bool((0..a.len()).map(|i| (1.0 - f[i]) * v[a[i]] as u8 as f32 + f[i] * v[b[i]] as u8 as f32 >= 0.5).collect()),
+        Array::Int(v) => Array::Int(
+            (0..a.len())
+                .map(|i| ((1.0 - f[i]) * v[a[i]] as f32 + f[i] * v[b[i]] as f32).round() as i32)
+                .collect(),
+        ),
+        Array::Int8(v) => Array::Int8(
+            (0..a.len())
+                .map(|i| ((1.0 - f[i]) * v[a[i]] as f32 + f[i] * v[b[i]] as f32).round() as i8)
+                .collect(),
+        ),
+        Array::Bool(v) => Array::Bool(
+            (0..a.len())
+                .map(|i| (1.0 - f[i]) * v[a[i]] as u8 as f32 + f[i] * v[b[i]] as u8 as f32 >= 0.5)
+                .collect(),
+        ),
         other => other.gather(a),
     }
 }
@@ -378,7 +416,10 @@ fn rotate_around_axis(d: V3, axis: V3, angle: f32) -> V3 {
     let axis_scaled = scale(axis, dot(d, axis));
     let diff = sub(d, axis_scaled);
     let c = cross(axis, diff);
-    add(add(axis_scaled, scale(diff, angle.cos())), scale(c, angle.sin()))
+    add(
+        add(axis_scaled, scale(diff, angle.cos())),
+        scale(c, angle.sin()),
+    )
 }
 
 fn z_up_normal(t: V3) -> V3 {

@@ -10,11 +10,15 @@ pub struct GeometryError {
 
 impl GeometryError {
     pub fn new(message: impl Into<String>) -> Self {
-        GeometryError { message: message.into() }
+        GeometryError {
+            message: message.into(),
+        }
     }
     /// Prefixes the message with where it happened.
     pub fn within(self, outer: impl fmt::Display) -> Self {
-        GeometryError { message: format!("{outer}: {}", self.message) }
+        GeometryError {
+            message: format!("{outer}: {}", self.message),
+        }
     }
 }
 

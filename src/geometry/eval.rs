@@ -37,12 +37,29 @@ pub struct Session<'s> {
 }
 
 impl<'s> Session<'s> {
-    pub fn new(scene: &'s Scene, frame: f64, world: Vec<Mat4f>, sort_ids: HashMap<String, Vec<i64>>) -> Self {
-        Session { scene, frame, world, sort_ids, cache: RefCell::new(HashMap::new()), in_progress: RefCell::new(Vec::new()) }
+    pub fn new(
+        scene: &'s Scene,
+        frame: f64,
+        world: Vec<Mat4f>,
+        sort_ids: HashMap<String, Vec<i64>>,
+    ) -> Self {
+        Session {
+            scene,
+            frame,
+            world,
+            sort_ids,
+            cache: RefCell::new(HashMap::new()),
+            in_progress: RefCell::new(Vec::new()),
+        }
     }
 
     pub fn world_matrix(&self, object: &str) -> Option<Mat4f> {
-        let i = self.scene.file.objects.iter().position(|o| o.name == object)?;
+        let i = self
+            .scene
+            .file
+            .objects
+            .iter()
+            .position(|o| o.name == object)?;
         self.world.get(i).copied()
     }
 
@@ -51,25 +68,47 @@ impl<'s> Session<'s> {
         let here = format!("objects[{}]", quote(&o.name));
         match o.kind.as_str() {
             "MESH" => {
-                let data = o.data.as_deref().ok_or_else(|| GeometryError::new(format!("{here}: mesh object without mesh data")))?;
+                let data = o.data.as_deref().ok_or_else(|| {
+                    GeometryError::new(format!("{here}: mesh object without mesh data"))
+                })?;
                 let index = self
                     .scene
                     .file
                     .meshes
                     .iter()
                     .position(|m| m.name == data)
-                    .ok_or_else(|| GeometryError::new(format!("{here}: mesh {data:?} is not in the export")))?;
+                    .ok_or_else(|| {
+                        GeometryError::new(format!("{here}: mesh {data:?} is not in the export"))
+                    })?;
                 let md = self.scene.load_mesh(index)?;
-                Ok(GeometrySet::from_mesh(Mesh::from_scene(&md, &self.scene.file.meshes[index].materials)))
+                Ok(GeometrySet::from_mesh(Mesh::from_scene(
+                    &md,
+                    &self.scene.file.meshes[index].materials,
+                )))
             }
             "CURVE" => {
-                let data = o.data.as_deref().ok_or_else(|| GeometryError::new(format!("{here}: curve object without curve data")))?;
-                let cu = self.scene.file.curves.iter().find(|c| c.name == data).ok_or_else(|| GeometryError::new(format!("{here}: curve {data:?} is not in the export")))?;
+                let data = o.data.as_deref().ok_or_else(|| {
+                    GeometryError::new(format!("{here}: curve object without curve data"))
+                })?;
+                let cu = self
+                    .scene
+                    .file
+                    .curves
+                    .iter()
+                    .find(|c| c.name == data)
+                    .ok_or_else(|| {
+                        GeometryError::new(format!("{here}: curve {data:?} is not in the export"))
+                    })?;
                 let curves = super::legacy_curve::to_curves(cu).map_err(|e| e.within(&here))?;
-                Ok(GeometrySet { curves: Some(std::sync::Arc::new(curves)), ..Default::default() })
+                Ok(GeometrySet {
+                    curves: Some(std::sync::Arc::new(curves)),
+                    ..Default::default()
+                })
             }
             "EMPTY" | "CAMERA" | "LIGHT" | "LIGHT_PROBE" | "SPEAKER" => Ok(GeometrySet::default()),
-            other => Err(GeometryError::new(format!("{here}: {other} objects cannot be evaluated as geometry yet"))),
+            other => Err(GeometryError::new(format!(
+                "{here}: {other} objects cannot be evaluated as geometry yet"
+            ))),
         }
     }
 
@@ -79,9 +118,15 @@ impl<'s> Session<'s> {
             return Ok(g.clone());
         }
         if self.in_progress.borrow().iter().any(|n| n == name) {
-            return Err(GeometryError::new(format!("objects[{}]: depends on its own geometry (dependency cycle)", quote(name))));
+            return Err(GeometryError::new(format!(
+                "objects[{}]: depends on its own geometry (dependency cycle)",
+                quote(name)
+            )));
         }
-        let o = self.scene.object(name).ok_or_else(|| GeometryError::new(format!("no object named {name:?} in the export")))?;
+        let o = self
+            .scene
+            .object(name)
+            .ok_or_else(|| GeometryError::new(format!("no object named {name:?} in the export")))?;
         self.in_progress.borrow_mut().push(name.to_string());
         let result = self.evaluate_stack(o);
         self.in_progress.borrow_mut().pop();
@@ -98,51 +143,100 @@ impl<'s> Session<'s> {
             }
             let here = format!("objects[{}].modifiers[{}]", quote(&o.name), quote(&m.name));
             if m.kind == "SUBSURF" {
-                g = super::nodes::subdivision_surface::subsurf_modifier(&m.properties, g).map_err(|e| GeometryError::new(format!("{here}: {e}")))?;
+                g = super::nodes::subdivision_surface::subsurf_modifier(&m.properties, g)
+                    .map_err(|e| GeometryError::new(format!("{here}: {e}")))?;
                 continue;
             }
             if m.kind != "NODES" {
                 return Err(GeometryError::new(format!("{here}: {} modifiers are not supported (only Geometry Nodes and Subdivision Surface)", m.kind)));
             }
-            g = self.evaluate_modifier(o, m, g).map_err(|e| e.within(&here))?;
+            g = self
+                .evaluate_modifier(o, m, g)
+                .map_err(|e| e.within(&here))?;
         }
         Ok(g)
     }
 
-    fn evaluate_modifier(&self, o: &Object, m: &Modifier, input: GeometrySet) -> Result<GeometrySet, GeometryError> {
+    fn evaluate_modifier(
+        &self,
+        o: &Object,
+        m: &Modifier,
+        input: GeometrySet,
+    ) -> Result<GeometrySet, GeometryError> {
         let Some(group) = m.node_group.as_deref() else {
             return Ok(input);
         };
-        let tree = self.scene.node_group(group).ok_or_else(|| GeometryError::new(format!("node group {group:?} is not in the export")))?;
-        let out_node = active_output(tree, "NodeGroupOutput", "")
-            .ok_or_else(|| GeometryError::new(format!("node tree {:?} has no Group Output node", tree.name)))?;
-        let graph = flatten(tree, &self.scene.file.node_groups, &out_node.name).map_err(|e| GeometryError::new(e.0))?;
+        let tree = self.scene.node_group(group).ok_or_else(|| {
+            GeometryError::new(format!("node group {group:?} is not in the export"))
+        })?;
+        let out_node = active_output(tree, "NodeGroupOutput", "").ok_or_else(|| {
+            GeometryError::new(format!(
+                "node tree {:?} has no Group Output node",
+                tree.name
+            ))
+        })?;
+        let graph = flatten(tree, &self.scene.file.node_groups, &out_node.name)
+            .map_err(|e| GeometryError::new(e.0))?;
         let mut inputs: HashMap<String, SocketValue> = HashMap::new();
         let mut geometry_given = false;
-        for item in tree.interface.iter().filter(|i| i.item_type == "SOCKET" && i.in_out.as_deref() == Some("INPUT")) {
-            let Some(id) = item.identifier.as_deref() else { continue };
+        for item in tree
+            .interface
+            .iter()
+            .filter(|i| i.item_type == "SOCKET" && i.in_out.as_deref() == Some("INPUT"))
+        {
+            let Some(id) = item.identifier.as_deref() else {
+                continue;
+            };
             let kind = SocketValue::interface_kind(item.socket_type.as_deref().unwrap_or(""));
             let v = if kind == "GEOMETRY" {
                 // Only the first geometry input receives the object's geometry.
-                let v = if geometry_given { GeometrySet::default() } else { input.clone() };
+                let v = if geometry_given {
+                    GeometrySet::default()
+                } else {
+                    input.clone()
+                };
                 geometry_given = true;
                 SocketValue::Geometry(v)
-            } else if m.inputs.get(&format!("{id}_use_attribute")).is_some_and(|u| u.as_bool() == Some(true) || u.as_i64() == Some(1)) {
-                let name = m.inputs.get(&format!("{id}_attribute_name")).and_then(Json::as_str).unwrap_or_default();
+            } else if m
+                .inputs
+                .get(&format!("{id}_use_attribute"))
+                .is_some_and(|u| u.as_bool() == Some(true) || u.as_i64() == Some(1))
+            {
+                let name = m
+                    .inputs
+                    .get(&format!("{id}_attribute_name"))
+                    .and_then(Json::as_str)
+                    .unwrap_or_default();
                 let ty = DataType::from_socket(kind).unwrap_or(DataType::Float);
-                SocketValue::Field(Field::input(AttributeInput { id: super::attribute::AttrId::named(name), ty }))
+                SocketValue::Field(Field::input(AttributeInput {
+                    id: super::attribute::AttrId::named(name),
+                    ty,
+                }))
             } else if let Some(v) = m.inputs.get(id) {
-                SocketValue::from_json(kind, v).map_err(|e| GeometryError::new(format!("input {:?}: {e}", item.name)))?
+                SocketValue::from_json(kind, v)
+                    .map_err(|e| GeometryError::new(format!("input {:?}: {e}", item.name)))?
             } else if let Some(v) = &item.default_value {
-                SocketValue::from_json(kind, v).map_err(|e| GeometryError::new(format!("input {:?}: {e}", item.name)))?
+                SocketValue::from_json(kind, v)
+                    .map_err(|e| GeometryError::new(format!("input {:?}: {e}", item.name)))?
             } else {
                 SocketValue::zero(kind)
             };
             inputs.insert(id.to_string(), v);
         }
-        let ev = Evaluator { session: self, tree, graph, group_inputs: inputs, object: o, memo: RefCell::new(HashMap::new()), busy: RefCell::new(HashSet::new()) };
+        let ev = Evaluator {
+            session: self,
+            tree,
+            graph,
+            group_inputs: inputs,
+            object: o,
+            memo: RefCell::new(HashMap::new()),
+            busy: RefCell::new(HashSet::new()),
+        };
         let root = &ev.graph.nodes[ev.graph.root];
-        let ctx = NodeCtx { ev: &ev, idx: ev.graph.root };
+        let ctx = NodeCtx {
+            ev: &ev,
+            idx: ev.graph.root,
+        };
         let mut result = None;
         let mut outputs: Vec<(String, SocketValue)> = Vec::new();
         for inp in &root.inputs {
@@ -163,19 +257,33 @@ impl<'s> Session<'s> {
         let mut g = result.unwrap_or_default();
         // Field outputs become named attributes when the modifier names one.
         for (id, v) in outputs {
-            let name = m.inputs.get(&format!("{id}_attribute_name")).and_then(Json::as_str).unwrap_or_default();
+            let name = m
+                .inputs
+                .get(&format!("{id}_attribute_name"))
+                .and_then(Json::as_str)
+                .unwrap_or_default();
             if name.is_empty() {
                 continue;
             }
             let SocketValue::Field(f) = v else { continue };
-            let item = tree.interface.iter().find(|i| i.identifier.as_deref() == Some(&id));
+            let item = tree
+                .interface
+                .iter()
+                .find(|i| i.identifier.as_deref() == Some(&id));
             let domain = item
                 .and_then(|i| i.properties.get("attribute_domain"))
                 .and_then(Json::as_str)
                 .and_then(Domain::parse)
                 .unwrap_or(Domain::Point);
-            super::nodes::attribute::store(&mut g, &super::attribute::AttrId::named(name), domain, &f, &Field::Constant(Value::Bool(true)), None)
-                .map_err(|e| GeometryError::new(format!("output attribute {name:?}: {e}")))?;
+            super::nodes::attribute::store(
+                &mut g,
+                &super::attribute::AttrId::named(name),
+                domain,
+                &f,
+                &Field::Constant(Value::Bool(true)),
+                None,
+            )
+            .map_err(|e| GeometryError::new(format!("output attribute {name:?}: {e}")))?;
         }
         Ok(g)
     }
@@ -211,7 +319,12 @@ impl<'a> Evaluator<'a> {
 
     /// The node tree whose node list holds `node` (to find its links).
     fn tree_of(&self, node: &Node) -> Option<&'a NodeTree> {
-        self.session.scene.file.node_groups.iter().find(|t| t.nodes.iter().any(|n| std::ptr::eq(n, node)))
+        self.session
+            .scene
+            .file
+            .node_groups
+            .iter()
+            .find(|t| t.nodes.iter().any(|n| std::ptr::eq(n, node)))
     }
 }
 
@@ -232,13 +345,24 @@ fn implicit_field(bl_idname: &str, identifier: &str) -> Option<Field> {
         | ("GeometryNodeRaycast", "Source Position")
         | ("GeometryNodeMeshToPoints", "Position") => Some(Field::input(PositionInput)),
         // Texture nodes in Geometry Nodes read the position when their vector is unlinked.
-        ("ShaderNodeTexNoise" | "ShaderNodeTexVoronoi" | "ShaderNodeTexWave" | "ShaderNodeTexGradient" | "ShaderNodeTexMagic"
-        | "ShaderNodeTexChecker" | "ShaderNodeTexBrick" | "ShaderNodeTexWhiteNoise" | "ShaderNodeTexMusgrave" | "GeometryNodeImageTexture", "Vector") => {
-            Some(Field::input(PositionInput))
-        }
+        (
+            "ShaderNodeTexNoise"
+            | "ShaderNodeTexVoronoi"
+            | "ShaderNodeTexWave"
+            | "ShaderNodeTexGradient"
+            | "ShaderNodeTexMagic"
+            | "ShaderNodeTexChecker"
+            | "ShaderNodeTexBrick"
+            | "ShaderNodeTexWhiteNoise"
+            | "ShaderNodeTexMusgrave"
+            | "GeometryNodeImageTexture",
+            "Vector",
+        ) => Some(Field::input(PositionInput)),
         ("FunctionNodeRandomValue", "ID") => Some(Field::input(IdInput)),
         ("GeometryNodeExtrudeMesh", "Offset") => Some(Field::input(super::field::NormalInput)),
-        ("GeometryNodeSampleIndex", "Index") | ("GeometryNodeFieldAtIndex", "Index") => Some(Field::input(IndexInput)),
+        ("GeometryNodeSampleIndex", "Index") | ("GeometryNodeFieldAtIndex", "Index") => {
+            Some(Field::input(IndexInput))
+        }
         _ => None,
     }
 }
@@ -255,17 +379,26 @@ impl<'e, 'a> NodeCtx<'e, 'a> {
     }
     /// An error naming the tree and node.
     pub fn err(&self, msg: impl std::fmt::Display) -> GeometryError {
-        GeometryError::new(format!("node tree {:?}, node {:?} ({}): {msg}", self.ev.tree.name, self.flat().path, self.node().bl_idname))
+        GeometryError::new(format!(
+            "node tree {:?}, node {:?} ({}): {msg}",
+            self.ev.tree.name,
+            self.flat().path,
+            self.node().bl_idname
+        ))
     }
 
     pub fn prop(&self, key: &str) -> Option<&'a Json> {
         self.node().properties.get(key)
     }
     pub fn prop_str(&self, key: &str) -> Result<&'a str, GeometryError> {
-        self.prop(key).and_then(Json::as_str).ok_or_else(|| self.err(format!("property {key:?} missing")))
+        self.prop(key)
+            .and_then(Json::as_str)
+            .ok_or_else(|| self.err(format!("property {key:?} missing")))
     }
     pub fn prop_bool(&self, key: &str) -> Result<bool, GeometryError> {
-        self.prop(key).and_then(|v| v.as_bool().or_else(|| v.as_i64().map(|i| i != 0))).ok_or_else(|| self.err(format!("property {key:?} missing")))
+        self.prop(key)
+            .and_then(|v| v.as_bool().or_else(|| v.as_i64().map(|i| i != 0)))
+            .ok_or_else(|| self.err(format!("property {key:?} missing")))
     }
 
     /// Whether input `id` is available in the node's current mode.
@@ -274,10 +407,17 @@ impl<'e, 'a> NodeCtx<'e, 'a> {
     }
     /// Whether output `id` is linked to anything.
     pub fn output_used(&self, id: &str) -> bool {
-        self.node().outputs.iter().any(|s| s.identifier == id && s.is_linked)
+        self.node()
+            .outputs
+            .iter()
+            .any(|s| s.identifier == id && s.is_linked)
     }
 
-    fn source_value(&self, src: &Source<'a>, consumer_kind: &str) -> Result<SocketValue, GeometryError> {
+    fn source_value(
+        &self,
+        src: &Source<'a>,
+        consumer_kind: &str,
+    ) -> Result<SocketValue, GeometryError> {
         let v = match src {
             Source::Link { node, output, .. } => {
                 let outs = self.ev.node_outputs(*node)?;
@@ -294,23 +434,38 @@ impl<'e, 'a> NodeCtx<'e, 'a> {
                 }
             }
             Source::Default(s) => {
-                let Some(dv) = &s.default_value else { return Ok(SocketValue::zero(&s.kind)) };
+                let Some(dv) = &s.default_value else {
+                    return Ok(SocketValue::zero(&s.kind));
+                };
                 SocketValue::from_json(&s.kind, dv).map_err(|e| self.err(e))?
             }
-            Source::GroupInput(id) => self.ev.group_inputs.get(*id).cloned().unwrap_or_else(|| SocketValue::zero(consumer_kind)),
+            Source::GroupInput(id) => self
+                .ev
+                .group_inputs
+                .get(*id)
+                .cloned()
+                .unwrap_or_else(|| SocketValue::zero(consumer_kind)),
             Source::Nothing => SocketValue::zero(consumer_kind),
         };
         Ok(coerce(v, consumer_kind))
     }
 
-    fn flat_input(&self, id: &str) -> Result<&'e crate::nodes::graph::FlatInput<'a>, GeometryError> {
-        self.flat().input(id).ok_or_else(|| self.err(format!("input {id:?} is not available")))
+    fn flat_input(
+        &self,
+        id: &str,
+    ) -> Result<&'e crate::nodes::graph::FlatInput<'a>, GeometryError> {
+        self.flat()
+            .input(id)
+            .ok_or_else(|| self.err(format!("input {id:?} is not available")))
     }
 
     /// The value of input `id` (the first link of a multi-input).
     pub fn input(&self, id: &str) -> Result<SocketValue, GeometryError> {
         let inp = self.flat_input(id)?;
-        let unlinked = inp.sources.iter().all(|s| matches!(s, Source::Default(_) | Source::Nothing));
+        let unlinked = inp
+            .sources
+            .iter()
+            .all(|s| matches!(s, Source::Default(_) | Source::Nothing));
         if unlinked {
             if let Some(f) = implicit_field(&self.node().bl_idname, id) {
                 return Ok(SocketValue::Field(f));
@@ -335,7 +490,9 @@ impl<'e, 'a> NodeCtx<'e, 'a> {
                     .links
                     .iter()
                     .enumerate()
-                    .filter(|(_, l)| l.to_node == node.name && l.to_socket == id && !l.is_muted && l.is_valid)
+                    .filter(|(_, l)| {
+                        l.to_node == node.name && l.to_socket == id && !l.is_muted && l.is_valid
+                    })
                     .map(|(i, _)| ids.and_then(|v| v.get(i)).copied().unwrap_or(0))
                     .collect();
                 if keys.len() == inp.sources.len() {
@@ -357,14 +514,19 @@ impl<'e, 'a> NodeCtx<'e, 'a> {
     pub fn field(&self, id: &str, ty: DataType) -> Result<Field, GeometryError> {
         match self.input(id)? {
             SocketValue::Field(f) => Ok(f.convert(ty)),
-            other => Err(self.err(format!("input {id:?} is a {}, expected a value or field", other.kind()))),
+            other => Err(self.err(format!(
+                "input {id:?} is a {}, expected a value or field",
+                other.kind()
+            ))),
         }
     }
     /// A single value: an input fed by a field that depends on geometry is an error.
     pub fn single(&self, id: &str, ty: DataType) -> Result<Value, GeometryError> {
         match self.field(id, ty)? {
             Field::Constant(v) => Ok(v),
-            _ => Err(self.err(format!("input {id:?} takes a single value but a field is connected"))),
+            _ => Err(self.err(format!(
+                "input {id:?} takes a single value but a field is connected"
+            ))),
         }
     }
     pub fn float(&self, id: &str) -> Result<f32, GeometryError> {
@@ -383,13 +545,19 @@ impl<'e, 'a> NodeCtx<'e, 'a> {
         match self.input(id)? {
             SocketValue::Geometry(g) => Ok(g),
             SocketValue::None => Ok(GeometrySet::default()),
-            other => Err(self.err(format!("input {id:?} is a {}, expected geometry", other.kind()))),
+            other => Err(self.err(format!(
+                "input {id:?} is a {}, expected geometry",
+                other.kind()
+            ))),
         }
     }
     pub fn string(&self, id: &str) -> Result<String, GeometryError> {
         match self.input(id)? {
             SocketValue::String(s) | SocketValue::Menu(s) => Ok(s),
-            other => Err(self.err(format!("input {id:?} is a {}, expected a string", other.kind()))),
+            other => Err(self.err(format!(
+                "input {id:?} is a {}, expected a string",
+                other.kind()
+            ))),
         }
     }
 }

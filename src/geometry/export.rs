@@ -15,14 +15,19 @@ fn io_err(path: &Path, e: std::io::Error) -> GeometryError {
 
 /// The first named FLOAT2 corner attribute (the UV map).
 fn uv_map(m: &Mesh) -> Option<(&str, &Vec<[f32; 2]>)> {
-    m.attributes.iter().find_map(|a| match (&a.data, a.domain, a.id.name()) {
-        (Array::Float2(v), Domain::Corner, Some(n)) => Some((n, v)),
-        _ => None,
-    })
+    m.attributes
+        .iter()
+        .find_map(|a| match (&a.data, a.domain, a.id.name()) {
+            (Array::Float2(v), Domain::Corner, Some(n)) => Some((n, v)),
+            _ => None,
+        })
 }
 
 fn material_indices(m: &Mesh) -> Vec<i32> {
-    m.attributes.named("material_index").map(|a| a.data.as_int().into_owned()).unwrap_or_else(|| vec![0; m.face_count()])
+    m.attributes
+        .named("material_index")
+        .map(|a| a.data.as_int().into_owned())
+        .unwrap_or_else(|| vec![0; m.face_count()])
 }
 
 /// Binary little-endian PLY: vertices (x, y, z), faces (vertex indices and
@@ -34,7 +39,13 @@ pub fn write_ply(path: &Path, m: &Mesh) -> Result<(), GeometryError> {
             *u = true;
         }
     }
-    let loose: Vec<[u32; 2]> = m.edges.iter().zip(&used).filter(|(_, u)| !**u).map(|(e, _)| *e).collect();
+    let loose: Vec<[u32; 2]> = m
+        .edges
+        .iter()
+        .zip(&used)
+        .filter(|(_, u)| !**u)
+        .map(|(e, _)| *e)
+        .collect();
     let mut out = Vec::new();
     let header = format!(
         "ply\nformat binary_little_endian 1.0\ncomment blendsynth: Blender vertex order\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nelement face {}\nproperty list uchar int vertex_indices\nproperty int material_index\nelement edge {}\nproperty int vertex1\nproperty int vertex2\nend_header\n",
@@ -52,7 +63,11 @@ pub fn write_ply(path: &Path, m: &Mesh) -> Result<(), GeometryError> {
     for f in 0..m.face_count() {
         let r = m.face(f);
         if r.len() > 255 {
-            return Err(GeometryError::new(format!("{}: face {f} has {} corners, more than PLY's uchar count holds", path.display(), r.len())));
+            return Err(GeometryError::new(format!(
+                "{}: face {f} has {} corners, more than PLY's uchar count holds",
+                path.display(),
+                r.len()
+            )));
         }
         out.push(r.len() as u8);
         for c in r {
@@ -86,7 +101,12 @@ pub fn write_obj(path: &Path, m: &Mesh) -> Result<(), GeometryError> {
     for f in 0..m.face_count() {
         if !m.materials.is_empty() && current != Some(mi[f]) {
             current = Some(mi[f]);
-            let name = m.materials.get(mi[f].max(0) as usize).cloned().flatten().unwrap_or_else(|| "None".into());
+            let name = m
+                .materials
+                .get(mi[f].max(0) as usize)
+                .cloned()
+                .flatten()
+                .unwrap_or_else(|| "None".into());
             s.push_str(&format!("usemtl {name}\n"));
         }
         s.push('f');
@@ -122,7 +142,14 @@ struct GlbBuilder {
 
 impl GlbBuilder {
     /// Adds an accessor (None for zero elements, as the exporter omits them).
-    fn add(&mut self, bytes: &[u8], count: usize, ty: &str, comp: u32, target: Option<u32>) -> Option<usize> {
+    fn add(
+        &mut self,
+        bytes: &[u8],
+        count: usize,
+        ty: &str,
+        comp: u32,
+        target: Option<u32>,
+    ) -> Option<usize> {
         if count == 0 {
             return None;
         }
@@ -131,7 +158,8 @@ impl GlbBuilder {
         }
         let offset = self.bin.len();
         self.bin.extend_from_slice(bytes);
-        let mut view = serde_json::json!({"buffer": 0, "byteOffset": offset, "byteLength": bytes.len()});
+        let mut view =
+            serde_json::json!({"buffer": 0, "byteOffset": offset, "byteLength": bytes.len()});
         if let Some(t) = target {
             view["target"] = t.into();
         }
@@ -139,7 +167,10 @@ impl GlbBuilder {
         let mut acc = serde_json::json!({"bufferView": self.views.len() - 1, "componentType": comp, "count": count, "type": ty});
         if ty == "VEC3" && comp == 5126 && target == Some(34962) {
             // POSITION needs bounds.
-            let f: Vec<f32> = bytes.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+            let f: Vec<f32> = bytes
+                .chunks_exact(4)
+                .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+                .collect();
             let mut mn = [f32::INFINITY; 3];
             let mut mx = [f32::NEG_INFINITY; 3];
             for p in f.chunks_exact(3) {
@@ -157,7 +188,9 @@ impl GlbBuilder {
 }
 
 fn f32s<const K: usize>(v: &[[f32; K]]) -> Vec<u8> {
-    v.iter().flat_map(|p| p.iter().flat_map(|c| c.to_le_bytes())).collect()
+    v.iter()
+        .flat_map(|p| p.iter().flat_map(|c| c.to_le_bytes()))
+        .collect()
 }
 fn u32s(v: impl Iterator<Item = u32>) -> Vec<u8> {
     v.flat_map(|c| c.to_le_bytes()).collect()
@@ -167,7 +200,11 @@ fn u32s(v: impl Iterator<Item = u32>) -> Vec<u8> {
 /// `extras.blendsynth` plus a corner-split triangle primitive for viewers.
 pub fn write_glb(path: &Path, m: &Mesh, name: &str) -> Result<(), GeometryError> {
     let md = m.to_scene(name);
-    let mut b = GlbBuilder { bin: Vec::new(), views: Vec::new(), accessors: Vec::new() };
+    let mut b = GlbBuilder {
+        bin: Vec::new(),
+        views: Vec::new(),
+        accessors: Vec::new(),
+    };
     let mut ex = serde_json::json!({
         "version": 1, "name": name, "vertex_count": m.vertex_count(), "edge_count": m.edge_count(),
         "face_count": m.face_count(), "corner_count": m.corner_count(), "triangle_count": md.triangles.len(),
@@ -177,27 +214,95 @@ pub fn write_glb(path: &Path, m: &Mesh, name: &str) -> Result<(), GeometryError>
             ex[key] = i.into();
         }
     };
-    put(&mut ex, "vertex_positions", b.add(&f32s(&m.positions), m.vertex_count(), "VEC3", 5126, None));
+    put(
+        &mut ex,
+        "vertex_positions",
+        b.add(&f32s(&m.positions), m.vertex_count(), "VEC3", 5126, None),
+    );
     let ev: Vec<[u32; 2]> = m.edges.clone();
-    put(&mut ex, "edge_verts", b.add(&u32s(ev.iter().flat_map(|e| e.iter().copied())), m.edge_count(), "VEC2", 5125, None));
+    put(
+        &mut ex,
+        "edge_verts",
+        b.add(
+            &u32s(ev.iter().flat_map(|e| e.iter().copied())),
+            m.edge_count(),
+            "VEC2",
+            5125,
+            None,
+        ),
+    );
     if m.face_count() > 0 {
-        put(&mut ex, "face_offsets", b.add(&u32s(m.face_offsets.iter().copied()), m.face_offsets.len(), "SCALAR", 5125, None));
+        put(
+            &mut ex,
+            "face_offsets",
+            b.add(
+                &u32s(m.face_offsets.iter().copied()),
+                m.face_offsets.len(),
+                "SCALAR",
+                5125,
+                None,
+            ),
+        );
     }
-    put(&mut ex, "corner_verts", b.add(&u32s(m.corner_verts.iter().copied()), m.corner_count(), "SCALAR", 5125, None));
-    put(&mut ex, "corner_edges", b.add(&u32s(m.corner_edges.iter().copied()), m.corner_count(), "SCALAR", 5125, None));
-    let normals = if m.face_count() > 0 { md.corner_normals.clone() } else { Vec::new() };
+    put(
+        &mut ex,
+        "corner_verts",
+        b.add(
+            &u32s(m.corner_verts.iter().copied()),
+            m.corner_count(),
+            "SCALAR",
+            5125,
+            None,
+        ),
+    );
+    put(
+        &mut ex,
+        "corner_edges",
+        b.add(
+            &u32s(m.corner_edges.iter().copied()),
+            m.corner_count(),
+            "SCALAR",
+            5125,
+            None,
+        ),
+    );
+    let normals = if m.face_count() > 0 {
+        md.corner_normals.clone()
+    } else {
+        Vec::new()
+    };
     let normals_idx = b.add(&f32s(&normals), normals.len(), "VEC3", 5126, None);
     put(&mut ex, "corner_normals", normals_idx);
-    let tri_idx = b.add(&u32s(md.triangles.iter().flat_map(|t| t.iter().copied())), md.triangles.len() * 3, "SCALAR", 5125, None);
+    let tri_idx = b.add(
+        &u32s(md.triangles.iter().flat_map(|t| t.iter().copied())),
+        md.triangles.len() * 3,
+        "SCALAR",
+        5125,
+        None,
+    );
     put(&mut ex, "triangle_corners", tri_idx);
-    put(&mut ex, "triangle_faces", b.add(&u32s(md.triangle_faces.iter().copied()), md.triangle_faces.len(), "SCALAR", 5125, None));
+    put(
+        &mut ex,
+        "triangle_faces",
+        b.add(
+            &u32s(md.triangle_faces.iter().copied()),
+            md.triangle_faces.len(),
+            "SCALAR",
+            5125,
+            None,
+        ),
+    );
     let mut attrs = Vec::new();
     let mut uvs: Vec<Vec<[f32; 2]>> = Vec::new();
     for a in &md.attributes {
         use crate::scene::AttributeData as D;
         let n = a.data.len();
         let (bytes, ty, comp) = match &a.data {
-            D::Float(v) => (v.iter().flat_map(|c| c.to_le_bytes()).collect(), "SCALAR", 5126),
+            D::Float(v) => (
+                v.iter().flat_map(|c| c.to_le_bytes()).collect(),
+                "SCALAR",
+                5126,
+            ),
             D::Float2(v) => {
                 if a.domain == crate::scene::Domain::Corner {
                     uvs.push(v.clone());
@@ -207,8 +312,18 @@ pub fn write_glb(path: &Path, m: &Mesh, name: &str) -> Result<(), GeometryError>
             D::Float3(v) => (f32s(v), "VEC3", 5126),
             D::Color(v) | D::Quaternion(v) => (f32s(v), "VEC4", 5126),
             D::Float4x4(v) => (f32s(v), "MAT4", 5126),
-            D::Int(v) => (v.iter().flat_map(|c| c.to_le_bytes()).collect(), "SCALAR", 5125),
-            D::Int2(v) => (v.iter().flat_map(|p| p.iter().flat_map(|c| c.to_le_bytes())).collect(), "VEC2", 5125),
+            D::Int(v) => (
+                v.iter().flat_map(|c| c.to_le_bytes()).collect(),
+                "SCALAR",
+                5125,
+            ),
+            D::Int2(v) => (
+                v.iter()
+                    .flat_map(|p| p.iter().flat_map(|c| c.to_le_bytes()))
+                    .collect(),
+                "VEC2",
+                5125,
+            ),
             D::Int8(v) => (v.iter().map(|c| *c as u8).collect(), "SCALAR", 5120),
             D::Bool(v) => (v.iter().map(|c| *c as u8).collect(), "SCALAR", 5121),
         };
@@ -219,8 +334,14 @@ pub fn write_glb(path: &Path, m: &Mesh, name: &str) -> Result<(), GeometryError>
     ex["attributes"] = attrs.into();
     let mut meshes = Vec::new();
     if let Some(ti) = tri_idx {
-        let split: Vec<[f32; 3]> = m.corner_verts.iter().map(|&v| m.positions[v as usize]).collect();
-        let pos = b.add(&f32s(&split), split.len(), "VEC3", 5126, Some(34962)).unwrap();
+        let split: Vec<[f32; 3]> = m
+            .corner_verts
+            .iter()
+            .map(|&v| m.positions[v as usize])
+            .collect();
+        let pos = b
+            .add(&f32s(&split), split.len(), "VEC3", 5126, Some(34962))
+            .unwrap();
         let mut attributes = serde_json::json!({"POSITION": pos});
         if let Some(n) = normals_idx {
             attributes["NORMAL"] = n.into();
@@ -271,18 +392,32 @@ pub fn write_glb(path: &Path, m: &Mesh, name: &str) -> Result<(), GeometryError>
 /// temporary file in the same folder renamed into place, so a failure never leaves a
 /// half-written output.
 pub fn write_mesh(path: &Path, m: &Mesh, name: &str) -> Result<(), GeometryError> {
-    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase)
+        .unwrap_or_default();
     if !matches!(ext.as_str(), "glb" | "ply" | "obj") {
-        return Err(GeometryError::new(format!("{}: unknown mesh format (use .glb, .ply or .obj)", path.display())));
+        return Err(GeometryError::new(format!(
+            "{}: unknown mesh format (use .glb, .ply or .obj)",
+            path.display()
+        )));
     }
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
     if !dir.is_dir() {
-        return Err(GeometryError::new(format!("{}: folder {} does not exist", path.display(), dir.display())));
+        return Err(GeometryError::new(format!(
+            "{}: folder {} does not exist",
+            path.display(),
+            dir.display()
+        )));
     }
-    let file_name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let file_name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     let tmp = dir.join(format!(".{file_name}.{}.part.{ext}", std::process::id()));
     let written = match ext.as_str() {
         "glb" => write_glb(&tmp, m, name),

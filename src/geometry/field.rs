@@ -40,7 +40,10 @@ impl<'a> ComponentRef<'a> {
     /// Whether the component has this domain.
     pub fn has_domain(&self, d: Domain) -> bool {
         match self {
-            ComponentRef::Mesh(_) => matches!(d, Domain::Point | Domain::Edge | Domain::Face | Domain::Corner),
+            ComponentRef::Mesh(_) => matches!(
+                d,
+                Domain::Point | Domain::Edge | Domain::Face | Domain::Corner
+            ),
             ComponentRef::Curves(_) => matches!(d, Domain::Point | Domain::Curve),
             ComponentRef::Points(_) => d == Domain::Point,
             ComponentRef::Instances(_) => d == Domain::Instance,
@@ -75,7 +78,15 @@ impl<'a> ComponentRef<'a> {
             }
             ComponentRef::Instances(i) => {
                 if is_pos {
-                    return Some((Domain::Instance, Array::Vector(i.transforms.iter().map(|t| [t[3][0], t[3][1], t[3][2]]).collect())));
+                    return Some((
+                        Domain::Instance,
+                        Array::Vector(
+                            i.transforms
+                                .iter()
+                                .map(|t| [t[3][0], t[3][1], t[3][2]])
+                                .collect(),
+                        ),
+                    ));
                 }
                 i.attributes.get(id).map(|a| (a.domain, a.data.clone()))
             }
@@ -102,7 +113,10 @@ pub struct FieldContext<'a> {
 
 impl<'a> FieldContext<'a> {
     pub fn new(component: ComponentRef<'a>) -> Self {
-        FieldContext { component, cache: RefCell::new(HashMap::new()) }
+        FieldContext {
+            component,
+            cache: RefCell::new(HashMap::new()),
+        }
     }
     /// Evaluates `field` on `domain`, converted to `ty`.
     pub fn eval(&self, field: &Field, domain: Domain, ty: DataType) -> Result<Array, String> {
@@ -172,12 +186,24 @@ impl Field {
         func: impl Fn(usize, &[Array]) -> Result<Vec<Array>, String> + Send + Sync + 'static,
     ) -> Result<Vec<Field>, String> {
         if inputs.iter().all(|f| matches!(f, Field::Constant(_))) {
-            let arrays: Vec<Array> = inputs.iter().map(|f| Array::filled(f.as_constant().unwrap(), 1)).collect();
+            let arrays: Vec<Array> = inputs
+                .iter()
+                .map(|f| Array::filled(f.as_constant().unwrap(), 1))
+                .collect();
             let out = func(1, &arrays)?;
-            return Ok(out.into_iter().zip(&outputs).map(|(a, t)| Field::Constant(a.convert(*t).get(0))).collect());
+            return Ok(out
+                .into_iter()
+                .zip(&outputs)
+                .map(|(a, t)| Field::Constant(a.convert(*t).get(0)))
+                .collect());
         }
         let n = outputs.len();
-        let op = Arc::new(FieldOp { label: label.into(), inputs, outputs, func: Box::new(func) });
+        let op = Arc::new(FieldOp {
+            label: label.into(),
+            inputs,
+            outputs,
+            func: Box::new(func),
+        });
         Ok((0..n).map(|k| Field::Op(op.clone(), k)).collect())
     }
 
@@ -188,7 +214,10 @@ impl Field {
         output: DataType,
         func: impl Fn(usize, &[Array]) -> Result<Array, String> + Send + Sync + 'static,
     ) -> Result<Field, String> {
-        Ok(Field::op(label, inputs, vec![output], move |n, a| Ok(vec![func(n, a)?]))?.remove(0))
+        Ok(Field::op(label, inputs, vec![output], move |n, a| {
+            Ok(vec![func(n, a)?])
+        })?
+        .remove(0))
     }
 
     /// The field with Blender's implicit conversion to `to` applied.
@@ -198,7 +227,8 @@ impl Field {
         }
         match self {
             Field::Constant(v) => Field::Constant(v.convert(to)),
-            f => Field::op1("convert", vec![f], to, move |_, a| Ok(a[0].convert(to))).expect("conversion cannot fail"),
+            f => Field::op1("convert", vec![f], to, move |_, a| Ok(a[0].convert(to)))
+                .expect("conversion cannot fail"),
         }
     }
 
@@ -227,7 +257,11 @@ impl Field {
                     args.push(f.evaluate(ctx, domain)?);
                 }
                 let out = (op.func)(n, &args).map_err(|e| format!("{}: {e}", op.label))?;
-                let out: Vec<Array> = out.into_iter().zip(&op.outputs).map(|(a, t)| a.convert(*t)).collect();
+                let out: Vec<Array> = out
+                    .into_iter()
+                    .zip(&op.outputs)
+                    .map(|(a, t)| a.convert(*t))
+                    .collect();
                 let r = out[*k].clone();
                 ctx.cache.borrow_mut().insert(key, Arc::new(out));
                 Ok(r)
@@ -240,7 +274,11 @@ impl Field {
         match self {
             Field::Constant(_) => None,
             Field::Input(i) => i.preferred_domain(ctx),
-            Field::Op(op, _) => op.inputs.iter().filter_map(|f| f.preferred_domain(ctx)).max_by_key(|d| d.priority()),
+            Field::Op(op, _) => op
+                .inputs
+                .iter()
+                .filter_map(|f| f.preferred_domain(ctx))
+                .max_by_key(|d| d.priority()),
         }
     }
 }
@@ -256,7 +294,9 @@ impl FieldInput for PositionInput {
     }
     fn evaluate(&self, ctx: &FieldContext, domain: Domain) -> Result<Array, String> {
         let c = &ctx.component;
-        let (d, a) = c.attribute(&AttrId::named("position")).ok_or("no positions")?;
+        let (d, a) = c
+            .attribute(&AttrId::named("position"))
+            .ok_or("no positions")?;
         Ok(c.adapt(&a, d, domain))
     }
     fn preferred_domain(&self, ctx: &FieldContext) -> Option<Domain> {
@@ -272,7 +312,9 @@ impl FieldInput for IndexInput {
         DataType::Int
     }
     fn evaluate(&self, ctx: &FieldContext, domain: Domain) -> Result<Array, String> {
-        Ok(Array::Int((0..ctx.component.domain_size(domain) as i32).collect()))
+        Ok(Array::Int(
+            (0..ctx.component.domain_size(domain) as i32).collect(),
+        ))
     }
 }
 
@@ -304,7 +346,10 @@ impl FieldInput for AttributeInput {
     fn evaluate(&self, ctx: &FieldContext, domain: Domain) -> Result<Array, String> {
         let n = ctx.component.domain_size(domain);
         match ctx.component.attribute(&self.id) {
-            Some((d, a)) if ctx.component.has_domain(d) => Ok(ctx.component.adapt(&a.convert(self.ty.socket_type()), d, domain).convert(self.ty)),
+            Some((d, a)) if ctx.component.has_domain(d) => Ok(ctx
+                .component
+                .adapt(&a.convert(self.ty.socket_type()), d, domain)
+                .convert(self.ty)),
             _ => Ok(Array::zeros(self.ty, n)),
         }
     }
@@ -342,7 +387,9 @@ impl FieldInput for NormalInput {
                 }
                 _ => vec![[0.0; 3]; m.domain_size(domain)],
             })),
-            ComponentRef::Points(p) => Ok(Array::Vector(vec![[0.0, 0.0, 1.0]; p.domain_size(domain)])),
+            ComponentRef::Points(p) => {
+                Ok(Array::Vector(vec![[0.0, 0.0, 1.0]; p.domain_size(domain)]))
+            }
             _ => Err("the Normal input is only supported on meshes and point clouds".into()),
         }
     }
@@ -366,7 +413,10 @@ impl FieldInput for EvaluateOnDomain {
     }
     fn evaluate(&self, ctx: &FieldContext, domain: Domain) -> Result<Array, String> {
         if !ctx.component.has_domain(self.domain) {
-            return Ok(Array::zeros(self.data_type(), ctx.component.domain_size(domain)));
+            return Ok(Array::zeros(
+                self.data_type(),
+                ctx.component.domain_size(domain),
+            ));
         }
         let a = self.field.evaluate(ctx, self.domain)?;
         Ok(ctx.component.adapt(&a, self.domain, domain))

@@ -14,7 +14,12 @@ fn mix(data: &Array, n_out: usize, pairs: &[(u32, u32)]) -> Array {
     for &(o, _) in pairs {
         count[o as usize] += 1.0;
     }
-    fn lanes<const K: usize>(v: &[[f32; K]], n_out: usize, pairs: &[(u32, u32)], count: &[f32]) -> Vec<[f32; K]> {
+    fn lanes<const K: usize>(
+        v: &[[f32; K]],
+        n_out: usize,
+        pairs: &[(u32, u32)],
+        count: &[f32],
+    ) -> Vec<[f32; K]> {
         let mut sum = vec![[0.0f32; K]; n_out];
         for &(o, s) in pairs {
             for k in 0..K {
@@ -31,7 +36,12 @@ fn mix(data: &Array, n_out: usize, pairs: &[(u32, u32)]) -> Array {
         }
         sum
     }
-    fn ints<const K: usize>(v: &[[i32; K]], n_out: usize, pairs: &[(u32, u32)], count: &[f32]) -> Vec<[i32; K]> {
+    fn ints<const K: usize>(
+        v: &[[i32; K]],
+        n_out: usize,
+        pairs: &[(u32, u32)],
+        count: &[f32],
+    ) -> Vec<[i32; K]> {
         let mut sum = vec![[0.0f64; K]; n_out];
         for &(o, s) in pairs {
             for k in 0..K {
@@ -54,7 +64,12 @@ fn mix(data: &Array, n_out: usize, pairs: &[(u32, u32)]) -> Array {
     match data {
         Array::Float(v) => {
             let w: Vec<[f32; 1]> = v.iter().map(|x| [*x]).collect();
-            Array::Float(lanes(&w, n_out, pairs, &count).into_iter().map(|x| x[0]).collect())
+            Array::Float(
+                lanes(&w, n_out, pairs, &count)
+                    .into_iter()
+                    .map(|x| x[0])
+                    .collect(),
+            )
         }
         Array::Float2(v) => Array::Float2(lanes(v, n_out, pairs, &count)),
         Array::Vector(v) => Array::Vector(lanes(v, n_out, pairs, &count)),
@@ -81,17 +96,32 @@ fn mix(data: &Array, n_out: usize, pairs: &[(u32, u32)]) -> Array {
         }
         Array::Int(v) => {
             let w: Vec<[i32; 1]> = v.iter().map(|x| [*x]).collect();
-            Array::Int(ints(&w, n_out, pairs, &count).into_iter().map(|x| x[0]).collect())
+            Array::Int(
+                ints(&w, n_out, pairs, &count)
+                    .into_iter()
+                    .map(|x| x[0])
+                    .collect(),
+            )
         }
         Array::Int8(v) => {
             let w: Vec<[i32; 1]> = v.iter().map(|x| [*x as i32]).collect();
-            Array::Int8(ints(&w, n_out, pairs, &count).into_iter().map(|x| x[0].clamp(-128, 127) as i8).collect())
+            Array::Int8(
+                ints(&w, n_out, pairs, &count)
+                    .into_iter()
+                    .map(|x| x[0].clamp(-128, 127) as i8)
+                    .collect(),
+            )
         }
         Array::Int2(v) => Array::Int2(ints(v, n_out, pairs, &count)),
         Array::Bool(v) => {
             // The generic boolean mixer: true when at least half the inputs are.
             let f: Vec<[f32; 1]> = v.iter().map(|x| [if *x { 1.0 } else { 0.0 }]).collect();
-            Array::Bool(lanes(&f, n_out, pairs, &count).into_iter().map(|x| x[0] >= 0.5).collect())
+            Array::Bool(
+                lanes(&f, n_out, pairs, &count)
+                    .into_iter()
+                    .map(|x| x[0] >= 0.5)
+                    .collect(),
+            )
         }
     }
 }
@@ -136,8 +166,24 @@ pub fn adapt_mesh(mesh: &Mesh, data: &Array, from: Domain, to: Domain) -> Array 
     let faces = mesh.face_count();
     match (from, to) {
         // One to one: copies.
-        (Point, Corner) => return data.gather(&mesh.corner_verts.iter().map(|&v| v as usize).collect::<Vec<_>>()),
-        (Face, Corner) => return data.gather(&mesh.corner_faces().iter().map(|&f| f as usize).collect::<Vec<_>>()),
+        (Point, Corner) => {
+            return data.gather(
+                &mesh
+                    .corner_verts
+                    .iter()
+                    .map(|&v| v as usize)
+                    .collect::<Vec<_>>(),
+            )
+        }
+        (Face, Corner) => {
+            return data.gather(
+                &mesh
+                    .corner_faces()
+                    .iter()
+                    .map(|&f| f as usize)
+                    .collect::<Vec<_>>(),
+            )
+        }
         (Corner, Point) => {
             for (c, &v) in mesh.corner_verts.iter().enumerate() {
                 pairs.push((v, c as u32));
@@ -160,7 +206,11 @@ pub fn adapt_mesh(mesh: &Mesh, data: &Array, from: Domain, to: Domain) -> Array 
         (Face, Point) | (Face, Edge) => {
             for f in 0..faces {
                 for c in mesh.face(f) {
-                    let o = if to == Point { mesh.corner_verts[c] } else { mesh.corner_edges[c] };
+                    let o = if to == Point {
+                        mesh.corner_verts[c]
+                    } else {
+                        mesh.corner_edges[c]
+                    };
                     pairs.push((o, f as u32));
                 }
             }

@@ -25,10 +25,14 @@ fn f3(v: &[f64]) -> [f32; 3] {
 
 pub fn to_curves(cu: &Curve) -> Result<Curves, GeometryError> {
     let here = format!("curves[{:?}]", cu.name);
-    let mut c = Curves { curve_offsets: vec![0], ..Default::default() };
+    let mut c = Curves {
+        curve_offsets: vec![0],
+        ..Default::default()
+    };
     let (mut types, mut cyclic, mut res) = (Vec::new(), Vec::new(), Vec::new());
     let (mut hl, mut hr, mut htl, mut htr) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
-    let (mut radius, mut tilt, mut weight, mut order) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let (mut radius, mut tilt, mut weight, mut order) =
+        (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut any_bezier = false;
     let mut any_nurbs = false;
     for (i, s) in cu.splines.iter().enumerate() {
@@ -36,7 +40,11 @@ pub fn to_curves(cu: &Curve) -> Result<Curves, GeometryError> {
             "BEZIER" => CURVE_TYPE_BEZIER,
             "POLY" => CURVE_TYPE_POLY,
             "NURBS" => CURVE_TYPE_NURBS,
-            other => return Err(GeometryError::new(format!("{here}.splines[{i}]: spline type {other} is not supported"))),
+            other => {
+                return Err(GeometryError::new(format!(
+                    "{here}.splines[{i}]: spline type {other} is not supported"
+                )))
+            }
         };
         if t == CURVE_TYPE_BEZIER {
             any_bezier = true;
@@ -70,25 +78,65 @@ pub fn to_curves(cu: &Curve) -> Result<Curves, GeometryError> {
         order.push(s.order_u as i32);
         c.curve_offsets.push(c.positions.len() as u32);
     }
-    let twist = cu.properties.get("twist_mode").and_then(|v| v.as_str()).unwrap_or("MINIMUM");
-    let mode = if twist == "Z_UP" { NORMAL_MODE_Z_UP } else { NORMAL_MODE_MINIMUM_TWIST };
+    let twist = cu
+        .properties
+        .get("twist_mode")
+        .and_then(|v| v.as_str())
+        .unwrap_or("MINIMUM");
+    let mode = if twist == "Z_UP" {
+        NORMAL_MODE_Z_UP
+    } else {
+        NORMAL_MODE_MINIMUM_TWIST
+    };
     let n = types.len();
     let a = &mut c.attributes;
-    a.set(AttrId::named("curve_type"), Domain::Curve, Array::Int8(types.iter().map(|t| *t as i8).collect()));
+    a.set(
+        AttrId::named("curve_type"),
+        Domain::Curve,
+        Array::Int8(types.iter().map(|t| *t as i8).collect()),
+    );
     a.set(AttrId::named("cyclic"), Domain::Curve, Array::Bool(cyclic));
     a.set(AttrId::named("resolution"), Domain::Curve, Array::Int(res));
-    a.set(AttrId::named("normal_mode"), Domain::Curve, Array::Int8(vec![mode; n]));
+    a.set(
+        AttrId::named("normal_mode"),
+        Domain::Curve,
+        Array::Int8(vec![mode; n]),
+    );
     a.set(AttrId::named("radius"), Domain::Point, Array::Float(radius));
     a.set(AttrId::named("tilt"), Domain::Point, Array::Float(tilt));
     if any_bezier {
-        a.set(AttrId::named("handle_left"), Domain::Point, Array::Vector(hl));
-        a.set(AttrId::named("handle_right"), Domain::Point, Array::Vector(hr));
-        a.set(AttrId::named("handle_type_left"), Domain::Point, Array::Int8(htl.iter().map(|t| *t as i8).collect()));
-        a.set(AttrId::named("handle_type_right"), Domain::Point, Array::Int8(htr.iter().map(|t| *t as i8).collect()));
+        a.set(
+            AttrId::named("handle_left"),
+            Domain::Point,
+            Array::Vector(hl),
+        );
+        a.set(
+            AttrId::named("handle_right"),
+            Domain::Point,
+            Array::Vector(hr),
+        );
+        a.set(
+            AttrId::named("handle_type_left"),
+            Domain::Point,
+            Array::Int8(htl.iter().map(|t| *t as i8).collect()),
+        );
+        a.set(
+            AttrId::named("handle_type_right"),
+            Domain::Point,
+            Array::Int8(htr.iter().map(|t| *t as i8).collect()),
+        );
     }
     if any_nurbs {
-        a.set(AttrId::named("nurbs_weight"), Domain::Point, Array::Float(weight));
-        a.set(AttrId::named("nurbs_order"), Domain::Curve, Array::Int8(order.iter().map(|t| *t as i8).collect()));
+        a.set(
+            AttrId::named("nurbs_weight"),
+            Domain::Point,
+            Array::Float(weight),
+        );
+        a.set(
+            AttrId::named("nurbs_order"),
+            Domain::Curve,
+            Array::Int8(order.iter().map(|t| *t as i8).collect()),
+        );
     }
     c.materials = cu.materials.clone();
     Ok(c)

@@ -8,7 +8,12 @@ pub type V3 = [f32; 3];
 pub type Mat4f = [[f32; 4]; 4];
 pub type Mat3f = [[f32; 3]; 3];
 
-pub const MAT4_IDENTITY: Mat4f = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
+pub const MAT4_IDENTITY: Mat4f = [
+    [1.0, 0.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0, 0.0],
+    [0.0, 0.0, 1.0, 0.0],
+    [0.0, 0.0, 0.0, 1.0],
+];
 
 #[inline]
 pub fn add(a: V3, b: V3) -> V3 {
@@ -32,7 +37,11 @@ pub fn dot(a: V3, b: V3) -> f32 {
 }
 #[inline]
 pub fn cross(a: V3, b: V3) -> V3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 #[inline]
 pub fn length(a: V3) -> f32 {
@@ -102,7 +111,12 @@ pub fn euler_to_quat(e: V3) -> [f32; 4] {
     let (ci, cj, ch) = (ti.cos(), tj.cos(), th.cos());
     let (si, sj, sh) = (ti.sin(), tj.sin(), th.sin());
     let (cc, cs, sc, ss) = (ci * ch, ci * sh, si * ch, si * sh);
-    [cj * cc + sj * ss, cj * sc - sj * cs, cj * ss + sj * cc, cj * cs - sj * sc]
+    [
+        cj * cc + sj * ss,
+        cj * sc - sj * cs,
+        cj * ss + sj * cc,
+        cj * cs - sj * sc,
+    ]
 }
 
 /// `from_rotation<float3x3>(EulerXYZ)` (`eul_to_mat3`), `m[col][row]`.
@@ -110,7 +124,11 @@ pub fn euler_to_mat3(e: V3) -> Mat3f {
     let (ci, cj, ch) = (e[0].cos(), e[1].cos(), e[2].cos());
     let (si, sj, sh) = (e[0].sin(), e[1].sin(), e[2].sin());
     let (cc, cs, sc, ss) = (ci * ch, ci * sh, si * ch, si * sh);
-    [[cj * ch, cj * sh, -sj], [sj * sc - cs, sj * ss + cc, cj * si], [sj * cc + ss, sj * cs - sc, cj * ci]]
+    [
+        [cj * ch, cj * sh, -sj],
+        [sj * sc - cs, sj * ss + cc, cj * si],
+        [sj * cc + ss, sj * cs - sc, cj * ci],
+    ]
 }
 
 /// `from_rotation<float3x3>(Quaternion)` (`quat_to_mat3`): the products are formed from
@@ -131,7 +149,11 @@ pub fn quat_to_mat3(q: [f32; 4]) -> Mat3f {
     let qbc = q2 * q3;
     let qcc = q3 * q3;
     let d = |a: f32, b: f32| (1.0f64 - a as f64 - b as f64) as f32;
-    [[d(qbb, qcc), qdc + qab, -qdb + qac], [-qdc + qab, d(qaa, qcc), qda + qbc], [qdb + qac, -qda + qbc, d(qaa, qbb)]]
+    [
+        [d(qbb, qcc), qdc + qab, -qdb + qac],
+        [-qdc + qab, d(qaa, qcc), qda + qbc],
+        [qdb + qac, -qda + qbc, d(qaa, qbb)],
+    ]
 }
 
 pub fn quat_to_mat4(q: [f32; 4]) -> Mat4f {
@@ -154,8 +176,16 @@ pub fn mat3_to_euler(m: &Mat3f) -> V3 {
     let cy = m[0][0].hypot(m[0][1]);
     let (e1, e2);
     if cy > 16.0 * f32::EPSILON {
-        e1 = [m[1][2].atan2(m[2][2]), (-m[0][2]).atan2(cy), m[0][1].atan2(m[0][0])];
-        e2 = [(-m[1][2]).atan2(-m[2][2]), (-m[0][2]).atan2(-cy), (-m[0][1]).atan2(-m[0][0])];
+        e1 = [
+            m[1][2].atan2(m[2][2]),
+            (-m[0][2]).atan2(cy),
+            m[0][1].atan2(m[0][0]),
+        ];
+        e2 = [
+            (-m[1][2]).atan2(-m[2][2]),
+            (-m[0][2]).atan2(-cy),
+            (-m[0][1]).atan2(-m[0][0]),
+        ];
     } else {
         e1 = [(-m[2][1]).atan2(m[1][1]), (-m[0][2]).atan2(cy), 0.0];
         e2 = e1;
@@ -181,11 +211,17 @@ pub fn mat3_normalized_to_quat(m: &Mat3f) -> [f32; 4] {
 /// normalization, a negative matrix negated, and the result normalized only when its
 /// squared length is off by 0.0006 or more (so a slightly sheared frame keeps its scale).
 pub fn mat3_to_quat_checked(m: &Mat3f) -> [f32; 4] {
-    let det = m[0][0] * (m[1][1] * m[2][2] - m[2][1] * m[1][2]) - m[1][0] * (m[0][1] * m[2][2] - m[2][1] * m[0][2]) + m[2][0] * (m[0][1] * m[1][2] - m[1][1] * m[0][2]);
+    let det = m[0][0] * (m[1][1] * m[2][2] - m[2][1] * m[1][2])
+        - m[1][0] * (m[0][1] * m[2][2] - m[2][1] * m[0][2])
+        + m[2][0] * (m[0][1] * m[1][2] - m[1][1] * m[0][2]);
     if !det.is_finite() {
         return [1.0, 0.0, 0.0, 0.0];
     }
-    let m = if det < 0.0 { m.map(|c| c.map(|x| -x)) } else { *m };
+    let m = if det < 0.0 {
+        m.map(|c| c.map(|x| -x))
+    } else {
+        *m
+    };
     let q = mat3_to_quat_raw(&m);
     let len_sq = q[1] * q[1] + q[2] * q[2] + q[3] * q[3] + q[0] * q[0];
     if (len_sq - 1.0).abs() >= 0.0002 * 3.0 {
@@ -376,7 +412,11 @@ pub fn flatten(m: &Mat4f) -> [f32; 16] {
 
 /// The transpose of the inverse of the 3x3 part, to move normals.
 pub fn normal_matrix(m: &Mat4f) -> Mat3f {
-    let a = [[m[0][0], m[0][1], m[0][2]], [m[1][0], m[1][1], m[1][2]], [m[2][0], m[2][1], m[2][2]]];
+    let a = [
+        [m[0][0], m[0][1], m[0][2]],
+        [m[1][0], m[1][1], m[1][2]],
+        [m[2][0], m[2][1], m[2][2]],
+    ];
     let inv = mat4_invert(&mat3_to_mat4(&a)).unwrap_or(MAT4_IDENTITY);
     // transpose of inverse
     let mut r = [[0.0f32; 3]; 3];

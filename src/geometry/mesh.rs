@@ -24,7 +24,10 @@ pub struct Mesh {
 
 impl Mesh {
     pub fn new() -> Mesh {
-        Mesh { face_offsets: vec![0], ..Default::default() }
+        Mesh {
+            face_offsets: vec![0],
+            ..Default::default()
+        }
     }
     pub fn vertex_count(&self) -> usize {
         self.positions.len()
@@ -84,13 +87,17 @@ impl Mesh {
     /// Checks sizes and indices (a node producing a broken mesh is a bug).
     pub fn validate(&self) -> Result<(), String> {
         let nv = self.vertex_count() as u32;
-        if self.face_offsets.first() != Some(&0) || *self.face_offsets.last().unwrap() as usize != self.corner_count() {
+        if self.face_offsets.first() != Some(&0)
+            || *self.face_offsets.last().unwrap() as usize != self.corner_count()
+        {
             return Err("face offsets do not span the corners".into());
         }
         if self.corner_edges.len() != self.corner_count() {
             return Err("corner_edges has the wrong size".into());
         }
-        if self.edges.iter().any(|e| e[0] >= nv || e[1] >= nv) || self.corner_verts.iter().any(|&v| v >= nv) {
+        if self.edges.iter().any(|e| e[0] >= nv || e[1] >= nv)
+            || self.corner_verts.iter().any(|&v| v >= nv)
+        {
             return Err("vertex index out of range".into());
         }
         let ne = self.edge_count() as u32;
@@ -99,7 +106,13 @@ impl Mesh {
         }
         for a in self.attributes.iter() {
             if a.data.len() != self.domain_size(a.domain) {
-                return Err(format!("attribute {} has {} values for {} {}", a.id.label(), a.data.len(), self.domain_size(a.domain), a.domain.name()));
+                return Err(format!(
+                    "attribute {} has {} values for {} {}",
+                    a.id.label(),
+                    a.data.len(),
+                    self.domain_size(a.domain),
+                    a.domain.name()
+                ));
             }
         }
         Ok(())
@@ -110,7 +123,11 @@ impl Mesh {
         let mut out = Mesh {
             positions: m.positions.clone(),
             edges: m.edges.clone(),
-            face_offsets: if m.face_offsets.is_empty() { vec![0] } else { m.face_offsets.clone() },
+            face_offsets: if m.face_offsets.is_empty() {
+                vec![0]
+            } else {
+                m.face_offsets.clone()
+            },
             corner_verts: m.corner_verts.clone(),
             corner_edges: m.corner_edges.clone(),
             attributes: Attributes::default(),
@@ -151,7 +168,8 @@ impl Mesh {
                 (AttributeData::Int8(v), _) => Array::Int8(v.clone()),
                 (AttributeData::Bool(v), _) => Array::Bool(v.clone()),
             };
-            out.attributes.set(AttrId::Named(a.name.clone()), domain, data);
+            out.attributes
+                .set(AttrId::Named(a.name.clone()), domain, data);
         }
         out
     }
@@ -171,7 +189,11 @@ impl Mesh {
         for f in 0..self.face_count() {
             let r = self.face(f);
             for k in 1..r.len().saturating_sub(1) {
-                m.triangles.push([r.start as u32, (r.start + k) as u32, (r.start + k + 1) as u32]);
+                m.triangles.push([
+                    r.start as u32,
+                    (r.start + k) as u32,
+                    (r.start + k + 1) as u32,
+                ]);
                 m.triangle_faces.push(f as u32);
             }
         }
@@ -195,11 +217,18 @@ impl Mesh {
                 Array::Vector(v) => AttributeData::Float3(v.clone()),
                 Array::Color(v) | Array::ByteColor(v) => AttributeData::Color(v.clone()),
                 Array::Quaternion(v) => AttributeData::Quaternion(v.clone()),
-                Array::Matrix(v) => AttributeData::Float4x4(v.iter().map(super::math::flatten).collect()),
+                Array::Matrix(v) => {
+                    AttributeData::Float4x4(v.iter().map(super::math::flatten).collect())
+                }
                 Array::Int8(v) => AttributeData::Int8(v.clone()),
                 Array::Int2(v) => AttributeData::Int2(v.clone()),
             };
-            m.attributes.push(scene::Attribute { name: name.to_string(), domain, data_type: a.data_type().name().to_string(), data });
+            m.attributes.push(scene::Attribute {
+                name: name.to_string(),
+                domain,
+                data_type: a.data_type().name().to_string(),
+                data,
+            });
         }
         m
     }
@@ -207,15 +236,23 @@ impl Mesh {
     /// Face normals as Blender computes them (`face_normal_calc`): triangles and quads by
     /// a cross product of edge / diagonal vectors, n-gons by Newell's method.
     pub fn face_normals(&self) -> Vec<V3> {
-        (0..self.face_count()).map(|f| self.face_normal(f)).collect()
+        (0..self.face_count())
+            .map(|f| self.face_normal(f))
+            .collect()
     }
 
     pub fn face_normal(&self, f: usize) -> V3 {
         let r = self.face(f);
         let p = |c: usize| self.positions[self.corner_verts[c] as usize];
         let n = match r.len() {
-            3 => cross(sub(p(r.start), p(r.start + 1)), sub(p(r.start + 1), p(r.start + 2))),
-            4 => cross(sub(p(r.start), p(r.start + 2)), sub(p(r.start + 1), p(r.start + 3))),
+            3 => cross(
+                sub(p(r.start), p(r.start + 1)),
+                sub(p(r.start + 1), p(r.start + 2)),
+            ),
+            4 => cross(
+                sub(p(r.start), p(r.start + 2)),
+                sub(p(r.start + 1), p(r.start + 3)),
+            ),
             _ => {
                 let mut n = [0.0f32; 3];
                 let mut prev = p(r.end - 1);
@@ -265,7 +302,13 @@ impl Mesh {
         }
         acc.iter()
             .enumerate()
-            .map(|(v, n)| if used[v] { normalize(*n) } else { normalize(self.positions[v]) })
+            .map(|(v, n)| {
+                if used[v] {
+                    normalize(*n)
+                } else {
+                    normalize(self.positions[v])
+                }
+            })
             .collect()
     }
 
@@ -378,7 +421,10 @@ impl Mesh {
         let maps = if self.face_count() < 1000 {
             1
         } else {
-            let threads = std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1).min(8);
+            let threads = std::thread::available_parallelism()
+                .map(|n| n.get())
+                .unwrap_or(1)
+                .min(8);
             1usize << (usize::BITS - 1 - threads.leading_zeros())
         };
         let mask = (maps - 1) as u32;
@@ -443,7 +489,11 @@ impl Mesh {
             self.attributes.remove(&AttrId::named("sharp_edge"));
         } else {
             let n = self.face_count();
-            self.attributes.set(AttrId::named("sharp_face"), Domain::Face, Array::Bool(vec![true; n]));
+            self.attributes.set(
+                AttrId::named("sharp_face"),
+                Domain::Face,
+                Array::Bool(vec![true; n]),
+            );
         }
     }
 
@@ -452,7 +502,9 @@ impl Mesh {
         if id.name() == Some("position") {
             return Some((Domain::Point, Array::Vector(self.positions.clone())));
         }
-        self.attributes.get(id).map(|a: &Attribute| (a.domain, a.data.clone()))
+        self.attributes
+            .get(id)
+            .map(|a: &Attribute| (a.domain, a.data.clone()))
     }
 }
 
@@ -462,7 +514,8 @@ impl Mesh {
 pub fn safe_acos_approx(x: f32) -> f32 {
     let f = x.abs();
     let m = if f < 1.0 { 1.0 - (1.0 - f) } else { 1.0 };
-    let a = (1.0 - m).sqrt() * (1.570_796_3 + m * (-0.213_300_99 + m * (0.077_980_48 + m * -0.021_640_95)));
+    let a = (1.0 - m).sqrt()
+        * (1.570_796_3 + m * (-0.213_300_99 + m * (0.077_980_48 + m * -0.021_640_95)));
     if x < 0.0 {
         std::f32::consts::PI - a
     } else {

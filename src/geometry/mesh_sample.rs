@@ -25,8 +25,15 @@ pub struct Triangles {
 impl Triangles {
     pub fn new(m: &Mesh) -> Result<Triangles, String> {
         let (corners, faces) = super::nodes::distribute::corner_tris(m)?;
-        let positions = corners.iter().map(|t| t.map(|c| m.positions[m.corner_verts[c as usize] as usize])).collect();
-        Ok(Triangles { corners, faces, positions })
+        let positions = corners
+            .iter()
+            .map(|t| t.map(|c| m.positions[m.corner_verts[c as usize] as usize]))
+            .collect();
+        Ok(Triangles {
+            corners,
+            faces,
+            positions,
+        })
     }
 
     /// Barycentric weights of `p` in triangle `t` (Interpolated).
@@ -81,12 +88,24 @@ pub fn mix3(w: V3, a: Value, b: Value, c: Value) -> Value {
     let f = |x: f32, y: f32, z: f32| w[0] * x + w[1] * y + w[2] * z;
     match (a, b, c) {
         (Value::Float(x), Value::Float(y), Value::Float(z)) => Value::Float(f(x, y, z)),
-        (Value::Int(x), Value::Int(y), Value::Int(z)) => Value::Int(f(x as f32, y as f32, z as f32).round() as i32),
-        (Value::Bool(x), Value::Bool(y), Value::Bool(z)) => Value::Bool(f(x as u8 as f32, y as u8 as f32, z as u8 as f32) >= 0.5),
-        (Value::Vector(x), Value::Vector(y), Value::Vector(z)) => Value::Vector(mix3_v3(w, x, y, z)),
-        (Value::Color(x), Value::Color(y), Value::Color(z)) => Value::Color(std::array::from_fn(|k| f(x[k], y[k], z[k]))),
-        (Value::Quaternion(x), Value::Quaternion(y), Value::Quaternion(z)) => Value::Quaternion(mix3_quat(w, x, y, z)),
-        (Value::Matrix(x), Value::Matrix(y), Value::Matrix(z)) => Value::Matrix(mix3_matrix(w, &x, &y, &z)),
+        (Value::Int(x), Value::Int(y), Value::Int(z)) => {
+            Value::Int(f(x as f32, y as f32, z as f32).round() as i32)
+        }
+        (Value::Bool(x), Value::Bool(y), Value::Bool(z)) => {
+            Value::Bool(f(x as u8 as f32, y as u8 as f32, z as u8 as f32) >= 0.5)
+        }
+        (Value::Vector(x), Value::Vector(y), Value::Vector(z)) => {
+            Value::Vector(mix3_v3(w, x, y, z))
+        }
+        (Value::Color(x), Value::Color(y), Value::Color(z)) => {
+            Value::Color(std::array::from_fn(|k| f(x[k], y[k], z[k])))
+        }
+        (Value::Quaternion(x), Value::Quaternion(y), Value::Quaternion(z)) => {
+            Value::Quaternion(mix3_quat(w, x, y, z))
+        }
+        (Value::Matrix(x), Value::Matrix(y), Value::Matrix(z)) => {
+            Value::Matrix(mix3_matrix(w, &x, &y, &z))
+        }
         // Fields reaching here are of socket types; anything else keeps the first value.
         (a, _, _) => a,
     }
@@ -130,7 +149,12 @@ pub fn expmap_to_quat(v: V3) -> [f32; 4] {
 }
 
 fn mix3_quat(w: V3, a: [f32; 4], b: [f32; 4], c: [f32; 4]) -> [f32; 4] {
-    expmap_to_quat(mix3_v3(w, quat_to_expmap(a), quat_to_expmap(b), quat_to_expmap(c)))
+    expmap_to_quat(mix3_v3(
+        w,
+        quat_to_expmap(a),
+        quat_to_expmap(b),
+        quat_to_expmap(c),
+    ))
 }
 
 fn column(m: &super::math::Mat4f, k: usize) -> V3 {
@@ -140,7 +164,11 @@ fn column(m: &super::math::Mat4f, k: usize) -> V3 {
 /// `normalized_to_quaternion_safe(normalize(float3x3(m)))`: through Euler angles, which
 /// tolerate shear.
 fn matrix_rotation(m: &super::math::Mat4f) -> [f32; 4] {
-    let r = [normalize(column(m, 0)), normalize(column(m, 1)), normalize(column(m, 2))];
+    let r = [
+        normalize(column(m, 0)),
+        normalize(column(m, 1)),
+        normalize(column(m, 2)),
+    ];
     euler_to_quat(mat3_to_euler(&r))
 }
 
@@ -151,9 +179,19 @@ fn matrix_scale(m: &super::math::Mat4f) -> V3 {
     })
 }
 
-fn mix3_matrix(w: V3, a: &super::math::Mat4f, b: &super::math::Mat4f, c: &super::math::Mat4f) -> super::math::Mat4f {
+fn mix3_matrix(
+    w: V3,
+    a: &super::math::Mat4f,
+    b: &super::math::Mat4f,
+    c: &super::math::Mat4f,
+) -> super::math::Mat4f {
     let loc = mix3_v3(w, column(a, 3), column(b, 3), column(c, 3));
-    let rot = mix3_quat(w, matrix_rotation(a), matrix_rotation(b), matrix_rotation(c));
+    let rot = mix3_quat(
+        w,
+        matrix_rotation(a),
+        matrix_rotation(b),
+        matrix_rotation(c),
+    );
     let scale = mix3_v3(w, matrix_scale(a), matrix_scale(b), matrix_scale(c));
     from_loc_rot_scale(loc, rot, scale)
 }
@@ -176,8 +214,17 @@ mod tests {
     #[test]
     fn integers_round_and_booleans_threshold() {
         let w = [0.25, 0.25, 0.5];
-        assert_eq!(mix3(w, Value::Int(1), Value::Int(2), Value::Int(4)), Value::Int(3));
-        assert_eq!(mix3(w, Value::Bool(true), Value::Bool(true), Value::Bool(false)), Value::Bool(true));
-        assert_eq!(mix3(w, Value::Bool(true), Value::Bool(false), Value::Bool(false)), Value::Bool(false));
+        assert_eq!(
+            mix3(w, Value::Int(1), Value::Int(2), Value::Int(4)),
+            Value::Int(3)
+        );
+        assert_eq!(
+            mix3(w, Value::Bool(true), Value::Bool(true), Value::Bool(false)),
+            Value::Bool(true)
+        );
+        assert_eq!(
+            mix3(w, Value::Bool(true), Value::Bool(false), Value::Bool(false)),
+            Value::Bool(false)
+        );
     }
 }

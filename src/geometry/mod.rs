@@ -29,13 +29,13 @@ pub mod catmull_clark;
 pub mod cdt;
 pub mod curve_eval;
 pub mod curves;
-pub mod legacy_curve;
 pub mod error;
 pub mod eval;
 pub mod export;
 pub mod field;
 pub mod instances;
 pub mod interpolate;
+pub mod legacy_curve;
 pub mod math;
 pub mod mesh;
 pub mod mesh_sample;
@@ -63,13 +63,22 @@ use crate::scene::Scene;
 /// Overrides address anything the export holds, e.g.
 /// `node_groups["G"].nodes["Value"].outputs[0].default_value` = 3 or
 /// `objects["Terrain"].modifiers["Terrain"]["Socket_2"]` = 7.
-pub fn evaluate_object(scene: &Scene, object: &str, frame: f64, overrides: &[(String, serde_json::Value)]) -> Result<GeometrySet, GeometryError> {
+pub fn evaluate_object(
+    scene: &Scene,
+    object: &str,
+    frame: f64,
+    overrides: &[(String, serde_json::Value)],
+) -> Result<GeometrySet, GeometryError> {
     if !frame.is_finite() {
         return Err(GeometryError::new(format!("frame {frame} is not finite")));
     }
     let scene = animated::scene_at(scene, frame, overrides)?;
     let anim = crate::anim::evaluate_scene(&scene, frame)?;
-    let world = anim.world_matrices.iter().map(math::from_rows_f64).collect();
+    let world = anim
+        .world_matrices
+        .iter()
+        .map(math::from_rows_f64)
+        .collect();
     let sort_ids = animated::link_sort_ids(&scene)?;
     let session = eval::Session::new(&scene, frame, world, sort_ids);
     session.evaluate_object(object)

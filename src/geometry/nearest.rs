@@ -88,7 +88,11 @@ pub fn closest_on_triangle(p: V3, a: V3, b: V3, c: V3) -> V3 {
 pub fn normal_tri(a: V3, b: V3, c: V3) -> V3 {
     let n1 = sub(a, b);
     let n2 = sub(b, c);
-    let n = [n1[1] * n2[2] - n1[2] * n2[1], n1[2] * n2[0] - n1[0] * n2[2], n1[0] * n2[1] - n1[1] * n2[0]];
+    let n = [
+        n1[1] * n2[2] - n1[2] * n2[1],
+        n1[2] * n2[0] - n1[0] * n2[2],
+        n1[0] * n2[1] - n1[1] * n2[0],
+    ];
     super::math::normalize_v3(n).0
 }
 
@@ -104,7 +108,9 @@ pub fn interp_weights_tri(a: V3, b: V3, c: V3, p: V3) -> V3 {
     } else {
         (1, 2)
     };
-    let area = |v1: V3, v2: V3, v3: V3| 0.5 * ((v1[i] - v2[i]) * (v2[j] - v3[j]) + (v1[j] - v2[j]) * (v3[i] - v2[i]));
+    let area = |v1: V3, v2: V3, v3: V3| {
+        0.5 * ((v1[i] - v2[i]) * (v2[j] - v3[j]) + (v1[j] - v2[j]) * (v3[i] - v2[i]))
+    };
     let w = [area(b, c, p), area(c, a, p), area(a, b, p)];
     let total = w[0] + w[1] + w[2];
     let inv = 1.0 / total;
@@ -140,7 +146,12 @@ impl NearestTree {
     pub fn build(bounds: &[(V3, V3)]) -> NearestTree {
         let n = bounds.len();
         let mut order: Vec<u32> = (0..n as u32).collect();
-        let mut nodes = vec![Node { min: [0.0; 3], max: [0.0; 3], start: 0, count: n as u32 }];
+        let mut nodes = vec![Node {
+            min: [0.0; 3],
+            max: [0.0; 3],
+            start: 0,
+            count: n as u32,
+        }];
         let mut stack = vec![0usize];
         let centre = |i: u32, a: usize| bounds[i as usize].0[a] + bounds[i as usize].1[a];
         while let Some(ni) = stack.pop() {
@@ -162,12 +173,26 @@ impl NearestTree {
                 continue;
             }
             // Median split along the widest spread of element centres.
-            let axis = (0..3).max_by(|&a, &b| (chi[a] - clo[a]).total_cmp(&(chi[b] - clo[b]))).unwrap();
+            let axis = (0..3)
+                .max_by(|&a, &b| (chi[a] - clo[a]).total_cmp(&(chi[b] - clo[b])))
+                .unwrap();
             let mid = count / 2;
-            order[start..start + count].select_nth_unstable_by(mid, |&x, &y| centre(x, axis).total_cmp(&centre(y, axis)).then(x.cmp(&y)));
+            order[start..start + count].select_nth_unstable_by(mid, |&x, &y| {
+                centre(x, axis).total_cmp(&centre(y, axis)).then(x.cmp(&y))
+            });
             let left = nodes.len();
-            nodes.push(Node { min: lo, max: hi, start: start as u32, count: mid as u32 });
-            nodes.push(Node { min: lo, max: hi, start: (start + mid) as u32, count: (count - mid) as u32 });
+            nodes.push(Node {
+                min: lo,
+                max: hi,
+                start: start as u32,
+                count: mid as u32,
+            });
+            nodes.push(Node {
+                min: lo,
+                max: hi,
+                start: (start + mid) as u32,
+                count: (count - mid) as u32,
+            });
             nodes[ni].start = left as u32;
             nodes[ni].count = 0;
             stack.push(left);
@@ -179,7 +204,11 @@ impl NearestTree {
     /// The element with the smallest `dist(element)` (a squared distance from `q`, with any
     /// payload it computed along), the lowest index among equal ones; None when there are
     /// no elements or no distance is a number.
-    pub fn nearest<T>(&self, q: V3, mut dist: impl FnMut(u32) -> (f32, T)) -> Option<(u32, f32, T)> {
+    pub fn nearest<T>(
+        &self,
+        q: V3,
+        mut dist: impl FnMut(u32) -> (f32, T),
+    ) -> Option<(u32, f32, T)> {
         if self.order.is_empty() {
             return None;
         }
@@ -208,7 +237,10 @@ impl NearestTree {
                 }
             } else {
                 let (l, r) = (node.start, node.start + 1);
-                let (dl, dr) = (box_dist_sq(&self.nodes[l as usize], q), box_dist_sq(&self.nodes[r as usize], q));
+                let (dl, dr) = (
+                    box_dist_sq(&self.nodes[l as usize], q),
+                    box_dist_sq(&self.nodes[r as usize], q),
+                );
                 // The nearer child is searched first (pushed last).
                 if dl <= dr {
                     stack.push(r);
@@ -268,7 +300,9 @@ mod tests {
         let tree = NearestTree::build(&pts.iter().map(|p| (*p, *p)).collect::<Vec<_>>());
         for _ in 0..200 {
             let q = [r() * 1.5, r() * 1.5, r() * 1.5];
-            let (i, d, _) = tree.nearest(q, |i| (dist_sq(pts[i as usize], q), ())).unwrap();
+            let (i, d, _) = tree
+                .nearest(q, |i| (dist_sq(pts[i as usize], q), ()))
+                .unwrap();
             let mut best = (0u32, f32::INFINITY);
             for (k, p) in pts.iter().enumerate() {
                 let dk = dist_sq(*p, q);

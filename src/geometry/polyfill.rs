@@ -66,7 +66,10 @@ impl Fill<'_> {
             if p[0] < minx || p[0] > maxx || p[1] < miny || p[1] > maxy {
                 continue;
             }
-            if span_sign(a, b, *p) != CONCAVE && span_sign(b, c, *p) != CONCAVE && span_sign(c, a, *p) != CONCAVE {
+            if span_sign(a, b, *p) != CONCAVE
+                && span_sign(b, c, *p) != CONCAVE
+                && span_sign(c, a, *p) != CONCAVE
+            {
                 return false;
             }
         }
@@ -80,7 +83,11 @@ impl Fill<'_> {
                 if self.ear_check(ear, accept) {
                     return ear;
                 }
-                ear = if reverse { self.prev[ear] } else { self.next[ear] };
+                ear = if reverse {
+                    self.prev[ear]
+                } else {
+                    self.next[ear]
+                };
             }
         }
         // Degenerate polygon: any convex or tangential vertex, else the last one visited.
@@ -177,5 +184,12 @@ pub fn project(normal: V3, points: impl Iterator<Item = V3>) -> Vec<[f32; 2]> {
         n1 = [if n[2] < 0.0 { -1.0 } else { 1.0 }, 0.0, 0.0];
         n2 = [0.0, 1.0, 0.0];
     }
-    points.map(|p| [n1[0] * p[0] + n1[1] * p[1] + n1[2] * p[2], n2[0] * p[0] + n2[1] * p[1] + n2[2] * p[2]]).collect()
+    points
+        .map(|p| {
+            [
+                n1[0] * p[0] + n1[1] * p[1] + n1[2] * p[2],
+                n2[0] * p[0] + n2[1] * p[1] + n2[2] * p[2],
+            ]
+        })
+        .collect()
 }

@@ -20,7 +20,9 @@ use super::set::GeometrySet;
 use super::types::{Array, DataType, Domain};
 
 /// Attribute ids, types and domains over several parts of one component type.
-fn merged_layout<'a>(parts: impl Iterator<Item = &'a Attributes>) -> Vec<(AttrId, DataType, Domain)> {
+fn merged_layout<'a>(
+    parts: impl Iterator<Item = &'a Attributes>,
+) -> Vec<(AttrId, DataType, Domain)> {
     let mut order: Vec<AttrId> = Vec::new();
     let mut info: HashMap<AttrId, (DataType, Domain)> = HashMap::new();
     for attrs in parts {
@@ -41,10 +43,13 @@ fn merged_layout<'a>(parts: impl Iterator<Item = &'a Attributes>) -> Vec<(AttrId
             }
         }
     }
-    order.into_iter().map(|id| {
-        let (t, d) = info[&id];
-        (id, t, d)
-    }).collect()
+    order
+        .into_iter()
+        .map(|id| {
+            let (t, d) = info[&id];
+            (id, t, d)
+        })
+        .collect()
 }
 
 /// Material slots of all parts, in order of first use; per part the index map.
@@ -52,7 +57,11 @@ fn merge_materials(parts: &[&Vec<Option<String>>]) -> (Vec<Option<String>>, Vec<
     let mut all: Vec<Option<String>> = Vec::new();
     let mut maps = Vec::new();
     for mats in parts {
-        let list: Vec<Option<String>> = if mats.is_empty() { vec![None] } else { mats.to_vec() };
+        let list: Vec<Option<String>> = if mats.is_empty() {
+            vec![None]
+        } else {
+            mats.to_vec()
+        };
         let map = list
             .iter()
             .map(|m| match all.iter().position(|x| x == m) {
@@ -80,22 +89,42 @@ pub fn join_meshes(parts: &[(&Mesh, Mat4f)]) -> Mesh {
     let layout = merged_layout(parts.iter().map(|(m, _)| &m.attributes));
     let mat_lists: Vec<&Vec<Option<String>>> = parts.iter().map(|(m, _)| &m.materials).collect();
     let (materials, maps) = merge_materials(&mat_lists);
-    let any_material_index = parts.iter().any(|(m, _)| m.attributes.named("material_index").is_some()) || materials.len() > 1;
+    let any_material_index = parts
+        .iter()
+        .any(|(m, _)| m.attributes.named("material_index").is_some())
+        || materials.len() > 1;
     let mut material_index: Vec<i32> = Vec::new();
     for (k, (m, t)) in parts.iter().enumerate() {
-        let (v0, e0, c0) = (out.positions.len() as u32, out.edges.len() as u32, out.corner_verts.len() as u32);
+        let (v0, e0, c0) = (
+            out.positions.len() as u32,
+            out.edges.len() as u32,
+            out.corner_verts.len() as u32,
+        );
         if *t == MAT4_IDENTITY {
             out.positions.extend_from_slice(&m.positions);
         } else {
-            out.positions.extend(m.positions.iter().map(|p| transform_point(t, *p)));
+            out.positions
+                .extend(m.positions.iter().map(|p| transform_point(t, *p)));
         }
-        out.edges.extend(m.edges.iter().map(|e| [e[0] + v0, e[1] + v0]));
-        out.face_offsets.extend(m.face_offsets[1..].iter().map(|o| o + c0));
-        out.corner_verts.extend(m.corner_verts.iter().map(|v| v + v0));
-        out.corner_edges.extend(m.corner_edges.iter().map(|e| e + e0));
-        let src_mi = m.attributes.named("material_index").map(|a| a.data.as_int().into_owned()).unwrap_or_else(|| vec![0; m.face_count()]);
+        out.edges
+            .extend(m.edges.iter().map(|e| [e[0] + v0, e[1] + v0]));
+        out.face_offsets
+            .extend(m.face_offsets[1..].iter().map(|o| o + c0));
+        out.corner_verts
+            .extend(m.corner_verts.iter().map(|v| v + v0));
+        out.corner_edges
+            .extend(m.corner_edges.iter().map(|e| e + e0));
+        let src_mi = m
+            .attributes
+            .named("material_index")
+            .map(|a| a.data.as_int().into_owned())
+            .unwrap_or_else(|| vec![0; m.face_count()]);
         let map = &maps[k];
-        material_index.extend(src_mi.iter().map(|&i| map.get(i.max(0) as usize).copied().unwrap_or(map.last().copied().unwrap_or(0))));
+        material_index.extend(src_mi.iter().map(|&i| {
+            map.get(i.max(0) as usize)
+                .copied()
+                .unwrap_or(map.last().copied().unwrap_or(0))
+        }));
     }
     for (id, t, d) in &layout {
         if id.name() == Some("material_index") {
@@ -115,7 +144,11 @@ pub fn join_meshes(parts: &[(&Mesh, Mat4f)]) -> Mesh {
         out.attributes.set(id.clone(), *d, data);
     }
     if any_material_index {
-        out.attributes.set(AttrId::named("material_index"), Domain::Face, Array::Int(material_index));
+        out.attributes.set(
+            AttrId::named("material_index"),
+            Domain::Face,
+            Array::Int(material_index),
+        );
     }
     out.materials = materials;
     out
@@ -125,7 +158,8 @@ pub fn join_points(parts: &[(&PointCloud, Mat4f)]) -> PointCloud {
     let mut out = PointCloud::default();
     let layout = merged_layout(parts.iter().map(|(p, _)| &p.attributes));
     for (p, t) in parts {
-        out.positions.extend(p.positions.iter().map(|x| transform_point(t, *x)));
+        out.positions
+            .extend(p.positions.iter().map(|x| transform_point(t, *x)));
     }
     for (id, ty, _) in &layout {
         let mut data = Array::zeros(*ty, 0);
@@ -143,19 +177,26 @@ pub fn join_points(parts: &[(&PointCloud, Mat4f)]) -> PointCloud {
 }
 
 pub fn join_curves(parts: &[(&Curves, Mat4f)]) -> Curves {
-    let mut out = Curves { curve_offsets: vec![0], ..Default::default() };
+    let mut out = Curves {
+        curve_offsets: vec![0],
+        ..Default::default()
+    };
     let layout = merged_layout(parts.iter().map(|(c, _)| &c.attributes));
     for (c, t) in parts {
         let p0 = out.positions.len() as u32;
-        out.positions.extend(c.positions.iter().map(|x| transform_point(t, *x)));
-        out.curve_offsets.extend(c.curve_offsets[1..].iter().map(|o| o + p0));
+        out.positions
+            .extend(c.positions.iter().map(|x| transform_point(t, *x)));
+        out.curve_offsets
+            .extend(c.curve_offsets[1..].iter().map(|o| o + p0));
     }
     for (id, ty, d) in &layout {
         let mut data = Array::zeros(*ty, 0);
         for (c, t) in parts {
             match c.attributes.get(id) {
                 Some(a) => {
-                    let mut v = ComponentRef::Curves(c).adapt(&a.data, a.domain, *d).convert(*ty);
+                    let mut v = ComponentRef::Curves(c)
+                        .adapt(&a.data, a.domain, *d)
+                        .convert(*ty);
                     // Bezier handles are positions too.
                     if matches!(id.name(), Some("handle_left" | "handle_right")) {
                         if let Array::Vector(h) = &mut v {
@@ -201,19 +242,31 @@ pub fn join_instances(parts: &[&Instances]) -> Instances {
 /// Join Geometry: each component type concatenated over the inputs, in input order.
 pub fn join_geometries(sets: &[GeometrySet]) -> GeometrySet {
     let mut out = GeometrySet::default();
-    let meshes: Vec<(&Mesh, Mat4f)> = sets.iter().filter_map(|s| s.mesh.as_deref()).map(|m| (m, MAT4_IDENTITY)).collect();
+    let meshes: Vec<(&Mesh, Mat4f)> = sets
+        .iter()
+        .filter_map(|s| s.mesh.as_deref())
+        .map(|m| (m, MAT4_IDENTITY))
+        .collect();
     if meshes.len() == 1 {
         out.mesh = sets.iter().find_map(|s| s.mesh.clone());
     } else if !meshes.is_empty() {
         out.mesh = Some(Arc::new(join_meshes(&meshes)));
     }
-    let points: Vec<(&PointCloud, Mat4f)> = sets.iter().filter_map(|s| s.points.as_deref()).map(|m| (m, MAT4_IDENTITY)).collect();
+    let points: Vec<(&PointCloud, Mat4f)> = sets
+        .iter()
+        .filter_map(|s| s.points.as_deref())
+        .map(|m| (m, MAT4_IDENTITY))
+        .collect();
     if points.len() == 1 {
         out.points = sets.iter().find_map(|s| s.points.clone());
     } else if !points.is_empty() {
         out.points = Some(Arc::new(join_points(&points)));
     }
-    let curves: Vec<(&Curves, Mat4f)> = sets.iter().filter_map(|s| s.curves.as_deref()).map(|m| (m, MAT4_IDENTITY)).collect();
+    let curves: Vec<(&Curves, Mat4f)> = sets
+        .iter()
+        .filter_map(|s| s.curves.as_deref())
+        .map(|m| (m, MAT4_IDENTITY))
+        .collect();
     if curves.len() == 1 {
         out.curves = sets.iter().find_map(|s| s.curves.clone());
     } else if !curves.is_empty() {
@@ -238,10 +291,24 @@ struct Part<'a> {
     id: u32,
 }
 
-fn gather<'a>(set: &'a GeometrySet, transform: Mat4f, inherited: Vec<(AttrId, crate::geometry::types::Value)>, id: u32, out: &mut Vec<Part<'a>>) {
-    out.push(Part { set, transform, inherited: inherited.clone(), id });
+fn gather<'a>(
+    set: &'a GeometrySet,
+    transform: Mat4f,
+    inherited: Vec<(AttrId, crate::geometry::types::Value)>,
+    id: u32,
+    out: &mut Vec<Part<'a>>,
+) {
+    out.push(Part {
+        set,
+        transform,
+        inherited: inherited.clone(),
+        id,
+    });
     if let Some(inst) = &set.instances {
-        let stored = inst.attributes.named("id").map(|a| a.data.as_int().into_owned());
+        let stored = inst
+            .attributes
+            .named("id")
+            .map(|a| a.data.as_int().into_owned());
         for i in 0..inst.len() {
             let r = &inst.references[inst.handles[i] as usize];
             let Some(g) = r.geometry() else { continue };
@@ -261,13 +328,26 @@ fn gather<'a>(set: &'a GeometrySet, transform: Mat4f, inherited: Vec<(AttrId, cr
 /// Whether any instances component in the tree has an `id` attribute.
 fn instances_have_ids(set: &GeometrySet) -> bool {
     set.instances.as_ref().is_some_and(|i| {
-        i.attributes.named("id").is_some() || i.references.iter().filter_map(|r| r.geometry()).any(instances_have_ids)
+        i.attributes.named("id").is_some()
+            || i.references
+                .iter()
+                .filter_map(|r| r.geometry())
+                .any(instances_have_ids)
     })
 }
 
 /// Realized ids: each point's stored id (or index) hashed with its instance's id.
 fn realized_ids(stored: Option<Vec<i32>>, n: usize, id: u32) -> Array {
-    Array::Int((0..n).map(|i| crate::nodes::random::hash2(id, stored.as_ref().map(|s| s[i] as u32).unwrap_or(i as u32)) as i32).collect())
+    Array::Int(
+        (0..n)
+            .map(|i| {
+                crate::nodes::random::hash2(
+                    id,
+                    stored.as_ref().map(|s| s[i] as u32).unwrap_or(i as u32),
+                ) as i32
+            })
+            .collect(),
+    )
 }
 
 /// Realize Instances: every instance's geometry moved into place and joined with the
@@ -280,11 +360,34 @@ pub fn realize_instances(set: &GeometrySet) -> GeometrySet {
     let mut parts = Vec::new();
     gather(set, MAT4_IDENTITY, Vec::new(), 0, &mut parts);
     let inst_ids = instances_have_ids(set);
-    let mesh_ids = inst_ids || parts.iter().any(|p| p.set.mesh.as_ref().is_some_and(|m| m.attributes.named("id").is_some()));
-    let point_ids = inst_ids || parts.iter().any(|p| p.set.points.as_ref().is_some_and(|m| m.attributes.named("id").is_some()));
-    let curve_ids = inst_ids || parts.iter().any(|p| p.set.curves.as_ref().is_some_and(|m| m.attributes.named("id").is_some()));
+    let mesh_ids = inst_ids
+        || parts.iter().any(|p| {
+            p.set
+                .mesh
+                .as_ref()
+                .is_some_and(|m| m.attributes.named("id").is_some())
+        });
+    let point_ids = inst_ids
+        || parts.iter().any(|p| {
+            p.set
+                .points
+                .as_ref()
+                .is_some_and(|m| m.attributes.named("id").is_some())
+        });
+    let curve_ids = inst_ids
+        || parts.iter().any(|p| {
+            p.set
+                .curves
+                .as_ref()
+                .is_some_and(|m| m.attributes.named("id").is_some())
+        });
     // Apply inherited instance attributes as point attributes on copies.
-    let with_inherited = |attrs: &Attributes, n: usize, inh: &[(AttrId, crate::geometry::types::Value)], domain: Domain, ids: bool, id: u32| {
+    let with_inherited = |attrs: &Attributes,
+                          n: usize,
+                          inh: &[(AttrId, crate::geometry::types::Value)],
+                          domain: Domain,
+                          ids: bool,
+                          id: u32| {
         let mut a = attrs.clone();
         for (aid, v) in inh {
             if !a.contains(aid) && aid.name() != Some("position") {
@@ -293,7 +396,11 @@ pub fn realize_instances(set: &GeometrySet) -> GeometrySet {
         }
         if ids {
             let stored = a.named("id").map(|x| x.data.as_int().into_owned());
-            a.set(AttrId::named("id"), Domain::Point, realized_ids(stored, n, id));
+            a.set(
+                AttrId::named("id"),
+                Domain::Point,
+                realized_ids(stored, n, id),
+            );
         }
         a
     };
@@ -302,7 +409,14 @@ pub fn realize_instances(set: &GeometrySet) -> GeometrySet {
         .filter_map(|p| {
             p.set.mesh.as_deref().map(|m| {
                 let mut m2 = m.clone();
-                m2.attributes = with_inherited(&m.attributes, m.vertex_count(), &p.inherited, Domain::Point, mesh_ids, p.id);
+                m2.attributes = with_inherited(
+                    &m.attributes,
+                    m.vertex_count(),
+                    &p.inherited,
+                    Domain::Point,
+                    mesh_ids,
+                    p.id,
+                );
                 (m2, p.transform)
             })
         })
@@ -312,7 +426,14 @@ pub fn realize_instances(set: &GeometrySet) -> GeometrySet {
         .filter_map(|p| {
             p.set.points.as_deref().map(|m| {
                 let mut m2 = m.clone();
-                m2.attributes = with_inherited(&m.attributes, m.len(), &p.inherited, Domain::Point, point_ids, p.id);
+                m2.attributes = with_inherited(
+                    &m.attributes,
+                    m.len(),
+                    &p.inherited,
+                    Domain::Point,
+                    point_ids,
+                    p.id,
+                );
                 (m2, p.transform)
             })
         })
@@ -322,7 +443,14 @@ pub fn realize_instances(set: &GeometrySet) -> GeometrySet {
         .filter_map(|p| {
             p.set.curves.as_deref().map(|m| {
                 let mut m2 = m.clone();
-                m2.attributes = with_inherited(&m.attributes, m.point_count(), &p.inherited, Domain::Point, curve_ids, p.id);
+                m2.attributes = with_inherited(
+                    &m.attributes,
+                    m.point_count(),
+                    &p.inherited,
+                    Domain::Point,
+                    curve_ids,
+                    p.id,
+                );
                 (m2, p.transform)
             })
         })
@@ -348,11 +476,17 @@ pub fn realize_instances(set: &GeometrySet) -> GeometrySet {
 pub fn to_mesh(set: &GeometrySet) -> Result<Mesh, String> {
     let r = realize_instances(set);
     if r.curves.is_some() {
-        return Err("the geometry holds curves, which blendsynth cannot convert to a mesh yet".into());
+        return Err(
+            "the geometry holds curves, which blendsynth cannot convert to a mesh yet".into(),
+        );
     }
     let mut m = r.mesh.as_deref().cloned().unwrap_or_else(Mesh::new);
     if let Some(p) = &r.points {
-        let pm = Mesh { positions: p.positions.clone(), face_offsets: vec![0], ..Default::default() };
+        let pm = Mesh {
+            positions: p.positions.clone(),
+            face_offsets: vec![0],
+            ..Default::default()
+        };
         m = join_meshes(&[(&m, MAT4_IDENTITY), (&pm, MAT4_IDENTITY)]);
     }
     Ok(m)

@@ -29,16 +29,28 @@ pub enum ComponentType {
 
 impl GeometrySet {
     pub fn from_mesh(m: Mesh) -> GeometrySet {
-        GeometrySet { mesh: Some(Arc::new(m)), ..Default::default() }
+        GeometrySet {
+            mesh: Some(Arc::new(m)),
+            ..Default::default()
+        }
     }
     pub fn from_points(p: PointCloud) -> GeometrySet {
-        GeometrySet { points: Some(Arc::new(p)), ..Default::default() }
+        GeometrySet {
+            points: Some(Arc::new(p)),
+            ..Default::default()
+        }
     }
     pub fn from_instances(i: Instances) -> GeometrySet {
-        GeometrySet { instances: Some(Arc::new(i)), ..Default::default() }
+        GeometrySet {
+            instances: Some(Arc::new(i)),
+            ..Default::default()
+        }
     }
     pub fn is_empty(&self) -> bool {
-        self.mesh.is_none() && self.curves.is_none() && self.points.is_none() && self.instances.is_none()
+        self.mesh.is_none()
+            && self.curves.is_none()
+            && self.points.is_none()
+            && self.instances.is_none()
     }
     pub fn mesh_mut(&mut self) -> Option<&mut Mesh> {
         self.mesh.as_mut().map(Arc::make_mut)

@@ -366,7 +366,9 @@ impl Value {
                 T::Bool => Value::Bool(a != [0, 0]),
                 T::Color => Value::Color([a[0] as f32, a[1] as f32, 0.0, 1.0]),
                 T::ByteColor => Value::ByteColor([a[0] as f32, a[1] as f32, 0.0, 1.0]),
-                T::Int8 => Value::Int8((((a[0] as i64 + a[1] as i64) / 2) as i32).clamp(-128, 127) as i8),
+                T::Int8 => {
+                    Value::Int8((((a[0] as i64 + a[1] as i64) / 2) as i32).clamp(-128, 127) as i8)
+                }
                 _ => Value::zero(to),
             },
         }
@@ -412,7 +414,12 @@ pub(crate) fn unit_to_byte(f: f32) -> u8 {
 /// sRGB, alpha to 8-bit linear, then decoded.
 pub fn byte_color_roundtrip(c: [f32; 4]) -> [f32; 4] {
     let rgb = |x: f32| srgb_to_linear(unit_to_byte(linear_to_srgb(x)) as f32 / 255.0);
-    [rgb(c[0]), rgb(c[1]), rgb(c[2]), unit_to_byte(c[3]) as f32 / 255.0]
+    [
+        rgb(c[0]),
+        rgb(c[1]),
+        rgb(c[2]),
+        unit_to_byte(c[3]) as f32 / 255.0,
+    ]
 }
 
 /// Values of one type, one per domain element.

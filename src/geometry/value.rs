@@ -68,7 +68,11 @@ impl SocketValue {
 
     /// Reads a default value as the exporter wrote it for a socket of type `kind`.
     pub fn from_json(kind: &str, v: &Json) -> Result<SocketValue, String> {
-        let num = |x: &Json| x.as_f64().map(|f| f as f32).or_else(|| x.as_bool().map(|b| b as u8 as f32));
+        let num = |x: &Json| {
+            x.as_f64()
+                .map(|f| f as f32)
+                .or_else(|| x.as_bool().map(|b| b as u8 as f32))
+        };
         let floats = |x: &Json| -> Option<Vec<f32>> {
             match x {
                 Json::Array(a) => a.iter().map(num).collect(),
@@ -79,11 +83,24 @@ impl SocketValue {
         let field = |val: Value| Ok(SocketValue::Field(Field::Constant(val)));
         match kind {
             "VALUE" => field(Value::Float(num(v).ok_or_else(bad)?)),
-            "INT" => field(Value::Int(v.as_i64().or_else(|| v.as_f64().map(|f| f as i64)).or_else(|| v.as_bool().map(|b| b as i64)).ok_or_else(bad)? as i32)),
-            "BOOLEAN" => field(Value::Bool(v.as_bool().or_else(|| v.as_f64().map(|f| f != 0.0)).ok_or_else(bad)?)),
+            "INT" => field(Value::Int(
+                v.as_i64()
+                    .or_else(|| v.as_f64().map(|f| f as i64))
+                    .or_else(|| v.as_bool().map(|b| b as i64))
+                    .ok_or_else(bad)? as i32,
+            )),
+            "BOOLEAN" => field(Value::Bool(
+                v.as_bool()
+                    .or_else(|| v.as_f64().map(|f| f != 0.0))
+                    .ok_or_else(bad)?,
+            )),
             "VECTOR" => {
                 let f = floats(v).ok_or_else(bad)?;
-                let g = |i: usize| f.get(i).copied().unwrap_or(if f.len() == 1 { f[0] } else { 0.0 });
+                let g = |i: usize| {
+                    f.get(i)
+                        .copied()
+                        .unwrap_or(if f.len() == 1 { f[0] } else { 0.0 })
+                };
                 field(Value::Vector([g(0), g(1), g(2)]))
             }
             "RGBA" => {
@@ -113,8 +130,12 @@ impl SocketValue {
                     field(Value::zero(DataType::Matrix))
                 }
             }
-            "STRING" => Ok(SocketValue::String(v.as_str().unwrap_or_default().to_string())),
-            "MENU" => Ok(SocketValue::Menu(v.as_str().unwrap_or_default().to_string())),
+            "STRING" => Ok(SocketValue::String(
+                v.as_str().unwrap_or_default().to_string(),
+            )),
+            "MENU" => Ok(SocketValue::Menu(
+                v.as_str().unwrap_or_default().to_string(),
+            )),
             "MATERIAL" | "OBJECT" | "COLLECTION" | "IMAGE" | "TEXTURE" => {
                 let name = match v {
                     Json::Null => None,
@@ -136,7 +157,9 @@ impl SocketValue {
 
     /// The socket type (`NodeSocket.type`) an interface socket's `bl_idname` stands for.
     pub fn interface_kind(socket_type: &str) -> &'static str {
-        let s = socket_type.strip_prefix("NodeSocket").unwrap_or(socket_type);
+        let s = socket_type
+            .strip_prefix("NodeSocket")
+            .unwrap_or(socket_type);
         if s.starts_with("Float") {
             "VALUE"
         } else if s.starts_with("Int") {

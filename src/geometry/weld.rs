@@ -22,14 +22,22 @@ const COLLAPSED: i32 = -2;
 /// `kdtree_calc_duplicates_fast` in index order: each selected vertex not yet merged takes
 /// every unmerged selected vertex within `distance`. Returns the destination map (-1 for
 /// vertices left alone, the vertex itself for cluster targets) and the number merged away.
-pub fn duplicates_all(positions: &[[f32; 3]], selection: &[bool], distance: f32) -> (Vec<i32>, usize) {
+pub fn duplicates_all(
+    positions: &[[f32; 3]],
+    selection: &[bool],
+    distance: f32,
+) -> (Vec<i32>, usize) {
     let order: Vec<usize> = (0..positions.len()).filter(|&i| selection[i]).collect();
     duplicates_in_order(positions, &order, distance)
 }
 
 /// The shared search: targets are tried in `order` (the selected vertices); each one not
 /// yet merged takes every unmerged vertex of `order` within `distance`.
-fn duplicates_in_order(positions: &[[f32; 3]], order: &[usize], distance: f32) -> (Vec<i32>, usize) {
+fn duplicates_in_order(
+    positions: &[[f32; 3]],
+    order: &[usize],
+    distance: f32,
+) -> (Vec<i32>, usize) {
     let mut dest = vec![OUT; positions.len()];
     let range_sq = distance * distance;
     // Candidates sorted by x, so each search scans a slab only.
@@ -87,7 +95,11 @@ pub fn duplicates_connected(mesh: &Mesh, selection: &[bool], distance: f32) -> (
         if v1 > v2 {
             std::mem::swap(&mut v1, &mut v2);
         }
-        let dir = [co[v2][0] - co[v1][0], co[v2][1] - co[v1][1], co[v2][2] - co[v1][2]];
+        let dir = [
+            co[v2][0] - co[v1][0],
+            co[v2][1] - co[v1][1],
+            co[v2][2] - co[v1][2],
+        ];
         if dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2] <= dist_sq {
             let influence = (merged[v2] + 1) as f32 / (merged[v1] + merged[v2] + 2) as f32;
             for k in 0..3 {
@@ -153,17 +165,35 @@ pub fn mix_groups(data: &Array, groups: &[Vec<u32>]) -> Array {
     }
     let first = |g: &Vec<u32>| g[0] as usize;
     match data {
-        Array::Float(v) => Array::Float(avg(&v.iter().map(|x| [*x]).collect::<Vec<_>>(), groups).into_iter().map(|x| x[0]).collect()),
+        Array::Float(v) => Array::Float(
+            avg(&v.iter().map(|x| [*x]).collect::<Vec<_>>(), groups)
+                .into_iter()
+                .map(|x| x[0])
+                .collect(),
+        ),
         Array::Float2(v) => Array::Float2(avg(v, groups)),
         Array::Vector(v) => Array::Vector(avg(v, groups)),
         Array::Color(v) => Array::Color(avg(v, groups)),
         Array::ByteColor(v) => Array::ByteColor(avg(v, groups)),
-        Array::Int(v) => Array::Int(avg_i(&v.iter().map(|x| [*x]).collect::<Vec<_>>(), groups).into_iter().map(|x| x[0]).collect()),
+        Array::Int(v) => Array::Int(
+            avg_i(&v.iter().map(|x| [*x]).collect::<Vec<_>>(), groups)
+                .into_iter()
+                .map(|x| x[0])
+                .collect(),
+        ),
         Array::Int2(v) => Array::Int2(avg_i(v, groups)),
         Array::Int8(v) => Array::Int8(
-            avg_i(&v.iter().map(|x| [*x as i32]).collect::<Vec<_>>(), groups).into_iter().map(|x| x[0].clamp(-128, 127) as i8).collect(),
+            avg_i(&v.iter().map(|x| [*x as i32]).collect::<Vec<_>>(), groups)
+                .into_iter()
+                .map(|x| x[0].clamp(-128, 127) as i8)
+                .collect(),
         ),
-        Array::Bool(v) => Array::Bool(groups.iter().map(|g| g.iter().any(|&i| v[i as usize])).collect()),
+        Array::Bool(v) => Array::Bool(
+            groups
+                .iter()
+                .map(|g| g.iter().any(|&i| v[i as usize]))
+                .collect(),
+        ),
         Array::Quaternion(v) => Array::Quaternion(groups.iter().map(|g| v[first(g)]).collect()),
         Array::Matrix(v) => Array::Matrix(groups.iter().map(|g| v[first(g)]).collect()),
     }
@@ -206,7 +236,8 @@ pub fn merge(m: &Mesh, dest: &[i32]) -> Result<Mesh, String> {
     // Edges: collapsed ones go; doubles (same welded ends) join the first.
     let ne = m.edge_count();
     let mut edge_dest = vec![OUT; ne];
-    let mut first_edge: std::collections::HashMap<(usize, usize), usize> = std::collections::HashMap::new();
+    let mut first_edge: std::collections::HashMap<(usize, usize), usize> =
+        std::collections::HashMap::new();
     for (e, ev) in m.edges.iter().enumerate() {
         let (a, b) = (ev[0] as usize, ev[1] as usize);
         if !in_ctx(a) && !in_ctx(b) {
@@ -256,14 +287,28 @@ pub fn merge(m: &Mesh, dest: &[i32]) -> Result<Mesh, String> {
         let mut corners = Vec::with_capacity(r.len());
         if !ctx_face {
             for c in r.clone() {
-                corners.push((m.corner_verts[c] as usize, m.corner_edges[c] as usize, vec![c as u32]));
+                corners.push((
+                    m.corner_verts[c] as usize,
+                    m.corner_edges[c] as usize,
+                    vec![c as u32],
+                ));
             }
-            faces.push(Face { src: f, corners, in_ctx: false });
+            faces.push(Face {
+                src: f,
+                corners,
+                in_ctx: false,
+            });
             continue;
         }
         // Corners "in context" (their vertex or the next one merges) mix with every such
         // corner of the face welded to the same vertex, collapsed ones included.
-        let ctx_corner: Vec<bool> = r.clone().map(|c| in_ctx(m.corner_verts[c] as usize) || in_ctx(m.corner_verts[m.next_corner(f, c)] as usize)).collect();
+        let ctx_corner: Vec<bool> = r
+            .clone()
+            .map(|c| {
+                in_ctx(m.corner_verts[c] as usize)
+                    || in_ctx(m.corner_verts[m.next_corner(f, c)] as usize)
+            })
+            .collect();
         for (k, c) in r.clone().enumerate() {
             let v = vmap(m.corner_verts[c] as usize);
             let e = emap(m.corner_edges[c] as usize);
@@ -271,7 +316,11 @@ pub fn merge(m: &Mesh, dest: &[i32]) -> Result<Mesh, String> {
                 continue;
             }
             let group = if ctx_corner[k] {
-                r.clone().enumerate().filter(|&(j, c2)| ctx_corner[j] && vmap(m.corner_verts[c2] as usize) == v).map(|(_, c2)| c2 as u32).collect()
+                r.clone()
+                    .enumerate()
+                    .filter(|&(j, c2)| ctx_corner[j] && vmap(m.corner_verts[c2] as usize) == v)
+                    .map(|(_, c2)| c2 as u32)
+                    .collect()
             } else {
                 vec![c as u32]
             };
@@ -285,10 +334,15 @@ pub fn merge(m: &Mesh, dest: &[i32]) -> Result<Mesh, String> {
         if seen.windows(2).any(|w| w[0] == w[1]) {
             return Err(format!("face {f} folds onto itself when merged (Blender splits such faces; not supported yet)"));
         }
-        faces.push(Face { src: f, corners, in_ctx: true });
+        faces.push(Face {
+            src: f,
+            corners,
+            in_ctx: true,
+        });
     }
     // Doubles: an in-context face made of edges all shared by a later face removes it.
-    let mut edge_faces: std::collections::HashMap<usize, Vec<usize>> = std::collections::HashMap::new();
+    let mut edge_faces: std::collections::HashMap<usize, Vec<usize>> =
+        std::collections::HashMap::new();
     for (i, f) in faces.iter().enumerate() {
         if f.in_ctx {
             for c in &f.corners {
@@ -301,7 +355,11 @@ pub fn merge(m: &Mesh, dest: &[i32]) -> Result<Mesh, String> {
         if !faces[i].in_ctx || double[i] {
             continue;
         }
-        let mut cand: Vec<usize> = edge_faces[&faces[i].corners[0].1].iter().copied().filter(|&j| j > i && !double[j]).collect();
+        let mut cand: Vec<usize> = edge_faces[&faces[i].corners[0].1]
+            .iter()
+            .copied()
+            .filter(|&j| j > i && !double[j])
+            .collect();
         for c in &faces[i].corners[1..] {
             let list = &edge_faces[&c.1];
             cand.retain(|j| list.contains(j));
@@ -316,12 +374,17 @@ pub fn merge(m: &Mesh, dest: &[i32]) -> Result<Mesh, String> {
 
     let mut out = Mesh::new();
     out.materials = m.materials.clone();
-    out.positions = mix_groups(&Array::Vector(m.positions.clone()), &vgroups).as_vector().into_owned();
+    out.positions = mix_groups(&Array::Vector(m.positions.clone()), &vgroups)
+        .as_vector()
+        .into_owned();
     mix_domain(&m.attributes, &mut out.attributes, Domain::Point, &vgroups);
-    out.edges = egroups.iter().map(|g| {
-        let e = m.edges[g[0] as usize];
-        [vert_final[e[0] as usize], vert_final[e[1] as usize]]
-    }).collect();
+    out.edges = egroups
+        .iter()
+        .map(|g| {
+            let e = m.edges[g[0] as usize];
+            [vert_final[e[0] as usize], vert_final[e[1] as usize]]
+        })
+        .collect();
     mix_domain(&m.attributes, &mut out.attributes, Domain::Edge, &egroups);
     let mut face_src = Vec::new();
     let mut cgroups: Vec<Vec<u32>> = Vec::new();
@@ -338,12 +401,18 @@ pub fn merge(m: &Mesh, dest: &[i32]) -> Result<Mesh, String> {
         out.face_offsets.push(out.corner_verts.len() as u32);
     }
     for a in m.attributes.on(Domain::Face) {
-        out.attributes.set(a.id.clone(), Domain::Face, a.data.gather(&face_src));
+        out.attributes
+            .set(a.id.clone(), Domain::Face, a.data.gather(&face_src));
     }
     mix_domain(&m.attributes, &mut out.attributes, Domain::Corner, &cgroups);
     // Keep Blender's attribute order (creation order of the source).
     let order: Vec<_> = m.attributes.iter().map(|a| a.id.clone()).collect();
-    out.attributes.0.sort_by_key(|a| order.iter().position(|id| id == &a.id).unwrap_or(usize::MAX));
+    out.attributes.0.sort_by_key(|a| {
+        order
+            .iter()
+            .position(|id| id == &a.id)
+            .unwrap_or(usize::MAX)
+    });
     Ok(out)
 }
 
@@ -395,7 +464,11 @@ fn kdtree_balanced_order(positions: &[[f32; 3]], nodes: &mut [usize], axis: usiz
 
 /// `kdtree_calc_duplicates_fast` without index order (as point clouds merge): targets are
 /// tried in the balanced tree's node order.
-pub fn duplicates_tree_order(positions: &[[f32; 3]], selection: &[bool], distance: f32) -> (Vec<i32>, usize) {
+pub fn duplicates_tree_order(
+    positions: &[[f32; 3]],
+    selection: &[bool],
+    distance: f32,
+) -> (Vec<i32>, usize) {
     let mut order: Vec<usize> = (0..positions.len()).filter(|&i| selection[i]).collect();
     kdtree_balanced_order(positions, &mut order, 0);
     duplicates_in_order(positions, &order, distance)

@@ -43,11 +43,21 @@ fn f(p: &Rna, k: &str, default: f64) -> f64 {
     p.get(k).and_then(|v| v.as_f64()).unwrap_or(default)
 }
 
-pub fn camera_info(name: &str, props: &Rna, matrix_world: [[f64; 4]; 4], width: u32, height: u32) -> CameraInfo {
+pub fn camera_info(
+    name: &str,
+    props: &Rna,
+    matrix_world: [[f64; 4]; 4],
+    width: u32,
+    height: u32,
+) -> CameraInfo {
     let lens = f(props, "lens", 50.0);
     let sw = f(props, "sensor_width", 36.0);
     let sh = f(props, "sensor_height", 24.0);
-    let fit = props.get("sensor_fit").and_then(|v| v.as_str()).unwrap_or("AUTO").to_string();
+    let fit = props
+        .get("sensor_fit")
+        .and_then(|v| v.as_str())
+        .unwrap_or("AUTO")
+        .to_string();
     let (w, h) = (width as f64, height as f64);
     // Which image side the sensor spans, and the sensor size along it (Blender's
     // BKE_camera_sensor_fit / sensor_size).
@@ -56,10 +66,22 @@ pub fn camera_info(name: &str, props: &Rna, matrix_world: [[f64; 4]; 4], width: 
         "VERTICAL" => (h, sh),
         _ => (w.max(h), sw),
     };
-    let kind = props.get("type").and_then(|v| v.as_str()).unwrap_or("PERSP");
+    let kind = props
+        .get("type")
+        .and_then(|v| v.as_str())
+        .unwrap_or("PERSP");
     let (projection, focal) = match kind {
         "ORTHO" => ("ORTHO".to_string(), side / f(props, "ortho_scale", 6.0)),
-        "PANO" => (format!("PANO:{}", props.get("panorama_type").and_then(|v| v.as_str()).unwrap_or("FISHEYE_EQUISOLID")), 0.0),
+        "PANO" => (
+            format!(
+                "PANO:{}",
+                props
+                    .get("panorama_type")
+                    .and_then(|v| v.as_str())
+                    .unwrap_or("FISHEYE_EQUISOLID")
+            ),
+            0.0,
+        ),
         other => (other.to_string(), lens / sensor * side),
     };
     let dof = props.get("dof");

@@ -33,7 +33,14 @@ pub struct LabelSpec {
 
 impl Default for LabelSpec {
     fn default() -> Self {
-        LabelSpec { classes: Vec::new(), class_property: "class".into(), min_pixels: 16, mm_per_unit: 1000.0, depth: false, normals: false }
+        LabelSpec {
+            classes: Vec::new(),
+            class_property: "class".into(),
+            min_pixels: 16,
+            mm_per_unit: 1000.0,
+            depth: false,
+            normals: false,
+        }
     }
 }
 
@@ -107,7 +114,12 @@ impl ClassMap {
             .file
             .objects
             .iter()
-            .filter_map(|o| o.custom_properties.get(&spec.class_property).and_then(|v| v.as_str()).map(String::from))
+            .filter_map(|o| {
+                o.custom_properties
+                    .get(&spec.class_property)
+                    .and_then(|v| v.as_str())
+                    .map(String::from)
+            })
             .filter(|n| !names.contains(n))
             .collect();
         extra.sort();
@@ -121,18 +133,32 @@ impl ClassMap {
             .objects
             .iter()
             .map(|o| {
-                if let Some(c) = o.custom_properties.get(&spec.class_property).and_then(|v| v.as_str()) {
+                if let Some(c) = o
+                    .custom_properties
+                    .get(&spec.class_property)
+                    .and_then(|v| v.as_str())
+                {
                     return names.iter().position(|n| n == c);
                 }
-                spec.classes.iter().position(|c| c.objects.iter().any(|p| glob(p, &o.name)))
+                spec.classes
+                    .iter()
+                    .position(|c| c.objects.iter().any(|p| glob(p, &o.name)))
             })
             .collect();
-        ClassMap { names, masks, object_class, object_names: scene.file.objects.iter().map(|o| o.name.clone()).collect() }
+        ClassMap {
+            names,
+            masks,
+            object_class,
+            object_names: scene.file.objects.iter().map(|o| o.name.clone()).collect(),
+        }
     }
 
     /// The class of an object by name.
     pub fn class_of(&self, object: &str) -> Option<usize> {
-        self.object_names.iter().position(|n| n == object).and_then(|i| self.object_class[i])
+        self.object_names
+            .iter()
+            .position(|n| n == object)
+            .and_then(|i| self.object_class[i])
     }
 }
 

@@ -8,8 +8,17 @@ use super::record::FrameRecord;
 
 /// The COCO JSON of the frames of one split. `records` are all frames of the dataset in
 /// index order, so annotation ids are unique across splits too.
-pub fn instances(records: &[FrameRecord], split: &str, names: &[String], description: &str) -> Value {
-    let categories: Vec<Value> = names.iter().enumerate().map(|(i, n)| json!({"id": i + 1, "name": n, "supercategory": "tissue"})).collect();
+pub fn instances(
+    records: &[FrameRecord],
+    split: &str,
+    names: &[String],
+    description: &str,
+) -> Value {
+    let categories: Vec<Value> = names
+        .iter()
+        .enumerate()
+        .map(|(i, n)| json!({"id": i + 1, "name": n, "supercategory": "tissue"}))
+        .collect();
     let mut images = Vec::with_capacity(records.len());
     let mut annotations = Vec::new();
     let mut next_id = 1u64;

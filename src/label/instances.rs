@@ -26,7 +26,11 @@ pub struct InstanceLabel {
 }
 
 /// Labels the instances of one frame, in instance order.
-pub fn extract(ids: &FrameIds, classes: &ClassMap, min_pixels: u64) -> Result<Vec<InstanceLabel>, String> {
+pub fn extract(
+    ids: &FrameIds,
+    classes: &ClassMap,
+    min_pixels: u64,
+) -> Result<Vec<InstanceLabel>, String> {
     ids.check()?;
     let n = ids.instances.len();
     let w = ids.width as usize;
@@ -49,17 +53,25 @@ pub fn extract(ids: &FrameIds, classes: &ClassMap, min_pixels: u64) -> Result<Ve
     }
     let mut out = Vec::new();
     for (i, s) in stats.iter().enumerate() {
-        let Some(class) = classes.class_of(&ids.instances[i].object) else { continue };
+        let Some(class) = classes.class_of(&ids.instances[i].object) else {
+            continue;
+        };
         if s.0 == 0 || s.0 < min_pixels {
             continue;
         }
         let want = (i + 1) as u32;
-        let rle = classes.masks[class].then(|| rle::counts(ids.width, ids.height, |p| ids.instance_id[p] == want));
+        let rle = classes.masks[class]
+            .then(|| rle::counts(ids.width, ids.height, |p| ids.instance_id[p] == want));
         out.push(InstanceLabel {
             instance: i,
             class,
             area: s.0,
-            bbox: [s.1 as u32, s.2 as u32, (s.3 - s.1 + 1) as u32, (s.4 - s.2 + 1) as u32],
+            bbox: [
+                s.1 as u32,
+                s.2 as u32,
+                (s.3 - s.1 + 1) as u32,
+                (s.4 - s.2 + 1) as u32,
+            ],
             rle,
             nearest_depth: ids.depth.as_ref().map(|_| s.5),
         });
@@ -74,5 +86,8 @@ pub fn semantic(ids: &FrameIds, labels: &[InstanceLabel]) -> Vec<u8> {
     for l in labels {
         class_of[l.instance + 1] = (l.class + 1).min(255) as u8;
     }
-    ids.instance_id.iter().map(|&id| class_of[id as usize]).collect()
+    ids.instance_id
+        .iter()
+        .map(|&id| class_of[id as usize])
+        .collect()
 }

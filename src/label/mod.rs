@@ -13,8 +13,8 @@ pub mod camera;
 pub mod classes;
 pub mod coco;
 pub mod instances;
-pub mod record;
 pub mod passes;
+pub mod record;
 pub mod rle;
 pub mod yolo;
 
@@ -52,7 +52,12 @@ impl FrameIds {
     pub fn check(&self) -> Result<(), String> {
         let n = self.width as usize * self.height as usize;
         if self.instance_id.len() != n {
-            return Err(format!("instance_id has {} pixels, expected {}x{} = {n}", self.instance_id.len(), self.width, self.height));
+            return Err(format!(
+                "instance_id has {} pixels, expected {}x{} = {n}",
+                self.instance_id.len(),
+                self.width,
+                self.height
+            ));
         }
         if let Some(d) = &self.depth {
             if d.len() != n {
@@ -64,8 +69,15 @@ impl FrameIds {
                 return Err(format!("normal has {} pixels, expected {n}", d.len()));
             }
         }
-        if let Some(bad) = self.instance_id.iter().find(|&&id| id as usize > self.instances.len()) {
-            return Err(format!("instance id {bad} but only {} instances", self.instances.len()));
+        if let Some(bad) = self
+            .instance_id
+            .iter()
+            .find(|&&id| id as usize > self.instances.len())
+        {
+            return Err(format!(
+                "instance id {bad} but only {} instances",
+                self.instances.len()
+            ));
         }
         Ok(())
     }

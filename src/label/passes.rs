@@ -50,16 +50,44 @@ pub fn depth_mm(z: f32, mm_per_unit: f64) -> u16 {
 
 /// The semantic class pass: 0 background or unlabelled, else class index + 1.
 pub fn semantic(p: &PassImages, classes: &ClassMap) -> Vec<u32> {
-    let of_instance: Vec<u32> = p.instance_objects.iter().map(|o| classes.class_of(o).map_or(0, |c| c as u32 + 1)).collect();
-    p.instance_id.iter().map(|&i| if i == 0 { 0 } else { of_instance.get(i as usize - 1).copied().unwrap_or(0) }).collect()
+    let of_instance: Vec<u32> = p
+        .instance_objects
+        .iter()
+        .map(|o| classes.class_of(o).map_or(0, |c| c as u32 + 1))
+        .collect();
+    p.instance_id
+        .iter()
+        .map(|&i| {
+            if i == 0 {
+                0
+            } else {
+                of_instance.get(i as usize - 1).copied().unwrap_or(0)
+            }
+        })
+        .collect()
 }
 
 /// Writes every pass into `dir` (created if needed); returns the files written.
-pub fn write_passes(dir: &Path, p: &PassImages, classes: &ClassMap, format: PassFormat, mm_per_unit: f64) -> Result<Vec<PathBuf>, String> {
+pub fn write_passes(
+    dir: &Path,
+    p: &PassImages,
+    classes: &ClassMap,
+    format: PassFormat,
+    mm_per_unit: f64,
+) -> Result<Vec<PathBuf>, String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
     let (w, h) = (p.width, p.height);
     let n = (w * h) as usize;
-    for (name, len) in [("depth", p.depth.len()), ("distance", p.distance.len()), ("object_index", p.object_index.len()), ("instance_id", p.instance_id.len()), ("material_index", p.material_index.len()), ("normal", p.normal.len()), ("albedo", p.albedo.len()), ("uv", p.uv.len())] {
+    for (name, len) in [
+        ("depth", p.depth.len()),
+        ("distance", p.distance.len()),
+        ("object_index", p.object_index.len()),
+        ("instance_id", p.instance_id.len()),
+        ("material_index", p.material_index.len()),
+        ("normal", p.normal.len()),
+        ("albedo", p.albedo.len()),
+        ("uv", p.uv.len()),
+    ] {
         if len != n {
             return Err(format!("{name} pass has {len} pixels, {w}x{h} needs {n}"));
         }
@@ -72,44 +100,101 @@ pub fn write_passes(dir: &Path, p: &PassImages, classes: &ClassMap, format: Pass
         written.push(path);
         Ok(())
     };
-    let ids: [(&str, &[u32]); 4] = [("object_index", p.object_index), ("instance_id", p.instance_id), ("material_index", p.material_index), ("semantic", &sem)];
+    let ids: [(&str, &[u32]); 4] = [
+        ("object_index", p.object_index),
+        ("instance_id", p.instance_id),
+        ("material_index", p.material_index),
+        ("semantic", &sem),
+    ];
     match format {
         PassFormat::Exr => {
             let grey = |v: &mut dyn Iterator<Item = f32>| v.map(|x| [x; 3]).collect::<Vec<_>>();
             let far = |d: &f32| if d.is_finite() { *d } else { 1e10 };
-            put("depth.exr".into(), exr_rgb_bytes(w, h, &grey(&mut p.depth.iter().map(far)))?)?;
-            put("distance.exr".into(), exr_rgb_bytes(w, h, &grey(&mut p.distance.iter().map(far)))?)?;
+            put(
+                "depth.exr".into(),
+                exr_rgb_bytes(w, h, &grey(&mut p.depth.iter().map(far)))?,
+            )?;
+            put(
+                "distance.exr".into(),
+                exr_rgb_bytes(w, h, &grey(&mut p.distance.iter().map(far)))?,
+            )?;
             for (name, v) in ids {
-                put(format!("{name}.exr"), exr_rgb_bytes(w, h, &grey(&mut v.iter().map(|&x| x as f32)))?)?;
+                put(
+                    format!("{name}.exr"),
+                    exr_rgb_bytes(w, h, &grey(&mut v.iter().map(|&x| x as f32)))?,
+                )?;
             }
             put("normal.exr".into(), exr_rgb_bytes(w, h, p.normal)?)?;
             put("albedo.exr".into(), exr_rgb_bytes(w, h, p.albedo)?)?;
-            put("uv.exr".into(), exr_rgb_bytes(w, h, &p.uv.iter().map(|u| [u[0], u[1], 0.0]).collect::<Vec<_>>())?)?;
+            put(
+                "uv.exr".into(),
+                exr_rgb_bytes(
+                    w,
+                    h,
+                    &p.uv.iter().map(|u| [u[0], u[1], 0.0]).collect::<Vec<_>>(),
+                )?,
+            )?;
         }
         PassFormat::Png => {
-            let mm = |v: &[f32]| v.iter().map(|&z| depth_mm(z, mm_per_unit)).collect::<Vec<u16>>();
+            let mm = |v: &[f32]| {
+                v.iter()
+                    .map(|&z| depth_mm(z, mm_per_unit))
+                    .collect::<Vec<u16>>()
+            };
             put("depth.png".into(), png16_bytes(w, h, &mm(p.depth))?)?;
             put("distance.png".into(), png16_bytes(w, h, &mm(p.distance))?)?;
             for (name, v) in ids {
-                let v16: Vec<u16> = v.iter().map(|&x| u16::try_from(x).map_err(|_| format!("{name} pass: id {x} does not fit a 16-bit PNG; use EXR passes"))).collect::<Result<_, _>>()?;
+                let v16: Vec<u16> = v
+                    .iter()
+                    .map(|&x| {
+                        u16::try_from(x).map_err(|_| {
+                            format!("{name} pass: id {x} does not fit a 16-bit PNG; use EXR passes")
+                        })
+                    })
+                    .collect::<Result<_, _>>()?;
                 put(format!("{name}.png"), png16_bytes(w, h, &v16)?)?;
             }
             let q8 = |x: f32| (x.clamp(0.0, 1.0) * 255.0 + 0.5) as u8;
-            let normal: Vec<u8> = p.normal.iter().flat_map(|n| n.map(|c| q8(c * 0.5 + 0.5))).collect();
+            let normal: Vec<u8> = p
+                .normal
+                .iter()
+                .flat_map(|n| n.map(|c| q8(c * 0.5 + 0.5)))
+                .collect();
             put("normal.png".into(), png_bytes(w, h, 3, &normal)?)?;
             let albedo: Vec<u8> = p.albedo.iter().flat_map(|a| a.map(q8)).collect();
             put("albedo.png".into(), png_bytes(w, h, 3, &albedo)?)?;
             let q16 = |x: f32| (x.clamp(0.0, 1.0) * 65535.0 + 0.5) as u16;
-            put("uv_u.png".into(), png16_bytes(w, h, &p.uv.iter().map(|u| q16(u[0])).collect::<Vec<_>>())?)?;
-            put("uv_v.png".into(), png16_bytes(w, h, &p.uv.iter().map(|u| q16(u[1])).collect::<Vec<_>>())?)?;
+            put(
+                "uv_u.png".into(),
+                png16_bytes(w, h, &p.uv.iter().map(|u| q16(u[0])).collect::<Vec<_>>())?,
+            )?;
+            put(
+                "uv_v.png".into(),
+                png16_bytes(w, h, &p.uv.iter().map(|u| q16(u[1])).collect::<Vec<_>>())?,
+            )?;
         }
     }
-    let names: serde_json::Map<String, serde_json::Value> = std::iter::once(("0".to_string(), serde_json::Value::from("background")))
-        .chain(classes.names.iter().enumerate().map(|(i, n)| ((i + 1).to_string(), serde_json::Value::from(n.as_str()))))
+    let names: serde_json::Map<String, serde_json::Value> =
+        std::iter::once(("0".to_string(), serde_json::Value::from("background")))
+            .chain(
+                classes
+                    .names
+                    .iter()
+                    .enumerate()
+                    .map(|(i, n)| ((i + 1).to_string(), serde_json::Value::from(n.as_str()))),
+            )
+            .collect();
+    let objects: serde_json::Map<String, serde_json::Value> = p
+        .instance_objects
+        .iter()
+        .enumerate()
+        .map(|(i, o)| ((i + 1).to_string(), serde_json::Value::from(o.as_str())))
         .collect();
-    let objects: serde_json::Map<String, serde_json::Value> = p.instance_objects.iter().enumerate().map(|(i, o)| ((i + 1).to_string(), serde_json::Value::from(o.as_str()))).collect();
     let meta = serde_json::json!({ "semantic": names, "instance_id": objects, "depth_unit": if format == PassFormat::Png { "mm" } else { "scene units" }, "mm_per_unit": mm_per_unit });
-    put("classes.json".into(), serde_json::to_vec_pretty(&meta).map_err(|e| e.to_string())?)?;
+    put(
+        "classes.json".into(),
+        serde_json::to_vec_pretty(&meta).map_err(|e| e.to_string())?,
+    )?;
     Ok(written)
 }
 

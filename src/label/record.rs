@@ -77,13 +77,17 @@ pub fn annotations(
             let inst = &ids.instances[l.instance];
             let (lo, hi) = inst.world_bounds;
             let m = &inst.world_transform;
-            let axis_len = |c: usize| ((0..3).map(|r| (m[r][c] as f64).powi(2)).sum::<f64>()).sqrt();
+            let axis_len =
+                |c: usize| ((0..3).map(|r| (m[r][c] as f64).powi(2)).sum::<f64>()).sqrt();
             let size = match (inst.instance_index, local_bounds(&inst.object)) {
                 (None, Some((llo, lhi))) => [0, 1, 2].map(|k| (lhi[k] - llo[k]) * axis_len(k)),
                 _ => [0, 1, 2].map(|k| (hi[k] - lo[k]) as f64),
             };
             let centre = [0, 1, 2].map(|k| (hi[k] as f64 + lo[k] as f64) / 2.0);
-            let distance = (0..3).map(|k| (centre[k] - camera.location[k]).powi(2)).sum::<f64>().sqrt();
+            let distance = (0..3)
+                .map(|k| (centre[k] - camera.location[k]).powi(2))
+                .sum::<f64>()
+                .sqrt();
             Annotation {
                 object: inst.object.clone(),
                 instance_index: inst.instance_index,

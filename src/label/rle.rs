@@ -58,7 +58,9 @@ pub fn from_string(s: &str) -> Result<Vec<u32>, String> {
         let mut x: i64 = 0;
         let mut k = 0;
         loop {
-            let Some(&ch) = b.get(p) else { return Err("RLE string ends inside a count".into()) };
+            let Some(&ch) = b.get(p) else {
+                return Err("RLE string ends inside a count".into());
+            };
             let c = ch as i64 - 48;
             if !(0..64).contains(&c) {
                 return Err(format!("bad RLE character {:?}", ch as char));
@@ -111,7 +113,15 @@ pub fn area_bbox(height: u32, counts: &[u32]) -> (u64, [u32; 4]) {
     if area == 0 {
         return (0, [0; 4]);
     }
-    (area, [x0 as u32, y0 as u32, (x1 - x0 + 1) as u32, (y1 - y0 + 1) as u32])
+    (
+        area,
+        [
+            x0 as u32,
+            y0 as u32,
+            (x1 - x0 + 1) as u32,
+            (y1 - y0 + 1) as u32,
+        ],
+    )
 }
 
 #[cfg(test)]

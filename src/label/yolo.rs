@@ -9,7 +9,14 @@ pub fn label_text(annotations: &[Annotation], width: u32, height: u32) -> String
     let mut s = String::new();
     for a in annotations {
         let [x, y, bw, bh] = a.bbox.map(|v| v as f64);
-        s.push_str(&format!("{} {:.6} {:.6} {:.6} {:.6}\n", a.category_id - 1, (x + bw / 2.0) / w, (y + bh / 2.0) / h, bw / w, bh / h));
+        s.push_str(&format!(
+            "{} {:.6} {:.6} {:.6} {:.6}\n",
+            a.category_id - 1,
+            (x + bw / 2.0) / w,
+            (y + bh / 2.0) / h,
+            bw / w,
+            bh / h
+        ));
     }
     s
 }
@@ -18,7 +25,9 @@ pub fn label_text(annotations: &[Annotation], width: u32, height: u32) -> String
 /// key: Ultralytics' `check_det_dataset` resolves a relative `path` (even `.`) against
 /// the working directory, but without one it uses the YAML file's own folder.
 pub fn data_yaml(splits: &[String], names: &[String]) -> String {
-    let mut s = String::from("# Ultralytics dataset written by blendsynth; paths are relative to this file's folder.\n");
+    let mut s = String::from(
+        "# Ultralytics dataset written by blendsynth; paths are relative to this file's folder.\n",
+    );
     for sp in splits {
         s.push_str(&format!("{sp}: images/{sp}\n"));
     }
@@ -26,7 +35,9 @@ pub fn data_yaml(splits: &[String], names: &[String]) -> String {
     // split only) names its first split for it, so `check_det_dataset` accepts it.
     for need in ["train", "val"] {
         if let (false, Some(first)) = (splits.iter().any(|sp| sp == need), splits.first()) {
-            s.push_str(&format!("{need}: images/{first}  # no {need} split in this dataset\n"));
+            s.push_str(&format!(
+                "{need}: images/{first}  # no {need} split in this dataset\n"
+            ));
         }
     }
     s.push_str(&format!("nc: {}\nnames:\n", names.len()));
@@ -43,7 +54,10 @@ mod tests {
     #[test]
     fn a_single_split_also_serves_as_val() {
         let y = data_yaml(&["train".into()], &["polyp".into()]);
-        assert!(y.contains("train: images/train\n") && y.contains("val: images/train "), "{y}");
+        assert!(
+            y.contains("train: images/train\n") && y.contains("val: images/train "),
+            "{y}"
+        );
         let y = data_yaml(&["train".into(), "val".into()], &["polyp".into()]);
         assert_eq!(y.matches("val:").count(), 1, "{y}");
     }

@@ -18,7 +18,10 @@ pub struct BrickSettings {
 fn brick_noise(n: u32) -> f32 {
     let mut n = n.wrapping_add(1013) & 0x7fff_ffff;
     n ^= n >> 13;
-    let nn = n.wrapping_mul(n.wrapping_mul(n).wrapping_mul(60493).wrapping_add(19990303)).wrapping_add(1376312589) & 0x7fff_ffff;
+    let nn = n
+        .wrapping_mul(n.wrapping_mul(n).wrapping_mul(60493).wrapping_add(19990303))
+        .wrapping_add(1376312589)
+        & 0x7fff_ffff;
     0.5 * (nn as f32 / 1073741824.0)
 }
 
@@ -35,7 +38,15 @@ fn smoothstep(f: f32) -> f32 {
 
 /// (tint, mortar) at `p` (already scaled).
 #[allow(clippy::too_many_arguments)]
-pub fn brick(p: Vec3, mortar_size: f32, mortar_smooth: f32, bias: f32, mut brick_width: f32, row_height: f32, s: BrickSettings) -> (f32, f32) {
+pub fn brick(
+    p: Vec3,
+    mortar_size: f32,
+    mortar_smooth: f32,
+    bias: f32,
+    mut brick_width: f32,
+    row_height: f32,
+    s: BrickSettings,
+) -> (f32, f32) {
     let rownum = (p[1] / row_height).floor() as i32;
     let mut offset = 0.0;
     if s.offset_frequency != 0 && s.squash_frequency != 0 {
@@ -80,7 +91,15 @@ pub fn brick_texture(
     s: BrickSettings,
 ) -> (Vec3, f32) {
     let p = [vector[0] * scale, vector[1] * scale, vector[2] * scale];
-    let (tint, f) = brick(p, mortar_size, mortar_smooth, bias, brick_width, row_height, s);
+    let (tint, f) = brick(
+        p,
+        mortar_size,
+        mortar_smooth,
+        bias,
+        brick_width,
+        row_height,
+        s,
+    );
     let mut c = color1;
     if f != 1.0 {
         let facm = 1.0 - tint;

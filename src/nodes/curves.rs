@@ -108,7 +108,10 @@ fn calc_handle(b: &mut Bez, prev: Option<Bez>, next: Option<Bez>) {
         len_b = 1.0;
     }
     if b.h == HD_AUTO || b.h == HD_AUTO_ANIM {
-        let tvec = [dvec_b[0] / len_b + dvec_a[0] / len_a, dvec_b[1] / len_b + dvec_a[1] / len_a];
+        let tvec = [
+            dvec_b[0] / len_b + dvec_a[0] / len_a,
+            dvec_b[1] / len_b + dvec_a[1] / len_a,
+        ];
         let len = len2(tvec) * 2.5614;
         if len != 0.0 {
             let la = len_a / len;
@@ -183,7 +186,13 @@ fn forward_diff(q0: f32, q1: f32, q2: f32, q3: f32, out: &mut [[f32; 2]], axis: 
 }
 
 /// `curvemap_calc_extend`: beyond the first/last point, flat or along the end handle.
-fn calc_extend(extrapolate: bool, t: &CurveMapTable, x: f32, first: [f32; 2], last: [f32; 2]) -> f32 {
+fn calc_extend(
+    extrapolate: bool,
+    t: &CurveMapTable,
+    x: f32,
+    first: [f32; 2],
+    last: [f32; 2],
+) -> f32 {
     if x <= first[0] {
         if !extrapolate {
             return first[1];
@@ -268,9 +277,17 @@ impl CurveMapping {
         // End handles point at the neighbour's handle instead of its centre.
         if n > 2 {
             let fix = |b: &mut Bez, toward: [f32; 2], left: bool| {
-                let hlen = if left { len2(sub(b.vec[1], b.vec[2])) } else { len2(sub(b.vec[1], b.vec[0])) };
+                let hlen = if left {
+                    len2(sub(b.vec[1], b.vec[2]))
+                } else {
+                    len2(sub(b.vec[1], b.vec[0]))
+                };
                 let mut v = toward;
-                v[0] = if left { v[0].max(b.vec[1][0]) } else { v[0].min(b.vec[1][0]) };
+                v[0] = if left {
+                    v[0].max(b.vec[1][0])
+                } else {
+                    v[0].min(b.vec[1][0])
+                };
                 let v = sub(v, b.vec[1]);
                 let nlen = len2(v);
                 if nlen > f32::EPSILON {
@@ -309,7 +326,13 @@ impl CurveMapping {
         let ext_in = unit(sub(bezt[0].vec[0], bezt[0].vec[1]));
         let ext_out = unit(sub(bezt[n - 1].vec[1], bezt[n - 1].vec[2]));
         let step = (1.0 / CM_TABLE as f32) * (maxtable - mintable);
-        let mut t = CurveMapTable { mintable, range: 1.0 / step, table: [[0.0; 2]; CM_TABLE + 1], ext_in, ext_out };
+        let mut t = CurveMapTable {
+            mintable,
+            range: 1.0 / step,
+            table: [[0.0; 2]; CM_TABLE + 1],
+            ext_in,
+            ext_out,
+        };
         let (first, last) = (all[0], all[all.len() - 1]);
         let mut k = 0usize;
         let lastk = all.len() - 1;
@@ -327,7 +350,11 @@ impl CurveMapping {
             } else {
                 let mut fac1 = all[k][0] - all[k - 1][0];
                 let fac2 = all[k][0] - cur_x;
-                fac1 = if fac1 > f32::EPSILON { fac2 / fac1 } else { 0.0 };
+                fac1 = if fac1 > f32::EPSILON {
+                    fac2 / fac1
+                } else {
+                    0.0
+                };
                 fac1 * all[k - 1][1] + (1.0 - fac1) * all[k][1]
             };
             t.table[a] = [cur_x, y];
@@ -405,15 +432,22 @@ impl CurveTable {
             CurveKind::Float => 1,
         };
         if m.curves.len() < count {
-            return Err(CurveError(format!("mapping has {} curves, {count} needed", m.curves.len())));
+            return Err(CurveError(format!(
+                "mapping has {} curves, {count} needed",
+                m.curves.len()
+            )));
         }
         if m.curves.iter().take(count).any(|c| c.is_empty()) {
             return Err(CurveError("a curve has no points".into()));
         }
         let (min_x, max_x) = m.min_max(count);
         let range = max_x - min_x;
-        let tables: Vec<CurveMapTable> =
-            m.curves.iter().take(count).map(|c| m.make_table(&m.prepared(c))).collect();
+        let tables: Vec<CurveMapTable> = m
+            .curves
+            .iter()
+            .take(count)
+            .map(|c| m.make_table(&m.prepared(c)))
+            .collect();
         let ev = |c: usize, x: f32| evaluate(m.extrapolate, &tables[c], x);
         let size = CURVE_TABLE_SIZE - 1;
         let table = (0..=size)
@@ -429,7 +463,12 @@ impl CurveTable {
                 }
             })
             .collect();
-        Ok(CurveTable { min_x, max_x, extrapolate: m.extrapolate, table })
+        Ok(CurveTable {
+            min_x,
+            max_x,
+            extrapolate: m.extrapolate,
+            table,
+        })
     }
 
     /// Cycles' `rgb_ramp_lookup` (interpolating) of channel `ch` at relative position f.
@@ -479,15 +518,26 @@ impl CurveTable {
 pub fn mapping_from_json(v: &serde_json::Value) -> Result<CurveMapping, CurveError> {
     let bad = |m: String| CurveError(m);
     let num = |k: &str| {
-        v.get(k).and_then(serde_json::Value::as_f64).map(|x| x as f32).ok_or_else(|| bad(format!("mapping has no number {k}")))
+        v.get(k)
+            .and_then(serde_json::Value::as_f64)
+            .map(|x| x as f32)
+            .ok_or_else(|| bad(format!("mapping has no number {k}")))
     };
     let extrapolate = match v.get("extend").and_then(serde_json::Value::as_str) {
         Some("EXTRAPOLATED") => true,
         Some("HORIZONTAL") => false,
         other => return Err(bad(format!("mapping extend {other:?} is not supported"))),
     };
-    let use_clip = v.get("use_clip").and_then(serde_json::Value::as_bool).unwrap_or(false);
-    let clip = [num("clip_min_x")?, num("clip_max_x")?, num("clip_min_y")?, num("clip_max_y")?];
+    let use_clip = v
+        .get("use_clip")
+        .and_then(serde_json::Value::as_bool)
+        .unwrap_or(false);
+    let clip = [
+        num("clip_min_x")?,
+        num("clip_max_x")?,
+        num("clip_min_y")?,
+        num("clip_max_y")?,
+    ];
     let curves = v
         .get("curves")
         .and_then(serde_json::Value::as_array)
@@ -506,16 +556,35 @@ pub fn mapping_from_json(v: &serde_json::Value) -> Result<CurveMapping, CurveErr
                         .filter(|l| l.len() >= 2)
                         .and_then(|l| Some([l[0].as_f64()? as f32, l[1].as_f64()? as f32]))
                         .ok_or_else(|| bad(format!("curve {ci} point {pi}: bad location")))?;
-                    let ht = p.get("handle_type").and_then(serde_json::Value::as_str).unwrap_or("AUTO");
-                    let handle = HandleType::from_blender(ht)
-                        .ok_or_else(|| bad(format!("curve {ci} point {pi}: handle type {ht:?} is not supported")))?;
-                    let select = p.get("select").and_then(serde_json::Value::as_bool).unwrap_or(false);
-                    Ok(CurvePoint { x: xy[0], y: xy[1], handle, select })
+                    let ht = p
+                        .get("handle_type")
+                        .and_then(serde_json::Value::as_str)
+                        .unwrap_or("AUTO");
+                    let handle = HandleType::from_blender(ht).ok_or_else(|| {
+                        bad(format!(
+                            "curve {ci} point {pi}: handle type {ht:?} is not supported"
+                        ))
+                    })?;
+                    let select = p
+                        .get("select")
+                        .and_then(serde_json::Value::as_bool)
+                        .unwrap_or(false);
+                    Ok(CurvePoint {
+                        x: xy[0],
+                        y: xy[1],
+                        handle,
+                        select,
+                    })
                 })
                 .collect::<Result<Vec<_>, _>>()
         })
         .collect::<Result<Vec<_>, _>>()?;
-    Ok(CurveMapping { extrapolate, use_clip, clip, curves })
+    Ok(CurveMapping {
+        extrapolate,
+        use_clip,
+        clip,
+        curves,
+    })
 }
 
 /// One curve of a mapping as Blender itself evaluates it (`BKE_curvemapping_evaluateF`,
@@ -529,9 +598,17 @@ pub struct BlenderCurve {
 
 impl BlenderCurve {
     pub fn new(m: &CurveMapping, index: usize) -> Result<Self, CurveError> {
-        let c = m.curves.get(index).filter(|c| !c.is_empty()).ok_or_else(|| CurveError(format!("mapping has no curve {index} with points")))?;
+        let c = m
+            .curves
+            .get(index)
+            .filter(|c| !c.is_empty())
+            .ok_or_else(|| CurveError(format!("mapping has no curve {index} with points")))?;
         let table = m.make_table(&m.prepared(c));
-        Ok(BlenderCurve { table, extrapolate: m.extrapolate, clip_y: m.use_clip.then_some([m.clip[2], m.clip[3]]) })
+        Ok(BlenderCurve {
+            table,
+            extrapolate: m.extrapolate,
+            clip_y: m.use_clip.then_some([m.clip[2], m.clip[3]]),
+        })
     }
     /// `BKE_curvemap_evaluateF`: the curve alone, without the mapping's clipping (what
     /// Geometry Nodes' RGB and Vector Curves use per channel).

@@ -15,7 +15,11 @@ use crate::scene::{Node, NodeTree, Socket};
 pub enum Source<'a> {
     /// Output `output` of flat node `node`; `kind` is that output's socket type
     /// (VALUE, VECTOR, RGBA, ...), so the consumer can apply Blender's implicit conversion.
-    Link { node: usize, output: usize, kind: &'a str },
+    Link {
+        node: usize,
+        output: usize,
+        kind: &'a str,
+    },
     /// A socket's own value: the unlinked input's default, or the default of a group
     /// socket that was left unlinked outside the group.
     Default(&'a Socket),
@@ -46,7 +50,9 @@ pub struct FlatNode<'a> {
 
 impl<'a> FlatNode<'a> {
     pub fn input(&self, identifier: &str) -> Option<&FlatInput<'a>> {
-        self.inputs.iter().find(|i| i.socket.identifier == identifier)
+        self.inputs
+            .iter()
+            .find(|i| i.socket.identifier == identifier)
     }
     pub fn property(&self, key: &str) -> Option<&'a Value> {
         self.node.properties.get(key)
@@ -91,18 +97,30 @@ struct Builder<'a> {
 
 /// Flattens `tree` from its output node `root` (e.g. the active Material Output).
 /// `groups` are the file's node groups, which group nodes name.
-pub fn flatten<'a>(tree: &'a NodeTree, groups: &'a [NodeTree], root: &str) -> Result<FlatGraph<'a>, GraphError> {
+pub fn flatten<'a>(
+    tree: &'a NodeTree,
+    groups: &'a [NodeTree],
+    root: &str,
+) -> Result<FlatGraph<'a>, GraphError> {
     let mut b = Builder {
         groups,
-        instances: vec![Instance { tree, prefix: String::new(), parent: None }],
+        instances: vec![Instance {
+            tree,
+            prefix: String::new(),
+            parent: None,
+        }],
         children: HashMap::new(),
         done: HashMap::new(),
         in_progress: Vec::new(),
         nodes: Vec::new(),
     };
-    let node = find(tree, root).ok_or_else(|| GraphError(format!("node tree {:?} has no node {root:?}", tree.name)))?;
+    let node = find(tree, root)
+        .ok_or_else(|| GraphError(format!("node tree {:?} has no node {root:?}", tree.name)))?;
     let root = b.node(0, node)?;
-    Ok(FlatGraph { nodes: b.nodes, root })
+    Ok(FlatGraph {
+        nodes: b.nodes,
+        root,
+    })
 }
 
 /// The output node Blender renders with: among nodes of type `bl_idname` whose
@@ -112,14 +130,21 @@ pub fn active_output<'a>(tree: &'a NodeTree, bl_idname: &str, target: &str) -> O
         .nodes
         .iter()
         .filter(|n| n.bl_idname == bl_idname)
-        .filter(|n| match n.properties.get("target").and_then(Value::as_str) {
-            Some(t) => t == "ALL" || t == target,
-            None => true,
-        })
+        .filter(
+            |n| match n.properties.get("target").and_then(Value::as_str) {
+                Some(t) => t == "ALL" || t == target,
+                None => true,
+            },
+        )
         .collect();
     candidates
         .iter()
-        .find(|n| n.properties.get("is_active_output").and_then(Value::as_bool) == Some(true))
+        .find(|n| {
+            n.properties
+                .get("is_active_output")
+                .and_then(Value::as_bool)
+                == Some(true)
+        })
         .or(candidates.first())
         .copied()
 }
@@ -139,7 +164,10 @@ impl<'a> Builder<'a> {
 
     fn err(&self, inst: usize, node: &Node, msg: impl std::fmt::Display) -> GraphError {
         let root = &self.instances[0].tree.name;
-        GraphError(format!("node tree {root:?}, node {:?}: {msg}", self.path(inst, node)))
+        GraphError(format!(
+            "node tree {root:?}, node {:?}: {msg}",
+            self.path(inst, node)
+        ))
     }
 
     /// Adds an evaluated node (its inputs first) and returns its flat index.
@@ -166,26 +194,48 @@ impl<'a> Builder<'a> {
     }
 
     /// The sources feeding input socket `s` of `node`.
-    fn input(&mut self, inst: usize, node: &'a Node, s: &'a Socket) -> Result<Vec<Source<'a>>, GraphError> {
+    fn input(
+        &mut self,
+        inst: usize,
+        node: &'a Node,
+        s: &'a Socket,
+    ) -> Result<Vec<Source<'a>>, GraphError> {
         let tree = self.instances[inst].tree;
         let links: Vec<_> = tree
             .links
             .iter()
-            .filter(|l| l.to_node == node.name && l.to_socket == s.identifier && !l.is_muted && l.is_valid)
+            .filter(|l| {
+                l.to_node == node.name && l.to_socket == s.identifier && !l.is_muted && l.is_valid
+            })
             .collect();
         if links.is_empty() {
-            return Ok(vec![if s.default_value.is_some() { Source::Default(s) } else { Source::Nothing }]);
+            return Ok(vec![if s.default_value.is_some() {
+                Source::Default(s)
+            } else {
+                Source::Nothing
+            }]);
         }
         let mut out = Vec::with_capacity(links.len());
         for l in links {
-            let from = find(tree, &l.from_node).ok_or_else(|| self.err(inst, node, format!("links from missing node {:?}", l.from_node)))?;
+            let from = find(tree, &l.from_node).ok_or_else(|| {
+                self.err(
+                    inst,
+                    node,
+                    format!("links from missing node {:?}", l.from_node),
+                )
+            })?;
             out.push(self.output(inst, from, &l.from_socket)?);
         }
         Ok(out)
     }
 
     /// What output `identifier` of `node` provides, seeing through structure.
-    fn output(&mut self, inst: usize, node: &'a Node, identifier: &str) -> Result<Source<'a>, GraphError> {
+    fn output(
+        &mut self,
+        inst: usize,
+        node: &'a Node,
+        identifier: &str,
+    ) -> Result<Source<'a>, GraphError> {
         let index = node
             .outputs
             .iter()
@@ -202,7 +252,13 @@ impl<'a> Builder<'a> {
                         .inputs
                         .iter()
                         .find(|s| s.identifier == identifier)
-                        .ok_or_else(|| self.err(outer, group_node, format!("has no input {identifier:?} for its group's interface")))?;
+                        .ok_or_else(|| {
+                            self.err(
+                                outer,
+                                group_node,
+                                format!("has no input {identifier:?} for its group's interface"),
+                            )
+                        })?;
                     self.single(outer, group_node, s)
                 }
             };
@@ -216,23 +272,47 @@ impl<'a> Builder<'a> {
         if is_group_node(node) {
             let child = self.group_instance(inst, node)?;
             let tree = self.instances[child].tree;
-            let out = active_output(tree, "NodeGroupOutput", "")
-                .ok_or_else(|| self.err(inst, node, format!("group {:?} has no Group Output node", tree.name)))?;
+            let out = active_output(tree, "NodeGroupOutput", "").ok_or_else(|| {
+                self.err(
+                    inst,
+                    node,
+                    format!("group {:?} has no Group Output node", tree.name),
+                )
+            })?;
             let s = out
                 .inputs
                 .iter()
                 .find(|s| s.identifier == identifier)
-                .ok_or_else(|| self.err(inst, node, format!("group {:?} has no output {identifier:?}", tree.name)))?;
+                .ok_or_else(|| {
+                    self.err(
+                        inst,
+                        node,
+                        format!("group {:?} has no output {identifier:?}", tree.name),
+                    )
+                })?;
             return self.single(child, out, s);
         }
         let i = self.node(inst, node)?;
-        Ok(Source::Link { node: i, output: index, kind: &node.outputs[index].kind })
+        Ok(Source::Link {
+            node: i,
+            output: index,
+            kind: &node.outputs[index].kind,
+        })
     }
 
     /// The (first) source of an input that is passed through (reroute, group boundary,
     /// muted node).
-    fn single(&mut self, inst: usize, node: &'a Node, s: &'a Socket) -> Result<Source<'a>, GraphError> {
-        Ok(self.input(inst, node, s)?.into_iter().next().unwrap_or(Source::Nothing))
+    fn single(
+        &mut self,
+        inst: usize,
+        node: &'a Node,
+        s: &'a Socket,
+    ) -> Result<Source<'a>, GraphError> {
+        Ok(self
+            .input(inst, node, s)?
+            .into_iter()
+            .next()
+            .unwrap_or(Source::Nothing))
     }
 
     fn group_instance(&mut self, inst: usize, node: &'a Node) -> Result<usize, GraphError> {
@@ -241,7 +321,10 @@ impl<'a> Builder<'a> {
             return Ok(c);
         }
         let name = node.node_tree.as_deref().unwrap_or_default();
-        let tree = self.groups.iter().find(|g| g.name == name).ok_or_else(|| self.err(inst, node, format!("names missing node group {name:?}")))?;
+        let tree =
+            self.groups.iter().find(|g| g.name == name).ok_or_else(|| {
+                self.err(inst, node, format!("names missing node group {name:?}"))
+            })?;
         // A group that (indirectly) contains itself cannot be inlined.
         let mut up = Some(inst);
         while let Some(i) = up {
@@ -251,7 +334,11 @@ impl<'a> Builder<'a> {
             up = self.instances[i].parent.map(|(p, _)| p);
         }
         let prefix = format!("{}{} > ", self.instances[inst].prefix, node.name);
-        self.instances.push(Instance { tree, prefix, parent: Some((inst, node)) });
+        self.instances.push(Instance {
+            tree,
+            prefix,
+            parent: Some((inst, node)),
+        });
         let c = self.instances.len() - 1;
         self.children.insert(key, c);
         Ok(c)
@@ -264,7 +351,10 @@ impl<'a> Builder<'a> {
 fn pass_through(node: &Node, index: usize) -> Option<&Socket> {
     let out = &node.outputs[index];
     if !node.internal_links.is_empty() {
-        let link = node.internal_links.iter().find(|l| l.to == out.identifier)?;
+        let link = node
+            .internal_links
+            .iter()
+            .find(|l| l.to == out.identifier)?;
         return node.inputs.iter().find(|s| s.identifier == link.from);
     }
     node.inputs.iter().find(|s| s.enabled && s.kind == out.kind)

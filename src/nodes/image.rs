@@ -140,7 +140,13 @@ impl<T: Texel> Pixels<'_, T> {
     }
 
     /// The interpolated texel value at texture coordinates (x, y) (0..1 over the image).
-    pub fn interp(&self, x: f32, y: f32, interpolation: Interpolation, extension: Extension) -> [f32; 4] {
+    pub fn interp(
+        &self,
+        x: f32,
+        y: f32,
+        interpolation: Interpolation,
+        extension: Extension,
+    ) -> [f32; 4] {
         match interpolation {
             Interpolation::Closest => self.closest(x, y, extension),
             Interpolation::Linear => self.linear(x, y, extension),
@@ -151,7 +157,13 @@ impl<T: Texel> Pixels<'_, T> {
     /// The lookup of Geometry Nodes' Image Texture (`node_geo_image_texture.cc`): Cycles'
     /// except Closest with Clip, which is black only left of / below the image and more
     /// than one texel right of / above it, and clamps to the edge in between.
-    pub fn interp_geometry_nodes(&self, x: f32, y: f32, interpolation: Interpolation, extension: Extension) -> [f32; 4] {
+    pub fn interp_geometry_nodes(
+        &self,
+        x: f32,
+        y: f32,
+        interpolation: Interpolation,
+        extension: Extension,
+    ) -> [f32; 4] {
         if interpolation == Interpolation::Closest && extension == Extension::Clip {
             let (_, ix) = frac(x * self.width as f32);
             let (_, iy) = frac(y * self.height as f32);
@@ -326,7 +338,12 @@ pub fn finish_lookup(mut r: [f32; 4], unassociate: bool, srgb: bool) -> [f32; 4]
         r[3] = alpha;
     }
     if srgb {
-        r = [srgb_to_linear(r[0]), srgb_to_linear(r[1]), srgb_to_linear(r[2]), r[3]];
+        r = [
+            srgb_to_linear(r[0]),
+            srgb_to_linear(r[1]),
+            srgb_to_linear(r[2]),
+            r[3],
+        ];
     }
     r
 }
@@ -341,7 +358,11 @@ pub fn project(p: Projection, co: Vec3) -> [f32; 2] {
             let c = co.map(sq);
             let l = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
             if l > 0.0 {
-                let u = if c[0] == 0.0 && c[1] == 0.0 { 0.0 } else { (1.0 - c[0].atan2(c[1]) / std::f32::consts::PI) / 2.0 };
+                let u = if c[0] == 0.0 && c[1] == 0.0 {
+                    0.0
+                } else {
+                    (1.0 - c[0].atan2(c[1]) / std::f32::consts::PI) / 2.0
+                };
                 let v = 1.0 - (c[2] / l.sqrt()).clamp(-1.0, 1.0).acos() / std::f32::consts::PI;
                 [u, v]
             } else {
@@ -352,7 +373,10 @@ pub fn project(p: Projection, co: Vec3) -> [f32; 2] {
             let c = co.map(sq);
             let len = (c[0] * c[0] + c[1] * c[1]).sqrt();
             if len > 0.0 {
-                [(1.0 - (c[0] / len).atan2(c[1] / len) / std::f32::consts::PI) * 0.5, (c[2] + 1.0) * 0.5]
+                [
+                    (1.0 - (c[0] / len).atan2(c[1] / len) / std::f32::consts::PI) * 0.5,
+                    (c[2] + 1.0) * 0.5,
+                ]
             } else {
                 [0.0, 0.0]
             }
@@ -401,9 +425,30 @@ pub fn box_weights(n: Vec3, blend: f32) -> Vec3 {
 /// The image coordinates each box face samples (no face appears mirrored).
 pub fn box_uvs(signed_n: Vec3, co: Vec3) -> [[f32; 2]; 3] {
     [
-        [if signed_n[0] < 0.0 { 1.0 - co[1] } else { co[1] }, co[2]],
-        [if signed_n[1] > 0.0 { 1.0 - co[0] } else { co[0] }, co[2]],
-        [if signed_n[2] > 0.0 { 1.0 - co[1] } else { co[1] }, co[0]],
+        [
+            if signed_n[0] < 0.0 {
+                1.0 - co[1]
+            } else {
+                co[1]
+            },
+            co[2],
+        ],
+        [
+            if signed_n[1] > 0.0 {
+                1.0 - co[0]
+            } else {
+                co[0]
+            },
+            co[2],
+        ],
+        [
+            if signed_n[2] > 0.0 {
+                1.0 - co[1]
+            } else {
+                co[1]
+            },
+            co[0],
+        ],
     ]
 }
 

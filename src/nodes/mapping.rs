@@ -40,7 +40,13 @@ fn safe_div(a: Vec3, b: Vec3) -> Vec3 {
     std::array::from_fn(|i| if b[i] != 0.0 { a[i] / b[i] } else { 0.0 })
 }
 
-pub fn mapping(kind: MappingType, vector: Vec3, location: Vec3, rotation: Vec3, scale: Vec3) -> Vec3 {
+pub fn mapping(
+    kind: MappingType,
+    vector: Vec3,
+    location: Vec3,
+    rotation: Vec3,
+    scale: Vec3,
+) -> Vec3 {
     let r = euler_rows(rotation);
     let mul = |a: Vec3, b: Vec3| -> Vec3 { std::array::from_fn(|i| a[i] * b[i]) };
     match kind {
@@ -49,7 +55,11 @@ pub fn mapping(kind: MappingType, vector: Vec3, location: Vec3, rotation: Vec3, 
             [v[0] + location[0], v[1] + location[1], v[2] + location[2]]
         }
         MappingType::Texture => {
-            let d = [vector[0] - location[0], vector[1] - location[1], vector[2] - location[2]];
+            let d = [
+                vector[0] - location[0],
+                vector[1] - location[1],
+                vector[2] - location[2],
+            ];
             safe_div(rotate_transposed(&r, d), scale)
         }
         MappingType::Vector => rotate(&r, mul(vector, scale)),

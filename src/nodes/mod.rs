@@ -47,8 +47,8 @@ pub mod map_range;
 pub mod math;
 pub mod mix;
 pub mod noise;
-pub mod random;
 pub mod ramp;
+pub mod random;
 pub mod sepcomb;
 pub mod wavelength;
 // Textures.
@@ -209,7 +209,11 @@ const SUPPORTED: &[&str] = &[
 pub fn support_in(tree: &str, bl_idname: &str) -> Support {
     // Geometry Nodes trees: exactly what the geometry evaluator implements.
     if tree == "GeometryNodeTree" && !STRUCTURAL.contains(&bl_idname) {
-        return if crate::geometry::supports_node(bl_idname) { Support::Supported } else { Support::Unsupported };
+        return if crate::geometry::supports_node(bl_idname) {
+            Support::Supported
+        } else {
+            Support::Unsupported
+        };
     }
     match support(bl_idname) {
         Support::Supported if tree != "ShaderNodeTree" => Support::Unsupported,

@@ -67,8 +67,15 @@ fn grad3_x8(hash: [u32; 8], x: [f32; 8], y: [f32; 8], z: [f32; 8]) -> [f32; 8] {
     // SAFETY: AVX2 is enabled for the whole build (the cfg above); loads and stores are
     // unaligned ones of whole 8-lane arrays.
     unsafe {
-        let (x, y, z) = (_mm256_loadu_ps(x.as_ptr()), _mm256_loadu_ps(y.as_ptr()), _mm256_loadu_ps(z.as_ptr()));
-        let h = _mm256_and_si256(_mm256_loadu_si256(hash.as_ptr().cast()), _mm256_set1_epi32(15));
+        let (x, y, z) = (
+            _mm256_loadu_ps(x.as_ptr()),
+            _mm256_loadu_ps(y.as_ptr()),
+            _mm256_loadu_ps(z.as_ptr()),
+        );
+        let h = _mm256_and_si256(
+            _mm256_loadu_si256(hash.as_ptr().cast()),
+            _mm256_set1_epi32(15),
+        );
         let is = |k: i32| _mm256_castsi256_ps(_mm256_cmpeq_epi32(h, _mm256_set1_epi32(k)));
         let below = |k: i32| _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(k), h));
         // blendv takes its second operand where the mask is set.
@@ -76,7 +83,12 @@ fn grad3_x8(hash: [u32; 8], x: [f32; 8], y: [f32; 8], z: [f32; 8]) -> [f32; 8] {
         let vt = _mm256_blendv_ps(z, x, _mm256_or_ps(is(12), is(14)));
         let v = _mm256_blendv_ps(vt, y, below(4));
         // negate_if: flipping the sign bit is exactly negation.
-        let sign = |bit: i32, shift: i32| _mm256_castsi256_ps(_mm256_sllv_epi32(_mm256_and_si256(h, _mm256_set1_epi32(bit)), _mm256_set1_epi32(shift)));
+        let sign = |bit: i32, shift: i32| {
+            _mm256_castsi256_ps(_mm256_sllv_epi32(
+                _mm256_and_si256(h, _mm256_set1_epi32(bit)),
+                _mm256_set1_epi32(shift),
+            ))
+        };
         let g = _mm256_add_ps(_mm256_xor_ps(u, sign(1, 31)), _mm256_xor_ps(v, sign(2, 30)));
         let mut out = [0.0f32; 8];
         _mm256_storeu_ps(out.as_mut_ptr(), g);
@@ -115,7 +127,8 @@ fn tri_mix(v: [f32; 8], x: f32, y: f32, z: f32) -> f32 {
     let x1 = (1.0 - x as f64) as f32;
     let y1 = (1.0 - y as f64) as f32;
     let z1 = (1.0 - z as f64) as f32;
-    z1 * (y1 * (v[0] * x1 + v[1] * x) + y * (v[2] * x1 + v[3] * x)) + z * (y1 * (v[4] * x1 + v[5] * x) + y * (v[6] * x1 + v[7] * x))
+    z1 * (y1 * (v[0] * x1 + v[1] * x) + y * (v[2] * x1 + v[3] * x))
+        + z * (y1 * (v[4] * x1 + v[5] * x) + y * (v[6] * x1 + v[7] * x))
 }
 
 #[inline(always)]
@@ -127,7 +140,11 @@ fn floor_fraction(x: f32) -> (i32, f32) {
 fn perlin_noise1(p: f32) -> f32 {
     let (x, fx) = floor_fraction(p);
     let u = fade(fx);
-    lerp(grad1(hash1(x as u32), fx), grad1(hash1(x.wrapping_add(1) as u32), fx - 1.0), u)
+    lerp(
+        grad1(hash1(x as u32), fx),
+        grad1(hash1(x.wrapping_add(1) as u32), fx - 1.0),
+        u,
+    )
 }
 
 fn perlin_noise2(p: [f32; 2]) -> f32 {
@@ -173,8 +190,19 @@ fn corners4(p: [f32; 4]) -> ([f32; 16], [f32; 4]) {
     let mut g = [0.0f32; 16];
     for (i, g) in g.iter_mut().enumerate() {
         let [dx, dy, dz, dw] = [i & 1, i >> 1 & 1, i >> 2 & 1, i >> 3 & 1].map(|d| d as i32);
-        let h = hash4(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32, z.wrapping_add(dz) as u32, w.wrapping_add(dw) as u32);
-        *g = grad4(h, fx - dx as f32, fy - dy as f32, fz - dz as f32, fw - dw as f32);
+        let h = hash4(
+            x.wrapping_add(dx) as u32,
+            y.wrapping_add(dy) as u32,
+            z.wrapping_add(dz) as u32,
+            w.wrapping_add(dw) as u32,
+        );
+        *g = grad4(
+            h,
+            fx - dx as f32,
+            fy - dy as f32,
+            fz - dz as f32,
+            fw - dw as f32,
+        );
     }
     (g, [fx, fy, fz, fw])
 }
@@ -320,7 +348,10 @@ impl NoisePoint for [f32; 2] {
     }
     #[inline]
     fn perlin_signed(self) -> f32 {
-        let p = [wrap(self[0]) + correction(self[0]), wrap(self[1]) + correction(self[1])];
+        let p = [
+            wrap(self[0]) + correction(self[0]),
+            wrap(self[1]) + correction(self[1]),
+        ];
         perlin_noise2(p) * 0.6616
     }
     fn scaled(self, s: f32) -> Self {
@@ -333,7 +364,10 @@ impl NoisePoint for [f32; 2] {
         [offset_component(seed, 0.0), offset_component(seed, 1.0)]
     }
     fn distortion(self, strength: f32) -> Self {
-        [self.plus(Self::offset(0.0)).perlin_signed() * strength, self.plus(Self::offset(1.0)).perlin_signed() * strength]
+        [
+            self.plus(Self::offset(0.0)).perlin_signed() * strength,
+            self.plus(Self::offset(1.0)).perlin_signed() * strength,
+        ]
     }
 }
 
@@ -353,7 +387,11 @@ impl NoisePoint for [f32; 3] {
         [self[0] + o[0], self[1] + o[1], self[2] + o[2]]
     }
     fn offset(seed: f32) -> Self {
-        [offset_component(seed, 0.0), offset_component(seed, 1.0), offset_component(seed, 2.0)]
+        [
+            offset_component(seed, 0.0),
+            offset_component(seed, 1.0),
+            offset_component(seed, 2.0),
+        ]
     }
     fn distortion(self, strength: f32) -> Self {
         [
@@ -377,10 +415,20 @@ impl NoisePoint for [f32; 4] {
         [s * self[0], s * self[1], s * self[2], s * self[3]]
     }
     fn plus(self, o: Self) -> Self {
-        [self[0] + o[0], self[1] + o[1], self[2] + o[2], self[3] + o[3]]
+        [
+            self[0] + o[0],
+            self[1] + o[1],
+            self[2] + o[2],
+            self[3] + o[3],
+        ]
     }
     fn offset(seed: f32) -> Self {
-        [offset_component(seed, 0.0), offset_component(seed, 1.0), offset_component(seed, 2.0), offset_component(seed, 3.0)]
+        [
+            offset_component(seed, 0.0),
+            offset_component(seed, 1.0),
+            offset_component(seed, 2.0),
+            offset_component(seed, 3.0),
+        ]
     }
     fn distortion(self, strength: f32) -> Self {
         [
@@ -397,7 +445,13 @@ pub fn perlin<P: NoisePoint>(p: P) -> f32 {
     p.perlin_signed() / 2.0 + 0.5
 }
 
-pub fn fbm<P: NoisePoint>(p: P, detail: f32, roughness: f32, lacunarity: f32, normalize: bool) -> f32 {
+pub fn fbm<P: NoisePoint>(
+    p: P,
+    detail: f32,
+    roughness: f32,
+    lacunarity: f32,
+    normalize: bool,
+) -> f32 {
     let mut fscale = 1.0f32;
     let mut amp = 1.0f32;
     let mut maxamp = 0.0f32;
@@ -414,7 +468,11 @@ pub fn fbm<P: NoisePoint>(p: P, detail: f32, roughness: f32, lacunarity: f32, no
         let t = p.scaled(fscale).perlin_signed();
         let sum2 = madd::<P>(t, amp, sum);
         return if normalize {
-            blend::<P>(0.5 * sum / maxamp + 0.5, 0.5 * sum2 / (maxamp + amp) + 0.5, rmd)
+            blend::<P>(
+                0.5 * sum / maxamp + 0.5,
+                0.5 * sum2 / (maxamp + amp) + 0.5,
+                rmd,
+            )
         } else {
             blend::<P>(sum, sum2, rmd)
         };
@@ -441,7 +499,13 @@ pub fn multi_fractal<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacun
     value
 }
 
-pub fn hetero_terrain<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacunarity: f32, offset: f32) -> f32 {
+pub fn hetero_terrain<P: NoisePoint>(
+    mut p: P,
+    detail: f32,
+    roughness: f32,
+    lacunarity: f32,
+    offset: f32,
+) -> f32 {
     let mut pwr = roughness;
     let mut value = offset + p.perlin_signed();
     p = p.scaled(lacunarity);
@@ -458,7 +522,14 @@ pub fn hetero_terrain<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacu
     value
 }
 
-pub fn hybrid_multi_fractal<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacunarity: f32, offset: f32, gain: f32) -> f32 {
+pub fn hybrid_multi_fractal<P: NoisePoint>(
+    mut p: P,
+    detail: f32,
+    roughness: f32,
+    lacunarity: f32,
+    offset: f32,
+    gain: f32,
+) -> f32 {
     let mut pwr = 1.0f32;
     let mut value = 0.0f32;
     let mut weight = 1.0f32;
@@ -485,7 +556,14 @@ pub fn hybrid_multi_fractal<P: NoisePoint>(mut p: P, detail: f32, roughness: f32
     value
 }
 
-pub fn ridged_multi_fractal<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacunarity: f32, offset: f32, gain: f32) -> f32 {
+pub fn ridged_multi_fractal<P: NoisePoint>(
+    mut p: P,
+    detail: f32,
+    roughness: f32,
+    lacunarity: f32,
+    offset: f32,
+    gain: f32,
+) -> f32 {
     let mut pwr = roughness;
     let mut signal = offset - p.perlin_signed().abs();
     signal *= signal;
@@ -542,9 +620,15 @@ fn select<P: NoisePoint>(p: P, n: &NoiseParams) -> f32 {
     match n.kind {
         NoiseType::MultiFractal => multi_fractal(p, n.detail, n.roughness, n.lacunarity),
         NoiseType::Fbm => fbm(p, n.detail, n.roughness, n.lacunarity, n.normalize),
-        NoiseType::HybridMultiFractal => hybrid_multi_fractal(p, n.detail, n.roughness, n.lacunarity, n.offset, n.gain),
-        NoiseType::RidgedMultiFractal => ridged_multi_fractal(p, n.detail, n.roughness, n.lacunarity, n.offset, n.gain),
-        NoiseType::HeteroTerrain => hetero_terrain(p, n.detail, n.roughness, n.lacunarity, n.offset),
+        NoiseType::HybridMultiFractal => {
+            hybrid_multi_fractal(p, n.detail, n.roughness, n.lacunarity, n.offset, n.gain)
+        }
+        NoiseType::RidgedMultiFractal => {
+            ridged_multi_fractal(p, n.detail, n.roughness, n.lacunarity, n.offset, n.gain)
+        }
+        NoiseType::HeteroTerrain => {
+            hetero_terrain(p, n.detail, n.roughness, n.lacunarity, n.offset)
+        }
     }
 }
 
@@ -558,13 +642,24 @@ pub fn fractal_distorted<P: NoisePoint>(p: P, n: &NoiseParams) -> f32 {
 /// seeds of the two extra channels depend on the dimension, as in Blender.
 pub fn fractal_distorted_color<P: NoisePoint>(p: P, n: &NoiseParams, seeds: [f32; 2]) -> [f32; 3] {
     let p = distorted(p, n.distortion);
-    [select(p, n), select(p.plus(P::offset(seeds[0])), n), select(p.plus(P::offset(seeds[1])), n)]
+    [
+        select(p, n),
+        select(p.plus(P::offset(seeds[0])), n),
+        select(p.plus(P::offset(seeds[1])), n),
+    ]
 }
 
 /// The Noise Texture node on one point: `dimensions` 1-4 (`vector` used for 2-4, `w` for
 /// 1 and 4). Returns (Fac, Color).
 #[allow(clippy::too_many_arguments)]
-pub fn noise_texture(dimensions: u8, vector: [f32; 3], w: f32, scale: f32, params: NoiseParams, want_color: bool) -> (f32, [f32; 4]) {
+pub fn noise_texture(
+    dimensions: u8,
+    vector: [f32; 3],
+    w: f32,
+    scale: f32,
+    params: NoiseParams,
+    want_color: bool,
+) -> (f32, [f32; 4]) {
     let mut n = params;
     n.detail = n.detail.clamp(0.0, 15.0);
     n.roughness = n.roughness.max(0.0);
@@ -613,7 +708,11 @@ fn cy_fade(t: f32) -> f32 {
 fn cy_perlin1(p: f32) -> f32 {
     let (x, fx) = floor_fraction(p);
     let u = t_fade1(fx);
-    cy_mix(grad1(hash1(x as u32), fx), grad1(hash1(x.wrapping_add(1) as u32), fx - 1.0), u)
+    cy_mix(
+        grad1(hash1(x as u32), fx),
+        grad1(hash1(x.wrapping_add(1) as u32), fx - 1.0),
+        u,
+    )
 }
 
 /// The scalar 1D kernel's fade: `t * t * t * (t * (t * 6 - 15) + 10)`.
@@ -628,7 +727,11 @@ fn cy_perlin2(p: [f32; 2]) -> f32 {
     let (u, v) = (cy_fade(fx), cy_fade(fy));
     let h = |dx: i32, dy: i32| hash2(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32);
     let g0 = cy_mix(grad2(h(0, 0), fx, fy), grad2(h(1, 0), fx - 1.0, fy), u);
-    let g1 = cy_mix(grad2(h(0, 1), fx, fy - 1.0), grad2(h(1, 1), fx - 1.0, fy - 1.0), u);
+    let g1 = cy_mix(
+        grad2(h(0, 1), fx, fy - 1.0),
+        grad2(h(1, 1), fx - 1.0, fy - 1.0),
+        u,
+    );
     cy_mix(g0, g1, v)
 }
 
@@ -763,7 +866,13 @@ cycles_point!([f32; 4], cy_perlin4, 0.8344);
 
 /// The Noise Texture node as Cycles' shader kernel evaluates it: (Fac, Color).
 #[allow(clippy::too_many_arguments)]
-pub fn noise_texture_cycles(dimensions: u8, vector: [f32; 3], w: f32, scale: f32, params: NoiseParams) -> (f32, [f32; 3]) {
+pub fn noise_texture_cycles(
+    dimensions: u8,
+    vector: [f32; 3],
+    w: f32,
+    scale: f32,
+    params: NoiseParams,
+) -> (f32, [f32; 3]) {
     let mut n = params;
     n.detail = n.detail.clamp(0.0, 15.0);
     n.roughness = n.roughness.max(0.0);
@@ -780,7 +889,13 @@ pub fn noise_texture_cycles(dimensions: u8, vector: [f32; 3], w: f32, scale: f32
 
 /// `noise_texture_cycles` when only Fac is read: the same bits as its Fac, without the
 /// Color output's two extra fractals (Cycles skips them too when Color is unlinked).
-pub fn noise_texture_cycles_fac(dimensions: u8, vector: [f32; 3], w: f32, scale: f32, params: NoiseParams) -> f32 {
+pub fn noise_texture_cycles_fac(
+    dimensions: u8,
+    vector: [f32; 3],
+    w: f32,
+    scale: f32,
+    params: NoiseParams,
+) -> f32 {
     let mut n = params;
     n.detail = n.detail.clamp(0.0, 15.0);
     n.roughness = n.roughness.max(0.0);

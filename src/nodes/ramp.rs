@@ -267,22 +267,49 @@ fn hue_interp(mode: HueInterpolation, mfac: f32, fac: f32, h1: f32, h2: f32) -> 
 /// `interpolation`, `color_mode`, `hue_interpolation`); the error says what is wrong.
 pub fn band_from_json(r: &serde_json::Value) -> Result<ColorBand, String> {
     use serde_json::Value;
-    let elements = r.get("elements").and_then(Value::as_array).ok_or("color_ramp has no elements")?;
+    let elements = r
+        .get("elements")
+        .and_then(Value::as_array)
+        .ok_or("color_ramp has no elements")?;
     let mut stops = Vec::with_capacity(elements.len());
     for e in elements {
-        let position = e.get("position").and_then(Value::as_f64).ok_or("color_ramp element without position")? as f32;
-        let c = e.get("color").and_then(Value::as_array).ok_or("color_ramp element without color")?;
+        let position = e
+            .get("position")
+            .and_then(Value::as_f64)
+            .ok_or("color_ramp element without position")? as f32;
+        let c = e
+            .get("color")
+            .and_then(Value::as_array)
+            .ok_or("color_ramp element without color")?;
         let mut color = [0.0, 0.0, 0.0, 1.0];
         for (o, x) in color.iter_mut().zip(c) {
-            *o = x.as_f64().ok_or("color_ramp element color is not numbers")? as f32;
+            *o = x
+                .as_f64()
+                .ok_or("color_ramp element color is not numbers")? as f32;
         }
         stops.push(RampStop { position, color });
     }
     let s = |k: &str| r.get(k).and_then(Value::as_str).unwrap_or("");
-    let interp = RampInterpolation::from_blender(s("interpolation")).ok_or_else(|| format!("color_ramp interpolation {:?} is not supported", s("interpolation")))?;
-    let cm = RampColorMode::from_blender(s("color_mode")).ok_or_else(|| format!("color_ramp color mode {:?} is not supported", s("color_mode")))?;
-    let hue = HueInterpolation::from_blender(s("hue_interpolation")).ok_or_else(|| format!("color_ramp hue interpolation {:?} is not supported", s("hue_interpolation")))?;
-    ColorBand::new(&stops, interp, cm, hue).ok_or_else(|| "color_ramp needs 1 to 32 elements".to_string())
+    let interp = RampInterpolation::from_blender(s("interpolation")).ok_or_else(|| {
+        format!(
+            "color_ramp interpolation {:?} is not supported",
+            s("interpolation")
+        )
+    })?;
+    let cm = RampColorMode::from_blender(s("color_mode")).ok_or_else(|| {
+        format!(
+            "color_ramp color mode {:?} is not supported",
+            s("color_mode")
+        )
+    })?;
+    let hue = HueInterpolation::from_blender(s("hue_interpolation")).ok_or_else(|| {
+        format!(
+            "color_ramp hue interpolation {:?} is not supported",
+            s("hue_interpolation")
+        )
+    })?;
+    ColorBand::new(&stops, interp, cm, hue)
+        .ok_or_else(|| "color_ramp needs 1 to 32 elements".to_string())
 }
 
 /// The band sampled at `i / RAMP_TABLE_SIZE` for i in 0..=RAMP_TABLE_SIZE, as Blender

@@ -120,7 +120,12 @@ pub fn hash_float_to_float3(k: [f32; 3]) -> f32 {
     uint_to_float_01(hash3(k[0].to_bits(), k[1].to_bits(), k[2].to_bits()))
 }
 pub fn hash_float_to_float4(k: [f32; 4]) -> f32 {
-    uint_to_float_01(hash4(k[0].to_bits(), k[1].to_bits(), k[2].to_bits(), k[3].to_bits()))
+    uint_to_float_01(hash4(
+        k[0].to_bits(),
+        k[1].to_bits(),
+        k[2].to_bits(),
+        k[3].to_bits(),
+    ))
 }
 
 // --- Random Value node ------------------------------------------------------------------
@@ -136,7 +141,11 @@ pub fn random_vector(min: [f32; 3], max: [f32; 3], id: i32, seed: i32) -> [f32; 
     let x = hash_to_float3(seed as u32, id as u32, 0);
     let y = hash_to_float3(seed as u32, id as u32, 1);
     let z = hash_to_float3(seed as u32, id as u32, 2);
-    [x * (max[0] - min[0]) + min[0], y * (max[1] - min[1]) + min[1], z * (max[2] - min[2]) + min[2]]
+    [
+        x * (max[0] - min[0]) + min[0],
+        y * (max[1] - min[1]) + min[1],
+        z * (max[2] - min[2]) + min[2],
+    ]
 }
 
 /// Random Value, Integer: note the swapped hash arguments and `max + 1` (so both ends

@@ -19,24 +19,49 @@ fn rotate_around_axis(p: Vec3, a: Vec3, angle: f32) -> Vec3 {
     let (c, s) = (angle.cos(), angle.sin());
     let t = 1.0 - c;
     [
-        ((c + t * a[0] * a[0]) * p[0]) + ((t * a[0] * a[1] - a[2] * s) * p[1]) + ((t * a[0] * a[2] + a[1] * s) * p[2]),
-        ((t * a[0] * a[1] + a[2] * s) * p[0]) + ((c + t * a[1] * a[1]) * p[1]) + ((t * a[1] * a[2] - a[0] * s) * p[2]),
-        ((t * a[0] * a[2] - a[1] * s) * p[0]) + ((t * a[1] * a[2] + a[0] * s) * p[1]) + ((c + t * a[2] * a[2]) * p[2]),
+        ((c + t * a[0] * a[0]) * p[0])
+            + ((t * a[0] * a[1] - a[2] * s) * p[1])
+            + ((t * a[0] * a[2] + a[1] * s) * p[2]),
+        ((t * a[0] * a[1] + a[2] * s) * p[0])
+            + ((c + t * a[1] * a[1]) * p[1])
+            + ((t * a[1] * a[2] - a[0] * s) * p[2]),
+        ((t * a[0] * a[2] - a[1] * s) * p[0])
+            + ((t * a[1] * a[2] + a[0] * s) * p[1])
+            + ((c + t * a[2] * a[2]) * p[2]),
     ]
 }
 
-pub fn vector_rotate(kind: VectorRotateType, invert: bool, vector: Vec3, center: Vec3, axis: Vec3, angle: f32, rotation: Vec3) -> Vec3 {
-    let d = [vector[0] - center[0], vector[1] - center[1], vector[2] - center[2]];
+pub fn vector_rotate(
+    kind: VectorRotateType,
+    invert: bool,
+    vector: Vec3,
+    center: Vec3,
+    axis: Vec3,
+    angle: f32,
+    rotation: Vec3,
+) -> Vec3 {
+    let d = [
+        vector[0] - center[0],
+        vector[1] - center[1],
+        vector[2] - center[2],
+    ];
     let add_c = |v: Vec3| [v[0] + center[0], v[1] + center[1], v[2] + center[2]];
     if kind == VectorRotateType::EulerXyz {
         let r = euler_rows(rotation);
-        return add_c(if invert { rotate_transposed(&r, d) } else { rotate(&r, d) });
+        return add_c(if invert {
+            rotate_transposed(&r, d)
+        } else {
+            rotate(&r, d)
+        });
     }
     let (axis, len) = match kind {
         VectorRotateType::XAxis => ([1.0, 0.0, 0.0], 1.0),
         VectorRotateType::YAxis => ([0.0, 1.0, 0.0], 1.0),
         VectorRotateType::ZAxis => ([0.0, 0.0, 1.0], 1.0),
-        _ => (axis, (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt()),
+        _ => (
+            axis,
+            (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt(),
+        ),
     };
     let angle = if invert { -angle } else { angle };
     if len != 0.0 {

@@ -14,7 +14,10 @@
 //! the cell-by-cell evaluation (tests/noise_speed.rs).
 
 use super::math::Vec3;
-use super::white_noise::{hash_f1_to_f1, hash_f1_to_f3, hash_f2_to_f2, hash_f2_to_f3, hash_f3_to_f3, hash_f4_to_f3, hash_f4_to_f4};
+use super::white_noise::{
+    hash_f1_to_f1, hash_f1_to_f3, hash_f2_to_f2, hash_f2_to_f3, hash_f3_to_f3, hash_f4_to_f3,
+    hash_f4_to_f4,
+};
 
 blender_enum! {
     pub enum VoronoiFeature {
@@ -225,7 +228,12 @@ where
         let m = side.pow(N as u32) as usize;
         debug_assert!(m <= P && P % 8 == 0);
         // Filled in place: building the arrays apart and moving them in costs a copy.
-        let mut b = Block { m, off: [[0.0f32; P]; N], jitter: [[0.0f32; P]; N], point: [[0.0f32; P]; N] };
+        let mut b = Block {
+            m,
+            off: [[0.0f32; P]; N],
+            jitter: [[0.0f32; P]; N],
+            point: [[0.0f32; P]; N],
+        };
         let mut stride = 1;
         for (i, axis) in b.off.iter_mut().enumerate() {
             for (t, o) in axis.iter_mut().enumerate().take(m) {
@@ -252,14 +260,29 @@ where
         let pt = &self.point;
         // One loop per metric (not a match per cell) so each loop vectorises.
         if N == 1 {
-            d.iter_mut().enumerate().for_each(|(t, d)| *d = (local[0] - pt[0][t]).abs());
+            d.iter_mut()
+                .enumerate()
+                .for_each(|(t, d)| *d = (local[0] - pt[0][t]).abs());
             return d;
         }
         match p.metric {
-            VoronoiMetric::Euclidean => d.iter_mut().enumerate().for_each(|(t, d)| *d = euclidean(at(pt, t), local)),
-            VoronoiMetric::Manhattan => d.iter_mut().enumerate().for_each(|(t, d)| *d = manhattan(at(pt, t), local)),
-            VoronoiMetric::Chebychev => d.iter_mut().enumerate().for_each(|(t, d)| *d = chebychev(at(pt, t), local)),
-            VoronoiMetric::Minkowski => d.iter_mut().take(self.m).enumerate().for_each(|(t, d)| *d = minkowski(at(pt, t), local, p.exponent)),
+            VoronoiMetric::Euclidean => d
+                .iter_mut()
+                .enumerate()
+                .for_each(|(t, d)| *d = euclidean(at(pt, t), local)),
+            VoronoiMetric::Manhattan => d
+                .iter_mut()
+                .enumerate()
+                .for_each(|(t, d)| *d = manhattan(at(pt, t), local)),
+            VoronoiMetric::Chebychev => d
+                .iter_mut()
+                .enumerate()
+                .for_each(|(t, d)| *d = chebychev(at(pt, t), local)),
+            VoronoiMetric::Minkowski => d
+                .iter_mut()
+                .take(self.m)
+                .enumerate()
+                .for_each(|(t, d)| *d = minkowski(at(pt, t), local, p.exponent)),
         }
         d
     }
@@ -302,10 +325,18 @@ where
     match first_min(&d, b.m) {
         Some(t) => {
             let target = add(cell, at(&b.off, t));
-            Octave { distance: d[t], color: D::color_with(target, at(&b.jitter, t)), position: D::position(add(at(&b.point, t), cell)) }
+            Octave {
+                distance: d[t],
+                color: D::color_with(target, at(&b.jitter, t)),
+                position: D::position(add(at(&b.point, t), cell)),
+            }
         }
         // No cell nearer than f32::MAX (NaN input): the initial target, offset 0.
-        None => Octave { distance: f32::MAX, color: D::color(add(cell, [0.0; N])), position: D::position(add([0.0; N], cell)) },
+        None => Octave {
+            distance: f32::MAX,
+            color: D::color(add(cell, [0.0; N])),
+            position: D::position(add([0.0; N], cell)),
+        },
     }
 }
 
@@ -351,9 +382,14 @@ where
         corr /= 1.0 + 3.0 * p.smoothness;
         sc = mixn(sc, at(&color, t), h).map(|x| x - corr);
         sp = mixn(sp, at(&b.point, t), h).map(|x| x - corr);
-        any_neg_zero = neg_zero(sd) || sc.iter().any(|&x| neg_zero(x)) || sp.iter().any(|&x| neg_zero(x));
+        any_neg_zero =
+            neg_zero(sd) || sc.iter().any(|&x| neg_zero(x)) || sp.iter().any(|&x| neg_zero(x));
     }
-    Octave { distance: sd, color: sc, position: D::position(add(cell, sp)) }
+    Octave {
+        distance: sd,
+        color: sc,
+        position: D::position(add(cell, sp)),
+    }
 }
 
 #[inline(always)]
@@ -397,7 +433,11 @@ where
         Some(j) => D::color_with(target, j),
         None => D::color(target),
     };
-    Octave { distance: d2, color, position: D::position(add(pos2, cell)) }
+    Octave {
+        distance: d2,
+        color,
+        position: D::position(add(pos2, cell)),
+    }
 }
 
 fn distance_to_edge<const N: usize, const P: usize>(p: &VoronoiParams, coord: [f32; N]) -> f32
@@ -453,7 +493,8 @@ where
     for (t, d) in d.iter_mut().enumerate() {
         *d = euclidean(at(&b.point, t), local);
     }
-    let (closest, closest_off) = first_min(&d, b.m).map_or(([0.0; N], [0.0; N]), |t| (at(&b.point, t), at(&b.off, t)));
+    let (closest, closest_off) =
+        first_min(&d, b.m).map_or(([0.0; N], [0.0; N]), |t| (at(&b.point, t), at(&b.off, t)));
     // The cells around the closest one, except itself (the middle of the block).
     let b2 = Block::<N, P>::new(cell, closest_off, 1, p.randomness);
     for (t, d) in d.iter_mut().enumerate() {
@@ -464,14 +505,21 @@ where
     euclidean(next, closest) / 2.0
 }
 
-fn fractal_x_fx<const N: usize, const P3: usize, const P5: usize>(p: &VoronoiParams, coord: [f32; N]) -> Octave
+fn fractal_x_fx<const N: usize, const P3: usize, const P5: usize>(
+    p: &VoronoiParams,
+    coord: [f32; N],
+) -> Octave
 where
     D: Cell<N>,
 {
     let mut amplitude = 1.0f32;
     let mut max_amplitude = 0.0f32;
     let mut sc = 1.0f32;
-    let mut out = Octave { distance: 0.0, color: [0.0; 3], position: [0.0; 4] };
+    let mut out = Octave {
+        distance: 0.0,
+        color: [0.0; 3],
+        position: [0.0; 4],
+    };
     let zero_input = p.detail == 0.0 || p.roughness == 0.0;
     let mut i = 0;
     while i as f32 <= p.detail.ceil() {
@@ -497,8 +545,18 @@ where
             let rem = p.detail - p.detail.floor();
             if rem != 0.0 {
                 max_amplitude = mix1(max_amplitude, max_amplitude + amplitude, rem);
-                out.distance = mix1(out.distance, out.distance + octave.distance * amplitude, rem);
-                out.color = std::array::from_fn(|k| mix1(out.color[k], out.color[k] + octave.color[k] * amplitude, rem));
+                out.distance = mix1(
+                    out.distance,
+                    out.distance + octave.distance * amplitude,
+                    rem,
+                );
+                out.color = std::array::from_fn(|k| {
+                    mix1(
+                        out.color[k],
+                        out.color[k] + octave.color[k] * amplitude,
+                        rem,
+                    )
+                });
                 let inner = mixn(out.position, octave.position.map(|x| x / sc), amplitude);
                 out.position = mixn(out.position, inner, rem);
             }
@@ -509,11 +567,16 @@ where
         out.distance /= max_amplitude * p.max_distance;
         out.color = out.color.map(|x| x / max_amplitude);
     }
-    out.position = out.position.map(|x| if p.scale != 0.0 { x / p.scale } else { 0.0 });
+    out.position = out
+        .position
+        .map(|x| if p.scale != 0.0 { x / p.scale } else { 0.0 });
     out
 }
 
-fn fractal_distance_to_edge<const N: usize, const P3: usize>(p: &VoronoiParams, coord: [f32; N]) -> f32
+fn fractal_distance_to_edge<const N: usize, const P3: usize>(
+    p: &VoronoiParams,
+    coord: [f32; N],
+) -> f32
 where
     D: Cell<N>,
 {
@@ -554,7 +617,18 @@ where
 impl VoronoiParams {
     /// Node settings as the sockets give them; clamped here as Cycles clamps them.
     #[allow(clippy::too_many_arguments)]
-    pub fn new(feature: VoronoiFeature, metric: VoronoiMetric, normalize: bool, scale: f32, detail: f32, roughness: f32, lacunarity: f32, smoothness: f32, exponent: f32, randomness: f32) -> Self {
+    pub fn new(
+        feature: VoronoiFeature,
+        metric: VoronoiMetric,
+        normalize: bool,
+        scale: f32,
+        detail: f32,
+        roughness: f32,
+        lacunarity: f32,
+        smoothness: f32,
+        exponent: f32,
+        randomness: f32,
+    ) -> Self {
         VoronoiParams {
             feature,
             metric,
@@ -575,22 +649,41 @@ impl VoronoiParams {
 /// a multiple of 8. Not inlined,
 /// so each dimension has a stack frame of its own size.
 #[inline(never)]
-fn run<const N: usize, const P3: usize, const P5: usize>(mut p: VoronoiParams, coord: [f32; N]) -> VoronoiOutput
+fn run<const N: usize, const P3: usize, const P5: usize>(
+    mut p: VoronoiParams,
+    coord: [f32; N],
+) -> VoronoiOutput
 where
     D: Cell<N>,
 {
     match p.feature {
         VoronoiFeature::DistanceToEdge => {
             p.max_distance = 0.5 + 0.5 * p.randomness;
-            VoronoiOutput { distance: fractal_distance_to_edge::<N, P3>(&p, coord), ..Default::default() }
+            VoronoiOutput {
+                distance: fractal_distance_to_edge::<N, P3>(&p, coord),
+                ..Default::default()
+            }
         }
-        VoronoiFeature::NSphereRadius => VoronoiOutput { radius: n_sphere_radius::<N, P3>(&p, coord), ..Default::default() },
+        VoronoiFeature::NSphereRadius => VoronoiOutput {
+            radius: n_sphere_radius::<N, P3>(&p, coord),
+            ..Default::default()
+        },
         _ => {
-            let f2_factor = if p.feature == VoronoiFeature::F2 { 2.0 } else { 1.0 };
+            let f2_factor = if p.feature == VoronoiFeature::F2 {
+                2.0
+            } else {
+                1.0
+            };
             let half = 0.5 + 0.5 * p.randomness;
             p.max_distance = metric_distance([0.0; N], [half; N], &p) * f2_factor;
             let o = fractal_x_fx::<N, P3, P5>(&p, coord);
-            VoronoiOutput { distance: o.distance, color: o.color, position: [o.position[0], o.position[1], o.position[2]], w: o.position[3], radius: 0.0 }
+            VoronoiOutput {
+                distance: o.distance,
+                color: o.color,
+                position: [o.position[0], o.position[1], o.position[2]],
+                w: o.position[3],
+                radius: 0.0,
+            }
         }
     }
 }

@@ -27,7 +27,16 @@ pub struct WaveSettings {
 
 /// Fac of the Wave Texture at `vector` (Color is Fac in all three channels).
 #[allow(clippy::too_many_arguments)]
-pub fn wave(s: WaveSettings, vector: Vec3, scale: f32, distortion: f32, detail: f32, detail_scale: f32, detail_roughness: f32, phase: f32) -> f32 {
+pub fn wave(
+    s: WaveSettings,
+    vector: Vec3,
+    scale: f32,
+    distortion: f32,
+    detail: f32,
+    detail_scale: f32,
+    detail_roughness: f32,
+    phase: f32,
+) -> f32 {
     // The nudge avoids precision trouble on unit coordinates, as Cycles does.
     let p = vector.map(|v| (v * scale + 0.000001) * 0.999999);
     let mut n = match s.kind {

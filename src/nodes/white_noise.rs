@@ -91,7 +91,10 @@ pub(crate) mod lookup3 {
         use std::arch::x86_64::*;
         macro_rules! rot {
             ($x:expr, $k:literal) => {
-                _mm256_or_si256(_mm256_slli_epi32::<$k>($x), _mm256_srli_epi32::<{ 32 - $k }>($x))
+                _mm256_or_si256(
+                    _mm256_slli_epi32::<$k>($x),
+                    _mm256_srli_epi32::<{ 32 - $k }>($x),
+                )
             };
         }
         // SAFETY: AVX2 is enabled for the whole build (the cfg above); loads and stores
@@ -159,35 +162,59 @@ pub fn hash_f4_to_f1(k: [f32; 4]) -> f32 {
 #[inline(always)]
 pub fn hash_f1_to_f3(k: f32) -> Vec3 {
     let x = k.to_bits();
-    [unit(lookup3::hash1(x)), unit(lookup3::hash2(x, 1.0f32.to_bits())), unit(lookup3::hash2(x, 2.0f32.to_bits()))]
+    [
+        unit(lookup3::hash1(x)),
+        unit(lookup3::hash2(x, 1.0f32.to_bits())),
+        unit(lookup3::hash2(x, 2.0f32.to_bits())),
+    ]
 }
 #[inline(always)]
 pub fn hash_f2_to_f2(k: [f32; 2]) -> [f32; 2] {
     let [x, y] = bits(k);
-    [unit(lookup3::hash2(x, y)), unit(lookup3::hash3(x, y, 1.0f32.to_bits()))]
+    [
+        unit(lookup3::hash2(x, y)),
+        unit(lookup3::hash3(x, y, 1.0f32.to_bits())),
+    ]
 }
 #[inline(always)]
 pub fn hash_f2_to_f3(k: [f32; 2]) -> Vec3 {
     let [x, y] = bits(k);
-    [unit(lookup3::hash2(x, y)), unit(lookup3::hash3(x, y, 1.0f32.to_bits())), unit(lookup3::hash3(x, y, 2.0f32.to_bits()))]
+    [
+        unit(lookup3::hash2(x, y)),
+        unit(lookup3::hash3(x, y, 1.0f32.to_bits())),
+        unit(lookup3::hash3(x, y, 2.0f32.to_bits())),
+    ]
 }
 #[inline(always)]
 pub fn hash_f3_to_f3(k: Vec3) -> Vec3 {
     let [x, y, z] = bits(k);
     let head = lookup3::hash4_head(x, y, z);
-    [unit(lookup3::hash3(x, y, z)), unit(lookup3::hash4_tail(head, 1.0f32.to_bits())), unit(lookup3::hash4_tail(head, 2.0f32.to_bits()))]
+    [
+        unit(lookup3::hash3(x, y, z)),
+        unit(lookup3::hash4_tail(head, 1.0f32.to_bits())),
+        unit(lookup3::hash4_tail(head, 2.0f32.to_bits())),
+    ]
 }
 #[inline(always)]
 pub fn hash_f4_to_f4(k: [f32; 4]) -> [f32; 4] {
     let [x, y, z, w] = bits(k);
     let h = lookup3::hash4;
-    [unit(h(x, y, z, w)), unit(h(w, x, y, z)), unit(h(z, w, x, y)), unit(h(y, z, w, x))]
+    [
+        unit(h(x, y, z, w)),
+        unit(h(w, x, y, z)),
+        unit(h(z, w, x, y)),
+        unit(h(y, z, w, x)),
+    ]
 }
 #[inline(always)]
 pub fn hash_f4_to_f3(k: [f32; 4]) -> Vec3 {
     let [x, y, z, w] = bits(k);
     let h = lookup3::hash4;
-    [unit(h(x, y, z, w)), unit(h(z, x, w, y)), unit(h(w, z, y, x))]
+    [
+        unit(h(x, y, z, w)),
+        unit(h(z, x, w, y)),
+        unit(h(w, z, y, x)),
+    ]
 }
 
 /// The White Noise Texture node: (Value, Color) for `dimensions` 1-4 (`vector` for 2-4,

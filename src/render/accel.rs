@@ -30,7 +30,15 @@ pub trait Accel: Sync {
     /// ray visibility: `ray::` bits, see `visibility`); others are passed through, as
     /// Cycles' BVH skips primitives whose visibility lacks the ray's. The default ignores
     /// the mask (every object visible to every ray).
-    fn intersect_vis(&self, org: V3, dir: V3, tmin: f32, tmax: f32, time: f32, _mask: u32) -> Option<Hit> {
+    fn intersect_vis(
+        &self,
+        org: V3,
+        dir: V3,
+        tmin: f32,
+        tmax: f32,
+        time: f32,
+        _mask: u32,
+    ) -> Option<Hit> {
         self.intersect_at(org, dir, tmin, tmax, time)
     }
     /// `occluded_at` by objects visible to a ray of visibility `mask`.
@@ -45,7 +53,12 @@ pub mod visibility {
     use crate::shader::point::ray;
 
     /// Every ray type an object can be hidden from.
-    pub const ALL: u32 = ray::CAMERA | ray::DIFFUSE | ray::GLOSSY | ray::TRANSMIT | ray::SHADOW | ray::VOLUME_SCATTER;
+    pub const ALL: u32 = ray::CAMERA
+        | ray::DIFFUSE
+        | ray::GLOSSY
+        | ray::TRANSMIT
+        | ray::SHADOW
+        | ray::VOLUME_SCATTER;
 
     /// The mask of a shadow ray (next-event estimation).
     pub const SHADOW: u32 = ray::SHADOW;
@@ -55,7 +68,8 @@ pub mod visibility {
     /// transmitted ray is seen by objects visible to transmission.
     #[inline]
     pub fn of_path(flags: u32) -> u32 {
-        let mut v = flags & (ray::CAMERA | ray::DIFFUSE | ray::GLOSSY | ray::TRANSMIT | ray::VOLUME_SCATTER);
+        let mut v = flags
+            & (ray::CAMERA | ray::DIFFUSE | ray::GLOSSY | ray::TRANSMIT | ray::VOLUME_SCATTER);
         if v & ray::TRANSMIT != 0 {
             v &= !(ray::DIFFUSE | ray::GLOSSY);
         }
@@ -102,7 +116,11 @@ impl Bvh {
     /// (`visibility`); `masks` empty, or every mask `visibility::ALL`, means all visible.
     pub fn build_masked(tris: &[[V3; 3]], masks: &[u32]) -> Bvh {
         let mut bvh = Bvh::build(tris);
-        if masks.len() == tris.len() && masks.iter().any(|&m| m & visibility::ALL != visibility::ALL) {
+        if masks.len() == tris.len()
+            && masks
+                .iter()
+                .any(|&m| m & visibility::ALL != visibility::ALL)
+        {
             bvh.masks = bvh.ids.iter().map(|&i| masks[i as usize]).collect();
         }
         bvh
@@ -111,10 +129,18 @@ impl Bvh {
     pub fn build(tris: &[[V3; 3]]) -> Bvh {
         let n = tris.len();
         let mut ids: Vec<u32> = (0..n as u32).collect();
-        let bounds: Vec<(V3, V3)> = tris.iter().map(|t| (vmin(vmin(t[0], t[1]), t[2]), vmax(vmax(t[0], t[1]), t[2]))).collect();
+        let bounds: Vec<(V3, V3)> = tris
+            .iter()
+            .map(|t| (vmin(vmin(t[0], t[1]), t[2]), vmax(vmax(t[0], t[1]), t[2])))
+            .collect();
         let centroids: Vec<V3> = bounds.iter().map(|b| scale(add(b.0, b.1), 0.5)).collect();
         let mut nodes = Vec::with_capacity(2 * n.max(1));
-        nodes.push(Node { min: [f32::INFINITY; 3], max: [f32::NEG_INFINITY; 3], start: 0, count: n as u32 });
+        nodes.push(Node {
+            min: [f32::INFINITY; 3],
+            max: [f32::NEG_INFINITY; 3],
+            start: 0,
+            count: n as u32,
+        });
         let mut stack = vec![0usize];
         while let Some(ni) = stack.pop() {
             let (start, count) = (nodes[ni].start as usize, nodes[ni].count as usize);
@@ -142,21 +168,24 @@ impl Bvh {
                 let mut bins = [([f32::INFINITY; 3], [f32::NEG_INFINITY; 3], 0usize); BINS];
                 let k = BINS as f32 / ext;
                 for &id in &ids[start..start + count] {
-                    let b = (((centroids[id as usize][axis] - cmin[axis]) * k) as usize).min(BINS - 1);
+                    let b =
+                        (((centroids[id as usize][axis] - cmin[axis]) * k) as usize).min(BINS - 1);
                     let bb = bounds[id as usize];
                     bins[b].0 = vmin(bins[b].0, bb.0);
                     bins[b].1 = vmax(bins[b].1, bb.1);
                     bins[b].2 += 1;
                 }
                 let mut right_cost = [0.0f32; BINS];
-                let (mut rmin, mut rmax, mut rc) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3], 0usize);
+                let (mut rmin, mut rmax, mut rc) =
+                    ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3], 0usize);
                 for i in (1..BINS).rev() {
                     rmin = vmin(rmin, bins[i].0);
                     rmax = vmax(rmax, bins[i].1);
                     rc += bins[i].2;
                     right_cost[i] = area(rmin, rmax) * rc as f32;
                 }
-                let (mut lmin, mut lmax, mut lc) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3], 0usize);
+                let (mut lmin, mut lmax, mut lc) =
+                    ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3], 0usize);
                 for i in 0..BINS - 1 {
                     lmin = vmin(lmin, bins[i].0);
                     lmax = vmax(lmax, bins[i].1);
@@ -176,7 +205,8 @@ impl Bvh {
                 let mut i = 0;
                 let mut j = slice.len();
                 while i < j {
-                    let b = (((centroids[slice[i] as usize][axis] - cmin[axis]) * k) as usize).min(BINS - 1);
+                    let b = (((centroids[slice[i] as usize][axis] - cmin[axis]) * k) as usize)
+                        .min(BINS - 1);
                     if b <= split {
                         i += 1;
                     } else {
@@ -195,19 +225,41 @@ impl Bvh {
                 continue;
             }
             let left = nodes.len();
-            nodes.push(Node { min: bmin, max: bmax, start: start as u32, count: mid as u32 });
-            nodes.push(Node { min: bmin, max: bmax, start: (start + mid) as u32, count: (count - mid) as u32 });
+            nodes.push(Node {
+                min: bmin,
+                max: bmax,
+                start: start as u32,
+                count: mid as u32,
+            });
+            nodes.push(Node {
+                min: bmin,
+                max: bmax,
+                start: (start + mid) as u32,
+                count: (count - mid) as u32,
+            });
             nodes[ni].start = left as u32;
             nodes[ni].count = 0;
             stack.push(left);
             stack.push(left + 1);
         }
         let tris_sorted = ids.iter().map(|&i| tris[i as usize]).collect();
-        Bvh { nodes, tris: tris_sorted, ids, masks: Vec::new() }
+        Bvh {
+            nodes,
+            tris: tris_sorted,
+            ids,
+            masks: Vec::new(),
+        }
     }
 
     #[inline(always)]
-    fn traverse<const ANY: bool>(&self, org: V3, dir: V3, tmin: f32, tmax: f32, mask: u32) -> Option<Hit> {
+    fn traverse<const ANY: bool>(
+        &self,
+        org: V3,
+        dir: V3,
+        tmin: f32,
+        tmax: f32,
+        mask: u32,
+    ) -> Option<Hit> {
         if self.tris.is_empty() {
             return None;
         }
@@ -229,7 +281,12 @@ impl Bvh {
                     }
                     if let Some((t, u, v)) = wt.intersect(org, &self.tris[i as usize], tmin, tfar) {
                         tfar = t;
-                        best = Some(Hit { t, prim: self.ids[i as usize], u, v });
+                        best = Some(Hit {
+                            t,
+                            prim: self.ids[i as usize],
+                            u,
+                            v,
+                        });
                         if ANY {
                             return best;
                         }
@@ -242,7 +299,11 @@ impl Bvh {
                 let tr = slab(r, org, inv, tmin, tfar);
                 match (tl, tr) {
                     (Some(a), Some(b)) => {
-                        let (near, far) = if a <= b { (node.start, node.start + 1) } else { (node.start + 1, node.start) };
+                        let (near, far) = if a <= b {
+                            (node.start, node.start + 1)
+                        } else {
+                            (node.start + 1, node.start)
+                        };
                         if sp < 64 {
                             stack[sp] = far;
                             sp += 1;
@@ -276,9 +337,18 @@ impl Accel for Bvh {
         self.traverse::<false>(org, dir, tmin, tmax, visibility::ALL)
     }
     fn occluded(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> bool {
-        self.traverse::<true>(org, dir, tmin, tmax, visibility::ALL).is_some()
+        self.traverse::<true>(org, dir, tmin, tmax, visibility::ALL)
+            .is_some()
     }
-    fn intersect_vis(&self, org: V3, dir: V3, tmin: f32, tmax: f32, _time: f32, mask: u32) -> Option<Hit> {
+    fn intersect_vis(
+        &self,
+        org: V3,
+        dir: V3,
+        tmin: f32,
+        tmax: f32,
+        _time: f32,
+        mask: u32,
+    ) -> Option<Hit> {
         self.traverse::<false>(org, dir, tmin, tmax, mask)
     }
     fn occluded_vis(&self, org: V3, dir: V3, tmin: f32, tmax: f32, _time: f32, mask: u32) -> bool {
@@ -319,13 +389,30 @@ impl Watertight {
     #[inline(always)]
     fn new(dir: V3) -> Watertight {
         let a = [dir[0].abs(), dir[1].abs(), dir[2].abs()];
-        let kz = if a[0] > a[1] { if a[0] > a[2] { 0 } else { 2 } } else if a[1] > a[2] { 1 } else { 2 };
+        let kz = if a[0] > a[1] {
+            if a[0] > a[2] {
+                0
+            } else {
+                2
+            }
+        } else if a[1] > a[2] {
+            1
+        } else {
+            2
+        };
         let mut kx = (kz + 1) % 3;
         let mut ky = (kx + 1) % 3;
         if dir[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
-        Watertight { kx, ky, kz, sx: dir[kx] / dir[kz], sy: dir[ky] / dir[kz], sz: 1.0 / dir[kz] }
+        Watertight {
+            kx,
+            ky,
+            kz,
+            sx: dir[kx] / dir[kz],
+            sy: dir[ky] / dir[kz],
+            sz: 1.0 / dir[kz],
+        }
     }
 
     #[inline(always)]
@@ -377,11 +464,18 @@ mod tests {
     #[test]
     fn shared_edge_is_watertight() {
         // Two triangles of a quad; rays through the diagonal must hit one of them.
-        let tris = vec![[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]], [[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]]];
+        let tris = vec![
+            [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]],
+            [[0.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+        ];
         let bvh = Bvh::build(&tris);
         for i in 0..1000 {
             let s = i as f32 / 1000.0;
-            assert!(bvh.intersect([s, s, 1.0], [0.0, 0.0, -1.0], 0.0, f32::INFINITY).is_some(), "miss at {s}");
+            assert!(
+                bvh.intersect([s, s, 1.0], [0.0, 0.0, -1.0], 0.0, f32::INFINITY)
+                    .is_some(),
+                "miss at {s}"
+            );
         }
     }
 
@@ -392,17 +486,51 @@ mod tests {
         // shadow rays, the far one visible to all.
         let near = [[-1.0, -1.0, 1.0], [1.0, -1.0, 1.0], [0.0, 1.0, 1.0]];
         let far = [[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [0.0, 1.0, 0.0]];
-        let bvh = Bvh::build_masked(&[near, far], &[visibility::ALL & !(ray::CAMERA | ray::SHADOW), visibility::ALL]);
+        let bvh = Bvh::build_masked(
+            &[near, far],
+            &[
+                visibility::ALL & !(ray::CAMERA | ray::SHADOW),
+                visibility::ALL,
+            ],
+        );
         let (o, d) = ([0.0, 0.0, 5.0], [0.0, 0.0, -1.0]);
-        let cam = bvh.intersect_vis(o, d, 0.0, f32::INFINITY, 0.5, visibility::of_path(ray::CAMERA)).unwrap();
+        let cam = bvh
+            .intersect_vis(
+                o,
+                d,
+                0.0,
+                f32::INFINITY,
+                0.5,
+                visibility::of_path(ray::CAMERA),
+            )
+            .unwrap();
         assert_eq!(cam.prim, 1);
         assert!((cam.t - 5.0).abs() < 1e-5);
-        let diffuse = bvh.intersect_vis(o, d, 0.0, f32::INFINITY, 0.5, visibility::of_path(ray::DIFFUSE | ray::REFLECT)).unwrap();
+        let diffuse = bvh
+            .intersect_vis(
+                o,
+                d,
+                0.0,
+                f32::INFINITY,
+                0.5,
+                visibility::of_path(ray::DIFFUSE | ray::REFLECT),
+            )
+            .unwrap();
         assert_eq!(diffuse.prim, 0);
         assert!(!bvh.occluded_vis(o, d, 0.0, 4.5, 0.5, visibility::SHADOW));
-        assert!(bvh.occluded_vis(o, d, 0.0, 4.5, 0.5, visibility::of_path(ray::GLOSSY | ray::REFLECT)));
+        assert!(bvh.occluded_vis(
+            o,
+            d,
+            0.0,
+            4.5,
+            0.5,
+            visibility::of_path(ray::GLOSSY | ray::REFLECT)
+        ));
         // A transmitted glossy ray is seen as transmission only.
-        assert_eq!(visibility::of_path(ray::GLOSSY | ray::TRANSMIT), ray::TRANSMIT);
+        assert_eq!(
+            visibility::of_path(ray::GLOSSY | ray::TRANSMIT),
+            ray::TRANSMIT
+        );
         assert_eq!(bvh.intersect(o, d, 0.0, f32::INFINITY).unwrap().prim, 0);
     }
 }
@@ -410,7 +538,14 @@ mod tests {
 impl Bvh {
     /// The nearest hit (`ANY` false) or any hit (`ANY` true), for structures built of BVHs.
     #[inline(always)]
-    pub fn intersect_or_occluded<const ANY: bool>(&self, org: V3, dir: V3, tmin: f32, tmax: f32, mask: u32) -> Option<Hit> {
+    pub fn intersect_or_occluded<const ANY: bool>(
+        &self,
+        org: V3,
+        dir: V3,
+        tmin: f32,
+        tmax: f32,
+        mask: u32,
+    ) -> Option<Hit> {
         self.traverse::<ANY>(org, dir, tmin, tmax, mask)
     }
 }

@@ -32,7 +32,12 @@ impl Adaptive {
         let f = |k: &str| cy.get(k).and_then(Value::as_f64);
         let (enabled, threshold) = match override_threshold {
             Some(t) => (t > 0.0 && t.is_finite(), t),
-            None => (cy.get("use_adaptive_sampling").and_then(Value::as_bool).unwrap_or(false), f("adaptive_threshold").unwrap_or(0.01) as f32),
+            None => (
+                cy.get("use_adaptive_sampling")
+                    .and_then(Value::as_bool)
+                    .unwrap_or(false),
+                f("adaptive_threshold").unwrap_or(0.01) as f32,
+            ),
         };
         let min_setting = f("adaptive_min_samples").unwrap_or(0.0).max(0.0) as u32;
         Adaptive::new(enabled, threshold, min_setting, samples)
@@ -40,15 +45,27 @@ impl Adaptive {
 
     pub fn new(enabled: bool, threshold_setting: f32, min_setting: u32, samples: u32) -> Adaptive {
         if !enabled {
-            return Adaptive { enabled: false, threshold: 0.0, min_samples: 0 };
+            return Adaptive {
+                enabled: false,
+                threshold: 0.0,
+                min_samples: 0,
+            };
         }
         let clamped = samples.min(1 << 24);
         let mut threshold = threshold_setting;
         if clamped > 0 && threshold_setting == 0.0 {
             threshold = (1.0 / samples as f32).max(0.001);
         }
-        let min_samples = if threshold > 0.0 && min_setting == 0 { ((16.0 / threshold.powf(0.3)).ceil() as u32).max(4) } else { min_setting.max(4) };
-        Adaptive { enabled: true, threshold: threshold * 5.0, min_samples }
+        let min_samples = if threshold > 0.0 && min_setting == 0 {
+            ((16.0 / threshold.powf(0.3)).ceil() as u32).max(4)
+        } else {
+            min_setting.max(4)
+        };
+        Adaptive {
+            enabled: true,
+            threshold: threshold * 5.0,
+            min_samples,
+        }
     }
 
     /// How many of `num` samples from `start` to take before the next check.
@@ -115,7 +132,9 @@ pub struct Film {
 
 impl Film {
     pub fn new(n: usize) -> Film {
-        Film { px: vec![PixelAcc::default(); n] }
+        Film {
+            px: vec![PixelAcc::default(); n],
+        }
     }
 
     #[inline]
@@ -130,7 +149,13 @@ impl Film {
 
     /// Convergence check then neighbour dilation over the whole image; returns the
     /// number of pixels still to sample.
-    pub fn converge_and_dilate(&mut self, a: &Adaptive, exposure: f32, w: usize, h: usize) -> usize {
+    pub fn converge_and_dilate(
+        &mut self,
+        a: &Adaptive,
+        exposure: f32,
+        w: usize,
+        h: usize,
+    ) -> usize {
         for p in self.px.iter_mut() {
             if p.converged {
                 continue;
@@ -139,7 +164,11 @@ impl Film {
             let (i, x) = (p.sum.map(|v| v as f32), p.aux.map(|v| v as f32));
             let diff = ((i[0] - x[0]).abs() + (i[1] - x[1]).abs() + (i[2] - x[2]).abs()) * scale;
             let intensity = (i[0] + i[1] + i[2]) * scale;
-            let norm = if intensity < 1.0 { intensity.sqrt() } else { intensity };
+            let norm = if intensity < 1.0 {
+                intensity.sqrt()
+            } else {
+                intensity
+            };
             p.converged = diff / (0.0001 + norm) < a.threshold;
         }
         // Rows, then columns: each run of unconverged pixels grows by one on both ends.
@@ -179,7 +208,11 @@ mod tests {
     fn schedule_matches_cycles() {
         // Cycles' own test (adaptive_sampling_test.cpp) uses step 4; with step 16 and
         // min samples 11 the first check is after index 15, then every 16.
-        let a = Adaptive { enabled: true, threshold: 0.05, min_samples: 11 };
+        let a = Adaptive {
+            enabled: true,
+            threshold: 0.05,
+            min_samples: 11,
+        };
         assert_eq!(a.align_samples(0, 7), 7);
         assert_eq!(a.align_samples(0, 64), 16);
         assert_eq!(a.align_samples(16, 48), 16);
@@ -198,15 +231,27 @@ mod tests {
     fn class_a_is_half_of_the_samples() {
         // The odd bits decide: 0,1 are class B, 2,3 class A, and exactly half of any
         // power-of-two run of at least 4 samples is class A.
-        assert_eq!((0..4).map(sample_is_class_a).collect::<Vec<_>>(), [false, false, true, true]);
+        assert_eq!(
+            (0..4).map(sample_is_class_a).collect::<Vec<_>>(),
+            [false, false, true, true]
+        );
         assert_eq!((0..64).filter(|&s| sample_is_class_a(s)).count(), 32);
     }
 
     #[test]
     fn dilation_grows_runs_by_one() {
-        let mut px = vec![PixelAcc { converged: true, ..Default::default() }; 5];
+        let mut px = vec![
+            PixelAcc {
+                converged: true,
+                ..Default::default()
+            };
+            5
+        ];
         px[2].converged = false;
         dilate_line(&mut px, 0, 1, 5);
-        assert_eq!(px.iter().map(|p| p.converged).collect::<Vec<_>>(), [true, false, false, false, true]);
+        assert_eq!(
+            px.iter().map(|p| p.converged).collect::<Vec<_>>(),
+            [true, false, false, false, true]
+        );
     }
 }

@@ -24,7 +24,10 @@ pub struct AnisoGgx {
 /// Cycles' rotate_around_axis: `p` rotated by `angle` radians about unit `axis`.
 pub fn rotate_around_axis(p: V3, axis: V3, angle: f32) -> V3 {
     let (s, c) = angle.sin_cos();
-    add(add(scale(p, c), scale(cross(axis, p), s)), scale(axis, dot(axis, p) * (1.0 - c)))
+    add(
+        add(scale(p, c), scale(cross(axis, p), s)),
+        scale(axis, dot(axis, p) * (1.0 - c)),
+    )
 }
 
 /// Glossy BSDF roughness parameters: alpha = roughness^2 stretched by the anisotropy
@@ -33,7 +36,11 @@ pub fn glossy_alphas(roughness: f32, anisotropy: f32) -> (f32, f32) {
     let r = roughness.clamp(0.0, 1.0);
     let a = r * r;
     let k = anisotropy.clamp(-0.99, 0.99);
-    let (ax, ay) = if k < 0.0 { (a / (1.0 + k), a * (1.0 + k)) } else { (a * (1.0 - k), a / (1.0 - k)) };
+    let (ax, ay) = if k < 0.0 {
+        (a / (1.0 + k), a * (1.0 + k))
+    } else {
+        (a * (1.0 - k), a / (1.0 - k))
+    };
     (ax.clamp(0.0, 1.0), ay.clamp(0.0, 1.0))
 }
 
@@ -59,7 +66,12 @@ impl AnisoGgx {
         } else {
             basis(n)
         };
-        AnisoGgx { alpha_x, alpha_y, x, y }
+        AnisoGgx {
+            alpha_x,
+            alpha_y,
+            x,
+            y,
+        }
     }
 
     pub fn singular(&self) -> bool {
@@ -98,7 +110,11 @@ impl AnisoGgx {
         let d = self.d(lh);
         let (lam_v, lam_l) = (self.lambda(lv), self.lambda(ll));
         let common = d * 0.25 / cos_v;
-        (common / (1.0 + lam_v + lam_l), common / (1.0 + lam_v), dot(v, h))
+        (
+            common / (1.0 + lam_v + lam_l),
+            common / (1.0 + lam_v),
+            dot(v, h),
+        )
     }
 
     /// A reflected direction from a visible microfacet normal.
@@ -113,7 +129,10 @@ impl AnisoGgx {
         if ll[2] <= 0.0 {
             return None;
         }
-        let l = add(add(scale(self.x, ll[0]), scale(self.y, ll[1])), scale(n, ll[2]));
+        let l = add(
+            add(scale(self.x, ll[0]), scale(self.y, ll[1])),
+            scale(n, ll[2]),
+        );
         if dot(ng, l) <= 0.0 {
             return None;
         }
@@ -136,7 +155,10 @@ mod tests {
         let h = normalize(add(v, l));
         let a2 = 0.09;
         let d = super::super::bsdf::ggx_d(h[2], a2);
-        let (lv, ll) = (super::super::bsdf::ggx_lambda(v[2], a2), super::super::bsdf::ggx_lambda(l[2], a2));
+        let (lv, ll) = (
+            super::super::bsdf::ggx_lambda(v[2], a2),
+            super::super::bsdf::ggx_lambda(l[2], a2),
+        );
         assert!((f - d / (4.0 * v[2]) / (1.0 + lv + ll)).abs() < 1e-5 * f.max(1.0));
         assert!((pdf - d / (4.0 * v[2]) / (1.0 + lv)).abs() < 1e-5 * pdf.max(1.0));
     }
@@ -170,7 +192,11 @@ mod tests {
 
     #[test]
     fn rotation_about_the_normal() {
-        let r = rotate_around_axis([1.0, 0.0, 0.0], [0.0, 0.0, 1.0], std::f32::consts::FRAC_PI_2);
+        let r = rotate_around_axis(
+            [1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0],
+            std::f32::consts::FRAC_PI_2,
+        );
         assert!((r[0]).abs() < 1e-6 && (r[1] - 1.0).abs() < 1e-6 && r[2].abs() < 1e-6);
     }
 }

@@ -45,7 +45,10 @@ impl Spread {
         } else {
             3.0 / (half * half * half)
         };
-        Some(Spread { tan_half, normalize })
+        Some(Spread {
+            tan_half,
+            normalize,
+        })
     }
 
     /// The fraction of the light's radiance leaving along `d` (from the shading point
@@ -96,8 +99,18 @@ impl Spread {
                     let axis_u = normalize(sub(r.centre, closest));
                     // Rotated a quarter turn about the light's normal.
                     let axis_v = cross(ng, axis_u);
-                    let centre = scale(add(add(r.centre, closest), scale(axis_u, r_spread - rad)), 0.5);
-                    return Some(Region { centre, axis_u, len_u: lu, axis_v, len_v: lv, rectangle: true });
+                    let centre = scale(
+                        add(add(r.centre, closest), scale(axis_u, r_spread - rad)),
+                        0.5,
+                    );
+                    return Some(Region {
+                        centre,
+                        axis_u,
+                        len_u: lu,
+                        axis_v,
+                        len_v: lv,
+                        rectangle: true,
+                    });
                 }
                 sample_spread = spread_area < circle_area;
             }
@@ -112,7 +125,11 @@ impl Spread {
             }
             let (lu, lv) = (max_u - min_u, max_v - min_v);
             let rect_area = lu * lv;
-            let ellipse_area = if r.rectangle { f32::MAX } else { PI / 4.0 * r.len_u * r.len_v };
+            let ellipse_area = if r.rectangle {
+                f32::MAX
+            } else {
+                PI / 4.0 * r.len_u * r.len_v
+            };
             let spread_area = PI * r_spread * r_spread;
             // A rectangle light stays a (smaller) rectangle: solid-angle sampling beats
             // sampling the circle by area.
@@ -146,7 +163,11 @@ pub fn rect_solid_angle(p: V3, r: &Region, u: Option<[f32; 2]>) -> (f32, Option<
     let d3 = |a: V3| [a[0] as f64, a[1] as f64, a[2] as f64];
     let dot64 = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let (x, y) = (d3(r.axis_u), d3(r.axis_v));
-    let mut z = [x[1] * y[2] - x[2] * y[1], x[2] * y[0] - x[0] * y[2], x[0] * y[1] - x[1] * y[0]];
+    let mut z = [
+        x[1] * y[2] - x[2] * y[1],
+        x[2] * y[0] - x[0] * y[2],
+        x[0] * y[1] - x[1] * y[0],
+    ];
     let (lu, lv) = (r.len_u as f64, r.len_v as f64);
     let c = d3(r.centre);
     let corner = [0, 1, 2].map(|i| c[i] - x[i] * lu * 0.5 - y[i] * lv * 0.5);
@@ -184,14 +205,19 @@ pub fn rect_solid_angle(p: V3, r: &Region, u: Option<[f32; 2]>) -> (f32, Option<
     let point = u.map(|u| {
         let au = u[0] as f64 * s + k;
         let fu = (au.cos() * b0 - b1) / au.sin();
-        let cu = (1.0 / (fu * fu + b0 * b0).sqrt() * if fu > 0.0 { 1.0 } else { -1.0 }).clamp(-1.0, 1.0);
+        let cu =
+            (1.0 / (fu * fu + b0 * b0).sqrt() * if fu > 0.0 { 1.0 } else { -1.0 }).clamp(-1.0, 1.0);
         let xu = (-(cu * z0) / (1.0 - cu * cu).sqrt().max(1e-7)).clamp(x0, x1);
         let dd = (xu * xu + z0 * z0).sqrt();
         let h0 = y0 / (dd * dd + y0 * y0).sqrt();
         let h1 = y1 / (dd * dd + y1 * y1).sqrt();
         let hv = h0 + u[1] as f64 * (h1 - h0);
         let hv2 = hv * hv;
-        let yv = if hv2 < 1.0 - 1e-12 { hv * dd / (1.0 - hv2).sqrt() } else { y1 };
+        let yv = if hv2 < 1.0 - 1e-12 {
+            hv * dd / (1.0 - hv2).sqrt()
+        } else {
+            y1
+        };
         [0, 1, 2].map(|i| (pp[i] + xu * x[i] + yv * y[i] + z0 * z[i]) as f32)
     });
     (s as f32, point)
@@ -202,7 +228,14 @@ mod tests {
     use super::*;
 
     fn square(len: f32) -> Region {
-        Region { centre: [0.0, 0.0, 0.0], axis_u: [1.0, 0.0, 0.0], len_u: len, axis_v: [0.0, 1.0, 0.0], len_v: len, rectangle: true }
+        Region {
+            centre: [0.0, 0.0, 0.0],
+            axis_u: [1.0, 0.0, 0.0],
+            len_u: len,
+            axis_v: [0.0, 1.0, 0.0],
+            len_v: len,
+            rectangle: true,
+        }
     }
 
     #[test]
@@ -211,7 +244,10 @@ mod tests {
         for (a, h) in [(1.0f32, 1.0f32), (0.5, 3.0), (2.0, 0.1), (0.01, 10.0)] {
             let (s, _) = rect_solid_angle([0.0, 0.0, h], &square(2.0 * a), None);
             let want = 4.0 * ((a * a) / (a * a + h * h)).asin();
-            assert!((s - want).abs() <= 1e-5 * want.max(1e-3), "a {a} h {h}: {s} vs {want}");
+            assert!(
+                (s - want).abs() <= 1e-5 * want.max(1e-3),
+                "a {a} h {h}: {s} vs {want}"
+            );
         }
     }
 
@@ -222,8 +258,18 @@ mod tests {
         let r = square(2.0);
         let p = [0.7, -0.3, 0.8];
         let (s, _) = rect_solid_angle(p, &r, None);
-        let quad = |cu: f32, cv: f32| Region { centre: [cu, cv, 0.0], len_u: 1.0, len_v: 1.0, ..r };
-        let quads = [quad(-0.5, -0.5), quad(0.5, -0.5), quad(-0.5, 0.5), quad(0.5, 0.5)];
+        let quad = |cu: f32, cv: f32| Region {
+            centre: [cu, cv, 0.0],
+            len_u: 1.0,
+            len_v: 1.0,
+            ..r
+        };
+        let quads = [
+            quad(-0.5, -0.5),
+            quad(0.5, -0.5),
+            quad(-0.5, 0.5),
+            quad(0.5, 0.5),
+        ];
         let mut count = [0u32; 4];
         let n = 64;
         for i in 0..n {
@@ -231,7 +277,10 @@ mod tests {
                 let u = [(i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32];
                 let (_, q) = rect_solid_angle(p, &r, Some(u));
                 let q = q.unwrap();
-                assert!(q[2].abs() < 1e-5 && q[0].abs() <= 1.0 + 1e-5 && q[1].abs() <= 1.0 + 1e-5, "{q:?}");
+                assert!(
+                    q[2].abs() < 1e-5 && q[0].abs() <= 1.0 + 1e-5 && q[1].abs() <= 1.0 + 1e-5,
+                    "{q:?}"
+                );
                 count[(q[0] > 0.0) as usize + 2 * (q[1] > 0.0) as usize] += 1;
             }
         }
@@ -254,9 +303,14 @@ mod tests {
                 let theta = (i as f64 + 0.5) / n as f64 * std::f64::consts::FRAC_PI_2;
                 let d = [-(theta.sin() as f32), 0.0, -(theta.cos() as f32)];
                 let a = sp.attenuation(d, [0.0, 0.0, 1.0]) as f64;
-                sum += a * theta.cos() * theta.sin() * std::f64::consts::FRAC_PI_2 / n as f64 * 2.0 * std::f64::consts::PI;
+                sum += a * theta.cos() * theta.sin() * std::f64::consts::FRAC_PI_2 / n as f64
+                    * 2.0
+                    * std::f64::consts::PI;
             }
-            assert!((sum - std::f64::consts::PI).abs() < 2e-3 * std::f64::consts::PI, "{deg}: {sum}");
+            assert!(
+                (sum - std::f64::consts::PI).abs() < 2e-3 * std::f64::consts::PI,
+                "{deg}: {sum}"
+            );
         }
         assert!(Spread::new(PI).is_none());
     }

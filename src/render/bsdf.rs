@@ -5,8 +5,8 @@
 
 use super::math::*;
 use super::microfacet::{Dielectric, Reflection};
-use super::subsurface::Bssrdf;
 use super::oren_nayar::OrenNayar;
+use super::subsurface::Bssrdf;
 use super::tables::Tables;
 use std::f32::consts::PI;
 
@@ -26,7 +26,11 @@ pub enum Fresnel {
 pub enum LobeKind {
     Diffuse,
     Translucent,
-    Glossy { alpha: f32, fresnel: Fresnel, energy: f32 },
+    Glossy {
+        alpha: f32,
+        fresnel: Fresnel,
+        energy: f32,
+    },
     Transparent,
     /// Dielectric interface (Glass and Refraction BSDFs, Principled transmission), rough
     /// or sharp: reflects or refracts by Fresnel (see `microfacet`).
@@ -43,7 +47,11 @@ pub enum LobeKind {
     /// Ashikhmin velvet (Sheen BSDF, Ashikhmin distribution); scatters like diffuse.
     Velvet(super::sheen::Velvet),
     /// Anisotropic GGX reflection (Glossy BSDF anisotropy, Principled anisotropic).
-    GlossyAniso { lobe: super::anisotropic::AnisoGgx, fresnel: Fresnel, energy: f32 },
+    GlossyAniso {
+        lobe: super::anisotropic::AnisoGgx,
+        fresnel: Fresnel,
+        energy: f32,
+    },
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -87,11 +95,25 @@ pub struct BsdfSample {
     pub kind: LobeKind,
 }
 
-const EMPTY: Lobe = Lobe { kind: LobeKind::Diffuse, weight: [0.0; 3], n: [0.0, 0.0, 1.0], sample_weight: 0.0 };
+const EMPTY: Lobe = Lobe {
+    kind: LobeKind::Diffuse,
+    weight: [0.0; 3],
+    n: [0.0, 0.0, 1.0],
+    sample_weight: 0.0,
+};
 
 impl Default for LobeSet {
     fn default() -> Self {
-        LobeSet { lobes: [EMPTY; MAX_LOBES], len: 0, emission: [0.0; 3], holdout: [0.0; 3], transparent: [0.0; 3], smooth_n: [0.0; 3], bump_correction: true, terminator_frequency: 1.0 }
+        LobeSet {
+            lobes: [EMPTY; MAX_LOBES],
+            len: 0,
+            emission: [0.0; 3],
+            holdout: [0.0; 3],
+            transparent: [0.0; 3],
+            smooth_n: [0.0; 3],
+            bump_correction: true,
+            terminator_frequency: 1.0,
+        }
     }
 }
 
@@ -102,9 +124,13 @@ impl Default for LobeSet {
 fn excluded(kind: &LobeKind, exclude: u32) -> bool {
     use crate::shader::point::ray;
     match kind {
-        LobeKind::Diffuse | LobeKind::OrenNayar(_) | LobeKind::Sheen(_) | LobeKind::Velvet(_) => exclude & ray::DIFFUSE != 0,
+        LobeKind::Diffuse | LobeKind::OrenNayar(_) | LobeKind::Sheen(_) | LobeKind::Velvet(_) => {
+            exclude & ray::DIFFUSE != 0
+        }
         LobeKind::Translucent => exclude & (ray::DIFFUSE | ray::TRANSMIT) != 0,
-        LobeKind::Glossy { .. } | LobeKind::Reflection(_) | LobeKind::GlossyAniso { .. } => exclude & ray::GLOSSY != 0,
+        LobeKind::Glossy { .. } | LobeKind::Reflection(_) | LobeKind::GlossyAniso { .. } => {
+            exclude & ray::GLOSSY != 0
+        }
         LobeKind::Glass(_) => exclude & ray::TRANSMIT != 0,
         LobeKind::Transparent | LobeKind::Subsurface(_) => false,
     }
@@ -117,7 +143,9 @@ impl LobeSet {
     /// Cycles' SD_BSDF_HAS_TRANSMISSION: some closure transmits (translucent, refraction,
     /// glass). Light selection then counts lights behind the surface too.
     pub fn has_transmission(&self) -> bool {
-        self.lobes[..self.len].iter().any(|l| matches!(l.kind, LobeKind::Translucent | LobeKind::Glass(_)))
+        self.lobes[..self.len]
+            .iter()
+            .any(|l| matches!(l.kind, LobeKind::Translucent | LobeKind::Glass(_)))
     }
 
     pub fn clear(&mut self) {
@@ -154,7 +182,12 @@ impl LobeSet {
             self.transparent = add(self.transparent, weight);
         }
         if self.len < MAX_LOBES {
-            self.lobes[self.len] = Lobe { kind, weight, n, sample_weight: sw };
+            self.lobes[self.len] = Lobe {
+                kind,
+                weight,
+                n,
+                sample_weight: sw,
+            };
             self.len += 1;
         }
     }
@@ -168,7 +201,14 @@ impl LobeSet {
     /// `eval` toward a light that some ray types do not see (`exclude`, `ray::` flags):
     /// the closures of those types give nothing but keep their share of the pdf, as in
     /// Cycles' _surface_shader_exclude.
-    pub fn eval_excluding(&self, wo: V3, wi: V3, ng: V3, tables: &Tables, exclude: u32) -> (V3, f32) {
+    pub fn eval_excluding(
+        &self,
+        wo: V3,
+        wi: V3,
+        ng: V3,
+        tables: &Tables,
+        exclude: u32,
+    ) -> (V3, f32) {
         let mut f = [0.0; 3];
         let mut pdf = 0.0;
         let mut total = 0.0;
@@ -180,8 +220,17 @@ impl LobeSet {
             let bump = if is_zero(self.smooth_n) {
                 1.0
             } else {
-                let diffuse = matches!(l.kind, LobeKind::Diffuse | LobeKind::OrenNayar(_) | LobeKind::Translucent);
-                super::bump_correction::bump_shadowing_term(self.smooth_n, l.n, wi, diffuse, self.bump_correction)
+                let diffuse = matches!(
+                    l.kind,
+                    LobeKind::Diffuse | LobeKind::OrenNayar(_) | LobeKind::Translucent
+                );
+                super::bump_correction::bump_shadowing_term(
+                    self.smooth_n,
+                    l.n,
+                    wi,
+                    diffuse,
+                    self.bump_correction,
+                )
             };
             if bump == 0.0 {
                 continue;
@@ -191,7 +240,10 @@ impl LobeSet {
             if self.terminator_frequency > 1.0 {
                 let c = dot(wi, l.n);
                 if c >= 0.0 {
-                    e = scale(e, super::terminator::shift_cos_in(c, self.terminator_frequency));
+                    e = scale(
+                        e,
+                        super::terminator::shift_cos_in(c, self.terminator_frequency),
+                    );
                 }
             }
             f = add(f, mul(e, l.weight));
@@ -222,21 +274,49 @@ impl LobeSet {
         let l = &self.lobes[pick];
         let sel = l.sample_weight / total;
         if let LobeKind::Subsurface(_) = l.kind {
-            return Some(BsdfSample { wi: l.n, weight: scale(l.weight, 1.0 / sel), pdf: 0.0, singular: false, glossy: false, transmit: true, kind: l.kind });
+            return Some(BsdfSample {
+                wi: l.n,
+                weight: scale(l.weight, 1.0 / sel),
+                pdf: 0.0,
+                singular: false,
+                glossy: false,
+                transmit: true,
+                kind: l.kind,
+            });
         }
         if let LobeKind::Glass(g) = l.kind {
             let u3 = (x / l.sample_weight).clamp(0.0, 1.0 - f32::EPSILON);
             let ds = g.sample(l.n, wo, ng, [u[0], u[1], u3])?;
             let (glossy, transmit) = (!ds.transmit, ds.transmit);
             if ds.singular {
-                let shift = if self.terminator_frequency > 1.0 && !transmit { super::terminator::shift_cos_in(dot(ds.l, l.n), self.terminator_frequency) } else { 1.0 };
-                return Some(BsdfSample { wi: ds.l, weight: scale(mul(ds.weight, l.weight), shift / sel), pdf: f32::INFINITY, singular: true, glossy, transmit, kind: l.kind });
+                let shift = if self.terminator_frequency > 1.0 && !transmit {
+                    super::terminator::shift_cos_in(dot(ds.l, l.n), self.terminator_frequency)
+                } else {
+                    1.0
+                };
+                return Some(BsdfSample {
+                    wi: ds.l,
+                    weight: scale(mul(ds.weight, l.weight), shift / sel),
+                    pdf: f32::INFINITY,
+                    singular: true,
+                    glossy,
+                    transmit,
+                    kind: l.kind,
+                });
             }
             let (f, pdf) = self.eval(wo, ds.l, ng, tables);
             if !(pdf > 0.0) || !pdf.is_finite() {
                 return None;
             }
-            return Some(BsdfSample { wi: ds.l, weight: scale(f, 1.0 / pdf), pdf, singular: false, glossy, transmit, kind: l.kind });
+            return Some(BsdfSample {
+                wi: ds.l,
+                weight: scale(f, 1.0 / pdf),
+                pdf,
+                singular: false,
+                glossy,
+                transmit,
+                kind: l.kind,
+            });
         }
         let (wi, singular) = sample_lobe(l, wo, ng, [u[0], u[1]])?;
         // The true normal is checked here, when sampling, and not in `eval_lobe` (as
@@ -251,21 +331,46 @@ impl LobeSet {
         if singular {
             // Mirror or pass-through: only this lobe contributes, with its discrete probability.
             let w = match l.kind {
-                LobeKind::Glossy { fresnel, energy, .. } => {
+                LobeKind::Glossy {
+                    fresnel, energy, ..
+                } => {
                     let h = l.n;
                     scale(fresnel_eval(fresnel, dot(wo, h), l.weight), energy)
                 }
                 _ => l.weight,
             };
             // Cycles' bsdf_sample shifts every sample that does not transmit.
-            let w = if self.terminator_frequency > 1.0 && !transmit { scale(w, super::terminator::shift_cos_in(dot(wi, l.n), self.terminator_frequency)) } else { w };
-            return Some(BsdfSample { wi, weight: scale(w, 1.0 / sel), pdf: f32::INFINITY, singular: true, glossy, transmit, kind: l.kind });
+            let w = if self.terminator_frequency > 1.0 && !transmit {
+                scale(
+                    w,
+                    super::terminator::shift_cos_in(dot(wi, l.n), self.terminator_frequency),
+                )
+            } else {
+                w
+            };
+            return Some(BsdfSample {
+                wi,
+                weight: scale(w, 1.0 / sel),
+                pdf: f32::INFINITY,
+                singular: true,
+                glossy,
+                transmit,
+                kind: l.kind,
+            });
         }
         let (f, pdf) = self.eval(wo, wi, ng, tables);
         if !(pdf > 0.0) || !pdf.is_finite() {
             return None;
         }
-        Some(BsdfSample { wi, weight: scale(f, 1.0 / pdf), pdf, singular: false, glossy, transmit, kind: l.kind })
+        Some(BsdfSample {
+            wi,
+            weight: scale(f, 1.0 / pdf),
+            pdf,
+            singular: false,
+            glossy,
+            transmit,
+            kind: l.kind,
+        })
     }
 
     /// Diffuse-like albedo of the closures (for the albedo pass).
@@ -336,7 +441,11 @@ pub fn ggx_lambda(cos: f32, a2: f32) -> f32 {
 pub fn sample_vndf(v: V3, alpha: f32, u: [f32; 2]) -> V3 {
     let vh = normalize([alpha * v[0], alpha * v[1], v[2]]);
     let lensq = vh[0] * vh[0] + vh[1] * vh[1];
-    let t1 = if lensq > 0.0 { scale([-vh[1], vh[0], 0.0], 1.0 / lensq.sqrt()) } else { [1.0, 0.0, 0.0] };
+    let t1 = if lensq > 0.0 {
+        scale([-vh[1], vh[0], 0.0], 1.0 / lensq.sqrt())
+    } else {
+        [1.0, 0.0, 0.0]
+    };
     let t2 = cross(vh, t1);
     let r = u[0].sqrt();
     let phi = 2.0 * PI * u[1];
@@ -344,7 +453,10 @@ pub fn sample_vndf(v: V3, alpha: f32, u: [f32; 2]) -> V3 {
     let mut p2 = r * phi.sin();
     let s = 0.5 * (1.0 + vh[2]);
     p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * p2;
-    let nh = add(add(scale(t1, p1), scale(t2, p2)), scale(vh, (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt()));
+    let nh = add(
+        add(scale(t1, p1), scale(t2, p2)),
+        scale(vh, (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt()),
+    );
     normalize([alpha * nh[0], alpha * nh[1], nh[2].max(0.0)])
 }
 
@@ -397,7 +509,11 @@ fn eval_lobe(l: &Lobe, wo: V3, wi: V3, _ng: V3, _tables: &Tables) -> (V3, f32) {
             }
         }
         LobeKind::Glass(g) => g.eval(l.n, wo, wi, ng),
-        LobeKind::Glossy { alpha, fresnel, energy } => {
+        LobeKind::Glossy {
+            alpha,
+            fresnel,
+            energy,
+        } => {
             if alpha < SINGULAR_ALPHA || !same_side || cos_i <= 0.0 {
                 return ([0.0; 3], 0.0);
             }
@@ -426,12 +542,19 @@ fn eval_lobe(l: &Lobe, wo: V3, wi: V3, _ng: V3, _tables: &Tables) -> (V3, f32) {
             let (f, p) = ve.eval(l.n, wo, wi, ng);
             ([f; 3], p)
         }
-        LobeKind::GlossyAniso { lobe, fresnel, energy } => {
+        LobeKind::GlossyAniso {
+            lobe,
+            fresnel,
+            energy,
+        } => {
             let (f, p, cos_hv) = lobe.eval(l.n, wo, wi, ng);
             if !(p > 0.0) {
                 return ([0.0; 3], 0.0);
             }
-            (scale(fresnel_eval(fresnel, cos_hv, [1.0; 3]), f * energy), p)
+            (
+                scale(fresnel_eval(fresnel, cos_hv, [1.0; 3]), f * energy),
+                p,
+            )
         }
     }
 }
@@ -441,7 +564,11 @@ fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
         LobeKind::Diffuse | LobeKind::Translucent | LobeKind::OrenNayar(_) => {
             let d = super::camera::concentric_disk(u);
             let z = (1.0 - d[0] * d[0] - d[1] * d[1]).max(0.0).sqrt();
-            let n = if let LobeKind::Translucent = l.kind { neg(l.n) } else { l.n };
+            let n = if let LobeKind::Translucent = l.kind {
+                neg(l.n)
+            } else {
+                l.n
+            };
             let wi = from_local(n, [d[0], d[1], z]);
             Some((wi, false))
         }

@@ -97,17 +97,24 @@ pub struct Geometry {
 }
 
 fn material_index(scene: &Scene, name: &Option<String>) -> Option<usize> {
-    name.as_ref().and_then(|n| scene.file.materials.iter().position(|m| &m.name == n))
+    name.as_ref()
+        .and_then(|n| scene.file.materials.iter().position(|m| &m.name == n))
 }
 
-pub fn build(scene: &Scene, eval: &EvaluatedScene, overrides: &[(String, serde_json::Value)]) -> Result<Geometry, RenderError> {
+pub fn build(
+    scene: &Scene,
+    eval: &EvaluatedScene,
+    overrides: &[(String, serde_json::Value)],
+) -> Result<Geometry, RenderError> {
     let mut cache: HashMap<usize, Arc<MeshData>> = HashMap::new();
     let mut instances = Vec::new();
     for (oi, obj) in eval.data.objects.iter().enumerate() {
         if obj.kind != "MESH" || obj.hide_render {
             continue;
         }
-        let Some(mesh_name) = obj.data.as_deref() else { continue };
+        let Some(mesh_name) = obj.data.as_deref() else {
+            continue;
+        };
         // Cycles does not sync an object no ray can see.
         if object_visibility(obj) == 0 {
             continue;
@@ -116,17 +123,32 @@ pub fn build(scene: &Scene, eval: &EvaluatedScene, overrides: &[(String, serde_j
             warn_shadow_catcher(&obj.name);
         }
         let Some(mi) = scene.file.meshes.iter().position(|m| m.name == mesh_name) else {
-            return Err(RenderError(format!("object {:?}: mesh {mesh_name:?} is not in the export", obj.name)));
+            return Err(RenderError(format!(
+                "object {:?}: mesh {mesh_name:?} is not in the export",
+                obj.name
+            )));
         };
         let info = &scene.file.meshes[mi];
-        let has_gn = obj.modifiers.iter().any(|m| m.kind == "NODES" && m.show_render);
-        let other_mods: Vec<&str> = obj.modifiers.iter().filter(|m| m.kind != "NODES" && m.show_render).map(|m| m.kind.as_str()).collect();
+        let has_gn = obj
+            .modifiers
+            .iter()
+            .any(|m| m.kind == "NODES" && m.show_render);
+        let other_mods: Vec<&str> = obj
+            .modifiers
+            .iter()
+            .filter(|m| m.kind != "NODES" && m.show_render)
+            .map(|m| m.kind.as_str())
+            .collect();
         if !other_mods.is_empty() {
-            return Err(RenderError(format!("object {:?}: modifier(s) {other_mods:?} are not supported by the renderer", obj.name)));
+            return Err(RenderError(format!(
+                "object {:?}: modifier(s) {other_mods:?} are not supported by the renderer",
+                obj.name
+            )));
         }
         let to_world = Affine::from_rows(&eval.world_matrices[oi]);
         if has_gn {
-            let set = crate::geometry::evaluate_object(scene, &obj.name, eval.frame, overrides).map_err(|e| RenderError(format!("object {:?}: geometry nodes: {e}", obj.name)))?;
+            let set = crate::geometry::evaluate_object(scene, &obj.name, eval.frame, overrides)
+                .map_err(|e| RenderError(format!("object {:?}: geometry nodes: {e}", obj.name)))?;
             // Top-level instances stay separate, each with its own id, sharing the
             // realised mesh of its reference; the rest of the set is one mesh.
             let mut rest = set.clone();
@@ -137,11 +159,25 @@ pub fn build(scene: &Scene, eval: &EvaluatedScene, overrides: &[(String, serde_j
                 Ok((Arc::new(m.to_scene(&obj.name)), mats))
             };
             let (mesh, mats) = realise(&rest)?;
-            push_instance(&mut instances, scene, oi, obj, info, mesh, &mats, to_world, None, false)?;
+            push_instance(
+                &mut instances,
+                scene,
+                oi,
+                obj,
+                info,
+                mesh,
+                &mats,
+                to_world,
+                None,
+                false,
+            )?;
             if let Some(inst) = instances_component {
-                let mut by_handle: HashMap<u32, (Arc<MeshData>, Vec<Option<String>>)> = HashMap::new();
+                let mut by_handle: HashMap<u32, (Arc<MeshData>, Vec<Option<String>>)> =
+                    HashMap::new();
                 for (i, (&h, t)) in inst.handles.iter().zip(&inst.transforms).enumerate() {
-                    let Some(g) = inst.references.get(h as usize).and_then(|r| r.geometry()) else { continue };
+                    let Some(g) = inst.references.get(h as usize).and_then(|r| r.geometry()) else {
+                        continue;
+                    };
                     let (mesh, mats) = match by_handle.get(&h) {
                         Some(x) => x.clone(),
                         None => {
@@ -158,39 +194,81 @@ pub fn build(scene: &Scene, eval: &EvaluatedScene, overrides: &[(String, serde_j
                         }
                     }
                     let world = compose(&to_world, &local);
-                    push_instance(&mut instances, scene, oi, obj, info, mesh, &mats, world, Some(i as u32), false)?;
+                    push_instance(
+                        &mut instances,
+                        scene,
+                        oi,
+                        obj,
+                        info,
+                        mesh,
+                        &mats,
+                        world,
+                        Some(i as u32),
+                        false,
+                    )?;
                 }
             }
         } else {
             let m = match cache.get(&mi) {
                 Some(m) => m.clone(),
                 None => {
-                    let m = Arc::new(scene.load_mesh(mi).map_err(|e| RenderError(e.to_string()))?);
+                    let m = Arc::new(
+                        scene
+                            .load_mesh(mi)
+                            .map_err(|e| RenderError(e.to_string()))?,
+                    );
                     cache.insert(mi, m.clone());
                     m
                 }
             };
-            push_instance(&mut instances, scene, oi, obj, info, m, &info.materials.clone(), to_world, None, true)?;
+            push_instance(
+                &mut instances,
+                scene,
+                oi,
+                obj,
+                info,
+                m,
+                &info.materials.clone(),
+                to_world,
+                None,
+                true,
+            )?;
         }
     }
     let (tris, refs) = world_triangles(&instances);
-    Ok(Geometry { instances, tris, refs })
+    Ok(Geometry {
+        instances,
+        tris,
+        refs,
+    })
 }
 
 /// The `accel::visibility` mask of an object: the ray types its Cycles ray visibility
 /// shows it to (Cycles' object_ray_visibility); everything without the setting.
 pub fn object_visibility(obj: &crate::scene::Object) -> u32 {
     use crate::shader::point::ray;
-    let Some(v) = &obj.visibility else { return super::accel::visibility::ALL };
-    [(v.camera, ray::CAMERA), (v.diffuse, ray::DIFFUSE), (v.glossy, ray::GLOSSY), (v.transmission, ray::TRANSMIT), (v.shadow, ray::SHADOW), (v.volume_scatter, ray::VOLUME_SCATTER)]
-        .iter()
-        .filter(|(on, _)| *on)
-        .fold(0, |m, (_, bit)| m | bit)
+    let Some(v) = &obj.visibility else {
+        return super::accel::visibility::ALL;
+    };
+    [
+        (v.camera, ray::CAMERA),
+        (v.diffuse, ray::DIFFUSE),
+        (v.glossy, ray::GLOSSY),
+        (v.transmission, ray::TRANSMIT),
+        (v.shadow, ray::SHADOW),
+        (v.volume_scatter, ray::VOLUME_SCATTER),
+    ]
+    .iter()
+    .filter(|(on, _)| *on)
+    .fold(0, |m, (_, bit)| m | bit)
 }
 
 /// Per scene triangle: its instance's visibility mask (for `Bvh::build_masked`).
 pub fn triangle_masks(geo: &Geometry) -> Vec<u32> {
-    geo.refs.iter().map(|r| geo.instances[r.inst as usize].visibility).collect()
+    geo.refs
+        .iter()
+        .map(|r| geo.instances[r.inst as usize].visibility)
+        .collect()
 }
 
 /// Says once per process that shadow catchers are rendered as ordinary objects.
@@ -205,14 +283,21 @@ pub fn world_triangles(instances: &[MeshInstance]) -> (Vec<[V3; 3]>, Vec<TriRef>
     let mut refs = Vec::new();
     for (ii, inst) in instances.iter().enumerate() {
         let m = &inst.mesh;
-        let world: Vec<V3> = m.positions.iter().map(|p| inst.to_world.point(*p)).collect();
+        let world: Vec<V3> = m
+            .positions
+            .iter()
+            .map(|p| inst.to_world.point(*p))
+            .collect();
         for (t, tri) in m.triangles.iter().enumerate() {
             let v = tri.map(|c| world[m.corner_verts[c as usize] as usize]);
             if v.iter().any(|p| !p.iter().all(|x| x.is_finite())) {
                 continue;
             }
             tris.push(v);
-            refs.push(TriRef { inst: ii as u32, tri: t as u32 });
+            refs.push(TriRef {
+                inst: ii as u32,
+                tri: t as u32,
+            });
         }
     }
     (tris, refs)
@@ -252,21 +337,42 @@ fn push_instance(
     let nslots = mesh_materials.len().max(obj.material_slots.len()).max(1);
     let slots: Vec<Option<usize>> = (0..nslots)
         .map(|s| {
-            let from_obj = obj.material_slots.get(s).filter(|sl| sl.link.as_deref() == Some("OBJECT")).map(|sl| sl.material.clone());
-            let name = from_obj.unwrap_or_else(|| mesh_materials.get(s).cloned().flatten().or_else(|| obj.material_slots.get(s).and_then(|sl| sl.material.clone())));
+            let from_obj = obj
+                .material_slots
+                .get(s)
+                .filter(|sl| sl.link.as_deref() == Some("OBJECT"))
+                .map(|sl| sl.material.clone());
+            let name = from_obj.unwrap_or_else(|| {
+                mesh_materials
+                    .get(s)
+                    .cloned()
+                    .flatten()
+                    .or_else(|| obj.material_slots.get(s).and_then(|sl| sl.material.clone()))
+            });
             material_index(scene, &name)
         })
         .collect();
     let face_slot: Vec<u32> = match mesh.attribute("material_index").map(|a| &a.data) {
-        Some(AttributeData::Int(v)) if v.len() == mesh.face_count() => v.iter().map(|&i| (i.max(0) as u32).min(nslots as u32 - 1)).collect(),
+        Some(AttributeData::Int(v)) if v.len() == mesh.face_count() => v
+            .iter()
+            .map(|&i| (i.max(0) as u32).min(nslots as u32 - 1))
+            .collect(),
         _ => vec![0; mesh.face_count()],
     };
-    let uv_name = info.active_render_uv.clone().or_else(|| info.uv_layers.first().cloned());
-    let uv = uv_name.as_deref().and_then(|n| mesh.attribute(n)).and_then(|a| match &a.data {
-        AttributeData::Float2(v) if v.len() == mesh.corner_count() => Some(Arc::new(v.clone())),
-        _ => None,
-    });
-    let to_object = to_world.inverse().ok_or_else(|| RenderError(format!("object {:?} has a singular transform", obj.name)))?;
+    let uv_name = info
+        .active_render_uv
+        .clone()
+        .or_else(|| info.uv_layers.first().cloned());
+    let uv = uv_name
+        .as_deref()
+        .and_then(|n| mesh.attribute(n))
+        .and_then(|a| match &a.data {
+            AttributeData::Float2(v) if v.len() == mesh.corner_count() => Some(Arc::new(v.clone())),
+            _ => None,
+        });
+    let to_object = to_world
+        .inverse()
+        .ok_or_else(|| RenderError(format!("object {:?} has a singular transform", obj.name)))?;
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for p in &mesh.positions {
         lo = vmin(lo, *p);
@@ -274,9 +380,16 @@ fn push_instance(
     }
     let (wlo, whi) = world_bounds(&mesh.positions, &to_world);
     // The exported texture space for plain meshes; the bounds for generated geometry.
-    let (tex_loc, tex_size) = match (info.texspace_location, info.texspace_size, exported_texspace) {
+    let (tex_loc, tex_size) = match (
+        info.texspace_location,
+        info.texspace_size,
+        exported_texspace,
+    ) {
         (Some(l), Some(s), true) => (l.map(|x| x as f32), s.map(|x| x as f32)),
-        _ => (scale(add(lo, hi), 0.5), scale(sub(hi, lo), 0.5).map(|x| if x == 0.0 { 1.0 } else { x })),
+        _ => (
+            scale(add(lo, hi), 0.5),
+            scale(sub(hi, lo), 0.5).map(|x| if x == 0.0 { 1.0 } else { x }),
+        ),
     };
     instances.push(MeshInstance {
         object: oi,
@@ -293,7 +406,13 @@ fn push_instance(
         world_bounds: (wlo, whi),
         info: {
             let m = to_world.m;
-            let rows: [[f64; 4]; 4] = std::array::from_fn(|r| if r < 3 { m[r].map(|x| x as f64) } else { [0.0, 0.0, 0.0, 1.0] });
+            let rows: [[f64; 4]; 4] = std::array::from_fn(|r| {
+                if r < 3 {
+                    m[r].map(|x| x as f64)
+                } else {
+                    [0.0, 0.0, 0.0, 1.0]
+                }
+            });
             crate::shader::view::object_info(obj, &rows)
         },
         motion: None,
@@ -313,12 +432,20 @@ fn push_instance(
 /// Binds, for every instance and slot, the mesh attributes its material reads (Cycles
 /// syncs them once per mesh): instances sharing a mesh and material share one binding.
 /// Call before true displacement, which Cycles also runs after the attributes are made.
-pub fn bind_attributes(geo: &mut Geometry, materials: &[super::shade::Material]) -> Result<(), RenderError> {
+pub fn bind_attributes(
+    geo: &mut Geometry,
+    materials: &[super::shade::Material],
+) -> Result<(), RenderError> {
     let mut done: HashMap<(*const MeshData, usize), Arc<BoundAttributes>> = HashMap::new();
     for inst in &mut geo.instances {
         let mut per_slot = Vec::with_capacity(inst.slots.len());
         for slot in &inst.slots {
-            let Some((mi, p)) = slot.and_then(|mi| materials.get(mi).and_then(|m| m.program.as_ref()).map(|p| (mi, p))) else {
+            let Some((mi, p)) = slot.and_then(|mi| {
+                materials
+                    .get(mi)
+                    .and_then(|m| m.program.as_ref())
+                    .map(|p| (mi, p))
+            }) else {
                 per_slot.push(None);
                 continue;
             };
@@ -333,8 +460,18 @@ pub fn bind_attributes(geo: &mut Geometry, materials: &[super::shade::Material])
             let bound = match done.get(&key) {
                 Some(b) => b.clone(),
                 None => {
-                    let b = BoundAttributes::bind(&inst.mesh, &p.attributes, inst.uv_name.as_deref(), inst.default_color.as_deref())
-                        .map_err(|e| RenderError(format!("object {:?}, material {:?}: {e}", inst.name, materials[mi].name)))?;
+                    let b = BoundAttributes::bind(
+                        &inst.mesh,
+                        &p.attributes,
+                        inst.uv_name.as_deref(),
+                        inst.default_color.as_deref(),
+                    )
+                    .map_err(|e| {
+                        RenderError(format!(
+                            "object {:?}, material {:?}: {e}",
+                            inst.name, materials[mi].name
+                        ))
+                    })?;
                     let b = Arc::new(b);
                     done.insert(key, b.clone());
                     b

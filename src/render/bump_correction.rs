@@ -32,7 +32,11 @@ pub fn ensure_valid_specular_reflection(ng: V3, i: V3, n: V3) -> V3 {
     let b = 2.0 * (a + iz * threshold);
     let c = (threshold + iz) * (threshold + iz);
     let disc = (b * b - 4.0 * a * c).max(0.0).sqrt();
-    let nz2 = if ix < 0.0 { 0.25 * (b + disc) / a } else { 0.25 * (b - disc) / a };
+    let nz2 = if ix < 0.0 {
+        0.25 * (b + disc) / a
+    } else {
+        0.25 * (b - disc) / a
+    };
     let nx = (1.0 - nz2).max(0.0).sqrt();
     let nz = nz2.max(0.0).sqrt();
     add(scale(x, nx), scale(ng, nz))
@@ -89,7 +93,10 @@ mod tests {
         let c = ensure_valid_specular_reflection(ng, i, n);
         assert!((len(c) - 1.0).abs() < 1e-5);
         assert!((dot(reflect(c, i), ng) - 0.01).abs() < 1e-4, "{c:?}");
-        assert!(c[1].abs() < 1e-6 && c[0] > 0.0, "stays in the plane of ng and n: {c:?}");
+        assert!(
+            c[1].abs() < 1e-6 && c[0] > 0.0,
+            "stays in the plane of ng and n: {c:?}"
+        );
         // Grazing view from the side the normal leans away from.
         let i = normalize([-1.0, 0.3, 0.2]);
         let n = normalize([1.0, 0.2, 0.6]);
@@ -104,7 +111,10 @@ mod tests {
         let ns = [0.0, 0.0, 1.0];
         let n = normalize([0.6, 0.0, 0.8]);
         // Unbumped closures are untouched.
-        assert_eq!(bump_shadowing_term(ns, ns, normalize([1.0, 0.0, -0.1]), true, true), 1.0);
+        assert_eq!(
+            bump_shadowing_term(ns, ns, normalize([1.0, 0.0, -0.1]), true, true),
+            1.0
+        );
         // Light below the smooth surface but above the bumped normal: cut for every closure.
         let below = normalize([1.0, 0.0, -0.1]);
         assert!(dot(n, below) > 0.0);

@@ -39,8 +39,16 @@ pub struct Camera {
 
 /// Blender's sensor fit for an image of (xratio, yratio) (pixel aspect included):
 /// whether the sensor spans the width, and the sensor size along that side in mm.
-pub(super) fn sensor_fit(p: &serde_json::Map<String, Value>, xratio: f32, yratio: f32) -> (bool, f32) {
-    let (horizontal, size) = match p.get("sensor_fit").and_then(Value::as_str).unwrap_or("AUTO") {
+pub(super) fn sensor_fit(
+    p: &serde_json::Map<String, Value>,
+    xratio: f32,
+    yratio: f32,
+) -> (bool, f32) {
+    let (horizontal, size) = match p
+        .get("sensor_fit")
+        .and_then(Value::as_str)
+        .unwrap_or("AUTO")
+    {
         "HORIZONTAL" => (true, num(p, "sensor_width", 36.0)),
         "VERTICAL" => (false, num(p, "sensor_height", 24.0)),
         _ => (xratio > yratio, num(p, "sensor_width", 36.0)),
@@ -53,25 +61,64 @@ fn num(p: &serde_json::Map<String, Value>, key: &str, default: f64) -> f64 {
 }
 
 impl Camera {
-    pub fn new(scene: &Scene, eval: &EvaluatedScene, width: u32, height: u32) -> Result<Camera, RenderError> {
-        let cam_name = scene.file.scene.camera.as_deref().ok_or_else(|| RenderError("the scene has no active camera (scene.camera is empty)".into()))?;
-        let oi = eval.data.objects.iter().position(|o| o.name == cam_name).ok_or_else(|| RenderError(format!("camera object {cam_name:?} is not in the export")))?;
+    pub fn new(
+        scene: &Scene,
+        eval: &EvaluatedScene,
+        width: u32,
+        height: u32,
+    ) -> Result<Camera, RenderError> {
+        let cam_name = scene.file.scene.camera.as_deref().ok_or_else(|| {
+            RenderError("the scene has no active camera (scene.camera is empty)".into())
+        })?;
+        let oi = eval
+            .data
+            .objects
+            .iter()
+            .position(|o| o.name == cam_name)
+            .ok_or_else(|| {
+                RenderError(format!("camera object {cam_name:?} is not in the export"))
+            })?;
         let obj = &eval.data.objects[oi];
         let data = obj.data.as_deref().unwrap_or(cam_name);
-        let cam = eval.data.cameras.iter().find(|c| c.name == data).ok_or_else(|| RenderError(format!("camera object {cam_name:?}: camera data {data:?} is not in the export")))?;
+        let cam = eval
+            .data
+            .cameras
+            .iter()
+            .find(|c| c.name == data)
+            .ok_or_else(|| {
+                RenderError(format!(
+                    "camera object {cam_name:?}: camera data {data:?} is not in the export"
+                ))
+            })?;
         let p = &cam.properties;
         let kind = p.get("type").and_then(Value::as_str).unwrap_or("PERSP");
         if !matches!(kind, "PERSP" | "ORTHO" | "PANO") {
-            return Err(RenderError(format!("camera {data:?}: camera type {kind:?} is not supported")));
+            return Err(RenderError(format!(
+                "camera {data:?}: camera type {kind:?} is not supported"
+            )));
         }
         let ortho = kind == "ORTHO";
         let r = &scene.file.scene.render;
-        let (pax, pay) = (num(r, "pixel_aspect_x", 1.0) as f32, num(r, "pixel_aspect_y", 1.0) as f32);
+        let (pax, pay) = (
+            num(r, "pixel_aspect_x", 1.0) as f32,
+            num(r, "pixel_aspect_y", 1.0) as f32,
+        );
         let xratio = width as f32 * pax;
         let yratio = height as f32 * pay;
-        let panorama = if kind == "PANO" { Some(super::panorama::Panorama::from_camera(p, xratio, yratio).map_err(|e| RenderError(format!("camera {data:?}: {e}")))?) } else { None };
+        let panorama = if kind == "PANO" {
+            Some(
+                super::panorama::Panorama::from_camera(p, xratio, yratio)
+                    .map_err(|e| RenderError(format!("camera {data:?}: {e}")))?,
+            )
+        } else {
+            None
+        };
         let (horizontal, sensor) = sensor_fit(p, xratio, yratio);
-        let (mut aspect, mut xaspect, mut yaspect) = if horizontal { (xratio / yratio, xratio / yratio, 1.0) } else { (yratio / xratio, 1.0, yratio / xratio) };
+        let (mut aspect, mut xaspect, mut yaspect) = if horizontal {
+            (xratio / yratio, xratio / yratio, 1.0)
+        } else {
+            (yratio / xratio, 1.0, yratio / xratio)
+        };
         let ortho_scale = num(p, "ortho_scale", 6.0) as f32;
         if ortho {
             xaspect = xaspect * ortho_scale / (aspect * 2.0);
@@ -82,16 +129,30 @@ impl Camera {
         let dx = 2.0 * aspect * sx;
         let dy = 2.0 * aspect * sy;
         let lens = num(p, "lens", 50.0) as f32;
-        let tan_half = if ortho { 1.0 } else { (0.5 * sensor) / lens / aspect };
+        let tan_half = if ortho {
+            1.0
+        } else {
+            (0.5 * sensor) / lens / aspect
+        };
         // Camera transform without scale (Cycles clears it).
         let to_world = without_scale(&Affine::from_rows(&eval.world_matrices[oi]));
         let dof = p.get("dof").and_then(Value::as_object);
-        let use_dof = dof.and_then(|d| d.get("use_dof")).and_then(Value::as_bool).unwrap_or(false);
-        let (mut aperture, mut focus, mut blades, mut rotation, mut ratio) = (0.0f32, 10.0f32, 0u32, 0.0f32, 1.0f32);
+        let use_dof = dof
+            .and_then(|d| d.get("use_dof"))
+            .and_then(Value::as_bool)
+            .unwrap_or(false);
+        let (mut aperture, mut focus, mut blades, mut rotation, mut ratio) =
+            (0.0f32, 10.0f32, 0u32, 0.0f32, 1.0f32);
         if let (true, Some(d)) = (use_dof, dof) {
             let fstop = num(d, "aperture_fstop", 2.8) as f32;
             // Cycles: lens in mm to a radius in metres; orthographic uses 1/(2 f-stop).
-            aperture = if fstop <= 0.0 { 0.0 } else if ortho { 1.0 / (2.0 * fstop) } else { (lens * 1e-3) / (2.0 * fstop) };
+            aperture = if fstop <= 0.0 {
+                0.0
+            } else if ortho {
+                1.0 / (2.0 * fstop)
+            } else {
+                (lens * 1e-3) / (2.0 * fstop)
+            };
             // Blender's unit scale applies to the lens; scene scale is 1 in our fixtures.
             blades = num(d, "aperture_blades", 0.0) as u32;
             rotation = num(d, "aperture_rotation", 0.0) as f32;
@@ -111,7 +172,11 @@ impl Camera {
         let clip_start = num(p, "clip_start", 0.1) as f32;
         let clip_end = num(p, "clip_end", 100.0) as f32;
         // A panoramic camera's viewplane is [0, 1]^2, moved by the shift as it is.
-        let (left, right, bottom, top) = if panorama.is_some() { (sx, 1.0 + sx, sy, 1.0 + sy) } else { (-xaspect + dx, xaspect + dx, -yaspect + dy, yaspect + dy) };
+        let (left, right, bottom, top) = if panorama.is_some() {
+            (sx, 1.0 + sx, sy, 1.0 + sy)
+        } else {
+            (-xaspect + dx, xaspect + dx, -yaspect + dy, yaspect + dy)
+        };
         Ok(Camera {
             ortho,
             left,
@@ -166,7 +231,14 @@ impl Camera {
             return self.panorama_ray(pano, to_world, vx, vy, lens);
         }
         // Camera space, looking down -Z.
-        let (mut p, mut d) = if self.ortho { ([vx, vy, 0.0], [0.0, 0.0, -1.0]) } else { ([0.0; 3], normalize([vx * self.tan_half, vy * self.tan_half, -1.0])) };
+        let (mut p, mut d) = if self.ortho {
+            ([vx, vy, 0.0], [0.0, 0.0, -1.0])
+        } else {
+            (
+                [0.0; 3],
+                normalize([vx * self.tan_half, vy * self.tan_half, -1.0]),
+            )
+        };
         let tmin;
         let tmax;
         if self.aperture > 0.0 {
@@ -198,7 +270,14 @@ impl Camera {
     /// Cycles' camera_sample_panorama: the direction from the projection, a thin lens
     /// across it, the near clip along the ray. Outside the lens: a zero direction and
     /// tmax 0 (the sample sees nothing).
-    fn panorama_ray(&self, pano: &super::panorama::Panorama, to_world: &Affine, u: f32, v: f32, lens: [f32; 2]) -> (V3, V3, f32, f32) {
+    fn panorama_ray(
+        &self,
+        pano: &super::panorama::Panorama,
+        to_world: &Affine,
+        u: f32,
+        v: f32,
+        lens: [f32; 2],
+    ) -> (V3, V3, f32, f32) {
         let mut d = pano.direction(u, v);
         if d == [0.0; 3] {
             return (to_world.column(3), [0.0; 3], 0.0, 0.0);
@@ -221,7 +300,12 @@ impl Camera {
         }
         let wo = to_world.point(pano.to_blender_camera(p));
         let wd = normalize(to_world.vector(pano.to_blender_camera(d)));
-        (madd(wo, wd, self.clip_start), wd, 0.0, self.clip_end - self.clip_start)
+        (
+            madd(wo, wd, self.clip_start),
+            wd,
+            0.0,
+            self.clip_end - self.clip_start,
+        )
     }
 
     /// Compact ray differentials (Cycles' ray.dP, ray.dD) of the ray through (x, y): the
@@ -231,11 +315,18 @@ impl Camera {
         let (ox, dx, ..) = self.ray(x + 1.0, y, lens);
         let (oy, dy, ..) = self.ray(x, y + 1.0, lens);
         let len = |v: V3| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-        (0.5 * (len(sub(ox, o)) + len(sub(oy, o))), 0.5 * (len(sub(dx, d)) + len(sub(dy, d))))
+        (
+            0.5 * (len(sub(ox, o)) + len(sub(oy, o))),
+            0.5 * (len(sub(dx, d)) + len(sub(dy, d))),
+        )
     }
 
     fn sample_aperture(&self, u: [f32; 2]) -> [f32; 2] {
-        let mut p = if self.blades < 3 { concentric_disk(u) } else { regular_polygon(self.blades, self.rotation, u) };
+        let mut p = if self.blades < 3 {
+            concentric_disk(u)
+        } else {
+            regular_polygon(self.blades, self.rotation, u)
+        };
         // Anamorphic ratio stretches the bokeh as Cycles does.
         p[0] *= self.ratio.sqrt().max(1e-6);
         p[1] /= self.ratio.sqrt().max(1e-6);
@@ -283,7 +374,14 @@ pub fn concentric_disk(u: [f32; 2]) -> [f32; 2] {
     if a == 0.0 && b == 0.0 {
         return [0.0, 0.0];
     }
-    let (r, phi) = if a * a > b * b { (a, std::f32::consts::FRAC_PI_4 * (b / a)) } else { (b, std::f32::consts::FRAC_PI_2 - std::f32::consts::FRAC_PI_4 * (a / b)) };
+    let (r, phi) = if a * a > b * b {
+        (a, std::f32::consts::FRAC_PI_4 * (b / a))
+    } else {
+        (
+            b,
+            std::f32::consts::FRAC_PI_2 - std::f32::consts::FRAC_PI_4 * (a / b),
+        )
+    };
     [r * phi.cos(), r * phi.sin()]
 }
 
@@ -306,6 +404,11 @@ impl Camera {
     /// The camera as the shader's texture-coordinate nodes see it (Cycles' world to
     /// camera and world to NDC transforms).
     pub fn view(&self) -> crate::shader::view::View {
-        crate::shader::view::View::new(&self.to_world.m, self.ortho, self.tan_half, [self.left, self.right, self.bottom, self.top])
+        crate::shader::view::View::new(
+            &self.to_world.m,
+            self.ortho,
+            self.tan_half,
+            [self.left, self.right, self.bottom, self.top],
+        )
     }
 }

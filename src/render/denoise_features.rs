@@ -27,7 +27,12 @@ pub struct Features {
 
 impl Default for Features {
     fn default() -> Self {
-        Features { active: true, throughput: [1.0; 3], normal: [0.0; 3], albedo: [0.0; 3] }
+        Features {
+            active: true,
+            throughput: [1.0; 3],
+            normal: [0.0; 3],
+            albedo: [0.0; 3],
+        }
     }
 }
 
@@ -106,7 +111,11 @@ mod tests {
     #[test]
     fn mostly_specular_surfaces_pass_the_guides_on() {
         let mut lobes = LobeSet::default();
-        let mirror = LobeKind::Glossy { alpha: 0.0, fresnel: Fresnel::Constant, energy: 1.0 };
+        let mirror = LobeKind::Glossy {
+            alpha: 0.0,
+            fresnel: Fresnel::Constant,
+            energy: 1.0,
+        };
         lobes.push(mirror, [0.9, 0.8, 0.7], [0.0, 0.0, 1.0]);
         lobes.push(LobeKind::Diffuse, [0.1, 0.1, 0.1], [0.0, 1.0, 0.0]);
         let mut f = Features::default();

@@ -24,7 +24,10 @@ use super::shade::Material;
 /// Displaces every mesh that uses a truly displacing material; returns how many vertices
 /// moved. The caller rebuilds the world triangles afterwards.
 pub fn apply(geo: &mut Geometry, materials: &[Material]) -> usize {
-    let displacing = |m: &Option<usize>| m.and_then(|m| materials[m].program.as_ref()).is_some_and(|p| p.displacement.is_some());
+    let displacing = |m: &Option<usize>| {
+        m.and_then(|m| materials[m].program.as_ref())
+            .is_some_and(|p| p.displacement.is_some())
+    };
     let mut done: HashMap<*const MeshData, (Arc<MeshData>, Arc<Vec<V3>>)> = HashMap::new();
     let mut moved = 0;
     for inst in &mut geo.instances {
@@ -46,7 +49,11 @@ pub fn apply(geo: &mut Geometry, materials: &[Material]) -> usize {
 }
 
 /// The material program of triangle `t` of `inst`, if it truly displaces.
-fn program_of<'m>(inst: &MeshInstance, materials: &'m [Material], t: usize) -> Option<(usize, &'m crate::shader::program::Program)> {
+fn program_of<'m>(
+    inst: &MeshInstance,
+    materials: &'m [Material],
+    t: usize,
+) -> Option<(usize, &'m crate::shader::program::Program)> {
     let mi = inst.material_of(t)?;
     let p = materials[mi].program.as_ref()?;
     p.displacement.map(|_| (mi, p))
@@ -58,7 +65,9 @@ fn displace(inst: &MeshInstance, materials: &[Material]) -> (MeshData, usize) {
     let mut owner = vec![u32::MAX; m.vertex_count()];
     let mut recompute = vec![false; m.triangles.len()];
     for (t, tri) in m.triangles.iter().enumerate() {
-        let Some((_, p)) = program_of(inst, materials, t) else { continue };
+        let Some((_, p)) = program_of(inst, materials, t) else {
+            continue;
+        };
         // "Displacement Only" triangles get new normals; "Both" keeps the old ones.
         recompute[t] = p.displacement.is_some_and(|d| d.bump_end.is_none());
         for (k, &c) in tri.iter().enumerate() {
@@ -69,15 +78,25 @@ fn displace(inst: &MeshInstance, materials: &[Material]) -> (MeshData, usize) {
         }
     }
     let vertex_normals = crate::shader::tangent::vertex_normals(m);
-    let jobs: Vec<(u32, u32)> = owner.iter().enumerate().filter(|(_, o)| **o != u32::MAX).map(|(v, o)| (v as u32, *o)).collect();
-    let transform = ObjectTransform { to_world: inst.to_world.m, to_object: inst.to_object.m };
+    let jobs: Vec<(u32, u32)> = owner
+        .iter()
+        .enumerate()
+        .filter(|(_, o)| **o != u32::MAX)
+        .map(|(v, o)| (v as u32, *o))
+        .collect();
+    let transform = ObjectTransform {
+        to_world: inst.to_world.m,
+        to_object: inst.to_object.m,
+    };
     let offsets: Vec<V3> = jobs
         .par_iter()
         .map_init(
             || vec![Vec::new(); materials.len()],
             |stacks, &(v, o)| {
                 let (t, k) = ((o / 3) as usize, (o % 3) as usize);
-                let Some((mi, p)) = program_of(inst, materials, t) else { return [0.0; 3] };
+                let Some((mi, p)) = program_of(inst, materials, t) else {
+                    return [0.0; 3];
+                };
                 let sp = vertex_point(inst, &vertex_normals, transform, t, k, v as usize);
                 let stack = &mut stacks[mi];
                 if stack.len() != p.initial.len() {
@@ -85,7 +104,8 @@ fn displace(inst: &MeshInstance, materials: &[Material]) -> (MeshData, usize) {
                 }
                 let d = p.displacement_at(&sp, stack).unwrap_or([0.0; 3]);
                 // Cycles' ensure_finite, then back to object space (the mesh's).
-                inst.to_object.vector(d.map(|x| if x.is_finite() { x } else { 0.0 }))
+                inst.to_object
+                    .vector(d.map(|x| if x.is_finite() { x } else { 0.0 }))
             },
         )
         .collect();
@@ -101,12 +121,22 @@ fn displace(inst: &MeshInstance, materials: &[Material]) -> (MeshData, usize) {
 
 /// The shading point Cycles' displacement shader sees at vertex `v`, corner `k` of
 /// triangle `t` (shader_setup_from_displace).
-fn vertex_point(inst: &MeshInstance, vertex_normals: &[V3], transform: ObjectTransform, t: usize, k: usize, v: usize) -> ShadingPoint {
+fn vertex_point(
+    inst: &MeshInstance,
+    vertex_normals: &[V3],
+    transform: ObjectTransform,
+    t: usize,
+    k: usize,
+    v: usize,
+) -> ShadingPoint {
     let m = &inst.mesh;
     let tri = m.triangles[t];
     let local = m.positions[v];
     let world = inst.to_world.point(local);
-    let wv = tri.map(|c| inst.to_world.point(m.positions[m.corner_verts[c as usize] as usize]));
+    let wv = tri.map(|c| {
+        inst.to_world
+            .point(m.positions[m.corner_verts[c as usize] as usize])
+    });
     let ng = normalize(cross(sub(wv[1], wv[0]), sub(wv[2], wv[0])));
     let n_obj = normalize(vertex_normals[v]);
     let mut n = normalize(Affine::normal_by_inverse(&inst.to_object, n_obj));
@@ -168,7 +198,10 @@ fn recompute_normals(m: &mut MeshData, recompute: &[bool]) {
             continue;
         }
         let tri = m.triangles[t];
-        let is_flat = flat.get(m.triangle_faces[t] as usize).copied().unwrap_or(false);
+        let is_flat = flat
+            .get(m.triangle_faces[t] as usize)
+            .copied()
+            .unwrap_or(false);
         let fno = tri_normal(m, &tri);
         for &c in &tri {
             let v = m.corner_verts[c as usize] as usize;

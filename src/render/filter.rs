@@ -44,7 +44,11 @@ impl FilterTable {
     #[inline]
     pub fn sample(&self, u: f32) -> f32 {
         // Symmetric: the sign from which half u falls in.
-        let (s, v) = if u < 0.5 { (-1.0, 1.0 - 2.0 * u) } else { (1.0, 2.0 * u - 1.0) };
+        let (s, v) = if u < 0.5 {
+            (-1.0, 1.0 - 2.0 * u)
+        } else {
+            (1.0, 2.0 * u - 1.0)
+        };
         let x = v * (TABLE - 1) as f32;
         let i = (x as usize).min(TABLE - 2);
         let t = x - i as f32;

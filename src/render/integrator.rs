@@ -6,8 +6,8 @@
 //! Cycles' clamping (direct and indirect limits on the sum of a contribution).
 
 use crate::scene::AttributeData;
-use crate::shader::ShadingPoint;
 use crate::shader::point::{ray, PathState, Undisplaced};
+use crate::shader::ShadingPoint;
 
 use super::accel::{visibility, Accel};
 use super::bsdf::{LobeKind, LobeSet};
@@ -100,7 +100,17 @@ pub struct Scratch {
 
 impl Scratch {
     pub fn new(n_materials: usize) -> Scratch {
-        Scratch { stacks: vec![Vec::new(); n_materials + 1], lobes: LobeSet::default(), light_lobes: LobeSet::default(), rays: 0, ray_dp: 0.0, ray_dd: 0.0, time: super::object_motion::CENTRE_TIME, features: Default::default(), transparent: 0.0 }
+        Scratch {
+            stacks: vec![Vec::new(); n_materials + 1],
+            lobes: LobeSet::default(),
+            light_lobes: LobeSet::default(),
+            rays: 0,
+            ray_dp: 0.0,
+            ray_dd: 0.0,
+            time: super::object_motion::CENTRE_TIME,
+            features: Default::default(),
+            transparent: 0.0,
+        }
     }
 }
 
@@ -158,7 +168,8 @@ impl Scene<'_> {
         // space before interpolation (it differs under non-uniform scale), and Texture
         // Coordinate > Normal transforms the result back.
         if m.corner_normals.len() == m.corner_verts.len() {
-            let cn = c.map(|c| normalize(Affine::normal_by_inverse(&to_object, m.corner_normals[c])));
+            let cn =
+                c.map(|c| normalize(Affine::normal_by_inverse(&to_object, m.corner_normals[c])));
             n = normalize(add(add(scale(cn[0], w0), scale(cn[1], u)), scale(cn[2], v)));
             n_obj = normalize(Affine::normal_by_inverse(&to_world, n));
         }
@@ -188,15 +199,26 @@ impl Scene<'_> {
         let orco = before.unwrap_or(local);
         sp.generated = inst.generated(orco);
         if let Some(b) = before {
-            sp.undisplaced = Some(Undisplaced { position: to_world.point(b), object_position: b, ..Undisplaced::default() });
+            sp.undisplaced = Some(Undisplaced {
+                position: to_world.point(b),
+                object_position: b,
+                ..Undisplaced::default()
+            });
         }
         if let Some(uv) = &inst.uv {
             let t = c.map(|c| uv[c]);
-            sp.uv = [t[0][0] * w0 + t[1][0] * u + t[2][0] * v, t[0][1] * w0 + t[1][1] * u + t[2][1] * v, 0.0];
+            sp.uv = [
+                t[0][0] * w0 + t[1][0] * u + t[2][0] * v,
+                t[0][1] * w0 + t[1][1] * u + t[2][1] * v,
+                0.0,
+            ];
         }
         self.fill_context(&mut sp, inst, wo, ng, backfacing, u, v);
         // Tangent-space normal maps turn their normal to world space with it.
-        sp.transform = crate::shader::bump::ObjectTransform { to_world: to_world.m, to_object: to_object.m };
+        sp.transform = crate::shader::bump::ObjectTransform {
+            to_world: to_world.m,
+            to_object: to_object.m,
+        };
         if let Some(Some(bound)) = inst.attributes.get(slot) {
             bound.fill(m, r.tri as usize, c, face, [w0, u, v], &mut sp);
         }
@@ -205,7 +227,17 @@ impl Scene<'_> {
             sp.object.location = to_world.column(3);
             sp.object.world_to_object = to_object.m;
         }
-        SurfaceHit { p, ng, sp, inst: r.inst, material, backfacing, time, prim, uv: [u, v] }
+        SurfaceHit {
+            p,
+            ng,
+            sp,
+            inst: r.inst,
+            material,
+            backfacing,
+            time,
+            prim,
+            uv: [u, v],
+        }
     }
 
     pub fn shade(&self, hit: &SurfaceHit, wo: V3, scratch: &mut Scratch) {
@@ -213,7 +245,12 @@ impl Scene<'_> {
     }
 
     fn shade_into(&self, hit: &SurfaceHit, wo: V3, stacks: &mut [Vec<f32>], lobes: &mut LobeSet) {
-        let ctx = Context { tables: self.tables, wo, backfacing: hit.backfacing, bump_correction: true };
+        let ctx = Context {
+            tables: self.tables,
+            wo,
+            backfacing: hit.backfacing,
+            bump_correction: true,
+        };
         match hit.material {
             Some(mi) => self.materials[mi].shade(&hit.sp, &mut stacks[mi], &ctx, lobes),
             None => {
@@ -224,14 +261,24 @@ impl Scene<'_> {
     }
 
     /// One path sample: radiance along the camera ray.
-    pub fn radiance(&self, org: V3, dir: V3, tmin: f32, tmax: f32, rng: &PixelSampler, index: u32, scratch: &mut Scratch) -> V3 {
+    pub fn radiance(
+        &self,
+        org: V3,
+        dir: V3,
+        tmin: f32,
+        tmax: f32,
+        rng: &PixelSampler,
+        index: u32,
+        scratch: &mut Scratch,
+    ) -> V3 {
         let st = &self.settings;
         let mut l = [0.0f32; 3];
         let mut throughput = [1.0f32; 3];
         scratch.features = Default::default();
         scratch.transparent = 0.0;
         let (mut o, mut d, mut t0, mut t1) = (org, dir, tmin, tmax);
-        let (mut bounce, mut diffuse, mut glossy, mut transmission, mut transparent) = (0u32, 0u32, 0u32, 0u32, 0u32);
+        let (mut bounce, mut diffuse, mut glossy, mut transmission, mut transparent) =
+            (0u32, 0u32, 0u32, 0u32, 0u32);
         let mut terminate_next = false;
         // Cycles' path flags of the ray being traced (Light Path node).
         let mut flags = ray::CAMERA;
@@ -263,14 +310,27 @@ impl Scene<'_> {
                 from_sss
             } else {
                 scratch.rays += 1;
-                self.accel.intersect_vis(o, d, t0, t1, scratch.time, visibility::of_path(flags))
+                self.accel
+                    .intersect_vis(o, d, t0, t1, scratch.time, visibility::of_path(flags))
             };
             // Emission reached by a ray clamps as the bounce before it (Cycles: light found
             // after one bounce is direct light, like the light sample at that vertex).
-            let clamp_limit = if bounce <= 1 { st.clamp_direct } else { st.clamp_indirect };
+            let clamp_limit = if bounce <= 1 {
+                st.clamp_direct
+            } else {
+                st.clamp_indirect
+            };
             // Lights are not in the BVH: a ray collects every light it passes before the surface.
-            let t_surface = hit_opt.map(|h| h.t).unwrap_or(if t1.is_finite() { t1 } else { f32::INFINITY });
-            for (li, light) in self.lights.iter().enumerate().filter(|(_, l)| from_sss.is_none() && l.visible_to(flags)) {
+            let t_surface =
+                hit_opt
+                    .map(|h| h.t)
+                    .unwrap_or(if t1.is_finite() { t1 } else { f32::INFINITY });
+            for (li, light) in self
+                .lights
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| from_sss.is_none() && l.visible_to(flags))
+            {
                 // Rays other than the camera's see only lights shared with BSDF sampling
                 // (Cycles' lights_intersect skips those without SHADER_USE_MIS).
                 if !light.mis && flags & ray::CAMERA == 0 {
@@ -280,9 +340,17 @@ impl Scene<'_> {
                     let w = if prev_singular {
                         1.0
                     } else {
-                        power_heuristic(prev_pdf, lh.pdf * self.light_select.pdf(o, mis_n, mis_trans, Pick::Lamp(li as u32)))
+                        power_heuristic(
+                            prev_pdf,
+                            lh.pdf
+                                * self
+                                    .light_select
+                                    .pdf(o, mis_n, mis_trans, Pick::Lamp(li as u32)),
+                        )
                     };
-                    scratch.features.add_emission(scale(mul(throughput, lh.radiance), w));
+                    scratch
+                        .features
+                        .add_emission(scale(mul(throughput, lh.radiance), w));
                     let c = clamp_contrib(scale(mul(throughput, lh.radiance), w), clamp_limit);
                     if finite(c) {
                         l = add(l, c);
@@ -311,7 +379,14 @@ impl Scene<'_> {
             let wo = neg(d);
             let mut hit = self.surface_at(h.prim, h.u, h.v, wo, scratch.time);
             hit.sp.ray_length = h.t;
-            hit.sp.path = PathState { flags, bounce, diffuse, glossy, transmission, transparent };
+            hit.sp.path = PathState {
+                flags,
+                bounce,
+                diffuse,
+                glossy,
+                transmission,
+                transparent,
+            };
             ray_dp += h.t * ray_dd;
             self.fill_differentials(&mut hit, h.prim, ray_dp);
             if from_sss.is_some() {
@@ -321,11 +396,17 @@ impl Scene<'_> {
                     Some(mi) if self.materials[mi].bssrdf_bump => {
                         self.shade(&hit, wo, scratch);
                         let smooth = scratch.lobes.smooth_n;
-                        (super::subsurface::exit_normal(&scratch.lobes, smooth), smooth)
+                        (
+                            super::subsurface::exit_normal(&scratch.lobes, smooth),
+                            smooth,
+                        )
                     }
                     _ => (hit.sp.normal, hit.sp.normal),
                 };
-                let correction = hit.material.map(|mi| self.materials[mi].bump_correction).unwrap_or(true);
+                let correction = hit
+                    .material
+                    .map(|mi| self.materials[mi].bump_correction)
+                    .unwrap_or(true);
                 scratch.lobes.clear();
                 scratch.lobes.smooth_n = smooth;
                 scratch.lobes.bump_correction = correction;
@@ -338,7 +419,10 @@ impl Scene<'_> {
                 if transparent_bg && self.geo.instances[hit.inst as usize].holdout {
                     // The holdout weight (Cycles' surface_shader_apply_holdout) is what
                     // the object's transparency does not let through.
-                    let weight = sub([1.0; 3], scratch.lobes.transparent.map(|t| t.clamp(0.0, 1.0)));
+                    let weight = sub(
+                        [1.0; 3],
+                        scratch.lobes.transparent.map(|t| t.clamp(0.0, 1.0)),
+                    );
                     scratch.transparent += average(mul(weight, throughput));
                     if !holdout_keep_transparent(&mut scratch.lobes) {
                         break;
@@ -352,7 +436,8 @@ impl Scene<'_> {
                     }
                 }
             }
-            scratch.lobes.terminator_frequency = self.geo.instances[hit.inst as usize].terminator_frequency;
+            scratch.lobes.terminator_frequency =
+                self.geo.instances[hit.inst as usize].terminator_frequency;
             if diffuse_ancestor {
                 super::subsurface::to_diffuse(&mut scratch.lobes);
             }
@@ -392,14 +477,26 @@ impl Scene<'_> {
                 let w = if prev_singular || !(if hit.backfacing { back } else { front }) {
                     1.0
                 } else {
-                    let pick = self.light_select.pdf(o, mis_n, mis_trans, Pick::Triangle(h.prim));
+                    let pick = self
+                        .light_select
+                        .pdf(o, mis_n, mis_trans, Pick::Triangle(h.prim));
                     if pick > 0.0 {
-                        power_heuristic(prev_pdf, pick * super::triangle_light::pdf(&self.geo.tris[h.prim as usize], o, d, h.t))
+                        power_heuristic(
+                            prev_pdf,
+                            pick * super::triangle_light::pdf(
+                                &self.geo.tris[h.prim as usize],
+                                o,
+                                d,
+                                h.t,
+                            ),
+                        )
                     } else {
                         1.0
                     }
                 };
-                scratch.features.add_emission(scale(mul(throughput, lobes.emission), w));
+                scratch
+                    .features
+                    .add_emission(scale(mul(throughput, lobes.emission), w));
                 let c = clamp_contrib(scale(mul(throughput, lobes.emission), w), clamp_limit);
                 if finite(c) {
                     l = add(l, c);
@@ -425,7 +522,11 @@ impl Scene<'_> {
             // as the setting plus one (so the first indirect hit always continues),
             // counted in transparent bounces when the ray just passed a transparent
             // surface; and not again at a subsurface exit (decided at the entry).
-            let roulette = if flags & ray::TRANSPARENT != 0 { transparent > st.min_transparent_bounces + 1 } else { bounce > st.min_light_bounces + 1 };
+            let roulette = if flags & ray::TRANSPARENT != 0 {
+                transparent > st.min_transparent_bounces + 1
+            } else {
+                bounce > st.min_light_bounces + 1
+            };
             if roulette && from_sss.is_none() {
                 let q = max3(throughput.map(f32::abs)).sqrt().min(1.0);
                 if q <= 0.0 || u_light[3] >= q {
@@ -437,22 +538,58 @@ impl Scene<'_> {
             // Next-event estimation: one emitter, picked as Cycles picks it at this point
             // (its shading normal, and whether its BSDF transmits), the sample divided by
             // the probability of the pick.
-            let n_sel = if is_zero(scratch.lobes.smooth_n) { hit.sp.normal } else { scratch.lobes.smooth_n };
+            let n_sel = if is_zero(scratch.lobes.smooth_n) {
+                hit.sp.normal
+            } else {
+                scratch.lobes.smooth_n
+            };
             let trans_sel = scratch.lobes.has_transmission();
-            let picked = if !terminate_next && scratch.lobes.len > 0 { self.light_select.select(hit.p, n_sel, trans_sel, u_light[2]) } else { None };
-            let clamp_nee = if bounce == 0 { st.clamp_direct } else { st.clamp_indirect };
+            let picked = if !terminate_next && scratch.lobes.len > 0 {
+                self.light_select
+                    .select(hit.p, n_sel, trans_sel, u_light[2])
+            } else {
+                None
+            };
+            let clamp_nee = if bounce == 0 {
+                st.clamp_direct
+            } else {
+                st.clamp_indirect
+            };
             match picked {
                 Some((Pick::Lamp(li), p_sel)) if bounce <= self.lights[li as usize].max_bounces => {
                     let light = &self.lights[li as usize];
                     if let Some(ls) = light.sample(hit.p, [u_light[0], u_light[1]]) {
-                        let (f, pdf_b) = scratch.lobes.eval_excluding(wo, ls.wi, hit.ng, self.tables, light.exclude);
+                        let (f, pdf_b) = scratch.lobes.eval_excluding(
+                            wo,
+                            ls.wi,
+                            hit.ng,
+                            self.tables,
+                            light.exclude,
+                        );
                         // Lights with extent are shared with BSDF sampling at every vertex, as
                         // Cycles does (light_sample_mis_weight_nee).
-                        let w = if light.mis { power_heuristic(ls.pdf * p_sel, pdf_b) } else { 1.0 };
+                        let w = if light.mis {
+                            power_heuristic(ls.pdf * p_sel, pdf_b)
+                        } else {
+                            1.0
+                        };
                         let c = scale(mul(mul(throughput, f), ls.value), w / p_sel);
                         if !is_zero(c) && finite(c) {
                             let start = self.shadow_origin(&hit, scratch.lobes.smooth_n, ls.wi);
-                            let tr = if light.cast_shadow { self.shadow_transmittance(start, ls.wi, if ls.dist.is_finite() { ls.dist * (1.0 - 1e-4) } else { f32::INFINITY }, scratch) } else { [1.0; 3] };
+                            let tr = if light.cast_shadow {
+                                self.shadow_transmittance(
+                                    start,
+                                    ls.wi,
+                                    if ls.dist.is_finite() {
+                                        ls.dist * (1.0 - 1e-4)
+                                    } else {
+                                        f32::INFINITY
+                                    },
+                                    scratch,
+                                )
+                            } else {
+                                [1.0; 3]
+                            };
                             if !is_zero(tr) {
                                 l = add(l, clamp_contrib(mul(c, tr), clamp_nee));
                             }
@@ -461,18 +598,46 @@ impl Scene<'_> {
                 }
                 Some((Pick::Triangle(prim), p_sel)) if prim != h.prim => {
                     let (front, back) = self.emission_sides(prim);
-                    if let Some(ts) = super::triangle_light::sample(&self.geo.tris[prim as usize], hit.p, [u_light[0], u_light[1]], front, back) {
+                    if let Some(ts) = super::triangle_light::sample(
+                        &self.geo.tris[prim as usize],
+                        hit.p,
+                        [u_light[0], u_light[1]],
+                        front,
+                        back,
+                    ) {
                         // The emitter's object hidden from some ray types lights only the
                         // closures of the others (Cycles' SHADER_EXCLUDE_* of mesh lights).
-                        let seen_by = self.geo.instances[self.geo.refs[prim as usize].inst as usize].visibility;
-                        let exclude = !seen_by & (ray::DIFFUSE | ray::GLOSSY | ray::TRANSMIT | ray::VOLUME_SCATTER);
-                        let (f, pdf_b) = if exclude == 0 { scratch.lobes.eval(wo, ts.wi, hit.ng, self.tables) } else { scratch.lobes.eval_excluding(wo, ts.wi, hit.ng, self.tables, exclude) };
+                        let seen_by = self.geo.instances
+                            [self.geo.refs[prim as usize].inst as usize]
+                            .visibility;
+                        let exclude = !seen_by
+                            & (ray::DIFFUSE | ray::GLOSSY | ray::TRANSMIT | ray::VOLUME_SCATTER);
+                        let (f, pdf_b) = if exclude == 0 {
+                            scratch.lobes.eval(wo, ts.wi, hit.ng, self.tables)
+                        } else {
+                            scratch
+                                .lobes
+                                .eval_excluding(wo, ts.wi, hit.ng, self.tables, exclude)
+                        };
                         if !is_zero(f) {
                             let pdf_l = p_sel * ts.pdf;
                             let start = self.shadow_origin(&hit, scratch.lobes.smooth_n, ts.wi);
-                            let tr = self.shadow_transmittance(start, ts.wi, ts.dist * (1.0 - 1e-4), scratch);
+                            let tr = self.shadow_transmittance(
+                                start,
+                                ts.wi,
+                                ts.dist * (1.0 - 1e-4),
+                                scratch,
+                            );
                             if !is_zero(tr) {
-                                let le = self.light_emission(prim, ts.b1, ts.b2, neg(ts.wi), ts.dist, bounce, scratch);
+                                let le = self.light_emission(
+                                    prim,
+                                    ts.b1,
+                                    ts.b2,
+                                    neg(ts.wi),
+                                    ts.dist,
+                                    bounce,
+                                    scratch,
+                                );
                                 let w = power_heuristic(pdf_l, pdf_b);
                                 let c = mul(scale(mul(mul(throughput, f), le), w / pdf_l), tr);
                                 if finite(c) {
@@ -483,7 +648,8 @@ impl Scene<'_> {
                     }
                 }
                 Some((Pick::World, p_sel)) => {
-                    let c = self.world_light_sample(&hit, wo, [u_light[0], u_light[1]], p_sel, scratch);
+                    let c =
+                        self.world_light_sample(&hit, wo, [u_light[0], u_light[1]], p_sel, scratch);
                     let c = mul(throughput, c);
                     if finite(c) && !is_zero(c) {
                         l = add(l, clamp_contrib(c, clamp_nee));
@@ -492,7 +658,10 @@ impl Scene<'_> {
                 _ => {}
             }
             let lobes = &scratch.lobes;
-            let Some(bs) = lobes.sample(wo, hit.ng, [u_bsdf[0], u_bsdf[1], u_bsdf[2]], self.tables) else { break };
+            let Some(bs) = lobes.sample(wo, hit.ng, [u_bsdf[0], u_bsdf[1], u_bsdf[2]], self.tables)
+            else {
+                break;
+            };
             if !finite(bs.weight) || is_zero(bs.weight) {
                 break;
             }
@@ -502,7 +671,18 @@ impl Scene<'_> {
             throughput = mul(throughput, bs.weight);
             if let LobeKind::Subsurface(b) = bs.kind {
                 // Not a bounce of its own: the walk's exit is the next vertex.
-                let exit = super::subsurface::enter_and_walk(self, &b, &hit, wo, bs.wi, rng, index, set, &mut throughput, &mut scratch.rays);
+                let exit = super::subsurface::enter_and_walk(
+                    self,
+                    &b,
+                    &hit,
+                    wo,
+                    bs.wi,
+                    rng,
+                    index,
+                    set,
+                    &mut throughput,
+                    &mut scratch.rays,
+                );
                 let Some((exit_hit, dir)) = exit else { break };
                 sss_exit = Some(exit_hit);
                 // The exit is no longer a camera ray (Cycles' subsurface_bounce clears
@@ -595,7 +775,9 @@ impl Scene<'_> {
             // transparent to the background; every other bounce ends that.
             transparent_bg = transparent_bg
                 && match bs.kind {
-                    LobeKind::Glass(g) if bs.transmit => st.transparent_glass >= 0.0 && g.alpha * g.alpha <= st.transparent_glass,
+                    LobeKind::Glass(g) if bs.transmit => {
+                        st.transparent_glass >= 0.0 && g.alpha * g.alpha <= st.transparent_glass
+                    }
                     _ => false,
                 };
             if bounce >= st.max_bounces {
@@ -633,9 +815,20 @@ impl Scene<'_> {
 impl Scene<'_> {
     /// MIS weight of world radiance reached by a BSDF-sampled ray (1 when the world is
     /// not light-sampled or the ray came from a singular lobe or the camera).
-    fn world_mis_weight(&self, d: V3, prev_singular: bool, prev_pdf: f32, o: V3, mis_n: V3, mis_trans: bool) -> f32 {
+    fn world_mis_weight(
+        &self,
+        d: V3,
+        prev_singular: bool,
+        prev_pdf: f32,
+        o: V3,
+        mis_n: V3,
+        mis_trans: bool,
+    ) -> f32 {
         match self.world.and_then(|w| w.map.as_ref()) {
-            Some(map) if !prev_singular => power_heuristic(prev_pdf, map.pdf(d) * self.light_select.pdf(o, mis_n, mis_trans, Pick::World)),
+            Some(map) if !prev_singular => power_heuristic(
+                prev_pdf,
+                map.pdf(d) * self.light_select.pdf(o, mis_n, mis_trans, Pick::World),
+            ),
             _ => 1.0,
         }
     }
@@ -643,12 +836,26 @@ impl Scene<'_> {
     /// Next-event estimate toward the world from surface point `hit` (BSDF in
     /// `scratch.lobes`), MIS-weighted against BSDF sampling; zero if unoccluded paths
     /// see nothing or the world is not light-sampled.
-    fn world_light_sample(&self, hit: &SurfaceHit, wo: V3, u: [f32; 2], p_sel: f32, scratch: &mut Scratch) -> V3 {
-        let Some(map) = self.world.and_then(|w| w.map.as_ref()) else { return [0.0; 3] };
-        let Some((wi, pdf_l)) = map.sample(u) else { return [0.0; 3] };
+    fn world_light_sample(
+        &self,
+        hit: &SurfaceHit,
+        wo: V3,
+        u: [f32; 2],
+        p_sel: f32,
+        scratch: &mut Scratch,
+    ) -> V3 {
+        let Some(map) = self.world.and_then(|w| w.map.as_ref()) else {
+            return [0.0; 3];
+        };
+        let Some((wi, pdf_l)) = map.sample(u) else {
+            return [0.0; 3];
+        };
         let pdf_l = pdf_l * p_sel;
         // Closures of the ray types the world is hidden from do not see it.
-        let (f, pdf_b) = scratch.lobes.eval_excluding(wo, wi, hit.ng, self.tables, self.world_exclude);
+        let (f, pdf_b) =
+            scratch
+                .lobes
+                .eval_excluding(wo, wi, hit.ng, self.tables, self.world_exclude);
         if is_zero(f) || pdf_l.is_nan() || pdf_l <= 0.0 {
             return [0.0; 3];
         }
@@ -673,7 +880,11 @@ impl Scene<'_> {
         let m = &inst.mesh;
         if inst.shadow_terminator > 0.0 && m.corner_normals.len() == m.corner_verts.len() {
             // Cycles' sd->N: the shading normal after the material's displacement bump.
-            let n = if is_zero(smooth_n) { hit.sp.normal } else { smooth_n };
+            let n = if is_zero(smooth_n) {
+                hit.sp.normal
+            } else {
+                smooth_n
+            };
             let (amount, ng) = super::terminator::amount(inst.shadow_terminator, n, hit.ng, wi);
             let r = self.geo.refs[hit.prim as usize];
             let flat = || {
@@ -686,7 +897,12 @@ impl Scene<'_> {
                 let c = m.triangles[r.tri as usize];
                 // World-space vertex normals, as Cycles has them once it applied the
                 // object's transform (the same normals `surface_at` shades with).
-                let n = c.map(|c| normalize(Affine::normal_by_inverse(&to_object, m.corner_normals[c as usize])));
+                let n = c.map(|c| {
+                    normalize(Affine::normal_by_inverse(
+                        &to_object,
+                        m.corner_normals[c as usize],
+                    ))
+                });
                 let [u, w] = hit.uv;
                 let lift = super::terminator::smooth_surface_offset(v, n, [1.0 - u - w, u, w], ng);
                 if finite(lift) {
@@ -707,7 +923,9 @@ impl Scene<'_> {
     fn shadow_transmittance(&self, start: V3, dir: V3, tmax: f32, scratch: &mut Scratch) -> V3 {
         scratch.rays += 1;
         if !self.settings.transparent_shadows {
-            let blocked = self.accel.occluded_vis(start, dir, 0.0, tmax, scratch.time, visibility::SHADOW);
+            let blocked =
+                self.accel
+                    .occluded_vis(start, dir, 0.0, tmax, scratch.time, visibility::SHADOW);
             return if blocked { [0.0; 3] } else { [1.0; 3] };
         }
         let mut through = [1.0f32; 3];
@@ -716,15 +934,28 @@ impl Scene<'_> {
             if crossed > 0 {
                 scratch.rays += 1;
             }
-            let Some(h) = self.accel.intersect_vis(o, dir, 0.0, left, scratch.time, visibility::SHADOW) else { return through };
+            let Some(h) =
+                self.accel
+                    .intersect_vis(o, dir, 0.0, left, scratch.time, visibility::SHADOW)
+            else {
+                return through;
+            };
             let mut hit = self.surface_at(h.prim, h.u, h.v, neg(dir), scratch.time);
             match hit.material {
                 Some(mi) if self.materials[mi].transparent_shadow => {}
                 _ => return [0.0; 3],
             }
             hit.sp.ray_length = h.t;
-            hit.sp.path = PathState { flags: ray::SHADOW, ..Default::default() };
-            self.shade_into(&hit, neg(dir), &mut scratch.stacks, &mut scratch.light_lobes);
+            hit.sp.path = PathState {
+                flags: ray::SHADOW,
+                ..Default::default()
+            };
+            self.shade_into(
+                &hit,
+                neg(dir),
+                &mut scratch.stacks,
+                &mut scratch.light_lobes,
+            );
             through = mul(through, scratch.light_lobes.transparent);
             if is_zero(through) {
                 return [0.0; 3];
@@ -741,7 +972,9 @@ impl Scene<'_> {
     /// Cycles' shader_setup_from_ray: expanded around Ng, with the UV and Generated
     /// attribute differentials the Bump node's coordinate copies read.
     pub fn fill_differentials(&self, hit: &mut SurfaceHit, prim: u32, dp: f32) {
-        use crate::shader::bump::{attribute_differential, differential_dudv, differential_from_compact, ObjectTransform};
+        use crate::shader::bump::{
+            attribute_differential, differential_dudv, differential_from_compact, ObjectTransform,
+        };
         let r = self.geo.refs[prim as usize];
         let inst = &self.geo.instances[r.inst as usize];
         let m = &inst.mesh;
@@ -757,7 +990,10 @@ impl Scene<'_> {
         let sp = &mut hit.sp;
         sp.ng = hit.ng;
         sp.backfacing = hit.backfacing;
-        sp.transform = ObjectTransform { to_world: to_world.m, to_object: to_object.m };
+        sp.transform = ObjectTransform {
+            to_world: to_world.m,
+            to_object: to_object.m,
+        };
         let (dx, dy) = differential_from_compact(hit.ng, dp);
         sp.dp_dx = dx;
         sp.dp_dy = dy;
@@ -809,7 +1045,14 @@ fn bounce_flags(kind: LobeKind, transmit: bool, singular: bool) -> u32 {
         LobeKind::Diffuse => ray::DIFFUSE | ray::REFLECT,
         LobeKind::Translucent => ray::DIFFUSE | ray::TRANSMIT,
         LobeKind::Glossy { .. } => ray::GLOSSY | ray::REFLECT,
-        LobeKind::Glass { .. } => ray::GLOSSY | if transmit { ray::TRANSMIT } else { ray::REFLECT },
+        LobeKind::Glass { .. } => {
+            ray::GLOSSY
+                | if transmit {
+                    ray::TRANSMIT
+                } else {
+                    ray::REFLECT
+                }
+        }
         LobeKind::Transparent => ray::TRANSPARENT,
         // The walk's exit scatters diffusely, as Cycles' subsurface exit closure does.
         LobeKind::OrenNayar(_) | LobeKind::Subsurface(_) => ray::DIFFUSE | ray::REFLECT,
@@ -827,7 +1070,16 @@ impl Scene<'_> {
     /// The shading context besides position, normals and UV: what the input nodes read
     /// (incoming direction, true normal, barycentrics in Cycles' convention, camera and
     /// window coordinates, object). Path state and ray length are the caller's.
-    fn fill_context(&self, sp: &mut ShadingPoint, inst: &super::build::MeshInstance, wo: V3, ng: V3, backfacing: bool, u: f32, v: f32) {
+    fn fill_context(
+        &self,
+        sp: &mut ShadingPoint,
+        inst: &super::build::MeshInstance,
+        wo: V3,
+        ng: V3,
+        backfacing: bool,
+        u: f32,
+        v: f32,
+    ) {
         sp.incoming = wo;
         sp.true_normal = ng;
         sp.backfacing = backfacing;
@@ -846,17 +1098,33 @@ impl Scene<'_> {
     /// Sampling (Front, Back, or both for Auto and Front and Back).
     fn emission_sides(&self, prim: u32) -> (bool, bool) {
         let r = self.geo.refs[prim as usize];
-        match self.geo.instances[r.inst as usize].material_of(r.tri as usize).map(|mi| self.materials[mi].sampling.as_str()) {
+        match self.geo.instances[r.inst as usize]
+            .material_of(r.tri as usize)
+            .map(|mi| self.materials[mi].sampling.as_str())
+        {
             Some("FRONT") => (true, false),
             Some("BACK") => (false, true),
             _ => (true, true),
         }
     }
 
-    pub fn light_emission(&self, prim: u32, u: f32, v: f32, wo: V3, dist: f32, bounce: u32, scratch: &mut Scratch) -> V3 {
+    pub fn light_emission(
+        &self,
+        prim: u32,
+        u: f32,
+        v: f32,
+        wo: V3,
+        dist: f32,
+        bounce: u32,
+        scratch: &mut Scratch,
+    ) -> V3 {
         let mut hit = self.surface(prim, u, v, wo);
         hit.sp.ray_length = dist;
-        hit.sp.path = PathState { flags: ray::EMISSION, bounce, ..PathState::default() };
+        hit.sp.path = PathState {
+            flags: ray::EMISSION,
+            bounce,
+            ..PathState::default()
+        };
         self.shade_into(&hit, wo, &mut scratch.stacks, &mut scratch.light_lobes);
         scratch.light_lobes.emission
     }

@@ -16,10 +16,22 @@ use crate::anim::EvaluatedScene;
 pub enum Shape {
     /// `sphere`: Cycles' sphere light (Soft Falloff off); otherwise a disk of the radius
     /// facing the shading point (Soft Falloff on, Blender's default).
-    Point { radius: f32, spot: Option<Spot>, sphere: bool },
+    Point {
+        radius: f32,
+        spot: Option<Spot>,
+        sphere: bool,
+    },
     /// `u`, `v`: the light's full extent along its axes; `spread`: None at 180 degrees.
-    Area { u: V3, v: V3, ellipse: bool, area: f32, spread: Option<Spread> },
-    Sun { half_angle: f32 },
+    Area {
+        u: V3,
+        v: V3,
+        ellipse: bool,
+        area: f32,
+        spread: Option<Spread>,
+    },
+    Sun {
+        half_angle: f32,
+    },
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -72,7 +84,8 @@ impl Light {
 pub fn visible_to(x: u32, flags: u32) -> bool {
     use crate::shader::point::ray;
     !((x & ray::DIFFUSE != 0 && flags & ray::DIFFUSE != 0)
-        || (x & ray::GLOSSY != 0 && flags & (ray::GLOSSY | ray::REFLECT) == ray::GLOSSY | ray::REFLECT)
+        || (x & ray::GLOSSY != 0
+            && flags & (ray::GLOSSY | ray::REFLECT) == ray::GLOSSY | ray::REFLECT)
         || (x & ray::TRANSMIT != 0 && flags & ray::TRANSMIT != 0)
         || (x & ray::CAMERA != 0 && flags & ray::CAMERA != 0)
         || (x & ray::VOLUME_SCATTER != 0 && flags & ray::VOLUME_SCATTER != 0))
@@ -84,7 +97,13 @@ pub fn excluded_rays(v: Option<&crate::scene::format::RayVisibility>) -> u32 {
     use crate::shader::point::ray;
     let Some(v) = v else { return ray::CAMERA };
     let mut x = 0;
-    for (on, flag) in [(v.camera, ray::CAMERA), (v.diffuse, ray::DIFFUSE), (v.glossy, ray::GLOSSY), (v.transmission, ray::TRANSMIT), (v.volume_scatter, ray::VOLUME_SCATTER)] {
+    for (on, flag) in [
+        (v.camera, ray::CAMERA),
+        (v.diffuse, ray::DIFFUSE),
+        (v.glossy, ray::GLOSSY),
+        (v.transmission, ray::TRANSMIT),
+        (v.volume_scatter, ray::VOLUME_SCATTER),
+    ] {
         if !on {
             x |= flag;
         }
@@ -111,7 +130,8 @@ pub struct LightHit {
 
 /// An RGB triple from an exported colour array (a missing channel reads 1).
 fn rgb(v: Option<&Value>) -> Option<V3> {
-    v.and_then(Value::as_array).map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(1.0) as f32))
+    v.and_then(Value::as_array)
+        .map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(1.0) as f32))
 }
 
 fn num(p: &serde_json::Map<String, Value>, k: &str, d: f64) -> f32 {
@@ -123,13 +143,37 @@ fn num(p: &serde_json::Map<String, Value>, k: &str, d: f64) -> f32 {
 /// constant (an Emission node with unlinked inputs into the active Light Output) is
 /// supported; any other is an error naming the light and node, never a stand-in.
 fn node_factor(l: &crate::scene::format::Light) -> Result<V3, RenderError> {
-    let use_nodes = l.properties.get("use_nodes").and_then(Value::as_bool).unwrap_or(false);
-    let Some(tree) = l.node_tree.as_ref().filter(|_| use_nodes) else { return Ok([1.0; 3]) };
+    let use_nodes = l
+        .properties
+        .get("use_nodes")
+        .and_then(Value::as_bool)
+        .unwrap_or(false);
+    let Some(tree) = l.node_tree.as_ref().filter(|_| use_nodes) else {
+        return Ok([1.0; 3]);
+    };
     // No output, or nothing linked to it: Cycles renders the light black.
-    let Some(out) = crate::nodes::graph::active_output(tree, "ShaderNodeOutputLight", "CYCLES") else { return Ok([0.0; 3]) };
-    let Some(link) = tree.links.iter().find(|k| k.to_node == out.name && k.to_socket == "Surface" && !k.is_muted) else { return Ok([0.0; 3]) };
+    let Some(out) = crate::nodes::graph::active_output(tree, "ShaderNodeOutputLight", "CYCLES")
+    else {
+        return Ok([0.0; 3]);
+    };
+    let Some(link) = tree
+        .links
+        .iter()
+        .find(|k| k.to_node == out.name && k.to_socket == "Surface" && !k.is_muted)
+    else {
+        return Ok([0.0; 3]);
+    };
     let name = &l.name;
-    let node = tree.nodes.iter().find(|n| n.name == link.from_node).ok_or_else(|| RenderError(format!("light {name:?}: its node tree links from a missing node {:?}", link.from_node)))?;
+    let node = tree
+        .nodes
+        .iter()
+        .find(|n| n.name == link.from_node)
+        .ok_or_else(|| {
+            RenderError(format!(
+                "light {name:?}: its node tree links from a missing node {:?}",
+                link.from_node
+            ))
+        })?;
     // A muted Emission has no closure input to pass through: nothing reaches the output.
     if node.bl_idname == "ShaderNodeEmission" && node.mute {
         return Ok([0.0; 3]);
@@ -137,10 +181,19 @@ fn node_factor(l: &crate::scene::format::Light) -> Result<V3, RenderError> {
     if node.bl_idname != "ShaderNodeEmission" {
         return Err(RenderError(format!("light {name:?}: node {:?} ({}) feeding the Light Output is not supported yet (only a constant Emission)", node.name, node.bl_idname)));
     }
-    if let Some(k) = tree.links.iter().find(|k| k.to_node == node.name && !k.is_muted) {
+    if let Some(k) = tree
+        .links
+        .iter()
+        .find(|k| k.to_node == node.name && !k.is_muted)
+    {
         return Err(RenderError(format!("light {name:?}: the linked {:?} input of {:?} (from {:?}) is not supported yet (only a constant Emission)", k.to_socket, node.name, k.from_node)));
     }
-    let input = |id: &str| node.inputs.iter().find(|s| s.identifier == id).and_then(|s| s.default_value.as_ref());
+    let input = |id: &str| {
+        node.inputs
+            .iter()
+            .find(|s| s.identifier == id)
+            .and_then(|s| s.default_value.as_ref())
+    };
     let color = rgb(input("Color")).unwrap_or([1.0; 3]);
     let strength = input("Strength").and_then(Value::as_f64).unwrap_or(1.0) as f32;
     Ok(scale(color, strength))
@@ -152,8 +205,12 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
         if obj.kind != "LIGHT" || obj.hide_render {
             continue;
         }
-        let Some(data) = obj.data.as_deref() else { continue };
-        let Some(l) = eval.data.lights.iter().find(|l| l.name == data) else { continue };
+        let Some(data) = obj.data.as_deref() else {
+            continue;
+        };
+        let Some(l) = eval.data.lights.iter().find(|l| l.name == data) else {
+            continue;
+        };
         let p = &l.properties;
         let m = Affine::from_rows(&eval.world_matrices[oi]);
         let color = rgb(p.get("color")).unwrap_or([1.0; 3]);
@@ -162,7 +219,10 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
         let mut strength = mul(scale(color, energy * 2f32.powf(exposure)), node_factor(l)?);
         // Blender 4.5's light temperature: the colour is multiplied by the blackbody colour
         // Blender computed (`temperature_color`, in the scene's working space).
-        if p.get("use_temperature").and_then(Value::as_bool).unwrap_or(false) {
+        if p.get("use_temperature")
+            .and_then(Value::as_bool)
+            .unwrap_or(false)
+        {
             if let Some(t) = rgb(p.get("temperature_color")) {
                 strength = mul(strength, t);
             }
@@ -178,7 +238,11 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
         let dir = normalize(neg(m.column(2)));
         // Blender 4.x keeps Cast Shadow as the light's `use_shadow` (Cycles syncs it from
         // there); older files had it under `cycles.cast_shadow`.
-        let cast_shadow = p.get("use_shadow").or_else(|| p.get("cycles").and_then(|c| c.get("cast_shadow"))).and_then(Value::as_bool).unwrap_or(true);
+        let cast_shadow = p
+            .get("use_shadow")
+            .or_else(|| p.get("cycles").and_then(|c| c.get("cast_shadow")))
+            .and_then(Value::as_bool)
+            .unwrap_or(true);
         let shape = match l.kind.as_str() {
             "POINT" | "SPOT" => {
                 let radius = num(p, "shadow_soft_size", 0.25);
@@ -186,7 +250,11 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
                     let size = num(p, "spot_size", 0.785398);
                     let blend = num(p, "spot_blend", 0.15);
                     let cos_half = (size * 0.5).cos();
-                    let smooth = if blend > 0.0 { 1.0 / ((1.0 - cos_half) * blend) } else { f32::INFINITY };
+                    let smooth = if blend > 0.0 {
+                        1.0 / ((1.0 - cos_half) * blend)
+                    } else {
+                        f32::INFINITY
+                    };
                     // Cycles divides by the axes' squared lengths so scale shapes the cone.
                     let inv = |a: V3| {
                         let l2 = dot(a, a);
@@ -196,20 +264,44 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
                             a
                         }
                     };
-                    Some(Spot { cos_half, smooth, u: inv(m.column(0)), v: inv(m.column(1)), w: inv(neg(m.column(2))) })
+                    Some(Spot {
+                        cos_half,
+                        smooth,
+                        u: inv(m.column(0)),
+                        v: inv(m.column(1)),
+                        w: inv(neg(m.column(2))),
+                    })
                 } else {
                     None
                 };
-                let sphere = !p.get("use_soft_falloff").and_then(Value::as_bool).unwrap_or(true);
-                Shape::Point { radius, spot, sphere }
+                let sphere = !p
+                    .get("use_soft_falloff")
+                    .and_then(Value::as_bool)
+                    .unwrap_or(true);
+                Shape::Point {
+                    radius,
+                    spot,
+                    sphere,
+                }
             }
             // A portal only guides Cycles' sampling of the world through it: it emits
             // nothing, and the world is sampled by its own map here.
-            "AREA" if p.get("cycles").and_then(|c| c.get("is_portal")).and_then(Value::as_bool).unwrap_or(false) => continue,
+            "AREA"
+                if p.get("cycles")
+                    .and_then(|c| c.get("is_portal"))
+                    .and_then(Value::as_bool)
+                    .unwrap_or(false) =>
+            {
+                continue
+            }
             "AREA" => {
                 let size = num(p, "size", 1.0);
                 let shape = p.get("shape").and_then(Value::as_str).unwrap_or("SQUARE");
-                let size_y = if shape == "RECTANGLE" || shape == "ELLIPSE" { num(p, "size_y", 1.0) } else { size };
+                let size_y = if shape == "RECTANGLE" || shape == "ELLIPSE" {
+                    num(p, "size_y", 1.0)
+                } else {
+                    size
+                };
                 let u = scale(m.column(0), size);
                 let v = scale(m.column(1), size_y);
                 let ellipse = shape == "DISK" || shape == "ELLIPSE";
@@ -220,9 +312,17 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
                 if area <= 0.0 {
                     continue;
                 }
-                Shape::Area { u, v, ellipse, area, spread: Spread::new(num(p, "spread", std::f64::consts::PI)) }
+                Shape::Area {
+                    u,
+                    v,
+                    ellipse,
+                    area,
+                    spread: Spread::new(num(p, "spread", std::f64::consts::PI)),
+                }
             }
-            "SUN" => Shape::Sun { half_angle: num(p, "angle", 0.00918) * 0.5 },
+            "SUN" => Shape::Sun {
+                half_angle: num(p, "angle", 0.00918) * 0.5,
+            },
             _ => continue,
         };
         // Normalize off (Blender 4.5): the power is not spread over the light's area, so the
@@ -232,24 +332,52 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
             let area = match &shape {
                 Shape::Point { radius, .. } => {
                     let a = 4.0 * PI * radius * radius;
-                    if a == 0.0 { 4.0 } else { a }
+                    if a == 0.0 {
+                        4.0
+                    } else {
+                        a
+                    }
                 }
                 Shape::Area { area, .. } => *area,
                 Shape::Sun { half_angle } => {
-                    if *half_angle > 0.0 { PI * half_angle.sin() * half_angle.sin() } else { 1.0 }
+                    if *half_angle > 0.0 {
+                        PI * half_angle.sin() * half_angle.sin()
+                    } else {
+                        1.0
+                    }
                 }
             };
             strength = scale(strength, area);
         }
         let exclude = excluded_rays(obj.visibility.as_ref());
-        let use_mis = p.get("cycles").and_then(|c| c.get("use_multiple_importance_sampling")).and_then(Value::as_bool).unwrap_or(true);
+        let use_mis = p
+            .get("cycles")
+            .and_then(|c| c.get("use_multiple_importance_sampling"))
+            .and_then(Value::as_bool)
+            .unwrap_or(true);
         let extent = match &shape {
             Shape::Point { radius, .. } => *radius > 0.0,
             Shape::Area { spread, .. } => spread.is_none_or(|s| s.tan_half > 0.0),
             Shape::Sun { half_angle } => *half_angle > 0.0,
         };
-        let max_bounces = p.get("cycles").and_then(|c| c.get("max_bounces")).and_then(Value::as_u64).unwrap_or(1024).min(u32::MAX as u64) as u32;
-        out.push(Light { shape, strength, pos, dir, cast_shadow, mis: use_mis && extent, max_bounces, exclude, tree_energy, spread });
+        let max_bounces = p
+            .get("cycles")
+            .and_then(|c| c.get("max_bounces"))
+            .and_then(Value::as_u64)
+            .unwrap_or(1024)
+            .min(u32::MAX as u64) as u32;
+        out.push(Light {
+            shape,
+            strength,
+            pos,
+            dir,
+            cast_shadow,
+            mis: use_mis && extent,
+            max_bounces,
+            exclude,
+            tree_energy,
+            spread,
+        });
     }
     Ok(out)
 }
@@ -285,7 +413,13 @@ fn sample_cone(axis: V3, omc: f32, u: [f32; 2]) -> (V3, f32) {
     let cos_theta = 1.0 - r2 * omc;
     let k = (omc * (2.0 - omc * r2)).max(0.0).sqrt();
     let (t, b) = basis(axis);
-    (add(add(scale(t, xy[0] * k), scale(b, xy[1] * k)), scale(axis, cos_theta)), cos_theta)
+    (
+        add(
+            add(scale(t, xy[0] * k), scale(b, xy[1] * k)),
+            scale(axis, cos_theta),
+        ),
+        cos_theta,
+    )
 }
 
 /// 1 - cos(half angle) of a sun's cone, without the cancellation of `1.0 - cos` at
@@ -317,7 +451,11 @@ fn smoothstep(x: f32) -> f32 {
 impl Light {
     pub fn sample(&self, p: V3, u: [f32; 2]) -> Option<LightSample> {
         match &self.shape {
-            Shape::Point { radius, spot, sphere } => {
+            Shape::Point {
+                radius,
+                spot,
+                sphere,
+            } => {
                 let to = sub(self.pos, p);
                 let d2 = dot(to, to);
                 if d2 <= 0.0 {
@@ -335,7 +473,12 @@ impl Light {
                     }
                     // Intensity power / (4 pi) over squared distance.
                     let v = scale(self.strength, atten / (4.0 * PI * d2));
-                    return Some(LightSample { wi: w, dist: d, value: v, pdf: f32::INFINITY });
+                    return Some(LightSample {
+                        wi: w,
+                        dist: d,
+                        value: v,
+                        pdf: f32::INFINITY,
+                    });
                 }
                 let r2 = radius * radius;
                 let radiance = 1.0 / (4.0 * PI * PI * r2);
@@ -346,7 +489,10 @@ impl Light {
                     // done here as the disk.)
                     let disk = super::camera::concentric_disk(u);
                     let (t, b) = basis(w);
-                    let q = add(self.pos, add(scale(t, disk[0] * radius), scale(b, disk[1] * radius)));
+                    let q = add(
+                        self.pos,
+                        add(scale(t, disk[0] * radius), scale(b, disk[1] * radius)),
+                    );
                     let to = sub(q, p);
                     let dq2 = dot(to, to);
                     let dq = dq2.sqrt();
@@ -361,14 +507,23 @@ impl Light {
                     }
                     let v = scale(self.strength, atten * radiance * cos_l * PI * r2 / dq2);
                     let pdf = dq2 / (cos_l.max(1e-8) * PI * r2);
-                    return Some(LightSample { wi, dist: dq, value: v, pdf });
+                    return Some(LightSample {
+                        wi,
+                        dist: dq,
+                        value: v,
+                        pdf,
+                    });
                 }
                 // Cycles' sphere light (light/point.h, spot.h): a direction uniform in the
                 // cone the sphere subtends or, for a spot narrower than that, in the spot's
                 // spread cone about its axis; the spot cone weighs each sampled direction.
                 let cap = one_minus_cos_from_sin2(r2 / d2);
                 let spread = spot.map(|s| 1.0 - s.cos_half).unwrap_or(f32::INFINITY);
-                let (axis, omc) = if cap < spread { (w, cap) } else { (neg(self.dir), spread) };
+                let (axis, omc) = if cap < spread {
+                    (w, cap)
+                } else {
+                    (neg(self.dir), spread)
+                };
                 let (wi, cos_theta) = sample_cone(axis, omc, u);
                 let dist = if cap < spread {
                     // Law of cosines: the nearer crossing of the sphere along the cone's ray.
@@ -387,9 +542,20 @@ impl Light {
                 }
                 let pdf = 1.0 / (2.0 * PI * omc);
                 let v = scale(self.strength, atten * radiance / pdf);
-                Some(LightSample { wi, dist, value: v, pdf })
+                Some(LightSample {
+                    wi,
+                    dist,
+                    value: v,
+                    pdf,
+                })
             }
-            Shape::Area { u: au, v: av, ellipse, area, spread } => {
+            Shape::Area {
+                u: au,
+                v: av,
+                ellipse,
+                area,
+                spread,
+            } => {
                 // One-sided: nothing behind the light's plane.
                 if dot(sub(p, self.pos), self.dir) <= 0.0 {
                     return None;
@@ -400,7 +566,13 @@ impl Light {
                     (q?, 1.0 / s)
                 } else {
                     let d = super::camera::concentric_disk(u);
-                    let q = add(region.centre, add(scale(region.axis_u, d[0] * 0.5 * region.len_u), scale(region.axis_v, d[1] * 0.5 * region.len_v)));
+                    let q = add(
+                        region.centre,
+                        add(
+                            scale(region.axis_u, d[0] * 0.5 * region.len_u),
+                            scale(region.axis_v, d[1] * 0.5 * region.len_v),
+                        ),
+                    );
                     (q, 4.0 / (PI * region.len_u * region.len_v))
                 };
                 // A region larger than the light (a spread circle, or the rectangle about
@@ -424,14 +596,28 @@ impl Light {
                     return None;
                 }
                 // Rectangles are sampled by solid angle; ellipses by area, in solid angle.
-                let pdf = if region.rectangle { pdf_region } else { pdf_region * d2 / cos_l };
+                let pdf = if region.rectangle {
+                    pdf_region
+                } else {
+                    pdf_region * d2 / cos_l
+                };
                 let radiance = atten / (PI * area);
-                Some(LightSample { wi, dist: d, value: scale(self.strength, radiance / pdf), pdf })
+                Some(LightSample {
+                    wi,
+                    dist: d,
+                    value: scale(self.strength, radiance / pdf),
+                    pdf,
+                })
             }
             Shape::Sun { half_angle } => {
                 let toward = neg(self.dir);
                 if *half_angle <= 0.0 {
-                    return Some(LightSample { wi: toward, dist: f32::INFINITY, value: self.strength, pdf: f32::INFINITY });
+                    return Some(LightSample {
+                        wi: toward,
+                        dist: f32::INFINITY,
+                        value: self.strength,
+                        pdf: f32::INFINITY,
+                    });
                 }
                 // Uniform in the cone by Cycles' concentric mapping (distant_light_sample:
                 // sample_uniform_cone), which keeps the sampler's 2D stratification: a polar
@@ -442,7 +628,12 @@ impl Light {
                 let s = half_angle.sin();
                 let radiance = 1.0 / (PI * s * s);
                 let pdf = 1.0 / (2.0 * PI * omc);
-                Some(LightSample { wi, dist: f32::INFINITY, value: scale(self.strength, radiance / pdf), pdf })
+                Some(LightSample {
+                    wi,
+                    dist: f32::INFINITY,
+                    value: scale(self.strength, radiance / pdf),
+                    pdf,
+                })
             }
         }
     }
@@ -451,7 +642,11 @@ impl Light {
     /// rays that leave the scene, `tmax` infinite).
     pub fn intersect(&self, o: V3, d: V3, tmax: f32) -> Option<LightHit> {
         match &self.shape {
-            Shape::Point { radius, spot, sphere } => {
+            Shape::Point {
+                radius,
+                spot,
+                sphere,
+            } => {
                 if *radius <= 0.0 {
                     return None;
                 }
@@ -477,7 +672,11 @@ impl Light {
                     }
                     let atten = spot.map(|s| s.attenuation(neg(d))).unwrap_or(1.0);
                     let radiance = scale(self.strength, atten / (4.0 * PI * PI * radius * radius));
-                    return Some(LightHit { t, radiance, pdf: t * t / ((-denom).max(1e-8) * PI * radius * radius) });
+                    return Some(LightHit {
+                        t,
+                        radiance,
+                        pdf: t * t / ((-denom).max(1e-8) * PI * radius * radius),
+                    });
                 }
                 let t = ray_sphere(o, d, self.pos, *radius)?;
                 if t >= tmax {
@@ -495,9 +694,19 @@ impl Light {
                     }
                 }
                 let radiance = scale(self.strength, atten / (4.0 * PI * PI * r2));
-                Some(LightHit { t, radiance, pdf: 1.0 / (2.0 * PI * omc) })
+                Some(LightHit {
+                    t,
+                    radiance,
+                    pdf: 1.0 / (2.0 * PI * omc),
+                })
             }
-            Shape::Area { u, v, ellipse, area, spread } => {
+            Shape::Area {
+                u,
+                v,
+                ellipse,
+                area,
+                spread,
+            } => {
                 let cos_l = -dot(d, self.dir);
                 if cos_l <= 0.0 {
                     return None;
@@ -512,12 +721,20 @@ impl Light {
                 }
                 // The pdf light sampling from `o` would have given this point.
                 let region = self.area_region(o, *u, *v, *ellipse, spread.as_ref())?;
-                let pdf = if region.rectangle { 1.0 / rect_solid_angle(o, &region, None).0 } else { 4.0 / (PI * region.len_u * region.len_v) * t * t / cos_l };
+                let pdf = if region.rectangle {
+                    1.0 / rect_solid_angle(o, &region, None).0
+                } else {
+                    4.0 / (PI * region.len_u * region.len_v) * t * t / cos_l
+                };
                 let atten = spread.map(|s| s.attenuation(d, self.dir)).unwrap_or(1.0);
                 if atten <= 0.0 || !pdf.is_finite() {
                     return None;
                 }
-                Some(LightHit { t, radiance: scale(self.strength, atten / (PI * area)), pdf })
+                Some(LightHit {
+                    t,
+                    radiance: scale(self.strength, atten / (PI * area)),
+                    pdf,
+                })
             }
             Shape::Sun { half_angle } => {
                 if tmax.is_finite() || *half_angle <= 0.0 {
@@ -528,7 +745,11 @@ impl Light {
                     return None;
                 }
                 let s = half_angle.sin();
-                Some(LightHit { t: f32::INFINITY, radiance: scale(self.strength, 1.0 / (PI * s * s)), pdf: 1.0 / (2.0 * PI * sun_one_minus_cos(*half_angle)) })
+                Some(LightHit {
+                    t: f32::INFINITY,
+                    radiance: scale(self.strength, 1.0 / (PI * s * s)),
+                    pdf: 1.0 / (2.0 * PI * sun_one_minus_cos(*half_angle)),
+                })
             }
         }
     }
@@ -537,9 +758,23 @@ impl Light {
 impl Light {
     /// The part of an area light that light sampling from `p` draws from: the whole light
     /// (a rectangle by solid angle, an ellipse by area), or what its spread lets reach `p`.
-    fn area_region(&self, p: V3, u: V3, v: V3, ellipse: bool, spread: Option<&Spread>) -> Option<Region> {
+    fn area_region(
+        &self,
+        p: V3,
+        u: V3,
+        v: V3,
+        ellipse: bool,
+        spread: Option<&Spread>,
+    ) -> Option<Region> {
         let (len_u, len_v) = (len(u), len(v));
-        let full = Region { centre: self.pos, axis_u: scale(u, 1.0 / len_u), len_u, axis_v: scale(v, 1.0 / len_v), len_v, rectangle: !ellipse };
+        let full = Region {
+            centre: self.pos,
+            axis_u: scale(u, 1.0 / len_u),
+            len_u,
+            axis_v: scale(v, 1.0 / len_v),
+            len_v,
+            rectangle: !ellipse,
+        };
         match spread {
             Some(s) => s.clamp(p, self.dir, full),
             None => Some(full),
@@ -570,14 +805,37 @@ mod tests {
             a *= PI / 4.0;
         }
         let spread = spread_deg.and_then(|d| Spread::new(d.to_radians()));
-        Light { shape: Shape::Area { u, v, ellipse, area: a, spread }, strength: [100.0; 3], pos: [0.0, 0.0, 2.0], dir: [0.0, 0.0, -1.0], cast_shadow: true, mis: true, max_bounces: 1024, exclude: 0, tree_energy: 25.0, spread: PI }
+        Light {
+            shape: Shape::Area {
+                u,
+                v,
+                ellipse,
+                area: a,
+                spread,
+            },
+            strength: [100.0; 3],
+            pos: [0.0, 0.0, 2.0],
+            dir: [0.0, 0.0, -1.0],
+            cast_shadow: true,
+            mis: true,
+            max_bounces: 1024,
+            exclude: 0,
+            tree_energy: 25.0,
+            spread: PI,
+        }
     }
 
     /// MIS needs the pdf of a light sample and the pdf a BSDF ray finds for the same
     /// direction to agree, and the same radiance; for every area shape and spread.
     #[test]
     fn area_sample_and_hit_agree() {
-        let lights = [area(false, (2.0, 1.0), None), area(true, (2.0, 2.0), None), area(false, (3.0, 1.5), Some(40.0)), area(true, (2.0, 2.0), Some(30.0)), area(true, (2.5, 1.0), Some(70.0))];
+        let lights = [
+            area(false, (2.0, 1.0), None),
+            area(true, (2.0, 2.0), None),
+            area(false, (3.0, 1.5), Some(40.0)),
+            area(true, (2.0, 2.0), Some(30.0)),
+            area(true, (2.5, 1.0), Some(70.0)),
+        ];
         for (li, l) in lights.iter().enumerate() {
             // (A narrow spread may light no point of a far region: none is required there.)
             let mut checked = 0;
@@ -586,12 +844,28 @@ mod tests {
                     for j in 0..16 {
                         let u = [(i as f32 + 0.5) / 16.0, (j as f32 + 0.5) / 16.0];
                         let Some(s) = l.sample(p, u) else { continue };
-                        let h = l.intersect(p, s.wi, f32::INFINITY).expect("the sampled direction hits the light");
-                        assert!((h.t - s.dist).abs() < 1e-4 * s.dist, "light {li}: t {} vs {}", h.t, s.dist);
-                        assert!((h.pdf - s.pdf).abs() <= 1e-3 * s.pdf, "light {li} at {p:?}: pdf {} vs {}", h.pdf, s.pdf);
+                        let h = l
+                            .intersect(p, s.wi, f32::INFINITY)
+                            .expect("the sampled direction hits the light");
+                        assert!(
+                            (h.t - s.dist).abs() < 1e-4 * s.dist,
+                            "light {li}: t {} vs {}",
+                            h.t,
+                            s.dist
+                        );
+                        assert!(
+                            (h.pdf - s.pdf).abs() <= 1e-3 * s.pdf,
+                            "light {li} at {p:?}: pdf {} vs {}",
+                            h.pdf,
+                            s.pdf
+                        );
                         // value = radiance / pdf
                         let want = h.radiance[0] / h.pdf;
-                        assert!((s.value[0] - want).abs() <= 1e-3 * want, "light {li}: value {} vs {want}", s.value[0]);
+                        assert!(
+                            (s.value[0] - want).abs() <= 1e-3 * want,
+                            "light {li}: value {} vs {want}",
+                            s.value[0]
+                        );
                         checked += 1;
                     }
                 }

@@ -33,15 +33,28 @@ pub enum Pick {
 #[derive(Clone, Copy, Debug)]
 pub enum Shape {
     /// Point or spot light. `spot_smooth`: Cycles' spot.spot_smooth (None for a point).
-    Point { pos: V3, radius: f32, sphere: bool, spot_smooth: Option<f32> },
+    Point {
+        pos: V3,
+        radius: f32,
+        sphere: bool,
+        spot_smooth: Option<f32>,
+    },
     /// Area light: centre and full extents along its two axes.
-    Area { pos: V3, eu: V3, ev: V3 },
+    Area {
+        pos: V3,
+        eu: V3,
+        ev: V3,
+    },
     /// Sun: the cone's axis is the direction its light travels.
     Distant,
     World,
-    Triangle { v: [V3; 3] },
+    Triangle {
+        v: [V3; 3],
+    },
     /// An emissive object: the root node of its triangles' subtree.
-    Mesh { root: u32 },
+    Mesh {
+        root: u32,
+    },
 }
 
 /// Cycles' OrientationBounds: the emitters' normals lie within `theta_o` of `axis`, and
@@ -54,7 +67,11 @@ pub struct Cone {
 }
 
 impl Cone {
-    const EMPTY: Cone = Cone { axis: [0.0; 3], theta_o: f32::MIN_POSITIVE, theta_e: f32::MIN_POSITIVE };
+    const EMPTY: Cone = Cone {
+        axis: [0.0; 3],
+        theta_o: f32::MIN_POSITIVE,
+        theta_e: f32::MIN_POSITIVE,
+    };
 
     fn is_empty(&self) -> bool {
         is_zero(self.axis)
@@ -67,7 +84,12 @@ impl Cone {
         }
         let theta_w = (self.theta_o + self.theta_e).min(PI);
         let (s, c) = self.theta_o.sin_cos();
-        2.0 * PI * (1.0 - c) + FRAC_PI_2 * (2.0 * theta_w * s - (self.theta_o - 2.0 * theta_w).cos() - 2.0 * self.theta_o * s + c)
+        2.0 * PI * (1.0 - c)
+            + FRAC_PI_2
+                * (2.0 * theta_w * s
+                    - (self.theta_o - 2.0 * theta_w).cos()
+                    - 2.0 * self.theta_o * s
+                    + c)
     }
 
     fn merge(a: Cone, b: Cone) -> Cone {
@@ -77,16 +99,28 @@ impl Cone {
         if b.is_empty() {
             return a;
         }
-        let (a, b) = if b.theta_o > a.theta_o { (b, a) } else { (a, b) };
+        let (a, b) = if b.theta_o > a.theta_o {
+            (b, a)
+        } else {
+            (a, b)
+        };
         let cos_ab = dot(a.axis, b.axis);
         let theta_d = cos_ab.clamp(-1.0, 1.0).acos();
         let theta_e = a.theta_e.max(b.theta_e);
         if a.theta_o + 5e-4 >= PI.min(theta_d + b.theta_o) {
-            return Cone { axis: a.axis, theta_o: a.theta_o, theta_e };
+            return Cone {
+                axis: a.axis,
+                theta_o: a.theta_o,
+                theta_e,
+            };
         }
         let theta_o = (theta_d + a.theta_o + b.theta_o) * 0.5;
         if theta_o >= PI {
-            return Cone { axis: a.axis, theta_o: PI, theta_e };
+            return Cone {
+                axis: a.axis,
+                theta_o: PI,
+                theta_e,
+            };
         }
         let axis = if cos_ab < -0.9995 {
             basis(a.axis).0
@@ -95,7 +129,11 @@ impl Cone {
             let ortho = normalize(sub(b.axis, scale(a.axis, cos_ab)));
             add(scale(a.axis, theta_r.cos()), scale(ortho, theta_r.sin()))
         };
-        Cone { axis, theta_o, theta_e }
+        Cone {
+            axis,
+            theta_o,
+            theta_e,
+        }
     }
 }
 
@@ -109,10 +147,19 @@ pub struct Measure {
 }
 
 impl Measure {
-    pub const EMPTY: Measure = Measure { bmin: [f32::INFINITY; 3], bmax: [f32::NEG_INFINITY; 3], cone: Cone::EMPTY, energy: 0.0 };
+    pub const EMPTY: Measure = Measure {
+        bmin: [f32::INFINITY; 3],
+        bmax: [f32::NEG_INFINITY; 3],
+        cone: Cone::EMPTY,
+        energy: 0.0,
+    };
 
     pub fn new(points: &[V3], cone: Cone, energy: f32) -> Measure {
-        let mut m = Measure { cone, energy, ..Measure::EMPTY };
+        let mut m = Measure {
+            cone,
+            energy,
+            ..Measure::EMPTY
+        };
         for &p in points {
             m.grow(p);
         }
@@ -145,7 +192,11 @@ impl Measure {
         }
         let d = sub(self.bmax, self.bmin);
         let valid = (0..3).all(|k| self.bmin[k] <= self.bmax[k]);
-        let area = if valid { 2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0]) } else { 0.0 };
+        let area = if valid {
+            2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0])
+        } else {
+            0.0
+        };
         let area_measure = if area == 0.0 { len(d) } else { area };
         self.energy * area_measure * self.cone.measure()
     }
@@ -198,7 +249,14 @@ pub struct LightTree {
 /// Cycles' sample_reservoir: keep `current` with probability weight / total so far,
 /// reusing the random number.
 #[inline]
-fn reservoir(current: usize, weight: f32, selected: &mut Option<usize>, selected_weight: &mut f32, total: &mut f32, rand: &mut f32) {
+fn reservoir(
+    current: usize,
+    weight: f32,
+    selected: &mut Option<usize>,
+    selected_weight: &mut f32,
+    total: &mut f32,
+    rand: &mut f32,
+) {
     if !(weight > 0.0) {
         return;
     }
@@ -245,11 +303,28 @@ fn smoothstep(x: f32) -> f32 {
 /// Cycles' light_tree_importance: upper and lower bounds of what a cluster can send to a
 /// point with normal `n` (a surface; `trans` if it transmits too).
 #[allow(clippy::too_many_arguments)]
-fn importance(n: V3, trans: bool, ptc: V3, cos_u: f32, cone: Cone, max_d: f32, min_d: f32, energy: f32) -> (f32, f32) {
+fn importance(
+    n: V3,
+    trans: bool,
+    ptc: V3,
+    cos_u: f32,
+    cone: Cone,
+    max_d: f32,
+    min_d: f32,
+    energy: f32,
+) -> (f32, f32) {
     let sin_u = sin_from_cos(cos_u);
-    let cos_i = if trans { dot(ptc, n).abs() } else { dot(ptc, n) };
+    let cos_i = if trans {
+        dot(ptc, n).abs()
+    } else {
+        dot(ptc, n)
+    };
     let sin_i = sin_from_cos(cos_i);
-    let cos_min_incidence = if cos_i >= cos_u { 1.0 } else { cos_i * cos_u + sin_i * sin_u };
+    let cos_min_incidence = if cos_i >= cos_u {
+        1.0
+    } else {
+        cos_i * cos_u + sin_i * sin_u
+    };
     if !trans && cos_min_incidence < 0.0 {
         return (0.0, 0.0);
     }
@@ -264,7 +339,9 @@ fn importance(n: V3, trans: bool, ptc: V3, cos_u: f32, cone: Cone, max_d: f32, m
     let (sin_o, cos_o) = cone.theta_o.sin_cos();
     let cos_min_outgoing = if cos_t >= cos_u || cos_t_minus_u >= cos_o {
         1.0
-    } else if cone.theta_o + cone.theta_e > PI || cos_t_minus_u > (cone.theta_o + cone.theta_e).cos() {
+    } else if cone.theta_o + cone.theta_e > PI
+        || cos_t_minus_u > (cone.theta_o + cone.theta_e).cos()
+    {
         let sin_t_minus_u = sin_from_cos(cos_t_minus_u);
         cos_t_minus_u * cos_o + sin_t_minus_u * sin_o
     } else {
@@ -272,7 +349,11 @@ fn importance(n: V3, trans: bool, ptc: V3, cos_u: f32, cone: Cone, max_d: f32, m
     };
     let max_imp = (cos_min_incidence * energy * cos_min_outgoing / (min_d * min_d)).abs();
     let cos_t_plus_u = cos_t * cos_u - sin_t * sin_u;
-    let min_imp = if cone.theta_e - cone.theta_o < 0.0 || cos_t < 0.0 || cos_u < 0.0 || cos_t_plus_u < (cone.theta_e - cone.theta_o).cos() {
+    let min_imp = if cone.theta_e - cone.theta_o < 0.0
+        || cos_t < 0.0
+        || cos_u < 0.0
+        || cos_t_plus_u < (cone.theta_e - cone.theta_o).cos()
+    {
         0.0
     } else {
         let sin_t_plus_u = sin_from_cos(cos_t_plus_u);
@@ -290,7 +371,11 @@ fn cos_box_angle(bmin: V3, bmax: V3, p: V3, ptc: V3) -> f32 {
     }
     let mut c = 1.0f32;
     for i in 0..8 {
-        let corner = [if i & 1 != 0 { bmax[0] } else { bmin[0] }, if i & 2 != 0 { bmax[1] } else { bmin[1] }, if i & 4 != 0 { bmax[2] } else { bmin[2] }];
+        let corner = [
+            if i & 1 != 0 { bmax[0] } else { bmin[0] },
+            if i & 2 != 0 { bmax[1] } else { bmin[1] },
+            if i & 4 != 0 { bmax[2] } else { bmin[2] },
+        ];
         c = c.min(dot(ptc, normalize(sub(corner, p))));
     }
     c
@@ -301,23 +386,49 @@ impl LightTree {
     /// its triangles (`meshes`, one list per object) and becomes one emitter beside the
     /// local lights; the root's left child holds those, its right child is one leaf of
     /// the distant lights (suns and the world).
-    pub fn build(local: Vec<Emitter>, distant: Vec<Emitter>, meshes: Vec<Vec<Emitter>>) -> LightTree {
-        let mut t = LightTree { nodes: Vec::new(), emitters: Vec::new(), lamp_emitter: Vec::new(), world_emitter: None, prim_emitter: Default::default() };
+    pub fn build(
+        local: Vec<Emitter>,
+        distant: Vec<Emitter>,
+        meshes: Vec<Vec<Emitter>>,
+    ) -> LightTree {
+        let mut t = LightTree {
+            nodes: Vec::new(),
+            emitters: Vec::new(),
+            lamp_emitter: Vec::new(),
+            world_emitter: None,
+            prim_emitter: Default::default(),
+        };
         // The root first, so that it is node 0.
-        t.nodes.push(Node { m: Measure::EMPTY, kind: NodeKind::Leaf { first: 0, count: 0 } });
+        t.nodes.push(Node {
+            m: Measure::EMPTY,
+            kind: NodeKind::Leaf { first: 0, count: 0 },
+        });
         let mut top: Vec<Emitter> = local;
         let mut mesh_ranges = Vec::new();
         for tris in meshes {
             let start = t.emitters.len();
-            t.emitters.extend(tris.into_iter().map(|e| Stored { e, bit_trail: 0, parent: u32::MAX }));
+            t.emitters.extend(tris.into_iter().map(|e| Stored {
+                e,
+                bit_trail: 0,
+                parent: u32::MAX,
+            }));
             let end = t.emitters.len();
             let root = t.recursive_build(start, end, 0, 0);
             let m = t.nodes[root as usize].m;
             mesh_ranges.push((root, start, end));
-            top.push(Emitter { pick: None, shape: Shape::Mesh { root }, centroid: m.centre(), measure: m });
+            top.push(Emitter {
+                pick: None,
+                shape: Shape::Mesh { root },
+                centroid: m.centre(),
+                measure: m,
+            });
         }
         let start = t.emitters.len();
-        t.emitters.extend(top.into_iter().map(|e| Stored { e, bit_trail: 0, parent: u32::MAX }));
+        t.emitters.extend(top.into_iter().map(|e| Stored {
+            e,
+            bit_trail: 0,
+            parent: u32::MAX,
+        }));
         let end = t.emitters.len();
         let left = t.recursive_build(start, end, 0, 1);
         let dstart = t.emitters.len();
@@ -325,12 +436,25 @@ impl LightTree {
         for e in &distant {
             dm.add(&e.measure);
         }
-        t.emitters.extend(distant.into_iter().map(|e| Stored { e, bit_trail: 1, parent: u32::MAX }));
+        t.emitters.extend(distant.into_iter().map(|e| Stored {
+            e,
+            bit_trail: 1,
+            parent: u32::MAX,
+        }));
         let right = t.nodes.len() as u32;
-        t.nodes.push(Node { m: dm, kind: NodeKind::Distant { first: dstart as u32, count: (t.emitters.len() - dstart) as u32 } });
+        t.nodes.push(Node {
+            m: dm,
+            kind: NodeKind::Distant {
+                first: dstart as u32,
+                count: (t.emitters.len() - dstart) as u32,
+            },
+        });
         let mut rm = t.nodes[left as usize].m;
         rm.add(&dm);
-        t.nodes[0] = Node { m: rm, kind: NodeKind::Inner { left, right } };
+        t.nodes[0] = Node {
+            m: rm,
+            kind: NodeKind::Inner { left, right },
+        };
         // Lookups from what light sampling knows (a light, a triangle) to emitters.
         for (i, s) in t.emitters.iter().enumerate() {
             match s.e.pick {
@@ -349,7 +473,18 @@ impl LightTree {
         }
         // Each object's triangles belong to the emitter of their subtree's root (the
         // top-level build has reordered the object emitters).
-        let emitter_of_root: std::collections::HashMap<u32, u32> = t.emitters.iter().enumerate().filter_map(|(i, s)| if let Shape::Mesh { root } = s.e.shape { Some((root, i as u32)) } else { None }).collect();
+        let emitter_of_root: std::collections::HashMap<u32, u32> = t
+            .emitters
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| {
+                if let Shape::Mesh { root } = s.e.shape {
+                    Some((root, i as u32))
+                } else {
+                    None
+                }
+            })
+            .collect();
         for (root, s, e) in mesh_ranges {
             let parent = emitter_of_root[&root];
             for st in &mut t.emitters[s..e] {
@@ -362,13 +497,21 @@ impl LightTree {
     /// Cycles' LightTree::recursive_build; returns the node's index.
     fn recursive_build(&mut self, start: usize, end: usize, bit_trail: u64, depth: u32) -> u32 {
         let idx = self.nodes.len();
-        self.nodes.push(Node { m: Measure::EMPTY, kind: NodeKind::Leaf { first: start as u32, count: (end - start) as u32 } });
+        self.nodes.push(Node {
+            m: Measure::EMPTY,
+            kind: NodeKind::Leaf {
+                first: start as u32,
+                count: (end - start) as u32,
+            },
+        });
         let (split, middle, dim, m) = self.should_split(start, end);
         self.nodes[idx].m = m;
         if split && depth < 63 && end - start > 1 {
             if let Some(dim) = dim {
                 if middle > start && middle < end {
-                    self.emitters[start..end].select_nth_unstable_by(middle - start, |a, b| a.e.centroid[dim].total_cmp(&b.e.centroid[dim]));
+                    self.emitters[start..end].select_nth_unstable_by(middle - start, |a, b| {
+                        a.e.centroid[dim].total_cmp(&b.e.centroid[dim])
+                    });
                 }
             }
             let left = self.recursive_build(start, middle, bit_trail, depth + 1);
@@ -387,7 +530,11 @@ impl LightTree {
     fn should_split(&self, start: usize, end: usize) -> (bool, usize, Option<usize>, Measure) {
         let n = end - start;
         if n < 2 {
-            let m = if n == 1 { self.emitters[start].e.measure } else { Measure::EMPTY };
+            let m = if n == 1 {
+                self.emitters[start].e.measure
+            } else {
+                Measure::EMPTY
+            };
             return (false, start, None, m);
         }
         let mut middle = (start + end) / 2;
@@ -455,18 +602,28 @@ impl LightTree {
                 }
             }
         }
-        (min_cost < total_cost || n > MAX_IN_LEAF, middle, split_dim, measure)
+        (
+            min_cost < total_cost || n > MAX_IN_LEAF,
+            middle,
+            split_dim,
+            measure,
+        )
     }
 
     /// Cycles' light_tree_node_importance.
     fn node_importance(&self, p: V3, n: V3, trans: bool, node: &Node) -> (f32, f32) {
         let m = &node.m;
         let (ptc, cos_u, distance) = if let NodeKind::Distant { .. } = node.kind {
-            (neg(m.cone.axis), (m.cone.theta_o + m.cone.theta_e).cos(), 1.0)
+            (
+                neg(m.cone.axis),
+                (m.cone.theta_o + m.cone.theta_e).cos(),
+                1.0,
+            )
         } else {
             let centroid = m.centre();
             let ext = sub(m.bmax, centroid);
-            let visible = trans || dot(n, sub(centroid, p)) + dot(n.map(f32::abs), ext.map(f32::abs)) > 0.0;
+            let visible =
+                trans || dot(n, sub(centroid, p)) + dot(n.map(f32::abs), ext.map(f32::abs)) > 0.0;
             if !visible {
                 return (0.0, 0.0);
             }
@@ -484,8 +641,15 @@ impl LightTree {
         let mut energy = m.energy;
         let centroid = e.centroid;
         let (visible, ptc, cos_u, dist) = match e.shape {
-            Shape::Mesh { root } => return self.node_importance(p, n, trans, &self.nodes[root as usize]),
-            Shape::Point { pos, radius, sphere, spot_smooth } => {
+            Shape::Mesh { root } => {
+                return self.node_importance(p, n, trans, &self.nodes[root as usize])
+            }
+            Shape::Point {
+                pos,
+                radius,
+                sphere,
+                spot_smooth,
+            } => {
                 let (ptc, min_d) = normalize_len(sub(pos, p));
                 let (cos_u, dist) = if sphere {
                     if min_d > radius {
@@ -505,9 +669,18 @@ impl LightTree {
                         cone.theta_o = 0.0;
                     }
                     Some(smooth) => {
-                        let cos_min_out = (dot(cone.axis, neg(ptc)).clamp(-1.0, 1.0).acos() - cos_u.clamp(-1.0, 1.0).acos()).max(0.0).cos();
+                        let cos_min_out = (dot(cone.axis, neg(ptc)).clamp(-1.0, 1.0).acos()
+                            - cos_u.clamp(-1.0, 1.0).acos())
+                        .max(0.0)
+                        .cos();
                         let x = (cos_min_out - cone.theta_e.cos()) * smooth;
-                        energy *= if smooth.is_finite() { smoothstep(x) } else if cos_min_out > cone.theta_e.cos() { 1.0 } else { 0.0 };
+                        energy *= if smooth.is_finite() {
+                            smoothstep(x)
+                        } else if cos_min_out > cone.theta_e.cos() {
+                            1.0
+                        } else {
+                            0.0
+                        };
                     }
                 }
                 (true, ptc, cos_u, dist)
@@ -517,7 +690,13 @@ impl LightTree {
                 let mut dist = [min_d, min_d];
                 let mut cos_u = f32::MAX;
                 for i in 0..4 {
-                    let corner = add(add(scale(eu, (i & 1) as f32 - 0.5), scale(ev, 0.5 * ((i & 2) as f32 - 1.0))), pos);
+                    let corner = add(
+                        add(
+                            scale(eu, (i & 1) as f32 - 0.5),
+                            scale(ev, 0.5 * ((i & 2) as f32 - 1.0)),
+                        ),
+                        pos,
+                    );
                     let (ptk, dk) = normalize_len(sub(corner, p));
                     cos_u = cos_u.min(dot(ptc, ptk));
                     dist[0] = dist[0].max(dk);
@@ -559,7 +738,9 @@ impl LightTree {
     fn child_importance(&self, p: V3, n: V3, trans: bool, node: u32) -> (f32, f32) {
         let nd = &self.nodes[node as usize];
         match nd.kind {
-            NodeKind::Leaf { first, count } | NodeKind::Distant { first, count } if count == 1 => self.emitter_importance(p, n, trans, &self.emitters[first as usize].e),
+            NodeKind::Leaf { first, count } | NodeKind::Distant { first, count } if count == 1 => {
+                self.emitter_importance(p, n, trans, &self.emitters[first as usize].e)
+            }
             NodeKind::Leaf { count: 0, .. } | NodeKind::Distant { count: 0, .. } => (0.0, 0.0),
             _ => self.node_importance(p, n, trans, nd),
         }
@@ -575,7 +756,11 @@ impl LightTree {
         }
         let total_min = lmin + rmin;
         let pmax = lmax / total_max;
-        let pmin = if total_min > 0.0 { lmin / total_min } else { 0.5 * ((lmax > 0.0) as u32 as f32 + (rmax == 0.0) as u32 as f32) };
+        let pmin = if total_min > 0.0 {
+            lmin / total_min
+        } else {
+            0.5 * ((lmax > 0.0) as u32 as f32 + (rmax == 0.0) as u32 as f32)
+        };
         Some(0.5 * (pmax + pmin))
     }
 
@@ -589,7 +774,8 @@ impl LightTree {
         loop {
             match self.nodes[node as usize].kind {
                 NodeKind::Leaf { first, count } | NodeKind::Distant { first, count } => {
-                    let e = self.select_in_leaf(p, n, trans, first, count, &mut rand, &mut pdf_sel)?;
+                    let e =
+                        self.select_in_leaf(p, n, trans, first, count, &mut rand, &mut pdf_sel)?;
                     let st = &self.emitters[e];
                     match st.e.shape {
                         Shape::Mesh { root } => node = root,
@@ -625,7 +811,16 @@ impl LightTree {
 
     /// Cycles' light_tree_cluster_select_emitter: two reservoirs, by the upper and by the
     /// lower bound of each emitter's importance, one chosen by the random number.
-    fn select_in_leaf(&self, p: V3, n: V3, trans: bool, first: u32, count: u32, rand: &mut f32, pdf: &mut f32) -> Option<usize> {
+    fn select_in_leaf(
+        &self,
+        p: V3,
+        n: V3,
+        trans: bool,
+        first: u32,
+        count: u32,
+        rand: &mut f32,
+        pdf: &mut f32,
+    ) -> Option<usize> {
         let mut sel_imp = [0.0f32; 2];
         let mut total = [0.0f32; 2];
         let mut selected = None;
@@ -639,7 +834,14 @@ impl LightTree {
         for (i, ei) in range.clone().enumerate() {
             let (imax, imin) = self.emitter_importance(p, n, trans, &self.emitters[ei].e);
             let imp = [imax, imin];
-            reservoir(ei, imp[smin], &mut selected, &mut sel_imp[smin], &mut total[smin], rand);
+            reservoir(
+                ei,
+                imp[smin],
+                &mut selected,
+                &mut sel_imp[smin],
+                &mut total[smin],
+                rand,
+            );
             if selected == Some(ei) {
                 sel_imp[smax] = imp[smax];
             }
@@ -660,10 +862,19 @@ impl LightTree {
                 selected = None;
                 let mut hi = has_importance;
                 for ei in range {
-                    reservoir(ei, (hi & 1) as f32, &mut selected, &mut sel_imp[1], &mut total[1], rand);
+                    reservoir(
+                        ei,
+                        (hi & 1) as f32,
+                        &mut selected,
+                        &mut sel_imp[1],
+                        &mut total[1],
+                        rand,
+                    );
                     hi >>= 1;
                 }
-                sel_imp[0] = self.emitter_importance(p, n, trans, &self.emitters[selected?].e).0;
+                sel_imp[0] = self
+                    .emitter_importance(p, n, trans, &self.emitters[selected?].e)
+                    .0;
             }
         }
         *pdf *= 0.5 * (sel_imp[0] / total[0] + sel_imp[1] / total[1]);
@@ -674,7 +885,11 @@ impl LightTree {
     /// light_tree_pdf), for MIS of what BSDF rays find; 0 if it is not an emitter.
     pub fn pdf(&self, p: V3, n: V3, trans: bool, pick: Pick) -> f32 {
         let target = match pick {
-            Pick::Lamp(l) => self.lamp_emitter.get(l as usize).copied().unwrap_or(u32::MAX),
+            Pick::Lamp(l) => self
+                .lamp_emitter
+                .get(l as usize)
+                .copied()
+                .unwrap_or(u32::MAX),
             Pick::World => self.world_emitter.unwrap_or(u32::MAX),
             Pick::Triangle(prim) => self.prim_emitter.get(&prim).copied().unwrap_or(u32::MAX),
         };
@@ -683,15 +898,25 @@ impl LightTree {
         }
         let t = &self.emitters[target as usize];
         // A triangle is reached through its object's emitter, then the object's subtree.
-        let (mut target, mut bits, mut then) = if t.parent != u32::MAX { (t.parent, self.emitters[t.parent as usize].bit_trail, Some((target, t.bit_trail))) } else { (target, t.bit_trail, None) };
+        let (mut target, mut bits, mut then) = if t.parent != u32::MAX {
+            (
+                t.parent,
+                self.emitters[t.parent as usize].bit_trail,
+                Some((target, t.bit_trail)),
+            )
+        } else {
+            (target, t.bit_trail, None)
+        };
         let mut pdf = 1.0f32;
         let mut node = 0u32;
         loop {
             match self.nodes[node as usize].kind {
                 NodeKind::Leaf { first, count } | NodeKind::Distant { first, count } => {
-                    let (mut tmax, mut tmin, mut total_max, mut total_min, mut num) = (0.0f32, 0.0f32, 0.0f32, 0.0f32, 0u32);
+                    let (mut tmax, mut tmin, mut total_max, mut total_min, mut num) =
+                        (0.0f32, 0.0f32, 0.0f32, 0.0f32, 0u32);
                     for ei in first..first + count {
-                        let (imax, imin) = self.emitter_importance(p, n, trans, &self.emitters[ei as usize].e);
+                        let (imax, imin) =
+                            self.emitter_importance(p, n, trans, &self.emitters[ei as usize].e);
                         num += (imax > 0.0) as u32;
                         if ei == target {
                             tmax = imax;
@@ -703,10 +928,19 @@ impl LightTree {
                     if !(tmax > 0.0) {
                         return 0.0;
                     }
-                    pdf *= 0.5 * (tmax / total_max + if total_min > 0.0 { tmin / total_min } else { 1.0 / num as f32 });
+                    pdf *= 0.5
+                        * (tmax / total_max
+                            + if total_min > 0.0 {
+                                tmin / total_min
+                            } else {
+                                1.0 / num as f32
+                            });
                     match then.take() {
                         Some((tri, tri_bits)) => {
-                            let Shape::Mesh { root } = self.emitters[target as usize].e.shape else { return 0.0 };
+                            let Shape::Mesh { root } = self.emitters[target as usize].e.shape
+                            else {
+                                return 0.0;
+                            };
                             node = root;
                             target = tri;
                             bits = tri_bits;
@@ -715,7 +949,9 @@ impl LightTree {
                     }
                 }
                 NodeKind::Inner { left, right } => {
-                    let Some(lp) = self.left_probability(p, n, trans, left, right) else { return 0.0 };
+                    let Some(lp) = self.left_probability(p, n, trans, left, right) else {
+                        return 0.0;
+                    };
                     let go_left = bits & 1 == 0;
                     bits >>= 1;
                     node = if go_left { left } else { right };
@@ -755,31 +991,60 @@ impl Distribution {
             entries.push(Pick::Triangle(prim));
         }
         let tri_area = total;
-        let light_area = if tri_area > 0.0 { tri_area / lights.len().max(1) as f64 } else { 1.0 };
+        let light_area = if tri_area > 0.0 {
+            tri_area / lights.len().max(1) as f64
+        } else {
+            1.0
+        };
         for &l in lights {
             total += light_area;
             cdf.push(total);
             entries.push(l);
         }
-        let cdf = cdf.iter().map(|&c| if total > 0.0 { (c / total) as f32 } else { 0.0 }).collect();
+        let cdf = cdf
+            .iter()
+            .map(|&c| if total > 0.0 { (c / total) as f32 } else { 0.0 })
+            .collect();
         let both = tri_area > 0.0 && !lights.is_empty();
-        let pdf_triangles = if tri_area > 0.0 { (1.0 / tri_area) as f32 * if both { 0.5 } else { 1.0 } } else { 0.0 };
-        let pdf_lights = if lights.is_empty() { 0.0 } else { 1.0 / lights.len() as f32 * if both { 0.5 } else { 1.0 } };
-        Distribution { cdf, entries, pdf_triangles, pdf_lights, prim_area: triangles.iter().copied().collect(), lights: lights.to_vec() }
+        let pdf_triangles = if tri_area > 0.0 {
+            (1.0 / tri_area) as f32 * if both { 0.5 } else { 1.0 }
+        } else {
+            0.0
+        };
+        let pdf_lights = if lights.is_empty() {
+            0.0
+        } else {
+            1.0 / lights.len() as f32 * if both { 0.5 } else { 1.0 }
+        };
+        Distribution {
+            cdf,
+            entries,
+            pdf_triangles,
+            pdf_lights,
+            prim_area: triangles.iter().copied().collect(),
+            lights: lights.to_vec(),
+        }
     }
 
     pub fn select(&self, rand: f32) -> Option<(Pick, f32)> {
         if self.entries.is_empty() {
             return None;
         }
-        let i = self.cdf.partition_point(|&c| c <= rand).min(self.entries.len() - 1);
+        let i = self
+            .cdf
+            .partition_point(|&c| c <= rand)
+            .min(self.entries.len() - 1);
         let k = self.entries[i];
         Some((k, self.pdf(k)))
     }
 
     pub fn pdf(&self, k: Pick) -> f32 {
         match k {
-            Pick::Triangle(p) => self.prim_area.get(&p).map(|a| a * self.pdf_triangles).unwrap_or(0.0),
+            Pick::Triangle(p) => self
+                .prim_area
+                .get(&p)
+                .map(|a| a * self.pdf_triangles)
+                .unwrap_or(0.0),
             _ if self.lights.contains(&k) => self.pdf_lights,
             _ => 0.0,
         }
@@ -819,15 +1084,46 @@ mod tests {
 
     fn point(l: u32, pos: V3, energy: f32) -> Emitter {
         let r = 0.1;
-        let m = Measure::new(&[sub(pos, [r; 3]), add(pos, [r; 3])], Cone { axis: [0.0, 0.0, -1.0], theta_o: PI, theta_e: FRAC_PI_2 }, energy);
-        Emitter { pick: Some(Pick::Lamp(l)), shape: Shape::Point { pos, radius: r, sphere: false, spot_smooth: None }, centroid: pos, measure: m }
+        let m = Measure::new(
+            &[sub(pos, [r; 3]), add(pos, [r; 3])],
+            Cone {
+                axis: [0.0, 0.0, -1.0],
+                theta_o: PI,
+                theta_e: FRAC_PI_2,
+            },
+            energy,
+        );
+        Emitter {
+            pick: Some(Pick::Lamp(l)),
+            shape: Shape::Point {
+                pos,
+                radius: r,
+                sphere: false,
+                spot_smooth: None,
+            },
+            centroid: pos,
+            measure: m,
+        }
     }
 
     fn tri(prim: u32, v: [V3; 3]) -> Emitter {
         let area = 0.5 * len(cross(sub(v[1], v[0]), sub(v[2], v[0])));
         let c = scale(add(add(v[0], v[1]), v[2]), 1.0 / 3.0);
-        let m = Measure::new(&v, Cone { axis: normalize(sub(v[0], v[1])), theta_o: FRAC_PI_2, theta_e: FRAC_PI_2 }, area);
-        Emitter { pick: Some(Pick::Triangle(prim)), shape: Shape::Triangle { v }, centroid: c, measure: m }
+        let m = Measure::new(
+            &v,
+            Cone {
+                axis: normalize(sub(v[0], v[1])),
+                theta_o: FRAC_PI_2,
+                theta_e: FRAC_PI_2,
+            },
+            area,
+        );
+        Emitter {
+            pick: Some(Pick::Triangle(prim)),
+            shape: Shape::Triangle { v },
+            centroid: c,
+            measure: m,
+        }
     }
 
     /// Selection probabilities over all emitters sum to one, and `pdf` gives the
@@ -837,18 +1133,42 @@ mod tests {
         let mut local = Vec::new();
         for i in 0..13 {
             let f = i as f32;
-            local.push(point(i, [f.sin() * 3.0, f.cos() * 2.0, 2.0 + 0.3 * f], 1.0 + f));
+            local.push(point(
+                i,
+                [f.sin() * 3.0, f.cos() * 2.0, 2.0 + 0.3 * f],
+                1.0 + f,
+            ));
         }
         let mut mesh = Vec::new();
         for i in 0..20u32 {
             let x = i as f32 * 0.2 - 2.0;
-            mesh.push(tri(100 + i, [[x, -1.0, 3.0], [x + 0.2, -1.0, 3.0], [x, -0.8, 3.2]]));
+            mesh.push(tri(
+                100 + i,
+                [[x, -1.0, 3.0], [x + 0.2, -1.0, 3.0], [x, -0.8, 3.2]],
+            ));
         }
-        let sun = Emitter { pick: Some(Pick::Lamp(13)), shape: Shape::Distant, centroid: normalize([0.3, 0.2, -1.0]), measure: Measure::new(&[], Cone { axis: normalize([0.3, 0.2, -1.0]), theta_o: 0.0, theta_e: 0.01 }, 3.0) };
+        let sun = Emitter {
+            pick: Some(Pick::Lamp(13)),
+            shape: Shape::Distant,
+            centroid: normalize([0.3, 0.2, -1.0]),
+            measure: Measure::new(
+                &[],
+                Cone {
+                    axis: normalize([0.3, 0.2, -1.0]),
+                    theta_o: 0.0,
+                    theta_e: 0.01,
+                },
+                3.0,
+            ),
+        };
         let t = LightTree::build(local, vec![sun], vec![mesh]);
         let mut picks: Vec<Pick> = (0..14).map(Pick::Lamp).collect();
         picks.extend((100..120).map(Pick::Triangle));
-        for (p, n, trans) in [([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], false), ([1.0, 0.5, 2.5], normalize([0.2, -0.5, 0.4]), true), ([-1.0, -1.0, 1.0], [0.0, 1.0, 0.0], false)] {
+        for (p, n, trans) in [
+            ([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], false),
+            ([1.0, 0.5, 2.5], normalize([0.2, -0.5, 0.4]), true),
+            ([-1.0, -1.0, 1.0], [0.0, 1.0, 0.0], false),
+        ] {
             let sum: f32 = picks.iter().map(|&k| t.pdf(p, n, trans, k)).sum();
             assert!((sum - 1.0).abs() < 1e-4, "pdfs sum to {sum}");
             let draws = 200_000;
@@ -857,13 +1177,19 @@ mod tests {
                 let u = (i as f32 + 0.5) / draws as f32;
                 let (k, pr) = t.select(p, n, trans, u).expect("something is picked");
                 let want = t.pdf(p, n, trans, k);
-                assert!((pr - want).abs() <= 1e-4 * want.max(1e-3), "{k:?}: select says {pr}, pdf {want}");
+                assert!(
+                    (pr - want).abs() <= 1e-4 * want.max(1e-3),
+                    "{k:?}: select says {pr}, pdf {want}"
+                );
                 *counts.entry(k).or_insert(0u32) += 1;
             }
             for &k in &picks {
                 let got = *counts.get(&k).unwrap_or(&0) as f32 / draws as f32;
                 let want = t.pdf(p, n, trans, k);
-                assert!((got - want).abs() < 0.003 + 0.02 * want, "{k:?} at {p:?}: picked {got}, pdf {want}");
+                assert!(
+                    (got - want).abs() < 0.003 + 0.02 * want,
+                    "{k:?} at {p:?}: picked {got}, pdf {want}"
+                );
             }
         }
     }
@@ -876,7 +1202,20 @@ mod tests {
         let mut meshes = Vec::new();
         for m in 0..6u32 {
             let x = 3.0 - m as f32;
-            meshes.push((0..4u32).map(|i| tri(10 * m + i, [[x, i as f32 * 0.3, 2.0], [x + 0.5, i as f32 * 0.3, 2.0], [x, i as f32 * 0.3 + 0.3, 2.4]])).collect::<Vec<_>>());
+            meshes.push(
+                (0..4u32)
+                    .map(|i| {
+                        tri(
+                            10 * m + i,
+                            [
+                                [x, i as f32 * 0.3, 2.0],
+                                [x + 0.5, i as f32 * 0.3, 2.0],
+                                [x, i as f32 * 0.3 + 0.3, 2.4],
+                            ],
+                        )
+                    })
+                    .collect::<Vec<_>>(),
+            );
         }
         let t = LightTree::build(vec![point(0, [0.0, -2.0, 3.0], 2.0)], Vec::new(), meshes);
         let mut picks = vec![Pick::Lamp(0)];
@@ -886,9 +1225,14 @@ mod tests {
             let sum: f32 = picks.iter().map(|&k| t.pdf(p, n, false, k)).sum();
             assert!((sum - 1.0).abs() < 1e-4, "pdfs sum to {sum}");
             for i in 0..2000 {
-                let (k, pr) = t.select(p, n, false, (i as f32 + 0.5) / 2000.0).expect("a pick");
+                let (k, pr) = t
+                    .select(p, n, false, (i as f32 + 0.5) / 2000.0)
+                    .expect("a pick");
                 let want = t.pdf(p, n, false, k);
-                assert!((pr - want).abs() <= 1e-4 * want.max(1e-3), "{k:?}: select says {pr}, pdf {want}");
+                assert!(
+                    (pr - want).abs() <= 1e-4 * want.max(1e-3),
+                    "{k:?}: select says {pr}, pdf {want}"
+                );
             }
         }
     }

@@ -29,7 +29,11 @@ pub fn dot(a: V3, b: V3) -> f32 {
 }
 #[inline(always)]
 pub fn cross(a: V3, b: V3) -> V3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 #[inline(always)]
 pub fn len(a: V3) -> f32 {
@@ -92,7 +96,10 @@ pub fn basis(n: V3) -> (V3, V3) {
     let s = if n[2] >= 0.0 { 1.0 } else { -1.0 };
     let a = -1.0 / (s + n[2]);
     let b = n[0] * n[1] * a;
-    ([1.0 + s * n[0] * n[0] * a, s * b, -s * n[0]], [b, s + n[1] * n[1] * a, -n[1]])
+    (
+        [1.0 + s * n[0] * n[0] * a, s * b, -s * n[0]],
+        [b, s + n[1] * n[1] * a, -n[1]],
+    )
 }
 
 /// Row-major affine transform (3x4, f32), as the exchange format's matrices.
@@ -135,7 +142,8 @@ impl Affine {
     /// Inverse (None when singular), computed in f64.
     pub fn inverse(&self) -> Option<Affine> {
         let a = |r: usize, c: usize| self.m[r][c] as f64;
-        let det = a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1)) - a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0))
+        let det = a(0, 0) * (a(1, 1) * a(2, 2) - a(1, 2) * a(2, 1))
+            - a(0, 1) * (a(1, 0) * a(2, 2) - a(1, 2) * a(2, 0))
             + a(0, 2) * (a(1, 0) * a(2, 1) - a(1, 1) * a(2, 0));
         if det.abs() < 1e-30 || !det.is_finite() {
             return None;

@@ -56,7 +56,11 @@ pub fn erf(x: f32) -> f32 {
     let s = x.signum();
     let x = x.abs();
     let t = 1.0 / (1.0 + 0.327_591_1 * x);
-    let y = 1.0 - (((((1.061_405_4 * t - 1.453_152_1) * t) + 1.421_413_7) * t - 0.284_496_74) * t + 0.254_829_6) * t * (-x * x).exp();
+    let y = 1.0
+        - (((((1.061_405_4 * t - 1.453_152_1) * t) + 1.421_413_7) * t - 0.284_496_74) * t
+            + 0.254_829_6)
+            * t
+            * (-x * x).exp();
     s * y
 }
 
@@ -105,7 +109,10 @@ pub fn sample_ggx_vndf(v: V3, ax: f32, ay: f32, u: [f32; 2]) -> V3 {
     let (tx, mut ty) = (t[0], t[1]);
     let s = 0.5 * (1.0 + vh[2]);
     ty = (1.0 - tx * tx).max(0.0).sqrt() * (1.0 - s) + ty * s;
-    let nh = add(add(scale(t1, tx), scale(t2, ty)), scale(vh, (1.0 - tx * tx - ty * ty).max(0.0).sqrt()));
+    let nh = add(
+        add(scale(t1, tx), scale(t2, ty)),
+        scale(vh, (1.0 - tx * tx - ty * ty).max(0.0).sqrt()),
+    );
     normalize([ax * nh[0], ay * nh[1], nh[2].max(0.0)])
 }
 
@@ -133,7 +140,11 @@ pub fn sample_beckmann_vndf(v: V3, ax: f32, ay: f32, u: [f32; 2]) -> V3 {
         let k = tan_t * SQRT_PI_INV;
         let y_approx = u[0] * (1.0 + erf_a + k * (1.0 - erf_a * erf_a));
         let y_exact = u[0] * (1.0 + erf_a + k * exp_a2);
-        let b = if k > 0.0 { (0.5 - (k * (k - y_approx + 1.0) + 0.25).max(0.0).sqrt()) / k } else { y_approx - 1.0 };
+        let b = if k > 0.0 {
+            (0.5 - (k * (k - y_approx + 1.0) + 0.25).max(0.0).sqrt()) / k
+        } else {
+            y_approx - 1.0
+        };
         let mut inv_erf = erfinv(b);
         let (mut begin_x, mut begin_y) = (-1.0f32, -y_exact);
         let mut end_x = erf_a;
@@ -150,7 +161,11 @@ pub fn sample_beckmann_vndf(v: V3, ax: f32, ay: f32, u: [f32; 2]) -> V3 {
                 end_x = cur_x;
             }
             let newton = cur_x - cur_y / (1.0 - inv_erf * tan_t);
-            cur_x = if newton >= begin_x && newton <= end_x { newton } else { 0.5 * (begin_x + end_x) };
+            cur_x = if newton >= begin_x && newton <= end_x {
+                newton
+            } else {
+                0.5 * (begin_x + end_x)
+            };
             inv_erf = erfinv(cur_x);
             cur_y = 1.0 + cur_x + k * (-inv_erf * inv_erf).exp() - y_exact;
         }
@@ -222,7 +237,11 @@ impl Dielectric {
         let (f, cos_ht) = fresnel_dielectric(cos_hv, self.eta);
         if f >= 1.0 {
             // Total internal reflection.
-            let r = if self.refract_only { [0.0; 3] } else { self.tint_r };
+            let r = if self.refract_only {
+                [0.0; 3]
+            } else {
+                self.tint_r
+            };
             return (r, [0.0; 3], cos_ht);
         }
         if self.refract_only {
@@ -231,7 +250,11 @@ impl Dielectric {
         }
         if let Some(film) = &self.film {
             let r = film.eval(cos_hv);
-            return (mul(self.tint_r, r), mul(self.tint_t, r.map(|x| 1.0 - x)), cos_ht);
+            return (
+                mul(self.tint_r, r),
+                mul(self.tint_t, r.map(|x| 1.0 - x)),
+                cos_ht,
+            );
         }
         (scale(self.tint_r, f), scale(self.tint_t, 1.0 - f), cos_ht)
     }
@@ -241,10 +264,18 @@ impl Dielectric {
         let cos_nv = dot(n, v);
         let cos_nl = dot(n, l);
         let is_t = cos_nl < 0.0;
-        if cos_nv <= 0.0 || self.singular() || (dot(ng, l) < 0.0) != is_t || (!is_t && self.refract_only) {
+        if cos_nv <= 0.0
+            || self.singular()
+            || (dot(ng, l) < 0.0) != is_t
+            || (!is_t && self.refract_only)
+        {
             return ([0.0; 3], 0.0);
         }
-        let hu = if is_t { neg(add(scale(l, self.eta), v)) } else { add(v, l) };
+        let hu = if is_t {
+            neg(add(scale(l, self.eta), v))
+        } else {
+            add(v, l)
+        };
         let hl = len(hu);
         if !(hl > 0.0) {
             return ([0.0; 3], 0.0);
@@ -260,11 +291,19 @@ impl Dielectric {
         let dd = d(self.dist, a2, dot(n, h));
         let lv = lambda(self.dist, a2, cos_nv);
         let ll = lambda(self.dist, a2, cos_nl);
-        let common = dd / cos_nv * if is_t { (self.eta / hl) * (self.eta / hl) * (cos_hv * dot(h, l)).abs() } else { 0.25 };
+        let common = dd / cos_nv
+            * if is_t {
+                (self.eta / hl) * (self.eta / hl) * (cos_hv * dot(h, l)).abs()
+            } else {
+                0.25
+            };
         let p_r = average(r) / sum;
         let lobe = if is_t { 1.0 - p_r } else { p_r };
         let pdf = common * lobe / (1.0 + lv);
-        let f = scale(if is_t { t } else { r }, common / (1.0 + lv + ll) * self.energy);
+        let f = scale(
+            if is_t { t } else { r },
+            common / (1.0 + lv + ll) * self.energy,
+        );
         (f, pdf)
     }
 
@@ -293,7 +332,10 @@ impl Dielectric {
         let refract = u[2] >= p_r;
         let l = if refract {
             // Snell: tangential part scaled by 1/eta, normal part from cos_ht.
-            add(scale(v, -1.0 / self.eta), scale(h, cos_hv / self.eta + cos_ht))
+            add(
+                scale(v, -1.0 / self.eta),
+                scale(h, cos_hv / self.eta + cos_ht),
+            )
         } else {
             sub(scale(h, 2.0 * cos_hv), v)
         };
@@ -306,7 +348,13 @@ impl Dielectric {
             singular = true;
         }
         if singular {
-            return Some(DielectricSample { l, weight: scale(e, self.energy / pdf), pdf: f32::INFINITY, singular: true, transmit: refract });
+            return Some(DielectricSample {
+                l,
+                weight: scale(e, self.energy / pdf),
+                pdf: f32::INFINITY,
+                singular: true,
+                transmit: refract,
+            });
         }
         let a2 = self.alpha * self.alpha;
         let cos_nl = dot(n, l);
@@ -314,13 +362,24 @@ impl Dielectric {
         let lv = lambda(self.dist, a2, cos_nv);
         let ll = lambda(self.dist, a2, cos_nl);
         let cos_hl = dot(h, l);
-        let common = dd / cos_nv * if refract { (cos_hv * cos_hl).abs() / (cos_hl + cos_hv / self.eta).powi(2) } else { 0.25 };
+        let common = dd / cos_nv
+            * if refract {
+                (cos_hv * cos_hl).abs() / (cos_hl + cos_hv / self.eta).powi(2)
+            } else {
+                0.25
+            };
         pdf *= common / (1.0 + lv);
         e = scale(e, common / (1.0 + lv + ll) * self.energy);
         if !(pdf > 0.0) || !pdf.is_finite() {
             return None;
         }
-        Some(DielectricSample { l, weight: scale(e, 1.0 / pdf), pdf, singular: false, transmit: refract })
+        Some(DielectricSample {
+            l,
+            weight: scale(e, 1.0 / pdf),
+            pdf,
+            singular: false,
+            transmit: refract,
+        })
     }
 }
 
@@ -369,12 +428,33 @@ pub fn glass_albedo(mu: f32, alpha: f32, eta: f32, samples: &[[f32; 2]]) -> f32 
 /// The Glass or Refraction closure as Cycles' SVM sets it up: alpha = roughness^2, IOR
 /// inverted on back faces, Multiscatter GGX glass scaled by 1 / E from the glass albedo
 /// table. `mu` is cos(N, view). Tints are one: the colour is the closure weight.
-pub fn glass_closure(tables: &super::tables::Tables, distribution: Option<&str>, refract_only: bool, roughness: f32, ior: f32, backfacing: bool, mu: f32) -> Dielectric {
+pub fn glass_closure(
+    tables: &super::tables::Tables,
+    distribution: Option<&str>,
+    refract_only: bool,
+    roughness: f32,
+    ior: f32,
+    backfacing: bool,
+    mu: f32,
+) -> Dielectric {
     let r = roughness.clamp(0.0, 1.0);
     let ior = ior.max(1e-5);
     let eta = if backfacing { 1.0 / ior } else { ior };
-    let dist = if distribution == Some("BECKMANN") { Distribution::Beckmann } else { Distribution::Ggx };
-    let mut g = Dielectric { dist, alpha: r * r, eta, refract_only, tint_r: [1.0; 3], tint_t: [1.0; 3], energy: 1.0, film: None };
+    let dist = if distribution == Some("BECKMANN") {
+        Distribution::Beckmann
+    } else {
+        Distribution::Ggx
+    };
+    let mut g = Dielectric {
+        dist,
+        alpha: r * r,
+        eta,
+        refract_only,
+        tint_r: [1.0; 3],
+        tint_t: [1.0; 3],
+        energy: 1.0,
+        film: None,
+    };
     if !refract_only && distribution == Some("MULTI_GGX") && !g.singular() {
         g.energy = 1.0 / tables.glass_e(mu.clamp(0.0, 1.0), r, eta).max(1e-3);
     }
@@ -421,7 +501,13 @@ impl Reflection {
             n
         } else {
             let (tx, ty) = basis(n);
-            let hl = sample_vndf(self.dist, [dot(v, tx), dot(v, ty), cos_nv], self.alpha, self.alpha, u);
+            let hl = sample_vndf(
+                self.dist,
+                [dot(v, tx), dot(v, ty), cos_nv],
+                self.alpha,
+                self.alpha,
+                u,
+            );
             add(add(scale(tx, hl[0]), scale(ty, hl[1])), scale(n, hl[2]))
         };
         let l = sub(scale(h, 2.0 * dot(h, v)), v);

@@ -25,9 +25,9 @@ pub mod integrator;
 pub mod light;
 pub mod light_tree;
 pub mod math;
+pub mod microfacet;
 pub mod motion;
 pub mod object_motion;
-pub mod microfacet;
 pub mod oren_nayar;
 pub mod panorama;
 pub mod sampler;
@@ -140,7 +140,12 @@ fn rna_f(m: &crate::scene::Rna, k: &str) -> Option<f64> {
 /// for the roughness-to-alpha convention, once to compare with alpha_x * alpha_y);
 /// otherwise -1.
 fn transparent_glass_threshold(film_transparent: bool, cycles: &crate::scene::Rna) -> f32 {
-    if film_transparent && cycles.get("film_transparent_glass").and_then(Value::as_bool).unwrap_or(false) {
+    if film_transparent
+        && cycles
+            .get("film_transparent_glass")
+            .and_then(Value::as_bool)
+            .unwrap_or(false)
+    {
         let t = rna_f(cycles, "film_transparent_roughness").unwrap_or(0.1) as f32;
         (t * t) * (t * t)
     } else {
@@ -154,7 +159,11 @@ pub fn render(scene: &Scene, opts: &RenderOptions) -> Result<RenderOutput, Rende
 }
 
 /// `render`, also passing data-path overrides to Geometry Nodes evaluation.
-pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(String, Value)]) -> Result<RenderOutput, RenderError> {
+pub fn render_with_overrides(
+    scene: &Scene,
+    opts: &RenderOptions,
+    overrides: &[(String, Value)],
+) -> Result<RenderOutput, RenderError> {
     let start = Instant::now();
     let s = &scene.file.scene;
     let (cy, r) = (&s.cycles, &s.render);
@@ -164,18 +173,27 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
             let pct = rna_f(r, "resolution_percentage").unwrap_or(100.0);
             let rx = rna_f(r, "resolution_x").unwrap_or(1920.0);
             let ry = rna_f(r, "resolution_y").unwrap_or(1080.0);
-            (((rx * pct / 100.0) as u32).max(1), ((ry * pct / 100.0) as u32).max(1))
+            (
+                ((rx * pct / 100.0) as u32).max(1),
+                ((ry * pct / 100.0) as u32).max(1),
+            )
         }
     };
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
-        return Err(RenderError(format!("resolution {w}x{h}: each side must be 1 to {MAX_SIDE}")));
+        return Err(RenderError(format!(
+            "resolution {w}x{h}: each side must be 1 to {MAX_SIDE}"
+        )));
     }
     let shutter = motion::Shutter::from_render(r).map_err(RenderError)?;
-    let samples = opts.samples.unwrap_or_else(|| rna_f(cy, "samples").unwrap_or(128.0) as u32);
+    let samples = opts
+        .samples
+        .unwrap_or_else(|| rna_f(cy, "samples").unwrap_or(128.0) as u32);
     if samples == 0 {
         return Err(RenderError("samples must be at least 1".into()));
     }
-    let seed = opts.seed.unwrap_or_else(|| rna_f(cy, "seed").unwrap_or(0.0) as u32);
+    let seed = opts
+        .seed
+        .unwrap_or_else(|| rna_f(cy, "seed").unwrap_or(0.0) as u32);
     let frame = opts.frame.unwrap_or(s.frame_current as f64);
     if !frame.is_finite() {
         return Err(RenderError(format!("frame {frame} is not finite")));
@@ -183,14 +201,23 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     // With motion blur Cycles syncs the scene at the shutter's centre (START and END
     // positions move it off the frame), and the camera at the shutter's ends too.
     let centre = frame + shutter.as_ref().map_or(0.0, |s| s.centre_delta);
-    let eval = crate::anim::evaluate_scene(scene, centre).map_err(|e| RenderError(format!("evaluating the scene at frame {centre}: {e}")))?;
+    let eval = crate::anim::evaluate_scene(scene, centre)
+        .map_err(|e| RenderError(format!("evaluating the scene at frame {centre}: {e}")))?;
     let mut camera = camera::Camera::new(scene, &eval, w, h)?;
     // Objects' world matrices at the motion steps (`object_motion::evaluate_steps`).
     let mut object_steps: Vec<Vec<crate::anim::Mat4>> = Vec::new();
     if let Some(sh) = &shutter {
         let mut steps = Vec::new();
         for (k, f) in sh.step_frames(frame).into_iter().enumerate() {
-            let e = if k == 1 { None } else { Some(crate::anim::evaluate_scene(scene, f).map_err(|e| RenderError(format!("evaluating the scene at frame {f} (motion blur): {e}")))?) };
+            let e = if k == 1 {
+                None
+            } else {
+                Some(crate::anim::evaluate_scene(scene, f).map_err(|e| {
+                    RenderError(format!(
+                        "evaluating the scene at frame {f} (motion blur): {e}"
+                    ))
+                })?)
+            };
             let at = e.as_ref().unwrap_or(&eval);
             steps.push(camera::Camera::new(scene, at, w, h)?.to_world);
         }
@@ -210,7 +237,12 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     if displace::apply(&mut geo, &materials) > 0 {
         (geo.tris, geo.refs) = build::world_triangles(&geo.instances);
     }
-    let moving = object_motion::attach(&mut geo, &eval.data.objects, &eval.world_matrices, &object_steps);
+    let moving = object_motion::attach(
+        &mut geo,
+        &eval.data.objects,
+        &eval.world_matrices,
+        &object_steps,
+    );
     let lights = light::collect(&eval)?;
     let background = world::background(scene)?;
     let world_shader = world::shader(scene)?;
@@ -220,10 +252,21 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     }
     // With moving objects the static rest goes in a BVH of its own (`object_motion`).
     let motion_accel = (moving > 0).then(|| object_motion::MotionAccel::build(&geo));
-    let bvh = if motion_accel.is_some() { Bvh::build(&[]) } else { Bvh::build_masked(&geo.tris, &build::triangle_masks(&geo)) };
-    let filter = filter::FilterTable::blackman_harris(rna_f(cy, "filter_width").or_else(|| rna_f(r, "filter_size")).unwrap_or(1.5) as f32);
+    let bvh = if motion_accel.is_some() {
+        Bvh::build(&[])
+    } else {
+        Bvh::build_masked(&geo.tris, &build::triangle_masks(&geo))
+    };
+    let filter = filter::FilterTable::blackman_harris(
+        rna_f(cy, "filter_width")
+            .or_else(|| rna_f(r, "filter_size"))
+            .unwrap_or(1.5) as f32,
+    );
     let gi = |k: &str, d: f64| rna_f(cy, k).unwrap_or(d) as u32;
-    let film_transparent = r.get("film_transparent").and_then(Value::as_bool).unwrap_or(false);
+    let film_transparent = r
+        .get("film_transparent")
+        .and_then(Value::as_bool)
+        .unwrap_or(false);
     let settings = Settings {
         max_bounces: gi("max_bounces", 12.0),
         max_diffuse: gi("diffuse_bounces", 4.0),
@@ -243,13 +286,34 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     };
     let exposure = 1.0f32;
     let build_seconds = start.elapsed().as_secs_f64();
-    let use_light_tree = cy.get("use_light_tree").and_then(Value::as_bool).unwrap_or(true);
-    let light_select = light_select(&geo, &materials, &lights, world_shader.as_ref(), use_light_tree);
+    let use_light_tree = cy
+        .get("use_light_tree")
+        .and_then(Value::as_bool)
+        .unwrap_or(true);
+    let light_select = light_select(
+        &geo,
+        &materials,
+        &lights,
+        world_shader.as_ref(),
+        use_light_tree,
+    );
     let accel: &dyn Accel = match &motion_accel {
         Some(m) => m,
         None => &bvh,
     };
-    let tracer = integrator::Scene { light_select: &light_select, accel, geo: &geo, materials: &materials, lights: &lights, background, world_exclude: world::excluded_rays(scene), tables, settings, world: world_shader.as_ref(), view: camera.view() };
+    let tracer = integrator::Scene {
+        light_select: &light_select,
+        accel,
+        geo: &geo,
+        materials: &materials,
+        lights: &lights,
+        background,
+        world_exclude: world::excluded_rays(scene),
+        tables,
+        settings,
+        world: world_shader.as_ref(),
+        view: camera.view(),
+    };
 
     let adaptive = adaptive::Adaptive::from_scene(cy, samples, opts.threshold);
     let tiles_x = w.div_ceil(TILE);
@@ -258,8 +322,10 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
     let bar = if opts.progress {
         let b = indicatif::ProgressBar::new(samples as u64);
         b.set_style(
-            indicatif::ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} samples  ETA {eta}  {msg}")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            indicatif::ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} samples  ETA {eta}  {msg}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
         Some(b)
     } else {
@@ -274,13 +340,26 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         .map(|t| {
             let tx = (t as u32 % tiles_x) * TILE;
             let ty = (t as u32 / tiles_x) * TILE;
-            TileWork { tx, ty, tw: TILE.min(w - tx), th: TILE.min(h - ty), acc: Vec::new(), passes: TilePasses::default(), rays: 0 }
+            TileWork {
+                tx,
+                ty,
+                tw: TILE.min(w - tx),
+                th: TILE.min(h - ty),
+                acc: Vec::new(),
+                passes: TilePasses::default(),
+                rays: 0,
+            }
         })
         .collect();
     let mut start_sample = 0u32;
     let mut taken = 0u64;
     let pool = match opts.threads {
-        Some(n) => Some(rayon::ThreadPoolBuilder::new().num_threads(n.max(1)).build().map_err(|e| RenderError(format!("thread pool: {e}")))?),
+        Some(n) => Some(
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(n.max(1))
+                .build()
+                .map_err(|e| RenderError(format!("thread pool: {e}")))?,
+        ),
         None => None,
     };
     while start_sample < samples {
@@ -322,12 +401,16 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
                                 let u = rng.get4(i, 0);
                                 let fx = x as f32 + 0.5 + filter.sample(u[0]);
                                 let fy = y as f32 + 0.5 + filter.sample(u[1]);
-                                scratch.time = shutter.as_ref().map_or(object_motion::CENTRE_TIME, |sh| sh.time(rng.get4(i, TIME_SET)[0]));
+                                scratch.time =
+                                    shutter.as_ref().map_or(object_motion::CENTRE_TIME, |sh| {
+                                        sh.time(rng.get4(i, TIME_SET)[0])
+                                    });
                                 let (o, d, t0, t1) = match &shutter {
                                     Some(_) => camera.ray_at(fx, fy, [u[2], u[3]], scratch.time),
                                     None => camera.ray(fx, fy, [u[2], u[3]]),
                                 };
-                                (scratch.ray_dp, scratch.ray_dd) = camera.ray_differentials(fx, fy, [u[2], u[3]]);
+                                (scratch.ray_dp, scratch.ray_dd) =
+                                    camera.ray_differentials(fx, fy, [u[2], u[3]]);
                                 // A panoramic camera's sample outside the lens sees nothing (black, opaque).
                                 let c = if t1 > 0.0 {
                                     tracer.radiance(o, d, t0, t1, &rng, i, scratch)
@@ -338,8 +421,10 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
                                 };
                                 px.add(i, c, scratch.transparent);
                                 let f = &scratch.features;
-                                tile.passes.feature_normal[k - 1] = add(tile.passes.feature_normal[k - 1], f.normal);
-                                tile.passes.feature_albedo[k - 1] = add(tile.passes.feature_albedo[k - 1], f.albedo);
+                                tile.passes.feature_normal[k - 1] =
+                                    add(tile.passes.feature_normal[k - 1], f.normal);
+                                tile.passes.feature_albedo[k - 1] =
+                                    add(tile.passes.feature_albedo[k - 1], f.albedo);
                             }
                         }
                     }
@@ -368,7 +453,9 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
             let secs = render_start.elapsed().as_secs_f64().max(1e-6);
             b.set_message(format!("{:.2} M samples/s", taken as f64 / secs / 1e6));
         }
-        if adaptive.need_filter(end_sample - 1) && film.converge_and_dilate(&adaptive, exposure, w as usize, h as usize) == 0 {
+        if adaptive.need_filter(end_sample - 1)
+            && film.converge_and_dilate(&adaptive, exposure, w as usize, h as usize) == 0
+        {
             break;
         }
     }
@@ -383,7 +470,12 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         // Colour stays premultiplied (the background and holdouts added none); alpha is
         // 1 - transparency, as Cycles' combined pass gives it.
         let alpha = (1.0 - p.transparent / p.count.max(1) as f64).clamp(0.0, 1.0);
-        color[i] = [(p.sum[0] * inv) as f32, (p.sum[1] * inv) as f32, (p.sum[2] * inv) as f32, alpha as f32];
+        color[i] = [
+            (p.sum[0] * inv) as f32,
+            (p.sum[1] * inv) as f32,
+            (p.sum[2] * inv) as f32,
+            alpha as f32,
+        ];
         sample_count[i] = p.count;
     }
     let mut passes = Passes {
@@ -400,7 +492,12 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         instances: geo
             .instances
             .iter()
-            .map(|i| InstanceInfo { object: i.name.clone(), instance_index: i.instance_index, world_bounds: i.world_bounds, world_transform: i.to_world.to_rows() })
+            .map(|i| InstanceInfo {
+                object: i.name.clone(),
+                instance_index: i.instance_index,
+                world_bounds: i.world_bounds,
+                world_transform: i.to_world.to_rows(),
+            })
             .collect(),
     };
     let mut rays = 0;
@@ -431,7 +528,14 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
         height: h,
         color,
         passes,
-        stats: RenderStats { samples, samples_taken: taken, wall_seconds: start.elapsed().as_secs_f64(), rays, triangles: geo.tris.len(), build_seconds },
+        stats: RenderStats {
+            samples,
+            samples_taken: taken,
+            wall_seconds: start.elapsed().as_secs_f64(),
+            rays,
+            triangles: geo.tris.len(),
+            build_seconds,
+        },
     })
 }
 
@@ -441,7 +545,13 @@ pub fn render_with_overrides(scene: &Scene, opts: &RenderOptions, overrides: &[(
 /// scene turns the tree off. Energies are Cycles' estimates (a triangle's area times the
 /// mean of its material's emission estimate), not the emission itself: they set the
 /// selection probabilities, which decide how clamping acts.
-fn light_select(geo: &build::Geometry, materials: &[shade::Material], lights: &[light::Light], world: Option<&world::WorldShader>, use_tree: bool) -> LightSelect {
+fn light_select(
+    geo: &build::Geometry,
+    materials: &[shade::Material],
+    lights: &[light::Light],
+    world: Option<&world::WorldShader>,
+    use_tree: bool,
+) -> LightSelect {
     use light_tree::{Cone, Emitter, Measure, Pick, Shape};
     use std::f32::consts::{FRAC_PI_2, PI};
     let mut local = Vec::new();
@@ -454,42 +564,130 @@ fn light_select(geo: &build::Geometry, materials: &[shade::Material], lights: &[
         let pick = Some(Pick::Lamp(li as u32));
         flat_lights.push(Pick::Lamp(li as u32));
         match &l.shape {
-            light::Shape::Point { radius, spot, sphere } => {
+            light::Shape::Point {
+                radius,
+                spot,
+                sphere,
+            } => {
                 let r = [*radius; 3];
                 let (cone, spot_smooth) = match spot {
-                    None => (Cone { axis: l.dir, theta_o: PI, theta_e: FRAC_PI_2 }, None),
+                    None => (
+                        Cone {
+                            axis: l.dir,
+                            theta_o: PI,
+                            theta_e: FRAC_PI_2,
+                        },
+                        None,
+                    ),
                     Some(s) => {
                         // Cycles widens the cone by the light's scale (its axes).
                         let (lu, lv, lw) = (len(s.u), len(s.v), len(s.w));
-                        let stretch = if lu > 0.0 && lv > 0.0 { lw / lu.min(lv) } else { 1.0 };
+                        let stretch = if lu > 0.0 && lv > 0.0 {
+                            lw / lu.min(lv)
+                        } else {
+                            1.0
+                        };
                         let half = s.cos_half.clamp(-1.0, 1.0).acos();
-                        (Cone { axis: l.dir, theta_o: 0.0, theta_e: (half.tan() * stretch).atan() }, Some(s.smooth))
+                        (
+                            Cone {
+                                axis: l.dir,
+                                theta_o: 0.0,
+                                theta_e: (half.tan() * stretch).atan(),
+                            },
+                            Some(s.smooth),
+                        )
                     }
                 };
                 let measure = Measure::new(&[sub(l.pos, r), add(l.pos, r)], cone, l.tree_energy);
-                local.push(Emitter { pick, shape: Shape::Point { pos: l.pos, radius: *radius, sphere: *sphere, spot_smooth }, centroid: l.pos, measure });
+                local.push(Emitter {
+                    pick,
+                    shape: Shape::Point {
+                        pos: l.pos,
+                        radius: *radius,
+                        sphere: *sphere,
+                        spot_smooth,
+                    },
+                    centroid: l.pos,
+                    measure,
+                });
             }
             light::Shape::Area { u, v, .. } => {
                 let (hu, hv) = (scale(*u, 0.5), scale(*v, 0.5));
-                let corners = [add(add(l.pos, hu), hv), sub(add(l.pos, hu), hv), add(sub(l.pos, hu), hv), sub(sub(l.pos, hu), hv)];
-                let measure = Measure::new(&corners, Cone { axis: l.dir, theta_o: 0.0, theta_e: 0.5 * l.spread }, l.tree_energy);
-                local.push(Emitter { pick, shape: Shape::Area { pos: l.pos, eu: *u, ev: *v }, centroid: l.pos, measure });
+                let corners = [
+                    add(add(l.pos, hu), hv),
+                    sub(add(l.pos, hu), hv),
+                    add(sub(l.pos, hu), hv),
+                    sub(sub(l.pos, hu), hv),
+                ];
+                let measure = Measure::new(
+                    &corners,
+                    Cone {
+                        axis: l.dir,
+                        theta_o: 0.0,
+                        theta_e: 0.5 * l.spread,
+                    },
+                    l.tree_energy,
+                );
+                local.push(Emitter {
+                    pick,
+                    shape: Shape::Area {
+                        pos: l.pos,
+                        eu: *u,
+                        ev: *v,
+                    },
+                    centroid: l.pos,
+                    measure,
+                });
             }
             light::Shape::Sun { half_angle } => {
-                let measure = Measure::new(&[], Cone { axis: l.dir, theta_o: 0.0, theta_e: *half_angle }, l.tree_energy);
-                distant.push(Emitter { pick, shape: Shape::Distant, centroid: l.dir, measure });
+                let measure = Measure::new(
+                    &[],
+                    Cone {
+                        axis: l.dir,
+                        theta_o: 0.0,
+                        theta_e: *half_angle,
+                    },
+                    l.tree_energy,
+                );
+                distant.push(Emitter {
+                    pick,
+                    shape: Shape::Distant,
+                    centroid: l.dir,
+                    measure,
+                });
             }
         }
     }
     if let Some((w, map)) = world.and_then(|w| w.map.as_ref().map(|m| (w, m))) {
         let energy = (average(w.program.emission_estimate) * map.average_radiance * PI).abs();
         if energy > 0.0 && energy.is_finite() {
-            let measure = Measure::new(&[], Cone { axis: [0.0, 0.0, 1.0], theta_o: PI, theta_e: 0.0 }, energy);
-            distant.push(Emitter { pick: Some(Pick::World), shape: Shape::World, centroid: [0.0; 3], measure });
+            let measure = Measure::new(
+                &[],
+                Cone {
+                    axis: [0.0, 0.0, 1.0],
+                    theta_o: PI,
+                    theta_e: 0.0,
+                },
+                energy,
+            );
+            distant.push(Emitter {
+                pick: Some(Pick::World),
+                shape: Shape::World,
+                centroid: [0.0; 3],
+                measure,
+            });
             flat_lights.push(Pick::World);
         }
     }
-    let sampled: Vec<Option<f32>> = materials.iter().map(|m| m.program.as_ref().filter(|p| light_sampled(p, &m.sampling)).map(|p| average(p.emission_estimate))).collect();
+    let sampled: Vec<Option<f32>> = materials
+        .iter()
+        .map(|m| {
+            m.program
+                .as_ref()
+                .filter(|p| light_sampled(p, &m.sampling))
+                .map(|p| average(p.emission_estimate))
+        })
+        .collect();
     let mut meshes: Vec<Vec<Emitter>> = Vec::new();
     let mut flat_tris = Vec::new();
     let mut last_inst = u32::MAX;
@@ -500,8 +698,12 @@ fn light_select(geo: &build::Geometry, materials: &[shade::Material], lights: &[
         if inst.motion.is_some() {
             continue;
         }
-        let Some(mi) = inst.material_of(r.tri as usize) else { continue };
-        let Some(estimate) = sampled[mi] else { continue };
+        let Some(mi) = inst.material_of(r.tri as usize) else {
+            continue;
+        };
+        let Some(estimate) = sampled[mi] else {
+            continue;
+        };
         let v = geo.tris[prim];
         let n = cross(sub(v[1], v[0]), sub(v[2], v[0]));
         let area = 0.5 * len(n);
@@ -509,12 +711,29 @@ fn light_select(geo: &build::Geometry, materials: &[shade::Material], lights: &[
             continue;
         }
         let cone = match materials[mi].sampling.as_str() {
-            "FRONT" => Cone { axis: normalize(n), theta_o: 0.0, theta_e: FRAC_PI_2 },
-            "BACK" => Cone { axis: neg(normalize(n)), theta_o: 0.0, theta_e: FRAC_PI_2 },
-            _ => Cone { axis: normalize(sub(v[0], v[1])), theta_o: FRAC_PI_2, theta_e: FRAC_PI_2 },
+            "FRONT" => Cone {
+                axis: normalize(n),
+                theta_o: 0.0,
+                theta_e: FRAC_PI_2,
+            },
+            "BACK" => Cone {
+                axis: neg(normalize(n)),
+                theta_o: 0.0,
+                theta_e: FRAC_PI_2,
+            },
+            _ => Cone {
+                axis: normalize(sub(v[0], v[1])),
+                theta_o: FRAC_PI_2,
+                theta_e: FRAC_PI_2,
+            },
         };
         let centroid = scale(add(add(v[0], v[1]), v[2]), 1.0 / 3.0);
-        let e = Emitter { pick: Some(light_tree::Pick::Triangle(prim as u32)), shape: Shape::Triangle { v }, centroid, measure: Measure::new(&v, cone, area * estimate) };
+        let e = Emitter {
+            pick: Some(light_tree::Pick::Triangle(prim as u32)),
+            shape: Shape::Triangle { v },
+            centroid,
+            measure: Measure::new(&v, cone, area * estimate),
+        };
         // One subtree per object (an instance's triangles are consecutive).
         if r.inst != last_inst || meshes.is_empty() {
             meshes.push(Vec::new());
@@ -577,11 +796,25 @@ struct TilePasses {
 /// Label passes from the primary ray through the pixel centre (exact ids, unfiltered), at
 /// the shutter's centre: with motion blur the labels show moving objects where the scene
 /// was synced (the frame for a centred shutter), sharp, not blurred as in the image.
-fn primary_passes(tracer: &integrator::Scene, camera: &camera::Camera, x: u32, y: u32, scratch: &mut Scratch, out: &mut TilePasses) {
+fn primary_passes(
+    tracer: &integrator::Scene,
+    camera: &camera::Camera,
+    x: u32,
+    y: u32,
+    scratch: &mut Scratch,
+    out: &mut TilePasses,
+) {
     out.feature_normal.push([0.0; 3]);
     out.feature_albedo.push([0.0; 3]);
     let (o, d, t0, t1) = camera.ray(x as f32 + 0.5, y as f32 + 0.5, [0.5, 0.5]);
-    match tracer.accel.intersect_vis(o, d, t0, t1, object_motion::CENTRE_TIME, accel::visibility::of_path(crate::shader::point::ray::CAMERA)) {
+    match tracer.accel.intersect_vis(
+        o,
+        d,
+        t0,
+        t1,
+        object_motion::CENTRE_TIME,
+        accel::visibility::of_path(crate::shader::point::ray::CAMERA),
+    ) {
         Some(h) => {
             let wo = neg(d);
             let hit = tracer.surface(h.prim, h.u, h.v, wo);
@@ -591,7 +824,8 @@ fn primary_passes(tracer: &integrator::Scene, camera: &camera::Camera, x: u32, y
             out.distance.push(camera.distance(hit.p));
             out.object_index.push(inst.object as u32 + 1);
             out.instance_id.push(hit.inst + 1);
-            out.material_index.push(hit.material.map(|m| m as u32 + 1).unwrap_or(0));
+            out.material_index
+                .push(hit.material.map(|m| m as u32 + 1).unwrap_or(0));
             out.normal.push(hit.sp.normal);
             out.uv.push([hit.sp.uv[0], hit.sp.uv[1]]);
         }
@@ -608,16 +842,31 @@ fn primary_passes(tracer: &integrator::Scene, camera: &camera::Camera, x: u32, y
 }
 
 /// Writes linear RGBA to a float EXR atomically (temp file + rename).
-pub fn write_exr(path: &std::path::Path, width: u32, height: u32, pixels: &[[f32; 4]]) -> Result<(), RenderError> {
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(std::path::Path::new("."));
+pub fn write_exr(
+    path: &std::path::Path,
+    width: u32,
+    height: u32,
+    pixels: &[[f32; 4]],
+) -> Result<(), RenderError> {
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
     let mut buf = Vec::with_capacity(pixels.len() * 4);
     for p in pixels {
         buf.extend_from_slice(p);
     }
-    let img = image::Rgba32FImage::from_raw(width, height, buf).ok_or_else(|| RenderError("image buffer size mismatch".into()))?;
-    let tmp = tempfile::Builder::new().suffix(".exr").tempfile_in(dir).map_err(|e| RenderError(format!("{}: {e}", dir.display())))?;
-    image::DynamicImage::ImageRgba32F(img).save_with_format(tmp.path(), image::ImageFormat::OpenExr).map_err(|e| RenderError(format!("{}: {e}", path.display())))?;
-    tmp.persist(path).map_err(|e| RenderError(format!("{}: {e}", path.display())))?;
+    let img = image::Rgba32FImage::from_raw(width, height, buf)
+        .ok_or_else(|| RenderError("image buffer size mismatch".into()))?;
+    let tmp = tempfile::Builder::new()
+        .suffix(".exr")
+        .tempfile_in(dir)
+        .map_err(|e| RenderError(format!("{}: {e}", dir.display())))?;
+    image::DynamicImage::ImageRgba32F(img)
+        .save_with_format(tmp.path(), image::ImageFormat::OpenExr)
+        .map_err(|e| RenderError(format!("{}: {e}", path.display())))?;
+    tmp.persist(path)
+        .map_err(|e| RenderError(format!("{}: {e}", path.display())))?;
     Ok(())
 }
 

@@ -32,26 +32,45 @@ impl Shutter {
         if r.get("use_motion_blur").and_then(Value::as_bool) != Some(true) {
             return Ok(None);
         }
-        let length = r.get("motion_blur_shutter").and_then(Value::as_f64).unwrap_or(0.5);
+        let length = r
+            .get("motion_blur_shutter")
+            .and_then(Value::as_f64)
+            .unwrap_or(0.5);
         if length.is_nan() || length <= 0.0 {
             return Ok(None);
         }
-        let centre_delta = match r.get("motion_blur_position").and_then(Value::as_str).unwrap_or("CENTER") {
+        let centre_delta = match r
+            .get("motion_blur_position")
+            .and_then(Value::as_str)
+            .unwrap_or("CENTER")
+        {
             "START" => 0.5 * length,
             "END" => -0.5 * length,
             "CENTER" => 0.0,
-            other => return Err(format!("render.motion_blur_position {other:?} is not START, CENTER or END")),
+            other => {
+                return Err(format!(
+                    "render.motion_blur_position {other:?} is not START, CENTER or END"
+                ))
+            }
         };
         let curve = match r.get("motion_blur_shutter_curve") {
             Some(v) if !v.is_null() => {
-                let m = mapping_from_json(v).map_err(|e| format!("render.motion_blur_shutter_curve: {}", e.0))?;
-                let t = CurveTable::new(&m, CurveKind::Float).map_err(|e| format!("render.motion_blur_shutter_curve: {}", e.0))?;
+                let m = mapping_from_json(v)
+                    .map_err(|e| format!("render.motion_blur_shutter_curve: {}", e.0))?;
+                let t = CurveTable::new(&m, CurveKind::Float)
+                    .map_err(|e| format!("render.motion_blur_shutter_curve: {}", e.0))?;
                 // Blender hands Cycles the curve sampled at TABLE evenly spaced points.
-                (0..TABLE).map(|i| t.eval1(1.0, i as f32 / (TABLE - 1) as f32)).collect()
+                (0..TABLE)
+                    .map(|i| t.eval1(1.0, i as f32 / (TABLE - 1) as f32))
+                    .collect()
             }
             _ => vec![1.0; TABLE],
         };
-        Ok(Some(Shutter { length, centre_delta, table: inverted_cdf(&curve) }))
+        Ok(Some(Shutter {
+            length,
+            centre_delta,
+            table: inverted_cdf(&curve),
+        }))
     }
 
     /// The relative times (-1, 0, 1) of the camera's motion steps as frames.
@@ -105,7 +124,11 @@ fn inverted_cdf(curve: &[f32]) -> Vec<f32> {
             let x = (i as f32 + 0.5) * inv_res;
             // Last entry <= x (upper_bound - 1).
             let idx = cdf.partition_point(|&c| c <= x).saturating_sub(1);
-            let (idx, t) = if idx < cdf.len() - 1 { (idx, (x - cdf[idx]) / (cdf[idx + 1] - cdf[idx])) } else { (TABLE, 0.0) };
+            let (idx, t) = if idx < cdf.len() - 1 {
+                (idx, (x - cdf[idx]) / (cdf[idx + 1] - cdf[idx]))
+            } else {
+                (TABLE, 0.0)
+            };
             (idx as f32 + t) * inv_res
         })
         .collect()
@@ -127,26 +150,57 @@ fn quat_from(m: &Affine) -> [f32; 4] {
     let trace = r(0, 0) + r(1, 1) + r(2, 2);
     let q = if trace > 0.0 {
         let s = (trace + 1.0).sqrt() * 2.0;
-        [(r(2, 1) - r(1, 2)) / s, (r(0, 2) - r(2, 0)) / s, (r(1, 0) - r(0, 1)) / s, 0.25 * s]
+        [
+            (r(2, 1) - r(1, 2)) / s,
+            (r(0, 2) - r(2, 0)) / s,
+            (r(1, 0) - r(0, 1)) / s,
+            0.25 * s,
+        ]
     } else if r(0, 0) > r(1, 1) && r(0, 0) > r(2, 2) {
         let s = (1.0 + r(0, 0) - r(1, 1) - r(2, 2)).sqrt() * 2.0;
-        [0.25 * s, (r(0, 1) + r(1, 0)) / s, (r(0, 2) + r(2, 0)) / s, (r(2, 1) - r(1, 2)) / s]
+        [
+            0.25 * s,
+            (r(0, 1) + r(1, 0)) / s,
+            (r(0, 2) + r(2, 0)) / s,
+            (r(2, 1) - r(1, 2)) / s,
+        ]
     } else if r(1, 1) > r(2, 2) {
         let s = (1.0 + r(1, 1) - r(0, 0) - r(2, 2)).sqrt() * 2.0;
-        [(r(0, 1) + r(1, 0)) / s, 0.25 * s, (r(1, 2) + r(2, 1)) / s, (r(0, 2) - r(2, 0)) / s]
+        [
+            (r(0, 1) + r(1, 0)) / s,
+            0.25 * s,
+            (r(1, 2) + r(2, 1)) / s,
+            (r(0, 2) - r(2, 0)) / s,
+        ]
     } else {
         let s = (1.0 + r(2, 2) - r(0, 0) - r(1, 1)).sqrt() * 2.0;
-        [(r(0, 2) + r(2, 0)) / s, (r(1, 2) + r(2, 1)) / s, 0.25 * s, (r(1, 0) - r(0, 1)) / s]
+        [
+            (r(0, 2) + r(2, 0)) / s,
+            (r(1, 2) + r(2, 1)) / s,
+            0.25 * s,
+            (r(1, 0) - r(0, 1)) / s,
+        ]
     };
     let n = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
-    [(q[0] / n) as f32, (q[1] / n) as f32, (q[2] / n) as f32, (q[3] / n) as f32]
+    [
+        (q[0] / n) as f32,
+        (q[1] / n) as f32,
+        (q[2] / n) as f32,
+        (q[3] / n) as f32,
+    ]
 }
 
 /// Cycles' transform_decompose: scale and shear by Gram-Schmidt on the columns, a
 /// negative determinant folded into the scale, the orthonormal rest as a quaternion.
 fn decompose_one(m: &Affine) -> Decomposed {
     let col = |i: usize| [m.m[0][i], m.m[1][i], m.m[2][i]];
-    let div = |v: V3, d: f32| if d != 0.0 { scale(v, 1.0 / d) } else { [0.0; 3] };
+    let div = |v: V3, d: f32| {
+        if d != 0.0 {
+            scale(v, 1.0 / d)
+        } else {
+            [0.0; 3]
+        }
+    };
     let (mut cx, mut cy, mut cz) = (col(0), col(1), col(2));
     let sx = len(cx);
     cx = div(cx, sx);
@@ -160,7 +214,9 @@ fn decompose_one(m: &Affine) -> Decomposed {
     cz = sub(cz, scale(cy, shx));
     let sz = len(cz);
     cz = div(cz, sz);
-    let mut r = Affine { m: std::array::from_fn(|i| [cx[i], cy[i], cz[i], 0.0]) };
+    let mut r = Affine {
+        m: std::array::from_fn(|i| [cx[i], cy[i], cz[i], 0.0]),
+    };
     let mut sc = [sx, sy, sz];
     if dot(cross(cx, cy), cz) < 0.0 {
         sc = sc.map(|v| -v);
@@ -170,7 +226,11 @@ fn decompose_one(m: &Affine) -> Decomposed {
             }
         }
     }
-    Decomposed { q: quat_from(&r), t: m.column(3), s: [sc[0], shz, shy, sc[1], shx, sc[2]] }
+    Decomposed {
+        q: quat_from(&r),
+        t: m.column(3),
+        s: [sc[0], shz, shy, sc[1], shx, sc[2]],
+    }
 }
 
 /// Decomposes the motion steps, flipping quaternions onto one hemisphere so slerp takes
@@ -181,7 +241,8 @@ pub fn decompose(steps: &[Affine]) -> Vec<Decomposed> {
     for m in steps {
         let mut d = decompose_one(m);
         if let Some(prev) = out.last() {
-            let c = d.q[0] * prev.q[0] + d.q[1] * prev.q[1] + d.q[2] * prev.q[2] + d.q[3] * prev.q[3];
+            let c =
+                d.q[0] * prev.q[0] + d.q[1] * prev.q[1] + d.q[2] * prev.q[2] + d.q[3] * prev.q[3];
             if c < 0.0 {
                 d.q = d.q.map(|c| -c);
             }
@@ -219,12 +280,34 @@ fn quat_interpolate(a: [f32; 4], b: [f32; 4], t: f32) -> [f32; 4] {
 fn compose(q: [f32; 4], t: V3, s: &[f32; 6]) -> Affine {
     let [x, y, z, w] = q;
     let r = [
-        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)],
-        [2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)],
-        [2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)],
+        [
+            1.0 - 2.0 * (y * y + z * z),
+            2.0 * (x * y - z * w),
+            2.0 * (x * z + y * w),
+        ],
+        [
+            2.0 * (x * y + z * w),
+            1.0 - 2.0 * (x * x + z * z),
+            2.0 * (y * z - x * w),
+        ],
+        [
+            2.0 * (x * z - y * w),
+            2.0 * (y * z + x * w),
+            1.0 - 2.0 * (x * x + y * y),
+        ],
     ];
     let sm = [[s[0], s[1], s[2]], [0.0, s[3], s[4]], [0.0, 0.0, s[5]]];
-    Affine { m: std::array::from_fn(|i| [0, 1, 2, 3].map(|j| if j == 3 { t[i] } else { r[i][0] * sm[0][j] + r[i][1] * sm[1][j] + r[i][2] * sm[2][j] })) }
+    Affine {
+        m: std::array::from_fn(|i| {
+            [0, 1, 2, 3].map(|j| {
+                if j == 3 {
+                    t[i]
+                } else {
+                    r[i][0] * sm[0][j] + r[i][1] * sm[1][j] + r[i][2] * sm[2][j]
+                }
+            })
+        }),
+    }
 }
 
 /// The transform at `time` in [0, 1] across the motion steps.
@@ -235,7 +318,11 @@ pub fn interpolate(steps: &[Decomposed], time: f32) -> Affine {
     let t = x - i as f32;
     let (a, b) = (&steps[i], &steps[i + 1]);
     let lerp = |x: f32, y: f32| (1.0 - t) * x + t * y;
-    compose(quat_interpolate(a.q, b.q, t), std::array::from_fn(|k| lerp(a.t[k], b.t[k])), &std::array::from_fn(|k| lerp(a.s[k], b.s[k])))
+    compose(
+        quat_interpolate(a.q, b.q, t),
+        std::array::from_fn(|k| lerp(a.t[k], b.t[k])),
+        &std::array::from_fn(|k| lerp(a.s[k], b.s[k])),
+    )
 }
 
 impl Decomposed {
@@ -248,7 +335,11 @@ impl Decomposed {
     /// two steps the reach stays below the larger of theirs.
     pub fn reach(&self, c: V3, r: f32) -> f32 {
         let s = &self.s;
-        let sc = [s[0] * c[0] + s[1] * c[1] + s[2] * c[2], s[3] * c[1] + s[4] * c[2], s[5] * c[2]];
+        let sc = [
+            s[0] * c[0] + s[1] * c[1] + s[2] * c[2],
+            s[3] * c[1] + s[4] * c[2],
+            s[5] * c[2],
+        ];
         let frobenius = s.iter().map(|v| v * v).sum::<f32>().sqrt();
         len(sc) + r * frobenius
     }
@@ -269,14 +360,25 @@ mod tests {
 
     #[test]
     fn interpolation_hits_the_steps_and_the_half_angle() {
-        let rz = |a: f32| Affine { m: [[a.cos(), -a.sin(), 0.0, a], [a.sin(), a.cos(), 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]] };
+        let rz = |a: f32| Affine {
+            m: [
+                [a.cos(), -a.sin(), 0.0, a],
+                [a.sin(), a.cos(), 0.0, 0.0],
+                [0.0, 0.0, 1.0, 0.0],
+            ],
+        };
         let steps = decompose(&[rz(0.0), rz(0.4), rz(0.8)]);
         for (time, a) in [(0.0, 0.0f32), (0.25, 0.2), (0.5, 0.4), (1.0, 0.8)] {
             let m = interpolate(&steps, time);
             let want = rz(a);
             for r in 0..3 {
                 for c in 0..4 {
-                    assert!((m.m[r][c] - want.m[r][c]).abs() < 1e-5, "time {time}: {:?} vs {:?}", m.m, want.m);
+                    assert!(
+                        (m.m[r][c] - want.m[r][c]).abs() < 1e-5,
+                        "time {time}: {:?} vs {:?}",
+                        m.m,
+                        want.m
+                    );
                 }
             }
         }
@@ -289,13 +391,31 @@ mod tests {
         // the shear, so a mirrored sheared transform does not survive there either.)
         let (c, s) = (0.6f32.cos(), 0.6f32.sin());
         let rot = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];
-        for sm in [[[2.0, 0.3, -0.2], [0.0, 0.5, 0.1], [0.0, 0.0, 1.5]], [[2.0, 0.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.0, -1.5]]] {
-            let m = Affine { m: std::array::from_fn(|i| [0, 1, 2, 3].map(|j| if j == 3 { [1.0, -2.0, 3.0][i] } else { (0..3).map(|k| rot[i][k] * sm[k][j]).sum() })) };
+        for sm in [
+            [[2.0, 0.3, -0.2], [0.0, 0.5, 0.1], [0.0, 0.0, 1.5]],
+            [[2.0, 0.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.0, -1.5]],
+        ] {
+            let m = Affine {
+                m: std::array::from_fn(|i| {
+                    [0, 1, 2, 3].map(|j| {
+                        if j == 3 {
+                            [1.0, -2.0, 3.0][i]
+                        } else {
+                            (0..3).map(|k| rot[i][k] * sm[k][j]).sum()
+                        }
+                    })
+                }),
+            };
             let steps = decompose(&[m, m]);
             let back = interpolate(&steps, 0.3);
             for r in 0..3 {
                 for c in 0..4 {
-                    assert!((back.m[r][c] - m.m[r][c]).abs() < 1e-5, "{:?} vs {:?}", back.m, m.m);
+                    assert!(
+                        (back.m[r][c] - m.m[r][c]).abs() < 1e-5,
+                        "{:?} vs {:?}",
+                        back.m,
+                        m.m
+                    );
                 }
             }
         }
@@ -304,7 +424,13 @@ mod tests {
     #[test]
     fn scale_interpolates_linearly() {
         // Cycles interpolates the scale matrix linearly between steps.
-        let sx = |k: f32| Affine { m: [[k, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]] };
+        let sx = |k: f32| Affine {
+            m: [
+                [k, 0.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0, 0.0],
+                [0.0, 0.0, 1.0, 0.0],
+            ],
+        };
         let steps = decompose(&[sx(1.0), sx(2.0), sx(4.0)]);
         for (time, want) in [(0.25, 1.5f32), (0.5, 2.0), (0.75, 3.0)] {
             assert!((interpolate(&steps, time).m[0][0] - want).abs() < 1e-6);

@@ -61,7 +61,8 @@ impl MeshInstance {
             return *synced;
         }
         let m = &self.mesh;
-        m.triangles[tri as usize].map(|c| to_world.point(m.positions[m.corner_verts[c as usize] as usize]))
+        m.triangles[tri as usize]
+            .map(|c| to_world.point(m.positions[m.corner_verts[c as usize] as usize]))
     }
 }
 
@@ -69,7 +70,9 @@ fn affine_mul(a: &Affine, b: &Affine) -> Affine {
     let mut o = Affine { m: [[0.0; 4]; 3] };
     for r in 0..3 {
         for c in 0..4 {
-            let mut v = a.m[r][0] as f64 * b.m[0][c] as f64 + a.m[r][1] as f64 * b.m[1][c] as f64 + a.m[r][2] as f64 * b.m[2][c] as f64;
+            let mut v = a.m[r][0] as f64 * b.m[0][c] as f64
+                + a.m[r][1] as f64 * b.m[1][c] as f64
+                + a.m[r][2] as f64 * b.m[2][c] as f64;
             if c == 3 {
                 v += a.m[r][3] as f64;
             }
@@ -87,7 +90,10 @@ pub fn step_count(obj: &crate::scene::Object) -> usize {
     if get("use_motion_blur").and_then(serde_json::Value::as_bool) == Some(false) {
         return 0;
     }
-    let steps = get("motion_steps").and_then(serde_json::Value::as_i64).unwrap_or(1).clamp(1, 7);
+    let steps = get("motion_steps")
+        .and_then(serde_json::Value::as_i64)
+        .unwrap_or(1)
+        .clamp(1, 7);
     ((2usize << (steps - 1)) + 1).min(MAX_MOTION_STEPS)
 }
 
@@ -98,8 +104,19 @@ const MAX_MOTION_STEPS: usize = 129;
 /// them, spread evenly over the shutter in time order (the synced centre among them),
 /// as Cycles syncs motion: frame = centre + relative time x shutter / 2. Empty when no
 /// rendered mesh object blurs.
-pub fn evaluate_steps(scene: &crate::scene::Scene, centre: &crate::anim::EvaluatedScene, shutter: &super::motion::Shutter) -> Result<Vec<Vec<Mat4>>, super::RenderError> {
-    let n = centre.data.objects.iter().filter(|o| o.kind == "MESH" && !o.hide_render).map(step_count).max().unwrap_or(0);
+pub fn evaluate_steps(
+    scene: &crate::scene::Scene,
+    centre: &crate::anim::EvaluatedScene,
+    shutter: &super::motion::Shutter,
+) -> Result<Vec<Vec<Mat4>>, super::RenderError> {
+    let n = centre
+        .data
+        .objects
+        .iter()
+        .filter(|o| o.kind == "MESH" && !o.hide_render)
+        .map(step_count)
+        .max()
+        .unwrap_or(0);
     if n < 3 {
         return Ok(Vec::new());
     }
@@ -110,7 +127,13 @@ pub fn evaluate_steps(scene: &crate::scene::Scene, centre: &crate::anim::Evaluat
                 return Ok(centre.world_matrices.clone());
             }
             let f = centre.frame + rel * 0.5 * shutter.length;
-            crate::anim::evaluate_scene(scene, f).map(|e| e.world_matrices).map_err(|e| super::RenderError(format!("evaluating the scene at frame {f} (motion blur): {e}")))
+            crate::anim::evaluate_scene(scene, f)
+                .map(|e| e.world_matrices)
+                .map_err(|e| {
+                    super::RenderError(format!(
+                        "evaluating the scene at frame {f} (motion blur): {e}"
+                    ))
+                })
         })
         .collect()
 }
@@ -120,14 +143,21 @@ pub fn evaluate_steps(scene: &crate::scene::Scene, centre: &crate::anim::Evaluat
 /// `centre` those the geometry was built with; `objects` the objects' settings. Returns
 /// how many instances move. Cycles keeps an object's motion only when some step
 /// differs from the centre.
-pub fn attach(geo: &mut Geometry, objects: &[crate::scene::Object], centre: &[Mat4], all_steps: &[Vec<Mat4>]) -> usize {
+pub fn attach(
+    geo: &mut Geometry,
+    objects: &[crate::scene::Object],
+    centre: &[Mat4],
+    all_steps: &[Vec<Mat4>],
+) -> usize {
     if all_steps.len() < 3 {
         return 0;
     }
     let mut moving = 0;
     for inst in geo.instances.iter_mut() {
         let oi = inst.object;
-        let Some(count) = objects.get(oi).map(step_count).filter(|&c| c >= 3) else { continue };
+        let Some(count) = objects.get(oi).map(step_count).filter(|&c| c >= 3) else {
+            continue;
+        };
         // This object's steps are every stride-th of the finest set.
         let stride = (all_steps.len() - 1) / (count - 1);
         let steps: Vec<&Vec<Mat4>> = all_steps.iter().step_by(stride.max(1)).collect();
@@ -154,7 +184,9 @@ pub fn attach(geo: &mut Geometry, objects: &[crate::scene::Object], centre: &[Ma
             // A singular step cannot take rays into object space; render it sharp.
             continue;
         }
-        inst.motion = Some(Arc::new(ObjectMotion { steps: decompose(&at_steps) }));
+        inst.motion = Some(Arc::new(ObjectMotion {
+            steps: decompose(&at_steps),
+        }));
         moving += 1;
     }
     moving
@@ -185,7 +217,11 @@ impl MotionAccel {
         let mut fixed_tris = Vec::new();
         let mut fixed_prims = Vec::new();
         let mut fixed_masks = Vec::new();
-        let mut per_inst: Vec<(Vec<[V3; 3]>, Vec<u32>)> = geo.instances.iter().map(|_| (Vec::new(), Vec::new())).collect();
+        let mut per_inst: Vec<(Vec<[V3; 3]>, Vec<u32>)> = geo
+            .instances
+            .iter()
+            .map(|_| (Vec::new(), Vec::new()))
+            .collect();
         for (prim, r) in geo.refs.iter().enumerate() {
             let inst = &geo.instances[r.inst as usize];
             if inst.motion.is_none() {
@@ -194,7 +230,8 @@ impl MotionAccel {
                 fixed_masks.push(inst.visibility);
             } else {
                 let m = &inst.mesh;
-                let tri = m.triangles[r.tri as usize].map(|c| m.positions[m.corner_verts[c as usize] as usize]);
+                let tri = m.triangles[r.tri as usize]
+                    .map(|c| m.positions[m.corner_verts[c as usize] as usize]);
                 per_inst[r.inst as usize].0.push(tri);
                 per_inst[r.inst as usize].1.push(prim as u32);
             }
@@ -213,9 +250,20 @@ impl MotionAccel {
                 }
             }
             let (lo, hi) = reach_bounds(&motion.steps, olo, ohi);
-            movers.push(Mover { bvh: Bvh::build(&tris), prims, motion: motion.clone(), lo, hi, mask: inst.visibility });
+            movers.push(Mover {
+                bvh: Bvh::build(&tris),
+                prims,
+                motion: motion.clone(),
+                lo,
+                hi,
+                mask: inst.visibility,
+            });
         }
-        MotionAccel { fixed: Bvh::build_masked(&fixed_tris, &fixed_masks), fixed_prims, movers }
+        MotionAccel {
+            fixed: Bvh::build_masked(&fixed_tris, &fixed_masks),
+            fixed_prims,
+            movers,
+        }
     }
 
     /// Moving instances (for the render summary and tests).
@@ -255,8 +303,22 @@ fn meets_box(lo: V3, hi: V3, org: V3, dir: V3, tmin: f32, tmax: f32) -> bool {
 
 impl MotionAccel {
     #[inline]
-    fn trace<const ANY: bool>(&self, org: V3, dir: V3, tmin: f32, tmax: f32, time: f32, mask: u32) -> Option<Hit> {
-        let mut best = self.fixed.intersect_or_occluded::<ANY>(org, dir, tmin, tmax, mask).map(|h| Hit { prim: self.fixed_prims[h.prim as usize], ..h });
+    fn trace<const ANY: bool>(
+        &self,
+        org: V3,
+        dir: V3,
+        tmin: f32,
+        tmax: f32,
+        time: f32,
+        mask: u32,
+    ) -> Option<Hit> {
+        let mut best = self
+            .fixed
+            .intersect_or_occluded::<ANY>(org, dir, tmin, tmax, mask)
+            .map(|h| Hit {
+                prim: self.fixed_prims[h.prim as usize],
+                ..h
+            });
         if ANY && best.is_some() {
             return best;
         }
@@ -268,10 +330,18 @@ impl MotionAccel {
             if !meets_box(mv.lo, mv.hi, org, dir, tmin, tfar) {
                 continue;
             }
-            let Some(to_object) = mv.motion.at(time).inverse() else { continue };
+            let Some(to_object) = mv.motion.at(time).inverse() else {
+                continue;
+            };
             let (o, d) = (to_object.point(org), to_object.vector(dir));
-            if let Some(h) = mv.bvh.intersect_or_occluded::<ANY>(o, d, tmin, tfar, visibility::ALL) {
-                best = Some(Hit { prim: mv.prims[h.prim as usize], ..h });
+            if let Some(h) = mv
+                .bvh
+                .intersect_or_occluded::<ANY>(o, d, tmin, tfar, visibility::ALL)
+            {
+                best = Some(Hit {
+                    prim: mv.prims[h.prim as usize],
+                    ..h
+                });
                 if ANY {
                     return best;
                 }
@@ -286,19 +356,30 @@ impl Accel for MotionAccel {
         self.trace::<false>(org, dir, tmin, tmax, CENTRE_TIME, visibility::ALL)
     }
     fn occluded(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> bool {
-        self.trace::<true>(org, dir, tmin, tmax, CENTRE_TIME, visibility::ALL).is_some()
+        self.trace::<true>(org, dir, tmin, tmax, CENTRE_TIME, visibility::ALL)
+            .is_some()
     }
     fn intersect_at(&self, org: V3, dir: V3, tmin: f32, tmax: f32, time: f32) -> Option<Hit> {
         self.trace::<false>(org, dir, tmin, tmax, time, visibility::ALL)
     }
     fn occluded_at(&self, org: V3, dir: V3, tmin: f32, tmax: f32, time: f32) -> bool {
-        self.trace::<true>(org, dir, tmin, tmax, time, visibility::ALL).is_some()
+        self.trace::<true>(org, dir, tmin, tmax, time, visibility::ALL)
+            .is_some()
     }
-    fn intersect_vis(&self, org: V3, dir: V3, tmin: f32, tmax: f32, time: f32, mask: u32) -> Option<Hit> {
+    fn intersect_vis(
+        &self,
+        org: V3,
+        dir: V3,
+        tmin: f32,
+        tmax: f32,
+        time: f32,
+        mask: u32,
+    ) -> Option<Hit> {
         self.trace::<false>(org, dir, tmin, tmax, time, mask)
     }
     fn occluded_vis(&self, org: V3, dir: V3, tmin: f32, tmax: f32, time: f32, mask: u32) -> bool {
-        self.trace::<true>(org, dir, tmin, tmax, time, mask).is_some()
+        self.trace::<true>(org, dir, tmin, tmax, time, mask)
+            .is_some()
     }
 }
 
@@ -306,8 +387,22 @@ impl Accel for MotionAccel {
 /// motion blur is on and a rendered object's mesh comes from Geometry Nodes (whose
 /// output can change over time) with Cycles' deformation blur on.
 pub fn warn_deformation(eval: &crate::anim::EvaluatedScene) {
-    let deform = |o: &crate::scene::Object| o.cycles.as_ref().and_then(|c| c.get("use_deform_motion")).and_then(serde_json::Value::as_bool) != Some(false);
-    let generated = eval.data.objects.iter().any(|o| o.kind == "MESH" && !o.hide_render && step_count(o) > 0 && deform(o) && o.modifiers.iter().any(|m| m.kind == "NODES" && m.show_render));
+    let deform = |o: &crate::scene::Object| {
+        o.cycles
+            .as_ref()
+            .and_then(|c| c.get("use_deform_motion"))
+            .and_then(serde_json::Value::as_bool)
+            != Some(false)
+    };
+    let generated = eval.data.objects.iter().any(|o| {
+        o.kind == "MESH"
+            && !o.hide_render
+            && step_count(o) > 0
+            && deform(o)
+            && o.modifiers
+                .iter()
+                .any(|m| m.kind == "NODES" && m.show_render)
+    });
     if generated {
         static WARN: std::sync::Once = std::sync::Once::new();
         WARN.call_once(|| eprintln!("warning: motion blur: objects are blurred by their transforms only; deformation motion blur (a mesh that changes within the shutter) is not rendered, meshes are taken at the shutter's centre"));
@@ -320,9 +415,30 @@ mod tests {
 
     #[test]
     fn box_test_sees_through_the_bound() {
-        assert!(meets_box([-1.0; 3], [1.0; 3], [0.0, 0.0, -5.0], [0.0, 0.0, 1.0], 0.0, f32::INFINITY));
-        assert!(!meets_box([-1.0; 3], [1.0; 3], [2.0, 0.0, -5.0], [0.0, 0.0, 1.0], 0.0, f32::INFINITY));
-        assert!(!meets_box([-1.0; 3], [1.0; 3], [0.0, 0.0, -5.0], [0.0, 0.0, 1.0], 0.0, 3.0));
+        assert!(meets_box(
+            [-1.0; 3],
+            [1.0; 3],
+            [0.0, 0.0, -5.0],
+            [0.0, 0.0, 1.0],
+            0.0,
+            f32::INFINITY
+        ));
+        assert!(!meets_box(
+            [-1.0; 3],
+            [1.0; 3],
+            [2.0, 0.0, -5.0],
+            [0.0, 0.0, 1.0],
+            0.0,
+            f32::INFINITY
+        ));
+        assert!(!meets_box(
+            [-1.0; 3],
+            [1.0; 3],
+            [0.0, 0.0, -5.0],
+            [0.0, 0.0, 1.0],
+            0.0,
+            3.0
+        ));
     }
 
     #[test]
@@ -331,16 +447,30 @@ mod tests {
         // many times between the steps stay inside the bound.
         let step = |a: f32, k: f32, t: V3| {
             let (c, s) = (a.cos(), a.sin());
-            Affine { m: [[c * k, -s, 0.0, t[0]], [s * k, c, 0.0, t[1]], [0.0, 0.0, 1.0 + 0.5 * k, t[2]]] }
+            Affine {
+                m: [
+                    [c * k, -s, 0.0, t[0]],
+                    [s * k, c, 0.0, t[1]],
+                    [0.0, 0.0, 1.0 + 0.5 * k, t[2]],
+                ],
+            }
         };
-        let steps = decompose(&[step(0.0, 1.0, [0.0; 3]), step(1.6, 2.0, [1.0, 0.5, 0.0]), step(3.1, 0.5, [3.0, -1.0, 2.0])]);
+        let steps = decompose(&[
+            step(0.0, 1.0, [0.0; 3]),
+            step(1.6, 2.0, [1.0, 0.5, 0.0]),
+            step(3.1, 0.5, [3.0, -1.0, 2.0]),
+        ]);
         let (olo, ohi) = ([1.0, 2.0, -0.5], [2.0, 3.0, 0.5]);
         let (lo, hi) = reach_bounds(&steps, olo, ohi);
         for i in 0..=200 {
             let m = interpolate(&steps, i as f32 / 200.0);
             for k in 0..8 {
                 let p = m.point([0, 1, 2].map(|a| if k >> a & 1 == 1 { ohi[a] } else { olo[a] }));
-                assert!((0..3).all(|a| p[a] >= lo[a] && p[a] <= hi[a]), "time {}: {p:?} outside {lo:?}..{hi:?}", i as f32 / 200.0);
+                assert!(
+                    (0..3).all(|a| p[a] >= lo[a] && p[a] <= hi[a]),
+                    "time {}: {p:?} outside {lo:?}..{hi:?}",
+                    i as f32 / 200.0
+                );
             }
         }
     }

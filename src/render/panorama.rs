@@ -14,9 +14,20 @@ pub enum Panorama {
     Equirectangular([f32; 4]),
     EquiangularCubemapFace,
     MirrorBall,
-    FisheyeEquidistant { fov: f32 },
-    FisheyeEquisolid { lens: f32, fov: f32, sensor: [f32; 2] },
-    FisheyeLensPolynomial { k0: f32, k: [f32; 4], fov: f32, sensor: [f32; 2] },
+    FisheyeEquidistant {
+        fov: f32,
+    },
+    FisheyeEquisolid {
+        lens: f32,
+        fov: f32,
+        sensor: [f32; 2],
+    },
+    FisheyeLensPolynomial {
+        k0: f32,
+        k: [f32; 4],
+        fov: f32,
+        sensor: [f32; 2],
+    },
     /// (-u_min, -u_max, v_min / radius, v_max / radius).
     CentralCylindrical([f32; 4]),
 }
@@ -28,8 +39,15 @@ fn num(p: &Map<String, Value>, key: &str, default: f64) -> f32 {
 impl Panorama {
     /// The camera data's panorama settings; `fit` is the render's (xratio, yratio) with
     /// pixel aspect, for the sensor size the equisolid and polynomial fisheyes use.
-    pub fn from_camera(p: &Map<String, Value>, xratio: f32, yratio: f32) -> Result<Panorama, String> {
-        let kind = p.get("panorama_type").and_then(Value::as_str).unwrap_or("FISHEYE_EQUISOLID");
+    pub fn from_camera(
+        p: &Map<String, Value>,
+        xratio: f32,
+        yratio: f32,
+    ) -> Result<Panorama, String> {
+        let kind = p
+            .get("panorama_type")
+            .and_then(Value::as_str)
+            .unwrap_or("FISHEYE_EQUISOLID");
         // Blender's sensor fit decides which side the sensor size spans (blender_camera_sync).
         let sensor = || {
             let (horizontal, size) = super::camera::sensor_fit(p, xratio, yratio);
@@ -42,17 +60,37 @@ impl Panorama {
         let fov = num(p, "fisheye_fov", std::f64::consts::PI);
         Ok(match kind {
             "EQUIRECTANGULAR" => {
-                let (lo_min, lo_max) = (num(p, "longitude_min", -std::f64::consts::PI), num(p, "longitude_max", std::f64::consts::PI));
-                let (la_min, la_max) = (num(p, "latitude_min", -std::f64::consts::FRAC_PI_2), num(p, "latitude_max", std::f64::consts::FRAC_PI_2));
-                Panorama::Equirectangular([lo_min - lo_max, -lo_min, la_min - la_max, -la_min + std::f32::consts::FRAC_PI_2])
+                let (lo_min, lo_max) = (
+                    num(p, "longitude_min", -std::f64::consts::PI),
+                    num(p, "longitude_max", std::f64::consts::PI),
+                );
+                let (la_min, la_max) = (
+                    num(p, "latitude_min", -std::f64::consts::FRAC_PI_2),
+                    num(p, "latitude_max", std::f64::consts::FRAC_PI_2),
+                );
+                Panorama::Equirectangular([
+                    lo_min - lo_max,
+                    -lo_min,
+                    la_min - la_max,
+                    -la_min + std::f32::consts::FRAC_PI_2,
+                ])
             }
             "EQUIANGULAR_CUBEMAP_FACE" => Panorama::EquiangularCubemapFace,
             "MIRRORBALL" => Panorama::MirrorBall,
             "FISHEYE_EQUIDISTANT" => Panorama::FisheyeEquidistant { fov },
-            "FISHEYE_EQUISOLID" => Panorama::FisheyeEquisolid { lens: num(p, "fisheye_lens", 10.5), fov, sensor: sensor() },
+            "FISHEYE_EQUISOLID" => Panorama::FisheyeEquisolid {
+                lens: num(p, "fisheye_lens", 10.5),
+                fov,
+                sensor: sensor(),
+            },
             "FISHEYE_LENS_POLYNOMIAL" => Panorama::FisheyeLensPolynomial {
                 k0: num(p, "fisheye_polynomial_k0", 0.0),
-                k: [num(p, "fisheye_polynomial_k1", 0.0), num(p, "fisheye_polynomial_k2", 0.0), num(p, "fisheye_polynomial_k3", 0.0), num(p, "fisheye_polynomial_k4", 0.0)],
+                k: [
+                    num(p, "fisheye_polynomial_k1", 0.0),
+                    num(p, "fisheye_polynomial_k2", 0.0),
+                    num(p, "fisheye_polynomial_k3", 0.0),
+                    num(p, "fisheye_polynomial_k4", 0.0),
+                ],
                 fov,
                 sensor: sensor(),
             },
@@ -141,12 +179,20 @@ impl Panorama {
 
 /// Cycles' fisheye_to_direction: polar angle `theta` from +X, azimuth from (u, v).
 fn fisheye(theta: f32, u: f32, v: f32, r: f32) -> V3 {
-    let c = if r != 0.0 { (u / r).clamp(-1.0, 1.0) } else { 0.0 };
+    let c = if r != 0.0 {
+        (u / r).clamp(-1.0, 1.0)
+    } else {
+        0.0
+    };
     let mut phi = c.acos();
     if v < 0.0 {
         phi = -phi;
     }
-    [theta.cos(), -phi.cos() * theta.sin(), phi.sin() * theta.sin()]
+    [
+        theta.cos(),
+        -phi.cos() * theta.sin(),
+        phi.sin() * theta.sin(),
+    ]
 }
 
 #[cfg(test)]
@@ -156,15 +202,27 @@ mod tests {
     #[test]
     fn centre_looks_down_the_view_axis() {
         let kinds = [
-            Panorama::Equirectangular([-2.0 * std::f32::consts::PI, std::f32::consts::PI, -std::f32::consts::PI, std::f32::consts::PI]),
+            Panorama::Equirectangular([
+                -2.0 * std::f32::consts::PI,
+                std::f32::consts::PI,
+                -std::f32::consts::PI,
+                std::f32::consts::PI,
+            ]),
             Panorama::EquiangularCubemapFace,
             Panorama::MirrorBall,
             Panorama::FisheyeEquidistant { fov: 3.0 },
-            Panorama::FisheyeEquisolid { lens: 10.5, fov: 3.0, sensor: [36.0, 24.0] },
+            Panorama::FisheyeEquisolid {
+                lens: 10.5,
+                fov: 3.0,
+                sensor: [36.0, 24.0],
+            },
         ];
         for k in kinds {
             let d = k.to_blender_camera(k.direction(0.5, 0.5));
-            assert!((d[2] + 1.0).abs() < 1e-5 && d[0].abs() < 1e-5 && d[1].abs() < 1e-5, "{k:?}: {d:?}");
+            assert!(
+                (d[2] + 1.0).abs() < 1e-5 && d[0].abs() < 1e-5 && d[1].abs() < 1e-5,
+                "{k:?}: {d:?}"
+            );
         }
     }
 }

@@ -12,7 +12,8 @@ const fn directions() -> [[u32; 32]; 4] {
         k += 1;
     }
     // (degree s, coefficients a, initial m) for dimensions 2..4.
-    let params: [(usize, u32, [u32; 3]); 3] = [(1, 0, [1, 0, 0]), (2, 1, [1, 3, 0]), (3, 1, [1, 3, 1])];
+    let params: [(usize, u32, [u32; 3]); 3] =
+        [(1, 0, [1, 0, 0]), (2, 1, [1, 3, 0]), (3, 1, [1, 3, 1])];
     let mut d = 0;
     while d < 3 {
         let (s, a, m) = params[d];
@@ -73,7 +74,10 @@ static SOBOL_BYTES: [[[u32; 256]; 4]; 4] = byte_tables();
 #[inline]
 fn sobol(index: u32, dim: usize) -> u32 {
     let t = &SOBOL_BYTES[dim];
-    t[0][(index & 255) as usize] ^ t[1][((index >> 8) & 255) as usize] ^ t[2][((index >> 16) & 255) as usize] ^ t[3][(index >> 24) as usize]
+    t[0][(index & 255) as usize]
+        ^ t[1][((index >> 8) & 255) as usize]
+        ^ t[2][((index >> 16) & 255) as usize]
+        ^ t[3][(index >> 24) as usize]
 }
 
 #[inline]
@@ -89,7 +93,13 @@ pub fn hash_u32(mut x: u32) -> u32 {
 
 #[inline]
 pub fn hash_combine(a: u32, b: u32) -> u32 {
-    hash_u32(a ^ b.wrapping_mul(0x9e3779b9).wrapping_add(0x632be5ab).wrapping_add(a << 6).wrapping_add(a >> 2))
+    hash_u32(
+        a ^ b
+            .wrapping_mul(0x9e3779b9)
+            .wrapping_add(0x632be5ab)
+            .wrapping_add(a << 6)
+            .wrapping_add(a >> 2),
+    )
 }
 
 #[inline]
@@ -121,7 +131,9 @@ pub struct PixelSampler {
 
 impl PixelSampler {
     pub fn new(x: u32, y: u32, seed: u32) -> PixelSampler {
-        PixelSampler { seed: hash_combine(hash_combine(hash_u32(x), y), seed) }
+        PixelSampler {
+            seed: hash_combine(hash_combine(hash_u32(x), y), seed),
+        }
     }
 
     /// Four dimensions of sample `index` from dimension set `set` (each set is its own
@@ -132,7 +144,10 @@ impl PixelSampler {
         let i = nested_uniform_scramble(index, s);
         let mut out = [0.0; 4];
         for (d, o) in out.iter_mut().enumerate() {
-            *o = to_unit(nested_uniform_scramble(sobol(i, d), hash_combine(s, d as u32 + 1)));
+            *o = to_unit(nested_uniform_scramble(
+                sobol(i, d),
+                hash_combine(s, d as u32 + 1),
+            ));
         }
         out
     }
@@ -150,7 +165,9 @@ mod tests {
         for _ in 0..10_000 {
             x = hash_u32(x);
             for (d, dir) in dirs.iter().enumerate() {
-                let want = (0..32).filter(|b| (x >> b) & 1 == 1).fold(0u32, |r, b| r ^ dir[b]);
+                let want = (0..32)
+                    .filter(|b| (x >> b) & 1 == 1)
+                    .fold(0u32, |r, b| r ^ dir[b]);
                 assert_eq!(sobol(x, d), want);
             }
         }

@@ -8,8 +8,8 @@ use crate::shader::{compile_material, ShadingPoint};
 
 use super::bsdf::{Fresnel, LobeKind, LobeSet};
 use super::math::*;
-use super::tables::Tables;
 use super::subsurface::Method;
+use super::tables::Tables;
 use super::RenderError;
 
 pub struct Material {
@@ -39,7 +39,16 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
     let mut out = Vec::new();
     for (i, m) in scene.file.materials.iter().enumerate() {
         if !used.get(i).copied().unwrap_or(false) {
-            out.push(Material { program: None, bsdf_of: Vec::new(), name: m.name.clone(), sampling: String::new(), bump_correction: true, bssrdf_bump: false, transparent_shadow: false, multiscatter_glass: false });
+            out.push(Material {
+                program: None,
+                bsdf_of: Vec::new(),
+                name: m.name.clone(),
+                sampling: String::new(),
+                bump_correction: true,
+                bssrdf_bump: false,
+                transparent_shadow: false,
+                multiscatter_glass: false,
+            });
             continue;
         }
         let p = compile_material(scene, &m.name).map_err(|e| RenderError(format!("{e}")))?;
@@ -49,12 +58,32 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
                 *slot = Some(bi as u32);
             }
         }
-        let sampling = m.properties.get("cycles").and_then(|c| c.get("emission_sampling")).and_then(|v| v.as_str()).unwrap_or("AUTO").to_string();
-        let bump_correction = m.properties.get("cycles").and_then(|c| c.get("use_bump_map_correction")).and_then(|v| v.as_bool()).unwrap_or(true);
+        let sampling = m
+            .properties
+            .get("cycles")
+            .and_then(|c| c.get("emission_sampling"))
+            .and_then(|v| v.as_str())
+            .unwrap_or("AUTO")
+            .to_string();
+        let bump_correction = m
+            .properties
+            .get("cycles")
+            .and_then(|c| c.get("use_bump_map_correction"))
+            .and_then(|v| v.as_bool())
+            .unwrap_or(true);
         let bssrdf_bump = has_bssrdf_bump(&p);
         let transparent_shadow = can_be_transparent(&p);
         let multiscatter_glass = has_multiscatter_glass(&p);
-        out.push(Material { program: Some(p), bsdf_of, name: m.name.clone(), sampling, bump_correction, bssrdf_bump, transparent_shadow, multiscatter_glass });
+        out.push(Material {
+            program: Some(p),
+            bsdf_of,
+            name: m.name.clone(),
+            sampling,
+            bump_correction,
+            bssrdf_bump,
+            transparent_shadow,
+            multiscatter_glass,
+        });
     }
     Ok(out)
 }
@@ -63,13 +92,30 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
 /// tangents: the renderer's displacement points (`displace`) do not carry them.
 pub fn displacement_reads_attributes(p: &Program) -> bool {
     use crate::shader::program::Op;
-    let Some(d) = p.displacement else { return false };
-    p.ops[..d.center_end.min(p.ops.len())].iter().any(|op| matches!(op, Op::Attribute { .. } | Op::ColorAttribute { .. } | Op::NamedUv { .. } | Op::NormalMapTangent { .. } | Op::VectorDisplacementTangent { .. } | Op::TangentUv { .. }))
+    let Some(d) = p.displacement else {
+        return false;
+    };
+    p.ops[..d.center_end.min(p.ops.len())].iter().any(|op| {
+        matches!(
+            op,
+            Op::Attribute { .. }
+                | Op::ColorAttribute { .. }
+                | Op::NamedUv { .. }
+                | Op::NormalMapTangent { .. }
+                | Op::VectorDisplacementTangent { .. }
+                | Op::TangentUv { .. }
+        )
+    })
 }
 
 /// Whether BSDF node `b`'s input `name` is linked, or unlinked with a constant for which
 /// `constant` holds (false when the node has no such input).
-fn linked_or_constant(p: &Program, b: &crate::shader::program::BsdfNode, name: &str, constant: impl Fn(f32) -> bool) -> bool {
+fn linked_or_constant(
+    p: &Program,
+    b: &crate::shader::program::BsdfNode,
+    name: &str,
+    constant: impl Fn(f32) -> bool,
+) -> bool {
     match b.input(name) {
         Some((_, true)) => true,
         Some((slot, false)) => p.initial.get(slot as usize).is_some_and(|v| constant(*v)),
@@ -92,7 +138,9 @@ fn is_multiggx(b: &BsdfNode) -> bool {
 fn has_multiscatter_glass(p: &Program) -> bool {
     p.bsdfs.iter().any(|b| match b.bl_idname.as_str() {
         "ShaderNodeBsdfGlass" => is_multiggx(b),
-        "ShaderNodeBsdfPrincipled" => is_multiggx(b) && linked_or_constant(p, b, "Transmission Weight", |w| w > 0.0),
+        "ShaderNodeBsdfPrincipled" => {
+            is_multiggx(b) && linked_or_constant(p, b, "Transmission Weight", |w| w > 0.0)
+        }
         _ => false,
     })
 }
@@ -115,7 +163,9 @@ fn has_bssrdf_bump(p: &Program) -> bool {
         || p.bsdfs.iter().any(|b| {
             let bssrdf = match b.bl_idname.as_str() {
                 "ShaderNodeSubsurfaceScattering" => true,
-                "ShaderNodeBsdfPrincipled" => linked_or_constant(p, b, "Subsurface Weight", |w| w > 1e-5),
+                "ShaderNodeBsdfPrincipled" => {
+                    linked_or_constant(p, b, "Subsurface Weight", |w| w > 1e-5)
+                }
                 _ => false,
             };
             bssrdf && matches!(b.input("Normal"), Some((_, true)))
@@ -174,12 +224,18 @@ impl Material {
             stack.extend_from_slice(&p.initial);
         }
         p.run(sp, stack);
-        let ctx = &Context { bump_correction: self.bump_correction, ..*ctx };
+        let ctx = &Context {
+            bump_correction: self.bump_correction,
+            ..*ctx
+        };
         // The material's displacement, bumped, is the shading normal of every closure.
         let bumped;
         let sp = match p.displaced_normal {
             Some(slot) => {
-                bumped = ShadingPoint { normal: v3(stack, slot), ..*sp };
+                bumped = ShadingPoint {
+                    normal: v3(stack, slot),
+                    ..*sp
+                };
                 &bumped
             }
             None => sp,
@@ -192,7 +248,16 @@ impl Material {
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn closure(&self, p: &Program, c: u32, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet) {
+    fn closure(
+        &self,
+        p: &Program,
+        c: u32,
+        w: f32,
+        s: &[f32],
+        sp: &ShadingPoint,
+        ctx: &Context,
+        out: &mut LobeSet,
+    ) {
         match p.closures[c as usize] {
             Closure::Emission { color, strength } => {
                 let e = scale(v3(s, color), finite_or(s[strength as usize], 0.0) * w);
@@ -229,10 +294,14 @@ impl Material {
 }
 
 fn input_f(b: &BsdfNode, s: &[f32], id: &str, d: f32) -> f32 {
-    b.input(id).map(|(slot, _)| finite_or(s[slot as usize], d)).unwrap_or(d)
+    b.input(id)
+        .map(|(slot, _)| finite_or(s[slot as usize], d))
+        .unwrap_or(d)
 }
 fn input_c(b: &BsdfNode, s: &[f32], id: &str, d: V3) -> V3 {
-    b.input(id).map(|(slot, _)| finite3(v3(s, slot))).unwrap_or(d)
+    b.input(id)
+        .map(|(slot, _)| finite3(v3(s, slot)))
+        .unwrap_or(d)
 }
 fn input_n(b: &BsdfNode, s: &[f32], id: &str, sp: &ShadingPoint) -> V3 {
     match b.input(id) {
@@ -268,7 +337,11 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
         }
         "ShaderNodeBsdfTranslucent" => {
             let c = input_c(b, s, "Color", [0.8; 3]);
-            out.push(LobeKind::Translucent, scale(c, w), valid_n(sp, ctx, input_n(b, s, "Normal", sp)));
+            out.push(
+                LobeKind::Translucent,
+                scale(c, w),
+                valid_n(sp, ctx, input_n(b, s, "Normal", sp)),
+            );
         }
         "ShaderNodeBsdfTransparent" => {
             let c = input_c(b, s, "Color", [1.0; 3]);
@@ -282,7 +355,10 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             let r = input_f(b, s, "Roughness", 0.5).clamp(0.0, 1.0);
             let n = valid_n(sp, ctx, input_n(b, s, "Normal", sp));
             if b.property("distribution") == Some("BECKMANN") {
-                let r = super::microfacet::Reflection { dist: super::microfacet::Distribution::Beckmann, alpha: r * r };
+                let r = super::microfacet::Reflection {
+                    dist: super::microfacet::Distribution::Beckmann,
+                    alpha: r * r,
+                };
                 out.push(LobeKind::Reflection(r), scale(c, w), n);
                 return;
             }
@@ -292,11 +368,34 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             if aniso.abs() > 1e-4 {
                 let (ax, ay) = super::anisotropic::glossy_alphas(r, aniso);
                 let t = tangent_input(b, s, sp, "Tangent", input_f(b, s, "Rotation", 0.0), n);
-                push_glossy(out, ctx, ax, ay, t, Fresnel::Constant, multi, scale(c, w), n, 1.0);
+                push_glossy(
+                    out,
+                    ctx,
+                    ax,
+                    ay,
+                    t,
+                    Fresnel::Constant,
+                    multi,
+                    scale(c, w),
+                    n,
+                    1.0,
+                );
                 return;
             }
-            let energy = if multi { multiscatter_energy(ctx.tables, mu, r) } else { 1.0 };
-            out.push(LobeKind::Glossy { alpha: r * r, fresnel: Fresnel::Constant, energy }, scale(c, w), n);
+            let energy = if multi {
+                multiscatter_energy(ctx.tables, mu, r)
+            } else {
+                1.0
+            };
+            out.push(
+                LobeKind::Glossy {
+                    alpha: r * r,
+                    fresnel: Fresnel::Constant,
+                    energy,
+                },
+                scale(c, w),
+                n,
+            );
         }
         "ShaderNodeBsdfPrincipled" => principled(b, w, s, sp, ctx, out),
         "ShaderNodeBsdfGlass" | "ShaderNodeBsdfRefraction" => {
@@ -305,17 +404,38 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             let r = input_f(b, s, "Roughness", 0.0);
             let n = valid_n(sp, ctx, input_n(b, s, "Normal", sp));
             let refract_only = b.bl_idname == "ShaderNodeBsdfRefraction";
-            let g = super::microfacet::glass_closure(ctx.tables, b.property("distribution"), refract_only, r, ior, ctx.backfacing, dot(n, ctx.wo));
+            let g = super::microfacet::glass_closure(
+                ctx.tables,
+                b.property("distribution"),
+                refract_only,
+                r,
+                ior,
+                ctx.backfacing,
+                dot(n, ctx.wo),
+            );
             out.push(LobeKind::Glass(g), scale(c, w), n);
         }
         "ShaderNodeSubsurfaceScattering" => {
             let c = input_c(b, s, "Color", [0.8; 3]);
-            let radius = scale(input_c(b, s, "Radius", [1.0, 0.2, 0.1]), input_f(b, s, "Scale", 0.05));
+            let radius = scale(
+                input_c(b, s, "Radius", [1.0, 0.2, 0.1]),
+                input_f(b, s, "Scale", 0.05),
+            );
             let method = Method::from_property(b.property("falloff"));
             let ior = input_f(b, s, "IOR", 1.4);
             let r = input_f(b, s, "Roughness", 1.0);
             let aniso = input_f(b, s, "Anisotropy", 0.0);
-            push_bssrdf(out, scale(c, w), radius, c, aniso, ior, r, method, valid_n(sp, ctx, input_n(b, s, "Normal", sp)));
+            push_bssrdf(
+                out,
+                scale(c, w),
+                radius,
+                c,
+                aniso,
+                ior,
+                r,
+                method,
+                valid_n(sp, ctx, input_n(b, s, "Normal", sp)),
+            );
         }
         "ShaderNodeBsdfSheen" => {
             let c = input_c(b, s, "Color", [0.8; 3]);
@@ -331,7 +451,14 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
     }
 }
 
-fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet) {
+fn principled(
+    b: &BsdfNode,
+    w: f32,
+    s: &[f32],
+    sp: &ShadingPoint,
+    ctx: &Context,
+    out: &mut LobeSet,
+) {
     let base = input_c(b, s, "Base Color", [0.8; 3]).map(|x| x.max(0.0));
     let metallic = input_f(b, s, "Metallic", 0.0).clamp(0.0, 1.0);
     let roughness = input_f(b, s, "Roughness", 0.5).clamp(0.0, 1.0);
@@ -357,11 +484,27 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
     // metallic, specular and transmission lobes for energy lost between microfacets; GGX
     // does not (Cycles' is_multiggx).
     let multi = is_multiggx(b);
-    let energy = if multi { multiscatter_energy(ctx.tables, mu, roughness) } else { 1.0 };
+    let energy = if multi {
+        multiscatter_energy(ctx.tables, mu, roughness)
+    } else {
+        1.0
+    };
     let a = roughness * roughness;
     // Anisotropic metallic and specular layers (alphas stretched along the tangent).
-    let (ax, ay) = super::anisotropic::principled_alphas(roughness, input_f(b, s, "Anisotropic", 0.0));
-    let tangent = if ax != ay { tangent_input(b, s, sp, "Tangent", input_f(b, s, "Anisotropic Rotation", 0.0), n) } else { [0.0; 3] };
+    let (ax, ay) =
+        super::anisotropic::principled_alphas(roughness, input_f(b, s, "Anisotropic", 0.0));
+    let tangent = if ax != ay {
+        tangent_input(
+            b,
+            s,
+            sp,
+            "Tangent",
+            input_f(b, s, "Anisotropic Rotation", 0.0),
+            n,
+        )
+    } else {
+        [0.0; 3]
+    };
     let coat = input_f(b, s, "Coat Weight", 0.0).clamp(0.0, 1.0);
     // Thin film (4.2+): on the dielectric specular layer and the transmission; Cycles 4.5
     // leaves the metallic layer without it.
@@ -384,24 +527,61 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         let avg_f0 = (clamped[0] + clamped[1] + clamped[2]) / 3.0;
         let albedo = (avg_f0 + (1.0 - avg_f0) / 21.0).clamp(0.0, 1.0);
         if ax != ay {
-            push_glossy(out, ctx, ax, ay, tangent, Fresnel::F82 { f0: clamped, b: bb }, multi, scale(weight, metallic), vn, albedo.max(1e-3));
+            push_glossy(
+                out,
+                ctx,
+                ax,
+                ay,
+                tangent,
+                Fresnel::F82 { f0: clamped, b: bb },
+                multi,
+                scale(weight, metallic),
+                vn,
+                albedo.max(1e-3),
+            );
         } else {
-            out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::F82 { f0: clamped, b: bb }, energy }, scale(weight, metallic), vn, albedo.max(1e-3));
+            out.push_scaled(
+                LobeKind::Glossy {
+                    alpha: a,
+                    fresnel: Fresnel::F82 { f0: clamped, b: bb },
+                    energy,
+                },
+                scale(weight, metallic),
+                vn,
+                albedo.max(1e-3),
+            );
         }
         weight = scale(weight, 1.0 - metallic);
     }
     if transmission > 0.0 {
         // Rough glass: reflection tinted by the specular tint, refraction by sqrt of the base
         // colour (light crosses the surface twice), as Cycles' Principled sets it up.
-        let mut g = super::microfacet::glass_closure(ctx.tables, Some(if multi { "MULTI_GGX" } else { "GGX" }), false, roughness, ior, ctx.backfacing, mu);
+        let mut g = super::microfacet::glass_closure(
+            ctx.tables,
+            Some(if multi { "MULTI_GGX" } else { "GGX" }),
+            false,
+            roughness,
+            ior,
+            ctx.backfacing,
+            mu,
+        );
         g.tint_r = spec_tint;
         g.tint_t = clamped.map(f32::sqrt);
         if film {
             // Cycles' film IOR is relative to the side the light comes from: film / ior
             // seen from inside. The specular tint scales the film's reflectance instead.
             let f0 = super::bsdf::f0_from_ior(ior);
-            let film_eta = if ctx.backfacing { film_ior / ior } else { film_ior };
-            g.film = Some(super::thin_film::ThinFilm { thickness: film_thickness, ior: film_eta, eta: g.eta, f0_scale: spec_tint.map(|t| (f0 * t).min(1.0) / f0) });
+            let film_eta = if ctx.backfacing {
+                film_ior / ior
+            } else {
+                film_ior
+            };
+            g.film = Some(super::thin_film::ThinFilm {
+                thickness: film_thickness,
+                ior: film_eta,
+                eta: g.eta,
+                f0_scale: spec_tint.map(|t| (f0 * t).min(1.0) / f0),
+            });
             g.tint_r = [1.0; 3];
         }
         out.push(LobeKind::Glass(g), scale(weight, transmission), vn);
@@ -418,15 +598,54 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
         }
     }
     if film && max3(weight) > 0.0 {
-        principled_film_specular(ctx, out, &mut weight, ior, eta, spec_level, spec_tint, (film_thickness, film_ior), (a, ax, ay, tangent, energy, multi), vn, mu);
+        principled_film_specular(
+            ctx,
+            out,
+            &mut weight,
+            ior,
+            eta,
+            spec_level,
+            spec_tint,
+            (film_thickness, film_ior),
+            (a, ax, ay, tangent, energy, multi),
+            vn,
+            mu,
+        );
     } else if spec_level > 0.0 && max3(weight) > 0.0 {
         // Anisotropic: the albedo tables at Cycles' equivalent roughness (alpha_x alpha_y)^(1/4).
-        let table_roughness = if ax != ay { (ax * ay).sqrt().sqrt() } else { roughness };
-        let e = ctx.tables.dielectric_fresnel_avg(mu, table_roughness, eta).clamp(0.0, 1.0);
-        if ax != ay {
-            push_glossy(out, ctx, ax, ay, tangent, Fresnel::Dielectric { eta }, multi, mul(weight, spec_tint), vn, e.max(1e-3));
+        let table_roughness = if ax != ay {
+            (ax * ay).sqrt().sqrt()
         } else {
-            out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::Dielectric { eta }, energy }, mul(weight, spec_tint), vn, e.max(1e-3));
+            roughness
+        };
+        let e = ctx
+            .tables
+            .dielectric_fresnel_avg(mu, table_roughness, eta)
+            .clamp(0.0, 1.0);
+        if ax != ay {
+            push_glossy(
+                out,
+                ctx,
+                ax,
+                ay,
+                tangent,
+                Fresnel::Dielectric { eta },
+                multi,
+                mul(weight, spec_tint),
+                vn,
+                e.max(1e-3),
+            );
+        } else {
+            out.push_scaled(
+                LobeKind::Glossy {
+                    alpha: a,
+                    fresnel: Fresnel::Dielectric { eta },
+                    energy,
+                },
+                mul(weight, spec_tint),
+                vn,
+                e.max(1e-3),
+            );
         }
         // Attenuate the layers below by the specular layer's albedo.
         let albedo = scale(spec_tint, e);
@@ -434,12 +653,29 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
     }
     let ss = input_f(b, s, "Subsurface Weight", 0.0).clamp(0.0, 1.0);
     if ss > 0.0 {
-        let radius = scale(input_c(b, s, "Subsurface Radius", [1.0, 0.2, 0.1]), input_f(b, s, "Subsurface Scale", 0.05));
+        let radius = scale(
+            input_c(b, s, "Subsurface Radius", [1.0, 0.2, 0.1]),
+            input_f(b, s, "Subsurface Scale", 0.05),
+        );
         let method = Method::from_property(b.property("subsurface_method"));
         // Random Walk (Skin) has its own IOR input; the other methods use the BSDF's.
-        let ss_ior = if method == Method::RandomWalkSkin { input_f(b, s, "Subsurface IOR", 1.4) } else { ior };
+        let ss_ior = if method == Method::RandomWalkSkin {
+            input_f(b, s, "Subsurface IOR", 1.4)
+        } else {
+            ior
+        };
         let aniso = input_f(b, s, "Subsurface Anisotropy", 0.0);
-        push_bssrdf(out, scale(mul(weight, clamped), ss), radius, clamped, aniso, ss_ior, roughness, method, vn);
+        push_bssrdf(
+            out,
+            scale(mul(weight, clamped), ss),
+            radius,
+            clamped,
+            aniso,
+            ss_ior,
+            roughness,
+            method,
+            vn,
+        );
         weight = scale(weight, 1.0 - ss);
     }
     let diffuse_roughness = input_f(b, s, "Diffuse Roughness", 0.0);
@@ -457,17 +693,58 @@ fn principled(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context,
 /// below, by the film's reflectance toward the viewer (no table fits iridescence), and
 /// keeps the film-free multiple-scattering compensation.
 #[allow(clippy::too_many_arguments)]
-fn principled_film_specular(ctx: &Context, out: &mut LobeSet, weight: &mut V3, ior: f32, eta: f32, spec_level: f32, spec_tint: V3, (thickness, film_ior): (f32, f32), (a, ax, ay, tangent, energy, multi): (f32, f32, f32, V3, f32, bool), vn: V3, mu: f32) {
+fn principled_film_specular(
+    ctx: &Context,
+    out: &mut LobeSet,
+    weight: &mut V3,
+    ior: f32,
+    eta: f32,
+    spec_level: f32,
+    spec_tint: V3,
+    (thickness, film_ior): (f32, f32),
+    (a, ax, ay, tangent, energy, multi): (f32, f32, f32, V3, f32, bool),
+    vn: V3,
+    mu: f32,
+) {
     let f0_real = super::bsdf::f0_from_ior(eta);
     let f0 = super::bsdf::f0_from_ior(ior) * 2.0 * spec_level;
-    let f0_scale = if f0_real > 0.0 { spec_tint.map(|t| (f0 * t).clamp(0.0, 1.0) / f0_real) } else { [1.0; 3] };
-    let tf = super::thin_film::ThinFilm { thickness, ior: film_ior, eta, f0_scale };
+    let f0_scale = if f0_real > 0.0 {
+        spec_tint.map(|t| (f0 * t).clamp(0.0, 1.0) / f0_real)
+    } else {
+        [1.0; 3]
+    };
+    let tf = super::thin_film::ThinFilm {
+        thickness,
+        ior: film_ior,
+        eta,
+        f0_scale,
+    };
     let albedo = tf.eval(mu);
     let sel = average(albedo).max(1e-3);
     if ax != ay {
-        push_glossy(out, ctx, ax, ay, tangent, Fresnel::ThinFilm(tf), multi, *weight, vn, sel);
+        push_glossy(
+            out,
+            ctx,
+            ax,
+            ay,
+            tangent,
+            Fresnel::ThinFilm(tf),
+            multi,
+            *weight,
+            vn,
+            sel,
+        );
     } else {
-        out.push_scaled(LobeKind::Glossy { alpha: a, fresnel: Fresnel::ThinFilm(tf), energy }, *weight, vn, sel);
+        out.push_scaled(
+            LobeKind::Glossy {
+                alpha: a,
+                fresnel: Fresnel::ThinFilm(tf),
+                energy,
+            },
+            *weight,
+            vn,
+            sel,
+        );
     }
     *weight = scale(*weight, (1.0 - max3(albedo)).clamp(0.0, 1.0));
 }
@@ -475,8 +752,19 @@ fn principled_film_specular(ctx: &Context, out: &mut LobeSet, weight: &mut V3, i
 /// A BSSRDF closure after Cycles' `bssrdf_setup`: its selection weight counts every
 /// channel, channels with no radius become diffuse.
 #[allow(clippy::too_many_arguments)]
-fn push_bssrdf(out: &mut LobeSet, weight: V3, radius: V3, albedo: V3, aniso: f32, ior: f32, roughness: f32, method: Method, n: V3) {
-    let (bssrdf, diffuse, channels) = super::subsurface::setup(weight, radius, albedo, aniso, ior, roughness, method);
+fn push_bssrdf(
+    out: &mut LobeSet,
+    weight: V3,
+    radius: V3,
+    albedo: V3,
+    aniso: f32,
+    ior: f32,
+    roughness: f32,
+    method: Method,
+    n: V3,
+) {
+    let (bssrdf, diffuse, channels) =
+        super::subsurface::setup(weight, radius, albedo, aniso, ior, roughness, method);
     if !is_zero(diffuse) {
         out.push(LobeKind::Diffuse, diffuse, n);
     }
@@ -492,18 +780,40 @@ fn push_bssrdf(out: &mut LobeSet, weight: V3, radius: V3, albedo: V3, aniso: f32
 /// Principled coat as Cycles 4.x layers it: a dielectric GGX lobe (Multiscatter) on top,
 /// the layers below attenuated by its albedo and by the coat tint along the refracted
 /// path (tint^(1 / cos) mixed by the coat weight). Returns the weight left for them.
-fn principled_coat(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet, weight: V3, coat: f32) -> V3 {
+fn principled_coat(
+    b: &BsdfNode,
+    s: &[f32],
+    sp: &ShadingPoint,
+    ctx: &Context,
+    out: &mut LobeSet,
+    weight: V3,
+    coat: f32,
+) -> V3 {
     let rough = input_f(b, s, "Coat Roughness", 0.03).clamp(0.0, 1.0);
     let coat_ior = input_f(b, s, "Coat IOR", 1.5).max(1.0);
     let tint = input_c(b, s, "Coat Tint", [1.0; 3]).map(|x| x.max(0.0));
     let n = valid_n(sp, ctx, input_n(b, s, "Coat Normal", sp));
     let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
     let energy = multiscatter_energy(ctx.tables, mu, rough);
-    let e = ctx.tables.dielectric_fresnel_avg(mu, rough, coat_ior).clamp(0.0, 1.0);
-    out.push_scaled(LobeKind::Glossy { alpha: rough * rough, fresnel: Fresnel::Dielectric { eta: coat_ior }, energy }, scale(weight, coat), n, e.max(1e-3));
+    let e = ctx
+        .tables
+        .dielectric_fresnel_avg(mu, rough, coat_ior)
+        .clamp(0.0, 1.0);
+    out.push_scaled(
+        LobeKind::Glossy {
+            alpha: rough * rough,
+            fresnel: Fresnel::Dielectric { eta: coat_ior },
+            energy,
+        },
+        scale(weight, coat),
+        n,
+        e.max(1e-3),
+    );
     let mut below = scale(weight, (1.0 - coat * e).clamp(0.0, 1.0));
     if tint != [1.0; 3] {
-        let cos_t = (1.0 - (1.0 - mu * mu) / (coat_ior * coat_ior)).max(1e-6).sqrt();
+        let cos_t = (1.0 - (1.0 - mu * mu) / (coat_ior * coat_ior))
+            .max(1e-6)
+            .sqrt();
         let depth = 1.0 / cos_t;
         below = mul(below, tint.map(|t| 1.0 - coat + coat * t.powf(depth)));
     }
@@ -511,7 +821,14 @@ fn principled_coat(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, ctx: &Context, ou
 }
 
 /// The Sheen BSDF node: microfiber sheen (the default) or Ashikhmin velvet.
-fn push_sheen_node(out: &mut LobeSet, distribution: Option<&str>, weight: V3, roughness: f32, n: V3, wo: V3) {
+fn push_sheen_node(
+    out: &mut LobeSet,
+    distribution: Option<&str>,
+    weight: V3,
+    roughness: f32,
+    n: V3,
+    wo: V3,
+) {
     let r = roughness.clamp(0.0, 1.0);
     if distribution == Some("ASHIKHMIN") {
         out.push(LobeKind::Velvet(super::sheen::Velvet::new(r)), weight, n);
@@ -525,7 +842,16 @@ fn push_sheen_node(out: &mut LobeSet, distribution: Option<&str>, weight: V3, ro
 /// weight x tint about the normal leaned toward the coat normal by the coat weight; the
 /// layers below are scaled by 1 - max(its albedo). Returns the weight left for them.
 #[allow(clippy::too_many_arguments)]
-fn principled_sheen(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet, weight: V3, n: V3, coat: f32) -> V3 {
+fn principled_sheen(
+    b: &BsdfNode,
+    s: &[f32],
+    sp: &ShadingPoint,
+    ctx: &Context,
+    out: &mut LobeSet,
+    weight: V3,
+    n: V3,
+    coat: f32,
+) -> V3 {
     let sheen_w = input_f(b, s, "Sheen Weight", 0.0).max(0.0);
     if sheen_w <= 1e-5 {
         return weight;
@@ -534,7 +860,11 @@ fn principled_sheen(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, ctx: &Context, o
     let r = input_f(b, s, "Sheen Roughness", 0.5).clamp(0.0, 1.0);
     let coat_n = input_n(b, s, "Coat Normal", sp);
     let sn = normalize(add(scale(n, 1.0 - coat), scale(coat_n, coat)));
-    let sn = if is_zero(sn) || !sn.iter().all(|x| x.is_finite()) { n } else { sn };
+    let sn = if is_zero(sn) || !sn.iter().all(|x| x.is_finite()) {
+        n
+    } else {
+        sn
+    };
     let lobe_w = mul(scale(weight, sheen_w), tint);
     if lobe_w[0].abs() + lobe_w[1].abs() + lobe_w[2].abs() <= 1e-5 {
         return weight;
@@ -564,13 +894,46 @@ fn tangent_input(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, id: &str, rotation:
 /// A GGX reflection lobe with alphas (`ax`, `ay`) along tangent `t`: anisotropic unless
 /// singular, Multiscatter energy from the isotropic table at (ax ay)^(1/4) when `multi`.
 #[allow(clippy::too_many_arguments)]
-fn push_glossy(out: &mut LobeSet, ctx: &Context, ax: f32, ay: f32, t: V3, fresnel: Fresnel, multi: bool, weight: V3, n: V3, albedo: f32) {
+fn push_glossy(
+    out: &mut LobeSet,
+    ctx: &Context,
+    ax: f32,
+    ay: f32,
+    t: V3,
+    fresnel: Fresnel,
+    multi: bool,
+    weight: V3,
+    n: V3,
+    albedo: f32,
+) {
     let lobe = super::anisotropic::AnisoGgx::new(n, t, ax, ay);
     let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
-    let energy = if multi { multiscatter_energy(ctx.tables, mu, lobe.table_roughness()) } else { 1.0 };
-    if lobe.singular() {
-        out.push_scaled(LobeKind::Glossy { alpha: (ax * ay).sqrt(), fresnel, energy }, weight, n, albedo);
+    let energy = if multi {
+        multiscatter_energy(ctx.tables, mu, lobe.table_roughness())
     } else {
-        out.push_scaled(LobeKind::GlossyAniso { lobe, fresnel, energy }, weight, n, albedo);
+        1.0
+    };
+    if lobe.singular() {
+        out.push_scaled(
+            LobeKind::Glossy {
+                alpha: (ax * ay).sqrt(),
+                fresnel,
+                energy,
+            },
+            weight,
+            n,
+            albedo,
+        );
+    } else {
+        out.push_scaled(
+            LobeKind::GlossyAniso {
+                lobe,
+                fresnel,
+                energy,
+            },
+            weight,
+            n,
+            albedo,
+        );
     }
 }

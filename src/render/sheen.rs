@@ -56,7 +56,11 @@ impl Sheen {
     /// Setup for normal `n`, viewer `v` and roughness (clamped to [1e-3, 1]); returns the
     /// lobe and its albedo, which scales the closure weight (and its selection weight).
     pub fn new(n: V3, v: V3, roughness: f32) -> (Sheen, f32) {
-        let r = if roughness.is_finite() { roughness.clamp(1e-3, 1.0) } else { 1.0 };
+        let r = if roughness.is_finite() {
+            roughness.clamp(1e-3, 1.0)
+        } else {
+            1.0
+        };
         // Cycles' make_orthonormals_tangent(N, view); a viewer along N has any frame.
         let c = cross(n, v);
         let (t, bt) = if dot(c, c) > 1e-12 {
@@ -102,7 +106,10 @@ impl Sheen {
         let d = super::camera::concentric_disk(u);
         let dz = (1.0 - d[0] * d[0] - d[1] * d[1]).max(0.0).sqrt();
         let local = normalize([(d[0] - dz * self.b) / self.a, d[1] / self.a, dz]);
-        let l = add(add(scale(self.t, local[0]), scale(self.bt, local[1])), scale(n, local[2]));
+        let l = add(
+            add(scale(self.t, local[0]), scale(self.bt, local[1])),
+            scale(n, local[2]),
+        );
         if dot(ng, l) <= 0.0 || dot(n, l) <= 0.0 {
             return None;
         }
@@ -121,8 +128,15 @@ impl Velvet {
     /// Setup for roughness sigma (the node's Roughness, clamped to [0, 1] by the node and
     /// to at least 0.01 here, as Cycles does).
     pub fn new(sigma: f32) -> Velvet {
-        let s = if sigma.is_finite() { sigma.clamp(0.0, 1.0) } else { 1.0 }.max(0.01);
-        Velvet { inv_sigma2: 1.0 / (s * s) }
+        let s = if sigma.is_finite() {
+            sigma.clamp(0.0, 1.0)
+        } else {
+            1.0
+        }
+        .max(0.01);
+        Velvet {
+            inv_sigma2: 1.0 / (s * s),
+        }
     }
 
     /// (BSDF * cos, pdf) toward `l` for a viewer at `v`.
@@ -139,7 +153,9 @@ impl Velvet {
             return (0.0, 0.0);
         }
         let k = (cos_nh / cos_hv).max(1e-5);
-        let g = (2.0 * (k * cos_nv).abs()).min(2.0 * (k * cos_nl).abs()).min(1.0);
+        let g = (2.0 * (k * cos_nv).abs())
+            .min(2.0 * (k * cos_nl).abs())
+            .min(1.0);
         let sin2 = 1.0 - cos_nh * cos_nh;
         let cot2 = cos_nh * cos_nh / sin2;
         let d = (-cot2 * self.inv_sigma2).exp() * self.inv_sigma2 / (PI * sin2 * sin2);
@@ -152,7 +168,10 @@ impl Velvet {
         let r = (1.0 - z * z).max(0.0).sqrt();
         let phi = 2.0 * PI * u[1];
         let (t, b) = basis(n);
-        let l = add(add(scale(t, r * phi.cos()), scale(b, r * phi.sin())), scale(n, z));
+        let l = add(
+            add(scale(t, r * phi.cos()), scale(b, r * phi.sin())),
+            scale(n, z),
+        );
         if dot(ng, l) <= 0.0 {
             return None;
         }
@@ -206,7 +225,10 @@ mod tests {
             let integral = integral / count as f64;
             let kept = hits as f64 / count as f64;
             // The sampler keeps exactly the mass the density has above the horizon.
-            assert!((integral - kept).abs() < 0.03, "mu {mu} r {r}: integral {integral}, kept {kept}");
+            assert!(
+                (integral - kept).abs() < 0.03,
+                "mu {mu} r {r}: integral {integral}, kept {kept}"
+            );
         }
     }
 }

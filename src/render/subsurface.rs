@@ -74,7 +74,15 @@ fn dipole_alpha_prime(rd: f32, fourthird_a: f32) -> f32 {
 /// Cycles' `bssrdf_setup` for a closure of colour `weight`: returns the BSSRDF (None when
 /// no channel has a usable radius) and the part of the weight that falls back to a
 /// diffuse closure (channels whose radius is too small), plus the number of channels.
-pub fn setup(weight: V3, radius: V3, albedo: V3, anisotropy: f32, ior: f32, roughness: f32, method: Method) -> (Option<(Bssrdf, V3)>, V3, u32) {
+pub fn setup(
+    weight: V3,
+    radius: V3,
+    albedo: V3,
+    anisotropy: f32,
+    ior: f32,
+    roughness: f32,
+    method: Method,
+) -> (Option<(Bssrdf, V3)>, V3, u32) {
     let anisotropy = anisotropy.clamp(0.0, 0.9);
     let ior = ior.clamp(1.01, 3.8);
     let mut w = weight;
@@ -105,8 +113,26 @@ pub fn setup(weight: V3, radius: V3, albedo: V3, anisotropy: f32, ior: f32, roug
         }
     }
     // Cycles' Random Walk enters through a rough interface of fixed roughness one.
-    let alpha = if method == Method::RandomWalk { 1.0 } else { (roughness * roughness).clamp(0.0, 1.0) };
-    (Some((Bssrdf { radius: r, albedo, anisotropy, ior, alpha, method }, w)), diffuse, channels)
+    let alpha = if method == Method::RandomWalk {
+        1.0
+    } else {
+        (roughness * roughness).clamp(0.0, 1.0)
+    };
+    (
+        Some((
+            Bssrdf {
+                radius: r,
+                albedo,
+                anisotropy,
+                ior,
+                alpha,
+                method,
+            },
+            w,
+        )),
+        diffuse,
+        channels,
+    )
 }
 
 /// Chiang et al. 2016's inversion of the multiple-scattering albedo, with anisotropy
@@ -118,15 +144,43 @@ fn remap(albedo: f32, d: f32, g: f32) -> (f32, f32) {
     let g5 = g4 * g;
     let g6 = g5 * g;
     let g7 = g6 * g;
-    let a = 1.826_052_4 - 1.284_510_6 * g - 1.799_046_3 * g2 + 9.193_932_9 * g3 - 22.821_558 * g4 + 32.023_487 * g5 - 23.626_48 * g6 + 7.210_670_2 * g7;
-    let b = 4.985_112 + 0.127_355_96 * (31.149_158 * g - 201.847_02 * g2 + 841.576_04 * g3 - 2018.092_9 * g4 + 2731.715_6 * g5 - 1935.414_2 * g6 + 559.009_03 * g7).exp();
-    let c = 1.096_861 - 0.394_704_06 * g + 1.052_581_2 * g2 - 8.839_637 * g3 + 28.864_323 * g4 - 46.880_29 * g5 + 38.540_283 * g6 - 12.718_104 * g7;
-    let dd = 0.496_310_2 + 0.360_146_6 * g - 2.151_393 * g2 + 17.889_69 * g3 - 55.298_4 * g4 + 82.065_98 * g5 - 58.510_6 * g6 + 15.847_83 * g7;
-    let e = 4.231_903 + 0.003_106_039_5 * (76.731_63 * g - 594.356_8 * g2 + 2448.883_4 * g3 - 5576.685_5 * g4 + 7116.602 * g5 - 4763.544_7 * g6 + 1303.531_8 * g7).exp();
-    let f = 2.406_03 - 2.518_148_4 * g + 9.184_949 * g2 - 79.219_17 * g3 + 259.082_87 * g4 - 403.613_8 * g5 + 302.857_12 * g6 - 87.437_05 * g7;
+    let a = 1.826_052_4 - 1.284_510_6 * g - 1.799_046_3 * g2 + 9.193_932_9 * g3 - 22.821_558 * g4
+        + 32.023_487 * g5
+        - 23.626_48 * g6
+        + 7.210_670_2 * g7;
+    let b = 4.985_112
+        + 0.127_355_96
+            * (31.149_158 * g - 201.847_02 * g2 + 841.576_04 * g3 - 2018.092_9 * g4
+                + 2731.715_6 * g5
+                - 1935.414_2 * g6
+                + 559.009_03 * g7)
+                .exp();
+    let c = 1.096_861 - 0.394_704_06 * g + 1.052_581_2 * g2 - 8.839_637 * g3 + 28.864_323 * g4
+        - 46.880_29 * g5
+        + 38.540_283 * g6
+        - 12.718_104 * g7;
+    let dd = 0.496_310_2 + 0.360_146_6 * g - 2.151_393 * g2 + 17.889_69 * g3 - 55.298_4 * g4
+        + 82.065_98 * g5
+        - 58.510_6 * g6
+        + 15.847_83 * g7;
+    let e = 4.231_903
+        + 0.003_106_039_5
+            * (76.731_63 * g - 594.356_8 * g2 + 2448.883_4 * g3 - 5576.685_5 * g4 + 7116.602 * g5
+                - 4763.544_7 * g6
+                + 1303.531_8 * g7)
+                .exp();
+    let f = 2.406_03 - 2.518_148_4 * g + 9.184_949 * g2 - 79.219_17 * g3 + 259.082_87 * g4
+        - 403.613_8 * g5
+        + 302.857_12 * g6
+        - 87.437_05 * g7;
     let blend = albedo.max(0.0).powf(0.25);
-    let alpha = (1.0 - blend) * a * (b * albedo).atan().powf(c) + blend * dd * (e * albedo).atan().powf(f);
-    let alpha = if alpha.is_finite() { alpha.clamp(0.0, 0.999_999) } else { 0.0 };
+    let alpha =
+        (1.0 - blend) * a * (b * albedo).atan().powf(c) + blend * dd * (e * albedo).atan().powf(f);
+    let alpha = if alpha.is_finite() {
+        alpha.clamp(0.0, 0.999_999)
+    } else {
+        0.0
+    };
     let sigma_t = 1.0 / d.max(1e-16) / (1.0 - g);
     (sigma_t, alpha)
 }
@@ -140,7 +194,10 @@ fn direction_from_cosine(axis: V3, cos: f32, u: f32) -> V3 {
     let sin = (1.0 - cos * cos).max(0.0).sqrt();
     let phi = 2.0 * PI * u;
     let (t, b) = basis(axis);
-    add(add(scale(t, sin * phi.cos()), scale(b, sin * phi.sin())), scale(axis, cos))
+    add(
+        add(scale(t, sin * phi.cos()), scale(b, sin * phi.sin())),
+        scale(axis, cos),
+    )
 }
 
 fn hg_sample(d: V3, g: f32, u: [f32; 2]) -> (V3, f32) {
@@ -180,7 +237,10 @@ pub fn entry_direction(b: &Bssrdf, n: V3, v: V3, mut u: [f32; 2]) -> Option<V3> 
     let cos_hv = dot(h, v);
     let arg = 1.0 - neta * neta * (1.0 - cos_hv * cos_hv);
     let dnp = arg.max(0.0).sqrt().max(1e-7);
-    Some(normalize(add(scale(v, -neta), scale(h, neta * cos_hv - dnp))))
+    Some(normalize(add(
+        scale(v, -neta),
+        scale(h, neta * cos_hv - dnp),
+    )))
 }
 
 /// Where a walk leaves the object.
@@ -194,14 +254,24 @@ pub struct Exit {
 
 /// Ray casts against one object only: the nearest hit within [0, tmax) on instance `inst`.
 pub trait LocalTrace {
-    fn local_hit(&mut self, org: V3, dir: V3, tmax: f32, inst: u32) -> Option<(f32, u32, f32, f32)>;
+    fn local_hit(&mut self, org: V3, dir: V3, tmax: f32, inst: u32)
+        -> Option<(f32, u32, f32, f32)>;
 }
 
 /// Cycles' `subsurface_random_walk`: walks from `p` (on the surface, normal `n` facing
 /// the side the path came from) along `d0` into the object; multiplies `throughput` by
 /// the walk's weight. `rand(bounce)` gives the walk's random numbers for one bounce.
 #[allow(clippy::too_many_arguments)]
-pub fn random_walk(b: &Bssrdf, p: V3, n: V3, d0: V3, inst: u32, throughput: &mut V3, trace: &mut dyn LocalTrace, rand: &dyn Fn(u32) -> [f32; 8]) -> Option<Exit> {
+pub fn random_walk(
+    b: &Bssrdf,
+    p: V3,
+    n: V3,
+    d0: V3,
+    inst: u32,
+    throughput: &mut V3,
+    trace: &mut dyn LocalTrace,
+    rand: &dyn Fn(u32) -> [f32; 8],
+) -> Option<Exit> {
     let g = b.anisotropy;
     let mut sigma_t = [0.0; 3];
     let mut alpha = [0.0; 3];
@@ -211,7 +281,11 @@ pub fn random_walk(b: &Bssrdf, p: V3, n: V3, d0: V3, inst: u32, throughput: &mut
         sigma_t[k] = st;
         alpha[k] = a;
         // The closure weight holds the albedo, which the walk's scattering adds back.
-        tp[k] = if b.albedo[k] != 0.0 { tp[k] / b.albedo[k] } else { 0.0 };
+        tp[k] = if b.albedo[k] != 0.0 {
+            tp[k] / b.albedo[k]
+        } else {
+            0.0
+        };
         const MIN_ALPHA: f32 = 0.2;
         if alpha[k] < MIN_ALPHA {
             tp[k] *= alpha[k] / MIN_ALPHA;
@@ -219,7 +293,8 @@ pub fn random_walk(b: &Bssrdf, p: V3, n: V3, d0: V3, inst: u32, throughput: &mut
         }
     }
     let amax = max3(alpha);
-    let diffusion_length = 1.0 / (1.0 - amax.powf(2.442_94 - 0.021_581_3 * amax + 0.578_637 / amax)).sqrt();
+    let diffusion_length =
+        1.0 / (1.0 - amax.powf(2.442_94 - 0.021_581_3 * amax + 0.578_637 / amax)).sqrt();
     if !(diffusion_length.is_finite()) || diffusion_length <= 1.0 {
         return None;
     }
@@ -236,18 +311,33 @@ pub fn random_walk(b: &Bssrdf, p: V3, n: V3, d0: V3, inst: u32, throughput: &mut
     let mut opposite_distance = 0.0f32;
     let mut hit = None;
     for bounce in 0..MAX_BOUNCES {
-        let (g, guided_fraction, st, ss) = if bounce <= 9 { (g, guided_fraction_org, sigma_t, sigma_s_org) } else { (0.0, 0.75, sigma_t_star, sigma_s_star) };
+        let (g, guided_fraction, st, ss) = if bounce <= 9 {
+            (g, guided_fraction_org, sigma_t, sigma_s_org)
+        } else {
+            (0.0, 0.75, sigma_t_star, sigma_s_star)
+        };
         let r = rand(bounce);
         // Channel by throughput * albedo, MIS (balance) over the channels.
         let wts = [0, 1, 2].map(|k| (tp[k] * alpha[k]).abs());
         let sum = wts[0] + wts[1] + wts[2];
-        let channel_pdf = if sum > 0.0 { scale(wts, 1.0 / sum) } else { [1.0 / 3.0; 3] };
+        let channel_pdf = if sum > 0.0 {
+            scale(wts, 1.0 / sum)
+        } else {
+            [1.0 / 3.0; 3]
+        };
         let x = r[0];
-        let channel = if x < channel_pdf[0] { 0 } else if x < channel_pdf[0] + channel_pdf[1] { 1 } else { 2 };
+        let channel = if x < channel_pdf[0] {
+            0
+        } else if x < channel_pdf[0] + channel_pdf[1] {
+            1
+        } else {
+            2
+        };
         let mut sample_sigma_t = st[channel];
         let randt = r[1];
         let mut backward_fraction = 0.0;
-        let (mut fwd_factor, mut bwd_factor, mut fwd_stretch, mut bwd_stretch) = (0.0, 0.0, 1.0, 1.0);
+        let (mut fwd_factor, mut bwd_factor, mut fwd_stretch, mut bwd_stretch) =
+            (0.0, 0.0, 1.0, 1.0);
         if bounce > 0 {
             let guided = r[2] < guided_fraction;
             let mut guide_backward = false;
@@ -255,7 +345,8 @@ pub fn random_walk(b: &Bssrdf, p: V3, n: V3, d0: V3, inst: u32, throughput: &mut
                 // Cycles' clamp is min(max(x, 0), d): the opposite hit can sit a hair behind the
                 // entry plane (d slightly negative), where f32::clamp would panic.
                 let x = dot(sub(pos, p), neg(n)).max(0.0).min(opposite_distance);
-                backward_fraction = 1.0 / (1.0 + ((opposite_distance - 2.0 * x) / diffusion_length).exp());
+                backward_fraction =
+                    1.0 / (1.0 + ((opposite_distance - 2.0 * x) / diffusion_length).exp());
                 guide_backward = r[3] < backward_fraction;
             }
             let (cos, hgp) = if guided {
@@ -278,11 +369,19 @@ pub fn random_walk(b: &Bssrdf, p: V3, n: V3, d0: V3, inst: u32, throughput: &mut
             fwd_stretch = 1.0 - cos / diffusion_length;
             bwd_stretch = 1.0 + cos / diffusion_length;
             if guided {
-                sample_sigma_t *= if guide_backward { bwd_stretch } else { fwd_stretch };
+                sample_sigma_t *= if guide_backward {
+                    bwd_stretch
+                } else {
+                    fwd_stretch
+                };
             }
         }
         let mut t = -(1.0 - randt).max(1e-30).ln() / sample_sigma_t;
-        let tmax = if bounce == 0 { t.max(10.0 / sigma_t[0].min(sigma_t[1]).min(sigma_t[2])) } else { t };
+        let tmax = if bounce == 0 {
+            t.max(10.0 / sigma_t[0].min(sigma_t[1]).min(sigma_t[2]))
+        } else {
+            t
+        };
         let h = trace.local_hit(pos, dir, tmax, inst);
         let mut is_hit = h.is_some();
         if bounce == 0 {
@@ -296,24 +395,40 @@ pub fn random_walk(b: &Bssrdf, p: V3, n: V3, d0: V3, inst: u32, throughput: &mut
             t = h.unwrap().0;
         }
         pos = madd(pos, dir, t);
-        let pdf_of = |s: V3| -> V3 { [0, 1, 2].map(|k| if is_hit { (-s[k] * t).exp() } else { s[k] * (-s[k] * t).exp() }) };
+        let pdf_of = |s: V3| -> V3 {
+            [0, 1, 2].map(|k| {
+                if is_hit {
+                    (-s[k] * t).exp()
+                } else {
+                    s[k] * (-s[k] * t).exp()
+                }
+            })
+        };
         let transmittance = [0, 1, 2].map(|k| (-st[k] * t).exp());
         let mut pdf = pdf_of(st);
         if bounce > 0 {
             let mut guided_pdf = pdf_of(scale(st, fwd_stretch));
             if have_opposite {
                 let back = pdf_of(scale(st, bwd_stretch));
-                guided_pdf = [0, 1, 2].map(|k| guided_pdf[k] * fwd_factor * (1.0 - backward_fraction) + back[k] * bwd_factor * backward_fraction);
+                guided_pdf = [0, 1, 2].map(|k| {
+                    guided_pdf[k] * fwd_factor * (1.0 - backward_fraction)
+                        + back[k] * bwd_factor * backward_fraction
+                });
             } else {
                 guided_pdf = scale(guided_pdf, fwd_factor);
             }
-            pdf = [0, 1, 2].map(|k| pdf[k] * (1.0 - guided_fraction) + guided_pdf[k] * guided_fraction);
+            pdf = [0, 1, 2]
+                .map(|k| pdf[k] * (1.0 - guided_fraction) + guided_pdf[k] * guided_fraction);
         }
         let denom = dot(channel_pdf, pdf);
         if !(denom > 0.0) || !denom.is_finite() {
             return None;
         }
-        let num = if is_hit { transmittance } else { mul(ss, transmittance) };
+        let num = if is_hit {
+            transmittance
+        } else {
+            mul(ss, transmittance)
+        };
         tp = scale(mul(tp, num), 1.0 / denom);
         if is_hit {
             let (_, prim, u, v) = h.unwrap();
@@ -368,12 +483,21 @@ struct Local<'a, 'b> {
 }
 
 impl LocalTrace for Local<'_, '_> {
-    fn local_hit(&mut self, org: V3, dir: V3, tmax: f32, inst: u32) -> Option<(f32, u32, f32, f32)> {
+    fn local_hit(
+        &mut self,
+        org: V3,
+        dir: V3,
+        tmax: f32,
+        inst: u32,
+    ) -> Option<(f32, u32, f32, f32)> {
         let mut t0 = 0.0f32;
         // Skip hits on other objects (Cycles' local intersection sees one object only).
         for _ in 0..64 {
             self.rays += 1;
-            let h = self.scene.accel.intersect_at(org, dir, t0, tmax, self.time)?;
+            let h = self
+                .scene
+                .accel
+                .intersect_at(org, dir, t0, tmax, self.time)?;
             if self.scene.geo.refs[h.prim as usize].inst == inst {
                 return Some((h.t, h.prim, h.u, h.v));
             }
@@ -415,11 +539,23 @@ pub fn enter_and_walk(
         let c = rng.get4(index, base.wrapping_add(2 + 2 * bounce));
         [a[0], a[1], a[2], a[3], c[0], c[1], c[2], c[3]]
     };
-    let mut local = Local { scene, rays: 0, time: hit.time };
+    let mut local = Local {
+        scene,
+        rays: 0,
+        time: hit.time,
+    };
     let exit = random_walk(b, start, n, d0, hit.inst, throughput, &mut local, &rand);
     *rays += local.rays;
     let e = exit?;
-    Some((super::accel::Hit { t: 0.0, prim: e.prim, u: e.u, v: e.v }, e.dir))
+    Some((
+        super::accel::Hit {
+            t: 0.0,
+            prim: e.prim,
+            u: e.u,
+            v: e.v,
+        },
+        e.dir,
+    ))
 }
 
 /// First sampler dimension of a subsurface bounce's random numbers (walk or disk probe):

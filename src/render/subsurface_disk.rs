@@ -36,7 +36,11 @@ fn pdf_channel(d: f32, r: f32) -> f32 {
 
 /// Radius (in units of d) where the profile's CDF is `xi`: Newton from Cycles' guess.
 fn root_find(xi: f32) -> f32 {
-    let mut r = if xi <= 0.9 { (xi * xi * 2.4).exp() - 1.0 } else { 15.0 };
+    let mut r = if xi <= 0.9 {
+        (xi * xi * 2.4).exp() - 1.0
+    } else {
+        15.0
+    };
     for _ in 0..10 {
         let e3 = (-r / 3.0).exp();
         let e = e3 * e3 * e3;
@@ -128,20 +132,35 @@ pub fn disk_exit(
     if !(h > 0.0) {
         return None;
     }
-    let disk_p = add(scale(disk_t, disk_r * phi.cos()), scale(disk_b, disk_r * phi.sin()));
+    let disk_p = add(
+        scale(disk_t, disk_r * phi.cos()),
+        scale(disk_b, disk_r * phi.sin()),
+    );
     let org = add(madd(hit.p, disk_n, h), disk_p);
     let dir = neg(disk_n);
     let tmax = 2.0 * h;
 
     // Every hit on the entry object along the probe (up to MAX_PROBE_HITS), in order.
-    let mut found = [ProbeHit { t: 0.0, prim: 0, u: 0.0, v: 0.0 }; MAX_PROBE_HITS];
+    let mut found = [ProbeHit {
+        t: 0.0,
+        prim: 0,
+        u: 0.0,
+        v: 0.0,
+    }; MAX_PROBE_HITS];
     let mut n_found = 0;
     let mut tmin = 0.0f32;
     while n_found < MAX_PROBE_HITS {
         *rays += 1;
-        let Some(x) = scene.accel.intersect(org, dir, tmin, tmax) else { break };
+        let Some(x) = scene.accel.intersect(org, dir, tmin, tmax) else {
+            break;
+        };
         if scene.geo.refs[x.prim as usize].inst == hit.inst {
-            found[n_found] = ProbeHit { t: x.t, prim: x.prim, u: x.u, v: x.v };
+            found[n_found] = ProbeHit {
+                t: x.t,
+                prim: x.prim,
+                u: x.u,
+                v: x.v,
+            };
             n_found += 1;
         }
         tmin = x.t * (1.0 + 1e-6) + 1e-7;
@@ -185,7 +204,11 @@ pub fn disk_exit(
         }
         let p = madd(org, dir, kept[k].t);
         let r = len(sub(p, hit.p));
-        let e = if disk_pdf > 0.0 { scale(eval(b.radius, r), w / disk_pdf) } else { [0.0; 3] };
+        let e = if disk_pdf > 0.0 {
+            scale(eval(b.radius, r), w / disk_pdf)
+        } else {
+            [0.0; 3]
+        };
         weights[k] = e;
         normals[k] = ng;
         sum += (e[0].abs() + e[1].abs() + e[2].abs()) / 3.0;
@@ -201,7 +224,15 @@ pub fn disk_exit(
         if target < next && sw > 0.0 {
             *throughput = mul(*throughput, scale(weights[k], sum / sw));
             let h = kept[k];
-            return Some((super::accel::Hit { t: 0.0, prim: h.prim, u: h.u, v: h.v }, normals[k]));
+            return Some((
+                super::accel::Hit {
+                    t: 0.0,
+                    prim: h.prim,
+                    u: h.u,
+                    v: h.v,
+                },
+                normals[k],
+            ));
         }
         partial = next;
     }

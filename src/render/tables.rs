@@ -36,7 +36,11 @@ fn albedo_parts(mu: f32, alpha: f32, eta: Option<f32>, samples: &[[f32; 2]]) -> 
     for u in samples {
         let h = sample_vndf(v, alpha, *u);
         let vh = v[0] * h[0] + v[1] * h[1] + v[2] * h[2];
-        let wi = [2.0 * vh * h[0] - v[0], 2.0 * vh * h[1] - v[1], 2.0 * vh * h[2] - v[2]];
+        let wi = [
+            2.0 * vh * h[0] - v[0],
+            2.0 * vh * h[1] - v[1],
+            2.0 * vh * h[2] - v[2],
+        ];
         if wi[2] <= 0.0 {
             continue;
         }
@@ -54,10 +58,12 @@ fn albedo_parts(mu: f32, alpha: f32, eta: Option<f32>, samples: &[[f32; 2]]) -> 
 /// The first `n` points of the tables' 2D sample pattern, drawn once for every entry.
 fn table_samples(n: u32) -> Vec<[f32; 2]> {
     let s = PixelSampler::new(7, 11, 13);
-    (0..n).map(|i| {
-        let u = s.get4(i, 0);
-        [u[0], u[1]]
-    }).collect()
+    (0..n)
+        .map(|i| {
+            let u = s.get4(i, 0);
+            [u[0], u[1]]
+        })
+        .collect()
 }
 
 /// A grid roughness as alpha, with Cycles' precompute clamp (roughness 0 is 1e-4: a mirror).
@@ -116,11 +122,17 @@ impl Tables {
                     let (gf, g) = albedo_parts(mu, alpha, Some(eta), &samples[..128]);
                     let ratio = if g > 0.0 { gf / g } else { 1.0 };
                     let f = f0_from_ior(eta);
-                    dielectric_s[(zi * N3 + ri) * N3 + mi] = ((ratio - f) / (1.0 - f).max(1e-6)).clamp(0.0, 1.0);
+                    dielectric_s[(zi * N3 + ri) * N3 + mi] =
+                        ((ratio - f) / (1.0 - f).max(1e-6)).clamp(0.0, 1.0);
                 }
             }
         }
-        Tables { ggx_e, ggx_e_avg, dielectric_s, glass: std::sync::OnceLock::new() }
+        Tables {
+            ggx_e,
+            ggx_e_avg,
+            dielectric_s,
+            glass: std::sync::OnceLock::new(),
+        }
     }
 
     /// Single-scattering albedo of GGX with Fresnel one; `roughness` = sqrt(alpha).
@@ -144,8 +156,18 @@ impl Tables {
         let x = z * (N3 - 1) as f32;
         let i = (x as usize).min(N3 - 2);
         let t = x - i as f32;
-        let a = lerp2(&self.dielectric_s[i * N3 * N3..(i + 1) * N3 * N3], N3, roughness, mu);
-        let b = lerp2(&self.dielectric_s[(i + 1) * N3 * N3..(i + 2) * N3 * N3], N3, roughness, mu);
+        let a = lerp2(
+            &self.dielectric_s[i * N3 * N3..(i + 1) * N3 * N3],
+            N3,
+            roughness,
+            mu,
+        );
+        let b = lerp2(
+            &self.dielectric_s[(i + 1) * N3 * N3..(i + 2) * N3 * N3],
+            N3,
+            roughness,
+            mu,
+        );
         let s = a * (1.0 - t) + b * t;
         let f = f0_from_ior(eta);
         f + (1.0 - f) * s
@@ -158,7 +180,8 @@ impl Tables {
     /// since a parallel build there could steal a render job that asks for the table
     /// while it is being built (OnceLock re-entry).
     fn glass(&self) -> &(Vec<f32>, Vec<f32>) {
-        self.glass.get_or_init(|| glass_tables(rayon::current_thread_index().is_none()))
+        self.glass
+            .get_or_init(|| glass_tables(rayon::current_thread_index().is_none()))
     }
 
     /// Builds the glass tables now, on the calling thread (in parallel outside rayon's
@@ -171,7 +194,11 @@ impl Tables {
     /// IOR `eta`; `roughness` = sqrt(alpha).
     pub fn glass_e(&self, mu: f32, roughness: f32, eta: f32) -> f32 {
         let (glass_e, glass_inv_e) = self.glass();
-        let (t, e) = if eta < 1.0 { (glass_inv_e, 1.0 / eta) } else { (glass_e, eta) };
+        let (t, e) = if eta < 1.0 {
+            (glass_inv_e, 1.0 / eta)
+        } else {
+            (glass_e, eta)
+        };
         let z = ((e - 1.0) / (e + 1.0)).abs().sqrt().clamp(0.0, 1.0);
         let x = z * (N3 - 1) as f32;
         let i = (x as usize).min(N3 - 2);
@@ -202,10 +229,12 @@ fn glass_grid_eta(zi: usize) -> f32 {
 fn glass_tables(parallel: bool) -> (Vec<f32>, Vec<f32>) {
     use rayon::prelude::*;
     let s = PixelSampler::new(7, 11, 17);
-    let samples: Vec<[f32; 2]> = (0..GLASS_TABLE_SAMPLES).map(|i| {
-        let u = s.get4(i, 0);
-        [u[0], u[1]]
-    }).collect();
+    let samples: Vec<[f32; 2]> = (0..GLASS_TABLE_SAMPLES)
+        .map(|i| {
+            let u = s.get4(i, 0);
+            [u[0], u[1]]
+        })
+        .collect();
     // Each entry is a pure function of its grid point, so the parallel and the
     // sequential build give the same bits on any thread count.
     let entry = |k: usize| {
@@ -213,9 +242,16 @@ fn glass_tables(parallel: bool) -> (Vec<f32>, Vec<f32>) {
         let eta = glass_grid_eta(zi);
         let alpha = rough_to_alpha(ri as f32 / (N3 - 1) as f32);
         let mu = mi as f32 / (N3 - 1) as f32;
-        (super::microfacet::glass_albedo(mu, alpha, eta, &samples), super::microfacet::glass_albedo(mu, alpha, 1.0 / eta, &samples))
+        (
+            super::microfacet::glass_albedo(mu, alpha, eta, &samples),
+            super::microfacet::glass_albedo(mu, alpha, 1.0 / eta, &samples),
+        )
     };
-    let entries: Vec<(f32, f32)> = if parallel { (0..N3 * N3 * N3).into_par_iter().map(entry).collect() } else { (0..N3 * N3 * N3).map(entry).collect() };
+    let entries: Vec<(f32, f32)> = if parallel {
+        (0..N3 * N3 * N3).into_par_iter().map(entry).collect()
+    } else {
+        (0..N3 * N3 * N3).map(entry).collect()
+    };
     entries.into_iter().unzip()
 }
 

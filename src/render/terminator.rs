@@ -28,7 +28,11 @@ pub fn amount(cutoff: f32, n: V3, ng: V3, l: V3) -> (f32, V3) {
     let ng = if nl < 0.0 { neg(ng) } else { ng };
     let nl = nl.abs();
     let ngl = dot(ng, l);
-    let a = if nl < cutoff { 2.0 - (ngl + nl) / cutoff } else { 1.0 - ngl / cutoff };
+    let a = if nl < cutoff {
+        2.0 - (ngl + nl) / cutoff
+    } else {
+        1.0 - ngl / cutoff
+    };
     (a.clamp(0.0, 1.0), ng)
 }
 
@@ -46,7 +50,11 @@ pub fn smooth_surface_offset(v: [V3; 3], n: [V3; 3], b: [f32; 3], ng: V3) -> V3 
     let c = dot(sub(n[1], n[0]), sub(v[1], v[0]));
     let mut h = a * u * (u - 1.0) + (a + bb + c) * u * w1 + bb * w1 * (w1 - 1.0);
     // The corners' envelope: the highest other corner above each corner's tangent plane.
-    let reach = |i: usize, j: usize, k: usize, sign: f32| -> f32 { (sign * dot(sub(v[j], v[i]), n[i])).max(sign * dot(sub(v[k], v[i]), n[i])).max(0.0) };
+    let reach = |i: usize, j: usize, k: usize, sign: f32| -> f32 {
+        (sign * dot(sub(v[j], v[i]), n[i]))
+            .max(sign * dot(sub(v[k], v[i]), n[i]))
+            .max(0.0)
+    };
     if dot(ni, ng) > 0.0 {
         let h0 = (dot(sub(v[0], p), n[0]) + reach(0, 1, 2, 1.0)).max(0.0);
         let h1 = (dot(sub(v[1], p), n[1]) + reach(1, 0, 2, 1.0)).max(0.0);
@@ -70,7 +78,10 @@ mod tests {
     fn flat_triangle_is_not_lifted() {
         let v = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
         let n = [[0.0, 0.0, 1.0]; 3];
-        assert_eq!(smooth_surface_offset(v, n, [0.3, 0.3, 0.4], [0.0, 0.0, 1.0]), [0.0, 0.0, 0.0]);
+        assert_eq!(
+            smooth_surface_offset(v, n, [0.3, 0.3, 0.4], [0.0, 0.0, 1.0]),
+            [0.0, 0.0, 0.0]
+        );
     }
 
     /// Vertex normals splayed outward, as on a coarse sphere: the surface they describe
@@ -78,7 +89,11 @@ mod tests {
     #[test]
     fn convex_triangle_is_lifted_inside() {
         let v = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
-        let n = [normalize([-0.3, -0.3, 1.0]), normalize([0.3, 0.0, 1.0]), normalize([0.0, 0.3, 1.0])];
+        let n = [
+            normalize([-0.3, -0.3, 1.0]),
+            normalize([0.3, 0.0, 1.0]),
+            normalize([0.0, 0.3, 1.0]),
+        ];
         let up = [0.0, 0.0, 1.0];
         let mid = smooth_surface_offset(v, n, [1.0 / 3.0; 3], up);
         assert!(mid[2] > 0.01, "{mid:?}");
@@ -98,7 +113,10 @@ mod tests {
         // the cutoff, 1 - NgL / cutoff.
         let l = normalize([1.0, 0.0, 0.05]);
         let a = amount(0.1, normalize([0.5, 0.0, 1.0]), up, l).0;
-        assert!((a - (1.0 - l[2] / 0.1)).abs() < 1e-6 && a > 0.4 && a < 0.6, "{a}");
+        assert!(
+            (a - (1.0 - l[2] / 0.1)).abs() < 1e-6 && a > 0.4 && a < 0.6,
+            "{a}"
+        );
         // A light behind the shading normal: the true normal is taken on the light's side.
         let (_, ng) = amount(0.1, up, up, [0.0, 0.0, -1.0]);
         assert_eq!(ng, [0.0, 0.0, -1.0]);

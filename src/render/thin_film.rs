@@ -74,7 +74,10 @@ fn sensitivity(opd: f32) -> V3 {
     let phase = 2.0 * PI * opd * 1e-9;
     let mut xyz = [0.0; 3];
     for k in 0..3 {
-        xyz[k] = VAL[k] * (2.0 * PI * VAR[k]).sqrt() * (POS[k] * phase).cos() * (-phase * phase * VAR[k]).exp();
+        xyz[k] = VAL[k]
+            * (2.0 * PI * VAR[k]).sqrt()
+            * (POS[k] * phase).cos()
+            * (-phase * phase * VAR[k]).exp();
     }
     // The fit's second lobe of X.
     xyz[0] += 1.64408e-8 * (2.2399e+06 * phase).cos() * (-4.5282e+09 * phase * phase).exp();
@@ -105,7 +108,11 @@ fn airy(r12: f32, r23: f32, sens: &[V3; 3], flip: bool) -> V3 {
 /// of the raw CIE curves (illuminant E), and Cycles adapts to the working white by
 /// scaling XYZ by its white point before the usual matrix. Rows sum to one, so a flat
 /// reflectance stays grey.
-const XYZ_TO_REC709_WHITE: [V3; 3] = [[3.079_954_5, -1.537_138_5, -0.542_815_9], [-0.921_258_2, 1.876_010_8, 0.045_247_4], [0.052_887_4, -0.204_025_9, 1.151_138_5]];
+const XYZ_TO_REC709_WHITE: [V3; 3] = [
+    [3.079_954_5, -1.537_138_5, -0.542_815_9],
+    [-0.921_258_2, 1.876_010_8, 0.045_247_4],
+    [0.052_887_4, -0.204_025_9, 1.151_138_5],
+];
 
 /// The film's reflectance (linear Rec.709, each channel in 0..1) for light arriving at
 /// cosine `cos_i` from a medium of IOR one onto a film of IOR `film_ior` over a substrate
@@ -116,16 +123,24 @@ pub fn reflectance(film_ior: f32, eta: f32, cos_i: f32, thickness: f32) -> V3 {
         let t = (thickness / FADE).clamp(0.0, 1.0);
         eta2 = 1.0 + (eta2 - 1.0) * t * t * (3.0 - 2.0 * t);
     }
-    let Some((r12, cos2, neg12)) = polarized(cos_i, eta2) else { return [1.0; 3] };
+    let Some((r12, cos2, neg12)) = polarized(cos_i, eta2) else {
+        return [1.0; 3];
+    };
     if r12 == [1.0; 2] {
         return [1.0; 3];
     }
-    let Some((r23, _, neg23)) = polarized(-cos2, eta / eta2) else { return [1.0; 3] };
+    let Some((r23, _, neg23)) = polarized(-cos2, eta / eta2) else {
+        return [1.0; 3];
+    };
     if r23 == [1.0; 2] {
         return [1.0; 3];
     }
     let opd = -2.0 * eta2 * thickness * cos2;
-    let sens = [sensitivity(opd), sensitivity(2.0 * opd), sensitivity(3.0 * opd)];
+    let sens = [
+        sensitivity(opd),
+        sensitivity(2.0 * opd),
+        sensitivity(3.0 * opd),
+    ];
     // Phase pi - phi12 + phi23: an odd multiple of pi unless exactly one interface flips.
     let flip = |p: usize| neg12[p] == neg23[p];
     let rs = airy(r12[0], r23[0], &sens, flip(0));
@@ -149,9 +164,15 @@ mod tests {
         for &cos_i in &[1.0f32, 0.8, 0.5, 0.2] {
             for &eta in &[1.33f32, 1.5, 2.0] {
                 let bare = fresnel(cos_i, eta);
-                for f in [reflectance(1.4, eta, cos_i, 1e-3), reflectance(eta, eta, cos_i, 500.0)] {
+                for f in [
+                    reflectance(1.4, eta, cos_i, 1e-3),
+                    reflectance(eta, eta, cos_i, 500.0),
+                ] {
                     for c in f {
-                        assert!((c - bare).abs() < 2e-3, "cos {cos_i} eta {eta}: {f:?} vs {bare}");
+                        assert!(
+                            (c - bare).abs() < 2e-3,
+                            "cos {cos_i} eta {eta}: {f:?} vs {bare}"
+                        );
                     }
                 }
             }
@@ -175,7 +196,10 @@ mod tests {
         // with total internal reflection inside the film giving one.
         let f = reflectance(1.33, 1.5, 1.0, 400.0);
         assert!(f.iter().all(|c| (0.0..=1.0).contains(c)));
-        assert!(f.iter().cloned().fold(0.0, f32::max) - f.iter().cloned().fold(1.0, f32::min) > 0.01, "{f:?}");
+        assert!(
+            f.iter().cloned().fold(0.0, f32::max) - f.iter().cloned().fold(1.0, f32::min) > 0.01,
+            "{f:?}"
+        );
         assert_eq!(reflectance(1.2, 1.0 / 1.5, 0.1, 400.0), [1.0; 3]);
     }
 
@@ -183,18 +207,31 @@ mod tests {
     fn matches_cycles_head_on() {
         // Blender 4.5.4 Cycles, a smooth black Principled (IOR 1.5) seen head-on under a
         // white world: each pixel is the film's reflectance at normal incidence.
-        let cases = [(300.0, 1.33, 1.5, [0.022044, 0.006795, 0.026982]), (500.0, 1.33, 1.5, [0.037087, 0.008976, 0.036142]), (15.0, 1.33, 1.5, [0.039087, 0.038547, 0.037827]), (500.0, 1.5, 1.33, [0.080149, 0.036745, 0.049041])];
+        let cases = [
+            (300.0, 1.33, 1.5, [0.022044, 0.006795, 0.026982]),
+            (500.0, 1.33, 1.5, [0.037087, 0.008976, 0.036142]),
+            (15.0, 1.33, 1.5, [0.039087, 0.038547, 0.037827]),
+            (500.0, 1.5, 1.33, [0.080149, 0.036745, 0.049041]),
+        ];
         for (thickness, film, eta, cycles) in cases {
             let f = reflectance(film, eta, 1.0, thickness);
             for k in 0..3 {
-                assert!((f[k] - cycles[k]).abs() < 2e-5, "{thickness} nm: {f:?} vs {cycles:?}");
+                assert!(
+                    (f[k] - cycles[k]).abs() < 2e-5,
+                    "{thickness} nm: {f:?} vs {cycles:?}"
+                );
             }
         }
     }
 
     #[test]
     fn f0_scale_one_changes_nothing() {
-        let tf = ThinFilm { thickness: 400.0, ior: 1.33, eta: 1.5, f0_scale: [1.0; 3] };
+        let tf = ThinFilm {
+            thickness: 400.0,
+            ior: 1.33,
+            eta: 1.5,
+            f0_scale: [1.0; 3],
+        };
         assert_eq!(tf.eval(0.7), reflectance(1.33, 1.5, 0.7, 400.0));
     }
 }

@@ -31,8 +31,14 @@ fn by_solid_angle(v: &[V3; 3], plane_distance: f32) -> bool {
 
 /// The solid angle of the triangle seen from `p` (Van Oosterom and Strackee).
 fn solid_angle(v: &[V3; 3], p: V3) -> f32 {
-    let (a, b, c) = (normalize(sub(v[0], p)), normalize(sub(v[1], p)), normalize(sub(v[2], p)));
-    2.0 * dot(a, cross(b, c)).abs().atan2(1.0 + dot(b, c) + dot(a, c) + dot(a, b))
+    let (a, b, c) = (
+        normalize(sub(v[0], p)),
+        normalize(sub(v[1], p)),
+        normalize(sub(v[2], p)),
+    );
+    2.0 * dot(a, cross(b, c))
+        .abs()
+        .atan2(1.0 + dot(b, c) + dot(a, c) + dot(a, b))
 }
 
 /// Ray-triangle intersection: distance and the weights of corners 1 and 2.
@@ -73,7 +79,11 @@ pub fn sample(v: &[V3; 3], p: V3, u: [f32; 2], front: bool, back: bool) -> Optio
     }
     let area = 0.5 * nn.sqrt();
     if by_solid_angle(v, plane_distance) {
-        let (a, b, c) = (normalize(sub(v[0], p)), normalize(sub(v[1], p)), normalize(sub(v[2], p)));
+        let (a, b, c) = (
+            normalize(sub(v[0], p)),
+            normalize(sub(v[1], p)),
+            normalize(sub(v[2], p)),
+        );
         let (cos_a, cos_b, cos_c) = (dot(b, c), dot(a, c), dot(a, b));
         let omega = 2.0 * dot(a, cross(b, c)).abs().atan2(1.0 + cos_a + cos_b + cos_c);
         if !(omega > 0.0) {
@@ -92,9 +102,18 @@ pub fn sample(v: &[V3; 3], p: V3, u: [f32; 2], front: bool, back: bool) -> Optio
         let uvec = normalize(sub(c, scale(a, cos_b)));
         let c2 = normalize(add(scale(a, q), scale(uvec, sin_from_cos(q))));
         let z = 1.0 - u[1] * (1.0 - dot(c2, b));
-        let d = add(scale(b, z), scale(normalize(sub(c2, scale(b, dot(c2, b)))), sin_from_cos(z)));
+        let d = add(
+            scale(b, z),
+            scale(normalize(sub(c2, scale(b, dot(c2, b)))), sin_from_cos(z)),
+        );
         let (t, b1, b2) = intersect(v, p, d)?;
-        Some(TriangleSample { wi: d, dist: t, pdf: 1.0 / omega, b1, b2 })
+        Some(TriangleSample {
+            wi: d,
+            dist: t,
+            pdf: 1.0 / omega,
+            b1,
+            b2,
+        })
     } else {
         let (mut s, mut t) = (u[0], u[1]);
         if t > s {
@@ -104,7 +123,10 @@ pub fn sample(v: &[V3; 3], p: V3, u: [f32; 2], front: bool, back: bool) -> Optio
             t *= 0.5;
             s -= t;
         }
-        let q = add(add(scale(v[0], 1.0 - s - t), scale(v[1], s)), scale(v[2], t));
+        let q = add(
+            add(scale(v[0], 1.0 - s - t), scale(v[1], s)),
+            scale(v[2], t),
+        );
         let to = sub(q, p);
         let dist = len(to);
         if !(dist > 0.0) {
@@ -115,7 +137,13 @@ pub fn sample(v: &[V3; 3], p: V3, u: [f32; 2], front: bool, back: bool) -> Optio
         if cos == 0.0 {
             return None;
         }
-        Some(TriangleSample { wi, dist, pdf: dist * dist / cos / area, b1: s, b2: t })
+        Some(TriangleSample {
+            wi,
+            dist,
+            pdf: dist * dist / cos / area,
+            b1: s,
+            b2: t,
+        })
     }
 }
 
@@ -163,17 +191,30 @@ mod tests {
                 for j in 0..64 {
                     let u = [(i as f32 + 0.5) / 64.0, (j as f32 + 0.5) / 64.0];
                     let s = sample(&v, p, u, true, true).expect("a sample");
-                    let q = add(add(scale(v[0], 1.0 - s.b1 - s.b2), scale(v[1], s.b1)), scale(v[2], s.b2));
+                    let q = add(
+                        add(scale(v[0], 1.0 - s.b1 - s.b2), scale(v[1], s.b1)),
+                        scale(v[2], s.b2),
+                    );
                     let hit = add(p, scale(s.wi, s.dist));
-                    assert!(len(sub(q, hit)) < 1e-3 * s.dist.max(1.0), "{q:?} vs {hit:?}");
+                    assert!(
+                        len(sub(q, hit)) < 1e-3 * s.dist.max(1.0),
+                        "{q:?} vs {hit:?}"
+                    );
                     let back = pdf(&v, p, s.wi, s.dist);
-                    assert!((back - s.pdf).abs() <= 2e-3 * s.pdf, "pdf {back} vs {}", s.pdf);
+                    assert!(
+                        (back - s.pdf).abs() <= 2e-3 * s.pdf,
+                        "pdf {back} vs {}",
+                        s.pdf
+                    );
                     sum_inv += 1.0 / s.pdf as f64;
                     n += 1;
                 }
             }
             let mean = sum_inv / n as f64;
-            assert!((mean - omega as f64).abs() < 0.01 * omega as f64, "mean 1/pdf {mean} vs solid angle {omega}");
+            assert!(
+                (mean - omega as f64).abs() < 0.01 * omega as f64,
+                "mean 1/pdf {mean} vs solid angle {omega}"
+            );
         }
     }
 

@@ -10,8 +10,12 @@ use super::RenderError;
 use crate::scene::Scene;
 
 pub fn background(scene: &Scene) -> Result<V3, RenderError> {
-    let Some(name) = scene.file.scene.world.as_deref() else { return Ok([0.0; 3]) };
-    let Some(w) = scene.file.worlds.iter().find(|w| w.name == name) else { return Ok([0.0; 3]) };
+    let Some(name) = scene.file.scene.world.as_deref() else {
+        return Ok([0.0; 3]);
+    };
+    let Some(w) = scene.file.worlds.iter().find(|w| w.name == name) else {
+        return Ok([0.0; 3]);
+    };
     let tree = match (&w.node_tree, w.use_nodes) {
         (Some(t), true) => t,
         _ => return Ok(w.color.map(|c| c.map(|x| x as f32)).unwrap_or([0.05; 3])),
@@ -24,21 +28,59 @@ pub fn background(scene: &Scene) -> Result<V3, RenderError> {
         .nodes
         .iter()
         .filter(|n| n.bl_idname == "ShaderNodeOutputWorld")
-        .find(|n| n.properties.get("is_active_output").and_then(Value::as_bool).unwrap_or(true))
-        .or_else(|| tree.nodes.iter().find(|n| n.bl_idname == "ShaderNodeOutputWorld"));
+        .find(|n| {
+            n.properties
+                .get("is_active_output")
+                .and_then(Value::as_bool)
+                .unwrap_or(true)
+        })
+        .or_else(|| {
+            tree.nodes
+                .iter()
+                .find(|n| n.bl_idname == "ShaderNodeOutputWorld")
+        });
     let Some(out) = out else { return Ok([0.0; 3]) };
-    let Some(link) = tree.links.iter().find(|l| l.to_node == out.name && l.to_socket == "Surface" && !l.is_muted) else { return Ok([0.0; 3]) };
-    let node = tree.nodes.iter().find(|n| n.name == link.from_node).ok_or_else(|| RenderError(format!("world {name:?}: link from missing node {:?}", link.from_node)))?;
+    let Some(link) = tree
+        .links
+        .iter()
+        .find(|l| l.to_node == out.name && l.to_socket == "Surface" && !l.is_muted)
+    else {
+        return Ok([0.0; 3]);
+    };
+    let node = tree
+        .nodes
+        .iter()
+        .find(|n| n.name == link.from_node)
+        .ok_or_else(|| {
+            RenderError(format!(
+                "world {name:?}: link from missing node {:?}",
+                link.from_node
+            ))
+        })?;
     if node.bl_idname != "ShaderNodeBackground" && node.bl_idname != "ShaderNodeEmission" {
-        return Err(RenderError(format!("world {name:?}: node {:?} ({}) is not supported as the world surface yet", node.name, node.bl_idname)));
+        return Err(RenderError(format!(
+            "world {name:?}: node {:?} ({}) is not supported as the world surface yet",
+            node.name, node.bl_idname
+        )));
     }
     let input = |id: &str| -> Result<Option<&Value>, RenderError> {
-        if tree.links.iter().any(|l| l.to_node == node.name && l.to_socket == id && !l.is_muted) {
+        if tree
+            .links
+            .iter()
+            .any(|l| l.to_node == node.name && l.to_socket == id && !l.is_muted)
+        {
             return Err(RenderError(format!("world {name:?}: a linked {id:?} on {:?} is not supported yet (constant backgrounds only)", node.name)));
         }
-        Ok(node.inputs.iter().find(|s| s.identifier == id).and_then(|s| s.default_value.as_ref()))
+        Ok(node
+            .inputs
+            .iter()
+            .find(|s| s.identifier == id)
+            .and_then(|s| s.default_value.as_ref()))
     };
-    let color = input("Color")?.and_then(Value::as_array).map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(0.0) as f32)).unwrap_or([0.8; 3]);
+    let color = input("Color")?
+        .and_then(Value::as_array)
+        .map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(0.0) as f32))
+        .unwrap_or([0.8; 3]);
     let strength = input("Strength")?.and_then(Value::as_f64).unwrap_or(1.0) as f32;
     Ok(color.map(|c| c * strength))
 }
@@ -47,11 +89,23 @@ pub fn background(scene: &Scene) -> Result<V3, RenderError> {
 /// exported as `cycles_visibility`), as `ray::` flags.
 pub fn excluded_rays(scene: &Scene) -> u32 {
     use crate::shader::point::ray;
-    let Some(name) = scene.file.scene.world.as_deref() else { return 0 };
-    let Some(w) = scene.file.worlds.iter().find(|w| w.name == name) else { return 0 };
-    let Some(v) = w.properties.get("cycles_visibility") else { return 0 };
+    let Some(name) = scene.file.scene.world.as_deref() else {
+        return 0;
+    };
+    let Some(w) = scene.file.worlds.iter().find(|w| w.name == name) else {
+        return 0;
+    };
+    let Some(v) = w.properties.get("cycles_visibility") else {
+        return 0;
+    };
     let mut x = 0;
-    for (key, flag) in [("camera", ray::CAMERA), ("diffuse", ray::DIFFUSE), ("glossy", ray::GLOSSY), ("transmission", ray::TRANSMIT), ("scatter", ray::VOLUME_SCATTER)] {
+    for (key, flag) in [
+        ("camera", ray::CAMERA),
+        ("diffuse", ray::DIFFUSE),
+        ("glossy", ray::GLOSSY),
+        ("transmission", ray::TRANSMIT),
+        ("scatter", ray::VOLUME_SCATTER),
+    ] {
         if v.get(key).and_then(Value::as_bool) == Some(false) {
             x |= flag;
         }
@@ -85,8 +139,12 @@ impl WorldShader {
 /// The scene world's shader when it is not a constant colour (None: `background`
 /// gives its constant radiance).
 pub fn shader(scene: &Scene) -> Result<Option<WorldShader>, RenderError> {
-    let Some(name) = scene.file.scene.world.as_deref() else { return Ok(None) };
-    let Some(w) = scene.file.worlds.iter().find(|w| w.name == name) else { return Ok(None) };
+    let Some(name) = scene.file.scene.world.as_deref() else {
+        return Ok(None);
+    };
+    let Some(w) = scene.file.worlds.iter().find(|w| w.name == name) else {
+        return Ok(None);
+    };
     let tree = match (&w.node_tree, w.use_nodes) {
         (Some(t), true) => t,
         _ => return Ok(None),
@@ -94,11 +152,17 @@ pub fn shader(scene: &Scene) -> Result<Option<WorldShader>, RenderError> {
     if is_constant(tree) {
         return Ok(None);
     }
-    let program = crate::shader::compile::compile_world(scene, name).map_err(|e| RenderError(e.to_string()))?;
+    let program = crate::shader::compile::compile_world(scene, name)
+        .map_err(|e| RenderError(e.to_string()))?;
     let mut shader = WorldShader { program, map: None };
     // World > Settings > Surface > Sampling "None": Cycles does not light-sample the world
     // (its background light is off); BSDF rays alone find it.
-    let sampled = w.properties.get("cycles").and_then(|c| c.get("sampling_method")).and_then(Value::as_str) != Some("NONE");
+    let sampled = w
+        .properties
+        .get("cycles")
+        .and_then(|c| c.get("sampling_method"))
+        .and_then(Value::as_str)
+        != Some("NONE");
     if sampled {
         shader.map = WorldMap::build(&shader, MAP_WIDTH, MAP_WIDTH / 2);
     }
@@ -115,12 +179,34 @@ fn is_constant(tree: &crate::scene::NodeTree) -> bool {
         .nodes
         .iter()
         .filter(|n| n.bl_idname == "ShaderNodeOutputWorld")
-        .find(|n| n.properties.get("is_active_output").and_then(Value::as_bool).unwrap_or(true))
-        .or_else(|| tree.nodes.iter().find(|n| n.bl_idname == "ShaderNodeOutputWorld"));
+        .find(|n| {
+            n.properties
+                .get("is_active_output")
+                .and_then(Value::as_bool)
+                .unwrap_or(true)
+        })
+        .or_else(|| {
+            tree.nodes
+                .iter()
+                .find(|n| n.bl_idname == "ShaderNodeOutputWorld")
+        });
     let Some(out) = out else { return true };
-    let Some(link) = tree.links.iter().find(|l| l.to_node == out.name && l.to_socket == "Surface" && !l.is_muted) else { return true };
-    let Some(node) = tree.nodes.iter().find(|n| n.name == link.from_node) else { return true };
-    (node.bl_idname == "ShaderNodeBackground" || node.bl_idname == "ShaderNodeEmission") && !node.mute && !tree.links.iter().any(|l| l.to_node == node.name && !l.is_muted)
+    let Some(link) = tree
+        .links
+        .iter()
+        .find(|l| l.to_node == out.name && l.to_socket == "Surface" && !l.is_muted)
+    else {
+        return true;
+    };
+    let Some(node) = tree.nodes.iter().find(|n| n.name == link.from_node) else {
+        return true;
+    };
+    (node.bl_idname == "ShaderNodeBackground" || node.bl_idname == "ShaderNodeEmission")
+        && !node.mute
+        && !tree
+            .links
+            .iter()
+            .any(|l| l.to_node == node.name && !l.is_muted)
 }
 
 /// Importance sampling of a world that varies with direction: a piecewise-constant
@@ -153,9 +239,16 @@ fn equirect_direction(u: f32, v: f32) -> (V3, f32) {
 /// Index of the bucket of `cdf` (ascending, 0..1) holding `x`, and the position in it.
 fn pick(cdf: &[f32], x: f32) -> (usize, f32) {
     let n = cdf.len() - 1;
-    let i = cdf.partition_point(|&c| c <= x).saturating_sub(1).min(n - 1);
+    let i = cdf
+        .partition_point(|&c| c <= x)
+        .saturating_sub(1)
+        .min(n - 1);
     let width = cdf[i + 1] - cdf[i];
-    let t = if width > 0.0 { ((x - cdf[i]) / width).clamp(0.0, 1.0) } else { 0.5 };
+    let t = if width > 0.0 {
+        ((x - cdf[i]) / width).clamp(0.0, 1.0)
+    } else {
+        0.5
+    };
     (i, t)
 }
 
@@ -168,14 +261,19 @@ impl WorldMap {
         let mut radiance = 0.0f64;
         for j in 0..h {
             for i in 0..w {
-                let (d, st) = equirect_direction((i as f32 + 0.5) / w as f32, (j as f32 + 0.5) / h as f32);
+                let (d, st) =
+                    equirect_direction((i as f32 + 0.5) / w as f32, (j as f32 + 0.5) / h as f32);
                 let c = shader.eval(d, &mut stack);
                 let lum = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
                 let mean = (c[0].abs() + c[1].abs() + c[2].abs()) / 3.0;
                 if mean.is_finite() {
                     radiance += mean as f64 * st as f64;
                 }
-                f[j * w + i] = if lum.is_finite() && lum > 0.0 { lum as f64 * st as f64 } else { 0.0 };
+                f[j * w + i] = if lum.is_finite() && lum > 0.0 {
+                    lum as f64 * st as f64
+                } else {
+                    0.0
+                };
             }
         }
         let total: f64 = f.iter().sum();
@@ -201,7 +299,14 @@ impl WorldMap {
         let n = (w * h) as f64;
         let pdf = f.iter().map(|&x| (x * n / total) as f32).collect();
         let average_radiance = (radiance / n * std::f64::consts::FRAC_PI_2) as f32;
-        Some(WorldMap { w, h, rows, marginal, pdf, average_radiance })
+        Some(WorldMap {
+            w,
+            h,
+            rows,
+            marginal,
+            pdf,
+            average_radiance,
+        })
     }
 
     /// A direction drawn from the map and its solid-angle pdf.
@@ -213,11 +318,17 @@ impl WorldMap {
         if p <= 0.0 {
             return None;
         }
-        let (d, st) = equirect_direction((i as f32 + tu) / self.w as f32, (j as f32 + tv) / self.h as f32);
+        let (d, st) = equirect_direction(
+            (i as f32 + tu) / self.w as f32,
+            (j as f32 + tv) / self.h as f32,
+        );
         if st <= 0.0 {
             return None;
         }
-        Some((d, p / (2.0 * std::f32::consts::PI * std::f32::consts::PI * st)))
+        Some((
+            d,
+            p / (2.0 * std::f32::consts::PI * std::f32::consts::PI * st),
+        ))
     }
 
     /// The solid-angle pdf with which `sample` draws direction `d` (unit).

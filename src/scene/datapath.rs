@@ -50,7 +50,9 @@ pub fn parse(path: &str) -> Result<Vec<Token>, String> {
                         return Err(bad("expected ']' after a string subscript"));
                     }
                     i += 1;
-                    out.push(Token::Key(String::from_utf8(s).map_err(|_| bad("not UTF-8"))?));
+                    out.push(Token::Key(
+                        String::from_utf8(s).map_err(|_| bad("not UTF-8"))?,
+                    ));
                 } else {
                     let start = i;
                     while i < b.len() && b[i].is_ascii_digit() {
@@ -59,7 +61,9 @@ pub fn parse(path: &str) -> Result<Vec<Token>, String> {
                     if start == i || i >= b.len() || b[i] != b']' {
                         return Err(bad("expected an integer or a quoted name in []"));
                     }
-                    out.push(Token::Index(path[start..i].parse().map_err(|_| bad("index too large"))?));
+                    out.push(Token::Index(
+                        path[start..i].parse().map_err(|_| bad("index too large"))?,
+                    ));
                     i += 1;
                 }
             }
@@ -89,11 +93,21 @@ mod tests {
         assert_eq!(parse("location").unwrap(), vec![Prop("location".into())]);
         assert_eq!(
             parse("constraints[\"Follow \\\"Path\\\"\"].offset").unwrap(),
-            vec![Prop("constraints".into()), Key("Follow \"Path\"".into()), Prop("offset".into())]
+            vec![
+                Prop("constraints".into()),
+                Key("Follow \"Path\"".into()),
+                Prop("offset".into())
+            ]
         );
         assert_eq!(
             parse("splines[0].bezier_points[12].co").unwrap(),
-            vec![Prop("splines".into()), Index(0), Prop("bezier_points".into()), Index(12), Prop("co".into())]
+            vec![
+                Prop("splines".into()),
+                Index(0),
+                Prop("bezier_points".into()),
+                Index(12),
+                Prop("co".into())
+            ]
         );
         assert_eq!(parse("[\"prop\"]").unwrap(), vec![Key("prop".into())]);
         assert!(parse("a[").is_err());

@@ -16,7 +16,11 @@ pub struct SceneError {
 
 impl SceneError {
     pub fn new(file: &Path, location: impl Into<String>, message: impl Into<String>) -> Self {
-        SceneError { file: file.to_path_buf(), location: location.into(), message: message.into() }
+        SceneError {
+            file: file.to_path_buf(),
+            location: location.into(),
+            message: message.into(),
+        }
     }
 }
 
@@ -25,7 +29,13 @@ impl fmt::Display for SceneError {
         if self.location.is_empty() {
             write!(f, "{}: {}", self.file.display(), self.message)
         } else {
-            write!(f, "{}: at {}: {}", self.file.display(), self.location, self.message)
+            write!(
+                f,
+                "{}: at {}: {}",
+                self.file.display(),
+                self.location,
+                self.message
+            )
         }
     }
 }

@@ -134,52 +134,98 @@ impl MeshData {
         let err = |loc: &str, msg: String| Err(SceneError::new(file, loc, msg));
         let nv = self.vertex_count() as u64;
         let nc = self.corner_count() as u64;
-        if let Some(i) = self.positions.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
-            return err("vertex_positions", format!("vertex {i} has a non-finite coordinate"));
+        if let Some(i) = self
+            .positions
+            .iter()
+            .position(|p| p.iter().any(|c| !c.is_finite()))
+        {
+            return err(
+                "vertex_positions",
+                format!("vertex {i} has a non-finite coordinate"),
+            );
         }
-        if let Some(i) = self.edges.iter().position(|e| e[0] as u64 >= nv || e[1] as u64 >= nv) {
-            return err("edge_verts", format!("edge {i} names a vertex >= vertex count {nv}"));
+        if let Some(i) = self
+            .edges
+            .iter()
+            .position(|e| e[0] as u64 >= nv || e[1] as u64 >= nv)
+        {
+            return err(
+                "edge_verts",
+                format!("edge {i} names a vertex >= vertex count {nv}"),
+            );
         }
         if self.face_offsets.first().copied().unwrap_or(0) != 0 {
             return err("face_offsets", "must start at 0".into());
         }
         if self.face_offsets.windows(2).any(|w| w[1] <= w[0]) {
-            return err("face_offsets", "faces must have at least one corner (offsets increasing)".into());
+            return err(
+                "face_offsets",
+                "faces must have at least one corner (offsets increasing)".into(),
+            );
         }
         if !self.face_offsets.is_empty() && *self.face_offsets.last().unwrap() as u64 != nc {
-            return err("face_offsets", format!("last offset must equal corner count {nc}"));
+            return err(
+                "face_offsets",
+                format!("last offset must equal corner count {nc}"),
+            );
         }
         if let Some(i) = self.corner_verts.iter().position(|&v| v as u64 >= nv) {
-            return err("corner_verts", format!("corner {i} names a vertex >= vertex count {nv}"));
+            return err(
+                "corner_verts",
+                format!("corner {i} names a vertex >= vertex count {nv}"),
+            );
         }
         if !self.corner_edges.is_empty() {
             if self.corner_edges.len() as u64 != nc {
-                return err("corner_edges", format!("has {} entries, expected {nc}", self.corner_edges.len()));
+                return err(
+                    "corner_edges",
+                    format!("has {} entries, expected {nc}", self.corner_edges.len()),
+                );
             }
             let ne = self.edges.len() as u64;
             if let Some(i) = self.corner_edges.iter().position(|&e| e as u64 >= ne) {
-                return err("corner_edges", format!("corner {i} names an edge >= edge count {ne}"));
+                return err(
+                    "corner_edges",
+                    format!("corner {i} names an edge >= edge count {ne}"),
+                );
             }
         }
         if !self.corner_normals.is_empty() && self.corner_normals.len() as u64 != nc {
-            return err("corner_normals", format!("has {} entries, expected {nc}", self.corner_normals.len()));
+            return err(
+                "corner_normals",
+                format!("has {} entries, expected {nc}", self.corner_normals.len()),
+            );
         }
-        if let Some(i) = self.triangles.iter().position(|t| t.iter().any(|&c| c as u64 >= nc)) {
-            return err("triangle_corners", format!("triangle {i} names a corner >= corner count {nc}"));
+        if let Some(i) = self
+            .triangles
+            .iter()
+            .position(|t| t.iter().any(|&c| c as u64 >= nc))
+        {
+            return err(
+                "triangle_corners",
+                format!("triangle {i} names a corner >= corner count {nc}"),
+            );
         }
         if self.triangle_faces.len() != self.triangles.len() {
             return err("triangle_faces", "must have one entry per triangle".into());
         }
         let nf = self.face_count() as u64;
         if let Some(i) = self.triangle_faces.iter().position(|&f| f as u64 >= nf) {
-            return err("triangle_faces", format!("triangle {i} names a face >= face count {nf}"));
+            return err(
+                "triangle_faces",
+                format!("triangle {i} names a face >= face count {nf}"),
+            );
         }
         for a in &self.attributes {
             let want = self.domain_size(a.domain);
             if a.data.len() != want {
                 return err(
                     &format!("attributes[\"{}\"]", a.name),
-                    format!("has {} values but the {} domain has {want}", a.data.len(), a.domain.name()),
+                    format!(
+                        "has {} values but the {} domain has {want}",
+                        a.data.len(),
+                        a.domain.name()
+                    ),
                 );
             }
         }
@@ -221,19 +267,28 @@ struct GlbAttribute {
 
 /// Reads an exporter glb (layout in `blender_export/FORMAT.md`).
 pub fn read_glb(path: &Path) -> Result<MeshData, SceneError> {
-    let bytes = std::fs::read(path).map_err(|e| SceneError::new(path, "", format!("cannot read: {e}")))?;
+    let bytes =
+        std::fs::read(path).map_err(|e| SceneError::new(path, "", format!("cannot read: {e}")))?;
     parse_glb(&bytes, path)
 }
 
 pub fn parse_glb(bytes: &[u8], path: &Path) -> Result<MeshData, SceneError> {
-    let gltf = gltf::Gltf::from_slice(bytes)
-        .map_err(|e| SceneError::new(path, "", format!("not a valid glb (truncated or corrupt?): {e}")))?;
+    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| {
+        SceneError::new(
+            path,
+            "",
+            format!("not a valid glb (truncated or corrupt?): {e}"),
+        )
+    })?;
     let blob: &[u8] = gltf.blob.as_deref().unwrap_or(&[]);
     let root = gltf.document.as_json();
-    let extras_raw = root
-        .extras
-        .as_ref()
-        .ok_or_else(|| SceneError::new(path, "extras", "no blendsynth extras: not written by blendsynth's exporter"))?;
+    let extras_raw = root.extras.as_ref().ok_or_else(|| {
+        SceneError::new(
+            path,
+            "extras",
+            "no blendsynth extras: not written by blendsynth's exporter",
+        )
+    })?;
     #[derive(Deserialize)]
     struct Wrap {
         blendsynth: GlbExtras,
@@ -242,21 +297,56 @@ pub fn parse_glb(bytes: &[u8], path: &Path) -> Result<MeshData, SceneError> {
         .map_err(|e| SceneError::new(path, "extras.blendsynth", e.to_string()))?
         .blendsynth;
     if ex.version != 1 {
-        return Err(SceneError::new(path, "extras.blendsynth.version", format!("unsupported mesh layout version {}", ex.version)));
+        return Err(SceneError::new(
+            path,
+            "extras.blendsynth.version",
+            format!("unsupported mesh layout version {}", ex.version),
+        ));
     }
     let reader = AccessorReader { root, blob, path };
-    let mut m = MeshData { name: ex.name.clone(), ..Default::default() };
+    let mut m = MeshData {
+        name: ex.name.clone(),
+        ..Default::default()
+    };
     m.positions = reader.vec3(ex.vertex_positions, "vertex_positions", ex.vertex_count)?;
     m.edges = reader.uvec2(ex.edge_verts, "edge_verts", ex.edge_count)?;
-    m.face_offsets = reader.u32s(ex.face_offsets, "face_offsets", if ex.face_count > 0 { ex.face_count + 1 } else { 0 })?;
+    m.face_offsets = reader.u32s(
+        ex.face_offsets,
+        "face_offsets",
+        if ex.face_count > 0 {
+            ex.face_count + 1
+        } else {
+            0
+        },
+    )?;
     if ex.face_count == 0 {
         // An empty offsets array and `[0]` both mean "no faces".
         m.face_offsets = vec![0];
     }
     m.corner_verts = reader.u32s(ex.corner_verts, "corner_verts", ex.corner_count)?;
-    m.corner_edges = reader.u32s(ex.corner_edges, "corner_edges", if ex.edge_count > 0 { ex.corner_count } else { 0 })?;
-    m.corner_normals = reader.vec3(ex.corner_normals, "corner_normals", if ex.face_count > 0 { ex.corner_count } else { 0 })?;
-    let tri = reader.u32s(ex.triangle_corners, "triangle_corners", ex.triangle_count * 3)?;
+    m.corner_edges = reader.u32s(
+        ex.corner_edges,
+        "corner_edges",
+        if ex.edge_count > 0 {
+            ex.corner_count
+        } else {
+            0
+        },
+    )?;
+    m.corner_normals = reader.vec3(
+        ex.corner_normals,
+        "corner_normals",
+        if ex.face_count > 0 {
+            ex.corner_count
+        } else {
+            0
+        },
+    )?;
+    let tri = reader.u32s(
+        ex.triangle_corners,
+        "triangle_corners",
+        ex.triangle_count * 3,
+    )?;
     m.triangles = tri.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
     m.triangle_faces = reader.u32s(ex.triangle_faces, "triangle_faces", ex.triangle_count)?;
     for (i, a) in ex.attributes.iter().enumerate() {
@@ -264,7 +354,12 @@ pub fn parse_glb(bytes: &[u8], path: &Path) -> Result<MeshData, SceneError> {
         let domain = Domain::parse(&a.domain)
             .ok_or_else(|| SceneError::new(path, &loc, format!("unknown domain {:?}", a.domain)))?;
         let data = reader.attribute(a.accessor, &a.data_type, &loc)?;
-        m.attributes.push(Attribute { name: a.name.clone(), domain, data_type: a.data_type.clone(), data });
+        m.attributes.push(Attribute {
+            name: a.name.clone(),
+            domain,
+            data_type: a.data_type.clone(),
+            data,
+        });
     }
     m.validate(path)?;
     Ok(m)
@@ -279,9 +374,19 @@ struct AccessorReader<'a> {
 impl AccessorReader<'_> {
     /// Returns the accessor's elements packed tightly, after checking its type and
     /// that every byte lies inside the BIN chunk.
-    fn bytes(&self, index: usize, ty: Type, comp: ComponentType, what: &str) -> Result<(usize, Vec<u8>), SceneError> {
+    fn bytes(
+        &self,
+        index: usize,
+        ty: Type,
+        comp: ComponentType,
+        what: &str,
+    ) -> Result<(usize, Vec<u8>), SceneError> {
         let err = |m: String| SceneError::new(self.path, format!("accessor {what} (#{index})"), m);
-        let acc = self.root.accessors.get(index).ok_or_else(|| err("does not exist".into()))?;
+        let acc = self
+            .root
+            .accessors
+            .get(index)
+            .ok_or_else(|| err("does not exist".into()))?;
         use gltf::json::validation::Checked;
         let acc_ty = match acc.type_ {
             Checked::Valid(t) => Some(t),
@@ -292,21 +397,40 @@ impl AccessorReader<'_> {
             Checked::Invalid => None,
         };
         if acc_ty != Some(ty) || acc_comp != Some(comp) {
-            return Err(err(format!("has type {:?}/{:?}, expected {ty:?}/{comp:?}", acc_ty, acc_comp)));
+            return Err(err(format!(
+                "has type {:?}/{:?}, expected {ty:?}/{comp:?}",
+                acc_ty, acc_comp
+            )));
         }
         let count = acc.count.0 as usize;
         let elem = ty.multiplicity() * comp.size();
-        let view_index = acc.buffer_view.ok_or_else(|| err("has no buffer view".into()))?.value();
-        let view = self.root.buffer_views.get(view_index).ok_or_else(|| err("buffer view missing".into()))?;
+        let view_index = acc
+            .buffer_view
+            .ok_or_else(|| err("has no buffer view".into()))?
+            .value();
+        let view = self
+            .root
+            .buffer_views
+            .get(view_index)
+            .ok_or_else(|| err("buffer view missing".into()))?;
         if view.buffer.value() != 0 {
             return Err(err("data must be in the glb's BIN chunk".into()));
         }
         let stride = view.byte_stride.map(|s| s.0).unwrap_or(elem);
-        let start = view.byte_offset.map(|o| o.0 as usize).unwrap_or(0) + acc.byte_offset.map(|o| o.0 as usize).unwrap_or(0);
-        let view_end = view.byte_offset.map(|o| o.0 as usize).unwrap_or(0) + view.byte_length.0 as usize;
-        let need_end = if count == 0 { start } else { start + stride * (count - 1) + elem };
+        let start = view.byte_offset.map(|o| o.0 as usize).unwrap_or(0)
+            + acc.byte_offset.map(|o| o.0 as usize).unwrap_or(0);
+        let view_end =
+            view.byte_offset.map(|o| o.0 as usize).unwrap_or(0) + view.byte_length.0 as usize;
+        let need_end = if count == 0 {
+            start
+        } else {
+            start + stride * (count - 1) + elem
+        };
         if need_end > view_end || view_end > self.blob.len() {
-            return Err(err(format!("reads bytes up to {need_end} but the data ends at {} (truncated file?)", view_end.min(self.blob.len()))));
+            return Err(err(format!(
+                "reads bytes up to {need_end} but the data ends at {} (truncated file?)",
+                view_end.min(self.blob.len())
+            )));
         }
         let mut out = Vec::with_capacity(count * elem);
         for i in 0..count {
@@ -315,68 +439,168 @@ impl AccessorReader<'_> {
         Ok((count, out))
     }
 
-    fn checked(&self, index: Option<usize>, ty: Type, comp: ComponentType, what: &str, expect: usize) -> Result<Vec<u8>, SceneError> {
+    fn checked(
+        &self,
+        index: Option<usize>,
+        ty: Type,
+        comp: ComponentType,
+        what: &str,
+        expect: usize,
+    ) -> Result<Vec<u8>, SceneError> {
         let Some(index) = index else {
             if expect == 0 {
                 return Ok(Vec::new());
             }
-            return Err(SceneError::new(self.path, format!("extras.blendsynth.{what}"), format!("missing, expected {expect} elements")));
+            return Err(SceneError::new(
+                self.path,
+                format!("extras.blendsynth.{what}"),
+                format!("missing, expected {expect} elements"),
+            ));
         };
         let (count, bytes) = self.bytes(index, ty, comp, what)?;
         if count != expect {
-            return Err(SceneError::new(self.path, format!("accessor {what} (#{index})"), format!("has {count} elements, expected {expect}")));
+            return Err(SceneError::new(
+                self.path,
+                format!("accessor {what} (#{index})"),
+                format!("has {count} elements, expected {expect}"),
+            ));
         }
         Ok(bytes)
     }
 
-    fn vec3(&self, index: Option<usize>, what: &str, n: usize) -> Result<Vec<[f32; 3]>, SceneError> {
+    fn vec3(
+        &self,
+        index: Option<usize>,
+        what: &str,
+        n: usize,
+    ) -> Result<Vec<[f32; 3]>, SceneError> {
         let b = self.checked(index, Type::Vec3, ComponentType::F32, what, n)?;
-        Ok(floats(&b).chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+        Ok(floats(&b)
+            .chunks_exact(3)
+            .map(|c| [c[0], c[1], c[2]])
+            .collect())
     }
-    fn uvec2(&self, index: Option<usize>, what: &str, n: usize) -> Result<Vec<[u32; 2]>, SceneError> {
+    fn uvec2(
+        &self,
+        index: Option<usize>,
+        what: &str,
+        n: usize,
+    ) -> Result<Vec<[u32; 2]>, SceneError> {
         let b = self.checked(index, Type::Vec2, ComponentType::U32, what, n)?;
         Ok(u32s(&b).chunks_exact(2).map(|c| [c[0], c[1]]).collect())
     }
     fn u32s(&self, index: Option<usize>, what: &str, n: usize) -> Result<Vec<u32>, SceneError> {
-        Ok(u32s(&self.checked(index, Type::Scalar, ComponentType::U32, what, n)?))
+        Ok(u32s(&self.checked(
+            index,
+            Type::Scalar,
+            ComponentType::U32,
+            what,
+            n,
+        )?))
     }
 
-    fn attribute(&self, index: usize, data_type: &str, loc: &str) -> Result<AttributeData, SceneError> {
+    fn attribute(
+        &self,
+        index: usize,
+        data_type: &str,
+        loc: &str,
+    ) -> Result<AttributeData, SceneError> {
         use AttributeData as A;
         let get = |ty, comp| self.bytes(index, ty, comp, loc).map(|(_, b)| b);
         Ok(match data_type {
             "FLOAT" => A::Float(floats(&get(Type::Scalar, ComponentType::F32)?)),
-            "FLOAT2" => A::Float2(floats(&get(Type::Vec2, ComponentType::F32)?).chunks_exact(2).map(|c| [c[0], c[1]]).collect()),
-            "FLOAT_VECTOR" => A::Float3(floats(&get(Type::Vec3, ComponentType::F32)?).chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()),
-            "FLOAT_COLOR" | "BYTE_COLOR" => A::Color(vec4s(&floats(&get(Type::Vec4, ComponentType::F32)?))),
+            "FLOAT2" => A::Float2(
+                floats(&get(Type::Vec2, ComponentType::F32)?)
+                    .chunks_exact(2)
+                    .map(|c| [c[0], c[1]])
+                    .collect(),
+            ),
+            "FLOAT_VECTOR" => A::Float3(
+                floats(&get(Type::Vec3, ComponentType::F32)?)
+                    .chunks_exact(3)
+                    .map(|c| [c[0], c[1], c[2]])
+                    .collect(),
+            ),
+            "FLOAT_COLOR" | "BYTE_COLOR" => {
+                A::Color(vec4s(&floats(&get(Type::Vec4, ComponentType::F32)?)))
+            }
             "QUATERNION" => A::Quaternion(vec4s(&floats(&get(Type::Vec4, ComponentType::F32)?))),
-            "FLOAT4X4" => A::Float4x4(floats(&get(Type::Mat4, ComponentType::F32)?).chunks_exact(16).map(|c| c.try_into().unwrap()).collect()),
-            "INT" => A::Int(u32s(&get(Type::Scalar, ComponentType::U32)?).into_iter().map(|v| v as i32).collect()),
-            "INT32_2D" => A::Int2(u32s(&get(Type::Vec2, ComponentType::U32)?).chunks_exact(2).map(|c| [c[0] as i32, c[1] as i32]).collect()),
-            "INT8" => A::Int8(get(Type::Scalar, ComponentType::I8)?.into_iter().map(|v| v as i8).collect()),
-            "BOOLEAN" => A::Bool(get(Type::Scalar, ComponentType::U8)?.into_iter().map(|v| v != 0).collect()),
-            other => return Err(SceneError::new(self.path, loc, format!("unknown attribute data type {other:?}"))),
+            "FLOAT4X4" => A::Float4x4(
+                floats(&get(Type::Mat4, ComponentType::F32)?)
+                    .chunks_exact(16)
+                    .map(|c| c.try_into().unwrap())
+                    .collect(),
+            ),
+            "INT" => A::Int(
+                u32s(&get(Type::Scalar, ComponentType::U32)?)
+                    .into_iter()
+                    .map(|v| v as i32)
+                    .collect(),
+            ),
+            "INT32_2D" => A::Int2(
+                u32s(&get(Type::Vec2, ComponentType::U32)?)
+                    .chunks_exact(2)
+                    .map(|c| [c[0] as i32, c[1] as i32])
+                    .collect(),
+            ),
+            "INT8" => A::Int8(
+                get(Type::Scalar, ComponentType::I8)?
+                    .into_iter()
+                    .map(|v| v as i8)
+                    .collect(),
+            ),
+            "BOOLEAN" => A::Bool(
+                get(Type::Scalar, ComponentType::U8)?
+                    .into_iter()
+                    .map(|v| v != 0)
+                    .collect(),
+            ),
+            other => {
+                return Err(SceneError::new(
+                    self.path,
+                    loc,
+                    format!("unknown attribute data type {other:?}"),
+                ))
+            }
         })
     }
 }
 
 fn floats(b: &[u8]) -> Vec<f32> {
-    b.chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect()
+    b.chunks_exact(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect()
 }
 fn u32s(b: &[u8]) -> Vec<u32> {
-    b.chunks_exact(4).map(|c| u32::from_le_bytes(c.try_into().unwrap())).collect()
+    b.chunks_exact(4)
+        .map(|c| u32::from_le_bytes(c.try_into().unwrap()))
+        .collect()
 }
 fn vec4s(f: &[f32]) -> Vec<[f32; 4]> {
-    f.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]).collect()
+    f.chunks_exact(4)
+        .map(|c| [c[0], c[1], c[2], c[3]])
+        .collect()
 }
 
 /// Reads a user's OBJ as Blender's OBJ importer would lay it out: one vertex per `v`
 /// line, faces keep their corner order, UVs and normals become corner data.
 pub fn read_obj(path: &Path) -> Result<MeshData, SceneError> {
-    let opts = tobj::LoadOptions { single_index: false, triangulate: false, ignore_points: true, ignore_lines: true, ..Default::default() };
-    let (models, _materials) =
-        tobj::load_obj(path, &opts).map_err(|e| SceneError::new(path, "", format!("cannot read OBJ: {e}")))?;
-    let mut m = MeshData { name: path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default(), ..Default::default() };
+    let opts = tobj::LoadOptions {
+        single_index: false,
+        triangulate: false,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    let (models, _materials) = tobj::load_obj(path, &opts)
+        .map_err(|e| SceneError::new(path, "", format!("cannot read OBJ: {e}")))?;
+    let mut m = MeshData {
+        name: path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        ..Default::default()
+    };
     m.face_offsets.push(0);
     let mut uvs: Vec<[f32; 2]> = Vec::new();
     let mut material_index: Vec<i32> = Vec::new();
@@ -385,7 +609,8 @@ pub fn read_obj(path: &Path) -> Result<MeshData, SceneError> {
     for model in &models {
         let mesh = &model.mesh;
         let base = m.positions.len() as u32;
-        m.positions.extend(mesh.positions.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
+        m.positions
+            .extend(mesh.positions.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
         let arities: Vec<u32> = if mesh.face_arities.is_empty() {
             vec![3; mesh.indices.len() / 3]
         } else {
@@ -409,7 +634,11 @@ pub fn read_obj(path: &Path) -> Result<MeshData, SceneError> {
                 uvs.push(uv);
                 if has_n {
                     let t = mesh.normal_indices[c] as usize;
-                    m.corner_normals.push([mesh.normals[3 * t], mesh.normals[3 * t + 1], mesh.normals[3 * t + 2]]);
+                    m.corner_normals.push([
+                        mesh.normals[3 * t],
+                        mesh.normals[3 * t + 1],
+                        mesh.normals[3 * t + 2],
+                    ]);
                 }
             }
             corner += n as usize;
@@ -423,9 +652,19 @@ pub fn read_obj(path: &Path) -> Result<MeshData, SceneError> {
     build_edges(&mut m);
     fan_triangulate(&mut m);
     if any_uv {
-        m.attributes.push(Attribute { name: "UVMap".into(), domain: Domain::Corner, data_type: "FLOAT2".into(), data: AttributeData::Float2(uvs) });
+        m.attributes.push(Attribute {
+            name: "UVMap".into(),
+            domain: Domain::Corner,
+            data_type: "FLOAT2".into(),
+            data: AttributeData::Float2(uvs),
+        });
     }
-    m.attributes.push(Attribute { name: "material_index".into(), domain: Domain::Face, data_type: "INT".into(), data: AttributeData::Int(material_index) });
+    m.attributes.push(Attribute {
+        name: "material_index".into(),
+        domain: Domain::Face,
+        data_type: "INT".into(),
+        data: AttributeData::Int(material_index),
+    });
     m.validate(path)?;
     Ok(m)
 }

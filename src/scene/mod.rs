@@ -29,11 +29,19 @@ impl Scene {
     pub fn load(dir: &Path) -> Result<Scene, SceneError> {
         let json_path = dir.join("scene.json");
         if !dir.is_dir() {
-            return Err(SceneError::new(dir, "", "not a folder (expected an export made by `blendsynth convert`)"));
+            return Err(SceneError::new(
+                dir,
+                "",
+                "not a folder (expected an export made by `blendsynth convert`)",
+            ));
         }
-        let bytes = std::fs::read(&json_path).map_err(|e| SceneError::new(&json_path, "", format!("cannot read: {e}")))?;
+        let bytes = std::fs::read(&json_path)
+            .map_err(|e| SceneError::new(&json_path, "", format!("cannot read: {e}")))?;
         let file = parse_scene_json(&bytes, &json_path)?;
-        let scene = Scene { dir: dir.to_path_buf(), file };
+        let scene = Scene {
+            dir: dir.to_path_buf(),
+            file,
+        };
         validate::validate(&scene, &json_path)?;
         Ok(scene)
     }
@@ -127,8 +135,20 @@ pub fn parse_scene_json(bytes: &[u8], path: &Path) -> Result<SceneFile, SceneErr
     };
     match value.get("format").and_then(|f| f.as_str()) {
         Some(FORMAT_TAG) => {}
-        Some(other) => return Err(SceneError::new(path, "format", format!("is {other:?}, expected {FORMAT_TAG:?}"))),
-        None => return Err(SceneError::new(path, "format", format!("missing: not a blendsynth scene (expected \"format\": {FORMAT_TAG:?})"))),
+        Some(other) => {
+            return Err(SceneError::new(
+                path,
+                "format",
+                format!("is {other:?}, expected {FORMAT_TAG:?}"),
+            ))
+        }
+        None => {
+            return Err(SceneError::new(
+                path,
+                "format",
+                format!("missing: not a blendsynth scene (expected \"format\": {FORMAT_TAG:?})"),
+            ))
+        }
     }
     match value.get("version").and_then(|v| v.as_u64()) {
         Some(v) if v as u32 <= FORMAT_VERSION && v >= 1 => {}
@@ -139,7 +159,11 @@ pub fn parse_scene_json(bytes: &[u8], path: &Path) -> Result<SceneFile, SceneErr
     }
     serde_path_to_error::deserialize(value).map_err(|e| {
         let loc = e.path().to_string();
-        SceneError::new(path, if loc == "." { String::new() } else { loc }, e.into_inner().to_string())
+        SceneError::new(
+            path,
+            if loc == "." { String::new() } else { loc },
+            e.into_inner().to_string(),
+        )
     })
 }
 
@@ -151,8 +175,16 @@ fn json_syntax_error(e: &serde_json::Error, bytes: &[u8], path: &Path) -> SceneE
         // JSON has no NaN or infinity; Python writes them as bare words unless told not to.
         let offset = line_col_offset(bytes, e.line(), e.column());
         let rest = &bytes[offset.min(bytes.len())..];
-        let rest = rest.get(rest.iter().position(|b| !b.is_ascii_whitespace()).unwrap_or(0)..).unwrap_or(&[]);
-        let word = |w: &[u8]| rest.starts_with(w) || (rest.first() == Some(&b'-') && rest[1..].starts_with(w));
+        let rest = rest
+            .get(
+                rest.iter()
+                    .position(|b| !b.is_ascii_whitespace())
+                    .unwrap_or(0)..,
+            )
+            .unwrap_or(&[]);
+        let word = |w: &[u8]| {
+            rest.starts_with(w) || (rest.first() == Some(&b'-') && rest[1..].starts_with(w))
+        };
         if word(b"NaN") || word(b"Infinity") || word(b"inf") {
             format!("non-finite number (NaN or infinity) is not allowed: {e}")
         } else {
@@ -190,15 +222,23 @@ pub fn resolve_inside(dir: &Path, rel: &str) -> Result<PathBuf, String> {
     for c in p.components() {
         match c {
             Component::Normal(_) | Component::CurDir => {}
-            Component::ParentDir => return Err(format!("path {rel:?} leaves the scene folder ('..')")),
-            Component::RootDir | Component::Prefix(_) => return Err(format!("path {rel:?} is absolute; paths must be relative to the scene folder")),
+            Component::ParentDir => {
+                return Err(format!("path {rel:?} leaves the scene folder ('..')"))
+            }
+            Component::RootDir | Component::Prefix(_) => {
+                return Err(format!(
+                    "path {rel:?} is absolute; paths must be relative to the scene folder"
+                ))
+            }
         }
     }
     let joined = dir.join(p);
     // A symlink inside the folder could still point outside it.
     if let (Ok(real), Ok(real_dir)) = (joined.canonicalize(), dir.canonicalize()) {
         if !real.starts_with(&real_dir) {
-            return Err(format!("path {rel:?} resolves outside the scene folder (symlink?)"));
+            return Err(format!(
+                "path {rel:?} resolves outside the scene folder (symlink?)"
+            ));
         }
     }
     Ok(joined)

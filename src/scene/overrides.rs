@@ -55,7 +55,10 @@ impl Override {
             return Err(format!("override {path:?} has no value"));
         }
         let value = serde_json::from_str(raw).unwrap_or_else(|_| Value::String(raw.to_string()));
-        Ok(Override { path: path.strip_prefix("bpy.data.").unwrap_or(path).to_string(), value })
+        Ok(Override {
+            path: path.strip_prefix("bpy.data.").unwrap_or(path).to_string(),
+            value,
+        })
     }
 }
 
@@ -66,20 +69,40 @@ impl Scene {
             return Ok(self.clone());
         }
         let json = self.json_path();
-        let mut v = serde_json::to_value(&self.file).map_err(|e| SceneError::new(&json, "", e.to_string()))?;
+        let mut v = serde_json::to_value(&self.file)
+            .map_err(|e| SceneError::new(&json, "", e.to_string()))?;
         for o in overrides {
-            set(&mut v, &o.path, &o.value).map_err(|m| SceneError::new(&json, format!("override {}", o.path), m))?;
+            set(&mut v, &o.path, &o.value)
+                .map_err(|m| SceneError::new(&json, format!("override {}", o.path), m))?;
         }
-        let file: SceneFile = serde_path_to_error::deserialize(v)
-            .map_err(|e| SceneError::new(&json, format!("after overrides, {}", e.path()), e.into_inner().to_string()))?;
-        let scene = Scene { dir: self.dir.clone(), file };
+        let file: SceneFile = serde_path_to_error::deserialize(v).map_err(|e| {
+            SceneError::new(
+                &json,
+                format!("after overrides, {}", e.path()),
+                e.into_inner().to_string(),
+            )
+        })?;
+        let scene = Scene {
+            dir: self.dir.clone(),
+            file,
+        };
         super::validate::validate(&scene, &json)?;
         Ok(scene)
     }
 }
 
 /// The top-level collections of `bpy.data` the format holds, by their Blender names.
-const COLLECTIONS: &[&str] = &["objects", "meshes", "curves", "materials", "worlds", "node_groups", "cameras", "lights", "images"];
+const COLLECTIONS: &[&str] = &[
+    "objects",
+    "meshes",
+    "curves",
+    "materials",
+    "worlds",
+    "node_groups",
+    "cameras",
+    "lights",
+    "images",
+];
 
 /// Sets the value at a Blender data path inside the scene JSON.
 pub fn set(root: &mut Value, path: &str, value: &Value) -> Result<(), String> {
@@ -92,17 +115,33 @@ pub fn set(root: &mut Value, path: &str, value: &Value) -> Result<(), String> {
             };
             let scene = &mut root["scene"];
             if scene["name"].as_str() != Some(name.as_str()) {
-                return Err(format!("no scene named {name:?} (the export holds {:?})", scene["name"]));
+                return Err(format!(
+                    "no scene named {name:?} (the export holds {:?})",
+                    scene["name"]
+                ));
             }
             scene
         }
-        Some(Token::Prop(c)) if COLLECTIONS.contains(&c.as_str()) => root.get_mut(c.as_str()).ok_or_else(|| format!("the export has no {c}"))?,
-        Some(t) => return Err(format!("{t:?} is not a bpy.data collection this format holds ({})", COLLECTIONS.join(", "))),
+        Some(Token::Prop(c)) if COLLECTIONS.contains(&c.as_str()) => root
+            .get_mut(c.as_str())
+            .ok_or_else(|| format!("the export has no {c}"))?,
+        Some(t) => {
+            return Err(format!(
+                "{t:?} is not a bpy.data collection this format holds ({})",
+                COLLECTIONS.join(", ")
+            ))
+        }
         None => return Err("empty path".into()),
     };
     let mut walked = String::new();
     for t in it {
-        cur = step(cur, t).map_err(|m| if walked.is_empty() { m } else { format!("{m} (after {walked})") })?;
+        cur = step(cur, t).map_err(|m| {
+            if walked.is_empty() {
+                m
+            } else {
+                format!("{m} (after {walked})")
+            }
+        })?;
         walked.push_str(&match t {
             Token::Prop(p) => format!(".{p}"),
             Token::Key(k) => format!("[{k:?}]"),
@@ -136,7 +175,11 @@ fn step<'a>(v: &'a mut Value, t: &Token) -> Result<&'a mut Value, String> {
                 let pos = items
                     .iter()
                     .position(|x| x.get("identifier").and_then(Value::as_str) == Some(k.as_str()))
-                    .or_else(|| items.iter().position(|x| x.get("name").and_then(Value::as_str) == Some(k.as_str())));
+                    .or_else(|| {
+                        items
+                            .iter()
+                            .position(|x| x.get("name").and_then(Value::as_str) == Some(k.as_str()))
+                    });
                 match pos {
                     Some(i) => Ok(&mut items[i]),
                     None => Err(format!("nothing named {k:?} here")),
@@ -155,7 +198,9 @@ fn step<'a>(v: &'a mut Value, t: &Token) -> Result<&'a mut Value, String> {
         Token::Index(i) => match v {
             Value::Array(items) => {
                 let n = items.len();
-                items.get_mut(*i).ok_or_else(|| format!("index {i} out of range (length {n})"))
+                items
+                    .get_mut(*i)
+                    .ok_or_else(|| format!("index {i} out of range (length {n})"))
             }
             _ => Err(format!("cannot index a {}", kind(v))),
         },
@@ -178,7 +223,11 @@ fn assign(slot: &mut Value, value: &Value) -> Result<(), String> {
                 return Ok(());
             }
             // A float stays a float, whatever way the number was written.
-            *slot = if old.is_f64() { Value::from(new_f) } else { value.clone() };
+            *slot = if old.is_f64() {
+                Value::from(new_f)
+            } else {
+                value.clone()
+            };
             Ok(())
         }
         (Value::Bool(_), Value::Bool(_)) | (Value::String(_), Value::String(_)) => {

@@ -13,21 +13,35 @@ pub(super) fn validate(scene: &Scene, json: &Path) -> Result<(), SceneError> {
     let objects = unique(json, "objects", f.objects.iter().map(|o| o.name.as_str()))?;
     let meshes = unique(json, "meshes", f.meshes.iter().map(|m| m.name.as_str()))?;
     let curves = unique(json, "curves", f.curves.iter().map(|c| c.name.as_str()))?;
-    let materials = unique(json, "materials", f.materials.iter().map(|m| m.name.as_str()))?;
+    let materials = unique(
+        json,
+        "materials",
+        f.materials.iter().map(|m| m.name.as_str()),
+    )?;
     let worlds = unique(json, "worlds", f.worlds.iter().map(|w| w.name.as_str()))?;
-    let groups = unique(json, "node_groups", f.node_groups.iter().map(|g| g.name.as_str()))?;
+    let groups = unique(
+        json,
+        "node_groups",
+        f.node_groups.iter().map(|g| g.name.as_str()),
+    )?;
     let cameras = unique(json, "cameras", f.cameras.iter().map(|c| c.name.as_str()))?;
     let lights = unique(json, "lights", f.lights.iter().map(|l| l.name.as_str()))?;
     unique(json, "images", f.images.iter().map(|i| i.name.as_str()))?;
 
     if let Some(cam) = &f.scene.camera {
         if !objects.contains(cam.as_str()) {
-            return err("scene.camera".into(), format!("names object {cam:?}, which is not in objects"));
+            return err(
+                "scene.camera".into(),
+                format!("names object {cam:?}, which is not in objects"),
+            );
         }
     }
     if let Some(w) = &f.scene.world {
         if !worlds.contains(w.as_str()) {
-            return err("scene.world".into(), format!("names world {w:?}, which is not in worlds"));
+            return err(
+                "scene.world".into(),
+                format!("names world {w:?}, which is not in worlds"),
+            );
         }
     }
 
@@ -43,26 +57,38 @@ pub(super) fn validate(scene: &Scene, json: &Path) -> Result<(), SceneError> {
             };
             if let Some(set) = set {
                 if !set.contains(d.as_str()) {
-                    return err(at("data"), format!("names {list} entry {d:?}, which does not exist"));
+                    return err(
+                        at("data"),
+                        format!("names {list} entry {d:?}, which does not exist"),
+                    );
                 }
             }
         }
         if let Some(p) = &o.parent {
             if !objects.contains(p.as_str()) {
-                return err(at("parent"), format!("names object {p:?}, which does not exist"));
+                return err(
+                    at("parent"),
+                    format!("names object {p:?}, which does not exist"),
+                );
             }
         }
         for (s, slot) in o.material_slots.iter().enumerate() {
             if let Some(m) = &slot.material {
                 if !materials.contains(m.as_str()) {
-                    return err(at(&format!("material_slots[{s}].material")), format!("names material {m:?}, which does not exist"));
+                    return err(
+                        at(&format!("material_slots[{s}].material")),
+                        format!("names material {m:?}, which does not exist"),
+                    );
                 }
             }
         }
         for (k, m) in o.modifiers.iter().enumerate() {
             if let Some(g) = &m.node_group {
                 if !groups.contains(g.as_str()) {
-                    return err(at(&format!("modifiers[{k}].node_group")), format!("names node group {g:?}, which does not exist"));
+                    return err(
+                        at(&format!("modifiers[{k}].node_group")),
+                        format!("names node group {g:?}, which does not exist"),
+                    );
                 }
             }
         }
@@ -70,29 +96,42 @@ pub(super) fn validate(scene: &Scene, json: &Path) -> Result<(), SceneError> {
     }
 
     for (i, m) in f.meshes.iter().enumerate() {
-        resolve_inside(&scene.dir, &m.file).map_err(|e| SceneError::new(json, format!("meshes[{i}].file"), e))?;
+        resolve_inside(&scene.dir, &m.file)
+            .map_err(|e| SceneError::new(json, format!("meshes[{i}].file"), e))?;
         for (s, mat) in m.materials.iter().enumerate() {
             if let Some(mat) = mat {
                 if !materials.contains(mat.as_str()) {
-                    return err(format!("meshes[{i}].materials[{s}]"), format!("names material {mat:?}, which does not exist"));
+                    return err(
+                        format!("meshes[{i}].materials[{s}]"),
+                        format!("names material {mat:?}, which does not exist"),
+                    );
                 }
             }
         }
     }
     for (i, e) in f.evaluated.iter().enumerate() {
-        resolve_inside(&scene.dir, &e.file).map_err(|m| SceneError::new(json, format!("evaluated[{i}].file"), m))?;
+        resolve_inside(&scene.dir, &e.file)
+            .map_err(|m| SceneError::new(json, format!("evaluated[{i}].file"), m))?;
         if !objects.contains(e.object.as_str()) {
-            return err(format!("evaluated[{i}].object"), format!("names object {:?}, which does not exist", e.object));
+            return err(
+                format!("evaluated[{i}].object"),
+                format!("names object {:?}, which does not exist", e.object),
+            );
         }
     }
     for (i, im) in f.images.iter().enumerate() {
         if let Some(p) = &im.file {
-            resolve_inside(&scene.dir, p).map_err(|m| SceneError::new(json, format!("images[{i}].file"), m))?;
+            resolve_inside(&scene.dir, p)
+                .map_err(|m| SceneError::new(json, format!("images[{i}].file"), m))?;
         }
     }
-    for (field, p) in [("dir", &f.color_management.dir), ("config", &f.color_management.config)] {
+    for (field, p) in [
+        ("dir", &f.color_management.dir),
+        ("config", &f.color_management.config),
+    ] {
         if let Some(p) = p {
-            resolve_inside(&scene.dir, p).map_err(|m| SceneError::new(json, format!("color_management.{field}"), m))?;
+            resolve_inside(&scene.dir, p)
+                .map_err(|m| SceneError::new(json, format!("color_management.{field}"), m))?;
         }
     }
 
@@ -112,11 +151,19 @@ pub(super) fn validate(scene: &Scene, json: &Path) -> Result<(), SceneError> {
     Ok(())
 }
 
-fn unique<'a>(json: &Path, list: &str, names: impl Iterator<Item = &'a str>) -> Result<HashSet<&'a str>, SceneError> {
+fn unique<'a>(
+    json: &Path,
+    list: &str,
+    names: impl Iterator<Item = &'a str>,
+) -> Result<HashSet<&'a str>, SceneError> {
     let mut set = HashSet::new();
     for (i, n) in names.enumerate() {
         if !set.insert(n) {
-            return Err(SceneError::new(json, format!("{list}[{i}].name"), format!("{n:?} appears twice")));
+            return Err(SceneError::new(
+                json,
+                format!("{list}[{i}].name"),
+                format!("{n:?} appears twice"),
+            ));
         }
     }
     Ok(set)
@@ -131,34 +178,54 @@ fn check_matrix(json: &Path, loc: &str, m: &[[f64; 4]; 4]) -> Result<(), SceneEr
 
 /// Node names are unique, links land on existing sockets, group nodes name existing
 /// groups, socket indices match their positions.
-fn check_tree(json: &Path, at: &str, t: &NodeTree, groups: &HashSet<&str>) -> Result<(), SceneError> {
+fn check_tree(
+    json: &Path,
+    at: &str,
+    t: &NodeTree,
+    groups: &HashSet<&str>,
+) -> Result<(), SceneError> {
     let err = |loc: String, msg: String| Err(SceneError::new(json, loc, msg));
     let mut nodes: HashMap<&str, usize> = HashMap::new();
     for (i, n) in t.nodes.iter().enumerate() {
         if nodes.insert(n.name.as_str(), i).is_some() {
-            return err(format!("{at}.nodes[{i}].name"), format!("node {:?} appears twice", n.name));
+            return err(
+                format!("{at}.nodes[{i}].name"),
+                format!("node {:?} appears twice", n.name),
+            );
         }
     }
     for (i, n) in t.nodes.iter().enumerate() {
         let nat = format!("{at}.nodes[{i}] ({:?})", n.name);
         if let Some(p) = &n.parent {
             if !nodes.contains_key(p.as_str()) {
-                return err(format!("{nat}.parent"), format!("names node {p:?}, which is not in this tree"));
+                return err(
+                    format!("{nat}.parent"),
+                    format!("names node {p:?}, which is not in this tree"),
+                );
             }
         }
         if let Some(g) = &n.node_tree {
             if !groups.contains(g.as_str()) {
-                return err(format!("{nat}.node_tree"), format!("names node group {g:?}, which does not exist"));
+                return err(
+                    format!("{nat}.node_tree"),
+                    format!("names node group {g:?}, which does not exist"),
+                );
             }
         }
         for (side, sockets) in [("inputs", &n.inputs), ("outputs", &n.outputs)] {
             let mut ids = HashSet::new();
             for (k, s) in sockets.iter().enumerate() {
                 if s.index != k {
-                    return err(format!("{nat}.{side}[{k}].index"), format!("is {} but the socket is at position {k}", s.index));
+                    return err(
+                        format!("{nat}.{side}[{k}].index"),
+                        format!("is {} but the socket is at position {k}", s.index),
+                    );
                 }
                 if !ids.insert(s.identifier.as_str()) {
-                    return err(format!("{nat}.{side}[{k}].identifier"), format!("{:?} appears twice", s.identifier));
+                    return err(
+                        format!("{nat}.{side}[{k}].identifier"),
+                        format!("{:?} appears twice", s.identifier),
+                    );
                 }
             }
         }
@@ -166,16 +233,48 @@ fn check_tree(json: &Path, at: &str, t: &NodeTree, groups: &HashSet<&str>) -> Re
     for (i, l) in t.links.iter().enumerate() {
         let lat = format!("{at}.links[{i}]");
         let Some(&from) = nodes.get(l.from_node.as_str()) else {
-            return err(format!("{lat}.from_node"), format!("names node {:?}, which is not in this tree (dangling link)", l.from_node));
+            return err(
+                format!("{lat}.from_node"),
+                format!(
+                    "names node {:?}, which is not in this tree (dangling link)",
+                    l.from_node
+                ),
+            );
         };
         let Some(&to) = nodes.get(l.to_node.as_str()) else {
-            return err(format!("{lat}.to_node"), format!("names node {:?}, which is not in this tree (dangling link)", l.to_node));
+            return err(
+                format!("{lat}.to_node"),
+                format!(
+                    "names node {:?}, which is not in this tree (dangling link)",
+                    l.to_node
+                ),
+            );
         };
-        if !t.nodes[from].outputs.iter().any(|s| s.identifier == l.from_socket) {
-            return err(format!("{lat}.from_socket"), format!("node {:?} has no output {:?} (dangling link)", l.from_node, l.from_socket));
+        if !t.nodes[from]
+            .outputs
+            .iter()
+            .any(|s| s.identifier == l.from_socket)
+        {
+            return err(
+                format!("{lat}.from_socket"),
+                format!(
+                    "node {:?} has no output {:?} (dangling link)",
+                    l.from_node, l.from_socket
+                ),
+            );
         }
-        if !t.nodes[to].inputs.iter().any(|s| s.identifier == l.to_socket) {
-            return err(format!("{lat}.to_socket"), format!("node {:?} has no input {:?} (dangling link)", l.to_node, l.to_socket));
+        if !t.nodes[to]
+            .inputs
+            .iter()
+            .any(|s| s.identifier == l.to_socket)
+        {
+            return err(
+                format!("{lat}.to_socket"),
+                format!(
+                    "node {:?} has no input {:?} (dangling link)",
+                    l.to_node, l.to_socket
+                ),
+            );
         }
     }
     Ok(())

@@ -52,7 +52,10 @@ enum Values {
     /// triangles, so a quad's two triangles may give a shared corner different values.
     TriangleCorner(Vec<[f32; 4]>),
     /// Smooth faces: corner normals interpolated; flat ones (per face): the triangle normal.
-    MapNormal { normals: Vec<Vec3>, flat: Vec<bool> },
+    MapNormal {
+        normals: Vec<Vec3>,
+        flat: Vec<bool>,
+    },
 }
 
 #[derive(Debug, Clone)]
@@ -76,14 +79,40 @@ fn convert(name: &str, data: &AttributeData) -> Result<(Vec<[f32; 4]>, FacMode),
     use AttributeData as A;
     Ok(match data {
         A::Float(v) => (v.iter().map(|&x| to4_float(x)).collect(), FacMode::Average),
-        A::Int(v) => (v.iter().map(|&x| to4_float(x as f32)).collect(), FacMode::Average),
-        A::Int8(v) => (v.iter().map(|&x| to4_float(x as f32)).collect(), FacMode::Average),
-        A::Bool(v) => (v.iter().map(|&x| to4_float(if x { 1.0 } else { 0.0 })).collect(), FacMode::Average),
-        A::Float2(v) => (v.iter().map(|x| [x[0], x[1], 0.0, 1.0]).collect(), FacMode::X),
-        A::Int2(v) => (v.iter().map(|x| [x[0] as f32, x[1] as f32, 0.0, 1.0]).collect(), FacMode::X),
-        A::Float3(v) => (v.iter().map(|x| [x[0], x[1], x[2], 1.0]).collect(), FacMode::Average),
+        A::Int(v) => (
+            v.iter().map(|&x| to4_float(x as f32)).collect(),
+            FacMode::Average,
+        ),
+        A::Int8(v) => (
+            v.iter().map(|&x| to4_float(x as f32)).collect(),
+            FacMode::Average,
+        ),
+        A::Bool(v) => (
+            v.iter()
+                .map(|&x| to4_float(if x { 1.0 } else { 0.0 }))
+                .collect(),
+            FacMode::Average,
+        ),
+        A::Float2(v) => (
+            v.iter().map(|x| [x[0], x[1], 0.0, 1.0]).collect(),
+            FacMode::X,
+        ),
+        A::Int2(v) => (
+            v.iter()
+                .map(|x| [x[0] as f32, x[1] as f32, 0.0, 1.0])
+                .collect(),
+            FacMode::X,
+        ),
+        A::Float3(v) => (
+            v.iter().map(|x| [x[0], x[1], x[2], 1.0]).collect(),
+            FacMode::Average,
+        ),
         A::Color(v) => (v.clone(), FacMode::Average),
-        A::Quaternion(_) | A::Float4x4(_) => return Err(format!("attribute {name:?}: quaternion and matrix attributes are not supported in shaders yet")),
+        A::Quaternion(_) | A::Float4x4(_) => {
+            return Err(format!(
+            "attribute {name:?}: quaternion and matrix attributes are not supported in shaders yet"
+        ))
+        }
     })
 }
 
@@ -99,17 +128,30 @@ fn edge_to_point(mesh: &MeshData, v: &[[f32; 4]]) -> Vec<[f32; 4]> {
             count[p as usize] += 1;
         }
     }
-    sum.iter().zip(&count).map(|(s, &c)| if c == 0 { *s } else { s.map(|x| x / c as f32) }).collect()
+    sum.iter()
+        .zip(&count)
+        .map(|(s, &c)| if c == 0 { *s } else { s.map(|x| x / c as f32) })
+        .collect()
 }
 
 impl BoundAttributes {
     /// Resolves `requests` on `mesh`. A name the mesh lacks reads as Cycles reads a missing
     /// attribute; a type no shader can read is an error naming it.
-    pub fn bind(mesh: &MeshData, requests: &[AttributeRequest], active_render_uv: Option<&str>, default_color: Option<&str>) -> Result<BoundAttributes, String> {
+    pub fn bind(
+        mesh: &MeshData,
+        requests: &[AttributeRequest],
+        active_render_uv: Option<&str>,
+        default_color: Option<&str>,
+    ) -> Result<BoundAttributes, String> {
         let mut items = Vec::with_capacity(requests.len());
         for r in requests {
             let named = |name: &str| -> Result<Bound, String> {
-                let Some(a) = mesh.attribute(name) else { return Ok(Bound { values: Values::Missing, fac: FacMode::Average }) };
+                let Some(a) = mesh.attribute(name) else {
+                    return Ok(Bound {
+                        values: Values::Missing,
+                        fac: FacMode::Average,
+                    });
+                };
                 let (v, fac) = convert(name, &a.data)?;
                 let values = match a.domain {
                     Domain::Point => Values::Point(v),
@@ -123,13 +165,25 @@ impl BoundAttributes {
                 AttributeRequest::Named(name) => named(name)?,
                 AttributeRequest::DefaultColor => match default_color {
                     Some(name) => named(name)?,
-                    None => Bound { values: Values::Missing, fac: FacMode::Average },
+                    None => Bound {
+                        values: Values::Missing,
+                        fac: FacMode::Average,
+                    },
                 },
                 AttributeRequest::Tangent(uv) => {
                     let uv = uv.as_deref().or(active_render_uv);
-                    match uv.and_then(|n| mesh.attribute(n)).map(|a| (&a.data, a.domain)) {
-                        Some((AttributeData::Float2(uvs), Domain::Corner)) => Bound { values: Values::TriangleCorner(mikk_tangents(mesh, uvs)), fac: FacMode::Average },
-                        _ => Bound { values: Values::Missing, fac: FacMode::Average },
+                    match uv
+                        .and_then(|n| mesh.attribute(n))
+                        .map(|a| (&a.data, a.domain))
+                    {
+                        Some((AttributeData::Float2(uvs), Domain::Corner)) => Bound {
+                            values: Values::TriangleCorner(mikk_tangents(mesh, uvs)),
+                            fac: FacMode::Average,
+                        },
+                        _ => Bound {
+                            values: Values::Missing,
+                            fac: FacMode::Average,
+                        },
                     }
                 }
                 AttributeRequest::MapNormal => {
@@ -139,27 +193,54 @@ impl BoundAttributes {
                     };
                     let vn = super::tangent::vertex_normals(mesh);
                     let normals = mesh.corner_verts.iter().map(|&v| vn[v as usize]).collect();
-                    Bound { values: Values::MapNormal { normals, flat }, fac: FacMode::Average }
+                    Bound {
+                        values: Values::MapNormal { normals, flat },
+                        fac: FacMode::Average,
+                    }
                 }
                 // Float attributes: Fac is the value itself, Color (v, v, v), Alpha 1.
                 AttributeRequest::Pointiness => {
                     let p = super::derived::pointiness(mesh, &super::tangent::vertex_normals(mesh));
-                    Bound { values: Values::Point(p.into_iter().map(to4_float).collect()), fac: FacMode::X }
+                    Bound {
+                        values: Values::Point(p.into_iter().map(to4_float).collect()),
+                        fac: FacMode::X,
+                    }
                 }
-                AttributeRequest::RandomPerIsland => Bound { values: Values::Face(super::derived::random_per_island(mesh).into_iter().map(to4_float).collect()), fac: FacMode::X },
+                AttributeRequest::RandomPerIsland => Bound {
+                    values: Values::Face(
+                        super::derived::random_per_island(mesh)
+                            .into_iter()
+                            .map(to4_float)
+                            .collect(),
+                    ),
+                    fac: FacMode::X,
+                },
             });
         }
         if items.len() > MAX_ATTRIBUTES {
-            return Err(format!("the material reads {} mesh attributes; at most {MAX_ATTRIBUTES} are supported", items.len()));
+            return Err(format!(
+                "the material reads {} mesh attributes; at most {MAX_ATTRIBUTES} are supported",
+                items.len()
+            ));
         }
         Ok(BoundAttributes { items })
     }
 
     /// Writes the attribute values at a point of triangle `tri` (Blender corners `c`, face
     /// `face`, barycentric weights `w` of its corners) into `sp`.
-    pub fn fill(&self, mesh: &MeshData, tri: usize, c: [usize; 3], face: usize, w: [f32; 3], sp: &mut ShadingPoint) {
+    pub fn fill(
+        &self,
+        mesh: &MeshData,
+        tri: usize,
+        c: [usize; 3],
+        face: usize,
+        w: [f32; 3],
+        sp: &mut ShadingPoint,
+    ) {
         sp.attr_missing = 0;
-        let lerp = |v: [[f32; 4]; 3]| -> [f32; 4] { std::array::from_fn(|k| w[0] * v[0][k] + w[1] * v[1][k] + w[2] * v[2][k]) };
+        let lerp = |v: [[f32; 4]; 3]| -> [f32; 4] {
+            std::array::from_fn(|k| w[0] * v[0][k] + w[1] * v[1][k] + w[2] * v[2][k])
+        };
         for (i, b) in self.items.iter().enumerate() {
             let v = match &b.values {
                 Values::Missing => {

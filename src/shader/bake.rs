@@ -7,7 +7,10 @@ use std::path::Path;
 use crate::nodes::math::{normalize3, Vec3};
 use crate::scene::{AttributeData, Scene};
 
-use super::bump::{attribute_differential, differential_dudv, differential_from_compact, differential_make_compact, ObjectTransform};
+use super::bump::{
+    attribute_differential, differential_dudv, differential_from_compact,
+    differential_make_compact, ObjectTransform,
+};
 use super::compile::compile_material;
 use super::point::ShadingPoint;
 use super::program::Program;
@@ -34,15 +37,32 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
     if size == 0 || size > 16384 {
         return Err(format!("--size {size}: must be 1 to 16384"));
     }
-    let obj = scene.object(&opts.object).ok_or_else(|| format!("no object {:?}", opts.object))?;
+    let obj = scene
+        .object(&opts.object)
+        .ok_or_else(|| format!("no object {:?}", opts.object))?;
     if obj.kind != "MESH" {
-        return Err(format!("object {:?} is a {}, not a mesh", obj.name, obj.kind));
+        return Err(format!(
+            "object {:?} is a {}, not a mesh",
+            obj.name, obj.kind
+        ));
     }
-    let mesh_name = obj.data.as_deref().ok_or_else(|| format!("object {:?} has no mesh", obj.name))?;
-    let mesh_index = scene.file.meshes.iter().position(|m| m.name == mesh_name).ok_or_else(|| format!("mesh {mesh_name:?} missing"))?;
+    let mesh_name = obj
+        .data
+        .as_deref()
+        .ok_or_else(|| format!("object {:?} has no mesh", obj.name))?;
+    let mesh_index = scene
+        .file
+        .meshes
+        .iter()
+        .position(|m| m.name == mesh_name)
+        .ok_or_else(|| format!("mesh {mesh_name:?} missing"))?;
     let info = &scene.file.meshes[mesh_index];
     let mesh = scene.load_mesh(mesh_index).map_err(|e| e.to_string())?;
-    let uv_name = opts.uv.clone().or_else(|| info.active_render_uv.clone()).ok_or_else(|| format!("mesh {mesh_name:?} has no UV map"))?;
+    let uv_name = opts
+        .uv
+        .clone()
+        .or_else(|| info.active_render_uv.clone())
+        .ok_or_else(|| format!("mesh {mesh_name:?} has no UV map"))?;
     let uvs = match mesh.attribute(&uv_name).map(|a| &a.data) {
         Some(AttributeData::Float2(v)) if v.len() == mesh.corner_count() => v,
         _ => return Err(format!("mesh {mesh_name:?} has no UV map {uv_name:?}")),
@@ -62,14 +82,24 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
     let custom = mesh.attribute("custom_normal").is_some();
     let smooth_normal = |c: usize| -> Vec3 {
         if custom {
-            mesh.corner_normals.get(c).copied().unwrap_or([0.0, 0.0, 1.0])
+            mesh.corner_normals
+                .get(c)
+                .copied()
+                .unwrap_or([0.0, 0.0, 1.0])
         } else {
             vertex_normals[mesh.corner_verts[c] as usize]
         }
     };
     // One program per material slot; a face without a material emits nothing.
     let mut programs: Vec<Option<Program>> = Vec::new();
-    let slots = if obj.material_slots.is_empty() { info.materials.clone() } else { obj.material_slots.iter().map(|s| s.material.clone()).collect() };
+    let slots = if obj.material_slots.is_empty() {
+        info.materials.clone()
+    } else {
+        obj.material_slots
+            .iter()
+            .map(|s| s.material.clone())
+            .collect()
+    };
     for m in &slots {
         programs.push(match m {
             Some(name) => Some(compile_material(scene, name).map_err(|e| e.to_string())?),
@@ -78,11 +108,21 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
     }
 
     let world = obj.matrix_world;
-    let inverse = crate::shader::view::invert_affine(&world).ok_or_else(|| format!("object {:?} has a singular transform", obj.name))?;
-    let normal_matrix = inverse_transpose3(&world).ok_or_else(|| format!("object {:?} has a singular transform", obj.name))?;
-    let (tex_loc, tex_size) = (info.texspace_location.unwrap_or([0.0; 3]), info.texspace_size.unwrap_or([1.0; 3]));
-    let f32_rows = |m: &[[f64; 4]; 4]| -> [[f32; 4]; 3] { std::array::from_fn(|r| std::array::from_fn(|k| m[r][k] as f32)) };
-    let transform = ObjectTransform { to_world: f32_rows(&world), to_object: f32_rows(&inverse) };
+    let inverse = crate::shader::view::invert_affine(&world)
+        .ok_or_else(|| format!("object {:?} has a singular transform", obj.name))?;
+    let normal_matrix = inverse_transpose3(&world)
+        .ok_or_else(|| format!("object {:?} has a singular transform", obj.name))?;
+    let (tex_loc, tex_size) = (
+        info.texspace_location.unwrap_or([0.0; 3]),
+        info.texspace_size.unwrap_or([1.0; 3]),
+    );
+    let f32_rows = |m: &[[f64; 4]; 4]| -> [[f32; 4]; 3] {
+        std::array::from_fn(|r| std::array::from_fn(|k| m[r][k] as f32))
+    };
+    let transform = ObjectTransform {
+        to_world: f32_rows(&world),
+        to_object: f32_rows(&inverse),
+    };
 
     // What Cycles' EMIT bake gives the context-reading nodes: the scene camera, the object.
     let view = super::view::scene_view(scene)?.unwrap_or_default();
@@ -92,15 +132,26 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
     let bound = programs
         .iter()
         .map(|p| match p {
-            Some(p) => super::attributes::BoundAttributes::bind(&mesh, &p.attributes, info.active_render_uv.as_deref(), info.default_color_attribute.as_deref()).map_err(|e| format!("mesh {mesh_name:?}: {e}")),
+            Some(p) => super::attributes::BoundAttributes::bind(
+                &mesh,
+                &p.attributes,
+                info.active_render_uv.as_deref(),
+                info.default_color_attribute.as_deref(),
+            )
+            .map_err(|e| format!("mesh {mesh_name:?}: {e}")),
             None => Ok(Default::default()),
         })
         .collect::<Result<Vec<_>, String>>()?;
-    let mut stacks: Vec<Vec<f32>> = programs.iter().map(|p| p.as_ref().map(Program::new_stack).unwrap_or_default()).collect();
+    let mut stacks: Vec<Vec<f32>> = programs
+        .iter()
+        .map(|p| p.as_ref().map(Program::new_stack).unwrap_or_default())
+        .collect();
     for (t, tri) in mesh.triangles.iter().enumerate() {
         let face = mesh.triangle_faces[t] as usize;
         let slot = (material_index[face].max(0) as usize).min(programs.len().saturating_sub(1));
-        let Some(program) = programs.get(slot).and_then(Option::as_ref) else { continue };
+        let Some(program) = programs.get(slot).and_then(Option::as_ref) else {
+            continue;
+        };
         let stack = &mut stacks[slot];
         let c = tri.map(|c| c as usize);
         let uv = c.map(|c| uvs[c]);
@@ -111,40 +162,76 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
         if area == 0.0 {
             continue;
         }
-        let diff = TriangleDifferentials::new(&world, uv, size, c.map(|c| mesh.positions[mesh.corner_verts[c] as usize]), tex_loc, tex_size);
+        let diff = TriangleDifferentials::new(
+            &world,
+            uv,
+            size,
+            c.map(|c| mesh.positions[mesh.corner_verts[c] as usize]),
+            tex_loc,
+            tex_size,
+        );
         for y in y0..y1 {
             for x in x0..x1 {
                 // Blender's bake rasteriser samples slightly off the texel centre
                 // (measured: +0.001 texel in u, +0.002 in v), so values match at its points.
                 let p = [x as f32 + 0.501, y as f32 + 0.502];
-                let (w0, w1, w2) = (edge(px[1], px[2], p) / area, edge(px[2], px[0], p) / area, edge(px[0], px[1], p) / area);
+                let (w0, w1, w2) = (
+                    edge(px[1], px[2], p) / area,
+                    edge(px[2], px[0], p) / area,
+                    edge(px[0], px[1], p) / area,
+                );
                 if w0 < 0.0 || w1 < 0.0 || w2 < 0.0 {
                     continue;
                 }
                 let w = [w0, w1, w2];
-                let lerp = |v: [Vec3; 3]| -> Vec3 { std::array::from_fn(|k| w[0] * v[0][k] + w[1] * v[1][k] + w[2] * v[2][k]) };
+                let lerp = |v: [Vec3; 3]| -> Vec3 {
+                    std::array::from_fn(|k| w[0] * v[0][k] + w[1] * v[1][k] + w[2] * v[2][k])
+                };
                 let local = lerp(c.map(|c| mesh.positions[mesh.corner_verts[c] as usize]));
                 // Cycles moves vertices to world space and derives object coordinates back
                 // through the inverse transform; doing the same keeps its rounding.
-                let position = lerp(c.map(|c| transform_point(&world, mesh.positions[mesh.corner_verts[c] as usize])));
+                let position = lerp(c.map(|c| {
+                    transform_point(&world, mesh.positions[mesh.corner_verts[c] as usize])
+                }));
                 // Cycles applies the object transform to a single-user mesh: vertex normals
                 // go to world space (normalised) before interpolation, and the object-space
                 // normal (Texture Coordinate > Normal, box projection) comes back through
                 // the transpose.
-                let world_n = normalize3(lerp(c.map(|c| normalize3(mul3x3(&normal_matrix, smooth_normal(c))))));
+                let world_n = normalize3(lerp(
+                    c.map(|c| normalize3(mul3x3(&normal_matrix, smooth_normal(c)))),
+                ));
                 // A flat face shades with its triangle's normal (Cycles' sd->N = Ng), which
                 // differs from Blender's face normal where a quad is not planar.
-                let world_n = if flat[face] { flat_normal(c.map(|c| transform_point(&world, mesh.positions[mesh.corner_verts[c] as usize]))) } else { world_n };
+                let world_n = if flat[face] {
+                    flat_normal(c.map(|c| {
+                        transform_point(&world, mesh.positions[mesh.corner_verts[c] as usize])
+                    }))
+                } else {
+                    world_n
+                };
                 let sp = ShadingPoint {
                     position,
                     normal: world_n,
                     object_position: transform_point(&inverse, position),
                     object_normal: normalize3(mul3x3_transposed(&world, world_n)),
-                    generated: std::array::from_fn(|k| ((local[k] as f64 - tex_loc[k]) / (2.0 * tex_size[k]) + 0.5) as f32),
-                    uv: { let u = lerp(c.map(|c| [uvs[c][0], uvs[c][1], 0.0])); [u[0], u[1], 0.0] },
+                    generated: std::array::from_fn(|k| {
+                        ((local[k] as f64 - tex_loc[k]) / (2.0 * tex_size[k]) + 0.5) as f32
+                    }),
+                    uv: {
+                        let u = lerp(c.map(|c| [uvs[c][0], uvs[c][1], 0.0]));
+                        [u[0], u[1], 0.0]
+                    },
                     ..diff.point(transform)
                 };
-                let mut sp = bake_context(sp, &view, object, c.map(|c| transform_point(&world, mesh.positions[mesh.corner_verts[c] as usize])), w);
+                let mut sp = bake_context(
+                    sp,
+                    &view,
+                    object,
+                    c.map(|c| {
+                        transform_point(&world, mesh.positions[mesh.corner_verts[c] as usize])
+                    }),
+                    w,
+                );
                 bound[slot].fill(&mesh, t, c, face, w, &mut sp);
                 program.run(&sp, stack);
                 let e = program.surface_emission(stack);
@@ -169,11 +256,15 @@ fn edge(a: [f32; 2], b: [f32; 2], p: [f32; 2]) -> f32 {
 }
 
 fn transform_point(m: &[[f64; 4]; 4], p: Vec3) -> Vec3 {
-    std::array::from_fn(|r| (m[r][0] * p[0] as f64 + m[r][1] * p[1] as f64 + m[r][2] * p[2] as f64 + m[r][3]) as f32)
+    std::array::from_fn(|r| {
+        (m[r][0] * p[0] as f64 + m[r][1] * p[1] as f64 + m[r][2] * p[2] as f64 + m[r][3]) as f32
+    })
 }
 
 fn mul3x3(m: &[[f64; 3]; 3], v: Vec3) -> Vec3 {
-    std::array::from_fn(|r| (m[r][0] * v[0] as f64 + m[r][1] * v[1] as f64 + m[r][2] * v[2] as f64) as f32)
+    std::array::from_fn(|r| {
+        (m[r][0] * v[0] as f64 + m[r][1] * v[1] as f64 + m[r][2] * v[2] as f64) as f32
+    })
 }
 
 fn inverse_transpose3(m: &[[f64; 4]; 4]) -> Option<[[f64; 3]; 3]> {
@@ -193,16 +284,27 @@ pub fn write_exr(b: &Baked, path: &Path) -> Result<(), String> {
             img.put_pixel(x, n - 1 - y, image::Rgba(p));
         }
     }
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let tmp = tempfile::Builder::new().prefix(".bake-").suffix(".exr").tempfile_in(dir).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    img.save_with_format(tmp.path(), image::ImageFormat::OpenExr).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    tmp.persist(path).map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    let dir = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let tmp = tempfile::Builder::new()
+        .prefix(".bake-")
+        .suffix(".exr")
+        .tempfile_in(dir)
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    img.save_with_format(tmp.path(), image::ImageFormat::OpenExr)
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
+    tmp.persist(path)
+        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     Ok(())
 }
 
 /// The transpose of the 3x3 part of `m` times `v` (world to object for normals).
 fn mul3x3_transposed(m: &[[f64; 4]; 4], v: Vec3) -> Vec3 {
-    std::array::from_fn(|c| (m[0][c] * v[0] as f64 + m[1][c] * v[1] as f64 + m[2][c] * v[2] as f64) as f32)
+    std::array::from_fn(|c| {
+        (m[0][c] * v[0] as f64 + m[1][c] * v[1] as f64 + m[2][c] * v[2] as f64) as f32
+    })
 }
 
 /// A bake triangle's ray differentials as Cycles gets them for a bake: Blender's
@@ -217,33 +319,61 @@ struct TriangleDifferentials {
 }
 
 impl TriangleDifferentials {
-    fn new(world: &[[f64; 4]; 4], uv: [[f32; 2]; 3], size: u32, local: [Vec3; 3], tex_loc: [f64; 3], tex_size: [f64; 3]) -> Self {
+    fn new(
+        world: &[[f64; 4]; 4],
+        uv: [[f32; 2]; 3],
+        size: u32,
+        local: [Vec3; 3],
+        tex_loc: [f64; 3],
+        tex_size: [f64; 3],
+    ) -> Self {
         let p = local.map(|l| transform_point(world, l));
         let sub = |a: Vec3, b: Vec3| -> Vec3 { [a[0] - b[0], a[1] - b[1], a[2] - b[2]] };
         let (dpdu, dpdv) = (sub(p[1], p[0]), sub(p[2], p[0]));
         let ng = normalize3(crate::nodes::math::cross3(dpdu, dpdv));
         // Blender's rasteriser coordinates (texel centres at integers).
-        let v = uv.map(|t| [t[0] * size as f32 - (0.5 + 0.001), t[1] * size as f32 - (0.5 + 0.002)]);
-        let mut a = (v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[2][0] - v[0][0]) * (v[1][1] - v[0][1]);
+        let v = uv.map(|t| {
+            [
+                t[0] * size as f32 - (0.5 + 0.001),
+                t[1] * size as f32 - (0.5 + 0.002),
+            ]
+        });
+        let mut a =
+            (v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[2][0] - v[0][0]) * (v[1][1] - v[0][1]);
         let (du_dx, dv_dx, du_dy, dv_dy) = if a.abs() > f32::EPSILON {
             a = 0.5 / a;
-            ((v[1][1] - v[2][1]) * a, (v[2][1] - v[0][1]) * a, (v[2][0] - v[1][0]) * a, (v[0][0] - v[2][0]) * a)
+            (
+                (v[1][1] - v[2][1]) * a,
+                (v[2][1] - v[0][1]) * a,
+                (v[2][0] - v[1][0]) * a,
+                (v[0][0] - v[2][0]) * a,
+            )
         } else {
             (0.0, 0.0, 0.0, 0.0)
         };
         // Blender weighs (corner 0, 1, 2) by (u, v, 1-u-v); Cycles by (1-u-v, u, v).
         let (cu_dx, cv_dx, cu_dy, cv_dy) = (dv_dx, -du_dx - dv_dx, dv_dy, -du_dy - dv_dy);
-        let lin = |a: Vec3, s: f32, b: Vec3, t: f32| -> Vec3 { std::array::from_fn(|k| a[k] * s + b[k] * t) };
+        let lin = |a: Vec3, s: f32, b: Vec3, t: f32| -> Vec3 {
+            std::array::from_fn(|k| a[k] * s + b[k] * t)
+        };
         let full = [lin(dpdu, cu_dx, dpdv, cv_dx), lin(dpdu, cu_dy, dpdv, cv_dy)];
         let (dx, dy) = differential_from_compact(ng, differential_make_compact(full[0], full[1]));
         let duv = differential_dudv(dpdu, dpdv, [dx, dy], ng);
-        let generated = local.map(|l| std::array::from_fn(|k| ((l[k] as f64 - tex_loc[k]) / (2.0 * tex_size[k]) + 0.5) as f32));
+        let generated = local.map(|l| {
+            std::array::from_fn(|k| ((l[k] as f64 - tex_loc[k]) / (2.0 * tex_size[k]) + 0.5) as f32)
+        });
         let uvs = uv.map(|t| [t[0], t[1], 0.0]);
         TriangleDifferentials {
             ng,
             dp: [dx, dy],
-            generated: [attribute_differential(generated, duv[0]), attribute_differential(generated, duv[1])],
-            uv: [attribute_differential(uvs, duv[0]), attribute_differential(uvs, duv[1])],
+            generated: [
+                attribute_differential(generated, duv[0]),
+                attribute_differential(generated, duv[1]),
+            ],
+            uv: [
+                attribute_differential(uvs, duv[0]),
+                attribute_differential(uvs, duv[1]),
+            ],
         }
     }
 
@@ -267,10 +397,20 @@ impl TriangleDifferentials {
 /// arriving along the shading normal (so Incoming is the normal), a camera ray's path
 /// state, the true normal of the world-space triangle, barycentrics as Cycles stores
 /// them, and the scene camera's view of the point.
-fn bake_context(mut sp: ShadingPoint, view: &super::view::View, object: super::point::ObjectInfo, tri: [Vec3; 3], w: [f32; 3]) -> ShadingPoint {
+fn bake_context(
+    mut sp: ShadingPoint,
+    view: &super::view::View,
+    object: super::point::ObjectInfo,
+    tri: [Vec3; 3],
+    w: [f32; 3],
+) -> ShadingPoint {
     let e1: Vec3 = std::array::from_fn(|k| tri[1][k] - tri[0][k]);
     let e2: Vec3 = std::array::from_fn(|k| tri[2][k] - tri[0][k]);
-    let ng = normalize3([e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]]);
+    let ng = normalize3([
+        e1[1] * e2[2] - e1[2] * e2[1],
+        e1[2] * e2[0] - e1[0] * e2[2],
+        e1[0] * e2[1] - e1[1] * e2[0],
+    ]);
     sp.incoming = sp.normal;
     sp.backfacing = ng[0] * sp.incoming[0] + ng[1] * sp.incoming[1] + ng[2] * sp.incoming[2] < 0.0;
     if sp.backfacing {

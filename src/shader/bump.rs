@@ -15,11 +15,18 @@ pub struct ObjectTransform {
     pub to_object: [[f32; 4]; 3],
 }
 
-const IDENTITY: [[f32; 4]; 3] = [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]];
+const IDENTITY: [[f32; 4]; 3] = [
+    [1.0, 0.0, 0.0, 0.0],
+    [0.0, 1.0, 0.0, 0.0],
+    [0.0, 0.0, 1.0, 0.0],
+];
 
 impl Default for ObjectTransform {
     fn default() -> Self {
-        ObjectTransform { to_world: IDENTITY, to_object: IDENTITY }
+        ObjectTransform {
+            to_world: IDENTITY,
+            to_object: IDENTITY,
+        }
     }
 }
 
@@ -81,7 +88,11 @@ fn signf(x: f32) -> f32 {
 /// (1,1,1) x N, or (-1,1,1) x N when N is on the diagonal), which decides the directions
 /// a compact differential expands to. Bump results depend on it to second order.
 pub fn make_orthonormals(n: Vec3) -> (Vec3, Vec3) {
-    let a = if n[0] != n[1] || n[0] != n[2] { [n[2] - n[1], n[0] - n[2], n[1] - n[0]] } else { [n[2] - n[1], n[0] + n[2], -n[1] - n[0]] };
+    let a = if n[0] != n[1] || n[0] != n[2] {
+        [n[2] - n[1], n[0] - n[2], n[1] - n[0]]
+    } else {
+        [n[2] - n[1], n[0] + n[2], -n[1] - n[0]]
+    };
     let a = normalize(a);
     (a, cross3(n, a))
 }
@@ -100,7 +111,12 @@ pub fn differential_make_compact(dx: Vec3, dy: Vec3) -> f32 {
 /// Changes of the barycentric (u, v) of a triangle along `dp` (Cycles' differential_dudv,
 /// Cramer's rule after dropping the axis the normal is largest along). `dpdu`, `dpdv` are
 /// p1 - p0 and p2 - p0 (the point is (1-u-v) p0 + u p1 + v p2).
-pub fn differential_dudv(mut dpdu: Vec3, mut dpdv: Vec3, mut dp: [Vec3; 2], ng: Vec3) -> [[f32; 2]; 2] {
+pub fn differential_dudv(
+    mut dpdu: Vec3,
+    mut dpdv: Vec3,
+    mut dp: [Vec3; 2],
+    ng: Vec3,
+) -> [[f32; 2]; 2] {
     let (xn, yn, zn) = (ng[0].abs(), ng[1].abs(), ng[2].abs());
     if zn < xn || zn < yn {
         if yn < xn || yn < zn {
@@ -119,12 +135,20 @@ pub fn differential_dudv(mut dpdu: Vec3, mut dpdv: Vec3, mut dp: [Vec3; 2], ng: 
         det = 1.0 / det;
     }
     // [[du/dx, dv/dx], [du/dy, dv/dy]]
-    std::array::from_fn(|k| [(dp[k][0] * dpdv[1] - dp[k][1] * dpdv[0]) * det, (dp[k][1] * dpdu[0] - dp[k][0] * dpdu[1]) * det])
+    std::array::from_fn(|k| {
+        [
+            (dp[k][0] * dpdv[1] - dp[k][1] * dpdv[0]) * det,
+            (dp[k][1] * dpdu[0] - dp[k][0] * dpdu[1]) * det,
+        ]
+    })
 }
 
 /// The change of a triangle attribute (values at corners `f`) for barycentric changes `d`.
 pub fn attribute_differential(f: [Vec3; 3], d: [f32; 2]) -> Vec3 {
-    add3(scale3(sub3(f[1], f[0]), d[0]), scale3(sub3(f[2], f[0]), d[1]))
+    add3(
+        scale3(sub3(f[1], f[0]), d[0]),
+        scale3(sub3(f[2], f[0]), d[1]),
+    )
 }
 
 /// Which of the three Height evaluations a bump program is running.
@@ -163,7 +187,16 @@ pub struct BumpSettings {
 /// Cycles' svm_node_set_bump: the normal perturbed by the finite differences of the
 /// height sampled at the centre and at the dx/dy points.
 #[allow(clippy::too_many_arguments)]
-pub fn bump_normal(sp: &ShadingPoint, set: BumpSettings, normal_in: Vec3, strength: f32, distance: f32, h_c: f32, h_x: f32, h_y: f32) -> Vec3 {
+pub fn bump_normal(
+    sp: &ShadingPoint,
+    set: BumpSettings,
+    normal_in: Vec3,
+    strength: f32,
+    distance: f32,
+    h_c: f32,
+    h_x: f32,
+    h_y: f32,
+) -> Vec3 {
     let (mut n, mut dx, mut dy) = (normal_in, sp.dp_dx, sp.dp_dy);
     if set.object_space {
         n = sp.transform.inverse_normal(n);
@@ -177,7 +210,10 @@ pub fn bump_normal(sp: &ShadingPoint, set: BumpSettings, normal_in: Vec3, streng
     let absdet = det.abs();
     let scale = if set.invert { -distance } else { distance };
     let strength = strength.max(0.0);
-    let mut out = safe_normalize(sub3(scale3(n, set.filter_width * absdet), scale3(surfgrad, scale * signf(det))));
+    let mut out = safe_normalize(sub3(
+        scale3(n, set.filter_width * absdet),
+        scale3(surfgrad, scale * signf(det)),
+    ));
     if out == [0.0; 3] {
         out = n;
     } else {
@@ -190,10 +226,18 @@ pub fn bump_normal(sp: &ShadingPoint, set: BumpSettings, normal_in: Vec3, streng
 }
 
 /// Displacement node: the offset along the normal, world or object space.
-pub fn displacement(sp: &ShadingPoint, object_space: bool, height: f32, midlevel: f32, scale: f32, normal: Vec3) -> Vec3 {
+pub fn displacement(
+    sp: &ShadingPoint,
+    object_space: bool,
+    height: f32,
+    midlevel: f32,
+    scale: f32,
+    normal: Vec3,
+) -> Vec3 {
     let k = (height - midlevel) * scale;
     if object_space {
-        sp.transform.dir(scale3(sp.transform.inverse_normal(normal), k))
+        sp.transform
+            .dir(scale3(sp.transform.inverse_normal(normal), k))
     } else {
         scale3(normal, k)
     }
@@ -223,7 +267,13 @@ impl MapSpace {
 }
 
 /// Vector Displacement in object or world space (tangent space needs tangents).
-pub fn vector_displacement(sp: &ShadingPoint, space: MapSpace, vector: Vec3, midlevel: f32, scale: f32) -> Vec3 {
+pub fn vector_displacement(
+    sp: &ShadingPoint,
+    space: MapSpace,
+    vector: Vec3,
+    midlevel: f32,
+    scale: f32,
+) -> Vec3 {
     let d = scale3(sub3(vector, [midlevel; 3]), scale);
     match space {
         MapSpace::World => d,
@@ -259,10 +309,29 @@ pub fn normal_map(sp: &ShadingPoint, space: MapSpace, color: Vec3, strength: f32
 /// The normal the displacement bump gives every closure: heights are the displacement
 /// projected on the unperturbed normal (Cycles' bump_from_displacement: distance 1,
 /// strength 1, the Bump node's default filter width).
-pub fn displacement_bump(sp: &ShadingPoint, object_space: bool, d_c: Vec3, d_x: Vec3, d_y: Vec3) -> Vec3 {
+pub fn displacement_bump(
+    sp: &ShadingPoint,
+    object_space: bool,
+    d_c: Vec3,
+    d_x: Vec3,
+    d_y: Vec3,
+) -> Vec3 {
     let n = sp.normal;
-    let set = BumpSettings { invert: false, object_space, filter_width: DEFAULT_FILTER_WIDTH };
-    bump_normal(sp, set, n, 1.0, 1.0, dot3(d_c, n), dot3(d_x, n), dot3(d_y, n))
+    let set = BumpSettings {
+        invert: false,
+        object_space,
+        filter_width: DEFAULT_FILTER_WIDTH,
+    };
+    bump_normal(
+        sp,
+        set,
+        n,
+        1.0,
+        1.0,
+        dot3(d_c, n),
+        dot3(d_x, n),
+        dot3(d_y, n),
+    )
 }
 
 /// Cycles' BumpNode default filter width, used by the displacement bump.

@@ -72,21 +72,44 @@ pub fn filter_width(g: &FlatGraph, i: usize) -> Result<f32, String> {
     let n = &g.nodes[i];
     match n.input("Filter Width").and_then(|inp| inp.sources.first()) {
         None => Ok(DEFAULT_FILTER_WIDTH),
-        Some(Source::Default(sock)) => Ok(sock.default_value.as_ref().and_then(|v| v.as_f64()).map_or(DEFAULT_FILTER_WIDTH, |v| v as f32)),
+        Some(Source::Default(sock)) => Ok(sock
+            .default_value
+            .as_ref()
+            .and_then(|v| v.as_f64())
+            .map_or(DEFAULT_FILTER_WIDTH, |v| v as f32)),
         Some(Source::Nothing) => Ok(0.0),
-        Some(_) => Err(format!("node {:?}: a linked Filter Width is not supported (Cycles reads it as a constant)", n.path)),
+        Some(_) => Err(format!(
+            "node {:?}: a linked Filter Width is not supported (Cycles reads it as a constant)",
+            n.path
+        )),
     }
 }
 
-fn add_copies(g: &FlatGraph, s: &mut Schedule, deps: &[bool], points: &[BumpPoint], width: f32) -> Result<Vec<usize>, String> {
+fn add_copies(
+    g: &FlatGraph,
+    s: &mut Schedule,
+    deps: &[bool],
+    points: &[BumpPoint],
+    width: f32,
+) -> Result<Vec<usize>, String> {
     if let Some(i) = (0..g.nodes.len()).find(|&i| deps[i] && is_bump(g, i)) {
-        return Err(format!("node {:?}: a Bump inside another bump's height is not supported yet", g.nodes[i].path));
+        return Err(format!(
+            "node {:?}: a Bump inside another bump's height is not supported yet",
+            g.nodes[i].path
+        ));
     }
     let mut out = Vec::new();
     for &point in points {
         let copy = s.copies.len();
-        s.copies.push(GraphCopy { point, filter_width: width });
-        s.steps.extend((0..g.nodes.len()).filter(|&i| deps[i]).map(|node| Step::Node { node, copy }));
+        s.copies.push(GraphCopy {
+            point,
+            filter_width: width,
+        });
+        s.steps.extend(
+            (0..g.nodes.len())
+                .filter(|&i| deps[i])
+                .map(|node| Step::Node { node, copy }),
+        );
         out.push(copy);
     }
     Ok(out)
@@ -97,7 +120,10 @@ fn add_copies(g: &FlatGraph, s: &mut Schedule, deps: &[bool], points: &[BumpPoin
 /// the renderer can run them alone at a vertex.
 pub fn schedule(g: &FlatGraph, bump: bool, value: bool) -> Result<Schedule, String> {
     let mut s = Schedule {
-        copies: vec![GraphCopy { point: BumpPoint::Center, filter_width: 0.0 }],
+        copies: vec![GraphCopy {
+            point: BumpPoint::Center,
+            filter_width: 0.0,
+        }],
         steps: Vec::new(),
         bump_copies: vec![None; g.nodes.len()],
         displacement: None,
@@ -112,7 +138,13 @@ pub fn schedule(g: &FlatGraph, bump: bool, value: bool) -> Result<Schedule, Stri
                 s.steps.push(Step::DisplacementValue);
             }
             if bump {
-                let xy = add_copies(g, &mut s, &deps, &[BumpPoint::Dx, BumpPoint::Dy], DEFAULT_FILTER_WIDTH)?;
+                let xy = add_copies(
+                    g,
+                    &mut s,
+                    &deps,
+                    &[BumpPoint::Dx, BumpPoint::Dy],
+                    DEFAULT_FILTER_WIDTH,
+                )?;
                 s.displacement = Some((c, xy[0], xy[1]));
                 s.steps.push(Step::DisplacementBump);
             }

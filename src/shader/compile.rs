@@ -6,29 +6,29 @@ use serde_json::Value;
 
 use crate::nodes::clamp::ClampType;
 use crate::nodes::color::{rgb_to_bw, LINEAR_REC709};
+use crate::nodes::curves::{mapping_from_json, CurveKind, CurveTable};
+use crate::nodes::gradient::GradientType;
 use crate::nodes::graph::{active_output, flatten, FlatGraph, FlatNode, Source};
 use crate::nodes::map_range::MapRangeInterpolation;
+use crate::nodes::mapping::MappingType;
 use crate::nodes::math::{MathOp, VectorMathOp};
 use crate::nodes::mix::MixBlend;
-use crate::nodes::vector_rotate::VectorRotateType;
-use crate::nodes::curves::{mapping_from_json, CurveKind, CurveTable};
+use crate::nodes::noise::NoiseType;
 use crate::nodes::ramp::{band_from_json, RampTable};
 use crate::nodes::sepcomb::ColorMode;
-use crate::nodes::gradient::GradientType;
-use crate::nodes::mapping::MappingType;
-use crate::nodes::noise::NoiseType;
+use crate::nodes::vector_rotate::VectorRotateType;
 use crate::nodes::voronoi::{VoronoiFeature, VoronoiMetric};
 use crate::nodes::wave::{BandsDirection, RingsDirection, WaveProfile, WaveSettings, WaveType};
 use crate::scene::{Scene, Socket};
 
-use super::program::{BsdfNode, Closure, Kind, Op, Program, Slot};
 use super::bump::{BumpSettings, MapSpace};
 use super::bump_graph::{self, Schedule, Step};
+use super::program::{BsdfNode, Closure, Kind, Op, Program, Slot};
 
-/// Compiling the input nodes that read the shading context.
-mod inputs;
 /// Compiling the nodes that read mesh attributes and tangents.
 mod attributes;
+/// Compiling the input nodes that read the shading context.
+mod inputs;
 
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct CompileError(pub String);
@@ -42,28 +42,49 @@ impl std::error::Error for CompileError {}
 
 /// Compiles the Cycles surface of material `name`.
 pub fn compile_material(scene: &Scene, name: &str) -> Result<Program, CompileError> {
-    let mat = scene.material(name).ok_or_else(|| CompileError(format!("no material {name:?}")))?;
-    let tree = mat.node_tree.as_ref().ok_or_else(|| CompileError(format!("material {name:?} has no node tree (use_nodes off)")))?;
-    let out = active_output(tree, "ShaderNodeOutputMaterial", "CYCLES")
-        .ok_or_else(|| CompileError(format!("material {name:?} has no Material Output for Cycles")))?;
-    let graph = flatten(tree, &scene.file.node_groups, &out.name).map_err(|e| CompileError(format!("material {name:?}: {e}")))?;
+    let mat = scene
+        .material(name)
+        .ok_or_else(|| CompileError(format!("no material {name:?}")))?;
+    let tree = mat.node_tree.as_ref().ok_or_else(|| {
+        CompileError(format!(
+            "material {name:?} has no node tree (use_nodes off)"
+        ))
+    })?;
+    let out = active_output(tree, "ShaderNodeOutputMaterial", "CYCLES").ok_or_else(|| {
+        CompileError(format!(
+            "material {name:?} has no Material Output for Cycles"
+        ))
+    })?;
+    let graph = flatten(tree, &scene.file.node_groups, &out.name)
+        .map_err(|e| CompileError(format!("material {name:?}: {e}")))?;
     let mut c = Compiler::new(&graph);
     c.scene = Some(scene);
-    (c.displace, c.true_displacement) = displacement_method(name, mat.properties.get("displacement_method").and_then(Value::as_str))?;
+    (c.displace, c.true_displacement) = displacement_method(
+        name,
+        mat.properties
+            .get("displacement_method")
+            .and_then(Value::as_str),
+    )?;
     c.material_pass_index = mat.pass_index as f32;
-    c.run().map_err(|e| CompileError(format!("material {name:?}: {}", e.0)))
+    c.run()
+        .map_err(|e| CompileError(format!("material {name:?}: {}", e.0)))
 }
 
 /// How the Material Output's Displacement is compiled, after Cycles' displacement methods:
 /// a bump of the shading normal (`Some(object_space)`; "Bump Only" in world space, "Both"
 /// in object space, as Cycles' bump_from_displacement), and/or a value the renderer moves
 /// the mesh's vertices by before tracing ("Displacement Only" and "Both").
-fn displacement_method(material: &str, method: Option<&str>) -> Result<(Option<bool>, bool), CompileError> {
+fn displacement_method(
+    material: &str,
+    method: Option<&str>,
+) -> Result<(Option<bool>, bool), CompileError> {
     match method.unwrap_or("BUMP") {
         "BUMP" => Ok((Some(false), false)),
         "BOTH" => Ok((Some(true), true)),
         "DISPLACEMENT" => Ok((None, true)),
-        other => Err(CompileError(format!("material {material:?}: displacement method {other:?} is not supported"))),
+        other => Err(CompileError(format!(
+            "material {material:?}: displacement method {other:?} is not supported"
+        ))),
     }
 }
 
@@ -115,13 +136,24 @@ fn kind_of(socket_type: &str) -> Option<Kind> {
 }
 
 fn prop<'n>(n: &FlatNode<'n>, key: &str) -> Result<&'n Value, CompileError> {
-    n.property(key).ok_or_else(|| CompileError(format!("node {:?} lacks property {key:?}", n.path)))
+    n.property(key)
+        .ok_or_else(|| CompileError(format!("node {:?} lacks property {key:?}", n.path)))
 }
 fn prop_str<'n>(n: &FlatNode<'n>, key: &str) -> Result<&'n str, CompileError> {
-    prop(n, key)?.as_str().ok_or_else(|| CompileError(format!("node {:?}: property {key:?} is not a string", n.path)))
+    prop(n, key)?.as_str().ok_or_else(|| {
+        CompileError(format!(
+            "node {:?}: property {key:?} is not a string",
+            n.path
+        ))
+    })
 }
 fn prop_bool(n: &FlatNode, key: &str) -> Result<bool, CompileError> {
-    prop(n, key)?.as_bool().ok_or_else(|| CompileError(format!("node {:?}: property {key:?} is not a boolean", n.path)))
+    prop(n, key)?.as_bool().ok_or_else(|| {
+        CompileError(format!(
+            "node {:?}: property {key:?} is not a boolean",
+            n.path
+        ))
+    })
 }
 fn mode<T>(n: &FlatNode, key: &str, parse: fn(&str) -> Option<T>) -> Result<T, CompileError> {
     let v = prop_str(n, key)?;
@@ -156,20 +188,35 @@ fn dimensions(n: &FlatNode, key: &str) -> Result<u8, CompileError> {
         "2D" => Ok(2),
         "3D" => Ok(3),
         "4D" => Ok(4),
-        other => Err(CompileError(format!("node {:?}: {key} {other:?} is not supported", n.path))),
+        other => Err(CompileError(format!(
+            "node {:?}: {key} {other:?} is not supported",
+            n.path
+        ))),
     }
 }
 
 fn linked(n: &FlatNode, id: &str) -> bool {
-    n.input(id).is_some_and(|i| matches!(i.sources.first(), Some(Source::Link { .. })))
+    n.input(id)
+        .is_some_and(|i| matches!(i.sources.first(), Some(Source::Link { .. })))
 }
 
 /// True when a texture node's `texture_mapping` leaves coordinates unchanged.
 fn identity_mapping(m: &Value) -> bool {
-    let v3 = |k: &str, want: f64| m.get(k).and_then(Value::as_array).map_or(true, |a| a.iter().all(|x| x.as_f64() == Some(want)));
+    let v3 = |k: &str, want: f64| {
+        m.get(k)
+            .and_then(Value::as_array)
+            .map_or(true, |a| a.iter().all(|x| x.as_f64() == Some(want)))
+    };
     let b = |k: &str| m.get(k).and_then(Value::as_bool).unwrap_or(false);
     let s = |k: &str, want: &str| m.get(k).and_then(Value::as_str).map_or(true, |x| x == want);
-    v3("translation", 0.0) && v3("rotation", 0.0) && v3("scale", 1.0) && !b("use_min") && !b("use_max") && s("mapping_x", "X") && s("mapping_y", "Y") && s("mapping_z", "Z")
+    v3("translation", 0.0)
+        && v3("rotation", 0.0)
+        && v3("scale", 1.0)
+        && !b("use_min")
+        && !b("use_max")
+        && s("mapping_x", "X")
+        && s("mapping_y", "Y")
+        && s("mapping_z", "Z")
 }
 
 impl<'g, 'a> Compiler<'g, 'a> {
@@ -201,7 +248,8 @@ impl<'g, 'a> Compiler<'g, 'a> {
 
     fn alloc(&mut self, kind: Kind) -> Slot {
         let s = self.initial.len() as Slot;
-        self.initial.extend(std::iter::repeat_n(0.0, kind.width() as usize));
+        self.initial
+            .extend(std::iter::repeat_n(0.0, kind.width() as usize));
         s
     }
 
@@ -235,7 +283,9 @@ impl<'g, 'a> Compiler<'g, 'a> {
         };
         match self.closures[c as usize] {
             Closure::Emission { color, strength } => emitter(color, strength),
-            Closure::Bsdf { emission: Some((color, strength)) } => emitter(color, strength),
+            Closure::Bsdf {
+                emission: Some((color, strength)),
+            } => emitter(color, strength),
             Closure::Bsdf { emission: None } => [0.0; 3],
             Closure::Add { a, b } => {
                 let (x, y) = (self.emission_estimate(a), self.emission_estimate(b));
@@ -245,7 +295,11 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 let (x, y) = (self.emission_estimate(a), self.emission_estimate(b));
                 if self.constants.contains(&fac) {
                     let f = self.initial[fac as usize];
-                    [(1.0 - f) * x[0] + f * y[0], (1.0 - f) * x[1] + f * y[1], (1.0 - f) * x[2] + f * y[2]]
+                    [
+                        (1.0 - f) * x[0] + f * y[0],
+                        (1.0 - f) * x[1] + f * y[1],
+                        (1.0 - f) * x[2] + f * y[2],
+                    ]
                 } else {
                     [x[0] + y[0], x[1] + y[1], x[2] + y[2]]
                 }
@@ -255,7 +309,11 @@ impl<'g, 'a> Compiler<'g, 'a> {
 
     /// A socket's default converted to `want`, as Blender converts unlinked values.
     fn default_value(&mut self, sock: &Socket, want: Kind) -> Slot {
-        let v = sock.default_value.as_ref().map(floats).unwrap_or([0.0, 0.0, 0.0, 1.0]);
+        let v = sock
+            .default_value
+            .as_ref()
+            .map(floats)
+            .unwrap_or([0.0, 0.0, 0.0, 1.0]);
         let rgb = [v[0], v[1], v[2]];
         let have = kind_of(&sock.kind).unwrap_or(Kind::Float);
         let value = match (have, want) {
@@ -270,17 +328,30 @@ impl<'g, 'a> Compiler<'g, 'a> {
     /// The slot holding input `id` of node `n` as `want`.
     fn input(&mut self, n: &FlatNode<'a>, id: &str, want: Kind) -> Result<Slot, CompileError> {
         let Some(inp) = n.input(id) else {
-            return Err(CompileError(format!("node {:?} has no available input {id:?}", n.path)));
+            return Err(CompileError(format!(
+                "node {:?} has no available input {id:?}",
+                n.path
+            )));
         };
         match inp.sources.first() {
             None | Some(Source::Nothing) => Ok(self.constant(want, [0.0; 3])),
             Some(Source::Default(sock)) => Ok(self.default_value(sock, want)),
-            Some(Source::GroupInput(i)) => Err(CompileError(format!("node {:?} reads group input {i:?}, which a material cannot provide", n.path))),
+            Some(Source::GroupInput(i)) => Err(CompileError(format!(
+                "node {:?} reads group input {i:?}, which a material cannot provide",
+                n.path
+            ))),
             Some(Source::Link { node, output, .. }) => {
-                let (slot, have) = self.values[*node].get(*output).copied().flatten().ok_or_else(|| {
-                    let from = &self.g.nodes[*node];
-                    CompileError(format!("node {:?} output {:?} is not supported yet (used by {:?})", from.path, from.node.outputs[*output].identifier, n.path))
-                })?;
+                let (slot, have) = self.values[*node]
+                    .get(*output)
+                    .copied()
+                    .flatten()
+                    .ok_or_else(|| {
+                        let from = &self.g.nodes[*node];
+                        CompileError(format!(
+                            "node {:?} output {:?} is not supported yet (used by {:?})",
+                            from.path, from.node.outputs[*output].identifier, n.path
+                        ))
+                    })?;
                 Ok(self.convert(slot, have, want))
             }
         }
@@ -304,7 +375,10 @@ impl<'g, 'a> Compiler<'g, 'a> {
         match n.input(id).and_then(|i| i.sources.first()) {
             Some(Source::Link { node, .. }) => match self.closure_of[*node] {
                 Some(c) => Ok(Some(c)),
-                None => Err(CompileError(format!("node {:?}: input {id:?} is linked to a non-shader output", n.path))),
+                None => Err(CompileError(format!(
+                    "node {:?}: input {id:?} is linked to a non-shader output",
+                    n.path
+                ))),
             },
             _ => Ok(None),
         }
@@ -322,29 +396,61 @@ impl<'g, 'a> Compiler<'g, 'a> {
 
     fn run(mut self) -> Result<Program, CompileError> {
         use Kind::{Color as C, Float as F, Vector as V};
-        let schedule = bump_graph::schedule(self.g, self.displace.is_some(), self.true_displacement).map_err(CompileError)?;
+        let schedule =
+            bump_graph::schedule(self.g, self.displace.is_some(), self.true_displacement)
+                .map_err(CompileError)?;
         self.copy_values = vec![vec![Vec::new(); self.g.nodes.len()]; schedule.copies.len()];
         for step in &schedule.steps {
-            let Some(i) = self.enter_step(&schedule, *step)? else { continue };
+            let Some(i) = self.enter_step(&schedule, *step)? else {
+                continue;
+            };
             let n = &self.g.nodes[i];
             match n.node.bl_idname.as_str() {
                 "ShaderNodeValue" => {
-                    let v = n.node.outputs[0].default_value.as_ref().map(floats).unwrap_or([0.0; 4]);
+                    let v = n.node.outputs[0]
+                        .default_value
+                        .as_ref()
+                        .map(floats)
+                        .unwrap_or([0.0; 4]);
                     let s = self.constant(F, [v[0]; 3]);
                     self.outputs(i, n, &[("Value", s, F)]);
                 }
                 "ShaderNodeRGB" => {
-                    let v = n.node.outputs[0].default_value.as_ref().map(floats).unwrap_or([0.0; 4]);
+                    let v = n.node.outputs[0]
+                        .default_value
+                        .as_ref()
+                        .map(floats)
+                        .unwrap_or([0.0; 4]);
                     let s = self.constant(C, [v[0], v[1], v[2]]);
                     self.outputs(i, n, &[("Color", s, C)]);
                 }
                 "ShaderNodeTexCoord" => {
-                    let (g, nn, uv, ob) = (self.alloc(V), self.alloc(V), self.alloc(V), self.alloc(V));
-                    self.ops.push(Op::TexCoord { generated: Some(g), normal: Some(nn), uv: Some(uv), object: Some(ob) });
-                    self.outputs(i, n, &[("Generated", g, V), ("Normal", nn, V), ("UV", uv, V), ("Object", ob, V)]);
+                    let (g, nn, uv, ob) =
+                        (self.alloc(V), self.alloc(V), self.alloc(V), self.alloc(V));
+                    self.ops.push(Op::TexCoord {
+                        generated: Some(g),
+                        normal: Some(nn),
+                        uv: Some(uv),
+                        object: Some(ob),
+                    });
+                    self.outputs(
+                        i,
+                        n,
+                        &[
+                            ("Generated", g, V),
+                            ("Normal", nn, V),
+                            ("UV", uv, V),
+                            ("Object", ob, V),
+                        ],
+                    );
                     self.tex_coord_more(i)?;
                 }
-                "ShaderNodeUVMap" if !prop_str(n, "uv_map")?.is_empty() || n.property("from_instancer").and_then(Value::as_bool) == Some(true) => self.named_uv(i)?,
+                "ShaderNodeUVMap"
+                    if !prop_str(n, "uv_map")?.is_empty()
+                        || n.property("from_instancer").and_then(Value::as_bool) == Some(true) =>
+                {
+                    self.named_uv(i)?
+                }
                 "ShaderNodeUVMap" => {
                     let d = self.alloc(V);
                     self.ops.push(Op::UvMap { dst: d });
@@ -353,9 +459,20 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 "ShaderNodeMath" => {
                     let op = mode(n, "operation", MathOp::from_blender)?;
                     let clamp = prop_bool(n, "use_clamp")?;
-                    let (a, b, c) = (self.input(n, "Value", F)?, self.opt_input(n, "Value_001", F)?, self.opt_input(n, "Value_002", F)?);
+                    let (a, b, c) = (
+                        self.input(n, "Value", F)?,
+                        self.opt_input(n, "Value_001", F)?,
+                        self.opt_input(n, "Value_002", F)?,
+                    );
                     let d = self.alloc(F);
-                    self.ops.push(Op::Math { op, clamp, a, b, c, dst: d });
+                    self.ops.push(Op::Math {
+                        op,
+                        clamp,
+                        a,
+                        b,
+                        c,
+                        dst: d,
+                    });
                     self.outputs(i, n, &[("Value", d, F)]);
                 }
                 "ShaderNodeVectorMath" => {
@@ -365,66 +482,138 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     let c = self.opt_input(n, "Vector_002", V)?;
                     let scale = self.opt_input(n, "Scale", F)?;
                     let (vector, value) = (self.alloc(V), self.alloc(F));
-                    self.ops.push(Op::VectorMath { op, a, b, c, scale, vector, value });
+                    self.ops.push(Op::VectorMath {
+                        op,
+                        a,
+                        b,
+                        c,
+                        scale,
+                        vector,
+                        value,
+                    });
                     self.outputs(i, n, &[("Vector", vector, V), ("Value", value, F)]);
                 }
                 "ShaderNodeMapRange" => {
-                    let interp = mode(n, "interpolation_type", MapRangeInterpolation::from_blender)?;
+                    let interp =
+                        mode(n, "interpolation_type", MapRangeInterpolation::from_blender)?;
                     let clamp = prop_bool(n, "clamp")?;
                     match prop_str(n, "data_type")? {
                         "FLOAT" => {
-                            let ids = ["Value", "From Min", "From Max", "To Min", "To Max", "Steps"];
+                            let ids =
+                                ["Value", "From Min", "From Max", "To Min", "To Max", "Steps"];
                             let args = self.inputs6(n, ids, F)?;
                             let d = self.alloc(F);
-                            self.ops.push(Op::MapRangeFloat { interp, clamp, args, dst: d });
+                            self.ops.push(Op::MapRangeFloat {
+                                interp,
+                                clamp,
+                                args,
+                                dst: d,
+                            });
                             self.outputs(i, n, &[("Result", d, F)]);
                         }
                         "FLOAT_VECTOR" => {
-                            let ids = ["Vector", "From_Min_FLOAT3", "From_Max_FLOAT3", "To_Min_FLOAT3", "To_Max_FLOAT3", "Steps_FLOAT3"];
+                            let ids = [
+                                "Vector",
+                                "From_Min_FLOAT3",
+                                "From_Max_FLOAT3",
+                                "To_Min_FLOAT3",
+                                "To_Max_FLOAT3",
+                                "Steps_FLOAT3",
+                            ];
                             let args = self.inputs6(n, ids, V)?;
                             let d = self.alloc(V);
-                            self.ops.push(Op::MapRangeVector { interp, clamp, args, dst: d });
+                            self.ops.push(Op::MapRangeVector {
+                                interp,
+                                clamp,
+                                args,
+                                dst: d,
+                            });
                             self.outputs(i, n, &[("Vector", d, V)]);
                         }
-                        other => return Err(CompileError(format!("node {:?}: Map Range data type {other:?} is not supported", n.path))),
+                        other => {
+                            return Err(CompileError(format!(
+                                "node {:?}: Map Range data type {other:?} is not supported",
+                                n.path
+                            )))
+                        }
                     }
                 }
                 "ShaderNodeClamp" => {
                     let kind = mode(n, "clamp_type", ClampType::from_blender)?;
-                    let (value, min, max) = (self.input(n, "Value", F)?, self.input(n, "Min", F)?, self.input(n, "Max", F)?);
+                    let (value, min, max) = (
+                        self.input(n, "Value", F)?,
+                        self.input(n, "Min", F)?,
+                        self.input(n, "Max", F)?,
+                    );
                     let d = self.alloc(F);
-                    self.ops.push(Op::Clamp { kind, value, min, max, dst: d });
+                    self.ops.push(Op::Clamp {
+                        kind,
+                        value,
+                        min,
+                        max,
+                        dst: d,
+                    });
                     self.outputs(i, n, &[("Result", d, F)]);
                 }
                 "ShaderNodeMix" => self.mix(i)?,
                 "ShaderNodeMixRGB" => {
                     let blend = mode(n, "blend_type", MixBlend::from_blender)?;
                     let clamp = prop_bool(n, "use_clamp")?;
-                    let (factor, a, b) = (self.input(n, "Fac", F)?, self.input(n, "Color1", C)?, self.input(n, "Color2", C)?);
+                    let (factor, a, b) = (
+                        self.input(n, "Fac", F)?,
+                        self.input(n, "Color1", C)?,
+                        self.input(n, "Color2", C)?,
+                    );
                     let d = self.alloc(C);
-                    self.ops.push(Op::MixRgb { blend, clamp, factor, a, b, dst: d });
+                    self.ops.push(Op::MixRgb {
+                        blend,
+                        clamp,
+                        factor,
+                        a,
+                        b,
+                        dst: d,
+                    });
                     self.outputs(i, n, &[("Color", d, C)]);
                 }
                 "ShaderNodeValToRGB" => {
                     let table = self.ramp(n)?;
                     let fac = self.input(n, "Fac", F)?;
                     let (color, alpha) = (self.alloc(C), self.alloc(F));
-                    self.ops.push(Op::Ramp { table, fac, color, alpha });
+                    self.ops.push(Op::Ramp {
+                        table,
+                        fac,
+                        color,
+                        alpha,
+                    });
                     self.outputs(i, n, &[("Color", color, C), ("Alpha", alpha, F)]);
                 }
                 "ShaderNodeRGBCurve" | "ShaderNodeVectorCurve" => {
-                    let (kind, sock, k) = if n.node.bl_idname == "ShaderNodeRGBCurve" { (CurveKind::Rgb, "Color", C) } else { (CurveKind::Vector, "Vector", V) };
+                    let (kind, sock, k) = if n.node.bl_idname == "ShaderNodeRGBCurve" {
+                        (CurveKind::Rgb, "Color", C)
+                    } else {
+                        (CurveKind::Vector, "Vector", V)
+                    };
                     let table = self.curve_table(n, kind)?;
                     let (fac, v) = (self.input(n, "Fac", F)?, self.input(n, sock, k)?);
                     let d = self.alloc(k);
-                    self.ops.push(Op::Curves3 { table, fac, v, dst: d });
+                    self.ops.push(Op::Curves3 {
+                        table,
+                        fac,
+                        v,
+                        dst: d,
+                    });
                     self.outputs(i, n, &[(sock, d, k)]);
                 }
                 "ShaderNodeFloatCurve" => {
                     let table = self.curve_table(n, CurveKind::Float)?;
                     let (fac, v) = (self.input(n, "Factor", F)?, self.input(n, "Value", F)?);
                     let d = self.alloc(F);
-                    self.ops.push(Op::Curve1 { table, fac, v, dst: d });
+                    self.ops.push(Op::Curve1 {
+                        table,
+                        fac,
+                        v,
+                        dst: d,
+                    });
                     self.outputs(i, n, &[("Value", d, F)]);
                 }
                 "ShaderNodeInvert" => {
@@ -436,13 +625,26 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 "ShaderNodeGamma" => {
                     let (color, gamma) = (self.input(n, "Color", C)?, self.input(n, "Gamma", F)?);
                     let d = self.alloc(C);
-                    self.ops.push(Op::Gamma { color, gamma, dst: d });
+                    self.ops.push(Op::Gamma {
+                        color,
+                        gamma,
+                        dst: d,
+                    });
                     self.outputs(i, n, &[("Color", d, C)]);
                 }
                 "ShaderNodeBrightContrast" => {
-                    let (color, bright, contrast) = (self.input(n, "Color", C)?, self.input(n, "Bright", F)?, self.input(n, "Contrast", F)?);
+                    let (color, bright, contrast) = (
+                        self.input(n, "Color", C)?,
+                        self.input(n, "Bright", F)?,
+                        self.input(n, "Contrast", F)?,
+                    );
                     let d = self.alloc(C);
-                    self.ops.push(Op::BrightContrast { color, bright, contrast, dst: d });
+                    self.ops.push(Op::BrightContrast {
+                        color,
+                        bright,
+                        contrast,
+                        dst: d,
+                    });
                     self.outputs(i, n, &[("Color", d, C)]);
                 }
                 "ShaderNodeHueSaturation" => {
@@ -452,7 +654,14 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     let fac = self.input(n, "Fac", F)?;
                     let color = self.input(n, "Color", C)?;
                     let d = self.alloc(C);
-                    self.ops.push(Op::HueSaturation { hue, saturation, value, fac, color, dst: d });
+                    self.ops.push(Op::HueSaturation {
+                        hue,
+                        saturation,
+                        value,
+                        fac,
+                        color,
+                        dst: d,
+                    });
                     self.outputs(i, n, &[("Color", d, C)]);
                 }
                 "ShaderNodeRGBToBW" => {
@@ -468,37 +677,72 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     self.outputs(i, n, &[("X", x, F), ("Y", y, F), ("Z", z, F)]);
                 }
                 "ShaderNodeCombineXYZ" => {
-                    let (x, y, z) = (self.input(n, "X", F)?, self.input(n, "Y", F)?, self.input(n, "Z", F)?);
+                    let (x, y, z) = (
+                        self.input(n, "X", F)?,
+                        self.input(n, "Y", F)?,
+                        self.input(n, "Z", F)?,
+                    );
                     let d = self.alloc(V);
                     self.ops.push(Op::CombineXyz { x, y, z, dst: d });
                     self.outputs(i, n, &[("Vector", d, V)]);
                 }
-                kind @ ("ShaderNodeSeparateColor" | "ShaderNodeSeparateRGB" | "ShaderNodeSeparateHSV") => {
+                kind @ ("ShaderNodeSeparateColor"
+                | "ShaderNodeSeparateRGB"
+                | "ShaderNodeSeparateHSV") => {
                     let (cm, input, outs) = match kind {
-                        "ShaderNodeSeparateColor" => (mode(n, "mode", ColorMode::from_blender)?, "Color", ["Red", "Green", "Blue"]),
+                        "ShaderNodeSeparateColor" => (
+                            mode(n, "mode", ColorMode::from_blender)?,
+                            "Color",
+                            ["Red", "Green", "Blue"],
+                        ),
                         "ShaderNodeSeparateRGB" => (ColorMode::Rgb, "Image", ["R", "G", "B"]),
                         _ => (ColorMode::Hsv, "Color", ["H", "S", "V"]),
                     };
                     let color = self.input(n, input, C)?;
                     let (a, b, c) = (self.alloc(F), self.alloc(F), self.alloc(F));
-                    self.ops.push(Op::SeparateColor { mode: cm, color, a, b, c });
+                    self.ops.push(Op::SeparateColor {
+                        mode: cm,
+                        color,
+                        a,
+                        b,
+                        c,
+                    });
                     self.outputs(i, n, &[(outs[0], a, F), (outs[1], b, F), (outs[2], c, F)]);
                 }
-                kind @ ("ShaderNodeCombineColor" | "ShaderNodeCombineRGB" | "ShaderNodeCombineHSV") => {
+                kind @ ("ShaderNodeCombineColor"
+                | "ShaderNodeCombineRGB"
+                | "ShaderNodeCombineHSV") => {
                     let (cm, ins, out) = match kind {
-                        "ShaderNodeCombineColor" => (mode(n, "mode", ColorMode::from_blender)?, ["Red", "Green", "Blue"], "Color"),
+                        "ShaderNodeCombineColor" => (
+                            mode(n, "mode", ColorMode::from_blender)?,
+                            ["Red", "Green", "Blue"],
+                            "Color",
+                        ),
                         "ShaderNodeCombineRGB" => (ColorMode::Rgb, ["R", "G", "B"], "Image"),
                         _ => (ColorMode::Hsv, ["H", "S", "V"], "Color"),
                     };
-                    let (a, b, c) = (self.input(n, ins[0], F)?, self.input(n, ins[1], F)?, self.input(n, ins[2], F)?);
+                    let (a, b, c) = (
+                        self.input(n, ins[0], F)?,
+                        self.input(n, ins[1], F)?,
+                        self.input(n, ins[2], F)?,
+                    );
                     let d = self.alloc(C);
-                    self.ops.push(Op::CombineColor { mode: cm, a, b, c, dst: d });
+                    self.ops.push(Op::CombineColor {
+                        mode: cm,
+                        a,
+                        b,
+                        c,
+                        dst: d,
+                    });
                     self.outputs(i, n, &[(out, d, C)]);
                 }
                 "ShaderNodeBlackbody" => {
                     let temperature = self.input(n, "Temperature", F)?;
                     let d = self.alloc(C);
-                    self.ops.push(Op::Blackbody { temperature, dst: d });
+                    self.ops.push(Op::Blackbody {
+                        temperature,
+                        dst: d,
+                    });
                     self.outputs(i, n, &[("Color", d, C)]);
                 }
                 "ShaderNodeWavelength" => {
@@ -517,7 +761,16 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     let angle = self.opt_input(n, "Angle", F)?;
                     let rotation = self.opt_input(n, "Rotation", V)?;
                     let d = self.alloc(V);
-                    self.ops.push(Op::VectorRotate { kind, invert, vector, center, axis, angle, rotation, dst: d });
+                    self.ops.push(Op::VectorRotate {
+                        kind,
+                        invert,
+                        vector,
+                        center,
+                        axis,
+                        angle,
+                        rotation,
+                        dst: d,
+                    });
                     self.outputs(i, n, &[("Vector", d, V)]);
                 }
                 "ShaderNodeMapping" => {
@@ -528,19 +781,44 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     let rotation = self.input(n, "Rotation", V)?;
                     let scale = self.input(n, "Scale", V)?;
                     let d = self.alloc(V);
-                    self.ops.push(Op::Mapping { kind, vector, location, rotation, scale, dst: d });
+                    self.ops.push(Op::Mapping {
+                        kind,
+                        vector,
+                        location,
+                        rotation,
+                        scale,
+                        dst: d,
+                    });
                     self.outputs(i, n, &[("Vector", d, V)]);
                 }
                 "ShaderNodeTexNoise" => {
                     let (dims, vector, w) = self.texture_point(n, Some("noise_dimensions"))?;
                     let kind = mode(n, "noise_type", NoiseType::from_blender)?;
                     let normalize = prop_bool(n, "normalize")?;
-                    let ids = ["Scale", "Detail", "Roughness", "Lacunarity", "Offset", "Gain", "Distortion"];
+                    let ids = [
+                        "Scale",
+                        "Detail",
+                        "Roughness",
+                        "Lacunarity",
+                        "Offset",
+                        "Gain",
+                        "Distortion",
+                    ];
                     let args = self.inputs_n(n, ids, F)?;
                     let (fac, color) = (self.alloc(F), self.alloc(C));
                     // Without a link from Color only Fac is computed (as Cycles does).
                     let want_color = self.output_used(i, "Color");
-                    self.ops.push(Op::TexNoise { dims, kind, normalize, vector, w, args, fac, color, want_color });
+                    self.ops.push(Op::TexNoise {
+                        dims,
+                        kind,
+                        normalize,
+                        vector,
+                        w,
+                        args,
+                        fac,
+                        color,
+                        want_color,
+                    });
                     self.outputs(i, n, &[("Fac", fac, F), ("Color", color, C)]);
                 }
                 "ShaderNodeTexVoronoi" => {
@@ -548,11 +826,48 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     let feature = mode(n, "feature", VoronoiFeature::from_blender)?;
                     let metric = mode(n, "distance", VoronoiMetric::from_blender)?;
                     let normalize = prop_bool(n, "normalize")?;
-                    let ids = ["Scale", "Detail", "Roughness", "Lacunarity", "Smoothness", "Exponent", "Randomness"];
+                    let ids = [
+                        "Scale",
+                        "Detail",
+                        "Roughness",
+                        "Lacunarity",
+                        "Smoothness",
+                        "Exponent",
+                        "Randomness",
+                    ];
                     let args = self.inputs_n(n, ids, F)?;
-                    let (distance, color, position, w_out, radius) = (self.alloc(F), self.alloc(C), self.alloc(V), self.alloc(F), self.alloc(F));
-                    self.ops.push(Op::TexVoronoi { dims, feature, metric, normalize, vector, w, args, distance, color, position, w_out, radius });
-                    self.outputs(i, n, &[("Distance", distance, F), ("Color", color, C), ("Position", position, V), ("W", w_out, F), ("Radius", radius, F)]);
+                    let (distance, color, position, w_out, radius) = (
+                        self.alloc(F),
+                        self.alloc(C),
+                        self.alloc(V),
+                        self.alloc(F),
+                        self.alloc(F),
+                    );
+                    self.ops.push(Op::TexVoronoi {
+                        dims,
+                        feature,
+                        metric,
+                        normalize,
+                        vector,
+                        w,
+                        args,
+                        distance,
+                        color,
+                        position,
+                        w_out,
+                        radius,
+                    });
+                    self.outputs(
+                        i,
+                        n,
+                        &[
+                            ("Distance", distance, F),
+                            ("Color", color, C),
+                            ("Position", position, V),
+                            ("W", w_out, F),
+                            ("Radius", radius, F),
+                        ],
+                    );
                 }
                 "ShaderNodeTexWave" => {
                     let (_, vector, _) = self.texture_point(n, None)?;
@@ -562,25 +877,56 @@ impl<'g, 'a> Compiler<'g, 'a> {
                         rings: mode(n, "rings_direction", RingsDirection::from_blender)?,
                         profile: mode(n, "wave_profile", WaveProfile::from_blender)?,
                     };
-                    let ids = ["Scale", "Distortion", "Detail", "Detail Scale", "Detail Roughness", "Phase Offset"];
+                    let ids = [
+                        "Scale",
+                        "Distortion",
+                        "Detail",
+                        "Detail Scale",
+                        "Detail Roughness",
+                        "Phase Offset",
+                    ];
                     let args = self.inputs_n(n, ids, F)?;
                     let (fac, color) = (self.alloc(F), self.alloc(C));
-                    self.ops.push(Op::TexWave { settings, vector, args, fac, color });
+                    self.ops.push(Op::TexWave {
+                        settings,
+                        vector,
+                        args,
+                        fac,
+                        color,
+                    });
                     self.outputs(i, n, &[("Fac", fac, F), ("Color", color, C)]);
                 }
                 "ShaderNodeTexGradient" => {
                     let (_, vector, _) = self.texture_point(n, None)?;
                     let kind = mode(n, "gradient_type", GradientType::from_blender)?;
                     let (fac, color) = (self.alloc(F), self.alloc(C));
-                    self.ops.push(Op::TexGradient { kind, vector, fac, color });
+                    self.ops.push(Op::TexGradient {
+                        kind,
+                        vector,
+                        fac,
+                        color,
+                    });
                     self.outputs(i, n, &[("Fac", fac, F), ("Color", color, C)]);
                 }
                 "ShaderNodeTexMagic" => {
                     let (_, vector, _) = self.texture_point(n, None)?;
-                    let depth = prop(n, "turbulence_depth")?.as_i64().ok_or_else(|| CompileError(format!("node {:?}: turbulence_depth is not an integer", n.path)))? as i32;
-                    let (scale, distortion) = (self.input(n, "Scale", F)?, self.input(n, "Distortion", F)?);
+                    let depth = prop(n, "turbulence_depth")?.as_i64().ok_or_else(|| {
+                        CompileError(format!(
+                            "node {:?}: turbulence_depth is not an integer",
+                            n.path
+                        ))
+                    })? as i32;
+                    let (scale, distortion) =
+                        (self.input(n, "Scale", F)?, self.input(n, "Distortion", F)?);
                     let (fac, color) = (self.alloc(F), self.alloc(C));
-                    self.ops.push(Op::TexMagic { depth, vector, scale, distortion, fac, color });
+                    self.ops.push(Op::TexMagic {
+                        depth,
+                        vector,
+                        scale,
+                        distortion,
+                        fac,
+                        color,
+                    });
                     self.outputs(i, n, &[("Fac", fac, F), ("Color", color, C)]);
                 }
                 "ShaderNodeTexWhiteNoise" => {
@@ -595,43 +941,90 @@ impl<'g, 'a> Compiler<'g, 'a> {
                     };
                     let w = self.opt_input(n, "W", F)?;
                     let (value, color) = (self.alloc(F), self.alloc(C));
-                    self.ops.push(Op::TexWhiteNoise { dims, vector, w, value, color });
+                    self.ops.push(Op::TexWhiteNoise {
+                        dims,
+                        vector,
+                        w,
+                        value,
+                        color,
+                    });
                     self.outputs(i, n, &[("Value", value, F), ("Color", color, C)]);
                 }
                 "ShaderNodeTexChecker" => {
                     let (_, vector, _) = self.texture_point(n, None)?;
-                    let (color1, color2, scale) = (self.input(n, "Color1", C)?, self.input(n, "Color2", C)?, self.input(n, "Scale", F)?);
+                    let (color1, color2, scale) = (
+                        self.input(n, "Color1", C)?,
+                        self.input(n, "Color2", C)?,
+                        self.input(n, "Scale", F)?,
+                    );
                     let (fac, color) = (self.alloc(F), self.alloc(C));
-                    self.ops.push(Op::TexChecker { vector, color1, color2, scale, fac, color });
+                    self.ops.push(Op::TexChecker {
+                        vector,
+                        color1,
+                        color2,
+                        scale,
+                        fac,
+                        color,
+                    });
                     self.outputs(i, n, &[("Fac", fac, F), ("Color", color, C)]);
                 }
                 "ShaderNodeEmission" => {
-                    let (color, strength) = (self.input(n, "Color", C)?, self.input(n, "Strength", F)?);
+                    let (color, strength) =
+                        (self.input(n, "Color", C)?, self.input(n, "Strength", F)?);
                     self.closure(i, Closure::Emission { color, strength });
                 }
                 "ShaderNodeBsdfPrincipled" => {
-                    let (color, strength) = (self.input(n, "Emission Color", C)?, self.input(n, "Emission Strength", F)?);
-                    self.closure(i, Closure::Bsdf { emission: Some((color, strength)) });
+                    let (color, strength) = (
+                        self.input(n, "Emission Color", C)?,
+                        self.input(n, "Emission Strength", F)?,
+                    );
+                    self.closure(
+                        i,
+                        Closure::Bsdf {
+                            emission: Some((color, strength)),
+                        },
+                    );
                     self.record_bsdf(i)?;
                 }
-                "ShaderNodeBsdfDiffuse" | "ShaderNodeBsdfGlossy" | "ShaderNodeBsdfAnisotropic" | "ShaderNodeBsdfGlass" | "ShaderNodeBsdfRefraction"
-                | "ShaderNodeBsdfTransparent" | "ShaderNodeBsdfTranslucent" | "ShaderNodeSubsurfaceScattering" | "ShaderNodeBsdfSheen" | "ShaderNodeHoldout" => {
+                "ShaderNodeBsdfDiffuse"
+                | "ShaderNodeBsdfGlossy"
+                | "ShaderNodeBsdfAnisotropic"
+                | "ShaderNodeBsdfGlass"
+                | "ShaderNodeBsdfRefraction"
+                | "ShaderNodeBsdfTransparent"
+                | "ShaderNodeBsdfTranslucent"
+                | "ShaderNodeSubsurfaceScattering"
+                | "ShaderNodeBsdfSheen"
+                | "ShaderNodeHoldout" => {
                     // No emission; their scattering parameters are compiled with the renderer.
                     self.closure(i, Closure::Bsdf { emission: None });
                     self.record_bsdf(i)?;
                 }
                 "ShaderNodeMixShader" => {
                     let fac = self.input(n, "Fac", F)?;
-                    let (a, b) = (self.closure_input(n, "Shader")?, self.closure_input(n, "Shader_001")?);
+                    let (a, b) = (
+                        self.closure_input(n, "Shader")?,
+                        self.closure_input(n, "Shader_001")?,
+                    );
                     self.closure(i, Closure::Mix { fac, a, b });
                 }
                 "ShaderNodeAddShader" => {
-                    let (a, b) = (self.closure_input(n, "Shader")?, self.closure_input(n, "Shader_001")?);
+                    let (a, b) = (
+                        self.closure_input(n, "Shader")?,
+                        self.closure_input(n, "Shader_001")?,
+                    );
                     self.closure(i, Closure::Add { a, b });
                 }
                 "ShaderNodeOutputMaterial" => {
-                    if self.displace.is_none() && !self.true_displacement && n.input("Displacement").is_some_and(|d| matches!(d.sources.first(), Some(Source::Link { .. }))) {
-                        return Err(CompileError(format!("node {:?}: displacement is not supported yet", n.path)));
+                    if self.displace.is_none()
+                        && !self.true_displacement
+                        && n.input("Displacement")
+                            .is_some_and(|d| matches!(d.sources.first(), Some(Source::Link { .. })))
+                    {
+                        return Err(CompileError(format!(
+                            "node {:?}: displacement is not supported yet",
+                            n.path
+                        )));
                     }
                     self.surface = self.closure_input(n, "Surface")?;
                 }
@@ -640,33 +1033,75 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 "ShaderNodeTexEnvironment" => self.environment_texture(i)?,
                 "ShaderNodeBackground" => {
                     // A world's Background is emission seen along the ray.
-                    let (color, strength) = (self.input(n, "Color", C)?, self.input(n, "Strength", F)?);
+                    let (color, strength) =
+                        (self.input(n, "Color", C)?, self.input(n, "Strength", F)?);
                     self.closure(i, Closure::Emission { color, strength });
                 }
                 "ShaderNodeOutputWorld" => self.surface = self.closure_input(n, "Surface")?,
                 "ShaderNodeBump" => {
-                    let settings = BumpSettings { invert: prop_bool(n, "invert")?, object_space: false, filter_width: bump_graph::filter_width(self.g, i).map_err(CompileError)? };
-                    let (strength, distance) = (self.input(n, "Strength", F)?, self.input(n, "Distance", F)?);
-                    let normal = if linked(n, "Normal") { Some(self.input(n, "Normal", V)?) } else { None };
+                    let settings = BumpSettings {
+                        invert: prop_bool(n, "invert")?,
+                        object_space: false,
+                        filter_width: bump_graph::filter_width(self.g, i).map_err(CompileError)?,
+                    };
+                    let (strength, distance) =
+                        (self.input(n, "Strength", F)?, self.input(n, "Distance", F)?);
+                    let normal = if linked(n, "Normal") {
+                        Some(self.input(n, "Normal", V)?)
+                    } else {
+                        None
+                    };
                     let center = self.input(n, "Height", F)?;
                     let (dx, dy) = match schedule.bump_copies[i] {
-                        Some((cx, cy)) => (self.input_in_copy(cx, i, "Height", F)?, self.input_in_copy(cy, i, "Height", F)?),
+                        Some((cx, cy)) => (
+                            self.input_in_copy(cx, i, "Height", F)?,
+                            self.input_in_copy(cy, i, "Height", F)?,
+                        ),
                         None => (center, center),
                     };
                     let d = self.alloc(V);
-                    self.ops.push(Op::Bump { settings, normal, strength, distance, center, dx, dy, dst: d });
+                    self.ops.push(Op::Bump {
+                        settings,
+                        normal,
+                        strength,
+                        distance,
+                        center,
+                        dx,
+                        dy,
+                        dst: d,
+                    });
                     self.outputs(i, n, &[("Normal", d, V)]);
                 }
                 "ShaderNodeDisplacement" => {
                     let object_space = match prop_str(n, "space")? {
                         "OBJECT" => true,
                         "WORLD" => false,
-                        other => return Err(CompileError(format!("node {:?}: space {other:?} is not supported", n.path))),
+                        other => {
+                            return Err(CompileError(format!(
+                                "node {:?}: space {other:?} is not supported",
+                                n.path
+                            )))
+                        }
                     };
-                    let (height, midlevel, scale) = (self.input(n, "Height", F)?, self.input(n, "Midlevel", F)?, self.input(n, "Scale", F)?);
-                    let normal = if linked(n, "Normal") { Some(self.input(n, "Normal", V)?) } else { None };
+                    let (height, midlevel, scale) = (
+                        self.input(n, "Height", F)?,
+                        self.input(n, "Midlevel", F)?,
+                        self.input(n, "Scale", F)?,
+                    );
+                    let normal = if linked(n, "Normal") {
+                        Some(self.input(n, "Normal", V)?)
+                    } else {
+                        None
+                    };
                     let d = self.alloc(V);
-                    self.ops.push(Op::Displacement { object_space, height, midlevel, scale, normal, dst: d });
+                    self.ops.push(Op::Displacement {
+                        object_space,
+                        height,
+                        midlevel,
+                        scale,
+                        normal,
+                        dst: d,
+                    });
                     self.outputs(i, n, &[("Displacement", d, V)]);
                 }
                 "ShaderNodeVectorDisplacement" => {
@@ -675,9 +1110,19 @@ impl<'g, 'a> Compiler<'g, 'a> {
                         self.vector_displacement_tangent(i)?;
                         continue;
                     }
-                    let (vector, midlevel, scale) = (self.input(n, "Vector", V)?, self.input(n, "Midlevel", F)?, self.input(n, "Scale", F)?);
+                    let (vector, midlevel, scale) = (
+                        self.input(n, "Vector", V)?,
+                        self.input(n, "Midlevel", F)?,
+                        self.input(n, "Scale", F)?,
+                    );
                     let d = self.alloc(V);
-                    self.ops.push(Op::VectorDisplacement { space, vector, midlevel, scale, dst: d });
+                    self.ops.push(Op::VectorDisplacement {
+                        space,
+                        vector,
+                        midlevel,
+                        scale,
+                        dst: d,
+                    });
                     self.outputs(i, n, &[("Displacement", d, V)]);
                 }
                 "ShaderNodeNormalMap" => {
@@ -686,20 +1131,50 @@ impl<'g, 'a> Compiler<'g, 'a> {
                         self.normal_map_tangent(i)?;
                         continue;
                     }
-                    let (color, strength) = (self.input(n, "Color", C)?, self.input(n, "Strength", F)?);
+                    let (color, strength) =
+                        (self.input(n, "Color", C)?, self.input(n, "Strength", F)?);
                     let d = self.alloc(V);
-                    self.ops.push(Op::NormalMap { space, color, strength, dst: d });
+                    self.ops.push(Op::NormalMap {
+                        space,
+                        color,
+                        strength,
+                        dst: d,
+                    });
                     self.outputs(i, n, &[("Normal", d, V)]);
                 }
-                "ShaderNodeFresnel" | "ShaderNodeLayerWeight" | "ShaderNodeNewGeometry" | "ShaderNodeObjectInfo" | "ShaderNodeCameraData" | "ShaderNodeLightPath"
-                | "ShaderNodeLightFalloff" | "ShaderNodeNormal" | "ShaderNodeTangent" => self.input_node(i)?,
+                "ShaderNodeFresnel"
+                | "ShaderNodeLayerWeight"
+                | "ShaderNodeNewGeometry"
+                | "ShaderNodeObjectInfo"
+                | "ShaderNodeCameraData"
+                | "ShaderNodeLightPath"
+                | "ShaderNodeLightFalloff"
+                | "ShaderNodeNormal"
+                | "ShaderNodeTangent" => self.input_node(i)?,
                 "ShaderNodeAttribute" | "ShaderNodeVertexColor" => self.attribute_node(i)?,
-                other => return Err(CompileError(format!("node {:?}: {other} is not supported yet", n.path))),
+                other => {
+                    return Err(CompileError(format!(
+                        "node {:?}: {other} is not supported yet",
+                        n.path
+                    )))
+                }
             }
         }
         self.switch_copy(&schedule, 0);
         let emission_estimate = self.emission_estimate(self.surface);
-        Ok(Program { ops: self.ops, initial: self.initial, ramps: self.ramps, curves: self.curves, closures: self.closures, surface: self.surface, bsdfs: self.bsdfs, displaced_normal: self.displaced_normal, attributes: self.attributes, displacement: self.displacement, emission_estimate })
+        Ok(Program {
+            ops: self.ops,
+            initial: self.initial,
+            ramps: self.ramps,
+            curves: self.curves,
+            closures: self.closures,
+            surface: self.surface,
+            bsdfs: self.bsdfs,
+            displaced_normal: self.displaced_normal,
+            attributes: self.attributes,
+            displacement: self.displacement,
+            emission_estimate,
+        })
     }
 
     /// Records a BSDF node's value inputs and enum properties for the renderer.
@@ -708,16 +1183,30 @@ impl<'g, 'a> Compiler<'g, 'a> {
         let closure = self.closures.len() as u32 - 1;
         let mut inputs = Vec::new();
         for sock in n.node.inputs.iter().filter(|s| s.enabled) {
-            let Some(kind) = kind_of(&sock.kind) else { continue };
+            let Some(kind) = kind_of(&sock.kind) else {
+                continue;
+            };
             if n.input(&sock.identifier).is_none() {
                 continue;
             }
-            let linked = n.input(&sock.identifier).is_some_and(|inp| matches!(inp.sources.first(), Some(Source::Link { .. })));
+            let linked = n
+                .input(&sock.identifier)
+                .is_some_and(|inp| matches!(inp.sources.first(), Some(Source::Link { .. })));
             let slot = self.input(n, &sock.identifier, kind)?;
             inputs.push((sock.identifier.clone(), slot, linked));
         }
-        let properties = n.node.properties.iter().filter_map(|(k, v)| v.as_str().map(|s| (k.clone(), s.to_string()))).collect();
-        self.bsdfs.push(BsdfNode { closure, bl_idname: n.node.bl_idname.clone(), inputs, properties });
+        let properties = n
+            .node
+            .properties
+            .iter()
+            .filter_map(|(k, v)| v.as_str().map(|s| (k.clone(), s.to_string())))
+            .collect();
+        self.bsdfs.push(BsdfNode {
+            closure,
+            bl_idname: n.node.bl_idname.clone(),
+            inputs,
+            properties,
+        });
         Ok(())
     }
 
@@ -730,7 +1219,12 @@ impl<'g, 'a> Compiler<'g, 'a> {
         }
     }
 
-    fn inputs_n<const K: usize>(&mut self, n: &FlatNode<'a>, ids: [&str; K], want: Kind) -> Result<[Slot; K], CompileError> {
+    fn inputs_n<const K: usize>(
+        &mut self,
+        n: &FlatNode<'a>,
+        ids: [&str; K],
+        want: Kind,
+    ) -> Result<[Slot; K], CompileError> {
         let mut out = [0; K];
         for (o, id) in out.iter_mut().zip(ids) {
             *o = self.opt_input(n, id, want)?;
@@ -741,14 +1235,21 @@ impl<'g, 'a> Compiler<'g, 'a> {
     /// A texture node's dimensions (if it has them), its Vector (Generated coordinates
     /// when unlinked, as Cycles does) and W. Only the identity texture mapping is
     /// supported: Cycles then adds no mapping step.
-    fn texture_point(&mut self, n: &FlatNode<'a>, dims_key: Option<&str>) -> Result<(u8, Slot, Slot), CompileError> {
+    fn texture_point(
+        &mut self,
+        n: &FlatNode<'a>,
+        dims_key: Option<&str>,
+    ) -> Result<(u8, Slot, Slot), CompileError> {
         let dims = match dims_key {
             Some(k) => dimensions(n, k)?,
             None => 3,
         };
         if let Some(m) = n.property("texture_mapping") {
             if !identity_mapping(m) {
-                return Err(CompileError(format!("node {:?}: a non-identity texture_mapping is not supported yet", n.path)));
+                return Err(CompileError(format!(
+                    "node {:?}: a non-identity texture_mapping is not supported yet",
+                    n.path
+                )));
             }
         }
         let vector = if dims == 1 {
@@ -757,14 +1258,28 @@ impl<'g, 'a> Compiler<'g, 'a> {
             self.input(n, "Vector", Kind::Vector)?
         } else {
             let d = self.alloc(Kind::Vector);
-            self.ops.push(Op::TexCoord { generated: Some(d), normal: None, uv: None, object: None });
+            self.ops.push(Op::TexCoord {
+                generated: Some(d),
+                normal: None,
+                uv: None,
+                object: None,
+            });
             d
         };
-        let w = if n.input("W").is_some() { self.input(n, "W", Kind::Float)? } else { self.constant(Kind::Float, [0.0; 3]) };
+        let w = if n.input("W").is_some() {
+            self.input(n, "W", Kind::Float)?
+        } else {
+            self.constant(Kind::Float, [0.0; 3])
+        };
         Ok((dims, vector, w))
     }
 
-    fn inputs6(&mut self, n: &FlatNode<'a>, ids: [&str; 6], want: Kind) -> Result<[Slot; 6], CompileError> {
+    fn inputs6(
+        &mut self,
+        n: &FlatNode<'a>,
+        ids: [&str; 6],
+        want: Kind,
+    ) -> Result<[Slot; 6], CompileError> {
         let mut out = [0; 6];
         for (o, id) in out.iter_mut().zip(ids) {
             *o = self.opt_input(n, id, want)?;
@@ -783,9 +1298,19 @@ impl<'g, 'a> Compiler<'g, 'a> {
         let clamp_factor = prop_bool(n, "clamp_factor")?;
         match prop_str(n, "data_type")? {
             "FLOAT" => {
-                let (factor, a, b) = (self.input(n, "Factor_Float", F)?, self.input(n, "A_Float", F)?, self.input(n, "B_Float", F)?);
+                let (factor, a, b) = (
+                    self.input(n, "Factor_Float", F)?,
+                    self.input(n, "A_Float", F)?,
+                    self.input(n, "B_Float", F)?,
+                );
                 let d = self.alloc(F);
-                self.ops.push(Op::MixFloat { clamp_factor, factor, a, b, dst: d });
+                self.ops.push(Op::MixFloat {
+                    clamp_factor,
+                    factor,
+                    a,
+                    b,
+                    dst: d,
+                });
                 self.outputs(i, n, &[("Result_Float", d, F)]);
             }
             "VECTOR" => {
@@ -793,37 +1318,69 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 let d = self.alloc(V);
                 if prop_str(n, "factor_mode")? == "NON_UNIFORM" {
                     let factor = self.input(n, "Factor_Vector", V)?;
-                    self.ops.push(Op::MixVectorNonUniform { clamp_factor, factor, a, b, dst: d });
+                    self.ops.push(Op::MixVectorNonUniform {
+                        clamp_factor,
+                        factor,
+                        a,
+                        b,
+                        dst: d,
+                    });
                 } else {
                     let factor = self.input(n, "Factor_Float", F)?;
-                    self.ops.push(Op::MixVector { clamp_factor, factor, a, b, dst: d });
+                    self.ops.push(Op::MixVector {
+                        clamp_factor,
+                        factor,
+                        a,
+                        b,
+                        dst: d,
+                    });
                 }
                 self.outputs(i, n, &[("Result_Vector", d, V)]);
             }
             "RGBA" => {
                 let blend = mode(n, "blend_type", MixBlend::from_blender)?;
                 let clamp_result = prop_bool(n, "clamp_result")?;
-                let (factor, a, b) = (self.input(n, "Factor_Float", F)?, self.input(n, "A_Color", C)?, self.input(n, "B_Color", C)?);
+                let (factor, a, b) = (
+                    self.input(n, "Factor_Float", F)?,
+                    self.input(n, "A_Color", C)?,
+                    self.input(n, "B_Color", C)?,
+                );
                 let d = self.alloc(C);
-                self.ops.push(Op::MixColor { blend, clamp_factor, clamp_result, factor, a, b, dst: d });
+                self.ops.push(Op::MixColor {
+                    blend,
+                    clamp_factor,
+                    clamp_result,
+                    factor,
+                    a,
+                    b,
+                    dst: d,
+                });
                 self.outputs(i, n, &[("Result_Color", d, C)]);
             }
-            other => return Err(CompileError(format!("node {:?}: Mix data type {other:?} is not supported", n.path))),
+            other => {
+                return Err(CompileError(format!(
+                    "node {:?}: Mix data type {other:?} is not supported",
+                    n.path
+                )))
+            }
         }
         Ok(())
     }
 
     /// The node's curve mapping, baked into the lookup table Cycles builds from it.
     fn curve_table(&mut self, n: &FlatNode, kind: CurveKind) -> Result<u32, CompileError> {
-        let m = mapping_from_json(prop(n, "mapping")?).map_err(|e| CompileError(format!("node {:?}: {}", n.path, e.0)))?;
-        let t = CurveTable::new(&m, kind).map_err(|e| CompileError(format!("node {:?}: {}", n.path, e.0)))?;
+        let m = mapping_from_json(prop(n, "mapping")?)
+            .map_err(|e| CompileError(format!("node {:?}: {}", n.path, e.0)))?;
+        let t = CurveTable::new(&m, kind)
+            .map_err(|e| CompileError(format!("node {:?}: {}", n.path, e.0)))?;
         self.curves.push(t);
         Ok(self.curves.len() as u32 - 1)
     }
 
     /// The node's colour band, sampled into a lookup table as Blender hands it to Cycles.
     fn ramp(&mut self, n: &FlatNode) -> Result<u32, CompileError> {
-        let band = band_from_json(prop(n, "color_ramp")?).map_err(|e| CompileError(format!("node {:?}: {e}", n.path)))?;
+        let band = band_from_json(prop(n, "color_ramp")?)
+            .map_err(|e| CompileError(format!("node {:?}: {e}", n.path)))?;
         self.ramps.push(RampTable::from_band(&band));
         Ok(self.ramps.len() as u32 - 1)
     }
@@ -838,28 +1395,43 @@ impl<'g, 'a> Compiler<'g, 'a> {
         std::mem::swap(&mut self.values, &mut self.copy_values[c]);
         let (old, new) = (schedule.copies[self.copy], schedule.copies[c]);
         if old.point != new.point || old.filter_width != new.filter_width {
-            self.ops.push(Op::BumpPoint { point: new.point, width: new.filter_width });
+            self.ops.push(Op::BumpPoint {
+                point: new.point,
+                width: new.filter_width,
+            });
         }
         self.copy = c;
         self.offset_copy = new.point != super::bump::BumpPoint::Center;
     }
 
     /// Prepares a schedule step; returns the node to compile, if it is one.
-    fn enter_step(&mut self, schedule: &Schedule, step: Step) -> Result<Option<usize>, CompileError> {
+    fn enter_step(
+        &mut self,
+        schedule: &Schedule,
+        step: Step,
+    ) -> Result<Option<usize>, CompileError> {
         match step {
             Step::Node { node, copy } => {
                 self.switch_copy(schedule, copy);
                 Ok(Some(node))
             }
             Step::DisplacementBump => {
-                let Some((c, x, y)) = schedule.displacement else { return Ok(None) };
+                let Some((c, x, y)) = schedule.displacement else {
+                    return Ok(None);
+                };
                 self.switch_copy(schedule, 0);
                 let root = self.g.root;
                 let center = self.input_in_copy(c, root, "Displacement", Kind::Vector)?;
                 let dx = self.input_in_copy(x, root, "Displacement", Kind::Vector)?;
                 let dy = self.input_in_copy(y, root, "Displacement", Kind::Vector)?;
                 let d = self.alloc(Kind::Vector);
-                self.ops.push(Op::DisplacementBump { object_space: self.displace == Some(true), center, dx, dy, dst: d });
+                self.ops.push(Op::DisplacementBump {
+                    object_space: self.displace == Some(true),
+                    center,
+                    dx,
+                    dy,
+                    dst: d,
+                });
                 self.displaced_normal = Some(d);
                 if let Some(t) = &mut self.displacement {
                     t.bump_end = Some(self.ops.len());
@@ -867,17 +1439,29 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 Ok(None)
             }
             Step::DisplacementValue => {
-                let Some(c) = schedule.displacement_value else { return Ok(None) };
+                let Some(c) = schedule.displacement_value else {
+                    return Ok(None);
+                };
                 self.switch_copy(schedule, 0);
                 let value = self.input_in_copy(c, self.g.root, "Displacement", Kind::Vector)?;
-                self.displacement = Some(super::program::TrueDisplacement { center_end: self.ops.len(), value, bump_end: None });
+                self.displacement = Some(super::program::TrueDisplacement {
+                    center_end: self.ops.len(),
+                    value,
+                    bump_end: None,
+                });
                 Ok(None)
             }
         }
     }
 
     /// Input `id` of flat node `i` as copy `c` of the graph computed it.
-    fn input_in_copy(&mut self, c: usize, i: usize, id: &str, want: Kind) -> Result<Slot, CompileError> {
+    fn input_in_copy(
+        &mut self,
+        c: usize,
+        i: usize,
+        id: &str,
+        want: Kind,
+    ) -> Result<Slot, CompileError> {
         debug_assert_eq!(self.copy, 0);
         std::mem::swap(&mut self.values, &mut self.copy_values[c]);
         let n = &self.g.nodes[i];
@@ -890,13 +1474,24 @@ impl<'g, 'a> Compiler<'g, 'a> {
 /// Compiles the Cycles surface of world `name`: Background closures as emission, and
 /// texture coordinates read from the ray direction (`world_point`).
 pub fn compile_world(scene: &Scene, name: &str) -> Result<Program, CompileError> {
-    let world = scene.file.worlds.iter().find(|w| w.name == name).ok_or_else(|| CompileError(format!("no world {name:?}")))?;
-    let tree = world.node_tree.as_ref().ok_or_else(|| CompileError(format!("world {name:?} has no node tree")))?;
-    let out = active_output(tree, "ShaderNodeOutputWorld", "CYCLES").ok_or_else(|| CompileError(format!("world {name:?} has no World Output")))?;
-    let graph = flatten(tree, &scene.file.node_groups, &out.name).map_err(|e| CompileError(format!("world {name:?}: {e}")))?;
+    let world = scene
+        .file
+        .worlds
+        .iter()
+        .find(|w| w.name == name)
+        .ok_or_else(|| CompileError(format!("no world {name:?}")))?;
+    let tree = world
+        .node_tree
+        .as_ref()
+        .ok_or_else(|| CompileError(format!("world {name:?} has no node tree")))?;
+    let out = active_output(tree, "ShaderNodeOutputWorld", "CYCLES")
+        .ok_or_else(|| CompileError(format!("world {name:?} has no World Output")))?;
+    let graph = flatten(tree, &scene.file.node_groups, &out.name)
+        .map_err(|e| CompileError(format!("world {name:?}: {e}")))?;
     let mut c = Compiler::new(&graph);
     c.scene = Some(scene);
-    c.run().map_err(|e| CompileError(format!("world {name:?}: {}", e.0)))
+    c.run()
+        .map_err(|e| CompileError(format!("world {name:?}: {}", e.0)))
 }
 
 /// A world shading point for direction `d` (unit, world space), as Cycles sets up the
@@ -904,17 +1499,36 @@ pub fn compile_world(scene: &Scene, name: &str) -> Result<Program, CompileError>
 /// normal faces back along the ray, no UV.
 pub fn world_point(d: crate::nodes::math::Vec3) -> super::point::ShadingPoint {
     let n = [-d[0], -d[1], -d[2]];
-    super::point::ShadingPoint { position: d, normal: n, object_position: d, object_normal: n, generated: d, ..Default::default() }
+    super::point::ShadingPoint {
+        position: d,
+        normal: n,
+        object_position: d,
+        object_normal: n,
+        generated: d,
+        ..Default::default()
+    }
 }
 
 impl<'g, 'a> Compiler<'g, 'a> {
     fn prop_f32(n: &FlatNode, key: &str) -> Result<f32, CompileError> {
-        prop(n, key)?.as_f64().map(|v| v as f32).ok_or_else(|| CompileError(format!("node {:?}: property {key:?} is not a number", n.path)))
+        prop(n, key)?.as_f64().map(|v| v as f32).ok_or_else(|| {
+            CompileError(format!(
+                "node {:?}: property {key:?} is not a number",
+                n.path
+            ))
+        })
     }
 
     /// Whether output `id` of flat node `i` feeds anything in the graph.
     fn output_used(&self, i: usize, id: &str) -> bool {
-        let Some(k) = self.g.nodes[i].node.outputs.iter().position(|o| o.identifier == id) else { return false };
+        let Some(k) = self.g.nodes[i]
+            .node
+            .outputs
+            .iter()
+            .position(|o| o.identifier == id)
+        else {
+            return false;
+        };
         self.g.nodes.iter().any(|m| m.inputs.iter().any(|inp| inp.sources.iter().any(|s| matches!(s, Source::Link { node, output, .. } if *node == i && *output == k))))
     }
 
@@ -922,22 +1536,65 @@ impl<'g, 'a> Compiler<'g, 'a> {
         use crate::nodes::brick::BrickSettings;
         let n = &self.g.nodes[i];
         let (_, vector, _) = self.texture_point(n, None)?;
-        let int = |key: &str| -> Result<i32, CompileError> { prop(n, key)?.as_i64().map(|v| v as i32).ok_or_else(|| CompileError(format!("node {:?}: property {key:?} is not an integer", n.path))) };
-        let settings = BrickSettings { offset: Self::prop_f32(n, "offset")?, offset_frequency: int("offset_frequency")?, squash: Self::prop_f32(n, "squash")?, squash_frequency: int("squash_frequency")? };
+        let int = |key: &str| -> Result<i32, CompileError> {
+            prop(n, key)?.as_i64().map(|v| v as i32).ok_or_else(|| {
+                CompileError(format!(
+                    "node {:?}: property {key:?} is not an integer",
+                    n.path
+                ))
+            })
+        };
+        let settings = BrickSettings {
+            offset: Self::prop_f32(n, "offset")?,
+            offset_frequency: int("offset_frequency")?,
+            squash: Self::prop_f32(n, "squash")?,
+            squash_frequency: int("squash_frequency")?,
+        };
         let [c1, c2, m] = self.inputs_n(n, ["Color1", "Color2", "Mortar"], Kind::Color)?;
-        let [scale, size, smooth, bias, width, height] = self.inputs_n(n, ["Scale", "Mortar Size", "Mortar Smooth", "Bias", "Brick Width", "Row Height"], Kind::Float)?;
+        let [scale, size, smooth, bias, width, height] = self.inputs_n(
+            n,
+            [
+                "Scale",
+                "Mortar Size",
+                "Mortar Smooth",
+                "Bias",
+                "Brick Width",
+                "Row Height",
+            ],
+            Kind::Float,
+        )?;
         let (fac, color) = (self.alloc(Kind::Float), self.alloc(Kind::Color));
-        self.ops.push(Op::TexBrick { settings, vector, args: [c1, c2, m, scale, size, smooth, bias, width, height], fac, color });
-        self.outputs(i, n, &[("Fac", fac, Kind::Float), ("Color", color, Kind::Color)]);
+        self.ops.push(Op::TexBrick {
+            settings,
+            vector,
+            args: [c1, c2, m, scale, size, smooth, bias, width, height],
+            fac,
+            color,
+        });
+        self.outputs(
+            i,
+            n,
+            &[("Fac", fac, Kind::Float), ("Color", color, Kind::Color)],
+        );
         Ok(())
     }
 
     /// The image an Image/Environment Texture node names (Cycles' magenta if none).
-    fn node_image(&self, n: &FlatNode) -> Result<std::sync::Arc<super::images::TexImage>, CompileError> {
-        let name = n.property("image").and_then(|v| v.get("name")).and_then(Value::as_str);
+    fn node_image(
+        &self,
+        n: &FlatNode,
+    ) -> Result<std::sync::Arc<super::images::TexImage>, CompileError> {
+        let name = n
+            .property("image")
+            .and_then(|v| v.get("name"))
+            .and_then(Value::as_str);
         match (name, self.scene) {
-            (Some(name), Some(scene)) => super::images::scene_image(scene, name).map_err(|e| CompileError(format!("node {:?}: {e}", n.path))),
-            (Some(_), None) => Err(CompileError(format!("node {:?}: images need the scene", n.path))),
+            (Some(name), Some(scene)) => super::images::scene_image(scene, name)
+                .map_err(|e| CompileError(format!("node {:?}: {e}", n.path))),
+            (Some(_), None) => Err(CompileError(format!(
+                "node {:?}: images need the scene",
+                n.path
+            ))),
             (None, _) => Ok(std::sync::Arc::new(super::images::TexImage::missing())),
         }
     }
@@ -951,7 +1608,10 @@ impl<'g, 'a> Compiler<'g, 'a> {
         let blend = Self::prop_f32(n, "projection_blend")?;
         if let Some(m) = n.property("texture_mapping") {
             if !identity_mapping(m) {
-                return Err(CompileError(format!("node {:?}: a non-identity texture_mapping is not supported yet", n.path)));
+                return Err(CompileError(format!(
+                    "node {:?}: a non-identity texture_mapping is not supported yet",
+                    n.path
+                )));
             }
         }
         let image = self.node_image(n)?;
@@ -965,8 +1625,22 @@ impl<'g, 'a> Compiler<'g, 'a> {
         };
         let unassociate = self.output_used(i, "Alpha") && image.unassociates();
         let (color, alpha) = (self.alloc(Kind::Color), self.alloc(Kind::Float));
-        self.ops.push(Op::TexImage { image, projection, blend, interpolation, extension, unassociate, vector, color, alpha });
-        self.outputs(i, n, &[("Color", color, Kind::Color), ("Alpha", alpha, Kind::Float)]);
+        self.ops.push(Op::TexImage {
+            image,
+            projection,
+            blend,
+            interpolation,
+            extension,
+            unassociate,
+            vector,
+            color,
+            alpha,
+        });
+        self.outputs(
+            i,
+            n,
+            &[("Color", color, Kind::Color), ("Alpha", alpha, Kind::Float)],
+        );
         Ok(())
     }
 
@@ -977,7 +1651,10 @@ impl<'g, 'a> Compiler<'g, 'a> {
         let projection = mode(n, "projection", EnvProjection::from_blender)?;
         if let Some(m) = n.property("texture_mapping") {
             if !identity_mapping(m) {
-                return Err(CompileError(format!("node {:?}: a non-identity texture_mapping is not supported yet", n.path)));
+                return Err(CompileError(format!(
+                    "node {:?}: a non-identity texture_mapping is not supported yet",
+                    n.path
+                )));
             }
         }
         let image = self.node_image(n)?;
@@ -991,8 +1668,20 @@ impl<'g, 'a> Compiler<'g, 'a> {
         };
         let unassociate = self.output_used(i, "Alpha") && image.unassociates();
         let (color, alpha) = (self.alloc(Kind::Color), self.alloc(Kind::Float));
-        self.ops.push(Op::TexEnvironment { image, projection, interpolation, unassociate, vector, color, alpha });
-        self.outputs(i, n, &[("Color", color, Kind::Color), ("Alpha", alpha, Kind::Float)]);
+        self.ops.push(Op::TexEnvironment {
+            image,
+            projection,
+            interpolation,
+            unassociate,
+            vector,
+            color,
+            alpha,
+        });
+        self.outputs(
+            i,
+            n,
+            &[("Color", color, Kind::Color), ("Alpha", alpha, Kind::Float)],
+        );
         Ok(())
     }
 }

@@ -22,7 +22,10 @@ pub fn pointiness(mesh: &MeshData, vertex_normals: &[Vec3]) -> Vec<f32> {
     let mut normal = vec![[0.0f32; 3]; n];
     for v in 0..n {
         let o = orig[v] as usize;
-        normal[o] = add3(normal[o], vertex_normals.get(v).copied().unwrap_or([0.0; 3]));
+        normal[o] = add3(
+            normal[o],
+            vertex_normals.get(v).copied().unwrap_or([0.0; 3]),
+        );
     }
     for v in 0..n {
         normal[v] = normalize3(normal[orig[v] as usize]);
@@ -81,7 +84,11 @@ fn weld(pos: &[Vec3]) -> Vec<u32> {
             return b.cmp(&a);
         }
         // Cycles orders only by the sum; ties of distinct points get a fixed order here.
-        sum(pa).total_cmp(&sum(pb)).then_with(|| pa[0].total_cmp(&pb[0])).then_with(|| pa[1].total_cmp(&pb[1])).then_with(|| pa[2].total_cmp(&pb[2]))
+        sum(pa)
+            .total_cmp(&sum(pb))
+            .then_with(|| pa[0].total_cmp(&pb[0]))
+            .then_with(|| pa[1].total_cmp(&pb[1]))
+            .then_with(|| pa[2].total_cmp(&pb[2]))
     });
     let mut orig: Vec<u32> = (0..n as u32).collect();
     for i in 0..n {
@@ -147,7 +154,10 @@ pub fn random_per_island(mesh: &MeshData) -> Vec<f32> {
     }
     (0..mesh.face_count())
         .map(|f| {
-            let v = mesh.corner_verts.get(mesh.face_offsets[f] as usize).map_or(0, |&v| v as usize);
+            let v = mesh
+                .corner_verts
+                .get(mesh.face_offsets[f] as usize)
+                .map_or(0, |&v| v as usize);
             if v < n {
                 hash_to_float1(find(&mut parent, v) as u32)
             } else {

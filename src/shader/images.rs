@@ -50,7 +50,15 @@ pub struct TexImage {
 impl TexImage {
     /// The 1x1 magenta image Cycles substitutes for one it cannot load.
     pub fn missing() -> TexImage {
-        TexImage { width: 1, height: 1, texels: Texels::Float(vec![MISSING]), encoding: Encoding::Raw, single_channel: false, is_data: false, alpha_mode: "STRAIGHT".into() }
+        TexImage {
+            width: 1,
+            height: 1,
+            texels: Texels::Float(vec![MISSING]),
+            encoding: Encoding::Raw,
+            single_channel: false,
+            is_data: false,
+            alpha_mode: "STRAIGHT".into(),
+        }
     }
 
     /// Whether an Alpha output in use divides colour by alpha after interpolation.
@@ -60,12 +68,34 @@ impl TexImage {
 
     /// A lookup as `svm_image_texture` does it: interpolate, unassociate if asked,
     /// decode sRGB.
-    pub fn lookup(&self, x: f32, y: f32, interpolation: Interpolation, extension: Extension, unassociate: bool) -> [f32; 4] {
+    pub fn lookup(
+        &self,
+        x: f32,
+        y: f32,
+        interpolation: Interpolation,
+        extension: Extension,
+        unassociate: bool,
+    ) -> [f32; 4] {
         let (w, h) = (self.width, self.height);
         let mut r = match &self.texels {
-            Texels::Byte(d) => Pixels { data: d, width: w, height: h }.interp(x, y, interpolation, extension),
-            Texels::Short(d) => Pixels { data: d, width: w, height: h }.interp(x, y, interpolation, extension),
-            Texels::Float(d) => Pixels { data: d, width: w, height: h }.interp(x, y, interpolation, extension),
+            Texels::Byte(d) => Pixels {
+                data: d,
+                width: w,
+                height: h,
+            }
+            .interp(x, y, interpolation, extension),
+            Texels::Short(d) => Pixels {
+                data: d,
+                width: w,
+                height: h,
+            }
+            .interp(x, y, interpolation, extension),
+            Texels::Float(d) => Pixels {
+                data: d,
+                width: w,
+                height: h,
+            }
+            .interp(x, y, interpolation, extension),
         };
         if self.single_channel {
             r = [r[0], r[0], r[0], 1.0];
@@ -107,7 +137,14 @@ pub fn scene_image(scene: &Scene, name: &str) -> Result<Arc<TexImage>, String> {
         warn_missing(name, "its file was not exported (missing or generated)");
         return Ok(Arc::new(TexImage::missing()));
     };
-    Ok(load_shared(&f.path, name, &f.colorspace, &f.alpha_mode, f.encoding, f.is_data))
+    Ok(load_shared(
+        &f.path,
+        name,
+        &f.colorspace,
+        &f.alpha_mode,
+        f.encoding,
+        f.is_data,
+    ))
 }
 
 /// Where an image datablock's file is and how its values are to be read.
@@ -122,25 +159,49 @@ pub struct ImageFile {
 /// The file of image `name` (None when it was not exported: missing or generated); an
 /// unsupported colour space or source is an error naming the image.
 pub fn image_file(scene: &Scene, name: &str) -> Result<Option<ImageFile>, String> {
-    let im = scene.file.images.iter().find(|i| i.name == name).ok_or_else(|| format!("no image {name:?} in the scene"))?;
+    let im = scene
+        .file
+        .images
+        .iter()
+        .find(|i| i.name == name)
+        .ok_or_else(|| format!("no image {name:?} in the scene"))?;
     let colorspace = im.colorspace.clone().unwrap_or_else(|| "sRGB".into());
     let alpha_mode = im.alpha_mode.clone().unwrap_or_else(|| "STRAIGHT".into());
-    let (encoding, is_data) = encoding_of(&colorspace).map_err(|e| format!("image {name:?}: {e}"))?;
+    let (encoding, is_data) =
+        encoding_of(&colorspace).map_err(|e| format!("image {name:?}: {e}"))?;
     let Some(rel) = im.file.as_deref().filter(|_| !im.missing) else {
         return Ok(None);
     };
     if matches!(im.source.as_deref(), Some("SEQUENCE" | "MOVIE" | "TILED")) {
-        return Err(format!("image {name:?}: source {} (sequences, movies, UDIM tiles) is not supported yet", im.source.as_deref().unwrap_or("")));
+        return Err(format!(
+            "image {name:?}: source {} (sequences, movies, UDIM tiles) is not supported yet",
+            im.source.as_deref().unwrap_or("")
+        ));
     }
-    let path = scene.resolve(rel, &format!("images[{name:?}].file")).map_err(|e| e.to_string())?;
-    Ok(Some(ImageFile { path, colorspace, alpha_mode, encoding, is_data }))
+    let path = scene
+        .resolve(rel, &format!("images[{name:?}].file"))
+        .map_err(|e| e.to_string())?;
+    Ok(Some(ImageFile {
+        path,
+        colorspace,
+        alpha_mode,
+        encoding,
+        is_data,
+    }))
 }
 
 fn warn_missing(name: &str, why: &str) {
     eprintln!("warning: image {name:?}: {why}; rendering it magenta as Cycles does");
 }
 
-fn load_shared(path: &Path, name: &str, colorspace: &str, alpha_mode: &str, encoding: Encoding, is_data: bool) -> Arc<TexImage> {
+fn load_shared(
+    path: &Path,
+    name: &str,
+    colorspace: &str,
+    alpha_mode: &str,
+    encoding: Encoding,
+    is_data: bool,
+) -> Arc<TexImage> {
     let meta = std::fs::metadata(path).ok();
     let key = Key {
         path: path.to_path_buf(),
@@ -185,7 +246,12 @@ pub fn flip_rows<T: Copy>(px: &[T], w: usize, h: usize) -> Vec<T> {
 }
 
 /// Decodes `path` into Cycles' storage for an image with these settings.
-pub fn load(path: &Path, encoding: Encoding, is_data: bool, alpha_mode: &str) -> Result<TexImage, String> {
+pub fn load(
+    path: &Path,
+    encoding: Encoding,
+    is_data: bool,
+    alpha_mode: &str,
+) -> Result<TexImage, String> {
     use image::DynamicImage as D;
     let img = decode(path)?;
     let (w, h) = (img.width() as usize, img.height() as usize);
@@ -248,5 +314,13 @@ pub fn load(path: &Path, encoding: Encoding, is_data: bool, alpha_mode: &str) ->
             Texels::Float(flip_rows(&px, w, h))
         }
     };
-    Ok(TexImage { width: w as i32, height: h as i32, texels, encoding, single_channel: channels == 1, is_data, alpha_mode: alpha_mode.into() })
+    Ok(TexImage {
+        width: w as i32,
+        height: h as i32,
+        texels,
+        encoding,
+        single_channel: channels == 1,
+        is_data,
+        alpha_mode: alpha_mode.into(),
+    })
 }

@@ -48,7 +48,21 @@ impl Input {
     /// True when the value is a vector (three slots), false for a float.
     pub fn is_vector(self) -> bool {
         use Input::*;
-        matches!(self, Position | Normal | Tangent | TrueNormal | Incoming | Parametric | ObjectLocation | ObjectColor | ViewVector | Camera | Window | Reflection)
+        matches!(
+            self,
+            Position
+                | Normal
+                | Tangent
+                | TrueNormal
+                | Incoming
+                | Parametric
+                | ObjectLocation
+                | ObjectColor
+                | ViewVector
+                | Camera
+                | Window
+                | Reflection
+        )
     }
 
     /// The Light Path output with socket identifier `id`.
@@ -77,7 +91,11 @@ fn dot(a: Vec3, b: Vec3) -> f32 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 /// Cycles' `normalize`: no guard, a zero vector gives NaNs as it does there.
 fn normalize(v: Vec3) -> Vec3 {
@@ -120,7 +138,11 @@ pub fn read(what: Input, sp: &ShadingPoint, s: &mut [f32], dst: u32) {
         Input::Tangent => radial_tangent(sp, 2),
         Input::TrueNormal => sp.true_normal,
         Input::Incoming => sp.incoming,
-        Input::Parametric => [1.0 - sp.parametric[0] - sp.parametric[1], sp.parametric[0], 0.0],
+        Input::Parametric => [
+            1.0 - sp.parametric[0] - sp.parametric[1],
+            sp.parametric[0],
+            0.0,
+        ],
         Input::ObjectLocation => sp.object.location,
         Input::ObjectColor => [sp.object.color[0], sp.object.color[1], sp.object.color[2]],
         Input::ViewVector => normalize(sp.camera_position),
@@ -128,7 +150,11 @@ pub fn read(what: Input, sp: &ShadingPoint, s: &mut [f32], dst: u32) {
         Input::Window => sp.window,
         Input::Reflection => {
             let k = 2.0 * dot(sp.normal, sp.incoming);
-            [k * sp.normal[0] - sp.incoming[0], k * sp.normal[1] - sp.incoming[1], k * sp.normal[2] - sp.incoming[2]]
+            [
+                k * sp.normal[0] - sp.incoming[0],
+                k * sp.normal[1] - sp.incoming[1],
+                k * sp.normal[2] - sp.incoming[2],
+            ]
         }
         scalar => {
             s[d] = match scalar {
@@ -141,7 +167,9 @@ pub fn read(what: Input, sp: &ShadingPoint, s: &mut [f32], dst: u32) {
                 Input::RayFlag(flag) => f(path.flags & flag != 0),
                 Input::RayLength => sp.ray_length,
                 // Shadow rays and light emission are one bounce further (Cycles).
-                Input::RayDepth => path.bounce as f32 + f(path.flags & (ray::SHADOW | ray::EMISSION) != 0),
+                Input::RayDepth => {
+                    path.bounce as f32 + f(path.flags & (ray::SHADOW | ray::EMISSION) != 0)
+                }
                 Input::DiffuseDepth => path.diffuse as f32,
                 Input::GlossyDepth => path.glossy as f32,
                 Input::TransparentDepth => path.transparent as f32,
@@ -163,7 +191,12 @@ pub fn fresnel_node(sp: &ShadingPoint, ior: f32, normal: Option<Vec3>) -> f32 {
 /// Layer Weight node: (Fresnel, Facing).
 #[inline]
 pub fn layer_weight_node(sp: &ShadingPoint, blend: f32, normal: Option<Vec3>) -> (f32, f32) {
-    layer_weight(blend, sp.incoming, normal.unwrap_or(sp.normal), sp.backfacing)
+    layer_weight(
+        blend,
+        sp.incoming,
+        normal.unwrap_or(sp.normal),
+        sp.backfacing,
+    )
 }
 
 /// Light Falloff node: (Quadratic, Linear, Constant).

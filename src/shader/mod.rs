@@ -2,18 +2,18 @@
 //! node tree flattened by `nodes::graph` (`compile`), and evaluated over a mesh's UV
 //! map the way Cycles' EMIT bake does (`bake`).
 
+pub mod attributes;
 pub mod bake;
 pub mod bump;
 pub mod bump_graph;
 pub mod compile;
-pub mod point;
-pub mod program;
+pub mod derived;
 pub mod images;
 pub mod inputs;
-pub mod view;
-pub mod attributes;
+pub mod point;
+pub mod program;
 pub mod tangent;
-pub mod derived;
+pub mod view;
 
 pub use compile::{compile_material, CompileError};
 pub use point::ShadingPoint;

@@ -107,7 +107,14 @@ pub struct PathState {
 
 impl PathState {
     /// A camera ray, as Cycles' EMIT bake and camera rays start.
-    pub const CAMERA: PathState = PathState { flags: ray::CAMERA, bounce: 0, diffuse: 0, glossy: 0, transmission: 0, transparent: 0 };
+    pub const CAMERA: PathState = PathState {
+        flags: ray::CAMERA,
+        bounce: 0,
+        diffuse: 0,
+        glossy: 0,
+        transmission: 0,
+        transparent: 0,
+    };
 }
 
 /// The object a shading point belongs to, as Cycles' Object Info node and object-space
@@ -133,7 +140,11 @@ impl Default for ObjectInfo {
             color: [1.0; 4],
             pass_index: 0.0,
             random: 0.0,
-            world_to_object: [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0]],
+            world_to_object: [
+                [1.0, 0.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0, 0.0],
+                [0.0, 0.0, 1.0, 0.0],
+            ],
         }
     }
 }

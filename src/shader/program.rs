@@ -1,32 +1,43 @@
 //! A compiled material: a flat list of operations over a float stack, run once per
 //! shading point with no allocation and no lookups by name (Cycles' SVM idea).
 
-use crate::nodes::clamp::{clamp_node, ClampType};
-use crate::nodes::color::{bright_contrast, gamma, hue_saturation, invert, rgb_to_bw, LINEAR_REC709};
-use crate::nodes::map_range::{map_range_float, map_range_vector, MapRangeInterpolation};
-use crate::nodes::math::{math_node, vector_math, MathOp, Vec3, VectorMathOp};
-use crate::nodes::mix::{mix_color, mix_float, mix_rgb, mix_vector, mix_vector_non_uniform, MixBlend};
-use crate::nodes::curves::CurveTable;
-use crate::nodes::vector_rotate::{vector_rotate, VectorRotateType};
-use crate::nodes::ramp::RampTable;
-use crate::nodes::sepcomb::{combine_color, separate_color, ColorMode};
-use crate::nodes::{blackbody, wavelength};
 use crate::nodes::checker::checker_texture;
+use crate::nodes::clamp::{clamp_node, ClampType};
+use crate::nodes::color::{
+    bright_contrast, gamma, hue_saturation, invert, rgb_to_bw, LINEAR_REC709,
+};
+use crate::nodes::curves::CurveTable;
 use crate::nodes::gradient::{gradient, GradientType};
 use crate::nodes::magic::magic;
+use crate::nodes::map_range::{map_range_float, map_range_vector, MapRangeInterpolation};
 use crate::nodes::mapping::{mapping, MappingType};
+use crate::nodes::math::{math_node, vector_math, MathOp, Vec3, VectorMathOp};
+use crate::nodes::mix::{
+    mix_color, mix_float, mix_rgb, mix_vector, mix_vector_non_uniform, MixBlend,
+};
 use crate::nodes::noise::{noise_texture_cycles, noise_texture_cycles_fac, NoiseParams, NoiseType};
+use crate::nodes::ramp::RampTable;
+use crate::nodes::sepcomb::{combine_color, separate_color, ColorMode};
+use crate::nodes::vector_rotate::{vector_rotate, VectorRotateType};
 use crate::nodes::voronoi::{voronoi_texture, VoronoiFeature, VoronoiMetric, VoronoiParams};
 use crate::nodes::wave::{wave, WaveSettings};
 use crate::nodes::white_noise::white_noise;
+use crate::nodes::{blackbody, wavelength};
 
 use crate::nodes::brick::{brick_texture, BrickSettings};
-use crate::nodes::image::{box_uvs, box_weights, direction_to_equirectangular, direction_to_mirrorball, project, safe_normalize, EnvProjection, Extension, Interpolation, Projection};
+use crate::nodes::image::{
+    box_uvs, box_weights, direction_to_equirectangular, direction_to_mirrorball, project,
+    safe_normalize, EnvProjection, Extension, Interpolation, Projection,
+};
 
+use super::bump::{
+    bump_normal, differential_from_compact, differential_make_compact, displacement,
+    displacement_bump, normal_map, offset_point, vector_displacement, BumpPoint, BumpSettings,
+    MapSpace,
+};
 use super::images::TexImage;
-use super::bump::{bump_normal, differential_from_compact, differential_make_compact, displacement, displacement_bump, normal_map, offset_point, vector_displacement, BumpPoint, BumpSettings, MapSpace};
-use super::point::ShadingPoint;
 use super::inputs::{self, Input};
+use super::point::ShadingPoint;
 
 /// A float's position on the stack; vectors and colours take three in a row.
 pub type Slot = u32;
@@ -51,103 +62,446 @@ impl Kind {
 #[derive(Debug, Clone)]
 pub enum Op {
     /// Blender's implicit socket conversions.
-    VectorToFloat { src: Slot, dst: Slot },
-    ColorToFloat { src: Slot, dst: Slot },
-    FloatToVector { src: Slot, dst: Slot },
+    VectorToFloat {
+        src: Slot,
+        dst: Slot,
+    },
+    ColorToFloat {
+        src: Slot,
+        dst: Slot,
+    },
+    FloatToVector {
+        src: Slot,
+        dst: Slot,
+    },
     /// Texture Coordinate outputs this program uses (None: not used).
-    TexCoord { generated: Option<Slot>, normal: Option<Slot>, uv: Option<Slot>, object: Option<Slot> },
-    UvMap { dst: Slot },
-    Math { op: MathOp, clamp: bool, a: Slot, b: Slot, c: Slot, dst: Slot },
-    VectorMath { op: VectorMathOp, a: Slot, b: Slot, c: Slot, scale: Slot, vector: Slot, value: Slot },
-    MapRangeFloat { interp: MapRangeInterpolation, clamp: bool, args: [Slot; 6], dst: Slot },
-    MapRangeVector { interp: MapRangeInterpolation, clamp: bool, args: [Slot; 6], dst: Slot },
-    Clamp { kind: ClampType, value: Slot, min: Slot, max: Slot, dst: Slot },
-    MixFloat { clamp_factor: bool, factor: Slot, a: Slot, b: Slot, dst: Slot },
-    MixVector { clamp_factor: bool, factor: Slot, a: Slot, b: Slot, dst: Slot },
-    MixVectorNonUniform { clamp_factor: bool, factor: Slot, a: Slot, b: Slot, dst: Slot },
-    MixColor { blend: MixBlend, clamp_factor: bool, clamp_result: bool, factor: Slot, a: Slot, b: Slot, dst: Slot },
-    MixRgb { blend: MixBlend, clamp: bool, factor: Slot, a: Slot, b: Slot, dst: Slot },
-    Ramp { table: u32, fac: Slot, color: Slot, alpha: Slot },
+    TexCoord {
+        generated: Option<Slot>,
+        normal: Option<Slot>,
+        uv: Option<Slot>,
+        object: Option<Slot>,
+    },
+    UvMap {
+        dst: Slot,
+    },
+    Math {
+        op: MathOp,
+        clamp: bool,
+        a: Slot,
+        b: Slot,
+        c: Slot,
+        dst: Slot,
+    },
+    VectorMath {
+        op: VectorMathOp,
+        a: Slot,
+        b: Slot,
+        c: Slot,
+        scale: Slot,
+        vector: Slot,
+        value: Slot,
+    },
+    MapRangeFloat {
+        interp: MapRangeInterpolation,
+        clamp: bool,
+        args: [Slot; 6],
+        dst: Slot,
+    },
+    MapRangeVector {
+        interp: MapRangeInterpolation,
+        clamp: bool,
+        args: [Slot; 6],
+        dst: Slot,
+    },
+    Clamp {
+        kind: ClampType,
+        value: Slot,
+        min: Slot,
+        max: Slot,
+        dst: Slot,
+    },
+    MixFloat {
+        clamp_factor: bool,
+        factor: Slot,
+        a: Slot,
+        b: Slot,
+        dst: Slot,
+    },
+    MixVector {
+        clamp_factor: bool,
+        factor: Slot,
+        a: Slot,
+        b: Slot,
+        dst: Slot,
+    },
+    MixVectorNonUniform {
+        clamp_factor: bool,
+        factor: Slot,
+        a: Slot,
+        b: Slot,
+        dst: Slot,
+    },
+    MixColor {
+        blend: MixBlend,
+        clamp_factor: bool,
+        clamp_result: bool,
+        factor: Slot,
+        a: Slot,
+        b: Slot,
+        dst: Slot,
+    },
+    MixRgb {
+        blend: MixBlend,
+        clamp: bool,
+        factor: Slot,
+        a: Slot,
+        b: Slot,
+        dst: Slot,
+    },
+    Ramp {
+        table: u32,
+        fac: Slot,
+        color: Slot,
+        alpha: Slot,
+    },
     /// RGB Curves / Vector Curves: `curves[table]` per channel.
-    Curves3 { table: u32, fac: Slot, v: Slot, dst: Slot },
+    Curves3 {
+        table: u32,
+        fac: Slot,
+        v: Slot,
+        dst: Slot,
+    },
     /// Float Curve.
-    Curve1 { table: u32, fac: Slot, v: Slot, dst: Slot },
-    Invert { fac: Slot, color: Slot, dst: Slot },
-    Gamma { color: Slot, gamma: Slot, dst: Slot },
-    BrightContrast { color: Slot, bright: Slot, contrast: Slot, dst: Slot },
-    HueSaturation { hue: Slot, saturation: Slot, value: Slot, fac: Slot, color: Slot, dst: Slot },
-    RgbToBw { color: Slot, dst: Slot },
-    SeparateXyz { v: Slot, x: Slot, y: Slot, z: Slot },
-    CombineXyz { x: Slot, y: Slot, z: Slot, dst: Slot },
-    SeparateColor { mode: ColorMode, color: Slot, a: Slot, b: Slot, c: Slot },
-    CombineColor { mode: ColorMode, a: Slot, b: Slot, c: Slot, dst: Slot },
-    Blackbody { temperature: Slot, dst: Slot },
-    Wavelength { wavelength: Slot, dst: Slot },
+    Curve1 {
+        table: u32,
+        fac: Slot,
+        v: Slot,
+        dst: Slot,
+    },
+    Invert {
+        fac: Slot,
+        color: Slot,
+        dst: Slot,
+    },
+    Gamma {
+        color: Slot,
+        gamma: Slot,
+        dst: Slot,
+    },
+    BrightContrast {
+        color: Slot,
+        bright: Slot,
+        contrast: Slot,
+        dst: Slot,
+    },
+    HueSaturation {
+        hue: Slot,
+        saturation: Slot,
+        value: Slot,
+        fac: Slot,
+        color: Slot,
+        dst: Slot,
+    },
+    RgbToBw {
+        color: Slot,
+        dst: Slot,
+    },
+    SeparateXyz {
+        v: Slot,
+        x: Slot,
+        y: Slot,
+        z: Slot,
+    },
+    CombineXyz {
+        x: Slot,
+        y: Slot,
+        z: Slot,
+        dst: Slot,
+    },
+    SeparateColor {
+        mode: ColorMode,
+        color: Slot,
+        a: Slot,
+        b: Slot,
+        c: Slot,
+    },
+    CombineColor {
+        mode: ColorMode,
+        a: Slot,
+        b: Slot,
+        c: Slot,
+        dst: Slot,
+    },
+    Blackbody {
+        temperature: Slot,
+        dst: Slot,
+    },
+    Wavelength {
+        wavelength: Slot,
+        dst: Slot,
+    },
     /// World-space position (unlinked White Noise vectors).
-    Position { dst: Slot },
+    Position {
+        dst: Slot,
+    },
     /// Textures: inputs in socket order after Vector; outputs Fac/Distance first.
-    TexNoise { dims: u8, kind: NoiseType, normalize: bool, vector: Slot, w: Slot, args: [Slot; 7], fac: Slot, color: Slot, want_color: bool },
-    TexVoronoi { dims: u8, feature: VoronoiFeature, metric: VoronoiMetric, normalize: bool, vector: Slot, w: Slot, args: [Slot; 7], distance: Slot, color: Slot, position: Slot, w_out: Slot, radius: Slot },
-    TexWave { settings: WaveSettings, vector: Slot, args: [Slot; 6], fac: Slot, color: Slot },
-    TexGradient { kind: GradientType, vector: Slot, fac: Slot, color: Slot },
-    TexMagic { depth: i32, vector: Slot, scale: Slot, distortion: Slot, fac: Slot, color: Slot },
-    TexWhiteNoise { dims: u8, vector: Slot, w: Slot, value: Slot, color: Slot },
-    TexChecker { vector: Slot, color1: Slot, color2: Slot, scale: Slot, fac: Slot, color: Slot },
-    VectorRotate { kind: VectorRotateType, invert: bool, vector: Slot, center: Slot, axis: Slot, angle: Slot, rotation: Slot, dst: Slot },
-    Mapping { kind: MappingType, vector: Slot, location: Slot, rotation: Slot, scale: Slot, dst: Slot },
+    TexNoise {
+        dims: u8,
+        kind: NoiseType,
+        normalize: bool,
+        vector: Slot,
+        w: Slot,
+        args: [Slot; 7],
+        fac: Slot,
+        color: Slot,
+        want_color: bool,
+    },
+    TexVoronoi {
+        dims: u8,
+        feature: VoronoiFeature,
+        metric: VoronoiMetric,
+        normalize: bool,
+        vector: Slot,
+        w: Slot,
+        args: [Slot; 7],
+        distance: Slot,
+        color: Slot,
+        position: Slot,
+        w_out: Slot,
+        radius: Slot,
+    },
+    TexWave {
+        settings: WaveSettings,
+        vector: Slot,
+        args: [Slot; 6],
+        fac: Slot,
+        color: Slot,
+    },
+    TexGradient {
+        kind: GradientType,
+        vector: Slot,
+        fac: Slot,
+        color: Slot,
+    },
+    TexMagic {
+        depth: i32,
+        vector: Slot,
+        scale: Slot,
+        distortion: Slot,
+        fac: Slot,
+        color: Slot,
+    },
+    TexWhiteNoise {
+        dims: u8,
+        vector: Slot,
+        w: Slot,
+        value: Slot,
+        color: Slot,
+    },
+    TexChecker {
+        vector: Slot,
+        color1: Slot,
+        color2: Slot,
+        scale: Slot,
+        fac: Slot,
+        color: Slot,
+    },
+    VectorRotate {
+        kind: VectorRotateType,
+        invert: bool,
+        vector: Slot,
+        center: Slot,
+        axis: Slot,
+        angle: Slot,
+        rotation: Slot,
+        dst: Slot,
+    },
+    Mapping {
+        kind: MappingType,
+        vector: Slot,
+        location: Slot,
+        rotation: Slot,
+        scale: Slot,
+        dst: Slot,
+    },
     /// Brick Texture: args are Color1, Color2, Mortar, Scale, Mortar Size, Mortar Smooth,
     /// Bias, Brick Width, Row Height.
-    TexBrick { settings: BrickSettings, vector: Slot, args: [Slot; 9], fac: Slot, color: Slot },
+    TexBrick {
+        settings: BrickSettings,
+        vector: Slot,
+        args: [Slot; 9],
+        fac: Slot,
+        color: Slot,
+    },
     /// Image Texture; `unassociate`: the Alpha output is used and the image is colour.
-    TexImage { image: std::sync::Arc<TexImage>, projection: Projection, blend: f32, interpolation: Interpolation, extension: Extension, unassociate: bool, vector: Slot, color: Slot, alpha: Slot },
+    TexImage {
+        image: std::sync::Arc<TexImage>,
+        projection: Projection,
+        blend: f32,
+        interpolation: Interpolation,
+        extension: Extension,
+        unassociate: bool,
+        vector: Slot,
+        color: Slot,
+        alpha: Slot,
+    },
     /// Environment Texture (the vector is a direction).
-    TexEnvironment { image: std::sync::Arc<TexImage>, projection: EnvProjection, interpolation: Interpolation, unassociate: bool, vector: Slot, color: Slot, alpha: Slot },
+    TexEnvironment {
+        image: std::sync::Arc<TexImage>,
+        projection: EnvProjection,
+        interpolation: Interpolation,
+        unassociate: bool,
+        vector: Slot,
+        color: Slot,
+        alpha: Slot,
+    },
     /// The shading point the following ops read: a Bump height copy's offset point.
-    BumpPoint { point: BumpPoint, width: f32 },
+    BumpPoint {
+        point: BumpPoint,
+        width: f32,
+    },
     /// Bump node; `normal` None: the shading normal.
-    Bump { settings: BumpSettings, normal: Option<Slot>, strength: Slot, distance: Slot, center: Slot, dx: Slot, dy: Slot, dst: Slot },
-    Displacement { object_space: bool, height: Slot, midlevel: Slot, scale: Slot, normal: Option<Slot>, dst: Slot },
-    VectorDisplacement { space: MapSpace, vector: Slot, midlevel: Slot, scale: Slot, dst: Slot },
+    Bump {
+        settings: BumpSettings,
+        normal: Option<Slot>,
+        strength: Slot,
+        distance: Slot,
+        center: Slot,
+        dx: Slot,
+        dy: Slot,
+        dst: Slot,
+    },
+    Displacement {
+        object_space: bool,
+        height: Slot,
+        midlevel: Slot,
+        scale: Slot,
+        normal: Option<Slot>,
+        dst: Slot,
+    },
+    VectorDisplacement {
+        space: MapSpace,
+        vector: Slot,
+        midlevel: Slot,
+        scale: Slot,
+        dst: Slot,
+    },
     /// Material Output's Displacement as a bump: sets the shading normal for all that follows.
-    DisplacementBump { object_space: bool, center: Slot, dx: Slot, dy: Slot, dst: Slot },
-    NormalMap { space: MapSpace, color: Slot, strength: Slot, dst: Slot },
+    DisplacementBump {
+        object_space: bool,
+        center: Slot,
+        dx: Slot,
+        dy: Slot,
+        dst: Slot,
+    },
+    NormalMap {
+        space: MapSpace,
+        color: Slot,
+        strength: Slot,
+        dst: Slot,
+    },
     /// A value of the shading context (Geometry, Object Info, Camera Data, Light Path,
     /// Texture Coordinate's Camera/Window/Reflection).
-    Input { what: Input, dst: Slot },
+    Input {
+        what: Input,
+        dst: Slot,
+    },
     /// Fresnel / Layer Weight: `normal` is None when unlinked (the shading normal).
-    Fresnel { ior: Slot, normal: Option<Slot>, dst: Slot },
-    LayerWeight { blend: Slot, normal: Option<Slot>, fresnel: Slot, facing: Slot },
+    Fresnel {
+        ior: Slot,
+        normal: Option<Slot>,
+        dst: Slot,
+    },
+    LayerWeight {
+        blend: Slot,
+        normal: Option<Slot>,
+        fresnel: Slot,
+        facing: Slot,
+    },
     /// Light Falloff: Quadratic, Linear, Constant.
-    LightFalloff { strength: Slot, smooth: Slot, dst: [Slot; 3] },
+    LightFalloff {
+        strength: Slot,
+        smooth: Slot,
+        dst: [Slot; 3],
+    },
     /// Normal node's Dot output (its Normal output is a constant).
-    NormalDot { direction: Vec3, normal: Slot, dst: Slot },
+    NormalDot {
+        direction: Vec3,
+        normal: Slot,
+        dst: Slot,
+    },
     /// Texture Coordinate > Object relative to another object (its world-to-object).
-    ObjectSpace { to_object: [[f32; 4]; 3], dst: Slot },
+    ObjectSpace {
+        to_object: [[f32; 4]; 3],
+        dst: Slot,
+    },
     /// Tangent node, radial mode around axis 0/1/2 (X/Y/Z).
-    TangentRadial { axis: u8, dst: Slot },
+    TangentRadial {
+        axis: u8,
+        dst: Slot,
+    },
     /// Attribute node (Geometry type): request `attr` as Color/Vector, Fac, Alpha.
-    Attribute { attr: u8, vector: Slot, fac: Slot, alpha: Slot },
+    Attribute {
+        attr: u8,
+        vector: Slot,
+        fac: Slot,
+        alpha: Slot,
+    },
     /// Color Attribute node: request `attr` as Color, Alpha (0 when missing, as Cycles).
-    ColorAttribute { attr: u8, color: Slot, alpha: Slot },
+    ColorAttribute {
+        attr: u8,
+        color: Slot,
+        alpha: Slot,
+    },
     /// UV Map node with a named map: request `attr` as (u, v, 0).
-    NamedUv { attr: u8, dst: Slot },
+    NamedUv {
+        attr: u8,
+        dst: Slot,
+    },
     /// Normal Map in tangent space: `tangent` and `normal` are requests (Tangent, MapNormal).
-    NormalMapTangent { tangent: u8, normal: u8, color: Slot, strength: Slot, dst: Slot },
+    NormalMapTangent {
+        tangent: u8,
+        normal: u8,
+        color: Slot,
+        strength: Slot,
+        dst: Slot,
+    },
     /// Vector Displacement in tangent space.
-    VectorDisplacementTangent { tangent: u8, vector: Slot, midlevel: Slot, scale: Slot, dst: Slot },
+    VectorDisplacementTangent {
+        tangent: u8,
+        vector: Slot,
+        midlevel: Slot,
+        scale: Slot,
+        dst: Slot,
+    },
     /// Tangent node, UV Map mode.
-    TangentUv { tangent: u8, dst: Slot },
+    TangentUv {
+        tangent: u8,
+        dst: Slot,
+    },
 }
 
 /// The shader part of a material: closures as a small tree over stack values.
 #[derive(Debug, Clone)]
 pub enum Closure {
-    Emission { color: Slot, strength: Slot },
+    Emission {
+        color: Slot,
+        strength: Slot,
+    },
     /// A BSDF node: its emission, if it has one (Principled), counts for EMIT bakes;
     /// its scattering is the renderer's business.
-    Bsdf { emission: Option<(Slot, Slot)> },
-    Mix { fac: Slot, a: Option<u32>, b: Option<u32> },
-    Add { a: Option<u32>, b: Option<u32> },
+    Bsdf {
+        emission: Option<(Slot, Slot)>,
+    },
+    Mix {
+        fac: Slot,
+        a: Option<u32>,
+        b: Option<u32>,
+    },
+    Add {
+        a: Option<u32>,
+        b: Option<u32>,
+    },
 }
 
 #[derive(Debug, Clone)]
@@ -204,7 +558,10 @@ impl BsdfNode {
         self.inputs.iter().find(|i| i.0 == id).map(|i| (i.1, i.2))
     }
     pub fn property(&self, key: &str) -> Option<&str> {
-        self.properties.iter().find(|p| p.0 == key).map(|p| p.1.as_str())
+        self.properties
+            .iter()
+            .find(|p| p.0 == key)
+            .map(|p| p.1.as_str())
     }
 }
 
@@ -239,12 +596,25 @@ impl Program {
                 // expanded around the displaced true normal as always; only the bump
                 // itself takes the full undisplaced differential (`DisplacementBump`).
                 let before = sp.undisplaced.map_or(*sp, |u| {
-                    let (dp_dx, dp_dy) = differential_from_compact(sp.ng, differential_make_compact(u.dp_dx, u.dp_dy));
-                    ShadingPoint { position: u.position, object_position: u.object_position, dp_dx, dp_dy, ..*sp }
+                    let (dp_dx, dp_dy) = differential_from_compact(
+                        sp.ng,
+                        differential_make_compact(u.dp_dx, u.dp_dy),
+                    );
+                    ShadingPoint {
+                        position: u.position,
+                        object_position: u.object_position,
+                        dp_dx,
+                        dp_dy,
+                        ..*sp
+                    }
                 });
                 self.exec(before, s, &self.ops[..end]);
                 let n = v3(s, normal);
-                let after = ShadingPoint { normal: n, object_normal: sp.transform.inverse_normal(n), ..*sp };
+                let after = ShadingPoint {
+                    normal: n,
+                    object_normal: sp.transform.inverse_normal(n),
+                    ..*sp
+                };
                 self.exec(after, s, &self.ops[end..]);
             }
             _ => self.exec(*sp, s, &self.ops[d.center_end..]),
@@ -270,12 +640,19 @@ impl Program {
                     let v = v3(s, src);
                     s[dst as usize] = (v[0] + v[1] + v[2]) * (1.0 / 3.0);
                 }
-                Op::ColorToFloat { src, dst } => s[dst as usize] = rgb_to_bw(v3(s, src), &LINEAR_REC709),
+                Op::ColorToFloat { src, dst } => {
+                    s[dst as usize] = rgb_to_bw(v3(s, src), &LINEAR_REC709)
+                }
                 Op::FloatToVector { src, dst } => {
                     let f = s[src as usize];
                     put3(s, dst, [f, f, f]);
                 }
-                Op::TexCoord { generated, normal, uv, object } => {
+                Op::TexCoord {
+                    generated,
+                    normal,
+                    uv,
+                    object,
+                } => {
                     if let Some(d) = generated {
                         put3(s, d, sp.generated);
                     }
@@ -290,39 +667,133 @@ impl Program {
                     }
                 }
                 Op::UvMap { dst } => put3(s, dst, sp.uv),
-                Op::Math { op, clamp, a, b, c, dst } => s[dst as usize] = math_node(op, clamp, s[a as usize], s[b as usize], s[c as usize]),
-                Op::VectorMath { op, a, b, c, scale, vector, value } => {
+                Op::Math {
+                    op,
+                    clamp,
+                    a,
+                    b,
+                    c,
+                    dst,
+                } => {
+                    s[dst as usize] =
+                        math_node(op, clamp, s[a as usize], s[b as usize], s[c as usize])
+                }
+                Op::VectorMath {
+                    op,
+                    a,
+                    b,
+                    c,
+                    scale,
+                    vector,
+                    value,
+                } => {
                     let r = vector_math(op, v3(s, a), v3(s, b), v3(s, c), s[scale as usize]);
                     put3(s, vector, r.vector);
                     s[value as usize] = r.value;
                 }
-                Op::MapRangeFloat { interp, clamp, args, dst } => {
+                Op::MapRangeFloat {
+                    interp,
+                    clamp,
+                    args,
+                    dst,
+                } => {
                     let a = args.map(|i| s[i as usize]);
-                    s[dst as usize] = map_range_float(interp, clamp, a[0], a[1], a[2], a[3], a[4], a[5]);
+                    s[dst as usize] =
+                        map_range_float(interp, clamp, a[0], a[1], a[2], a[3], a[4], a[5]);
                 }
-                Op::MapRangeVector { interp, clamp, args, dst } => {
+                Op::MapRangeVector {
+                    interp,
+                    clamp,
+                    args,
+                    dst,
+                } => {
                     let a = args.map(|i| v3(s, i));
-                    put3(s, dst, map_range_vector(interp, clamp, a[0], a[1], a[2], a[3], a[4], a[5]));
+                    put3(
+                        s,
+                        dst,
+                        map_range_vector(interp, clamp, a[0], a[1], a[2], a[3], a[4], a[5]),
+                    );
                 }
-                Op::Clamp { kind, value, min, max, dst } => s[dst as usize] = clamp_node(kind, s[value as usize], s[min as usize], s[max as usize]),
-                Op::MixFloat { clamp_factor, factor, a, b, dst } => s[dst as usize] = mix_float(clamp_factor, s[factor as usize], s[a as usize], s[b as usize]),
-                Op::MixVector { clamp_factor, factor, a, b, dst } => {
+                Op::Clamp {
+                    kind,
+                    value,
+                    min,
+                    max,
+                    dst,
+                } => {
+                    s[dst as usize] =
+                        clamp_node(kind, s[value as usize], s[min as usize], s[max as usize])
+                }
+                Op::MixFloat {
+                    clamp_factor,
+                    factor,
+                    a,
+                    b,
+                    dst,
+                } => {
+                    s[dst as usize] = mix_float(
+                        clamp_factor,
+                        s[factor as usize],
+                        s[a as usize],
+                        s[b as usize],
+                    )
+                }
+                Op::MixVector {
+                    clamp_factor,
+                    factor,
+                    a,
+                    b,
+                    dst,
+                } => {
                     let r = mix_vector(clamp_factor, s[factor as usize], v3(s, a), v3(s, b));
                     put3(s, dst, r)
                 }
-                Op::MixVectorNonUniform { clamp_factor, factor, a, b, dst } => {
+                Op::MixVectorNonUniform {
+                    clamp_factor,
+                    factor,
+                    a,
+                    b,
+                    dst,
+                } => {
                     let r = mix_vector_non_uniform(clamp_factor, v3(s, factor), v3(s, a), v3(s, b));
                     put3(s, dst, r)
                 }
-                Op::MixColor { blend, clamp_factor, clamp_result, factor, a, b, dst } => {
-                    let r = mix_color(blend, clamp_factor, clamp_result, s[factor as usize], v3(s, a), v3(s, b));
+                Op::MixColor {
+                    blend,
+                    clamp_factor,
+                    clamp_result,
+                    factor,
+                    a,
+                    b,
+                    dst,
+                } => {
+                    let r = mix_color(
+                        blend,
+                        clamp_factor,
+                        clamp_result,
+                        s[factor as usize],
+                        v3(s, a),
+                        v3(s, b),
+                    );
                     put3(s, dst, r)
                 }
-                Op::MixRgb { blend, clamp, factor, a, b, dst } => {
+                Op::MixRgb {
+                    blend,
+                    clamp,
+                    factor,
+                    a,
+                    b,
+                    dst,
+                } => {
                     let r = mix_rgb(blend, clamp, s[factor as usize], v3(s, a), v3(s, b));
                     put3(s, dst, r)
                 }
-                Op::Ramp { table, fac, color, alpha } => {
+                Op::Ramp {
+                    table,
+                    fac,
+                    color,
+                    alpha,
+                } => {
                     let (c, a) = self.ramps[table as usize].color_ramp(s[fac as usize]);
                     put3(s, color, c);
                     s[alpha as usize] = a;
@@ -332,25 +803,50 @@ impl Program {
                     put3(s, dst, r)
                 }
                 Op::Curve1 { table, fac, v, dst } => {
-                    s[dst as usize] = self.curves[table as usize].eval1(s[fac as usize], s[v as usize]);
+                    s[dst as usize] =
+                        self.curves[table as usize].eval1(s[fac as usize], s[v as usize]);
                 }
                 Op::Invert { fac, color, dst } => {
                     let r = invert(s[fac as usize], v3(s, color));
                     put3(s, dst, r)
                 }
-                Op::Gamma { color, gamma: g, dst } => {
+                Op::Gamma {
+                    color,
+                    gamma: g,
+                    dst,
+                } => {
                     let r = gamma(v3(s, color), s[g as usize]);
                     put3(s, dst, r)
                 }
-                Op::BrightContrast { color, bright, contrast, dst } => {
+                Op::BrightContrast {
+                    color,
+                    bright,
+                    contrast,
+                    dst,
+                } => {
                     let r = bright_contrast(v3(s, color), s[bright as usize], s[contrast as usize]);
                     put3(s, dst, r)
                 }
-                Op::HueSaturation { hue, saturation, value, fac, color, dst } => {
-                    let r = hue_saturation(s[hue as usize], s[saturation as usize], s[value as usize], s[fac as usize], v3(s, color));
+                Op::HueSaturation {
+                    hue,
+                    saturation,
+                    value,
+                    fac,
+                    color,
+                    dst,
+                } => {
+                    let r = hue_saturation(
+                        s[hue as usize],
+                        s[saturation as usize],
+                        s[value as usize],
+                        s[fac as usize],
+                        v3(s, color),
+                    );
                     put3(s, dst, r)
                 }
-                Op::RgbToBw { color, dst } => s[dst as usize] = rgb_to_bw(v3(s, color), &LINEAR_REC709),
+                Op::RgbToBw { color, dst } => {
+                    s[dst as usize] = rgb_to_bw(v3(s, color), &LINEAR_REC709)
+                }
                 Op::SeparateXyz { v, x, y, z } => {
                     let c = v3(s, v);
                     s[x as usize] = c[0];
@@ -361,7 +857,13 @@ impl Program {
                     let r = [s[x as usize], s[y as usize], s[z as usize]];
                     put3(s, dst, r)
                 }
-                Op::SeparateColor { mode, color, a, b, c } => {
+                Op::SeparateColor {
+                    mode,
+                    color,
+                    a,
+                    b,
+                    c,
+                } => {
                     let r = separate_color(mode, v3(s, color));
                     s[a as usize] = r[0];
                     s[b as usize] = r[1];
@@ -380,20 +882,61 @@ impl Program {
                     put3(s, dst, r)
                 }
                 Op::Position { dst } => put3(s, dst, sp.position),
-                Op::TexNoise { dims, kind, normalize, vector, w, args, fac, color, want_color } => {
+                Op::TexNoise {
+                    dims,
+                    kind,
+                    normalize,
+                    vector,
+                    w,
+                    args,
+                    fac,
+                    color,
+                    want_color,
+                } => {
                     let a = args.map(|i| s[i as usize]);
-                    let params = NoiseParams { kind, normalize, detail: a[1], roughness: a[2], lacunarity: a[3], offset: a[4], gain: a[5], distortion: a[6] };
+                    let params = NoiseParams {
+                        kind,
+                        normalize,
+                        detail: a[1],
+                        roughness: a[2],
+                        lacunarity: a[3],
+                        offset: a[4],
+                        gain: a[5],
+                        distortion: a[6],
+                    };
                     if want_color {
-                        let (f, c) = noise_texture_cycles(dims, v3(s, vector), s[w as usize], a[0], params);
+                        let (f, c) =
+                            noise_texture_cycles(dims, v3(s, vector), s[w as usize], a[0], params);
                         s[fac as usize] = f;
                         put3(s, color, c);
                     } else {
-                        s[fac as usize] = noise_texture_cycles_fac(dims, v3(s, vector), s[w as usize], a[0], params);
+                        s[fac as usize] = noise_texture_cycles_fac(
+                            dims,
+                            v3(s, vector),
+                            s[w as usize],
+                            a[0],
+                            params,
+                        );
                     }
                 }
-                Op::TexVoronoi { dims, feature, metric, normalize, vector, w, args, distance, color, position, w_out, radius } => {
+                Op::TexVoronoi {
+                    dims,
+                    feature,
+                    metric,
+                    normalize,
+                    vector,
+                    w,
+                    args,
+                    distance,
+                    color,
+                    position,
+                    w_out,
+                    radius,
+                } => {
                     let a = args.map(|i| s[i as usize]);
-                    let p = VoronoiParams::new(feature, metric, normalize, a[0], a[1], a[2], a[3], a[4], a[5], a[6]);
+                    let p = VoronoiParams::new(
+                        feature, metric, normalize, a[0], a[1], a[2], a[3], a[4], a[5], a[6],
+                    );
                     let o = voronoi_texture(dims, v3(s, vector), s[w as usize], p);
                     s[distance as usize] = o.distance;
                     put3(s, color, o.color);
@@ -401,47 +944,146 @@ impl Program {
                     s[w_out as usize] = o.w;
                     s[radius as usize] = o.radius;
                 }
-                Op::TexWave { settings, vector, args, fac, color } => {
+                Op::TexWave {
+                    settings,
+                    vector,
+                    args,
+                    fac,
+                    color,
+                } => {
                     let a = args.map(|i| s[i as usize]);
                     let f = wave(settings, v3(s, vector), a[0], a[1], a[2], a[3], a[4], a[5]);
                     s[fac as usize] = f;
                     put3(s, color, [f; 3]);
                 }
-                Op::TexGradient { kind, vector, fac, color } => {
+                Op::TexGradient {
+                    kind,
+                    vector,
+                    fac,
+                    color,
+                } => {
                     let f = gradient(kind, v3(s, vector));
                     s[fac as usize] = f;
                     put3(s, color, [f; 3]);
                 }
-                Op::TexMagic { depth, vector, scale, distortion, fac, color } => {
-                    let (c, f) = magic(v3(s, vector), s[scale as usize], depth, s[distortion as usize]);
+                Op::TexMagic {
+                    depth,
+                    vector,
+                    scale,
+                    distortion,
+                    fac,
+                    color,
+                } => {
+                    let (c, f) = magic(
+                        v3(s, vector),
+                        s[scale as usize],
+                        depth,
+                        s[distortion as usize],
+                    );
                     s[fac as usize] = f;
                     put3(s, color, c);
                 }
-                Op::TexWhiteNoise { dims, vector, w, value, color } => {
+                Op::TexWhiteNoise {
+                    dims,
+                    vector,
+                    w,
+                    value,
+                    color,
+                } => {
                     let (v, c) = white_noise(dims, v3(s, vector), s[w as usize]);
                     s[value as usize] = v;
                     put3(s, color, c);
                 }
-                Op::VectorRotate { kind, invert, vector, center, axis, angle, rotation, dst } => {
-                    let r = vector_rotate(kind, invert, v3(s, vector), v3(s, center), v3(s, axis), s[angle as usize], v3(s, rotation));
+                Op::VectorRotate {
+                    kind,
+                    invert,
+                    vector,
+                    center,
+                    axis,
+                    angle,
+                    rotation,
+                    dst,
+                } => {
+                    let r = vector_rotate(
+                        kind,
+                        invert,
+                        v3(s, vector),
+                        v3(s, center),
+                        v3(s, axis),
+                        s[angle as usize],
+                        v3(s, rotation),
+                    );
                     put3(s, dst, r);
                 }
-                Op::Mapping { kind, vector, location, rotation, scale, dst } => {
-                    let r = mapping(kind, v3(s, vector), v3(s, location), v3(s, rotation), v3(s, scale));
+                Op::Mapping {
+                    kind,
+                    vector,
+                    location,
+                    rotation,
+                    scale,
+                    dst,
+                } => {
+                    let r = mapping(
+                        kind,
+                        v3(s, vector),
+                        v3(s, location),
+                        v3(s, rotation),
+                        v3(s, scale),
+                    );
                     put3(s, dst, r);
                 }
-                Op::TexChecker { vector, color1, color2, scale, fac, color } => {
-                    let (c, f) = checker_texture(v3(s, vector), v3(s, color1), v3(s, color2), s[scale as usize]);
+                Op::TexChecker {
+                    vector,
+                    color1,
+                    color2,
+                    scale,
+                    fac,
+                    color,
+                } => {
+                    let (c, f) = checker_texture(
+                        v3(s, vector),
+                        v3(s, color1),
+                        v3(s, color2),
+                        s[scale as usize],
+                    );
                     s[fac as usize] = f;
                     put3(s, color, c);
                 }
-                Op::TexBrick { settings, vector, args, fac, color } => {
+                Op::TexBrick {
+                    settings,
+                    vector,
+                    args,
+                    fac,
+                    color,
+                } => {
                     let [c1, c2, m, scale, size, smooth, bias, width, height] = args;
-                    let (c, f) = brick_texture(v3(s, vector), v3(s, c1), v3(s, c2), v3(s, m), s[scale as usize], s[size as usize], s[smooth as usize], s[bias as usize], s[width as usize], s[height as usize], settings);
+                    let (c, f) = brick_texture(
+                        v3(s, vector),
+                        v3(s, c1),
+                        v3(s, c2),
+                        v3(s, m),
+                        s[scale as usize],
+                        s[size as usize],
+                        s[smooth as usize],
+                        s[bias as usize],
+                        s[width as usize],
+                        s[height as usize],
+                        settings,
+                    );
                     s[fac as usize] = f;
                     put3(s, color, c);
                 }
-                Op::TexImage { ref image, projection, blend, interpolation, extension, unassociate, vector, color, alpha } => {
+                Op::TexImage {
+                    ref image,
+                    projection,
+                    blend,
+                    interpolation,
+                    extension,
+                    unassociate,
+                    vector,
+                    color,
+                    alpha,
+                } => {
                     let co = v3(s, vector);
                     let r = if projection == Projection::Box {
                         // Cycles weighs the three axis images by the object-space normal.
@@ -451,7 +1093,13 @@ impl Program {
                         let mut f = [0.0f32; 4];
                         for k in 0..3 {
                             if w[k] > 0.0 {
-                                let t = image.lookup(uvs[k][0], uvs[k][1], interpolation, extension, unassociate);
+                                let t = image.lookup(
+                                    uvs[k][0],
+                                    uvs[k][1],
+                                    interpolation,
+                                    extension,
+                                    unassociate,
+                                );
                                 f = std::array::from_fn(|c| f[c] + w[k] * t[c]);
                             }
                         }
@@ -463,67 +1111,158 @@ impl Program {
                     put3(s, color, [r[0], r[1], r[2]]);
                     s[alpha as usize] = r[3];
                 }
-                Op::TexEnvironment { ref image, projection, interpolation, unassociate, vector, color, alpha } => {
+                Op::TexEnvironment {
+                    ref image,
+                    projection,
+                    interpolation,
+                    unassociate,
+                    vector,
+                    color,
+                    alpha,
+                } => {
                     let d = safe_normalize(v3(s, vector));
                     let uv = match projection {
                         EnvProjection::Equirectangular => direction_to_equirectangular(d),
                         EnvProjection::MirrorBall => direction_to_mirrorball(d),
                     };
                     // Environment textures always repeat (Cycles' EXTENSION_REPEAT).
-                    let r = image.lookup(uv[0], uv[1], interpolation, Extension::Repeat, unassociate);
+                    let r =
+                        image.lookup(uv[0], uv[1], interpolation, Extension::Repeat, unassociate);
                     put3(s, color, [r[0], r[1], r[2]]);
                     s[alpha as usize] = r[3];
                 }
                 Op::BumpPoint { point, width } => sp = offset_point(&base, point, width),
-                Op::Bump { settings, normal, strength, distance, center, dx, dy, dst } => {
+                Op::Bump {
+                    settings,
+                    normal,
+                    strength,
+                    distance,
+                    center,
+                    dx,
+                    dy,
+                    dst,
+                } => {
                     let n = normal.map_or(sp.normal, |n| v3(s, n));
-                    let r = bump_normal(&sp, settings, n, s[strength as usize], s[distance as usize], s[center as usize], s[dx as usize], s[dy as usize]);
+                    let r = bump_normal(
+                        &sp,
+                        settings,
+                        n,
+                        s[strength as usize],
+                        s[distance as usize],
+                        s[center as usize],
+                        s[dx as usize],
+                        s[dy as usize],
+                    );
                     put3(s, dst, r);
                 }
-                Op::Displacement { object_space, height, midlevel, scale, normal, dst } => {
+                Op::Displacement {
+                    object_space,
+                    height,
+                    midlevel,
+                    scale,
+                    normal,
+                    dst,
+                } => {
                     let n = normal.map_or(sp.normal, |n| v3(s, n));
-                    let r = displacement(&sp, object_space, s[height as usize], s[midlevel as usize], s[scale as usize], n);
+                    let r = displacement(
+                        &sp,
+                        object_space,
+                        s[height as usize],
+                        s[midlevel as usize],
+                        s[scale as usize],
+                        n,
+                    );
                     put3(s, dst, r);
                 }
-                Op::VectorDisplacement { space, vector, midlevel, scale, dst } => {
-                    let r = vector_displacement(&sp, space, v3(s, vector), s[midlevel as usize], s[scale as usize]);
+                Op::VectorDisplacement {
+                    space,
+                    vector,
+                    midlevel,
+                    scale,
+                    dst,
+                } => {
+                    let r = vector_displacement(
+                        &sp,
+                        space,
+                        v3(s, vector),
+                        s[midlevel as usize],
+                        s[scale as usize],
+                    );
                     put3(s, dst, r);
                 }
-                Op::DisplacementBump { object_space, center, dx, dy, dst } => {
+                Op::DisplacementBump {
+                    object_space,
+                    center,
+                    dx,
+                    dy,
+                    dst,
+                } => {
                     // At the undisplaced surface, Cycles' bump reads the full differential
                     // svm_node_enter_bump_eval saved, not the compact one.
                     let mut full = base;
                     if let Some(u) = base.undisplaced {
                         (full.dp_dx, full.dp_dy) = (u.dp_dx, u.dp_dy);
                     }
-                    let n = displacement_bump(&full, object_space, v3(s, center), v3(s, dx), v3(s, dy));
+                    let n =
+                        displacement_bump(&full, object_space, v3(s, center), v3(s, dx), v3(s, dy));
                     base.normal = n;
                     base.object_normal = base.transform.inverse_normal(n);
                     sp = base;
                     put3(s, dst, n);
                 }
-                Op::NormalMap { space, color, strength, dst } => {
+                Op::NormalMap {
+                    space,
+                    color,
+                    strength,
+                    dst,
+                } => {
                     let r = normal_map(&sp, space, v3(s, color), s[strength as usize]);
                     put3(s, dst, r);
                 }
                 Op::Input { what, dst } => inputs::read(what, &sp, s, dst),
-                Op::Fresnel { ior, normal, dst } => s[dst as usize] = inputs::fresnel_node(&sp, s[ior as usize], normal.map(|n| v3(s, n))),
-                Op::LayerWeight { blend, normal, fresnel, facing } => {
-                    let (f, g) = inputs::layer_weight_node(&sp, s[blend as usize], normal.map(|n| v3(s, n)));
+                Op::Fresnel { ior, normal, dst } => {
+                    s[dst as usize] =
+                        inputs::fresnel_node(&sp, s[ior as usize], normal.map(|n| v3(s, n)))
+                }
+                Op::LayerWeight {
+                    blend,
+                    normal,
+                    fresnel,
+                    facing,
+                } => {
+                    let (f, g) =
+                        inputs::layer_weight_node(&sp, s[blend as usize], normal.map(|n| v3(s, n)));
                     s[fresnel as usize] = f;
                     s[facing as usize] = g;
                 }
-                Op::LightFalloff { strength, smooth, dst } => {
-                    let r = inputs::light_falloff_node(&sp, s[strength as usize], s[smooth as usize]);
+                Op::LightFalloff {
+                    strength,
+                    smooth,
+                    dst,
+                } => {
+                    let r =
+                        inputs::light_falloff_node(&sp, s[strength as usize], s[smooth as usize]);
                     for (d, v) in dst.iter().zip(r) {
                         s[*d as usize] = v;
                     }
                 }
-                Op::NormalDot { direction, normal, dst } => s[dst as usize] = inputs::normal_dot(direction, v3(s, normal)),
-                Op::ObjectSpace { to_object, dst } => put3(s, dst, inputs::transform_point(&to_object, sp.position)),
+                Op::NormalDot {
+                    direction,
+                    normal,
+                    dst,
+                } => s[dst as usize] = inputs::normal_dot(direction, v3(s, normal)),
+                Op::ObjectSpace { to_object, dst } => {
+                    put3(s, dst, inputs::transform_point(&to_object, sp.position))
+                }
                 Op::TangentRadial { axis, dst } => put3(s, dst, inputs::radial_tangent(&sp, axis)),
-                Op::Attribute { attr, vector, fac, alpha } => {
-                    let (a, missing) = (sp.attrs[attr as usize], sp.attr_missing & (1 << attr) != 0);
+                Op::Attribute {
+                    attr,
+                    vector,
+                    fac,
+                    alpha,
+                } => {
+                    let (a, missing) =
+                        (sp.attrs[attr as usize], sp.attr_missing & (1 << attr) != 0);
                     put3(s, vector, [a[0], a[1], a[2]]);
                     s[fac as usize] = sp.attr_fac[attr as usize];
                     // Cycles reads a missing attribute's Alpha as 1 (its float3 fallback).
@@ -538,19 +1277,46 @@ impl Program {
                     let a = sp.attrs[attr as usize];
                     put3(s, dst, [a[0], a[1], 0.0]);
                 }
-                Op::NormalMapTangent { tangent, normal, color, strength, dst } => {
-                    let t = (sp.attr_missing & (1 << tangent) == 0).then_some(sp.attrs[tangent as usize]);
+                Op::NormalMapTangent {
+                    tangent,
+                    normal,
+                    color,
+                    strength,
+                    dst,
+                } => {
+                    let t = (sp.attr_missing & (1 << tangent) == 0)
+                        .then_some(sp.attrs[tangent as usize]);
                     let n = sp.attrs[normal as usize];
-                    let r = super::tangent::normal_map_tangent(&sp, t, [n[0], n[1], n[2]], v3(s, color), s[strength as usize]);
+                    let r = super::tangent::normal_map_tangent(
+                        &sp,
+                        t,
+                        [n[0], n[1], n[2]],
+                        v3(s, color),
+                        s[strength as usize],
+                    );
                     put3(s, dst, r);
                 }
-                Op::VectorDisplacementTangent { tangent, vector, midlevel, scale, dst } => {
-                    let t = (sp.attr_missing & (1 << tangent) == 0).then_some(sp.attrs[tangent as usize]);
-                    let r = super::tangent::vector_displacement_tangent(&sp, t, v3(s, vector), s[midlevel as usize], s[scale as usize]);
+                Op::VectorDisplacementTangent {
+                    tangent,
+                    vector,
+                    midlevel,
+                    scale,
+                    dst,
+                } => {
+                    let t = (sp.attr_missing & (1 << tangent) == 0)
+                        .then_some(sp.attrs[tangent as usize]);
+                    let r = super::tangent::vector_displacement_tangent(
+                        &sp,
+                        t,
+                        v3(s, vector),
+                        s[midlevel as usize],
+                        s[scale as usize],
+                    );
                     put3(s, dst, r);
                 }
                 Op::TangentUv { tangent, dst } => {
-                    let t = (sp.attr_missing & (1 << tangent) == 0).then_some(sp.attrs[tangent as usize]);
+                    let t = (sp.attr_missing & (1 << tangent) == 0)
+                        .then_some(sp.attrs[tangent as usize]);
                     put3(s, dst, super::tangent::tangent_uv(&sp, t));
                 }
             }
@@ -573,7 +1339,10 @@ impl Program {
             _ => [0.0; 3],
         };
         match self.closures[c as usize] {
-            Closure::Emission { color, strength } | Closure::Bsdf { emission: Some((color, strength)) } => {
+            Closure::Emission { color, strength }
+            | Closure::Bsdf {
+                emission: Some((color, strength)),
+            } => {
                 let k = w * s[strength as usize];
                 let col = v3(s, color);
                 [col[0] * k, col[1] * k, col[2] * k]

@@ -59,7 +59,13 @@ pub fn mikk_tangents(mesh: &MeshData, uvs: &[[f32; 2]]) -> Vec<[f32; 4]> {
         Some(AttributeData::Bool(v)) => v.clone(),
         _ => vec![false; mesh.face_count()],
     };
-    let mut m = MikkMesh { mesh, uvs, flat, vertex_normals: vertex_normals(mesh), out: vec![[0.0; 4]; mesh.triangles.len() * 3] };
+    let mut m = MikkMesh {
+        mesh,
+        uvs,
+        flat,
+        vertex_normals: vertex_normals(mesh),
+        out: vec![[0.0; 4]; mesh.triangles.len() * 3],
+    };
     mikktspace::generate_tangents(&mut m);
     m.out
 }
@@ -68,7 +74,13 @@ pub fn mikk_tangents(mesh: &MeshData, uvs: &[[f32; 2]]) -> Vec<[f32; 4]> {
 /// (x, y, z, sign), `normal` the interpolated object-space normal (see
 /// `AttributeRequest::MapNormal`); None when the mesh has no such UV map, then the
 /// unperturbed normal.
-pub fn normal_map_tangent(sp: &ShadingPoint, tangent: Option<[f32; 4]>, normal: Vec3, color: Vec3, strength: f32) -> Vec3 {
+pub fn normal_map_tangent(
+    sp: &ShadingPoint,
+    tangent: Option<[f32; 4]>,
+    normal: Vec3,
+    color: Vec3,
+    strength: f32,
+) -> Vec3 {
     let Some(t4) = tangent else { return sp.normal };
     let mut c = scale3(sub3(color, [0.5; 3]), 2.0);
     // Tangent space scales the map's x and y by strength instead of blending normals.
@@ -77,7 +89,10 @@ pub fn normal_map_tangent(sp: &ShadingPoint, tangent: Option<[f32; 4]>, normal: 
     c[2] = 1.0 + (c[2] - 1.0) * strength.clamp(0.0, 1.0);
     let t = [t4[0], t4[1], t4[2]];
     let b = scale3(cross3(normal, t), t4[3]);
-    let local = safe_normalize3(add3(add3(scale3(t, c[0]), scale3(b, c[1])), scale3(normal, c[2])));
+    let local = safe_normalize3(add3(
+        add3(scale3(t, c[0]), scale3(b, c[1])),
+        scale3(normal, c[2]),
+    ));
     let mut n = sp.transform.normal(local);
     if sp.backfacing {
         n = scale3(n, -1.0);
@@ -91,7 +106,13 @@ pub fn normal_map_tangent(sp: &ShadingPoint, tangent: Option<[f32; 4]>, normal: 
 /// Vector Displacement, tangent space (Cycles' svm_node_vector_displacement): x along the
 /// tangent, y along the normal, z along the bitangent, then to world space. Without the
 /// UV map Cycles uses dPdu, which a bake does not have: None is then zero.
-pub fn vector_displacement_tangent(sp: &ShadingPoint, tangent: Option<[f32; 4]>, vector: Vec3, midlevel: f32, scale: f32) -> Vec3 {
+pub fn vector_displacement_tangent(
+    sp: &ShadingPoint,
+    tangent: Option<[f32; 4]>,
+    vector: Vec3,
+    midlevel: f32,
+    scale: f32,
+) -> Vec3 {
     let Some(t4) = tangent else { return [0.0; 3] };
     let d = scale3(sub3(vector, [midlevel; 3]), scale);
     let normal = sp.transform.inverse_normal(sp.normal);
@@ -116,7 +137,11 @@ pub fn vertex_normals(mesh: &MeshData) -> Vec<Vec3> {
     // Without sharp faces, sharp edges or custom normals Blender's corner normals are its
     // vertex normals: take them as Blender rounded them.
     let any = |name: &str| matches!(mesh.attribute(name).map(|a| &a.data), Some(AttributeData::Bool(v)) if v.iter().any(|&b| b));
-    if !any("sharp_face") && !any("sharp_edge") && mesh.attribute("custom_normal").is_none() && mesh.corner_normals.len() == mesh.corner_count() {
+    if !any("sharp_face")
+        && !any("sharp_edge")
+        && mesh.attribute("custom_normal").is_none()
+        && mesh.corner_normals.len() == mesh.corner_count()
+    {
         let mut out = vec![[0.0f32; 3]; mesh.vertex_count()];
         for (c, &v) in mesh.corner_verts.iter().enumerate() {
             out[v as usize] = mesh.corner_normals[c];
@@ -126,14 +151,23 @@ pub fn vertex_normals(mesh: &MeshData) -> Vec<Vec3> {
     let mut acc = vec![[0.0f32; 3]; mesh.vertex_count()];
     let pos = |c: usize| mesh.positions[mesh.corner_verts[c] as usize];
     for f in 0..mesh.face_count() {
-        let (a, b) = (mesh.face_offsets[f] as usize, mesh.face_offsets[f + 1] as usize);
+        let (a, b) = (
+            mesh.face_offsets[f] as usize,
+            mesh.face_offsets[f + 1] as usize,
+        );
         let n = b - a;
         if n < 3 {
             continue;
         }
         let fno = match n {
-            3 => normalize3(cross3(sub3(pos(a), pos(a + 1)), sub3(pos(a + 1), pos(a + 2)))),
-            4 => normalize3(cross3(sub3(pos(a), pos(a + 2)), sub3(pos(a + 1), pos(a + 3)))),
+            3 => normalize3(cross3(
+                sub3(pos(a), pos(a + 1)),
+                sub3(pos(a + 1), pos(a + 2)),
+            )),
+            4 => normalize3(cross3(
+                sub3(pos(a), pos(a + 2)),
+                sub3(pos(a + 1), pos(a + 3)),
+            )),
             _ => {
                 // Newell's method.
                 let mut s = [0.0f32; 3];
@@ -152,7 +186,9 @@ pub fn vertex_normals(mesh: &MeshData) -> Vec<Vec3> {
             let next = a + (k + 1) % n;
             let d1 = safe_normalize3(sub3(pos(prev), pos(c)));
             let d2 = safe_normalize3(sub3(pos(next), pos(c)));
-            let angle = (d1[0] * d2[0] + d1[1] * d2[1] + d1[2] * d2[2]).clamp(-1.0, 1.0).acos();
+            let angle = (d1[0] * d2[0] + d1[1] * d2[1] + d1[2] * d2[2])
+                .clamp(-1.0, 1.0)
+                .acos();
             let v = mesh.corner_verts[c] as usize;
             acc[v] = add3(acc[v], scale3(fno, angle));
         }

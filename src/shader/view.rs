@@ -27,18 +27,66 @@ impl Default for View {
     /// A camera at the origin looking down -Z with a square 90 degree view, for scenes
     /// without one.
     fn default() -> Self {
-        View { world_to_camera: [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, -1.0, 0.0]], ortho: false, tan_half: 1.0, left: -1.0, right: 1.0, bottom: -1.0, top: 1.0 }
+        View {
+            world_to_camera: [
+                [1.0, 0.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0, 0.0],
+                [0.0, 0.0, -1.0, 0.0],
+            ],
+            ortho: false,
+            tan_half: 1.0,
+            left: -1.0,
+            right: 1.0,
+            bottom: -1.0,
+            top: 1.0,
+        }
     }
 }
 
 impl View {
     /// A view from a camera-to-world transform (Blender convention, scale removed).
-    pub fn new(camera_to_world: &[[f32; 4]; 3], ortho: bool, tan_half: f32, viewplane: [f32; 4]) -> View {
-        let m: [[f64; 4]; 4] = std::array::from_fn(|r| std::array::from_fn(|c| if r < 3 { camera_to_world[r][c] as f64 } else if c == 3 { 1.0 } else { 0.0 }));
-        let inv = invert_affine(&m).unwrap_or([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]]);
+    pub fn new(
+        camera_to_world: &[[f32; 4]; 3],
+        ortho: bool,
+        tan_half: f32,
+        viewplane: [f32; 4],
+    ) -> View {
+        let m: [[f64; 4]; 4] = std::array::from_fn(|r| {
+            std::array::from_fn(|c| {
+                if r < 3 {
+                    camera_to_world[r][c] as f64
+                } else if c == 3 {
+                    1.0
+                } else {
+                    0.0
+                }
+            })
+        });
+        let inv = invert_affine(&m).unwrap_or([
+            [1.0, 0.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0, 1.0],
+        ]);
         // Cycles flips Blender's camera Z so that it looks down +Z.
-        let world_to_camera = std::array::from_fn(|r| std::array::from_fn(|c| if r == 2 { -inv[r][c] as f32 } else { inv[r][c] as f32 }));
-        View { world_to_camera, ortho, tan_half, left: viewplane[0], right: viewplane[1], bottom: viewplane[2], top: viewplane[3] }
+        let world_to_camera = std::array::from_fn(|r| {
+            std::array::from_fn(|c| {
+                if r == 2 {
+                    -inv[r][c] as f32
+                } else {
+                    inv[r][c] as f32
+                }
+            })
+        });
+        View {
+            world_to_camera,
+            ortho,
+            tan_half,
+            left: viewplane[0],
+            right: viewplane[1],
+            bottom: viewplane[2],
+            top: viewplane[3],
+        }
     }
 
     /// A world point in Cycles' camera space.
@@ -51,14 +99,24 @@ impl View {
     /// A camera-space point in normalised window coordinates (0..1 over the image, z = 0).
     #[inline]
     pub fn window(&self, c: Vec3) -> Vec3 {
-        let (sx, sy) = if self.ortho { (c[0], c[1]) } else { (c[0] / (c[2] * self.tan_half), c[1] / (c[2] * self.tan_half)) };
-        [(sx - self.left) / (self.right - self.left), (sy - self.bottom) / (self.top - self.bottom), 0.0]
+        let (sx, sy) = if self.ortho {
+            (c[0], c[1])
+        } else {
+            (c[0] / (c[2] * self.tan_half), c[1] / (c[2] * self.tan_half))
+        };
+        [
+            (sx - self.left) / (self.right - self.left),
+            (sy - self.bottom) / (self.top - self.bottom),
+            0.0,
+        ]
     }
 }
 
 /// Cycles' string hash (`hash_string`): i = i * 37 + byte.
 fn hash_string(s: &str) -> u32 {
-    s.bytes().fold(0u32, |i, c| i.wrapping_mul(37).wrapping_add(c as i8 as i32 as u32))
+    s.bytes().fold(0u32, |i, c| {
+        i.wrapping_mul(37).wrapping_add(c as i8 as i32 as u32)
+    })
 }
 
 /// Object Info > Random of an object that is not an instance: Cycles hashes its name.
@@ -69,10 +127,19 @@ pub fn object_random(name: &str) -> f32 {
 
 /// The Object Info values of an exported object at its world transform `to_world`.
 pub fn object_info(obj: &Object, to_world: &[[f64; 4]; 4]) -> ObjectInfo {
-    let inv = invert_affine(to_world).unwrap_or([[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]]);
+    let inv = invert_affine(to_world).unwrap_or([
+        [1.0, 0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0, 0.0],
+        [0.0, 0.0, 1.0, 0.0],
+        [0.0, 0.0, 0.0, 1.0],
+    ]);
     let color = obj.color.unwrap_or([1.0; 4]);
     ObjectInfo {
-        location: [to_world[0][3] as f32, to_world[1][3] as f32, to_world[2][3] as f32],
+        location: [
+            to_world[0][3] as f32,
+            to_world[1][3] as f32,
+            to_world[2][3] as f32,
+        ],
         color: color.map(|c| c as f32),
         pass_index: obj.pass_index as f32,
         random: object_random(&obj.name),
@@ -115,7 +182,8 @@ pub fn scene_view(scene: &crate::scene::Scene) -> Result<Option<View>, String> {
     let pct = get("resolution_percentage", 100.0);
     let w = ((get("resolution_x", 1920.0) * pct / 100.0) as u32).max(1);
     let h = ((get("resolution_y", 1080.0) * pct / 100.0) as u32).max(1);
-    let eval = crate::anim::evaluate_scene(scene, scene.file.scene.frame_current as f64).map_err(|e| format!("evaluating the scene for its camera: {e}"))?;
+    let eval = crate::anim::evaluate_scene(scene, scene.file.scene.frame_current as f64)
+        .map_err(|e| format!("evaluating the scene for its camera: {e}"))?;
     let cam = crate::render::camera::Camera::new(scene, &eval, w, h).map_err(|e| e.0)?;
     Ok(Some(cam.view()))
 }

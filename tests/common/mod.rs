@@ -15,7 +15,9 @@ pub fn bin() -> Command {
 /// Runs the CLI with a clean Blender environment plus `envs`.
 pub fn run(args: &[&str], envs: &[(&str, &str)]) -> Output {
     let mut c = bin();
-    c.args(args).env_remove("BLENDSYNTH_BLENDER").env_remove("BLENDSYNTH_BPY_PYTHON");
+    c.args(args)
+        .env_remove("BLENDSYNTH_BLENDER")
+        .env_remove("BLENDSYNTH_BPY_PYTHON");
     for (k, v) in envs {
         c.env(k, v);
     }
@@ -39,7 +41,11 @@ pub fn assert_clean_error(o: &Output, code: i32, must_contain: &[&str]) {
     assert_eq!(lines.len(), 1, "expected one error line, got: {err}");
     assert!(lines[0].starts_with("error: "), "{err}");
     for m in must_contain {
-        assert!(lines[0].contains(m), "error {:?} should mention {m:?}", lines[0]);
+        assert!(
+            lines[0].contains(m),
+            "error {:?} should mention {m:?}",
+            lines[0]
+        );
     }
 }
 
@@ -55,7 +61,11 @@ pub fn bpy_python() -> Option<PathBuf> {
     }
     let venv = repo().join(".venv/bin/python");
     if venv.is_file() {
-        let ok = Command::new(&venv).args(["-c", "import bpy"]).output().map(|o| o.status.success()).unwrap_or(false);
+        let ok = Command::new(&venv)
+            .args(["-c", "import bpy"])
+            .output()
+            .map(|o| o.status.success())
+            .unwrap_or(false);
         if ok {
             return Some(venv);
         }
@@ -96,8 +106,18 @@ pub fn copy_dir(src: &Path, dst: &Path) {
 
 /// Runs a bpy script with the given python and returns stdout, panicking with stderr on failure.
 pub fn run_python(python: &Path, script: &Path, args: &[&str]) -> String {
-    let o = Command::new(python).arg(script).args(args).output().expect("run python");
-    assert!(o.status.success(), "{} failed: {}\n{}", script.display(), stderr(&o), stdout(&o));
+    let o = Command::new(python)
+        .arg(script)
+        .args(args)
+        .output()
+        .expect("run python");
+    assert!(
+        o.status.success(),
+        "{} failed: {}\n{}",
+        script.display(),
+        stderr(&o),
+        stdout(&o)
+    );
     stdout(&o)
 }
 
@@ -141,16 +161,33 @@ pub fn export_counts(s: &blendsynth::scene::Scene) -> serde_json::Value {
 /// blendsynth's bake of every case against Cycles', the worst absolute error by case name.
 pub fn bake_cases_worst(dir: &Path) -> Vec<(String, f32)> {
     let scene = blendsynth::scene::Scene::load(dir).unwrap();
-    let meta: serde_json::Value = serde_json::from_slice(&std::fs::read(dir.join("cases.json")).unwrap()).unwrap();
+    let meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("cases.json")).unwrap()).unwrap();
     let size = meta["size"].as_u64().unwrap() as u32;
     let mut out = Vec::new();
     for (case, object) in meta["cases"].as_object().unwrap() {
-        let reference: Vec<f32> = std::fs::read(dir.join(format!("{case}.f32"))).unwrap().chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+        let reference: Vec<f32> = std::fs::read(dir.join(format!("{case}.f32")))
+            .unwrap()
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+            .collect();
         assert_eq!(reference.len(), (size * size * 4) as usize);
-        let ours = blendsynth::shader::bake::bake_emission(&scene, &blendsynth::shader::bake::BakeOptions { object: object.as_str().unwrap().into(), uv: None, size }).unwrap_or_else(|e| panic!("{case}: {e}"));
+        let ours = blendsynth::shader::bake::bake_emission(
+            &scene,
+            &blendsynth::shader::bake::BakeOptions {
+                object: object.as_str().unwrap().into(),
+                uv: None,
+                size,
+            },
+        )
+        .unwrap_or_else(|e| panic!("{case}: {e}"));
         let (mut worst, mut at) = (0.0f32, (0, 0));
         for (i, p) in ours.pixels.iter().enumerate() {
-            assert_eq!(p[3], reference[i * 4 + 3], "{case}: texel {i} coverage differs");
+            assert_eq!(
+                p[3],
+                reference[i * 4 + 3],
+                "{case}: texel {i} coverage differs"
+            );
             for c in 0..3 {
                 let d = (p[c] - reference[i * 4 + c]).abs();
                 if !(d <= worst) {

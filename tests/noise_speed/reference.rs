@@ -125,13 +125,21 @@ pub mod random {
         uint_to_float_01(hash3(k[0].to_bits(), k[1].to_bits(), k[2].to_bits()))
     }
     pub fn hash_float_to_float4(k: [f32; 4]) -> f32 {
-        uint_to_float_01(hash4(k[0].to_bits(), k[1].to_bits(), k[2].to_bits(), k[3].to_bits()))
+        uint_to_float_01(hash4(
+            k[0].to_bits(),
+            k[1].to_bits(),
+            k[2].to_bits(),
+            k[3].to_bits(),
+        ))
     }
 }
 
 pub mod white_noise {
     type Vec3 = [f32; 3];
-    use super::random::{hash_float_to_float1 as h1, hash_float_to_float2 as h2, hash_float_to_float3 as h3, hash_float_to_float4 as h4};
+    use super::random::{
+        hash_float_to_float1 as h1, hash_float_to_float2 as h2, hash_float_to_float3 as h3,
+        hash_float_to_float4 as h4,
+    };
 
     pub fn hash_f1_to_f3(k: f32) -> Vec3 {
         [h1(k), h2([k, 1.0]), h2([k, 2.0])]
@@ -143,13 +151,26 @@ pub mod white_noise {
         [h2(k), h3([k[0], k[1], 1.0]), h3([k[0], k[1], 2.0])]
     }
     pub fn hash_f3_to_f3(k: Vec3) -> Vec3 {
-        [h3(k), h4([k[0], k[1], k[2], 1.0]), h4([k[0], k[1], k[2], 2.0])]
+        [
+            h3(k),
+            h4([k[0], k[1], k[2], 1.0]),
+            h4([k[0], k[1], k[2], 2.0]),
+        ]
     }
     pub fn hash_f4_to_f4(k: [f32; 4]) -> [f32; 4] {
-        [h4(k), h4([k[3], k[0], k[1], k[2]]), h4([k[2], k[3], k[0], k[1]]), h4([k[1], k[2], k[3], k[0]])]
+        [
+            h4(k),
+            h4([k[3], k[0], k[1], k[2]]),
+            h4([k[2], k[3], k[0], k[1]]),
+            h4([k[1], k[2], k[3], k[0]]),
+        ]
     }
     pub fn hash_f4_to_f3(k: [f32; 4]) -> Vec3 {
-        [h4(k), h4([k[2], k[0], k[3], k[1]]), h4([k[3], k[2], k[1], k[0]])]
+        [
+            h4(k),
+            h4([k[2], k[0], k[3], k[1]]),
+            h4([k[3], k[2], k[1], k[0]]),
+        ]
     }
 
     /// The White Noise Texture node: (Value, Color) for `dimensions` 1-4 (`vector` for 2-4,
@@ -167,10 +188,11 @@ pub mod white_noise {
 
 pub mod voronoi {
     type Vec3 = [f32; 3];
-    pub use blendsynth::nodes::voronoi::{VoronoiFeature, VoronoiMetric};
-    use super::white_noise::{hash_f1_to_f3, hash_f2_to_f2, hash_f2_to_f3, hash_f3_to_f3, hash_f4_to_f3, hash_f4_to_f4};
     use super::random::hash_float_to_float1;
-
+    use super::white_noise::{
+        hash_f1_to_f3, hash_f2_to_f2, hash_f2_to_f3, hash_f3_to_f3, hash_f4_to_f3, hash_f4_to_f4,
+    };
+    pub use blendsynth::nodes::voronoi::{VoronoiFeature, VoronoiMetric};
 
     #[derive(Debug, Clone, Copy)]
     pub struct VoronoiParams {
@@ -294,7 +316,9 @@ pub mod voronoi {
             VoronoiMetric::Euclidean => euclidean(a, b),
             VoronoiMetric::Manhattan => reduce_add(d),
             VoronoiMetric::Chebychev => d.iter().fold(d[0], |m, &x| m.max(x)),
-            VoronoiMetric::Minkowski => reduce_add(d.map(|x| x.powf(p.exponent))).powf(1.0 / p.exponent),
+            VoronoiMetric::Minkowski => {
+                reduce_add(d.map(|x| x.powf(p.exponent))).powf(1.0 / p.exponent)
+            }
         }
     }
 
@@ -352,7 +376,11 @@ pub mod voronoi {
                 target_pos = point;
             }
         });
-        Octave { distance: min_d, color: D::color(add(cell, target_off)), position: D::position(add(target_pos, cell)) }
+        Octave {
+            distance: min_d,
+            color: D::color(add(cell, target_off)),
+            position: D::position(add(target_pos, cell)),
+        }
     }
 
     fn smooth_f1<const N: usize>(p: &VoronoiParams, coord: [f32; N]) -> Octave
@@ -368,7 +396,11 @@ pub mod voronoi {
             let jitter = D::jitter(add(cell, off));
             let point = add(off, scale(jitter, p.randomness));
             let d = metric_distance(point, local, p);
-            h = if h == -1.0 { 1.0 } else { smoothstep(0.5 + 0.5 * (sd - d) / p.smoothness) };
+            h = if h == -1.0 {
+                1.0
+            } else {
+                smoothstep(0.5 + 0.5 * (sd - d) / p.smoothness)
+            };
             let mut corr = p.smoothness * h * (1.0 - h);
             sd = mix1(sd, d, h) - corr;
             corr /= 1.0 + 3.0 * p.smoothness;
@@ -376,7 +408,11 @@ pub mod voronoi {
             sc = mixn(sc, c, h).map(|x| x - corr);
             sp = mixn(sp, point, h).map(|x| x - corr);
         });
-        Octave { distance: sd, color: sc, position: D::position(add(cell, sp)) }
+        Octave {
+            distance: sd,
+            color: sc,
+            position: D::position(add(cell, sp)),
+        }
     }
 
     fn smoothstep(x: f32) -> f32 {
@@ -412,7 +448,11 @@ pub mod voronoi {
                 pos2 = point;
             }
         });
-        Octave { distance: d2, color: D::color(add(cell, off2)), position: D::position(add(pos2, cell)) }
+        Octave {
+            distance: d2,
+            color: D::color(add(cell, off2)),
+            position: D::position(add(pos2, cell)),
+        }
     }
 
     fn distance_to_edge<const N: usize>(p: &VoronoiParams, coord: [f32; N]) -> f32
@@ -429,7 +469,12 @@ pub mod voronoi {
             let dr = ((mid + right) / 2.0 - local[0]).abs();
             return dl.min(dr);
         }
-        let to_point = |off: [f32; N]| sub(add(off, scale(D::jitter(add(cell, off)), p.randomness)), local);
+        let to_point = |off: [f32; N]| {
+            sub(
+                add(off, scale(D::jitter(add(cell, off)), p.randomness)),
+                local,
+            )
+        };
         let mut min_d = f32::MAX;
         let mut closest = [0.0; N];
         for_cells(1, |off: [f32; N]| {
@@ -495,7 +540,11 @@ pub mod voronoi {
         let mut amplitude = 1.0f32;
         let mut max_amplitude = 0.0f32;
         let mut sc = 1.0f32;
-        let mut out = Octave { distance: 0.0, color: [0.0; 3], position: [0.0; 4] };
+        let mut out = Octave {
+            distance: 0.0,
+            color: [0.0; 3],
+            position: [0.0; 4],
+        };
         let zero_input = p.detail == 0.0 || p.roughness == 0.0;
         let mut i = 0;
         while i as f32 <= p.detail.ceil() {
@@ -521,8 +570,18 @@ pub mod voronoi {
                 let rem = p.detail - p.detail.floor();
                 if rem != 0.0 {
                     max_amplitude = mix1(max_amplitude, max_amplitude + amplitude, rem);
-                    out.distance = mix1(out.distance, out.distance + octave.distance * amplitude, rem);
-                    out.color = std::array::from_fn(|k| mix1(out.color[k], out.color[k] + octave.color[k] * amplitude, rem));
+                    out.distance = mix1(
+                        out.distance,
+                        out.distance + octave.distance * amplitude,
+                        rem,
+                    );
+                    out.color = std::array::from_fn(|k| {
+                        mix1(
+                            out.color[k],
+                            out.color[k] + octave.color[k] * amplitude,
+                            rem,
+                        )
+                    });
                     let inner = mixn(out.position, octave.position.map(|x| x / sc), amplitude);
                     out.position = mixn(out.position, inner, rem);
                 }
@@ -533,7 +592,9 @@ pub mod voronoi {
             out.distance /= max_amplitude * p.max_distance;
             out.color = out.color.map(|x| x / max_amplitude);
         }
-        out.position = out.position.map(|x| if p.scale != 0.0 { x / p.scale } else { 0.0 });
+        out.position = out
+            .position
+            .map(|x| if p.scale != 0.0 { x / p.scale } else { 0.0 });
         out
     }
 
@@ -578,7 +639,18 @@ pub mod voronoi {
     impl VoronoiParams {
         /// Node settings as the sockets give them; clamped here as Cycles clamps them.
         #[allow(clippy::too_many_arguments)]
-        pub fn new(feature: VoronoiFeature, metric: VoronoiMetric, normalize: bool, scale: f32, detail: f32, roughness: f32, lacunarity: f32, smoothness: f32, exponent: f32, randomness: f32) -> Self {
+        pub fn new(
+            feature: VoronoiFeature,
+            metric: VoronoiMetric,
+            normalize: bool,
+            scale: f32,
+            detail: f32,
+            roughness: f32,
+            lacunarity: f32,
+            smoothness: f32,
+            exponent: f32,
+            randomness: f32,
+        ) -> Self {
             VoronoiParams {
                 feature,
                 metric,
@@ -602,22 +674,43 @@ pub mod voronoi {
         match p.feature {
             VoronoiFeature::DistanceToEdge => {
                 p.max_distance = 0.5 + 0.5 * p.randomness;
-                VoronoiOutput { distance: fractal_distance_to_edge(&p, coord), ..Default::default() }
+                VoronoiOutput {
+                    distance: fractal_distance_to_edge(&p, coord),
+                    ..Default::default()
+                }
             }
-            VoronoiFeature::NSphereRadius => VoronoiOutput { radius: n_sphere_radius(&p, coord), ..Default::default() },
+            VoronoiFeature::NSphereRadius => VoronoiOutput {
+                radius: n_sphere_radius(&p, coord),
+                ..Default::default()
+            },
             _ => {
-                let f2_factor = if p.feature == VoronoiFeature::F2 { 2.0 } else { 1.0 };
+                let f2_factor = if p.feature == VoronoiFeature::F2 {
+                    2.0
+                } else {
+                    1.0
+                };
                 let half = 0.5 + 0.5 * p.randomness;
                 p.max_distance = metric_distance([0.0; N], [half; N], &p) * f2_factor;
                 let o = fractal_x_fx(&p, coord);
-                VoronoiOutput { distance: o.distance, color: o.color, position: [o.position[0], o.position[1], o.position[2]], w: o.position[3], radius: 0.0 }
+                VoronoiOutput {
+                    distance: o.distance,
+                    color: o.color,
+                    position: [o.position[0], o.position[1], o.position[2]],
+                    w: o.position[3],
+                    radius: 0.0,
+                }
             }
         }
     }
 
     /// The Voronoi Texture node on one point: `dimensions` 1-4 (`vector` for 2-4, `w` for 1
     /// and 4).
-    pub fn voronoi_texture(dimensions: u8, vector: Vec3, w: f32, p: VoronoiParams) -> VoronoiOutput {
+    pub fn voronoi_texture(
+        dimensions: u8,
+        vector: Vec3,
+        w: f32,
+        p: VoronoiParams,
+    ) -> VoronoiOutput {
         let v = vector.map(|x| x * p.scale);
         let w = w * p.scale;
         match dimensions {
@@ -696,7 +789,8 @@ pub mod noise {
         let x1 = (1.0 - x as f64) as f32;
         let y1 = (1.0 - y as f64) as f32;
         let z1 = (1.0 - z as f64) as f32;
-        z1 * (y1 * (v[0] * x1 + v[1] * x) + y * (v[2] * x1 + v[3] * x)) + z * (y1 * (v[4] * x1 + v[5] * x) + y * (v[6] * x1 + v[7] * x))
+        z1 * (y1 * (v[0] * x1 + v[1] * x) + y * (v[2] * x1 + v[3] * x))
+            + z * (y1 * (v[4] * x1 + v[5] * x) + y * (v[6] * x1 + v[7] * x))
     }
 
     #[inline]
@@ -708,7 +802,11 @@ pub mod noise {
     fn perlin_noise1(p: f32) -> f32 {
         let (x, fx) = floor_fraction(p);
         let u = fade(fx);
-        lerp(grad1(hash1(x as u32), fx), grad1(hash1(x.wrapping_add(1) as u32), fx - 1.0), u)
+        lerp(
+            grad1(hash1(x as u32), fx),
+            grad1(hash1(x.wrapping_add(1) as u32), fx - 1.0),
+            u,
+        )
     }
 
     fn perlin_noise2(p: [f32; 2]) -> f32 {
@@ -733,13 +831,31 @@ pub mod noise {
         let (u, v, w) = (fade(fx), fade(fy), fade(fz));
         let g = |dx: i32, dy: i32, dz: i32| {
             grad3(
-                hash3(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32, z.wrapping_add(dz) as u32),
+                hash3(
+                    x.wrapping_add(dx) as u32,
+                    y.wrapping_add(dy) as u32,
+                    z.wrapping_add(dz) as u32,
+                ),
                 fx - dx as f32,
                 fy - dy as f32,
                 fz - dz as f32,
             )
         };
-        tri_mix([g(0, 0, 0), g(1, 0, 0), g(0, 1, 0), g(1, 1, 0), g(0, 0, 1), g(1, 0, 1), g(0, 1, 1), g(1, 1, 1)], u, v, w)
+        tri_mix(
+            [
+                g(0, 0, 0),
+                g(1, 0, 0),
+                g(0, 1, 0),
+                g(1, 1, 0),
+                g(0, 0, 1),
+                g(1, 0, 1),
+                g(0, 1, 1),
+                g(1, 1, 1),
+            ],
+            u,
+            v,
+            w,
+        )
     }
 
     fn perlin_noise4(p: [f32; 4]) -> f32 {
@@ -750,15 +866,48 @@ pub mod noise {
         let (u, v, t, s) = (fade(fx), fade(fy), fade(fz), fade(fw));
         let g = |dx: i32, dy: i32, dz: i32, dw: i32| {
             grad4(
-                hash4(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32, z.wrapping_add(dz) as u32, w.wrapping_add(dw) as u32),
+                hash4(
+                    x.wrapping_add(dx) as u32,
+                    y.wrapping_add(dy) as u32,
+                    z.wrapping_add(dz) as u32,
+                    w.wrapping_add(dw) as u32,
+                ),
                 fx - dx as f32,
                 fy - dy as f32,
                 fz - dz as f32,
                 fw - dw as f32,
             )
         };
-        let a = tri_mix([g(0, 0, 0, 0), g(1, 0, 0, 0), g(0, 1, 0, 0), g(1, 1, 0, 0), g(0, 0, 1, 0), g(1, 0, 1, 0), g(0, 1, 1, 0), g(1, 1, 1, 0)], u, v, t);
-        let b = tri_mix([g(0, 0, 0, 1), g(1, 0, 0, 1), g(0, 1, 0, 1), g(1, 1, 0, 1), g(0, 0, 1, 1), g(1, 0, 1, 1), g(0, 1, 1, 1), g(1, 1, 1, 1)], u, v, t);
+        let a = tri_mix(
+            [
+                g(0, 0, 0, 0),
+                g(1, 0, 0, 0),
+                g(0, 1, 0, 0),
+                g(1, 1, 0, 0),
+                g(0, 0, 1, 0),
+                g(1, 0, 1, 0),
+                g(0, 1, 1, 0),
+                g(1, 1, 1, 0),
+            ],
+            u,
+            v,
+            t,
+        );
+        let b = tri_mix(
+            [
+                g(0, 0, 0, 1),
+                g(1, 0, 0, 1),
+                g(0, 1, 0, 1),
+                g(1, 1, 0, 1),
+                g(0, 0, 1, 1),
+                g(1, 0, 1, 1),
+                g(0, 1, 1, 1),
+                g(1, 1, 1, 1),
+            ],
+            u,
+            v,
+            t,
+        );
         lerp(a, b, s)
     }
 
@@ -828,7 +977,10 @@ pub mod noise {
 
     impl NoisePoint for [f32; 2] {
         fn perlin_signed(self) -> f32 {
-            let p = [self[0] % 100000.0 + correction(self[0]), self[1] % 100000.0 + correction(self[1])];
+            let p = [
+                self[0] % 100000.0 + correction(self[0]),
+                self[1] % 100000.0 + correction(self[1]),
+            ];
             perlin_noise2(p) * 0.6616
         }
         fn scaled(self, s: f32) -> Self {
@@ -841,7 +993,10 @@ pub mod noise {
             [offset_component(seed, 0.0), offset_component(seed, 1.0)]
         }
         fn distortion(self, strength: f32) -> Self {
-            [self.plus(Self::offset(0.0)).perlin_signed() * strength, self.plus(Self::offset(1.0)).perlin_signed() * strength]
+            [
+                self.plus(Self::offset(0.0)).perlin_signed() * strength,
+                self.plus(Self::offset(1.0)).perlin_signed() * strength,
+            ]
         }
     }
 
@@ -861,7 +1016,11 @@ pub mod noise {
             [self[0] + o[0], self[1] + o[1], self[2] + o[2]]
         }
         fn offset(seed: f32) -> Self {
-            [offset_component(seed, 0.0), offset_component(seed, 1.0), offset_component(seed, 2.0)]
+            [
+                offset_component(seed, 0.0),
+                offset_component(seed, 1.0),
+                offset_component(seed, 2.0),
+            ]
         }
         fn distortion(self, strength: f32) -> Self {
             [
@@ -884,10 +1043,20 @@ pub mod noise {
             [s * self[0], s * self[1], s * self[2], s * self[3]]
         }
         fn plus(self, o: Self) -> Self {
-            [self[0] + o[0], self[1] + o[1], self[2] + o[2], self[3] + o[3]]
+            [
+                self[0] + o[0],
+                self[1] + o[1],
+                self[2] + o[2],
+                self[3] + o[3],
+            ]
         }
         fn offset(seed: f32) -> Self {
-            [offset_component(seed, 0.0), offset_component(seed, 1.0), offset_component(seed, 2.0), offset_component(seed, 3.0)]
+            [
+                offset_component(seed, 0.0),
+                offset_component(seed, 1.0),
+                offset_component(seed, 2.0),
+                offset_component(seed, 3.0),
+            ]
         }
         fn distortion(self, strength: f32) -> Self {
             [
@@ -904,7 +1073,13 @@ pub mod noise {
         p.perlin_signed() / 2.0 + 0.5
     }
 
-    pub fn fbm<P: NoisePoint>(p: P, detail: f32, roughness: f32, lacunarity: f32, normalize: bool) -> f32 {
+    pub fn fbm<P: NoisePoint>(
+        p: P,
+        detail: f32,
+        roughness: f32,
+        lacunarity: f32,
+        normalize: bool,
+    ) -> f32 {
         let mut fscale = 1.0f32;
         let mut amp = 1.0f32;
         let mut maxamp = 0.0f32;
@@ -921,7 +1096,11 @@ pub mod noise {
             let t = p.scaled(fscale).perlin_signed();
             let sum2 = madd::<P>(t, amp, sum);
             return if normalize {
-                blend::<P>(0.5 * sum / maxamp + 0.5, 0.5 * sum2 / (maxamp + amp) + 0.5, rmd)
+                blend::<P>(
+                    0.5 * sum / maxamp + 0.5,
+                    0.5 * sum2 / (maxamp + amp) + 0.5,
+                    rmd,
+                )
             } else {
                 blend::<P>(sum, sum2, rmd)
             };
@@ -933,7 +1112,12 @@ pub mod noise {
         }
     }
 
-    pub fn multi_fractal<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacunarity: f32) -> f32 {
+    pub fn multi_fractal<P: NoisePoint>(
+        mut p: P,
+        detail: f32,
+        roughness: f32,
+        lacunarity: f32,
+    ) -> f32 {
         let mut value = 1.0f32;
         let mut pwr = 1.0f32;
         for _ in 0..=(detail as i32) {
@@ -948,7 +1132,13 @@ pub mod noise {
         value
     }
 
-    pub fn hetero_terrain<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacunarity: f32, offset: f32) -> f32 {
+    pub fn hetero_terrain<P: NoisePoint>(
+        mut p: P,
+        detail: f32,
+        roughness: f32,
+        lacunarity: f32,
+        offset: f32,
+    ) -> f32 {
         let mut pwr = roughness;
         let mut value = offset + p.perlin_signed();
         p = p.scaled(lacunarity);
@@ -965,7 +1155,14 @@ pub mod noise {
         value
     }
 
-    pub fn hybrid_multi_fractal<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacunarity: f32, offset: f32, gain: f32) -> f32 {
+    pub fn hybrid_multi_fractal<P: NoisePoint>(
+        mut p: P,
+        detail: f32,
+        roughness: f32,
+        lacunarity: f32,
+        offset: f32,
+        gain: f32,
+    ) -> f32 {
         let mut pwr = 1.0f32;
         let mut value = 0.0f32;
         let mut weight = 1.0f32;
@@ -992,7 +1189,14 @@ pub mod noise {
         value
     }
 
-    pub fn ridged_multi_fractal<P: NoisePoint>(mut p: P, detail: f32, roughness: f32, lacunarity: f32, offset: f32, gain: f32) -> f32 {
+    pub fn ridged_multi_fractal<P: NoisePoint>(
+        mut p: P,
+        detail: f32,
+        roughness: f32,
+        lacunarity: f32,
+        offset: f32,
+        gain: f32,
+    ) -> f32 {
         let mut pwr = roughness;
         let mut signal = offset - p.perlin_signed().abs();
         signal *= signal;
@@ -1015,9 +1219,15 @@ pub mod noise {
         match n.kind {
             NoiseType::MultiFractal => multi_fractal(p, n.detail, n.roughness, n.lacunarity),
             NoiseType::Fbm => fbm(p, n.detail, n.roughness, n.lacunarity, n.normalize),
-            NoiseType::HybridMultiFractal => hybrid_multi_fractal(p, n.detail, n.roughness, n.lacunarity, n.offset, n.gain),
-            NoiseType::RidgedMultiFractal => ridged_multi_fractal(p, n.detail, n.roughness, n.lacunarity, n.offset, n.gain),
-            NoiseType::HeteroTerrain => hetero_terrain(p, n.detail, n.roughness, n.lacunarity, n.offset),
+            NoiseType::HybridMultiFractal => {
+                hybrid_multi_fractal(p, n.detail, n.roughness, n.lacunarity, n.offset, n.gain)
+            }
+            NoiseType::RidgedMultiFractal => {
+                ridged_multi_fractal(p, n.detail, n.roughness, n.lacunarity, n.offset, n.gain)
+            }
+            NoiseType::HeteroTerrain => {
+                hetero_terrain(p, n.detail, n.roughness, n.lacunarity, n.offset)
+            }
         }
     }
 
@@ -1029,15 +1239,30 @@ pub mod noise {
 
     /// `perlin_float3_fractal_distorted`: the Color output (its first channel is Fac). The
     /// seeds of the two extra channels depend on the dimension, as in Blender.
-    pub fn fractal_distorted_color<P: NoisePoint>(p: P, n: &NoiseParams, seeds: [f32; 2]) -> [f32; 3] {
+    pub fn fractal_distorted_color<P: NoisePoint>(
+        p: P,
+        n: &NoiseParams,
+        seeds: [f32; 2],
+    ) -> [f32; 3] {
         let p = p.distorted(n.distortion);
-        [select(p, n), select(p.plus(P::offset(seeds[0])), n), select(p.plus(P::offset(seeds[1])), n)]
+        [
+            select(p, n),
+            select(p.plus(P::offset(seeds[0])), n),
+            select(p.plus(P::offset(seeds[1])), n),
+        ]
     }
 
     /// The Noise Texture node on one point: `dimensions` 1-4 (`vector` used for 2-4, `w` for
     /// 1 and 4). Returns (Fac, Color).
     #[allow(clippy::too_many_arguments)]
-    pub fn noise_texture(dimensions: u8, vector: [f32; 3], w: f32, scale: f32, params: NoiseParams, want_color: bool) -> (f32, [f32; 4]) {
+    pub fn noise_texture(
+        dimensions: u8,
+        vector: [f32; 3],
+        w: f32,
+        scale: f32,
+        params: NoiseParams,
+        want_color: bool,
+    ) -> (f32, [f32; 4]) {
         let mut n = params;
         n.detail = n.detail.clamp(0.0, 15.0);
         n.roughness = n.roughness.max(0.0);
@@ -1086,7 +1311,11 @@ pub mod noise {
     fn cy_perlin1(p: f32) -> f32 {
         let (x, fx) = floor_fraction(p);
         let u = t_fade1(fx);
-        cy_mix(grad1(hash1(x as u32), fx), grad1(hash1(x.wrapping_add(1) as u32), fx - 1.0), u)
+        cy_mix(
+            grad1(hash1(x as u32), fx),
+            grad1(hash1(x.wrapping_add(1) as u32), fx - 1.0),
+            u,
+        )
     }
 
     /// The scalar 1D kernel's fade: `t * t * t * (t * (t * 6 - 15) + 10)`.
@@ -1101,7 +1330,11 @@ pub mod noise {
         let (u, v) = (cy_fade(fx), cy_fade(fy));
         let h = |dx: i32, dy: i32| hash2(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32);
         let g0 = cy_mix(grad2(h(0, 0), fx, fy), grad2(h(1, 0), fx - 1.0, fy), u);
-        let g1 = cy_mix(grad2(h(0, 1), fx, fy - 1.0), grad2(h(1, 1), fx - 1.0, fy - 1.0), u);
+        let g1 = cy_mix(
+            grad2(h(0, 1), fx, fy - 1.0),
+            grad2(h(1, 1), fx - 1.0, fy - 1.0),
+            u,
+        );
         cy_mix(g0, g1, v)
     }
 
@@ -1121,7 +1354,11 @@ pub mod noise {
         let (z, fz) = floor_fraction(p[2]);
         let g = |dx: i32, dy: i32, dz: i32| {
             grad3(
-                hash3(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32, z.wrapping_add(dz) as u32),
+                hash3(
+                    x.wrapping_add(dx) as u32,
+                    y.wrapping_add(dy) as u32,
+                    z.wrapping_add(dz) as u32,
+                ),
                 fx - dx as f32,
                 fy - dy as f32,
                 fz - dz as f32,
@@ -1139,7 +1376,12 @@ pub mod noise {
         let g = |dx: i32, dy: i32, dz: i32| {
             let at = |dw: i32| {
                 grad4(
-                    hash4(x.wrapping_add(dx) as u32, y.wrapping_add(dy) as u32, z.wrapping_add(dz) as u32, w.wrapping_add(dw) as u32),
+                    hash4(
+                        x.wrapping_add(dx) as u32,
+                        y.wrapping_add(dy) as u32,
+                        z.wrapping_add(dz) as u32,
+                        w.wrapping_add(dw) as u32,
+                    ),
                     fx - dx as f32,
                     fy - dy as f32,
                     fz - dz as f32,
@@ -1241,7 +1483,13 @@ pub mod noise {
 
     /// The Noise Texture node as Cycles' shader kernel evaluates it: (Fac, Color).
     #[allow(clippy::too_many_arguments)]
-    pub fn noise_texture_cycles(dimensions: u8, vector: [f32; 3], w: f32, scale: f32, params: NoiseParams) -> (f32, [f32; 3]) {
+    pub fn noise_texture_cycles(
+        dimensions: u8,
+        vector: [f32; 3],
+        w: f32,
+        scale: f32,
+        params: NoiseParams,
+    ) -> (f32, [f32; 3]) {
         let mut n = params;
         n.detail = n.detail.clamp(0.0, 15.0);
         n.roughness = n.roughness.max(0.0);
@@ -1259,14 +1507,23 @@ pub mod noise {
 
 pub mod wave {
     type Vec3 = [f32; 3];
-    pub use blendsynth::nodes::wave::{BandsDirection, RingsDirection, WaveProfile, WaveSettings, WaveType};
     use super::noise::{fbm, Cycles};
-
-
+    pub use blendsynth::nodes::wave::{
+        BandsDirection, RingsDirection, WaveProfile, WaveSettings, WaveType,
+    };
 
     /// Fac of the Wave Texture at `vector` (Color is Fac in all three channels).
     #[allow(clippy::too_many_arguments)]
-    pub fn wave(s: WaveSettings, vector: Vec3, scale: f32, distortion: f32, detail: f32, detail_scale: f32, detail_roughness: f32, phase: f32) -> f32 {
+    pub fn wave(
+        s: WaveSettings,
+        vector: Vec3,
+        scale: f32,
+        distortion: f32,
+        detail: f32,
+        detail_scale: f32,
+        detail_roughness: f32,
+        phase: f32,
+    ) -> f32 {
         // The nudge avoids precision trouble on unit coordinates, as Cycles does.
         let p = vector.map(|v| (v * scale + 0.000001) * 0.999999);
         let mut n = match s.kind {
@@ -1306,4 +1563,3 @@ pub mod wave {
         }
     }
 }
-

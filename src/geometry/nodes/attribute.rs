@@ -13,7 +13,14 @@ use super::geometry_ops::modify_geometry_sets;
 /// Writes `field` as attribute `id` on `domain` of every top-level component that has the
 /// domain: selected elements get the field's value, the others keep the attribute's old
 /// values (moved to this domain and type) or the type's default.
-pub fn store(g: &mut GeometrySet, id: &AttrId, domain: Domain, field: &Field, selection: &Field, ty: Option<DataType>) -> Result<(), String> {
+pub fn store(
+    g: &mut GeometrySet,
+    id: &AttrId,
+    domain: Domain,
+    field: &Field,
+    selection: &Field,
+    ty: Option<DataType>,
+) -> Result<(), String> {
     let ty = ty.unwrap_or_else(|| field.data_type());
     let is_position = id.name() == Some("position");
     let compute = |comp: ComponentRef| -> Result<Option<Array>, String> {
@@ -97,7 +104,11 @@ fn domain_prop(ctx: &NodeCtx) -> Result<Domain, GeometryError> {
 
 /// The enabled input named `name` (identifiers of typed sockets vary by Blender version).
 fn input_by_name(ctx: &NodeCtx, name: &str) -> Option<String> {
-    ctx.flat().inputs.iter().find(|i| i.socket.name == name).map(|i| i.socket.identifier.clone())
+    ctx.flat()
+        .inputs
+        .iter()
+        .find(|i| i.socket.name == name)
+        .map(|i| i.socket.identifier.clone())
 }
 
 pub fn store_named_attribute(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -116,7 +127,9 @@ pub fn store_named_attribute(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let r = if domain == Domain::Instance {
         store(&mut g, &id, domain, &value, &sel, Some(ty))
     } else {
-        modify_geometry_sets(&mut g, &mut |s: &mut GeometrySet| store(s, &id, domain, &value, &sel, Some(ty)))
+        modify_geometry_sets(&mut g, &mut |s: &mut GeometrySet| {
+            store(s, &id, domain, &value, &sel, Some(ty))
+        })
     };
     r.map_err(|e| ctx.err(e))?;
     Ok(outputs([("Geometry", SocketValue::Geometry(g))]))
@@ -136,11 +149,18 @@ pub fn capture_attribute(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             return Err(ctx.err(format!("cannot capture a {} socket", inp.socket.kind)));
         };
         let f = ctx.field(id_s, ty)?;
-        let out_socket = ctx.node().outputs.iter().find(|o| &o.identifier == id_s || o.name == inp.socket.name && o.kind == inp.socket.kind);
-        let Some(out_socket) = out_socket else { continue };
+        let out_socket = ctx.node().outputs.iter().find(|o| {
+            &o.identifier == id_s || o.name == inp.socket.name && o.kind == inp.socket.kind
+        });
+        let Some(out_socket) = out_socket else {
+            continue;
+        };
         let id = AttrId::anonymous(&format!("Capture {}", inp.socket.name));
         store(&mut g, &id, domain, &f, &all, Some(ty)).map_err(|e| ctx.err(e))?;
-        out.insert(out_socket.identifier.clone(), SocketValue::Field(Field::input(AttributeInput { id, ty })));
+        out.insert(
+            out_socket.identifier.clone(),
+            SocketValue::Field(Field::input(AttributeInput { id, ty })),
+        );
     }
     out.insert("Geometry".into(), SocketValue::Geometry(g));
     Ok(out)
@@ -151,7 +171,10 @@ pub fn named_attribute(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let ty = DataType::parse(dt).ok_or_else(|| ctx.err(format!("data type {dt} not supported")))?;
     let name = ctx.string("Name")?;
     let id = AttrId::Named(name);
-    let attr = Field::input(AttributeInput { id: id.clone(), ty: ty.socket_type() });
+    let attr = Field::input(AttributeInput {
+        id: id.clone(),
+        ty: ty.socket_type(),
+    });
     let exists = Field::input(ExistsInput { id });
     let mut out = Outputs::new();
     for o in ctx.node().outputs.iter() {

@@ -2,16 +2,16 @@
 //! positions) as a cube mesh, per geometry its instances reference, plus Min and Max of
 //! the top level (`node_geo_bounding_box.cc`).
 
+use super::super::attribute::AttrId;
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::Field;
 use super::super::math::V3;
 use super::super::set::GeometrySet;
 use super::super::types::Value;
+use super::super::types::{Array, Domain};
 use super::super::value::SocketValue;
 use super::geometry_ops::modify_geometry_sets;
-use super::super::attribute::AttrId;
-use super::super::types::{Array, Domain};
 use super::primitives::{cuboid_mesh, cuboid_uvs_for};
 
 fn bounds(g: &GeometrySet) -> Option<(V3, V3)> {
@@ -41,7 +41,10 @@ fn bounds(g: &GeometrySet) -> Option<(V3, V3)> {
 
 pub fn bounding_box(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let mut g = ctx.geometry("Geometry")?;
-    if ctx.has_input("Use Radius") && ctx.bool("Use Radius")? && (g.points.is_some() || g.curves.is_some()) {
+    if ctx.has_input("Use Radius")
+        && ctx.bool("Use Radius")?
+        && (g.points.is_some() || g.curves.is_some())
+    {
         return Err(ctx.err("Use Radius with points or curves is not supported yet"));
     }
     let (mn, mx) = bounds(&g).unwrap_or(([0.0; 3], [0.0; 3]));
@@ -52,11 +55,16 @@ pub fn bounding_box(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         s.instances = inst;
         if let Some((lo, hi)) = b {
             let size = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
-            let centre = [lo[0] + size[0] / 2.0, lo[1] + size[1] / 2.0, lo[2] + size[2] / 2.0];
+            let centre = [
+                lo[0] + size[0] / 2.0,
+                lo[1] + size[1] / 2.0,
+                lo[2] + size[2] / 2.0,
+            ];
             let mut m = cuboid_mesh(size, 2, 2, 2);
             // Blender names the box's UV map "uv_map".
             let uvs = cuboid_uvs_for(size);
-            m.attributes.set(AttrId::named("uv_map"), Domain::Corner, Array::Float2(uvs));
+            m.attributes
+                .set(AttrId::named("uv_map"), Domain::Corner, Array::Float2(uvs));
             for p in m.positions.iter_mut() {
                 for k in 0..3 {
                     p[k] += centre[k];
@@ -69,7 +77,13 @@ pub fn bounding_box(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     .map_err(|e| ctx.err(e))?;
     Ok(outputs([
         ("Bounding Box", SocketValue::Geometry(g)),
-        ("Min", SocketValue::Field(Field::Constant(Value::Vector(mn)))),
-        ("Max", SocketValue::Field(Field::Constant(Value::Vector(mx)))),
+        (
+            "Min",
+            SocketValue::Field(Field::Constant(Value::Vector(mn))),
+        ),
+        (
+            "Max",
+            SocketValue::Field(Field::Constant(Value::Vector(mx))),
+        ),
     ]))
 }

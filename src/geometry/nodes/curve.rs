@@ -30,7 +30,13 @@ pub fn sample_at_length(lengths: &[f32], len: f32) -> (usize, f32) {
 }
 
 /// `count` uniform samples along accumulated `lengths` (`length_parameterize::sample_uniform`).
-fn sample_uniform(lengths: &[f32], include_last: bool, count: usize, idx: &mut Vec<usize>, fac: &mut Vec<f32>) {
+fn sample_uniform(
+    lengths: &[f32],
+    include_last: bool,
+    count: usize,
+    idx: &mut Vec<usize>,
+    fac: &mut Vec<f32>,
+) {
     if count == 1 {
         idx.push(0);
         fac.push(0.0);
@@ -65,10 +71,16 @@ pub struct Samples {
 }
 
 /// `resample` with where each new point came from (for tangents and normals).
-pub fn resample_indexed(c: &Curves, mode: ResampleMode) -> Result<(Curves, Samples, Evaluated), String> {
+pub fn resample_indexed(
+    c: &Curves,
+    mode: ResampleMode,
+) -> Result<(Curves, Samples, Evaluated), String> {
     let ev = Evaluated::new(c)?;
     let eval_pos = ev.positions(c);
-    let mut out = Curves { curve_offsets: vec![0], ..Default::default() };
+    let mut out = Curves {
+        curve_offsets: vec![0],
+        ..Default::default()
+    };
     // Per output point: the evaluated points it lies between, and the factor.
     let (mut ia, mut ib, mut fac) = (Vec::new(), Vec::new(), Vec::new());
     for i in 0..c.curve_count() {
@@ -102,32 +114,67 @@ pub fn resample_indexed(c: &Curves, mode: ResampleMode) -> Result<(Curves, Sampl
         }
         out.curve_offsets.push(ia.len() as u32);
     }
-    out.positions = (0..ia.len()).map(|k| lerp3(eval_pos[ia[k]], eval_pos[ib[k]], fac[k])).collect();
+    out.positions = (0..ia.len())
+        .map(|k| lerp3(eval_pos[ia[k]], eval_pos[ib[k]], fac[k]))
+        .collect();
     for a in c.attributes.iter() {
         match a.domain {
             Domain::Curve => {
-                let data = if a.id.name() == Some("curve_type") { Array::Int8(vec![CURVE_TYPE_POLY; c.curve_count()]) } else { a.data.clone() };
+                let data = if a.id.name() == Some("curve_type") {
+                    Array::Int8(vec![CURVE_TYPE_POLY; c.curve_count()])
+                } else {
+                    a.data.clone()
+                };
                 out.attributes.set(a.id.clone(), Domain::Curve, data);
             }
             Domain::Point => {
-                if a.id.name().is_some_and(|n| matches!(n, "handle_type_left" | "handle_type_right" | "handle_left" | "handle_right" | "nurbs_weight")) {
+                if a.id.name().is_some_and(|n| {
+                    matches!(
+                        n,
+                        "handle_type_left"
+                            | "handle_type_right"
+                            | "handle_left"
+                            | "handle_right"
+                            | "nurbs_weight"
+                    )
+                }) {
                     continue;
                 }
                 let evaluated = ev.interpolate(c, &a.data);
-                out.attributes.set(a.id.clone(), Domain::Point, super::super::curve_eval::lerp_gather(&evaluated, &ia, &ib, &fac));
+                out.attributes.set(
+                    a.id.clone(),
+                    Domain::Point,
+                    super::super::curve_eval::lerp_gather(&evaluated, &ia, &ib, &fac),
+                );
             }
             _ => {}
         }
     }
     if out.attributes.named("curve_type").is_none() {
-        out.attributes.set(AttrId::named("curve_type"), Domain::Curve, Array::Int8(vec![CURVE_TYPE_POLY; c.curve_count()]));
+        out.attributes.set(
+            AttrId::named("curve_type"),
+            Domain::Curve,
+            Array::Int8(vec![CURVE_TYPE_POLY; c.curve_count()]),
+        );
     }
     out.materials = c.materials.clone();
-    Ok((out, Samples { a: ia, b: ib, factor: fac }, ev))
+    Ok((
+        out,
+        Samples {
+            a: ia,
+            b: ib,
+            factor: fac,
+        },
+        ev,
+    ))
 }
 
 fn lerp3(a: V3, b: V3, t: f32) -> V3 {
-    [a[0] * (1.0 - t) + b[0] * t, a[1] * (1.0 - t) + b[1] * t, a[2] * (1.0 - t) + b[2] * t]
+    [
+        a[0] * (1.0 - t) + b[0] * t,
+        a[1] * (1.0 - t) + b[1] * t,
+        a[2] * (1.0 - t) + b[2] * t,
+    ]
 }
 
 pub fn resample_curve(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -138,20 +185,42 @@ pub fn resample_curve(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         if ctx.has_input(id) {
             ctx.field(id, ty)
         } else {
-            Ok(super::super::field::Field::Constant(super::super::types::Value::zero(ty)))
+            Ok(super::super::field::Field::Constant(
+                super::super::types::Value::zero(ty),
+            ))
         }
     };
-    let count = if mode == "COUNT" { value("Count", DataType::Int)? } else { value("", DataType::Int)? };
-    let length = if mode == "LENGTH" { value("Length", DataType::Float)? } else { value("", DataType::Float)? };
+    let count = if mode == "COUNT" {
+        value("Count", DataType::Int)?
+    } else {
+        value("", DataType::Int)?
+    };
+    let length = if mode == "LENGTH" {
+        value("Length", DataType::Float)?
+    } else {
+        value("", DataType::Float)?
+    };
     modify_geometry_sets(&mut g, &mut |s| {
-        let Some(c) = s.curves.clone() else { return Ok(()) };
-        let r = eval_fields(ComponentRef::Curves(&c), Domain::Curve, &[(&sel, DataType::Bool), (&count, DataType::Int), (&length, DataType::Float)])?;
+        let Some(c) = s.curves.clone() else {
+            return Ok(());
+        };
+        let r = eval_fields(
+            ComponentRef::Curves(&c),
+            Domain::Curve,
+            &[
+                (&sel, DataType::Bool),
+                (&count, DataType::Int),
+                (&length, DataType::Float),
+            ],
+        )?;
         if r[0].as_bool().iter().any(|x| !x) {
             return Err("resampling only some curves (a Selection) is not supported yet".into());
         }
         let m = match mode.as_str() {
             "COUNT" => ResampleMode::Count(r[1].as_int().into_owned()),
-            "LENGTH" => ResampleMode::Length(r[2].as_float().iter().map(|l| l.max(0.0001)).collect()),
+            "LENGTH" => {
+                ResampleMode::Length(r[2].as_float().iter().map(|l| l.max(0.0001)).collect())
+            }
             "EVALUATED" => ResampleMode::Evaluated,
             other => return Err(format!("mode {other} is not supported")),
         };
@@ -163,16 +232,30 @@ pub fn resample_curve(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
 }
 
 /// Set Curve Radius / Set Curve Tilt: a float point attribute from a field, selected points.
-fn set_point_float(ctx: &NodeCtx, input: &str, attr: &str, default: f32) -> Result<Outputs, GeometryError> {
+fn set_point_float(
+    ctx: &NodeCtx,
+    input: &str,
+    attr: &str,
+    default: f32,
+) -> Result<Outputs, GeometryError> {
     let mut g = ctx.geometry("Curve")?;
     let sel = ctx.field("Selection", DataType::Bool)?;
     let value = ctx.field(input, DataType::Float)?;
     modify_geometry_sets(&mut g, &mut |s| {
-        let Some(c) = s.curves.clone() else { return Ok(()) };
-        let r = eval_fields(ComponentRef::Curves(&c), Domain::Point, &[(&sel, DataType::Bool), (&value, DataType::Float)])?;
+        let Some(c) = s.curves.clone() else {
+            return Ok(());
+        };
+        let r = eval_fields(
+            ComponentRef::Curves(&c),
+            Domain::Point,
+            &[(&sel, DataType::Bool), (&value, DataType::Float)],
+        )?;
         let (sel, v) = (r[0].as_bool(), r[1].as_float());
         let mut cur = match c.attributes.named(attr) {
-            Some(a) => ComponentRef::Curves(&c).adapt(&a.data, a.domain, Domain::Point).as_float().into_owned(),
+            Some(a) => ComponentRef::Curves(&c)
+                .adapt(&a.data, a.domain, Domain::Point)
+                .as_float()
+                .into_owned(),
             None => vec![default; c.point_count()],
         };
         for i in 0..cur.len() {
@@ -180,7 +263,11 @@ fn set_point_float(ctx: &NodeCtx, input: &str, attr: &str, default: f32) -> Resu
                 cur[i] = v[i];
             }
         }
-        s.curves_mut().unwrap().attributes.set(AttrId::named(attr), Domain::Point, Array::Float(cur));
+        s.curves_mut().unwrap().attributes.set(
+            AttrId::named(attr),
+            Domain::Point,
+            Array::Float(cur),
+        );
         Ok(())
     })
     .map_err(|e| ctx.err(e))?;
@@ -198,7 +285,21 @@ pub fn set_curve_tilt(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
 fn is_builtin_curve_attribute(n: &str) -> bool {
     matches!(
         n,
-        "position" | "radius" | "tilt" | "handle_left" | "handle_right" | "handle_type_left" | "handle_type_right" | "nurbs_weight" | "normal_mode" | "curve_type" | "cyclic" | "resolution" | "nurbs_order" | "knots_mode" | "custom_normal"
+        "position"
+            | "radius"
+            | "tilt"
+            | "handle_left"
+            | "handle_right"
+            | "handle_type_left"
+            | "handle_type_right"
+            | "nurbs_weight"
+            | "normal_mode"
+            | "curve_type"
+            | "cyclic"
+            | "resolution"
+            | "nurbs_order"
+            | "knots_mode"
+            | "custom_normal"
     )
 }
 
@@ -212,12 +313,20 @@ fn segments(n: usize, cyclic: bool) -> usize {
 
 /// Sweeps every profile curve along every main curve (main curves outer, profiles inner),
 /// with Blender's vertex, edge, face and corner order (`bke::curve_to_mesh_sweep`).
-fn sweep(main: &Curves, scale_field: &[f32], profile: Option<&Curves>, fill_caps: bool) -> Result<Mesh, String> {
+fn sweep(
+    main: &Curves,
+    scale_field: &[f32],
+    profile: Option<&Curves>,
+    fill_caps: bool,
+) -> Result<Mesh, String> {
     let mev = Evaluated::new(main)?;
     let mpos = mev.positions(main);
     let mtan = mev.tangents(main, &mpos);
     let mnorm = mev.normals(main, &mtan);
-    let mscale = mev.interpolate(main, &Array::Float(scale_field.to_vec())).as_float().into_owned();
+    let mscale = mev
+        .interpolate(main, &Array::Float(scale_field.to_vec()))
+        .as_float()
+        .into_owned();
     // Without a profile Blender sweeps a single point at the origin.
     let default_profile;
     let profile = match profile {
@@ -228,7 +337,11 @@ fn sweep(main: &Curves, scale_field: &[f32], profile: Option<&Curves>, fill_caps
                 curve_offsets: vec![0, 1],
                 attributes: {
                     let mut a = super::super::attribute::Attributes::default();
-                    a.set(AttrId::named("curve_type"), Domain::Curve, Array::Int8(vec![CURVE_TYPE_POLY]));
+                    a.set(
+                        AttrId::named("curve_type"),
+                        Domain::Curve,
+                        Array::Int8(vec![CURVE_TYPE_POLY]),
+                    );
                     a
                 },
                 materials: Vec::new(),
@@ -260,7 +373,10 @@ fn sweep(main: &Curves, scale_field: &[f32], profile: Option<&Curves>, fill_caps
                 let s = mscale[i];
                 for j in pr.clone() {
                     let p = ppos[j];
-                    let v = add(add(add(mpos[i], scale(n, p[0] * s)), scale(b, p[1] * s)), scale(t, p[2] * s));
+                    let v = add(
+                        add(add(mpos[i], scale(n, p[0] * s)), scale(b, p[1] * s)),
+                        scale(t, p[2] * s),
+                    );
                     m.positions.push(v);
                 }
             }
@@ -275,14 +391,18 @@ fn sweep(main: &Curves, scale_field: &[f32], profile: Option<&Curves>, fill_caps
             for jp in 0..pn {
                 for i in 0..mseg {
                     let next = if i + 1 == mn { 0 } else { i + 1 };
-                    m.edges.push([vert0 + (pn * i + jp) as u32, vert0 + (pn * next + jp) as u32]);
+                    m.edges.push([
+                        vert0 + (pn * i + jp) as u32,
+                        vert0 + (pn * next + jp) as u32,
+                    ]);
                 }
             }
             let ring_edges = edge0 + (pn * mseg) as u32;
             for i in 0..mn {
                 for jp in 0..pseg {
                     let nj = if jp + 1 == pn { 0 } else { jp + 1 };
-                    m.edges.push([vert0 + (pn * i + jp) as u32, vert0 + (pn * i + nj) as u32]);
+                    m.edges
+                        .push([vert0 + (pn * i + jp) as u32, vert0 + (pn * i + nj) as u32]);
                 }
             }
             for i in 0..mseg {
@@ -295,8 +415,18 @@ fn sweep(main: &Curves, scale_field: &[f32], profile: Option<&Curves>, fill_caps
                     let nj = if jp + 1 == pn { 0 } else { jp + 1 };
                     let main_e = edge0 + (mseg * jp) as u32;
                     let next_main_e = edge0 + (mseg * nj) as u32;
-                    m.corner_verts.extend([ring_v + jp as u32, ring_v + nj as u32, next_ring_v + nj as u32, next_ring_v + jp as u32]);
-                    m.corner_edges.extend([ring_e + jp as u32, next_main_e + i as u32, next_ring_e + jp as u32, main_e + i as u32]);
+                    m.corner_verts.extend([
+                        ring_v + jp as u32,
+                        ring_v + nj as u32,
+                        next_ring_v + nj as u32,
+                        next_ring_v + jp as u32,
+                    ]);
+                    m.corner_edges.extend([
+                        ring_e + jp as u32,
+                        next_main_e + i as u32,
+                        next_ring_e + jp as u32,
+                        main_e + i as u32,
+                    ]);
                     m.face_offsets.push(m.corner_verts.len() as u32);
                 }
             }
@@ -310,7 +440,8 @@ fn sweep(main: &Curves, scale_field: &[f32], profile: Option<&Curves>, fill_caps
                 for k in 0..pseg {
                     let inv = pseg - k - 1;
                     m.corner_verts.push(vert0 + inv as u32);
-                    m.corner_edges.push(ring_edges + if k == pseg - 1 { pseg - 1 } else { inv - 1 } as u32);
+                    m.corner_edges
+                        .push(ring_edges + if k == pseg - 1 { pseg - 1 } else { inv - 1 } as u32);
                 }
                 m.face_offsets.push(m.corner_verts.len() as u32);
                 for k in 0..pseg {
@@ -337,7 +468,8 @@ fn sweep(main: &Curves, scale_field: &[f32], profile: Option<&Curves>, fill_caps
                 }
             }
         }
-        m.attributes.set(a.id.clone(), Domain::Point, evaluated.gather(&idx));
+        m.attributes
+            .set(a.id.clone(), Domain::Point, evaluated.gather(&idx));
     }
     if !sharp_faces.is_empty() {
         let mut e = vec![false; m.edge_count()];
@@ -348,8 +480,10 @@ fn sweep(main: &Curves, scale_field: &[f32], profile: Option<&Curves>, fill_caps
         for i in sharp_faces {
             f[i as usize] = true;
         }
-        m.attributes.set(AttrId::named("sharp_edge"), Domain::Edge, Array::Bool(e));
-        m.attributes.set(AttrId::named("sharp_face"), Domain::Face, Array::Bool(f));
+        m.attributes
+            .set(AttrId::named("sharp_edge"), Domain::Edge, Array::Bool(e));
+        m.attributes
+            .set(AttrId::named("sharp_face"), Domain::Face, Array::Bool(f));
     }
     m.materials = main.materials.clone();
     Ok(m)
@@ -359,9 +493,14 @@ pub fn curve_to_mesh(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let mut g = ctx.geometry("Curve")?;
     let profile_set = ctx.geometry("Profile Curve")?;
     let fill_caps = ctx.bool("Fill Caps")?;
-    let scale_f = if ctx.has_input("Scale") { Some(ctx.field("Scale", DataType::Float)?) } else { None };
+    let scale_f = if ctx.has_input("Scale") {
+        Some(ctx.field("Scale", DataType::Float)?)
+    } else {
+        None
+    };
     if profile_set.instances.is_some() {
-        return Err(ctx.err("a Profile Curve with instances is not supported (Blender realizes them first)"));
+        return Err(ctx
+            .err("a Profile Curve with instances is not supported (Blender realizes them first)"));
     }
     let profile = profile_set.curves.clone();
     modify_geometry_sets(&mut g, &mut |s| {
@@ -370,7 +509,14 @@ pub fn curve_to_mesh(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         let mesh = match s.curves.clone() {
             Some(c) => {
                 let sc = match &scale_f {
-                    Some(f) => eval_fields(ComponentRef::Curves(&c), Domain::Point, &[(f, DataType::Float)])?.remove(0).as_float().into_owned(),
+                    Some(f) => eval_fields(
+                        ComponentRef::Curves(&c),
+                        Domain::Point,
+                        &[(f, DataType::Float)],
+                    )?
+                    .remove(0)
+                    .as_float()
+                    .into_owned(),
                     None => vec![1.0; c.point_count()],
                 };
                 Some(Arc::new(sweep(&c, &sc, profile.as_deref(), fill_caps)?))

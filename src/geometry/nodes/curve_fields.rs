@@ -101,7 +101,9 @@ impl FieldInput for SplineParameter {
                         acc.iter_mut().for_each(|x| *x *= inv);
                     } else {
                         let last = (n.max(2) - 1) as f32;
-                        acc.iter_mut().enumerate().for_each(|(i, x)| *x = i as f32 / last);
+                        acc.iter_mut()
+                            .enumerate()
+                            .for_each(|(i, x)| *x = i as f32 / last);
                     }
                 }
                 Ok(Array::Float(acc))
@@ -116,16 +118,29 @@ impl FieldInput for SplineParameter {
 
 pub fn spline_parameter(_: &NodeCtx) -> Result<Outputs, GeometryError> {
     Ok(outputs([
-        ("Factor", SocketValue::Field(Field::input(SplineParameter(Param::Factor)))),
-        ("Length", SocketValue::Field(Field::input(SplineParameter(Param::Length)))),
-        ("Index", SocketValue::Field(Field::input(SplineParameter(Param::Index)))),
+        (
+            "Factor",
+            SocketValue::Field(Field::input(SplineParameter(Param::Factor))),
+        ),
+        (
+            "Length",
+            SocketValue::Field(Field::input(SplineParameter(Param::Length))),
+        ),
+        (
+            "Index",
+            SocketValue::Field(Field::input(SplineParameter(Param::Index))),
+        ),
     ]))
 }
 
 pub fn curve_length(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let g = ctx.geometry("Curve")?;
     let total = match &g.curves {
-        Some(c) => point_lengths(c).map_err(|e| ctx.err(e))?.1.iter().sum::<f32>(),
+        Some(c) => point_lengths(c)
+            .map_err(|e| ctx.err(e))?
+            .1
+            .iter()
+            .sum::<f32>(),
         None => 0.0,
     };
     Ok(outputs([("Length", SocketValue::float(total))]))

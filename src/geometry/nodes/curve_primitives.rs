@@ -15,16 +15,34 @@ use super::geometry_ops::geo;
 
 fn single(positions: Vec<V3>, kind: i8, cyclic: bool) -> Curves {
     let n = positions.len() as u32;
-    let mut c = Curves { positions, curve_offsets: vec![0, n], ..Default::default() };
-    c.attributes.set(AttrId::named("curve_type"), Domain::Curve, Array::Int8(vec![kind]));
+    let mut c = Curves {
+        positions,
+        curve_offsets: vec![0, n],
+        ..Default::default()
+    };
+    c.attributes.set(
+        AttrId::named("curve_type"),
+        Domain::Curve,
+        Array::Int8(vec![kind]),
+    );
     if cyclic {
-        c.attributes.set(AttrId::named("cyclic"), Domain::Curve, Array::Bool(vec![true]));
+        c.attributes.set(
+            AttrId::named("cyclic"),
+            Domain::Curve,
+            Array::Bool(vec![true]),
+        );
     }
     c
 }
 
 fn out(c: Curves) -> Outputs {
-    outputs([("Curve", geo(GeometrySet { curves: Some(Arc::new(c)), ..Default::default() }))])
+    outputs([(
+        "Curve",
+        geo(GeometrySet {
+            curves: Some(Arc::new(c)),
+            ..Default::default()
+        }),
+    )])
 }
 
 fn not_used(ctx: &NodeCtx, output: &str) -> Result<(), GeometryError> {
@@ -37,7 +55,10 @@ fn not_used(ctx: &NodeCtx, output: &str) -> Result<(), GeometryError> {
 pub fn line(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let start = ctx.vector("Start")?;
     let end = match ctx.prop_str("mode")? {
-        "DIRECTION" => add(start, scale(normalize(ctx.vector("Direction")?), ctx.float("Length")?)),
+        "DIRECTION" => add(
+            start,
+            scale(normalize(ctx.vector("Direction")?), ctx.float("Length")?),
+        ),
         _ => ctx.vector("End")?,
     };
     Ok(out(single(vec![start, end], CURVE_TYPE_POLY, false)))
@@ -63,7 +84,11 @@ pub fn circle(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
 pub fn star(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     not_used(ctx, "Outer Points")?;
     let points = ctx.int("Points")?.max(3);
-    let (inner, outer, twist) = (ctx.float("Inner Radius")?, ctx.float("Outer Radius")?, ctx.float("Twist")?);
+    let (inner, outer, twist) = (
+        ctx.float("Inner Radius")?,
+        ctx.float("Outer Radius")?,
+        ctx.float("Twist")?,
+    );
     let step = ((2.0 * PI) / points as f64) as f32;
     let mut p = Vec::with_capacity(2 * points as usize);
     for i in 0..points {
@@ -78,12 +103,17 @@ pub fn star(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
 pub fn spiral(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let res = ctx.int("Resolution")?;
     let rotations = ctx.float("Rotations")?;
-    let (r0, r1, height) = (ctx.float("Start Radius")?, ctx.float("End Radius")?, ctx.float("Height")?);
+    let (r0, r1, height) = (
+        ctx.float("Start Radius")?,
+        ctx.float("End Radius")?,
+        ctx.float("Height")?,
+    );
     let reverse = ctx.bool("Reverse")?;
     let total = ((res as f32 * rotations) as i32).max(1);
     let dr = (r1 - r0) / total as f32;
     let dh = height / total as f32;
-    let dt = ((PI * 2.0 * rotations as f64) as f32) / total as f32 * if reverse { 1.0 } else { -1.0 };
+    let dt =
+        ((PI * 2.0 * rotations as f64) as f32) / total as f32 * if reverse { 1.0 } else { -1.0 };
     let p = (0..=total)
         .map(|i| {
             let t = i as f32 * dt;
@@ -98,9 +128,19 @@ pub fn quadrilateral(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let p = match ctx.prop_str("mode")? {
         "RECTANGLE" => {
             let (w, h) = (ctx.float("Width")?, ctx.float("Height")?);
-            vec![[w / 2.0, h / 2.0, 0.0], [-w / 2.0, h / 2.0, 0.0], [-w / 2.0, -h / 2.0, 0.0], [w / 2.0, -h / 2.0, 0.0]]
+            vec![
+                [w / 2.0, h / 2.0, 0.0],
+                [-w / 2.0, h / 2.0, 0.0],
+                [-w / 2.0, -h / 2.0, 0.0],
+                [w / 2.0, -h / 2.0, 0.0],
+            ]
         }
-        "POINTS" => vec![ctx.vector("Point 1")?, ctx.vector("Point 2")?, ctx.vector("Point 3")?, ctx.vector("Point 4")?],
+        "POINTS" => vec![
+            ctx.vector("Point 1")?,
+            ctx.vector("Point 2")?,
+            ctx.vector("Point 3")?,
+            ctx.vector("Point 4")?,
+        ],
         m => return Err(ctx.err(format!("mode {m} is not supported yet"))),
     };
     Ok(out(single(p, CURVE_TYPE_POLY, true)))
@@ -110,13 +150,29 @@ pub fn bezier_segment(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let res = ctx.int("Resolution")?.max(1);
     let (start, end) = (ctx.vector("Start")?, ctx.vector("End")?);
     let (sh, eh) = (ctx.vector("Start Handle")?, ctx.vector("End Handle")?);
-    let (right0, left1) = if ctx.prop_str("mode")? == "OFFSET" { (add(start, sh), add(end, eh)) } else { (sh, eh) };
+    let (right0, left1) = if ctx.prop_str("mode")? == "OFFSET" {
+        (add(start, sh), add(end, eh))
+    } else {
+        (sh, eh)
+    };
     // The outer handles mirror the inner ones through the end points.
     let left0 = sub(scale(start, 2.0), right0);
     let right1 = sub(scale(end, 2.0), left1);
     let mut c = single(vec![start, end], CURVE_TYPE_BEZIER, false);
-    c.attributes.set(AttrId::named("resolution"), Domain::Curve, Array::Int(vec![res]));
-    c.attributes.set(AttrId::named("handle_left"), Domain::Point, Array::Vector(vec![left0, left1]));
-    c.attributes.set(AttrId::named("handle_right"), Domain::Point, Array::Vector(vec![right0, right1]));
+    c.attributes.set(
+        AttrId::named("resolution"),
+        Domain::Curve,
+        Array::Int(vec![res]),
+    );
+    c.attributes.set(
+        AttrId::named("handle_left"),
+        Domain::Point,
+        Array::Vector(vec![left0, left1]),
+    );
+    c.attributes.set(
+        AttrId::named("handle_right"),
+        Domain::Point,
+        Array::Vector(vec![right0, right1]),
+    );
     Ok(out(c))
 }

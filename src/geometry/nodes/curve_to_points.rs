@@ -21,7 +21,11 @@ fn lerp_normalized(v: &[V3], a: &[usize], b: &[usize], f: &[f32]) -> Vec<V3> {
     (0..a.len())
         .map(|k| {
             let (p, q, t) = (v[a[k]], v[b[k]], f[k]);
-            normalize([p[0] * (1.0 - t) + q[0] * t, p[1] * (1.0 - t) + q[1] * t, p[2] * (1.0 - t) + q[2] * t])
+            normalize([
+                p[0] * (1.0 - t) + q[0] * t,
+                p[1] * (1.0 - t) + q[1] * t,
+                p[2] * (1.0 - t) + q[2] * t,
+            ])
         })
         .collect()
 }
@@ -38,31 +42,73 @@ pub fn frame_rotation(normal: V3, tangent: V3) -> [f32; 4] {
 pub fn curve_to_points(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let mut g = ctx.geometry("Curve")?;
     let mode = ctx.prop_str("mode")?.to_string();
-    let count = if mode == "COUNT" { ctx.field("Count", DataType::Int)? } else { Field::Constant(Value::Int(0)) };
-    let length = if mode == "LENGTH" { ctx.field("Length", DataType::Float)? } else { Field::Constant(Value::Float(0.0)) };
-    let rot_id = ctx.output_used("Rotation").then(|| AttrId::anonymous("Rotation"));
-    let tan_id = ctx.output_used("Tangent").then(|| AttrId::anonymous("Tangent"));
-    let nor_id = ctx.output_used("Normal").then(|| AttrId::anonymous("Normal"));
+    let count = if mode == "COUNT" {
+        ctx.field("Count", DataType::Int)?
+    } else {
+        Field::Constant(Value::Int(0))
+    };
+    let length = if mode == "LENGTH" {
+        ctx.field("Length", DataType::Float)?
+    } else {
+        Field::Constant(Value::Float(0.0))
+    };
+    let rot_id = ctx
+        .output_used("Rotation")
+        .then(|| AttrId::anonymous("Rotation"));
+    let tan_id = ctx
+        .output_used("Tangent")
+        .then(|| AttrId::anonymous("Tangent"));
+    let nor_id = ctx
+        .output_used("Normal")
+        .then(|| AttrId::anonymous("Normal"));
     modify_geometry_sets(&mut g, &mut |s| {
-        let Some(c) = s.curves.clone() else { return Ok(()) };
-        let r = eval_fields(ComponentRef::Curves(&c), Domain::Curve, &[(&count, DataType::Int), (&length, DataType::Float)])?;
+        let Some(c) = s.curves.clone() else {
+            return Ok(());
+        };
+        let r = eval_fields(
+            ComponentRef::Curves(&c),
+            Domain::Curve,
+            &[(&count, DataType::Int), (&length, DataType::Float)],
+        )?;
         let m = match mode.as_str() {
             "COUNT" => ResampleMode::Count(r[0].as_int().into_owned()),
-            "LENGTH" => ResampleMode::Length(r[1].as_float().iter().map(|l| l.max(0.0001)).collect()),
+            "LENGTH" => {
+                ResampleMode::Length(r[1].as_float().iter().map(|l| l.max(0.0001)).collect())
+            }
             "EVALUATED" => ResampleMode::Evaluated,
             other => return Err(format!("mode {other} is not a Curve to Points mode")),
         };
         let (rc, samples, ev) = resample_indexed(&c, m)?;
-        let mut pc = PointCloud { positions: rc.positions.clone(), materials: rc.materials.clone(), ..Default::default() };
+        let mut pc = PointCloud {
+            positions: rc.positions.clone(),
+            materials: rc.materials.clone(),
+            ..Default::default()
+        };
         for a in rc.attributes.on(Domain::Point) {
-            pc.attributes.set(a.id.clone(), Domain::Point, a.data.clone());
+            pc.attributes
+                .set(a.id.clone(), Domain::Point, a.data.clone());
         }
         // Curve-domain attributes (not the built-in ones) move to the points.
         for a in c.attributes.on(Domain::Curve) {
-            if a.id.name().is_some_and(|n| matches!(n, "curve_type" | "cyclic" | "resolution" | "normal_mode" | "nurbs_order" | "knots_mode" | "material_index")) {
+            if a.id.name().is_some_and(|n| {
+                matches!(
+                    n,
+                    "curve_type"
+                        | "cyclic"
+                        | "resolution"
+                        | "normal_mode"
+                        | "nurbs_order"
+                        | "knots_mode"
+                        | "material_index"
+                )
+            }) {
                 continue;
             }
-            pc.attributes.set(a.id.clone(), Domain::Point, ComponentRef::Curves(&rc).adapt(&a.data, Domain::Curve, Domain::Point));
+            pc.attributes.set(
+                a.id.clone(),
+                Domain::Point,
+                ComponentRef::Curves(&rc).adapt(&a.data, Domain::Curve, Domain::Point),
+            );
         }
         if tan_id.is_some() || nor_id.is_some() || rot_id.is_some() {
             let eval_pos = ev.positions(&c);
@@ -72,13 +118,16 @@ pub fn curve_to_points(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             let n = lerp_normalized(&normals, &samples.a, &samples.b, &samples.factor);
             if let Some(id) = &rot_id {
                 let rot = (0..t.len()).map(|k| frame_rotation(n[k], t[k])).collect();
-                pc.attributes.set(id.clone(), Domain::Point, Array::Quaternion(rot));
+                pc.attributes
+                    .set(id.clone(), Domain::Point, Array::Quaternion(rot));
             }
             if let Some(id) = &tan_id {
-                pc.attributes.set(id.clone(), Domain::Point, Array::Vector(t));
+                pc.attributes
+                    .set(id.clone(), Domain::Point, Array::Vector(t));
             }
             if let Some(id) = &nor_id {
-                pc.attributes.set(id.clone(), Domain::Point, Array::Vector(n));
+                pc.attributes
+                    .set(id.clone(), Domain::Point, Array::Vector(n));
             }
         }
         s.curves = None;
@@ -88,9 +137,16 @@ pub fn curve_to_points(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     })
     .map_err(|e| ctx.err(e))?;
     let mut o = outputs([("Points", geo(g))]);
-    for (name, id, ty) in [("Tangent", tan_id, DataType::Vector), ("Normal", nor_id, DataType::Vector), ("Rotation", rot_id, DataType::Quaternion)] {
+    for (name, id, ty) in [
+        ("Tangent", tan_id, DataType::Vector),
+        ("Normal", nor_id, DataType::Vector),
+        ("Rotation", rot_id, DataType::Quaternion),
+    ] {
         if let Some(id) = id {
-            o.insert(name.into(), SocketValue::Field(Field::input(AttributeInput { id, ty })));
+            o.insert(
+                name.into(),
+                SocketValue::Field(Field::input(AttributeInput { id, ty })),
+            );
         }
     }
     Ok(o)

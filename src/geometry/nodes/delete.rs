@@ -31,12 +31,20 @@ pub fn mesh_keep(m: &Mesh, domain: Domain, keep: &[bool], mode: Mode) -> Mesh {
     let (nv, ne, nf) = (m.vertex_count(), m.edge_count(), m.face_count());
     let (vk, ek, fk): (Vec<bool>, Vec<bool>, Vec<bool>) = match domain {
         Domain::Point => {
-            let ek: Vec<bool> = m.edges.iter().map(|e| keep[e[0] as usize] && keep[e[1] as usize]).collect();
-            let fk: Vec<bool> = (0..nf).map(|f| m.face(f).all(|c| keep[m.corner_verts[c] as usize])).collect();
+            let ek: Vec<bool> = m
+                .edges
+                .iter()
+                .map(|e| keep[e[0] as usize] && keep[e[1] as usize])
+                .collect();
+            let fk: Vec<bool> = (0..nf)
+                .map(|f| m.face(f).all(|c| keep[m.corner_verts[c] as usize]))
+                .collect();
             (keep.to_vec(), ek, fk)
         }
         Domain::Edge => {
-            let fk: Vec<bool> = (0..nf).map(|f| m.face(f).all(|c| keep[m.corner_edges[c] as usize])).collect();
+            let fk: Vec<bool> = (0..nf)
+                .map(|f| m.face(f).all(|c| keep[m.corner_edges[c] as usize]))
+                .collect();
             let mut vk = vec![false; nv];
             for (e, ev) in m.edges.iter().enumerate() {
                 if keep[e] {
@@ -78,7 +86,10 @@ pub fn mesh_keep(m: &Mesh, domain: Domain, keep: &[bool], mode: Mode) -> Mesh {
     }
     let mut out = Mesh::new();
     out.positions = vi.iter().map(|&v| m.positions[v]).collect();
-    out.edges = ei.iter().map(|&e| [vmap[m.edges[e][0] as usize], vmap[m.edges[e][1] as usize]]).collect();
+    out.edges = ei
+        .iter()
+        .map(|&e| [vmap[m.edges[e][0] as usize], vmap[m.edges[e][1] as usize]])
+        .collect();
     let mut corners = Vec::new();
     for &f in &fi {
         for c in m.face(f) {
@@ -97,24 +108,43 @@ pub fn mesh_keep(m: &Mesh, domain: Domain, keep: &[bool], mode: Mode) -> Mesh {
             Domain::Corner => &corners,
             _ => continue,
         };
-        out.attributes.set(a.id.clone(), a.domain, a.data.gather(idx));
+        out.attributes
+            .set(a.id.clone(), a.domain, a.data.gather(idx));
     }
     out
 }
 
 /// Keeps the selected (or, `invert`, the unselected) elements of every component.
-fn separate(s: &mut GeometrySet, domain: Domain, mode: Mode, sel: &Field, invert: bool) -> Result<(), String> {
-    let pick = |v: std::borrow::Cow<'_, [bool]>| -> Vec<bool> { v.iter().map(|x| *x != invert).collect() };
+fn separate(
+    s: &mut GeometrySet,
+    domain: Domain,
+    mode: Mode,
+    sel: &Field,
+    invert: bool,
+) -> Result<(), String> {
+    let pick =
+        |v: std::borrow::Cow<'_, [bool]>| -> Vec<bool> { v.iter().map(|x| *x != invert).collect() };
     if let Some(m) = s.mesh.clone() {
-        if matches!(domain, Domain::Point | Domain::Edge | Domain::Face | Domain::Corner) {
-            let d = if domain == Domain::Corner { return Err("the corner domain cannot be deleted".into()) } else { domain };
+        if matches!(
+            domain,
+            Domain::Point | Domain::Edge | Domain::Face | Domain::Corner
+        ) {
+            let d = if domain == Domain::Corner {
+                return Err("the corner domain cannot be deleted".into());
+            } else {
+                domain
+            };
             let r = eval_fields(ComponentRef::Mesh(&m), d, &[(sel, DataType::Bool)])?;
             s.mesh = Some(Arc::new(mesh_keep(&m, d, &pick(r[0].as_bool()), mode)));
         }
     }
     if let Some(p) = s.points.clone() {
         if domain == Domain::Point {
-            let r = eval_fields(ComponentRef::Points(&p), Domain::Point, &[(sel, DataType::Bool)])?;
+            let r = eval_fields(
+                ComponentRef::Points(&p),
+                Domain::Point,
+                &[(sel, DataType::Bool)],
+            )?;
             let idx = indices(&pick(r[0].as_bool()));
             let mut q = (*p).clone();
             q.positions = idx.iter().map(|&i| p.positions[i]).collect();
@@ -127,7 +157,11 @@ fn separate(s: &mut GeometrySet, domain: Domain, mode: Mode, sel: &Field, invert
     }
     if let Some(i) = s.instances.clone() {
         if domain == Domain::Instance {
-            let r = eval_fields(ComponentRef::Instances(&i), Domain::Instance, &[(sel, DataType::Bool)])?;
+            let r = eval_fields(
+                ComponentRef::Instances(&i),
+                Domain::Instance,
+                &[(sel, DataType::Bool)],
+            )?;
             let idx = indices(&pick(r[0].as_bool()));
             let mut q = (*i).clone();
             q.transforms = idx.iter().map(|&k| i.transforms[k]).collect();
@@ -151,11 +185,19 @@ fn domain_and_mode(ctx: &NodeCtx) -> Result<(Domain, Mode), GeometryError> {
     Ok((domain, mode))
 }
 
-fn run(g: &mut GeometrySet, domain: Domain, mode: Mode, sel: &Field, invert: bool) -> Result<(), String> {
+fn run(
+    g: &mut GeometrySet,
+    domain: Domain,
+    mode: Mode,
+    sel: &Field,
+    invert: bool,
+) -> Result<(), String> {
     if domain == Domain::Instance {
         separate(g, domain, mode, sel, invert)
     } else {
-        modify_geometry_sets(g, &mut |s: &mut GeometrySet| separate(s, domain, mode, sel, invert))
+        modify_geometry_sets(g, &mut |s: &mut GeometrySet| {
+            separate(s, domain, mode, sel, invert)
+        })
     }
 }
 
@@ -179,5 +221,8 @@ pub fn separate_geometry(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     if ctx.output_used("Inverted") {
         run(&mut b, domain, Mode::All, &sel, true).map_err(|e| ctx.err(e))?;
     }
-    Ok(outputs([("Selection", SocketValue::Geometry(a)), ("Inverted", SocketValue::Geometry(b))]))
+    Ok(outputs([
+        ("Selection", SocketValue::Geometry(a)),
+        ("Inverted", SocketValue::Geometry(b)),
+    ]))
 }

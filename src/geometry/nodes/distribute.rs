@@ -42,7 +42,10 @@ pub fn corner_tris(m: &Mesh) -> Result<(Vec<[u32; 3]>, Vec<u32>), String> {
             }
             n => {
                 let normal = m.face_normal(f);
-                let co = super::super::polyfill::project(normal, r.clone().map(|c| m.positions[m.corner_verts[c] as usize]));
+                let co = super::super::polyfill::project(
+                    normal,
+                    r.clone().map(|c| m.positions[m.corner_verts[c] as usize]),
+                );
                 for t in super::super::polyfill::polyfill(&co) {
                     tris.push([s + t[0], s + t[1], s + t[2]]);
                     faces.push(f as u32);
@@ -57,7 +60,11 @@ pub fn corner_tris(m: &Mesh) -> Result<(Vec<[u32; 3]>, Vec<u32>), String> {
 fn area_tri(a: V3, b: V3, c: V3) -> f32 {
     let n1 = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
     let n2 = [b[0] - c[0], b[1] - c[1], b[2] - c[2]];
-    let n = [n1[1] * n2[2] - n1[2] * n2[1], n1[2] * n2[0] - n1[0] * n2[2], n1[0] * n2[1] - n1[1] * n2[0]];
+    let n = [
+        n1[1] * n2[2] - n1[2] * n2[1],
+        n1[2] * n2[0] - n1[0] * n2[2],
+        n1[0] * n2[1] - n1[1] * n2[0],
+    ];
     (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() * 0.5
 }
 
@@ -67,13 +74,26 @@ struct Samples {
     tri: Vec<usize>,
 }
 
-fn sample_surface(m: &Mesh, tris: &[[u32; 3]], base_density: f32, factors: Option<&[f32]>, seed: i32) -> Samples {
-    let mut s = Samples { positions: Vec::new(), bary: Vec::new(), tri: Vec::new() };
+fn sample_surface(
+    m: &Mesh,
+    tris: &[[u32; 3]],
+    base_density: f32,
+    factors: Option<&[f32]>,
+    seed: i32,
+) -> Samples {
+    let mut s = Samples {
+        positions: Vec::new(),
+        bary: Vec::new(),
+        tri: Vec::new(),
+    };
     for (ti, t) in tris.iter().enumerate() {
         let p = |c: u32| m.positions[m.corner_verts[c as usize] as usize];
         let (p0, p1, p2) = (p(t[0]), p(t[1]), p(t[2]));
         let factor = match factors {
-            Some(f) => (f[t[0] as usize].max(0.0) + f[t[1] as usize].max(0.0) + f[t[2] as usize].max(0.0)) / 3.0,
+            Some(f) => {
+                (f[t[0] as usize].max(0.0) + f[t[1] as usize].max(0.0) + f[t[2] as usize].max(0.0))
+                    / 3.0
+            }
             None => 1.0,
         };
         let area = area_tri(p0, p1, p2);
@@ -103,8 +123,15 @@ fn eliminate_close(positions: &[V3], dist: f32, mask: &mut [bool]) {
     }
     let r2 = dist * dist;
     // A uniform grid with cells of the search radius.
-    let cell = |p: &V3| [(p[0] / dist).floor() as i64, (p[1] / dist).floor() as i64, (p[2] / dist).floor() as i64];
-    let mut grid: std::collections::HashMap<[i64; 3], Vec<usize>> = std::collections::HashMap::new();
+    let cell = |p: &V3| {
+        [
+            (p[0] / dist).floor() as i64,
+            (p[1] / dist).floor() as i64,
+            (p[2] / dist).floor() as i64,
+        ]
+    };
+    let mut grid: std::collections::HashMap<[i64; 3], Vec<usize>> =
+        std::collections::HashMap::new();
     for (i, p) in positions.iter().enumerate() {
         grid.entry(cell(p)).or_default().push(i);
     }
@@ -122,7 +149,9 @@ fn eliminate_close(positions: &[V3], dist: f32, mask: &mut [bool]) {
                                 continue;
                             }
                             let (a, b) = (positions[i], positions[j]);
-                            let d = (a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]);
+                            let d = (a[0] - b[0]) * (a[0] - b[0])
+                                + (a[1] - b[1]) * (a[1] - b[1])
+                                + (a[2] - b[2]) * (a[2] - b[2]);
                             if d <= r2 {
                                 mask[j] = true;
                             }
@@ -141,7 +170,11 @@ fn vec_to_quat(vec: V3, axis: i32, upflag: i32) -> [f32; 4] {
     if len == 0.0 {
         return [1.0, 0.0, 0.0, 0.0];
     }
-    let (tvec, axis) = if axis > 2 { (vec, axis - 3) } else { ([-vec[0], -vec[1], -vec[2]], axis) };
+    let (tvec, axis) = if axis > 2 {
+        (vec, axis - 3)
+    } else {
+        ([-vec[0], -vec[1], -vec[2]], axis)
+    };
     let (mut nor, co);
     match axis {
         0 => {
@@ -180,8 +213,17 @@ fn vec_to_quat(vec: V3, axis: i32, upflag: i32) -> [f32; 4] {
     let mut q = [c, nor[0] * si, nor[1] * si, nor[2] * si];
     if axis != upflag {
         // Third column of quat_to_mat3 (double precision in Blender's C code).
-        let (q0, q1, q2, q3) = (std::f64::consts::SQRT_2 * q[0] as f64, std::f64::consts::SQRT_2 * q[1] as f64, std::f64::consts::SQRT_2 * q[2] as f64, std::f64::consts::SQRT_2 * q[3] as f64);
-        let fp = [(q0 * q2 + q1 * q3) as f32, (-q0 * q1 + q2 * q3) as f32, (1.0 - q1 * q1 - q2 * q2) as f32];
+        let (q0, q1, q2, q3) = (
+            std::f64::consts::SQRT_2 * q[0] as f64,
+            std::f64::consts::SQRT_2 * q[1] as f64,
+            std::f64::consts::SQRT_2 * q[2] as f64,
+            std::f64::consts::SQRT_2 * q[3] as f64,
+        );
+        let fp = [
+            (q0 * q2 + q1 * q3) as f32,
+            (-q0 * q1 + q2 * q3) as f32,
+            (1.0 - q1 * q1 - q2 * q2) as f32,
+        ];
         let angle = match (axis, upflag) {
             (0, 1) => 0.5 * fp[2].atan2(fp[1]),
             (0, _) => -0.5 * fp[1].atan2(fp[2]),
@@ -209,14 +251,25 @@ fn qmul(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
 
 /// Built-in mesh attributes that do not become point cloud attributes.
 fn mesh_builtin(name: &str) -> bool {
-    matches!(name, "position" | "material_index" | "sharp_face" | "sharp_edge") || name.starts_with('.')
+    matches!(
+        name,
+        "position" | "material_index" | "sharp_face" | "sharp_edge"
+    ) || name.starts_with('.')
 }
 
 fn mix3(a: &Array, idx: [usize; 3], w: V3) -> Value {
     let t = a.data_type();
     match a {
-        Array::Bool(v) => Value::Bool((v[idx[0]] as u8 as f32 * w[0] + v[idx[1]] as u8 as f32 * w[1] + v[idx[2]] as u8 as f32 * w[2]) >= 0.5),
-        Array::Int(v) => Value::Int((v[idx[0]] as f32 * w[0] + v[idx[1]] as f32 * w[1] + v[idx[2]] as f32 * w[2]).round() as i32),
+        Array::Bool(v) => Value::Bool(
+            (v[idx[0]] as u8 as f32 * w[0]
+                + v[idx[1]] as u8 as f32 * w[1]
+                + v[idx[2]] as u8 as f32 * w[2])
+                >= 0.5,
+        ),
+        Array::Int(v) => Value::Int(
+            (v[idx[0]] as f32 * w[0] + v[idx[1]] as f32 * w[1] + v[idx[2]] as f32 * w[2]).round()
+                as i32,
+        ),
         _ => {
             let lanes = match a {
                 Array::Float(_) => 1,
@@ -251,22 +304,41 @@ fn mix3(a: &Array, idx: [usize; 3], w: V3) -> Value {
 }
 
 #[allow(clippy::too_many_arguments)]
-fn distribute_mesh(ctx: &NodeCtx, m: &Mesh, method: &str, sel: &Field, seed: i32, want_normal: Option<&AttrId>, want_rot: Option<&AttrId>, legacy: bool) -> Result<Option<PointCloud>, String> {
+fn distribute_mesh(
+    ctx: &NodeCtx,
+    m: &Mesh,
+    method: &str,
+    sel: &Field,
+    seed: i32,
+    want_normal: Option<&AttrId>,
+    want_rot: Option<&AttrId>,
+    legacy: bool,
+) -> Result<Option<PointCloud>, String> {
     let (tris, tri_faces) = corner_tris(m)?;
     let comp = ComponentRef::Mesh(m);
     let density_factors = |f: &Field| -> Result<Vec<f32>, String> {
-        let r = eval_fields(comp, Domain::Corner, &[(sel, DataType::Bool), (f, DataType::Float)])?;
+        let r = eval_fields(
+            comp,
+            Domain::Corner,
+            &[(sel, DataType::Bool), (f, DataType::Float)],
+        )?;
         let (s, d) = (r[0].as_bool(), r[1].as_float());
-        Ok((0..d.len()).map(|i| if s[i] { d[i] } else { 0.0 }).collect())
+        Ok((0..d.len())
+            .map(|i| if s[i] { d[i] } else { 0.0 })
+            .collect())
     };
     let s = if method == "RANDOM" {
-        let density = ctx.field("Density", DataType::Float).map_err(|e| e.message)?;
+        let density = ctx
+            .field("Density", DataType::Float)
+            .map_err(|e| e.message)?;
         let f = density_factors(&density)?;
         sample_surface(m, &tris, 1.0, Some(&f), seed)
     } else {
         let dmin = ctx.float("Distance Min").map_err(|e| e.message)?;
         let dmax = ctx.float("Density Max").map_err(|e| e.message)?;
-        let factor = ctx.field("Density Factor", DataType::Float).map_err(|e| e.message)?;
+        let factor = ctx
+            .field("Density Factor", DataType::Float)
+            .map_err(|e| e.message)?;
         let mut s = sample_surface(m, &tris, dmax, None, seed);
         let mut mask = vec![false; s.positions.len()];
         eliminate_close(&s.positions, dmin, &mut mask);
@@ -277,7 +349,9 @@ fn distribute_mesh(ctx: &NodeCtx, m: &Mesh, method: &str, sel: &Field, seed: i32
             }
             let t = tris[s.tri[i]];
             let b = s.bary[i];
-            let p = f[t[0] as usize].max(0.0) * b[0] + f[t[1] as usize].max(0.0) * b[1] + f[t[2] as usize].max(0.0) * b[2];
+            let p = f[t[0] as usize].max(0.0) * b[0]
+                + f[t[1] as usize].max(0.0) * b[1]
+                + f[t[2] as usize].max(0.0) * b[2];
             if hash_float_to_float3(b) > p {
                 mask[i] = true;
             }
@@ -296,8 +370,15 @@ fn distribute_mesh(ctx: &NodeCtx, m: &Mesh, method: &str, sel: &Field, seed: i32
         return Ok(None);
     }
     let n = s.positions.len();
-    let mut pc = PointCloud { positions: s.positions.clone(), ..Default::default() };
-    pc.attributes.set(AttrId::named("radius"), Domain::Point, Array::Float(vec![0.05; n]));
+    let mut pc = PointCloud {
+        positions: s.positions.clone(),
+        ..Default::default()
+    };
+    pc.attributes.set(
+        AttrId::named("radius"),
+        Domain::Point,
+        Array::Float(vec![0.05; n]),
+    );
     // Mesh attributes, sampled at the points.
     for a in m.attributes.iter() {
         if a.id.name().is_some_and(mesh_builtin) || a.domain == Domain::Edge {
@@ -307,8 +388,20 @@ fn distribute_mesh(ctx: &NodeCtx, m: &Mesh, method: &str, sel: &Field, seed: i32
         for i in 0..n {
             let t = tris[s.tri[i]];
             let v = match a.domain {
-                Domain::Point => mix3(&a.data, [m.corner_verts[t[0] as usize] as usize, m.corner_verts[t[1] as usize] as usize, m.corner_verts[t[2] as usize] as usize], s.bary[i]),
-                Domain::Corner => mix3(&a.data, [t[0] as usize, t[1] as usize, t[2] as usize], s.bary[i]),
+                Domain::Point => mix3(
+                    &a.data,
+                    [
+                        m.corner_verts[t[0] as usize] as usize,
+                        m.corner_verts[t[1] as usize] as usize,
+                        m.corner_verts[t[2] as usize] as usize,
+                    ],
+                    s.bary[i],
+                ),
+                Domain::Corner => mix3(
+                    &a.data,
+                    [t[0] as usize, t[1] as usize, t[2] as usize],
+                    s.bary[i],
+                ),
                 _ => a.data.get(tri_faces[s.tri[i]] as usize),
             };
             out.set(i, v);
@@ -318,18 +411,31 @@ fn distribute_mesh(ctx: &NodeCtx, m: &Mesh, method: &str, sel: &Field, seed: i32
     let ids: Vec<i32> = (0..n)
         .map(|i| {
             let b = s.bary[i];
-            hash2(hash3(b[0].to_bits(), b[1].to_bits(), b[2].to_bits()), s.tri[i] as u32) as i32
+            hash2(
+                hash3(b[0].to_bits(), b[1].to_bits(), b[2].to_bits()),
+                s.tri[i] as u32,
+            ) as i32
         })
         .collect();
-    pc.attributes.set(AttrId::named("id"), Domain::Point, Array::Int(ids));
+    pc.attributes
+        .set(AttrId::named("id"), Domain::Point, Array::Int(ids));
     if want_normal.is_some() || want_rot.is_some() {
-        let normals = if legacy { legacy_normals(m, &tris, &s) } else { sample_normals(m, &tris, &tri_faces, &s) };
+        let normals = if legacy {
+            legacy_normals(m, &tris, &s)
+        } else {
+            sample_normals(m, &tris, &tri_faces, &s)
+        };
         if let Some(id) = want_normal {
-            pc.attributes.set(id.clone(), Domain::Point, Array::Vector(normals.clone()));
+            pc.attributes
+                .set(id.clone(), Domain::Point, Array::Vector(normals.clone()));
         }
         if let Some(id) = want_rot {
-            let rot = normals.iter().map(|n| super::super::math::normalize_quat(vec_to_quat(*n, 5, 1))).collect();
-            pc.attributes.set(id.clone(), Domain::Point, Array::Quaternion(rot));
+            let rot = normals
+                .iter()
+                .map(|n| super::super::math::normalize_quat(vec_to_quat(*n, 5, 1)))
+                .collect();
+            pc.attributes
+                .set(id.clone(), Domain::Point, Array::Quaternion(rot));
         }
     }
     Ok(Some(pc))
@@ -346,7 +452,11 @@ fn legacy_normals(m: &Mesh, tris: &[[u32; 3]], s: &Samples) -> Vec<V3> {
             let (a, b, d) = (p(0), p(1), p(2));
             let n1 = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
             let n2 = [b[0] - d[0], b[1] - d[1], b[2] - d[2]];
-            normalize([n1[1] * n2[2] - n1[2] * n2[1], n1[2] * n2[0] - n1[0] * n2[2], n1[0] * n2[1] - n1[1] * n2[0]])
+            normalize([
+                n1[1] * n2[2] - n1[2] * n2[1],
+                n1[2] * n2[0] - n1[0] * n2[2],
+                n1[0] * n2[1] - n1[1] * n2[0],
+            ])
         })
         .collect()
 }
@@ -355,7 +465,10 @@ fn legacy_normals(m: &Mesh, tris: &[[u32; 3]], s: &Samples) -> Vec<V3> {
 /// faces, interpolated vertex or corner normals on smooth ones).
 fn sample_normals(m: &Mesh, tris: &[[u32; 3]], tri_faces: &[u32], s: &Samples) -> Vec<V3> {
     let sharp = m.sharp_faces();
-    let has_sharp_edges = m.attributes.named("sharp_edge").is_some_and(|a| a.data.as_bool().iter().any(|x| *x));
+    let has_sharp_edges = m
+        .attributes
+        .named("sharp_edge")
+        .is_some_and(|a| a.data.as_bool().iter().any(|x| *x));
     let all_flat = !sharp.is_empty() && sharp.iter().all(|x| *x);
     let none_flat = !sharp.iter().any(|x| *x) && !has_sharp_edges;
     let interp = |vals: [V3; 3], b: V3| -> V3 {
@@ -367,7 +480,10 @@ fn sample_normals(m: &Mesh, tris: &[[u32; 3]], tri_faces: &[u32], s: &Samples) -
     };
     if all_flat {
         let fnorm = m.face_normals();
-        s.tri.iter().map(|&t| fnorm[tri_faces[t] as usize]).collect()
+        s.tri
+            .iter()
+            .map(|&t| fnorm[tri_faces[t] as usize])
+            .collect()
     } else if none_flat {
         let vn = m.vertex_normals();
         s.tri
@@ -375,7 +491,14 @@ fn sample_normals(m: &Mesh, tris: &[[u32; 3]], tri_faces: &[u32], s: &Samples) -
             .zip(&s.bary)
             .map(|(&t, b)| {
                 let c = tris[t];
-                interp([vn[m.corner_verts[c[0] as usize] as usize], vn[m.corner_verts[c[1] as usize] as usize], vn[m.corner_verts[c[2] as usize] as usize]], *b)
+                interp(
+                    [
+                        vn[m.corner_verts[c[0] as usize] as usize],
+                        vn[m.corner_verts[c[1] as usize] as usize],
+                        vn[m.corner_verts[c[2] as usize] as usize],
+                    ],
+                    *b,
+                )
             })
             .collect()
     } else {
@@ -385,7 +508,10 @@ fn sample_normals(m: &Mesh, tris: &[[u32; 3]], tri_faces: &[u32], s: &Samples) -
             .zip(&s.bary)
             .map(|(&t, b)| {
                 let c = tris[t];
-                interp([cn[c[0] as usize], cn[c[1] as usize], cn[c[2] as usize]], *b)
+                interp(
+                    [cn[c[0] as usize], cn[c[1] as usize], cn[c[2] as usize]],
+                    *b,
+                )
             })
             .collect()
     }
@@ -400,11 +526,24 @@ pub fn distribute_points_on_faces(ctx: &NodeCtx) -> Result<Outputs, GeometryErro
     let legacy = ctx.prop_bool("use_legacy_normal").unwrap_or(false);
     let seed = ctx.int("Seed")?.wrapping_mul(5383843);
     let sel = ctx.field("Selection", DataType::Bool)?;
-    let rot_id = ctx.output_used("Rotation").then(|| AttrId::anonymous("Rotation"));
-    let normal_id = ctx.output_used("Normal").then(|| AttrId::anonymous("Normal"));
+    let rot_id = ctx
+        .output_used("Rotation")
+        .then(|| AttrId::anonymous("Rotation"));
+    let normal_id = ctx
+        .output_used("Normal")
+        .then(|| AttrId::anonymous("Normal"));
     modify_geometry_sets(&mut g, &mut |s: &mut GeometrySet| {
         if let Some(m) = s.mesh.clone() {
-            let pc = distribute_mesh(ctx, &m, &method, &sel, seed, normal_id.as_ref(), rot_id.as_ref(), legacy)?;
+            let pc = distribute_mesh(
+                ctx,
+                &m,
+                &method,
+                &sel,
+                seed,
+                normal_id.as_ref(),
+                rot_id.as_ref(),
+                legacy,
+            )?;
             s.points = pc.map(Arc::new);
         } else {
             s.points = None;
@@ -416,10 +555,22 @@ pub fn distribute_points_on_faces(ctx: &NodeCtx) -> Result<Outputs, GeometryErro
     .map_err(|e| ctx.err(e))?;
     let mut o = outputs([("Points", SocketValue::Geometry(g))]);
     if let Some(id) = normal_id {
-        o.insert("Normal".into(), SocketValue::Field(Field::input(AttributeInput { id, ty: DataType::Vector })));
+        o.insert(
+            "Normal".into(),
+            SocketValue::Field(Field::input(AttributeInput {
+                id,
+                ty: DataType::Vector,
+            })),
+        );
     }
     if let Some(id) = rot_id {
-        o.insert("Rotation".into(), SocketValue::Field(Field::input(AttributeInput { id, ty: DataType::Quaternion })));
+        o.insert(
+            "Rotation".into(),
+            SocketValue::Field(Field::input(AttributeInput {
+                id,
+                ty: DataType::Quaternion,
+            })),
+        );
     }
     Ok(o)
 }

@@ -79,7 +79,15 @@ fn edge_has(m: &Mesh, e: usize, v: usize) -> bool {
 
 /// Sorts `faces` around vertex `v` (`sort_vertex_faces`); fills the shared edges and each
 /// face's corner. False when the faces do not form a fan.
-fn sort_faces(m: &Mesh, v: usize, boundary: bool, et: &[EdgeType], faces: &mut [usize], shared: &mut Vec<usize>, sorted: &mut Vec<usize>) -> bool {
+fn sort_faces(
+    m: &Mesh,
+    v: usize,
+    boundary: bool,
+    et: &[EdgeType],
+    faces: &mut [usize],
+    shared: &mut Vec<usize>,
+    sorted: &mut Vec<usize>,
+) -> bool {
     let n = faces.len();
     sorted.clear();
     sorted.resize(n, 0);
@@ -92,7 +100,9 @@ fn sort_faces(m: &Mesh, v: usize, boundary: bool, et: &[EdgeType], faces: &mut [
     let mut fc: Vec<(usize, usize)> = faces
         .iter()
         .map(|&f| {
-            let mut it = m.face(f).filter(|&c| edge_has(m, m.corner_edges[c] as usize, v));
+            let mut it = m
+                .face(f)
+                .filter(|&c| edge_has(m, m.corner_edges[c] as usize, v));
             let a = it.next().unwrap_or(0);
             (a, it.next().unwrap_or(a))
         })
@@ -133,7 +143,9 @@ fn sort_faces(m: &Mesh, v: usize, boundary: bool, et: &[EdgeType], faces: &mut [
             shared_edge = Some(ce(c1));
         }
     }
-    let Some(mut se) = shared_edge else { return false };
+    let Some(mut se) = shared_edge else {
+        return false;
+    };
     for i in 0..n - 1 {
         shared[i] = se;
         let mut found = None;
@@ -163,7 +175,10 @@ fn sort_faces(m: &Mesh, v: usize, boundary: bool, et: &[EdgeType], faces: &mut [
 }
 
 fn boundary_edge_on_face(m: &Mesh, f: usize, v: usize, et: &[EdgeType]) -> usize {
-    m.face(f).map(|c| m.corner_edges[c] as usize).find(|&e| et[e] == EdgeType::Boundary && edge_has(m, e, v)).unwrap_or(0)
+    m.face(f)
+        .map(|c| m.corner_edges[c] as usize)
+        .find(|&e| et[e] == EdgeType::Boundary && edge_has(m, e, v))
+        .unwrap_or(0)
 }
 
 /// The two boundary edges of `f` at `v`, in the face's winding.
@@ -203,7 +218,11 @@ pub fn dual(m: &Mesh, keep_boundaries: bool) -> Mesh {
             vert_faces[m.corner_verts[c] as usize].push(f);
         }
     }
-    let usable = |t: VertType| !(t == VertType::Loose || t >= VertType::NonManifold || (!keep_boundaries && t == VertType::Boundary));
+    let usable = |t: VertType| {
+        !(t == VertType::Loose
+            || t >= VertType::NonManifold
+            || (!keep_boundaries && t == VertType::Boundary))
+    };
     let mut sorted_faces = vert_faces.clone();
     let mut shared_edges: Vec<Vec<usize>> = vec![Vec::new(); nv];
     let mut sorted_corners: Vec<Vec<usize>> = vec![Vec::new(); nv];
@@ -212,7 +231,15 @@ pub fn dual(m: &Mesh, keep_boundaries: bool) -> Mesh {
             continue;
         }
         let (mut sh, mut so) = (Vec::new(), Vec::new());
-        if !sort_faces(m, v, vt[v] == VertType::Boundary, &et, &mut sorted_faces[v], &mut sh, &mut so) {
+        if !sort_faces(
+            m,
+            v,
+            vt[v] == VertType::Boundary,
+            &et,
+            &mut sorted_faces[v],
+            &mut sh,
+            &mut so,
+        ) {
             vt[v] = VertType::NonManifold;
             continue;
         }
@@ -239,7 +266,11 @@ pub fn dual(m: &Mesh, keep_boundaries: bool) -> Mesh {
             if et[e] == EdgeType::Boundary {
                 let (a, b) = (m.positions[ev[0] as usize], m.positions[ev[1] as usize]);
                 midpoint[e] = positions.len();
-                positions.push([(a[0] + b[0]) * 0.5, (a[1] + b[1]) * 0.5, (a[2] + b[2]) * 0.5]);
+                positions.push([
+                    (a[0] + b[0]) * 0.5,
+                    (a[1] + b[1]) * 0.5,
+                    (a[2] + b[2]) * 0.5,
+                ]);
             }
         }
     }
@@ -252,7 +283,12 @@ pub fn dual(m: &Mesh, keep_boundaries: bool) -> Mesh {
     let mut old_to_new = vec![usize::MAX; m.edge_count()];
 
     // Vertices between exactly two faces dissolve into one edge between the faces.
-    let needs_dissolve = |vt: &[VertType], x: usize, f0: usize, f1: usize| vt[x] != VertType::Boundary && vert_faces[x].len() == 2 && vert_faces[x][0] == f0 && vert_faces[x][1] == f1;
+    let needs_dissolve = |vt: &[VertType], x: usize, f0: usize, f1: usize| {
+        vt[x] != VertType::Boundary
+            && vert_faces[x].len() == 2
+            && vert_faces[x][0] == f0
+            && vert_faces[x][1] == f1
+    };
     for v in 0..nv {
         if vert_faces[v].len() != 2 || vt[v] != VertType::Normal {
             continue;
@@ -288,7 +324,12 @@ pub fn dual(m: &Mesh, keep_boundaries: bool) -> Mesh {
         let mut ring: Vec<usize> = sorted_faces[v].clone();
         let shared = &shared_edges[v];
         let sorted = &sorted_corners[v];
-        let mut add_shared = |i: usize, a: usize, b: usize, out: &mut Mesh, new_edges: &mut Vec<[u32; 2]>, edge_src: &mut Vec<usize>| {
+        let mut add_shared = |i: usize,
+                              a: usize,
+                              b: usize,
+                              out: &mut Mesh,
+                              new_edges: &mut Vec<[u32; 2]>,
+                              edge_src: &mut Vec<usize>| {
             let e = shared[i];
             if old_to_new[e] == usize::MAX {
                 edge_src.push(e);
@@ -302,20 +343,42 @@ pub fn dual(m: &Mesh, keep_boundaries: bool) -> Mesh {
                 continue;
             }
             for i in 0..shared.len() {
-                add_shared(i, ring[i], ring[(i + 1) % ring.len()], &mut out, &mut new_edges, &mut edge_src);
+                add_shared(
+                    i,
+                    ring[i],
+                    ring[(i + 1) % ring.len()],
+                    &mut out,
+                    &mut new_edges,
+                    &mut edge_src,
+                );
             }
             corner_src.extend(sorted.iter().copied());
         } else {
             for i in 0..shared.len() {
-                add_shared(i, ring[i], ring[i + 1], &mut out, &mut new_edges, &mut edge_src);
+                add_shared(
+                    i,
+                    ring[i],
+                    ring[i + 1],
+                    &mut out,
+                    &mut new_edges,
+                    &mut edge_src,
+                );
             }
             corner_src.extend(sorted.iter().copied());
             let (e1, e2) = if ring.len() >= 2 {
-                (boundary_edge_on_face(m, *ring.last().unwrap(), v, &et), boundary_edge_on_face(m, ring[0], v, &et))
+                (
+                    boundary_edge_on_face(m, *ring.last().unwrap(), v, &et),
+                    boundary_edge_on_face(m, ring[0], v, &et),
+                )
             } else {
                 boundary_edges_on_face(m, ring[0], v, &et)
             };
-            let push_edge = |e: usize, a: usize, b: usize, out: &mut Mesh, new_edges: &mut Vec<[u32; 2]>, edge_src: &mut Vec<usize>| {
+            let push_edge = |e: usize,
+                             a: usize,
+                             b: usize,
+                             out: &mut Mesh,
+                             new_edges: &mut Vec<[u32; 2]>,
+                             edge_src: &mut Vec<usize>| {
                 edge_src.push(e);
                 new_edges.push([a as u32, b as u32]);
                 out.corner_edges.push((new_edges.len() - 1) as u32);
@@ -325,7 +388,14 @@ pub fn dual(m: &Mesh, keep_boundaries: bool) -> Mesh {
             corner_src.push(*sorted.last().unwrap());
             let first_mid = midpoint[e1];
             if old_to_new[e1] == usize::MAX {
-                push_edge(e1, last_center, first_mid, &mut out, &mut new_edges, &mut edge_src);
+                push_edge(
+                    e1,
+                    last_center,
+                    first_mid,
+                    &mut out,
+                    &mut new_edges,
+                    &mut edge_src,
+                );
                 old_to_new[e1] = new_edges.len() - 1;
                 boundary_face_of.push((first_mid, last_center));
             } else {
@@ -343,7 +413,14 @@ pub fn dual(m: &Mesh, keep_boundaries: bool) -> Mesh {
             push_edge(e2, bv, second_mid, &mut out, &mut new_edges, &mut edge_src);
             if old_to_new[e2] == usize::MAX {
                 let first_center = ring[0];
-                push_edge(e2, second_mid, first_center, &mut out, &mut new_edges, &mut edge_src);
+                push_edge(
+                    e2,
+                    second_mid,
+                    first_center,
+                    &mut out,
+                    &mut new_edges,
+                    &mut edge_src,
+                );
                 old_to_new[e2] = new_edges.len() - 1;
                 boundary_face_of.push((second_mid, first_center));
             } else {

@@ -19,7 +19,11 @@ use super::geometry_ops::{eval_fields, modify_geometry_sets};
 
 /// Values for new elements: the average of each group of old ones (booleans: any).
 fn mix_groups(data: &Array, groups: &[Vec<usize>]) -> Array {
-    let pairs: Vec<(u32, u32)> = groups.iter().enumerate().flat_map(|(o, g)| g.iter().map(move |&s| (o as u32, s as u32))).collect();
+    let pairs: Vec<(u32, u32)> = groups
+        .iter()
+        .enumerate()
+        .flat_map(|(o, g)| g.iter().map(move |&s| (o as u32, s as u32)))
+        .collect();
     combine(data, groups.len(), &pairs, false)
 }
 
@@ -44,7 +48,17 @@ fn edge_to_faces(m: &Mesh) -> Vec<Vec<usize>> {
 /// `fill_quad_consistent_direction`: the side quad's corners, wound like the face it
 /// extends (when there is exactly one).
 #[allow(clippy::too_many_arguments)]
-fn quad(other: Option<(&[u32], &[u32])>, v_conn_1: u32, v_conn_2: u32, v_across_1: u32, v_across_2: u32, e_conn_face: u32, e_connect_1: u32, e_across: u32, e_connect_2: u32) -> ([u32; 4], [u32; 4]) {
+fn quad(
+    other: Option<(&[u32], &[u32])>,
+    v_conn_1: u32,
+    v_conn_2: u32,
+    v_across_1: u32,
+    v_across_2: u32,
+    e_conn_face: u32,
+    e_connect_1: u32,
+    e_across: u32,
+    e_connect_2: u32,
+) -> ([u32; 4], [u32; 4]) {
     let mut start_with_connecting = true;
     if let Some((verts, edges)) = other {
         if let Some(i) = edges.iter().position(|&e| e == e_conn_face) {
@@ -52,9 +66,15 @@ fn quad(other: Option<(&[u32], &[u32])>, v_conn_1: u32, v_conn_2: u32, v_across_
         }
     }
     if start_with_connecting {
-        ([v_conn_1, v_across_1, v_across_2, v_conn_2], [e_connect_1, e_across, e_connect_2, e_conn_face])
+        (
+            [v_conn_1, v_across_1, v_across_2, v_conn_2],
+            [e_connect_1, e_across, e_connect_2, e_conn_face],
+        )
     } else {
-        ([v_conn_1, v_conn_2, v_across_2, v_across_1], [e_conn_face, e_connect_2, e_across, e_connect_1])
+        (
+            [v_conn_1, v_conn_2, v_across_2, v_across_1],
+            [e_conn_face, e_connect_2, e_across, e_connect_1],
+        )
     }
 }
 
@@ -70,7 +90,9 @@ fn push_quads(m: &mut Mesh, quads: &[([u32; 4], [u32; 4])]) {
 fn vertex_offsets(offsets: &[V3], single: Option<V3>, nv: usize, pairs: &[(u32, u32)]) -> Vec<V3> {
     match single {
         Some(o) => vec![o; nv],
-        None => combine(&Array::Vector(offsets.to_vec()), nv, pairs, false).as_vector().into_owned(),
+        None => combine(&Array::Vector(offsets.to_vec()), nv, pairs, false)
+            .as_vector()
+            .into_owned(),
     }
 }
 
@@ -83,7 +105,10 @@ fn extrude_vertices(m: &mut Mesh, sel: &[bool], offsets: &[V3]) -> Outs {
     let (nv, ne) = (m.vertex_count(), m.edge_count());
     let picked: Vec<usize> = (0..nv).filter(|&i| sel[i]).collect();
     if picked.is_empty() {
-        return Outs { top: None, side: None };
+        return Outs {
+            top: None,
+            side: None,
+        };
     }
     let mut v2e: Vec<Vec<usize>> = vec![Vec::new(); nv];
     for (e, ev) in m.edges.iter().enumerate() {
@@ -103,14 +128,25 @@ fn extrude_vertices(m: &mut Mesh, sel: &[bool], offsets: &[V3]) -> Outs {
     top[nv..].iter_mut().for_each(|x| *x = true);
     let mut side = vec![false; m.edge_count()];
     side[ne..].iter_mut().for_each(|x| *x = true);
-    Outs { top: Some((Domain::Point, top)), side: Some((Domain::Edge, side)) }
+    Outs {
+        top: Some((Domain::Point, top)),
+        side: Some((Domain::Edge, side)),
+    }
 }
 
 fn extrude_edges(m: &mut Mesh, sel: &[bool], offsets: &[V3], single: Option<V3>) -> Outs {
-    let (nv, ne, nf, nc) = (m.vertex_count(), m.edge_count(), m.face_count(), m.corner_count());
+    let (nv, ne, nf, nc) = (
+        m.vertex_count(),
+        m.edge_count(),
+        m.face_count(),
+        m.corner_count(),
+    );
     let edges: Vec<usize> = (0..ne).filter(|&e| sel[e]).collect();
     if edges.is_empty() {
-        return Outs { top: None, side: None };
+        return Outs {
+            top: None,
+            side: None,
+        };
     }
     let mut pairs = Vec::new();
     let mut used = vec![false; nv];
@@ -144,7 +180,10 @@ fn extrude_edges(m: &mut Mesh, sel: &[bool], offsets: &[V3], single: Option<V3>)
     let mut dups = Vec::new();
     for &e in &edges {
         let ev = orig.edges[e];
-        let d = [(nv + vert_to_new[ev[0] as usize]) as u32, (nv + vert_to_new[ev[1] as usize]) as u32];
+        let d = [
+            (nv + vert_to_new[ev[0] as usize]) as u32,
+            (nv + vert_to_new[ev[1] as usize]) as u32,
+        ];
         dups.push(d);
         m.edges.push(d);
     }
@@ -173,14 +212,19 @@ fn extrude_edges(m: &mut Mesh, sel: &[bool], offsets: &[V3], single: Option<V3>)
     push_quads(m, &quads);
     // Attributes.
     append(&mut m.attributes, Domain::Point, &|a| a.gather(&new_verts));
-    let connect_groups: Vec<Vec<usize>> = new_verts.iter().map(|&v| vert_sel_edges[v].clone()).collect();
+    let connect_groups: Vec<Vec<usize>> = new_verts
+        .iter()
+        .map(|&v| vert_sel_edges[v].clone())
+        .collect();
     append(&mut m.attributes, Domain::Edge, &|a| {
         let mut x = mix_groups(a, &connect_groups);
         x.extend(&a.gather(&edges));
         x
     });
     let face_groups: Vec<Vec<usize>> = edges.iter().map(|&e| e2f[e].clone()).collect();
-    append(&mut m.attributes, Domain::Face, &|a| mix_groups(a, &face_groups));
+    append(&mut m.attributes, Domain::Face, &|a| {
+        mix_groups(a, &face_groups)
+    });
     append(&mut m.attributes, Domain::Corner, &|a| {
         let mut out = Array::zeros(a.data_type(), edges.len() * 4);
         for (i, &e) in edges.iter().enumerate() {
@@ -222,13 +266,19 @@ fn extrude_edges(m: &mut Mesh, sel: &[bool], offsets: &[V3], single: Option<V3>)
     top[dup_start..].iter_mut().for_each(|x| *x = true);
     let mut side = vec![false; m.face_count()];
     side[nf..].iter_mut().for_each(|x| *x = true);
-    Outs { top: Some((Domain::Edge, top)), side: Some((Domain::Face, side)) }
+    Outs {
+        top: Some((Domain::Edge, top)),
+        side: Some((Domain::Face, side)),
+    }
 }
 
 fn extrude_face_regions(m: &mut Mesh, sel: &[bool], offsets: &[V3], single: Option<V3>) -> Outs {
     let (nv, ne, nf) = (m.vertex_count(), m.edge_count(), m.face_count());
     if !sel.iter().any(|x| *x) {
-        return Outs { top: None, side: None };
+        return Outs {
+            top: None,
+            side: None,
+        };
     }
     let orig = m.clone();
     let mut pairs = Vec::new();
@@ -296,13 +346,19 @@ fn extrude_face_regions(m: &mut Mesh, sel: &[bool], offsets: &[V3], single: Opti
     let mut boundary_edges = Vec::new();
     for &e in &boundary {
         let ev = orig.edges[e];
-        let d = [(nv + idx(ev[0]).unwrap()) as u32, (nv + idx(ev[1]).unwrap()) as u32];
+        let d = [
+            (nv + idx(ev[0]).unwrap()) as u32,
+            (nv + idx(ev[1]).unwrap()) as u32,
+        ];
         boundary_edges.push(d);
         m.edges.push(d);
     }
     for &e in &new_inner {
         let ev = orig.edges[e];
-        m.edges.push([(nv + idx(ev[0]).unwrap()) as u32, (nv + idx(ev[1]).unwrap()) as u32]);
+        m.edges.push([
+            (nv + idx(ev[0]).unwrap()) as u32,
+            (nv + idx(ev[1]).unwrap()) as u32,
+        ]);
     }
     for &e in &inner {
         for k in 0..2 {
@@ -351,7 +407,9 @@ fn extrude_face_regions(m: &mut Mesh, sel: &[bool], offsets: &[V3], single: Opti
     push_quads(m, &quads);
     // Attributes.
     append(&mut m.attributes, Domain::Point, &|a| a.gather(&new_verts));
-    append(&mut m.attributes, Domain::Face, &|a| a.gather(&boundary_face));
+    append(&mut m.attributes, Domain::Face, &|a| {
+        a.gather(&boundary_face)
+    });
     let mut v2b: Vec<Vec<usize>> = vec![Vec::new(); nv + new_verts.len()];
     for i in 0..boundary.len() {
         // Blender maps over the boundary edges of the mesh being edited.
@@ -369,7 +427,10 @@ fn extrude_face_regions(m: &mut Mesh, sel: &[bool], offsets: &[V3], single: Opti
     let mut orig_corners = vec![0usize; boundary.len() * 4];
     for i in 0..boundary.len() {
         let d = boundary_edges[i];
-        let (o1, o2) = (new_verts[d[0] as usize - nv] as u32, new_verts[d[1] as usize - nv] as u32);
+        let (o1, o2) = (
+            new_verts[d[0] as usize - nv] as u32,
+            new_verts[d[1] as usize - nv] as u32,
+        );
         let (mut c1, mut c2) = (0, 0);
         for c in edited.face(boundary_face[i]) {
             if edited.corner_verts[c] == d[0] {
@@ -388,7 +449,9 @@ fn extrude_face_regions(m: &mut Mesh, sel: &[bool], offsets: &[V3], single: Opti
             }
         }
     }
-    append(&mut m.attributes, Domain::Corner, &|a| a.gather(&orig_corners));
+    append(&mut m.attributes, Domain::Corner, &|a| {
+        a.gather(&orig_corners)
+    });
     for &v in &new_verts {
         m.positions.push(orig.positions[v]);
     }
@@ -408,14 +471,25 @@ fn extrude_face_regions(m: &mut Mesh, sel: &[bool], offsets: &[V3], single: Opti
     top.resize(m.face_count(), false);
     let mut side = vec![false; m.face_count()];
     side[nf..].iter_mut().for_each(|x| *x = true);
-    Outs { top: Some((Domain::Face, top)), side: Some((Domain::Face, side)) }
+    Outs {
+        top: Some((Domain::Face, top)),
+        side: Some((Domain::Face, side)),
+    }
 }
 
 fn extrude_individual_faces(m: &mut Mesh, sel: &[bool], offsets: &[V3]) -> Outs {
-    let (nv, ne, nf, nc) = (m.vertex_count(), m.edge_count(), m.face_count(), m.corner_count());
+    let (nv, ne, nf, nc) = (
+        m.vertex_count(),
+        m.edge_count(),
+        m.face_count(),
+        m.corner_count(),
+    );
     let faces: Vec<usize> = (0..nf).filter(|&f| sel[f]).collect();
     if faces.is_empty() {
-        return Outs { top: None, side: None };
+        return Outs {
+            top: None,
+            side: None,
+        };
     }
     let total: usize = faces.iter().map(|&f| m.face_size(f)).sum();
     let orig = m.clone();
@@ -444,8 +518,18 @@ fn extrude_individual_faces(m: &mut Mesh, sel: &[bool], offsets: &[V3]) -> Outs 
             let new_vert = (nv + ie) as u32;
             let new_next = (nv + ien) as u32;
             dup[ie] = [new_vert, new_next];
-            side_v[ie] = [new_next, new_vert, new_vert_src[ie] as u32, new_vert_src[ien] as u32];
-            side_e[ie] = [(ne + total + ie) as u32, (ne + ie) as u32, dup_edge_src[ie] as u32, (ne + ien) as u32];
+            side_v[ie] = [
+                new_next,
+                new_vert,
+                new_vert_src[ie] as u32,
+                new_vert_src[ien] as u32,
+            ];
+            side_e[ie] = [
+                (ne + total + ie) as u32,
+                (ne + ie) as u32,
+                dup_edge_src[ie] as u32,
+                (ne + ien) as u32,
+            ];
             connect[ie] = [new_vert_src[ie] as u32, new_vert];
             side_face_src[ie] = f;
             let c = r.start + i;
@@ -456,9 +540,12 @@ fn extrude_individual_faces(m: &mut Mesh, sel: &[bool], offsets: &[V3]) -> Outs 
     }
     m.edges.extend_from_slice(&connect);
     m.edges.extend_from_slice(&dup);
-    let quads: Vec<([u32; 4], [u32; 4])> = side_v.iter().zip(&side_e).map(|(v, e)| (*v, *e)).collect();
+    let quads: Vec<([u32; 4], [u32; 4])> =
+        side_v.iter().zip(&side_e).map(|(v, e)| (*v, *e)).collect();
     push_quads(m, &quads);
-    append(&mut m.attributes, Domain::Point, &|a| a.gather(&new_vert_src));
+    append(&mut m.attributes, Domain::Point, &|a| {
+        a.gather(&new_vert_src)
+    });
     // Connecting edges mix the face's two edges at the vertex.
     let mut neighbors = vec![Vec::new(); total];
     let mut s = 0;
@@ -475,8 +562,12 @@ fn extrude_individual_faces(m: &mut Mesh, sel: &[bool], offsets: &[V3]) -> Outs 
         x.extend(&a.gather(&dup_edge_src));
         x
     });
-    append(&mut m.attributes, Domain::Face, &|a| a.gather(&side_face_src));
-    append(&mut m.attributes, Domain::Corner, &|a| a.gather(&orig_corners));
+    append(&mut m.attributes, Domain::Face, &|a| {
+        a.gather(&side_face_src)
+    });
+    append(&mut m.attributes, Domain::Corner, &|a| {
+        a.gather(&orig_corners)
+    });
     let mut s = 0;
     for &f in &faces {
         let n = orig.face_size(f);
@@ -492,7 +583,10 @@ fn extrude_individual_faces(m: &mut Mesh, sel: &[bool], offsets: &[V3]) -> Outs 
     top.resize(m.face_count(), false);
     let mut side = vec![false; m.face_count()];
     side[nf..].iter_mut().for_each(|x| *x = true);
-    Outs { top: Some((Domain::Face, top)), side: Some((Domain::Face, side)) }
+    Outs {
+        top: Some((Domain::Face, top)),
+        side: Some((Domain::Face, side)),
+    }
 }
 
 pub fn extrude_mesh(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -501,25 +595,44 @@ pub fn extrude_mesh(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let sel = ctx.field("Selection", DataType::Bool)?;
     let offset = ctx.field("Offset", DataType::Vector)?;
     let scale = ctx.field("Offset Scale", DataType::Float)?;
-    let individual = if ctx.has_input("Individual") { ctx.bool("Individual")? } else { false };
+    let individual = if ctx.has_input("Individual") {
+        ctx.bool("Individual")?
+    } else {
+        false
+    };
     // Offset x scale as one field, so constants stay constants.
-    let off = Field::op1("Offset x Scale", vec![offset, scale], DataType::Vector, |n, x| {
-        let (o, s) = (x[0].as_vector(), x[1].as_float());
-        Ok(Array::Vector((0..n).map(|i| [o[i][0] * s[i], o[i][1] * s[i], o[i][2] * s[i]]).collect()))
-    })
+    let off = Field::op1(
+        "Offset x Scale",
+        vec![offset, scale],
+        DataType::Vector,
+        |n, x| {
+            let (o, s) = (x[0].as_vector(), x[1].as_float());
+            Ok(Array::Vector(
+                (0..n)
+                    .map(|i| [o[i][0] * s[i], o[i][1] * s[i], o[i][2] * s[i]])
+                    .collect(),
+            ))
+        },
+    )
     .map_err(|e| ctx.err(e))?;
     let single = off.as_constant().map(|v| v.as_vector());
     let top_id = ctx.output_used("Top").then(|| AttrId::anonymous("Top"));
     let side_id = ctx.output_used("Side").then(|| AttrId::anonymous("Side"));
     modify_geometry_sets(&mut g, &mut |s: &mut GeometrySet| {
-        let Some(m) = s.mesh.clone() else { return Ok(()) };
+        let Some(m) = s.mesh.clone() else {
+            return Ok(());
+        };
         let domain = match mode.as_str() {
             "VERTICES" => Domain::Point,
             "EDGES" => Domain::Edge,
             "FACES" => Domain::Face,
             other => return Err(format!("mode {other} is not supported")),
         };
-        let r = eval_fields(ComponentRef::Mesh(&m), domain, &[(&sel, DataType::Bool), (&off, DataType::Vector)])?;
+        let r = eval_fields(
+            ComponentRef::Mesh(&m),
+            domain,
+            &[(&sel, DataType::Bool), (&off, DataType::Vector)],
+        )?;
         let (sv, ov) = (r[0].as_bool().into_owned(), r[1].as_vector().into_owned());
         let mm = s.mesh_mut().unwrap();
         let outs = match domain {
@@ -540,7 +653,13 @@ pub fn extrude_mesh(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let mut o = outputs([("Mesh", SocketValue::Geometry(g))]);
     for (name, id) in [("Top", top_id), ("Side", side_id)] {
         if let Some(id) = id {
-            o.insert(name.into(), SocketValue::Field(Field::input(AttributeInput { id, ty: DataType::Bool })));
+            o.insert(
+                name.into(),
+                SocketValue::Field(Field::input(AttributeInput {
+                    id,
+                    ty: DataType::Bool,
+                })),
+            );
         }
     }
     Ok(o)

@@ -18,15 +18,26 @@ fn domain_prop(ctx: &NodeCtx) -> Result<Domain, GeometryError> {
 
 fn data_type_prop(ctx: &NodeCtx) -> Result<DataType, GeometryError> {
     let d = ctx.prop_str("data_type")?;
-    DataType::parse(d).map(|t| t.socket_type()).ok_or_else(|| ctx.err(format!("data type {d} is not supported")))
+    DataType::parse(d)
+        .map(|t| t.socket_type())
+        .ok_or_else(|| ctx.err(format!("data type {d} is not supported")))
 }
 
 fn value_input(ctx: &NodeCtx) -> Option<String> {
-    ctx.flat().inputs.iter().find(|i| i.socket.name == "Value").map(|i| i.socket.identifier.clone())
+    ctx.flat()
+        .inputs
+        .iter()
+        .find(|i| i.socket.name == "Value")
+        .map(|i| i.socket.identifier.clone())
 }
 
 fn value_output(ctx: &NodeCtx, name: &str) -> String {
-    ctx.node().outputs.iter().find(|o| o.name == name && o.enabled).map(|o| o.identifier.clone()).unwrap_or_else(|| name.to_string())
+    ctx.node()
+        .outputs
+        .iter()
+        .find(|o| o.name == name && o.enabled)
+        .map(|o| o.identifier.clone())
+        .unwrap_or_else(|| name.to_string())
 }
 
 pub fn evaluate_on_domain(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -38,7 +49,10 @@ pub fn evaluate_on_domain(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         Field::Constant(v) => Field::Constant(v),
         f => Field::input(EvaluateOnDomain { field: f, domain }),
     };
-    Ok(outputs([(value_output(ctx, "Value").as_str(), SocketValue::Field(out))]))
+    Ok(outputs([(
+        value_output(ctx, "Value").as_str(),
+        SocketValue::Field(out),
+    )]))
 }
 
 /// Field at Index: `value` evaluated on `domain`, read at `index` (evaluated where used).
@@ -78,8 +92,15 @@ pub fn field_at_index(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let id = value_input(ctx).ok_or_else(|| ctx.err("no Value input"))?;
     let value = ctx.field(&id, ty)?;
     let index = ctx.field("Index", DataType::Int)?;
-    let f = Field::input(FieldAtIndex { value, index, domain });
-    Ok(outputs([(value_output(ctx, "Value").as_str(), SocketValue::Field(f))]))
+    let f = Field::input(FieldAtIndex {
+        value,
+        index,
+        domain,
+    });
+    Ok(outputs([(
+        value_output(ctx, "Value").as_str(),
+        SocketValue::Field(f),
+    )]))
 }
 
 /// Sample Index: `value` evaluated on another geometry, read at `index`.
@@ -100,10 +121,16 @@ impl FieldInput for SampleIndex {
         let n = ctx.component.domain_size(domain);
         let g = &*self.geometry;
         let comp = match self.domain {
-            Domain::Point | Domain::Edge | Domain::Face | Domain::Corner if g.mesh.is_some() => ComponentRef::Mesh(g.mesh.as_ref().unwrap()),
+            Domain::Point | Domain::Edge | Domain::Face | Domain::Corner if g.mesh.is_some() => {
+                ComponentRef::Mesh(g.mesh.as_ref().unwrap())
+            }
             Domain::Point if g.points.is_some() => ComponentRef::Points(g.points.as_ref().unwrap()),
-            Domain::Point | Domain::Curve if g.curves.is_some() => ComponentRef::Curves(g.curves.as_ref().unwrap()),
-            Domain::Instance if g.instances.is_some() => ComponentRef::Instances(g.instances.as_ref().unwrap()),
+            Domain::Point | Domain::Curve if g.curves.is_some() => {
+                ComponentRef::Curves(g.curves.as_ref().unwrap())
+            }
+            Domain::Instance if g.instances.is_some() => {
+                ComponentRef::Instances(g.instances.as_ref().unwrap())
+            }
             _ => return Ok(Array::zeros(self.data_type(), n)),
         };
         let source = FieldContext::new(comp);
@@ -133,8 +160,17 @@ pub fn sample_index(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let id = value_input(ctx).ok_or_else(|| ctx.err("no Value input"))?;
     let value = ctx.field(&id, ty)?;
     let index = ctx.field("Index", DataType::Int)?;
-    let f = Field::input(SampleIndex { geometry, value, index, domain, clamp });
-    Ok(outputs([(value_output(ctx, "Value").as_str(), SocketValue::Field(f))]))
+    let f = Field::input(SampleIndex {
+        geometry,
+        value,
+        index,
+        domain,
+        clamp,
+    });
+    Ok(outputs([(
+        value_output(ctx, "Value").as_str(),
+        SocketValue::Field(f),
+    )]))
 }
 
 /// Face areas (`face_area_calc`), moved to the requested domain.
@@ -147,7 +183,10 @@ impl FieldInput for FaceArea {
     }
     fn evaluate(&self, ctx: &FieldContext, domain: Domain) -> Result<Array, String> {
         let ComponentRef::Mesh(m) = ctx.component else {
-            return Ok(Array::zeros(DataType::Float, ctx.component.domain_size(domain)));
+            return Ok(Array::zeros(
+                DataType::Float,
+                ctx.component.domain_size(domain),
+            ));
         };
         let areas: Vec<f32> = (0..m.face_count())
             .map(|f| {
@@ -166,7 +205,9 @@ impl FieldInput for FaceArea {
                 ((n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt() * 0.5) as f32
             })
             .collect();
-        Ok(ctx.component.adapt(&Array::Float(areas), Domain::Face, domain))
+        Ok(ctx
+            .component
+            .adapt(&Array::Float(areas), Domain::Face, domain))
     }
     fn preferred_domain(&self, _ctx: &FieldContext) -> Option<Domain> {
         Some(Domain::Face)
@@ -174,25 +215,51 @@ impl FieldInput for FaceArea {
 }
 
 pub fn face_area(_: &NodeCtx) -> Result<Outputs, GeometryError> {
-    Ok(outputs([("Area", SocketValue::Field(Field::input(FaceArea)))]))
+    Ok(outputs([(
+        "Area",
+        SocketValue::Field(Field::input(FaceArea)),
+    )]))
 }
 
 pub fn euler_to_rotation(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let e = ctx.field("Euler", DataType::Vector)?;
-    let f = Field::op1("Euler to Rotation", vec![e], DataType::Quaternion, |_, x| Ok(Array::Quaternion(x[0].as_vector().iter().map(|v| euler_to_quat(*v)).collect())))
-        .map_err(|e| ctx.err(e))?;
+    let f = Field::op1(
+        "Euler to Rotation",
+        vec![e],
+        DataType::Quaternion,
+        |_, x| {
+            Ok(Array::Quaternion(
+                x[0].as_vector().iter().map(|v| euler_to_quat(*v)).collect(),
+            ))
+        },
+    )
+    .map_err(|e| ctx.err(e))?;
     Ok(outputs([("Rotation", SocketValue::Field(f))]))
 }
 
 pub fn rotation_to_euler(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let r = ctx.field("Rotation", DataType::Quaternion)?;
-    let f = Field::op1("Rotation to Euler", vec![r], DataType::Vector, |_, x| Ok(Array::Vector(x[0].as_quat().iter().map(|q| quat_to_euler(*q)).collect())))
-        .map_err(|e| ctx.err(e))?;
+    let f = Field::op1("Rotation to Euler", vec![r], DataType::Vector, |_, x| {
+        Ok(Array::Vector(
+            x[0].as_quat().iter().map(|q| quat_to_euler(*q)).collect(),
+        ))
+    })
+    .map_err(|e| ctx.err(e))?;
     Ok(outputs([("Euler", SocketValue::Field(f))]))
 }
 
 pub fn input_rotation(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
-    let e = ctx.prop("rotation_euler").and_then(|v| v.as_array()).ok_or_else(|| ctx.err("property \"rotation_euler\" missing"))?;
+    let e = ctx
+        .prop("rotation_euler")
+        .and_then(|v| v.as_array())
+        .ok_or_else(|| ctx.err("property \"rotation_euler\" missing"))?;
     let c = |i: usize| e.get(i).and_then(|x| x.as_f64()).unwrap_or(0.0) as f32;
-    Ok(outputs([("Rotation", SocketValue::Field(Field::Constant(Value::Quaternion(euler_to_quat([c(0), c(1), c(2)])))))]))
+    Ok(outputs([(
+        "Rotation",
+        SocketValue::Field(Field::Constant(Value::Quaternion(euler_to_quat([
+            c(0),
+            c(1),
+            c(2),
+        ])))),
+    )]))
 }

@@ -46,8 +46,10 @@ pub fn fill(c: &Curves, group_ids: &[i32], output: Output) -> Result<Mesh, Strin
         }
         let res = cdt::triangulate(&verts, &faces, output)?;
         let base = m.positions.len() as u32;
-        m.positions.extend(res.verts.iter().map(|p| [p[0] as f32, p[1] as f32, 0.0]));
-        m.edges.extend(res.edges.iter().map(|e| [e[0] + base, e[1] + base]));
+        m.positions
+            .extend(res.verts.iter().map(|p| [p[0] as f32, p[1] as f32, 0.0]));
+        m.edges
+            .extend(res.edges.iter().map(|e| [e[0] + base, e[1] + base]));
         for f in &res.faces {
             m.corner_verts.extend(f.iter().map(|v| v + base));
             m.face_offsets.push(m.corner_verts.len() as u32);
@@ -62,7 +64,11 @@ pub fn fill(c: &Curves, group_ids: &[i32], output: Output) -> Result<Mesh, Strin
 pub fn fill_curve(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let mut g = ctx.geometry("Curve")?;
     // Blender 4.5 has a Mode menu socket; older files a `mode` property.
-    let mode = if ctx.has_input("Mode") { ctx.string("Mode")? } else { ctx.prop_str("mode").unwrap_or("TRIANGLES").to_string() };
+    let mode = if ctx.has_input("Mode") {
+        ctx.string("Mode")?
+    } else {
+        ctx.prop_str("mode").unwrap_or("TRIANGLES").to_string()
+    };
     let output = match mode.as_str() {
         "TRIANGLES" => Output::InsideWithHoles,
         "NGONS" => Output::ValidBmeshWithHoles,
@@ -70,9 +76,18 @@ pub fn fill_curve(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     };
     let group = ctx.field("Group ID", DataType::Int)?;
     modify_geometry_sets(&mut g, &mut |s| {
-        let Some(c) = s.curves.clone() else { return Ok(()) };
+        let Some(c) = s.curves.clone() else {
+            return Ok(());
+        };
         if c.curve_count() > 0 {
-            let ids = eval_fields(ComponentRef::Curves(&c), Domain::Curve, &[(&group, DataType::Int)])?.remove(0).as_int().into_owned();
+            let ids = eval_fields(
+                ComponentRef::Curves(&c),
+                Domain::Curve,
+                &[(&group, DataType::Int)],
+            )?
+            .remove(0)
+            .as_int()
+            .into_owned();
             s.mesh = Some(Arc::new(fill(&c, &ids, output)?));
         }
         s.curves = None;

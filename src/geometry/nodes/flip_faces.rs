@@ -13,11 +13,17 @@ pub fn flip_faces(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let mut g = ctx.geometry("Mesh")?;
     let sel = ctx.field("Selection", DataType::Bool)?;
     modify_geometry_sets(&mut g, &mut |s: &mut GeometrySet| {
-        let Some(m) = s.mesh.clone() else { return Ok(()) };
+        let Some(m) = s.mesh.clone() else {
+            return Ok(());
+        };
         if m.face_count() == 0 {
             return Ok(());
         }
-        let sel = eval_fields(ComponentRef::Mesh(&m), Domain::Face, &[(&sel, DataType::Bool)])?;
+        let sel = eval_fields(
+            ComponentRef::Mesh(&m),
+            Domain::Face,
+            &[(&sel, DataType::Bool)],
+        )?;
         let sel = sel[0].as_bool();
         // New corner order: each selected face's first corner, then the rest reversed.
         let mut order: Vec<usize> = (0..m.corner_count()).collect();
@@ -33,7 +39,12 @@ pub fn flip_faces(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             mm.corner_edges[r.clone()].copy_from_slice(&edges);
         }
         mm.corner_verts = order.iter().map(|&c| m.corner_verts[c]).collect();
-        let ids: Vec<_> = m.attributes.iter().filter(|a| a.domain == Domain::Corner).map(|a| a.id.clone()).collect();
+        let ids: Vec<_> = m
+            .attributes
+            .iter()
+            .filter(|a| a.domain == Domain::Corner)
+            .map(|a| a.id.clone())
+            .collect();
         for id in ids {
             let data = m.attributes.get(&id).unwrap().data.gather(&order);
             mm.attributes.set(id, Domain::Corner, data);

@@ -5,8 +5,8 @@
 //! Geometry Nodes computes differently (BLI's double-precision cross product, its
 //! normalize, Map Range of an empty range, the degree constants) that is done here.
 
-use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::error::GeometryError;
+use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::Field;
 use super::super::types::{Array, DataType, Value};
 use super::super::value::SocketValue;
@@ -33,12 +33,19 @@ fn opt_field(ctx: &NodeCtx, id: &str, ty: DataType) -> Result<Field, GeometryErr
 
 pub fn value(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let s = &ctx.node().outputs[0];
-    let v = s.default_value.as_ref().and_then(|v| v.as_f64()).unwrap_or(0.0) as f32;
+    let v = s
+        .default_value
+        .as_ref()
+        .and_then(|v| v.as_f64())
+        .unwrap_or(0.0) as f32;
     Ok(outputs([(s.identifier.as_str(), SocketValue::float(v))]))
 }
 
 pub fn integer(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
-    let v = ctx.prop("integer").and_then(|v| v.as_i64()).ok_or_else(|| ctx.err("property \"integer\" missing"))?;
+    let v = ctx
+        .prop("integer")
+        .and_then(|v| v.as_i64())
+        .ok_or_else(|| ctx.err("property \"integer\" missing"))?;
     Ok(outputs([("Integer", SocketValue::int(v as i32))]))
 }
 
@@ -48,9 +55,15 @@ pub fn boolean(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
 }
 
 pub fn vector(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
-    let v = ctx.prop("vector").and_then(|v| v.as_array()).ok_or_else(|| ctx.err("property \"vector\" missing"))?;
+    let v = ctx
+        .prop("vector")
+        .and_then(|v| v.as_array())
+        .ok_or_else(|| ctx.err("property \"vector\" missing"))?;
     let c = |i: usize| v.get(i).and_then(|x| x.as_f64()).unwrap_or(0.0) as f32;
-    Ok(outputs([("Vector", f(Field::Constant(Value::Vector([c(0), c(1), c(2)]))))]))
+    Ok(outputs([(
+        "Vector",
+        f(Field::Constant(Value::Vector([c(0), c(1), c(2)]))),
+    )]))
 }
 
 /// Geometry Nodes' Math: Cycles' operations except the angle constants, which Blender
@@ -70,15 +83,33 @@ fn gn_math(op: MathOp, clamp: bool, a: f32, b: f32, c: f32) -> f32 {
 
 pub fn math(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let op_name = ctx.prop_str("operation")?;
-    let op = MathOp::from_blender(op_name).ok_or_else(|| ctx.err(format!("unknown operation {op_name}")))?;
+    let op = MathOp::from_blender(op_name)
+        .ok_or_else(|| ctx.err(format!("unknown operation {op_name}")))?;
     let clamp = ctx.prop_bool("use_clamp").unwrap_or(false);
     let a = ctx.field("Value", DataType::Float)?;
-    let b = if ctx.has_input("Value_001") { ctx.field("Value_001", DataType::Float)? } else { Field::Constant(Value::Float(0.0)) };
-    let c = if ctx.has_input("Value_002") { ctx.field("Value_002", DataType::Float)? } else { Field::Constant(Value::Float(0.0)) };
-    let out = Field::op1(format!("Math {op_name}"), vec![a, b, c], DataType::Float, move |n, x| {
-        let (a, b, c) = (x[0].as_float(), x[1].as_float(), x[2].as_float());
-        Ok(Array::Float((0..n).map(|i| gn_math(op, clamp, a[i], b[i], c[i])).collect()))
-    })
+    let b = if ctx.has_input("Value_001") {
+        ctx.field("Value_001", DataType::Float)?
+    } else {
+        Field::Constant(Value::Float(0.0))
+    };
+    let c = if ctx.has_input("Value_002") {
+        ctx.field("Value_002", DataType::Float)?
+    } else {
+        Field::Constant(Value::Float(0.0))
+    };
+    let out = Field::op1(
+        format!("Math {op_name}"),
+        vec![a, b, c],
+        DataType::Float,
+        move |n, x| {
+            let (a, b, c) = (x[0].as_float(), x[1].as_float(), x[2].as_float());
+            Ok(Array::Float(
+                (0..n)
+                    .map(|i| gn_math(op, clamp, a[i], b[i], c[i]))
+                    .collect(),
+            ))
+        },
+    )
     .map_err(|e| op_err(ctx, e))?;
     Ok(outputs([("Value", f(out))]))
 }
@@ -86,7 +117,11 @@ pub fn math(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
 /// BLI `cross_high_precision`: products in double.
 fn cross_hp(a: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     let (ax, ay, az) = (a[0] as f64, a[1] as f64, a[2] as f64);
-    [(ay * b[2] as f64 - az * b[1] as f64) as f32, (az * b[0] as f64 - ax * b[2] as f64) as f32, (ax * b[1] as f64 - ay * b[0] as f64) as f32]
+    [
+        (ay * b[2] as f64 - az * b[1] as f64) as f32,
+        (az * b[0] as f64 - ax * b[2] as f64) as f32,
+        (ax * b[1] as f64 - ay * b[0] as f64) as f32,
+    ]
 }
 
 /// BLI `math::normalize`: zero below a tiny squared length, else divided by the length.
@@ -114,12 +149,17 @@ fn refract_bli(i: [f32; 3], n: [f32; 3], eta: f32) -> [f32; 3] {
         return [0.0; 3];
     }
     let s = eta * d + k.sqrt();
-    [eta * i[0] - s * n[0], eta * i[1] - s * n[1], eta * i[2] - s * n[2]]
+    [
+        eta * i[0] - s * n[0],
+        eta * i[1] - s * n[1],
+        eta * i[2] - s * n[2],
+    ]
 }
 
 pub fn vector_math_node(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let op_name = ctx.prop_str("operation")?;
-    let op = VectorMathOp::from_blender(op_name).ok_or_else(|| ctx.err(format!("unknown operation {op_name}")))?;
+    let op = VectorMathOp::from_blender(op_name)
+        .ok_or_else(|| ctx.err(format!("unknown operation {op_name}")))?;
     let get = |id: &str, t: DataType, d: Value| -> Result<Field, GeometryError> {
         if ctx.has_input(id) {
             ctx.field(id, t)
@@ -131,34 +171,70 @@ pub fn vector_math_node(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let b = get("Vector_001", DataType::Vector, Value::Vector([0.0; 3]))?;
     let c = get("Vector_002", DataType::Vector, Value::Vector([0.0; 3]))?;
     let s = get("Scale", DataType::Float, Value::Float(1.0))?;
-    let outs = Field::op(format!("Vector Math {op_name}"), vec![a, b, c, s], vec![DataType::Vector, DataType::Float], move |n, x| {
-        let (a, b, c, s) = (x[0].as_vector(), x[1].as_vector(), x[2].as_vector(), x[3].as_float());
-        let mut vv = Vec::with_capacity(n);
-        let mut fv = Vec::with_capacity(n);
-        for i in 0..n {
-            let r = match op {
-                VectorMathOp::CrossProduct => crate::nodes::math::VectorMathResult { vector: cross_hp(a[i], b[i]), value: 0.0 },
-                VectorMathOp::Normalize => crate::nodes::math::VectorMathResult { vector: normalize_bli(a[i]), value: 0.0 },
-                VectorMathOp::Reflect => crate::nodes::math::VectorMathResult { vector: reflect_bli(a[i], normalize_bli(b[i])), value: 0.0 },
-                VectorMathOp::Refract => crate::nodes::math::VectorMathResult { vector: refract_bli(a[i], normalize_bli(b[i]), s[i]), value: 0.0 },
-                VectorMathOp::Scale => crate::nodes::math::VectorMathResult { vector: [a[i][0] * s[i], a[i][1] * s[i], a[i][2] * s[i]], value: 0.0 },
-                _ => vector_math(op, a[i], b[i], c[i], s[i]),
-            };
-            vv.push(r.vector);
-            fv.push(r.value);
-        }
-        Ok(vec![Array::Vector(vv), Array::Float(fv)])
-    })
+    let outs = Field::op(
+        format!("Vector Math {op_name}"),
+        vec![a, b, c, s],
+        vec![DataType::Vector, DataType::Float],
+        move |n, x| {
+            let (a, b, c, s) = (
+                x[0].as_vector(),
+                x[1].as_vector(),
+                x[2].as_vector(),
+                x[3].as_float(),
+            );
+            let mut vv = Vec::with_capacity(n);
+            let mut fv = Vec::with_capacity(n);
+            for i in 0..n {
+                let r = match op {
+                    VectorMathOp::CrossProduct => crate::nodes::math::VectorMathResult {
+                        vector: cross_hp(a[i], b[i]),
+                        value: 0.0,
+                    },
+                    VectorMathOp::Normalize => crate::nodes::math::VectorMathResult {
+                        vector: normalize_bli(a[i]),
+                        value: 0.0,
+                    },
+                    VectorMathOp::Reflect => crate::nodes::math::VectorMathResult {
+                        vector: reflect_bli(a[i], normalize_bli(b[i])),
+                        value: 0.0,
+                    },
+                    VectorMathOp::Refract => crate::nodes::math::VectorMathResult {
+                        vector: refract_bli(a[i], normalize_bli(b[i]), s[i]),
+                        value: 0.0,
+                    },
+                    VectorMathOp::Scale => crate::nodes::math::VectorMathResult {
+                        vector: [a[i][0] * s[i], a[i][1] * s[i], a[i][2] * s[i]],
+                        value: 0.0,
+                    },
+                    _ => vector_math(op, a[i], b[i], c[i], s[i]),
+                };
+                vv.push(r.vector);
+                fv.push(r.value);
+            }
+            Ok(vec![Array::Vector(vv), Array::Float(fv)])
+        },
+    )
     .map_err(|e| op_err(ctx, e))?;
     let mut it = outs.into_iter();
-    Ok(outputs([("Vector", f(it.next().unwrap())), ("Value", f(it.next().unwrap()))]))
+    Ok(outputs([
+        ("Vector", f(it.next().unwrap())),
+        ("Value", f(it.next().unwrap())),
+    ]))
 }
 
 pub fn compare(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let dt = ctx.prop_str("data_type")?;
     let op = ctx.prop_str("operation")?.to_string();
-    let mode = ctx.prop("mode").and_then(|v| v.as_str()).unwrap_or("ELEMENT").to_string();
-    let eps = if ctx.has_input("Epsilon") { ctx.field("Epsilon", DataType::Float)? } else { Field::Constant(Value::Float(0.0)) };
+    let mode = ctx
+        .prop("mode")
+        .and_then(|v| v.as_str())
+        .unwrap_or("ELEMENT")
+        .to_string();
+    let eps = if ctx.has_input("Epsilon") {
+        ctx.field("Epsilon", DataType::Float)?
+    } else {
+        Field::Constant(Value::Float(0.0))
+    };
     let label = format!("Compare {dt} {op}");
     let cmp_f = |op: &str, a: f32, b: f32, e: f32| -> Option<bool> {
         Some(match op {
@@ -180,7 +256,11 @@ pub fn compare(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             }
             Field::op1(label, vec![a, b, eps], DataType::Bool, move |n, x| {
                 let (a, b, e) = (x[0].as_float(), x[1].as_float(), x[2].as_float());
-                Ok(Array::Bool((0..n).map(|i| cmp_f(&op, a[i], b[i], e[i]).unwrap()).collect()))
+                Ok(Array::Bool(
+                    (0..n)
+                        .map(|i| cmp_f(&op, a[i], b[i], e[i]).unwrap())
+                        .collect(),
+                ))
             })
         }
         "INT" => {
@@ -207,29 +287,62 @@ pub fn compare(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "VECTOR" => {
             let a = ctx.field("A_VEC3", DataType::Vector)?;
             let b = ctx.field("B_VEC3", DataType::Vector)?;
-            let c = if ctx.has_input("C") { ctx.field("C", DataType::Float)? } else { Field::Constant(Value::Float(0.0)) };
-            let angle = if ctx.has_input("Angle") { ctx.field("Angle", DataType::Float)? } else { Field::Constant(Value::Float(0.0)) };
-            Field::op1(label, vec![a, b, c, angle, eps], DataType::Bool, move |n, x| {
-                let (a, b, c, ang, e) = (x[0].as_vector(), x[1].as_vector(), x[2].as_float(), x[3].as_float(), x[4].as_float());
-                let mut out = Vec::with_capacity(n);
-                for i in 0..n {
-                    let (va, vb) = (a[i], b[i]);
-                    let r = match mode.as_str() {
-                        "ELEMENT" => match op.as_str() {
-                            "EQUAL" => (0..3).all(|k| (va[k] - vb[k]).abs() <= e[i]),
-                            "NOT_EQUAL" => (0..3).any(|k| (va[k] - vb[k]).abs() > e[i]),
-                            o => (0..3).all(|k| cmp_f(o, va[k], vb[k], e[i]).unwrap_or(false)),
-                        },
-                        "LENGTH" => cmp_f(&op, len(va), len(vb), e[i]).unwrap_or(false),
-                        "AVERAGE" => cmp_f(&op, (va[0] + va[1] + va[2]) / 3.0, (vb[0] + vb[1] + vb[2]) / 3.0, e[i]).unwrap_or(false),
-                        "DOT_PRODUCT" => cmp_f(&op, va[0] * vb[0] + va[1] * vb[1] + va[2] * vb[2], c[i], e[i]).unwrap_or(false),
-                        "DIRECTION" => cmp_f(&op, angle_between(va, vb), ang[i], e[i]).unwrap_or(false),
-                        m => return Err(format!("vector mode {m} is not supported")),
-                    };
-                    out.push(r);
-                }
-                Ok(Array::Bool(out))
-            })
+            let c = if ctx.has_input("C") {
+                ctx.field("C", DataType::Float)?
+            } else {
+                Field::Constant(Value::Float(0.0))
+            };
+            let angle = if ctx.has_input("Angle") {
+                ctx.field("Angle", DataType::Float)?
+            } else {
+                Field::Constant(Value::Float(0.0))
+            };
+            Field::op1(
+                label,
+                vec![a, b, c, angle, eps],
+                DataType::Bool,
+                move |n, x| {
+                    let (a, b, c, ang, e) = (
+                        x[0].as_vector(),
+                        x[1].as_vector(),
+                        x[2].as_float(),
+                        x[3].as_float(),
+                        x[4].as_float(),
+                    );
+                    let mut out = Vec::with_capacity(n);
+                    for i in 0..n {
+                        let (va, vb) = (a[i], b[i]);
+                        let r = match mode.as_str() {
+                            "ELEMENT" => match op.as_str() {
+                                "EQUAL" => (0..3).all(|k| (va[k] - vb[k]).abs() <= e[i]),
+                                "NOT_EQUAL" => (0..3).any(|k| (va[k] - vb[k]).abs() > e[i]),
+                                o => (0..3).all(|k| cmp_f(o, va[k], vb[k], e[i]).unwrap_or(false)),
+                            },
+                            "LENGTH" => cmp_f(&op, len(va), len(vb), e[i]).unwrap_or(false),
+                            "AVERAGE" => cmp_f(
+                                &op,
+                                (va[0] + va[1] + va[2]) / 3.0,
+                                (vb[0] + vb[1] + vb[2]) / 3.0,
+                                e[i],
+                            )
+                            .unwrap_or(false),
+                            "DOT_PRODUCT" => cmp_f(
+                                &op,
+                                va[0] * vb[0] + va[1] * vb[1] + va[2] * vb[2],
+                                c[i],
+                                e[i],
+                            )
+                            .unwrap_or(false),
+                            "DIRECTION" => {
+                                cmp_f(&op, angle_between(va, vb), ang[i], e[i]).unwrap_or(false)
+                            }
+                            m => return Err(format!("vector mode {m} is not supported")),
+                        };
+                        out.push(r);
+                    }
+                    Ok(Array::Bool(out))
+                },
+            )
         }
         "RGBA" => {
             let a = ctx.field("A_COL", DataType::Color)?;
@@ -278,28 +391,37 @@ fn angle_between(a: [f32; 3], b: [f32; 3]) -> f32 {
 pub fn boolean_math(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let op = ctx.prop_str("operation")?.to_string();
     let a = ctx.field("Boolean", DataType::Bool)?;
-    let b = if ctx.has_input("Boolean_001") { ctx.field("Boolean_001", DataType::Bool)? } else { Field::Constant(Value::Bool(false)) };
-    let out = Field::op1(format!("Boolean Math {op}"), vec![a, b], DataType::Bool, move |n, x| {
-        let (a, b) = (x[0].as_bool(), x[1].as_bool());
-        let r: Result<Vec<bool>, String> = (0..n)
-            .map(|i| {
-                let (a, b) = (a[i], b[i]);
-                Ok(match op.as_str() {
-                    "AND" => a && b,
-                    "OR" => a || b,
-                    "NOT" => !a,
-                    "NAND" => !(a && b),
-                    "NOR" => !(a || b),
-                    "XNOR" => a == b,
-                    "XOR" => a != b,
-                    "IMPLY" => !a || b,
-                    "NIMPLY" => a && !b,
-                    o => return Err(format!("unknown operation {o}")),
+    let b = if ctx.has_input("Boolean_001") {
+        ctx.field("Boolean_001", DataType::Bool)?
+    } else {
+        Field::Constant(Value::Bool(false))
+    };
+    let out = Field::op1(
+        format!("Boolean Math {op}"),
+        vec![a, b],
+        DataType::Bool,
+        move |n, x| {
+            let (a, b) = (x[0].as_bool(), x[1].as_bool());
+            let r: Result<Vec<bool>, String> = (0..n)
+                .map(|i| {
+                    let (a, b) = (a[i], b[i]);
+                    Ok(match op.as_str() {
+                        "AND" => a && b,
+                        "OR" => a || b,
+                        "NOT" => !a,
+                        "NAND" => !(a && b),
+                        "NOR" => !(a || b),
+                        "XNOR" => a == b,
+                        "XOR" => a != b,
+                        "IMPLY" => !a || b,
+                        "NIMPLY" => a && !b,
+                        o => return Err(format!("unknown operation {o}")),
+                    })
                 })
-            })
-            .collect();
-        Ok(Array::Bool(r?))
-    })
+                .collect();
+            Ok(Array::Bool(r?))
+        },
+    )
     .map_err(|e| op_err(ctx, e))?;
     Ok(outputs([("Boolean", f(out))]))
 }
@@ -330,7 +452,16 @@ fn clamp_range(v: f32, a: f32, b: f32) -> f32 {
 /// Map Range as Geometry Nodes computes it (`node_shader_map_range.cc` multi-functions):
 /// an empty "from" range maps to "to min" (Cycles gives 0).
 #[allow(clippy::too_many_arguments)]
-fn map_range_gn(interp: &str, clamp: bool, v: f32, fmin: f32, fmax: f32, tmin: f32, tmax: f32, steps: f32) -> f32 {
+fn map_range_gn(
+    interp: &str,
+    clamp: bool,
+    v: f32,
+    fmin: f32,
+    fmax: f32,
+    tmin: f32,
+    tmax: f32,
+    steps: f32,
+) -> f32 {
     match interp {
         "LINEAR" => {
             let factor = safe_divide(v - fmin, fmax - fmin);
@@ -343,7 +474,11 @@ fn map_range_gn(interp: &str, clamp: bool, v: f32, fmin: f32, fmax: f32, tmin: f
         }
         "STEPPED" => {
             let mut factor = safe_divide(v - fmin, fmax - fmin);
-            factor = if steps > 0.0 { (factor * (steps + 1.0)).floor() / steps } else { 0.0 };
+            factor = if steps > 0.0 {
+                (factor * (steps + 1.0)).floor() / steps
+            } else {
+                0.0
+            };
             let r = tmin + factor * (tmax - tmin);
             if clamp {
                 clamp_range(r, tmin, tmax)
@@ -352,11 +487,19 @@ fn map_range_gn(interp: &str, clamp: bool, v: f32, fmin: f32, fmax: f32, tmin: f
             }
         }
         "SMOOTHSTEP" => {
-            let factor = if fmin > fmax { 1.0 - smoothstep(fmax, fmin, v) } else { smoothstep(fmin, fmax, v) };
+            let factor = if fmin > fmax {
+                1.0 - smoothstep(fmax, fmin, v)
+            } else {
+                smoothstep(fmin, fmax, v)
+            };
             tmin + factor * (tmax - tmin)
         }
         _ => {
-            let factor = if fmin > fmax { 1.0 - smootherstep(fmax, fmin, v) } else { smootherstep(fmin, fmax, v) };
+            let factor = if fmin > fmax {
+                1.0 - smootherstep(fmax, fmin, v)
+            } else {
+                smootherstep(fmin, fmax, v)
+            };
             tmin + factor * (tmax - tmin)
         }
     }
@@ -365,36 +508,67 @@ fn map_range_gn(interp: &str, clamp: bool, v: f32, fmin: f32, fmax: f32, tmin: f
 pub fn map_range(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let dt = ctx.prop_str("data_type")?;
     let interp = ctx.prop_str("interpolation_type")?.to_string();
-    if !matches!(interp.as_str(), "LINEAR" | "STEPPED" | "SMOOTHSTEP" | "SMOOTHERSTEP") {
+    if !matches!(
+        interp.as_str(),
+        "LINEAR" | "STEPPED" | "SMOOTHSTEP" | "SMOOTHERSTEP"
+    ) {
         return Err(ctx.err(format!("interpolation {interp} is not supported")));
     }
     let clamp = ctx.prop_bool("clamp").unwrap_or(false);
     match dt {
         "FLOAT" => {
             let ids = ["Value", "From Min", "From Max", "To Min", "To Max", "Steps"];
-            let ins: Vec<Field> = ids.iter().map(|id| opt_field(ctx, id, DataType::Float)).collect::<Result<_, _>>()?;
+            let ins: Vec<Field> = ids
+                .iter()
+                .map(|id| opt_field(ctx, id, DataType::Float))
+                .collect::<Result<_, _>>()?;
             let out = Field::op1("Map Range", ins, DataType::Float, move |n, x| {
                 let a: Vec<_> = x.iter().map(|a| a.as_float()).collect();
-                Ok(Array::Float((0..n).map(|i| map_range_gn(&interp, clamp, a[0][i], a[1][i], a[2][i], a[3][i], a[4][i], a[5][i])).collect()))
+                Ok(Array::Float(
+                    (0..n)
+                        .map(|i| {
+                            map_range_gn(
+                                &interp, clamp, a[0][i], a[1][i], a[2][i], a[3][i], a[4][i],
+                                a[5][i],
+                            )
+                        })
+                        .collect(),
+                ))
             })
             .map_err(|e| op_err(ctx, e))?;
             Ok(outputs([("Result", f(out))]))
         }
         "FLOAT_VECTOR" => {
-            let ids = ["Vector", "From_Min_FLOAT3", "From_Max_FLOAT3", "To_Min_FLOAT3", "To_Max_FLOAT3", "Steps_FLOAT3"];
-            let ins: Vec<Field> = ids.iter().map(|id| opt_field(ctx, id, DataType::Vector)).collect::<Result<_, _>>()?;
+            let ids = [
+                "Vector",
+                "From_Min_FLOAT3",
+                "From_Max_FLOAT3",
+                "To_Min_FLOAT3",
+                "To_Max_FLOAT3",
+                "Steps_FLOAT3",
+            ];
+            let ins: Vec<Field> = ids
+                .iter()
+                .map(|id| opt_field(ctx, id, DataType::Vector))
+                .collect::<Result<_, _>>()?;
             let out = Field::op1("Map Range", ins, DataType::Vector, move |n, x| {
                 let a: Vec<_> = x.iter().map(|a| a.as_vector()).collect();
                 let mut out = Vec::with_capacity(n);
                 for i in 0..n {
                     let mut r = [0.0; 3];
                     for k in 0..3 {
-                        let (v, fmin, fmax, tmin, tmax, steps) = (a[0][i][k], a[1][i][k], a[2][i][k], a[3][i][k], a[4][i][k], a[5][i][k]);
+                        let (v, fmin, fmax, tmin, tmax, steps) = (
+                            a[0][i][k], a[1][i][k], a[2][i][k], a[3][i][k], a[4][i][k], a[5][i][k],
+                        );
                         let mut factor = safe_divide(v - fmin, fmax - fmin);
                         let clamp_it = match interp.as_str() {
                             "LINEAR" => true,
                             "STEPPED" => {
-                                factor = if steps > 0.0 { (factor * (steps + 1.0)).floor() / steps } else { 0.0 };
+                                factor = if steps > 0.0 {
+                                    (factor * (steps + 1.0)).floor() / steps
+                                } else {
+                                    0.0
+                                };
                                 true
                             }
                             "SMOOTHSTEP" => {
@@ -409,7 +583,11 @@ pub fn map_range(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
                             }
                         };
                         let v = factor * (tmax - tmin) + tmin;
-                        r[k] = if clamp && clamp_it { clamp_range(v, tmin, tmax) } else { v };
+                        r[k] = if clamp && clamp_it {
+                            clamp_range(v, tmin, tmax)
+                        } else {
+                            v
+                        };
                     }
                     out.push(r);
                 }
@@ -425,7 +603,11 @@ pub fn map_range(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
 pub fn clamp(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let ty = ctx.prop_str("clamp_type")?;
     let range = ty == "RANGE";
-    let ins = vec![ctx.field("Value", DataType::Float)?, ctx.field("Min", DataType::Float)?, ctx.field("Max", DataType::Float)?];
+    let ins = vec![
+        ctx.field("Value", DataType::Float)?,
+        ctx.field("Min", DataType::Float)?,
+        ctx.field("Max", DataType::Float)?,
+    ];
     let out = Field::op1("Clamp", ins, DataType::Float, move |n, x| {
         let (v, a, b) = (x[0].as_float(), x[1].as_float(), x[2].as_float());
         Ok(Array::Float(
@@ -449,13 +631,21 @@ pub fn mix(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let clamp_factor = ctx.prop_bool("clamp_factor").unwrap_or(true);
     match dt {
         "FLOAT" => {
-            let ins = vec![ctx.field("Factor_Float", DataType::Float)?, ctx.field("A_Float", DataType::Float)?, ctx.field("B_Float", DataType::Float)?];
+            let ins = vec![
+                ctx.field("Factor_Float", DataType::Float)?,
+                ctx.field("A_Float", DataType::Float)?,
+                ctx.field("B_Float", DataType::Float)?,
+            ];
             let out = Field::op1("Mix", ins, DataType::Float, move |n, x| {
                 let (t, a, b) = (x[0].as_float(), x[1].as_float(), x[2].as_float());
                 Ok(Array::Float(
                     (0..n)
                         .map(|i| {
-                            let t = if clamp_factor { t[i].clamp(0.0, 1.0) } else { t[i] };
+                            let t = if clamp_factor {
+                                t[i].clamp(0.0, 1.0)
+                            } else {
+                                t[i]
+                            };
                             // BLI interpf(target, origin, t)
                             t * b[i] + (1.0 - t) * a[i]
                         })
@@ -467,8 +657,17 @@ pub fn mix(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         }
         "VECTOR" => {
             let uniform = ctx.prop_str("factor_mode").unwrap_or("UNIFORM") == "UNIFORM";
-            let tf = if uniform { ctx.field("Factor_Float", DataType::Float)?.convert(DataType::Vector) } else { ctx.field("Factor_Vector", DataType::Vector)? };
-            let ins = vec![tf, ctx.field("A_Vector", DataType::Vector)?, ctx.field("B_Vector", DataType::Vector)?];
+            let tf = if uniform {
+                ctx.field("Factor_Float", DataType::Float)?
+                    .convert(DataType::Vector)
+            } else {
+                ctx.field("Factor_Vector", DataType::Vector)?
+            };
+            let ins = vec![
+                tf,
+                ctx.field("A_Vector", DataType::Vector)?,
+                ctx.field("B_Vector", DataType::Vector)?,
+            ];
             let out = Field::op1("Mix", ins, DataType::Vector, move |n, x| {
                 let (t, a, b) = (x[0].as_vector(), x[1].as_vector(), x[2].as_vector());
                 Ok(Array::Vector(
@@ -476,7 +675,11 @@ pub fn mix(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
                         .map(|i| {
                             let mut r = [0.0; 3];
                             for k in 0..3 {
-                                let tk = if clamp_factor { t[i][k].clamp(0.0, 1.0) } else { t[i][k] };
+                                let tk = if clamp_factor {
+                                    t[i][k].clamp(0.0, 1.0)
+                                } else {
+                                    t[i][k]
+                                };
                                 r[k] = (1.0 - tk) * a[i][k] + tk * b[i][k];
                             }
                             r
@@ -488,12 +691,18 @@ pub fn mix(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             Ok(outputs([("Result_Vector", f(out))]))
         }
         "RGBA" => super::color::mix_rgba(ctx),
-        other => Err(ctx.err(format!("Mix of {other} is not supported in Geometry Nodes yet"))),
+        other => Err(ctx.err(format!(
+            "Mix of {other} is not supported in Geometry Nodes yet"
+        ))),
     }
 }
 
 pub fn combine_xyz(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
-    let ins = vec![ctx.field("X", DataType::Float)?, ctx.field("Y", DataType::Float)?, ctx.field("Z", DataType::Float)?];
+    let ins = vec![
+        ctx.field("X", DataType::Float)?,
+        ctx.field("Y", DataType::Float)?,
+        ctx.field("Z", DataType::Float)?,
+    ];
     let out = Field::op1("Combine XYZ", ins, DataType::Vector, |n, x| {
         let (a, b, c) = (x[0].as_float(), x[1].as_float(), x[2].as_float());
         Ok(Array::Vector((0..n).map(|i| [a[i], b[i], c[i]]).collect()))
@@ -506,11 +715,17 @@ pub fn separate_xyz(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let v = ctx.field("Vector", DataType::Vector)?;
     let outs = Field::op("Separate XYZ", vec![v], vec![DataType::Float; 3], |_, x| {
         let v = x[0].as_vector();
-        Ok((0..3).map(|k| Array::Float(v.iter().map(|p| p[k]).collect())).collect())
+        Ok((0..3)
+            .map(|k| Array::Float(v.iter().map(|p| p[k]).collect()))
+            .collect())
     })
     .map_err(|e| op_err(ctx, e))?;
     let mut it = outs.into_iter();
-    Ok(outputs([("X", f(it.next().unwrap())), ("Y", f(it.next().unwrap())), ("Z", f(it.next().unwrap()))]))
+    Ok(outputs([
+        ("X", f(it.next().unwrap())),
+        ("Y", f(it.next().unwrap())),
+        ("Z", f(it.next().unwrap())),
+    ]))
 }
 
 pub fn random_value(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -520,28 +735,65 @@ pub fn random_value(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let e = |x| op_err(ctx, x);
     match dt {
         "FLOAT" => {
-            let ins = vec![ctx.field("Min_001", DataType::Float)?, ctx.field("Max_001", DataType::Float)?, id, seed];
+            let ins = vec![
+                ctx.field("Min_001", DataType::Float)?,
+                ctx.field("Max_001", DataType::Float)?,
+                id,
+                seed,
+            ];
             let out = Field::op1("Random Value", ins, DataType::Float, |n, x| {
-                let (a, b, id, s) = (x[0].as_float(), x[1].as_float(), x[2].as_int(), x[3].as_int());
-                Ok(Array::Float((0..n).map(|i| random_float(a[i], b[i], id[i], s[i])).collect()))
+                let (a, b, id, s) = (
+                    x[0].as_float(),
+                    x[1].as_float(),
+                    x[2].as_int(),
+                    x[3].as_int(),
+                );
+                Ok(Array::Float(
+                    (0..n)
+                        .map(|i| random_float(a[i], b[i], id[i], s[i]))
+                        .collect(),
+                ))
             })
             .map_err(e)?;
             Ok(outputs([("Value_001", f(out))]))
         }
         "INT" => {
-            let ins = vec![ctx.field("Min_002", DataType::Int)?, ctx.field("Max_002", DataType::Int)?, id, seed];
+            let ins = vec![
+                ctx.field("Min_002", DataType::Int)?,
+                ctx.field("Max_002", DataType::Int)?,
+                id,
+                seed,
+            ];
             let out = Field::op1("Random Value", ins, DataType::Int, |n, x| {
                 let (a, b, id, s) = (x[0].as_int(), x[1].as_int(), x[2].as_int(), x[3].as_int());
-                Ok(Array::Int((0..n).map(|i| random_int(a[i], b[i], id[i], s[i])).collect()))
+                Ok(Array::Int(
+                    (0..n)
+                        .map(|i| random_int(a[i], b[i], id[i], s[i]))
+                        .collect(),
+                ))
             })
             .map_err(e)?;
             Ok(outputs([("Value_002", f(out))]))
         }
         "FLOAT_VECTOR" => {
-            let ins = vec![ctx.field("Min", DataType::Vector)?, ctx.field("Max", DataType::Vector)?, id, seed];
+            let ins = vec![
+                ctx.field("Min", DataType::Vector)?,
+                ctx.field("Max", DataType::Vector)?,
+                id,
+                seed,
+            ];
             let out = Field::op1("Random Value", ins, DataType::Vector, |n, x| {
-                let (a, b, id, s) = (x[0].as_vector(), x[1].as_vector(), x[2].as_int(), x[3].as_int());
-                Ok(Array::Vector((0..n).map(|i| random_vector(a[i], b[i], id[i], s[i])).collect()))
+                let (a, b, id, s) = (
+                    x[0].as_vector(),
+                    x[1].as_vector(),
+                    x[2].as_int(),
+                    x[3].as_int(),
+                );
+                Ok(Array::Vector(
+                    (0..n)
+                        .map(|i| random_vector(a[i], b[i], id[i], s[i]))
+                        .collect(),
+                ))
             })
             .map_err(e)?;
             Ok(outputs([("Value", f(out))]))
@@ -550,7 +802,9 @@ pub fn random_value(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             let ins = vec![ctx.field("Probability", DataType::Float)?, id, seed];
             let out = Field::op1("Random Value", ins, DataType::Bool, |n, x| {
                 let (p, id, s) = (x[0].as_float(), x[1].as_int(), x[2].as_int());
-                Ok(Array::Bool((0..n).map(|i| random_bool(p[i], id[i], s[i])).collect()))
+                Ok(Array::Bool(
+                    (0..n).map(|i| random_bool(p[i], id[i], s[i])).collect(),
+                ))
             })
             .map_err(e)?;
             Ok(outputs([("Value_003", f(out))]))
@@ -568,7 +822,8 @@ pub fn noise_texture_node(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         d => return Err(ctx.err(format!("dimensions {d} not supported"))),
     };
     let kind_name = ctx.prop_str("noise_type").unwrap_or("FBM");
-    let kind = NoiseType::from_blender(kind_name).ok_or_else(|| ctx.err(format!("noise type {kind_name} not supported")))?;
+    let kind = NoiseType::from_blender(kind_name)
+        .ok_or_else(|| ctx.err(format!("noise type {kind_name} not supported")))?;
     let normalize = ctx.prop_bool("normalize").unwrap_or(true);
     let zero = Field::Constant(Value::Float(0.0));
     let opt = |id: &str| -> Result<Field, GeometryError> {
@@ -578,34 +833,56 @@ pub fn noise_texture_node(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             Ok(zero.clone())
         }
     };
-    let vector = if ctx.has_input("Vector") { ctx.field("Vector", DataType::Vector)? } else { Field::Constant(Value::Vector([0.0; 3])) };
-    let ins = vec![vector, opt("W")?, opt("Scale")?, opt("Detail")?, opt("Roughness")?, opt("Lacunarity")?, opt("Offset")?, opt("Gain")?, opt("Distortion")?];
+    let vector = if ctx.has_input("Vector") {
+        ctx.field("Vector", DataType::Vector)?
+    } else {
+        Field::Constant(Value::Vector([0.0; 3]))
+    };
+    let ins = vec![
+        vector,
+        opt("W")?,
+        opt("Scale")?,
+        opt("Detail")?,
+        opt("Roughness")?,
+        opt("Lacunarity")?,
+        opt("Offset")?,
+        opt("Gain")?,
+        opt("Distortion")?,
+    ];
     let want_color = ctx.output_used("Color");
-    let outs = Field::op("Noise Texture", ins, vec![DataType::Float, DataType::Color], move |n, x| {
-        let v = x[0].as_vector();
-        let s: Vec<_> = x[1..].iter().map(|a| a.as_float()).collect();
-        let mut fac = Vec::with_capacity(n);
-        let mut col = Vec::with_capacity(n);
-        for i in 0..n {
-            let p = NoiseParams {
-                kind,
-                normalize,
-                detail: s[2][i],
-                roughness: s[3][i],
-                lacunarity: s[4][i],
-                offset: s[5][i],
-                gain: s[6][i],
-                distortion: s[7][i],
-            };
-            let (fv, c) = noise_texture(dims, v[i], s[0][i], s[1][i], p, want_color);
-            fac.push(fv);
-            col.push(c);
-        }
-        Ok(vec![Array::Float(fac), Array::Color(col)])
-    })
+    let outs = Field::op(
+        "Noise Texture",
+        ins,
+        vec![DataType::Float, DataType::Color],
+        move |n, x| {
+            let v = x[0].as_vector();
+            let s: Vec<_> = x[1..].iter().map(|a| a.as_float()).collect();
+            let mut fac = Vec::with_capacity(n);
+            let mut col = Vec::with_capacity(n);
+            for i in 0..n {
+                let p = NoiseParams {
+                    kind,
+                    normalize,
+                    detail: s[2][i],
+                    roughness: s[3][i],
+                    lacunarity: s[4][i],
+                    offset: s[5][i],
+                    gain: s[6][i],
+                    distortion: s[7][i],
+                };
+                let (fv, c) = noise_texture(dims, v[i], s[0][i], s[1][i], p, want_color);
+                fac.push(fv);
+                col.push(c);
+            }
+            Ok(vec![Array::Float(fac), Array::Color(col)])
+        },
+    )
     .map_err(|e| op_err(ctx, e))?;
     let mut it = outs.into_iter();
-    Ok(outputs([("Fac", f(it.next().unwrap())), ("Color", f(it.next().unwrap()))]))
+    Ok(outputs([
+        ("Fac", f(it.next().unwrap())),
+        ("Color", f(it.next().unwrap())),
+    ]))
 }
 
 /// Switch: a single condition picks one input, evaluating only that one; a field
@@ -618,10 +895,16 @@ pub fn switch(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             Ok(outputs([("Output", ctx.input(pick)?)]))
         }
         c => {
-            let (SocketValue::Field(a), SocketValue::Field(b)) = (ctx.input("False")?, ctx.input("True")?) else {
+            let (SocketValue::Field(a), SocketValue::Field(b)) =
+                (ctx.input("False")?, ctx.input("True")?)
+            else {
                 return Err(ctx.err("a field condition can only switch between fields"));
             };
-            let t = if super::super::types::Value::can_convert(a.data_type(), b.data_type()) { b.data_type() } else { a.data_type() };
+            let t = if super::super::types::Value::can_convert(a.data_type(), b.data_type()) {
+                b.data_type()
+            } else {
+                a.data_type()
+            };
             let out = Field::op1("Switch", vec![c, a.convert(t), b.convert(t)], t, |n, x| {
                 let s = x[0].as_bool();
                 let mut out = x[1].clone();

@@ -22,20 +22,32 @@ pub fn geo(g: GeometrySet) -> SocketValue {
 }
 
 /// Evaluates `fields` on `domain` of a component.
-pub fn eval_fields(comp: ComponentRef, domain: Domain, fields: &[(&Field, DataType)]) -> Result<Vec<Array>, String> {
+pub fn eval_fields(
+    comp: ComponentRef,
+    domain: Domain,
+    fields: &[(&Field, DataType)],
+) -> Result<Vec<Array>, String> {
     let ctx = FieldContext::new(comp);
-    fields.iter().map(|(f, t)| ctx.eval(f, domain, *t)).collect()
+    fields
+        .iter()
+        .map(|(f, t)| ctx.eval(f, domain, *t))
+        .collect()
 }
 
 /// Applies `f` to a geometry set and to every geometry its instances reference, as
 /// Blender's `modify_geometry_sets` does.
-pub fn modify_geometry_sets(set: &mut GeometrySet, f: &mut dyn FnMut(&mut GeometrySet) -> Result<(), String>) -> Result<(), String> {
+pub fn modify_geometry_sets(
+    set: &mut GeometrySet,
+    f: &mut dyn FnMut(&mut GeometrySet) -> Result<(), String>,
+) -> Result<(), String> {
     // Blender gathers every set first and then modifies each, so references the callback
     // adds to this set are not visited: children first, then the set itself.
     if let Some(inst) = set.instances_mut() {
         for r in inst.references.iter_mut() {
             match r {
-                InstanceReference::Geometry(g) | InstanceReference::Object(_, g) => modify_geometry_sets(g, f)?,
+                InstanceReference::Geometry(g) | InstanceReference::Object(_, g) => {
+                    modify_geometry_sets(g, f)?
+                }
                 InstanceReference::None => {}
             }
         }
@@ -89,7 +101,10 @@ pub fn transform_set(g: &mut GeometrySet, m: &Mat4f) {
 
 pub fn transform(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let mut g = ctx.geometry("Geometry")?;
-    let mode = ctx.prop("mode").and_then(|v| v.as_str()).unwrap_or("COMPONENTS");
+    let mode = ctx
+        .prop("mode")
+        .and_then(|v| v.as_str())
+        .unwrap_or("COMPONENTS");
     let m = if mode == "MATRIX" {
         ctx.single("Transform", DataType::Matrix)?.as_matrix()
     } else {
@@ -107,7 +122,11 @@ pub fn set_position(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let sel = ctx.field("Selection", DataType::Bool)?;
     let pos = ctx.field("Position", DataType::Vector)?;
     let off = ctx.field("Offset", DataType::Vector)?;
-    let fields = [(&sel, DataType::Bool), (&pos, DataType::Vector), (&off, DataType::Vector)];
+    let fields = [
+        (&sel, DataType::Bool),
+        (&pos, DataType::Vector),
+        (&off, DataType::Vector),
+    ];
     let apply = |positions: &mut Vec<[f32; 3]>, r: Vec<Array>| {
         let (s, p, o) = (r[0].as_bool(), r[1].as_vector(), r[2].as_vector());
         for i in 0..positions.len() {
@@ -132,8 +151,13 @@ pub fn set_position(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         apply(&mut g.curves_mut().unwrap().positions, r);
     }
     if let Some(inst) = g.instances.clone() {
-        let r = eval_fields(ComponentRef::Instances(&inst), Domain::Instance, &fields).map_err(e)?;
-        let mut pos: Vec<[f32; 3]> = inst.transforms.iter().map(|t| [t[3][0], t[3][1], t[3][2]]).collect();
+        let r =
+            eval_fields(ComponentRef::Instances(&inst), Domain::Instance, &fields).map_err(e)?;
+        let mut pos: Vec<[f32; 3]> = inst
+            .transforms
+            .iter()
+            .map(|t| [t[3][0], t[3][1], t[3][2]])
+            .collect();
         apply(&mut pos, r);
         for (t, p) in g.instances_mut().unwrap().transforms.iter_mut().zip(pos) {
             t[3][0] = p[0];
@@ -160,7 +184,11 @@ pub fn set_material(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             if m.face_count() == 0 {
                 return Ok(());
             }
-            let r = eval_fields(ComponentRef::Mesh(&m), Domain::Face, &[(&sel, DataType::Bool)])?;
+            let r = eval_fields(
+                ComponentRef::Mesh(&m),
+                Domain::Face,
+                &[(&sel, DataType::Bool)],
+            )?;
             let sel = r[0].as_bool();
             let count = sel.iter().filter(|x| **x).count();
             let mm = s.mesh_mut().unwrap();
@@ -174,13 +202,21 @@ pub fn set_material(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
                     mm.materials.len() - 1
                 }
             } as i32;
-            let mut mi = mm.attributes.named("material_index").map(|a| a.data.as_int().into_owned()).unwrap_or_else(|| vec![0; mm.face_count()]);
+            let mut mi = mm
+                .attributes
+                .named("material_index")
+                .map(|a| a.data.as_int().into_owned())
+                .unwrap_or_else(|| vec![0; mm.face_count()]);
             for (i, s) in sel.iter().enumerate() {
                 if *s {
                     mi[i] = index;
                 }
             }
-            mm.attributes.set(AttrId::named("material_index"), Domain::Face, Array::Int(mi));
+            mm.attributes.set(
+                AttrId::named("material_index"),
+                Domain::Face,
+                Array::Int(mi),
+            );
         }
         if let Some(p) = s.points_mut() {
             p.materials = vec![material.clone()];
@@ -196,20 +232,34 @@ pub fn set_material(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
 
 pub fn set_shade_smooth(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let mut g = ctx.geometry("Geometry")?;
-    let domain = match ctx.prop("domain").and_then(|v| v.as_str()).unwrap_or("FACE") {
+    let domain = match ctx
+        .prop("domain")
+        .and_then(|v| v.as_str())
+        .unwrap_or("FACE")
+    {
         "EDGE" => Domain::Edge,
         _ => Domain::Face,
     };
-    let name = if domain == Domain::Edge { "sharp_edge" } else { "sharp_face" };
+    let name = if domain == Domain::Edge {
+        "sharp_edge"
+    } else {
+        "sharp_face"
+    };
     let sel = ctx.field("Selection", DataType::Bool)?;
     let smooth = ctx.field("Shade Smooth", DataType::Bool)?;
     modify_geometry_sets(&mut g, &mut |s: &mut GeometrySet| {
-        let Some(m) = s.mesh.clone() else { return Ok(()) };
+        let Some(m) = s.mesh.clone() else {
+            return Ok(());
+        };
         let n = m.domain_size(domain);
         if n == 0 {
             return Ok(());
         }
-        let r = eval_fields(ComponentRef::Mesh(&m), domain, &[(&sel, DataType::Bool), (&smooth, DataType::Bool)])?;
+        let r = eval_fields(
+            ComponentRef::Mesh(&m),
+            domain,
+            &[(&sel, DataType::Bool), (&smooth, DataType::Bool)],
+        )?;
         let (sel, smooth) = (r[0].as_bool(), r[1].as_bool());
         let mm = s.mesh_mut().unwrap();
         let mut sharp = match mm.attributes.named(name) {
@@ -221,7 +271,8 @@ pub fn set_shade_smooth(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
                 sharp[i] = !smooth[i];
             }
         }
-        mm.attributes.set(AttrId::named(name), domain, Array::Bool(sharp));
+        mm.attributes
+            .set(AttrId::named(name), domain, Array::Bool(sharp));
         Ok(())
     })
     .map_err(|e| ctx.err(e))?;
@@ -234,9 +285,13 @@ pub fn realize(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         let sel = ctx.field("Selection", DataType::Bool)?;
         let all = ctx.field("Realize All", DataType::Bool)?;
         let depth = ctx.field("Depth", DataType::Int)?;
-        let ok = matches!(sel, Field::Constant(Value::Bool(true))) && matches!(all, Field::Constant(Value::Bool(true))) && matches!(depth, Field::Constant(_));
+        let ok = matches!(sel, Field::Constant(Value::Bool(true)))
+            && matches!(all, Field::Constant(Value::Bool(true)))
+            && matches!(depth, Field::Constant(_));
         if !ok {
-            return Err(ctx.err("only realizing all instances (Selection on, Realize All on) is supported"));
+            return Err(
+                ctx.err("only realizing all instances (Selection on, Realize All on) is supported")
+            );
         }
     }
     Ok(outputs([("Geometry", geo(realize_instances(&g)))]))
@@ -250,7 +305,10 @@ fn point_attributes(comp: ComponentRef) -> Vec<(AttrId, Domain, Array)> {
         ComponentRef::Curves(c) => &c.attributes,
         ComponentRef::Instances(i) => &i.attributes,
     };
-    attrs.iter().map(|a| (a.id.clone(), a.domain, a.data.clone())).collect()
+    attrs
+        .iter()
+        .map(|a| (a.id.clone(), a.domain, a.data.clone()))
+        .collect()
 }
 
 pub fn instance_on_points(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -265,9 +323,18 @@ pub fn instance_on_points(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     modify_geometry_sets(&mut g, &mut |s: &mut GeometrySet| {
         let mut dst = s.instances.as_deref().cloned().unwrap_or_default();
         let comps: Vec<GeometrySet> = vec![
-            GeometrySet { mesh: s.mesh.clone(), ..Default::default() },
-            GeometrySet { points: s.points.clone(), ..Default::default() },
-            GeometrySet { curves: s.curves.clone(), ..Default::default() },
+            GeometrySet {
+                mesh: s.mesh.clone(),
+                ..Default::default()
+            },
+            GeometrySet {
+                points: s.points.clone(),
+                ..Default::default()
+            },
+            GeometrySet {
+                curves: s.curves.clone(),
+                ..Default::default()
+            },
         ];
         for c in &comps {
             let comp = if let Some(m) = &c.mesh {
@@ -279,8 +346,24 @@ pub fn instance_on_points(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             } else {
                 continue;
             };
-            let r = eval_fields(comp, Domain::Point, &[(&sel, DataType::Bool), (&pick, DataType::Bool), (&index, DataType::Int), (&rot, DataType::Quaternion), (&scale, DataType::Vector)])?;
-            let (sel, pick, _index, rot, scale) = (r[0].as_bool(), r[1].as_bool(), r[2].as_int(), r[3].as_quat(), r[4].as_vector());
+            let r = eval_fields(
+                comp,
+                Domain::Point,
+                &[
+                    (&sel, DataType::Bool),
+                    (&pick, DataType::Bool),
+                    (&index, DataType::Int),
+                    (&rot, DataType::Quaternion),
+                    (&scale, DataType::Vector),
+                ],
+            )?;
+            let (sel, pick, _index, rot, scale) = (
+                r[0].as_bool(),
+                r[1].as_bool(),
+                r[2].as_int(),
+                r[3].as_quat(),
+                r[4].as_vector(),
+            );
             let selected: Vec<usize> = (0..sel.len()).filter(|&i| sel[i]).collect();
             if selected.is_empty() {
                 continue;
@@ -288,17 +371,23 @@ pub fn instance_on_points(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             if selected.iter().any(|&i| pick[i]) {
                 return Err("Pick Instance is not supported yet".into());
             }
-            let (_, pos) = comp.attribute(&AttrId::named("position")).ok_or("no positions")?;
+            let (_, pos) = comp
+                .attribute(&AttrId::named("position"))
+                .ok_or("no positions")?;
             let pos = pos.as_vector().into_owned();
             let start = dst.len();
             let handle = dst.add_reference(InstanceReference::Geometry(instance.clone()));
             for &i in &selected {
-                dst.transforms.push(from_loc_rot_scale(pos[i], rot[i], scale[i]));
+                dst.transforms
+                    .push(from_loc_rot_scale(pos[i], rot[i], scale[i]));
                 dst.handles.push(handle);
             }
             // Point attributes move to the new instances.
             for (id, domain, data) in point_attributes(comp) {
-                if id.name().is_some_and(|n| n == "position" || n.starts_with('.')) {
+                if id
+                    .name()
+                    .is_some_and(|n| n == "position" || n.starts_with('.'))
+                {
                     continue;
                 }
                 let on_points = comp.adapt(&data, domain, Domain::Point).gather(&selected);
@@ -324,7 +413,11 @@ pub fn instance_on_points(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         s.mesh = None;
         s.points = None;
         s.curves = None;
-        s.instances = if dst.is_empty() && dst.references.is_empty() { None } else { Some(Arc::new(dst)) };
+        s.instances = if dst.is_empty() && dst.references.is_empty() {
+            None
+        } else {
+            Some(Arc::new(dst))
+        };
         Ok(())
     })
     .map_err(e)?;
@@ -344,19 +437,43 @@ pub fn mesh_to_points(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         m => return Err(ctx.err(format!("mode {m} is not supported"))),
     };
     modify_geometry_sets(&mut g, &mut |s: &mut GeometrySet| {
-        let Some(m) = s.mesh.clone() else { return Ok(()) };
-        let r = eval_fields(ComponentRef::Mesh(&m), domain, &[(&sel, DataType::Bool), (&pos, DataType::Vector), (&radius, DataType::Float)])?;
+        let Some(m) = s.mesh.clone() else {
+            return Ok(());
+        };
+        let r = eval_fields(
+            ComponentRef::Mesh(&m),
+            domain,
+            &[
+                (&sel, DataType::Bool),
+                (&pos, DataType::Vector),
+                (&radius, DataType::Float),
+            ],
+        )?;
         let (sel, pos, rad) = (r[0].as_bool(), r[1].as_vector(), r[2].as_float());
         let idx: Vec<usize> = (0..sel.len()).filter(|&i| sel[i]).collect();
-        let mut pc = PointCloud { positions: idx.iter().map(|&i| pos[i]).collect(), ..Default::default() };
+        let mut pc = PointCloud {
+            positions: idx.iter().map(|&i| pos[i]).collect(),
+            ..Default::default()
+        };
         for a in m.attributes.iter() {
-            if a.id.name().is_some_and(|n| n.starts_with('.') || n == "sharp_face" || n == "material_index" || n == "sharp_edge") {
+            if a.id.name().is_some_and(|n| {
+                n.starts_with('.')
+                    || n == "sharp_face"
+                    || n == "material_index"
+                    || n == "sharp_edge"
+            }) {
                 continue;
             }
-            let on = ComponentRef::Mesh(&m).adapt(&a.data, a.domain, domain).gather(&idx);
+            let on = ComponentRef::Mesh(&m)
+                .adapt(&a.data, a.domain, domain)
+                .gather(&idx);
             pc.attributes.set(a.id.clone(), Domain::Point, on);
         }
-        pc.attributes.set(AttrId::named("radius"), Domain::Point, Array::Float(idx.iter().map(|&i| rad[i]).collect()));
+        pc.attributes.set(
+            AttrId::named("radius"),
+            Domain::Point,
+            Array::Float(idx.iter().map(|&i| rad[i]).collect()),
+        );
         s.mesh = None;
         s.points = Some(Arc::new(pc));
         Ok(())
@@ -369,8 +486,14 @@ pub fn points_to_vertices(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let mut g = ctx.geometry("Points")?;
     let sel = ctx.field("Selection", DataType::Bool)?;
     modify_geometry_sets(&mut g, &mut |s: &mut GeometrySet| {
-        let Some(p) = s.points.clone() else { return Ok(()) };
-        let r = eval_fields(ComponentRef::Points(&p), Domain::Point, &[(&sel, DataType::Bool)])?;
+        let Some(p) = s.points.clone() else {
+            return Ok(());
+        };
+        let r = eval_fields(
+            ComponentRef::Points(&p),
+            Domain::Point,
+            &[(&sel, DataType::Bool)],
+        )?;
         let sel = r[0].as_bool();
         let idx: Vec<usize> = (0..sel.len()).filter(|&i| sel[i]).collect();
         let mut m = Mesh::new();
@@ -379,7 +502,8 @@ pub fn points_to_vertices(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             if a.id.name() == Some("radius") {
                 continue;
             }
-            m.attributes.set(a.id.clone(), Domain::Point, a.data.gather(&idx));
+            m.attributes
+                .set(a.id.clone(), Domain::Point, a.data.gather(&idx));
         }
         m.materials = p.materials.clone();
         s.points = None;

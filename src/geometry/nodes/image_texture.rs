@@ -36,7 +36,10 @@ fn decode(f: &ImageFile) -> Result<FloatImage, String> {
     let rows: Vec<[f32; 4]> = match &img {
         D::ImageRgb32F(_) | D::ImageRgba32F(_) => {
             if f.encoding == Encoding::Srgb {
-                return Err("float images in the sRGB colour space are not supported in Geometry Nodes yet".into());
+                return Err(
+                    "float images in the sRGB colour space are not supported in Geometry Nodes yet"
+                        .into(),
+                );
             }
             img.to_rgba32f()
                 .pixels()
@@ -110,50 +113,94 @@ fn decode(f: &ImageFile) -> Result<FloatImage, String> {
                 .collect()
         }
     };
-    Ok(FloatImage { width: w as i32, height: h as i32, pixels: flip_rows(&rows, w, h) })
+    Ok(FloatImage {
+        width: w as i32,
+        height: h as i32,
+        pixels: flip_rows(&rows, w, h),
+    })
 }
 
 pub fn image_texture(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let interp_name = ctx.prop_str("interpolation")?;
-    let interpolation = Interpolation::from_blender(interp_name).ok_or_else(|| ctx.err(format!("interpolation {interp_name:?} is not supported")))?;
+    let interpolation = Interpolation::from_blender(interp_name)
+        .ok_or_else(|| ctx.err(format!("interpolation {interp_name:?} is not supported")))?;
     let ext_name = ctx.prop_str("extension")?;
-    let extension = Extension::from_blender(ext_name).ok_or_else(|| ctx.err(format!("extension {ext_name:?} is not supported")))?;
+    let extension = Extension::from_blender(ext_name)
+        .ok_or_else(|| ctx.err(format!("extension {ext_name:?} is not supported")))?;
     let name = match ctx.input("Image")? {
         SocketValue::Image(n) => n,
-        other => return Err(ctx.err(format!("input \"Image\" is a {}, expected an image", other.kind()))),
+        other => {
+            return Err(ctx.err(format!(
+                "input \"Image\" is a {}, expected an image",
+                other.kind()
+            )))
+        }
     };
     let Some(name) = name else {
         // No image: Blender sets the outputs' defaults.
-        return Ok(outputs([("Color", SocketValue::Field(Field::Constant(super::super::types::Value::Color([0.0; 4])))), ("Alpha", SocketValue::float(0.0))]));
+        return Ok(outputs([
+            (
+                "Color",
+                SocketValue::Field(Field::Constant(super::super::types::Value::Color([0.0; 4]))),
+            ),
+            ("Alpha", SocketValue::float(0.0)),
+        ]));
     };
-    let file = image_file(ctx.session().scene, &name).map_err(|e| ctx.err(e))?.ok_or_else(|| ctx.err(format!("image {name:?} has no file in the export (missing or generated)")))?;
-    let alpha_mode = if file.is_data { "CHANNEL_PACKED".to_string() } else { file.alpha_mode.clone() };
-    if !matches!(alpha_mode.as_str(), "STRAIGHT" | "PREMUL" | "CHANNEL_PACKED" | "NONE") {
-        return Err(ctx.err(format!("image {name:?}: alpha mode {alpha_mode:?} is not supported")));
+    let file = image_file(ctx.session().scene, &name)
+        .map_err(|e| ctx.err(e))?
+        .ok_or_else(|| {
+            ctx.err(format!(
+                "image {name:?} has no file in the export (missing or generated)"
+            ))
+        })?;
+    let alpha_mode = if file.is_data {
+        "CHANNEL_PACKED".to_string()
+    } else {
+        file.alpha_mode.clone()
+    };
+    if !matches!(
+        alpha_mode.as_str(),
+        "STRAIGHT" | "PREMUL" | "CHANNEL_PACKED" | "NONE"
+    ) {
+        return Err(ctx.err(format!(
+            "image {name:?}: alpha mode {alpha_mode:?} is not supported"
+        )));
     }
     let img = Arc::new(decode(&file).map_err(|e| ctx.err(format!("image {name:?}: {e}")))?);
-    let outs = Field::op("Image Texture", vec![ctx.field("Vector", DataType::Vector)?], vec![DataType::Color, DataType::Float], move |n, x| {
-        let v = x[0].as_vector();
-        let px = Pixels { data: &img.pixels, width: img.width, height: img.height };
-        let (mut col, mut alpha) = (Vec::with_capacity(n), Vec::with_capacity(n));
-        for p in v.iter() {
-            let mut c = px.interp_geometry_nodes(p[0], p[1], interpolation, extension);
-            match alpha_mode.as_str() {
-                // The field's colours are associated: straight images are multiplied.
-                "STRAIGHT" => {
-                    for k in 0..3 {
-                        c[k] *= c[3];
+    let outs = Field::op(
+        "Image Texture",
+        vec![ctx.field("Vector", DataType::Vector)?],
+        vec![DataType::Color, DataType::Float],
+        move |n, x| {
+            let v = x[0].as_vector();
+            let px = Pixels {
+                data: &img.pixels,
+                width: img.width,
+                height: img.height,
+            };
+            let (mut col, mut alpha) = (Vec::with_capacity(n), Vec::with_capacity(n));
+            for p in v.iter() {
+                let mut c = px.interp_geometry_nodes(p[0], p[1], interpolation, extension);
+                match alpha_mode.as_str() {
+                    // The field's colours are associated: straight images are multiplied.
+                    "STRAIGHT" => {
+                        for k in 0..3 {
+                            c[k] *= c[3];
+                        }
                     }
+                    "NONE" => c[3] = 1.0,
+                    _ => {}
                 }
-                "NONE" => c[3] = 1.0,
-                _ => {}
+                col.push(c);
+                alpha.push(c[3]);
             }
-            col.push(c);
-            alpha.push(c[3]);
-        }
-        Ok(vec![Array::Color(col), Array::Float(alpha)])
-    })
+            Ok(vec![Array::Color(col), Array::Float(alpha)])
+        },
+    )
     .map_err(|e| ctx.err(e))?;
     let mut it = outs.into_iter();
-    Ok(outputs([("Color", SocketValue::Field(it.next().unwrap())), ("Alpha", SocketValue::Field(it.next().unwrap()))]))
+    Ok(outputs([
+        ("Color", SocketValue::Field(it.next().unwrap())),
+        ("Alpha", SocketValue::Field(it.next().unwrap())),
+    ]))
 }

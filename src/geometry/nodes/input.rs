@@ -29,29 +29,46 @@ pub fn id(_: &NodeCtx) -> Result<Outputs, GeometryError> {
 }
 
 pub fn self_object(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
-    Ok(outputs([("Self Object", SocketValue::Object(Some(ctx.ev.object.name.clone())))]))
+    Ok(outputs([(
+        "Self Object",
+        SocketValue::Object(Some(ctx.ev.object.name.clone())),
+    )]))
 }
 
 pub fn scene_time(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let s = &ctx.session().scene.file.scene;
     let ctime = crate::anim::ctime(ctx.session().frame);
     let fps = (s.fps / s.fps_base) as f32;
-    Ok(outputs([("Seconds", SocketValue::float(ctime / fps)), ("Frame", SocketValue::float(ctime))]))
+    Ok(outputs([
+        ("Seconds", SocketValue::float(ctime / fps)),
+        ("Frame", SocketValue::float(ctime)),
+    ]))
 }
 
 pub fn input_material(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
-    let m = ctx.prop("material").and_then(|v| v.get("name")).and_then(|v| v.as_str()).map(str::to_string);
+    let m = ctx
+        .prop("material")
+        .and_then(|v| v.get("name"))
+        .and_then(|v| v.as_str())
+        .map(str::to_string);
     Ok(outputs([("Material", SocketValue::Material(m))]))
 }
 
 pub fn input_string(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
-    let s = ctx.prop("string").and_then(|v| v.as_str()).unwrap_or_default().to_string();
+    let s = ctx
+        .prop("string")
+        .and_then(|v| v.as_str())
+        .unwrap_or_default()
+        .to_string();
     Ok(outputs([("String", SocketValue::String(s))]))
 }
 
 pub fn is_viewport(_: &NodeCtx) -> Result<Outputs, GeometryError> {
     // blendsynth renders: the final render's answer.
-    Ok(outputs([("Is Viewport", f(Field::Constant(Value::Bool(false))))]))
+    Ok(outputs([(
+        "Is Viewport",
+        f(Field::Constant(Value::Bool(false))),
+    )]))
 }
 
 /// Location, rotation and scale of a matrix (`to_loc_rot_scale_safe`).
@@ -59,7 +76,9 @@ fn decompose(m: &Mat4f) -> ([f32; 3], [f32; 4], [f32; 3]) {
     let loc = [m[3][0], m[3][1], m[3][2]];
     let len = |c: usize| (m[c][0] * m[c][0] + m[c][1] * m[c][1] + m[c][2] * m[c][2]).sqrt();
     let mut scale = [len(0), len(1), len(2)];
-    let det = m[0][0] * (m[1][1] * m[2][2] - m[2][1] * m[1][2]) - m[1][0] * (m[0][1] * m[2][2] - m[2][1] * m[0][2]) + m[2][0] * (m[0][1] * m[1][2] - m[1][1] * m[0][2]);
+    let det = m[0][0] * (m[1][1] * m[2][2] - m[2][1] * m[1][2])
+        - m[1][0] * (m[0][1] * m[2][2] - m[2][1] * m[0][2])
+        + m[2][0] * (m[0][1] * m[1][2] - m[1][1] * m[0][2]);
     let mut r = *m;
     if det < 0.0 {
         scale = [-scale[0], -scale[1], -scale[2]];
@@ -78,14 +97,25 @@ pub fn object_info(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     };
     let relative = ctx.prop_str("transform_space")? == "RELATIVE";
     let Some(name) = obj else {
-        return Ok(ctx.node().outputs.iter().map(|s| (s.identifier.clone(), SocketValue::zero(&s.kind))).collect());
+        return Ok(ctx
+            .node()
+            .outputs
+            .iter()
+            .map(|s| (s.identifier.clone(), SocketValue::zero(&s.kind)))
+            .collect());
     };
     if name == ctx.ev.object.name {
-        return Err(ctx.err("Object Info cannot read its own object (Blender reports a dependency cycle)"));
+        return Err(
+            ctx.err("Object Info cannot read its own object (Blender reports a dependency cycle)")
+        );
     }
     let session = ctx.session();
-    let world = session.world_matrix(&name).ok_or_else(|| ctx.err(format!("object {name:?} is not in the export")))?;
-    let self_world = session.world_matrix(&ctx.ev.object.name).unwrap_or(MAT4_IDENTITY);
+    let world = session
+        .world_matrix(&name)
+        .ok_or_else(|| ctx.err(format!("object {name:?} is not in the export")))?;
+    let self_world = session
+        .world_matrix(&ctx.ev.object.name)
+        .unwrap_or(MAT4_IDENTITY);
     let self_inv = mat4_invert(&self_world).unwrap_or(MAT4_IDENTITY);
     let transform = mat4_mul(&self_inv, &world);
     let out_t = if relative { transform } else { world };
@@ -94,7 +124,10 @@ pub fn object_info(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let geometry = session.evaluate_object(&name).map_err(|e| ctx.err(e))?;
     let g = if as_instance {
         let t = if relative { transform } else { MAT4_IDENTITY };
-        GeometrySet::from_instances(single_instance(InstanceReference::Object(name.clone(), geometry), t))
+        GeometrySet::from_instances(single_instance(
+            InstanceReference::Object(name.clone(), geometry),
+            t,
+        ))
     } else {
         let mut g = geometry;
         if relative {

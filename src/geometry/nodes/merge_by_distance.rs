@@ -17,19 +17,31 @@ pub fn merge_by_distance(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let sel = ctx.field("Selection", DataType::Bool)?;
     let distance = ctx.float("Distance")?;
     // Blender 4.5 has a Mode menu socket; older files a `mode` property.
-    let mode = if ctx.has_input("Mode") { ctx.string("Mode")? } else { ctx.prop_str("mode").unwrap_or("ALL").to_string() };
+    let mode = if ctx.has_input("Mode") {
+        ctx.string("Mode")?
+    } else {
+        ctx.prop_str("mode").unwrap_or("ALL").to_string()
+    };
     if mode != "ALL" && mode != "CONNECTED" {
         return Err(ctx.err(format!("mode {mode:?} is not a Merge by Distance mode")));
     }
     modify_geometry_sets(&mut g, &mut |s| {
         if let Some(p) = s.points.clone() {
-            let r = eval_fields(ComponentRef::Points(&p), Domain::Point, &[(&sel, DataType::Bool)])?;
+            let r = eval_fields(
+                ComponentRef::Points(&p),
+                Domain::Point,
+                &[(&sel, DataType::Bool)],
+            )?;
             if let Some(np) = merge_points(&p, &r[0].as_bool(), distance) {
                 s.points = Some(Arc::new(np));
             }
         }
         if let Some(m) = s.mesh.clone() {
-            let r = eval_fields(ComponentRef::Mesh(&m), Domain::Point, &[(&sel, DataType::Bool)])?;
+            let r = eval_fields(
+                ComponentRef::Mesh(&m),
+                Domain::Point,
+                &[(&sel, DataType::Bool)],
+            )?;
             let selection = r[0].as_bool();
             let (dest, killed) = if mode == "ALL" {
                 weld::duplicates_all(&m.positions, &selection, distance)
@@ -71,17 +83,28 @@ fn merge_points(p: &PointCloud, selection: &[bool], distance: f32) -> Option<Poi
     for g in groups.iter_mut() {
         g.sort_unstable();
     }
-    let mut out = PointCloud { materials: p.materials.clone(), ..Default::default() };
-    out.positions = weld::mix_groups(&super::super::types::Array::Vector(p.positions.clone()), &groups).as_vector().into_owned();
+    let mut out = PointCloud {
+        materials: p.materials.clone(),
+        ..Default::default()
+    };
+    out.positions = weld::mix_groups(
+        &super::super::types::Array::Vector(p.positions.clone()),
+        &groups,
+    )
+    .as_vector()
+    .into_owned();
     for a in p.attributes.iter() {
         let data = if a.id.name() == Some("id") {
             // Blender reads the id at each group's offset into its merge map (the running
             // count of merged sources), not at the group's first source index; match it.
-            let offsets: Vec<usize> = groups.iter().scan(0, |acc, g| {
-                let o = *acc;
-                *acc += g.len();
-                Some(o)
-            }).collect();
+            let offsets: Vec<usize> = groups
+                .iter()
+                .scan(0, |acc, g| {
+                    let o = *acc;
+                    *acc += g.len();
+                    Some(o)
+                })
+                .collect();
             a.data.gather(&offsets)
         } else {
             weld::mix_groups(&a.data, &groups)

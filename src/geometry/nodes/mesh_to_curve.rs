@@ -63,7 +63,10 @@ pub fn edges_to_curve_points(verts: usize, edges: &[[u32; 2]]) -> (Vec<u32>, Vec
                 if count(current) != 2 {
                     break;
                 }
-                let (a, b) = (neighbors[offs[current]] as usize, neighbors[offs[current] + 1] as usize);
+                let (a, b) = (
+                    neighbors[offs[current]] as usize,
+                    neighbors[offs[current] + 1] as usize,
+                );
                 next = if last == a { b } else { a };
             }
         }
@@ -83,7 +86,10 @@ pub fn edges_to_curve_points(verts: usize, edges: &[[u32; 2]]) -> (Vec<u32>, Vec
             points.push(current as u32);
             unused[current] -= 1;
             unused[last] -= 1;
-            let (a, b) = (neighbors[offs[current]] as usize, neighbors[offs[current] + 1] as usize);
+            let (a, b) = (
+                neighbors[offs[current]] as usize,
+                neighbors[offs[current] + 1] as usize,
+            );
             next = if last == a { b } else { a };
         }
     }
@@ -100,17 +106,30 @@ pub fn mesh_edges_to_curves(m: &Mesh, edges: &[[u32; 2]]) -> Curves {
     let n_curves = offsets.len();
     offsets.push(points.len() as u32);
     let idx: Vec<usize> = points.iter().map(|&v| v as usize).collect();
-    let mut c = Curves { positions: idx.iter().map(|&v| m.positions[v]).collect(), curve_offsets: offsets, ..Default::default() };
-    c.attributes.set(AttrId::named("curve_type"), Domain::Curve, Array::Int8(vec![CURVE_TYPE_POLY; n_curves]));
+    let mut c = Curves {
+        positions: idx.iter().map(|&v| m.positions[v]).collect(),
+        curve_offsets: offsets,
+        ..Default::default()
+    };
+    c.attributes.set(
+        AttrId::named("curve_type"),
+        Domain::Curve,
+        Array::Int8(vec![CURVE_TYPE_POLY; n_curves]),
+    );
     if cyclic_start < n_curves {
-        c.attributes.set(AttrId::named("cyclic"), Domain::Curve, Array::Bool((0..n_curves).map(|i| i >= cyclic_start).collect()));
+        c.attributes.set(
+            AttrId::named("cyclic"),
+            Domain::Curve,
+            Array::Bool((0..n_curves).map(|i| i >= cyclic_start).collect()),
+        );
     }
     for a in m.attributes.iter() {
         if a.id.name().is_some_and(is_mesh_builtin) {
             continue;
         }
         let on_points = ComponentRef::Mesh(m).adapt(&a.data, a.domain, Domain::Point);
-        c.attributes.set(a.id.clone(), Domain::Point, on_points.gather(&idx));
+        c.attributes
+            .set(a.id.clone(), Domain::Point, on_points.gather(&idx));
     }
     c.materials = m.materials.clone();
     c
@@ -126,22 +145,46 @@ pub fn mesh_faces_to_curves(m: &Mesh, faces: &[usize]) -> Curves {
         corners.extend(m.face(f));
         offsets.push(corners.len() as u32);
     }
-    let verts: Vec<usize> = corners.iter().map(|&c| m.corner_verts[c] as usize).collect();
+    let verts: Vec<usize> = corners
+        .iter()
+        .map(|&c| m.corner_verts[c] as usize)
+        .collect();
     let n = faces.len();
-    let mut c = Curves { positions: verts.iter().map(|&v| m.positions[v]).collect(), curve_offsets: offsets, ..Default::default() };
-    c.attributes.set(AttrId::named("curve_type"), Domain::Curve, Array::Int8(vec![CURVE_TYPE_POLY; n]));
-    c.attributes.set(AttrId::named("cyclic"), Domain::Curve, Array::Bool(vec![true; n]));
+    let mut c = Curves {
+        positions: verts.iter().map(|&v| m.positions[v]).collect(),
+        curve_offsets: offsets,
+        ..Default::default()
+    };
+    c.attributes.set(
+        AttrId::named("curve_type"),
+        Domain::Curve,
+        Array::Int8(vec![CURVE_TYPE_POLY; n]),
+    );
+    c.attributes.set(
+        AttrId::named("cyclic"),
+        Domain::Curve,
+        Array::Bool(vec![true; n]),
+    );
     for a in m.attributes.iter() {
-        if a.id.name().is_some_and(|x| x.starts_with('.') || matches!(x, "sharp_face" | "sharp_edge")) {
+        if a.id
+            .name()
+            .is_some_and(|x| x.starts_with('.') || matches!(x, "sharp_face" | "sharp_edge"))
+        {
             continue;
         }
         match a.domain {
             Domain::Point | Domain::Edge => {
                 let on_points = ComponentRef::Mesh(m).adapt(&a.data, a.domain, Domain::Point);
-                c.attributes.set(a.id.clone(), Domain::Point, on_points.gather(&verts));
+                c.attributes
+                    .set(a.id.clone(), Domain::Point, on_points.gather(&verts));
             }
-            Domain::Corner => c.attributes.set(a.id.clone(), Domain::Point, a.data.gather(&corners)),
-            Domain::Face => c.attributes.set(a.id.clone(), Domain::Curve, a.data.gather(faces)),
+            Domain::Corner => {
+                c.attributes
+                    .set(a.id.clone(), Domain::Point, a.data.gather(&corners))
+            }
+            Domain::Face => c
+                .attributes
+                .set(a.id.clone(), Domain::Curve, a.data.gather(faces)),
             _ => {}
         }
     }
@@ -158,16 +201,29 @@ pub fn mesh_to_curve(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         other => return Err(ctx.err(format!("mode {other} is not a Mesh to Curve mode"))),
     };
     modify_geometry_sets(&mut g, &mut |s| {
-        let Some(m) = s.mesh.clone() else { return Ok(()) };
+        let Some(m) = s.mesh.clone() else {
+            return Ok(());
+        };
         let curves = if faces_mode {
-            let r = eval_fields(ComponentRef::Mesh(&m), Domain::Face, &[(&sel, DataType::Bool)])?;
+            let r = eval_fields(
+                ComponentRef::Mesh(&m),
+                Domain::Face,
+                &[(&sel, DataType::Bool)],
+            )?;
             let sel = r[0].as_bool();
             let faces: Vec<usize> = (0..m.face_count()).filter(|&f| sel[f]).collect();
             (!faces.is_empty()).then(|| mesh_faces_to_curves(&m, &faces))
         } else {
-            let r = eval_fields(ComponentRef::Mesh(&m), Domain::Edge, &[(&sel, DataType::Bool)])?;
+            let r = eval_fields(
+                ComponentRef::Mesh(&m),
+                Domain::Edge,
+                &[(&sel, DataType::Bool)],
+            )?;
             let sel = r[0].as_bool();
-            let edges: Vec<[u32; 2]> = (0..m.edge_count()).filter(|&e| sel[e]).map(|e| m.edges[e]).collect();
+            let edges: Vec<[u32; 2]> = (0..m.edge_count())
+                .filter(|&e| sel[e])
+                .map(|e| m.edges[e])
+                .collect();
             (!edges.is_empty()).then(|| mesh_edges_to_curves(&m, &edges))
         };
         s.mesh = None;

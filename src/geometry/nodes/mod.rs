@@ -7,11 +7,13 @@ pub mod color;
 pub mod curve;
 pub mod curve_fields;
 pub mod curve_primitives;
+pub mod curve_to_points;
 pub mod delete;
 pub mod distribute;
+pub mod dual_mesh;
 pub mod extrude;
-pub mod fill_curve;
 pub mod field_nodes;
+pub mod fill_curve;
 pub mod flip_faces;
 pub mod float_curve;
 pub mod function;
@@ -20,15 +22,13 @@ pub mod image_texture;
 pub mod input;
 pub mod instance_transform;
 pub mod merge_by_distance;
-pub mod curve_to_points;
 pub mod mesh_to_curve;
-pub mod dual_mesh;
-pub mod sample_curve;
-pub mod sample_nearest;
 pub mod primitives;
 pub mod proximity;
 pub mod raycast;
 pub mod rotation;
+pub mod sample_curve;
+pub mod sample_nearest;
 pub mod subdivide;
 pub mod subdivision_surface;
 pub mod texture;
@@ -263,6 +263,8 @@ pub fn evaluate(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "FunctionNodeFloatToInt" => color::float_to_int(ctx),
         "ShaderNodeBlackbody" => color::blackbody_node(ctx),
         "GeometryNodeImageTexture" => image_texture::image_texture(ctx),
-        _ => Err(ctx.err("this node type is not supported by blendsynth's Geometry Nodes evaluator")),
+        _ => {
+            Err(ctx.err("this node type is not supported by blendsynth's Geometry Nodes evaluator"))
+        }
     }
 }

@@ -28,17 +28,26 @@ fn attr_field(id: &AttrId, ty: DataType) -> SocketValue {
 }
 
 fn empty_out(ctx: &NodeCtx) -> Outputs {
-    ctx.node().outputs.iter().map(|s| (s.identifier.clone(), SocketValue::zero(&s.kind))).collect()
+    ctx.node()
+        .outputs
+        .iter()
+        .map(|s| (s.identifier.clone(), SocketValue::zero(&s.kind)))
+        .collect()
 }
 
 /// Stores `uvs` as the anonymous UV Map attribute when the output is used.
-fn with_uv(ctx: &NodeCtx, mesh: &mut Mesh, uvs: impl FnOnce(&Mesh) -> Vec<[f32; 2]>) -> Vec<(&'static str, SocketValue)> {
+fn with_uv(
+    ctx: &NodeCtx,
+    mesh: &mut Mesh,
+    uvs: impl FnOnce(&Mesh) -> Vec<[f32; 2]>,
+) -> Vec<(&'static str, SocketValue)> {
     if !ctx.output_used("UV Map") {
         return Vec::new();
     }
     let id = AttrId::anonymous("UV Map");
     let uv = uvs(mesh);
-    mesh.attributes.set(id.clone(), Domain::Corner, Array::Float2(uv));
+    mesh.attributes
+        .set(id.clone(), Domain::Corner, Array::Float2(uv));
     vec![("UV Map", attr_field(&id, DataType::Vector))]
 }
 
@@ -54,7 +63,8 @@ pub fn grid_mesh(verts_x: usize, verts_y: usize, size_x: f32, size_y: f32) -> Me
     let y_shift = ey as f32 / 2.0;
     for x in 0..verts_x {
         for y in 0..verts_y {
-            m.positions.push([(x as f32 - x_shift) * dx, (y as f32 - y_shift) * dy, 0.0]);
+            m.positions
+                .push([(x as f32 - x_shift) * dx, (y as f32 - y_shift) * dy, 0.0]);
         }
     }
     let x_edges_start = verts_x * ey;
@@ -110,7 +120,11 @@ pub fn grid(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let mut m = grid_mesh(vx as usize, vy as usize, sx, sy);
     // The node gives the mesh an empty material slot (as all primitive nodes do).
     m.materials = vec![None];
-    let extra = if m.face_count() > 0 { with_uv(ctx, &mut m, |m| grid_uvs(m, sx, sy)) } else { Vec::new() };
+    let extra = if m.face_count() > 0 {
+        with_uv(ctx, &mut m, |m| grid_uvs(m, sx, sy))
+    } else {
+        Vec::new()
+    };
     Ok(mesh_out(m, extra))
 }
 
@@ -147,7 +161,11 @@ pub fn line(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
                     line_mesh(start, [0.0; 3], 1)
                 } else {
                     let c = (count - 1) as f32;
-                    line_mesh(start, [total[0] / c, total[1] / c, total[2] / c], count.max(0) as usize)
+                    line_mesh(
+                        start,
+                        [total[0] / c, total[1] / c, total[2] / c],
+                        count.max(0) as usize,
+                    )
                 }
             }
         }
@@ -307,7 +325,9 @@ fn cuboid_faces(c: &Cuboid) -> Vec<[u32; 4]> {
         v1s += if z == 0 { vx * vy } else { xy_cross };
         v2s += xy_cross;
     }
-    f.into_iter().map(|q| [q[0] as u32, q[1] as u32, q[2] as u32, q[3] as u32]).collect()
+    f.into_iter()
+        .map(|q| [q[0] as u32, q[1] as u32, q[2] as u32, q[3] as u32])
+        .collect()
 }
 
 fn cuboid_uvs(c: &Cuboid) -> Vec<[f32; 2]> {
@@ -386,7 +406,11 @@ fn cuboid_uvs(c: &Cuboid) -> Vec<[f32; 2]> {
 
 pub fn cube(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let size = ctx.vector("Size")?;
-    let (vx, vy, vz) = (ctx.int("Vertices X")?, ctx.int("Vertices Y")?, ctx.int("Vertices Z")?);
+    let (vx, vy, vz) = (
+        ctx.int("Vertices X")?,
+        ctx.int("Vertices Y")?,
+        ctx.int("Vertices Z")?,
+    );
     if vx < 1 || vy < 1 || vz < 1 {
         return Ok(empty_out(ctx));
     }
@@ -396,13 +420,25 @@ pub fn cube(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     }
     if dims == 1 {
         let (start, delta) = if vx > 1 {
-            ([-size[0] / 2.0, 0.0, 0.0], [size[0] / (vx - 1) as f32, 0.0, 0.0])
+            (
+                [-size[0] / 2.0, 0.0, 0.0],
+                [size[0] / (vx - 1) as f32, 0.0, 0.0],
+            )
         } else if vy > 1 {
-            ([0.0, -size[1] / 2.0, 0.0], [0.0, size[1] / (vy - 1) as f32, 0.0])
+            (
+                [0.0, -size[1] / 2.0, 0.0],
+                [0.0, size[1] / (vy - 1) as f32, 0.0],
+            )
         } else {
-            ([0.0, 0.0, -size[2] / 2.0], [0.0, 0.0, size[2] / (vz - 1) as f32])
+            (
+                [0.0, 0.0, -size[2] / 2.0],
+                [0.0, 0.0, size[2] / (vz - 1) as f32],
+            )
         };
-        return Ok(mesh_out(line_mesh(start, delta, (vx * vy * vz) as usize), Vec::new()));
+        return Ok(mesh_out(
+            line_mesh(start, delta, (vx * vy * vz) as usize),
+            Vec::new(),
+        ));
     }
     if dims == 2 {
         if vz == 1 {
@@ -412,7 +448,15 @@ pub fn cube(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         }
         return Err(ctx.err("a cube flat in X or Y (one vertex along it) is not supported yet"));
     }
-    let c = Cuboid { size, vx: vx as usize, vy: vy as usize, vz: vz as usize, ex: vx as usize - 1, ey: vy as usize - 1, ez: vz as usize - 1 };
+    let c = Cuboid {
+        size,
+        vx: vx as usize,
+        vy: vy as usize,
+        vz: vz as usize,
+        ex: vx as usize - 1,
+        ey: vy as usize - 1,
+        ez: vz as usize - 1,
+    };
     let mut m = Mesh::new();
     m.positions = cuboid_positions(&c);
     for q in cuboid_faces(&c) {
@@ -492,7 +536,8 @@ pub fn uv_sphere_mesh(radius: f32, segments: usize, rings: usize) -> Mesh {
         for s in 0..seg {
             let n = next_of(s);
             m.corner_verts.extend([rv + s, nv + s, nv + n, rv + n]);
-            m.corner_edges.extend([vert_e + s, ne + s, vert_e + n, re + s]);
+            m.corner_edges
+                .extend([vert_e + s, ne + s, vert_e + n, re + s]);
             m.face_offsets.push(m.corner_verts.len() as u32);
         }
     }
@@ -501,7 +546,8 @@ pub fn uv_sphere_mesh(radius: f32, segments: usize, rings: usize) -> Mesh {
     for s in 0..seg {
         let n = next_of(s);
         m.corner_verts.extend([last, last_ring + n, last_ring + s]);
-        m.corner_edges.extend([fan + n, last_edge_ring + s, fan + s]);
+        m.corner_edges
+            .extend([fan + n, last_edge_ring + s, fan + s]);
         m.face_offsets.push(m.corner_verts.len() as u32);
     }
     m.set_smooth(false);
@@ -533,7 +579,11 @@ fn uv_sphere_uvs(segments: usize, rings: usize) -> Vec<[f32; 2]> {
     }
     for s in 0..segments {
         let s = s as f32;
-        uv.extend([[(s + 0.5) * inv, 1.0], [(s + 1.0) * inv, 1.0 - dy], [s * inv, 1.0 - dy]]);
+        uv.extend([
+            [(s + 0.5) * inv, 1.0],
+            [(s + 1.0) * inv, 1.0 - dy],
+            [s * inv, 1.0 - dy],
+        ]);
     }
     uv
 }
@@ -635,7 +685,15 @@ struct Cone {
 }
 
 impl Cone {
-    fn new(radius_top: f32, radius_bottom: f32, depth: f32, circle: usize, side: usize, fill_segments: usize, fill: Fill) -> Cone {
+    fn new(
+        radius_top: f32,
+        radius_bottom: f32,
+        depth: f32,
+        circle: usize,
+        side: usize,
+        fill_segments: usize,
+        fill: Fill,
+    ) -> Cone {
         let top_is_point = radius_top == 0.0;
         let bottom_is_point = radius_bottom == 0.0;
         let top_center = top_is_point || fill == Fill::Triangles;
@@ -647,7 +705,11 @@ impl Cone {
             if !top_is_point {
                 q += fill_segments - 1;
             }
-            q += if !top_is_point && !bottom_is_point { side } else { side - 1 };
+            q += if !top_is_point && !bottom_is_point {
+                side
+            } else {
+                side - 1
+            };
             if !bottom_is_point {
                 q += fill_segments - 1;
             }
@@ -670,15 +732,25 @@ impl Cone {
             side + 1
         } else {
             top_center as usize
-                + if !top_is_point { circle * fill_segments } else { 0 }
+                + if !top_is_point {
+                    circle * fill_segments
+                } else {
+                    0
+                }
                 + circle * (side - 1)
-                + if !bottom_is_point { circle * fill_segments } else { 0 }
+                + if !bottom_is_point {
+                    circle * fill_segments
+                } else {
+                    0
+                }
                 + bottom_center as usize
         };
         let tot_edges = if top_is_point && bottom_is_point {
             side
         } else {
-            (if top_center { circle } else { 0 }) + circle * (quad_rings * 2 + 1) + if bottom_center { circle } else { 0 }
+            (if top_center { circle } else { 0 })
+                + circle * (quad_rings * 2 + 1)
+                + if bottom_center { circle } else { 0 }
         };
         let first_ring_verts_start = if top_center { 1 } else { 0 };
         let last_vert = tot_verts - 1;
@@ -687,13 +759,21 @@ impl Cone {
         let last_ring_edges_start = first_ring_edges_start + quad_rings * circle * 2;
         let last_fan_edges_start = tot_edges.wrapping_sub(circle);
         let top_faces_len = if !top_is_point {
-            (fill_segments - 1) * circle + if top_center { circle } else { 0 } + (fill == Fill::NGon) as usize
+            (fill_segments - 1) * circle
+                + if top_center { circle } else { 0 }
+                + (fill == Fill::NGon) as usize
         } else {
             0
         };
-        let side_faces_len = if top_is_point && bottom_is_point { 0 } else { side * circle };
+        let side_faces_len = if top_is_point && bottom_is_point {
+            0
+        } else {
+            side * circle
+        };
         let bottom_faces_len = if !bottom_is_point {
-            (fill_segments - 1) * circle + if bottom_center { circle } else { 0 } + (fill == Fill::NGon) as usize
+            (fill_segments - 1) * circle
+                + if bottom_center { circle } else { 0 }
+                + (fill == Fill::NGon) as usize
         } else {
             0
         };
@@ -786,7 +866,8 @@ impl Cone {
             let this = self.first_ring_verts_start + i * c;
             let next = this + c;
             for j in 0..c {
-                m.edges.push([(this + j) as u32, (this + (j + 1) % c) as u32]);
+                m.edges
+                    .push([(this + j) as u32, (this + (j + 1) % c) as u32]);
             }
             if i == self.edge_rings - 1 {
                 break;
@@ -797,7 +878,10 @@ impl Cone {
         }
         if self.bottom_center {
             for i in 0..c {
-                m.edges.push([(self.last_ring_verts_start + i) as u32, self.last_vert as u32]);
+                m.edges.push([
+                    (self.last_ring_verts_start + i) as u32,
+                    self.last_vert as u32,
+                ]);
             }
         }
         // Faces.
@@ -809,7 +893,15 @@ impl Cone {
         if self.top_center {
             for i in 0..c {
                 let n = (i + 1) % c;
-                push(&mut m, &[self.first_ring_verts_start + i, self.first_ring_verts_start + n, 0], &[self.first_ring_edges_start + i, n, i]);
+                push(
+                    &mut m,
+                    &[
+                        self.first_ring_verts_start + i,
+                        self.first_ring_verts_start + n,
+                        0,
+                    ],
+                    &[self.first_ring_edges_start + i, n, i],
+                );
             }
         } else if self.fill == Fill::NGon {
             let vs: Vec<usize> = (0..c).collect();
@@ -823,7 +915,11 @@ impl Cone {
             let conn = this_e + c;
             for j in 0..c {
                 let n = (j + 1) % c;
-                push(&mut m, &[this_v + j, next_v + j, next_v + n, this_v + n], &[conn + j, next_e + j, conn + n, this_e + j]);
+                push(
+                    &mut m,
+                    &[this_v + j, next_v + j, next_v + n, this_v + n],
+                    &[conn + j, next_e + j, conn + n, this_e + j],
+                );
             }
         }
         if self.bottom_center {
@@ -831,8 +927,16 @@ impl Cone {
                 let n = (i + 1) % c;
                 push(
                     &mut m,
-                    &[self.last_ring_verts_start + i, self.last_vert, self.last_ring_verts_start + n],
-                    &[self.last_fan_edges_start + i, self.last_fan_edges_start + n, self.last_ring_edges_start + i],
+                    &[
+                        self.last_ring_verts_start + i,
+                        self.last_vert,
+                        self.last_ring_verts_start + n,
+                    ],
+                    &[
+                        self.last_fan_edges_start + i,
+                        self.last_fan_edges_start + n,
+                        self.last_ring_edges_start + i,
+                    ],
                 );
             }
         } else if self.fill == Fill::NGon {
@@ -852,7 +956,11 @@ impl Cone {
         let mut uv = Vec::new();
         if self.top_is_point || self.fill != Fill::None {
             let center = [0.25, 0.25];
-            let segs = if self.top_is_point { self.side } else { self.fill_segments };
+            let segs = if self.top_is_point {
+                self.side
+            } else {
+                self.fill_segments
+            };
             let d = 1.0 / segs as f32;
             if self.top_center {
                 for i in 0..c {
@@ -892,7 +1000,11 @@ impl Cone {
         }
         if self.bottom_is_point || self.fill != Fill::None {
             let center = [0.75, 0.25];
-            let segs = if self.bottom_is_point { self.side } else { self.fill_segments };
+            let segs = if self.bottom_is_point {
+                self.side
+            } else {
+                self.fill_segments
+            };
             let d = 1.0 / segs as f32;
             for i in 0..segs - 1 {
                 let outer = 1.0 - i as f32 * d;
@@ -923,38 +1035,85 @@ impl Cone {
     /// Top / Side / Bottom selections (face domain when there is a fill, else points).
     fn selections(&self, m: &Mesh) -> [(Domain, Vec<bool>); 3] {
         let face_top = !self.top_is_point && self.fill != Fill::None;
-        let mut top = vec![false; if face_top { m.face_count() } else { m.vertex_count() }];
+        let mut top = vec![
+            false;
+            if face_top {
+                m.face_count()
+            } else {
+                m.vertex_count()
+            }
+        ];
         if self.top_is_point {
             top[0] = true;
         } else {
-            let n = if face_top { self.top_faces_len } else { self.circle };
+            let n = if face_top {
+                self.top_faces_len
+            } else {
+                self.circle
+            };
             top[..n].iter_mut().for_each(|x| *x = true);
         }
         let face_bottom = !self.bottom_is_point && self.fill != Fill::None;
-        let mut bottom = vec![false; if face_bottom { m.face_count() } else { m.vertex_count() }];
+        let mut bottom = vec![
+            false;
+            if face_bottom {
+                m.face_count()
+            } else {
+                m.vertex_count()
+            }
+        ];
         if self.bottom_is_point {
             bottom[self.last_vert] = true;
         } else if face_bottom {
-            bottom[self.bottom_faces_start..self.bottom_faces_start + self.bottom_faces_len].iter_mut().for_each(|x| *x = true);
+            bottom[self.bottom_faces_start..self.bottom_faces_start + self.bottom_faces_len]
+                .iter_mut()
+                .for_each(|x| *x = true);
         } else {
-            bottom[self.last_ring_verts_start + 1..self.last_ring_verts_start + 1 + self.circle].iter_mut().for_each(|x| *x = true);
+            bottom[self.last_ring_verts_start + 1..self.last_ring_verts_start + 1 + self.circle]
+                .iter_mut()
+                .for_each(|x| *x = true);
         }
         let mut side = vec![false; m.face_count()];
-        side[self.side_faces_start..self.side_faces_start + self.side_faces_len].iter_mut().for_each(|x| *x = true);
+        side[self.side_faces_start..self.side_faces_start + self.side_faces_len]
+            .iter_mut()
+            .for_each(|x| *x = true);
         [
-            (if face_top { Domain::Face } else { Domain::Point }, top),
+            (
+                if face_top {
+                    Domain::Face
+                } else {
+                    Domain::Point
+                },
+                top,
+            ),
             (Domain::Face, side),
-            (if face_bottom { Domain::Face } else { Domain::Point }, bottom),
+            (
+                if face_bottom {
+                    Domain::Face
+                } else {
+                    Domain::Point
+                },
+                bottom,
+            ),
         ]
     }
 }
 
 /// Cylinder and Cone; the Cone node moves its base to the origin (`lift`).
-fn cone_like(ctx: &NodeCtx, radius_top: f32, radius_bottom: f32, lift: bool) -> Result<Outputs, GeometryError> {
+fn cone_like(
+    ctx: &NodeCtx,
+    radius_top: f32,
+    radius_bottom: f32,
+    lift: bool,
+) -> Result<Outputs, GeometryError> {
     let circle = ctx.int("Vertices")?;
     let side = ctx.int("Side Segments")?;
     // Unavailable without a fill; Blender's default then.
-    let fill_segments = if ctx.has_input("Fill Segments") { ctx.int("Fill Segments")? } else { 1 };
+    let fill_segments = if ctx.has_input("Fill Segments") {
+        ctx.int("Fill Segments")?
+    } else {
+        1
+    };
     let depth = ctx.float("Depth")?;
     let fill = match ctx.prop_str("fill_type")? {
         "NONE" => Fill::None,
@@ -964,7 +1123,15 @@ fn cone_like(ctx: &NodeCtx, radius_top: f32, radius_bottom: f32, lift: bool) -> 
     if circle < 3 || side < 1 || (fill != Fill::None && fill_segments < 1) {
         return Ok(empty_out(ctx));
     }
-    let cfg = Cone::new(radius_top, radius_bottom, depth, circle as usize, side as usize, fill_segments.max(1) as usize, fill);
+    let cfg = Cone::new(
+        radius_top,
+        radius_bottom,
+        depth,
+        circle as usize,
+        side as usize,
+        fill_segments.max(1) as usize,
+        fill,
+    );
     if cfg.top_is_point && cfg.bottom_is_point {
         let m = if cfg.height == 0.0 {
             line_mesh([0.0; 3], [0.0; 3], 1)
@@ -1049,21 +1216,66 @@ const ICO_FACES: [[u32; 3]; 20] = [
     [10, 9, 11],
 ];
 const ICO_UVS: [[f32; 2]; 60] = [
-    [0.181819, 0.0], [0.272728, 0.157461], [0.090910, 0.157461], [0.272728, 0.157461],
-    [0.363637, 0.0], [0.454546, 0.157461], [0.909091, 0.0], [1.0, 0.157461],
-    [0.818182, 0.157461], [0.727273, 0.0], [0.818182, 0.157461], [0.636364, 0.157461],
-    [0.545455, 0.0], [0.636364, 0.157461], [0.454546, 0.157461], [0.272728, 0.157461],
-    [0.454546, 0.157461], [0.363637, 0.314921], [0.090910, 0.157461], [0.272728, 0.157461],
-    [0.181819, 0.314921], [0.818182, 0.157461], [1.0, 0.157461], [0.909091, 0.314921],
-    [0.636364, 0.157461], [0.818182, 0.157461], [0.727273, 0.314921], [0.454546, 0.157461],
-    [0.636364, 0.157461], [0.545455, 0.314921], [0.272728, 0.157461], [0.363637, 0.314921],
-    [0.181819, 0.314921], [0.090910, 0.157461], [0.181819, 0.314921], [0.0, 0.314921],
-    [0.818182, 0.157461], [0.909091, 0.314921], [0.727273, 0.314921], [0.636364, 0.157461],
-    [0.727273, 0.314921], [0.545455, 0.314921], [0.454546, 0.157461], [0.545455, 0.314921],
-    [0.363637, 0.314921], [0.181819, 0.314921], [0.363637, 0.314921], [0.272728, 0.472382],
-    [0.0, 0.314921], [0.181819, 0.314921], [0.090910, 0.472382], [0.727273, 0.314921],
-    [0.909091, 0.314921], [0.818182, 0.472382], [0.545455, 0.314921], [0.727273, 0.314921],
-    [0.636364, 0.472382], [0.363637, 0.314921], [0.545455, 0.314921], [0.454546, 0.472382],
+    [0.181819, 0.0],
+    [0.272728, 0.157461],
+    [0.090910, 0.157461],
+    [0.272728, 0.157461],
+    [0.363637, 0.0],
+    [0.454546, 0.157461],
+    [0.909091, 0.0],
+    [1.0, 0.157461],
+    [0.818182, 0.157461],
+    [0.727273, 0.0],
+    [0.818182, 0.157461],
+    [0.636364, 0.157461],
+    [0.545455, 0.0],
+    [0.636364, 0.157461],
+    [0.454546, 0.157461],
+    [0.272728, 0.157461],
+    [0.454546, 0.157461],
+    [0.363637, 0.314921],
+    [0.090910, 0.157461],
+    [0.272728, 0.157461],
+    [0.181819, 0.314921],
+    [0.818182, 0.157461],
+    [1.0, 0.157461],
+    [0.909091, 0.314921],
+    [0.636364, 0.157461],
+    [0.818182, 0.157461],
+    [0.727273, 0.314921],
+    [0.454546, 0.157461],
+    [0.636364, 0.157461],
+    [0.545455, 0.314921],
+    [0.272728, 0.157461],
+    [0.363637, 0.314921],
+    [0.181819, 0.314921],
+    [0.090910, 0.157461],
+    [0.181819, 0.314921],
+    [0.0, 0.314921],
+    [0.818182, 0.157461],
+    [0.909091, 0.314921],
+    [0.727273, 0.314921],
+    [0.636364, 0.157461],
+    [0.727273, 0.314921],
+    [0.545455, 0.314921],
+    [0.454546, 0.157461],
+    [0.545455, 0.314921],
+    [0.363637, 0.314921],
+    [0.181819, 0.314921],
+    [0.363637, 0.314921],
+    [0.272728, 0.472382],
+    [0.0, 0.314921],
+    [0.181819, 0.314921],
+    [0.090910, 0.472382],
+    [0.727273, 0.314921],
+    [0.909091, 0.314921],
+    [0.818182, 0.472382],
+    [0.545455, 0.314921],
+    [0.727273, 0.314921],
+    [0.636364, 0.472382],
+    [0.363637, 0.314921],
+    [0.545455, 0.314921],
+    [0.454546, 0.472382],
 ];
 
 /// Ico Sphere with one subdivision (the icosahedron), in BMesh's creation order: faces as
@@ -1075,11 +1287,16 @@ pub fn ico_sphere(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         return Ok(empty_out(ctx));
     }
     if subdivisions > 1 {
-        return Err(ctx.err("Subdivisions above 1 (BMesh sphere subdivision) are not supported yet"));
+        return Err(
+            ctx.err("Subdivisions above 1 (BMesh sphere subdivision) are not supported yet")
+        );
     }
     let div = radius.abs() / 200.0;
     let mut m = Mesh::new();
-    m.positions = ICO_VERTS.iter().map(|v| [div * v[0], div * v[1], div * v[2]]).collect();
+    m.positions = ICO_VERTS
+        .iter()
+        .map(|v| [div * v[0], div * v[1], div * v[2]])
+        .collect();
     let mut edge_of = std::collections::HashMap::new();
     for f in ICO_FACES {
         // `BM_edges_from_verts_ensure`: edges (prev, this) from (last, first) on.
@@ -1107,7 +1324,15 @@ pub fn ico_sphere(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
 /// Blender's `create_cuboid_mesh` without a UV map (Bounding Box uses it): `size`
 /// centred on the origin, at least two vertices along each axis.
 pub fn cuboid_mesh(size: V3, vx: usize, vy: usize, vz: usize) -> Mesh {
-    let c = Cuboid { size, vx, vy, vz, ex: vx - 1, ey: vy - 1, ez: vz - 1 };
+    let c = Cuboid {
+        size,
+        vx,
+        vy,
+        vz,
+        ex: vx - 1,
+        ey: vy - 1,
+        ez: vz - 1,
+    };
     let mut m = Mesh::new();
     m.positions = cuboid_positions(&c);
     for q in cuboid_faces(&c) {
@@ -1122,5 +1347,13 @@ pub fn cuboid_mesh(size: V3, vx: usize, vy: usize, vz: usize) -> Mesh {
 
 /// The UV map of a 2x2x2-vertex cuboid of `size` (Bounding Box's "uv_map").
 pub fn cuboid_uvs_for(size: V3) -> Vec<[f32; 2]> {
-    cuboid_uvs(&Cuboid { size, vx: 2, vy: 2, vz: 2, ex: 1, ey: 1, ez: 1 })
+    cuboid_uvs(&Cuboid {
+        size,
+        vx: 2,
+        vy: 2,
+        vz: 2,
+        ex: 1,
+        ey: 1,
+        ez: 1,
+    })
 }

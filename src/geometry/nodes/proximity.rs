@@ -7,7 +7,9 @@ use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::Field;
 use super::super::math::V3;
-use super::super::nearest::{bounds_of, closest_on_segment, closest_on_triangle, dist_sq, NearestTree};
+use super::super::nearest::{
+    bounds_of, closest_on_segment, closest_on_triangle, dist_sq, NearestTree,
+};
 use super::super::realize::realize_instances;
 use super::super::types::{Array, DataType};
 use super::super::value::SocketValue;
@@ -20,14 +22,22 @@ struct SortedPoints {
 
 impl SortedPoints {
     fn new(mut p: Vec<V3>) -> Self {
-        p.sort_by(|a, b| a[0].total_cmp(&b[0]).then(a[1].total_cmp(&b[1])).then(a[2].total_cmp(&b[2])));
+        p.sort_by(|a, b| {
+            a[0].total_cmp(&b[0])
+                .then(a[1].total_cmp(&b[1]))
+                .then(a[2].total_cmp(&b[2]))
+        });
         SortedPoints { p }
     }
     fn nearest(&self, q: V3) -> Option<(V3, f32)> {
         if self.p.is_empty() {
             return None;
         }
-        let d2 = |a: &V3| (a[0] - q[0]) * (a[0] - q[0]) + (a[1] - q[1]) * (a[1] - q[1]) + (a[2] - q[2]) * (a[2] - q[2]);
+        let d2 = |a: &V3| {
+            (a[0] - q[0]) * (a[0] - q[0])
+                + (a[1] - q[1]) * (a[1] - q[1])
+                + (a[2] - q[2]) * (a[2] - q[2])
+        };
         let start = self.p.partition_point(|a| a[0] < q[0]);
         let mut best = f32::INFINITY;
         let mut best_p = self.p[0];
@@ -65,7 +75,12 @@ pub fn geometry_proximity(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let target = realize_instances(&ctx.geometry("Target")?);
     let element = ctx.prop_str("target_element")?;
     for id in ["Group ID", "Sample Group ID"] {
-        if ctx.has_input(id) && ctx.field(id, DataType::Int)?.as_constant().map_or(true, |v| v.as_int() != 0) {
+        if ctx.has_input(id)
+            && ctx
+                .field(id, DataType::Int)?
+                .as_constant()
+                .map_or(true, |v| v.as_int() != 0)
+        {
             return Err(ctx.err(format!("{id} is not supported yet")));
         }
     }
@@ -81,14 +96,21 @@ pub fn geometry_proximity(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             Target::Points(SortedPoints::new(pts))
         }
         "EDGES" => {
-            let segs = target.mesh.as_ref().map_or(Vec::new(), |m| m.edges.iter().map(|e| [m.positions[e[0] as usize], m.positions[e[1] as usize]]).collect());
+            let segs = target.mesh.as_ref().map_or(Vec::new(), |m| {
+                m.edges
+                    .iter()
+                    .map(|e| [m.positions[e[0] as usize], m.positions[e[1] as usize]])
+                    .collect()
+            });
             Target::edges(segs)
         }
         "FACES" => {
             let tris = match &target.mesh {
                 Some(m) => {
                     let (tris, _) = super::distribute::corner_tris(m).map_err(|e| ctx.err(e))?;
-                    tris.iter().map(|t| t.map(|c| m.positions[m.corner_verts[c as usize] as usize])).collect()
+                    tris.iter()
+                        .map(|t| t.map(|c| m.positions[m.corner_verts[c as usize] as usize]))
+                        .collect()
                 }
                 None => Vec::new(),
             };
@@ -98,24 +120,37 @@ pub fn geometry_proximity(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     };
     let tree = std::sync::Arc::new(target);
     let src = ctx.field("Source Position", DataType::Vector)?;
-    let fields = Field::op("Geometry Proximity", vec![src], vec![DataType::Vector, DataType::Float, DataType::Bool], move |n, a| {
-        let q = a[0].as_vector();
-        let mut pos = vec![[0.0f32; 3]; n];
-        let mut dist = vec![0.0f32; n];
-        let mut valid = vec![false; n];
-        for i in 0..n {
-            if let Some((p, d)) = tree.nearest(q[i]) {
-                pos[i] = p;
-                dist[i] = d;
-                valid[i] = true;
+    let fields = Field::op(
+        "Geometry Proximity",
+        vec![src],
+        vec![DataType::Vector, DataType::Float, DataType::Bool],
+        move |n, a| {
+            let q = a[0].as_vector();
+            let mut pos = vec![[0.0f32; 3]; n];
+            let mut dist = vec![0.0f32; n];
+            let mut valid = vec![false; n];
+            for i in 0..n {
+                if let Some((p, d)) = tree.nearest(q[i]) {
+                    pos[i] = p;
+                    dist[i] = d;
+                    valid[i] = true;
+                }
             }
-        }
-        Ok(vec![Array::Vector(pos), Array::Float(dist), Array::Bool(valid)])
-    })
+            Ok(vec![
+                Array::Vector(pos),
+                Array::Float(dist),
+                Array::Bool(valid),
+            ])
+        },
+    )
     .map_err(|e| ctx.err(e))?;
     let mut it = fields.into_iter();
     let (p, d, v) = (it.next().unwrap(), it.next().unwrap(), it.next().unwrap());
-    Ok(outputs([("Position", SocketValue::Field(p)), ("Distance", SocketValue::Field(d)), ("Is Valid", SocketValue::Field(v))]))
+    Ok(outputs([
+        ("Position", SocketValue::Field(p)),
+        ("Distance", SocketValue::Field(d)),
+        ("Is Valid", SocketValue::Field(v)),
+    ]))
 }
 
 enum Target {

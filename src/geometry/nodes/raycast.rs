@@ -26,7 +26,8 @@ use crate::render::accel::{Accel, Bvh};
 pub fn sample_data_type(ctx: &NodeCtx) -> Result<DataType, GeometryError> {
     let d = ctx.prop_str("data_type")?;
     match d {
-        "FLOAT" | "INT" | "FLOAT_VECTOR" | "FLOAT_COLOR" | "BOOLEAN" | "QUATERNION" | "FLOAT4X4" => Ok(DataType::parse(d).unwrap()),
+        "FLOAT" | "INT" | "FLOAT_VECTOR" | "FLOAT_COLOR" | "BOOLEAN" | "QUATERNION"
+        | "FLOAT4X4" => Ok(DataType::parse(d).unwrap()),
         other => Err(ctx.err(format!("data type {other} is not supported"))),
     }
 }
@@ -53,47 +54,78 @@ pub fn raycast(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         ]));
     };
     let tris = Triangles::new(&mesh).map_err(|e| ctx.err(e))?;
-    let values = if want_attribute { Some(corner_values(&mesh, &attribute, ty).map_err(|e| ctx.err(format!("Attribute: {e}")))?) } else { None };
+    let values = if want_attribute {
+        Some(corner_values(&mesh, &attribute, ty).map_err(|e| ctx.err(format!("Attribute: {e}")))?)
+    } else {
+        None
+    };
     let bvh = Bvh::build(&tris.positions);
     let shared = Arc::new((tris, bvh, values));
     let src = ctx.field("Source Position", DataType::Vector)?;
     let dir = ctx.field("Ray Direction", DataType::Vector)?;
     let len = ctx.field("Ray Length", DataType::Float)?;
-    let fields = Field::op("Raycast", vec![src, dir, len], vec![DataType::Bool, DataType::Vector, DataType::Vector, DataType::Float, ty], move |n, a| {
-        let (tris, bvh, values) = &*shared;
-        let (src, dir, len) = (a[0].as_vector(), a[1].as_vector(), a[2].as_float());
-        let mut is_hit = vec![false; n];
-        let mut pos = vec![[0.0f32; 3]; n];
-        let mut nor = vec![[0.0f32; 3]; n];
-        let mut dist = vec![0.0f32; n];
-        let mut attr = Array::filled(cleared(ty), if values.is_some() { n } else { 0 });
-        for i in 0..n {
-            let d = normalize(dir[i]);
-            // Blender accepts hits at distance 0 (also -0), so the lower bound sits just below.
-            match bvh.intersect(src[i], d, -f32::MIN_POSITIVE, len[i]) {
-                Some(h) => {
-                    let t = h.prim as usize;
-                    let p: V3 = std::array::from_fn(|k| src[i][k] + d[k] * h.t);
-                    is_hit[i] = true;
-                    pos[i] = p;
-                    let [v0, v1, v2] = tris.positions[t];
-                    nor[i] = normal_tri(v0, v1, v2);
-                    dist[i] = h.t;
-                    if let Some(v) = values {
-                        let w = if nearest { tris.nearest_weights(t, p) } else { tris.bary_weights(t, p) };
-                        attr.set(i, sample(v, tris, t, w));
+    let fields = Field::op(
+        "Raycast",
+        vec![src, dir, len],
+        vec![
+            DataType::Bool,
+            DataType::Vector,
+            DataType::Vector,
+            DataType::Float,
+            ty,
+        ],
+        move |n, a| {
+            let (tris, bvh, values) = &*shared;
+            let (src, dir, len) = (a[0].as_vector(), a[1].as_vector(), a[2].as_float());
+            let mut is_hit = vec![false; n];
+            let mut pos = vec![[0.0f32; 3]; n];
+            let mut nor = vec![[0.0f32; 3]; n];
+            let mut dist = vec![0.0f32; n];
+            let mut attr = Array::filled(cleared(ty), if values.is_some() { n } else { 0 });
+            for i in 0..n {
+                let d = normalize(dir[i]);
+                // Blender accepts hits at distance 0 (also -0), so the lower bound sits just below.
+                match bvh.intersect(src[i], d, -f32::MIN_POSITIVE, len[i]) {
+                    Some(h) => {
+                        let t = h.prim as usize;
+                        let p: V3 = std::array::from_fn(|k| src[i][k] + d[k] * h.t);
+                        is_hit[i] = true;
+                        pos[i] = p;
+                        let [v0, v1, v2] = tris.positions[t];
+                        nor[i] = normal_tri(v0, v1, v2);
+                        dist[i] = h.t;
+                        if let Some(v) = values {
+                            let w = if nearest {
+                                tris.nearest_weights(t, p)
+                            } else {
+                                tris.bary_weights(t, p)
+                            };
+                            attr.set(i, sample(v, tris, t, w));
+                        }
                     }
+                    None => dist[i] = len[i],
                 }
-                None => dist[i] = len[i],
             }
-        }
-        if values.is_none() {
-            attr = Array::filled(cleared(ty), n);
-        }
-        Ok(vec![Array::Bool(is_hit), Array::Vector(pos), Array::Vector(nor), Array::Float(dist), attr])
-    })
+            if values.is_none() {
+                attr = Array::filled(cleared(ty), n);
+            }
+            Ok(vec![
+                Array::Bool(is_hit),
+                Array::Vector(pos),
+                Array::Vector(nor),
+                Array::Float(dist),
+                attr,
+            ])
+        },
+    )
     .map_err(|e| ctx.err(e))?;
     let mut it = fields.into_iter().map(SocketValue::Field);
     let mut next = || it.next().unwrap();
-    Ok(outputs([("Is Hit", next()), ("Hit Position", next()), ("Hit Normal", next()), ("Hit Distance", next()), ("Attribute", next())]))
+    Ok(outputs([
+        ("Is Hit", next()),
+        ("Hit Position", next()),
+        ("Hit Normal", next()),
+        ("Hit Distance", next()),
+        ("Attribute", next()),
+    ]))
 }

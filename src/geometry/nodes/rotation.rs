@@ -4,7 +4,9 @@
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::Field;
-use super::super::math::{euler_to_mat3, mat3_normalized_to_quat, mat3_to_euler, normalize, quat_to_mat3, Mat3f, V3};
+use super::super::math::{
+    euler_to_mat3, mat3_normalized_to_quat, mat3_to_euler, normalize, quat_to_mat3, Mat3f, V3,
+};
 use super::super::types::{Array, DataType};
 use super::super::value::SocketValue;
 use super::instance_transform::{axis_angle_mat3, mat3_mul};
@@ -22,19 +24,24 @@ pub fn quat_mul(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
 pub fn axis_angle_to_rotation(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let axis = ctx.field("Axis", DataType::Vector)?;
     let angle = ctx.field("Angle", DataType::Float)?;
-    let f = Field::op1("Axis Angle to Rotation", vec![axis, angle], DataType::Quaternion, |_, x| {
-        let (ax, an) = (x[0].as_vector(), x[1].as_float());
-        Ok(Array::Quaternion(
-            ax.iter()
-                .zip(an.iter())
-                .map(|(a, t)| {
-                    let n = normalize(*a);
-                    let (s, c) = (t * 0.5).sin_cos();
-                    [c, n[0] * s, n[1] * s, n[2] * s]
-                })
-                .collect(),
-        ))
-    })
+    let f = Field::op1(
+        "Axis Angle to Rotation",
+        vec![axis, angle],
+        DataType::Quaternion,
+        |_, x| {
+            let (ax, an) = (x[0].as_vector(), x[1].as_float());
+            Ok(Array::Quaternion(
+                ax.iter()
+                    .zip(an.iter())
+                    .map(|(a, t)| {
+                        let n = normalize(*a);
+                        let (s, c) = (t * 0.5).sin_cos();
+                        [c, n[0] * s, n[1] * s, n[2] * s]
+                    })
+                    .collect(),
+            ))
+        },
+    )
     .map_err(|e| ctx.err(e))?;
     Ok(outputs([("Rotation", SocketValue::Field(f))]))
 }
@@ -43,10 +50,26 @@ pub fn rotate_rotation(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let local = ctx.prop("rotation_space").and_then(|v| v.as_str()) == Some("LOCAL");
     let r = ctx.field("Rotation", DataType::Quaternion)?;
     let by = ctx.field("Rotate By", DataType::Quaternion)?;
-    let f = Field::op1("Rotate Rotation", vec![r, by], DataType::Quaternion, move |_, x| {
-        let (r, by) = (x[0].as_quat(), x[1].as_quat());
-        Ok(Array::Quaternion(r.iter().zip(by.iter()).map(|(r, b)| if local { quat_mul(*r, *b) } else { quat_mul(*b, *r) }).collect()))
-    })
+    let f = Field::op1(
+        "Rotate Rotation",
+        vec![r, by],
+        DataType::Quaternion,
+        move |_, x| {
+            let (r, by) = (x[0].as_quat(), x[1].as_quat());
+            Ok(Array::Quaternion(
+                r.iter()
+                    .zip(by.iter())
+                    .map(|(r, b)| {
+                        if local {
+                            quat_mul(*r, *b)
+                        } else {
+                            quat_mul(*b, *r)
+                        }
+                    })
+                    .collect(),
+            ))
+        },
+    )
     .map_err(|e| ctx.err(e))?;
     Ok(outputs([("Rotation", SocketValue::Field(f))]))
 }
@@ -77,7 +100,11 @@ fn angle_normalized(a: V3, b: V3) -> f32 {
 
 fn cross_f64(a: V3, b: V3) -> V3 {
     let (a, b) = (a.map(|x| x as f64), b.map(|x| x as f64));
-    [(a[1] * b[2] - a[2] * b[1]) as f32, (a[2] * b[0] - a[0] * b[2]) as f32, (a[0] * b[1] - a[1] * b[0]) as f32]
+    [
+        (a[1] * b[2] - a[2] * b[1]) as f32,
+        (a[2] * b[0] - a[0] * b[2]) as f32,
+        (a[0] * b[1] - a[1] * b[0]) as f32,
+    ]
 }
 
 fn is_zero(v: V3) -> bool {
@@ -147,22 +174,54 @@ fn align_settings(ctx: &NodeCtx) -> Result<(V3, Option<V3>), GeometryError> {
 
 pub fn align_euler_to_vector(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let (main, pivot) = align_settings(ctx)?;
-    let ins = vec![ctx.field("Rotation", DataType::Vector)?, ctx.field("Factor", DataType::Float)?, ctx.field("Vector", DataType::Vector)?];
-    let f = Field::op1("Align Euler to Vector", ins, DataType::Vector, move |_, x| {
-        let (r, fac, v) = (x[0].as_vector(), x[1].as_float(), x[2].as_vector());
-        Ok(Array::Vector((0..r.len()).map(|i| align(&euler_to_mat3(r[i]), v[i], fac[i], main, pivot).map_or(r[i], |m| mat3_to_euler(&m))).collect()))
-    })
+    let ins = vec![
+        ctx.field("Rotation", DataType::Vector)?,
+        ctx.field("Factor", DataType::Float)?,
+        ctx.field("Vector", DataType::Vector)?,
+    ];
+    let f = Field::op1(
+        "Align Euler to Vector",
+        ins,
+        DataType::Vector,
+        move |_, x| {
+            let (r, fac, v) = (x[0].as_vector(), x[1].as_float(), x[2].as_vector());
+            Ok(Array::Vector(
+                (0..r.len())
+                    .map(|i| {
+                        align(&euler_to_mat3(r[i]), v[i], fac[i], main, pivot)
+                            .map_or(r[i], |m| mat3_to_euler(&m))
+                    })
+                    .collect(),
+            ))
+        },
+    )
     .map_err(|e| ctx.err(e))?;
     Ok(outputs([("Rotation", SocketValue::Field(f))]))
 }
 
 pub fn align_rotation_to_vector(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let (main, pivot) = align_settings(ctx)?;
-    let ins = vec![ctx.field("Rotation", DataType::Quaternion)?, ctx.field("Factor", DataType::Float)?, ctx.field("Vector", DataType::Vector)?];
-    let f = Field::op1("Align Rotation to Vector", ins, DataType::Quaternion, move |_, x| {
-        let (r, fac, v) = (x[0].as_quat(), x[1].as_float(), x[2].as_vector());
-        Ok(Array::Quaternion((0..r.len()).map(|i| align(&quat_to_mat3(r[i]), v[i], fac[i], main, pivot).map_or(r[i], |m| mat3_normalized_to_quat(&m))).collect()))
-    })
+    let ins = vec![
+        ctx.field("Rotation", DataType::Quaternion)?,
+        ctx.field("Factor", DataType::Float)?,
+        ctx.field("Vector", DataType::Vector)?,
+    ];
+    let f = Field::op1(
+        "Align Rotation to Vector",
+        ins,
+        DataType::Quaternion,
+        move |_, x| {
+            let (r, fac, v) = (x[0].as_quat(), x[1].as_float(), x[2].as_vector());
+            Ok(Array::Quaternion(
+                (0..r.len())
+                    .map(|i| {
+                        align(&quat_to_mat3(r[i]), v[i], fac[i], main, pivot)
+                            .map_or(r[i], |m| mat3_normalized_to_quat(&m))
+                    })
+                    .collect(),
+            ))
+        },
+    )
     .map_err(|e| ctx.err(e))?;
     Ok(outputs([("Rotation", SocketValue::Field(f))]))
 }

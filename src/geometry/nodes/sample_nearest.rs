@@ -23,7 +23,9 @@ use super::super::field::{ComponentRef, Field, FieldContext};
 use super::super::math::V3;
 use super::super::mesh::Mesh;
 use super::super::mesh_sample::{cleared, corner_values, sample, Triangles};
-use super::super::nearest::{bounds_of, closest_on_segment, closest_on_triangle, dist_sq, NearestTree};
+use super::super::nearest::{
+    bounds_of, closest_on_segment, closest_on_triangle, dist_sq, NearestTree,
+};
 use super::super::types::{Array, DataType, Domain, Value};
 use super::super::value::SocketValue;
 use super::raycast::sample_data_type;
@@ -57,11 +59,24 @@ impl Target {
     fn index(&self, q: V3) -> i32 {
         let found = match self {
             Target::Nothing => return 0,
-            Target::Points(p, tree) => tree.nearest(q, |i| (dist_sq(p[i as usize], q), ())).map(|r| r.0),
-            Target::Edges(s, tree) => tree.nearest(q, |i| (dist_sq(closest_on_segment(q, s[i as usize][0], s[i as usize][1]), q), ())).map(|r| r.0),
-            Target::Faces(tris, tree) => nearest_tri(tris, tree, q).map(|(t, _)| tris.faces[t as usize]),
+            Target::Points(p, tree) => tree
+                .nearest(q, |i| (dist_sq(p[i as usize], q), ()))
+                .map(|r| r.0),
+            Target::Edges(s, tree) => tree
+                .nearest(q, |i| {
+                    (
+                        dist_sq(closest_on_segment(q, s[i as usize][0], s[i as usize][1]), q),
+                        (),
+                    )
+                })
+                .map(|r| r.0),
+            Target::Faces(tris, tree) => {
+                nearest_tri(tris, tree, q).map(|(t, _)| tris.faces[t as usize])
+            }
             Target::Corners(tris, tree, m) => {
-                let Some((t, _)) = nearest_tri(tris, tree, q) else { return -1 };
+                let Some((t, _)) = nearest_tri(tris, tree, q) else {
+                    return -1;
+                };
                 let face = m.face(tris.faces[t as usize] as usize);
                 let mut best = (face.start, f32::MAX);
                 for c in face {
@@ -85,13 +100,24 @@ pub fn sample_nearest(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         _ => return Err(ctx.err(format!("domain {d} is not supported"))),
     };
     let mesh = g.mesh.clone().filter(|m| m.domain_size(domain) > 0);
-    let points = g.points.clone().filter(|p| domain == Domain::Point && !p.positions.is_empty());
+    let points = g
+        .points
+        .clone()
+        .filter(|p| domain == Domain::Point && !p.positions.is_empty());
     let target = if let Some(m) = mesh {
         match domain {
-            Domain::Point => Target::Points(m.positions.clone(), NearestTree::build(&m.positions.iter().map(|p| (*p, *p)).collect::<Vec<_>>())),
+            Domain::Point => Target::Points(
+                m.positions.clone(),
+                NearestTree::build(&m.positions.iter().map(|p| (*p, *p)).collect::<Vec<_>>()),
+            ),
             Domain::Edge => {
-                let segs: Vec<[V3; 2]> = m.edges.iter().map(|e| [m.positions[e[0] as usize], m.positions[e[1] as usize]]).collect();
-                let tree = NearestTree::build(&segs.iter().map(|s| bounds_of(s)).collect::<Vec<_>>());
+                let segs: Vec<[V3; 2]> = m
+                    .edges
+                    .iter()
+                    .map(|e| [m.positions[e[0] as usize], m.positions[e[1] as usize]])
+                    .collect();
+                let tree =
+                    NearestTree::build(&segs.iter().map(|s| bounds_of(s)).collect::<Vec<_>>());
                 Target::Edges(segs, tree)
             }
             Domain::Face => {
@@ -106,14 +132,21 @@ pub fn sample_nearest(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             }
         }
     } else if let Some(p) = points {
-        Target::Points(p.positions.clone(), NearestTree::build(&p.positions.iter().map(|p| (*p, *p)).collect::<Vec<_>>()))
+        Target::Points(
+            p.positions.clone(),
+            NearestTree::build(&p.positions.iter().map(|p| (*p, *p)).collect::<Vec<_>>()),
+        )
     } else {
         Target::Nothing
     };
     let target = Arc::new(target);
     let pos = ctx.field("Sample Position", DataType::Vector)?;
-    let f = Field::op1("Sample Nearest", vec![pos], DataType::Int, move |_, a| Ok(Array::Int(a[0].as_vector().iter().map(|q| target.index(*q)).collect())))
-        .map_err(|e| ctx.err(e))?;
+    let f = Field::op1("Sample Nearest", vec![pos], DataType::Int, move |_, a| {
+        Ok(Array::Int(
+            a[0].as_vector().iter().map(|q| target.index(*q)).collect(),
+        ))
+    })
+    .map_err(|e| ctx.err(e))?;
     Ok(outputs([("Index", SocketValue::Field(f))]))
 }
 
@@ -129,15 +162,27 @@ pub fn sample_nearest_surface(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let value = ctx.field("Value", ty)?;
     let group_id = ctx.field("Group ID", DataType::Int)?;
     // No mesh, no vertices, or no faces (Blender warns about the latter): default outputs.
-    let Some(mesh) = g.mesh.clone().filter(|m| m.vertex_count() > 0 && m.face_count() > 0) else {
+    let Some(mesh) = g
+        .mesh
+        .clone()
+        .filter(|m| m.vertex_count() > 0 && m.face_count() > 0)
+    else {
         return Ok(outputs([
-            ("Value", SocketValue::Field(Field::Constant(Value::zero(ty)))),
-            ("Is Valid", SocketValue::Field(Field::Constant(Value::Bool(false)))),
+            (
+                "Value",
+                SocketValue::Field(Field::Constant(Value::zero(ty))),
+            ),
+            (
+                "Is Valid",
+                SocketValue::Field(Field::Constant(Value::Bool(false))),
+            ),
         ]));
     };
     let tris = Triangles::new(&mesh).map_err(|e| ctx.err(e))?;
     let values = corner_values(&mesh, &value, ty).map_err(|e| ctx.err(format!("Value: {e}")))?;
-    let ids = FieldContext::new(ComponentRef::Mesh(&mesh)).eval(&group_id, Domain::Face, DataType::Int).map_err(|e| ctx.err(format!("Group ID: {e}")))?;
+    let ids = FieldContext::new(ComponentRef::Mesh(&mesh))
+        .eval(&group_id, Domain::Face, DataType::Int)
+        .map_err(|e| ctx.err(format!("Group ID: {e}")))?;
     let ids = ids.as_int();
     let mut index: HashMap<i32, usize> = HashMap::new();
     let mut groups: Vec<Vec<u32>> = Vec::new();
@@ -152,35 +197,50 @@ pub fn sample_nearest_surface(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let groups: Vec<Group> = groups
         .into_iter()
         .map(|tris_of| {
-            let tree = NearestTree::build(&tris_of.iter().map(|&t| bounds_of(&tris.positions[t as usize])).collect::<Vec<_>>());
-            Group { tris: tris_of, tree }
+            let tree = NearestTree::build(
+                &tris_of
+                    .iter()
+                    .map(|&t| bounds_of(&tris.positions[t as usize]))
+                    .collect::<Vec<_>>(),
+            );
+            Group {
+                tris: tris_of,
+                tree,
+            }
         })
         .collect();
     let shared = Arc::new((tris, values, index, groups));
     let pos = ctx.field("Sample Position", DataType::Vector)?;
     let sample_id = ctx.field("Sample Group ID", DataType::Int)?;
-    let fields = Field::op("Sample Nearest Surface", vec![pos, sample_id], vec![ty, DataType::Bool], move |n, a| {
-        let (tris, values, index, groups) = &*shared;
-        let (pos, sid) = (a[0].as_vector(), a[1].as_int());
-        let mut out = Array::filled(cleared(ty), n);
-        let mut valid = vec![false; n];
-        for i in 0..n {
-            let Some(group) = index.get(&sid[i]).map(|&k| &groups[k]) else { continue };
-            let q = pos[i];
-            // The tree's elements are the group's triangles by position in `group.tris`.
-            let found = group.tree.nearest(q, |k| {
-                let [a, b, c] = tris.positions[group.tris[k as usize] as usize];
-                let p = closest_on_triangle(q, a, b, c);
-                (dist_sq(q, p), p)
-            });
-            valid[i] = true;
-            if let Some((k, _, p)) = found {
-                let t = group.tris[k as usize] as usize;
-                out.set(i, sample(values, tris, t, tris.bary_weights(t, p)));
+    let fields = Field::op(
+        "Sample Nearest Surface",
+        vec![pos, sample_id],
+        vec![ty, DataType::Bool],
+        move |n, a| {
+            let (tris, values, index, groups) = &*shared;
+            let (pos, sid) = (a[0].as_vector(), a[1].as_int());
+            let mut out = Array::filled(cleared(ty), n);
+            let mut valid = vec![false; n];
+            for i in 0..n {
+                let Some(group) = index.get(&sid[i]).map(|&k| &groups[k]) else {
+                    continue;
+                };
+                let q = pos[i];
+                // The tree's elements are the group's triangles by position in `group.tris`.
+                let found = group.tree.nearest(q, |k| {
+                    let [a, b, c] = tris.positions[group.tris[k as usize] as usize];
+                    let p = closest_on_triangle(q, a, b, c);
+                    (dist_sq(q, p), p)
+                });
+                valid[i] = true;
+                if let Some((k, _, p)) = found {
+                    let t = group.tris[k as usize] as usize;
+                    out.set(i, sample(values, tris, t, tris.bary_weights(t, p)));
+                }
             }
-        }
-        Ok(vec![out, Array::Bool(valid)])
-    })
+            Ok(vec![out, Array::Bool(valid)])
+        },
+    )
     .map_err(|e| ctx.err(e))?;
     let mut it = fields.into_iter().map(SocketValue::Field);
     let (v, ok) = (it.next().unwrap(), it.next().unwrap());

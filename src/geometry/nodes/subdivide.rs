@@ -227,7 +227,11 @@ pub fn subdivide_with_locations(m: &Mesh, level: u32) -> (Mesh, Vec<Loc>) {
             b.vert_loc[idx] = Loc::Edge(e, i as usize);
         }
     }
-    let corner_to_vert = |w: &Weights| -> Vec<(usize, f64)> { w.iter().map(|&(c, x)| (m.corner_verts[c] as usize, x)).collect() };
+    let corner_to_vert = |w: &Weights| -> Vec<(usize, f64)> {
+        w.iter()
+            .map(|&(c, x)| (m.corner_verts[c] as usize, x))
+            .collect()
+    };
     // Inner vertices.
     for f in 0..m.face_count() {
         let size = m.face_size(f);
@@ -294,7 +298,8 @@ pub fn subdivide_with_locations(m: &Mesh, level: u32) -> (Mesh, Vec<Loc>) {
     out.corner_verts = b.corner_verts;
     out.corner_edges = b.corner_edges;
     out.materials = m.materials.clone();
-    out.attributes = interpolate_attributes(m, &b.vert_src, &b.edge_src, &b.corner_src, &b.face_src);
+    out.attributes =
+        interpolate_attributes(m, &b.vert_src, &b.edge_src, &b.corner_src, &b.face_src);
     (out, b.vert_loc)
 }
 
@@ -353,7 +358,9 @@ fn from_lanes(t: super::super::types::DataType, a: &[f64]) -> super::super::type
         T::Vector => V::Vector([f(0), f(1), f(2)]),
         T::Color => V::Color([f(0), f(1), f(2), f(3)]),
         T::ByteColor => V::ByteColor([f(0), f(1), f(2), f(3)]),
-        T::Quaternion => V::Quaternion(super::super::math::normalize_quat([f(0), f(1), f(2), f(3)])),
+        T::Quaternion => {
+            V::Quaternion(super::super::math::normalize_quat([f(0), f(1), f(2), f(3)]))
+        }
         T::Matrix => {
             let mut m = [[0.0f32; 4]; 4];
             for k in 0..16 {
@@ -366,7 +373,13 @@ fn from_lanes(t: super::super::types::DataType, a: &[f64]) -> super::super::type
     }
 }
 
-fn interpolate_attributes(m: &Mesh, verts: &[Vec<(usize, f64)>], edges: &[Option<usize>], corners: &[Weights], faces: &[usize]) -> Attributes {
+fn interpolate_attributes(
+    m: &Mesh,
+    verts: &[Vec<(usize, f64)>],
+    edges: &[Option<usize>],
+    corners: &[Weights],
+    faces: &[usize],
+) -> Attributes {
     let mut out = Attributes::default();
     for a in m.attributes.iter() {
         let data = match a.domain {
@@ -446,7 +459,11 @@ fn edges_regular(ctx: &Ctx, b: &mut Build, f: usize) {
         };
         let _ = side_stride;
         for i in 0..res - 2 {
-            let v1 = if flip { start_edge_vert + (res - i - 3) } else { start_edge_vert + i };
+            let v1 = if flip {
+                start_edge_vert + (res - i - 3)
+            } else {
+                start_edge_vert + i
+            };
             let v2 = side_start + stride * i;
             b.edges[e as usize] = [v1 as u32, v2 as u32];
             e += 1;
@@ -502,7 +519,11 @@ fn edges_special(ctx: &Ctx, b: &mut Build, f: usize) {
         {
             let sev = ctx.vertices_edge_offset + ce as i64 * per_edge;
             let flip = m.edges[ce][1] == cv;
-            let side = if pr >= 3 { start_vert + inner_per_ptex * corner } else { center };
+            let side = if pr >= 3 {
+                start_vert + inner_per_ptex * corner
+            } else {
+                center
+            };
             for i in 0..pr - 1 {
                 let v1 = if flip { sev + (res - i - 3) } else { sev + i };
                 b.edges[e as usize] = [v1 as u32, (side + i) as u32];
@@ -526,8 +547,27 @@ fn edges_special(ctx: &Ctx, b: &mut Build, f: usize) {
 /// One sub-face: vertex and edge indices rotated by `rot`, corners at the patch points
 /// (u, v), (u+du, v), (u+du, v+dv), (u, v+dv).
 #[allow(clippy::too_many_arguments)]
-fn face(ctx: &Ctx, b: &mut Build, loop_start: i64, ptex: usize, rot: usize, v: [i64; 4], e: [i64; 4], u0: f64, v0: f64, du: f64, dv: f64) {
-    let rotate = |x: [i64; 4]| [x[(4 - rot) % 4], x[(5 - rot) % 4], x[(6 - rot) % 4], x[(7 - rot) % 4]];
+fn face(
+    ctx: &Ctx,
+    b: &mut Build,
+    loop_start: i64,
+    ptex: usize,
+    rot: usize,
+    v: [i64; 4],
+    e: [i64; 4],
+    u0: f64,
+    v0: f64,
+    du: f64,
+    dv: f64,
+) {
+    let rotate = |x: [i64; 4]| {
+        [
+            x[(4 - rot) % 4],
+            x[(5 - rot) % 4],
+            x[(6 - rot) % 4],
+            x[(7 - rot) % 4],
+        ]
+    };
     let (v, e) = (rotate(v), rotate(e));
     let uv = [(u0, v0), (u0 + du, v0), (u0 + du, v0 + dv), (u0, v0 + dv)];
     let l = loop_start as usize;
@@ -564,7 +604,19 @@ fn loops_regular(ctx: &Ctx, b: &mut Build, f: usize) {
             let u = x as f64 * inv;
             let v0 = start_vert + iy * pir + ix;
             let e0 = start_edge + iy * (2 * pir - 1) + ix;
-            face(ctx, b, l, ptex, 0, [v0, v0 + 1, v0 + pir + 1, v0 + pir], [e0, e0 + pir, e0 + 2 * pir - 1, e0 + pir - 1], u, vv, du, dv);
+            face(
+                ctx,
+                b,
+                l,
+                ptex,
+                0,
+                [v0, v0 + 1, v0 + pir + 1, v0 + pir],
+                [e0, e0 + pir, e0 + 2 * pir - 1, e0 + pir - 1],
+                u,
+                vv,
+                du,
+                dv,
+            );
             l += 4;
         }
     }
@@ -579,9 +631,15 @@ fn loops_regular(ctx: &Ctx, b: &mut Build, f: usize) {
         let flip = m.edges[ce][1] == cv;
         let mut v0 = cv as i64;
         let (mut v3, mut e3) = if pv == m.edges[pe][0] {
-            (ctx.vertices_edge_offset + pe as i64 * per_edge + per_edge - 1, pe as i64 * edges_per_coarse + edges_per_coarse - 1)
+            (
+                ctx.vertices_edge_offset + pe as i64 * per_edge + per_edge - 1,
+                pe as i64 * edges_per_coarse + edges_per_coarse - 1,
+            )
         } else {
-            (ctx.vertices_edge_offset + pe as i64 * per_edge, pe as i64 * edges_per_coarse)
+            (
+                ctx.vertices_edge_offset + pe as i64 * per_edge,
+                pe as i64 * edges_per_coarse,
+            )
         };
         let (mut side_start, side_stride, e2_offset, e2_stride, u, v, delta_u, delta_v);
         side_start = start_vert;
@@ -629,16 +687,36 @@ fn loops_regular(ctx: &Ctx, b: &mut Build, f: usize) {
         for i in 0..res - 2 {
             let v1 = if flip { sev + (res - i - 3) } else { sev + i };
             let v2 = side_start + side_stride * i;
-            let e0 = if flip { ce as i64 * edges_per_coarse + edges_per_coarse - i - 1 } else { ce as i64 * edges_per_coarse + i };
+            let e0 = if flip {
+                ce as i64 * edges_per_coarse + edges_per_coarse - i - 1
+            } else {
+                ce as i64 * edges_per_coarse + i
+            };
             let e1 = start_edge + edges_per_ptex(res - 2) + corner as i64 * per_edge + i;
             let e2 = if i == 0 {
-                start_edge + edges_per_ptex(res - 2) + ((corner as i64 - 1 + r.len() as i64) % r.len() as i64) * per_edge + per_edge - 1
+                start_edge
+                    + edges_per_ptex(res - 2)
+                    + ((corner as i64 - 1 + r.len() as i64) % r.len() as i64) * per_edge
+                    + per_edge
+                    - 1
             } else {
                 start_edge + e2_offset + e2_stride * (i - 1)
             };
             let lu = u + delta_u * i as f64;
             let lv = v + delta_v * i as f64;
-            face(ctx, b, l, ptex, corner, [v0, v1, v2, v3], [e0, e1, e2, e3], lu, lv, du, dv);
+            face(
+                ctx,
+                b,
+                l,
+                ptex,
+                corner,
+                [v0, v1, v2, v3],
+                [e0, e1, e2, e3],
+                lu,
+                lv,
+                du,
+                dv,
+            );
             l += 4;
             v0 = v1;
             v3 = v2;
@@ -677,7 +755,19 @@ fn loops_special(ctx: &Ctx, b: &mut Build, f: usize) {
                 let u = x as f64 * inv;
                 let v0 = cvi + iy * (pir + 1) + ix;
                 let e0 = cei + iy * (2 * pir + 1) + ix;
-                face(ctx, b, l, ptex + corner as usize, 0, [v0, v0 + 1, v0 + pir + 2, v0 + pir + 1], [e0, e0 + pir + 1, e0 + 2 * pir + 1, e0 + pir], u, vv, du, dv);
+                face(
+                    ctx,
+                    b,
+                    l,
+                    ptex + corner as usize,
+                    0,
+                    [v0, v0 + 1, v0 + pir + 2, v0 + pir + 1],
+                    [e0, e0 + pir + 1, e0 + 2 * pir + 1, e0 + pir],
+                    u,
+                    vv,
+                    du,
+                    dv,
+                );
                 l += 4;
             }
         }
@@ -701,7 +791,19 @@ fn loops_special(ctx: &Ctx, b: &mut Build, f: usize) {
             let e2 = e0 + 1;
             let u = row as f64 * du;
             let vv = 1.0 - dv;
-            face(ctx, b, l, ptex + next as usize, 3, [v0, v1, v2, v3], [e0, e1, e2, e3], u, vv, du, dv);
+            face(
+                ctx,
+                b,
+                l,
+                ptex + next as usize,
+                3,
+                [v0, v1, v2, v3],
+                [e0, e1, e2, e3],
+                u,
+                vv,
+                du,
+                dv,
+            );
             l += 4;
             cur += pir + 1;
             nxt += 1;
@@ -727,7 +829,12 @@ fn loops_special(ctx: &Ctx, b: &mut Build, f: usize) {
                 ptex + corner as usize,
                 2,
                 [center, prev_end, end - 1, end],
-                [start_center_edge + prev, start_boundary_edge + prev * pir, cei + inner_edges - 1, start_center_edge + corner],
+                [
+                    start_center_edge + prev,
+                    start_boundary_edge + prev * pir,
+                    cei + inner_edges - 1,
+                    start_center_edge + corner,
+                ],
                 1.0 - du,
                 1.0 - dv,
                 du,
@@ -750,14 +857,24 @@ fn loops_special(ctx: &Ctx, b: &mut Build, f: usize) {
         let cei = start_edge + corner * inner_edges;
         let mut v0 = cv as i64;
         let (mut v3, mut e3) = if pv == m.edges[pe][0] {
-            (ctx.vertices_edge_offset + pe as i64 * per_edge + per_edge - 1, pe as i64 * edges_per_coarse + edges_per_coarse - 1)
+            (
+                ctx.vertices_edge_offset + pe as i64 * per_edge + per_edge - 1,
+                pe as i64 * edges_per_coarse + edges_per_coarse - 1,
+            )
         } else {
-            (ctx.vertices_edge_offset + pe as i64 * per_edge, pe as i64 * edges_per_coarse)
+            (
+                ctx.vertices_edge_offset + pe as i64 * per_edge,
+                pe as i64 * edges_per_coarse,
+            )
         };
         for i in 0..=pir {
             let v1 = if flip { sev + (res - i - 3) } else { sev + i };
             let v2 = if pir >= 1 { cvi + i } else { center };
-            let e0 = if flip { ce as i64 * edges_per_coarse + edges_per_coarse - i - 1 } else { ce as i64 * edges_per_coarse + i };
+            let e0 = if flip {
+                ce as i64 * edges_per_coarse + edges_per_coarse - i - 1
+            } else {
+                ce as i64 * edges_per_coarse + i
+            };
             let mut e1 = start_edge + corner * (2 * pir + 1);
             if pr >= 3 {
                 e1 += n * (inner_edges + pir + 1) + i;
@@ -769,7 +886,19 @@ fn loops_special(ctx: &Ctx, b: &mut Build, f: usize) {
             } else {
                 cei + i - 1
             };
-            face(ctx, b, l, ptex + corner as usize, 0, [v0, v1, v2, v3], [e0, e1, e2, e3], du * i as f64, 0.0, du, dv);
+            face(
+                ctx,
+                b,
+                l,
+                ptex + corner as usize,
+                0,
+                [v0, v1, v2, v3],
+                [e0, e1, e2, e3],
+                du * i as f64,
+                0.0,
+                du,
+                dv,
+            );
             l += 4;
             v0 = v1;
             v3 = v2;
@@ -777,7 +906,11 @@ fn loops_special(ctx: &Ctx, b: &mut Build, f: usize) {
         }
         let flip_prev = m.edges[pe][1] == cv;
         v0 = cvi;
-        v3 = if pv == m.edges[pe][0] { ctx.vertices_edge_offset + pe as i64 * per_edge + per_edge - 1 } else { ctx.vertices_edge_offset + pe as i64 * per_edge };
+        v3 = if pv == m.edges[pe][0] {
+            ctx.vertices_edge_offset + pe as i64 * per_edge + per_edge - 1
+        } else {
+            ctx.vertices_edge_offset + pe as i64 * per_edge
+        };
         e3 = start_edge + n * (inner_edges + pir + 1) + corner * (2 * pir + 1) + pir + 1;
         for i in 0..pir {
             let (v1, e0, e1);
@@ -791,8 +924,24 @@ fn loops_special(ctx: &Ctx, b: &mut Build, f: usize) {
                 e1 = e3 + 1;
             }
             let v2 = if flip_prev { v3 - 1 } else { v3 + 1 };
-            let e2 = if flip_prev { pe as i64 * edges_per_coarse + edges_per_coarse - 2 - i } else { pe as i64 * edges_per_coarse + 1 + i };
-            face(ctx, b, l, ptex + corner as usize, 1, [v0, v1, v2, v3], [e0, e1, e2, e3], 0.0, du * (i + 1) as f64, du, dv);
+            let e2 = if flip_prev {
+                pe as i64 * edges_per_coarse + edges_per_coarse - 2 - i
+            } else {
+                pe as i64 * edges_per_coarse + 1 + i
+            };
+            face(
+                ctx,
+                b,
+                l,
+                ptex + corner as usize,
+                1,
+                [v0, v1, v2, v3],
+                [e0, e1, e2, e3],
+                0.0,
+                du * (i + 1) as f64,
+                du,
+                dv,
+            );
             l += 4;
             v0 = v1;
             v3 = v2;

@@ -9,7 +9,20 @@ use crate::shader::attributes::{AttributeRequest, MAX_ATTRIBUTES};
 use super::{prop_str, CompileError, Compiler, Kind, Op};
 
 /// Attribute names Cycles resolves to built-in data rather than to a mesh attribute.
-const STANDARD_NAMES: [&str; 12] = ["generated", "uv", "tangent", "N", "Ng", "undeformed", "undisplaced", "pointiness", "random_per_island", "vertex_color", "ptex_face_id", "ptex_uv"];
+const STANDARD_NAMES: [&str; 12] = [
+    "generated",
+    "uv",
+    "tangent",
+    "N",
+    "Ng",
+    "undeformed",
+    "undisplaced",
+    "pointiness",
+    "random_per_island",
+    "vertex_color",
+    "ptex_face_id",
+    "ptex_uv",
+];
 
 impl<'g, 'a> Compiler<'g, 'a> {
     /// The index of request `r`, added when new.
@@ -18,7 +31,9 @@ impl<'g, 'a> Compiler<'g, 'a> {
             return Ok(k as u8);
         }
         if self.attributes.len() == MAX_ATTRIBUTES {
-            return Err(CompileError(format!("node {path:?}: the material reads more than {MAX_ATTRIBUTES} mesh attributes")));
+            return Err(CompileError(format!(
+                "node {path:?}: the material reads more than {MAX_ATTRIBUTES} mesh attributes"
+            )));
         }
         self.attributes.push(r);
         Ok(self.attributes.len() as u8 - 1)
@@ -49,7 +64,11 @@ impl<'g, 'a> Compiler<'g, 'a> {
         self.no_offset(&n.path, &n.node.bl_idname)?;
         if n.node.bl_idname == "ShaderNodeVertexColor" {
             let name = prop_str(n, "layer_name")?;
-            let r = if name.is_empty() { AttributeRequest::DefaultColor } else { AttributeRequest::Named(name.to_string()) };
+            let r = if name.is_empty() {
+                AttributeRequest::DefaultColor
+            } else {
+                AttributeRequest::Named(name.to_string())
+            };
             let attr = self.request(&n.path, r)?;
             let (color, alpha) = (self.alloc(C), self.alloc(F));
             self.ops.push(Op::ColorAttribute { attr, color, alpha });
@@ -69,26 +88,62 @@ impl<'g, 'a> Compiler<'g, 'a> {
         if let Some(r) = derived {
             let attr = self.request(&n.path, r)?;
             let (vector, fac, alpha) = (self.alloc(V), self.alloc(F), self.alloc(F));
-            self.ops.push(Op::Attribute { attr, vector, fac, alpha });
-            self.outputs(i, n, &[("Color", vector, C), ("Vector", vector, V), ("Fac", fac, F), ("Alpha", alpha, F)]);
+            self.ops.push(Op::Attribute {
+                attr,
+                vector,
+                fac,
+                alpha,
+            });
+            self.outputs(
+                i,
+                n,
+                &[
+                    ("Color", vector, C),
+                    ("Vector", vector, V),
+                    ("Fac", fac, F),
+                    ("Alpha", alpha, F),
+                ],
+            );
             return Ok(());
         }
         if STANDARD_NAMES.contains(&name) {
-            return Err(CompileError(format!("node {:?}: Attribute name {name:?} is Cycles built-in data, not supported yet", n.path)));
+            return Err(CompileError(format!(
+                "node {:?}: Attribute name {name:?} is Cycles built-in data, not supported yet",
+                n.path
+            )));
         }
         let attr = self.request(&n.path, AttributeRequest::Named(name.to_string()))?;
         let (vector, fac, alpha) = (self.alloc(V), self.alloc(F), self.alloc(F));
-        self.ops.push(Op::Attribute { attr, vector, fac, alpha });
-        self.outputs(i, n, &[("Color", vector, C), ("Vector", vector, V), ("Fac", fac, F), ("Alpha", alpha, F)]);
+        self.ops.push(Op::Attribute {
+            attr,
+            vector,
+            fac,
+            alpha,
+        });
+        self.outputs(
+            i,
+            n,
+            &[
+                ("Color", vector, C),
+                ("Vector", vector, V),
+                ("Fac", fac, F),
+                ("Alpha", alpha, F),
+            ],
+        );
         Ok(())
     }
 
     /// Geometry > Pointiness and Random Per Island: Cycles compiles them as float
     /// attribute reads of its derived mesh attributes.
     pub(super) fn geometry_derived(&mut self, i: usize) -> Result<(), CompileError> {
-        for (id, r) in [("Pointiness", AttributeRequest::Pointiness), ("Random Per Island", AttributeRequest::RandomPerIsland)] {
+        for (id, r) in [
+            ("Pointiness", AttributeRequest::Pointiness),
+            ("Random Per Island", AttributeRequest::RandomPerIsland),
+        ] {
             let n = &self.g.nodes[i];
-            let Some(k) = n.node.outputs.iter().position(|o| o.identifier == id) else { continue };
+            let Some(k) = n.node.outputs.iter().position(|o| o.identifier == id) else {
+                continue;
+            };
             // At a bump's offset points the output stays unset (a use there is an
             // error): that needs attribute differentials.
             if !self.output_used(i, id) || self.offset_copy {
@@ -96,8 +151,17 @@ impl<'g, 'a> Compiler<'g, 'a> {
             }
             let path = n.path.clone();
             let attr = self.request(&path, r)?;
-            let (vector, fac, alpha) = (self.alloc(Kind::Vector), self.alloc(Kind::Float), self.alloc(Kind::Float));
-            self.ops.push(Op::Attribute { attr, vector, fac, alpha });
+            let (vector, fac, alpha) = (
+                self.alloc(Kind::Vector),
+                self.alloc(Kind::Float),
+                self.alloc(Kind::Float),
+            );
+            self.ops.push(Op::Attribute {
+                attr,
+                vector,
+                fac,
+                alpha,
+            });
             self.values[i][k] = Some((fac, Kind::Float));
         }
         Ok(())
@@ -106,7 +170,10 @@ impl<'g, 'a> Compiler<'g, 'a> {
     pub(super) fn named_uv(&mut self, i: usize) -> Result<(), CompileError> {
         let n = &self.g.nodes[i];
         if n.property("from_instancer").and_then(Value::as_bool) == Some(true) {
-            return Err(CompileError(format!("node {:?}: UV Map 'From Instancer' is not supported yet", n.path)));
+            return Err(CompileError(format!(
+                "node {:?}: UV Map 'From Instancer' is not supported yet",
+                n.path
+            )));
         }
         self.no_offset(&n.path, "a named UV Map")?;
         let name = prop_str(n, "uv_map")?.to_string();
@@ -121,9 +188,18 @@ impl<'g, 'a> Compiler<'g, 'a> {
         let tangent = self.tangent_request(i, Some("uv_map"))?;
         let n = &self.g.nodes[i];
         let normal = self.request(&n.path, AttributeRequest::MapNormal)?;
-        let (color, strength) = (self.input(n, "Color", Kind::Color)?, self.input(n, "Strength", Kind::Float)?);
+        let (color, strength) = (
+            self.input(n, "Color", Kind::Color)?,
+            self.input(n, "Strength", Kind::Float)?,
+        );
         let dst = self.alloc(Kind::Vector);
-        self.ops.push(Op::NormalMapTangent { tangent, normal, color, strength, dst });
+        self.ops.push(Op::NormalMapTangent {
+            tangent,
+            normal,
+            color,
+            strength,
+            dst,
+        });
         self.outputs(i, n, &[("Normal", dst, Kind::Vector)]);
         Ok(())
     }
@@ -132,9 +208,19 @@ impl<'g, 'a> Compiler<'g, 'a> {
     pub(super) fn vector_displacement_tangent(&mut self, i: usize) -> Result<(), CompileError> {
         let tangent = self.tangent_request(i, None)?;
         let n = &self.g.nodes[i];
-        let (vector, midlevel, scale) = (self.input(n, "Vector", Kind::Vector)?, self.input(n, "Midlevel", Kind::Float)?, self.input(n, "Scale", Kind::Float)?);
+        let (vector, midlevel, scale) = (
+            self.input(n, "Vector", Kind::Vector)?,
+            self.input(n, "Midlevel", Kind::Float)?,
+            self.input(n, "Scale", Kind::Float)?,
+        );
         let dst = self.alloc(Kind::Vector);
-        self.ops.push(Op::VectorDisplacementTangent { tangent, vector, midlevel, scale, dst });
+        self.ops.push(Op::VectorDisplacementTangent {
+            tangent,
+            vector,
+            midlevel,
+            scale,
+            dst,
+        });
         self.outputs(i, n, &[("Displacement", dst, Kind::Vector)]);
         Ok(())
     }
