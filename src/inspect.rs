@@ -396,7 +396,7 @@ impl Report {
                 write!(o, " (hidden in render)")?;
             }
             writeln!(o)?;
-            let mats: Vec<String> = ob.materials.iter().map(|m| opt(m)).collect();
+            let mats: Vec<String> = ob.materials.iter().map(opt).collect();
             if !mats.is_empty() {
                 writeln!(o, "    materials: {}", mats.join(", "))?;
             }

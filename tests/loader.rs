@@ -122,7 +122,7 @@ fn with_token(word: &str) -> (tempfile::TempDir, PathBuf) {
     let text = std::fs::read_to_string(&p).unwrap();
     let key = "\"frame_current\": ";
     let at = text.find(key).unwrap() + key.len();
-    let end = at + text[at..].find(|c: char| c == ',' || c == '\n').unwrap();
+    let end = at + text[at..].find([',', '\n']).unwrap();
     std::fs::write(&p, format!("{}{}{}", &text[..at], word, &text[end..])).unwrap();
     (t, dir)
 }

@@ -513,9 +513,7 @@ fn varying_light_node_tree_is_a_clear_error() {
     link.to_node = "Emission".into();
     link.to_socket = "Strength".into();
     tree.links.push(link);
-    let RenderError(m) = render(&scene, &opts)
-        .err()
-        .expect("a linked Emission input is refused");
+    let RenderError(m) = render(&scene, &opts).expect_err("a linked Emission input is refused");
     assert!(
         m.contains("NodeSpot") && m.contains("Strength") && m.contains("Light Falloff"),
         "{m}"

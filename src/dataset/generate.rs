@@ -269,7 +269,7 @@ pub fn generate(
                     Err(e) => {
                         stop.store(true, Ordering::Relaxed);
                         let mut g = first_error.lock().unwrap();
-                        if g.as_ref().map_or(true, |(j, _)| i < *j) {
+                        if g.as_ref().is_none_or(|(j, _)| i < *j) {
                             *g = Some((i, e));
                         }
                         return;

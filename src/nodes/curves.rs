@@ -474,7 +474,7 @@ impl CurveTable {
     /// Cycles' `rgb_ramp_lookup` (interpolating) of channel `ch` at relative position f.
     fn lookup(&self, f: f32, ch: usize) -> f32 {
         let n = self.table.len();
-        if (f < 0.0 || f > 1.0) && self.extrapolate {
+        if !(0.0..=1.0).contains(&f) && self.extrapolate {
             let (t0, t1, f) = if f < 0.0 {
                 (self.table[0][ch], self.table[1][ch], -f)
             } else {

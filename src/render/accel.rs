@@ -457,6 +457,21 @@ impl Watertight {
     }
 }
 
+impl Bvh {
+    /// The nearest hit (`ANY` false) or any hit (`ANY` true), for structures built of BVHs.
+    #[inline(always)]
+    pub fn intersect_or_occluded<const ANY: bool>(
+        &self,
+        org: V3,
+        dir: V3,
+        tmin: f32,
+        tmax: f32,
+        mask: u32,
+    ) -> Option<Hit> {
+        self.traverse::<ANY>(org, dir, tmin, tmax, mask)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -532,20 +547,5 @@ mod tests {
             ray::TRANSMIT
         );
         assert_eq!(bvh.intersect(o, d, 0.0, f32::INFINITY).unwrap().prim, 0);
-    }
-}
-
-impl Bvh {
-    /// The nearest hit (`ANY` false) or any hit (`ANY` true), for structures built of BVHs.
-    #[inline(always)]
-    pub fn intersect_or_occluded<const ANY: bool>(
-        &self,
-        org: V3,
-        dir: V3,
-        tmin: f32,
-        tmax: f32,
-        mask: u32,
-    ) -> Option<Hit> {
-        self.traverse::<ANY>(org, dir, tmin, tmax, mask)
     }
 }

@@ -9,6 +9,7 @@
 //!   intensity when above 1) is below the threshold.
 //! - dilation: a box filter in x then in y marks the neighbours of unconverged pixels
 //!   unconverged again.
+//!
 //! The check runs over the whole image at fixed sample counts, so the result does not
 //! depend on threads or timing.
 

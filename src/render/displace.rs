@@ -35,10 +35,10 @@ pub fn apply(geo: &mut Geometry, materials: &[Material]) -> usize {
             continue;
         }
         let key = Arc::as_ptr(&inst.mesh);
-        if !done.contains_key(&key) {
+        if let std::collections::hash_map::Entry::Vacant(e) = done.entry(key) {
             let (mesh, n) = displace(inst, materials);
             moved += n;
-            done.insert(key, (Arc::new(mesh), Arc::new(inst.mesh.positions.clone())));
+            e.insert((Arc::new(mesh), Arc::new(inst.mesh.positions.clone())));
         }
         let (mesh, undisplaced) = done[&key].clone();
         inst.mesh = mesh;
@@ -143,11 +143,13 @@ fn vertex_point(
     if !n.iter().all(|x| x.is_finite()) || is_zero(n) {
         n = ng;
     }
-    let mut sp = ShadingPoint::default();
-    sp.position = world;
-    sp.normal = n;
-    sp.object_position = local;
-    sp.object_normal = n_obj;
+    let mut sp = ShadingPoint {
+        position: world,
+        normal: n,
+        object_position: local,
+        object_normal: n_obj,
+        ..Default::default()
+    };
     sp.generated = inst.generated(local);
     if let Some(uv) = &inst.uv {
         let c = tri[k] as usize;

@@ -185,11 +185,13 @@ impl Scene<'_> {
         let face = m.triangle_faces[r.tri as usize] as usize;
         let slot = inst.face_slot.get(face).copied().unwrap_or(0) as usize;
         let material = inst.slots.get(slot).copied().flatten();
-        let mut sp = ShadingPoint::default();
-        sp.position = p;
-        sp.normal = n;
-        sp.object_position = local;
-        sp.object_normal = n_obj;
+        let mut sp = ShadingPoint {
+            position: p,
+            normal: n,
+            object_position: local,
+            object_normal: n_obj,
+            ..Default::default()
+        };
         // Generated coordinates (and a displacement bump) read the mesh before true
         // displacement moved it.
         let before = inst.undisplaced.as_ref().map(|orig| {
@@ -261,6 +263,8 @@ impl Scene<'_> {
     }
 
     /// One path sample: radiance along the camera ray.
+    // The shading state is passed apart, as Cycles passes it to its kernels.
+    #[allow(clippy::too_many_arguments)]
     pub fn radiance(
         &self,
         org: V3,
@@ -1070,6 +1074,8 @@ impl Scene<'_> {
     /// The shading context besides position, normals and UV: what the input nodes read
     /// (incoming direction, true normal, barycentrics in Cycles' convention, camera and
     /// window coordinates, object). Path state and ray length are the caller's.
+    // The shading state is passed apart, as Cycles passes it to its kernels.
+    #[allow(clippy::too_many_arguments)]
     fn fill_context(
         &self,
         sp: &mut ShadingPoint,
@@ -1108,6 +1114,8 @@ impl Scene<'_> {
         }
     }
 
+    // The shading state is passed apart, as Cycles passes it to its kernels.
+    #[allow(clippy::too_many_arguments)]
     pub fn light_emission(
         &self,
         prim: u32,

@@ -247,7 +247,7 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
             "POINT" | "SPOT" => {
                 let radius = num(p, "shadow_soft_size", 0.25);
                 let spot = if l.kind == "SPOT" {
-                    let size = num(p, "spot_size", 0.785398);
+                    let size = num(p, "spot_size", std::f64::consts::FRAC_PI_4);
                     let blend = num(p, "spot_blend", 0.15);
                     let cos_half = (size * 0.5).cos();
                     let smooth = if blend > 0.0 {

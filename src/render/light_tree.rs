@@ -811,6 +811,8 @@ impl LightTree {
 
     /// Cycles' light_tree_cluster_select_emitter: two reservoirs, by the upper and by the
     /// lower bound of each emitter's importance, one chosen by the random number.
+    // The shading state is passed apart, as Cycles passes it to its kernels.
+    #[allow(clippy::too_many_arguments)]
     fn select_in_leaf(
         &self,
         p: V3,

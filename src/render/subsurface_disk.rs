@@ -177,7 +177,7 @@ pub fn disk_exit(
         let mut state = (u[3] * 4_294_967_296.0) as u32 ^ 0x68bc_21eb;
         for (i, f) in found[..n_found].iter().enumerate().skip(MAX_HITS) {
             state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            let j = (state as u64 * (i as u64 + 1) >> 32) as usize;
+            let j = ((state as u64 * (i as u64 + 1)) >> 32) as usize;
             if j < MAX_HITS {
                 kept[j] = *f;
             }

@@ -590,7 +590,6 @@ pub fn read_obj(path: &Path) -> Result<MeshData, SceneError> {
         triangulate: false,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     let (models, _materials) = tobj::load_obj(path, &opts)
         .map_err(|e| SceneError::new(path, "", format!("cannot read OBJ: {e}")))?;

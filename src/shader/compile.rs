@@ -205,10 +205,10 @@ fn identity_mapping(m: &Value) -> bool {
     let v3 = |k: &str, want: f64| {
         m.get(k)
             .and_then(Value::as_array)
-            .map_or(true, |a| a.iter().all(|x| x.as_f64() == Some(want)))
+            .is_none_or(|a| a.iter().all(|x| x.as_f64() == Some(want)))
     };
     let b = |k: &str| m.get(k).and_then(Value::as_bool).unwrap_or(false);
-    let s = |k: &str, want: &str| m.get(k).and_then(Value::as_str).map_or(true, |x| x == want);
+    let s = |k: &str, want: &str| m.get(k).and_then(Value::as_str).is_none_or(|x| x == want);
     v3("translation", 0.0)
         && v3("rotation", 0.0)
         && v3("scale", 1.0)

@@ -633,7 +633,7 @@ impl Program {
     fn exec(&self, sp: ShadingPoint, s: &mut [f32], ops: &[Op]) {
         // `sp` is what the ops read: `base`, or a bump copy's offset point.
         let mut base = sp;
-        let mut sp = base;
+        let mut sp = sp;
         for op in ops {
             match *op {
                 Op::VectorToFloat { src, dst } => {

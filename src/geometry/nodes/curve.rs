@@ -464,7 +464,7 @@ fn sweep(
             for ip in 0..profile.curve_count() {
                 let pn = pev.range(ip).len();
                 for i in mev.range(im) {
-                    idx.extend(std::iter::repeat(i).take(pn));
+                    idx.extend(std::iter::repeat_n(i, pn));
                 }
             }
         }

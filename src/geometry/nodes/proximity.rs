@@ -79,7 +79,7 @@ pub fn geometry_proximity(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             && ctx
                 .field(id, DataType::Int)?
                 .as_constant()
-                .map_or(true, |v| v.as_int() != 0)
+                .is_none_or(|v| v.as_int() != 0)
         {
             return Err(ctx.err(format!("{id} is not supported yet")));
         }
