@@ -10,6 +10,7 @@ pub mod blender;
 pub mod color;
 pub mod dataset;
 pub mod denoise;
+pub mod foundation;
 pub mod geometry;
 pub mod inspect;
 pub mod label;

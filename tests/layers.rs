@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 
 /// Lowest first. Modules in one row are siblings and do not use each other.
 const LAYERS: &[&[&str]] = &[
+    &["foundation"],
     &["scene"],
     &["nodes", "anim", "color"],
     &["shader"],
@@ -30,11 +31,6 @@ const KNOWN: &[(&str, &str, &str)] = &[
         "shader",
         "render",
         "shader/view.rs builds the render camera; the camera model belongs below shader",
-    ),
-    (
-        "geometry",
-        "render",
-        "Raycast uses the renderer's BVH; the BVH belongs in the foundation",
     ),
     (
         "label",

@@ -10,7 +10,8 @@
 //! independent, and pixels are summed in sample order, so the image has the same bits
 //! for any thread count.
 
-pub mod accel;
+/// The BVH lives in the foundation (Geometry Nodes' Raycast uses it too).
+pub use crate::foundation::bvh as accel;
 pub mod adaptive;
 pub mod anisotropic;
 pub mod area_light;
@@ -24,7 +25,7 @@ pub mod filter;
 pub mod integrator;
 pub mod light;
 pub mod light_tree;
-pub mod math;
+pub use crate::foundation::math;
 pub mod microfacet;
 pub mod motion;
 pub mod object_motion;

@@ -76,22 +76,9 @@ pub struct Undisplaced {
     pub dp_dy: Vec3,
 }
 
-/// Cycles' path flags (`PATH_RAY_*`) that the Light Path node reads.
-pub mod ray {
-    pub const CAMERA: u32 = 1 << 0;
-    pub const REFLECT: u32 = 1 << 1;
-    pub const TRANSMIT: u32 = 1 << 2;
-    pub const DIFFUSE: u32 = 1 << 3;
-    pub const GLOSSY: u32 = 1 << 4;
-    pub const SINGULAR: u32 = 1 << 5;
-    pub const TRANSPARENT: u32 = 1 << 6;
-    pub const SHADOW: u32 = 1 << 7;
-    /// Emission evaluated for a light sample (Cycles counts it one bounce further).
-    pub const EMISSION: u32 = 1 << 8;
-    /// Never set: blendsynth has no volumes (Is Volume Scatter Ray reads 0, as Cycles
-    /// does for surfaces reached without volume scattering).
-    pub const VOLUME_SCATTER: u32 = 1 << 9;
-}
+/// Cycles' path flags (`PATH_RAY_*`): defined in the foundation, since the BVH's ray
+/// visibility reads them too.
+pub use crate::foundation::ray;
 
 /// The path state a Light Path node reads: flags from `ray` and bounce counts so far.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]

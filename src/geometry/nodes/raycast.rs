@@ -20,7 +20,7 @@ use super::super::mesh_sample::{cleared, corner_values, sample, Triangles};
 use super::super::nearest::normal_tri;
 use super::super::types::{Array, DataType, Value};
 use super::super::value::SocketValue;
-use crate::render::accel::{Accel, Bvh};
+use crate::foundation::bvh::{Accel, Bvh};
 
 /// The data types the node's `data_type` menu offers in Blender 4.5.
 pub fn sample_data_type(ctx: &NodeCtx) -> Result<DataType, GeometryError> {

@@ -50,7 +50,7 @@ pub trait Accel: Sync {
 /// Visibility masks: an object's is the `ray::` bits of the rays that see it, a ray's the
 /// bits of its type; the object is hit when they share a bit (Cycles' PATH_RAY_* masks).
 pub mod visibility {
-    use crate::shader::point::ray;
+    use crate::foundation::ray;
 
     /// Every ray type an object can be hidden from.
     pub const ALL: u32 = ray::CAMERA
@@ -496,7 +496,7 @@ mod tests {
 
     #[test]
     fn masked_triangles_are_passed_through() {
-        use crate::shader::point::ray;
+        use crate::foundation::ray;
         // Two stacked quads' worth of triangles: the near one hidden from the camera and
         // shadow rays, the far one visible to all.
         let near = [[-1.0, -1.0, 1.0], [1.0, -1.0, 1.0], [0.0, 1.0, 1.0]];
