@@ -18,6 +18,7 @@ pub mod bsdf;
 pub mod build;
 pub mod bump_correction;
 pub mod camera;
+pub mod control;
 pub mod denoise_features;
 pub mod displace;
 pub mod filter;
@@ -63,6 +64,13 @@ impl std::fmt::Display for RenderError {
     }
 }
 impl std::error::Error for RenderError {}
+
+impl RenderError {
+    /// Whether the render stopped because its `Control` was cancelled.
+    pub fn is_cancelled(&self) -> bool {
+        self.0 == control::CANCELLED
+    }
+}
 
 #[derive(Debug, Clone, Default)]
 pub struct RenderOptions {
@@ -163,6 +171,17 @@ pub fn render_with_overrides(
     scene: &Scene,
     opts: &RenderOptions,
     overrides: &[(String, Value)],
+) -> Result<RenderOutput, RenderError> {
+    render_controlled(scene, opts, overrides, None)
+}
+
+/// `render_with_overrides` that another thread can follow and stop through `control`
+/// (checked between tiles; the image is the same when it is not cancelled).
+pub fn render_controlled(
+    scene: &Scene,
+    opts: &RenderOptions,
+    overrides: &[(String, Value)],
+    control: Option<&control::Control>,
 ) -> Result<RenderOutput, RenderError> {
     let start = Instant::now();
     let s = &scene.file.scene;
@@ -334,6 +353,10 @@ pub fn render_with_overrides(
     let render_start = Instant::now();
     let nmat = materials.len();
     let npix = (w * h) as usize;
+    if let Some(c) = control {
+        c.start(npix as u64 * samples as u64);
+    }
+    let cancelled = || control.is_some_and(|c| c.is_cancelled());
     // Per-pixel accumulators live in image order; tiles read and write disjoint pixels.
     let mut film = adaptive::Film::new(npix);
     let mut tiles: Vec<TileWork> = (0..n_tiles)
@@ -380,6 +403,9 @@ pub fn render_with_overrides(
             tiles.par_iter_mut().for_each_init(
                 || Scratch::new(nmat),
                 |scratch, tile| {
+                    if cancelled() {
+                        return;
+                    }
                     let rays0 = scratch.rays;
                     let mut k = 0;
                     for y in tile.ty..tile.ty + tile.th {
@@ -429,12 +455,18 @@ pub fn render_with_overrides(
                         }
                     }
                     tile.rays += scratch.rays - rays0;
+                    if let Some(c) = control {
+                        c.add((tile.tw * tile.th) as u64 * n as u64);
+                    }
                 },
             )
         };
         match &pool {
             Some(p) => p.install(|| run(&mut tiles)),
             None => run(&mut tiles),
+        }
+        if cancelled() {
+            return Err(RenderError(control::CANCELLED.into()));
         }
         for t in &tiles {
             let mut k = 0;
@@ -461,6 +493,9 @@ pub fn render_with_overrides(
     }
     if let Some(b) = &bar {
         b.finish_and_clear();
+    }
+    if let Some(c) = control {
+        c.finish();
     }
     let mut color = vec![[0.0f32; 4]; npix];
     let mut sample_count = vec![0u32; npix];
