@@ -420,13 +420,12 @@ fn run_render(
         };
         match got {
             Ok(r) => {
+                let r = r.map_err(py_err)?;
                 if let Some(cb) = &progress {
                     let (_, total) = control.progress();
-                    if let Err(e) = cb.call1(py, (total, total)) {
-                        return Err(e);
-                    }
+                    cb.call1(py, (total, total))?;
                 }
-                return r.map_err(py_err);
+                return Ok(r);
             }
             Err(mpsc::RecvTimeoutError::Timeout) => {}
             Err(mpsc::RecvTimeoutError::Disconnected) => {

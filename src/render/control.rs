@@ -1,4 +1,4 @@
-//! Control of a running render from outside it: a cancel flag checked between tiles and
+//! Control of a running render from outside it: a cancel flag checked between pixels and
 //! a progress count, both atomics so another thread (a UI, the Python bindings) can read
 //! and set them while the render's workers run. A render without a `Control` behaves as
 //! before; one with it renders the same bits unless it is cancelled.
@@ -30,8 +30,8 @@ impl Control {
         }
     }
 
-    /// Asks the render to stop: tiles not yet started are skipped, and the render
-    /// returns `RenderError(CANCELLED)` at the end of the current sample range.
+    /// Asks the render to stop: workers stop at their next pixel, and the render returns
+    /// `RenderError(CANCELLED)` once they have.
     pub fn cancel(&self) {
         self.cancel.store(true, Ordering::Relaxed);
     }

@@ -176,7 +176,7 @@ pub fn render_with_overrides(
 }
 
 /// `render_with_overrides` that another thread can follow and stop through `control`
-/// (checked between tiles; the image is the same when it is not cancelled).
+/// (checked between pixels; the image is the same when it is not cancelled).
 pub fn render_controlled(
     scene: &Scene,
     opts: &RenderOptions,
@@ -417,6 +417,11 @@ pub fn render_controlled(
                             }
                             if px.converged {
                                 continue;
+                            }
+                            // A sample range can be long (all samples without adaptive
+                            // sampling), so a cancel is also seen between pixels.
+                            if cancelled() {
+                                return;
                             }
                             let rng = PixelSampler::new(x, y, seed);
                             // Like Cycles with a sample count pass, a pixel's sample
