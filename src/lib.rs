@@ -6,6 +6,7 @@
 //! and reported on by `inspect`. See ARCHITECTURE.md.
 
 pub mod anim;
+pub mod api;
 pub mod blender;
 pub mod color;
 pub mod dataset;
@@ -18,3 +19,7 @@ pub mod nodes;
 pub mod render;
 pub mod scene;
 pub mod shader;
+
+/// Python bindings (the `blendsynth` wheel, built by maturin with `--features python`).
+#[cfg(feature = "python")]
+mod python;

@@ -65,7 +65,7 @@ fn atomic(
 
 /// Display value to an n-bit code, rounding half up and clamping, as Blender does.
 #[inline]
-fn quantize(v: f32, max: f32) -> f32 {
+pub fn quantize(v: f32, max: f32) -> f32 {
     if !(v > 0.0) {
         0.0
     } else if v >= 1.0 {

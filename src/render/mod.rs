@@ -19,6 +19,7 @@ pub mod bsdf;
 pub mod build;
 pub mod bump_correction;
 pub mod camera;
+pub mod control;
 pub mod denoise_features;
 pub mod displace;
 pub mod filter;
@@ -64,6 +65,13 @@ impl std::fmt::Display for RenderError {
     }
 }
 impl std::error::Error for RenderError {}
+
+impl RenderError {
+    /// Whether the render stopped because its `Control` was cancelled.
+    pub fn is_cancelled(&self) -> bool {
+        self.0 == control::CANCELLED
+    }
+}
 
 #[derive(Debug, Clone, Default)]
 pub struct RenderOptions {
@@ -164,6 +172,17 @@ pub fn render_with_overrides(
     scene: &Scene,
     opts: &RenderOptions,
     overrides: &[(String, Value)],
+) -> Result<RenderOutput, RenderError> {
+    render_controlled(scene, opts, overrides, None)
+}
+
+/// `render_with_overrides` that another thread can follow and stop through `control`
+/// (checked between pixels; the image is the same when it is not cancelled).
+pub fn render_controlled(
+    scene: &Scene,
+    opts: &RenderOptions,
+    overrides: &[(String, Value)],
+    control: Option<&control::Control>,
 ) -> Result<RenderOutput, RenderError> {
     let start = Instant::now();
     let s = &scene.file.scene;
@@ -335,6 +354,10 @@ pub fn render_with_overrides(
     let render_start = Instant::now();
     let nmat = materials.len();
     let npix = (w * h) as usize;
+    if let Some(c) = control {
+        c.start(npix as u64 * samples as u64);
+    }
+    let cancelled = || control.is_some_and(|c| c.is_cancelled());
     // Per-pixel accumulators live in image order; tiles read and write disjoint pixels.
     let mut film = adaptive::Film::new(npix);
     let mut tiles: Vec<TileWork> = (0..n_tiles)
@@ -381,6 +404,9 @@ pub fn render_with_overrides(
             tiles.par_iter_mut().for_each_init(
                 || Scratch::new(nmat),
                 |scratch, tile| {
+                    if cancelled() {
+                        return;
+                    }
                     let rays0 = scratch.rays;
                     let mut k = 0;
                     for y in tile.ty..tile.ty + tile.th {
@@ -392,6 +418,11 @@ pub fn render_with_overrides(
                             }
                             if px.converged {
                                 continue;
+                            }
+                            // A sample range can be long (all samples without adaptive
+                            // sampling), so a cancel is also seen between pixels.
+                            if cancelled() {
+                                return;
                             }
                             let rng = PixelSampler::new(x, y, seed);
                             // Like Cycles with a sample count pass, a pixel's sample
@@ -430,12 +461,18 @@ pub fn render_with_overrides(
                         }
                     }
                     tile.rays += scratch.rays - rays0;
+                    if let Some(c) = control {
+                        c.add((tile.tw * tile.th) as u64 * n as u64);
+                    }
                 },
             )
         };
         match &pool {
             Some(p) => p.install(|| run(&mut tiles)),
             None => run(&mut tiles),
+        }
+        if cancelled() {
+            return Err(RenderError(control::CANCELLED.into()));
         }
         for t in &tiles {
             let mut k = 0;
@@ -462,6 +499,9 @@ pub fn render_with_overrides(
     }
     if let Some(b) = &bar {
         b.finish_and_clear();
+    }
+    if let Some(c) = control {
+        c.finish();
     }
     let mut color = vec![[0.0f32; 4]; npix];
     let mut sample_count = vec![0u32; npix];

@@ -106,6 +106,21 @@ const COLLECTIONS: &[&str] = &[
 
 /// Sets the value at a Blender data path inside the scene JSON.
 pub fn set(root: &mut Value, path: &str, value: &Value) -> Result<(), String> {
+    assign(walk(root, path)?, value)
+}
+
+/// The value at a Blender data path inside the scene JSON, found as `set` finds it; a
+/// path to a structure rather than a value is an error, as it is for `set`.
+pub fn get(root: &mut Value, path: &str) -> Result<Value, String> {
+    let v = walk(root, path)?;
+    if v.is_object() {
+        return Err("points at a structure, not a value".into());
+    }
+    Ok(v.clone())
+}
+
+/// The slot a data path names.
+fn walk<'a>(root: &'a mut Value, path: &str) -> Result<&'a mut Value, String> {
     let tokens = parse(path)?;
     let mut it = tokens.iter();
     let mut cur: &mut Value = match it.next() {
@@ -148,7 +163,7 @@ pub fn set(root: &mut Value, path: &str, value: &Value) -> Result<(), String> {
             Token::Index(i) => format!("[{i}]"),
         });
     }
-    assign(cur, value)
+    Ok(cur)
 }
 
 /// One step of the walk: an attribute, a named member of a collection, or an index.
