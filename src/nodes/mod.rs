@@ -60,6 +60,9 @@ pub mod vector_rotate;
 pub mod voronoi;
 pub mod wave;
 pub mod white_noise;
+// Sky Texture (sky.rs; the Hosek/Wilkie data in sky_hosek.rs).
+pub mod sky;
+pub mod sky_hosek;
 // Brick, Image and Environment Textures.
 pub mod brick;
 pub mod image;

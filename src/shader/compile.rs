@@ -1031,6 +1031,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 "ShaderNodeTexBrick" => self.brick(i)?,
                 "ShaderNodeTexImage" => self.image_texture(i)?,
                 "ShaderNodeTexEnvironment" => self.environment_texture(i)?,
+                "ShaderNodeTexSky" => self.sky_texture(i)?,
                 "ShaderNodeBackground" => {
                     // A world's Background is emission seen along the ray.
                     let (color, strength) =
@@ -1641,6 +1642,57 @@ impl<'g, 'a> Compiler<'g, 'a> {
             n,
             &[("Color", color, Kind::Color), ("Alpha", alpha, Kind::Float)],
         );
+        Ok(())
+    }
+
+    /// Sky Texture: the model precomputed once here, as Cycles' `SkyTextureNode::compile`.
+    /// Its Vector is Generated when unlinked (with Nishita's sun disc Blender makes the
+    /// socket unavailable, so it always is then).
+    fn sky_texture(&mut self, i: usize) -> Result<(), CompileError> {
+        use crate::nodes::sky::{Sky, SkySettings, SkyType};
+        let n = &self.g.nodes[i];
+        let (_, vector, _) = self.texture_point(n, None)?;
+        let f = |key: &str| Self::prop_f32(n, key);
+        let sun = prop(n, "sun_direction")?
+            .as_array()
+            .filter(|a| a.len() == 3)
+            .and_then(|a| {
+                a.iter()
+                    .map(|x| x.as_f64().map(|v| v as f32))
+                    .collect::<Option<Vec<f32>>>()
+            })
+            .ok_or_else(|| {
+                CompileError(format!(
+                    "node {:?}: sun_direction is not a 3-vector",
+                    n.path
+                ))
+            })?;
+        // Blender's sync normalises the sun direction.
+        let l = (sun[0] * sun[0] + sun[1] * sun[1] + sun[2] * sun[2]).sqrt();
+        let settings = SkySettings {
+            sky_type: mode(n, "sky_type", SkyType::from_blender)?,
+            sun_direction: [sun[0] / l, sun[1] / l, sun[2] / l],
+            turbidity: f("turbidity")?,
+            ground_albedo: f("ground_albedo")?,
+            sun_disc: prop_bool(n, "sun_disc")?,
+            sun_size: f("sun_size")?,
+            sun_intensity: f("sun_intensity")?,
+            sun_elevation: f("sun_elevation")?,
+            sun_rotation: f("sun_rotation")?,
+            altitude: f("altitude")?,
+            air_density: f("air_density")?,
+            dust_density: f("dust_density")?,
+            ozone_density: f("ozone_density")?,
+        };
+        let sky =
+            Sky::new(&settings).map_err(|e| CompileError(format!("node {:?}: {e}", n.path)))?;
+        let color = self.alloc(Kind::Color);
+        self.ops.push(Op::TexSky {
+            sky: std::sync::Arc::new(sky),
+            vector,
+            color,
+        });
+        self.outputs(i, n, &[("Color", color, Kind::Color)]);
         Ok(())
     }
 

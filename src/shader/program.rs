@@ -345,6 +345,12 @@ pub enum Op {
         color: Slot,
         alpha: Slot,
     },
+    /// Sky Texture, precomputed per node.
+    TexSky {
+        sky: std::sync::Arc<crate::nodes::sky::Sky>,
+        vector: Slot,
+        color: Slot,
+    },
     /// Environment Texture (the vector is a direction).
     TexEnvironment {
         image: std::sync::Arc<TexImage>,
@@ -1111,6 +1117,11 @@ impl Program {
                     put3(s, color, [r[0], r[1], r[2]]);
                     s[alpha as usize] = r[3];
                 }
+                Op::TexSky {
+                    ref sky,
+                    vector,
+                    color,
+                } => put3(s, color, sky.eval(v3(s, vector), &LINEAR_REC709)),
                 Op::TexEnvironment {
                     ref image,
                     projection,
