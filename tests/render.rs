@@ -167,7 +167,19 @@ const ASSERTED: &[&str] = &[
 ];
 
 /// Scenes that do not pass yet, with the reason.
-const KNOWN_FAILURES: &[(&str, &str)] = &[];
+const WALK: &str = "the random walk departs from Cycles' subsurface_random_walk";
+const KNOWN_FAILURES: &[(&str, &str)] = &[
+    // Random-walk subsurface where the walk can leave the object's volume (issue 32): an
+    // open tube seen from inside at three scales, a single-sided plane, a closed shell
+    // thinner than the radius (Random Walk and Random Walk (Skin)). Worst channel mean
+    // error: 0.70%, 2.11%, 2.40% (the scales disagree), 6.44%, 1.70%, 1.48%.
+    ("sss_rw_tube_3cm", WALK),
+    ("sss_rw_tube_30cm", WALK),
+    ("sss_rw_tube_3m", WALK),
+    ("sss_rw_plane", WALK),
+    ("sss_rw_thin_shell", WALK),
+    ("sss_rw_skin_thin_shell", WALK),
+];
 
 /// Scenes whose one-seed figures are no parity criterion, with the test that compares them
 /// instead (their figures are still printed).
