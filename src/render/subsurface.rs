@@ -43,7 +43,9 @@ pub struct Bssrdf {
 }
 
 const MIN_RADIUS: f32 = 1e-8;
-const MAX_BOUNCES: u32 = 1024;
+/// Cycles' BSSRDF_MAX_BOUNCES: a walk still inside after this many steps is lost (the path
+/// ends), which on an open surface is most walks that wander away from it.
+const MAX_BOUNCES: u32 = 256;
 const THROUGHPUT_EPSILON: f32 = 1e-6;
 
 fn dipole_rd(alpha_prime: f32, fourthird_a: f32) -> f32 {
@@ -112,8 +114,9 @@ pub fn setup(
             }
         }
     }
-    // Cycles' Random Walk enters through a rough interface of fixed roughness one.
-    let alpha = if method == Method::RandomWalk {
+    // Cycles' Random Walk (Skin) enters through a rough interface of fixed roughness one
+    // (bssrdf_setup); the other methods keep the closure's roughness.
+    let alpha = if method == Method::RandomWalkSkin {
         1.0
     } else {
         (roughness * roughness).clamp(0.0, 1.0)
@@ -211,10 +214,11 @@ fn hg_sample(d: V3, g: f32, u: [f32; 2]) -> (V3, f32) {
 }
 
 /// The walk's direction into the surface (Cycles' `subsurface_entry_bounce`): half the
-/// Random Walk's entries are diffuse, the rest refract about a GGX normal; `v` is the
-/// direction toward the viewer, `n` the closure normal.
+/// Random Walk (Skin)'s entries are diffuse, the rest (and every entry of the plain Random
+/// Walk) refract about a GGX normal; `v` is the direction toward the viewer, `n` the
+/// closure normal.
 pub fn entry_direction(b: &Bssrdf, n: V3, v: V3, mut u: [f32; 2]) -> Option<V3> {
-    if b.method == Method::RandomWalk {
+    if b.method == Method::RandomWalkSkin {
         if u[0] < 0.5 {
             u[0] *= 2.0;
             let d = super::camera::concentric_disk(u);
@@ -252,15 +256,26 @@ pub struct Exit {
     pub dir: V3,
 }
 
-/// Ray casts against one object only: the nearest hit within [0, tmax) on instance `inst`.
+/// Ray casts against one object only: the nearest hit within (0, tmax) on instance `inst`,
+/// both sides of its faces, passing through triangle `skip` (the walk's first ray starts on
+/// its entry triangle and, as Cycles' ray self-exclusion, ignores it instead of being
+/// offset off it).
 pub trait LocalTrace {
-    fn local_hit(&mut self, org: V3, dir: V3, tmax: f32, inst: u32)
-        -> Option<(f32, u32, f32, f32)>;
+    fn local_hit(
+        &mut self,
+        org: V3,
+        dir: V3,
+        tmax: f32,
+        inst: u32,
+        skip: Option<u32>,
+    ) -> Option<(f32, u32, f32, f32)>;
 }
 
-/// Cycles' `subsurface_random_walk`: walks from `p` (on the surface, normal `n` facing
-/// the side the path came from) along `d0` into the object; multiplies `throughput` by
-/// the walk's weight. `rand(bounce)` gives the walk's random numbers for one bounce.
+/// Cycles' `subsurface_random_walk`: walks from `p` (on triangle `prim` of instance
+/// `inst`, normal `n` facing the side the path came from) along `d0` into the object;
+/// multiplies `throughput` by the walk's weight. `rand(bounce)` gives the walk's random
+/// numbers for one bounce. Nothing in it has a length of its own: every distance comes from
+/// the radius, so the walk is the same at any scene scale.
 #[allow(clippy::too_many_arguments)]
 pub fn random_walk(
     b: &Bssrdf,
@@ -268,6 +283,7 @@ pub fn random_walk(
     n: V3,
     d0: V3,
     inst: u32,
+    prim: u32,
     throughput: &mut V3,
     trace: &mut dyn LocalTrace,
     rand: &dyn Fn(u32) -> [f32; 8],
@@ -382,7 +398,10 @@ pub fn random_walk(
         } else {
             t
         };
-        let h = trace.local_hit(pos, dir, tmax, inst);
+        // Only the first ray starts on a surface (the entry triangle); after it the walk may
+        // meet that triangle again.
+        let skip = if bounce == 0 { Some(prim) } else { None };
+        let h = trace.local_hit(pos, dir, tmax, inst, skip);
         let mut is_hit = h.is_some();
         if bounce == 0 {
             if let Some((th, ..)) = h {
@@ -489,19 +508,22 @@ impl LocalTrace for Local<'_, '_> {
         dir: V3,
         tmax: f32,
         inst: u32,
+        skip: Option<u32>,
     ) -> Option<(f32, u32, f32, f32)> {
         let mut t0 = 0.0f32;
-        // Skip hits on other objects (Cycles' local intersection sees one object only).
+        // Pass through other objects (Cycles' local intersection sees one object only) and
+        // the skipped triangle. The next search starts just past the hit (hits count only
+        // beyond t0): no absolute epsilon, which would not scale with the scene.
         for _ in 0..64 {
             self.rays += 1;
             let h = self
                 .scene
                 .accel
                 .intersect_at(org, dir, t0, tmax, self.time)?;
-            if self.scene.geo.refs[h.prim as usize].inst == inst {
+            if self.scene.geo.refs[h.prim as usize].inst == inst && Some(h.prim) != skip {
                 return Some((h.t, h.prim, h.u, h.v));
             }
-            t0 = h.t * (1.0 + 1e-6) + 1e-7;
+            t0 = h.t.next_up();
         }
         None
     }
@@ -532,8 +554,8 @@ pub fn enter_and_walk(
     if dot(hit.ng, d0) >= 0.0 {
         return None;
     }
-    // Into the surface: d0 points below the true normal.
-    let start = offset_origin(hit.p, hit.ng, d0);
+    // Cycles starts the walk on the surface itself (no offset: the first ray ignores the
+    // entry triangle instead), so the walk has no length scale but the radius.
     let rand = |bounce: u32| {
         let a = rng.get4(index, base.wrapping_add(1 + 2 * bounce));
         let c = rng.get4(index, base.wrapping_add(2 + 2 * bounce));
@@ -544,7 +566,9 @@ pub fn enter_and_walk(
         rays: 0,
         time: hit.time,
     };
-    let exit = random_walk(b, start, n, d0, hit.inst, throughput, &mut local, &rand);
+    let exit = random_walk(
+        b, hit.p, n, d0, hit.inst, hit.prim, throughput, &mut local, &rand,
+    );
     *rays += local.rays;
     let e = exit?;
     Some((
