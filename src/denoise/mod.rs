@@ -15,6 +15,7 @@
 //! is the background colour. Images are row-major, top row first, like the renderer's.
 
 mod oidn;
+pub mod provision;
 
 use std::path::{Path, PathBuf};
 

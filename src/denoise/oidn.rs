@@ -28,6 +28,8 @@ pub enum DenoiseError {
     },
     #[error("denoise: {0}")]
     Input(String),
+    #[error("provisioning Open Image Denoise: {0}")]
+    Provision(#[from] super::provision::ProvisionError),
 }
 
 struct Api {
