@@ -628,3 +628,61 @@ fn a_wheel_with_the_wrong_checksum_is_a_notice_not_a_failure() {
         .collect();
     assert_eq!(left, vec!["oidn-2.5.1.lock".to_string()]);
 }
+
+/// `generate` (what `replicate` runs) on the built-in colonoscopy scene, its spec's
+/// render settings shrunk: without denoising nothing is fetched; with denoising, from an
+/// empty cache and no OIDN installed, the library is fetched once and the frame differs
+/// from the noisy one. Needs the Python package index: skipped without it, except in CI.
+#[test]
+fn generate_fetches_only_when_a_frame_asks_for_denoising() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cache = tmp.path().join("cache");
+    let assets = common::repo().join("assets/doi-23843904");
+    let spec = std::fs::read_to_string(assets.join("colonoscopy.toml")).unwrap();
+    let (head, rest) = spec.split_once("[render]").unwrap();
+    let rest = &rest[rest.find("\n[").unwrap()..];
+    let run = |denoise: bool| {
+        let spec_file = tmp.path().join(format!("spec-{denoise}.toml"));
+        std::fs::write(
+            &spec_file,
+            format!("{head}[render]\nresolution = [40, 32]\nsamples = 4\nthreshold = 0.0\ndenoise = {denoise}\n{rest}"),
+        )
+        .unwrap();
+        let out = tmp.path().join(format!("ds-{denoise}"));
+        let o = isolated(tmp.path(), &cache)
+            .arg("generate")
+            .arg(assets.join("colonoscopy"))
+            .arg("--spec")
+            .arg(&spec_file)
+            .args(["--frames", "1", "--seed", "0", "--jobs", "1", "-o"])
+            .arg(&out)
+            .output()
+            .unwrap();
+        let err = ok(&o);
+        // images/<split>/<frame>.png
+        let frames: Vec<_> = std::fs::read_dir(out.join("images"))
+            .unwrap()
+            .flatten()
+            .flat_map(|split| std::fs::read_dir(split.path()).unwrap().flatten())
+            .map(|e| e.path())
+            .filter(|p| p.extension().is_some_and(|x| x == "png"))
+            .collect();
+        assert_eq!(frames.len(), 1, "{err}");
+        (err, std::fs::read(&frames[0]).unwrap())
+    };
+    let (err, noisy) = run(false);
+    assert!(!err.contains("Open Image Denoise"), "{err}");
+    assert!(!cache.exists(), "fetched although no frame denoises");
+    let (err, denoised) = run(true);
+    if err.contains("cannot run `python3 -m pip") {
+        common::require::<()>("the Python package index (pip download pyoidn)", None);
+        return;
+    }
+    println!("{err}");
+    assert_eq!(err.matches("downloading it once").count(), 1, "{err}");
+    assert!(err.contains("Open Image Denoise ready in"), "{err}");
+    assert!(cache
+        .join("blendsynth/oidn-2.5.1/lib/libOpenImageDenoise.so.2")
+        .is_file());
+    assert!(denoised != noisy, "the denoised frame equals the noisy one");
+}
