@@ -686,3 +686,37 @@ fn generate_fetches_only_when_a_frame_asks_for_denoising() {
         .is_file());
     assert!(denoised != noisy, "the denoised frame equals the noisy one");
 }
+
+/// A python3 without pip (Debian's default): the render still succeeds, noisy, and the
+/// notice says to install pip.
+#[test]
+fn without_pip_the_notice_says_what_to_install() {
+    use std::os::unix::fs::PermissionsExt;
+    let tmp = tempfile::tempdir().unwrap();
+    let bin = tmp.path().join("bin");
+    std::fs::create_dir_all(&bin).unwrap();
+    let py = bin.join("python3");
+    std::fs::write(
+        &py,
+        "#!/bin/sh\necho '/usr/bin/python3: No module named pip' >&2\nexit 1\n",
+    )
+    .unwrap();
+    std::fs::set_permissions(&py, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let mut c = isolated(tmp.path(), &tmp.path().join("cache"));
+    let path = c
+        .get_envs()
+        .find(|(k, _)| *k == "PATH")
+        .and_then(|(_, v)| v.map(|v| v.to_os_string()))
+        .unwrap();
+    let mut dirs = vec![bin.clone()];
+    dirs.extend(std::env::split_paths(&path));
+    c.env("PATH", std::env::join_paths(dirs).unwrap());
+    let out = tmp.path().join("a.exr");
+    let e = ok(&c.args(render_args(&out)).output().unwrap());
+    assert!(
+        e.contains("No module named pip") && e.contains("apt-get install python3-pip"),
+        "{e}"
+    );
+    assert!(e.contains("written noisy"), "{e}");
+    assert!(out.is_file());
+}

@@ -450,9 +450,14 @@ fn cli_name() -> String {
         .unwrap_or_else(|| "blendsynth".into())
 }
 
-/// The command that installs OIDN where blendsynth finds it.
+/// The command that installs OIDN where blendsynth finds it (where no wheel is pinned
+/// for the platform, what to set instead).
 pub fn install_command() -> String {
-    format!("{} fetch-oidn", cli_name())
+    if provision::PINNED.is_some() {
+        format!("{} fetch-oidn", cli_name())
+    } else {
+        "set BLENDSYNTH_OIDN to an Open Image Denoise 2.x library (no pyoidn wheel is pinned for this platform)".into()
+    }
 }
 
 /// The denoiser for `render`, `generate` and `replicate`: `Denoiser::load`'s search

@@ -298,9 +298,14 @@ pub fn provision(root: &Path, say: &dyn Fn(&str)) -> Result<PathBuf, ProvisionEr
             .find(|l| !l.trim().is_empty())
             .unwrap_or("")
             .trim();
+        let hint = if err.contains("No module named pip") {
+            "; install pip first (Debian/Ubuntu: apt-get install python3-pip)"
+        } else {
+            ""
+        };
         return Err(ProvisionError::Pip {
             command: pip_command_line(),
-            message: format!("{} ({last})", out.status),
+            message: format!("{} ({last}){hint}", out.status),
         });
     }
     let wheel = dl.join(w.file_name);
