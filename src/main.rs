@@ -21,6 +21,10 @@ use blendsynth::{blender, inspect, scene::Override, scene::Scene};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// Never download Open Image Denoise when none is installed (offline clusters); the
+    /// same as BLENDSYNTH_OIDN_DOWNLOAD=0.
+    #[arg(long, global = true)]
+    no_oidn_download: bool,
 }
 
 #[derive(Subcommand)]
@@ -85,6 +89,14 @@ enum Command {
     /// Evaluate an object's geometry (modifiers, Geometry Nodes) at a frame and write it
     /// as a mesh: instances realised, Blender's vertices kept one to one.
     Mesh(MeshArgs),
+    /// Download Open Image Denoise (the pinned pyoidn wheel, through python3 -m pip) into
+    /// the cache folder, or DIR, unless it is there; print the library folder.
+    FetchOidn {
+        /// Folder to provision into instead of $XDG_CACHE_HOME/blendsynth (e.g. shared
+        /// storage); give the printed folder to the jobs as BLENDSYNTH_OIDN.
+        #[arg(long)]
+        dir: Option<PathBuf>,
+    },
 }
 
 #[derive(Clone, Copy, PartialEq, clap::ValueEnum)]
@@ -376,13 +388,10 @@ fn run_render(a: RenderArgs) -> Result<()> {
         |d| d == OnOff::On,
     );
     let denoiser = if want_denoise {
-        blendsynth::denoise::Denoiser::load(a.oidn.as_deref())?
+        blendsynth::denoise::find_for_render(a.oidn.as_deref())?
     } else {
         None
     };
-    if want_denoise && denoiser.is_none() {
-        eprintln!("notice: no Open Image Denoise library found (--oidn, $BLENDSYNTH_OIDN, a bpy/Blender install or the pyoidn wheel); writing the noisy image");
-    }
     let mut out = render::render(&scene, &opts)
         .map_err(|e| anyhow::anyhow!("render {}: {e}", a.dir.display()))?;
     if let Some(d) = &denoiser {
@@ -601,6 +610,11 @@ fn run(cli: Cli) -> Result<Outcome> {
             );
             Ok(Outcome::Done)
         }
+        Command::FetchOidn { dir } => {
+            let lib = blendsynth::denoise::fetch(dir.as_deref())?;
+            println!("{}", lib.display());
+            Ok(Outcome::Done)
+        }
     }
 }
 
@@ -613,6 +627,10 @@ fn main() -> ExitCode {
             return ExitCode::from(if e.use_stderr() { 2 } else { 0 });
         }
     };
+    if cli.no_oidn_download {
+        // Before any thread starts; child processes inherit it.
+        std::env::set_var(blendsynth::denoise::provision::DOWNLOAD_ENV, "0");
+    }
     match run(cli) {
         Ok(Outcome::Done) => ExitCode::SUCCESS,
         Ok(Outcome::Unsupported) => ExitCode::from(3),

@@ -51,7 +51,9 @@ pub fn resolution(scene: &Scene, settings: &RenderSettings) -> (u32, u32) {
 /// The path tracer as a `FrameRenderer`: render, denoise when the spec or the scene asks
 /// for it (as Cycles does after the last sample), then the scene's view transform.
 struct PathTracer {
-    denoiser: Option<crate::denoise::Denoiser>,
+    /// Found when the first frame asks for denoising (so a run that never denoises never
+    /// downloads OIDN); every frame then uses the same one.
+    denoiser: std::sync::OnceLock<Result<Option<crate::denoise::Denoiser>, String>>,
 }
 
 impl FrameRenderer for PathTracer {
@@ -76,7 +78,10 @@ impl FrameRenderer for PathTracer {
         if s.denoise
             .unwrap_or_else(|| crate::denoise::scene_wants_denoising(scene))
         {
-            if let Some(d) = &self.denoiser {
+            let found = self
+                .denoiser
+                .get_or_init(|| crate::denoise::find_for_render(None).map_err(|e| e.to_string()));
+            if let Some(d) = found.as_ref().map_err(Clone::clone)? {
                 crate::denoise::denoise_render(d, scene, frame, &mut out)
                     .map_err(|e| format!("denoising: {e}"))?;
             }
@@ -109,12 +114,15 @@ impl FrameRenderer for PathTracer {
     }
 }
 
-/// The path tracer, with Open Image Denoise when one can be found (a notice otherwise:
-/// frames are then written noisy).
+/// The path tracer, with Open Image Denoise when one can be found or fetched (a notice
+/// otherwise: frames are then written noisy).
 pub fn path_tracer(_scene: &Scene) -> Result<Box<dyn FrameRenderer>, String> {
-    let denoiser = crate::denoise::Denoiser::load(None).map_err(|e| e.to_string())?;
-    if denoiser.is_none() {
-        eprintln!("notice: no Open Image Denoise library found ($BLENDSYNTH_OIDN, a bpy/Blender install or the pyoidn wheel); frames that ask for denoising are written noisy");
+    // An installed library that cannot be used fails the run before any frame; a missing
+    // one is fetched into the cache folder by the first frame that asks for denoising (a
+    // notice, not an error, when that fails: frames are then written noisy).
+    let denoiser = std::sync::OnceLock::new();
+    if let Some(d) = crate::denoise::Denoiser::load(None).map_err(|e| e.to_string())? {
+        let _ = denoiser.set(Ok(Some(d)));
     }
     Ok(Box::new(PathTracer { denoiser }))
 }

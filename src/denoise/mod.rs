@@ -1,7 +1,8 @@
 //! Denoising as Cycles does it by default: Intel Open Image Denoise's "RT" filter on the
 //! HDR colour with albedo and normal guides. OIDN has no Debian package, so the library is
 //! loaded at run time (the copy shipped with Blender or the bpy wheel, a pip wheel, or a
-//! path the user gives) and called through its C API.
+//! path the user gives) and called through its C API. Where none is installed,
+//! `find_for_render` fetches a pinned copy into the user's cache folder (`provision`).
 //!
 //! Cycles (intern/cycles/integrator/denoiser_oidn.cpp, 4.5): CPU device with
 //! `setAffinity` off; filter "RT" with `hdr` on, `srgb` off, `quality` from the scene
@@ -15,6 +16,7 @@
 //! is the background colour. Images are row-major, top row first, like the renderer's.
 
 mod oidn;
+pub mod provision;
 
 use std::path::{Path, PathBuf};
 
@@ -436,4 +438,105 @@ pub fn scene_wants_denoising(scene: &crate::scene::Scene) -> bool {
         .get("use_denoising")
         .and_then(|v| v.as_bool())
         .unwrap_or(false)
+}
+
+/// How the install command is spelled in notices: this executable when it is the
+/// blendsynth CLI, else `blendsynth`.
+fn cli_name() -> String {
+    std::env::current_exe()
+        .ok()
+        .filter(|p| p.file_stem().is_some_and(|s| s == "blendsynth"))
+        .map(|p| p.display().to_string())
+        .unwrap_or_else(|| "blendsynth".into())
+}
+
+/// The command that installs OIDN where blendsynth finds it (where no wheel is pinned
+/// for the platform, what to set instead).
+pub fn install_command() -> String {
+    if provision::PINNED.is_some() {
+        format!("{} fetch-oidn", cli_name())
+    } else {
+        "set BLENDSYNTH_OIDN to an Open Image Denoise 2.x library (no pyoidn wheel is pinned for this platform)".into()
+    }
+}
+
+/// The denoiser for `render`, `generate` and `replicate`: `Denoiser::load`'s search
+/// (`explicit`, $BLENDSYNTH_OIDN, bpy/Blender, pip wheels), then the copy provisioned in
+/// the cache folder, then, unless $BLENDSYNTH_OIDN_DOWNLOAD turns it off, provisioning it
+/// now. Notices go to stderr; not finding or not fetching the library is a notice and
+/// Ok(None) (images are then written noisy), while a library that is named or installed
+/// but unusable stays an error.
+pub fn find_for_render(explicit: Option<&Path>) -> Result<Option<Denoiser>, DenoiseError> {
+    if let Some(d) = Denoiser::load(explicit)? {
+        return Ok(Some(d));
+    }
+    let noisy = "images that ask for denoising are written noisy";
+    let root = match provision::cache_root() {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!(
+                "notice: no Open Image Denoise library found, and {e}; {noisy}. To install it: {}",
+                install_command()
+            );
+            return Ok(None);
+        }
+    };
+    if let Some(dir) = provision::existing(&root) {
+        return match lib_in(&dir).map(|f| Denoiser::open(&f)) {
+            Some(Ok(d)) => Ok(Some(d)),
+            Some(Err(e)) => {
+                eprintln!(
+                    "notice: {e}; {noisy}. Delete {} to download it again",
+                    dir.parent().unwrap_or(&dir).display()
+                );
+                Ok(None)
+            }
+            None => Ok(None),
+        };
+    }
+    if !provision::enabled() {
+        eprintln!(
+            "notice: no Open Image Denoise library found ($BLENDSYNTH_OIDN, a bpy/Blender install, a pyoidn wheel, {}) and downloading it is turned off (--no-oidn-download or {}=0); {noisy}. To install it: {}",
+            provision::lib_dir(&root).unwrap_or_else(|_| root.clone()).display(),
+            provision::DOWNLOAD_ENV,
+            install_command()
+        );
+        return Ok(None);
+    }
+    let t0 = std::time::Instant::now();
+    let fetched = provision::provision(&root, &|m| eprintln!("{m}"))
+        .map_err(DenoiseError::from)
+        .and_then(|dir| {
+            let f = lib_in(&dir).ok_or_else(|| DenoiseError::NotFound(dir.clone()))?;
+            Denoiser::open(&f)
+        });
+    match fetched {
+        Ok(d) => {
+            eprintln!(
+                "notice: Open Image Denoise ready in {} ({:.1} s); later runs load it from there",
+                d.path().parent().unwrap_or(d.path()).display(),
+                t0.elapsed().as_secs_f64()
+            );
+            Ok(Some(d))
+        }
+        Err(e) => {
+            eprintln!("notice: {e}; {noisy}. To install it by hand: {} (on a machine with network; then set BLENDSYNTH_OIDN to the folder it prints if the cache folder is not shared)", install_command());
+            Ok(None)
+        }
+    }
+}
+
+/// `blendsynth fetch-oidn`: provisions OIDN under `root` (default: the cache folder)
+/// whatever $BLENDSYNTH_OIDN_DOWNLOAD says, checks that the library loads, and returns
+/// its folder.
+pub fn fetch(root: Option<&Path>) -> Result<PathBuf, DenoiseError> {
+    let root = match root {
+        Some(r) => std::path::absolute(r)
+            .map_err(|e| DenoiseError::Input(format!("{}: {e}", r.display())))?,
+        None => provision::cache_root()?,
+    };
+    let dir = provision::provision(&root, &|m| eprintln!("{m}"))?;
+    let f = lib_in(&dir).ok_or_else(|| DenoiseError::NotFound(dir.clone()))?;
+    Denoiser::open(&f)?;
+    Ok(dir)
 }

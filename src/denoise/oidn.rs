@@ -28,6 +28,15 @@ pub enum DenoiseError {
     },
     #[error("denoise: {0}")]
     Input(String),
+    // Not a #[source]: the message already includes it (anyhow would print it twice).
+    #[error("provisioning Open Image Denoise: {0}")]
+    Provision(super::provision::ProvisionError),
+}
+
+impl From<super::provision::ProvisionError> for DenoiseError {
+    fn from(e: super::provision::ProvisionError) -> Self {
+        DenoiseError::Provision(e)
+    }
 }
 
 struct Api {
