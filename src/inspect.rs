@@ -298,17 +298,23 @@ pub fn report_at(scene: &Scene, frame: Option<f64>) -> Report {
         .collect();
     // Node types alone do not tell everything (an unsupported option, a Texture
     // Coordinate output, displacement): each material must also compile.
-    let material_status: Vec<MaterialStatus> = f
-        .materials
-        .iter()
-        .filter(|m| m.node_tree.is_some())
-        .map(|m| MaterialStatus {
-            name: m.name.clone(),
-            error: compile_material(scene, &m.name)
-                .err()
-                .map(|e| e.to_string()),
-        })
-        .collect();
+    // Use Nodes off materials compile as the surface Cycles builds for them.
+    let material_status: Vec<MaterialStatus> = match crate::render::default_surface::apply(scene) {
+        Ok(surfaced) => f
+            .materials
+            .iter()
+            .map(|m| MaterialStatus {
+                name: m.name.clone(),
+                error: compile_material(&surfaced, &m.name)
+                    .err()
+                    .map(|e| e.to_string()),
+            })
+            .collect(),
+        Err(e) => vec![MaterialStatus {
+            name: String::new(),
+            error: Some(e),
+        }],
+    };
     let (frozen, mesh_errors) = geometry_checks(scene, frame);
     let opts = crate::render::RenderOptions {
         frame: Some(frame),

@@ -18,6 +18,7 @@ pub mod bsdf;
 pub mod build;
 pub mod bump_correction;
 pub mod camera;
+pub mod default_surface;
 pub mod denoise_features;
 pub mod displace;
 pub mod filter;
@@ -509,6 +510,8 @@ fn prepare(
     opts: &RenderOptions,
     overrides: &[(String, Value)],
 ) -> Result<Prepared, RenderError> {
+    let with_surfaces = default_surface::apply(scene).map_err(RenderError)?;
+    let scene: &Scene = &with_surfaces;
     let start = Instant::now();
     let s = &scene.file.scene;
     let (cy, r) = (&s.cycles, &s.render);
