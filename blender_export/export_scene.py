@@ -517,7 +517,7 @@ FROZEN_TYPES = {"CURVE", "SURFACE", "FONT", "META"}
 ID_COLLECTIONS = {"OBJECT": "objects", "MESH": "meshes", "CURVE": "curves", "KEY": "shape_keys",
                   "ARMATURE": "armatures", "META": "metaballs", "METABALL": "metaballs", "LATTICE": "lattices",
                   "PARTICLE": "particles", "COLLECTION": "collections", "TEXTURE": "textures",
-                  "NODETREE": "node_groups", "IMAGE": "images", "VECTOR_FONT": "fonts", "FONT": "curves"}
+                  "NODETREE": "node_groups", "IMAGE": "images", "FONT": "fonts"}
 
 
 def frozen_target(o):
