@@ -652,6 +652,7 @@ def object_entry(o, view_layer):
     return {
         "name": o.name, "type": o.type, "data": o.data.name if o.data else None,
         "parent": o.parent.name if o.parent else None, "parent_type": o.parent_type,
+        "parent_bone": o.parent_bone or None,
         "matrix_world": matrix(o.matrix_world), "matrix_local": matrix(o.matrix_local),
         "matrix_basis": matrix(o.matrix_basis), "matrix_parent_inverse": matrix(o.matrix_parent_inverse),
         "location": vec(o.location), "rotation_mode": o.rotation_mode,

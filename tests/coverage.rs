@@ -217,3 +217,63 @@ fn objects_blendsynth_does_not_build_render_frozen_or_are_refused_by_name() {
         stdout(&o)
     );
 }
+
+/// Blender-side: objects parented to bones (`fixtures/coverage/make_bone_scene.py`) sit
+/// where Blender puts them at the exported frame and, while the armature's pose is not
+/// animated, at other frames too; with an animated pose another frame is refused by name.
+#[test]
+fn bone_parents_follow_blender_while_the_pose_is_known() {
+    let Some(py) = require("bpy", bpy_python()) else {
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let blend = tmp.path().join("bone.blend");
+    let want = tmp.path().join("bone.json");
+    let export = tmp.path().join("export");
+    run_python(
+        &py,
+        &repo().join("fixtures/coverage/make_bone_scene.py"),
+        &["--", blend.to_str().unwrap(), want.to_str().unwrap()],
+    );
+    let o = run(
+        &[
+            "convert",
+            blend.to_str().unwrap(),
+            "-o",
+            export.to_str().unwrap(),
+        ],
+        &[("BLENDSYNTH_BPY_PYTHON", py.to_str().unwrap())],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let want: serde_json::Value = serde_json::from_slice(&std::fs::read(&want).unwrap()).unwrap();
+    let scene = Scene::load(&export).unwrap();
+    // Without the posed armature's child, every frame evaluates.
+    let mut unposed = scene.clone();
+    unposed.file.objects.retain(|o| o.name != "Prop");
+    let check = |frame: f64, name: &str| {
+        let s = if frame == 1.0 { &scene } else { &unposed };
+        let i = s.file.objects.iter().position(|o| o.name == name).unwrap();
+        let m = blendsynth::anim::evaluate_transforms(s, frame).unwrap()[i];
+        let w = &want[format!("{frame}")][name];
+        for r in 0..4 {
+            for c in 0..4 {
+                let b = w[r][c].as_f64().unwrap();
+                assert!(
+                    (m[r][c] - b).abs() < 1e-4,
+                    "{name} at frame {frame}: [{r}][{c}] {} vs Blender {b}",
+                    m[r][c]
+                );
+            }
+        }
+    };
+    check(1.0, "Hand");
+    check(7.0, "Hand");
+    check(1.0, "Prop");
+    let e = blendsynth::anim::evaluate_transforms(&scene, 7.0)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("Prop") && e.contains("Dancer") && e.contains("pose"),
+        "{e}"
+    );
+}

@@ -114,6 +114,9 @@ pub struct Object {
     pub parent: Option<String>,
     #[serde(default)]
     pub parent_type: Option<String>,
+    /// The parent bone of a bone-parented object (parent_type BONE).
+    #[serde(default)]
+    pub parent_bone: Option<String>,
     pub matrix_world: Matrix4,
     #[serde(default)]
     pub matrix_local: Option<Matrix4>,
