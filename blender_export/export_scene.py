@@ -541,6 +541,24 @@ def under(path, prefix):
     return path == prefix or (path.startswith(prefix) and path[len(prefix)] in ".[")
 
 
+TIME_MODIFIERS = {"CLOTH", "SOFT_BODY", "FLUID", "DYNAMIC_PAINT", "OCEAN", "EXPLODE", "PARTICLE_SYSTEM",
+                  "PARTICLE_INSTANCE", "WAVE", "BUILD", "MESH_CACHE", "MESH_SEQUENCE_CACHE"}
+TIME_NODES = {"GeometryNodeInputSceneTime", "GeometryNodeSimulationInput", "GeometryNodeSimulationOutput"}
+
+
+def tree_reads_time(tree, seen):
+    """Whether a Geometry Nodes tree (groups included) reads the scene time or simulates."""
+    if tree.name in seen:
+        return False
+    seen.add(tree.name)
+    for n in tree.nodes:
+        if n.bl_idname in TIME_NODES:
+            return True
+        if getattr(n, "node_tree", None) is not None and tree_reads_time(n.node_tree, seen):
+            return True
+    return False
+
+
 def frozen_inputs(o):
     """What the object's evaluated geometry reads, as data-path prefixes, and which of
     those are animated (F-curves, drivers, NLA): an override under a prefix, or another
@@ -600,6 +618,12 @@ def frozen_inputs(o):
             add(x.data)
             add(getattr(x.data, "shape_keys", None))
     animated = []
+    # Modifiers whose result moves with the frame without any F-curve: simulations,
+    # particles, time-driven deformers, Geometry Nodes reading the scene time.
+    for m in o.modifiers:
+        if m.show_render and (m.type in TIME_MODIFIERS or (m.type == "NODES" and m.node_group is not None
+                                                          and tree_reads_time(m.node_group, set()))):
+            animated.append(f"{id_path(o)}.modifiers[{q(m.name)}] ({m.type} depends on the frame)")
     for idb, prefix in reads:
         ad = getattr(idb, "animation_data", None)
         if ad is None:
