@@ -474,6 +474,11 @@ def evaluated_meshes(objs, depsgraph):
             me = ev.to_mesh()
         except RuntimeError:
             me = None
+        instancer = o.instance_type != "NONE" or any(m.type == "PARTICLE_SYSTEM" for m in o.modifiers)
+        if me is not None and instancer and not o.show_instancer_for_render:
+            # Object > Instancing > Show Instancer > Render off: only the instances render.
+            ev.to_mesh_clear()
+            me = None
         if me is None:
             parts[o.name] = [empty_part()]
             uvinfo[o.name] = ([], None, None)
