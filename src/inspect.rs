@@ -359,7 +359,7 @@ pub fn report_at(scene: &Scene, frame: Option<f64>) -> Report {
 
 /// Frozen objects, and `mesh`'s errors for every object with geometry, at `frame`.
 fn geometry_checks(scene: &Scene, frame: f64) -> (Vec<FrozenSummary>, Vec<ObjectError>) {
-    use crate::geometry::source::{frozen_reason, object_source, Source};
+    use crate::geometry::source::{frozen_reason, object_source, unsupported_gn_node, Source};
     let mut frozen = Vec::new();
     let mut errors = Vec::new();
     for o in &scene.file.objects {
@@ -369,7 +369,13 @@ fn geometry_checks(scene: &Scene, frame: f64) -> (Vec<FrozenSummary>, Vec<Object
                 let e = &scene.file.evaluated[i];
                 frozen.push(FrozenSummary {
                     object: o.name.clone(),
-                    reason: frozen_reason(scene, o).unwrap_or_default(),
+                    reason: frozen_reason(scene, o)
+                        .or_else(|| {
+                            unsupported_gn_node(scene, o).map(|n| {
+                                format!("Geometry Nodes node {n} that blendsynth does not evaluate")
+                            })
+                        })
+                        .unwrap_or_default(),
                     frame: e.frame,
                     reads: e.reads.clone().unwrap_or_default(),
                     animated: e.animated.clone(),

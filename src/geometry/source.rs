@@ -115,6 +115,22 @@ pub fn object_source(
         return Ok(Source::None);
     }
     let has_mods = o.modifiers.iter().any(|m| m.show_render);
+    // A Geometry Nodes stack with a node blendsynth does not evaluate (the Auto Smooth
+    // modifier 4.1 adds to old files, ...): Blender's evaluated mesh, while valid.
+    if matches!(o.kind.as_str(), "MESH" | "CURVE") {
+        if let Some(node) = unsupported_gn_node(scene, o) {
+            let has_frozen = scene
+                .file
+                .evaluated
+                .iter()
+                .any(|e| e.object == o.name && e.reads.is_some());
+            if has_frozen {
+                let reason =
+                    format!("Geometry Nodes node {node} that blendsynth does not evaluate");
+                return frozen(scene, o, frame, overrides, &reason).map(Source::Frozen);
+            }
+        }
+    }
     match o.kind.as_str() {
         "MESH" => {
             let data = o.data.as_deref().ok_or_else(|| {
@@ -139,6 +155,37 @@ pub fn object_source(
             "{here}: {other} objects are not supported by the renderer"
         ))),
     }
+}
+
+/// The first node (`"name" (bl_idname)`) of the object's render-enabled Geometry Nodes
+/// modifiers, nested groups included, that the evaluator does not implement.
+pub fn unsupported_gn_node(scene: &Scene, o: &Object) -> Option<String> {
+    fn walk(scene: &Scene, group: &str, seen: &mut Vec<String>) -> Option<String> {
+        if seen.iter().any(|g| g == group) {
+            return None;
+        }
+        seen.push(group.to_string());
+        let tree = scene.node_group(group)?;
+        for n in &tree.nodes {
+            if let Some(g) = n.node_tree.as_deref() {
+                if let Some(x) = walk(scene, g, seen) {
+                    return Some(x);
+                }
+            }
+            if crate::nodes::support_in("GeometryNodeTree", &n.bl_idname)
+                == crate::nodes::Support::Unsupported
+            {
+                return Some(format!("{:?} ({})", n.name, n.bl_idname));
+            }
+        }
+        None
+    }
+    let mut seen = Vec::new();
+    o.modifiers
+        .iter()
+        .filter(|m| m.show_render && m.kind == "NODES")
+        .filter_map(|m| m.node_group.as_deref())
+        .find_map(|g| walk(scene, g, &mut seen))
 }
 
 /// The export's evaluated mesh of `o`, when it may stand for the object at `frame` with
