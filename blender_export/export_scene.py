@@ -430,18 +430,67 @@ def transform_part(part, m):
 NON_GEOMETRY = {"EMPTY", "LIGHT", "CAMERA", "SPEAKER", "LIGHT_PROBE", "ARMATURE", "LATTICE"}
 
 
+def empty_part():
+    """mesh_arrays() of an empty mesh (an object with no mesh of its own, e.g. an empty
+    instancing a collection)."""
+    me = bpy.data.meshes.new("blendsynth-empty")
+    try:
+        return mesh_arrays(me, "empty")
+    finally:
+        bpy.data.meshes.remove(me)
+
+
+def with_materials(part, materials, slots):
+    """The part with its face material indices moved into the owner's slot list
+    `materials` (extended with the part's `slots`), so joined parts keep their materials."""
+    counts, arrays, attrs, uvs = part
+    nf = counts[2]
+    base = len(materials)
+    materials.extend(slots or [None])
+    idx = next((d for n, dom, dt, d in attrs if n == "material_index" and dom == "FACE" and dt == "INT"), None)
+    idx = np.zeros(nf, np.int32) if idx is None else idx.reshape(-1).astype(np.int32)
+    idx = np.clip(idx, 0, max(len(slots) - 1, 0)) + base
+    attrs = [a for a in attrs if a[0] != "material_index"] + [("material_index", "FACE", "INT", idx.astype(np.int32))]
+    return counts, arrays, attrs, uvs
+
+
+def slot_materials(ob, me):
+    """An evaluated object's material per slot, object-linked slots included."""
+    if ob is not None and len(ob.material_slots):
+        return [s.material.name if s.material else None for s in ob.material_slots]
+    return [m.name if m else None for m in me.materials]
+
+
 def evaluated_meshes(objs, depsgraph):
     """For each object: its evaluated mesh plus the instances it generates (realised),
-    in its local space. One pass over depsgraph.object_instances (instance objects are
-    only valid during their iteration step, so each is converted right away)."""
-    parts, n_inst, inverse = {}, {}, {}
+    in its local space, and the material slots its faces index. One pass over
+    depsgraph.object_instances (instance objects are only valid during their iteration
+    step, so each is converted right away)."""
+    parts, n_inst, inverse, mats, uvinfo = {}, {}, {}, {}, {}
     for o in objs:
         ev = o.evaluated_get(depsgraph)
-        me = ev.to_mesh()
+        mats[o.name] = []
         try:
-            parts[o.name] = [mesh_arrays(me, f"evaluated[{q(o.name)}]")]
-        finally:
+            me = ev.to_mesh()
+        except RuntimeError:
+            me = None
+        instancer = o.instance_type != "NONE" or any(m.type == "PARTICLE_SYSTEM" for m in o.modifiers)
+        if me is not None and instancer and not o.show_instancer_for_render:
+            # Object > Instancing > Show Instancer > Render off: only the instances render.
             ev.to_mesh_clear()
+            me = None
+        if me is None:
+            parts[o.name] = [empty_part()]
+            uvinfo[o.name] = ([], None, None)
+        else:
+            try:
+                part = mesh_arrays(me, f"evaluated[{q(o.name)}]")
+                parts[o.name] = [with_materials(part, mats[o.name], slot_materials(ev, me))]
+                uvinfo[o.name] = ([uv.name for uv in me.uv_layers],
+                                  next((uv.name for uv in me.uv_layers if uv.active_render), None),
+                                  getattr(me.attributes, "default_color_name", None) or None)
+            finally:
+                ev.to_mesh_clear()
         n_inst[o.name] = 0
         inverse[o.name] = np.linalg.inv(np.array(ev.matrix_world, dtype=np.float64))
     for inst in depsgraph.object_instances:
@@ -461,11 +510,136 @@ def evaluated_meshes(objs, depsgraph):
             continue
         try:
             part = mesh_arrays(ime, f"evaluated[{q(owner)}].instance")
+            part = with_materials(part, mats[owner], slot_materials(io, ime))
         finally:
             io.to_mesh_clear()
         parts[owner].append(transform_part(part, inverse[owner] @ np.array(inst.matrix_world, dtype=np.float64)))
         n_inst[owner] += 1
-    return {name: (concat_meshes(p), n_inst[name]) for name, p in parts.items()}
+    return {name: (concat_meshes(p), n_inst[name], mats[name], uvinfo[name]) for name, p in parts.items()}
+
+
+FROZEN_TYPES = {"CURVE", "SURFACE", "FONT", "META"}
+ID_COLLECTIONS = {"OBJECT": "objects", "MESH": "meshes", "CURVE": "curves", "KEY": "shape_keys",
+                  "ARMATURE": "armatures", "META": "metaballs", "METABALL": "metaballs", "LATTICE": "lattices",
+                  "PARTICLE": "particles", "COLLECTION": "collections", "TEXTURE": "textures",
+                  "NODETREE": "node_groups", "IMAGE": "images", "FONT": "fonts"}
+
+
+def frozen_target(o):
+    """Whether blendsynth renders this object from its evaluated mesh (it does not build
+    it itself): meshes with modifiers (the export keeps these as reference meshes too),
+    shape keys or vertex/face instancing; curves, surfaces, text, metaballs; empties
+    instancing a collection."""
+    if o.type == "MESH":
+        return bool(len(o.modifiers)) or getattr(o.data, "shape_keys", None) is not None \
+            or o.instance_type in ("VERTS", "FACES")
+    if o.type in FROZEN_TYPES:
+        return True
+    return o.type == "EMPTY" and o.instance_type == "COLLECTION" and o.instance_collection is not None
+
+
+def id_path(idb):
+    return f"{ID_COLLECTIONS.get(idb.id_type, idb.id_type.lower() + 's')}[{q(idb.name)}]"
+
+
+def under(path, prefix):
+    return path == prefix or (path.startswith(prefix) and path[len(prefix)] in ".[")
+
+
+TIME_MODIFIERS = {"CLOTH", "SOFT_BODY", "FLUID", "DYNAMIC_PAINT", "OCEAN", "EXPLODE", "PARTICLE_SYSTEM",
+                  "PARTICLE_INSTANCE", "WAVE", "BUILD", "MESH_CACHE", "MESH_SEQUENCE_CACHE"}
+TIME_NODES = {"GeometryNodeInputSceneTime", "GeometryNodeSimulationInput", "GeometryNodeSimulationOutput"}
+
+
+def tree_reads_time(tree, seen):
+    """Whether a Geometry Nodes tree (groups included) reads the scene time or simulates."""
+    if tree.name in seen:
+        return False
+    seen.add(tree.name)
+    for n in tree.nodes:
+        if n.bl_idname in TIME_NODES:
+            return True
+        if getattr(n, "node_tree", None) is not None and tree_reads_time(n.node_tree, seen):
+            return True
+    return False
+
+
+def frozen_inputs(o):
+    """What the object's evaluated geometry reads, as data-path prefixes, and which of
+    those are animated (F-curves, drivers, NLA): an override under a prefix, or another
+    frame with an animated one, would need Blender to evaluate it again. Also what the
+    evaluated mesh lacks that Cycles renders (hair)."""
+    reads = [(o, f"{id_path(o)}.modifiers")]
+    others, unsupported = [], []
+    def add(idb):
+        if idb is not None and isinstance(idb, bpy.types.ID) and all(r[0] != idb or r[1] != id_path(idb) for r in reads):
+            reads.append((idb, id_path(idb)))
+    if o.data is not None:
+        add(o.data)
+        add(getattr(o.data, "shape_keys", None))
+        if o.type == "FONT":
+            for f in ("font", "font_bold", "font_italic", "font_bold_italic"):
+                add(getattr(o.data, f, None))
+        for attr in ("bevel_object", "taper_object"):
+            ob = getattr(o.data, attr, None)
+            if ob is not None:
+                others.append(ob)
+    for m in o.modifiers:
+        for p in m.bl_rna.properties:
+            if p.type != "POINTER" or p.identifier == "rna_type":
+                continue
+            v = getattr(m, p.identifier, None)
+            if isinstance(v, bpy.types.Object):
+                others.append(v)
+            elif isinstance(v, bpy.types.Collection):
+                add(v)
+                others.extend(v.all_objects)
+            elif isinstance(v, bpy.types.ID):
+                add(v)
+        if m.type == "PARTICLE_SYSTEM":
+            st = m.particle_system.settings
+            add(st)
+            if st.type == "HAIR" and st.render_type == "PATH":
+                unsupported.append(f"hair particle system {q(m.particle_system.name)}")
+            if st.instance_object is not None:
+                others.append(st.instance_object)
+            if st.instance_collection is not None:
+                others.extend(st.instance_collection.all_objects)
+    if o.type == "META":
+        # Metaballs of one family (same base name) melt into its first object.
+        base = o.name.split(".")[0]
+        others.extend(x for x in bpy.data.objects if x.type == "META" and x != o and x.name.split(".")[0] == base)
+    if o.instance_type in ("VERTS", "FACES"):
+        others.extend(o.children)
+    if o.instance_type == "COLLECTION" and o.instance_collection is not None:
+        add(o.instance_collection)
+        others.extend(o.instance_collection.all_objects)
+    if others:
+        # Another object's transform acts relative to this one's.
+        reads[0] = (o, id_path(o))
+    for x in others:
+        add(x)
+        if x.data is not None:
+            add(x.data)
+            add(getattr(x.data, "shape_keys", None))
+    animated = []
+    # Modifiers whose result moves with the frame without any F-curve: simulations,
+    # particles, time-driven deformers, Geometry Nodes reading the scene time.
+    for m in o.modifiers:
+        if m.show_render and (m.type in TIME_MODIFIERS or (m.type == "NODES" and m.node_group is not None
+                                                          and tree_reads_time(m.node_group, set()))):
+            animated.append(f"{id_path(o)}.modifiers[{q(m.name)}] ({m.type} depends on the frame)")
+    for idb, prefix in reads:
+        ad = getattr(idb, "animation_data", None)
+        if ad is None:
+            continue
+        for fc, kind in [(fc, "") for fc in action_fcurves(ad)] + [(fc, " (driver)") for fc in ad.drivers]:
+            full = f"{id_path(idb)}.{fc.data_path}"
+            if under(full, prefix):
+                animated.append(f"{full}[{fc.array_index}]{kind}")
+        if len(ad.nla_tracks):
+            animated.append(f"{id_path(idb)} (NLA tracks)")
+    return sorted({r[1] for r in reads}), sorted(set(animated)), unsupported
 
 
 # ---------------------------------------------------------------- other datablocks
@@ -507,6 +681,7 @@ def object_entry(o, view_layer):
     return {
         "name": o.name, "type": o.type, "data": o.data.name if o.data else None,
         "parent": o.parent.name if o.parent else None, "parent_type": o.parent_type,
+        "parent_bone": o.parent_bone or None,
         "matrix_world": matrix(o.matrix_world), "matrix_local": matrix(o.matrix_local),
         "matrix_basis": matrix(o.matrix_basis), "matrix_parent_inverse": matrix(o.matrix_parent_inverse),
         "location": vec(o.location), "rotation_mode": o.rotation_mode,
@@ -731,17 +906,22 @@ def main():
                                       for a in me.attributes if not a.name.startswith(".")],
                        "texspace_location": vec(me.texspace_location), "texspace_size": vec(me.texspace_size),
                        "use_auto_texspace": me.use_auto_texspace,
-                       "default_color_attribute": getattr(me.attributes, "default_color_name", None) or None})
+                       "default_color_attribute": getattr(me.attributes, "default_color_name", None) or None,
+                       "shape_keys": me.shape_keys is not None})
 
     evaluated = []
     if not args.no_evaluated:
         index = {o.name: i for i, o in enumerate(data.objects)}
-        targets = [o for o in data.objects if o.type == "MESH" and len(o.modifiers) and view_layer.objects.get(o.name)]
-        for name, ((counts, arrays, attrs, uvs), n_inst) in evaluated_meshes(targets, depsgraph).items():
+        targets = [o for o in data.objects if frozen_target(o) and view_layer.objects.get(o.name)]
+        for name, ((counts, arrays, attrs, uvs), n_inst, mats, (uv_layers, render_uv, color)) in evaluated_meshes(targets, depsgraph).items():
             rel = f"evaluated/{safe_name(index[name], name)}"
             write_mesh_glb(os.path.join(out, rel), name, counts, arrays, attrs, uvs)
+            reads, animated, unsupported = frozen_inputs(data.objects[name])
             evaluated.append({"object": name, "frame": scene.frame_current + scene.frame_subframe, "file": rel,
-                              "vertex_count": counts[0], "face_count": counts[2], "instances_realized": n_inst})
+                              "vertex_count": counts[0], "face_count": counts[2], "instances_realized": n_inst,
+                              "reads": reads, "animated": animated, "unsupported": unsupported,
+                              "materials": mats, "uv_layers": uv_layers, "active_render_uv": render_uv,
+                              "default_color_attribute": color})
 
     used_images = set()
     images = [image_entry(im, out, used_images) for im in data.images

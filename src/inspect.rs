@@ -1,5 +1,7 @@
-//! `blendsynth inspect`: a readable account of an exported scene and of which node
-//! types blendsynth can evaluate.
+//! `blendsynth inspect`: a readable account of an exported scene, of which node types
+//! blendsynth can evaluate, and the result of every check `render` and `mesh` make at
+//! the frame (the same code: `render::check`, `geometry::evaluate_object`), so exit 0
+//! means both succeed.
 
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -24,7 +26,17 @@ pub struct Report {
     pub coverage: Vec<CoverageRow>,
     /// Whether each material compiles for the renderer, and if not, why.
     pub material_status: Vec<MaterialStatus>,
-    /// True when every node type used is supported or structural.
+    /// Objects rendered from Blender's evaluated mesh in the export, and what would
+    /// make it stale.
+    pub frozen: Vec<FrozenSummary>,
+    /// The frame the checks ran at.
+    pub frame: f64,
+    /// `render`'s verdict at the frame: None when it would render.
+    pub render_error: Option<String>,
+    /// Per object with geometry, `mesh`'s error at the frame.
+    pub mesh_errors: Vec<ObjectError>,
+    /// True when every node type used is supported or structural, every material
+    /// compiles, and `render` and `mesh` would succeed at the frame.
     pub all_supported: bool,
     pub warnings: Vec<String>,
 }
@@ -107,6 +119,25 @@ pub struct ImageSummary {
 }
 
 #[derive(Debug, Serialize)]
+pub struct FrozenSummary {
+    pub object: String,
+    /// Why blendsynth does not build it itself (modifiers, object type, shape keys, ...).
+    pub reason: String,
+    /// The frame Blender evaluated it at.
+    pub frame: f64,
+    /// What its evaluation reads: an override under one of these is an error.
+    pub reads: Vec<String>,
+    /// Animated inputs: any other frame is an error.
+    pub animated: Vec<String>,
+}
+
+#[derive(Debug, Serialize)]
+pub struct ObjectError {
+    pub object: String,
+    pub error: String,
+}
+
+#[derive(Debug, Serialize)]
 pub struct MaterialStatus {
     pub name: String,
     /// None when the material compiles.
@@ -121,8 +152,15 @@ pub struct CoverageRow {
     pub support: Support,
 }
 
+/// The report at the scene's current frame.
 pub fn report(scene: &Scene) -> Report {
+    report_at(scene, None)
+}
+
+/// The report, its render and mesh checks run at `frame` (default: the current frame).
+pub fn report_at(scene: &Scene, frame: Option<f64>) -> Report {
     let f = &scene.file;
+    let frame = frame.unwrap_or(f.scene.frame_current as f64);
     let s = &f.scene;
     let render = &s.render;
     let res = match (int(render, "resolution_x"), int(render, "resolution_y")) {
@@ -260,19 +298,35 @@ pub fn report(scene: &Scene) -> Report {
         .collect();
     // Node types alone do not tell everything (an unsupported option, a Texture
     // Coordinate output, displacement): each material must also compile.
-    let material_status: Vec<MaterialStatus> = f
-        .materials
-        .iter()
-        .filter(|m| m.node_tree.is_some())
-        .map(|m| MaterialStatus {
-            name: m.name.clone(),
-            error: compile_material(scene, &m.name)
-                .err()
-                .map(|e| e.to_string()),
-        })
-        .collect();
+    // Use Nodes off materials compile as the surface Cycles builds for them.
+    let material_status: Vec<MaterialStatus> = match crate::render::default_surface::apply(scene) {
+        Ok(surfaced) => f
+            .materials
+            .iter()
+            .map(|m| MaterialStatus {
+                name: m.name.clone(),
+                error: compile_material(&surfaced, &m.name)
+                    .err()
+                    .map(|e| e.to_string()),
+            })
+            .collect(),
+        Err(e) => vec![MaterialStatus {
+            name: String::new(),
+            error: Some(e),
+        }],
+    };
+    let (frozen, mesh_errors) = geometry_checks(scene, frame);
+    let opts = crate::render::RenderOptions {
+        frame: Some(frame),
+        ..Default::default()
+    };
+    let render_error = crate::render::check(scene, &opts, &[])
+        .err()
+        .map(|e| e.to_string());
     let all_supported = coverage.iter().all(|r| r.support != Support::Unsupported)
-        && material_status.iter().all(|m| m.error.is_none());
+        && material_status.iter().all(|m| m.error.is_none())
+        && render_error.is_none()
+        && mesh_errors.is_empty();
 
     Report {
         source_file: f.source_file.clone(),
@@ -294,9 +348,58 @@ pub fn report(scene: &Scene) -> Report {
             .collect(),
         coverage,
         material_status,
+        frozen,
+        frame,
+        render_error,
+        mesh_errors,
         all_supported,
         warnings: f.warnings.clone(),
     }
+}
+
+/// Frozen objects, and `mesh`'s errors for every object with geometry, at `frame`.
+fn geometry_checks(scene: &Scene, frame: f64) -> (Vec<FrozenSummary>, Vec<ObjectError>) {
+    use crate::geometry::source::{frozen_reason, object_source, unsupported_gn_node, Source};
+    let mut frozen = Vec::new();
+    let mut errors = Vec::new();
+    for o in &scene.file.objects {
+        match object_source(scene, o, frame, &[]) {
+            Ok(Source::None) => continue,
+            Ok(Source::Frozen(i)) => {
+                let e = &scene.file.evaluated[i];
+                frozen.push(FrozenSummary {
+                    object: o.name.clone(),
+                    reason: frozen_reason(scene, o)
+                        .or_else(|| {
+                            unsupported_gn_node(scene, o).map(|n| {
+                                format!("Geometry Nodes node {n} that blendsynth does not evaluate")
+                            })
+                        })
+                        .unwrap_or_default(),
+                    frame: e.frame,
+                    reads: e.reads.clone().unwrap_or_default(),
+                    animated: e.animated.clone(),
+                });
+            }
+            Ok(_) => {}
+            Err(e) => {
+                errors.push(ObjectError {
+                    object: o.name.clone(),
+                    error: e.to_string(),
+                });
+                continue;
+            }
+        }
+        let r = crate::geometry::evaluate_object(scene, &o.name, frame, &[])
+            .and_then(|set| crate::geometry::realize_to_mesh(&set));
+        if let Err(e) = r {
+            errors.push(ObjectError {
+                object: o.name.clone(),
+                error: format!("mesh {:?}: {e}", o.name),
+            });
+        }
+    }
+    (frozen, errors)
 }
 
 fn int(m: &Rna, k: &str) -> Option<i64> {
@@ -531,6 +634,35 @@ impl Report {
                     Some(e) => writeln!(o, "  {:?}: NOT YET: {e}", m.name)?,
                 }
             }
+        }
+        if !self.frozen.is_empty() {
+            writeln!(
+                o,
+                "\nFrozen geometry (Blender's evaluated mesh from the export)"
+            )?;
+            for z in &self.frozen {
+                writeln!(
+                    o,
+                    "  {:?}: {} (frame {}); reads {}{}",
+                    z.object,
+                    z.reason,
+                    z.frame,
+                    z.reads.join(", "),
+                    if z.animated.is_empty() {
+                        String::new()
+                    } else {
+                        format!("; ANIMATED {} (no other frame)", z.animated.join(", "))
+                    }
+                )?;
+            }
+        }
+        writeln!(o, "\nChecks at frame {}", self.frame)?;
+        for m in &self.mesh_errors {
+            writeln!(o, "  mesh NOT YET: {}", m.error)?;
+        }
+        match &self.render_error {
+            None => writeln!(o, "  render: ok")?,
+            Some(e) => writeln!(o, "  render NOT YET: {e}")?,
         }
         for w in &self.warnings {
             writeln!(o, "warning: {w}")?;

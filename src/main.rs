@@ -1,7 +1,8 @@
 //! The `blendsynth` command line: parses arguments and calls the library.
 //!
 //! Exit codes: 0 success, 1 failure (one line naming what was wrong), 2 bad usage,
-//! 3 `inspect` found node types blendsynth does not support yet.
+//! 3 `inspect` found something `render` or `mesh` would refuse, or node types
+//! blendsynth does not support yet.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -52,11 +53,15 @@ enum Command {
     Bake(BakeArgs),
     /// Render an exported scene with the path tracer to a linear float EXR.
     Render(RenderArgs),
-    /// Describe an exported scene and list which node types blendsynth supports.
-    /// Exits with status 3 when the scene uses unsupported node types.
+    /// Describe an exported scene, list which node types blendsynth supports, and run
+    /// every check `render` and `mesh` make at the frame. Exits with status 3 when
+    /// something would be refused (exit 0: `render` and `mesh` succeed).
     Inspect {
         /// A folder written by `blendsynth convert`.
         dir: PathBuf,
+        /// Frame to check at (default: the scene's current frame).
+        #[arg(long, allow_negative_numbers = true)]
+        frame: Option<f64>,
         /// Print the report as JSON.
         #[arg(long)]
         json: bool,
@@ -510,12 +515,12 @@ fn run(cli: Cli) -> Result<Outcome> {
             run_render(a)?;
             Ok(Outcome::Done)
         }
-        Command::Inspect { dir, json } => {
+        Command::Inspect { dir, frame, json } => {
             let scene = Scene::load(&dir)?;
             for i in 0..scene.file.meshes.len() {
                 scene.load_mesh(i)?;
             }
-            let report = inspect::report(&scene);
+            let report = inspect::report_at(&scene, frame);
             if json {
                 println!(
                     "{}",

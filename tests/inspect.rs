@@ -68,7 +68,17 @@ fn shared_maths_counts_only_where_an_evaluator_runs_it() {
 fn texture_and_colour_nodes_count_in_geometry_nodes_trees() {
     // The textures parity scene (tests/geometry.rs) uses them only in Geometry Nodes trees.
     let (code, r) = report("fixtures/geometry/scenes/textures");
-    assert_eq!(code, Some(0), "{r}");
+    // Every node and the meshes evaluate; only `render` would refuse it, for want of a
+    // camera (inspect's exit status is render's and mesh's).
+    assert_eq!(code, Some(3), "{r}");
+    assert_eq!(r["mesh_errors"], serde_json::json!([]), "{r}");
+    assert!(
+        r["render_error"]
+            .as_str()
+            .unwrap()
+            .contains("no active camera"),
+        "{r}"
+    );
     for kind in [
         "ShaderNodeTexVoronoi",
         "ShaderNodeTexWhiteNoise",

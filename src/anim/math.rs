@@ -94,7 +94,6 @@ pub fn inverse3(m: &Mat3) -> Option<Mat3> {
 }
 
 /// General 4x4 inverse (Gauss-Jordan with partial pivoting); None when singular.
-#[cfg(test)]
 pub fn inverse(m: &Mat4) -> Option<Mat4> {
     let mut a = *m;
     let mut r = IDENTITY;

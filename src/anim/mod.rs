@@ -98,13 +98,50 @@ pub fn evaluate_scene_with(
     let mut data = Datablocks::from_file(&scene.file);
     let unapplied = animate::apply(&scene.file.animation, frame, &mut data)?;
     let axes = track_axes(scene);
-    let world_matrices = transform::Solver::new(&data, opts.for_render, &axes).solve_all()?;
+    let bones = transform::BoneParents {
+        frame,
+        export_frame: scene.file.scene.frame_current as f64,
+        posed: posed_armatures(scene),
+    };
+    let world_matrices = transform::Solver::new(&data, opts.for_render, &axes)
+        .with_bone_parents(bones)
+        .solve_all()?;
     Ok(EvaluatedScene {
         frame,
         data,
         world_matrices,
         unapplied,
     })
+}
+
+/// Armature objects whose pose is animated (F-curves or drivers under `pose`), each with
+/// one such path.
+fn posed_armatures(scene: &Scene) -> HashMap<String, String> {
+    let mut out = HashMap::new();
+    for a in &scene.file.animation {
+        if a.id_type != "OBJECT" {
+            continue;
+        }
+        if let Some(fc) = a
+            .fcurves
+            .iter()
+            .chain(&a.drivers)
+            .find(|fc| fc.data_path.starts_with("pose"))
+        {
+            out.entry(a.id_name.clone())
+                .or_insert_with(|| format!("{}.{}", a.id_path, fc.data_path));
+        }
+    }
+    // NLA strips are not exported: they may pose the armature at any frame.
+    for o in scene.file.objects.iter().filter(|o| o.kind == "ARMATURE") {
+        let prefix = format!("objects[{}]: NLA strips", crate::scene::quote(&o.name));
+        if scene.file.warnings.iter().any(|w| w.starts_with(&prefix)) {
+            out.entry(o.name.clone()).or_insert_with(|| {
+                format!("objects[{}] (NLA strips)", crate::scene::quote(&o.name))
+            });
+        }
+    }
+    out
 }
 
 /// Objects' `track_axis`/`up_axis` as indices (only children of following path curves

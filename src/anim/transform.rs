@@ -145,6 +145,19 @@ pub struct Solver<'a> {
     state: Vec<State>,
     world: Vec<Mat4>,
     paths: HashMap<String, Option<Path>>,
+    bones: Option<BoneParents>,
+}
+
+/// What bone parenting needs: pose bones are not exported, so a bone's matrix relative to
+/// its armature is taken from the exported world matrices (child world times the inverse
+/// of its parent inverse and basis, relative to the armature's world), which holds at
+/// every frame while nothing poses the armature, and only at the exported frame otherwise.
+#[derive(Debug, Clone, Default)]
+pub struct BoneParents {
+    pub frame: f64,
+    pub export_frame: f64,
+    /// Armature object name -> an animated pose path (F-curve or driver).
+    pub posed: HashMap<String, String>,
 }
 
 impl<'a> Solver<'a> {
@@ -168,7 +181,49 @@ impl<'a> Solver<'a> {
             state: vec![State::Todo; n],
             world: vec![IDENTITY; n],
             paths: HashMap::new(),
+            bones: None,
         }
+    }
+
+    /// Enables bone parents (see `BoneParents`).
+    pub fn with_bone_parents(mut self, bones: BoneParents) -> Self {
+        self.bones = Some(bones);
+        self
+    }
+
+    /// A bone parent's matrix at this frame: the armature's world times the bone's pose
+    /// relative to it at the export.
+    fn bone_parent(&self, o: &Object, p: usize, pw: &Mat4) -> Result<Mat4, AnimError> {
+        let arm = &self.data.objects[p];
+        let bone = o.parent_bone.as_deref().unwrap_or("");
+        let Some(b) = &self.bones else {
+            return Err(AnimError::new(
+                "parent_type",
+                "parent type \"BONE\" is not supported here",
+            ));
+        };
+        if let Some(path) = b.posed.get(&arm.name) {
+            if (b.frame - b.export_frame).abs() > 1e-6 {
+                return Err(AnimError::new(
+                    "parent_type",
+                    format!(
+                        "parent type \"BONE\" (bone {bone:?} of {:?}): the armature is posed by animation ({path}), and pose bones are only known at the exported frame {}",
+                        arm.name, b.export_frame
+                    ),
+                ));
+            }
+        }
+        let (Some(basis), Some(mpi)) = (o.matrix_basis, o.matrix_parent_inverse) else {
+            return Err(AnimError::new(
+                "parent_type",
+                "parent type \"BONE\": the export lacks matrix_basis / matrix_parent_inverse",
+            ));
+        };
+        let singular = || AnimError::new("parent_type", "parent type \"BONE\": singular matrix");
+        let local = super::math::inverse(&mul(&mpi, &basis)).ok_or_else(singular)?;
+        let bone_world = mul(&o.matrix_world, &local);
+        let arm_inv = super::math::inverse(&arm.matrix_world).ok_or_else(singular)?;
+        Ok(mul(pw, &mul(&arm_inv, &bone_world)))
     }
 
     pub fn solve_all(mut self) -> Result<Vec<Mat4>, AnimError> {
@@ -240,6 +295,7 @@ impl<'a> Solver<'a> {
                     },
                     // Armature/lattice deform parents move children like a plain parent.
                     "ARMATURE" | "LATTICE" => pw,
+                    "BONE" => self.bone_parent(o, p, &pw)?,
                     other => {
                         return Err(AnimError::new(
                             "parent_type",

@@ -113,8 +113,13 @@ pub fn scene_at(
         set(&mut root, path, value)
             .map_err(|m| GeometryError::new(format!("override {path}: {m}")))?;
     }
-    let file: SceneFile = serde_json::from_value(root)
+    let mut file: SceneFile = serde_json::from_value(root)
         .map_err(|e| GeometryError::new(format!("after overrides: {e}")))?;
+    file.overridden.extend(
+        overrides
+            .iter()
+            .map(|(p, _)| p.strip_prefix("bpy.data.").unwrap_or(p).to_string()),
+    );
     Ok(Scene {
         dir: scene.dir.clone(),
         file,

@@ -136,6 +136,15 @@ impl<'s> Session<'s> {
     }
 
     fn evaluate_stack(&self, o: &Object) -> Result<GeometrySet, GeometryError> {
+        match super::source::object_source(self.scene, o, self.frame, &[])? {
+            super::source::Source::None => return Ok(GeometrySet::default()),
+            super::source::Source::Frozen(i) => {
+                let e = &self.scene.file.evaluated[i];
+                let md = self.scene.load_evaluated(i)?;
+                return Ok(GeometrySet::from_mesh(Mesh::from_scene(&md, &e.materials)));
+            }
+            super::source::Source::Mesh(_) | super::source::Source::Evaluate => {}
+        }
         let mut g = self.original_geometry(o)?;
         for m in &o.modifiers {
             if !m.show_render {

@@ -45,6 +45,7 @@ pub mod pointcloud;
 pub mod polyfill;
 pub mod realize;
 pub mod set;
+pub mod source;
 pub mod types;
 pub mod value;
 pub mod weld;

@@ -101,138 +101,202 @@ fn material_index(scene: &Scene, name: &Option<String>) -> Option<usize> {
         .and_then(|n| scene.file.materials.iter().position(|m| &m.name == n))
 }
 
+/// What an instance's mesh carries beside its triangles: material slots, the UV map and
+/// colour attribute unnamed reads use, and the texture space (None: the mesh's bounds).
+struct MeshInfo<'a> {
+    materials: &'a [Option<String>],
+    uv_name: Option<String>,
+    default_color: Option<String>,
+    texspace: Option<(V3, V3)>,
+}
+
+impl<'a> MeshInfo<'a> {
+    fn of_mesh(m: &'a crate::scene::MeshRef) -> MeshInfo<'a> {
+        MeshInfo {
+            materials: &m.materials,
+            uv_name: m
+                .active_render_uv
+                .clone()
+                .or_else(|| m.uv_layers.first().cloned()),
+            default_color: m.default_color_attribute.clone(),
+            texspace: match (m.texspace_location, m.texspace_size) {
+                (Some(l), Some(s)) => Some((l.map(|x| x as f32), s.map(|x| x as f32))),
+                _ => None,
+            },
+        }
+    }
+}
+
+/// Whether Blender renders the object itself: not hidden in render, seen by some ray,
+/// and not the child of a vertex or face instancer (Blender renders only its instances).
+pub fn renders_itself(eval: &EvaluatedScene, obj: &crate::scene::Object) -> bool {
+    if obj.hide_render || object_visibility(obj) == 0 {
+        return false;
+    }
+    let instanced_by_parent = obj.parent.as_deref().is_some_and(|p| {
+        eval.data
+            .objects
+            .iter()
+            .find(|o| o.name == p)
+            .is_some_and(|o| matches!(o.instance_type.as_deref(), Some("VERTS" | "FACES")))
+    });
+    !instanced_by_parent
+}
+
 pub fn build(
     scene: &Scene,
     eval: &EvaluatedScene,
     overrides: &[(String, serde_json::Value)],
 ) -> Result<Geometry, RenderError> {
+    use crate::geometry::source::{object_source, Source};
     let mut cache: HashMap<usize, Arc<MeshData>> = HashMap::new();
     let mut instances = Vec::new();
+    let overridden: Vec<String> = overrides.iter().map(|(p, _)| p.clone()).collect();
     for (oi, obj) in eval.data.objects.iter().enumerate() {
-        if obj.kind != "MESH" || obj.hide_render {
+        // Cycles does not sync an object no ray can see.
+        if !renders_itself(eval, obj) {
             continue;
         }
-        let Some(mesh_name) = obj.data.as_deref() else {
-            continue;
-        };
-        // Cycles does not sync an object no ray can see.
-        if object_visibility(obj) == 0 {
+        let source = object_source(scene, obj, eval.frame, &overridden)
+            .map_err(|e| RenderError(e.to_string()))?;
+        if source == Source::None {
             continue;
         }
         if obj.is_shadow_catcher {
             warn_shadow_catcher(&obj.name);
         }
-        let Some(mi) = scene.file.meshes.iter().position(|m| m.name == mesh_name) else {
-            return Err(RenderError(format!(
-                "object {:?}: mesh {mesh_name:?} is not in the export",
-                obj.name
-            )));
-        };
-        let info = &scene.file.meshes[mi];
-        let has_gn = obj
-            .modifiers
-            .iter()
-            .any(|m| m.kind == "NODES" && m.show_render);
-        let other_mods: Vec<&str> = obj
-            .modifiers
-            .iter()
-            .filter(|m| m.kind != "NODES" && m.show_render)
-            .map(|m| m.kind.as_str())
-            .collect();
-        if !other_mods.is_empty() {
-            return Err(RenderError(format!(
-                "object {:?}: modifier(s) {other_mods:?} are not supported by the renderer",
-                obj.name
-            )));
-        }
         let to_world = Affine::from_rows(&eval.world_matrices[oi]);
-        if has_gn {
-            let set = crate::geometry::evaluate_object(scene, &obj.name, eval.frame, overrides)
-                .map_err(|e| RenderError(format!("object {:?}: geometry nodes: {e}", obj.name)))?;
-            // Top-level instances stay separate, each with its own id, sharing the
-            // realised mesh of its reference; the rest of the set is one mesh.
-            let mut rest = set.clone();
-            let instances_component = rest.instances.take();
-            let realise = |g: &crate::geometry::GeometrySet| -> Result<(Arc<MeshData>, Vec<Option<String>>), RenderError> {
-                let m = crate::geometry::realize_to_mesh(g).map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))?;
-                let mats = if m.materials.is_empty() { info.materials.clone() } else { m.materials.clone() };
-                Ok((Arc::new(m.to_scene(&obj.name)), mats))
-            };
-            let (mesh, mats) = realise(&rest)?;
-            push_instance(
-                &mut instances,
-                scene,
-                oi,
-                obj,
-                info,
-                mesh,
-                &mats,
-                to_world,
-                None,
-                false,
-            )?;
-            if let Some(inst) = instances_component {
-                let mut by_handle: HashMap<u32, (Arc<MeshData>, Vec<Option<String>>)> =
-                    HashMap::new();
-                for (i, (&h, t)) in inst.handles.iter().zip(&inst.transforms).enumerate() {
-                    let Some(g) = inst.references.get(h as usize).and_then(|r| r.geometry()) else {
-                        continue;
-                    };
-                    let (mesh, mats) = match by_handle.get(&h) {
-                        Some(x) => x.clone(),
-                        None => {
-                            let x = realise(g)?;
-                            by_handle.insert(h, x.clone());
-                            x
-                        }
-                    };
-                    // Instance transforms are column-major (`m[col][row]`).
-                    let mut local = Affine { m: [[0.0; 4]; 3] };
-                    for r in 0..3 {
-                        for c in 0..4 {
-                            local.m[r][c] = t[c][r];
-                        }
+        let mesh_ref = obj
+            .data
+            .as_deref()
+            .and_then(|d| scene.file.meshes.iter().find(|m| m.name == d));
+        match source {
+            Source::None => {}
+            Source::Mesh(mi) => {
+                let info = &scene.file.meshes[mi];
+                let m = match cache.get(&mi) {
+                    Some(m) => m.clone(),
+                    None => {
+                        let m = Arc::new(
+                            scene
+                                .load_mesh(mi)
+                                .map_err(|e| RenderError(e.to_string()))?,
+                        );
+                        cache.insert(mi, m.clone());
+                        m
                     }
-                    let world = compose(&to_world, &local);
-                    push_instance(
-                        &mut instances,
-                        scene,
-                        oi,
-                        obj,
-                        info,
-                        mesh,
-                        &mats,
-                        world,
-                        Some(i as u32),
-                        false,
-                    )?;
+                };
+                push_instance(
+                    &mut instances,
+                    scene,
+                    oi,
+                    obj,
+                    &MeshInfo::of_mesh(info),
+                    m,
+                    to_world,
+                    None,
+                )?;
+            }
+            Source::Frozen(ei) => {
+                let e = &scene.file.evaluated[ei];
+                let m = Arc::new(
+                    scene
+                        .load_evaluated(ei)
+                        .map_err(|err| RenderError(format!("object {:?}: {err}", obj.name)))?,
+                );
+                // Cycles' Generated coordinates of a modified mesh follow the mesh's
+                // texture space; other types' follow the evaluated bounds.
+                let texspace = mesh_ref.and_then(|r| MeshInfo::of_mesh(r).texspace);
+                let info = MeshInfo {
+                    materials: &e.materials,
+                    uv_name: e
+                        .active_render_uv
+                        .clone()
+                        .or_else(|| e.uv_layers.first().cloned()),
+                    default_color: e.default_color_attribute.clone(),
+                    texspace,
+                };
+                push_instance(&mut instances, scene, oi, obj, &info, m, to_world, None)?;
+            }
+            Source::Evaluate => {
+                let curve_materials = obj
+                    .data
+                    .as_deref()
+                    .and_then(|d| scene.file.curves.iter().find(|c| c.name == d))
+                    .map(|c| c.materials.clone())
+                    .unwrap_or_default();
+                let base = match mesh_ref {
+                    Some(r) => MeshInfo::of_mesh(r),
+                    None => MeshInfo {
+                        materials: &curve_materials,
+                        uv_name: None,
+                        default_color: None,
+                        texspace: None,
+                    },
+                };
+                let set = crate::geometry::evaluate_object(scene, &obj.name, eval.frame, overrides)
+                    .map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))?;
+                // Top-level instances stay separate, each with its own id, sharing the
+                // realised mesh of its reference; the rest of the set is one mesh.
+                let mut rest = set.clone();
+                let instances_component = rest.instances.take();
+                let realise = |g: &crate::geometry::GeometrySet| -> Result<(Arc<MeshData>, Vec<Option<String>>), RenderError> {
+                    let m = crate::geometry::realize_to_mesh(g).map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))?;
+                    let mats = if m.materials.is_empty() { base.materials.to_vec() } else { m.materials.clone() };
+                    Ok((Arc::new(m.to_scene(&obj.name)), mats))
+                };
+                let (mesh, mats) = realise(&rest)?;
+                let info = MeshInfo {
+                    materials: &mats,
+                    uv_name: base.uv_name.clone(),
+                    default_color: base.default_color.clone(),
+                    // Generated geometry: the bounds.
+                    texspace: None,
+                };
+                push_instance(&mut instances, scene, oi, obj, &info, mesh, to_world, None)?;
+                if let Some(inst) = instances_component {
+                    let mut by_handle: HashMap<u32, (Arc<MeshData>, Vec<Option<String>>)> =
+                        HashMap::new();
+                    for (i, (&h, t)) in inst.handles.iter().zip(&inst.transforms).enumerate() {
+                        let Some(g) = inst.references.get(h as usize).and_then(|r| r.geometry())
+                        else {
+                            continue;
+                        };
+                        let (mesh, mats) = match by_handle.get(&h) {
+                            Some(x) => x.clone(),
+                            None => {
+                                let x = realise(g)?;
+                                by_handle.insert(h, x.clone());
+                                x
+                            }
+                        };
+                        // Instance transforms are column-major (`m[col][row]`).
+                        let mut local = Affine { m: [[0.0; 4]; 3] };
+                        for r in 0..3 {
+                            for c in 0..4 {
+                                local.m[r][c] = t[c][r];
+                            }
+                        }
+                        let world = compose(&to_world, &local);
+                        let info = MeshInfo {
+                            materials: &mats,
+                            uv_name: base.uv_name.clone(),
+                            default_color: base.default_color.clone(),
+                            texspace: None,
+                        };
+                        push_instance(
+                            &mut instances,
+                            scene,
+                            oi,
+                            obj,
+                            &info,
+                            mesh,
+                            world,
+                            Some(i as u32),
+                        )?;
+                    }
                 }
             }
-        } else {
-            let m = match cache.get(&mi) {
-                Some(m) => m.clone(),
-                None => {
-                    let m = Arc::new(
-                        scene
-                            .load_mesh(mi)
-                            .map_err(|e| RenderError(e.to_string()))?,
-                    );
-                    cache.insert(mi, m.clone());
-                    m
-                }
-            };
-            push_instance(
-                &mut instances,
-                scene,
-                oi,
-                obj,
-                info,
-                m,
-                &info.materials.clone(),
-                to_world,
-                None,
-                true,
-            )?;
         }
     }
     let (tris, refs) = world_triangles(&instances);
@@ -323,17 +387,16 @@ fn push_instance(
     scene: &Scene,
     oi: usize,
     obj: &crate::scene::Object,
-    info: &crate::scene::MeshRef,
+    info: &MeshInfo,
     mesh: Arc<MeshData>,
-    mesh_materials: &[Option<String>],
     to_world: Affine,
     instance_index: Option<u32>,
-    exported_texspace: bool,
 ) -> Result<(), RenderError> {
     if mesh.triangles.is_empty() {
         return Ok(());
     }
     // Object-linked slots override the mesh's materials (Blender's slot link).
+    let mesh_materials = info.materials;
     let nslots = mesh_materials.len().max(obj.material_slots.len()).max(1);
     let slots: Vec<Option<usize>> = (0..nslots)
         .map(|s| {
@@ -359,10 +422,7 @@ fn push_instance(
             .collect(),
         _ => vec![0; mesh.face_count()],
     };
-    let uv_name = info
-        .active_render_uv
-        .clone()
-        .or_else(|| info.uv_layers.first().cloned());
+    let uv_name = info.uv_name.clone();
     let uv = uv_name
         .as_deref()
         .and_then(|n| mesh.attribute(n))
@@ -380,13 +440,9 @@ fn push_instance(
     }
     let (wlo, whi) = world_bounds(&mesh.positions, &to_world);
     // The exported texture space for plain meshes; the bounds for generated geometry.
-    let (tex_loc, tex_size) = match (
-        info.texspace_location,
-        info.texspace_size,
-        exported_texspace,
-    ) {
-        (Some(l), Some(s), true) => (l.map(|x| x as f32), s.map(|x| x as f32)),
-        _ => (
+    let (tex_loc, tex_size) = match info.texspace {
+        Some(t) => t,
+        None => (
             scale(add(lo, hi), 0.5),
             scale(sub(hi, lo), 0.5).map(|x| if x == 0.0 { 1.0 } else { x }),
         ),
@@ -418,7 +474,7 @@ fn push_instance(
         motion: None,
         undisplaced: None,
         uv_name,
-        default_color: info.default_color_attribute.clone(),
+        default_color: info.default_color.clone(),
         attributes: Vec::new(),
         visibility: object_visibility(obj),
         holdout: obj.is_holdout,

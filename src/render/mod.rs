@@ -20,6 +20,7 @@ pub mod build;
 pub mod bump_correction;
 pub mod camera;
 pub mod control;
+pub mod default_surface;
 pub mod denoise_features;
 pub mod displace;
 pub mod filter;
@@ -184,88 +185,23 @@ pub fn render_controlled(
     overrides: &[(String, Value)],
     control: Option<&control::Control>,
 ) -> Result<RenderOutput, RenderError> {
-    let start = Instant::now();
+    let Prepared {
+        start,
+        w,
+        h,
+        shutter,
+        samples,
+        seed,
+        camera,
+        geo,
+        materials,
+        lights,
+        background,
+        world_shader,
+        moving,
+    } = prepare(scene, opts, overrides)?;
     let s = &scene.file.scene;
     let (cy, r) = (&s.cycles, &s.render);
-    let (w, h) = match opts.resolution {
-        Some(res) => res,
-        None => {
-            let pct = rna_f(r, "resolution_percentage").unwrap_or(100.0);
-            let rx = rna_f(r, "resolution_x").unwrap_or(1920.0);
-            let ry = rna_f(r, "resolution_y").unwrap_or(1080.0);
-            (
-                ((rx * pct / 100.0) as u32).max(1),
-                ((ry * pct / 100.0) as u32).max(1),
-            )
-        }
-    };
-    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
-        return Err(RenderError(format!(
-            "resolution {w}x{h}: each side must be 1 to {MAX_SIDE}"
-        )));
-    }
-    let shutter = motion::Shutter::from_render(r).map_err(RenderError)?;
-    let samples = opts
-        .samples
-        .unwrap_or_else(|| rna_f(cy, "samples").unwrap_or(128.0) as u32);
-    if samples == 0 {
-        return Err(RenderError("samples must be at least 1".into()));
-    }
-    let seed = opts
-        .seed
-        .unwrap_or_else(|| rna_f(cy, "seed").unwrap_or(0.0) as u32);
-    let frame = opts.frame.unwrap_or(s.frame_current as f64);
-    if !frame.is_finite() {
-        return Err(RenderError(format!("frame {frame} is not finite")));
-    }
-    // With motion blur Cycles syncs the scene at the shutter's centre (START and END
-    // positions move it off the frame), and the camera at the shutter's ends too.
-    let centre = frame + shutter.as_ref().map_or(0.0, |s| s.centre_delta);
-    let eval = crate::anim::evaluate_scene(scene, centre)
-        .map_err(|e| RenderError(format!("evaluating the scene at frame {centre}: {e}")))?;
-    let mut camera = camera::Camera::new(scene, &eval, w, h)?;
-    // Objects' world matrices at the motion steps (`object_motion::evaluate_steps`).
-    let mut object_steps: Vec<Vec<crate::anim::Mat4>> = Vec::new();
-    if let Some(sh) = &shutter {
-        let mut steps = Vec::new();
-        for (k, f) in sh.step_frames(frame).into_iter().enumerate() {
-            let e = if k == 1 {
-                None
-            } else {
-                Some(crate::anim::evaluate_scene(scene, f).map_err(|e| {
-                    RenderError(format!(
-                        "evaluating the scene at frame {f} (motion blur): {e}"
-                    ))
-                })?)
-            };
-            let at = e.as_ref().unwrap_or(&eval);
-            steps.push(camera::Camera::new(scene, at, w, h)?.to_world);
-        }
-        object_steps = object_motion::evaluate_steps(scene, &eval, sh)?;
-        object_motion::warn_deformation(&eval);
-        camera.set_motion(&steps);
-    }
-    let mut geo = build::build(scene, &eval, overrides)?;
-    let mut used = vec![false; scene.file.materials.len()];
-    for inst in &geo.instances {
-        for m in inst.slots.iter().flatten() {
-            used[*m] = true;
-        }
-    }
-    let materials = shade::compile_all(scene, &used)?;
-    build::bind_attributes(&mut geo, &materials)?;
-    if displace::apply(&mut geo, &materials) > 0 {
-        (geo.tris, geo.refs) = build::world_triangles(&geo.instances);
-    }
-    let moving = object_motion::attach(
-        &mut geo,
-        &eval.data.objects,
-        &eval.world_matrices,
-        &object_steps,
-    );
-    let lights = light::collect(&eval)?;
-    let background = world::background(scene)?;
-    let world_shader = world::shader(scene)?;
     let tables = tables::Tables::shared();
     if materials.iter().any(|m| m.multiscatter_glass) {
         tables.warm_glass();
@@ -577,6 +513,142 @@ pub fn render_controlled(
             triangles: geo.tris.len(),
             build_seconds,
         },
+    })
+}
+
+/// Everything a render needs before it traces: the scene evaluated at the frame, its
+/// geometry built, materials compiled, lights, world and camera.
+struct Prepared {
+    start: Instant,
+    w: u32,
+    h: u32,
+    shutter: Option<motion::Shutter>,
+    samples: u32,
+    seed: u32,
+    camera: camera::Camera,
+    geo: build::Geometry,
+    materials: Vec<shade::Material>,
+    lights: Vec<light::Light>,
+    background: V3,
+    world_shader: Option<world::WorldShader>,
+    moving: usize,
+}
+
+/// Every check `render` makes of the scene (objects, modifiers, frozen geometry, nodes,
+/// materials, lights, world, camera, options) at the options' frame, without tracing a
+/// ray: `inspect` runs this, so its exit status is the render's. Returns the number of
+/// triangles the render would trace.
+pub fn check(
+    scene: &Scene,
+    opts: &RenderOptions,
+    overrides: &[(String, Value)],
+) -> Result<usize, RenderError> {
+    prepare(scene, opts, overrides).map(|p| p.geo.tris.len())
+}
+
+fn prepare(
+    scene: &Scene,
+    opts: &RenderOptions,
+    overrides: &[(String, Value)],
+) -> Result<Prepared, RenderError> {
+    let with_surfaces = default_surface::apply(scene).map_err(RenderError)?;
+    let scene: &Scene = &with_surfaces;
+    let start = Instant::now();
+    let s = &scene.file.scene;
+    let (cy, r) = (&s.cycles, &s.render);
+    let (w, h) = match opts.resolution {
+        Some(res) => res,
+        None => {
+            let pct = rna_f(r, "resolution_percentage").unwrap_or(100.0);
+            let rx = rna_f(r, "resolution_x").unwrap_or(1920.0);
+            let ry = rna_f(r, "resolution_y").unwrap_or(1080.0);
+            (
+                ((rx * pct / 100.0) as u32).max(1),
+                ((ry * pct / 100.0) as u32).max(1),
+            )
+        }
+    };
+    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
+        return Err(RenderError(format!(
+            "resolution {w}x{h}: each side must be 1 to {MAX_SIDE}"
+        )));
+    }
+    let shutter = motion::Shutter::from_render(r).map_err(RenderError)?;
+    let samples = opts
+        .samples
+        .unwrap_or_else(|| rna_f(cy, "samples").unwrap_or(128.0) as u32);
+    if samples == 0 {
+        return Err(RenderError("samples must be at least 1".into()));
+    }
+    let seed = opts
+        .seed
+        .unwrap_or_else(|| rna_f(cy, "seed").unwrap_or(0.0) as u32);
+    let frame = opts.frame.unwrap_or(s.frame_current as f64);
+    if !frame.is_finite() {
+        return Err(RenderError(format!("frame {frame} is not finite")));
+    }
+    // With motion blur Cycles syncs the scene at the shutter's centre (START and END
+    // positions move it off the frame), and the camera at the shutter's ends too.
+    let centre = frame + shutter.as_ref().map_or(0.0, |s| s.centre_delta);
+    let eval = crate::anim::evaluate_scene(scene, centre)
+        .map_err(|e| RenderError(format!("evaluating the scene at frame {centre}: {e}")))?;
+    let mut camera = camera::Camera::new(scene, &eval, w, h)?;
+    // Objects' world matrices at the motion steps (`object_motion::evaluate_steps`).
+    let mut object_steps: Vec<Vec<crate::anim::Mat4>> = Vec::new();
+    if let Some(sh) = &shutter {
+        let mut steps = Vec::new();
+        for (k, f) in sh.step_frames(frame).into_iter().enumerate() {
+            let e = if k == 1 {
+                None
+            } else {
+                Some(crate::anim::evaluate_scene(scene, f).map_err(|e| {
+                    RenderError(format!(
+                        "evaluating the scene at frame {f} (motion blur): {e}"
+                    ))
+                })?)
+            };
+            let at = e.as_ref().unwrap_or(&eval);
+            steps.push(camera::Camera::new(scene, at, w, h)?.to_world);
+        }
+        object_steps = object_motion::evaluate_steps(scene, &eval, sh)?;
+        object_motion::warn_deformation(&eval);
+        camera.set_motion(&steps);
+    }
+    let mut geo = build::build(scene, &eval, overrides)?;
+    let mut used = vec![false; scene.file.materials.len()];
+    for inst in &geo.instances {
+        for m in inst.slots.iter().flatten() {
+            used[*m] = true;
+        }
+    }
+    let materials = shade::compile_all(scene, &used)?;
+    build::bind_attributes(&mut geo, &materials)?;
+    if displace::apply(&mut geo, &materials) > 0 {
+        (geo.tris, geo.refs) = build::world_triangles(&geo.instances);
+    }
+    let moving = object_motion::attach(
+        &mut geo,
+        &eval.data.objects,
+        &eval.world_matrices,
+        &object_steps,
+    );
+    let lights = light::collect(&eval)?;
+    let background = world::background(scene)?;
+    let world_shader = world::shader(scene)?;
+    Ok(Prepared {
+        start,
+        w,
+        h,
+        shutter,
+        samples,
+        seed,
+        camera,
+        geo,
+        materials,
+        lights,
+        background,
+        world_shader,
+        moving,
     })
 }
 

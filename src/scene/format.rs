@@ -51,6 +51,10 @@ pub struct SceneFile {
     pub animation: Vec<AnimData>,
     #[serde(default)]
     pub evaluated: Vec<Evaluated>,
+    /// Data paths changed by `--set` or a spec since the export (not in scene.json as
+    /// written): frozen geometry that reads one of them is refused.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub overridden: Vec<String>,
     #[serde(default)]
     pub color_management: ColorManagement,
     #[serde(default)]
@@ -110,6 +114,9 @@ pub struct Object {
     pub parent: Option<String>,
     #[serde(default)]
     pub parent_type: Option<String>,
+    /// The parent bone of a bone-parented object (parent_type BONE).
+    #[serde(default)]
+    pub parent_bone: Option<String>,
     pub matrix_world: Matrix4,
     #[serde(default)]
     pub matrix_local: Option<Matrix4>,
@@ -258,6 +265,9 @@ pub struct MeshRef {
     /// default colour attribute).
     #[serde(default)]
     pub default_color_attribute: Option<String>,
+    /// Whether the mesh has shape keys (their blend is only in the evaluated mesh).
+    #[serde(default)]
+    pub shape_keys: bool,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -574,6 +584,27 @@ pub struct Evaluated {
     pub face_count: Option<usize>,
     #[serde(default)]
     pub instances_realized: Option<usize>,
+    /// What the object's evaluation reads, as Blender data path prefixes (its modifiers,
+    /// its data, shape keys, objects its modifiers reference); None in exports made
+    /// before frozen geometry, which are reference meshes only.
+    #[serde(default)]
+    pub reads: Option<Vec<String>>,
+    /// The animated (F-curve or driver) properties under `reads`, as full data paths.
+    #[serde(default)]
+    pub animated: Vec<String>,
+    /// The evaluated mesh's material slots, UV maps and default colour attribute.
+    #[serde(default)]
+    pub materials: Vec<Option<String>>,
+    #[serde(default)]
+    pub uv_layers: Vec<String>,
+    #[serde(default)]
+    pub active_render_uv: Option<String>,
+    #[serde(default)]
+    pub default_color_attribute: Option<String>,
+    /// What the object renders that its evaluated mesh lacks (hair particle systems,
+    /// ...), named: such an object is refused.
+    #[serde(default)]
+    pub unsupported: Vec<String>,
 }
 
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]

@@ -75,13 +75,16 @@ impl Scene {
             set(&mut v, &o.path, &o.value)
                 .map_err(|m| SceneError::new(&json, format!("override {}", o.path), m))?;
         }
-        let file: SceneFile = serde_path_to_error::deserialize(v).map_err(|e| {
+        let mut file: SceneFile = serde_path_to_error::deserialize(v).map_err(|e| {
             SceneError::new(
                 &json,
                 format!("after overrides, {}", e.path()),
                 e.into_inner().to_string(),
             )
         })?;
+        // Frozen geometry must know what changed since the export.
+        file.overridden
+            .extend(overrides.iter().map(|o| o.path.clone()));
         let scene = Scene {
             dir: self.dir.clone(),
             file,
