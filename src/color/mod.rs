@@ -16,7 +16,7 @@ mod write;
 
 use std::path::{Path, PathBuf};
 
-pub use write::{write_exr, write_png};
+pub use write::{user_file_permissions, write_exr, write_png};
 
 use crate::scene::Scene;
 
