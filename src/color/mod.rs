@@ -8,8 +8,8 @@
 //! config without the OCIO library; alpha is divided out around it, as Blender does for
 //! premultiplied float buffers.
 
-mod config;
-mod lut;
+pub mod config;
+pub mod lut;
 mod pipeline;
 mod tone;
 mod write;
