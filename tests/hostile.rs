@@ -257,3 +257,297 @@ fn scene_json_that_is_a_fifo_is_an_error() {
     let e = Scene::load(&dir).unwrap_err().to_string();
     assert!(e.contains("not a regular file"), "{e}");
 }
+
+// --- Colour management: nothing read outside the config's folder, nothing echoed -------
+
+fn write_config(dir: &Path, body: &str) -> PathBuf {
+    std::fs::create_dir_all(dir).unwrap();
+    let p = dir.join("config.ocio");
+    std::fs::write(&p, body).unwrap();
+    p
+}
+
+const MINIMAL_CONFIG: &str = "ocio_profile_version: 2\nroles:\n  default: Linear\ncolorspaces:\n  - !<ColorSpace>\n    name: Linear\n";
+
+#[test]
+fn color_config_search_path_outside_its_folder_is_an_error() {
+    use blendsynth::color::config::Config;
+    let t = tempfile::tempdir().unwrap();
+    let ok = write_config(
+        &t.path().join("a"),
+        &format!("search_path: luts\n{MINIMAL_CONFIG}"),
+    );
+    Config::load(&ok).unwrap();
+    for sp in ["/etc", "../..", "luts:../../..", "luts/../../x"] {
+        let p = write_config(
+            &t.path().join("b"),
+            &format!("search_path: \"{sp}\"\n{MINIMAL_CONFIG}"),
+        );
+        let e = Config::load(&p)
+            .err()
+            .unwrap_or_else(|| panic!("{sp} accepted"));
+        let e = e.to_string();
+        assert!(e.contains("search_path"), "{sp}: {e}");
+    }
+}
+
+#[test]
+fn lut_paths_outside_the_config_folder_are_errors() {
+    use blendsynth::color::config::Config;
+    let t = tempfile::tempdir().unwrap();
+    let p = write_config(
+        &t.path().join("c"),
+        &format!("search_path: luts\n{MINIMAL_CONFIG}"),
+    );
+    std::fs::write(t.path().join("outside.spi1d"), "Version 1\n").unwrap();
+    let cfg = Config::load(&p).unwrap();
+    for name in ["/etc/passwd", "../outside.spi1d", "../../outside.spi1d"] {
+        assert!(cfg.find_file(name).is_err(), "{name} was looked up");
+    }
+    std::fs::create_dir_all(t.path().join("c/luts")).unwrap();
+    std::fs::write(t.path().join("c/luts/in.spi1d"), "Version 1\n").unwrap();
+    assert!(cfg.find_file("in.spi1d").unwrap().is_some());
+}
+
+#[test]
+fn color_errors_never_echo_file_content() {
+    use blendsynth::color::config::Config;
+    let t = tempfile::tempdir().unwrap();
+    let p = write_config(t.path(), "SECRET-KEY-MATERIAL: [unclosed\n  - SECRET2 {\n");
+    let e = Config::load(&p).unwrap_err().to_string();
+    assert!(!e.contains("SECRET"), "{e}");
+    let lut = t.path().join("x.spi1d");
+    std::fs::write(&lut, "SECRETWORD here\n").unwrap();
+    let e = blendsynth::color::lut::load(&lut).unwrap_err().to_string();
+    assert!(!e.contains("SECRET"), "{e}");
+    std::fs::write(&lut, "Version 1\nLength 2\n{\n SECRETNUMBER\n}\n").unwrap();
+    let e = blendsynth::color::lut::load(&lut).unwrap_err().to_string();
+    assert!(!e.contains("SECRET"), "{e}");
+    let cube = t.path().join("x.cube");
+    std::fs::write(&cube, "LUT_3D_SIZE 4000000\n").unwrap();
+    let e = blendsynth::color::lut::load(&cube).unwrap_err().to_string();
+    assert!(e.contains("limit"), "{e}");
+}
+
+// --- Command-line values and scene settings: errors naming them, checked up front ----
+
+const RENDER_SCENE: &str = "fixtures/render/scenes/diffuse_point";
+
+fn render_scene() -> String {
+    repo().join(RENDER_SCENE).to_string_lossy().into_owned()
+}
+
+/// `render` with `extra` arguments into a fresh folder; must fail cleanly mentioning
+/// every string in `must`, and write nothing.
+fn render_fails(extra: &[&str], must: &[&str]) {
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("x.png");
+    let scene = render_scene();
+    let mut args = vec!["render", &scene, "-o", out.to_str().unwrap()];
+    args.extend_from_slice(extra);
+    let o = run(&args, &[]);
+    assert_clean_error(&o, 1, must);
+    assert!(!out.exists(), "{extra:?} wrote an image");
+}
+
+#[test]
+fn render_resolution_16384_squared_is_an_error_before_allocating() {
+    render_fails(&["--resolution", "16384x16384"], &["16384x16384", "limit"]);
+}
+
+#[test]
+fn render_threads_beyond_the_cap_and_zero_are_errors() {
+    render_fails(
+        &["--threads", "100000", "--resolution", "8x8"],
+        &["--threads"],
+    );
+    render_fails(&["--threads", "0", "--resolution", "8x8"], &["--threads"]);
+}
+
+#[test]
+fn render_threshold_nan_and_inf_are_errors() {
+    for t in ["NaN", "inf", "-inf", "-1"] {
+        let arg = format!("--threshold={t}");
+        render_fails(&[&arg, "--resolution", "8x8"], &["--threshold"]);
+    }
+}
+
+#[test]
+fn scene_resolution_zero_percent_and_zero_samples_are_errors_naming_the_setting() {
+    let cases = [
+        ("scenes[\"Scene\"].render.resolution_x=0", "resolution_x"),
+        (
+            "scenes[\"Scene\"].render.resolution_percentage=0",
+            "resolution_percentage",
+        ),
+        ("scenes[\"Scene\"].cycles.samples=0", "samples"),
+        ("scenes[\"Scene\"].cycles.samples=-3", "samples"),
+    ];
+    for (set, name) in cases {
+        render_fails(&["--set", set], &[name]);
+    }
+    // --samples 0 names the option.
+    render_fails(&["--samples", "0", "--resolution", "8x8"], &["--samples"]);
+}
+
+#[test]
+fn mesh_of_an_object_without_geometry_is_an_error() {
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("cam.glb");
+    let dir = repo().join("fixtures/scenes/geonodes");
+    let o = run(
+        &[
+            "mesh",
+            dir.to_str().unwrap(),
+            "--object",
+            "Camera",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_clean_error(&o, 1, &["Camera", "not a geometry object"]);
+    assert!(!out.exists());
+}
+
+#[test]
+fn huge_grid_and_subdivide_level_through_set_are_errors_naming_the_node() {
+    let dir = repo().join("fixtures/scenes/geonodes");
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("t.glb");
+    let node = |n: &str, i: &str, v: &str| {
+        format!("node_groups[\"Terrain Builder\"].nodes[\"{n}\"].inputs[\"{i}\"].default_value={v}")
+    };
+    let cases = [
+        (
+            vec![
+                node("Grid", "Vertices X", "100000"),
+                node("Grid", "Vertices Y", "100000"),
+            ],
+            "Grid",
+        ),
+        (
+            vec![node("Subdivide Mesh", "Level", "30")],
+            "Subdivide Mesh",
+        ),
+    ];
+    for (sets, name) in cases {
+        let mut args = vec![
+            "mesh",
+            dir.to_str().unwrap(),
+            "--object",
+            "Terrain",
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        for s in &sets {
+            args.push("--set");
+            args.push(s);
+        }
+        let o = run(&args, &[]);
+        assert_clean_error(&o, 1, &[name, "limit"]);
+        assert!(!out.exists());
+    }
+}
+
+#[test]
+fn render_passes_to_an_unwritable_folder_fails_before_rendering() {
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("x.png");
+    // A regular file where the passes folder should go: nothing can be created in it.
+    let blocker = t.path().join("blocker");
+    std::fs::write(&blocker, b"").unwrap();
+    let passes = blocker.join("passes");
+    let o = run(
+        &[
+            "render",
+            &render_scene(),
+            "--resolution",
+            "8x8",
+            "--samples",
+            "1",
+            "--passes",
+            passes.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_clean_error(&o, 1, &["--passes"]);
+    assert!(
+        !out.exists(),
+        "the image was written before the passes failed"
+    );
+}
+
+#[test]
+fn png_output_has_normal_permissions() {
+    use std::os::unix::fs::PermissionsExt;
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("x.png");
+    let o = run(
+        &[
+            "render",
+            &render_scene(),
+            "--resolution",
+            "8x8",
+            "--samples",
+            "1",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let umask = std::process::Command::new("sh")
+        .args(["-c", "umask"])
+        .output()
+        .unwrap();
+    let umask = u32::from_str_radix(String::from_utf8_lossy(&umask.stdout).trim(), 8).unwrap();
+    let mode = std::fs::metadata(&out).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode, 0o666 & !umask, "mode {mode:o}, umask {umask:o}");
+}
+
+// --- Strict types for socket values ----------------------------------------------------
+
+#[test]
+fn a_float_socket_holding_a_string_or_null_is_an_error_naming_the_field() {
+    for bad in [Value::from("0.5"), Value::Null] {
+        let t = tempfile::tempdir().unwrap();
+        let dir = t.path().join("scene");
+        copy_dir(&repo().join(FIXTURE), &dir);
+        let p = dir.join("scene.json");
+        let mut v: Value = serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
+        let mut hit = None;
+        'outer: for (mi, m) in v["materials"]
+            .as_array_mut()
+            .unwrap()
+            .iter_mut()
+            .enumerate()
+        {
+            let Some(nodes) = m["node_tree"]["nodes"].as_array_mut() else {
+                continue;
+            };
+            for (ni, n) in nodes.iter_mut().enumerate() {
+                for (si, s) in n["inputs"].as_array_mut().unwrap().iter_mut().enumerate() {
+                    if s["type"] == "VALUE" {
+                        s["default_value"] = bad.clone();
+                        hit = Some(format!(
+                            "materials[{mi}].node_tree.nodes[{ni}] ({:?}).inputs[{si}]",
+                            n["name"].as_str().unwrap()
+                        ));
+                        break 'outer;
+                    }
+                }
+            }
+        }
+        let hit = hit.expect("the fixture has a float socket");
+        std::fs::write(&p, serde_json::to_vec(&v).unwrap()).unwrap();
+        let e = Scene::load(&dir).unwrap_err().to_string();
+        assert!(
+            e.contains(&hit) && e.contains("default_value"),
+            "{hit}: {e}"
+        );
+        assert!(e.contains("must be a number"), "{e}");
+    }
+}
