@@ -127,9 +127,15 @@ pub struct Config {
     pub looks: Vec<Look>,
 }
 
-/// `rel` joined to `dir` when it stays inside (the scene's path policy).
-fn inside(dir: &Path, rel: &str) -> Result<PathBuf, String> {
-    crate::scene::resolve_inside(dir, rel).map_err(|m| m.replace("scene folder", "config's folder"))
+/// `rel` joined to `dir` when it stays inside (the scene's path policy); `file`: it must
+/// also be a regular file when it exists (a LUT), rather than a search folder.
+fn inside(dir: &Path, rel: &str, file: bool) -> Result<PathBuf, String> {
+    let r = if file {
+        crate::scene::resolve_inside(dir, rel)
+    } else {
+        crate::scene::confine(dir, rel)
+    };
+    r.map_err(|m| m.replace("scene folder", "config's folder"))
 }
 
 fn err(path: &Path, msg: impl std::fmt::Display) -> ColorError {
@@ -405,7 +411,7 @@ impl Config {
             .unwrap_or_default()
             .split(':')
             .filter(|s| !s.is_empty())
-            .map(|s| inside(&base, s).map_err(|m| err(path, format!("search_path: {m}"))))
+            .map(|s| inside(&base, s, false).map_err(|m| err(path, format!("search_path: {m}"))))
             .chain(std::iter::once(Ok(base.clone())))
             .collect::<Result<_, _>>()?;
         let mut roles = HashMap::new();
@@ -518,7 +524,7 @@ impl Config {
             let rel = d.strip_prefix(base).unwrap_or(Path::new(""));
             let rel = rel.join(name);
             let rel = rel.to_string_lossy();
-            let p = inside(base, &rel)
+            let p = inside(base, &rel, true)
                 .map_err(|m| err(&self.path, format!("LUT file {name:?}: {m}")))?;
             if p.is_file() {
                 return Ok(Some(p));

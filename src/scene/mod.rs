@@ -219,8 +219,20 @@ fn line_col_offset(bytes: &[u8], line: usize, col: usize) -> usize {
     start + col.saturating_sub(1)
 }
 
-/// Joins `rel` to `dir` if it stays inside `dir`; the error says why not.
+/// Joins `rel` to `dir` if it stays inside `dir` and, when it exists, is a regular file
+/// (every path a scene names is a file to read: a FIFO would block the reader forever);
+/// the error says why not.
 pub fn resolve_inside(dir: &Path, rel: &str) -> Result<PathBuf, String> {
+    let joined = confine(dir, rel)?;
+    if joined.exists() {
+        file::check_regular(&joined).map_err(|m| format!("path {rel:?} {m}"))?;
+    }
+    Ok(joined)
+}
+
+/// Joins `rel` to `dir` if it stays inside `dir` (no absolute path, no `..`, no symlink
+/// out), whatever it names (a search folder too).
+pub fn confine(dir: &Path, rel: &str) -> Result<PathBuf, String> {
     if rel.is_empty() {
         return Err("empty path".into());
     }
@@ -249,10 +261,6 @@ pub fn resolve_inside(dir: &Path, rel: &str) -> Result<PathBuf, String> {
                 "path {rel:?} resolves outside the scene folder (symlink?)"
             ));
         }
-    }
-    // Every path a scene names is a file to read: a FIFO would block the reader forever.
-    if joined.exists() {
-        file::check_regular(&joined).map_err(|m| format!("path {rel:?} {m}"))?;
     }
     Ok(joined)
 }
