@@ -503,6 +503,9 @@ fn run(cli: Cli) -> Result<Outcome> {
             Ok(Outcome::Done)
         }
         Command::Bake(a) => {
+            // The image is size x size texels: the render's size limits apply.
+            blendsynth::render::limits::check_film(a.size, a.size, "--size")
+                .map_err(|e| anyhow::anyhow!("bake: {e}"))?;
             let overrides = parse_overrides(&a.set)?;
             let scene = Scene::load(&a.dir)?.with_overrides(&overrides)?;
             let opts = BakeOptions {

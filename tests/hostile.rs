@@ -551,3 +551,26 @@ fn a_float_socket_holding_a_string_or_null_is_an_error_naming_the_field() {
         assert!(e.contains("must be a number"), "{e}");
     }
 }
+
+#[test]
+fn bake_size_beyond_the_limits_is_an_error_before_allocating() {
+    let t = tempfile::tempdir().unwrap();
+    let out = t.path().join("b.exr");
+    for size in ["100000", "0", "16384"] {
+        let o = run(
+            &[
+                "bake",
+                &render_scene(),
+                "--object",
+                "Cube",
+                "--size",
+                size,
+                "-o",
+                out.to_str().unwrap(),
+            ],
+            &[],
+        );
+        assert_clean_error(&o, 1, &["--size"]);
+        assert!(!out.exists());
+    }
+}
