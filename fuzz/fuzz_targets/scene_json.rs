@@ -4,5 +4,6 @@
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
-    let _ = blendsynth::scene::Scene::from_json(std::path::Path::new("/nonexistent-fuzz-scene"), data);
+    let _ =
+        blendsynth::scene::Scene::from_json(std::path::Path::new("/nonexistent-fuzz-scene"), data);
 });
