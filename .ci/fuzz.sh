@@ -17,11 +17,13 @@ for target in scene_json glb spec set_value; do
   work=$(mktemp -d)
   echo "fuzz: $target for ${SECONDS_EACH}s"
   # The committed seeds are read only; new inputs go to a scratch folder.
+  status=0
   cargo fuzz run "${FLAGS[@]}" "$target" "$work" "fuzz/seeds/$target" -- \
     -max_total_time="$SECONDS_EACH" -timeout=10 -rss_limit_mb=4096 -max_len=262144 \
-    -print_final_stats=1 2>&1 | grep -E "^(stat::|#[0-9]+ +DONE|==|SUMMARY|Done)" || true
-  status=${PIPESTATUS[0]}
-  rm -rf "$work"
+    -print_final_stats=1 >"$work.log" 2>&1 || status=$?
+  grep -E "^(stat::(number_of_executed_units|new_units_added|peak_rss_mb)|Done|SUMMARY|==[0-9]+== ERROR)" "$work.log" || true
+  [ "$status" -eq 0 ] || tail -n 40 "$work.log" >&2
+  rm -rf "$work" "$work.log"
   if [ "$status" -ne 0 ]; then
     echo "fuzz: $target FAILED (exit $status); see fuzz/artifacts/$target/" >&2
     exit 1
