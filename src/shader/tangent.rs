@@ -59,6 +59,33 @@ pub fn mikk_tangents(mesh: &MeshData, uvs: &[[f32; 2]]) -> Vec<[f32; 4]> {
     // range (its cell index then runs past its table: a panic). Its output directions
     // do not depend on a uniform scale, so such a mesh runs scaled down by a power of
     // two. Ordinary meshes are left alone, so their tangents keep every bit.
+    // A NaN or infinite position or UV (Geometry Nodes can make them) sends
+    // MikkTSpace's welding into an endless loop. Such triangles are never hit by a ray,
+    // so their tangents do not matter: the non-finite values go in as 0.
+    let finite_uvs;
+    let uvs = if uvs.iter().flatten().all(|c| c.is_finite()) {
+        uvs
+    } else {
+        finite_uvs = uvs
+            .iter()
+            .map(|u| u.map(finite_or_zero))
+            .collect::<Vec<_>>();
+        &finite_uvs[..]
+    };
+    let finite;
+    let mesh = if mesh.positions.iter().flatten().all(|c| c.is_finite()) {
+        mesh
+    } else {
+        finite = MeshData {
+            positions: mesh
+                .positions
+                .iter()
+                .map(|p| p.map(finite_or_zero))
+                .collect(),
+            ..mesh.clone()
+        };
+        &finite
+    };
     let scaled;
     let mesh = match scale_down(&mesh.positions) {
         Some(positions) => {
@@ -83,6 +110,14 @@ pub fn mikk_tangents(mesh: &MeshData, uvs: &[[f32; 2]]) -> Vec<[f32; 4]> {
     };
     mikktspace::generate_tangents(&mut m);
     m.out
+}
+
+fn finite_or_zero(c: f32) -> f32 {
+    if c.is_finite() {
+        c
+    } else {
+        0.0
+    }
 }
 
 /// Largest coordinate MikkTSpace gets as is: squared it stays far inside f32's range.
@@ -285,6 +320,10 @@ mod tests {
             m.positions[2][0] = bad;
             let t = std::panic::catch_unwind(|| mikk_tangents(&m, &uv));
             assert!(t.is_ok(), "mikk_tangents panicked with a {bad} coordinate");
+            let (m, mut uv) = plane(1.0);
+            uv[1][0] = bad;
+            let t = std::panic::catch_unwind(|| mikk_tangents(&m, &uv));
+            assert!(t.is_ok(), "mikk_tangents panicked with a {bad} UV");
         }
     }
 }
