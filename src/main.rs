@@ -362,6 +362,25 @@ fn parse_resolution(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
+/// The folder a file will be written in ("." for a bare file name).
+fn output_dir(file: &std::path::Path) -> &std::path::Path {
+    match file.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => std::path::Path::new("."),
+    }
+}
+
+/// Errors unless `dir` is a folder this process can create files in (checked by creating
+/// an anonymous temporary file there).
+fn writable_dir(dir: &std::path::Path, what: &str) -> Result<()> {
+    if !dir.is_dir() {
+        anyhow::bail!("{what} {} does not exist or is not a folder", dir.display());
+    }
+    tempfile::tempfile_in(dir)
+        .map(drop)
+        .with_context(|| format!("{what} {} is not writable", dir.display()))
+}
+
 fn run_render(a: RenderArgs) -> Result<()> {
     use blendsynth::render;
     let overrides = parse_overrides(&a.set)?;
@@ -386,6 +405,14 @@ fn run_render(a: RenderArgs) -> Result<()> {
             "{}: the output must be a .png or .exr file",
             a.output.display()
         );
+    }
+    // Every output location is checked before spending the render time, so a bad folder
+    // fails now rather than after the image is written.
+    writable_dir(output_dir(&a.output), "output folder")?;
+    if let Some(dir) = &a.passes {
+        std::fs::create_dir_all(dir)
+            .with_context(|| format!("--passes {}: cannot create the folder", dir.display()))?;
+        writable_dir(dir, "--passes folder")?;
     }
     // Find the denoiser before spending the render time.
     let want_denoise = a.denoise.map_or_else(
@@ -490,6 +517,9 @@ fn run(cli: Cli) -> Result<Outcome> {
             Ok(Outcome::Done)
         }
         Command::Bake(a) => {
+            // The image is size x size texels: the render's size limits apply.
+            blendsynth::render::limits::check_film(a.size, a.size, "--size")
+                .map_err(|e| anyhow::anyhow!("bake: {e}"))?;
             let overrides = parse_overrides(&a.set)?;
             let scene = Scene::load(&a.dir)?.with_overrides(&overrides)?;
             let opts = BakeOptions {
@@ -597,6 +627,19 @@ fn run(cli: Cli) -> Result<Outcome> {
             let overrides: Vec<(String, serde_json::Value)> =
                 overrides.into_iter().map(|o| (o.path, o.value)).collect();
             let scene = Scene::load(&a.dir)?;
+            // Objects without geometry would evaluate to an empty mesh: say so instead.
+            if let Some(o) = scene.object(&a.object) {
+                if matches!(
+                    o.kind.as_str(),
+                    "EMPTY" | "CAMERA" | "LIGHT" | "LIGHT_PROBE" | "SPEAKER"
+                ) {
+                    anyhow::bail!(
+                        "mesh {:?}: not a geometry object (it is a {} object)",
+                        a.object,
+                        o.kind
+                    );
+                }
+            }
             let frame = a.frame.unwrap_or(scene.file.scene.frame_current as f64);
             let start = std::time::Instant::now();
             let set = blendsynth::geometry::evaluate_object(&scene, &a.object, frame, &overrides)

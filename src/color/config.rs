@@ -3,6 +3,7 @@
 //! and looks. Parsed with a YAML reader; transforms stay symbolic here and are turned into
 //! pixel operations by `pipeline`.
 
+use crate::scene::limits::MAX_COLOR_FILE_BYTES;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -124,6 +125,17 @@ pub struct Config {
     pub displays: Vec<(String, Vec<(String, String)>)>,
     pub spaces: Vec<ColorSpace>,
     pub looks: Vec<Look>,
+}
+
+/// `rel` joined to `dir` when it stays inside (the scene's path policy); `file`: it must
+/// also be a regular file when it exists (a LUT), rather than a search folder.
+fn inside(dir: &Path, rel: &str, file: bool) -> Result<PathBuf, String> {
+    let r = if file {
+        crate::scene::resolve_inside(dir, rel)
+    } else {
+        crate::scene::confine(dir, rel)
+    };
+    r.map_err(|m| m.replace("scene folder", "config's folder"))
 }
 
 fn err(path: &Path, msg: impl std::fmt::Display) -> ColorError {
@@ -377,20 +389,31 @@ fn verbatim_tags_to_local(text: &str) -> String {
 
 impl Config {
     pub fn load(path: &Path) -> Result<Config, ColorError> {
+        let bytes = crate::scene::file::read_regular(path, MAX_COLOR_FILE_BYTES)
+            .map_err(|m| err(path, m))?;
         let text =
-            std::fs::read_to_string(path).map_err(|e| err(path, format!("cannot read: {e}")))?;
+            String::from_utf8(bytes).map_err(|_| err(path, "not a text file (not UTF-8)"))?;
         // serde_yaml drops verbatim tags (`!<ColorSpace>`); the local form (`!ColorSpace`) is kept.
         let text = verbatim_tags_to_local(&text);
-        let doc: Value = serde_yaml::from_str(&text)
-            .map_err(|e| err(path, format!("not a readable OCIO config: {e}")))?;
+        // serde_yaml's messages can quote the document ("invalid type: string ..."):
+        // only the location is reported, so a wrong file's content is never echoed.
+        let doc: Value = serde_yaml::from_str(&text).map_err(|e| {
+            let at = e
+                .location()
+                .map(|l| format!(" (at line {} column {})", l.line(), l.column()))
+                .unwrap_or_default();
+            err(path, format!("not a readable OCIO config{at}"))
+        })?;
         let base = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+        // The search path stays inside the config's folder (which the scene's path
+        // policy already confines): an absolute or `..` entry is an error.
         let search_dirs = string(get(&doc, "search_path"))
             .unwrap_or_default()
             .split(':')
             .filter(|s| !s.is_empty())
-            .map(|s| base.join(s))
-            .chain(std::iter::once(base.clone()))
-            .collect();
+            .map(|s| inside(&base, s, false).map_err(|m| err(path, format!("search_path: {m}"))))
+            .chain(std::iter::once(Ok(base.clone())))
+            .collect::<Result<_, _>>()?;
         let mut roles = HashMap::new();
         if let Some(Value::Mapping(m)) = get(&doc, "roles") {
             for (k, v) in m {
@@ -493,10 +516,20 @@ impl Config {
         self.looks.iter().find(|l| l.name == name)
     }
 
-    pub fn find_file(&self, name: &str) -> Option<PathBuf> {
-        self.search_dirs
-            .iter()
-            .map(|d| d.join(name))
-            .find(|p| p.is_file())
+    /// A LUT file named by a transform, looked up in the search path. The name must stay
+    /// inside the config's folder (no absolute path, no `..`, no symlink out).
+    pub fn find_file(&self, name: &str) -> Result<Option<PathBuf>, ColorError> {
+        let base = self.path.parent().unwrap_or(Path::new("."));
+        for d in &self.search_dirs {
+            let rel = d.strip_prefix(base).unwrap_or(Path::new(""));
+            let rel = rel.join(name);
+            let rel = rel.to_string_lossy();
+            let p = inside(base, &rel, true)
+                .map_err(|m| err(&self.path, format!("LUT file {name:?}: {m}")))?;
+            if p.is_file() {
+                return Ok(Some(p));
+            }
+        }
+        Ok(None)
     }
 }

@@ -42,7 +42,9 @@ fn bad(path: &Path, msg: impl std::fmt::Display) -> ColorError {
 }
 
 pub fn load(path: &Path) -> Result<LutFile, ColorError> {
-    let text = std::fs::read_to_string(path).map_err(|e| bad(path, format!("cannot read: {e}")))?;
+    let bytes = crate::scene::file::read_regular(path, crate::scene::limits::MAX_COLOR_FILE_BYTES)
+        .map_err(|m| bad(path, m))?;
+    let text = String::from_utf8(bytes).map_err(|_| bad(path, "not a text file (not UTF-8)"))?;
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -66,9 +68,12 @@ pub fn load(path: &Path) -> Result<LutFile, ColorError> {
     }
 }
 
+/// Largest 3D LUT edge accepted (256^3 entries, 200 MB): sizes come from the file.
+pub const MAX_LUT_3D_SIZE: usize = 256;
+
 fn num(tok: &str) -> Result<f32, String> {
     tok.parse::<f32>()
-        .map_err(|_| format!("not a number: {tok:?}"))
+        .map_err(|_| "a value is not a number".to_string())
 }
 
 fn parse_spi1d(text: &str) -> Result<Lut1D, String> {
@@ -113,7 +118,8 @@ fn parse_spi1d(text: &str) -> Result<Lut1D, String> {
                     .map_err(|e| e.to_string())?
             }
             Some("{") => in_body = true,
-            Some(other) => return Err(format!("unexpected line starting with {other:?}")),
+            // The word itself is not quoted: errors never echo a file's content.
+            Some(_) => return Err("a line starts with an unknown keyword".into()),
             None => {}
         }
     }
@@ -193,6 +199,11 @@ fn parse_cube(text: &str) -> Result<LutFile, String> {
     }
     match (size3, size1) {
         (Some(n), _) => {
+            if n > MAX_LUT_3D_SIZE {
+                return Err(format!(
+                    "LUT_3D_SIZE is more than the limit of {MAX_LUT_3D_SIZE}"
+                ));
+            }
             if n < 2 || rows.len() != n * n * n {
                 return Err(format!(
                     "LUT_3D_SIZE {n} needs {} rows, found {}",
@@ -237,7 +248,12 @@ fn parse_spi3d(text: &str) -> Result<Lut3D, String> {
         .map(|t| t.parse::<usize>().map_err(|e| e.to_string()))
         .collect::<Result<_, _>>()?;
     if sizes.len() != 3 || sizes[0] != sizes[1] || sizes[1] != sizes[2] || sizes[0] < 2 {
-        return Err(format!("unsupported spi3d sizes {sizes:?}"));
+        return Err("unsupported spi3d sizes (need three equal sizes of at least 2)".into());
+    }
+    if sizes[0] > MAX_LUT_3D_SIZE {
+        return Err(format!(
+            "spi3d size is more than the limit of {MAX_LUT_3D_SIZE}"
+        ));
     }
     let n = sizes[0];
     let mut data = vec![[0.0f32; 3]; n * n * n];
@@ -245,7 +261,7 @@ fn parse_spi3d(text: &str) -> Result<Lut3D, String> {
     for line in lines {
         let t: Vec<&str> = line.split_whitespace().collect();
         if t.len() != 6 {
-            return Err(format!("spi3d row needs 6 fields: {line:?}"));
+            return Err(format!("spi3d row {} needs 6 fields", count + 1));
         }
         let (i, j, k) = (
             t[0].parse::<usize>().map_err(|e| e.to_string())?,
@@ -253,7 +269,7 @@ fn parse_spi3d(text: &str) -> Result<Lut3D, String> {
             t[2].parse::<usize>().map_err(|e| e.to_string())?,
         );
         if i >= n || j >= n || k >= n {
-            return Err(format!("spi3d index out of range: {line:?}"));
+            return Err(format!("spi3d row {}: index out of range", count + 1));
         }
         data[i + n * (j + n * k)] = [num(t[3])?, num(t[4])?, num(t[5])?];
         count += 1;
@@ -272,7 +288,10 @@ fn parse_spi3d(text: &str) -> Result<Lut3D, String> {
 fn parse_spimtx(text: &str) -> Result<[[f64; 4]; 3], String> {
     let v: Vec<f64> = text
         .split_whitespace()
-        .map(|t| t.parse::<f64>().map_err(|_| format!("not a number: {t:?}")))
+        .map(|t| {
+            t.parse::<f64>()
+                .map_err(|_| "a value is not a number".to_string())
+        })
         .collect::<Result<_, _>>()?;
     if v.len() != 12 {
         return Err(format!("spimtx needs 12 numbers, found {}", v.len()));

@@ -8,15 +8,15 @@
 //! config without the OCIO library; alpha is divided out around it, as Blender does for
 //! premultiplied float buffers.
 
-mod config;
-mod lut;
+pub mod config;
+pub mod lut;
 mod pipeline;
 mod tone;
 mod write;
 
 use std::path::{Path, PathBuf};
 
-pub use write::{quantize, write_exr, write_png};
+pub use write::{quantize, user_file_permissions, write_exr, write_png};
 
 use crate::scene::Scene;
 

@@ -246,7 +246,7 @@ impl<'a> Builder<'a> {
     }
 
     fn load_lut(&mut self, name: &str) -> Result<LutFile, ColorError> {
-        let path = self.config.find_file(name).ok_or_else(|| {
+        let path = self.config.find_file(name)?.ok_or_else(|| {
             self.cerr(format!(
                 "LUT file {name:?} not found in the config's search path"
             ))

@@ -35,6 +35,14 @@ fn check(path: &Path, width: u32, height: u32, n: usize) -> Result<(), ColorErro
     Ok(())
 }
 
+/// For the temporary file an output is written to before it is renamed into place: an
+/// image is a file the user asked for, so it gets the mode any program's new file gets
+/// (0666 less the umask), not a temporary file's private 0600.
+pub fn user_file_permissions() -> std::fs::Permissions {
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::Permissions::from_mode(0o666)
+}
+
 /// Writes through `f` into a temp file in the target's folder, then renames it over `path`.
 fn atomic(
     path: &Path,
@@ -47,6 +55,7 @@ fn atomic(
     let mut tmp = tempfile::Builder::new()
         .prefix(".blendsynth-")
         .suffix(".tmp")
+        .permissions(user_file_permissions())
         .tempfile_in(dir)
         .map_err(|e| {
             werr(

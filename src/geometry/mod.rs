@@ -36,6 +36,7 @@ pub mod field;
 pub mod instances;
 pub mod interpolate;
 pub mod legacy_curve;
+pub mod limits;
 pub mod math;
 pub mod mesh;
 pub mod mesh_sample;

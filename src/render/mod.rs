@@ -27,6 +27,7 @@ pub mod filter;
 pub mod integrator;
 pub mod light;
 pub mod light_tree;
+pub mod limits;
 pub use crate::foundation::math;
 pub mod microfacet;
 pub mod motion;
@@ -135,8 +136,7 @@ pub struct InstanceInfo {
     pub world_transform: [[f32; 4]; 4],
 }
 
-/// Largest accepted image side, so a typo cannot ask for terabytes.
-pub const MAX_SIDE: u32 = 16384;
+pub use limits::MAX_SIDE;
 const TILE: u32 = 16;
 /// Sample dimension set of the shutter time (apart from the sets paths use).
 const TIME_SET: u32 = 0x7000_0000;
@@ -161,6 +161,32 @@ fn transparent_glass_threshold(film_transparent: bool, cycles: &crate::scene::Rn
     } else {
         -1.0
     }
+}
+
+/// The image size Blender renders from the scene's settings: resolution times its
+/// percentage, truncated; a size below one pixel is Blender's "Image too small" error.
+fn scene_resolution(r: &crate::scene::Rna) -> Result<(u32, u32), RenderError> {
+    let get = |k: &str, default: f64| {
+        let v = rna_f(r, k).unwrap_or(default);
+        if v.is_finite() && v >= 1.0 {
+            Ok(v)
+        } else {
+            Err(RenderError(format!(
+                "scenes.render.{k} is {v}: must be at least 1"
+            )))
+        }
+    };
+    let pct = get("resolution_percentage", 100.0)?;
+    let rx = get("resolution_x", 1920.0)?;
+    let ry = get("resolution_y", 1080.0)?;
+    let (w, h) = (rx * pct / 100.0, ry * pct / 100.0);
+    if w < 1.0 || h < 1.0 {
+        return Err(RenderError(format!(
+            "scenes.render resolution {rx}x{ry} at {pct}% is below one pixel (Blender: \"Image too small\")"
+        )));
+    }
+    // Saturating: anything beyond u32 is then refused by the size check.
+    Ok((w as u32, h as u32))
 }
 
 /// Renders `scene` (overrides already applied) at the options' frame.
@@ -316,7 +342,7 @@ pub fn render_controlled(
     let pool = match opts.threads {
         Some(n) => Some(
             rayon::ThreadPoolBuilder::new()
-                .num_threads(n.max(1))
+                .num_threads(n)
                 .build()
                 .map_err(|e| RenderError(format!("thread pool: {e}")))?,
         ),
@@ -557,28 +583,38 @@ fn prepare(
     let s = &scene.file.scene;
     let (cy, r) = (&s.cycles, &s.render);
     let (w, h) = match opts.resolution {
-        Some(res) => res,
+        Some((w, h)) => {
+            limits::check_film(w, h, "--resolution")?;
+            (w, h)
+        }
         None => {
-            let pct = rna_f(r, "resolution_percentage").unwrap_or(100.0);
-            let rx = rna_f(r, "resolution_x").unwrap_or(1920.0);
-            let ry = rna_f(r, "resolution_y").unwrap_or(1080.0);
-            (
-                ((rx * pct / 100.0) as u32).max(1),
-                ((ry * pct / 100.0) as u32).max(1),
-            )
+            let (w, h) = scene_resolution(r)?;
+            limits::check_film(w, h, "the scene's resolution (scenes.render)")?;
+            (w, h)
         }
     };
-    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
-        return Err(RenderError(format!(
-            "resolution {w}x{h}: each side must be 1 to {MAX_SIDE}"
-        )));
-    }
     let shutter = motion::Shutter::from_render(r).map_err(RenderError)?;
-    let samples = opts
-        .samples
-        .unwrap_or_else(|| rna_f(cy, "samples").unwrap_or(128.0) as u32);
-    if samples == 0 {
-        return Err(RenderError("samples must be at least 1".into()));
+    let samples = match opts.samples {
+        Some(n) => {
+            limits::check_samples(n, "--samples")?;
+            n
+        }
+        None => {
+            let n = rna_f(cy, "samples").unwrap_or(128.0);
+            if !(n >= 1.0 && n <= limits::MAX_SAMPLES as f64 && n.fract() == 0.0) {
+                return Err(RenderError(format!(
+                    "scenes.cycles.samples is {n}: must be a whole number from 1 to {}",
+                    limits::MAX_SAMPLES
+                )));
+            }
+            n as u32
+        }
+    };
+    if let Some(t) = opts.threshold {
+        limits::check_threshold(t)?;
+    }
+    if let Some(n) = opts.threads {
+        limits::check_threads(n)?;
     }
     let seed = opts
         .seed
@@ -973,6 +1009,7 @@ pub fn write_exr(
         .ok_or_else(|| RenderError("image buffer size mismatch".into()))?;
     let tmp = tempfile::Builder::new()
         .suffix(".exr")
+        .permissions(crate::color::user_file_permissions())
         .tempfile_in(dir)
         .map_err(|e| RenderError(format!("{}: {e}", dir.display())))?;
     image::DynamicImage::ImageRgba32F(img)

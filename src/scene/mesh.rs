@@ -10,6 +10,7 @@ use gltf::json::accessor::{ComponentType, Type};
 use serde::Deserialize;
 
 use super::error::SceneError;
+use super::limits::{mul_add, MAX_GLB_BYTES, MAX_MESH_ELEMENTS};
 
 /// The attribute domains of a Blender mesh.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -196,6 +197,17 @@ impl MeshData {
                 format!("has {} entries, expected {nc}", self.corner_normals.len()),
             );
         }
+        // Blender's normals are unit vectors; a NaN would shade the whole face black.
+        if let Some(i) = self
+            .corner_normals
+            .iter()
+            .position(|n| n.iter().any(|c| !c.is_finite()))
+        {
+            return err(
+                "corner_normals",
+                format!("mesh {:?}: corner {i} has a non-finite normal", self.name),
+            );
+        }
         if let Some(i) = self
             .triangles
             .iter()
@@ -217,6 +229,16 @@ impl MeshData {
             );
         }
         for a in &self.attributes {
+            // UV maps (2D vectors) feed texture lookups and tangents: NaN there is
+            // corrupt data, not a value Blender's UV editor can make.
+            if let (Domain::Corner, AttributeData::Float2(v)) = (a.domain, &a.data) {
+                if let Some(i) = v.iter().position(|p| p.iter().any(|c| !c.is_finite())) {
+                    return err(
+                        &format!("attributes[\"{}\"]", a.name),
+                        format!("mesh {:?}: value {i} is not finite", self.name),
+                    );
+                }
+            }
             let want = self.domain_size(a.domain);
             if a.data.len() != want {
                 return err(
@@ -268,7 +290,7 @@ struct GlbAttribute {
 /// Reads an exporter glb (layout in `blender_export/FORMAT.md`).
 pub fn read_glb(path: &Path) -> Result<MeshData, SceneError> {
     let bytes =
-        std::fs::read(path).map_err(|e| SceneError::new(path, "", format!("cannot read: {e}")))?;
+        super::file::read_regular(path, MAX_GLB_BYTES).map_err(|m| SceneError::new(path, "", m))?;
     parse_glb(&bytes, path)
 }
 
@@ -302,6 +324,22 @@ pub fn parse_glb(bytes: &[u8], path: &Path) -> Result<MeshData, SceneError> {
             "extras.blendsynth.version",
             format!("unsupported mesh layout version {}", ex.version),
         ));
+    }
+    let counts = [
+        ("vertex_count", ex.vertex_count),
+        ("edge_count", ex.edge_count),
+        ("face_count", ex.face_count),
+        ("corner_count", ex.corner_count),
+        ("triangle_count", ex.triangle_count),
+    ];
+    for (what, n) in counts {
+        if n > MAX_MESH_ELEMENTS {
+            return Err(SceneError::new(
+                path,
+                format!("extras.blendsynth.{what}"),
+                format!("{n} is more than the limit of {MAX_MESH_ELEMENTS} elements"),
+            ));
+        }
     }
     let reader = AccessorReader { root, blob, path };
     let mut m = MeshData {
@@ -345,6 +383,7 @@ pub fn parse_glb(bytes: &[u8], path: &Path) -> Result<MeshData, SceneError> {
     let tri = reader.u32s(
         ex.triangle_corners,
         "triangle_corners",
+        // Cannot overflow: the count is at most MAX_MESH_ELEMENTS (checked above).
         ex.triangle_count * 3,
     )?;
     m.triangles = tri.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
@@ -402,7 +441,15 @@ impl AccessorReader<'_> {
                 acc_ty, acc_comp
             )));
         }
-        let count = acc.count.0 as usize;
+        let count = usize::try_from(acc.count.0)
+            .ok()
+            .filter(|&n| n <= MAX_MESH_ELEMENTS)
+            .ok_or_else(|| {
+                err(format!(
+                    "count {} is more than the limit of {MAX_MESH_ELEMENTS} elements",
+                    acc.count.0
+                ))
+            })?;
         let elem = ty.multiplicity() * comp.size();
         let view_index = acc
             .buffer_view
@@ -417,21 +464,36 @@ impl AccessorReader<'_> {
             return Err(err("data must be in the glb's BIN chunk".into()));
         }
         let stride = view.byte_stride.map(|s| s.0).unwrap_or(elem);
-        let start = view.byte_offset.map(|o| o.0 as usize).unwrap_or(0)
-            + acc.byte_offset.map(|o| o.0 as usize).unwrap_or(0);
-        let view_end =
-            view.byte_offset.map(|o| o.0 as usize).unwrap_or(0) + view.byte_length.0 as usize;
-        let need_end = if count == 0 {
-            start
-        } else {
-            start + stride * (count - 1) + elem
-        };
-        if need_end > view_end || view_end > self.blob.len() {
+        if stride < elem {
             return Err(err(format!(
-                "reads bytes up to {need_end} but the data ends at {} (truncated file?)",
-                view_end.min(self.blob.len())
+                "byte stride {stride} is less than its element size {elem}"
             )));
         }
+        // Offsets and lengths are input numbers: every sum and product is checked, so a
+        // crafted file gets this error rather than a wrapped bounds check. With the end
+        // inside the blob, the copy below is at most the blob's size.
+        let size = |v: u64| usize::try_from(v).ok();
+        let view_off = size(view.byte_offset.map(|o| o.0).unwrap_or(0));
+        let acc_off = size(acc.byte_offset.map(|o| o.0).unwrap_or(0));
+        let view_len = size(view.byte_length.0);
+        let ends = (|| {
+            let start = view_off?.checked_add(acc_off?)?;
+            let view_end = view_off?.checked_add(view_len?)?;
+            let need_end = match count {
+                0 => start,
+                n => mul_add(stride, n - 1, start)?.checked_add(elem)?,
+            };
+            Some((start, view_end, need_end))
+        })();
+        let inside = |&(_, view_end, need_end): &(usize, usize, usize)| {
+            need_end <= view_end && view_end <= self.blob.len()
+        };
+        let Some((start, _, _)) = ends.filter(inside) else {
+            return Err(err(format!(
+                "reads past the end of its data ({} bytes; truncated or corrupt file?)",
+                self.blob.len()
+            )));
+        };
         let mut out = Vec::with_capacity(count * elem);
         for i in 0..count {
             out.extend_from_slice(&self.blob[start + i * stride..start + i * stride + elem]);

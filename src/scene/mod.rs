@@ -5,7 +5,9 @@
 
 pub mod datapath;
 pub mod error;
+pub mod file;
 pub mod format;
+pub mod limits;
 pub mod mesh;
 pub mod overrides;
 mod validate;
@@ -35,9 +37,16 @@ impl Scene {
                 "not a folder (expected an export made by `blendsynth convert`)",
             ));
         }
-        let bytes = std::fs::read(&json_path)
-            .map_err(|e| SceneError::new(&json_path, "", format!("cannot read: {e}")))?;
-        let file = parse_scene_json(&bytes, &json_path)?;
+        let bytes = file::read_regular(&json_path, limits::MAX_SCENE_JSON_BYTES)
+            .map_err(|m| SceneError::new(&json_path, "", m))?;
+        Scene::from_json(dir, &bytes)
+    }
+
+    /// Parses and validates scene.json bytes as if read from `DIR/scene.json`; nothing
+    /// else is read (meshes load on demand). The fuzz target's entry point.
+    pub fn from_json(dir: &Path, bytes: &[u8]) -> Result<Scene, SceneError> {
+        let json_path = dir.join("scene.json");
+        let file = parse_scene_json(bytes, &json_path)?;
         let scene = Scene {
             dir: dir.to_path_buf(),
             file,
@@ -210,8 +219,20 @@ fn line_col_offset(bytes: &[u8], line: usize, col: usize) -> usize {
     start + col.saturating_sub(1)
 }
 
-/// Joins `rel` to `dir` if it stays inside `dir`; the error says why not.
+/// Joins `rel` to `dir` if it stays inside `dir` and, when it exists, is a regular file
+/// (every path a scene names is a file to read: a FIFO would block the reader forever);
+/// the error says why not.
 pub fn resolve_inside(dir: &Path, rel: &str) -> Result<PathBuf, String> {
+    let joined = confine(dir, rel)?;
+    if joined.exists() {
+        file::check_regular(&joined).map_err(|m| format!("path {rel:?} {m}"))?;
+    }
+    Ok(joined)
+}
+
+/// Joins `rel` to `dir` if it stays inside `dir` (no absolute path, no `..`, no symlink
+/// out), whatever it names (a search folder too).
+pub fn confine(dir: &Path, rel: &str) -> Result<PathBuf, String> {
     if rel.is_empty() {
         return Err("empty path".into());
     }

@@ -227,6 +227,9 @@ fn check_tree(
                         format!("{:?} appears twice", s.identifier),
                     );
                 }
+                if let Some(m) = socket_value_error(&s.kind, s.default_value.as_ref()) {
+                    return err(format!("{nat}.{side}[{k}] ({:?}).default_value", s.name), m);
+                }
             }
         }
     }
@@ -278,4 +281,57 @@ fn check_tree(
         }
     }
     Ok(())
+}
+
+/// Strict types for a socket's value: a float socket holds a number, not a string or
+/// null (which downstream code would otherwise read as 0). Types without a value
+/// (geometry, shader, ...) and those this build does not know are not checked.
+fn socket_value_error(kind: &str, v: Option<&serde_json::Value>) -> Option<String> {
+    use serde_json::Value;
+    let numbers = |v: &Value, lens: &[usize]| match v {
+        Value::Array(a) => lens.contains(&a.len()) && a.iter().all(Value::is_number),
+        _ => false,
+    };
+    let ok = |v: &Value| match kind {
+        "VALUE" => v.is_number(),
+        "INT" => v.as_i64().is_some_and(|i| i32::try_from(i).is_ok()),
+        "BOOLEAN" => v.is_boolean(),
+        "VECTOR" => numbers(v, &[2, 3, 4]),
+        "RGBA" => numbers(v, &[4]),
+        "ROTATION" => numbers(v, &[3]),
+        "STRING" => v.is_string(),
+        _ => true,
+    };
+    let expected = match kind {
+        "VALUE" => "a number",
+        "INT" => "a 32-bit integer",
+        "BOOLEAN" => "true or false",
+        "VECTOR" => "a list of 2 to 4 numbers",
+        "RGBA" => "a list of 4 numbers",
+        "ROTATION" => "a list of 3 numbers (Euler angles)",
+        "STRING" => "a string",
+        _ => return None,
+    };
+    match v {
+        Some(v) if ok(v) => None,
+        Some(v) => Some(format!(
+            "a {kind} socket's value must be {expected}, not {}",
+            json_kind(v)
+        )),
+        None => Some(format!(
+            "a {kind} socket's value must be {expected}, not null or missing"
+        )),
+    }
+}
+
+fn json_kind(v: &serde_json::Value) -> &'static str {
+    use serde_json::Value;
+    match v {
+        Value::Null => "null",
+        Value::Bool(_) => "a boolean",
+        Value::Number(_) => "a number",
+        Value::String(_) => "a string",
+        Value::Array(_) => "a list",
+        Value::Object(_) => "an object",
+    }
 }

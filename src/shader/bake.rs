@@ -291,6 +291,7 @@ pub fn write_exr(b: &Baked, path: &Path) -> Result<(), String> {
     let tmp = tempfile::Builder::new()
         .prefix(".bake-")
         .suffix(".exr")
+        .permissions(crate::color::user_file_permissions())
         .tempfile_in(dir)
         .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
     img.save_with_format(tmp.path(), image::ImageFormat::OpenExr)

@@ -55,6 +55,48 @@ impl mikktspace::Geometry for MikkMesh<'_> {
 /// MikkTSpace tangents (x, y, z, bitangent sign) for UV map `uvs`, per corner of each
 /// triangle (index 3 * triangle + k), object space.
 pub fn mikk_tangents(mesh: &MeshData, uvs: &[[f32; 2]]) -> Vec<[f32; 4]> {
+    // MikkTSpace's vertex welding and area terms overflow for coordinates near f32's
+    // range (its cell index then runs past its table: a panic). Its output directions
+    // do not depend on a uniform scale, so such a mesh runs scaled down by a power of
+    // two. Ordinary meshes are left alone, so their tangents keep every bit.
+    // A NaN or infinite position or UV (Geometry Nodes can make them) sends
+    // MikkTSpace's welding into an endless loop. Such triangles are never hit by a ray,
+    // so their tangents do not matter: the non-finite values go in as 0.
+    let finite_uvs;
+    let uvs = if uvs.iter().flatten().all(|c| c.is_finite()) {
+        uvs
+    } else {
+        finite_uvs = uvs
+            .iter()
+            .map(|u| u.map(finite_or_zero))
+            .collect::<Vec<_>>();
+        &finite_uvs[..]
+    };
+    let finite;
+    let mesh = if mesh.positions.iter().flatten().all(|c| c.is_finite()) {
+        mesh
+    } else {
+        finite = MeshData {
+            positions: mesh
+                .positions
+                .iter()
+                .map(|p| p.map(finite_or_zero))
+                .collect(),
+            ..mesh.clone()
+        };
+        &finite
+    };
+    let scaled;
+    let mesh = match scale_down(&mesh.positions) {
+        Some(positions) => {
+            scaled = MeshData {
+                positions,
+                ..mesh.clone()
+            };
+            &scaled
+        }
+        None => mesh,
+    };
     let flat = match mesh.attribute("sharp_face").map(|a| &a.data) {
         Some(AttributeData::Bool(v)) => v.clone(),
         _ => vec![false; mesh.face_count()],
@@ -68,6 +110,38 @@ pub fn mikk_tangents(mesh: &MeshData, uvs: &[[f32; 2]]) -> Vec<[f32; 4]> {
     };
     mikktspace::generate_tangents(&mut m);
     m.out
+}
+
+fn finite_or_zero(c: f32) -> f32 {
+    if c.is_finite() {
+        c
+    } else {
+        0.0
+    }
+}
+
+/// Largest coordinate MikkTSpace gets as is: squared it stays far inside f32's range.
+const MIKK_MAX_COORD: f32 = (1u64 << 40) as f32;
+
+/// The positions scaled by a power of two (exact in floating point) to a largest
+/// coordinate near 1, when they are beyond MIKK_MAX_COORD; None otherwise.
+fn scale_down(positions: &[[f32; 3]]) -> Option<Vec<[f32; 3]>> {
+    let max = positions
+        .iter()
+        .flatten()
+        .map(|c| c.abs())
+        .filter(|c| c.is_finite())
+        .fold(0.0f32, f32::max);
+    if max <= MIKK_MAX_COORD {
+        return None;
+    }
+    let k = 2f64.powi(-(max as f64).log2().floor() as i32);
+    Some(
+        positions
+            .iter()
+            .map(|p| p.map(|c| (c as f64 * k) as f32))
+            .collect(),
+    )
 }
 
 /// Normal Map, tangent space (Cycles' svm_node_normal_map): `tangent` is the interpolated
@@ -194,4 +268,62 @@ pub fn vertex_normals(mesh: &MeshData) -> Vec<Vec3> {
         }
     }
     acc.into_iter().map(safe_normalize3).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A unit plane (one quad, two triangles) with a UV map, positions scaled by `s`.
+    fn plane(s: f32) -> (MeshData, Vec<[f32; 2]>) {
+        let p = [
+            [-1.0, -1.0, 0.0],
+            [1.0, -1.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [-1.0, 1.0, 0.0],
+        ];
+        let m = MeshData {
+            name: "Plane".into(),
+            positions: p.iter().map(|v: &[f32; 3]| v.map(|c| c * s)).collect(),
+            edges: vec![[0, 1], [1, 2], [2, 3], [3, 0]],
+            face_offsets: vec![0, 4],
+            corner_verts: vec![0, 1, 2, 3],
+            corner_edges: vec![0, 1, 2, 3],
+            corner_normals: vec![[0.0, 0.0, 1.0]; 4],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+            triangle_faces: vec![0, 0],
+            attributes: vec![],
+        };
+        (m, vec![[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    }
+
+    #[test]
+    fn huge_positions_give_the_same_tangents_as_small_ones() {
+        let (m, uv) = plane(1.0);
+        let small = mikk_tangents(&m, &uv);
+        for s in [3e38f32, 1e30, 1e20, f32::MAX] {
+            let (m, uv) = plane(s);
+            let big = std::panic::catch_unwind(|| mikk_tangents(&m, &uv))
+                .unwrap_or_else(|_| panic!("mikk_tangents panicked at scale {s}"));
+            for (a, b) in small.iter().zip(&big) {
+                for k in 0..4 {
+                    assert!((a[k] - b[k]).abs() < 1e-6, "scale {s}: {a:?} vs {b:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn non_finite_positions_do_not_panic() {
+        for bad in [f32::NAN, f32::INFINITY] {
+            let (mut m, uv) = plane(1.0);
+            m.positions[2][0] = bad;
+            let t = std::panic::catch_unwind(|| mikk_tangents(&m, &uv));
+            assert!(t.is_ok(), "mikk_tangents panicked with a {bad} coordinate");
+            let (m, mut uv) = plane(1.0);
+            uv[1][0] = bad;
+            let t = std::panic::catch_unwind(|| mikk_tangents(&m, &uv));
+            assert!(t.is_ok(), "mikk_tangents panicked with a {bad} UV");
+        }
+    }
 }

@@ -9,6 +9,7 @@ use super::super::attribute::AttrId;
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::{AttributeInput, Field};
+use super::super::limits;
 use super::super::math::{add, scale, V3};
 use super::super::mesh::Mesh;
 use super::super::set::GeometrySet;
@@ -117,6 +118,9 @@ pub fn grid(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     if vx < 1 || vy < 1 {
         return Ok(empty_out(ctx));
     }
+    let (x, y) = (vx as u64, vy as u64);
+    limits::check(limits::product(&[4, x, y]), "Vertices X x Vertices Y")
+        .map_err(|m| ctx.err(m))?;
     let mut m = grid_mesh(vx as usize, vy as usize, sx, sy);
     // The node gives the mesh an empty material slot (as all primitive nodes do).
     m.materials = vec![None];

@@ -14,6 +14,7 @@
 use super::super::attribute::Attributes;
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
+use super::super::limits;
 use super::super::mesh::Mesh;
 use super::super::set::GeometrySet;
 use super::super::types::{Array, Domain};
@@ -958,6 +959,10 @@ pub fn subdivide_node(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         modify_geometry_sets(&mut g, &mut |s: &mut GeometrySet| {
             if let Some(m) = s.mesh.clone() {
                 if m.face_count() > 0 {
+                    limits::check(
+                        limits::subdivided_corners(m.corner_count() as u64, level),
+                        &format!("Level {level} on a mesh of {} faces", m.face_count()),
+                    )?;
                     // A new Arc: `mesh_mut` would first deep-copy the shared input.
                     s.mesh = Some(std::sync::Arc::new(subdivide_mesh(&m, level)));
                 }

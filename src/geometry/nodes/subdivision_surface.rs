@@ -6,6 +6,7 @@ use super::super::catmull_clark::{self, crease_to_sharpness, Options};
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::ComponentRef;
+use super::super::limits;
 use super::super::mesh::Mesh;
 use super::super::set::GeometrySet;
 use super::super::types::{DataType, Domain};
@@ -83,6 +84,10 @@ pub fn subdivision_surface_node(ctx: &NodeCtx) -> Result<Outputs, GeometryError>
             if m.face_count() == 0 {
                 return Ok(());
             }
+            limits::check(
+                limits::subdivided_corners(m.corner_count() as u64, level),
+                &format!("Level {level} on a mesh of {} faces", m.face_count()),
+            )?;
             let ec = eval_fields(
                 ComponentRef::Mesh(&m),
                 Domain::Edge,
@@ -141,6 +146,13 @@ pub fn subsurf_modifier(
     if m.face_count() == 0 {
         return Ok(g);
     }
+    limits::check(
+        limits::subdivided_corners(m.corner_count() as u64, level),
+        &format!(
+            "render_levels {level} on a mesh of {} faces",
+            m.face_count()
+        ),
+    )?;
     let crease = |name: &str, domain: Domain| -> Vec<f32> {
         match m.attributes.named(name) {
             Some(a) if creases && a.domain == domain => a.data.as_float().into_owned(),

@@ -1,0 +1,56 @@
+//! Element-count limits for nodes that size a mesh from an input number (Grid's
+//! vertices, Subdivide Mesh's level, ...): the count is computed with checked arithmetic
+//! and compared with the limit before anything is allocated, so `--set` with a huge
+//! value is an error naming the node and the input, not an out-of-memory abort.
+//! docs/limits.md lists the limits.
+
+/// Most elements a node may make in one domain (vertices, edges, faces or corners):
+/// 2^26, about 67 million, a few GB of mesh. Blender itself stops at 2^31 - 1.
+pub const MAX_ELEMENTS: u64 = 1 << 26;
+
+/// `Ok` when `count` (None: it overflowed) is within MAX_ELEMENTS; the error names the
+/// input(s) the count came from, for the caller to prefix with the node.
+pub fn check(count: Option<u64>, input: &str) -> Result<(), String> {
+    match count {
+        Some(n) if n <= MAX_ELEMENTS => Ok(()),
+        Some(n) => Err(format!(
+            "{input} would make {n} elements, more than the limit of {MAX_ELEMENTS}"
+        )),
+        None => Err(format!(
+            "{input} would make more elements than can be counted (limit {MAX_ELEMENTS})"
+        )),
+    }
+}
+
+/// Product of input numbers, None on overflow.
+pub fn product(factors: &[u64]) -> Option<u64> {
+    factors.iter().try_fold(1u64, |acc, &f| acc.checked_mul(f))
+}
+
+/// Faces (and corners / 4) after `level` rounds of subdividing a mesh with `corners`
+/// face corners: the first round makes one quad per corner, each later round four per
+/// quad. The largest domain of the result is its corners, four per quad.
+pub fn subdivided_corners(corners: u64, level: u32) -> Option<u64> {
+    if level == 0 {
+        return Some(corners);
+    }
+    let quads = corners.checked_mul(4u64.checked_pow(level - 1)?)?;
+    quads.checked_mul(4)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn counts() {
+        assert!(check(product(&[100, 100]), "x").is_ok());
+        assert!(check(product(&[100_000, 100_000]), "x").is_err());
+        assert!(check(product(&[u64::MAX, 2]), "x").is_err());
+        // A cube (24 corners) at level 1: 24 quads, 96 corners.
+        assert_eq!(subdivided_corners(24, 1), Some(96));
+        assert_eq!(subdivided_corners(24, 2), Some(384));
+        assert!(check(subdivided_corners(24, 11), "Level").is_err());
+        assert_eq!(subdivided_corners(u64::MAX, 3), None);
+    }
+}
