@@ -183,8 +183,11 @@ fn generate_options(
     let cores = std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1);
-    if frames == 0 {
-        anyhow::bail!("--frames must be at least 1");
+    blendsynth::dataset::generate::check_frames(frames).map_err(|e| anyhow::anyhow!("--{e}"))?;
+    // Each job is a thread rendering a frame; more than this is a typo, not a machine.
+    const MAX_JOBS: usize = 1024;
+    if let Some(j) = run.jobs.filter(|j| !(1..=MAX_JOBS).contains(j)) {
+        anyhow::bail!("--jobs {j}: must be within [1, {MAX_JOBS}]");
     }
     Ok(blendsynth::dataset::GenerateOptions {
         frames,
@@ -198,7 +201,7 @@ fn generate_options(
             .map_err(anyhow::Error::msg)?
             .unwrap_or((0, 1)),
         resume: run.resume,
-        jobs: run.jobs.unwrap_or(cores).max(1),
+        jobs: run.jobs.unwrap_or(cores),
         threads_per_frame: 1,
         progress: true,
         after_write: None,
