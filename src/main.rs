@@ -42,6 +42,10 @@ enum Command {
         /// Do not write evaluated reference meshes.
         #[arg(long)]
         no_evaluated: bool,
+        /// Also copy image files from this folder (repeatable). By default only files
+        /// under the .blend's own folder are copied; others are an error.
+        #[arg(long = "allow-path", value_name = "DIR")]
+        allow_path: Vec<PathBuf>,
     },
     /// Evaluate an object's material over its UV map as Cycles' EMIT bake does (surface
     /// emission at each texel), writing a float EXR.
@@ -454,13 +458,23 @@ fn run(cli: Cli) -> Result<Outcome> {
             blender,
             frame,
             no_evaluated,
+            allow_path,
         } => {
             let opts = blender::ConvertOptions {
                 blender,
                 frame,
                 no_evaluated,
+                allow_paths: allow_path,
             };
-            let scene = blender::convert(&input, &output, &opts)?;
+            let (scene, copied) = blender::convert_listing(&input, &output, &opts)?;
+            for c in &copied {
+                println!(
+                    "copied {} -> {} (image {:?})",
+                    c.from.display(),
+                    output.join(&c.to).display(),
+                    c.image
+                );
+            }
             let f = &scene.file;
             println!(
                 "converted {} -> {}: {} objects, {} meshes, {} materials, {} node groups, {} animated ID(s) (Blender {})",
