@@ -108,22 +108,28 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
 /// The kernel releases it when the process exits however it ends, so a lock left by a
 /// killed run is never stale, and no lock file is added to the dataset.
 #[derive(Debug)]
-pub struct FolderLock(#[allow(dead_code)] std::fs::File);
+pub struct FolderLock(#[allow(dead_code)] Option<std::fs::File>);
 
 /// Locks the folder `dir` (which must exist); a second writer gets an error at once.
+#[cfg(unix)]
 pub fn lock(dir: &Path) -> Result<FolderLock, String> {
+    use rustix::fs::{flock, FlockOperation};
     let f = std::fs::File::open(dir)
         .map_err(|e| format!("{}: cannot open to lock: {e}", dir.display()))?;
-    match f.try_lock() {
-        Ok(()) => Ok(FolderLock(f)),
-        Err(std::fs::TryLockError::WouldBlock) => Err(format!(
+    match flock(&f, FlockOperation::NonBlockingLockExclusive) {
+        Ok(()) => Ok(FolderLock(Some(f))),
+        Err(rustix::io::Errno::WOULDBLOCK) => Err(format!(
             "{} is in use by another blendsynth process (generate or merge); wait for it to finish, or stop it and rerun with --resume",
             dir.display()
         )),
-        Err(std::fs::TryLockError::Error(e)) => {
-            Err(format!("{}: cannot lock: {e}", dir.display()))
-        }
+        Err(e) => Err(format!("{}: cannot lock: {e}", dir.display())),
     }
+}
+
+/// Without flock (not unix) folders are not locked.
+#[cfg(not(unix))]
+pub fn lock(_dir: &Path) -> Result<FolderLock, String> {
+    Ok(FolderLock(None))
 }
 
 /// Deletes `.partial` leftovers of a killed run.
