@@ -34,6 +34,10 @@ MAX_DEPTH = 5            # nesting limit for non-ID structs (FORMAT.md "Generic 
 MAX_ARRAY = 1 << 16      # longer RNA arrays (preview pixels and the like) are not scene data
 
 WARNINGS = []
+# Folders the .blend's external files may come from (its own folder, then every
+# --allow-path), as real paths; and the files copied into the export.
+ALLOWED_ROOTS = []
+COPIED = []
 
 
 def fail(msg):
@@ -757,12 +761,23 @@ def image_entry(im, out_dir, used_names):
             f.write(im.packed_file.data)
     else:
         src = bpy.path.abspath(im.filepath, library=im.library)
+        # isfile follows symlinks and is false for folders, FIFOs and devices: those are
+        # missing files (magenta, as in Cycles), never read.
         if not (src and os.path.isfile(src)):
             d["missing"] = True
             WARNINGS.append(f"images[{q(im.name)}]: file {im.filepath!r} not found and not packed")
             return d
+        # The path policy: a .blend may name any file on the machine (an absolute path,
+        # //../../..), and the export is meant to be shared, so only files under the
+        # .blend's folder (or a folder the user allowed) are copied. Symlinks resolved.
+        real = os.path.realpath(src)
+        if not any(os.path.commonpath([real, root]) == root for root in ALLOWED_ROOTS):
+            fail(f"images[{q(im.name)}]: file {im.filepath!r} resolves to {real}, outside the .blend's folder "
+                 f"{ALLOWED_ROOTS[0]}; if you trust this file, allow its folder with --allow-path "
+                 f"{os.path.dirname(real)} (or pack the image into the .blend)")
         os.makedirs(os.path.dirname(target), exist_ok=True)
-        shutil.copyfile(src, target)
+        shutil.copyfile(real, target)
+        COPIED.append({"image": im.name, "from": real, "to": f"images/{name}"})
     used_names.add(name)
     d["file"] = f"images/{name}"
     return d
@@ -861,6 +876,9 @@ def main():
     ap.add_argument("--out", required=True, help="output folder")
     ap.add_argument("--frame", type=int, help="frame to evaluate at (default: the file's current frame)")
     ap.add_argument("--no-evaluated", action="store_true", help="skip the evaluated reference meshes")
+    ap.add_argument("--allow-path", action="append", default=[], metavar="DIR",
+                    help="a folder outside the .blend's own whose files (images) may be copied into the export")
+    ap.add_argument("--copied-list", help="write the list of files copied into the export to this JSON file")
     args = ap.parse_args(argv)
     # Older Blenders keep nodes that 4.x's versioning rewrites on load (3.x's Musgrave
     # Texture becomes a Noise Texture plus Math nodes in 4.1), and their sockets differ.
@@ -874,6 +892,12 @@ def main():
         args.input = bpy.data.filepath
     else:
         open_blend(args.input)
+
+    ALLOWED_ROOTS.append(os.path.dirname(os.path.realpath(args.input)))
+    for a in args.allow_path:
+        if not os.path.isdir(a):
+            fail(f"--allow-path {a}: not a folder")
+        ALLOWED_ROOTS.append(os.path.realpath(a))
 
     out = args.out
     try:
@@ -989,6 +1013,9 @@ def main():
     with open(tmp, "w", encoding="utf-8") as f:
         json.dump(doc, f, indent=1, allow_nan=False)
     os.replace(tmp, os.path.join(out, "scene.json"))  # readers never see a half-written file
+    if args.copied_list:
+        with open(args.copied_list, "w", encoding="utf-8") as f:
+            json.dump(COPIED, f)
     print(f"blendsynth-export: {os.path.basename(args.input)} -> {out}: {len(doc['objects'])} objects, "
           f"{len(meshes)} meshes, {len(doc['materials'])} materials, {len(doc['node_groups'])} node groups, "
           f"{len(doc['animation'])} animated IDs, {len(evaluated)} evaluated, {len(doc['warnings'])} warnings "

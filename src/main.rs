@@ -47,6 +47,10 @@ enum Command {
         /// Do not write evaluated reference meshes.
         #[arg(long)]
         no_evaluated: bool,
+        /// Also copy image files from this folder (repeatable). By default only files
+        /// under the .blend's own folder are copied; others are an error.
+        #[arg(long = "allow-path", value_name = "DIR")]
+        allow_path: Vec<PathBuf>,
     },
     /// Evaluate an object's material over its UV map as Cycles' EMIT bake does (surface
     /// emission at each texel), writing a float EXR.
@@ -200,8 +204,11 @@ fn generate_options(
     let cores = std::thread::available_parallelism()
         .map(|n| n.get())
         .unwrap_or(1);
-    if frames == 0 {
-        anyhow::bail!("--frames must be at least 1");
+    blendsynth::dataset::generate::check_frames(frames).map_err(|e| anyhow::anyhow!("--{e}"))?;
+    // Each job is a thread rendering a frame; more than this is a typo, not a machine.
+    const MAX_JOBS: usize = 1024;
+    if let Some(j) = run.jobs.filter(|j| !(1..=MAX_JOBS).contains(j)) {
+        anyhow::bail!("--jobs {j}: must be within [1, {MAX_JOBS}]");
     }
     Ok(blendsynth::dataset::GenerateOptions {
         frames,
@@ -215,7 +222,7 @@ fn generate_options(
             .map_err(anyhow::Error::msg)?
             .unwrap_or((0, 1)),
         resume: run.resume,
-        jobs: run.jobs.unwrap_or(cores).max(1),
+        jobs: run.jobs.unwrap_or(cores),
         threads_per_frame: 1,
         progress: true,
         after_write: None,
@@ -492,13 +499,23 @@ fn run(cli: Cli) -> Result<Outcome> {
             blender,
             frame,
             no_evaluated,
+            allow_path,
         } => {
             let opts = blender::ConvertOptions {
                 blender,
                 frame,
                 no_evaluated,
+                allow_paths: allow_path,
             };
-            let scene = blender::convert(&input, &output, &opts)?;
+            let (scene, copied) = blender::convert_listing(&input, &output, &opts)?;
+            for c in &copied {
+                println!(
+                    "copied {} -> {} (image {:?})",
+                    c.from.display(),
+                    output.join(&c.to).display(),
+                    c.image
+                );
+            }
             let f = &scene.file;
             println!(
                 "converted {} -> {}: {} objects, {} meshes, {} materials, {} node groups, {} animated ID(s) (Blender {})",

@@ -3,7 +3,9 @@
 //! Blender is only a converter here: it reads the .blend and writes the exchange
 //! format; blendsynth never needs it to render. A .blend can carry Python, so Blender
 //! always runs with auto-run scripts disabled, and the exporter opens the file itself
-//! with `use_scripts=False`.
+//! with `use_scripts=False`. A .blend can also name any file on the machine as an
+//! image: the exporter copies only regular files under the .blend's folder or a folder
+//! the user allowed (`allow_paths`), and lists every file it copies.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -115,13 +117,47 @@ pub struct ConvertOptions {
     pub frame: Option<i32>,
     /// Skip writing evaluated reference meshes.
     pub no_evaluated: bool,
+    /// Folders outside the .blend's own whose files (images) may be copied into the
+    /// export (`--allow-path`). Files elsewhere are an error: a .blend can name any
+    /// file on the machine, and an export is meant to be shared.
+    pub allow_paths: Vec<PathBuf>,
+}
+
+/// A file `convert` copied into the export.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Deserialize)]
+pub struct CopiedFile {
+    /// The image (Blender name) that named it.
+    pub image: String,
+    /// Where it was read (symlinks resolved).
+    pub from: PathBuf,
+    /// Where it went, relative to the export folder.
+    pub to: String,
 }
 
 /// Exports `input` into `out` with Blender, then loads and validates the result
 /// (scene.json and every mesh). The export is written to a staging folder and moved
 /// into place only when it is complete and valid, so `out` is never half-written.
 pub fn convert(input: &Path, out: &Path, opts: &ConvertOptions) -> Result<Scene> {
+    Ok(convert_listing(input, out, opts)?.0)
+}
+
+/// `convert`, also returning every file it copied into the export.
+pub fn convert_listing(
+    input: &Path,
+    out: &Path,
+    opts: &ConvertOptions,
+) -> Result<(Scene, Vec<CopiedFile>)> {
     check_blend_file(input)?;
+    let allowed = opts
+        .allow_paths
+        .iter()
+        .map(|p| {
+            std::fs::canonicalize(p)
+                .ok()
+                .filter(|c| c.is_dir())
+                .ok_or_else(|| anyhow!("--allow-path {}: not a folder", p.display()))
+        })
+        .collect::<Result<Vec<_>>>()?;
     check_output_dir(out)?;
 
     let parent = out
@@ -166,6 +202,13 @@ pub fn convert(input: &Path, out: &Path, opts: &ConvertOptions) -> Result<Scene>
     if opts.no_evaluated {
         args.push("--no-evaluated".as_ref());
     }
+    for a in &allowed {
+        args.push("--allow-path".as_ref());
+        args.push(a.as_os_str());
+    }
+    let copied_list = script_dir.path().join("copied.json");
+    args.push("--copied-list".as_ref());
+    args.push(copied_list.as_os_str());
     let output = runner
         .command(&script, &args)
         .stdin(Stdio::null())
@@ -183,6 +226,11 @@ pub fn convert(input: &Path, out: &Path, opts: &ConvertOptions) -> Result<Scene>
         );
     }
 
+    let copied: Vec<CopiedFile> = std::fs::read(&copied_list)
+        .ok()
+        .and_then(|b| serde_json::from_slice(&b).ok())
+        .ok_or_else(|| anyhow!("the exporter did not list the files it copied"))?;
+
     // Validate everything before the export replaces anything.
     let staged = Scene::load(staging.path()).context("the exporter wrote an invalid scene")?;
     for i in 0..staged.file.meshes.len() {
@@ -198,7 +246,7 @@ pub fn convert(input: &Path, out: &Path, opts: &ConvertOptions) -> Result<Scene>
     }
     std::fs::rename(&staging_path, out)
         .with_context(|| format!("cannot move the export into {}", out.display()))?;
-    Ok(Scene::load(out)?)
+    Ok((Scene::load(out)?, copied))
 }
 
 /// The input must exist and look like a .blend (plain, gzip or zstd compressed).

@@ -47,6 +47,34 @@ pub fn finalize(
     )
 }
 
+/// A shard's record of frame `i`, checked before any of its fields becomes a path: it
+/// is frame `i`, its split is one of the dataset's, and its image is where the layout
+/// puts it.
+fn checked_record(dir: &Path, i: u64, splits: &[String]) -> Result<FrameRecord, String> {
+    let rec = read_record(dir, i)?;
+    let p = layout::record_path(dir, i);
+    if rec.index != i {
+        return Err(format!("{}: index is {}, not {i}", p.display(), rec.index));
+    }
+    if !splits.contains(&rec.split) {
+        return Err(format!(
+            "{}: split {:?} is not one of the dataset's ({})",
+            p.display(),
+            rec.split,
+            splits.join(", ")
+        ));
+    }
+    if rec.image != layout::image_rel(&rec.split, i) {
+        return Err(format!(
+            "{}: image {:?} is not {:?}",
+            p.display(),
+            rec.image,
+            layout::image_rel(&rec.split, i)
+        ));
+    }
+    Ok(rec)
+}
+
 fn read_manifest(dir: &Path) -> Result<Value, String> {
     let p = dir.join("manifest.json");
     let b = std::fs::read(&p)
@@ -84,28 +112,38 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<u64, String> {
             out.display()
         ));
     }
+    let man_path = shards[0].join("manifest.json");
     let frames = manifest["frames"]
         .as_u64()
-        .ok_or("manifest has no frame count")?;
+        .ok_or_else(|| format!("{}: no frame count", man_path.display()))?;
+    super::generate::check_frames(frames).map_err(|e| format!("{}: {e}", man_path.display()))?;
     let splits: Vec<String> = manifest["split"]
         .as_array()
-        .ok_or("manifest has no split")?
+        .ok_or_else(|| format!("{}: no split", man_path.display()))?
         .iter()
-        .filter_map(|s| s[0].as_str().map(String::from))
-        .collect();
+        .map(|s| {
+            let name = s[0]
+                .as_str()
+                .ok_or_else(|| format!("{}: split {s} has no name", man_path.display()))?;
+            layout::check_split_name(name).map_err(|e| format!("{}: {e}", man_path.display()))?;
+            Ok(name.to_string())
+        })
+        .collect::<Result<_, String>>()?;
     let classes: Vec<String> = manifest["classes"]
         .as_array()
         .ok_or("manifest has no classes")?
         .iter()
         .filter_map(|s| s.as_str().map(String::from))
         .collect();
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: cannot create: {e}", out.display()))?;
+    let _lock = layout::lock(out)?;
     let mut missing = Vec::new();
     for i in 0..frames {
         let Some(src) = shards.iter().find(|s| layout::record_path(s, i).exists()) else {
             missing.push(i);
             continue;
         };
-        let rec = read_record(src, i)?;
+        let rec = checked_record(src, i, &splits)?;
         let files = [
             (
                 layout::image_path(src, &rec.split, i),

@@ -6,7 +6,7 @@
 //! shard, on another thread count or after a resume is the same bytes.
 
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;
 
@@ -67,15 +67,7 @@ pub fn parse_split(s: &str) -> Result<Vec<(String, f64)>, String> {
             .split_once('=')
             .ok_or_else(|| format!("split {part:?} is not NAME=FRACTION"))?;
         let name = name.trim();
-        if name.is_empty()
-            || !name
-                .chars()
-                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
-        {
-            return Err(format!(
-                "split name {name:?} must be letters, digits, '_' or '-'"
-            ));
-        }
+        layout::check_split_name(name)?;
         let f: f64 = frac
             .trim()
             .parse()
@@ -110,37 +102,109 @@ pub fn parse_shard(s: &str) -> Result<(u64, u64), String> {
     Ok((i, n))
 }
 
-/// The split of every frame: exact counts (largest remainder), frames ordered by a
-/// seed-keyed hash so each split is a random subset, identical on every shard.
+/// The most frames a dataset can have: frame files are named by a 9-digit index, and
+/// the dataset-wide files (COCO, frames.jsonl) hold every frame's record.
+pub const MAX_FRAMES: u64 = 1_000_000_000;
+
+/// Checks a dataset's frame count (`--frames`, a manifest's `frames`).
+pub fn check_frames(frames: u64) -> Result<(), String> {
+    if frames == 0 || frames > MAX_FRAMES {
+        return Err(format!(
+            "frames: {frames} is not within [1, {MAX_FRAMES}] (frame files are named by a 9-digit index)"
+        ));
+    }
+    Ok(())
+}
+
+/// The split of every frame, without a table of frames: exact counts per split (largest
+/// remainder); frames ordered by a seed-keyed hash so each split is a random subset,
+/// identical on every shard. Split `k` holds the frames whose hash ranks in
+/// [cut k-1, cut k); the hash is a bijection of the index (a chain of bijective mixes),
+/// so ranks have no ties and each cut is one hash value, found by radix selection in
+/// constant memory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SplitPlan {
+    seed: u64,
+    /// The hash at each split boundary (None: past the last frame).
+    cuts: Vec<Option<u64>>,
+}
+
+fn split_hash(seed: u64, i: u64) -> u64 {
+    rng::bits(seed, i, rng::key("#split"), 0)
+}
+
+/// The value of rank `rank` (0-based) among `split_hash(seed, i)` for i in 0..frames:
+/// four passes, each fixing 16 more bits of the answer.
+fn select_hash(frames: u64, seed: u64, mut rank: u64) -> u64 {
+    let mut prefix = 0u64;
+    let mut hist = vec![0u64; 1 << 16];
+    for level in 0..4 {
+        let shift = 48 - 16 * level;
+        let high = if level == 0 { 0 } else { !0u64 << (shift + 16) };
+        hist.iter_mut().for_each(|h| *h = 0);
+        for i in 0..frames {
+            let x = split_hash(seed, i);
+            if x & high == prefix {
+                hist[((x >> shift) & 0xffff) as usize] += 1;
+            }
+        }
+        let mut digit = 0;
+        for (d, &c) in hist.iter().enumerate() {
+            if rank < c {
+                digit = d as u64;
+                break;
+            }
+            rank -= c;
+        }
+        prefix |= digit << shift;
+    }
+    prefix
+}
+
+impl SplitPlan {
+    pub fn new(frames: u64, seed: u64, split: &[(String, f64)]) -> SplitPlan {
+        let n = frames as f64;
+        let mut counts: Vec<u64> = split.iter().map(|(_, f)| (f * n).floor() as u64).collect();
+        let mut rest: Vec<usize> = (0..split.len()).collect();
+        rest.sort_by(|&a, &b| {
+            let ra = split[a].1 * n - counts[a] as f64;
+            let rb = split[b].1 * n - counts[b] as f64;
+            rb.total_cmp(&ra).then(a.cmp(&b))
+        });
+        let mut left = frames.saturating_sub(counts.iter().sum::<u64>());
+        for &k in rest.iter().cycle() {
+            if left == 0 {
+                break;
+            }
+            counts[k] += 1;
+            left -= 1;
+        }
+        let mut pos = 0u64;
+        let cuts = counts[..counts.len().saturating_sub(1)]
+            .iter()
+            .map(|c| {
+                pos += c;
+                (pos < frames).then(|| select_hash(frames, seed, pos))
+            })
+            .collect();
+        SplitPlan { seed, cuts }
+    }
+
+    /// The split (index into the split list) of frame `i`.
+    pub fn split_of(&self, i: u64) -> u16 {
+        let h = split_hash(self.seed, i);
+        self.cuts
+            .iter()
+            .filter(|c| c.is_some_and(|c| h >= c))
+            .count() as u16
+    }
+}
+
+/// The split of every frame as a table (for tests and small datasets; `generate` asks a
+/// `SplitPlan` frame by frame).
 pub fn assign_splits(frames: u64, seed: u64, split: &[(String, f64)]) -> Vec<u16> {
-    let n = frames as f64;
-    let mut counts: Vec<u64> = split.iter().map(|(_, f)| (f * n).floor() as u64).collect();
-    let mut rest: Vec<usize> = (0..split.len()).collect();
-    rest.sort_by(|&a, &b| {
-        let ra = split[a].1 * n - counts[a] as f64;
-        let rb = split[b].1 * n - counts[b] as f64;
-        rb.partial_cmp(&ra).unwrap().then(a.cmp(&b))
-    });
-    let mut left = frames - counts.iter().sum::<u64>();
-    for &k in rest.iter().cycle() {
-        if left == 0 {
-            break;
-        }
-        counts[k] += 1;
-        left -= 1;
-    }
-    let key = rng::key("#split");
-    let mut order: Vec<u64> = (0..frames).collect();
-    order.sort_by_key(|&i| (rng::bits(seed, i, key, 0), i));
-    let mut out = vec![0u16; frames as usize];
-    let mut pos = 0usize;
-    for (k, c) in counts.iter().enumerate() {
-        for &i in &order[pos..pos + *c as usize] {
-            out[i as usize] = k as u16;
-        }
-        pos += *c as usize;
-    }
-    out
+    let plan = SplitPlan::new(frames, seed, split);
+    (0..frames).map(|i| plan.split_of(i)).collect()
 }
 
 /// The manifest: everything that determines the frames. Resume and merge require equal
@@ -170,8 +234,29 @@ pub struct Summary {
     pub complete: bool,
 }
 
+/// The frame indices of shard `(index, count)` of a dataset of `frames` frames, lazily.
+pub fn shard_frames(frames: u64, shard: (u64, u64)) -> impl Iterator<Item = u64> + Clone {
+    (shard.0..frames).step_by(shard.1.clamp(1, usize::MAX as u64) as usize)
+}
+
+/// The dataset folder is empty apart from `.partial` leftovers of a run killed before
+/// its manifest was in place (a run killed while writing the manifest).
+fn only_partials(out: &Path) -> bool {
+    let Ok(entries) = std::fs::read_dir(out) else {
+        return false;
+    };
+    entries.into_iter().all(|e| {
+        e.is_ok_and(|e| {
+            e.file_type().is_ok_and(|t| t.is_file())
+                && e.file_name().to_string_lossy().ends_with(".partial")
+        })
+    })
+}
+
 /// Renders the frames of this shard that are not finished, then writes the COCO, YOLO
-/// and JSONL files over the finished frames.
+/// and JSONL files over the finished frames. Holds an exclusive lock on `out` while
+/// it runs (see `layout::lock`), so a second writer is refused instead of deleting
+/// this run's in-flight files.
 pub fn generate(
     scene: &Scene,
     spec: &Spec,
@@ -180,12 +265,31 @@ pub fn generate(
     opts: &GenerateOptions,
 ) -> Result<Summary, String> {
     let start = Instant::now();
+    check_frames(opts.frames)?;
+    if opts.shard.1 == 0 || opts.shard.0 >= opts.shard.1 {
+        return Err(format!(
+            "shard {}/{}: need 0 <= I < N",
+            opts.shard.0, opts.shard.1
+        ));
+    }
     for w in spec.validate(scene).map_err(|e| e.to_string())? {
         eprintln!("warning: {w}");
     }
+    spec.frames
+        .check(scene.file.scene.frame_current as i64, opts.frames)
+        .map_err(|e| e.to_string())?;
     let classes = ClassMap::new(&spec.labels, scene);
+    if classes.names.len() > layout::MAX_CLASSES {
+        return Err(format!(
+            "spec: labels: {} classes; masks hold at most {}",
+            classes.names.len(),
+            layout::MAX_CLASSES
+        ));
+    }
     let man = manifest(scene, spec, opts, &classes);
     let man_path = out.join("manifest.json");
+    std::fs::create_dir_all(out).map_err(|e| format!("{}: cannot create: {e}", out.display()))?;
+    let _lock = layout::lock(out)?;
     if man_path.exists() {
         let old: Value = serde_json::from_slice(
             &std::fs::read(&man_path).map_err(|e| format!("{}: {e}", man_path.display()))?,
@@ -202,31 +306,22 @@ pub fn generate(
         }
         layout::remove_partials(out).map_err(|e| format!("{}: {e}", out.display()))?;
     } else {
-        if out.exists()
-            && std::fs::read_dir(out)
-                .map(|mut d| d.next().is_some())
-                .unwrap_or(false)
-        {
+        if !only_partials(out) {
             return Err(format!(
                 "{} exists and is not a blendsynth dataset; choose an empty or new folder",
                 out.display()
             ));
         }
+        layout::remove_partials(out).map_err(|e| format!("{}: {e}", out.display()))?;
         write_atomic(
             &man_path,
             format!("{}\n", serde_json::to_string_pretty(&man).unwrap()).as_bytes(),
-        )?;
+        )
+        .map_err(|e| format!("{e} (nothing rendered yet; rerun with --resume)"))?;
     }
-    let splits = assign_splits(opts.frames, opts.seed, &opts.split);
-    let mine: Vec<u64> = (0..opts.frames)
-        .filter(|i| i % opts.shard.1 == opts.shard.0)
-        .collect();
-    let todo: Vec<u64> = mine
-        .iter()
-        .copied()
-        .filter(|&i| !layout::record_path(out, i).exists())
-        .collect();
-    let skipped = (mine.len() - todo.len()) as u64;
+    let splits = SplitPlan::new(opts.frames, opts.seed, &opts.split);
+    let mine = shard_frames(opts.frames, opts.shard);
+    let mine_count = mine.clone().count() as u64;
 
     let scene_json = serde_json::to_value(&scene.file).map_err(|e| e.to_string())?;
     let ctx = FrameContext {
@@ -242,7 +337,7 @@ pub fn generate(
     };
 
     let bar = if opts.progress {
-        let b = indicatif::ProgressBar::new(todo.len() as u64);
+        let b = indicatif::ProgressBar::new(mine_count);
         b.set_style(
             indicatif::ProgressStyle::with_template(
                 "{spinner} frames {pos}/{len} [{elapsed_precise} < {eta_precise}] {per_sec} {msg}",
@@ -253,19 +348,36 @@ pub fn generate(
     } else {
         indicatif::ProgressBar::hidden()
     };
-    let next = AtomicUsize::new(0);
+    // Workers take this shard's frames in order from a shared iterator and skip the
+    // finished ones, so no list of frames is built.
+    let queue = Mutex::new(mine.clone());
+    let rendered = AtomicU64::new(0);
+    let skipped = AtomicU64::new(0);
     let stop = AtomicBool::new(false);
     let first_error: Mutex<Option<(u64, String)>> = Mutex::new(None);
+    let workers = (opts.jobs.max(1) as u64).min(mine_count.max(1)) as usize;
+    let mut spawned = 0;
+    let mut spawn_error = None;
     std::thread::scope(|s| {
-        for _ in 0..opts.jobs.max(1).min(todo.len().max(1)) {
-            s.spawn(|| loop {
+        for _ in 0..workers {
+            // A thread the system refuses ends the spawning (fewer workers), not a panic.
+            let worker = std::thread::Builder::new().spawn_scoped(s, || loop {
                 if stop.load(Ordering::Relaxed) {
                     return;
                 }
-                let k = next.fetch_add(1, Ordering::Relaxed);
-                let Some(&i) = todo.get(k) else { return };
+                let Some(i) = queue.lock().unwrap().next() else {
+                    return;
+                };
+                if layout::record_path(out, i).exists() {
+                    skipped.fetch_add(1, Ordering::Relaxed);
+                    bar.inc(1);
+                    continue;
+                }
                 match ctx.frame(i) {
-                    Ok(()) => bar.inc(1),
+                    Ok(()) => {
+                        rendered.fetch_add(1, Ordering::Relaxed);
+                        bar.inc(1)
+                    }
                     Err(e) => {
                         stop.store(true, Ordering::Relaxed);
                         let mut g = first_error.lock().unwrap();
@@ -276,19 +388,34 @@ pub fn generate(
                     }
                 }
             });
+            match worker {
+                Ok(_) => spawned += 1,
+                Err(e) => {
+                    spawn_error = Some(e);
+                    break;
+                }
+            }
         }
     });
     bar.finish_and_clear();
+    if spawned == 0 {
+        if let Some(e) = spawn_error {
+            return Err(format!("cannot start a worker thread: {e}"));
+        }
+    }
     if let Some((i, e)) = first_error.into_inner().unwrap() {
         return Err(format!(
             "frame {i}: {e} (finished frames are kept; rerun with --resume)"
         ));
     }
     let names: Vec<String> = opts.split.iter().map(|(n, _)| n.clone()).collect();
-    finalize::finalize(out, &mine, &names, &classes.names)?;
+    let indices: Vec<u64> = mine.collect();
+    finalize::finalize(out, &indices, &names, &classes.names).map_err(|e| {
+        format!("writing the dataset files: {e} (every frame is finished and kept; rerun with --resume)")
+    })?;
     Ok(Summary {
-        rendered: todo.len() as u64,
-        skipped,
+        rendered: rendered.into_inner(),
+        skipped: skipped.into_inner(),
         seconds: start.elapsed().as_secs_f64(),
         out: out.to_path_buf(),
         complete: true,
@@ -303,7 +430,7 @@ struct FrameContext<'a> {
     classes: &'a ClassMap,
     out: &'a Path,
     opts: &'a GenerateOptions,
-    splits: &'a [u16],
+    splits: &'a SplitPlan,
     /// Mesh bounds in object space, by object name (meshes do not change per frame).
     bounds: Mutex<std::collections::HashMap<String, Option<Bounds>>>,
 }
@@ -325,7 +452,7 @@ impl FrameContext<'_> {
 
     fn frame(&self, i: u64) -> Result<(), String> {
         let opts = self.opts;
-        let split = &opts.split[self.splits[i as usize] as usize].0;
+        let split = &opts.split[self.splits.split_of(i) as usize].0;
         let fv = self
             .spec
             .frame_values(
@@ -380,7 +507,12 @@ impl FrameContext<'_> {
         let mask = layout::mask_path(self.out, split, i);
         write_atomic(
             &mask,
-            &layout::png_bytes(r.width, r.height, 1, &semantic(&r.ids, &labels))?,
+            &layout::mask_png_bytes(
+                r.width,
+                r.height,
+                self.classes.names.len(),
+                &semantic(&r.ids, &labels),
+            )?,
         )?;
         hook(&mask)?;
         let labels_spec = &self.spec.labels;
@@ -414,7 +546,7 @@ impl FrameContext<'_> {
         let record = FrameRecord {
             index: i,
             split: split.clone(),
-            image: format!("images/{split}/{}.png", layout::frame_name(i)),
+            image: layout::image_rel(split, i),
             width: r.width,
             height: r.height,
             frame: fv.frame,

@@ -3,7 +3,8 @@
 //! ```text
 //! OUT/manifest.json                     what made it (spec, seed, frames, split, shard)
 //! OUT/images/SPLIT/NNNNNNNNN.png        8-bit RGB image
-//! OUT/masks/SPLIT/NNNNNNNNN.png         semantic mask (0 background, else class id)
+//! OUT/masks/SPLIT/NNNNNNNNN.png         semantic mask (0 background, else class id;
+//!                                       8-bit up to 254 classes, else 16-bit)
 //! OUT/labels/SPLIT/NNNNNNNNN.txt        YOLO boxes
 //! OUT/depth/SPLIT/NNNNNNNNN.png         optional: depth in mm, 16-bit (0: none/far)
 //! OUT/normals/SPLIT/NNNNNNNNN.exr       optional: world-space normals, float RGB
@@ -15,9 +16,32 @@
 //! ```
 //! Every file is written to `.NAME.partial` beside it and renamed into place, so a
 //! killed run leaves whole files or `.partial` leftovers that a resumed run deletes.
+//! A writer holds an exclusive flock on OUT itself (no lock file), so two writers
+//! never share a folder.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+
+/// A split name becomes a folder name: letters, digits, '_' and '-' only, so a name
+/// read from a manifest or a frame record can never lead outside the dataset.
+pub fn check_split_name(name: &str) -> Result<(), String> {
+    if name.is_empty()
+        || name.len() > 64
+        || !name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+    {
+        return Err(format!(
+            "split name {name:?} must be 1 to 64 letters, digits, '_' or '-'"
+        ));
+    }
+    Ok(())
+}
+
+/// The image path a frame record must name (relative to the dataset folder).
+pub fn image_rel(split: &str, index: u64) -> String {
+    format!("images/{split}/{}.png", frame_name(index))
+}
 
 pub fn frame_name(index: u64) -> String {
     format!("{index:09}")
@@ -52,22 +76,60 @@ pub fn record_path(out: &Path, index: u64) -> PathBuf {
         .join(format!("{}.json", frame_name(index)))
 }
 
-/// Writes `bytes` to `path` atomically (temp file beside it, fsync, rename).
+/// Writes `bytes` to `path` atomically (temp file beside it, fsync, rename). A failed
+/// write (a full disk) removes its temp file, so it leaves nothing half-written.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
     let dir = path
         .parent()
         .ok_or_else(|| format!("{}: no parent folder", path.display()))?;
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
-    let name = path.file_name().unwrap().to_string_lossy();
+    let name = path
+        .file_name()
+        .ok_or_else(|| format!("{}: no file name", path.display()))?
+        .to_string_lossy();
     let tmp = dir.join(format!(".{name}.partial"));
-    let mut f =
-        std::fs::File::create(&tmp).map_err(|e| format!("{}: cannot write: {e}", tmp.display()))?;
-    f.write_all(bytes)
-        .and_then(|_| f.sync_all())
-        .map_err(|e| format!("{}: cannot write: {e}", tmp.display()))?;
-    drop(f);
-    std::fs::rename(&tmp, path)
-        .map_err(|e| format!("{}: cannot rename into place: {e}", path.display()))
+    let written = (|| {
+        let mut f = std::fs::File::create(&tmp)
+            .map_err(|e| format!("{}: cannot write: {e}", tmp.display()))?;
+        f.write_all(bytes)
+            .and_then(|_| f.sync_all())
+            .map_err(|e| format!("{}: cannot write: {e}", tmp.display()))?;
+        drop(f);
+        std::fs::rename(&tmp, path)
+            .map_err(|e| format!("{}: cannot rename into place: {e}", path.display()))
+    })();
+    if written.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    written
+}
+
+/// An exclusive advisory lock (flock) on a dataset folder, held while the value lives.
+/// The kernel releases it when the process exits however it ends, so a lock left by a
+/// killed run is never stale, and no lock file is added to the dataset.
+#[derive(Debug)]
+pub struct FolderLock(#[allow(dead_code)] Option<std::fs::File>);
+
+/// Locks the folder `dir` (which must exist); a second writer gets an error at once.
+#[cfg(unix)]
+pub fn lock(dir: &Path) -> Result<FolderLock, String> {
+    use rustix::fs::{flock, FlockOperation};
+    let f = std::fs::File::open(dir)
+        .map_err(|e| format!("{}: cannot open to lock: {e}", dir.display()))?;
+    match flock(&f, FlockOperation::NonBlockingLockExclusive) {
+        Ok(()) => Ok(FolderLock(Some(f))),
+        Err(rustix::io::Errno::WOULDBLOCK) => Err(format!(
+            "{} is in use by another blendsynth process (generate or merge); wait for it to finish, or stop it and rerun with --resume",
+            dir.display()
+        )),
+        Err(e) => Err(format!("{}: cannot lock: {e}", dir.display())),
+    }
+}
+
+/// Without flock (not unix) folders are not locked.
+#[cfg(not(unix))]
+pub fn lock(_dir: &Path) -> Result<FolderLock, String> {
+    Ok(FolderLock(None))
 }
 
 /// Deletes `.partial` leftovers of a killed run.
@@ -90,6 +152,33 @@ pub fn remove_partials(dir: &Path) -> std::io::Result<usize> {
         }
     }
     Ok(n)
+}
+
+/// The most classes an 8-bit mask holds: values 1..=254, leaving 255 free (the usual
+/// "ignore" label of segmentation tools); with more classes masks are 16-bit.
+pub const MAX_CLASSES_8BIT: usize = 254;
+/// The most classes a 16-bit mask holds (values 1..=65535).
+pub const MAX_CLASSES: usize = 65535;
+
+/// PNG bytes of a semantic mask: 8-bit grey while the dataset has at most
+/// `MAX_CLASSES_8BIT` classes, else 16-bit grey (the same values, never clamped).
+pub fn mask_png_bytes(
+    width: u32,
+    height: u32,
+    classes: usize,
+    mask: &[u16],
+) -> Result<Vec<u8>, String> {
+    if classes > MAX_CLASSES {
+        return Err(format!(
+            "{classes} classes do not fit a 16-bit mask (at most {MAX_CLASSES})"
+        ));
+    }
+    if classes <= MAX_CLASSES_8BIT {
+        let m: Vec<u8> = mask.iter().map(|&v| v as u8).collect();
+        png_bytes(width, height, 1, &m)
+    } else {
+        png16_bytes(width, height, mask)
+    }
 }
 
 /// PNG bytes of an 8-bit image (`channels` 1 = gray, 3 = RGB, 4 = RGBA).

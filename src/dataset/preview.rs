@@ -42,14 +42,54 @@ pub fn contact_sheet(dir: &Path, output: &Path, count: usize) -> Result<usize, S
     let (sw, sh) = (cols * (THUMB + GAP) + GAP, rows * (THUMB + GAP) + GAP);
     let mut sheet = vec![40u8; (sw * sh * 3) as usize];
     for (n, r) in recs.iter().enumerate() {
-        let img_path = dir.join(&r.image);
+        // The record's fields name files: only the layout's own paths are read.
+        layout::check_split_name(&r.split)?;
+        if r.image != layout::image_rel(&r.split, r.index) {
+            return Err(format!(
+                "{}: frame {}: image {:?} is not {:?}",
+                dir.join("frames.jsonl").display(),
+                r.index,
+                r.image,
+                layout::image_rel(&r.split, r.index)
+            ));
+        }
+        let img_path = layout::image_path(dir, &r.split, r.index);
         let img = image::open(&img_path)
             .map_err(|e| format!("{}: {e}", img_path.display()))?
             .to_rgb8();
+        if (img.width(), img.height()) != (r.width, r.height) {
+            return Err(format!(
+                "{}: {}x{}, but the frame is {}x{}",
+                img_path.display(),
+                img.width(),
+                img.height(),
+                r.width,
+                r.height
+            ));
+        }
         let mask_path = layout::mask_path(dir, &r.split, r.index);
-        let mask = image::open(&mask_path)
-            .map_err(|e| format!("{}: {e}", mask_path.display()))?
-            .to_luma8();
+        // Masks are 8-bit, or 16-bit with more than 254 classes: read the values as
+        // they are (a conversion would rescale them).
+        let mask =
+            match image::open(&mask_path).map_err(|e| format!("{}: {e}", mask_path.display()))? {
+                image::DynamicImage::ImageLuma16(m) => m,
+                other => {
+                    let m = other.to_luma8();
+                    image::ImageBuffer::from_fn(m.width(), m.height(), |x, y| {
+                        image::Luma([m.get_pixel(x, y).0[0] as u16])
+                    })
+                }
+            };
+        if (mask.width(), mask.height()) != (r.width, r.height) {
+            return Err(format!(
+                "{}: {}x{}, but the frame is {}x{}",
+                mask_path.display(),
+                mask.width(),
+                mask.height(),
+                r.width,
+                r.height
+            ));
+        }
         let scale = THUMB as f64 / r.width.max(r.height) as f64;
         let (tw, th) = (
             ((r.width as f64) * scale) as u32,

@@ -55,13 +55,42 @@ pub struct FrameSchedule {
     pub modulo: Option<i64>,
 }
 
+/// Blender's frame limits (`MINAFRAME`, `MAXFRAME`): a scene frame outside them is not
+/// one Blender can show.
+pub const MIN_FRAME: i64 = -1_048_574;
+pub const MAX_FRAME: i64 = 1_048_574;
+
 impl FrameSchedule {
+    /// The scene frame of dataset frame `index`. Exact (128-bit); `check` has made sure
+    /// every index of the dataset lands within Blender's frame range.
     pub fn frame(&self, scene_current: i64, index: u64) -> i64 {
         let f = self.start.unwrap_or(scene_current) as i128 + self.step as i128 * index as i128;
         match self.modulo {
             Some(m) => f.rem_euclid(m as i128) as i64,
-            None => f as i64,
+            None => f.clamp(i64::MIN as i128, i64::MAX as i128) as i64,
         }
+    }
+
+    /// Every frame of a dataset of `frames` frames must be a Blender frame: the schedule
+    /// is linear in the index (or wraps into [0, modulo)), so its ends decide.
+    pub fn check(&self, scene_current: i64, frames: u64) -> Result<(), SpecError> {
+        let last = frames.saturating_sub(1);
+        for (at, i) in [("frames.start", 0), ("frames.step", last)] {
+            let f = self.start.unwrap_or(scene_current) as i128 + self.step as i128 * i as i128;
+            let f = match self.modulo {
+                Some(m) => f.rem_euclid(m as i128),
+                None => f,
+            };
+            if !(MIN_FRAME as i128..=MAX_FRAME as i128).contains(&f) {
+                return Err(err(
+                    at,
+                    format!(
+                        "dataset frame {i} would show scene frame {f}, outside Blender's frame range [{MIN_FRAME}, {MAX_FRAME}]"
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 }
 
@@ -267,6 +296,11 @@ impl Spec {
     }
 }
 
+/// Blender's largest render resolution side (`resolution_x`, `resolution_y`).
+pub const MAX_RESOLUTION: i64 = 65536;
+/// Cycles' largest sample count (`cycles.samples`).
+pub const MAX_SAMPLES: i64 = 1 << 24;
+
 fn parse_render(v: &Toml) -> Result<RenderSettings, SpecError> {
     let t = v
         .as_table()
@@ -280,30 +314,41 @@ fn parse_render(v: &Toml) -> Result<RenderSettings, SpecError> {
                     .as_array()
                     .filter(|a| a.len() == 2)
                     .ok_or_else(|| err(&at, "must be [width, height]"))?;
-                let w = a[0]
-                    .as_integer()
-                    .filter(|w| *w > 0)
-                    .ok_or_else(|| err(&at, "width must be a positive integer"))?;
-                let h = a[1]
-                    .as_integer()
-                    .filter(|h| *h > 0)
-                    .ok_or_else(|| err(&at, "height must be a positive integer"))?;
-                r.resolution = Some((w as u32, h as u32));
+                let side = |v: &Toml, what: &str| {
+                    v.as_integer()
+                        .filter(|n| (1..=MAX_RESOLUTION).contains(n))
+                        .map(|n| n as u32)
+                        .ok_or_else(|| {
+                            err(
+                                &at,
+                                format!("{what} must be an integer in [1, {MAX_RESOLUTION}] (Blender's limit), not {v}"),
+                            )
+                        })
+                };
+                r.resolution = Some((side(&a[0], "width")?, side(&a[1], "height")?));
             }
             "samples" => {
                 r.samples = Some(
                     x.as_integer()
-                        .filter(|s| *s > 0)
-                        .ok_or_else(|| err(&at, "must be a positive integer"))?
-                        as u32,
+                        .filter(|s| (1..=MAX_SAMPLES).contains(s))
+                        .ok_or_else(|| {
+                            err(
+                                &at,
+                                format!("must be an integer in [1, {MAX_SAMPLES}] (Cycles' limit), not {x}"),
+                            )
+                        })? as u32,
                 )
             }
             "threshold" => {
                 r.threshold = Some(
                     num(x)
-                        .filter(|t| *t >= 0.0)
-                        .ok_or_else(|| err(&at, "must be a number >= 0"))?
-                        as f32,
+                        .filter(|t| (0.0..=1.0).contains(t))
+                        .ok_or_else(|| {
+                            err(
+                                &at,
+                                format!("must be a number in [0, 1] (Cycles' adaptive threshold range; 0 turns adaptive sampling off), not {x}"),
+                            )
+                        })? as f32,
                 )
             }
             "denoise" => {
@@ -337,23 +382,49 @@ fn parse_frames(v: &Toml) -> Result<FrameSchedule, SpecError> {
         let i = x
             .as_integer()
             .ok_or_else(|| err(&at, "must be an integer"))?;
+        // Within Blender's frame range, so the schedule's arithmetic cannot overflow
+        // and `check` can bound every frame.
+        let span = MAX_FRAME - MIN_FRAME;
         match k.as_str() {
-            "start" => f.start = Some(i),
-            "step" => f.step = i,
-            "modulo" if i > 0 => f.modulo = Some(i),
-            "modulo" => return Err(err(&at, "must be positive")),
+            "start" if (MIN_FRAME..=MAX_FRAME).contains(&i) => f.start = Some(i),
+            "start" => {
+                return Err(err(
+                    &at,
+                    format!("{i} is outside Blender's frame range [{MIN_FRAME}, {MAX_FRAME}]"),
+                ))
+            }
+            "step" if (-span..=span).contains(&i) => f.step = i,
+            "step" => {
+                return Err(err(
+                    &at,
+                    format!("{i} is not within [-{span}, {span}] (Blender's frame range)"),
+                ))
+            }
+            "modulo" if (1..=MAX_FRAME + 1).contains(&i) => f.modulo = Some(i),
+            "modulo" => {
+                return Err(err(
+                    &at,
+                    format!(
+                        "must be positive and at most {} (Blender's frame range), not {i}",
+                        MAX_FRAME + 1
+                    ),
+                ))
+            }
             _ => return Err(err(&at, "unknown key (expected start, step, modulo)")),
         }
     }
     Ok(f)
 }
 
+/// A spec number: finite and within the 32-bit float range, since Blender stores its
+/// float properties as 32-bit floats (a larger value would become infinity there).
 fn num(v: &Toml) -> Option<f64> {
     match v {
         Toml::Float(f) => Some(*f),
         Toml::Integer(i) => Some(*i as f64),
         _ => None,
     }
+    .filter(|x| x.is_finite() && x.abs() <= f32::MAX as f64)
 }
 
 fn nums(v: &Toml) -> Option<Vec<f64>> {
@@ -364,16 +435,12 @@ fn nums(v: &Toml) -> Option<Vec<f64>> {
 }
 
 fn pair(v: Option<&Toml>, what: &str) -> Result<(f64, f64), SpecError> {
-    let a = v
-        .and_then(nums)
-        .filter(|a| a.len() == 2)
-        .ok_or_else(|| err("", format!("{what} must be [low, high]")))?;
-    if !(a[0].is_finite() && a[1].is_finite()) {
-        return Err(err(
+    let a = v.and_then(nums).filter(|a| a.len() == 2).ok_or_else(|| {
+        err(
             "",
-            format!("{what} must be finite numbers (got {}, {})", a[0], a[1]),
-        ));
-    }
+            format!("{what} must be [low, high], finite numbers within the 32-bit float range"),
+        )
+    })?;
     if a[0] > a[1] {
         return Err(err("", format!("{what}: low {} > high {}", a[0], a[1])));
     }
@@ -434,10 +501,12 @@ fn parse_param(v: &Toml) -> Result<Param, SpecError> {
     let with_path = |e: SpecError| at(e.message);
     let dist = match kind {
         "uniform" => {
-            let min = nums(get("min")?)
-                .ok_or_else(|| at("min must be a number or a list of numbers".into()))?;
-            let max = nums(get("max")?)
-                .ok_or_else(|| at("max must be a number or a list of numbers".into()))?;
+            let min = nums(get("min")?).ok_or_else(|| {
+                at("min must be a finite number or a list of them (32-bit float range)".into())
+            })?;
+            let max = nums(get("max")?).ok_or_else(|| {
+                at("max must be a finite number or a list of them (32-bit float range)".into())
+            })?;
             if min.len() != max.len() || min.is_empty() {
                 return Err(at("min and max must have the same length".into()));
             }
@@ -462,18 +531,21 @@ fn parse_param(v: &Toml) -> Result<Param, SpecError> {
             Dist::UniformInt { min, max }
         }
         "log_uniform" => {
-            let min = num(get("min")?).ok_or_else(|| at("min must be a number".into()))?;
-            let max = num(get("max")?).ok_or_else(|| at("max must be a number".into()))?;
+            let min = num(get("min")?)
+                .ok_or_else(|| at("min must be a finite number (32-bit float range)".into()))?;
+            let max = num(get("max")?)
+                .ok_or_else(|| at("max must be a finite number (32-bit float range)".into()))?;
             if !(min > 0.0 && min <= max) {
                 return Err(at(format!("needs 0 < min <= max (got {min}, {max})")));
             }
             Dist::LogUniform { min, max }
         }
         "normal" => {
-            let mean = num(get("mean")?).ok_or_else(|| at("mean must be a number".into()))?;
-            let std = num(get("std")?)
-                .filter(|s| *s >= 0.0)
-                .ok_or_else(|| at("std must be a number >= 0".into()))?;
+            let mean = num(get("mean")?)
+                .ok_or_else(|| at("mean must be a finite number (32-bit float range)".into()))?;
+            let std = num(get("std")?).filter(|s| *s >= 0.0).ok_or_else(|| {
+                at("std must be a finite number >= 0 (32-bit float range)".into())
+            })?;
             let clamp = match t.get("clamp") {
                 None => None,
                 Some(c) => Some(pair(Some(c), "clamp").map_err(with_path)?),
@@ -493,9 +565,9 @@ fn parse_param(v: &Toml) -> Result<Param, SpecError> {
             let weights = match t.get("weights") {
                 None => None,
                 Some(w) => {
-                    let w = nums(w)
-                        .filter(|w| w.len() == values.len())
-                        .ok_or_else(|| at("weights must be a list as long as values".into()))?;
+                    let w = nums(w).filter(|w| w.len() == values.len()).ok_or_else(|| {
+                        at("weights must be a list of finite numbers as long as values".into())
+                    })?;
                     if w.iter().any(|x| *x < 0.0 || !x.is_finite()) || w.iter().sum::<f64>() <= 0.0
                     {
                         return Err(at("weights must be >= 0 with a positive sum".into()));
@@ -516,7 +588,11 @@ fn parse_param(v: &Toml) -> Result<Param, SpecError> {
                     .get(k)
                     .and_then(nums)
                     .filter(|a| a.len() == 3)
-                    .ok_or_else(|| at(format!("{k} must be [r, g, b]")))?;
+                    .ok_or_else(|| {
+                        at(format!(
+                            "{k} must be [r, g, b], finite numbers (32-bit float range)"
+                        ))
+                    })?;
                 Ok([a[0], a[1], a[2]])
             };
             let (min, max) = (three("min")?, three("max")?);

@@ -80,11 +80,12 @@ pub fn extract(
 }
 
 /// The semantic mask: per pixel 0 for background, else 1 + the class of the labelled
-/// instance seen there.
-pub fn semantic(ids: &FrameIds, labels: &[InstanceLabel]) -> Vec<u8> {
-    let mut class_of = vec![0u8; ids.instances.len() + 1];
+/// instance seen there (classes beyond 65534 do not fit and saturate; `generate`
+/// refuses that many classes).
+pub fn semantic(ids: &FrameIds, labels: &[InstanceLabel]) -> Vec<u16> {
+    let mut class_of = vec![0u16; ids.instances.len() + 1];
     for l in labels {
-        class_of[l.instance + 1] = (l.class + 1).min(255) as u8;
+        class_of[l.instance + 1] = u16::try_from(l.class + 1).unwrap_or(u16::MAX);
     }
     ids.instance_id
         .iter()
