@@ -285,11 +285,13 @@ pub fn convert(
     blender: Option<PathBuf>,
     frame: Option<i32>,
     no_evaluated: bool,
+    allow_paths: Vec<PathBuf>,
 ) -> Result<Scene, ApiError> {
     let opts = crate::blender::ConvertOptions {
         blender,
         frame,
         no_evaluated,
+        allow_paths,
     };
     crate::blender::convert(input, out, &opts)
         .map_err(|e| ApiError::new(ErrorKind::Blender, format!("{e:#}").replace('\n', " ")))

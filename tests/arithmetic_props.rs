@@ -34,11 +34,11 @@ fn glb(
                    "vertex_positions": 0}}
     });
     let mut j = serde_json::to_vec(&doc).unwrap();
-    while j.len() % 4 != 0 {
+    while !j.len().is_multiple_of(4) {
         j.push(b' ');
     }
     let mut b = bin.to_vec();
-    while b.len() % 4 != 0 {
+    while !b.len().is_multiple_of(4) {
         b.push(0);
     }
     let mut out = Vec::new();

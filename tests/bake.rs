@@ -107,7 +107,7 @@ fn cycles_self_spread(root: &std::path::Path, case: &str) -> Diff {
     let reference = read_f32(&dir.join("blender_emit.f32"));
     let moved = read_f32(&dir.join("cycles_moved.f32"));
     assert!(
-        !moved.is_empty() && moved.len() % reference.len() == 0,
+        !moved.is_empty() && moved.len().is_multiple_of(reference.len()),
         "{case}: cycles_moved.f32 has {} values",
         moved.len()
     );

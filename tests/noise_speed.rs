@@ -63,7 +63,7 @@ impl Rng {
     }
     /// An ordinary coordinate (as shading points give), for the costly fractal cases.
     fn near(&mut self) -> f32 {
-        if self.u64() % 8 == 0 {
+        if self.u64().is_multiple_of(8) {
             self.coord()
         } else {
             self.range(-4.0, 4.0)
@@ -71,7 +71,7 @@ impl Rng {
     }
     /// A node setting: mostly in its useful range, sometimes at or past its clamps.
     fn setting(&mut self, lo: f32, hi: f32, specials: &[f32]) -> f32 {
-        if self.u64() % 4 == 0 {
+        if self.u64().is_multiple_of(4) {
             self.pick(specials)
         } else {
             self.range(lo, hi)
@@ -158,10 +158,10 @@ fn voronoi_case(r: &mut Rng) -> (voronoi::VoronoiParams, old::voronoi::VoronoiPa
     use voronoi::{VoronoiFeature, VoronoiMetric};
     let feature = r.pick(VoronoiFeature::ALL);
     let metric = r.pick(VoronoiMetric::ALL);
-    let normalize = r.u64() % 2 == 0;
+    let normalize = r.u64().is_multiple_of(2);
     let scale = r.setting(-5.0, 30.0, &[0.0, 1.0, 5.0, 21.8, -1.0]);
     // Fractal octaves multiply the cost; most cases keep to one or two.
-    let detail = if r.u64() % 8 == 0 {
+    let detail = if r.u64().is_multiple_of(8) {
         r.setting(0.0, 15.0, &[15.0, 16.0, 2.5])
     } else {
         r.setting(0.0, 2.0, &[0.0, 1.0, -1.0, 0.5])
@@ -219,7 +219,7 @@ fn voronoi_matches_the_old_code_for_every_feature_metric_and_dimension() {
     for i in 0..60_000 {
         let (new, old, args) = voronoi_case(&mut r);
         let dims = (i % 4 + 1) as u8;
-        let (v, w) = if r.u64() % 4 == 0 {
+        let (v, w) = if r.u64().is_multiple_of(4) {
             (r.vec3(), r.coord())
         } else {
             ([r.near(), r.near(), r.near()], r.near())
@@ -271,8 +271,8 @@ fn noise_params(r: &mut Rng) -> noise::NoiseParams {
             RidgedMultiFractal,
             HeteroTerrain,
         ]),
-        normalize: r.u64() % 2 == 0,
-        detail: if r.u64() % 4 == 0 {
+        normalize: r.u64().is_multiple_of(2),
+        detail: if r.u64().is_multiple_of(4) {
             r.setting(0.0, 16.0, &[15.0, 16.0, 10.689_58])
         } else {
             r.setting(0.0, 4.0, &[0.0, 1.0, 2.0, -1.0])
@@ -291,7 +291,7 @@ fn noise_texture_matches_the_old_code_in_both_flavours() {
     for i in 0..60_000 {
         let params = noise_params(&mut r);
         let dims = (i % 4 + 1) as u8;
-        let (v, w) = if r.u64() % 4 == 0 {
+        let (v, w) = if r.u64().is_multiple_of(4) {
             (r.vec3(), r.coord())
         } else {
             ([r.near(), r.near(), r.near()], r.near())
@@ -312,7 +312,7 @@ fn noise_texture_matches_the_old_code_in_both_flavours() {
             &[of],
             &(dims, v, w, scale, params),
         );
-        let want_color = r.u64() % 2 == 0;
+        let want_color = r.u64().is_multiple_of(2);
         let (f, c) = noise::noise_texture(dims, v, w, scale, params, want_color);
         let (of, oc) = old::noise::noise_texture(dims, v, w, scale, params, want_color);
         check(
@@ -367,7 +367,7 @@ fn wave_matches_the_old_code() {
             rings: r.pick(RingsDirection::ALL),
             profile: r.pick(WaveProfile::ALL),
         };
-        let v = if r.u64() % 4 == 0 {
+        let v = if r.u64().is_multiple_of(4) {
             r.vec3()
         } else {
             [r.near(), r.near(), r.near()]

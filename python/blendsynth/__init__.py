@@ -363,10 +363,13 @@ def convert(
     *,
     frame: Optional[int] = None,
     evaluated: bool = True,
+    allow_paths: Sequence[PathLike] = (),
 ) -> Scene:
     """``blendsynth convert``: exports a .blend with Blender (``blender``: an executable or
     a Python with bpy; default $BLENDSYNTH_BLENDER, $BLENDSYNTH_BPY_PYTHON, ``blender``
-    on PATH) into ``out_dir`` and loads it. Raises :class:`BlenderError`."""
+    on PATH) into ``out_dir`` and loads it. Image files outside the .blend's folder are
+    copied only from the folders in ``allow_paths`` (the CLI's ``--allow-path``).
+    Raises :class:`BlenderError`."""
     return Scene(
         _native.convert(
             os.fspath(blend),
@@ -374,6 +377,7 @@ def convert(
             None if blender is None else os.fspath(blender),
             frame,
             evaluated,
+            [os.fspath(p) for p in allow_paths],
         )
     )
 

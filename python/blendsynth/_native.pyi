@@ -53,7 +53,12 @@ class Scene:
     ) -> Dict[str, Any]: ...
 
 def convert(
-    blend: str, out_dir: str, blender: Optional[str] = ..., frame: Optional[int] = ..., evaluated: bool = ...
+    blend: str,
+    out_dir: str,
+    blender: Optional[str] = ...,
+    frame: Optional[int] = ...,
+    evaluated: bool = ...,
+    allow_paths: List[str] = ...,
 ) -> Scene: ...
 def generate(
     dir: str,

@@ -153,7 +153,7 @@ impl GlbBuilder {
         if count == 0 {
             return None;
         }
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let offset = self.bin.len();
@@ -354,7 +354,7 @@ pub fn write_glb(path: &Path, m: &Mesh, name: &str) -> Result<(), GeometryError>
         }
         meshes.push(serde_json::json!({"name": name, "primitives": [{"attributes": attributes, "indices": ti, "mode": 4}]}));
     }
-    while b.bin.len() % 4 != 0 {
+    while !b.bin.len().is_multiple_of(4) {
         b.bin.push(0);
     }
     let mut doc = serde_json::json!({

@@ -226,7 +226,7 @@ where
     fn new(cell: [f32; N], base: [f32; N], r: i32, randomness: f32) -> Self {
         let side = 2 * r + 1;
         let m = side.pow(N as u32) as usize;
-        debug_assert!(m <= P && P % 8 == 0);
+        debug_assert!(m <= P && P.is_multiple_of(8));
         // Filled in place: building the arrays apart and moving them in costs a copy.
         let mut b = Block {
             m,

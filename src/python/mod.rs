@@ -451,7 +451,7 @@ fn run_render(
 
 /// `blendsynth convert`; returns the loaded scene.
 #[pyfunction]
-#[pyo3(signature = (blend, out_dir, blender=None, frame=None, evaluated=true))]
+#[pyo3(signature = (blend, out_dir, blender=None, frame=None, evaluated=true, allow_paths=Vec::new()))]
 fn convert(
     py: Python<'_>,
     blend: PathBuf,
@@ -459,9 +459,10 @@ fn convert(
     blender: Option<PathBuf>,
     frame: Option<i32>,
     evaluated: bool,
+    allow_paths: Vec<PathBuf>,
 ) -> PyResult<PyScene> {
     let scene = py
-        .detach(|| api::convert(&blend, &out_dir, blender, frame, !evaluated))
+        .detach(|| api::convert(&blend, &out_dir, blender, frame, !evaluated, allow_paths))
         .map_err(py_err)?;
     Ok(PyScene::new(scene))
 }
