@@ -13,10 +13,14 @@ use clap::{Parser, Subcommand};
 use blendsynth::shader::bake::{bake_emission, write_exr, BakeOptions};
 use blendsynth::{blender, inspect, scene::Override, scene::Scene};
 
+/// The crate version and the exchange format it reads (`tests/cli.rs` keeps the number
+/// equal to `scene::FORMAT_VERSION`).
+const VERSION: &str = concat!(env!("CARGO_PKG_VERSION"), " (exchange format 1)");
+
 #[derive(Parser)]
 #[command(
     name = "blendsynth",
-    version,
+    version = VERSION,
     about = "Render Blender scenes without Blender, to make labelled synthetic training datasets"
 )]
 struct Cli {

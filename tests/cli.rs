@@ -8,6 +8,9 @@ fn version_and_help() {
     let o = run(&["--version"], &[]);
     assert_eq!(o.status.code(), Some(0));
     assert!(stdout(&o).starts_with("blendsynth "), "{}", stdout(&o));
+    // --version names the exchange format this build reads.
+    let format = format!("(exchange format {})", blendsynth::scene::FORMAT_VERSION);
+    assert!(stdout(&o).contains(&format), "{}", stdout(&o));
     for sub in [
         vec!["--help"],
         vec!["convert", "--help"],

@@ -9,7 +9,7 @@ use crate::scene::{quote, Evaluated, Object, Scene};
 use super::GeometryError;
 
 /// Object types that hold no renderable geometry of their own.
-const NO_GEOMETRY: &[&str] = &[
+pub const NO_GEOMETRY: &[&str] = &[
     "EMPTY",
     "LIGHT",
     "CAMERA",
@@ -23,7 +23,7 @@ const NO_GEOMETRY: &[&str] = &[
 ];
 
 /// Modifiers blendsynth evaluates itself (`eval::Session::evaluate_stack`).
-const NATIVE_MODIFIERS: &[&str] = &["NODES", "SUBSURF"];
+pub const NATIVE_MODIFIERS: &[&str] = &["NODES", "SUBSURF"];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Source {

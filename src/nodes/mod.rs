@@ -224,6 +224,11 @@ pub fn support_in(tree: &str, bl_idname: &str) -> Support {
     }
 }
 
+/// Every shader node type evaluated (the registry `inspect` and docs/features.md read).
+pub fn supported_shader_nodes() -> &'static [&'static str] {
+    SUPPORTED
+}
+
 pub fn support(bl_idname: &str) -> Support {
     if STRUCTURAL.contains(&bl_idname) {
         Support::Structural
