@@ -158,6 +158,7 @@ pub fn report(scene: &Scene) -> Report {
 }
 
 /// The report, its render and mesh checks run at `frame` (default: the current frame).
+// Long because one section per part of the report, in the order it prints.
 pub fn report_at(scene: &Scene, frame: Option<f64>) -> Report {
     let f = &scene.file;
     let frame = frame.unwrap_or(f.scene.frame_current as f64);
@@ -447,6 +448,7 @@ impl Report {
         o
     }
 
+    // Long because one section per part of the report, in the order it prints.
     fn write_text(&self, o: &mut String) -> std::fmt::Result {
         let s = &self.scene;
         writeln!(

@@ -495,6 +495,7 @@ enum Outcome {
     Unsupported,
 }
 
+// Long because one arm per subcommand; each only maps arguments to library calls.
 fn run(cli: Cli) -> Result<Outcome> {
     match cli.command {
         Command::Convert {

@@ -185,6 +185,25 @@ fn mesh_paths_stay_inside_the_scene_folder() {
     assert!(e.contains("outside the scene folder"), "{e}");
 }
 
+/// The exporter writes the colour-management config into a folder of its own (Filmic,
+/// AgX, ...): that folder passes the regular-file rule meant for the files a scene reads.
+#[test]
+fn colour_management_folder_is_a_folder() {
+    let (_t, dir) = broken(|v| {
+        v["color_management"] = serde_json::json!({"dir": "colormanagement"});
+    });
+    std::fs::create_dir(dir.join("colormanagement")).unwrap();
+    Scene::load(&dir).unwrap_or_else(|e| panic!("{e}"));
+    let (_t, dir) = broken(|v| {
+        v["color_management"] = serde_json::json!({"dir": "scene.json"});
+    });
+    let e = load_err(&dir);
+    assert!(
+        e.contains("color_management.dir") && e.contains("not a folder"),
+        "{e}"
+    );
+}
+
 #[test]
 fn truncated_files() {
     let (_t, dir) = broken(|_| {});

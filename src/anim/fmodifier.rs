@@ -168,6 +168,7 @@ fn cycle_mode(s: &str) -> Result<i32, AnimError> {
     })
 }
 
+// Long because one arm per F-modifier type, each reading that type's settings as Blender's fcm_* functions do.
 fn compile_one(m: &FModifier, first: bool) -> Result<FMod, AnimError> {
     let p = &m.properties;
     let kind = match m.kind.as_str() {

@@ -259,6 +259,7 @@ impl<'a> Builder<'a> {
         Ok(l)
     }
 
+    // Long because one arm per OCIO transform type, as OCIO builds its ops.
     pub fn transform(&mut self, t: &Transform, outer: Dir) -> Result<(), ColorError> {
         match t {
             Transform::Group(children, dir) => {

@@ -257,6 +257,7 @@ fn only_partials(out: &Path) -> bool {
 /// and JSONL files over the finished frames. Holds an exclusive lock on `out` while
 /// it runs (see `layout::lock`), so a second writer is refused instead of deleting
 /// this run's in-flight files.
+// Long because the frame loop keeps resume, shards and progress in one place, so the order of writes (the record last) stays visible.
 pub fn generate(
     scene: &Scene,
     spec: &Spec,

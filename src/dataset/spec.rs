@@ -463,6 +463,7 @@ fn toml_to_json(v: &Toml) -> Value {
     }
 }
 
+// Long because one arm per distribution, each checking its own keys.
 fn parse_param(v: &Toml) -> Result<Param, SpecError> {
     let t = v.as_table().ok_or_else(|| err("", "must be a table"))?;
     let path = t

@@ -191,6 +191,7 @@ impl Refined {
 /// is deeper: the limit surface is isolated that far, which moves the corners of
 /// single-face boundary vertices. `edge_sharpness` and `vert_sharpness` are OpenSubdiv
 /// sharpness per coarse edge and vertex.
+// Long because it follows OpenSubdiv's refinement step by step.
 pub fn refine(
     m: &Mesh,
     level: u32,
@@ -411,6 +412,7 @@ fn refine_grid(
     (out, fout)
 }
 
+// Long because it follows OpenSubdiv's refinement step by step.
 fn refine_once(lv: &Level, adj: &Adjacency) -> (Level, ChildMap) {
     let nf = lv.face_count();
     let ne = lv.edges.len();

@@ -198,6 +198,7 @@ fn u32s(v: impl Iterator<Item = u32>) -> Vec<u8> {
 
 /// glb in the exporter's layout (FORMAT.md, "The mesh glb"): the exact mesh in
 /// `extras.blendsynth` plus a corner-split triangle primitive for viewers.
+// Long because it writes the glb's JSON and binary chunks in one pass, in the exporter's layout.
 pub fn write_glb(path: &Path, m: &Mesh, name: &str) -> Result<(), GeometryError> {
     let md = m.to_scene(name);
     let mut b = GlbBuilder {

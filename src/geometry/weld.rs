@@ -206,6 +206,7 @@ fn mix_domain(src: &Attributes, dst: &mut Attributes, domain: Domain, groups: &[
 }
 
 /// The mesh with vertices merged by `dest` (from `duplicates_all` / `duplicates_connected`).
+// Long because it follows Blender's vertex merge step by step.
 pub fn merge(m: &Mesh, dest: &[i32]) -> Result<Mesh, String> {
     let nv = m.vertex_count();
     let in_ctx = |v: usize| dest[v] != OUT;

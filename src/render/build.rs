@@ -143,6 +143,7 @@ pub fn renders_itself(eval: &EvaluatedScene, obj: &crate::scene::Object) -> bool
     !instanced_by_parent
 }
 
+// Long because one pass over the objects, every per-object decision (visibility, geometry source, materials) in Cycles' sync order.
 pub fn build(
     scene: &Scene,
     eval: &EvaluatedScene,

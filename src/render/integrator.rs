@@ -265,6 +265,7 @@ impl Scene<'_> {
     /// One path sample: radiance along the camera ray.
     // The shading state is passed apart, as Cycles passes it to its kernels.
     #[allow(clippy::too_many_arguments)]
+    // Long because the path loop keeps its state in locals; splitting it into a PathState and steps is open work (issue 25).
     pub fn radiance(
         &self,
         org: V3,

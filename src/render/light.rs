@@ -199,6 +199,7 @@ fn node_factor(l: &crate::scene::format::Light) -> Result<V3, RenderError> {
     Ok(scale(color, strength))
 }
 
+// Long because one arm per light type, reading its settings as Cycles' light sync does.
 pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
     let mut out = Vec::new();
     for (oi, obj) in eval.data.objects.iter().enumerate() {
@@ -449,6 +450,7 @@ fn smoothstep(x: f32) -> f32 {
 }
 
 impl Light {
+    // Long because one arm per light type, as Cycles' light sample functions.
     pub fn sample(&self, p: V3, u: [f32; 2]) -> Option<LightSample> {
         match &self.shape {
             Shape::Point {

@@ -205,6 +205,7 @@ pub fn render_with_overrides(
 
 /// `render_with_overrides` that another thread can follow and stop through `control`
 /// (checked between pixels; the image is the same when it is not cancelled).
+// Long because the render driver still holds film, tiles, adaptive ranges and passes; separating them is open work (issue 25).
 pub fn render_controlled(
     scene: &Scene,
     opts: &RenderOptions,
@@ -694,6 +695,7 @@ fn prepare(
 /// scene turns the tree off. Energies are Cycles' estimates (a triangle's area times the
 /// mean of its material's emission estimate), not the emission itself: they set the
 /// selection probabilities, which decide how clamping acts.
+// Long because it collects every kind of emitter (lights, world, emissive triangles) as Cycles' LightManager does, in its order.
 fn light_select(
     geo: &build::Geometry,
     materials: &[shade::Material],

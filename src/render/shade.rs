@@ -451,6 +451,7 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
     }
 }
 
+// Long because it follows Cycles' Principled BSDF node layer by layer.
 fn principled(
     b: &BsdfNode,
     w: f32,

@@ -125,14 +125,20 @@ pub(super) fn validate(scene: &Scene, json: &Path) -> Result<(), SceneError> {
                 .map_err(|m| SceneError::new(json, format!("images[{i}].file"), m))?;
         }
     }
-    for (field, p) in [
-        ("dir", &f.color_management.dir),
-        ("config", &f.color_management.config),
-    ] {
-        if let Some(p) = p {
-            resolve_inside(&scene.dir, p)
-                .map_err(|m| SceneError::new(json, format!("color_management.{field}"), m))?;
+    // The colour-management folder is a folder; the config in it is a regular file.
+    if let Some(p) = &f.color_management.dir {
+        let joined = super::confine(&scene.dir, p)
+            .map_err(|m| SceneError::new(json, "color_management.dir", m))?;
+        if joined.exists() && !joined.is_dir() {
+            return err(
+                "color_management.dir".into(),
+                format!("path {p:?} is not a folder"),
+            );
         }
+    }
+    if let Some(p) = &f.color_management.config {
+        resolve_inside(&scene.dir, p)
+            .map_err(|m| SceneError::new(json, "color_management.config", m))?;
     }
 
     for (i, m) in f.materials.iter().enumerate() {

@@ -32,6 +32,7 @@ pub struct Baked {
     pub pixels: Vec<[f32; 4]>,
 }
 
+// Long because the bake driver: UV rasterisation, the texel loop and writing, in Cycles' EMIT bake order.
 pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String> {
     let size = opts.size;
     if size == 0 || size > 16384 {

@@ -394,6 +394,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
         self.values[i] = v;
     }
 
+    // Long because one arm per node type; one registration table per evaluator is open work (issue 25).
     fn run(mut self) -> Result<Program, CompileError> {
         use Kind::{Color as C, Float as F, Vector as V};
         let schedule =

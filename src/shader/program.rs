@@ -636,6 +636,7 @@ impl Program {
         Some(v3(s, d.value))
     }
 
+    // Long because one arm per op, kept in one function so the interpreter's loop stays one jump table.
     fn exec(&self, sp: ShadingPoint, s: &mut [f32], ops: &[Op]) {
         // `sp` is what the ops read: `base`, or a bump copy's offset point.
         let mut base = sp;

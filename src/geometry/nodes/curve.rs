@@ -313,6 +313,7 @@ fn segments(n: usize, cyclic: bool) -> usize {
 
 /// Sweeps every profile curve along every main curve (main curves outer, profiles inner),
 /// with Blender's vertex, edge, face and corner order (`bke::curve_to_mesh_sweep`).
+// Long because it follows Blender's curve-to-mesh sweep step by step.
 fn sweep(
     main: &Curves,
     scale_field: &[f32],

@@ -208,6 +208,7 @@ fn boundary_edges_on_face(m: &Mesh, f: usize, v: usize, et: &[EdgeType]) -> (usi
     (e1, e2)
 }
 
+// Long because it follows Blender's Dual Mesh node step by step.
 pub fn dual(m: &Mesh, keep_boundaries: bool) -> Mesh {
     let (mut vt, et) = classify(m);
     let nv = m.vertex_count();

@@ -272,6 +272,7 @@ fn extrude_edges(m: &mut Mesh, sel: &[bool], offsets: &[V3], single: Option<V3>)
     }
 }
 
+// Long because it follows Blender's face-region extrusion step by step.
 fn extrude_face_regions(m: &mut Mesh, sel: &[bool], offsets: &[V3], single: Option<V3>) -> Outs {
     let (nv, ne, nf) = (m.vertex_count(), m.edge_count(), m.face_count());
     if !sel.iter().any(|x| *x) {

@@ -727,6 +727,7 @@ fn loops_regular(ctx: &Ctx, b: &mut Build, f: usize) {
     }
 }
 
+// Long because it follows Blender's subdivision pattern table case by case.
 fn loops_special(ctx: &Ctx, b: &mut Build, f: usize) {
     let m = ctx.m;
     let res = ctx.res;
