@@ -136,6 +136,11 @@ impl<'s> Session<'s> {
     }
 
     fn evaluate_stack(&self, o: &Object) -> Result<GeometrySet, GeometryError> {
+        // Object Info on a curve object without modifiers reads its curves, whatever
+        // Blender would mesh of them for rendering.
+        if o.kind == "CURVE" && !o.modifiers.iter().any(|m| m.show_render) {
+            return self.original_geometry(o);
+        }
         match super::source::object_source(self.scene, o, self.frame, &[])? {
             super::source::Source::None => return Ok(GeometrySet::default()),
             super::source::Source::Frozen(i) => {

@@ -88,8 +88,12 @@ pub fn frozen_reason(scene: &Scene, o: &Object) -> Option<String> {
                         .collect::<Vec<_>>()
                         .join(", ")
                 ))
-            } else {
+            } else if curve_has_surface(scene, o) {
                 Some("curve object meshed as Blender meshes it (bevel, extrude, fill)".into())
+            } else {
+                // A bare path (no bevel, extrude or 2D fill): Blender makes no faces of it
+                // and Cycles renders nothing (object_source gives None).
+                None
             }
         }
         "SURFACE" => Some("NURBS surface object".into()),
@@ -97,6 +101,26 @@ pub fn frozen_reason(scene: &Scene, o: &Object) -> Option<String> {
         "META" => Some("metaball object".into()),
         _ => None,
     }
+}
+
+/// Whether Blender makes faces of a curve object without modifiers: a bevel (depth, or
+/// an object in Object mode), an extrusion, or a 2D curve whose closed splines are filled.
+pub fn curve_has_surface(scene: &Scene, o: &Object) -> bool {
+    let Some(c) = o
+        .data
+        .as_deref()
+        .and_then(|d| scene.file.curves.iter().find(|c| c.name == d))
+    else {
+        return false;
+    };
+    let p = &c.properties;
+    let num = |k: &str| p.get(k).and_then(|v| v.as_f64()).unwrap_or(0.0);
+    let text = |k: &str| p.get(k).and_then(|v| v.as_str()).unwrap_or("");
+    let bevel_object = text("bevel_mode") == "OBJECT" && !text("bevel_object").is_empty();
+    let filled_2d = text("dimensions") == "2D"
+        && text("fill_mode") != "NONE"
+        && c.splines.iter().any(|s| s.use_cyclic_u);
+    num("bevel_depth") > 0.0 || num("extrude") > 0.0 || bevel_object || filled_2d
 }
 
 /// The source of object `o`'s geometry at `frame`, with `overrides` (data paths) applied
@@ -150,6 +174,7 @@ pub fn object_source(
                 Source::Mesh(mi)
             })
         }
+        "CURVE" if !has_mods => Ok(Source::None),
         "CURVE" => Ok(Source::Evaluate),
         other => Err(GeometryError::new(format!(
             "{here}: {other} objects are not supported by the renderer"
