@@ -6,7 +6,7 @@
 
 mod common;
 
-use std::collections::BTreeMap;
+use common::{assert_same_tree, tree};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -75,40 +75,6 @@ fn ok(o: Output) -> Output {
         common::stderr(&o)
     );
     o
-}
-
-/// Every file under `dir`, relative path -> bytes.
-fn tree(dir: &Path) -> BTreeMap<String, Vec<u8>> {
-    fn walk(root: &Path, d: &Path, out: &mut BTreeMap<String, Vec<u8>>) {
-        for e in std::fs::read_dir(d).unwrap() {
-            let p = e.unwrap().path();
-            if p.is_dir() {
-                walk(root, &p, out);
-            } else {
-                out.insert(
-                    p.strip_prefix(root).unwrap().to_string_lossy().into_owned(),
-                    std::fs::read(&p).unwrap(),
-                );
-            }
-        }
-    }
-    let mut out = BTreeMap::new();
-    walk(dir, dir, &mut out);
-    out
-}
-
-fn assert_same_tree(a: &Path, b: &Path) {
-    let (ta, tb) = (tree(a), tree(b));
-    assert_eq!(
-        ta.keys().collect::<Vec<_>>(),
-        tb.keys().collect::<Vec<_>>(),
-        "file lists of {} and {}",
-        a.display(),
-        b.display()
-    );
-    for (k, v) in &ta {
-        assert!(v == &tb[k], "{k} differs");
-    }
 }
 
 // ---------------------------------------------------------------- frame counts
