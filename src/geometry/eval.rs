@@ -136,9 +136,12 @@ impl<'s> Session<'s> {
     }
 
     fn evaluate_stack(&self, o: &Object) -> Result<GeometrySet, GeometryError> {
-        // Object Info on a curve object without modifiers reads its curves, whatever
-        // Blender would mesh of them for rendering.
-        if o.kind == "CURVE" && !o.modifiers.iter().any(|m| m.show_render) {
+        // A bare curve path without modifiers (no bevel, extrude or fill: nothing to
+        // render) gives Object Info its curves; a curve Blender meshes stays frozen.
+        if o.kind == "CURVE"
+            && !o.modifiers.iter().any(|m| m.show_render)
+            && !super::source::curve_has_surface(self.scene, o)
+        {
             return self.original_geometry(o);
         }
         match super::source::object_source(self.scene, o, self.frame, &[])? {
