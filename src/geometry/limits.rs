@@ -31,7 +31,9 @@ pub fn product(factors: &[u64]) -> Option<u64> {
 /// face corners: the first round makes one quad per corner, each later round four per
 /// quad. The largest domain of the result is its corners, four per quad.
 pub fn subdivided_corners(corners: u64, level: u32) -> Option<u64> {
-    if level == 0 {
+    // No corners stay no corners at any level; checking 4^level first would
+    // refuse an empty mesh at a level whose factor alone overflows.
+    if level == 0 || corners == 0 {
         return Some(corners);
     }
     let quads = corners.checked_mul(4u64.checked_pow(level - 1)?)?;
