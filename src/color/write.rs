@@ -1,7 +1,7 @@
 //! Image writers. Each writes to a temporary file beside the target and renames it into
 //! place, so a reader never sees a half-written image.
 
-use std::io::{BufWriter, Write};
+use std::io::Write;
 use std::path::Path;
 
 use image::codecs::png::{CompressionType, FilterType, PngEncoder};
@@ -35,41 +35,14 @@ fn check(path: &Path, width: u32, height: u32, n: usize) -> Result<(), ColorErro
     Ok(())
 }
 
-/// For the temporary file an output is written to before it is renamed into place: an
-/// image is a file the user asked for, so it gets the mode any program's new file gets
-/// (0666 less the umask), not a temporary file's private 0600.
-pub fn user_file_permissions() -> std::fs::Permissions {
-    use std::os::unix::fs::PermissionsExt;
-    std::fs::Permissions::from_mode(0o666)
-}
+pub use crate::foundation::files::user_file_permissions;
 
-/// Writes through `f` into a temp file in the target's folder, then renames it over `path`.
+/// Writes through `f` atomically (the one writer in `foundation::files`).
 fn atomic(
     path: &Path,
-    f: impl FnOnce(&mut BufWriter<&mut std::fs::File>) -> Result<(), String>,
+    f: impl FnOnce(&mut dyn Write) -> Result<(), String>,
 ) -> Result<(), ColorError> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".blendsynth-")
-        .suffix(".tmp")
-        .permissions(user_file_permissions())
-        .tempfile_in(dir)
-        .map_err(|e| {
-            werr(
-                path,
-                format!("cannot create a temporary file in {}: {e}", dir.display()),
-            )
-        })?;
-    {
-        let mut w = BufWriter::new(tmp.as_file_mut());
-        f(&mut w).map_err(|m| werr(path, m))?;
-        w.flush().map_err(|e| werr(path, e))?;
-    }
-    tmp.persist(path).map_err(|e| werr(path, e.error))?;
-    Ok(())
+    crate::foundation::files::write_atomic_with(path, f).map_err(|m| werr(path, m))
 }
 
 /// Display value to an n-bit code, rounding half up and clamping, as Blender does.
@@ -151,11 +124,7 @@ pub fn write_exr(
     pixels: &[[f32; 4]],
 ) -> Result<(), ColorError> {
     check(path, width, height, pixels.len())?;
-    let buf: Vec<f32> = pixels.iter().flatten().copied().collect();
-    let img: ImageBuffer<Rgba<f32>, Vec<f32>> = ImageBuffer::from_raw(width, height, buf)
-        .ok_or_else(|| werr(path, "pixel buffer size mismatch"))?;
-    atomic(path, |w| {
-        let enc = image::codecs::openexr::OpenExrEncoder::new(w);
-        img.write_with_encoder(enc).map_err(|e| e.to_string())
-    })
+    let bytes =
+        crate::foundation::exr::rgba_bytes(width, height, pixels).map_err(|m| werr(path, m))?;
+    atomic(path, |w| w.write_all(&bytes).map_err(|e| e.to_string()))
 }

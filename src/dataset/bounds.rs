@@ -85,7 +85,7 @@ impl FrameRenderer for BoundsRenderer {
         settings: &RenderSettings,
         _threads: usize,
     ) -> Result<RenderedFrame, String> {
-        let (w, h) = resolution(scene, settings);
+        let (w, h) = resolution(scene, settings)?;
         let cam = super::generate::scene_camera(scene, frame, w, h)?;
         let world_to_cam = affine_inverse(&cam.matrix_world).ok_or("camera matrix is singular")?;
         let ev = crate::anim::evaluate_scene(scene, frame).map_err(|e| e.to_string())?;

@@ -14,12 +14,11 @@
 //! OUT/frames.jsonl                      every record, one per line, in frame order
 //! OUT/data.yaml                         Ultralytics dataset file
 //! ```
-//! Every file is written to `.NAME.partial` beside it and renamed into place, so a
+//! Every file is written to `.NAME.XXXXXX.partial` beside it and renamed into place, so a
 //! killed run leaves whole files or `.partial` leftovers that a resumed run deletes.
 //! A writer holds an exclusive flock on OUT itself (no lock file), so two writers
 //! never share a folder.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// A split name becomes a folder name: letters, digits, '_' and '-' only, so a name
@@ -83,25 +82,7 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), String> {
         .parent()
         .ok_or_else(|| format!("{}: no parent folder", path.display()))?;
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: cannot create: {e}", dir.display()))?;
-    let name = path
-        .file_name()
-        .ok_or_else(|| format!("{}: no file name", path.display()))?
-        .to_string_lossy();
-    let tmp = dir.join(format!(".{name}.partial"));
-    let written = (|| {
-        let mut f = std::fs::File::create(&tmp)
-            .map_err(|e| format!("{}: cannot write: {e}", tmp.display()))?;
-        f.write_all(bytes)
-            .and_then(|_| f.sync_all())
-            .map_err(|e| format!("{}: cannot write: {e}", tmp.display()))?;
-        drop(f);
-        std::fs::rename(&tmp, path)
-            .map_err(|e| format!("{}: cannot rename into place: {e}", path.display()))
-    })();
-    if written.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    written
+    crate::foundation::files::write_atomic(path, bytes)
 }
 
 /// An exclusive advisory lock (flock) on a dataset folder, held while the value lives.
@@ -211,16 +192,7 @@ pub fn png16_bytes(width: u32, height: u32, data: &[u16]) -> Result<Vec<u8>, Str
 
 /// Float RGB OpenEXR bytes.
 pub fn exr_rgb_bytes(width: u32, height: u32, data: &[[f32; 3]]) -> Result<Vec<u8>, String> {
-    use image::ImageEncoder;
-    let bytes: Vec<u8> = data
-        .iter()
-        .flat_map(|p| p.iter().flat_map(|v| v.to_ne_bytes()))
-        .collect();
-    let mut out = std::io::Cursor::new(Vec::new());
-    image::codecs::openexr::OpenExrEncoder::new(&mut out)
-        .write_image(&bytes, width, height, image::ExtendedColorType::Rgb32F)
-        .map_err(|e| format!("EXR encode: {e}"))?;
-    Ok(out.into_inner())
+    crate::foundation::exr::rgb_bytes(width, height, data)
 }
 
 /// Display-referred [0, 1] RGBA to 8-bit RGB, rounded.

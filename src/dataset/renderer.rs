@@ -34,18 +34,12 @@ pub trait FrameRenderer: Sync {
 }
 
 /// The output resolution: the spec's, else the scene's resolution x percentage / 100
-/// as Blender computes it.
-pub fn resolution(scene: &Scene, settings: &RenderSettings) -> (u32, u32) {
-    if let Some(r) = settings.resolution {
-        return r;
+/// as Blender computes it (an error when that is below a pixel).
+pub fn resolution(scene: &Scene, settings: &RenderSettings) -> Result<(u32, u32), String> {
+    match settings.resolution {
+        Some(r) => Ok(r),
+        None => crate::scene::settings::Output::of(&scene.file.scene).size(),
     }
-    let r = &scene.file.scene.render;
-    let g = |k: &str, d: i64| r.get(k).and_then(|v| v.as_i64()).unwrap_or(d);
-    let pct = g("resolution_percentage", 100);
-    (
-        ((g("resolution_x", 1920) * pct) / 100).max(1) as u32,
-        ((g("resolution_y", 1080) * pct) / 100).max(1) as u32,
-    )
 }
 
 /// The path tracer as a `FrameRenderer`: render, denoise when the spec or the scene asks
@@ -69,7 +63,7 @@ impl FrameRenderer for PathTracer {
             frame: Some(frame),
             samples: s.samples,
             threshold: s.threshold,
-            resolution: Some(resolution(scene, s)),
+            resolution: Some(resolution(scene, s)?),
             seed: Some(seed),
             threads: Some(threads.max(1)),
             progress: false,

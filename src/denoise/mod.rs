@@ -431,13 +431,7 @@ pub fn denoise_render(
 
 /// Whether the scene asks for denoising of the final render (`cycles.use_denoising`).
 pub fn scene_wants_denoising(scene: &crate::scene::Scene) -> bool {
-    scene
-        .file
-        .scene
-        .cycles
-        .get("use_denoising")
-        .and_then(|v| v.as_bool())
-        .unwrap_or(false)
+    crate::scene::settings::Integrator::of(&scene.file.scene).use_denoising
 }
 
 /// How the install command is spelled in notices: this executable when it is the

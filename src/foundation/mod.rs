@@ -1,7 +1,10 @@
 //! The foundation every other layer builds on: small vector maths for the hot path,
-//! Cycles' ray flags, and the BVH (used by the renderer and by Geometry Nodes' Raycast).
+//! Cycles' ray flags, the BVH (used by the renderer and by Geometry Nodes' Raycast), EXR
+//! encoding and the one atomic file writer.
 //! Nothing here knows Blender's data.
 
 pub mod bvh;
+pub mod exr;
+pub mod files;
 pub mod math;
 pub mod ray;

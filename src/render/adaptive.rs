@@ -13,9 +13,6 @@
 //! The check runs over the whole image at fixed sample counts, so the result does not
 //! depend on threads or timing.
 
-use crate::scene::Rna;
-use serde_json::Value;
-
 const STEP: u32 = 16;
 
 #[derive(Debug, Clone, Copy)]
@@ -29,18 +26,16 @@ pub struct Adaptive {
 impl Adaptive {
     /// From the scene's Cycles settings; `override_threshold` (`--threshold`) turns
     /// adaptive sampling on with that threshold when above 0, and off when 0.
-    pub fn from_scene(cy: &Rna, samples: u32, override_threshold: Option<f32>) -> Adaptive {
-        let f = |k: &str| cy.get(k).and_then(Value::as_f64);
+    pub fn from_settings(
+        i: &crate::scene::settings::Integrator,
+        samples: u32,
+        override_threshold: Option<f32>,
+    ) -> Adaptive {
         let (enabled, threshold) = match override_threshold {
             Some(t) => (t > 0.0 && t.is_finite(), t),
-            None => (
-                cy.get("use_adaptive_sampling")
-                    .and_then(Value::as_bool)
-                    .unwrap_or(false),
-                f("adaptive_threshold").unwrap_or(0.01) as f32,
-            ),
+            None => (i.use_adaptive_sampling, i.adaptive_threshold as f32),
         };
-        let min_setting = f("adaptive_min_samples").unwrap_or(0.0).max(0.0) as u32;
+        let min_setting = i.adaptive_min_samples.max(0.0) as u32;
         Adaptive::new(enabled, threshold, min_setting, samples)
     }
 

@@ -3,11 +3,10 @@
 //! f-stop, focus distance or focus object, aperture blades and rotation; panoramic
 //! cameras (`panorama`: equirectangular, fisheyes, mirror ball, cube face, cylindrical).
 
-use serde_json::Value;
-
 use super::math::*;
 use super::RenderError;
 use crate::anim::EvaluatedScene;
+use crate::scene::settings::{CameraSettings, Output, Projection};
 use crate::scene::Scene;
 
 #[derive(Debug, Clone)]
@@ -35,29 +34,6 @@ pub struct Camera {
     motion: Option<Vec<super::motion::Decomposed>>,
     /// A panoramic camera's projection (viewplane [0, 1]^2 plus shift).
     pub panorama: Option<super::panorama::Panorama>,
-}
-
-/// Blender's sensor fit for an image of (xratio, yratio) (pixel aspect included):
-/// whether the sensor spans the width, and the sensor size along that side in mm.
-pub(super) fn sensor_fit(
-    p: &serde_json::Map<String, Value>,
-    xratio: f32,
-    yratio: f32,
-) -> (bool, f32) {
-    let (horizontal, size) = match p
-        .get("sensor_fit")
-        .and_then(Value::as_str)
-        .unwrap_or("AUTO")
-    {
-        "HORIZONTAL" => (true, num(p, "sensor_width", 36.0)),
-        "VERTICAL" => (false, num(p, "sensor_height", 24.0)),
-        _ => (xratio > yratio, num(p, "sensor_width", 36.0)),
-    };
-    (horizontal, size as f32)
-}
-
-fn num(p: &serde_json::Map<String, Value>, key: &str, default: f64) -> f64 {
-    p.get(key).and_then(Value::as_f64).unwrap_or(default)
 }
 
 impl Camera {
@@ -90,45 +66,43 @@ impl Camera {
                     "camera object {cam_name:?}: camera data {data:?} is not in the export"
                 ))
             })?;
-        let p = &cam.properties;
-        let kind = p.get("type").and_then(Value::as_str).unwrap_or("PERSP");
-        if !matches!(kind, "PERSP" | "ORTHO" | "PANO") {
+        let p = CameraSettings::of(cam);
+        let Some(projection) = p.projection else {
             return Err(RenderError(format!(
-                "camera {data:?}: camera type {kind:?} is not supported"
+                "camera {data:?}: camera type {:?} is not supported",
+                p.kind
             )));
-        }
-        let ortho = kind == "ORTHO";
-        let r = &scene.file.scene.render;
-        let (pax, pay) = (
-            num(r, "pixel_aspect_x", 1.0) as f32,
-            num(r, "pixel_aspect_y", 1.0) as f32,
-        );
+        };
+        let ortho = projection == Projection::Orthographic;
+        let out = Output::of(&scene.file.scene);
+        let (pax, pay) = (out.pixel_aspect_x as f32, out.pixel_aspect_y as f32);
         let xratio = width as f32 * pax;
         let yratio = height as f32 * pay;
-        let panorama = if kind == "PANO" {
+        let panorama = if projection == Projection::Panoramic {
             Some(
-                super::panorama::Panorama::from_camera(p, xratio, yratio)
+                super::panorama::Panorama::from_camera(&p, xratio, yratio)
                     .map_err(|e| RenderError(format!("camera {data:?}: {e}")))?,
             )
         } else {
             None
         };
-        let (horizontal, sensor) = sensor_fit(p, xratio, yratio);
+        let (horizontal, sensor) = p.fit(xratio as f64, yratio as f64);
+        let sensor = sensor as f32;
         let (mut aspect, mut xaspect, mut yaspect) = if horizontal {
             (xratio / yratio, xratio / yratio, 1.0)
         } else {
             (yratio / xratio, 1.0, yratio / xratio)
         };
-        let ortho_scale = num(p, "ortho_scale", 6.0) as f32;
+        let ortho_scale = p.ortho_scale as f32;
         if ortho {
             xaspect = xaspect * ortho_scale / (aspect * 2.0);
             yaspect = yaspect * ortho_scale / (aspect * 2.0);
             aspect = ortho_scale / 2.0;
         }
-        let (sx, sy) = (num(p, "shift_x", 0.0) as f32, num(p, "shift_y", 0.0) as f32);
+        let (sx, sy) = (p.shift_x as f32, p.shift_y as f32);
         let dx = 2.0 * aspect * sx;
         let dy = 2.0 * aspect * sy;
-        let lens = num(p, "lens", 50.0) as f32;
+        let lens = p.lens as f32;
         let tan_half = if ortho {
             1.0
         } else {
@@ -136,15 +110,10 @@ impl Camera {
         };
         // Camera transform without scale (Cycles clears it).
         let to_world = without_scale(&Affine::from_rows(&eval.world_matrices[oi]));
-        let dof = p.get("dof").and_then(Value::as_object);
-        let use_dof = dof
-            .and_then(|d| d.get("use_dof"))
-            .and_then(Value::as_bool)
-            .unwrap_or(false);
         let (mut aperture, mut focus, mut blades, mut rotation, mut ratio) =
             (0.0f32, 10.0f32, 0u32, 0.0f32, 1.0f32);
-        if let (true, Some(d)) = (use_dof, dof) {
-            let fstop = num(d, "aperture_fstop", 2.8) as f32;
+        if let Some(d) = &p.dof {
+            let fstop = d.aperture_fstop as f32;
             // Cycles: lens in mm to a radius in metres; orthographic uses 1/(2 f-stop).
             aperture = if fstop <= 0.0 {
                 0.0
@@ -154,11 +123,11 @@ impl Camera {
                 (lens * 1e-3) / (2.0 * fstop)
             };
             // Blender's unit scale applies to the lens; scene scale is 1 in our fixtures.
-            blades = num(d, "aperture_blades", 0.0) as u32;
-            rotation = num(d, "aperture_rotation", 0.0) as f32;
-            ratio = num(d, "aperture_ratio", 1.0) as f32;
-            focus = num(d, "focus_distance", 10.0) as f32;
-            if let Some(fo) = d.get("focus_object").and_then(Value::as_str) {
+            blades = d.aperture_blades as u32;
+            rotation = d.aperture_rotation as f32;
+            ratio = d.aperture_ratio as f32;
+            focus = d.focus_distance as f32;
+            if let Some(fo) = d.focus_object.as_deref() {
                 if let Some(fi) = eval.data.objects.iter().position(|o| o.name == fo) {
                     // Distance along the view axis to the focus object's origin.
                     let t = eval.world_matrices[fi];
@@ -169,8 +138,8 @@ impl Camera {
             }
             focus = focus.max(1e-5);
         }
-        let clip_start = num(p, "clip_start", 0.1) as f32;
-        let clip_end = num(p, "clip_end", 100.0) as f32;
+        let clip_start = p.clip_start as f32;
+        let clip_end = p.clip_end as f32;
         // A panoramic camera's viewplane is [0, 1]^2, moved by the shift as it is.
         let (left, right, bottom, top) = if panorama.is_some() {
             (sx, 1.0 + sx, sy, 1.0 + sy)

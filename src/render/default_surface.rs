@@ -17,17 +17,11 @@ pub fn apply(scene: &Scene) -> Result<Cow<'_, Scene>, String> {
     }
     let mut out = scene.clone();
     for m in out.file.materials.iter_mut().filter(|m| !m.use_nodes) {
-        let colour = match m.properties.get("diffuse_color") {
-            Some(Value::Array(c)) if c.len() >= 3 && c.iter().all(Value::is_number) => {
-                let c: Vec<f64> = c.iter().filter_map(Value::as_f64).collect();
-                [c[0], c[1], c[2]]
-            }
-            _ => {
-                return Err(format!(
-                    "material {:?}: Use Nodes is off and the export has no diffuse_color",
-                    m.name
-                ))
-            }
+        let Some(colour) = crate::scene::settings::MaterialSettings::of(m).diffuse_color else {
+            return Err(format!(
+                "material {:?}: Use Nodes is off and the export has no diffuse_color",
+                m.name
+            ));
         };
         m.node_tree = Some(diffuse_tree(colour)?);
     }

@@ -11,6 +11,7 @@ use super::area_light::{rect_solid_angle, Region, Spread};
 use super::math::*;
 use super::RenderError;
 use crate::anim::EvaluatedScene;
+use crate::scene::settings::{AreaShape, LightSettings};
 
 #[derive(Debug, Clone)]
 pub enum Shape {
@@ -134,20 +135,12 @@ fn rgb(v: Option<&Value>) -> Option<V3> {
         .map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(1.0) as f32))
 }
 
-fn num(p: &serde_json::Map<String, Value>, k: &str, d: f64) -> f32 {
-    p.get(k).and_then(Value::as_f64).unwrap_or(d) as f32
-}
-
 /// The factor a light's node tree puts on its colour and power: Cycles multiplies the
 /// light's strength by the emission its shader evaluates to. Only a tree that reduces to a
 /// constant (an Emission node with unlinked inputs into the active Light Output) is
 /// supported; any other is an error naming the light and node, never a stand-in.
 fn node_factor(l: &crate::scene::format::Light) -> Result<V3, RenderError> {
-    let use_nodes = l
-        .properties
-        .get("use_nodes")
-        .and_then(Value::as_bool)
-        .unwrap_or(false);
+    let use_nodes = LightSettings::of(l).use_nodes;
     let Some(tree) = l.node_tree.as_ref().filter(|_| use_nodes) else {
         return Ok([1.0; 3]);
     };
@@ -212,20 +205,17 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
         let Some(l) = eval.data.lights.iter().find(|l| l.name == data) else {
             continue;
         };
-        let p = &l.properties;
+        let p = LightSettings::of(l);
         let m = Affine::from_rows(&eval.world_matrices[oi]);
-        let color = rgb(p.get("color")).unwrap_or([1.0; 3]);
-        let energy = num(p, "energy", 10.0);
-        let exposure = num(p, "exposure", 0.0);
+        let color = p.color.map_or([1.0; 3], |c| c.map(|x| x as f32));
+        let energy = p.energy as f32;
+        let exposure = p.exposure as f32;
         let mut strength = mul(scale(color, energy * 2f32.powf(exposure)), node_factor(l)?);
         // Blender 4.5's light temperature: the colour is multiplied by the blackbody colour
         // Blender computed (`temperature_color`, in the scene's working space).
-        if p.get("use_temperature")
-            .and_then(Value::as_bool)
-            .unwrap_or(false)
-        {
-            if let Some(t) = rgb(p.get("temperature_color")) {
-                strength = mul(strength, t);
+        if p.use_temperature {
+            if let Some(t) = p.temperature_color {
+                strength = mul(strength, t.map(|x| x as f32));
             }
         }
         let tree_energy = average(strength).abs()
@@ -234,22 +224,16 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
                 "SUN" => 1.0,
                 _ => 0.25 / PI,
             };
-        let spread = num(p, "spread", std::f64::consts::PI);
+        let spread = p.spread as f32;
         let pos = m.column(3);
         let dir = normalize(neg(m.column(2)));
-        // Blender 4.x keeps Cast Shadow as the light's `use_shadow` (Cycles syncs it from
-        // there); older files had it under `cycles.cast_shadow`.
-        let cast_shadow = p
-            .get("use_shadow")
-            .or_else(|| p.get("cycles").and_then(|c| c.get("cast_shadow")))
-            .and_then(Value::as_bool)
-            .unwrap_or(true);
+        let cast_shadow = p.cast_shadow;
         let shape = match l.kind.as_str() {
             "POINT" | "SPOT" => {
-                let radius = num(p, "shadow_soft_size", 0.25);
+                let radius = p.shadow_soft_size as f32;
                 let spot = if l.kind == "SPOT" {
-                    let size = num(p, "spot_size", std::f64::consts::FRAC_PI_4);
-                    let blend = num(p, "spot_blend", 0.15);
+                    let size = p.spot_size as f32;
+                    let blend = p.spot_blend as f32;
                     let cos_half = (size * 0.5).cos();
                     let smooth = if blend > 0.0 {
                         1.0 / ((1.0 - cos_half) * blend)
@@ -275,10 +259,7 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
                 } else {
                     None
                 };
-                let sphere = !p
-                    .get("use_soft_falloff")
-                    .and_then(Value::as_bool)
-                    .unwrap_or(true);
+                let sphere = !p.use_soft_falloff;
                 Shape::Point {
                     radius,
                     spot,
@@ -287,25 +268,16 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
             }
             // A portal only guides Cycles' sampling of the world through it: it emits
             // nothing, and the world is sampled by its own map here.
-            "AREA"
-                if p.get("cycles")
-                    .and_then(|c| c.get("is_portal"))
-                    .and_then(Value::as_bool)
-                    .unwrap_or(false) =>
-            {
-                continue
-            }
+            "AREA" if p.is_portal => continue,
             "AREA" => {
-                let size = num(p, "size", 1.0);
-                let shape = p.get("shape").and_then(Value::as_str).unwrap_or("SQUARE");
-                let size_y = if shape == "RECTANGLE" || shape == "ELLIPSE" {
-                    num(p, "size_y", 1.0)
-                } else {
-                    size
+                let size = p.size as f32;
+                let size_y = match p.shape {
+                    AreaShape::Rectangle | AreaShape::Ellipse => p.size_y as f32,
+                    AreaShape::Square | AreaShape::Disk => size,
                 };
                 let u = scale(m.column(0), size);
                 let v = scale(m.column(1), size_y);
-                let ellipse = shape == "DISK" || shape == "ELLIPSE";
+                let ellipse = matches!(p.shape, AreaShape::Disk | AreaShape::Ellipse);
                 let mut area = len(u) * len(v);
                 if ellipse {
                     area *= PI / 4.0;
@@ -318,18 +290,18 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
                     v,
                     ellipse,
                     area,
-                    spread: Spread::new(num(p, "spread", std::f64::consts::PI)),
+                    spread: Spread::new(p.spread as f32),
                 }
             }
             "SUN" => Shape::Sun {
-                half_angle: num(p, "angle", 0.00918) * 0.5,
+                half_angle: p.angle as f32 * 0.5,
             },
             _ => continue,
         };
         // Normalize off (Blender 4.5): the power is not spread over the light's area, so the
         // radiance is that many times higher (Cycles' Light::area: a point's sphere, 4 when
         // its radius is 0; the rectangle or ellipse; the sun's disk, 1 when its angle is 0).
-        if !p.get("normalize").and_then(Value::as_bool).unwrap_or(true) {
+        if !p.normalize {
             let area = match &shape {
                 Shape::Point { radius, .. } => {
                     let a = 4.0 * PI * radius * radius;
@@ -351,22 +323,13 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
             strength = scale(strength, area);
         }
         let exclude = excluded_rays(obj.visibility.as_ref());
-        let use_mis = p
-            .get("cycles")
-            .and_then(|c| c.get("use_multiple_importance_sampling"))
-            .and_then(Value::as_bool)
-            .unwrap_or(true);
+        let use_mis = p.use_multiple_importance_sampling;
         let extent = match &shape {
             Shape::Point { radius, .. } => *radius > 0.0,
             Shape::Area { spread, .. } => spread.is_none_or(|s| s.tan_half > 0.0),
             Shape::Sun { half_angle } => *half_angle > 0.0,
         };
-        let max_bounces = p
-            .get("cycles")
-            .and_then(|c| c.get("max_bounces"))
-            .and_then(Value::as_u64)
-            .unwrap_or(1024)
-            .min(u32::MAX as u64) as u32;
+        let max_bounces = p.max_bounces;
         out.push(Light {
             shape,
             strength,

@@ -51,7 +51,7 @@ use std::time::Instant;
 use rayon::prelude::*;
 use serde_json::Value;
 
-use crate::scene::Scene;
+use crate::scene::{settings, Scene};
 use accel::{Accel, Bvh};
 use integrator::{Scratch, Settings};
 use light_tree::LightSelect;
@@ -141,52 +141,17 @@ const TILE: u32 = 16;
 /// Sample dimension set of the shutter time (apart from the sets paths use).
 const TIME_SET: u32 = 0x7000_0000;
 
-fn rna_f(m: &crate::scene::Rna, k: &str) -> Option<f64> {
-    m.get(k).and_then(Value::as_f64)
-}
-
 /// Cycles' `transparent_roughness_squared_threshold` (scene/background.cpp): with Film >
 /// Transparent and Transparent Glass, the Roughness Threshold to the fourth (squared once
 /// for the roughness-to-alpha convention, once to compare with alpha_x * alpha_y);
 /// otherwise -1.
-fn transparent_glass_threshold(film_transparent: bool, cycles: &crate::scene::Rna) -> f32 {
-    if film_transparent
-        && cycles
-            .get("film_transparent_glass")
-            .and_then(Value::as_bool)
-            .unwrap_or(false)
-    {
-        let t = rna_f(cycles, "film_transparent_roughness").unwrap_or(0.1) as f32;
+fn transparent_glass_threshold(i: &settings::Integrator) -> f32 {
+    if i.film_transparent && i.film_transparent_glass {
+        let t = i.film_transparent_roughness as f32;
         (t * t) * (t * t)
     } else {
         -1.0
     }
-}
-
-/// The image size Blender renders from the scene's settings: resolution times its
-/// percentage, truncated; a size below one pixel is Blender's "Image too small" error.
-fn scene_resolution(r: &crate::scene::Rna) -> Result<(u32, u32), RenderError> {
-    let get = |k: &str, default: f64| {
-        let v = rna_f(r, k).unwrap_or(default);
-        if v.is_finite() && v >= 1.0 {
-            Ok(v)
-        } else {
-            Err(RenderError(format!(
-                "scenes.render.{k} is {v}: must be at least 1"
-            )))
-        }
-    };
-    let pct = get("resolution_percentage", 100.0)?;
-    let rx = get("resolution_x", 1920.0)?;
-    let ry = get("resolution_y", 1080.0)?;
-    let (w, h) = (rx * pct / 100.0, ry * pct / 100.0);
-    if w < 1.0 || h < 1.0 {
-        return Err(RenderError(format!(
-            "scenes.render resolution {rx}x{ry} at {pct}% is below one pixel (Blender: \"Image too small\")"
-        )));
-    }
-    // Saturating: anything beyond u32 is then refused by the size check.
-    Ok((w as u32, h as u32))
 }
 
 /// Renders `scene` (overrides already applied) at the options' frame.
@@ -227,8 +192,7 @@ pub fn render_controlled(
         world_shader,
         moving,
     } = prepare(scene, opts, overrides)?;
-    let s = &scene.file.scene;
-    let (cy, r) = (&s.cycles, &s.render);
+    let integrator = settings::Integrator::of(&scene.file.scene);
     let tables = tables::Tables::shared();
     if materials.iter().any(|m| m.multiscatter_glass) {
         tables.warm_glass();
@@ -240,39 +204,28 @@ pub fn render_controlled(
     } else {
         Bvh::build_masked(&geo.tris, &build::triangle_masks(&geo))
     };
-    let filter = filter::FilterTable::blackman_harris(
-        rna_f(cy, "filter_width")
-            .or_else(|| rna_f(r, "filter_size"))
-            .unwrap_or(1.5) as f32,
-    );
-    let gi = |k: &str, d: f64| rna_f(cy, k).unwrap_or(d) as u32;
-    let film_transparent = r
-        .get("film_transparent")
-        .and_then(Value::as_bool)
-        .unwrap_or(false);
+    let filter = filter::FilterTable::blackman_harris(integrator.filter_width as f32);
+    let i = &integrator;
     let settings = Settings {
-        max_bounces: gi("max_bounces", 12.0),
-        max_diffuse: gi("diffuse_bounces", 4.0),
-        max_glossy: gi("glossy_bounces", 4.0),
-        max_transmission: gi("transmission_bounces", 12.0),
-        max_transparent: gi("transparent_max_bounces", 8.0),
+        max_bounces: i.max_bounces,
+        max_diffuse: i.diffuse_bounces,
+        max_glossy: i.glossy_bounces,
+        max_transmission: i.transmission_bounces,
+        max_transparent: i.transparent_max_bounces,
         // The clamp compares the sum of the three channels, so Cycles (integrator.cpp)
         // stores the per-channel setting times three; 0 stays off.
-        clamp_direct: 3.0 * rna_f(cy, "sample_clamp_direct").unwrap_or(0.0) as f32,
-        clamp_indirect: 3.0 * rna_f(cy, "sample_clamp_indirect").unwrap_or(10.0) as f32,
-        min_light_bounces: gi("min_light_bounces", 0.0),
-        min_transparent_bounces: gi("min_transparent_bounces", 0.0),
-        filter_glossy: rna_f(cy, "blur_glossy").unwrap_or(1.0) as f32,
-        film_transparent,
+        clamp_direct: 3.0 * i.sample_clamp_direct as f32,
+        clamp_indirect: 3.0 * i.sample_clamp_indirect as f32,
+        min_light_bounces: i.min_light_bounces,
+        min_transparent_bounces: i.min_transparent_bounces,
+        filter_glossy: i.blur_glossy as f32,
+        film_transparent: i.film_transparent,
         transparent_shadows: materials.iter().any(|m| m.transparent_shadow),
-        transparent_glass: transparent_glass_threshold(film_transparent, cy),
+        transparent_glass: transparent_glass_threshold(i),
     };
     let exposure = 1.0f32;
     let build_seconds = start.elapsed().as_secs_f64();
-    let use_light_tree = cy
-        .get("use_light_tree")
-        .and_then(Value::as_bool)
-        .unwrap_or(true);
+    let use_light_tree = i.use_light_tree;
     let light_select = light_select(
         &geo,
         &materials,
@@ -298,7 +251,7 @@ pub fn render_controlled(
         view: camera.view(),
     };
 
-    let adaptive = adaptive::Adaptive::from_scene(cy, samples, opts.threshold);
+    let adaptive = adaptive::Adaptive::from_settings(&integrator, samples, opts.threshold);
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);
     let n_tiles = (tiles_x * tiles_y) as usize;
@@ -582,26 +535,28 @@ fn prepare(
     let scene: &Scene = &with_surfaces;
     let start = Instant::now();
     let s = &scene.file.scene;
-    let (cy, r) = (&s.cycles, &s.render);
+    let integrator = settings::Integrator::of(s);
     let (w, h) = match opts.resolution {
         Some((w, h)) => {
             limits::check_film(w, h, "--resolution")?;
             (w, h)
         }
         None => {
-            let (w, h) = scene_resolution(r)?;
+            let (w, h) = settings::Output::of(s).size().map_err(RenderError)?;
             limits::check_film(w, h, "the scene's resolution (scenes.render)")?;
             (w, h)
         }
     };
-    let shutter = motion::Shutter::from_render(r).map_err(RenderError)?;
+    let shutter =
+        motion::Shutter::from_settings(&settings::MotionBlur::of(s).map_err(RenderError)?)
+            .map_err(RenderError)?;
     let samples = match opts.samples {
         Some(n) => {
             limits::check_samples(n, "--samples")?;
             n
         }
         None => {
-            let n = rna_f(cy, "samples").unwrap_or(128.0);
+            let n = integrator.samples;
             if !(n >= 1.0 && n <= limits::MAX_SAMPLES as f64 && n.fract() == 0.0) {
                 return Err(RenderError(format!(
                     "scenes.cycles.samples is {n}: must be a whole number from 1 to {}",
@@ -617,9 +572,7 @@ fn prepare(
     if let Some(n) = opts.threads {
         limits::check_threads(n)?;
     }
-    let seed = opts
-        .seed
-        .unwrap_or_else(|| rna_f(cy, "seed").unwrap_or(0.0) as u32);
+    let seed = opts.seed.unwrap_or(integrator.seed as u32);
     let frame = opts.frame.unwrap_or(s.frame_current as f64);
     if !frame.is_finite() {
         return Err(RenderError(format!("frame {frame} is not finite")));
@@ -999,27 +952,9 @@ pub fn write_exr(
     height: u32,
     pixels: &[[f32; 4]],
 ) -> Result<(), RenderError> {
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(std::path::Path::new("."));
-    let mut buf = Vec::with_capacity(pixels.len() * 4);
-    for p in pixels {
-        buf.extend_from_slice(p);
-    }
-    let img = image::Rgba32FImage::from_raw(width, height, buf)
-        .ok_or_else(|| RenderError("image buffer size mismatch".into()))?;
-    let tmp = tempfile::Builder::new()
-        .suffix(".exr")
-        .permissions(crate::color::user_file_permissions())
-        .tempfile_in(dir)
-        .map_err(|e| RenderError(format!("{}: {e}", dir.display())))?;
-    image::DynamicImage::ImageRgba32F(img)
-        .save_with_format(tmp.path(), image::ImageFormat::OpenExr)
+    let bytes = crate::foundation::exr::rgba_bytes(width, height, pixels)
         .map_err(|e| RenderError(format!("{}: {e}", path.display())))?;
-    tmp.persist(path)
-        .map_err(|e| RenderError(format!("{}: {e}", path.display())))?;
-    Ok(())
+    crate::foundation::files::write_atomic(path, &bytes).map_err(RenderError)
 }
 
 #[doc(hidden)]

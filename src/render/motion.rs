@@ -7,10 +7,9 @@
 //! Objects use the same decomposition and interpolation (`object_motion` keeps moving
 //! objects in object space and moves each ray into it at the ray's time).
 
-use serde_json::Value;
-
 use super::math::*;
 use crate::nodes::curves::{mapping_from_json, CurveKind, CurveTable};
+use crate::scene::settings::{MotionBlur, ShutterPosition};
 
 /// Cycles' SHUTTER_TABLE_SIZE and the resolution Blender samples the curve at.
 const TABLE: usize = 256;
@@ -28,33 +27,18 @@ pub struct Shutter {
 
 impl Shutter {
     /// None when motion blur is off (or the shutter is empty).
-    pub fn from_render(r: &crate::scene::Rna) -> Result<Option<Shutter>, String> {
-        if r.get("use_motion_blur").and_then(Value::as_bool) != Some(true) {
+    pub fn from_settings(m: &MotionBlur) -> Result<Option<Shutter>, String> {
+        let length = m.shutter;
+        if !m.enabled || length.is_nan() || length <= 0.0 {
             return Ok(None);
         }
-        let length = r
-            .get("motion_blur_shutter")
-            .and_then(Value::as_f64)
-            .unwrap_or(0.5);
-        if length.is_nan() || length <= 0.0 {
-            return Ok(None);
-        }
-        let centre_delta = match r
-            .get("motion_blur_position")
-            .and_then(Value::as_str)
-            .unwrap_or("CENTER")
-        {
-            "START" => 0.5 * length,
-            "END" => -0.5 * length,
-            "CENTER" => 0.0,
-            other => {
-                return Err(format!(
-                    "render.motion_blur_position {other:?} is not START, CENTER or END"
-                ))
-            }
+        let centre_delta = match m.position {
+            ShutterPosition::Start => 0.5 * length,
+            ShutterPosition::End => -0.5 * length,
+            ShutterPosition::Center => 0.0,
         };
-        let curve = match r.get("motion_blur_shutter_curve") {
-            Some(v) if !v.is_null() => {
+        let curve = match &m.shutter_curve {
+            Some(v) => {
                 let m = mapping_from_json(v)
                     .map_err(|e| format!("render.motion_blur_shutter_curve: {}", e.0))?;
                 let t = CurveTable::new(&m, CurveKind::Float)

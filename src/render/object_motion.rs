@@ -387,13 +387,8 @@ impl Accel for MotionAccel {
 /// motion blur is on and a rendered object's mesh comes from Geometry Nodes (whose
 /// output can change over time) with Cycles' deformation blur on.
 pub fn warn_deformation(eval: &crate::anim::EvaluatedScene) {
-    let deform = |o: &crate::scene::Object| {
-        o.cycles
-            .as_ref()
-            .and_then(|c| c.get("use_deform_motion"))
-            .and_then(serde_json::Value::as_bool)
-            != Some(false)
-    };
+    let deform =
+        |o: &crate::scene::Object| crate::scene::settings::ObjectSettings::of(o).use_deform_motion;
     let generated = eval.data.objects.iter().any(|o| {
         o.kind == "MESH"
             && !o.hide_render

@@ -4,7 +4,7 @@
 //! into Blender's camera space (looking down -Z) as Cycles' camera matrix does. A zero
 //! direction means the point is outside the lens: the sample sees nothing (black).
 
-use serde_json::{Map, Value};
+use crate::scene::settings::CameraSettings;
 
 use super::math::*;
 
@@ -32,42 +32,27 @@ pub enum Panorama {
     CentralCylindrical([f32; 4]),
 }
 
-fn num(p: &Map<String, Value>, key: &str, default: f64) -> f32 {
-    p.get(key).and_then(Value::as_f64).unwrap_or(default) as f32
-}
-
 impl Panorama {
-    /// The camera data's panorama settings; `fit` is the render's (xratio, yratio) with
-    /// pixel aspect, for the sensor size the equisolid and polynomial fisheyes use.
-    pub fn from_camera(
-        p: &Map<String, Value>,
-        xratio: f32,
-        yratio: f32,
-    ) -> Result<Panorama, String> {
-        let kind = p
-            .get("panorama_type")
-            .and_then(Value::as_str)
-            .unwrap_or("FISHEYE_EQUISOLID");
+    /// The camera data's panorama settings; `xratio`, `yratio` are the render's size
+    /// with pixel aspect, for the sensor size the equisolid and polynomial fisheyes use.
+    pub fn from_camera(c: &CameraSettings, xratio: f32, yratio: f32) -> Result<Panorama, String> {
+        let p = &c.panorama;
         // Blender's sensor fit decides which side the sensor size spans (blender_camera_sync).
         let sensor = || {
-            let (horizontal, size) = super::camera::sensor_fit(p, xratio, yratio);
+            let (horizontal, size) = c.fit(xratio as f64, yratio as f64);
+            let size = size as f32;
             if horizontal {
                 [size, size * yratio / xratio]
             } else {
                 [size * xratio / yratio, size]
             }
         };
-        let fov = num(p, "fisheye_fov", std::f64::consts::PI);
-        Ok(match kind {
+        let fov = p.fisheye_fov as f32;
+        let k = p.fisheye_polynomial.map(|k| k as f32);
+        Ok(match p.panorama_type.as_str() {
             "EQUIRECTANGULAR" => {
-                let (lo_min, lo_max) = (
-                    num(p, "longitude_min", -std::f64::consts::PI),
-                    num(p, "longitude_max", std::f64::consts::PI),
-                );
-                let (la_min, la_max) = (
-                    num(p, "latitude_min", -std::f64::consts::FRAC_PI_2),
-                    num(p, "latitude_max", std::f64::consts::FRAC_PI_2),
-                );
+                let [lo_min, lo_max] = p.longitude.map(|v| v as f32);
+                let [la_min, la_max] = p.latitude.map(|v| v as f32);
                 Panorama::Equirectangular([
                     lo_min - lo_max,
                     -lo_min,
@@ -79,29 +64,21 @@ impl Panorama {
             "MIRRORBALL" => Panorama::MirrorBall,
             "FISHEYE_EQUIDISTANT" => Panorama::FisheyeEquidistant { fov },
             "FISHEYE_EQUISOLID" => Panorama::FisheyeEquisolid {
-                lens: num(p, "fisheye_lens", 10.5),
+                lens: p.fisheye_lens as f32,
                 fov,
                 sensor: sensor(),
             },
             "FISHEYE_LENS_POLYNOMIAL" => Panorama::FisheyeLensPolynomial {
-                k0: num(p, "fisheye_polynomial_k0", 0.0),
-                k: [
-                    num(p, "fisheye_polynomial_k1", 0.0),
-                    num(p, "fisheye_polynomial_k2", 0.0),
-                    num(p, "fisheye_polynomial_k3", 0.0),
-                    num(p, "fisheye_polynomial_k4", 0.0),
-                ],
+                k0: k[0],
+                k: [k[1], k[2], k[3], k[4]],
                 fov,
                 sensor: sensor(),
             },
             "CENTRAL_CYLINDRICAL" => {
-                let r = num(p, "central_cylindrical_radius", 1.0);
-                Panorama::CentralCylindrical([
-                    -num(p, "central_cylindrical_range_u_min", -std::f64::consts::PI),
-                    -num(p, "central_cylindrical_range_u_max", std::f64::consts::PI),
-                    num(p, "central_cylindrical_range_v_min", -1.0) / r,
-                    num(p, "central_cylindrical_range_v_max", 1.0) / r,
-                ])
+                let r = p.central_cylindrical_radius as f32;
+                let [u_min, u_max] = p.central_cylindrical_range_u.map(|v| v as f32);
+                let [v_min, v_max] = p.central_cylindrical_range_v.map(|v| v as f32);
+                Panorama::CentralCylindrical([-u_min, -u_max, v_min / r, v_max / r])
             }
             other => return Err(format!("panorama type {other:?} is not supported")),
         })

@@ -58,19 +58,9 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
                 *slot = Some(bi as u32);
             }
         }
-        let sampling = m
-            .properties
-            .get("cycles")
-            .and_then(|c| c.get("emission_sampling"))
-            .and_then(|v| v.as_str())
-            .unwrap_or("AUTO")
-            .to_string();
-        let bump_correction = m
-            .properties
-            .get("cycles")
-            .and_then(|c| c.get("use_bump_map_correction"))
-            .and_then(|v| v.as_bool())
-            .unwrap_or(true);
+        let ms = crate::scene::settings::MaterialSettings::of(m);
+        let sampling = ms.emission_sampling;
+        let bump_correction = ms.use_bump_map_correction;
         let bssrdf_bump = has_bssrdf_bump(&p);
         let transparent_shadow = can_be_transparent(&p);
         let multiscatter_glass = has_multiscatter_glass(&p);

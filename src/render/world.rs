@@ -95,18 +95,16 @@ pub fn excluded_rays(scene: &Scene) -> u32 {
     let Some(w) = scene.file.worlds.iter().find(|w| w.name == name) else {
         return 0;
     };
-    let Some(v) = w.properties.get("cycles_visibility") else {
-        return 0;
-    };
+    let seen = crate::scene::settings::WorldSettings::of(w).visible_to;
     let mut x = 0;
-    for (key, flag) in [
-        ("camera", ray::CAMERA),
-        ("diffuse", ray::DIFFUSE),
-        ("glossy", ray::GLOSSY),
-        ("transmission", ray::TRANSMIT),
-        ("scatter", ray::VOLUME_SCATTER),
-    ] {
-        if v.get(key).and_then(Value::as_bool) == Some(false) {
+    for (visible, flag) in seen.into_iter().zip([
+        ray::CAMERA,
+        ray::DIFFUSE,
+        ray::GLOSSY,
+        ray::TRANSMIT,
+        ray::VOLUME_SCATTER,
+    ]) {
+        if !visible {
             x |= flag;
         }
     }
@@ -157,12 +155,7 @@ pub fn shader(scene: &Scene) -> Result<Option<WorldShader>, RenderError> {
     let mut shader = WorldShader { program, map: None };
     // World > Settings > Surface > Sampling "None": Cycles does not light-sample the world
     // (its background light is off); BSDF rays alone find it.
-    let sampled = w
-        .properties
-        .get("cycles")
-        .and_then(|c| c.get("sampling_method"))
-        .and_then(Value::as_str)
-        != Some("NONE");
+    let sampled = crate::scene::settings::WorldSettings::of(w).sampled;
     if sampled {
         shader.map = WorldMap::build(&shader, MAP_WIDTH, MAP_WIDTH / 2);
     }

@@ -10,6 +10,7 @@ pub mod format;
 pub mod limits;
 pub mod mesh;
 pub mod overrides;
+pub mod settings;
 mod validate;
 
 use std::path::{Component, Path, PathBuf};

@@ -277,29 +277,14 @@ fn inverse_transpose3(m: &[[f64; 4]; 4]) -> Option<[[f64; 3]; 3]> {
 /// Writes a baked image as a 32-bit float RGBA EXR (top row first, as image files are),
 /// atomically: to a temporary file beside `path`, then renamed.
 pub fn write_exr(b: &Baked, path: &Path) -> Result<(), String> {
-    let n = b.size;
-    let mut img = image::Rgba32FImage::new(n, n);
+    let n = b.size as usize;
+    let mut rows = vec![[0.0f32; 4]; n * n];
     for y in 0..n {
-        for x in 0..n {
-            let p = b.pixels[(y * n + x) as usize];
-            img.put_pixel(x, n - 1 - y, image::Rgba(p));
-        }
+        rows[(n - 1 - y) * n..(n - y) * n].copy_from_slice(&b.pixels[y * n..(y + 1) * n]);
     }
-    let dir = path
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let tmp = tempfile::Builder::new()
-        .prefix(".bake-")
-        .suffix(".exr")
-        .permissions(crate::color::user_file_permissions())
-        .tempfile_in(dir)
+    let bytes = crate::foundation::exr::rgba_bytes(b.size, b.size, &rows)
         .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    img.save_with_format(tmp.path(), image::ImageFormat::OpenExr)
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    tmp.persist(path)
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    Ok(())
+    crate::foundation::files::write_atomic(path, &bytes)
 }
 
 /// The transpose of the 3x3 part of `m` times `v` (world to object for normals).

@@ -177,11 +177,7 @@ pub fn scene_view(scene: &crate::scene::Scene) -> Result<Option<View>, String> {
     if scene.file.scene.camera.is_none() {
         return Ok(None);
     }
-    let r = &scene.file.scene.render;
-    let get = |k: &str, d: f64| r.get(k).and_then(serde_json::Value::as_f64).unwrap_or(d);
-    let pct = get("resolution_percentage", 100.0);
-    let w = ((get("resolution_x", 1920.0) * pct / 100.0) as u32).max(1);
-    let h = ((get("resolution_y", 1080.0) * pct / 100.0) as u32).max(1);
+    let (w, h) = crate::scene::settings::Output::of(&scene.file.scene).size()?;
     let eval = crate::anim::evaluate_scene(scene, scene.file.scene.frame_current as f64)
         .map_err(|e| format!("evaluating the scene for its camera: {e}"))?;
     let cam = crate::render::camera::Camera::new(scene, &eval, w, h).map_err(|e| e.0)?;
