@@ -15,6 +15,7 @@ use super::build::Geometry;
 use super::light::Light;
 use super::light_tree::{LightSelect, Pick};
 use super::math::*;
+use super::path_state::{Next, Path, SETS_PER_VERTEX};
 use super::sampler::PixelSampler;
 use super::shade::{Context, Material};
 use super::tables::Tables;
@@ -262,10 +263,12 @@ impl Scene<'_> {
         }
     }
 
-    /// One path sample: radiance along the camera ray.
+    /// One path sample: radiance along the camera ray. Each vertex runs the steps Cycles'
+    /// kernels run: lights the ray passes and the world it may miss into, then at a
+    /// surface its shader, emission, Russian roulette, one light sample, and the BSDF
+    /// sample that `Path::next` turns into the next ray (or a subsurface walk).
     // The shading state is passed apart, as Cycles passes it to its kernels.
     #[allow(clippy::too_many_arguments)]
-    // Long because the path loop keeps its state in locals; splitting it into a PathState and steps is open work (issue 25).
     pub fn radiance(
         &self,
         org: V3,
@@ -277,390 +280,75 @@ impl Scene<'_> {
         scratch: &mut Scratch,
     ) -> V3 {
         let st = &self.settings;
-        let mut l = [0.0f32; 3];
-        let mut throughput = [1.0f32; 3];
         scratch.features = Default::default();
         scratch.transparent = 0.0;
-        let (mut o, mut d, mut t0, mut t1) = (org, dir, tmin, tmax);
-        let (mut bounce, mut diffuse, mut glossy, mut transmission, mut transparent) =
-            (0u32, 0u32, 0u32, 0u32, 0u32);
-        let mut terminate_next = false;
-        // Cycles' path flags of the ray being traced (Light Path node).
-        let mut flags = ray::CAMERA;
-        let mut set = 1u32;
-        // MIS state of the ray being traced: the BSDF pdf that chose it, or singular.
-        let mut prev_pdf = f32::INFINITY;
-        let mut prev_singular = true;
-        // Smallest pdf of the non-singular bounces so far (Cycles' min_ray_pdf).
-        let mut min_ray_pdf = f32::INFINITY;
-        // Where the ray being traced was sampled, as light selection saw it (Cycles'
-        // mis_origin_n and PATH_RAY_MIS_HAD_TRANSMISSION): the probability of picking
-        // what the ray finds, for its MIS weight, is computed there.
-        let mut mis_n = [0.0f32; 3];
-        let mut mis_trans = false;
-        // Where a subsurface random walk left the object: the next vertex, shaded white
-        // diffuse (Cycles' subsurface_shader_data_setup); and whether the path has taken a
-        // diffuse bounce (a BSSRDF then falls back to diffuse, as in Cycles).
-        let mut sss_exit: Option<super::accel::Hit> = None;
-        let mut diffuse_ancestor = false;
-        // Cycles' PATH_RAY_TRANSPARENT_BACKGROUND: camera rays, kept through transparent
-        // surfaces and (with Transparent Glass) through smooth enough refraction.
-        let mut transparent_bg = true;
-        // Ray differentials, carried through bounces as Cycles does: the next ray's dP is
-        // the hit's; dD stays, except that a subsurface bounce zeroes it.
-        let (mut ray_dp, mut ray_dd) = (scratch.ray_dp, scratch.ray_dd);
+        let mut path = Path::camera(org, dir, tmin, tmax, scratch.ray_dp, scratch.ray_dd);
         loop {
-            let from_sss = sss_exit.take();
+            let from_sss = path.sss_exit.take();
             let hit_opt = if from_sss.is_some() {
                 from_sss
             } else {
                 scratch.rays += 1;
-                self.accel
-                    .intersect_vis(o, d, t0, t1, scratch.time, visibility::of_path(flags))
+                self.accel.intersect_vis(
+                    path.o,
+                    path.d,
+                    path.t0,
+                    path.t1,
+                    scratch.time,
+                    visibility::of_path(path.state.flags),
+                )
             };
-            // Emission reached by a ray clamps as the bounce before it (Cycles: light found
-            // after one bounce is direct light, like the light sample at that vertex).
-            let clamp_limit = if bounce <= 1 {
-                st.clamp_direct
-            } else {
-                st.clamp_indirect
-            };
-            // Lights are not in the BVH: a ray collects every light it passes before the surface.
-            let t_surface =
-                hit_opt
-                    .map(|h| h.t)
-                    .unwrap_or(if t1.is_finite() { t1 } else { f32::INFINITY });
-            for (li, light) in self
-                .lights
-                .iter()
-                .enumerate()
-                .filter(|(_, l)| from_sss.is_none() && l.visible_to(flags))
-            {
-                // Rays other than the camera's see only lights shared with BSDF sampling
-                // (Cycles' lights_intersect skips those without SHADER_USE_MIS).
-                if !light.mis && flags & ray::CAMERA == 0 {
-                    continue;
-                }
-                if let Some(lh) = light.intersect(o, d, t_surface) {
-                    let w = if prev_singular {
-                        1.0
-                    } else {
-                        power_heuristic(
-                            prev_pdf,
-                            lh.pdf
-                                * self
-                                    .light_select
-                                    .pdf(o, mis_n, mis_trans, Pick::Lamp(li as u32)),
-                        )
-                    };
-                    scratch
-                        .features
-                        .add_emission(scale(mul(throughput, lh.radiance), w));
-                    let c = clamp_contrib(scale(mul(throughput, lh.radiance), w), clamp_limit);
-                    if finite(c) {
-                        l = add(l, c);
-                    }
-                }
+            let clamp_limit = path.hit_clamp(st);
+            if from_sss.is_none() {
+                self.lights_along(&mut path, hit_opt.map(|h| h.t), clamp_limit, scratch);
             }
             let Some(h) = hit_opt else {
-                if st.film_transparent && transparent_bg {
-                    scratch.transparent += average(throughput);
-                    break;
-                }
-                // A world hidden from this ray type gives it nothing (Cycles'
-                // integrator_eval_background_shader).
-                if !super::light::visible_to(self.world_exclude, flags) {
-                    break;
-                }
-                let w = self.world_mis_weight(d, prev_singular, prev_pdf, o, mis_n, mis_trans);
-                let bg = scale(mul(throughput, self.background_toward(d, scratch)), w);
-                scratch.features.add_emission(bg);
-                let c = clamp_contrib(bg, clamp_limit);
-                if finite(c) {
-                    l = add(l, c);
-                }
+                self.miss(&mut path, clamp_limit, scratch);
                 break;
             };
-            let wo = neg(d);
-            let mut hit = self.surface_at(h.prim, h.u, h.v, wo, scratch.time);
-            hit.sp.ray_length = h.t;
-            hit.sp.path = PathState {
-                flags,
-                bounce,
-                diffuse,
-                glossy,
-                transmission,
-                transparent,
-            };
-            ray_dp += h.t * ray_dd;
-            self.fill_differentials(&mut hit, h.prim, ray_dp);
-            if from_sss.is_some() {
-                // With a bumped BSSRDF Cycles runs the material at the exit and lights
-                // with the BSSRDF's normal there (corrected as seen along the true normal).
-                let (n, smooth) = match hit.material {
-                    Some(mi) if self.materials[mi].bssrdf_bump => {
-                        self.shade(&hit, wo, scratch);
-                        let smooth = scratch.lobes.smooth_n;
-                        (
-                            super::subsurface::exit_normal(&scratch.lobes, smooth),
-                            smooth,
-                        )
-                    }
-                    _ => (hit.sp.normal, hit.sp.normal),
-                };
-                let correction = hit
-                    .material
-                    .map(|mi| self.materials[mi].bump_correction)
-                    .unwrap_or(true);
-                scratch.lobes.clear();
-                scratch.lobes.smooth_n = smooth;
-                scratch.lobes.bump_correction = correction;
-                scratch.lobes.push(LobeKind::Diffuse, [1.0; 3], n);
-            } else {
-                self.shade(&hit, wo, scratch);
-                // A holdout object seen by the camera (directly or through transparent
-                // surfaces: Cycles' PATH_RAY_TRANSPARENT_BACKGROUND) keeps only its
-                // transparency; the rest is a hole in the film.
-                if transparent_bg && self.geo.instances[hit.inst as usize].holdout {
-                    // The holdout weight (Cycles' surface_shader_apply_holdout) is what
-                    // the object's transparency does not let through.
-                    let weight = sub(
-                        [1.0; 3],
-                        scratch.lobes.transparent.map(|t| t.clamp(0.0, 1.0)),
-                    );
-                    scratch.transparent += average(mul(weight, throughput));
-                    if !holdout_keep_transparent(&mut scratch.lobes) {
-                        break;
-                    }
-                } else if transparent_bg && !is_zero(scratch.lobes.holdout) {
-                    // Holdout closures (the Holdout shader node) seen by the camera.
-                    let weight = scratch.lobes.holdout;
-                    scratch.transparent += average(mul(weight, throughput));
-                    if weight.iter().all(|&w| w == 1.0) {
-                        break;
-                    }
-                }
+            let wo = neg(path.d);
+            let hit = self.vertex(&mut path, &h, wo, scratch);
+            if !self.shade_vertex(&path, &hit, wo, from_sss.is_some(), scratch) {
+                break;
             }
             scratch.lobes.terminator_frequency =
                 self.geo.instances[hit.inst as usize].terminator_frequency;
-            if diffuse_ancestor {
+            if path.diffuse_ancestor {
                 super::subsurface::to_diffuse(&mut scratch.lobes);
             }
-            // Cycles' surface_shader_prepare_closures. Its 3.x defensive sampling (a floor
-            // on each closure's selection weight at the first hit) is gone in 4.x: the
-            // firefly histograms of a sharp specular over a diffuse base match Cycles 4.5
-            // only without it. Filter Glossy: after diffuse-like bounces, glossy lobes are
-            // roughened.
-            if st.filter_glossy > 0.0 && min_ray_pdf.is_finite() {
-                // Cycles' kernel uses 1 / blur_glossy.
-                let blur_pdf = min_ray_pdf / st.filter_glossy;
-                if blur_pdf < 1.0 {
-                    let blur = (1.0 - blur_pdf).sqrt() * 0.5;
-                    let n = scratch.lobes.len;
-                    for lobe in &mut scratch.lobes.lobes[..n] {
-                        if let LobeKind::Glossy { alpha, .. } = &mut lobe.kind {
-                            *alpha = alpha.max(blur);
-                        }
-                        if let LobeKind::Glass(g) = &mut lobe.kind {
-                            g.alpha = g.alpha.max(blur);
-                        }
-                        if let LobeKind::Reflection(r) = &mut lobe.kind {
-                            r.alpha = r.alpha.max(blur);
-                        }
-                        if let LobeKind::GlossyAniso { lobe: a, .. } = &mut lobe.kind {
-                            a.alpha_x = a.alpha_x.max(blur);
-                            a.alpha_y = a.alpha_y.max(blur);
-                        }
-                    }
-                }
-            }
-            let lobes = &scratch.lobes;
-            if !is_zero(lobes.emission) {
-                // Only the sides light sampling draws from share the emission by MIS
-                // (Cycles' SD_MIS_FRONT / SD_MIS_BACK).
-                let (front, back) = self.emission_sides(h.prim);
-                let w = if prev_singular || !(if hit.backfacing { back } else { front }) {
-                    1.0
-                } else {
-                    let pick = self
-                        .light_select
-                        .pdf(o, mis_n, mis_trans, Pick::Triangle(h.prim));
-                    if pick > 0.0 {
-                        power_heuristic(
-                            prev_pdf,
-                            pick * super::triangle_light::pdf(
-                                &self.geo.tris[h.prim as usize],
-                                o,
-                                d,
-                                h.t,
-                            ),
-                        )
-                    } else {
-                        1.0
-                    }
-                };
-                scratch
-                    .features
-                    .add_emission(scale(mul(throughput, lobes.emission), w));
-                let c = clamp_contrib(scale(mul(throughput, lobes.emission), w), clamp_limit);
-                if finite(c) {
-                    l = add(l, c);
-                }
-            }
+            filter_glossy(&mut scratch.lobes, path.min_ray_pdf, st.filter_glossy);
+            self.emission_at_hit(&mut path, &h, &hit, clamp_limit, scratch);
             // A subsurface exit is not a surface the camera path saw (Cycles writes no
             // guides there).
             if from_sss.is_none() {
-                scratch.features.surface(lobes);
+                scratch.features.surface(&scratch.lobes);
             }
-            let u_bsdf = rng.get4(index, set);
-            let u_light = rng.get4(index, set + 1);
-            set += 3;
-            if terminate_next {
-                // Only transparent surfaces let such a path continue (Cycles'
-                // TERMINATE_AFTER_TRANSPARENT).
-                if is_zero(lobes.transparent) {
-                    break;
-                }
+            let u_bsdf = rng.get4(index, path.set);
+            let u_light = rng.get4(index, path.set + 1);
+            path.set += SETS_PER_VERTEX;
+            // Only transparent surfaces let a path at its bounce limit continue.
+            if path.terminate_next && is_zero(scratch.lobes.transparent) {
+                break;
             }
-            // Russian roulette as Cycles (path_state_continuation_probability): sqrt of the
-            // throughput, but never within the minimum bounces, which Cycles' kernel takes
-            // as the setting plus one (so the first indirect hit always continues),
-            // counted in transparent bounces when the ray just passed a transparent
-            // surface; and not again at a subsurface exit (decided at the entry).
-            let roulette = if flags & ray::TRANSPARENT != 0 {
-                transparent > st.min_transparent_bounces + 1
-            } else {
-                bounce > st.min_light_bounces + 1
-            };
-            if roulette && from_sss.is_none() {
-                let q = max3(throughput.map(f32::abs)).sqrt().min(1.0);
-                if q <= 0.0 || u_light[3] >= q {
-                    break;
-                }
-                throughput = scale(throughput, 1.0 / q);
+            // Not again at a subsurface exit: decided at the entry.
+            if from_sss.is_none() && !path.survives_roulette(st, u_light[3]) {
+                break;
             }
-            let p_off = |dir: V3| offset_origin(hit.p, hit.ng, dir);
-            // Next-event estimation: one emitter, picked as Cycles picks it at this point
-            // (its shading normal, and whether its BSDF transmits), the sample divided by
-            // the probability of the pick.
+            // Light selection sees the vertex by its shading normal and whether its BSDF
+            // transmits; the next ray's MIS weights are computed from there.
             let n_sel = if is_zero(scratch.lobes.smooth_n) {
                 hit.sp.normal
             } else {
                 scratch.lobes.smooth_n
             };
             let trans_sel = scratch.lobes.has_transmission();
-            let picked = if !terminate_next && scratch.lobes.len > 0 {
-                self.light_select
-                    .select(hit.p, n_sel, trans_sel, u_light[2])
-            } else {
-                None
-            };
-            let clamp_nee = if bounce == 0 {
-                st.clamp_direct
-            } else {
-                st.clamp_indirect
-            };
-            match picked {
-                Some((Pick::Lamp(li), p_sel)) if bounce <= self.lights[li as usize].max_bounces => {
-                    let light = &self.lights[li as usize];
-                    if let Some(ls) = light.sample(hit.p, [u_light[0], u_light[1]]) {
-                        let (f, pdf_b) = scratch.lobes.eval_excluding(
-                            wo,
-                            ls.wi,
-                            hit.ng,
-                            self.tables,
-                            light.exclude,
-                        );
-                        // Lights with extent are shared with BSDF sampling at every vertex, as
-                        // Cycles does (light_sample_mis_weight_nee).
-                        let w = if light.mis {
-                            power_heuristic(ls.pdf * p_sel, pdf_b)
-                        } else {
-                            1.0
-                        };
-                        let c = scale(mul(mul(throughput, f), ls.value), w / p_sel);
-                        if !is_zero(c) && finite(c) {
-                            let start = self.shadow_origin(&hit, scratch.lobes.smooth_n, ls.wi);
-                            let tr = if light.cast_shadow {
-                                self.shadow_transmittance(
-                                    start,
-                                    ls.wi,
-                                    if ls.dist.is_finite() {
-                                        ls.dist * (1.0 - 1e-4)
-                                    } else {
-                                        f32::INFINITY
-                                    },
-                                    scratch,
-                                )
-                            } else {
-                                [1.0; 3]
-                            };
-                            if !is_zero(tr) {
-                                l = add(l, clamp_contrib(mul(c, tr), clamp_nee));
-                            }
-                        }
-                    }
+            if !path.terminate_next && scratch.lobes.len > 0 {
+                let u = [u_light[0], u_light[1], u_light[2]];
+                if let Some(c) =
+                    self.direct_light(&path, &hit, h.prim, wo, u, n_sel, trans_sel, scratch)
+                {
+                    path.l = add(path.l, c);
                 }
-                Some((Pick::Triangle(prim), p_sel)) if prim != h.prim => {
-                    let (front, back) = self.emission_sides(prim);
-                    if let Some(ts) = super::triangle_light::sample(
-                        &self.geo.tris[prim as usize],
-                        hit.p,
-                        [u_light[0], u_light[1]],
-                        front,
-                        back,
-                    ) {
-                        // The emitter's object hidden from some ray types lights only the
-                        // closures of the others (Cycles' SHADER_EXCLUDE_* of mesh lights).
-                        let seen_by = self.geo.instances
-                            [self.geo.refs[prim as usize].inst as usize]
-                            .visibility;
-                        let exclude = !seen_by
-                            & (ray::DIFFUSE | ray::GLOSSY | ray::TRANSMIT | ray::VOLUME_SCATTER);
-                        let (f, pdf_b) = if exclude == 0 {
-                            scratch.lobes.eval(wo, ts.wi, hit.ng, self.tables)
-                        } else {
-                            scratch
-                                .lobes
-                                .eval_excluding(wo, ts.wi, hit.ng, self.tables, exclude)
-                        };
-                        if !is_zero(f) {
-                            let pdf_l = p_sel * ts.pdf;
-                            let start = self.shadow_origin(&hit, scratch.lobes.smooth_n, ts.wi);
-                            let tr = self.shadow_transmittance(
-                                start,
-                                ts.wi,
-                                ts.dist * (1.0 - 1e-4),
-                                scratch,
-                            );
-                            if !is_zero(tr) {
-                                let le = self.light_emission(
-                                    prim,
-                                    ts.b1,
-                                    ts.b2,
-                                    neg(ts.wi),
-                                    ts.dist,
-                                    bounce,
-                                    scratch,
-                                );
-                                let w = power_heuristic(pdf_l, pdf_b);
-                                let c = mul(scale(mul(mul(throughput, f), le), w / pdf_l), tr);
-                                if finite(c) {
-                                    l = add(l, clamp_contrib(c, clamp_nee));
-                                }
-                            }
-                        }
-                    }
-                }
-                Some((Pick::World, p_sel)) => {
-                    let c =
-                        self.world_light_sample(&hit, wo, [u_light[0], u_light[1]], p_sel, scratch);
-                    let c = mul(throughput, c);
-                    if finite(c) && !is_zero(c) {
-                        l = add(l, clamp_contrib(c, clamp_nee));
-                    }
-                }
-                _ => {}
             }
             let lobes = &scratch.lobes;
             let Some(bs) = lobes.sample(wo, hit.ng, [u_bsdf[0], u_bsdf[1], u_bsdf[2]], self.tables)
@@ -670,10 +358,10 @@ impl Scene<'_> {
             if !finite(bs.weight) || is_zero(bs.weight) {
                 break;
             }
-            if terminate_next && !matches!(bs.kind, LobeKind::Transparent) {
+            if path.terminate_next && !matches!(bs.kind, LobeKind::Transparent) {
                 break;
             }
-            throughput = mul(throughput, bs.weight);
+            path.throughput = mul(path.throughput, bs.weight);
             if let LobeKind::Subsurface(b) = bs.kind {
                 // Not a bounce of its own: the walk's exit is the next vertex.
                 let exit = super::subsurface::enter_and_walk(
@@ -684,125 +372,346 @@ impl Scene<'_> {
                     bs.wi,
                     rng,
                     index,
-                    set,
-                    &mut throughput,
+                    path.set,
+                    &mut path.throughput,
                     &mut scratch.rays,
                 );
                 let Some((exit_hit, dir)) = exit else { break };
-                sss_exit = Some(exit_hit);
-                // The exit is no longer a camera ray (Cycles' subsurface_bounce clears
-                // PATH_RAY_CAMERA): its Light Path node sees it so.
-                flags &= !ray::CAMERA;
-                // Cycles' probe and walk rays carry no direction differential, and the
-                // exit's bounce keeps that: from here on the footprint no longer widens
-                // with distance.
-                ray_dd = 0.0;
-                d = neg(dir);
+                path.leave_subsurface(exit_hit, dir);
                 continue;
             }
-            match bs.kind {
-                LobeKind::Transparent => {
-                    transparent += 1;
-                    flags |= ray::TRANSPARENT;
-                    if transparent > st.max_transparent {
-                        break;
-                    }
-                    // Transparent bounces keep the bounce count and continue from the hit.
-                    o = p_off(d);
-                    t0 = 0.0;
-                    t1 = f32::INFINITY;
-                    continue;
-                }
-                LobeKind::Diffuse => {
-                    diffuse_ancestor = true;
-                    if diffuse >= st.max_diffuse {
-                        terminate_next = true;
-                    }
-                    diffuse += 1;
-                }
-                LobeKind::Translucent => {
-                    diffuse_ancestor = true;
-                    if diffuse >= st.max_diffuse {
-                        terminate_next = true;
-                    }
-                    diffuse += 1;
-                }
-                LobeKind::Glossy { .. } => {
-                    if glossy >= st.max_glossy {
-                        terminate_next = true;
-                    }
-                    glossy += 1;
-                }
-                LobeKind::Glass { .. } => {
-                    if bs.transmit {
-                        if transmission >= st.max_transmission {
-                            terminate_next = true;
-                        }
-                        transmission += 1;
-                    } else {
-                        if glossy >= st.max_glossy {
-                            terminate_next = true;
-                        }
-                        glossy += 1;
-                    }
-                }
-                LobeKind::Subsurface(_) => {}
-                LobeKind::Reflection(_) => {
-                    if glossy >= st.max_glossy {
-                        terminate_next = true;
-                    }
-                    glossy += 1;
-                }
-                LobeKind::OrenNayar(_) => {
-                    diffuse_ancestor = true;
-                    if diffuse >= st.max_diffuse {
-                        terminate_next = true;
-                    }
-                    diffuse += 1;
-                }
-                // Cycles labels sheen REFLECT | DIFFUSE: a diffuse bounce.
-                LobeKind::Sheen(_) | LobeKind::Velvet(_) => {
-                    diffuse_ancestor = true;
-                    if diffuse >= st.max_diffuse {
-                        terminate_next = true;
-                    }
-                    diffuse += 1;
-                }
-                LobeKind::GlossyAniso { .. } => {
-                    if glossy >= st.max_glossy {
-                        terminate_next = true;
-                    }
-                    glossy += 1;
-                }
+            if path.next(&bs, hit.p, hit.ng, n_sel, trans_sel, st) == Next::Stop {
+                break;
             }
-            // Cycles (bsdf_sample, path_state_next): only a refraction whose roughness
-            // squared (alpha_x * alpha_y) is within the threshold keeps the path
-            // transparent to the background; every other bounce ends that.
-            transparent_bg = transparent_bg
-                && match bs.kind {
-                    LobeKind::Glass(g) if bs.transmit => {
-                        st.transparent_glass >= 0.0 && g.alpha * g.alpha <= st.transparent_glass
-                    }
-                    _ => false,
-                };
-            if bounce >= st.max_bounces {
-                terminate_next = true;
-            }
-            bounce += 1;
-            flags = bounce_flags(bs.kind, bs.transmit, bs.singular);
-            mis_n = n_sel;
-            mis_trans = trans_sel;
-            prev_pdf = bs.pdf;
-            prev_singular = bs.singular;
-            if !bs.singular {
-                min_ray_pdf = min_ray_pdf.min(bs.pdf);
-            }
-            o = p_off(bs.wi);
-            d = bs.wi;
-            t0 = 0.0;
-            t1 = f32::INFINITY;
         }
-        l
+        path.l
+    }
+
+    /// Lights are not in the BVH: a ray collects every light it passes before the
+    /// surface at `t_hit` (or its end).
+    fn lights_along(&self, path: &mut Path, t_hit: Option<f32>, clamp: f32, scratch: &mut Scratch) {
+        let t_surface = t_hit.unwrap_or(if path.t1.is_finite() {
+            path.t1
+        } else {
+            f32::INFINITY
+        });
+        let flags = path.state.flags;
+        for (li, light) in self
+            .lights
+            .iter()
+            .enumerate()
+            .filter(|(_, l)| l.visible_to(flags))
+        {
+            // Rays other than the camera's see only lights shared with BSDF sampling
+            // (Cycles' lights_intersect skips those without SHADER_USE_MIS).
+            if !light.mis && flags & ray::CAMERA == 0 {
+                continue;
+            }
+            if let Some(lh) = light.intersect(path.o, path.d, t_surface) {
+                let w = if path.prev_singular {
+                    1.0
+                } else {
+                    power_heuristic(
+                        path.prev_pdf,
+                        lh.pdf
+                            * self.light_select.pdf(
+                                path.o,
+                                path.mis_n,
+                                path.mis_trans,
+                                Pick::Lamp(li as u32),
+                            ),
+                    )
+                };
+                scratch
+                    .features
+                    .add_emission(scale(mul(path.throughput, lh.radiance), w));
+                let c = clamp_contrib(scale(mul(path.throughput, lh.radiance), w), clamp);
+                if finite(c) {
+                    path.l = add(path.l, c);
+                }
+            }
+        }
+    }
+
+    /// The ray left the scene: the world (or, for a camera ray with Film > Transparent,
+    /// alpha).
+    fn miss(&self, path: &mut Path, clamp: f32, scratch: &mut Scratch) {
+        if self.settings.film_transparent && path.transparent_bg {
+            scratch.transparent += average(path.throughput);
+            return;
+        }
+        // A world hidden from this ray type gives it nothing (Cycles'
+        // integrator_eval_background_shader).
+        if !super::light::visible_to(self.world_exclude, path.state.flags) {
+            return;
+        }
+        let d = path.d;
+        let w = self.world_mis_weight(
+            d,
+            path.prev_singular,
+            path.prev_pdf,
+            path.o,
+            path.mis_n,
+            path.mis_trans,
+        );
+        let bg = scale(mul(path.throughput, self.background_toward(d, scratch)), w);
+        scratch.features.add_emission(bg);
+        let c = clamp_contrib(bg, clamp);
+        if finite(c) {
+            path.l = add(path.l, c);
+        }
+    }
+
+    /// The surface the ray hit, with the path state its shader sees and the ray
+    /// differentials carried to it.
+    fn vertex(
+        &self,
+        path: &mut Path,
+        h: &super::accel::Hit,
+        wo: V3,
+        scratch: &Scratch,
+    ) -> SurfaceHit {
+        let mut hit = self.surface_at(h.prim, h.u, h.v, wo, scratch.time);
+        hit.sp.ray_length = h.t;
+        hit.sp.path = path.state;
+        path.ray_dp += h.t * path.ray_dd;
+        self.fill_differentials(&mut hit, h.prim, path.ray_dp);
+        hit
+    }
+
+    /// Runs the vertex's shader into `scratch.lobes`; false when a holdout ends the path.
+    fn shade_vertex(
+        &self,
+        path: &Path,
+        hit: &SurfaceHit,
+        wo: V3,
+        sss_exit: bool,
+        scratch: &mut Scratch,
+    ) -> bool {
+        if sss_exit {
+            // With a bumped BSSRDF Cycles runs the material at the exit and lights
+            // with the BSSRDF's normal there (corrected as seen along the true normal).
+            let (n, smooth) = match hit.material {
+                Some(mi) if self.materials[mi].bssrdf_bump => {
+                    self.shade(hit, wo, scratch);
+                    let smooth = scratch.lobes.smooth_n;
+                    (
+                        super::subsurface::exit_normal(&scratch.lobes, smooth),
+                        smooth,
+                    )
+                }
+                _ => (hit.sp.normal, hit.sp.normal),
+            };
+            let correction = hit
+                .material
+                .map(|mi| self.materials[mi].bump_correction)
+                .unwrap_or(true);
+            scratch.lobes.clear();
+            scratch.lobes.smooth_n = smooth;
+            scratch.lobes.bump_correction = correction;
+            scratch.lobes.push(LobeKind::Diffuse, [1.0; 3], n);
+            return true;
+        }
+        self.shade(hit, wo, scratch);
+        // A holdout object seen by the camera (directly or through transparent
+        // surfaces: Cycles' PATH_RAY_TRANSPARENT_BACKGROUND) keeps only its
+        // transparency; the rest is a hole in the film.
+        if path.transparent_bg && self.geo.instances[hit.inst as usize].holdout {
+            // The holdout weight (Cycles' surface_shader_apply_holdout) is what
+            // the object's transparency does not let through.
+            let weight = sub(
+                [1.0; 3],
+                scratch.lobes.transparent.map(|t| t.clamp(0.0, 1.0)),
+            );
+            scratch.transparent += average(mul(weight, path.throughput));
+            if !holdout_keep_transparent(&mut scratch.lobes) {
+                return false;
+            }
+        } else if path.transparent_bg && !is_zero(scratch.lobes.holdout) {
+            // Holdout closures (the Holdout shader node) seen by the camera.
+            let weight = scratch.lobes.holdout;
+            scratch.transparent += average(mul(weight, path.throughput));
+            if weight.iter().all(|&w| w == 1.0) {
+                return false;
+            }
+        }
+        true
+    }
+
+    /// Emission of the surface the ray found, shared by MIS with light sampling on the
+    /// sides light sampling draws from (Cycles' SD_MIS_FRONT / SD_MIS_BACK).
+    fn emission_at_hit(
+        &self,
+        path: &mut Path,
+        h: &super::accel::Hit,
+        hit: &SurfaceHit,
+        clamp: f32,
+        scratch: &mut Scratch,
+    ) {
+        let lobes = &scratch.lobes;
+        if is_zero(lobes.emission) {
+            return;
+        }
+        let (front, back) = self.emission_sides(h.prim);
+        let w = if path.prev_singular || !(if hit.backfacing { back } else { front }) {
+            1.0
+        } else {
+            let pick =
+                self.light_select
+                    .pdf(path.o, path.mis_n, path.mis_trans, Pick::Triangle(h.prim));
+            if pick > 0.0 {
+                power_heuristic(
+                    path.prev_pdf,
+                    pick * super::triangle_light::pdf(
+                        &self.geo.tris[h.prim as usize],
+                        path.o,
+                        path.d,
+                        h.t,
+                    ),
+                )
+            } else {
+                1.0
+            }
+        };
+        let e = scale(mul(path.throughput, lobes.emission), w);
+        scratch.features.add_emission(e);
+        let c = clamp_contrib(scale(mul(path.throughput, lobes.emission), w), clamp);
+        if finite(c) {
+            path.l = add(path.l, c);
+        }
+    }
+
+    /// Next-event estimation: one emitter, picked as Cycles picks it at this vertex, the
+    /// sample divided by the probability of the pick; the clamped contribution, if any.
+    #[allow(clippy::too_many_arguments)]
+    fn direct_light(
+        &self,
+        path: &Path,
+        hit: &SurfaceHit,
+        prim: u32,
+        wo: V3,
+        u: [f32; 3],
+        n_sel: V3,
+        trans_sel: bool,
+        scratch: &mut Scratch,
+    ) -> Option<V3> {
+        let clamp = path.light_clamp(&self.settings);
+        let throughput = path.throughput;
+        let bounce = path.state.bounce;
+        let picked = self.light_select.select(hit.p, n_sel, trans_sel, u[2]);
+        match picked {
+            Some((Pick::Lamp(li), p_sel)) if bounce <= self.lights[li as usize].max_bounces => {
+                let light = &self.lights[li as usize];
+                let ls = light.sample(hit.p, [u[0], u[1]])?;
+                let (f, pdf_b) =
+                    scratch
+                        .lobes
+                        .eval_excluding(wo, ls.wi, hit.ng, self.tables, light.exclude);
+                // Lights with extent are shared with BSDF sampling at every vertex, as
+                // Cycles does (light_sample_mis_weight_nee).
+                let w = if light.mis {
+                    power_heuristic(ls.pdf * p_sel, pdf_b)
+                } else {
+                    1.0
+                };
+                let c = scale(mul(mul(throughput, f), ls.value), w / p_sel);
+                if is_zero(c) || !finite(c) {
+                    return None;
+                }
+                let start = self.shadow_origin(hit, scratch.lobes.smooth_n, ls.wi);
+                let tr = if light.cast_shadow {
+                    self.shadow_transmittance(
+                        start,
+                        ls.wi,
+                        if ls.dist.is_finite() {
+                            ls.dist * (1.0 - 1e-4)
+                        } else {
+                            f32::INFINITY
+                        },
+                        scratch,
+                    )
+                } else {
+                    [1.0; 3]
+                };
+                (!is_zero(tr)).then(|| clamp_contrib(mul(c, tr), clamp))
+            }
+            Some((Pick::Triangle(tri), p_sel)) if tri != prim => {
+                let (front, back) = self.emission_sides(tri);
+                let ts = super::triangle_light::sample(
+                    &self.geo.tris[tri as usize],
+                    hit.p,
+                    [u[0], u[1]],
+                    front,
+                    back,
+                )?;
+                // The emitter's object hidden from some ray types lights only the
+                // closures of the others (Cycles' SHADER_EXCLUDE_* of mesh lights).
+                let seen_by =
+                    self.geo.instances[self.geo.refs[tri as usize].inst as usize].visibility;
+                let exclude =
+                    !seen_by & (ray::DIFFUSE | ray::GLOSSY | ray::TRANSMIT | ray::VOLUME_SCATTER);
+                let (f, pdf_b) = if exclude == 0 {
+                    scratch.lobes.eval(wo, ts.wi, hit.ng, self.tables)
+                } else {
+                    scratch
+                        .lobes
+                        .eval_excluding(wo, ts.wi, hit.ng, self.tables, exclude)
+                };
+                if is_zero(f) {
+                    return None;
+                }
+                let pdf_l = p_sel * ts.pdf;
+                let start = self.shadow_origin(hit, scratch.lobes.smooth_n, ts.wi);
+                let tr = self.shadow_transmittance(start, ts.wi, ts.dist * (1.0 - 1e-4), scratch);
+                if is_zero(tr) {
+                    return None;
+                }
+                let le =
+                    self.light_emission(tri, ts.b1, ts.b2, neg(ts.wi), ts.dist, bounce, scratch);
+                let w = power_heuristic(pdf_l, pdf_b);
+                let c = mul(scale(mul(mul(throughput, f), le), w / pdf_l), tr);
+                finite(c).then(|| clamp_contrib(c, clamp))
+            }
+            Some((Pick::World, p_sel)) => {
+                let c = self.world_light_sample(hit, wo, [u[0], u[1]], p_sel, scratch);
+                let c = mul(throughput, c);
+                (finite(c) && !is_zero(c)).then(|| clamp_contrib(c, clamp))
+            }
+            _ => None,
+        }
+    }
+}
+
+/// Cycles' surface_shader_prepare_closures. Its 3.x defensive sampling (a floor on each
+/// closure's selection weight at the first hit) is gone in 4.x: the firefly histograms
+/// of a sharp specular over a diffuse base match Cycles 4.5 only without it. Filter
+/// Glossy: after diffuse-like bounces (a finite `min_ray_pdf`), glossy lobes are
+/// roughened.
+fn filter_glossy(lobes: &mut LobeSet, min_ray_pdf: f32, filter_glossy: f32) {
+    if filter_glossy <= 0.0 || !min_ray_pdf.is_finite() {
+        return;
+    }
+    // Cycles' kernel uses 1 / blur_glossy.
+    let blur_pdf = min_ray_pdf / filter_glossy;
+    if blur_pdf >= 1.0 {
+        return;
+    }
+    let blur = (1.0 - blur_pdf).sqrt() * 0.5;
+    let n = lobes.len;
+    for lobe in &mut lobes.lobes[..n] {
+        if let LobeKind::Glossy { alpha, .. } = &mut lobe.kind {
+            *alpha = alpha.max(blur);
+        }
+        if let LobeKind::Glass(g) = &mut lobe.kind {
+            g.alpha = g.alpha.max(blur);
+        }
+        if let LobeKind::Reflection(r) = &mut lobe.kind {
+            r.alpha = r.alpha.max(blur);
+        }
+        if let LobeKind::GlossyAniso { lobe: a, .. } = &mut lobe.kind {
+            a.alpha_x = a.alpha_x.max(blur);
+            a.alpha_y = a.alpha_y.max(blur);
+        }
     }
 }
 
@@ -1042,33 +951,6 @@ fn holdout_keep_transparent(lobes: &mut LobeSet) -> bool {
     }
     lobes.len = k;
     true
-}
-
-/// Cycles' path flags after a non-transparent bounce of lobe `kind`.
-fn bounce_flags(kind: LobeKind, transmit: bool, singular: bool) -> u32 {
-    let mut f = match kind {
-        LobeKind::Diffuse => ray::DIFFUSE | ray::REFLECT,
-        LobeKind::Translucent => ray::DIFFUSE | ray::TRANSMIT,
-        LobeKind::Glossy { .. } => ray::GLOSSY | ray::REFLECT,
-        LobeKind::Glass { .. } => {
-            ray::GLOSSY
-                | if transmit {
-                    ray::TRANSMIT
-                } else {
-                    ray::REFLECT
-                }
-        }
-        LobeKind::Transparent => ray::TRANSPARENT,
-        // The walk's exit scatters diffusely, as Cycles' subsurface exit closure does.
-        LobeKind::OrenNayar(_) | LobeKind::Subsurface(_) => ray::DIFFUSE | ray::REFLECT,
-        LobeKind::Reflection(_) => ray::GLOSSY | ray::REFLECT,
-        LobeKind::Sheen(_) | LobeKind::Velvet(_) => ray::DIFFUSE | ray::REFLECT,
-        LobeKind::GlossyAniso { .. } => ray::GLOSSY | ray::REFLECT,
-    };
-    if singular {
-        f |= ray::SINGULAR;
-    }
-    f
 }
 
 impl Scene<'_> {

@@ -34,6 +34,7 @@ pub mod motion;
 pub mod object_motion;
 pub mod oren_nayar;
 pub mod panorama;
+pub mod path_state;
 pub mod sampler;
 pub mod shade;
 pub mod sheen;
