@@ -294,14 +294,57 @@ pub fn read_glb(path: &Path) -> Result<MeshData, SceneError> {
     parse_glb(&bytes, path)
 }
 
+/// The accessor references of every mesh primitive are in range. The `gltf` crate's
+/// validation indexes the POSITION accessor before checking it exists (a panic on a
+/// corrupt file, found by tests/fuzz_mutations.rs), so this runs first.
+fn check_primitive_accessors(bytes: &[u8]) -> Result<(), String> {
+    // A file this cannot read is left to the full reader, for its error message.
+    let Ok(glb) = gltf::Glb::from_slice(bytes) else {
+        return Ok(());
+    };
+    let Ok(root) = gltf::json::deserialize::from_slice::<gltf::json::Root>(&glb.json) else {
+        return Ok(());
+    };
+    let n = root.accessors.len();
+    for (mi, m) in root.meshes.iter().enumerate() {
+        for (pi, p) in m.primitives.iter().enumerate() {
+            let targets = p.targets.iter().flatten().flat_map(|t| {
+                [&t.positions, &t.normals, &t.tangents]
+                    .into_iter()
+                    .flatten()
+                    .map(|i| i.value())
+            });
+            let used = p
+                .attributes
+                .values()
+                .map(|i| i.value())
+                .chain(p.indices.iter().map(|i| i.value()))
+                .chain(targets);
+            for i in used {
+                if i >= n {
+                    return Err(format!(
+                        "meshes[{mi}].primitives[{pi}] uses accessor {i}, but the file has {n}"
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 pub fn parse_glb(bytes: &[u8], path: &Path) -> Result<MeshData, SceneError> {
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| {
+    let corrupt = |e: String| {
         SceneError::new(
             path,
             "",
             format!("not a valid glb (truncated or corrupt?): {e}"),
         )
-    })?;
+    };
+    check_primitive_accessors(bytes).map_err(corrupt)?;
+    // A backstop for other such holes in the reader: an error, never a panic.
+    let gltf = std::panic::catch_unwind(|| gltf::Gltf::from_slice(bytes))
+        .map_err(|_| corrupt("the glTF reader failed on it".into()))?
+        .map_err(|e| corrupt(e.to_string()))?;
     let blob: &[u8] = gltf.blob.as_deref().unwrap_or(&[]);
     let root = gltf.document.as_json();
     let extras_raw = root.extras.as_ref().ok_or_else(|| {
