@@ -8,7 +8,8 @@ use std::fmt::Write;
 
 use serde::Serialize;
 
-use crate::nodes::{support_in, Support};
+use crate::geometry::support_in;
+use crate::nodes::Support;
 use crate::scene::{quote, Rna, Scene};
 use crate::shader::compile_material;
 

@@ -11,7 +11,7 @@ use std::collections::BTreeSet;
 fn features_page() -> String {
     let mut shader: Vec<&str> = blendsynth::nodes::supported_shader_nodes().to_vec();
     shader.sort_unstable();
-    let mut geo: Vec<&str> = blendsynth::geometry::nodes::SUPPORTED.to_vec();
+    let mut geo: Vec<&str> = blendsynth::geometry::nodes::supported().collect();
     geo.sort_unstable();
     let mut o = String::new();
     o.push_str("# Supported Blender features\n\n");

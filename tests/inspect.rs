@@ -39,7 +39,8 @@ fn shared_maths_counts_only_where_an_evaluator_runs_it() {
     // World surfaces compile since the world shader (render/world.rs, tests/world.rs).
     assert_eq!(row(&r, "ShaderNodeOutputWorld")["support"], "supported");
     // In a Geometry Nodes tree only what the geometry evaluator implements counts.
-    use blendsynth::nodes::{support_in, Support};
+    use blendsynth::geometry::support_in;
+    use blendsynth::nodes::Support;
     assert!(matches!(
         support_in("GeometryNodeTree", "GeometryNodeCurveToMesh"),
         Support::Supported
@@ -101,7 +102,8 @@ fn texture_and_colour_nodes_count_in_geometry_nodes_trees() {
     ] {
         assert_eq!(row(&r, kind)["support"], "supported", "{kind}");
     }
-    use blendsynth::nodes::{support_in, Support};
+    use blendsynth::geometry::support_in;
+    use blendsynth::nodes::Support;
     // Gabor has no implementation on either side yet.
     assert!(matches!(
         support_in("GeometryNodeTree", "ShaderNodeTexGabor"),

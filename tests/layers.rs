@@ -24,11 +24,6 @@ const LAYERS: &[&[&str]] = &[
 /// shrink: an entry that no longer occurs fails the test too, so it is taken out.
 const KNOWN: &[(&str, &str, &str)] = &[
     (
-        "nodes",
-        "geometry",
-        "support_in asks the geometry evaluator; the registry belongs above both",
-    ),
-    (
         "shader",
         "render",
         "shader/view.rs builds the render camera; the camera model belongs below shader",

@@ -197,7 +197,7 @@ pub fn unsupported_gn_node(scene: &Scene, o: &Object) -> Option<String> {
                     return Some(x);
                 }
             }
-            if crate::nodes::support_in("GeometryNodeTree", &n.bl_idname)
+            if super::support_in("GeometryNodeTree", &n.bl_idname)
                 == crate::nodes::Support::Unsupported
             {
                 return Some(format!("{:?} ({})", n.name, n.bl_idname));

@@ -204,26 +204,6 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeVertexColor",
 ];
 
-/// Support for a node inside a tree of type `tree` (`ShaderNodeTree`,
-/// `GeometryNodeTree`, ...): the shared maths only counts where an evaluator for that
-/// tree type runs it. In Geometry Nodes trees that is the geometry evaluator's own list
-/// (`geometry::nodes::SUPPORTED`: shader-named texture, ramp, curve and colour nodes
-/// count there once they run as fields with Blender's Geometry Nodes semantics).
-pub fn support_in(tree: &str, bl_idname: &str) -> Support {
-    // Geometry Nodes trees: exactly what the geometry evaluator implements.
-    if tree == "GeometryNodeTree" && !STRUCTURAL.contains(&bl_idname) {
-        return if crate::geometry::supports_node(bl_idname) {
-            Support::Supported
-        } else {
-            Support::Unsupported
-        };
-    }
-    match support(bl_idname) {
-        Support::Supported if tree != "ShaderNodeTree" => Support::Unsupported,
-        s => s,
-    }
-}
-
 /// Every shader node type evaluated (the registry `inspect` and docs/features.md read).
 pub fn supported_shader_nodes() -> &'static [&'static str] {
     SUPPORTED
