@@ -21,6 +21,9 @@
 
 use std::path::{Path, PathBuf};
 
+pub use crate::foundation::exr::rgb_bytes as exr_rgb_bytes;
+pub use crate::foundation::png::{png16_bytes, png_bytes};
+
 /// A split name becomes a folder name: letters, digits, '_' and '-' only, so a name
 /// read from a manifest or a frame record can never lead outside the dataset.
 pub fn check_split_name(name: &str) -> Result<(), String> {
@@ -160,39 +163,6 @@ pub fn mask_png_bytes(
     } else {
         png16_bytes(width, height, mask)
     }
-}
-
-/// PNG bytes of an 8-bit image (`channels` 1 = gray, 3 = RGB, 4 = RGBA).
-pub fn png_bytes(width: u32, height: u32, channels: u8, data: &[u8]) -> Result<Vec<u8>, String> {
-    use image::ImageEncoder;
-    let kind = match channels {
-        1 => image::ExtendedColorType::L8,
-        3 => image::ExtendedColorType::Rgb8,
-        4 => image::ExtendedColorType::Rgba8,
-        _ => return Err(format!("{channels} channels")),
-    };
-    let mut out = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut out)
-        .write_image(data, width, height, kind)
-        .map_err(|e| format!("PNG encode: {e}"))?;
-    Ok(out)
-}
-
-/// 16-bit grey PNG bytes.
-pub fn png16_bytes(width: u32, height: u32, data: &[u16]) -> Result<Vec<u8>, String> {
-    use image::ImageEncoder;
-    // The encoder takes native-endian samples (it writes PNG big-endian itself).
-    let bytes: Vec<u8> = data.iter().flat_map(|v| v.to_ne_bytes()).collect();
-    let mut out = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut out)
-        .write_image(&bytes, width, height, image::ExtendedColorType::L16)
-        .map_err(|e| format!("PNG encode: {e}"))?;
-    Ok(out)
-}
-
-/// Float RGB OpenEXR bytes.
-pub fn exr_rgb_bytes(width: u32, height: u32, data: &[[f32; 3]]) -> Result<Vec<u8>, String> {
-    crate::foundation::exr::rgb_bytes(width, height, data)
 }
 
 /// Display-referred [0, 1] RGBA to 8-bit RGB, rounded.

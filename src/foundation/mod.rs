@@ -7,4 +7,5 @@ pub mod bvh;
 pub mod exr;
 pub mod files;
 pub mod math;
+pub mod png;
 pub mod ray;

@@ -6,7 +6,9 @@
 
 use std::path::{Path, PathBuf};
 
-use crate::dataset::layout::{exr_rgb_bytes, png16_bytes, png_bytes, write_atomic};
+use crate::foundation::exr::rgb_bytes as exr_rgb_bytes;
+use crate::foundation::files::write_atomic;
+use crate::foundation::png::{png16_bytes, png_bytes};
 use crate::label::ClassMap;
 
 /// How the passes are stored.
