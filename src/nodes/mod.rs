@@ -146,6 +146,9 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeTexMagic",
     "ShaderNodeTexWhiteNoise",
     "ShaderNodeTexChecker",
+    // sky.rs, sky_hosek.rs: Nishita, Preetham and Hosek/Wilkie, every option, in
+    // tests/sky_texture.rs (within 1e-4 of Cycles' bakes).
+    "ShaderNodeTexSky",
     // mapping.rs
     "ShaderNodeMapping",
     // vector_rotate.rs
