@@ -619,6 +619,7 @@ impl Report {
                 Support::Supported => "yes",
                 Support::Structural => "structural",
                 Support::Unsupported => "NO",
+                Support::IgnoredByCycles => "ignored",
             };
             writeln!(
                 o,

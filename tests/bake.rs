@@ -135,6 +135,24 @@ fn closure_weights_match_cycles() {
     assert!(compare("closures") <= TOL);
 }
 
+/// Shader to RGB, Specular BSDF (EEVEE-only) and Squeeze Value (legacy) feeding an
+/// Emission and an Add Shader: Cycles drops their links (its bake is the Emission's own
+/// colour times its own strength), and so does blendsynth; compiling them instead fails.
+#[test]
+fn nodes_cycles_ignores_are_dropped_as_cycles_drops_them() {
+    assert!(compare("cycles_ignored") <= TOL);
+    for t in [
+        "ShaderNodeShaderToRGB",
+        "ShaderNodeEeveeSpecular",
+        "ShaderNodeSqueeze",
+    ] {
+        assert_eq!(
+            blendsynth::nodes::support(t),
+            blendsynth::nodes::Support::IgnoredByCycles
+        );
+    }
+}
+
 /// Mapping, 6-octave Noise, Voronoi, Wave, Magic, Gradient and Checker in one material.
 #[test]
 fn texture_material_matches_cycles() {

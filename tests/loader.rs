@@ -294,7 +294,7 @@ fn inspect_exits_0_when_every_node_is_supported() {
         &[],
     );
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
-    // A world node blendsynth does not evaluate (Sky Texture) makes it exit 3, named.
+    // A world node blendsynth does not evaluate (Script: OSL) makes it exit 3, named.
     let mut v: Value = serde_json::from_slice(
         &std::fs::read(repo().join("fixtures/scenes/animated_camera/scene.json")).unwrap(),
     )
@@ -302,12 +302,12 @@ fn inspect_exits_0_when_every_node_is_supported() {
     let nodes = v["worlds"][0]["node_tree"]["nodes"]
         .as_array_mut()
         .expect("world nodes");
-    let mut sky = nodes[0].clone();
-    sky["name"] = Value::from("Sky");
-    sky["bl_idname"] = Value::from("ShaderNodeTexSky");
-    nodes.push(sky);
+    let mut script = nodes[0].clone();
+    script["name"] = Value::from("Script");
+    script["bl_idname"] = Value::from("ShaderNodeScript");
+    nodes.push(script);
     std::fs::write(&p, serde_json::to_vec(&v).unwrap()).unwrap();
     let o = run(&["inspect", dir.to_str().unwrap()], &[]);
     assert_eq!(o.status.code(), Some(3), "{}", stdout(&o));
-    assert!(stdout(&o).contains("ShaderNodeTexSky"));
+    assert!(stdout(&o).contains("ShaderNodeScript"));
 }

@@ -207,6 +207,11 @@ impl<'a> Builder<'a> {
             .filter(|l| {
                 l.to_node == node.name && l.to_socket == s.identifier && !l.is_muted && l.is_valid
             })
+            // Links from nodes Cycles ignores are dropped, as Cycles' sync drops them.
+            .filter(|l| {
+                find(tree, &l.from_node)
+                    .is_none_or(|n| !super::IGNORED_BY_CYCLES.contains(&n.bl_idname.as_str()))
+            })
             .collect();
         if links.is_empty() {
             return Ok(vec![if s.default_value.is_some() {

@@ -81,7 +81,20 @@ pub enum Support {
     Structural,
     /// Not implemented yet: a scene using it cannot be evaluated faithfully.
     Unsupported,
+    /// Cycles' Blender sync creates nothing for it (EEVEE-only and legacy nodes): its
+    /// links are dropped, so the sockets it feeds keep their own values. blendsynth does
+    /// the same (`graph::flatten`), proven by tests/bake.rs' `cycles_ignored` bake.
+    IgnoredByCycles,
 }
+
+/// Shader node types Cycles 4.5 ignores (`add_node` in intern/cycles/blender/shader.cpp
+/// has no case for them): Shader to RGB and Specular BSDF are EEVEE-only, Squeeze Value
+/// is legacy.
+pub const IGNORED_BY_CYCLES: &[&str] = &[
+    "ShaderNodeShaderToRGB",
+    "ShaderNodeEeveeSpecular",
+    "ShaderNodeSqueeze",
+];
 
 /// Node types that only shape the graph: frames and reroutes are dropped, group nodes
 /// are inlined, group input/output nodes become the group's boundary.
@@ -146,6 +159,9 @@ const SUPPORTED: &[&str] = &[
     "ShaderNodeTexMagic",
     "ShaderNodeTexWhiteNoise",
     "ShaderNodeTexChecker",
+    // sky.rs, sky_hosek.rs: Nishita, Preetham and Hosek/Wilkie, every option, in
+    // tests/sky_texture.rs (within 1e-4 of Cycles' bakes).
+    "ShaderNodeTexSky",
     // mapping.rs
     "ShaderNodeMapping",
     // vector_rotate.rs
@@ -212,6 +228,8 @@ pub fn supported_shader_nodes() -> &'static [&'static str] {
 pub fn support(bl_idname: &str) -> Support {
     if STRUCTURAL.contains(&bl_idname) {
         Support::Structural
+    } else if IGNORED_BY_CYCLES.contains(&bl_idname) {
+        Support::IgnoredByCycles
     } else if SUPPORTED.contains(&bl_idname) {
         Support::Supported
     } else {

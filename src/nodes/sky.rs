@@ -153,7 +153,10 @@ fn spherical_to_direction(theta: f32, phi: f32) -> Vec3 {
 }
 
 fn angle_between(thetav: f32, phiv: f32, theta: f32, phi: f32) -> f32 {
-    let cospsi = thetav.sin() * theta.sin() * (phi - phiv).cos() + thetav.cos() * theta.cos();
+    // Cycles' kernel is built with FMA contraction (the x86-64 AVX2 kernel), which fuses
+    // the first product into the sum; near the sun the acos magnifies that last bit.
+    let cospsi =
+        (thetav.sin() * theta.sin()).mul_add((phi - phiv).cos(), thetav.cos() * theta.cos());
     cospsi.clamp(-1.0, 1.0).acos()
 }
 
@@ -621,6 +624,10 @@ impl Nishita {
         let s = &SkySettings {
             sun_elevation,
             sun_rotation,
+            // Cycles precomputes at an altitude clamped to [1 m, 59999 m] (below 1 m is
+            // numerically unstable, above 60 km is space): the default 0 m sky is the 1 m
+            // sky, 1e-3 brighter at the horizon (measured against the bakes).
+            altitude: settings.altitude.clamp(1.0, 59999.0),
             ..*settings
         };
         // Cycles clamps the sun's size for numerical precision (`get_sun_size`).
