@@ -746,6 +746,33 @@ def curve_entry(c):
             "materials": [m.name if m else None for m in c.materials], "splines": splines}
 
 
+def save_generated(im, target):
+    """Writes generated image IM's pixels to TARGET losslessly. A byte buffer: Image.save
+    (8-bit PNG). A float buffer: Image.save would write a 16-bit PNG through the display
+    transform whatever the extension, so it goes through save_render as a 32-bit EXR
+    (scene-linear values, no view transform), with the scene's output format restored."""
+    if not im.is_float:
+        fmt = im.file_format
+        im.file_format = "PNG"
+        try:
+            im.save(filepath=target, save_copy=True)
+        finally:
+            im.file_format = fmt
+        return
+    scene = bpy.context.scene
+    f = scene.render.image_settings
+    keep = {k: getattr(f, k) for k in ("file_format", "color_depth", "exr_codec", "color_mode")}
+    try:
+        f.file_format, f.color_depth, f.exr_codec, f.color_mode = "OPEN_EXR", "32", "ZIP", "RGBA"
+        im.save_render(filepath=target, scene=scene)
+    finally:
+        for k in ("file_format", "color_depth", "exr_codec", "color_mode"):
+            try:
+                setattr(f, k, keep[k])
+            except Exception:  # an option the restored format does not have
+                pass
+
+
 def image_entry(im, out_dir, used_names):
     d = {"name": im.name, "source": im.source, "filepath": im.filepath, "file": None,
          "packed": im.packed_file is not None, "missing": False,
@@ -769,20 +796,11 @@ def image_entry(im, out_dir, used_names):
     target = os.path.join(out_dir, "images", name)
     if generated:
         os.makedirs(os.path.dirname(target), exist_ok=True)
-        fmt, cs = im.file_format, im.colorspace_settings.name
-        im.file_format = "OPEN_EXR" if im.is_float else "PNG"
-        if im.is_float:
-            # Saving a float buffer otherwise writes it through the display transform
-            # (sRGB values in the EXR); as Non-Color its linear values are written.
-            im.colorspace_settings.name = "Non-Color"
         try:
-            im.save(filepath=target, save_copy=True)
+            save_generated(im, target)
         except Exception as e:
             WARNINGS.append(f"images[{q(im.name)}]: generated image not exported ({e})")
             return d
-        finally:
-            im.file_format = fmt
-            im.colorspace_settings.name = cs
     elif im.packed_file is not None:
         os.makedirs(os.path.dirname(target), exist_ok=True)
         with open(target, "wb") as f:
