@@ -102,6 +102,27 @@ fn objects_blendsynth_does_not_build_render_frozen_or_are_refused_by_name() {
     frozen.sort();
     assert_eq!(frozen, ["Bars", "Label", "Still", "Tube"]);
 
+    // mesh of a bare path: Blender's wire mesh of its evaluated points (Object.to_mesh).
+    let scene = Scene::load(&export).unwrap();
+    let i = scene
+        .file
+        .evaluated
+        .iter()
+        .position(|e| e.object == "Path")
+        .expect("the export's mesh of Path");
+    let theirs = scene.load_evaluated(i).unwrap();
+    let ours = blendsynth::geometry::evaluate_object(&scene, "Path", 1.0, &[])
+        .and_then(|g| blendsynth::geometry::realize_to_mesh(&g))
+        .unwrap();
+    assert_eq!(ours.positions.len(), theirs.positions.len());
+    assert_eq!(ours.edges.len(), theirs.edges.len(), "wire edges");
+    assert_eq!(ours.face_count(), 0);
+    for (a, b) in ours.positions.iter().zip(&theirs.positions) {
+        for k in 0..3 {
+            assert!((a[k] - b[k]).abs() < 1e-5, "Path vertex {a:?} vs Blender {b:?}");
+        }
+    }
+
     // render: every object is in the image, the Use Nodes off cube in its diffuse colour.
     let scene = Scene::load(&export).unwrap();
     let mut opts = small(None);
@@ -274,6 +295,90 @@ fn bone_parents_follow_blender_while_the_pose_is_known() {
         .to_string();
     assert!(
         e.contains("Prop") && e.contains("Dancer") && e.contains("pose"),
+        "{e}"
+    );
+}
+
+/// Blender-side: a file saved with an add-on's node classes, converted without them
+/// (`fixtures/coverage/make_addon_nodes_scene.py`): the add-on's tree and nodes export
+/// (their value-less sockets as CUSTOM), `inspect` names them, and the material, whose
+/// Cycles output does not use the add-on node, renders as Cycles renders it.
+#[test]
+fn files_with_add_on_nodes_convert_and_name_them() {
+    let Some(py) = require("bpy", bpy_python()) else {
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let blend = tmp.path().join("addon.blend");
+    let export = tmp.path().join("export");
+    run_python(
+        &py,
+        &repo().join("fixtures/coverage/make_addon_nodes_scene.py"),
+        &["--", blend.to_str().unwrap()],
+    );
+    let o = run(
+        &[
+            "convert",
+            blend.to_str().unwrap(),
+            "-o",
+            export.to_str().unwrap(),
+        ],
+        &[("BLENDSYNTH_BPY_PYTHON", py.to_str().unwrap())],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let scene = Scene::load(&export).unwrap();
+    let tree = scene
+        .file
+        .node_groups
+        .iter()
+        .find(|g| g.name == "Add-on material")
+        .expect("the add-on's node tree is exported");
+    assert_eq!(tree.bl_idname, "NodeTreeUndefined");
+    for n in &tree.nodes {
+        assert_eq!(n.bl_idname, "NodeUndefined");
+        for s in n.inputs.iter().chain(&n.outputs) {
+            assert_eq!(s.kind, "CUSTOM", "{} {}", n.name, s.name);
+            assert!(s.default_value.is_none());
+        }
+    }
+    let o = run(&["inspect", export.to_str().unwrap()], &[]);
+    assert!(stdout(&o).contains("NodeUndefined"), "{}", stdout(&o));
+    assert!(stdout(&o).contains("render: ok"), "{}", stdout(&o));
+    render(&scene, &small(None)).unwrap();
+}
+
+/// A constraint blendsynth does not evaluate, on a camera that is not the scene's, moves
+/// nothing that renders: the frame renders (issue 26). On the scene camera it is an
+/// error naming the camera and the constraint.
+#[test]
+fn constraints_on_other_cameras_do_not_block_the_render() {
+    use serde_json::Value;
+    let src = repo().join("fixtures/scenes/animated_camera");
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("scene");
+    copy_dir(&src, &dir);
+    let p = dir.join("scene.json");
+    let mut v: Value = serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
+    let objects = v["objects"].as_array_mut().unwrap();
+    let camera = objects.iter().position(|o| o["name"] == "Camera").unwrap();
+    let limit = serde_json::json!({"name": "Limit Distance", "type": "LIMIT_DISTANCE",
+        "mute": false, "influence": 1.0, "owner_space": "WORLD", "target_space": "WORLD",
+        "properties": {}});
+    let mut other = objects[camera].clone();
+    other["name"] = Value::from("Spare");
+    other["constraints"] = Value::Array(vec![limit.clone()]);
+    objects.push(other);
+    std::fs::write(&p, serde_json::to_vec(&v).unwrap()).unwrap();
+    let scene = Scene::load(&dir).unwrap();
+    render(&scene, &small(None)).expect("a spare camera's constraint blocks nothing");
+    assert!(blendsynth::inspect::report(&scene).render_error.is_none());
+
+    v["objects"][camera]["constraints"] = Value::Array(vec![limit]);
+    std::fs::write(&p, serde_json::to_vec(&v).unwrap()).unwrap();
+    let scene = Scene::load(&dir).unwrap();
+    let e = render(&scene, &small(None)).unwrap_err().to_string();
+    assert!(
+        e.contains("\"Camera\"") && e.contains("LIMIT_DISTANCE"),
         "{e}"
     );
 }

@@ -79,6 +79,7 @@ const ASSERTED: &[&str] = &[
     "normal_map",
     "normal_map_scaled",
     "attribute_color",
+    "generated_images",
     // Geometry Pointiness and Random Per Island as base colour on a mesh of four islands.
     "pointiness_islands",
     // Mesh objects' ray visibility (camera, shadow, glossy, and an emitter hidden from

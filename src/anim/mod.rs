@@ -103,9 +103,12 @@ pub fn evaluate_scene_with(
         export_frame: scene.file.scene.frame_current as f64,
         posed: posed_armatures(scene),
     };
+    // A camera other than the scene's moves nothing that renders (issue 26: a constraint
+    // blendsynth does not evaluate on it must not block the frame).
+    let camera = scene.file.scene.camera.as_deref();
     let world_matrices = transform::Solver::new(&data, opts.for_render, &axes)
         .with_bone_parents(bones)
-        .solve_all()?;
+        .solve_needed(|o| o.kind != "CAMERA" || Some(o.name.as_str()) == camera)?;
     Ok(EvaluatedScene {
         frame,
         data,

@@ -132,6 +132,8 @@ enum State {
     Todo,
     Busy,
     Done,
+    /// Its matrix could not be computed (`Solver::failed` holds why).
+    Failed,
 }
 
 /// Computes world matrices in dependency order (parents and constraint targets first).
@@ -146,6 +148,7 @@ pub struct Solver<'a> {
     world: Vec<Mat4>,
     paths: HashMap<String, Option<Path>>,
     bones: Option<BoneParents>,
+    failed: HashMap<usize, AnimError>,
 }
 
 /// What bone parenting needs: pose bones are not exported, so a bone's matrix relative to
@@ -182,6 +185,7 @@ impl<'a> Solver<'a> {
             world: vec![IDENTITY; n],
             paths: HashMap::new(),
             bones: None,
+            failed: HashMap::new(),
         }
     }
 
@@ -226,9 +230,23 @@ impl<'a> Solver<'a> {
         Ok(mul(pw, &mul(&arm_inv, &bone_world)))
     }
 
-    pub fn solve_all(mut self) -> Result<Vec<Mat4>, AnimError> {
+    /// Every object's world matrix; an object `needed` rejects whose matrix cannot be
+    /// computed (a camera that is not the scene's with an unsupported constraint) keeps
+    /// its exported matrix instead of failing the frame: Blender evaluates it, but
+    /// nothing rendered depends on it. Objects it parents or targets are still solved
+    /// through it and fail by name.
+    pub fn solve_needed(
+        mut self,
+        needed: impl Fn(&Object) -> bool,
+    ) -> Result<Vec<Mat4>, AnimError> {
         for i in 0..self.data.objects.len() {
-            self.world(i)?;
+            if let Err(e) = self.world(i) {
+                let o = &self.data.objects[i];
+                if needed(o) {
+                    return Err(e);
+                }
+                self.world[i] = o.matrix_world;
+            }
         }
         Ok(self.world)
     }
@@ -262,6 +280,7 @@ impl<'a> Solver<'a> {
     fn world(&mut self, i: usize) -> Result<Mat4, AnimError> {
         match self.state[i] {
             State::Done => return Ok(self.world[i]),
+            State::Failed => return Err(self.failed[&i].clone()),
             State::Busy => {
                 return Err(AnimError::new(
                     object_label(&self.data.objects[i].name),
@@ -273,7 +292,15 @@ impl<'a> Solver<'a> {
         self.state[i] = State::Busy;
         let o = &self.data.objects[i];
         let label = object_label(&o.name);
-        let m = self.compute(i).map_err(|e| e.within(&label))?;
+        let m = match self.compute(i) {
+            Ok(m) => m,
+            Err(e) => {
+                let e = e.within(&label);
+                self.state[i] = State::Failed;
+                self.failed.insert(i, e.clone());
+                return Err(e);
+            }
+        };
         self.world[i] = m;
         self.state[i] = State::Done;
         Ok(m)

@@ -472,9 +472,13 @@ pub fn realize_instances(set: &GeometrySet) -> GeometrySet {
 }
 
 /// Everything as one mesh, as the exporter's evaluated reference holds it: the realized
-/// mesh, then point clouds as loose vertices. Curves are not converted (an error).
+/// mesh, then point clouds as loose vertices. Curves alone become Blender's wire mesh of
+/// them (a bare curve path); curves beside a mesh or points are an error.
 pub fn to_mesh(set: &GeometrySet) -> Result<Mesh, String> {
     let r = realize_instances(set);
+    if let (Some(c), None, None) = (&r.curves, &r.mesh, &r.points) {
+        return super::nodes::curve::curves_to_wire_mesh(c);
+    }
     if r.curves.is_some() {
         return Err(
             "the geometry holds curves, which blendsynth cannot convert to a mesh yet".into(),

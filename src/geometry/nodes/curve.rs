@@ -490,6 +490,13 @@ fn sweep(
     Ok(m)
 }
 
+/// Blender's mesh of curves alone (`curve_to_wire_mesh`, what `Object.to_mesh` gives for a
+/// curve object without bevel or extrusion): the evaluated points as vertices, the
+/// segments as edges, no faces.
+pub fn curves_to_wire_mesh(c: &Curves) -> Result<Mesh, String> {
+    sweep(c, &vec![1.0; c.point_count()], None, false)
+}
+
 pub fn curve_to_mesh(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let mut g = ctx.geometry("Curve")?;
     let profile_set = ctx.geometry("Profile Curve")?;

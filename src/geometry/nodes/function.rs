@@ -1,5 +1,5 @@
 //! Field function nodes: Math, Vector Math, Compare, Boolean Math, Map Range, Clamp,
-//! Mix (float, vector), Combine/Separate XYZ, Random Value, Noise Texture, Switch.
+//! Mix (float, vector), Combine/Separate XYZ, Random Value, Noise Texture, Switch, Index Switch.
 //!
 //! Shared shader-node arithmetic comes from `crate::nodes` (Cycles semantics); where
 //! Geometry Nodes computes differently (BLI's double-precision cross product, its
@@ -919,4 +919,69 @@ pub fn switch(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             Ok(outputs([("Output", f(out))]))
         }
     }
+}
+
+/// Index Switch (`node_geo_index_switch.cc`): the item input at Index; an index outside
+/// the items gives the type's default (zero, identity, empty geometry). A field index
+/// picks per element, for field types only.
+pub fn index_switch(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
+    let node = ctx.node();
+    // Inputs after Index, without the virtual "extend" socket Blender adds for links.
+    let items: Vec<&str> = node
+        .inputs
+        .iter()
+        .skip(1)
+        .filter(|s| s.identifier != "__extend__" && ctx.has_input(&s.identifier))
+        .map(|s| s.identifier.as_str())
+        .collect();
+    let out_kind = node
+        .outputs
+        .first()
+        .map(|s| s.kind.as_str())
+        .ok_or_else(|| ctx.err("has no output"))?;
+    let index = match ctx.input("Index")? {
+        SocketValue::Field(x) => x.convert(DataType::Int),
+        other => {
+            return Err(ctx.err(format!(
+                "input \"Index\" is a {}, expected an integer",
+                other.kind()
+            )))
+        }
+    };
+    let Some(t) = DataType::from_socket(out_kind) else {
+        // Geometry, strings, data-blocks: a single index only.
+        let Field::Constant(i) = index else {
+            return Err(ctx.err(format!(
+                "a field index cannot switch {out_kind} values (Blender takes one value)"
+            )));
+        };
+        let v = match usize::try_from(i.as_int()).ok().and_then(|i| items.get(i)) {
+            Some(id) => ctx.input(id)?,
+            None => SocketValue::zero(out_kind),
+        };
+        return Ok(outputs([("Output", v)]));
+    };
+    if let Field::Constant(i) = &index {
+        let v = match usize::try_from(i.as_int()).ok().and_then(|i| items.get(i)) {
+            Some(id) => f(ctx.field(id, t)?),
+            None => f(Field::Constant(Value::zero(t))),
+        };
+        return Ok(outputs([("Output", v)]));
+    }
+    let mut inputs = vec![index];
+    for id in &items {
+        inputs.push(ctx.field(id, t)?);
+    }
+    let out = Field::op1("Index Switch", inputs, t, move |n, x| {
+        let idx = x[0].as_int();
+        let mut out = Array::zeros(t, n);
+        for (i, k) in idx.iter().enumerate().take(n) {
+            if let Some(a) = usize::try_from(*k).ok().and_then(|k| x.get(k + 1)) {
+                out.set(i, a.get(i));
+            }
+        }
+        Ok(out)
+    })
+    .map_err(|e| op_err(ctx, e))?;
+    Ok(outputs([("Output", f(out))]))
 }

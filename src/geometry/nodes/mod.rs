@@ -74,6 +74,7 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ("FunctionNodeRandomValue", function::random_value),
     ("ShaderNodeTexNoise", function::noise_texture_node),
     ("GeometryNodeSwitch", function::switch),
+    ("GeometryNodeIndexSwitch", function::index_switch),
     ("GeometryNodeTransform", geometry_ops::transform),
     ("GeometryNodeSetPosition", geometry_ops::set_position),
     ("GeometryNodeJoinGeometry", geometry_ops::join),
@@ -176,6 +177,7 @@ pub const NODES: &[(&str, Evaluate)] = &[
         "FunctionNodeAlignRotationToVector",
         rotation::align_rotation_to_vector,
     ),
+    ("FunctionNodeRotateEuler", rotation::rotate_euler),
     ("ShaderNodeFloatCurve", float_curve::float_curve),
     (
         "GeometryNodeMergeByDistance",

@@ -1,5 +1,5 @@
 //! Rotation function nodes: Axis Angle to Rotation, Rotate Rotation, Align Rotation to
-//! Vector and Align Euler to Vector (`function/nodes/node_fn_*`).
+//! Vector, Align Euler to Vector and Rotate Euler (`function/nodes/node_fn_*`).
 
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
@@ -224,4 +224,59 @@ pub fn align_rotation_to_vector(ctx: &NodeCtx) -> Result<Outputs, GeometryError>
     )
     .map_err(|e| ctx.err(e))?;
     Ok(outputs([("Rotation", SocketValue::Field(f))]))
+}
+
+/// Rotate Euler (`node_fn_rotate_euler.cc`, deprecated but in old files): the Euler
+/// Rotation turned by an Euler or an axis and angle, in object space (the turn applied
+/// after) or local space (before), back to Euler angles.
+pub fn rotate_euler(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
+    let axis_angle = ctx.prop("rotation_type").and_then(|v| v.as_str()) == Some("AXIS_ANGLE");
+    let local = ctx.prop("space").and_then(|v| v.as_str()) == Some("LOCAL");
+    let mut inputs = vec![ctx.field("Rotation", DataType::Vector)?];
+    if axis_angle {
+        inputs.push(ctx.field("Axis", DataType::Vector)?);
+        inputs.push(ctx.field("Angle", DataType::Float)?);
+    } else {
+        inputs.push(ctx.field("Rotate By", DataType::Vector)?);
+    }
+    let f = Field::op1("Rotate Euler", inputs, DataType::Vector, move |n, x| {
+        let input = x[0].as_vector();
+        let by = x[1].as_vector();
+        let angle = if axis_angle {
+            x[2].as_float().to_vec()
+        } else {
+            vec![0.0; n]
+        };
+        Ok(Array::Vector(
+            (0..n)
+                .map(|i| {
+                    let m = euler_to_mat3(input[i]);
+                    let r = if axis_angle {
+                        // `axis_angle_to_mat3`: a zero axis is no rotation.
+                        let a = by[i];
+                        if a[0] * a[0] + a[1] * a[1] + a[2] * a[2] == 0.0 {
+                            [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+                        } else {
+                            axis_angle_mat3(a, angle[i])
+                        }
+                    } else {
+                        euler_to_mat3(by[i])
+                    };
+                    let res = if local {
+                        mat3_mul(&m, &r)
+                    } else {
+                        mat3_mul(&r, &m)
+                    };
+                    mat3_to_euler(&normalized(&res))
+                })
+                .collect(),
+        ))
+    })
+    .map_err(|e| ctx.err(e))?;
+    Ok(outputs([("Rotation", SocketValue::Field(f))]))
+}
+
+/// Each column scaled to unit length (`mat3_to_eul` normalizes before converting).
+fn normalized(m: &Mat3f) -> Mat3f {
+    [normalize(m[0]), normalize(m[1]), normalize(m[2])]
 }
