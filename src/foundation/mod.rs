@@ -3,5 +3,6 @@
 //! Nothing here knows Blender's data.
 
 pub mod bvh;
+pub mod bvh4;
 pub mod math;
 pub mod ray;
