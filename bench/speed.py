@@ -248,20 +248,21 @@ def main():
     log = os.path.join(a.work, "commands.log")
     load_before = os.getloadavg()
     rows = []
+    path = a.json or os.path.join(a.work, "speed.json")
     for n in names:
         print(f"{n} ...", flush=True)
         rows.append(bench(n, a, log))
         print(table(rows[-1:]).splitlines()[-1], flush=True)
-    result = {
-        "cores": os.cpu_count(),
-        "load_average_before": load_before,
-        "load_average_after": os.getloadavg(),
-        "quick": a.quick,
-        "rows": rows,
-    }
-    path = a.json or os.path.join(a.work, "speed.json")
-    with open(path, "w") as f:
-        json.dump(result, f, indent=1)
+        # Written after every scene, so an interrupted run keeps the scenes it finished.
+        result = {
+            "cores": os.cpu_count(),
+            "load_average_before": load_before,
+            "load_average_after": os.getloadavg(),
+            "quick": a.quick,
+            "rows": rows,
+        }
+        with open(path, "w") as f:
+            json.dump(result, f, indent=1)
     print()
     print(table(rows))
     print(f"\n{os.cpu_count()} cores, load average {load_before[0]:.2f} before, {result['load_average_after'][0]:.2f} after "
