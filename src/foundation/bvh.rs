@@ -80,20 +80,60 @@ pub mod visibility {
     }
 }
 
+/// Which acceleration structure renders build: the 4-wide BVH (`bvh4`, the default, the
+/// faster one measured in docs/speed.md) or the binary one (`bvh2`). Both return the
+/// same hits, so images are identical; `BLENDSYNTH_ACCEL` chooses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Backend {
+    Binary,
+    Wide4,
+}
+
+impl Backend {
+    pub const DEFAULT: Backend = Backend::Wide4;
+
+    /// `BLENDSYNTH_ACCEL` (`bvh4` or `bvh2`), or the default when it is unset or empty.
+    pub fn from_env() -> Result<Backend, String> {
+        match std::env::var("BLENDSYNTH_ACCEL") {
+            Ok(v) => Backend::parse(&v),
+            Err(_) => Ok(Backend::DEFAULT),
+        }
+    }
+
+    pub fn parse(name: &str) -> Result<Backend, String> {
+        match name.trim() {
+            "" => Ok(Backend::DEFAULT),
+            "bvh4" => Ok(Backend::Wide4),
+            "bvh2" => Ok(Backend::Binary),
+            other => Err(format!(
+                "BLENDSYNTH_ACCEL={other:?} is not a ray acceleration backend (bvh4 or bvh2)"
+            )),
+        }
+    }
+
+    /// The structure over `tris` with visibility `masks` (as `Bvh::build_masked`).
+    pub fn build_masked(self, tris: &[[V3; 3]], masks: &[u32]) -> Box<dyn Accel> {
+        match self {
+            Backend::Binary => Box::new(Bvh::build_masked(tris, masks)),
+            Backend::Wide4 => Box::new(super::bvh4::Bvh4::build_masked(tris, masks)),
+        }
+    }
+}
+
 #[derive(Debug, Clone, Copy)]
-struct Node {
-    min: V3,
-    max: V3,
+pub(super) struct Node {
+    pub(super) min: V3,
+    pub(super) max: V3,
     /// Leaf: first primitive; inner: index of the left child (right = left + 1).
-    start: u32,
+    pub(super) start: u32,
     /// Primitive count; 0 for inner nodes.
-    count: u32,
+    pub(super) count: u32,
 }
 
 pub struct Bvh {
-    nodes: Vec<Node>,
+    pub(super) nodes: Vec<Node>,
     /// Triangles in leaf order, with their index in the caller's list.
-    tris: Vec<[V3; 3]>,
+    pub(super) tris: Vec<[V3; 3]>,
     ids: Vec<u32>,
     /// Per triangle in leaf order: the visibility mask of its object; empty when every
     /// triangle is visible to every ray (then no test is made).
@@ -103,7 +143,7 @@ pub struct Bvh {
 const BINS: usize = 16;
 const MAX_LEAF: usize = 4;
 
-fn area(min: V3, max: V3) -> f32 {
+pub(super) fn area(min: V3, max: V3) -> f32 {
     let d = sub(max, min);
     if d[0] < 0.0 {
         return 0.0;
@@ -264,7 +304,7 @@ impl Bvh {
             return None;
         }
         // Only a scene with hidden objects and a ray some of them hide from tests masks.
-        let filter = !self.masks.is_empty() && mask & visibility::ALL != visibility::ALL;
+        let filter = self.filters(mask);
         let inv = [1.0 / dir[0], 1.0 / dir[1], 1.0 / dir[2]];
         let wt = Watertight::new(dir);
         let mut best: Option<Hit> = None;
@@ -275,22 +315,11 @@ impl Bvh {
         loop {
             let node = &self.nodes[ni as usize];
             if node.count > 0 {
-                for i in node.start..node.start + node.count {
-                    if filter && self.masks[i as usize] & mask == 0 {
-                        continue;
-                    }
-                    if let Some((t, u, v)) = wt.intersect(org, &self.tris[i as usize], tmin, tfar) {
-                        tfar = t;
-                        best = Some(Hit {
-                            t,
-                            prim: self.ids[i as usize],
-                            u,
-                            v,
-                        });
-                        if ANY {
-                            return best;
-                        }
-                    }
+                let range = node.start..node.start + node.count;
+                if self.leaf::<ANY>(range, &wt, org, tmin, &mut tfar, &mut best, filter, mask)
+                    && ANY
+                {
+                    return best;
                 }
             } else {
                 let l = &self.nodes[node.start as usize];
@@ -332,6 +361,53 @@ impl Bvh {
     }
 }
 
+impl Bvh {
+    /// Tests the triangles `range` (leaf order) and keeps the nearest hit in `best`
+    /// (`tfar` its distance); true when one was found. A hit at exactly `tfar` replaces
+    /// the best when its triangle comes first in the caller's list, so the nearest hit is
+    /// the least (t, prim) whatever order a structure visits its leaves in: every backend
+    /// (`Bvh`, `Bvh4`) returns the same hit, and images are identical.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn leaf<const ANY: bool>(
+        &self,
+        range: std::ops::Range<u32>,
+        wt: &Watertight,
+        org: V3,
+        tmin: f32,
+        tfar: &mut f32,
+        best: &mut Option<Hit>,
+        filter: bool,
+        mask: u32,
+    ) -> bool {
+        let mut found = false;
+        for i in range {
+            if filter && self.masks[i as usize] & mask == 0 {
+                continue;
+            }
+            if let Some((t, u, v)) = wt.intersect(org, &self.tris[i as usize], tmin, *tfar) {
+                let prim = self.ids[i as usize];
+                if t == *tfar && best.is_none_or(|b| prim > b.prim) {
+                    continue;
+                }
+                *tfar = t;
+                *best = Some(Hit { t, prim, u, v });
+                found = true;
+                if ANY {
+                    return true;
+                }
+            }
+        }
+        found
+    }
+
+    /// Whether a ray of visibility `mask` must test triangles' masks.
+    #[inline(always)]
+    pub(super) fn filters(&self, mask: u32) -> bool {
+        !self.masks.is_empty() && mask & visibility::ALL != visibility::ALL
+    }
+}
+
 impl Accel for Bvh {
     fn intersect(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> Option<Hit> {
         self.traverse::<false>(org, dir, tmin, tmax, visibility::ALL)
@@ -363,9 +439,12 @@ fn slab(n: &Node, org: V3, inv: V3, tmin: f32, tmax: f32) -> Option<f32> {
     for a in 0..3 {
         let ta = (n.min[a] - org[a]) * inv[a];
         let tb = (n.max[a] - org[a]) * inv[a];
-        // NaN (0 * inf) compares false, so min/max keep the other value.
-        t0 = t0.max(ta.min(tb));
-        t1 = t1.min(ta.max(tb));
+        // The near plane by the direction's sign; a NaN distance (0 * inf: the origin on
+        // the plane of an axis the ray is parallel to) is ignored by max/min, so such a
+        // grazing ray still enters the box (the 4-wide BVH's test does the same).
+        let (near, far) = if inv[a] < 0.0 { (tb, ta) } else { (ta, tb) };
+        t0 = t0.max(near);
+        t1 = t1.min(far);
     }
     // Robust slab test: widen slightly for rounding (Ize 2013).
     if t0 <= t1 * 1.000_000_24 {
@@ -376,7 +455,7 @@ fn slab(n: &Node, org: V3, inv: V3, tmin: f32, tmax: f32) -> Option<f32> {
 }
 
 /// Per-ray precomputation of the watertight test.
-struct Watertight {
+pub(super) struct Watertight {
     kx: usize,
     ky: usize,
     kz: usize,
@@ -387,7 +466,7 @@ struct Watertight {
 
 impl Watertight {
     #[inline(always)]
-    fn new(dir: V3) -> Watertight {
+    pub(super) fn new(dir: V3) -> Watertight {
         let a = [dir[0].abs(), dir[1].abs(), dir[2].abs()];
         let kz = if a[0] > a[1] {
             if a[0] > a[2] {
@@ -416,7 +495,13 @@ impl Watertight {
     }
 
     #[inline(always)]
-    fn intersect(&self, org: V3, tri: &[V3; 3], tmin: f32, tmax: f32) -> Option<(f32, f32, f32)> {
+    pub(super) fn intersect(
+        &self,
+        org: V3,
+        tri: &[V3; 3],
+        tmin: f32,
+        tmax: f32,
+    ) -> Option<(f32, f32, f32)> {
         let (kx, ky, kz) = (self.kx, self.ky, self.kz);
         let a = sub(tri[0], org);
         let b = sub(tri[1], org);
@@ -449,7 +534,9 @@ impl Watertight {
         let t = u * az + v * bz + w * cz;
         let inv = 1.0 / det;
         let t = t * inv;
-        if !(t > tmin && t < tmax) {
+        // Up to tmax inclusive: `Bvh::leaf` decides a tie at the best distance so far
+        // (with no hit yet, tmax itself is excluded there).
+        if !(t > tmin && t <= tmax) {
             return None;
         }
         // u weights vertex 0, v vertex 1, w vertex 2 here.

@@ -4,6 +4,7 @@
 //! Nothing here knows Blender's data.
 
 pub mod bvh;
+pub mod bvh4;
 pub mod exr;
 pub mod files;
 pub mod math;

@@ -53,7 +53,7 @@ use rayon::prelude::*;
 use serde_json::Value;
 
 use crate::scene::{settings, Scene};
-use accel::{Accel, Bvh};
+use accel::Accel;
 use integrator::{Scratch, Settings};
 use light_tree::LightSelect;
 use math::*;
@@ -200,10 +200,11 @@ pub fn render_controlled(
     }
     // With moving objects the static rest goes in a BVH of its own (`object_motion`).
     let motion_accel = (moving > 0).then(|| object_motion::MotionAccel::build(&geo));
+    let backend = accel::Backend::from_env().map_err(RenderError)?;
     let bvh = if motion_accel.is_some() {
-        Bvh::build(&[])
+        backend.build_masked(&[], &[])
     } else {
-        Bvh::build_masked(&geo.tris, &build::triangle_masks(&geo))
+        backend.build_masked(&geo.tris, &build::triangle_masks(&geo))
     };
     let filter = filter::FilterTable::blackman_harris(integrator.filter_width as f32);
     let i = &integrator;
@@ -236,7 +237,7 @@ pub fn render_controlled(
     );
     let accel: &dyn Accel = match &motion_accel {
         Some(m) => m,
-        None => &bvh,
+        None => bvh.as_ref(),
     };
     let tracer = integrator::Scene {
         light_select: &light_select,

@@ -1,0 +1,239 @@
+//! Every ray acceleration backend renders the same image, bit for bit: the CLI renders
+//! fixture scenes with `BLENDSYNTH_ACCEL=bvh2` (binary BVH) and `bvh4` (4-wide BVH) and
+//! the EXRs must be byte-identical. Subsurface (many short walk rays), depth of field
+//! and a light with soft shadows cover the query kinds (nearest hit, occlusion).
+
+mod common;
+
+fn render(scene: &str, backend: &str, out: &std::path::Path) -> Vec<u8> {
+    let dir = common::repo().join("fixtures/render/scenes").join(scene);
+    let o = common::run(
+        &[
+            "render",
+            dir.to_str().unwrap(),
+            "--samples",
+            "4",
+            "--resolution",
+            "40x40",
+            "--threshold",
+            "0",
+            "--denoise",
+            "off",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[("BLENDSYNTH_ACCEL", backend)],
+    );
+    assert!(
+        o.status.success(),
+        "{scene} with {backend}: {}",
+        common::stderr(&o)
+    );
+    std::fs::read(out).unwrap()
+}
+
+#[test]
+fn every_backend_renders_identical_images() {
+    let tmp = tempfile::tempdir().unwrap();
+    for scene in [
+        "sss_principled",
+        "dof",
+        "area_glossy_mis",
+        "object_visibility",
+    ] {
+        let a = render(scene, "bvh2", &tmp.path().join(format!("{scene}_2.exr")));
+        let b = render(scene, "bvh4", &tmp.path().join(format!("{scene}_4.exr")));
+        assert!(a == b, "{scene}: bvh2 and bvh4 images differ");
+    }
+}
+
+#[test]
+fn an_unknown_backend_is_refused_by_name() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = common::repo().join("fixtures/render/scenes/dof");
+    let out = tmp.path().join("x.exr");
+    let o = common::run(
+        &[
+            "render",
+            dir.to_str().unwrap(),
+            "--samples",
+            "1",
+            "--resolution",
+            "8x8",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[("BLENDSYNTH_ACCEL", "embree")],
+    );
+    assert!(!o.status.success());
+    let e = common::stderr(&o);
+    assert!(
+        e.contains("BLENDSYNTH_ACCEL") && e.contains("embree"),
+        "{e}"
+    );
+    assert!(!out.exists(), "no output on an error");
+}
+
+use blendsynth::foundation::bvh::{visibility, Accel, Backend, Bvh, Hit};
+use blendsynth::foundation::bvh4::Bvh4;
+use blendsynth::foundation::math::V3;
+
+/// A fixed-seed generator (no dependence on a random draw).
+struct Lcg(u64);
+impl Lcg {
+    fn f(&mut self) -> f32 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+fn grid_z(x: f32, y: f32) -> f32 {
+    0.05 * ((x * 9.0).sin() + (y * 7.0).cos())
+}
+
+/// A bumpy n x n grid of quads (shared edges and vertices everywhere) and a soup of
+/// random triangles crossing it.
+fn scene(n: usize, soup: usize, rng: &mut Lcg) -> Vec<[V3; 3]> {
+    let p = |i: usize, j: usize| {
+        let (x, y) = (i as f32 / n as f32, j as f32 / n as f32);
+        [x, y, grid_z(x, y)]
+    };
+    let mut tris = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
+            tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
+        }
+    }
+    for _ in 0..soup {
+        let c = [rng.f(), rng.f(), rng.f() * 0.4 - 0.2];
+        let mut t = [[0.0; 3]; 3];
+        for v in &mut t {
+            *v = [
+                c[0] + 0.1 * (rng.f() - 0.5),
+                c[1] + 0.1 * (rng.f() - 0.5),
+                c[2] + 0.1 * (rng.f() - 0.5),
+            ];
+        }
+        tris.push(t);
+    }
+    tris
+}
+
+fn same(a: Option<Hit>, b: Option<Hit>) -> bool {
+    match (a, b) {
+        (None, None) => true,
+        (Some(a), Some(b)) => {
+            a.prim == b.prim
+                && a.t.to_bits() == b.t.to_bits()
+                && a.u.to_bits() == b.u.to_bits()
+                && a.v.to_bits() == b.v.to_bits()
+        }
+        _ => false,
+    }
+}
+
+/// Every query of the wide BVH returns exactly the binary BVH's hit: rays aimed at the
+/// grid's shared vertices and edges (where two or more triangles tie at the same
+/// distance, so the visiting order would pick one if the tie rule, least triangle index,
+/// did not), random rays, with visibility masks and finite ranges.
+#[test]
+fn wide_bvh_returns_the_binary_bvh_hits() {
+    let mut rng = Lcg(7);
+    let n = 24;
+    let tris = scene(n, 600, &mut rng);
+    let masks: Vec<u32> = (0..tris.len())
+        .map(|i| {
+            if i % 7 == 3 {
+                visibility::ALL & !visibility::SHADOW
+            } else {
+                visibility::ALL
+            }
+        })
+        .collect();
+    let bin = Bvh::build_masked(&tris, &masks);
+    let wide = Bvh4::build_masked(&tris, &masks);
+    // One structure per triangle, to find ties by brute force.
+    let singles: Vec<Bvh> = tris.iter().map(|t| Bvh::build(&[*t])).collect();
+    let mut ties = 0;
+    for k in 0..20_000 {
+        let target = if k % 2 == 0 {
+            // A grid vertex or an edge midpoint.
+            let (i, j) = ((k / 2) % (n + 1), (k / 2 / (n + 1)) % (n + 1));
+            let (x, y) = (i as f32 / n as f32, j as f32 / n as f32);
+            let x = if k % 4 == 0 { x } else { x + 0.5 / n as f32 };
+            [x, y, grid_z(x, y)]
+        } else {
+            [rng.f(), rng.f(), rng.f() * 0.3 - 0.15]
+        };
+        let org = [
+            rng.f() * 3.0 - 1.0,
+            rng.f() * 3.0 - 1.0,
+            if k % 3 == 0 { -1.5 } else { 1.5 },
+        ];
+        let dir = [target[0] - org[0], target[1] - org[1], target[2] - org[2]];
+        let (tmin, tmax) = if k % 5 == 0 {
+            (0.0, 0.9)
+        } else {
+            (1e-4, f32::INFINITY)
+        };
+        let mask = if k % 2 == 0 {
+            visibility::ALL
+        } else {
+            visibility::SHADOW
+        };
+        let a = bin.intersect_or_occluded::<false>(org, dir, tmin, tmax, mask);
+        let b = wide.intersect_or_occluded::<false>(org, dir, tmin, tmax, mask);
+        assert!(same(a, b), "ray {k}: binary {a:?}, wide {b:?}");
+        assert_eq!(
+            bin.occluded_vis(org, dir, tmin, tmax, 0.5, mask),
+            wide.occluded_vis(org, dir, tmin, tmax, 0.5, mask),
+            "ray {k} occlusion"
+        );
+        if k < 3000 && mask == visibility::ALL {
+            if let Some(h) = a {
+                let tied = singles.iter().enumerate().any(|(i, s)| {
+                    i as u32 != h.prim
+                        && s.intersect(org, dir, tmin, tmax)
+                            .is_some_and(|o| o.t == h.t)
+                });
+                ties += tied as usize;
+            }
+        }
+    }
+    // The test means something only if ties occur.
+    assert!(ties > 100, "only {ties} ties");
+}
+
+#[test]
+fn wide_bvh_small_and_empty_scenes() {
+    let one = [[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]];
+    let w = Bvh4::build(&one);
+    let h = w
+        .intersect([0.2, 0.2, 1.0], [0.0, 0.0, -1.0], 0.0, f32::INFINITY)
+        .unwrap();
+    assert_eq!(h.prim, 0);
+    assert!(w
+        .intersect([2.0, 2.0, 1.0], [0.0, 0.0, -1.0], 0.0, f32::INFINITY)
+        .is_none());
+    let empty = Bvh4::build(&[]);
+    assert!(empty
+        .intersect([0.0; 3], [0.0, 0.0, 1.0], 0.0, f32::INFINITY)
+        .is_none());
+    assert!(!empty.occluded([0.0; 3], [0.0, 0.0, 1.0], 0.0, f32::INFINITY));
+}
+
+#[test]
+fn backend_names() {
+    assert_eq!(Backend::parse("bvh2"), Ok(Backend::Binary));
+    assert_eq!(Backend::parse("bvh4"), Ok(Backend::Wide4));
+    assert_eq!(Backend::parse(""), Ok(Backend::DEFAULT));
+    let e = Backend::parse("embree").unwrap_err();
+    assert!(
+        e.contains("BLENDSYNTH_ACCEL") && e.contains("embree"),
+        "{e}"
+    );
+}
