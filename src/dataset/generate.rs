@@ -600,11 +600,14 @@ pub fn scene_camera(
         .iter()
         .find(|c| c.name == data)
         .ok_or_else(|| format!("camera data {data:?} of {name:?} not found"))?;
+    let r = &scene.file.scene.render;
+    let aspect = |k: &str| r.get(k).and_then(|v| v.as_f64()).unwrap_or(1.0);
     Ok(camera_info(
         name,
         &cam.properties,
         ev.world_matrices[idx],
         width,
         height,
+        [aspect("pixel_aspect_x"), aspect("pixel_aspect_y")],
     ))
 }
