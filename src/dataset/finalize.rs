@@ -144,7 +144,7 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<u64, String> {
             continue;
         };
         let rec = checked_record(src, i, &splits)?;
-        let files = [
+        let mut files = vec![
             (
                 layout::image_path(src, &rec.split, i),
                 layout::image_path(out, &rec.split, i),
@@ -154,24 +154,20 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<u64, String> {
                 layout::mask_path(out, &rec.split, i),
             ),
             (
-                layout::depth_path(src, &rec.split, i),
-                layout::depth_path(out, &rec.split, i),
-            ),
-            (
-                layout::normal_path(src, &rec.split, i),
-                layout::normal_path(out, &rec.split, i),
-            ),
-            (
                 layout::label_path(src, &rec.split, i),
                 layout::label_path(out, &rec.split, i),
             ),
-            (layout::record_path(src, i), layout::record_path(out, i)),
         ];
-        for (k, (a, b)) in files.into_iter().enumerate() {
-            // Depth and normals are optional.
-            if (k == 2 || k == 3) && !a.exists() {
-                continue;
-            }
+        // Depth, normals and the other optional files, where the shard has them.
+        files.extend(
+            layout::optional_frame_files(src, &rec.split, i)
+                .into_iter()
+                .zip(layout::optional_frame_files(out, &rec.split, i))
+                .filter(|(a, _)| a.exists()),
+        );
+        // The record last: its presence marks the frame finished.
+        files.push((layout::record_path(src, i), layout::record_path(out, i)));
+        for (a, b) in files {
             let bytes = std::fs::read(&a).map_err(|e| format!("{}: {e}", a.display()))?;
             write_atomic(&b, &bytes)?;
         }

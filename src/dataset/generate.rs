@@ -523,12 +523,48 @@ impl FrameContext<'_> {
                 .depth
                 .as_ref()
                 .ok_or("the spec asks for depth but the renderer gave none")?;
-            let mm: Vec<u16> = d
+            let q: Vec<u16> = d
                 .iter()
-                .map(|&z| crate::label::passes::depth_mm(z, labels_spec.mm_per_unit))
+                .map(|&z| {
+                    crate::label::passes::depth_png16(
+                        z,
+                        labels_spec.mm_per_unit,
+                        labels_spec.depth_png_max_mm,
+                    )
+                })
                 .collect();
             let p = layout::depth_path(self.out, split, i);
-            write_atomic(&p, &layout::png16_bytes(r.width, r.height, &mm)?)?;
+            write_atomic(&p, &layout::png16_bytes(r.width, r.height, &q)?)?;
+            hook(&p)?;
+        }
+        if let Some(format) = labels_spec.depth_float {
+            let d = r
+                .ids
+                .depth
+                .as_ref()
+                .ok_or("the spec asks for depth but the renderer gave none")?;
+            let unit = if labels_spec.depth_float_mm {
+                labels_spec.mm_per_unit
+            } else {
+                1.0
+            };
+            // 0 marks "no surface", as in the PNG.
+            let v: Vec<f32> = d
+                .iter()
+                .map(|&z| {
+                    if z.is_finite() {
+                        (z as f64 * unit) as f32
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+            let p = layout::depth_float_path(self.out, split, i, format.extension());
+            let bytes = match format {
+                crate::label::FloatFormat::Exr => layout::exr_grey_bytes(r.width, r.height, &v)?,
+                crate::label::FloatFormat::Npy => layout::npy_f32_bytes(r.width, r.height, &v)?,
+            };
+            write_atomic(&p, &bytes)?;
             hook(&p)?;
         }
         if labels_spec.normals {
@@ -539,6 +575,17 @@ impl FrameContext<'_> {
                 .ok_or("the spec asks for normals but the renderer gave none")?;
             let p = layout::normal_path(self.out, split, i);
             write_atomic(&p, &layout::exr_rgb_bytes(r.width, r.height, n)?)?;
+            hook(&p)?;
+        }
+        if labels_spec.normals_camera {
+            let n = r
+                .ids
+                .normal
+                .as_ref()
+                .ok_or("the spec asks for normals but the renderer gave none")?;
+            let cam = crate::label::passes::normals_to_camera(n, &camera.world_to_camera_opencv);
+            let p = layout::normal_camera_path(self.out, split, i);
+            write_atomic(&p, &layout::exr_rgb_bytes(r.width, r.height, &cam)?)?;
             hook(&p)?;
         }
         let txt = layout::label_path(self.out, split, i);

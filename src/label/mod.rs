@@ -18,7 +18,7 @@ pub mod record;
 pub mod rle;
 pub mod yolo;
 
-pub use classes::{ClassMap, ClassSpec, LabelSpec};
+pub use classes::{ClassMap, ClassSpec, FloatFormat, LabelSpec};
 pub use instances::{extract, InstanceLabel};
 
 /// One rendered instance, as the renderer's `InstanceInfo` describes it.
