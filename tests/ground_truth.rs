@@ -340,3 +340,136 @@ fn dataset_depth_files_hold_cycles_metric_depth() {
         assert!(c[2] < 0.0, "pixel {i}: camera normal {c:?} faces away");
     }
 }
+
+fn sequence_spec() -> blendsynth::dataset::Spec {
+    blendsynth::dataset::Spec::parse(
+        "[render]\nresolution = [16, 12]\nsamples = 1\ndenoise = false\n\
+         [frames]\nstart = 1\nstep = 0\n\
+         [sequence]\nlength = 3\nstep = 1\ncount = 3\n\
+         [labels]\ndepth_float = \"npy\"\n\
+         [[param]]\npath = 'cameras[\"Cam\"].lens'\ndist = \"uniform\"\nmin = 25.0\nmax = 45.0\n",
+    )
+    .unwrap()
+}
+
+fn run_sequences(out: &std::path::Path, shard: (u64, u64)) {
+    use blendsynth::dataset::{generate, renderer::path_tracer, GenerateOptions};
+    let scene = scene();
+    let r = path_tracer(&scene).unwrap();
+    let opts = GenerateOptions {
+        frames: 9,
+        seed: 7,
+        split: vec![("train".into(), 0.5), ("val".into(), 0.5)],
+        shard,
+        ..GenerateOptions::default()
+    };
+    generate(&scene, &sequence_spec(), r.as_ref(), out, &opts).unwrap();
+}
+
+#[test]
+fn sequences_draw_once_animate_the_camera_and_regenerate_on_any_shard_split() {
+    let tmp = tempfile::tempdir().unwrap();
+    let one = tmp.path().join("one");
+    run_sequences(&one, (0, 1));
+    let records: Vec<Value> = std::fs::read_to_string(one.join("frames.jsonl"))
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(records.len(), 9);
+    for (i, r) in records.iter().enumerate() {
+        let (s, k) = (i / 3, i % 3);
+        assert_eq!(r["sequence"], s as u64);
+        assert_eq!(r["sequence_frame"], k as u64);
+        // Scene frames 1, 2, 3 of the animated camera; one draw per sequence, one split.
+        assert_eq!(r["frame"], 1 + k as i64);
+        let first = &records[s * 3];
+        assert_eq!(
+            r["values"], first["values"],
+            "frame {i}: values differ within its sequence"
+        );
+        assert_eq!(r["split"], first["split"]);
+        assert_eq!(
+            r["camera"]["lens_mm"],
+            first["values"]["cameras[\"Cam\"].lens"]
+        );
+        // 24 fps: frame f is at f / 24 s.
+        assert_eq!(r["time"].as_f64().unwrap(), (1 + k) as f64 / 24.0);
+    }
+    assert_ne!(records[0]["values"], records[3]["values"]);
+    assert_ne!(
+        records[0]["camera"]["location"],
+        records[1]["camera"]["location"]
+    );
+
+    // TUM trajectory: the records' camera positions, camera-to-world rotations.
+    for s in 0..3 {
+        let dir = one.join(format!("sequences/{s:09}"));
+        let traj = std::fs::read_to_string(dir.join("trajectory.txt")).unwrap();
+        let lines: Vec<Vec<f64>> = traj
+            .lines()
+            .filter(|l| !l.starts_with('#'))
+            .map(|l| l.split(' ').map(|v| v.parse().unwrap()).collect())
+            .collect();
+        assert_eq!(lines.len(), 3);
+        for (k, l) in lines.iter().enumerate() {
+            let rec = &records[s * 3 + k];
+            let loc = nums(&rec["camera"]["location"]);
+            assert_eq!(l[0], rec["time"].as_f64().unwrap());
+            assert_eq!(&l[1..4], &loc[..]);
+            // The quaternion's rotation turns OpenCV camera axes into world axes: its
+            // third column (camera z, forward) is Blender's camera -Z.
+            let (x, y, z, w) = (l[4], l[5], l[6], l[7]);
+            let fwd = [
+                2.0 * (x * z + y * w),
+                2.0 * (y * z - x * w),
+                1.0 - 2.0 * (x * x + y * y),
+            ];
+            let m = &rec["camera"]["matrix_world"];
+            let col: Vec<f64> = (0..3).map(|r| -m[r][2].as_f64().unwrap()).collect();
+            let n = col.iter().map(|v| v * v).sum::<f64>().sqrt();
+            for c in 0..3 {
+                assert!(
+                    (fwd[c] - col[c] / n).abs() < 1e-9,
+                    "sequence {s} frame {k}: {fwd:?} vs {col:?}"
+                );
+            }
+        }
+        // COLMAP: one PINHOLE camera (the lens is drawn once per sequence), three images.
+        let cams = std::fs::read_to_string(dir.join("cameras.txt")).unwrap();
+        let cam_lines: Vec<&str> = cams.lines().filter(|l| !l.starts_with('#')).collect();
+        assert_eq!(cam_lines.len(), 1, "{cams}");
+        assert!(cam_lines[0].starts_with("1 PINHOLE 16 12 "), "{cams}");
+        let images = std::fs::read_to_string(dir.join("images.txt")).unwrap();
+        let img_lines: Vec<&str> = images.lines().filter(|l| !l.starts_with('#')).collect();
+        assert_eq!(img_lines.len(), 6, "{images}");
+        assert!(img_lines[0].ends_with(records[s * 3]["image"].as_str().unwrap()));
+        assert!(dir.join("points3D.txt").exists());
+    }
+
+    // Shards hold whole sequences: two shards merged, and a sequence regenerated alone
+    // (shard 1 of 3 is sequence 1), are the same bytes.
+    let shards: Vec<std::path::PathBuf> = (0..2)
+        .map(|i| {
+            let d = tmp.path().join(format!("shard{i}"));
+            run_sequences(&d, (i, 2));
+            d
+        })
+        .collect();
+    let merged = tmp.path().join("merged");
+    assert_eq!(blendsynth::dataset::merge(&shards, &merged).unwrap(), 9);
+    common::assert_same_tree(&one, &merged);
+    let alone = tmp.path().join("alone");
+    run_sequences(&alone, (1, 3));
+    let (a, b) = (common::tree(&alone), common::tree(&one));
+    let mut compared = 0;
+    for (k, v) in &a {
+        if k.starts_with("sequences/") || k.starts_with("frames/") || k.contains("/0000000") {
+            if k != "manifest.json" && b.get(k) != Some(v) {
+                panic!("{k} differs when sequence 1 is regenerated alone");
+            }
+            compared += 1;
+        }
+    }
+    assert!(a.contains_key("sequences/000000001/trajectory.txt") && compared >= 3 * 3 + 4);
+}

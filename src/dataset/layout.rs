@@ -10,6 +10,8 @@
 //! OUT/depth/SPLIT/NNNNNNNNN.exr|npy     optional: metric depth, float32 (0: none)
 //! OUT/normals/SPLIT/NNNNNNNNN.exr       optional: world-space normals, float RGB
 //! OUT/normals_camera/SPLIT/NNNNNNNNN.exr optional: normals in OpenCV camera axes
+//! OUT/sequences/SSSSSSSSS/             with [sequence]: trajectory.txt (TUM), COLMAP's
+//!                                       cameras.txt, images.txt, points3D.txt
 //! OUT/frames/NNNNNNNNN.json             per-frame record; written last: its presence
 //!                                       marks the frame finished
 //! OUT/annotations/instances_SPLIT.json  COCO (written when all frames are done)
@@ -92,6 +94,11 @@ pub fn optional_frame_files(out: &Path, split: &str, index: u64) -> Vec<PathBuf>
         normal_path(out, split, index),
         normal_camera_path(out, split, index),
     ]
+}
+/// A sequence's folder: trajectory.txt (TUM) and COLMAP's cameras.txt, images.txt,
+/// points3D.txt.
+pub fn sequence_dir(out: &Path, sequence: u64) -> PathBuf {
+    out.join("sequences").join(frame_name(sequence))
 }
 pub fn record_path(out: &Path, index: u64) -> PathBuf {
     out.join("frames")
