@@ -119,7 +119,10 @@ fn objects_blendsynth_does_not_build_render_frozen_or_are_refused_by_name() {
     assert_eq!(ours.face_count(), 0);
     for (a, b) in ours.positions.iter().zip(&theirs.positions) {
         for k in 0..3 {
-            assert!((a[k] - b[k]).abs() < 1e-5, "Path vertex {a:?} vs Blender {b:?}");
+            assert!(
+                (a[k] - b[k]).abs() < 1e-5,
+                "Path vertex {a:?} vs Blender {b:?}"
+            );
         }
     }
 

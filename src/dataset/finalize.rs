@@ -1,6 +1,7 @@
 //! The dataset-wide files, written from the finished frames alone (so a dataset made
 //! by one process, by shards then `merge`, or by a resumed run is byte-identical):
-//! `frames.jsonl`, `annotations/instances_SPLIT.json` (COCO), `data.yaml` (YOLO).
+//! `frames.jsonl`, `annotations/instances_SPLIT.json` (COCO), `data.yaml` (YOLO), and per
+//! sequence `sequences/S/trajectory.txt` (TUM) and COLMAP's text model.
 
 use std::path::{Path, PathBuf};
 
@@ -9,6 +10,7 @@ use serde_json::Value;
 use super::layout::{self, write_atomic};
 use crate::label::coco;
 use crate::label::record::FrameRecord;
+use crate::label::trajectory;
 use crate::label::yolo;
 
 fn read_record(out: &Path, i: u64) -> Result<FrameRecord, String> {
@@ -44,7 +46,36 @@ pub fn finalize(
     write_atomic(
         &out.join("data.yaml"),
         yolo::data_yaml(splits, class_names).as_bytes(),
-    )
+    )?;
+    write_sequences(out, &records)
+}
+
+/// Each sequence's trajectory (TUM) and COLMAP model, from its records in frame order.
+fn write_sequences(out: &Path, records: &[FrameRecord]) -> Result<(), String> {
+    let mut by_sequence: std::collections::BTreeMap<u64, Vec<&FrameRecord>> =
+        std::collections::BTreeMap::new();
+    for r in records {
+        if let Some(s) = r.sequence {
+            by_sequence.entry(s).or_default().push(r);
+        }
+    }
+    for (s, mut recs) in by_sequence {
+        recs.sort_by_key(|r| r.sequence_frame);
+        let dir = layout::sequence_dir(out, s);
+        write_atomic(
+            &dir.join("trajectory.txt"),
+            trajectory::tum(&recs).as_bytes(),
+        )?;
+        if let Some(files) = trajectory::colmap(&recs) {
+            for (name, text) in ["cameras.txt", "images.txt", "points3D.txt"]
+                .iter()
+                .zip(files)
+            {
+                write_atomic(&dir.join(name), text.as_bytes())?;
+            }
+        }
+    }
+    Ok(())
 }
 
 /// A shard's record of frame `i`, checked before any of its fields becomes a path: it
@@ -144,7 +175,7 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<u64, String> {
             continue;
         };
         let rec = checked_record(src, i, &splits)?;
-        let files = [
+        let mut files = vec![
             (
                 layout::image_path(src, &rec.split, i),
                 layout::image_path(out, &rec.split, i),
@@ -154,24 +185,20 @@ pub fn merge(shards: &[PathBuf], out: &Path) -> Result<u64, String> {
                 layout::mask_path(out, &rec.split, i),
             ),
             (
-                layout::depth_path(src, &rec.split, i),
-                layout::depth_path(out, &rec.split, i),
-            ),
-            (
-                layout::normal_path(src, &rec.split, i),
-                layout::normal_path(out, &rec.split, i),
-            ),
-            (
                 layout::label_path(src, &rec.split, i),
                 layout::label_path(out, &rec.split, i),
             ),
-            (layout::record_path(src, i), layout::record_path(out, i)),
         ];
-        for (k, (a, b)) in files.into_iter().enumerate() {
-            // Depth and normals are optional.
-            if (k == 2 || k == 3) && !a.exists() {
-                continue;
-            }
+        // Depth, normals and the other optional files, where the shard has them.
+        files.extend(
+            layout::optional_frame_files(src, &rec.split, i)
+                .into_iter()
+                .zip(layout::optional_frame_files(out, &rec.split, i))
+                .filter(|(a, _)| a.exists()),
+        );
+        // The record last: its presence marks the frame finished.
+        files.push((layout::record_path(src, i), layout::record_path(out, i)));
+        for (a, b) in files {
             let bytes = std::fs::read(&a).map_err(|e| format!("{}: {e}", a.display()))?;
             write_atomic(&b, &bytes)?;
         }

@@ -239,6 +239,40 @@ pub fn shard_frames(frames: u64, shard: (u64, u64)) -> impl Iterator<Item = u64>
     (shard.0..frames).step_by(shard.1.clamp(1, usize::MAX as u64) as usize)
 }
 
+/// The frames of shard `(index, count)` when frames come in sequences of `length`: whole
+/// sequences, sequence `s` in shard `s % count` (with `length` 1, `shard_frames`).
+pub fn shard_sequence_frames(
+    frames: u64,
+    length: u64,
+    shard: (u64, u64),
+) -> impl Iterator<Item = u64> + Clone {
+    let length = length.max(1);
+    let n = shard.1.max(1);
+    (0..frames).filter(move |i| (i / length) % n == shard.0)
+}
+
+/// Every frame of every sequence is a Blender frame: the schedule's starts are checked by
+/// `FrameSchedule::check`; here the ends of the first, last and (wrapping) largest start.
+fn check_sequence_frames(spec: &Spec, current: i64, sequences: u64) -> Result<(), String> {
+    let Some(q) = &spec.sequence else {
+        return Ok(());
+    };
+    let mut starts = vec![
+        spec.frames.frame(current, 0),
+        spec.frames.frame(current, sequences - 1),
+    ];
+    if let Some(m) = spec.frames.modulo {
+        starts.extend([0, m - 1]);
+    }
+    for s in starts {
+        let end = s as i128 + q.step as i128 * (q.length as i128 - 1);
+        if !(super::spec::MIN_FRAME as i128..=super::spec::MAX_FRAME as i128).contains(&end) {
+            return Err(format!("spec: sequence: a sequence starting at scene frame {s} would end at {end}, outside Blender's frame range"));
+        }
+    }
+    Ok(())
+}
+
 /// The dataset folder is empty apart from `.partial` leftovers of a run killed before
 /// its manifest was in place (a run killed while writing the manifest).
 fn only_partials(out: &Path) -> bool {
@@ -276,9 +310,22 @@ pub fn generate(
     for w in spec.validate(scene).map_err(|e| e.to_string())? {
         eprintln!("warning: {w}");
     }
-    spec.frames
-        .check(scene.file.scene.frame_current as i64, opts.frames)
-        .map_err(|e| e.to_string())?;
+    let current = scene.file.scene.frame_current as i64;
+    // Splits and shards hold whole sequences: the unit is a sequence, or a frame.
+    let (units, length) = match &spec.sequence {
+        Some(q) => {
+            let n = q.sequences(opts.frames).map_err(|e| e.to_string())?;
+            spec.frames.check(current, n).map_err(|e| e.to_string())?;
+            check_sequence_frames(spec, current, n)?;
+            (n, q.length)
+        }
+        None => {
+            spec.frames
+                .check(current, opts.frames)
+                .map_err(|e| e.to_string())?;
+            (opts.frames, 1)
+        }
+    };
     let classes = ClassMap::new(&spec.labels, scene);
     if classes.names.len() > layout::MAX_CLASSES {
         return Err(format!(
@@ -320,8 +367,8 @@ pub fn generate(
         )
         .map_err(|e| format!("{e} (nothing rendered yet; rerun with --resume)"))?;
     }
-    let splits = SplitPlan::new(opts.frames, opts.seed, &opts.split);
-    let mine = shard_frames(opts.frames, opts.shard);
+    let splits = SplitPlan::new(units, opts.seed, &opts.split);
+    let mine = shard_sequence_frames(opts.frames, length, opts.shard);
     let mine_count = mine.clone().count() as u64;
 
     let scene_json = serde_json::to_value(&scene.file).map_err(|e| e.to_string())?;
@@ -453,7 +500,8 @@ impl FrameContext<'_> {
 
     fn frame(&self, i: u64) -> Result<(), String> {
         let opts = self.opts;
-        let split = &opts.split[self.splits.split_of(i) as usize].0;
+        let length = self.spec.sequence.as_ref().map_or(1, |q| q.length);
+        let split = &opts.split[self.splits.split_of(i / length) as usize].0;
         let fv = self
             .spec
             .frame_values(
@@ -523,12 +571,48 @@ impl FrameContext<'_> {
                 .depth
                 .as_ref()
                 .ok_or("the spec asks for depth but the renderer gave none")?;
-            let mm: Vec<u16> = d
+            let q: Vec<u16> = d
                 .iter()
-                .map(|&z| crate::label::passes::depth_mm(z, labels_spec.mm_per_unit))
+                .map(|&z| {
+                    crate::label::passes::depth_png16(
+                        z,
+                        labels_spec.mm_per_unit,
+                        labels_spec.depth_png_max_mm,
+                    )
+                })
                 .collect();
             let p = layout::depth_path(self.out, split, i);
-            write_atomic(&p, &layout::png16_bytes(r.width, r.height, &mm)?)?;
+            write_atomic(&p, &layout::png16_bytes(r.width, r.height, &q)?)?;
+            hook(&p)?;
+        }
+        if let Some(format) = labels_spec.depth_float {
+            let d = r
+                .ids
+                .depth
+                .as_ref()
+                .ok_or("the spec asks for depth but the renderer gave none")?;
+            let unit = if labels_spec.depth_float_mm {
+                labels_spec.mm_per_unit
+            } else {
+                1.0
+            };
+            // 0 marks "no surface", as in the PNG.
+            let v: Vec<f32> = d
+                .iter()
+                .map(|&z| {
+                    if z.is_finite() {
+                        (z as f64 * unit) as f32
+                    } else {
+                        0.0
+                    }
+                })
+                .collect();
+            let p = layout::depth_float_path(self.out, split, i, format.extension());
+            let bytes = match format {
+                crate::label::FloatFormat::Exr => layout::exr_grey_bytes(r.width, r.height, &v)?,
+                crate::label::FloatFormat::Npy => layout::npy_f32_bytes(r.width, r.height, &v)?,
+            };
+            write_atomic(&p, &bytes)?;
             hook(&p)?;
         }
         if labels_spec.normals {
@@ -539,6 +623,17 @@ impl FrameContext<'_> {
                 .ok_or("the spec asks for normals but the renderer gave none")?;
             let p = layout::normal_path(self.out, split, i);
             write_atomic(&p, &layout::exr_rgb_bytes(r.width, r.height, n)?)?;
+            hook(&p)?;
+        }
+        if labels_spec.normals_camera {
+            let n = r
+                .ids
+                .normal
+                .as_ref()
+                .ok_or("the spec asks for normals but the renderer gave none")?;
+            let cam = crate::label::passes::normals_to_camera(n, &camera.world_to_camera_opencv);
+            let p = layout::normal_camera_path(self.out, split, i);
+            write_atomic(&p, &layout::exr_rgb_bytes(r.width, r.height, &cam)?)?;
             hook(&p)?;
         }
         let txt = layout::label_path(self.out, split, i);
@@ -561,6 +656,13 @@ impl FrameContext<'_> {
             drawn: fv.drawn.iter().cloned().collect(),
             camera,
             annotations: anns,
+            sequence: self.spec.sequence.as_ref().map(|q| i / q.length),
+            sequence_frame: self.spec.sequence.as_ref().map(|q| i % q.length),
+            time: self.spec.sequence.as_ref().map(|_| {
+                let r = &self.scene.file.scene.render;
+                let g = |k: &str, d: f64| r.get(k).and_then(|v| v.as_f64()).unwrap_or(d);
+                fv.frame as f64 * g("fps_base", 1.0) / g("fps", 24.0)
+            }),
         };
         let rec = layout::record_path(self.out, i);
         write_atomic(
@@ -600,11 +702,14 @@ pub fn scene_camera(
         .iter()
         .find(|c| c.name == data)
         .ok_or_else(|| format!("camera data {data:?} of {name:?} not found"))?;
+    let r = &scene.file.scene.render;
+    let aspect = |k: &str| r.get(k).and_then(|v| v.as_f64()).unwrap_or(1.0);
     Ok(camera_info(
         name,
         &cam.properties,
         ev.world_matrices[idx],
         width,
         height,
+        [aspect("pixel_aspect_x"), aspect("pixel_aspect_y")],
     ))
 }

@@ -7,7 +7,11 @@
 //!                                       8-bit up to 254 classes, else 16-bit)
 //! OUT/labels/SPLIT/NNNNNNNNN.txt        YOLO boxes
 //! OUT/depth/SPLIT/NNNNNNNNN.png         optional: depth in mm, 16-bit (0: none/far)
+//! OUT/depth/SPLIT/NNNNNNNNN.exr|npy     optional: metric depth, float32 (0: none)
 //! OUT/normals/SPLIT/NNNNNNNNN.exr       optional: world-space normals, float RGB
+//! OUT/normals_camera/SPLIT/NNNNNNNNN.exr optional: normals in OpenCV camera axes
+//! OUT/sequences/SSSSSSSSS/             with [sequence]: trajectory.txt (TUM), COLMAP's
+//!                                       cameras.txt, images.txt, points3D.txt
 //! OUT/frames/NNNNNNNNN.json             per-frame record; written last: its presence
 //!                                       marks the frame finished
 //! OUT/annotations/instances_SPLIT.json  COCO (written when all frames are done)
@@ -72,6 +76,31 @@ pub fn normal_path(out: &Path, split: &str, index: u64) -> PathBuf {
     out.join("normals")
         .join(split)
         .join(format!("{}.exr", frame_name(index)))
+}
+pub fn depth_float_path(out: &Path, split: &str, index: u64, ext: &str) -> PathBuf {
+    out.join("depth")
+        .join(split)
+        .join(format!("{}.{ext}", frame_name(index)))
+}
+pub fn normal_camera_path(out: &Path, split: &str, index: u64) -> PathBuf {
+    out.join("normals_camera")
+        .join(split)
+        .join(format!("{}.exr", frame_name(index)))
+}
+/// A frame's optional files (written when the spec asks for them).
+pub fn optional_frame_files(out: &Path, split: &str, index: u64) -> Vec<PathBuf> {
+    vec![
+        depth_path(out, split, index),
+        depth_float_path(out, split, index, "exr"),
+        depth_float_path(out, split, index, "npy"),
+        normal_path(out, split, index),
+        normal_camera_path(out, split, index),
+    ]
+}
+/// A sequence's folder: trajectory.txt (TUM) and COLMAP's cameras.txt, images.txt,
+/// points3D.txt.
+pub fn sequence_dir(out: &Path, sequence: u64) -> PathBuf {
+    out.join("sequences").join(frame_name(sequence))
 }
 pub fn record_path(out: &Path, index: u64) -> PathBuf {
     out.join("frames")
@@ -163,6 +192,33 @@ pub fn mask_png_bytes(
     } else {
         png16_bytes(width, height, mask)
     }
+}
+
+pub use crate::foundation::exr::grey_bytes as exr_grey_bytes;
+
+/// NumPy `.npy` (format 1.0): little-endian float32, C order, shape (height, width).
+pub fn npy_f32_bytes(width: u32, height: u32, data: &[f32]) -> Result<Vec<u8>, String> {
+    if data.len() != width as usize * height as usize {
+        return Err(format!(
+            "npy encode: {} values for {width}x{height}",
+            data.len()
+        ));
+    }
+    let mut header =
+        format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({height}, {width}), }}");
+    // Magic (6) + version (2) + length (2) + header, padded with spaces to a multiple of
+    // 64 and ended by a newline, as numpy writes it.
+    let total = (10 + header.len() + 1).div_ceil(64) * 64;
+    header.push_str(&" ".repeat(total - 10 - header.len() - 1));
+    header.push('\n');
+    let mut out = Vec::with_capacity(total + data.len() * 4);
+    out.extend_from_slice(b"\x93NUMPY\x01\x00");
+    out.extend_from_slice(&(header.len() as u16).to_le_bytes());
+    out.extend_from_slice(header.as_bytes());
+    for v in data {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    Ok(out)
 }
 
 /// Display-referred [0, 1] RGBA to 8-bit RGB, rounded.

@@ -55,6 +55,81 @@ pub struct FrameSchedule {
     pub modulo: Option<i64>,
 }
 
+/// `[sequence]`: dataset frames come in runs of `length` consecutive frames: frame i is
+/// frame `i % length` of sequence `i / length`, which starts at the scene frame the
+/// `[frames]` schedule gives index `i / length` and advances by `step` scene frames;
+/// parameters are drawn once per sequence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SequenceSpec {
+    pub length: u64,
+    pub step: i64,
+    /// How many sequences (the dataset has count x length frames); None: --frames / length.
+    pub count: Option<u64>,
+}
+
+impl SequenceSpec {
+    /// The number of sequences of a dataset of `frames` frames; an error unless the
+    /// frames are whole sequences (and `count` sequences when it is set).
+    // `%`: u64::is_multiple_of needs Rust 1.87 (MSRV 1.80).
+    #[allow(clippy::manual_is_multiple_of)]
+    pub fn sequences(&self, frames: u64) -> Result<u64, SpecError> {
+        if frames % self.length != 0 {
+            return Err(err(
+                "sequence.length",
+                format!("{frames} frames are not whole sequences of {}", self.length),
+            ));
+        }
+        let n = frames / self.length;
+        match self.count {
+            Some(c) if c != n => Err(err(
+                "sequence.count",
+                format!(
+                    "{c} sequences of {} frames need {} frames, not {frames}",
+                    self.length,
+                    c as u128 * self.length as u128
+                ),
+            )),
+            _ => Ok(n),
+        }
+    }
+}
+
+fn parse_sequence(v: &Toml) -> Result<SequenceSpec, SpecError> {
+    let t = v
+        .as_table()
+        .ok_or_else(|| err("sequence", "must be a table"))?;
+    let mut q = SequenceSpec {
+        length: 0,
+        step: 1,
+        count: None,
+    };
+    let span = MAX_FRAME - MIN_FRAME;
+    for (k, x) in t {
+        let at = format!("sequence.{k}");
+        let i = x
+            .as_integer()
+            .ok_or_else(|| err(&at, "must be an integer"))?;
+        match k.as_str() {
+            "length" if (1..=span).contains(&i) => q.length = i as u64,
+            "length" => return Err(err(&at, format!("{i} is not within [1, {span}]"))),
+            "step" if (-span..=span).contains(&i) && i != 0 => q.step = i,
+            "step" => {
+                return Err(err(
+                    &at,
+                    format!("{i} is not a non-zero step within [-{span}, {span}]"),
+                ))
+            }
+            "count" if i >= 1 => q.count = Some(i as u64),
+            "count" => return Err(err(&at, format!("{i}: need at least one sequence"))),
+            _ => return Err(err(&at, "unknown key (expected length, step, count)")),
+        }
+    }
+    if q.length == 0 {
+        return Err(err("sequence.length", "missing (frames per sequence)"));
+    }
+    Ok(q)
+}
+
 /// Blender's frame limits (`MINAFRAME`, `MAXFRAME`): a scene frame outside them is not
 /// one Blender can show.
 pub const MIN_FRAME: i64 = -1_048_574;
@@ -140,6 +215,8 @@ pub struct Param {
 pub struct Spec {
     pub render: RenderSettings,
     pub frames: FrameSchedule,
+    /// Runs of consecutive scene frames (`[sequence]`), when set.
+    pub sequence: Option<SequenceSpec>,
     pub labels: LabelSpec,
     pub params: Vec<Param>,
     /// The TOML text, recorded in the dataset manifest.
@@ -179,6 +256,7 @@ impl Spec {
                 step: 1,
                 modulo: None,
             },
+            sequence: None,
             labels: LabelSpec::default(),
             params: Vec::new(),
             source: text.to_string(),
@@ -187,6 +265,7 @@ impl Spec {
             match k.as_str() {
                 "render" => spec.render = parse_render(v)?,
                 "frames" => spec.frames = parse_frames(v)?,
+                "sequence" => spec.sequence = Some(parse_sequence(v)?),
                 "labels" => spec.labels = LabelSpec::from_toml(v).map_err(|m| err("labels", m))?,
                 "param" => {
                     let Toml::Array(items) = v else {
@@ -205,7 +284,7 @@ impl Spec {
                 other => {
                     return Err(err(
                         other,
-                        "unknown section (expected render, frames, labels, param)",
+                        "unknown section (expected render, frames, sequence, labels, param)",
                     ))
                 }
             }
@@ -229,9 +308,19 @@ impl Spec {
     ) -> Result<FrameValues, SpecError> {
         let mut drawn = Vec::with_capacity(self.params.len());
         let mut overrides = Vec::with_capacity(self.params.len());
+        // In a sequence, parameters are drawn once per sequence (keyed by its index) and
+        // the scene frame advances by the sequence's step.
+        let (draw_index, frame) = match &self.sequence {
+            Some(q) => {
+                let (s, k) = (index / q.length, index % q.length);
+                let f = self.frames.frame(scene_current, s) as i128 + q.step as i128 * k as i128;
+                (s, f.clamp(i64::MIN as i128, i64::MAX as i128) as i64)
+            }
+            None => (index, self.frames.frame(scene_current, index)),
+        };
         for p in &self.params {
             let key = rng::key(&p.path);
-            let v = sample(&p.dist, seed, index, key);
+            let v = sample(&p.dist, seed, draw_index, key);
             let slot = lookup(scene_json, &p.path).map_err(|m| err(&p.path, m))?;
             let applied = if p.offset {
                 add_offset(slot, &v).map_err(|m| err(&p.path, m))?
@@ -247,7 +336,7 @@ impl Spec {
         let render_seed = rng::bits(seed, index, rng::key("#render_seed"), 0) as u32;
         Ok(FrameValues {
             index,
-            frame: self.frames.frame(scene_current, index),
+            frame,
             render_seed,
             drawn,
             overrides,

@@ -57,6 +57,30 @@ pub fn rgb_bytes(
     Ok(out.into_inner())
 }
 
+/// One float32 channel named "Y" (read as grey by OpenEXR tools and OpenCV) as EXR bytes.
+pub fn grey_bytes(width: u32, height: u32, data: &[f32]) -> std::result::Result<Vec<u8>, String> {
+    if data.len() != width as usize * height as usize {
+        return Err(format!(
+            "EXR encode: {} values for {width}x{height}",
+            data.len()
+        ));
+    }
+    let channel = AnyChannel::new("Y", FlatSamples::F32(data.to_vec()));
+    let layer = Layer::new(
+        (width as usize, height as usize),
+        LayerAttributes::default(),
+        ENCODING,
+        AnyChannels::sort(vec![channel].into()),
+    );
+    let mut out = std::io::Cursor::new(Vec::new());
+    Image::from_layer(layer)
+        .write()
+        .non_parallel()
+        .to_buffered(&mut out)
+        .map_err(|e| format!("EXR encode: {e}"))?;
+    Ok(out.into_inner())
+}
+
 fn check(width: u32, height: u32, n: usize) -> std::result::Result<(), String> {
     if width == 0 || height == 0 {
         return Err(format!("cannot write an empty {width}x{height} image"));

@@ -29,6 +29,33 @@ pub struct LabelSpec {
     /// Also write depth (16-bit PNG, millimetres) and normals (float EXR).
     pub depth: bool,
     pub normals: bool,
+    /// The depth PNG's full scale in mm: value = round(depth_mm / depth_png_max_mm *
+    /// 65535) (default 65535: whole millimetres; SimCol3D's convention is 200).
+    pub depth_png_max_mm: f64,
+    /// Metric depth as float32 too: `Some(Exr)` or `Some(Npy)`.
+    pub depth_float: Option<FloatFormat>,
+    /// The float depth's unit: millimetres (true) or scene units (false, the default).
+    pub depth_float_mm: bool,
+    /// Also write normals in OpenCV camera axes (x right, y down, z forward).
+    pub normals_camera: bool,
+}
+
+/// A float32 file format for per-pixel values.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FloatFormat {
+    /// One-channel ("Y") float32 EXR, top row first.
+    Exr,
+    /// NumPy `.npy`, little-endian float32, shape (height, width), top row first.
+    Npy,
+}
+
+impl FloatFormat {
+    pub fn extension(self) -> &'static str {
+        match self {
+            FloatFormat::Exr => "exr",
+            FloatFormat::Npy => "npy",
+        }
+    }
 }
 
 impl Default for LabelSpec {
@@ -40,6 +67,10 @@ impl Default for LabelSpec {
             mm_per_unit: 1000.0,
             depth: false,
             normals: false,
+            depth_png_max_mm: 65535.0,
+            depth_float: None,
+            depth_float_mm: false,
+            normals_camera: false,
         }
     }
 }
@@ -61,6 +92,28 @@ impl LabelSpec {
                 }
                 "depth" => s.depth = x.as_bool().ok_or("depth must be true or false")?,
                 "normals" => s.normals = x.as_bool().ok_or("normals must be true or false")?,
+                "normals_camera" => s.normals_camera = x.as_bool().ok_or("normals_camera must be true or false")?,
+                "depth_png_max_mm" => {
+                    s.depth_png_max_mm = match x {
+                        Toml::Float(f) if f.is_finite() && *f > 0.0 => *f,
+                        Toml::Integer(i) if *i > 0 => *i as f64,
+                        _ => return Err("depth_png_max_mm must be a positive number (the 16-bit PNG's full scale in mm; SimCol3D uses 200)".into()),
+                    }
+                }
+                "depth_float" => {
+                    s.depth_float = match x.as_str() {
+                        Some("exr") => Some(FloatFormat::Exr),
+                        Some("npy") => Some(FloatFormat::Npy),
+                        _ => return Err("depth_float must be \"exr\" or \"npy\"".into()),
+                    }
+                }
+                "depth_float_unit" => {
+                    s.depth_float_mm = match x.as_str() {
+                        Some("mm") => true,
+                        Some("scene") => false,
+                        _ => return Err("depth_float_unit must be \"scene\" or \"mm\"".into()),
+                    }
+                }
                 "class" => {
                     for (i, c) in x.as_array().ok_or("class must be an array of tables ([[labels.class]])")?.iter().enumerate() {
                         let c = c.as_table().ok_or(format!("class[{i}] must be a table"))?;
@@ -87,7 +140,7 @@ impl LabelSpec {
                         s.classes.push(ClassSpec { name, objects, mask });
                     }
                 }
-                other => return Err(format!("unknown key {other:?} (expected class, class_property, min_pixels, mm_per_unit, depth, normals)")),
+                other => return Err(format!("unknown key {other:?} (expected class, class_property, min_pixels, mm_per_unit, depth, depth_png_max_mm, depth_float, depth_float_unit, normals, normals_camera)")),
             }
         }
         Ok(s)

@@ -7,7 +7,7 @@
 //! One idea per file: `classes` (which object is which class), `instances` (masks,
 //! boxes, the drop rule), `rle` (COCO's compressed RLE), `camera` (intrinsics, pose),
 //! `coco` and `yolo` (file formats), `record` (the per-frame JSON), `passes` (a render's
-//! label passes as image files).
+//! label passes as image files), `trajectory` (a sequence's poses as TUM and COLMAP text).
 
 pub mod camera;
 pub mod classes;
@@ -16,9 +16,10 @@ pub mod instances;
 pub mod passes;
 pub mod record;
 pub mod rle;
+pub mod trajectory;
 pub mod yolo;
 
-pub use classes::{ClassMap, ClassSpec, LabelSpec};
+pub use classes::{ClassMap, ClassSpec, FloatFormat, LabelSpec};
 pub use instances::{extract, InstanceLabel};
 
 /// One rendered instance, as the renderer's `InstanceInfo` describes it.

@@ -42,12 +42,32 @@ pub struct PassImages<'a> {
 /// A depth in scene units to 16-bit millimetres: 0 for the background and for what
 /// lies beyond the 16-bit range (65.535 m), so 0 always means "no depth".
 pub fn depth_mm(z: f32, mm_per_unit: f64) -> u16 {
-    let mm = (z as f64 * mm_per_unit).round();
-    if z.is_finite() && (0.0..=65535.0).contains(&mm) {
-        mm as u16
+    depth_png16(z, mm_per_unit, 65535.0)
+}
+
+/// A depth in scene units to a 16-bit value with full scale `max_mm`: round(mm /
+/// max_mm * 65535); 0 for the background and for what lies beyond `max_mm`.
+pub fn depth_png16(z: f32, mm_per_unit: f64, max_mm: f64) -> u16 {
+    let q = (z as f64 * mm_per_unit / max_mm * 65535.0).round();
+    if z.is_finite() && (0.0..=65535.0).contains(&q) {
+        q as u16
     } else {
         0
     }
+}
+
+/// World-space normals turned into OpenCV camera axes by the rotation rows of a
+/// world-to-camera matrix (`CameraInfo::world_to_camera_opencv`).
+pub fn normals_to_camera(normals: &[[f32; 3]], world_to_camera: &[[f64; 4]; 4]) -> Vec<[f32; 3]> {
+    let r = world_to_camera;
+    normals
+        .iter()
+        .map(|n| {
+            std::array::from_fn(|i| {
+                (r[i][0] * n[0] as f64 + r[i][1] * n[1] as f64 + r[i][2] * n[2] as f64) as f32
+            })
+        })
+        .collect()
 }
 
 /// The semantic class pass: 0 background or unlabelled, else class index + 1.
@@ -202,7 +222,7 @@ pub fn write_passes(
 
 #[cfg(test)]
 mod tests {
-    use super::depth_mm;
+    use super::{depth_mm, depth_png16};
 
     #[test]
     fn depth_in_millimetres_with_zero_for_none() {
@@ -210,5 +230,27 @@ mod tests {
         assert_eq!(depth_mm(f32::INFINITY, 1000.0), 0);
         assert_eq!(depth_mm(70.0, 1000.0), 0);
         assert_eq!(depth_mm(65.535, 1000.0), 65535);
+    }
+
+    /// SimCol3D's convention: 20 cm full scale; decoding value * 200 / 65535 mm is within
+    /// half a step of the depth, and 0 stays "no depth".
+    #[test]
+    fn depth_png_scale_round_trips_within_half_a_step() {
+        let step = 200.0 / 65535.0;
+        for i in 0..20000 {
+            let z = 0.2 * i as f64 / 19999.0 + 1e-7 * (i % 7) as f64;
+            let v = depth_png16(z as f32, 1000.0, 200.0);
+            let back = v as f64 * step;
+            let mm = z as f32 as f64 * 1000.0;
+            if mm <= 200.0 {
+                assert!(
+                    (back - mm).abs() <= step / 2.0 + 1e-9,
+                    "{mm} mm -> {v} -> {back}"
+                );
+            }
+        }
+        assert_eq!(depth_png16(0.2001, 1000.0, 200.0), 0);
+        assert_eq!(depth_png16(f32::INFINITY, 1000.0, 200.0), 0);
+        assert_eq!(depth_png16(0.2, 1000.0, 200.0), 65535);
     }
 }

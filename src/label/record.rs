@@ -56,6 +56,14 @@ pub struct FrameRecord {
     pub drawn: serde_json::Map<String, Value>,
     pub camera: CameraInfo,
     pub annotations: Vec<Annotation>,
+    /// With `[sequence]`: the sequence (0-based), the frame's place in it, and its time
+    /// in seconds (scene frame / the scene's frame rate).
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub sequence: Option<u64>,
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub sequence_frame: Option<u64>,
+    #[serde(skip_serializing_if = "Option::is_none", default)]
+    pub time: Option<f64>,
 }
 
 /// Axis-aligned bounds (min, max).
