@@ -498,6 +498,8 @@ impl FrameContext<'_> {
         b
     }
 
+    // Long because one frame's files are written in the order resume relies on (image,
+    // passes, depth, labels, then the record that marks the frame done).
     fn frame(&self, i: u64) -> Result<(), String> {
         let opts = self.opts;
         let length = self.spec.sequence.as_ref().map_or(1, |q| q.length);
@@ -659,9 +661,8 @@ impl FrameContext<'_> {
             sequence: self.spec.sequence.as_ref().map(|q| i / q.length),
             sequence_frame: self.spec.sequence.as_ref().map(|q| i % q.length),
             time: self.spec.sequence.as_ref().map(|_| {
-                let r = &self.scene.file.scene.render;
-                let g = |k: &str, d: f64| r.get(k).and_then(|v| v.as_f64()).unwrap_or(d);
-                fv.frame as f64 * g("fps_base", 1.0) / g("fps", 24.0)
+                let s = &self.scene.file.scene;
+                fv.frame as f64 * s.fps_base / s.fps
             }),
         };
         let rec = layout::record_path(self.out, i);
@@ -702,14 +703,13 @@ pub fn scene_camera(
         .iter()
         .find(|c| c.name == data)
         .ok_or_else(|| format!("camera data {data:?} of {name:?} not found"))?;
-    let r = &scene.file.scene.render;
-    let aspect = |k: &str| r.get(k).and_then(|v| v.as_f64()).unwrap_or(1.0);
+    let out = crate::scene::settings::Output::of(&scene.file.scene);
     Ok(camera_info(
         name,
-        &cam.properties,
+        &crate::scene::settings::CameraSettings::of(cam),
         ev.world_matrices[idx],
         width,
         height,
-        [aspect("pixel_aspect_x"), aspect("pixel_aspect_y")],
+        [out.pixel_aspect_x, out.pixel_aspect_y],
     ))
 }

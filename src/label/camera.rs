@@ -5,7 +5,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::scene::Rna;
+use crate::scene::settings::{CameraSettings, Panoramic, Projection};
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CameraInfo {
@@ -90,10 +90,6 @@ fn square() -> [f64; 2] {
     [1.0, 1.0]
 }
 
-fn f(p: &Rna, k: &str, default: f64) -> f64 {
-    p.get(k).and_then(|v| v.as_f64()).unwrap_or(default)
-}
-
 /// OpenCV's world-to-camera [R | t] from Blender's camera-to-world matrix: the rotation
 /// with scale removed (each axis normalised), camera axes x = Blender +X, y = Blender
 /// -Y, z = Blender -Z.
@@ -123,34 +119,18 @@ pub fn opencv_world_to_camera(m: &[[f64; 4]; 4]) -> [[f64; 4]; 4] {
 /// The frame's camera. `pixel_aspect` is the render's (pixel_aspect_x, pixel_aspect_y).
 pub fn camera_info(
     name: &str,
-    props: &Rna,
+    cam: &CameraSettings,
     matrix_world: [[f64; 4]; 4],
     width: u32,
     height: u32,
     pixel_aspect: [f64; 2],
 ) -> CameraInfo {
-    let lens = f(props, "lens", 50.0);
-    let sw = f(props, "sensor_width", 36.0);
-    let sh = f(props, "sensor_height", 24.0);
-    let fit = props
-        .get("sensor_fit")
-        .and_then(|v| v.as_str())
-        .unwrap_or("AUTO")
-        .to_string();
     let (w, h) = (width as f64, height as f64);
     let (xratio, yratio) = (w * pixel_aspect[0], h * pixel_aspect[1]);
     // Which side the sensor spans, and its size along it (Cycles' blender_camera_sync:
     // AUTO fits the longer side of the image with pixel aspect, using sensor_width).
-    let (horizontal, sensor) = match fit.as_str() {
-        "HORIZONTAL" => (true, sw),
-        "VERTICAL" => (false, sh),
-        _ => (xratio > yratio, sw),
-    };
-    let kind = props
-        .get("type")
-        .and_then(|v| v.as_str())
-        .unwrap_or("PERSP");
-    let (sx, sy) = (f(props, "shift_x", 0.0), f(props, "shift_y", 0.0));
+    let (horizontal, sensor) = cam.fit(xratio, yratio);
+    let (sx, sy) = (cam.shift_x, cam.shift_y);
     // Cycles' viewplane: [left, right] x [bottom, top] spans the image; a pixel's ray
     // is (vx tan, vy tan, -1) in Blender camera space (perspective) or starts at
     // (vx, vy, 0) (orthographic).
@@ -159,9 +139,9 @@ pub fn camera_info(
     } else {
         (yratio / xratio, 1.0, yratio / xratio)
     };
-    let ortho = kind == "ORTHO";
+    let ortho = cam.projection == Some(Projection::Orthographic);
     if ortho {
-        let scale = f(props, "ortho_scale", 6.0);
+        let scale = cam.ortho_scale;
         xaspect *= scale / (aspect * 2.0);
         yaspect *= scale / (aspect * 2.0);
         aspect = scale / 2.0;
@@ -172,98 +152,41 @@ pub fn camera_info(
     let tan_half = if ortho {
         1.0
     } else {
-        0.5 * sensor / lens / aspect
+        0.5 * sensor / cam.lens / aspect
     };
     let mut fx = w / ((right - left) * tan_half);
     let mut fy = h / ((top - bottom) * tan_half);
     let mut cx = -left * w / (right - left);
     let mut cy = top * h / (top - bottom);
     let mut panorama = None;
-    let projection = match kind {
-        "PANO" => {
-            let model = props
-                .get("panorama_type")
-                .and_then(|v| v.as_str())
-                .unwrap_or("FISHEYE_EQUISOLID")
-                .to_string();
-            let fov = f(props, "fisheye_fov", std::f64::consts::PI);
-            let fisheye_lens = f(props, "fisheye_lens", 10.5);
-            let sensor_mm = if horizontal {
-                [sensor, sensor * yratio / xratio]
-            } else {
-                [sensor * xratio / yratio, sensor]
-            };
-            // The panoramic viewplane is [0, 1]^2 moved by the shift.
-            cx = w * (0.5 - sx);
-            cy = h * (0.5 + sy);
-            (fx, fy) = match model.as_str() {
-                // theta = sqrt(((x - cx) / fx)^2 + ((y - cy) / fy)^2)
-                "FISHEYE_EQUIDISTANT" => (w / fov, h / fov),
-                // 2 sin(theta / 2) = sqrt(((x - cx) / fx)^2 + ((y - cy) / fy)^2)
-                "FISHEYE_EQUISOLID" => (
-                    fisheye_lens * w / sensor_mm[0],
-                    fisheye_lens * h / sensor_mm[1],
-                ),
-                // Pixels per mm on the sensor; r = sqrt(((x-cx)/fx)^2 + ((y-cy)/fy)^2).
-                "FISHEYE_LENS_POLYNOMIAL" => (w / sensor_mm[0], h / sensor_mm[1]),
-                _ => (0.0, 0.0),
-            };
-            let p = |k: &str| f(props, k, 0.0);
-            panorama = Some(PanoramaInfo {
-                fov,
-                fisheye_lens_mm: fisheye_lens,
-                sensor_mm,
-                polynomial: [
-                    p("fisheye_polynomial_k0"),
-                    p("fisheye_polynomial_k1"),
-                    p("fisheye_polynomial_k2"),
-                    p("fisheye_polynomial_k3"),
-                    p("fisheye_polynomial_k4"),
-                ],
-                longitude: [
-                    f(props, "longitude_min", -std::f64::consts::PI),
-                    f(props, "longitude_max", std::f64::consts::PI),
-                ],
-                latitude: [
-                    f(props, "latitude_min", -std::f64::consts::FRAC_PI_2),
-                    f(props, "latitude_max", std::f64::consts::FRAC_PI_2),
-                ],
-                cylindrical_u: [
-                    f(
-                        props,
-                        "central_cylindrical_range_u_min",
-                        -std::f64::consts::PI,
-                    ),
-                    f(
-                        props,
-                        "central_cylindrical_range_u_max",
-                        std::f64::consts::PI,
-                    ),
-                ],
-                cylindrical_v: [
-                    f(props, "central_cylindrical_range_v_min", -1.0),
-                    f(props, "central_cylindrical_range_v_max", 1.0),
-                ],
-                cylindrical_radius: f(props, "central_cylindrical_radius", 1.0),
-                model: model.clone(),
-            });
-            format!("PANO:{model}")
-        }
-        other => other.to_string(),
+    let projection = if cam.projection == Some(Projection::Panoramic) {
+        let sensor_mm = if horizontal {
+            [sensor, sensor * yratio / xratio]
+        } else {
+            [sensor * xratio / yratio, sensor]
+        };
+        // The panoramic viewplane is [0, 1]^2 moved by the shift.
+        cx = w * (0.5 - sx);
+        cy = h * (0.5 + sy);
+        let info = panorama_info(&cam.panorama, sensor_mm);
+        (fx, fy) = info.focal_pixels(w, h);
+        let projection = format!("PANO:{}", info.model);
+        panorama = Some(info);
+        projection
+    } else {
+        cam.kind.clone()
     };
     let k = if panorama.is_some() {
         [[0.0; 3]; 3]
     } else {
         [[fx, 0.0, cx], [0.0, fy, cy], [0.0, 0.0, 1.0]]
     };
-    let dof = props.get("dof");
-    let d = |k: &str| dof.and_then(|x| x.get(k)).and_then(|v| v.as_f64());
     CameraInfo {
         name: name.to_string(),
-        lens_mm: lens,
-        sensor_width_mm: sw,
-        sensor_height_mm: sh,
-        sensor_fit: fit,
+        lens_mm: cam.lens,
+        sensor_width_mm: cam.sensor_width,
+        sensor_height_mm: cam.sensor_height,
+        sensor_fit: cam.sensor_fit_name().to_string(),
         projection,
         width,
         height,
@@ -273,14 +196,48 @@ pub fn camera_info(
         cx,
         cy,
         k,
-        clip_start: f(props, "clip_start", 0.1),
-        clip_end: f(props, "clip_end", 1000.0),
-        aperture_fstop: d("aperture_fstop"),
-        focus_distance: d("focus_distance"),
+        clip_start: cam.clip_start,
+        clip_end: cam.clip_end,
+        aperture_fstop: cam.dof.as_ref().map(|d| d.aperture_fstop),
+        focus_distance: cam.dof.as_ref().map(|d| d.focus_distance),
         matrix_world,
         world_to_camera_opencv: opencv_world_to_camera(&matrix_world),
         location: [matrix_world[0][3], matrix_world[1][3], matrix_world[2][3]],
         panorama,
+    }
+}
+
+/// A panoramic camera's model and parameters as the records state them.
+fn panorama_info(p: &Panoramic, sensor_mm: [f64; 2]) -> PanoramaInfo {
+    PanoramaInfo {
+        fov: p.fisheye_fov,
+        fisheye_lens_mm: p.fisheye_lens,
+        sensor_mm,
+        polynomial: p.fisheye_polynomial,
+        longitude: p.longitude,
+        latitude: p.latitude,
+        cylindrical_u: p.central_cylindrical_range_u,
+        cylindrical_v: p.central_cylindrical_range_v,
+        cylindrical_radius: p.central_cylindrical_radius,
+        model: p.panorama_type.clone(),
+    }
+}
+
+impl PanoramaInfo {
+    /// Focal lengths in pixels of the fisheye models (0 for the others).
+    fn focal_pixels(&self, w: f64, h: f64) -> (f64, f64) {
+        match self.model.as_str() {
+            // theta = sqrt(((x - cx) / fx)^2 + ((y - cy) / fy)^2)
+            "FISHEYE_EQUIDISTANT" => (w / self.fov, h / self.fov),
+            // 2 sin(theta / 2) = sqrt(((x - cx) / fx)^2 + ((y - cy) / fy)^2)
+            "FISHEYE_EQUISOLID" => (
+                self.fisheye_lens_mm * w / self.sensor_mm[0],
+                self.fisheye_lens_mm * h / self.sensor_mm[1],
+            ),
+            // Pixels per mm on the sensor; r = sqrt(((x-cx)/fx)^2 + ((y-cy)/fy)^2).
+            "FISHEYE_LENS_POLYNOMIAL" => (w / self.sensor_mm[0], h / self.sensor_mm[1]),
+            _ => (0.0, 0.0),
+        }
     }
 }
 

@@ -112,7 +112,7 @@ impl Camera {
         let to_world = without_scale(&Affine::from_rows(&eval.world_matrices[oi]));
         let (mut aperture, mut focus, mut blades, mut rotation, mut ratio) =
             (0.0f32, 10.0f32, 0u32, 0.0f32, 1.0f32);
-        if let Some(d) = &p.dof {
+        if let Some(d) = p.dof.as_ref().filter(|d| d.use_dof) {
             let fstop = d.aperture_fstop as f32;
             // Cycles: lens in mm to a radius in metres; orthographic uses 1/(2 f-stop).
             aperture = if fstop <= 0.0 {

@@ -209,9 +209,10 @@ pub enum Projection {
     Panoramic,
 }
 
-/// Depth of field (`camera.dof`), when on.
+/// Depth of field (`camera.dof`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct DepthOfField {
+    pub use_dof: bool,
     pub aperture_fstop: f64,
     pub aperture_blades: f64,
     pub aperture_rotation: f64,
@@ -236,6 +237,7 @@ pub struct CameraSettings {
     pub shift_y: f64,
     pub clip_start: f64,
     pub clip_end: f64,
+    /// As exported (None for an export without it); on when `use_dof`.
     pub dof: Option<DepthOfField>,
     /// The exported settings of a panoramic camera, by RNA name (see `Panoramic`).
     pub panorama: Panoramic,
@@ -270,16 +272,15 @@ impl CameraSettings {
             "VERTICAL" => SensorFit::Vertical,
             _ => SensorFit::Auto,
         };
-        let dof = group(p, "dof")
-            .filter(|d| flag(d, "use_dof").unwrap_or(false))
-            .map(|d| DepthOfField {
-                aperture_fstop: num(d, "aperture_fstop").unwrap_or(2.8),
-                aperture_blades: num(d, "aperture_blades").unwrap_or(0.0),
-                aperture_rotation: num(d, "aperture_rotation").unwrap_or(0.0),
-                aperture_ratio: num(d, "aperture_ratio").unwrap_or(1.0),
-                focus_distance: num(d, "focus_distance").unwrap_or(10.0),
-                focus_object: text(d, "focus_object").map(str::to_string),
-            });
+        let dof = group(p, "dof").map(|d| DepthOfField {
+            use_dof: flag(d, "use_dof").unwrap_or(false),
+            aperture_fstop: num(d, "aperture_fstop").unwrap_or(2.8),
+            aperture_blades: num(d, "aperture_blades").unwrap_or(0.0),
+            aperture_rotation: num(d, "aperture_rotation").unwrap_or(0.0),
+            aperture_ratio: num(d, "aperture_ratio").unwrap_or(1.0),
+            focus_distance: num(d, "focus_distance").unwrap_or(10.0),
+            focus_object: text(d, "focus_object").map(str::to_string),
+        });
         let n = |k: &str, d: f64| num(p, k).unwrap_or(d);
         use std::f64::consts::{FRAC_PI_2, PI};
         CameraSettings {
@@ -320,6 +321,15 @@ impl CameraSettings {
                     n("central_cylindrical_range_v_max", 1.0),
                 ],
             },
+        }
+    }
+
+    /// The sensor fit's name as Blender spells it.
+    pub fn sensor_fit_name(&self) -> &'static str {
+        match self.sensor_fit {
+            SensorFit::Auto => "AUTO",
+            SensorFit::Horizontal => "HORIZONTAL",
+            SensorFit::Vertical => "VERTICAL",
         }
     }
 
