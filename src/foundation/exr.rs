@@ -25,14 +25,11 @@ pub fn rgba_bytes(
         let p = pixels[y * w + x];
         (p[0], p[1], p[2], p[3])
     });
-    let image = Image::from_encoded_channels((w, height as usize), ENCODING, channels);
-    let mut out = std::io::Cursor::new(Vec::new());
-    image
-        .write()
-        .non_parallel()
-        .to_buffered(&mut out)
-        .map_err(|e| format!("EXR encode: {e}"))?;
-    Ok(out.into_inner())
+    encode(&Image::from_encoded_channels(
+        (w, height as usize),
+        ENCODING,
+        channels,
+    ))
 }
 
 /// Linear float RGB EXR bytes; `pixels` row by row from the top.
@@ -47,24 +44,16 @@ pub fn rgb_bytes(
         let p = pixels[y * w + x];
         (p[0], p[1], p[2])
     });
-    let image = Image::from_encoded_channels((w, height as usize), ENCODING, channels);
-    let mut out = std::io::Cursor::new(Vec::new());
-    image
-        .write()
-        .non_parallel()
-        .to_buffered(&mut out)
-        .map_err(|e| format!("EXR encode: {e}"))?;
-    Ok(out.into_inner())
+    encode(&Image::from_encoded_channels(
+        (w, height as usize),
+        ENCODING,
+        channels,
+    ))
 }
 
 /// One float32 channel named "Y" (read as grey by OpenEXR tools and OpenCV) as EXR bytes.
 pub fn grey_bytes(width: u32, height: u32, data: &[f32]) -> std::result::Result<Vec<u8>, String> {
-    if data.len() != width as usize * height as usize {
-        return Err(format!(
-            "EXR encode: {} values for {width}x{height}",
-            data.len()
-        ));
-    }
+    check(width, height, data.len())?;
     let channel = AnyChannel::new("Y", FlatSamples::F32(data.to_vec()));
     let layer = Layer::new(
         (width as usize, height as usize),
@@ -72,8 +61,15 @@ pub fn grey_bytes(width: u32, height: u32, data: &[f32]) -> std::result::Result<
         ENCODING,
         AnyChannels::sort(vec![channel].into()),
     );
+    encode(&Image::from_layer(layer))
+}
+
+/// The image's bytes, its blocks compressed and written one after another.
+fn encode<'i, L: ::exr::image::write::layers::WritableLayers<'i>>(
+    image: &'i Image<L>,
+) -> std::result::Result<Vec<u8>, String> {
     let mut out = std::io::Cursor::new(Vec::new());
-    Image::from_layer(layer)
+    image
         .write()
         .non_parallel()
         .to_buffered(&mut out)
