@@ -129,12 +129,6 @@ pub struct LightHit {
     pub pdf: f32,
 }
 
-/// An RGB triple from an exported colour array (a missing channel reads 1).
-fn rgb(v: Option<&Value>) -> Option<V3> {
-    v.and_then(Value::as_array)
-        .map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(1.0) as f32))
-}
-
 /// The factor a light's node tree puts on its colour and power: Cycles multiplies the
 /// light's strength by the emission its shader evaluates to. Only a tree that reduces to a
 /// constant (an Emission node with unlinked inputs into the active Light Output) is
@@ -187,7 +181,8 @@ fn node_factor(l: &crate::scene::format::Light) -> Result<V3, RenderError> {
             .find(|s| s.identifier == id)
             .and_then(|s| s.default_value.as_ref())
     };
-    let color = rgb(input("Color")).unwrap_or([1.0; 3]);
+    let color =
+        crate::scene::settings::rgb(input("Color")).map_or([1.0; 3], |c| c.map(|x| x as f32));
     let strength = input("Strength").and_then(Value::as_f64).unwrap_or(1.0) as f32;
     Ok(scale(color, strength))
 }

@@ -383,7 +383,7 @@ pub struct LightSettings {
 
 /// An RGB triple from an exported colour array (a missing channel reads 1, as a light's
 /// colour always has been read).
-fn rgb(v: Option<&Value>) -> Option<[f64; 3]> {
+pub fn rgb(v: Option<&Value>) -> Option<[f64; 3]> {
     v.and_then(Value::as_array)
         .map(|a| [0, 1, 2].map(|i| a.get(i).and_then(Value::as_f64).unwrap_or(1.0)))
 }
