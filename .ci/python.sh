@@ -20,7 +20,7 @@ fi
 cargo build --release --bin blendsynth
 mkdir -p python/blendsynth/bin
 cp target/release/blendsynth python/blendsynth/bin/blendsynth
-# The release profile keeps debug info (about 3/4 of the binary); the wheel drops it.
+# The release profile keeps line tables (symbols and lines for profiles); the wheel drops them.
 if command -v strip >/dev/null; then strip python/blendsynth/bin/blendsynth; fi
 
 rm -rf "$work/wheels"
