@@ -2,8 +2,8 @@
 # Fuzzing step (issue 27): builds the cargo-fuzz targets in fuzz/ and runs each for a
 # bounded time (FUZZ_SECONDS, default 45) from the committed seed corpus; any panic,
 # abort, timeout or out-of-memory fails the step and leaves the input in
-# fuzz/artifacts/<target>/. cargo-fuzz needs nightly features: the stable toolchain
-# allows them with RUSTC_BOOTSTRAP=1.
+# fuzz/artifacts/<target>/; FUZZ_TARGETS names a subset. cargo-fuzz needs nightly
+# features: the stable toolchain allows them with RUSTC_BOOTSTRAP=1.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 export RUSTC_BOOTSTRAP=1
@@ -13,7 +13,7 @@ command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked
 # No sanitizer: the crate is safe Rust, and ASan would double the build time.
 FLAGS=(-O -a --sanitizer none)
 cargo fuzz build "${FLAGS[@]}"
-for target in scene_json glb spec set_value; do
+for target in ${FUZZ_TARGETS:-scene_json glb spec set_value}; do
   work=$(mktemp -d)
   echo "fuzz: $target for ${SECONDS_EACH}s"
   # The committed seeds are read only; new inputs go to a scratch folder.

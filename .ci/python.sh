@@ -36,4 +36,29 @@ export PATH="$PWD/$work/venv/bin:$PATH"
 blendsynth --version
 # From python/tests, so `import blendsynth` finds the installed wheel, not python/.
 (cd python/tests && python -m pytest -q -p no:cacheprovider)
+
+# The dataset class with PyTorch tensors and a DataLoader. PyPI's torch brings CUDA
+# (gigabytes); Debian's CPU build (python3-torch, about 150 MB of packages) is for the
+# system Python 3.11, so this environment is made from that Python and sees its packages.
+if [ "${CI:-}" = true ] && ! /usr/bin/python3 -c "import torch" 2>/dev/null; then
+  apt-get install -y -q --no-install-recommends python3-torch python3-venv >/dev/null
+fi
+if /usr/bin/python3 -c "import torch" 2>/dev/null; then
+  rm -rf "$work/venv-torch"
+  /usr/bin/python3 -m venv --system-site-packages "$work/venv-torch"
+  "$work/venv-torch/bin/pip" install --quiet --disable-pip-version-check "$wheel" pytest pypng
+  # It must run, not skip (conftest skips what lacks its modules).
+  torch_rc=0
+  torch_out=$(cd python/tests && BLENDSYNTH_REQUIRE_TORCH=1 PATH="$PWD/../../$work/venv-torch/bin:$PATH" \
+    python -m pytest -q -rs -p no:cacheprovider test_data.py -k torch 2>&1) || torch_rc=$?
+  echo "$torch_out"
+  rm -rf "$work/venv-torch"
+  if [ "$torch_rc" != 0 ] || ! grep -q "^1 passed" <<<"$torch_out"; then
+    echo "python step: the PyTorch test did not pass" >&2
+    exit 1
+  fi
+elif [ "${CI:-}" = true ]; then
+  echo "python step: no PyTorch for the dataset class test" >&2
+  exit 1
+fi
 echo "python step: $(( $(date +%s) - start )) s"

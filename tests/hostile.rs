@@ -80,6 +80,26 @@ fn glb_roundtrip_of_the_test_helpers_is_faithful() {
 }
 
 #[test]
+fn glb_header_length_below_the_header_is_named() {
+    // cargo fuzz (glb target) found this: the gltf crate subtracts 12 from the header's
+    // length unchecked, a panic where overflow checks are on.
+    let mut bytes = std::fs::read(repo().join(GLB)).unwrap();
+    for length in [0u32, 4, 11] {
+        bytes[8..12].copy_from_slice(&length.to_le_bytes());
+        let e = parse_glb(&bytes, Path::new("a.glb"))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains(&format!("header's length {length} ")), "{e}");
+    }
+    let too_long = bytes.len() as u32 + 1;
+    bytes[8..12].copy_from_slice(&too_long.to_le_bytes());
+    let e = parse_glb(&bytes, Path::new("a.glb"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("header's length"), "{e}");
+}
+
+#[test]
 fn glb_accessor_count_2_pow_62_is_an_error() {
     let e = glb_err(|j| accessor(j, "vertex_positions")["count"] = Value::from(1u64 << 62));
     assert!(e.contains("vertex_positions"), "{e}");

@@ -297,6 +297,25 @@ pub fn read_glb(path: &Path) -> Result<MeshData, SceneError> {
 /// The accessor references of every mesh primitive are in range. The `gltf` crate's
 /// validation indexes the POSITION accessor before checking it exists (a panic on a
 /// corrupt file, found by tests/fuzz_mutations.rs), so this runs first.
+/// The 12-byte GLB header of the glTF 2.0 specification: magic `glTF`, version, total
+/// length. The gltf crate subtracts the header's size from the length unchecked (an
+/// overflow panic where overflow checks are on: found by `cargo fuzz run glb`), so the
+/// length is checked here first.
+fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
+    let word = |i: usize| u32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+    if bytes.len() < 12 || &bytes[..4] != b"glTF" {
+        return Err("no glTF header".into());
+    }
+    let length = word(8) as usize;
+    if length < 12 || length > bytes.len() {
+        return Err(format!(
+            "the header's length {length} is outside 12..={}, the file's size",
+            bytes.len()
+        ));
+    }
+    Ok(())
+}
+
 fn check_primitive_accessors(bytes: &[u8]) -> Result<(), String> {
     // A file this cannot read is left to the full reader, for its error message.
     let Ok(glb) = gltf::Glb::from_slice(bytes) else {
@@ -340,6 +359,7 @@ pub fn parse_glb(bytes: &[u8], path: &Path) -> Result<MeshData, SceneError> {
             format!("not a valid glb (truncated or corrupt?): {e}"),
         )
     };
+    check_glb_header(bytes).map_err(corrupt)?;
     check_primitive_accessors(bytes).map_err(corrupt)?;
     // A backstop for other such holes in the reader: an error, never a panic.
     let gltf = std::panic::catch_unwind(|| gltf::Gltf::from_slice(bytes))
