@@ -147,7 +147,7 @@ fn nodes_cycles_ignores_are_dropped_as_cycles_drops_them() {
         "ShaderNodeSqueeze",
     ] {
         assert_eq!(
-            blendsynth::nodes::support(t),
+            blendsynth::shader::compile::support(t),
             blendsynth::nodes::Support::IgnoredByCycles
         );
     }
