@@ -58,9 +58,12 @@ pub mod gradient;
 pub mod magic;
 pub mod mapping;
 pub mod vector_rotate;
+pub mod vector_transform;
 pub mod voronoi;
 pub mod wave;
 pub mod white_noise;
+// Gabor Texture.
+pub mod gabor;
 // Sky Texture (sky.rs; the Hosek/Wilkie data in sky_hosek.rs).
 pub mod sky;
 pub mod sky_hosek;

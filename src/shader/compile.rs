@@ -117,6 +117,8 @@ struct Compiler<'g, 'a> {
     attributes: Vec<super::attributes::AttributeRequest>,
     /// The current graph copy evaluates at a bump offset point (dx or dy).
     offset_copy: bool,
+    /// Compiling a world's shader: no object, no camera-space view of the point.
+    world: bool,
 }
 
 fn kind_of(socket_type: &str) -> Option<Kind> {
@@ -236,6 +238,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
             material_pass_index: 0.0,
             attributes: Vec::new(),
             offset_copy: false,
+            world: false,
         }
     }
 
@@ -735,6 +738,7 @@ pub fn compile_world(scene: &Scene, name: &str) -> Result<Program, CompileError>
         .map_err(|e| CompileError(format!("world {name:?}: {e}")))?;
     let mut c = Compiler::new(&graph);
     c.scene = Some(scene);
+    c.world = true;
     c.run()
         .map_err(|e| CompileError(format!("world {name:?}: {}", e.0)))
 }

@@ -7,6 +7,7 @@ use serde_json::Value;
 
 use crate::nodes::clamp::ClampType;
 use crate::nodes::curves::CurveKind;
+use crate::nodes::gabor::GaborType;
 use crate::nodes::gradient::GradientType;
 use crate::nodes::graph::Source;
 use crate::nodes::map_range::MapRangeInterpolation;
@@ -16,6 +17,7 @@ use crate::nodes::mix::MixBlend;
 use crate::nodes::noise::NoiseType;
 use crate::nodes::sepcomb::ColorMode;
 use crate::nodes::vector_rotate::VectorRotateType;
+use crate::nodes::vector_transform::{TransformSpace, VectorTransformType};
 use crate::nodes::voronoi::{VoronoiFeature, VoronoiMetric};
 use crate::nodes::wave::{BandsDirection, RingsDirection, WaveProfile, WaveSettings, WaveType};
 use crate::nodes::{Support, IGNORED_BY_CYCLES, STRUCTURAL};
@@ -23,8 +25,8 @@ use crate::nodes::{Support, IGNORED_BY_CYCLES, STRUCTURAL};
 use super::super::bump::{BumpSettings, MapSpace};
 use super::super::bump_graph::{self, Schedule};
 use super::{
-    dimensions, floats, linked, mode, prop, prop_bool, prop_str, Closure, CompileError, Compiler,
-    Kind, Op,
+    dimensions, floats, kind_of, linked, mode, prop, prop_bool, prop_str, Closure, CompileError,
+    Compiler, Kind, Op,
 };
 use Kind::{Color as C, Float as F, Vector as V};
 
@@ -74,6 +76,14 @@ const INPUT_CONTEXT: &str =
     "reads the shading context (shader/inputs.rs; nodes/fresnel.rs, light_falloff.rs; Pointiness and Random Per Island from shader/derived.rs); tests/inputs.rs against Cycles' EMIT bakes";
 const ATTRIBUTE: &str =
     "mesh attributes (shader/attributes.rs, tangent.rs); tests/attributes.rs; types Object/Instancer/View Layer are compile errors naming the node";
+const WIREFRAME: &str =
+    "shader/inputs.rs (the hit triangle's world-space corners): Size in world units and in pixels, Cycles' EMIT bakes in tests/bake.rs";
+const PARTICLE_INFO: &str =
+    "on a mesh not instanced by particles, Cycles' dummy particle (all zero, Random the hash of index 0), Cycles' EMIT bakes in tests/bake.rs; in a scene with a particle system a compile error (particle instances are frozen meshes without their particle data)";
+const INFO_ON_MESH: &str =
+    "on a mesh (the only primitive blendsynth renders; hair curves, point clouds and volumes are refused) every output is zero as in Cycles, Cycles' EMIT bakes in tests/bake.rs";
+const AOV: &str =
+    "Cycles writes it to its AOV pass only, never the image: nothing to evaluate (blendsynth writes no AOV passes)";
 const OUTPUT: &str =
     "closure weights and emission, whole-material bakes (tests/bake.rs); a Displacement the material's method does not use is a compile error";
 const WORLD: &str = "world surfaces (render/world.rs); tests/world.rs";
@@ -82,12 +92,16 @@ const CLOSURE: &str =
     "light transport in render/ (bsdf.rs and the closure files), a Cycles parity scene in tests/render.rs";
 const TEXTURE: &str =
     "nodes/<texture>.rs (Cycles flavour); every mode in tests/shader_conformance.rs";
+const GABOR: &str =
+    "nodes/gabor.rs: 2D and 3D, isotropic and anisotropic, within 1e-4 of Cycles' EMIT bakes (tests/bake.rs, fixtures/bake/nodes)";
 const SKY: &str =
     "nodes/sky.rs, sky_hosek.rs: Nishita, Preetham and Hosek/Wilkie, every option, within 1e-4 of Cycles' bakes (tests/sky_texture.rs)";
 const IMAGE: &str =
     "nodes/brick.rs, image.rs, shader/images.rs: every interpolation, extension, projection and alpha mode in tests/textures.rs; colour spaces other than sRGB, Non-Color and Linear Rec.709, sequences and UDIM are compile errors naming the image";
 const COLOR: &str = "nodes/color.rs, mix.rs, curves.rs; tests/shader_conformance.rs";
 const VECTOR: &str = "nodes/mapping.rs, vector_rotate.rs, curves.rs; tests/shader_conformance.rs";
+const VECTOR_TRANSFORM: &str =
+    "nodes/vector_transform.rs: every type, from and to space within 1e-5 of Cycles' EMIT bakes (tests/bake.rs, fixtures/bake/nodes); camera space in a world shader is a compile error";
 const BUMP: &str =
     "shader/bump.rs, bump_graph.rs; tests/bump.rs (tangent space through shader/tangent.rs, tests/attributes.rs)";
 const CONVERTER: &str =
@@ -111,8 +125,14 @@ pub const NODES: &[ShaderNode] = &[
     node("ShaderNodeTangent", input, INPUT_CONTEXT),
     node("ShaderNodeAttribute", attribute, ATTRIBUTE),
     node("ShaderNodeVertexColor", attribute, ATTRIBUTE),
+    node("ShaderNodeWireframe", wireframe, WIREFRAME),
+    node("ShaderNodeParticleInfo", info_on_mesh, PARTICLE_INFO),
+    node("ShaderNodePointInfo", info_on_mesh, INFO_ON_MESH),
+    node("ShaderNodeHairInfo", info_on_mesh, INFO_ON_MESH),
+    node("ShaderNodeVolumeInfo", info_on_mesh, INFO_ON_MESH),
     // Output
     node("ShaderNodeOutputMaterial", material_output, OUTPUT),
+    node("ShaderNodeOutputAOV", aov_output, AOV),
     node("ShaderNodeOutputWorld", world_output, WORLD),
     node("ShaderNodeBackground", background, WORLD),
     // Shader
@@ -138,6 +158,7 @@ pub const NODES: &[ShaderNode] = &[
     node("ShaderNodeTexMagic", magic_texture, TEXTURE),
     node("ShaderNodeTexWhiteNoise", white_noise_texture, TEXTURE),
     node("ShaderNodeTexChecker", checker_texture, TEXTURE),
+    node("ShaderNodeTexGabor", gabor_texture, GABOR),
     node("ShaderNodeTexSky", sky_texture, SKY),
     node("ShaderNodeTexBrick", brick_texture, IMAGE),
     node("ShaderNodeTexImage", image_texture, IMAGE),
@@ -152,6 +173,11 @@ pub const NODES: &[ShaderNode] = &[
     node("ShaderNodeRGBCurve", rgb_vector_curves, COLOR),
     // Vector
     node("ShaderNodeMapping", mapping, VECTOR),
+    node(
+        "ShaderNodeVectorTransform",
+        vector_transform,
+        VECTOR_TRANSFORM,
+    ),
     node("ShaderNodeVectorRotate", vector_rotate, VECTOR),
     node("ShaderNodeVectorCurve", rgb_vector_curves, VECTOR),
     node("ShaderNodeBump", bump, BUMP),
@@ -252,6 +278,54 @@ fn attribute(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), Com
     c.attribute_node(i)
 }
 
+fn wireframe(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let pixel_size = prop_bool(n, "use_pixel_size")?;
+    let size = c.input(n, "Size", F)?;
+    let dst = c.alloc(F);
+    c.ops.push(Op::Wireframe {
+        size,
+        pixel_size,
+        dst,
+    });
+    c.outputs(i, n, &[("Fac", dst, F)]);
+    Ok(())
+}
+
+/// Particle, Point, Curves and Volume Info on a triangle mesh, as Cycles evaluates them
+/// there: the point, curve and volume data are absent (zero), and the particle is Cycles'
+/// dummy particle 0, whose Random is the hash of its index.
+fn info_on_mesh(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let particle = n.node.bl_idname == "ShaderNodeParticleInfo";
+    if particle {
+        if let Some(o) = c.scene.and_then(|s| {
+            s.file
+                .objects
+                .iter()
+                .find(|o| o.modifiers.iter().any(|m| m.kind == "PARTICLE_SYSTEM"))
+        }) {
+            return Err(CompileError(format!(
+                "node {:?}: Particle Info in a scene with a particle system (object {:?}) is not supported yet: its particle instances are rendered without their particle data",
+                n.path, o.name
+            )));
+        }
+    }
+    let mut slots = Vec::new();
+    for o in &n.node.outputs {
+        let kind = kind_of(&o.kind).unwrap_or(F);
+        let v = if particle && o.identifier == "Random" {
+            crate::nodes::random::hash_to_float2(0, 0)
+        } else {
+            0.0
+        };
+        let s = c.constant(kind, [v; 3]);
+        slots.push((o.identifier.as_str(), s, kind));
+    }
+    c.outputs(i, n, &slots);
+    Ok(())
+}
+
 // Output.
 
 fn material_output(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
@@ -266,12 +340,31 @@ fn material_output(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(
             n.path
         )));
     }
+    // Cycles renders a linked Volume; blendsynth has no volume rendering yet.
+    if linked(n, "Volume") {
+        return Err(CompileError(format!(
+            "node {:?}: volume shading (its Volume input is linked) is not supported yet",
+            n.path
+        )));
+    }
     c.surface = c.closure_input(n, "Surface")?;
+    Ok(())
+}
+
+/// AOV Output has no outputs, so no material output reaches it; Cycles evaluates it
+/// only into its AOV pass.
+fn aov_output(_: &mut Compiler<'_, '_>, _: usize, _: &Schedule) -> Result<(), CompileError> {
     Ok(())
 }
 
 fn world_output(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
     let n = &c.g.nodes[i];
+    if linked(n, "Volume") {
+        return Err(CompileError(format!(
+            "node {:?}: volume shading (its Volume input is linked) is not supported yet",
+            n.path
+        )));
+    }
     c.surface = c.closure_input(n, "Surface")?;
     Ok(())
 }
@@ -539,6 +632,35 @@ fn sky_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), C
     c.sky_texture(i)
 }
 
+fn gabor_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (_, vector, _) = c.texture_point(n, None)?;
+    let kind = mode(n, "gabor_type", GaborType::from_blender)?;
+    let ids = ["Scale", "Frequency", "Anisotropy", "Orientation 2D"];
+    let args = c.inputs_n(n, ids, F)?;
+    let orientation = c.opt_input(n, "Orientation 3D", V)?;
+    let (value, phase, intensity) = (c.alloc(F), c.alloc(F), c.alloc(F));
+    c.ops.push(Op::TexGabor {
+        kind,
+        vector,
+        args,
+        orientation,
+        value,
+        phase,
+        intensity,
+    });
+    c.outputs(
+        i,
+        n,
+        &[
+            ("Value", value, F),
+            ("Phase", phase, F),
+            ("Intensity", intensity, F),
+        ],
+    );
+    Ok(())
+}
+
 fn brick_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
     c.brick(i)
 }
@@ -683,6 +805,31 @@ fn mapping(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), Compi
         dst: d,
     });
     c.outputs(i, n, &[("Vector", d, V)]);
+    Ok(())
+}
+
+fn vector_transform(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let kind = mode(n, "vector_type", VectorTransformType::from_blender)?;
+    let from = mode(n, "convert_from", TransformSpace::from_blender)?;
+    let to = mode(n, "convert_to", TransformSpace::from_blender)?;
+    if c.world && from != to && (from == TransformSpace::Camera || to == TransformSpace::Camera) {
+        return Err(CompileError(format!(
+            "node {:?}: Vector Transform to or from camera space in a world shader is not supported yet",
+            n.path
+        )));
+    }
+    let vector = c.input(n, "Vector", V)?;
+    let dst = c.alloc(V);
+    c.ops.push(Op::VectorTransform {
+        kind,
+        from,
+        to,
+        object: !c.world,
+        vector,
+        dst,
+    });
+    c.outputs(i, n, &[("Vector", dst, V)]);
     Ok(())
 }
 
