@@ -94,11 +94,13 @@ pub enum Support {
 
 /// Shader node types Cycles 4.5 ignores (`add_node` in intern/cycles/blender/shader.cpp
 /// has no case for them): Shader to RGB and Specular BSDF are EEVEE-only, Squeeze Value
-/// is legacy.
+/// is legacy, UV Along Stroke and Line Style Output are Freestyle's.
 pub const IGNORED_BY_CYCLES: &[&str] = &[
     "ShaderNodeShaderToRGB",
     "ShaderNodeEeveeSpecular",
     "ShaderNodeSqueeze",
+    "ShaderNodeUVAlongStroke",
+    "ShaderNodeOutputLineStyle",
 ];
 
 /// Node types that only shape the graph: frames and reroutes are dropped, group nodes

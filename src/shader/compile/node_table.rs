@@ -84,6 +84,8 @@ const INFO_ON_MESH: &str =
     "on a mesh (the only primitive blendsynth renders; hair curves, point clouds and volumes are refused) every output is zero as in Cycles, Cycles' EMIT bakes in tests/bake.rs";
 const AOV: &str =
     "Cycles writes it to its AOV pass only, never the image: nothing to evaluate (blendsynth writes no AOV passes)";
+const LIGHT_OUTPUT: &str =
+    "the output of a light's node tree (render/light.rs: a constant Emission scales the light, anything else is an error naming the light and node); in a material Cycles renders only the Material Output (fixtures/bake/nodes, case freestyle_and_light_nodes)";
 const OUTPUT: &str =
     "closure weights and emission, whole-material bakes (tests/bake.rs); a Displacement the material's method does not use is a compile error";
 const WORLD: &str = "world surfaces (render/world.rs); tests/world.rs";
@@ -133,6 +135,7 @@ pub const NODES: &[ShaderNode] = &[
     // Output
     node("ShaderNodeOutputMaterial", material_output, OUTPUT),
     node("ShaderNodeOutputAOV", aov_output, AOV),
+    node("ShaderNodeOutputLight", light_output, LIGHT_OUTPUT),
     node("ShaderNodeOutputWorld", world_output, WORLD),
     node("ShaderNodeBackground", background, WORLD),
     // Shader
@@ -354,6 +357,12 @@ fn material_output(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(
 /// AOV Output has no outputs, so no material output reaches it; Cycles evaluates it
 /// only into its AOV pass.
 fn aov_output(_: &mut Compiler<'_, '_>, _: usize, _: &Schedule) -> Result<(), CompileError> {
+    Ok(())
+}
+
+/// A light's output: render/light.rs reads a light's tree; in a material or world only
+/// their own output node is compiled, so this is never reached there.
+fn light_output(_: &mut Compiler<'_, '_>, _: usize, _: &Schedule) -> Result<(), CompileError> {
     Ok(())
 }
 
