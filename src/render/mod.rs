@@ -29,6 +29,7 @@ pub mod light;
 pub mod light_tree;
 pub mod limits;
 pub use crate::foundation::math;
+pub mod metallic;
 pub mod microfacet;
 pub mod motion;
 pub mod object_motion;

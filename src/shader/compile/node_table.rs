@@ -86,6 +86,8 @@ const AOV: &str =
     "Cycles writes it to its AOV pass only, never the image: nothing to evaluate (blendsynth writes no AOV passes)";
 const LIGHT_OUTPUT: &str =
     "the output of a light's node tree (render/light.rs: a constant Emission scales the light, anything else is an error naming the light and node); in a material Cycles renders only the Material Output (fixtures/bake/nodes, case freestyle_and_light_nodes)";
+const METALLIC: &str =
+    "render/metallic.rs: F82 Tint with GGX and Multiscatter GGX, a Cycles parity scene in tests/render.rs (metallic_bsdf); Physical Conductor and Beckmann are compile errors naming the node";
 const OUTPUT: &str =
     "closure weights and emission, whole-material bakes (tests/bake.rs); a Displacement the material's method does not use is a compile error";
 const WORLD: &str = "world surfaces (render/world.rs); tests/world.rs";
@@ -153,6 +155,7 @@ pub const NODES: &[ShaderNode] = &[
     node("ShaderNodeSubsurfaceScattering", bsdf, CLOSURE),
     node("ShaderNodeHoldout", bsdf, CLOSURE),
     node("ShaderNodeBsdfSheen", bsdf, CLOSURE),
+    node("ShaderNodeBsdfMetallic", metallic_bsdf, METALLIC),
     // Texture
     node("ShaderNodeTexNoise", noise_texture, TEXTURE),
     node("ShaderNodeTexVoronoi", voronoi_texture, TEXTURE),
@@ -393,6 +396,20 @@ fn emission(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), Comp
     let (color, strength) = (c.input(n, "Color", C)?, c.input(n, "Strength", F)?);
     c.closure(i, Closure::Emission { color, strength });
     Ok(())
+}
+
+/// Metallic BSDF: its F82 Tint mode with GGX or Multiscatter GGX (render/metallic.rs).
+fn metallic_bsdf(c: &mut Compiler<'_, '_>, i: usize, s: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let fresnel = prop_str(n, "fresnel_type")?;
+    let distribution = prop_str(n, "distribution")?;
+    if fresnel != "F82" || distribution == "BECKMANN" {
+        return Err(CompileError(format!(
+            "node {:?}: Metallic BSDF with fresnel_type {fresnel:?} and distribution {distribution:?} is not supported yet (F82 with GGX or Multiscatter GGX is)",
+            n.path
+        )));
+    }
+    bsdf(c, i, s)
 }
 
 fn mix_shader(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
