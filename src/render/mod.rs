@@ -45,6 +45,7 @@ pub mod subsurface_disk;
 pub mod tables;
 pub mod terminator;
 pub mod thin_film;
+pub mod toon;
 pub mod triangle_light;
 pub mod world;
 

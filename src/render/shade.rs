@@ -389,6 +389,20 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
         }
         "ShaderNodeBsdfPrincipled" => principled(b, w, s, sp, ctx, out),
         "ShaderNodeBsdfMetallic" => super::metallic::metallic(b, w, s, sp, ctx, out),
+        "ShaderNodeBsdfToon" => {
+            let c = input_c(b, s, "Color", [0.8; 3]);
+            let toon = super::toon::Toon::new(
+                input_f(b, s, "Size", 0.5),
+                input_f(b, s, "Smooth", 0.0),
+                b.property("component") == Some("GLOSSY"),
+            );
+            // Cycles gives the toon closures the normal as given (no specular correction).
+            out.push(
+                LobeKind::Toon(toon),
+                scale(c, w),
+                input_n(b, s, "Normal", sp),
+            );
+        }
         "ShaderNodeBsdfGlass" | "ShaderNodeBsdfRefraction" => {
             let c = input_c(b, s, "Color", [1.0; 3]);
             let ior = input_f(b, s, "IOR", 1.45);

@@ -88,6 +88,8 @@ const LIGHT_OUTPUT: &str =
     "the output of a light's node tree (render/light.rs: a constant Emission scales the light, anything else is an error naming the light and node); in a material Cycles renders only the Material Output (fixtures/bake/nodes, case freestyle_and_light_nodes)";
 const METALLIC: &str =
     "render/metallic.rs: F82 Tint with GGX and Multiscatter GGX, a Cycles parity scene in tests/render.rs (metallic_bsdf); Physical Conductor and Beckmann are compile errors naming the node";
+const TOON: &str =
+    "render/toon.rs (closure/bsdf_toon.h): Diffuse and Glossy components, a Cycles parity scene in tests/render.rs (toon)";
 const OUTPUT: &str =
     "closure weights and emission, whole-material bakes (tests/bake.rs); a Displacement the material's method does not use is a compile error";
 const WORLD: &str = "world surfaces (render/world.rs); tests/world.rs";
@@ -156,6 +158,7 @@ pub const NODES: &[ShaderNode] = &[
     node("ShaderNodeHoldout", bsdf, CLOSURE),
     node("ShaderNodeBsdfSheen", bsdf, CLOSURE),
     node("ShaderNodeBsdfMetallic", metallic_bsdf, METALLIC),
+    node("ShaderNodeBsdfToon", bsdf, TOON),
     // Texture
     node("ShaderNodeTexNoise", noise_texture, TEXTURE),
     node("ShaderNodeTexVoronoi", voronoi_texture, TEXTURE),
