@@ -9,7 +9,10 @@ use common::*;
 use std::collections::BTreeSet;
 
 fn features_page() -> String {
-    let mut shader: Vec<&str> = blendsynth::nodes::supported_shader_nodes().to_vec();
+    let mut shader: Vec<(&str, &str)> = blendsynth::shader::compile::NODES
+        .iter()
+        .map(|n| (n.bl_idname, n.notes))
+        .collect();
     shader.sort_unstable();
     let mut geo: Vec<&str> = blendsynth::geometry::nodes::supported().collect();
     geo.sort_unstable();
@@ -40,8 +43,8 @@ fn features_page() -> String {
          export, only while nothing it reads changes (\"frozen\")\n\n",
     );
     o.push_str(&format!("## Shader nodes ({})\n\n", shader.len()));
-    for n in &shader {
-        o.push_str(&format!("- `{n}`\n"));
+    for (n, notes) in &shader {
+        o.push_str(&format!("- `{n}`: {notes}\n"));
     }
     o.push_str(&format!("\n## Geometry Nodes ({})\n\n", geo.len()));
     for n in &geo {

@@ -54,6 +54,10 @@ const ASSERTED: &[&str] = &[
     // Anisotropic GGX: Glossy BSDF (default radial tangent), Principled (linked tangent).
     "anisotropic",
     "principled_aniso",
+    // Metallic BSDF (render/metallic.rs), F82 Tint: Multiscatter GGX and anisotropic GGX.
+    "metallic_bsdf",
+    // Toon BSDF (render/toon.rs): Diffuse and Glossy components.
+    "toon",
     // Subsurface Scattering node, Burley method: disk projection (render/subsurface_disk.rs).
     "sss_node",
     // The colon's material in small: Principled Burley under a strong bump in a Mix with a

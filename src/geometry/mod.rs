@@ -102,17 +102,19 @@ pub fn supports_node(bl_idname: &str) -> bool {
 /// tree type runs it. In Geometry Nodes trees that is this evaluator's own table
 /// (`nodes::NODES`: shader-named texture, ramp, curve and colour nodes count there once
 /// they run as fields with Blender's Geometry Nodes semantics); in shader trees, the
-/// shader registry (`crate::nodes::support`). It lives here, above both evaluators.
+/// shader node table (`crate::shader::compile::support`). It lives here, above both evaluators.
 pub fn support_in(tree: &str, bl_idname: &str) -> crate::nodes::Support {
     use crate::nodes::Support;
-    if tree == "GeometryNodeTree" && crate::nodes::support(bl_idname) != Support::Structural {
+    if tree == "GeometryNodeTree"
+        && crate::shader::compile::support(bl_idname) != Support::Structural
+    {
         return if supports_node(bl_idname) {
             Support::Supported
         } else {
             Support::Unsupported
         };
     }
-    match crate::nodes::support(bl_idname) {
+    match crate::shader::compile::support(bl_idname) {
         Support::Supported if tree != "ShaderNodeTree" => Support::Unsupported,
         s => s,
     }

@@ -5,7 +5,8 @@
 //! field nodes (`geometry/nodes/function.rs`, `texture.rs`, `color.rs`). Where Blender's
 //! Geometry Nodes compute differently from Cycles (Gradient's clamp, the ramp's table,
 //! curve clipping) the family offers both as siblings. Until a family is implemented
-//! and proven against Blender's numbers, `support` reports it as unsupported:
+//! and proven against Blender's numbers, the shader node table (`shader::compile::NODES`,
+//! read by `shader::compile::support`) reports it as unsupported:
 //! `blendsynth inspect` must never claim a node that would be evaluated as something else.
 
 /// Declares a node-mode enum together with the Blender RNA enum identifiers it is parsed
@@ -57,9 +58,12 @@ pub mod gradient;
 pub mod magic;
 pub mod mapping;
 pub mod vector_rotate;
+pub mod vector_transform;
 pub mod voronoi;
 pub mod wave;
 pub mod white_noise;
+// Gabor Texture.
+pub mod gabor;
 // Sky Texture (sky.rs; the Hosek/Wilkie data in sky_hosek.rs).
 pub mod sky;
 pub mod sky_hosek;
@@ -70,7 +74,8 @@ pub mod image;
 pub mod fresnel;
 pub mod light_falloff;
 
-/// How blendsynth handles a node type (by its `bl_idname`).
+/// How blendsynth handles a node type (by its `bl_idname`; `shader::compile::support`
+/// answers for shader nodes from the shader node table).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Support {
@@ -89,16 +94,18 @@ pub enum Support {
 
 /// Shader node types Cycles 4.5 ignores (`add_node` in intern/cycles/blender/shader.cpp
 /// has no case for them): Shader to RGB and Specular BSDF are EEVEE-only, Squeeze Value
-/// is legacy.
+/// is legacy, UV Along Stroke and Line Style Output are Freestyle's.
 pub const IGNORED_BY_CYCLES: &[&str] = &[
     "ShaderNodeShaderToRGB",
     "ShaderNodeEeveeSpecular",
     "ShaderNodeSqueeze",
+    "ShaderNodeUVAlongStroke",
+    "ShaderNodeOutputLineStyle",
 ];
 
 /// Node types that only shape the graph: frames and reroutes are dropped, group nodes
 /// are inlined, group input/output nodes become the group's boundary.
-const STRUCTURAL: &[&str] = &[
+pub const STRUCTURAL: &[&str] = &[
     "NodeFrame",
     "NodeReroute",
     "NodeGroupInput",
@@ -106,133 +113,3 @@ const STRUCTURAL: &[&str] = &[
     "ShaderNodeGroup",
     "GeometryNodeGroup",
 ];
-
-/// Evaluated node types, added family by family as each passes the Blender
-/// conformance suite.
-const SUPPORTED: &[&str] = &[
-    // math.rs
-    "ShaderNodeMath",
-    "ShaderNodeVectorMath",
-    // map_range.rs, clamp.rs
-    "ShaderNodeMapRange",
-    "ShaderNodeClamp",
-    // mix.rs
-    "ShaderNodeMix",
-    "ShaderNodeMixRGB",
-    // ramp.rs
-    "ShaderNodeValToRGB",
-    // curves.rs
-    "ShaderNodeRGBCurve",
-    "ShaderNodeVectorCurve",
-    "ShaderNodeFloatCurve",
-    // color.rs
-    "ShaderNodeInvert",
-    "ShaderNodeGamma",
-    "ShaderNodeBrightContrast",
-    "ShaderNodeHueSaturation",
-    "ShaderNodeRGBToBW",
-    // sepcomb.rs
-    "ShaderNodeSeparateXYZ",
-    "ShaderNodeCombineXYZ",
-    "ShaderNodeSeparateColor",
-    "ShaderNodeCombineColor",
-    "ShaderNodeSeparateRGB",
-    "ShaderNodeCombineRGB",
-    "ShaderNodeSeparateHSV",
-    "ShaderNodeCombineHSV",
-    // blackbody.rs, wavelength.rs
-    "ShaderNodeBlackbody",
-    "ShaderNodeWavelength",
-    // Shader structure, proven by whole-material bakes (tests/bake.rs): closure
-    // weights and emission. The Material Output's displacement is checked per material
-    // by the compiler (inspect's "Materials for the renderer").
-    "ShaderNodeEmission",
-    "ShaderNodeMixShader",
-    "ShaderNodeAddShader",
-    "ShaderNodeOutputMaterial",
-    // noise.rs (Cycles flavour), voronoi.rs, wave.rs, gradient.rs, magic.rs,
-    // white_noise.rs, checker.rs: every mode in tests/shader_conformance.rs.
-    "ShaderNodeTexNoise",
-    "ShaderNodeTexVoronoi",
-    "ShaderNodeTexWave",
-    "ShaderNodeTexGradient",
-    "ShaderNodeTexMagic",
-    "ShaderNodeTexWhiteNoise",
-    "ShaderNodeTexChecker",
-    // sky.rs, sky_hosek.rs: Nishita, Preetham and Hosek/Wilkie, every option, in
-    // tests/sky_texture.rs (within 1e-4 of Cycles' bakes).
-    "ShaderNodeTexSky",
-    // mapping.rs
-    "ShaderNodeMapping",
-    // vector_rotate.rs
-    "ShaderNodeVectorRotate",
-    // brick.rs, image.rs (+ shader/images.rs): every interpolation, extension,
-    // projection and alpha mode in tests/textures.rs. Image colour spaces other than
-    // sRGB, Non-Color and Linear Rec.709, and sequences/UDIM, are compile errors naming
-    // the image, never stand-ins.
-    "ShaderNodeTexBrick",
-    "ShaderNodeTexImage",
-    "ShaderNodeTexEnvironment",
-    // World surfaces (render/world.rs): tests/world.rs.
-    "ShaderNodeBackground",
-    "ShaderNodeOutputWorld",
-    // shader/bump.rs, bump_graph.rs: tests/bump.rs. Tangent space (Normal Map, Vector
-    // Displacement) is refused per material by the compiler.
-    "ShaderNodeBump",
-    "ShaderNodeDisplacement",
-    "ShaderNodeVectorDisplacement",
-    "ShaderNodeNormalMap",
-    // Input nodes reading the shading context (shader/inputs.rs; fresnel.rs,
-    // light_falloff.rs), proven by tests/inputs.rs against Cycles' EMIT bakes; Geometry
-    // Pointiness and Random Per Island come from the mesh (shader/derived.rs).
-    "ShaderNodeFresnel",
-    "ShaderNodeLayerWeight",
-    "ShaderNodeNewGeometry",
-    "ShaderNodeObjectInfo",
-    "ShaderNodeCameraData",
-    "ShaderNodeLightPath",
-    "ShaderNodeLightFalloff",
-    "ShaderNodeNormal",
-    "ShaderNodeTangent",
-    // Constant and coordinate inputs (shader/compile.rs), proven by tests/bake.rs and
-    // tests/inputs.rs.
-    "ShaderNodeValue",
-    "ShaderNodeRGB",
-    "ShaderNodeTexCoord",
-    "ShaderNodeUVMap",
-    // Closures the renderer gives light transport, each with a Cycles parity scene in
-    // tests/render.rs (Anisotropic is the 3.x name of Glossy).
-    "ShaderNodeBsdfDiffuse",
-    "ShaderNodeBsdfGlossy",
-    "ShaderNodeBsdfAnisotropic",
-    "ShaderNodeBsdfGlass",
-    "ShaderNodeBsdfRefraction",
-    "ShaderNodeBsdfTranslucent",
-    "ShaderNodeBsdfTransparent",
-    "ShaderNodeBsdfPrincipled",
-    "ShaderNodeSubsurfaceScattering",
-    "ShaderNodeHoldout",
-    "ShaderNodeBsdfSheen",
-    // Mesh attributes and tangent space (shader/attributes.rs, tangent.rs), proven by
-    // tests/attributes.rs: in bakes; the renderer refuses materials that read them.
-    // Attribute types Object/Instancer/View Layer are compile errors naming the node.
-    "ShaderNodeAttribute",
-    "ShaderNodeVertexColor",
-];
-
-/// Every shader node type evaluated (the registry `inspect` and docs/features.md read).
-pub fn supported_shader_nodes() -> &'static [&'static str] {
-    SUPPORTED
-}
-
-pub fn support(bl_idname: &str) -> Support {
-    if STRUCTURAL.contains(&bl_idname) {
-        Support::Structural
-    } else if IGNORED_BY_CYCLES.contains(&bl_idname) {
-        Support::IgnoredByCycles
-    } else if SUPPORTED.contains(&bl_idname) {
-        Support::Supported
-    } else {
-        Support::Unsupported
-    }
-}

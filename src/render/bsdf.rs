@@ -46,6 +46,8 @@ pub enum LobeKind {
     Sheen(super::sheen::Sheen),
     /// Ashikhmin velvet (Sheen BSDF, Ashikhmin distribution); scatters like diffuse.
     Velvet(super::sheen::Velvet),
+    /// Toon BSDF, Diffuse or Glossy component.
+    Toon(super::toon::Toon),
     /// Anisotropic GGX reflection (Glossy BSDF anisotropy, Principled anisotropic).
     GlossyAniso {
         lobe: super::anisotropic::AnisoGgx,
@@ -132,6 +134,8 @@ fn excluded(kind: &LobeKind, exclude: u32) -> bool {
             exclude & ray::GLOSSY != 0
         }
         LobeKind::Glass(_) => exclude & ray::TRANSMIT != 0,
+        LobeKind::Toon(t) if t.glossy => exclude & ray::GLOSSY != 0,
+        LobeKind::Toon(_) => exclude & ray::DIFFUSE != 0,
         LobeKind::Transparent | LobeKind::Subsurface(_) => false,
     }
 }
@@ -327,6 +331,7 @@ impl LobeSet {
         }
         let glossy = matches!(l.kind, LobeKind::Glossy { .. } | LobeKind::Reflection(_));
         let glossy = glossy || matches!(l.kind, LobeKind::GlossyAniso { .. });
+        let glossy = glossy || matches!(l.kind, LobeKind::Toon(t) if t.glossy);
         let transmit = matches!(l.kind, LobeKind::Translucent | LobeKind::Transparent);
         if singular {
             // Mirror or pass-through: only this lobe contributes, with its discrete probability.
@@ -542,6 +547,10 @@ fn eval_lobe(l: &Lobe, wo: V3, wi: V3, _ng: V3, _tables: &Tables) -> (V3, f32) {
             let (f, p) = ve.eval(l.n, wo, wi, ng);
             ([f; 3], p)
         }
+        LobeKind::Toon(t) => {
+            let (f, p) = t.eval(l.n, wo, wi);
+            ([f; 3], p)
+        }
         LobeKind::GlossyAniso {
             lobe,
             fresnel,
@@ -598,6 +607,7 @@ fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
         }
         LobeKind::Sheen(sh) => sh.sample(l.n, ng, u).map(|wi| (wi, false)),
         LobeKind::Velvet(ve) => ve.sample(l.n, ng, u).map(|wi| (wi, false)),
+        LobeKind::Toon(t) => t.sample(l.n, wo, ng, u).map(|wi| (wi, false)),
         LobeKind::GlossyAniso { lobe, .. } => lobe.sample(l.n, wo, ng, u).map(|wi| (wi, false)),
     }
 }

@@ -191,6 +191,7 @@ impl Scene<'_> {
             normal: n,
             object_position: local,
             object_normal: n_obj,
+            triangle: *tri,
             ..Default::default()
         };
         // Generated coordinates (and a displacement bump) read the mesh before true
@@ -974,6 +975,7 @@ impl Scene<'_> {
         sp.backfacing = backfacing;
         sp.parametric = [u, v];
         sp.camera_position = self.view.camera_space(sp.position);
+        sp.camera = self.view.camera();
         sp.window = self.view.window(sp.camera_position);
         sp.object = inst.info;
         sp.path = PathState::CAMERA;

@@ -29,6 +29,7 @@ pub mod light;
 pub mod light_tree;
 pub mod limits;
 pub use crate::foundation::math;
+pub mod metallic;
 pub mod microfacet;
 pub mod motion;
 pub mod object_motion;
@@ -44,6 +45,7 @@ pub mod subsurface_disk;
 pub mod tables;
 pub mod terminator;
 pub mod thin_film;
+pub mod toon;
 pub mod triangle_light;
 pub mod world;
 

@@ -38,6 +38,8 @@ fn counter(kind: &LobeKind, transmit: bool) -> Option<Counter> {
         LobeKind::Glossy { .. } | LobeKind::Reflection(_) | LobeKind::GlossyAniso { .. } => {
             Some(Counter::Glossy)
         }
+        LobeKind::Toon(t) if t.glossy => Some(Counter::Glossy),
+        LobeKind::Toon(_) => Some(Counter::Diffuse),
         LobeKind::Glass(_) if transmit => Some(Counter::Transmission),
         LobeKind::Glass(_) => Some(Counter::Glossy),
         LobeKind::Transparent | LobeKind::Subsurface(_) => None,
@@ -266,6 +268,8 @@ pub fn bounce_flags(kind: LobeKind, transmit: bool, singular: bool) -> u32 {
         LobeKind::Reflection(_) => ray::GLOSSY | ray::REFLECT,
         LobeKind::Sheen(_) | LobeKind::Velvet(_) => ray::DIFFUSE | ray::REFLECT,
         LobeKind::GlossyAniso { .. } => ray::GLOSSY | ray::REFLECT,
+        LobeKind::Toon(t) if t.glossy => ray::GLOSSY | ray::REFLECT,
+        LobeKind::Toon(_) => ray::DIFFUSE | ray::REFLECT,
     };
     if singular {
         f |= ray::SINGULAR;

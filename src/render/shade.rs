@@ -116,7 +116,7 @@ fn linked_or_constant(
 /// Whether a microfacet node compensates multiple scattering (Cycles' is_multiggx): the
 /// Principled BSDF unless its distribution is GGX (Multiscatter GGX is its default), the
 /// other nodes only when theirs is Multiscatter GGX.
-fn is_multiggx(b: &BsdfNode) -> bool {
+pub(super) fn is_multiggx(b: &BsdfNode) -> bool {
     match b.bl_idname.as_str() {
         "ShaderNodeBsdfPrincipled" => b.property("distribution") != Some("GGX"),
         _ => b.property("distribution") == Some("MULTI_GGX"),
@@ -176,7 +176,7 @@ pub struct Context<'a> {
 /// Cycles' `maybe_ensure_valid_specular_reflection`: the normal of the closures whose
 /// mirror direction must stay above the surface (microfacet, glass, translucent, BSSRDF),
 /// raised toward the true normal when the material's Bump Map Correction is on.
-fn valid_n(sp: &ShadingPoint, ctx: &Context, n: V3) -> V3 {
+pub(super) fn valid_n(sp: &ShadingPoint, ctx: &Context, n: V3) -> V3 {
     if ctx.bump_correction && n != sp.true_normal {
         super::bump_correction::ensure_valid_specular_reflection(sp.true_normal, ctx.wo, n)
     } else {
@@ -283,17 +283,17 @@ impl Material {
     }
 }
 
-fn input_f(b: &BsdfNode, s: &[f32], id: &str, d: f32) -> f32 {
+pub(super) fn input_f(b: &BsdfNode, s: &[f32], id: &str, d: f32) -> f32 {
     b.input(id)
         .map(|(slot, _)| finite_or(s[slot as usize], d))
         .unwrap_or(d)
 }
-fn input_c(b: &BsdfNode, s: &[f32], id: &str, d: V3) -> V3 {
+pub(super) fn input_c(b: &BsdfNode, s: &[f32], id: &str, d: V3) -> V3 {
     b.input(id)
         .map(|(slot, _)| finite3(v3(s, slot)))
         .unwrap_or(d)
 }
-fn input_n(b: &BsdfNode, s: &[f32], id: &str, sp: &ShadingPoint) -> V3 {
+pub(super) fn input_n(b: &BsdfNode, s: &[f32], id: &str, sp: &ShadingPoint) -> V3 {
     match b.input(id) {
         Some((slot, true)) => {
             let n = normalize(finite3(v3(s, slot)));
@@ -307,7 +307,7 @@ fn input_n(b: &BsdfNode, s: &[f32], id: &str, sp: &ShadingPoint) -> V3 {
     }
 }
 
-fn multiscatter_energy(tables: &Tables, mu: f32, roughness: f32) -> f32 {
+pub(super) fn multiscatter_energy(tables: &Tables, mu: f32, roughness: f32) -> f32 {
     let e = tables.ggx_e(mu, roughness).max(1e-3);
     1.0 / e
 }
@@ -388,6 +388,21 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             );
         }
         "ShaderNodeBsdfPrincipled" => principled(b, w, s, sp, ctx, out),
+        "ShaderNodeBsdfMetallic" => super::metallic::metallic(b, w, s, sp, ctx, out),
+        "ShaderNodeBsdfToon" => {
+            let c = input_c(b, s, "Color", [0.8; 3]);
+            let toon = super::toon::Toon::new(
+                input_f(b, s, "Size", 0.5),
+                input_f(b, s, "Smooth", 0.0),
+                b.property("component") == Some("GLOSSY"),
+            );
+            // Cycles gives the toon closures the normal as given (no specular correction).
+            out.push(
+                LobeKind::Toon(toon),
+                scale(c, w),
+                input_n(b, s, "Normal", sp),
+            );
+        }
         "ShaderNodeBsdfGlass" | "ShaderNodeBsdfRefraction" => {
             let c = input_c(b, s, "Color", [1.0; 3]);
             let ior = input_f(b, s, "IOR", 1.45);
@@ -870,7 +885,14 @@ fn principled_sheen(
 /// The tangent of an anisotropic closure: the node's Tangent input when linked, else
 /// Cycles' default (Geometry > Tangent: radial about the object's Z), rotated about the
 /// closure normal `n` by `rotation` turns.
-fn tangent_input(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, id: &str, rotation: f32, n: V3) -> V3 {
+pub(super) fn tangent_input(
+    b: &BsdfNode,
+    s: &[f32],
+    sp: &ShadingPoint,
+    id: &str,
+    rotation: f32,
+    n: V3,
+) -> V3 {
     let t = match b.input(id) {
         Some((slot, true)) => finite3(v3(s, slot)),
         _ => crate::shader::inputs::radial_tangent(sp, 2),
@@ -885,7 +907,7 @@ fn tangent_input(b: &BsdfNode, s: &[f32], sp: &ShadingPoint, id: &str, rotation:
 /// A GGX reflection lobe with alphas (`ax`, `ay`) along tangent `t`: anisotropic unless
 /// singular, Multiscatter energy from the isotropic table at (ax ay)^(1/4) when `multi`.
 #[allow(clippy::too_many_arguments)]
-fn push_glossy(
+pub(super) fn push_glossy(
     out: &mut LobeSet,
     ctx: &Context,
     ax: f32,

@@ -411,6 +411,8 @@ fn bake_context(
     sp.ray_length = 1.0;
     sp.path = super::point::PathState::CAMERA;
     sp.camera_position = view.camera_space(sp.position);
+    sp.camera = view.camera();
+    sp.triangle = tri;
     sp.window = view.window(sp.camera_position);
     sp.object = object;
     sp

@@ -216,3 +216,38 @@ pub fn normal_dot(direction: Vec3, normal: Vec3) -> f32 {
 pub fn transform_point(m: &[[f32; 4]; 3], p: Vec3) -> Vec3 {
     std::array::from_fn(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3])
 }
+
+/// Cycles' Wireframe (svm/wireframe.h): 1 where the point lies within half of `size`
+/// (world units, or pixel widths with `pixel_size`) of an edge of its triangle; the
+/// neighbouring triangle draws the other half.
+pub fn wireframe_node(sp: &ShadingPoint, size: f32, pixel_size: bool) -> f32 {
+    let co = sp.triangle;
+    let mut width = 1.0;
+    if pixel_size {
+        // The position's differentials projected onto the plane facing the ray.
+        let wi = sp.incoming;
+        let across = |d: Vec3| {
+            let k = dot(d, wi);
+            len([d[0] - k * wi[0], d[1] - k * wi[1], d[2] - k * wi[2]])
+        };
+        width = (across(sp.dp_dx) + across(sp.dp_dy)) * 0.5;
+    }
+    width *= 0.5 * size;
+    width *= width;
+    for i in 0..3 {
+        let i2 = if i > 0 { i - 1 } else { 2 };
+        let p = sp.position;
+        let dir = [p[0] - co[i][0], p[1] - co[i][1], p[2] - co[i][2]];
+        let edge = [
+            co[i][0] - co[i2][0],
+            co[i][1] - co[i2][1],
+            co[i][2] - co[i2][2],
+        ];
+        let c = cross(edge, dir);
+        // |c|^2 / |edge|^2 is the squared distance to the edge.
+        if dot(c, c) < dot(edge, edge) * width {
+            return 1.0;
+        }
+    }
+    0.0
+}

@@ -49,6 +49,10 @@ pub struct ShadingPoint {
     /// Position in Cycles' camera space: x right, y up, z forward (Texture Coordinate >
     /// Camera, Camera Data).
     pub camera_position: Vec3,
+    /// Cycles' camera-to-world transform and its inverse (Vector Transform).
+    pub camera: crate::nodes::vector_transform::Affine,
+    /// The world-space corners of the triangle hit (Wireframe); zero where there is none.
+    pub triangle: [Vec3; 3],
     /// Position in the camera's normalised frame, 0..1 over the image, z = 0
     /// (Texture Coordinate > Window).
     pub window: Vec3,

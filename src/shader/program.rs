@@ -7,6 +7,7 @@ use crate::nodes::color::{
     bright_contrast, gamma, hue_saturation, invert, rgb_to_bw, LINEAR_REC709,
 };
 use crate::nodes::curves::CurveTable;
+use crate::nodes::gabor::{gabor_texture, GaborType};
 use crate::nodes::gradient::{gradient, GradientType};
 use crate::nodes::magic::magic;
 use crate::nodes::map_range::{map_range_float, map_range_vector, MapRangeInterpolation};
@@ -19,6 +20,9 @@ use crate::nodes::noise::{noise_texture_cycles, noise_texture_cycles_fac, NoiseP
 use crate::nodes::ramp::RampTable;
 use crate::nodes::sepcomb::{combine_color, separate_color, ColorMode};
 use crate::nodes::vector_rotate::{vector_rotate, VectorRotateType};
+use crate::nodes::vector_transform::{
+    vector_transform, Affine, TransformSpace, VectorTransformType,
+};
 use crate::nodes::voronoi::{voronoi_texture, VoronoiFeature, VoronoiMetric, VoronoiParams};
 use crate::nodes::wave::{wave, WaveSettings};
 use crate::nodes::white_noise::white_noise;
@@ -315,6 +319,30 @@ pub enum Op {
         angle: Slot,
         rotation: Slot,
         dst: Slot,
+    },
+    /// Vector Transform; `object` false where there is no object (a world shader).
+    VectorTransform {
+        kind: VectorTransformType,
+        from: TransformSpace,
+        to: TransformSpace,
+        object: bool,
+        vector: Slot,
+        dst: Slot,
+    },
+    Wireframe {
+        size: Slot,
+        pixel_size: bool,
+        dst: Slot,
+    },
+    /// Gabor Texture: args are Scale, Frequency, Anisotropy, Orientation 2D.
+    TexGabor {
+        kind: GaborType,
+        vector: Slot,
+        args: [Slot; 4],
+        orientation: Slot,
+        value: Slot,
+        phase: Slot,
+        intensity: Slot,
     },
     Mapping {
         kind: MappingType,
@@ -1000,6 +1028,56 @@ impl Program {
                     let (v, c) = white_noise(dims, v3(s, vector), s[w as usize]);
                     s[value as usize] = v;
                     put3(s, color, c);
+                }
+                Op::VectorTransform {
+                    kind,
+                    from,
+                    to,
+                    object,
+                    vector,
+                    dst,
+                } => {
+                    let o = Affine {
+                        forward: sp.transform.to_world,
+                        inverse: sp.transform.to_object,
+                    };
+                    let v = vector_transform(
+                        kind,
+                        from,
+                        to,
+                        v3(s, vector),
+                        object.then_some(&o),
+                        &sp.camera,
+                    );
+                    put3(s, dst, v);
+                }
+                Op::Wireframe {
+                    size,
+                    pixel_size,
+                    dst,
+                } => s[dst as usize] = inputs::wireframe_node(&sp, s[size as usize], pixel_size),
+                Op::TexGabor {
+                    kind,
+                    vector,
+                    args,
+                    orientation,
+                    value,
+                    phase,
+                    intensity,
+                } => {
+                    let a = args.map(|a| s[a as usize]);
+                    let r = gabor_texture(
+                        kind,
+                        v3(s, vector),
+                        a[0],
+                        a[1],
+                        a[2],
+                        a[3],
+                        v3(s, orientation),
+                    );
+                    s[value as usize] = r[0];
+                    s[phase as usize] = r[1];
+                    s[intensity as usize] = r[2];
                 }
                 Op::VectorRotate {
                     kind,

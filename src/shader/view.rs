@@ -13,6 +13,8 @@ use super::point::ObjectInfo;
 pub struct View {
     /// World to Cycles camera space (x right, y up, z forward; Blender's camera looks down -Z).
     pub world_to_camera: [[f32; 4]; 3],
+    /// Its inverse, Cycles' cameratoworld (Vector Transform).
+    pub camera_to_world: [[f32; 4]; 3],
     pub ortho: bool,
     /// tan(fov/2) of a perspective camera, so screen = camera xy / (z tan_half).
     pub tan_half: f32,
@@ -29,6 +31,11 @@ impl Default for View {
     fn default() -> Self {
         View {
             world_to_camera: [
+                [1.0, 0.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0, 0.0],
+                [0.0, 0.0, -1.0, 0.0],
+            ],
+            camera_to_world: [
                 [1.0, 0.0, 0.0, 0.0],
                 [0.0, 1.0, 0.0, 0.0],
                 [0.0, 0.0, -1.0, 0.0],
@@ -78,14 +85,33 @@ impl View {
                 }
             })
         });
+        // Cycles' cameratoworld: Blender's camera-to-world with its Z axis flipped.
+        let camera_to_world = std::array::from_fn(|r| {
+            std::array::from_fn(|c| {
+                if c == 2 {
+                    -m[r][c] as f32
+                } else {
+                    m[r][c] as f32
+                }
+            })
+        });
         View {
             world_to_camera,
+            camera_to_world,
             ortho,
             tan_half,
             left: viewplane[0],
             right: viewplane[1],
             bottom: viewplane[2],
             top: viewplane[3],
+        }
+    }
+
+    /// Cycles' camera-to-world transform and its inverse (Vector Transform's camera space).
+    pub fn camera(&self) -> crate::nodes::vector_transform::Affine {
+        crate::nodes::vector_transform::Affine {
+            forward: self.camera_to_world,
+            inverse: self.world_to_camera,
         }
     }
 

@@ -1,0 +1,1257 @@
+//! The shader node table: every node type the compiler runs, with its compile step and
+//! where its semantics and their proof against Cycles live. `support` (and so `inspect`),
+//! the compiler's dispatch and docs/features.md all read this one table; a new shader
+//! node is one line here plus its compile function below, in its Blender group.
+
+use serde_json::Value;
+
+use crate::nodes::clamp::ClampType;
+use crate::nodes::curves::CurveKind;
+use crate::nodes::gabor::GaborType;
+use crate::nodes::gradient::GradientType;
+use crate::nodes::graph::Source;
+use crate::nodes::map_range::MapRangeInterpolation;
+use crate::nodes::mapping::MappingType;
+use crate::nodes::math::{MathOp, VectorMathOp};
+use crate::nodes::mix::MixBlend;
+use crate::nodes::noise::NoiseType;
+use crate::nodes::sepcomb::ColorMode;
+use crate::nodes::vector_rotate::VectorRotateType;
+use crate::nodes::vector_transform::{TransformSpace, VectorTransformType};
+use crate::nodes::voronoi::{VoronoiFeature, VoronoiMetric};
+use crate::nodes::wave::{BandsDirection, RingsDirection, WaveProfile, WaveSettings, WaveType};
+use crate::nodes::{Support, IGNORED_BY_CYCLES, STRUCTURAL};
+
+use super::super::bump::{BumpSettings, MapSpace};
+use super::super::bump_graph::{self, Schedule};
+use super::{
+    dimensions, floats, kind_of, linked, mode, prop, prop_bool, prop_str, Closure, CompileError,
+    Compiler, Kind, Op,
+};
+use Kind::{Color as C, Float as F, Vector as V};
+
+/// One node type's compile step: node `i` of the compiler's graph into ops, output slots
+/// and closures (the schedule gives the bump copies).
+pub(super) type Compile = fn(&mut Compiler<'_, '_>, usize, &Schedule) -> Result<(), CompileError>;
+
+/// A shader node type blendsynth evaluates with Cycles' semantics.
+pub struct ShaderNode {
+    /// Blender's node type (`bl_idname`).
+    pub bl_idname: &'static str,
+    /// Where its semantics live and what proves them against Cycles.
+    pub notes: &'static str,
+    pub(super) compile: Compile,
+}
+
+const fn node(bl_idname: &'static str, compile: Compile, notes: &'static str) -> ShaderNode {
+    ShaderNode {
+        bl_idname,
+        notes,
+        compile,
+    }
+}
+
+/// How blendsynth handles a shader node type (by its `bl_idname`): graph structure,
+/// ignored as Cycles ignores it, compiled from this table, or not supported.
+pub fn support(bl_idname: &str) -> Support {
+    if STRUCTURAL.contains(&bl_idname) {
+        Support::Structural
+    } else if IGNORED_BY_CYCLES.contains(&bl_idname) {
+        Support::IgnoredByCycles
+    } else if find(bl_idname).is_some() {
+        Support::Supported
+    } else {
+        Support::Unsupported
+    }
+}
+
+/// The table entry of a node type, if blendsynth compiles it.
+pub fn find(bl_idname: &str) -> Option<&'static ShaderNode> {
+    NODES.iter().find(|n| n.bl_idname == bl_idname)
+}
+
+const INPUT_CONSTANT: &str =
+    "constant and coordinate inputs (shader/compile); tests/bake.rs, tests/inputs.rs";
+const INPUT_CONTEXT: &str =
+    "reads the shading context (shader/inputs.rs; nodes/fresnel.rs, light_falloff.rs; Pointiness and Random Per Island from shader/derived.rs); tests/inputs.rs against Cycles' EMIT bakes";
+const ATTRIBUTE: &str =
+    "mesh attributes (shader/attributes.rs, tangent.rs); tests/attributes.rs; types Object/Instancer/View Layer are compile errors naming the node";
+const WIREFRAME: &str =
+    "shader/inputs.rs (the hit triangle's world-space corners): Size in world units and in pixels, Cycles' EMIT bakes in tests/bake.rs";
+const PARTICLE_INFO: &str =
+    "on a mesh not instanced by particles, Cycles' dummy particle (all zero, Random the hash of index 0), Cycles' EMIT bakes in tests/bake.rs; in a scene with a particle system a compile error (particle instances are frozen meshes without their particle data)";
+const INFO_ON_MESH: &str =
+    "on a mesh (the only primitive blendsynth renders; hair curves, point clouds and volumes are refused) every output is zero as in Cycles, Cycles' EMIT bakes in tests/bake.rs";
+const AOV: &str =
+    "Cycles writes it to its AOV pass only, never the image: nothing to evaluate (blendsynth writes no AOV passes)";
+const LIGHT_OUTPUT: &str =
+    "the output of a light's node tree (render/light.rs: a constant Emission scales the light, anything else is an error naming the light and node); in a material Cycles renders only the Material Output (fixtures/bake/nodes, case freestyle_and_light_nodes)";
+const METALLIC: &str =
+    "render/metallic.rs: F82 Tint with GGX and Multiscatter GGX, a Cycles parity scene in tests/render.rs (metallic_bsdf); Physical Conductor and Beckmann are compile errors naming the node";
+const TOON: &str =
+    "render/toon.rs (closure/bsdf_toon.h): Diffuse and Glossy components, a Cycles parity scene in tests/render.rs (toon)";
+const OUTPUT: &str =
+    "closure weights and emission, whole-material bakes (tests/bake.rs); a Displacement the material's method does not use is a compile error";
+const WORLD: &str = "world surfaces (render/world.rs); tests/world.rs";
+const SHADER_STRUCTURE: &str = "closure weights and emission, whole-material bakes (tests/bake.rs)";
+const CLOSURE: &str =
+    "light transport in render/ (bsdf.rs and the closure files), a Cycles parity scene in tests/render.rs";
+const TEXTURE: &str =
+    "nodes/<texture>.rs (Cycles flavour); every mode in tests/shader_conformance.rs";
+const GABOR: &str =
+    "nodes/gabor.rs: 2D and 3D, isotropic and anisotropic, within 1e-4 of Cycles' EMIT bakes (tests/bake.rs, fixtures/bake/nodes)";
+const SKY: &str =
+    "nodes/sky.rs, sky_hosek.rs: Nishita, Preetham and Hosek/Wilkie, every option, within 1e-4 of Cycles' bakes (tests/sky_texture.rs)";
+const IMAGE: &str =
+    "nodes/brick.rs, image.rs, shader/images.rs: every interpolation, extension, projection and alpha mode in tests/textures.rs; colour spaces other than sRGB, Non-Color and Linear Rec.709, sequences and UDIM are compile errors naming the image";
+const COLOR: &str = "nodes/color.rs, mix.rs, curves.rs; tests/shader_conformance.rs";
+const VECTOR: &str = "nodes/mapping.rs, vector_rotate.rs, curves.rs; tests/shader_conformance.rs";
+const VECTOR_TRANSFORM: &str =
+    "nodes/vector_transform.rs: every type, from and to space within 1e-5 of Cycles' EMIT bakes (tests/bake.rs, fixtures/bake/nodes); camera space in a world shader is a compile error";
+const BUMP: &str =
+    "shader/bump.rs, bump_graph.rs; tests/bump.rs (tangent space through shader/tangent.rs, tests/attributes.rs)";
+const CONVERTER: &str =
+    "nodes/math.rs, map_range.rs, clamp.rs, ramp.rs, curves.rs, color.rs, sepcomb.rs, blackbody.rs, wavelength.rs; tests/shader_conformance.rs";
+
+/// Every shader node type blendsynth compiles, grouped as Blender's Add menu groups them.
+pub const NODES: &[ShaderNode] = &[
+    // Input
+    node("ShaderNodeValue", value, INPUT_CONSTANT),
+    node("ShaderNodeRGB", rgb, INPUT_CONSTANT),
+    node("ShaderNodeTexCoord", texture_coordinate, INPUT_CONSTANT),
+    node("ShaderNodeUVMap", uv_map, INPUT_CONSTANT),
+    node("ShaderNodeFresnel", input, INPUT_CONTEXT),
+    node("ShaderNodeLayerWeight", input, INPUT_CONTEXT),
+    node("ShaderNodeNewGeometry", input, INPUT_CONTEXT),
+    node("ShaderNodeObjectInfo", input, INPUT_CONTEXT),
+    node("ShaderNodeCameraData", input, INPUT_CONTEXT),
+    node("ShaderNodeLightPath", input, INPUT_CONTEXT),
+    node("ShaderNodeLightFalloff", input, INPUT_CONTEXT),
+    node("ShaderNodeNormal", input, INPUT_CONTEXT),
+    node("ShaderNodeTangent", input, INPUT_CONTEXT),
+    node("ShaderNodeAttribute", attribute, ATTRIBUTE),
+    node("ShaderNodeVertexColor", attribute, ATTRIBUTE),
+    node("ShaderNodeWireframe", wireframe, WIREFRAME),
+    node("ShaderNodeParticleInfo", info_on_mesh, PARTICLE_INFO),
+    node("ShaderNodePointInfo", info_on_mesh, INFO_ON_MESH),
+    node("ShaderNodeHairInfo", info_on_mesh, INFO_ON_MESH),
+    node("ShaderNodeVolumeInfo", info_on_mesh, INFO_ON_MESH),
+    // Output
+    node("ShaderNodeOutputMaterial", material_output, OUTPUT),
+    node("ShaderNodeOutputAOV", aov_output, AOV),
+    node("ShaderNodeOutputLight", light_output, LIGHT_OUTPUT),
+    node("ShaderNodeOutputWorld", world_output, WORLD),
+    node("ShaderNodeBackground", background, WORLD),
+    // Shader
+    node("ShaderNodeEmission", emission, SHADER_STRUCTURE),
+    node("ShaderNodeMixShader", mix_shader, SHADER_STRUCTURE),
+    node("ShaderNodeAddShader", add_shader, SHADER_STRUCTURE),
+    node("ShaderNodeBsdfPrincipled", principled_bsdf, CLOSURE),
+    node("ShaderNodeBsdfDiffuse", bsdf, CLOSURE),
+    node("ShaderNodeBsdfGlossy", bsdf, CLOSURE),
+    node("ShaderNodeBsdfAnisotropic", bsdf, CLOSURE),
+    node("ShaderNodeBsdfGlass", bsdf, CLOSURE),
+    node("ShaderNodeBsdfRefraction", bsdf, CLOSURE),
+    node("ShaderNodeBsdfTranslucent", bsdf, CLOSURE),
+    node("ShaderNodeBsdfTransparent", bsdf, CLOSURE),
+    node("ShaderNodeSubsurfaceScattering", bsdf, CLOSURE),
+    node("ShaderNodeHoldout", bsdf, CLOSURE),
+    node("ShaderNodeBsdfSheen", bsdf, CLOSURE),
+    node("ShaderNodeBsdfMetallic", metallic_bsdf, METALLIC),
+    node("ShaderNodeBsdfToon", bsdf, TOON),
+    // Texture
+    node("ShaderNodeTexNoise", noise_texture, TEXTURE),
+    node("ShaderNodeTexVoronoi", voronoi_texture, TEXTURE),
+    node("ShaderNodeTexWave", wave_texture, TEXTURE),
+    node("ShaderNodeTexGradient", gradient_texture, TEXTURE),
+    node("ShaderNodeTexMagic", magic_texture, TEXTURE),
+    node("ShaderNodeTexWhiteNoise", white_noise_texture, TEXTURE),
+    node("ShaderNodeTexChecker", checker_texture, TEXTURE),
+    node("ShaderNodeTexGabor", gabor_texture, GABOR),
+    node("ShaderNodeTexSky", sky_texture, SKY),
+    node("ShaderNodeTexBrick", brick_texture, IMAGE),
+    node("ShaderNodeTexImage", image_texture, IMAGE),
+    node("ShaderNodeTexEnvironment", environment_texture, IMAGE),
+    // Color
+    node("ShaderNodeMix", mix, COLOR),
+    node("ShaderNodeMixRGB", mix_rgb, COLOR),
+    node("ShaderNodeInvert", invert, COLOR),
+    node("ShaderNodeGamma", gamma, COLOR),
+    node("ShaderNodeBrightContrast", bright_contrast, COLOR),
+    node("ShaderNodeHueSaturation", hue_saturation, COLOR),
+    node("ShaderNodeRGBCurve", rgb_vector_curves, COLOR),
+    // Vector
+    node("ShaderNodeMapping", mapping, VECTOR),
+    node(
+        "ShaderNodeVectorTransform",
+        vector_transform,
+        VECTOR_TRANSFORM,
+    ),
+    node("ShaderNodeVectorRotate", vector_rotate, VECTOR),
+    node("ShaderNodeVectorCurve", rgb_vector_curves, VECTOR),
+    node("ShaderNodeBump", bump, BUMP),
+    node("ShaderNodeDisplacement", displacement, BUMP),
+    node("ShaderNodeVectorDisplacement", vector_displacement, BUMP),
+    node("ShaderNodeNormalMap", normal_map, BUMP),
+    // Converter
+    node("ShaderNodeMath", math, CONVERTER),
+    node("ShaderNodeVectorMath", vector_math, CONVERTER),
+    node("ShaderNodeMapRange", map_range, CONVERTER),
+    node("ShaderNodeClamp", clamp, CONVERTER),
+    node("ShaderNodeValToRGB", color_ramp, CONVERTER),
+    node("ShaderNodeFloatCurve", float_curve, CONVERTER),
+    node("ShaderNodeRGBToBW", rgb_to_bw, CONVERTER),
+    node("ShaderNodeSeparateXYZ", separate_xyz, CONVERTER),
+    node("ShaderNodeCombineXYZ", combine_xyz, CONVERTER),
+    node("ShaderNodeSeparateColor", separate_color, CONVERTER),
+    node("ShaderNodeCombineColor", combine_color, CONVERTER),
+    node("ShaderNodeSeparateRGB", separate_color, CONVERTER),
+    node("ShaderNodeCombineRGB", combine_color, CONVERTER),
+    node("ShaderNodeSeparateHSV", separate_color, CONVERTER),
+    node("ShaderNodeCombineHSV", combine_color, CONVERTER),
+    node("ShaderNodeBlackbody", blackbody, CONVERTER),
+    node("ShaderNodeWavelength", wavelength, CONVERTER),
+];
+
+// Input.
+
+fn value(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let v = n.node.outputs[0]
+        .default_value
+        .as_ref()
+        .map(floats)
+        .unwrap_or([0.0; 4]);
+    let s = c.constant(F, [v[0]; 3]);
+    c.outputs(i, n, &[("Value", s, F)]);
+    Ok(())
+}
+
+fn rgb(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let v = n.node.outputs[0]
+        .default_value
+        .as_ref()
+        .map(floats)
+        .unwrap_or([0.0; 4]);
+    let s = c.constant(C, [v[0], v[1], v[2]]);
+    c.outputs(i, n, &[("Color", s, C)]);
+    Ok(())
+}
+
+fn texture_coordinate(
+    c: &mut Compiler<'_, '_>,
+    i: usize,
+    _: &Schedule,
+) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (g, nn, uv, ob) = (c.alloc(V), c.alloc(V), c.alloc(V), c.alloc(V));
+    c.ops.push(Op::TexCoord {
+        generated: Some(g),
+        normal: Some(nn),
+        uv: Some(uv),
+        object: Some(ob),
+    });
+    c.outputs(
+        i,
+        n,
+        &[
+            ("Generated", g, V),
+            ("Normal", nn, V),
+            ("UV", uv, V),
+            ("Object", ob, V),
+        ],
+    );
+    c.tex_coord_more(i)?;
+    Ok(())
+}
+
+fn uv_map(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    if !prop_str(n, "uv_map")?.is_empty()
+        || n.property("from_instancer").and_then(Value::as_bool) == Some(true)
+    {
+        return c.named_uv(i);
+    }
+    let d = c.alloc(V);
+    c.ops.push(Op::UvMap { dst: d });
+    c.outputs(i, n, &[("UV", d, V)]);
+    Ok(())
+}
+
+fn input(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    c.input_node(i)
+}
+
+fn attribute(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    c.attribute_node(i)
+}
+
+fn wireframe(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let pixel_size = prop_bool(n, "use_pixel_size")?;
+    let size = c.input(n, "Size", F)?;
+    let dst = c.alloc(F);
+    c.ops.push(Op::Wireframe {
+        size,
+        pixel_size,
+        dst,
+    });
+    c.outputs(i, n, &[("Fac", dst, F)]);
+    Ok(())
+}
+
+/// Particle, Point, Curves and Volume Info on a triangle mesh, as Cycles evaluates them
+/// there: the point, curve and volume data are absent (zero), and the particle is Cycles'
+/// dummy particle 0, whose Random is the hash of its index.
+fn info_on_mesh(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let particle = n.node.bl_idname == "ShaderNodeParticleInfo";
+    if particle {
+        if let Some(o) = c.scene.and_then(|s| {
+            s.file
+                .objects
+                .iter()
+                .find(|o| o.modifiers.iter().any(|m| m.kind == "PARTICLE_SYSTEM"))
+        }) {
+            return Err(CompileError(format!(
+                "node {:?}: Particle Info in a scene with a particle system (object {:?}) is not supported yet: its particle instances are rendered without their particle data",
+                n.path, o.name
+            )));
+        }
+    }
+    let mut slots = Vec::new();
+    for o in &n.node.outputs {
+        let kind = kind_of(&o.kind).unwrap_or(F);
+        let v = if particle && o.identifier == "Random" {
+            crate::nodes::random::hash_to_float2(0, 0)
+        } else {
+            0.0
+        };
+        let s = c.constant(kind, [v; 3]);
+        slots.push((o.identifier.as_str(), s, kind));
+    }
+    c.outputs(i, n, &slots);
+    Ok(())
+}
+
+// Output.
+
+fn material_output(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    if c.displace.is_none()
+        && !c.true_displacement
+        && n.input("Displacement")
+            .is_some_and(|d| matches!(d.sources.first(), Some(Source::Link { .. })))
+    {
+        return Err(CompileError(format!(
+            "node {:?}: displacement is not supported yet",
+            n.path
+        )));
+    }
+    // Cycles renders a linked Volume; blendsynth has no volume rendering yet.
+    if linked(n, "Volume") {
+        return Err(CompileError(format!(
+            "node {:?}: volume shading (its Volume input is linked) is not supported yet",
+            n.path
+        )));
+    }
+    c.surface = c.closure_input(n, "Surface")?;
+    Ok(())
+}
+
+/// AOV Output has no outputs, so no material output reaches it; Cycles evaluates it
+/// only into its AOV pass.
+fn aov_output(_: &mut Compiler<'_, '_>, _: usize, _: &Schedule) -> Result<(), CompileError> {
+    Ok(())
+}
+
+/// A light's output: render/light.rs reads a light's tree; in a material or world only
+/// their own output node is compiled, so this is never reached there.
+fn light_output(_: &mut Compiler<'_, '_>, _: usize, _: &Schedule) -> Result<(), CompileError> {
+    Ok(())
+}
+
+fn world_output(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    if linked(n, "Volume") {
+        return Err(CompileError(format!(
+            "node {:?}: volume shading (its Volume input is linked) is not supported yet",
+            n.path
+        )));
+    }
+    c.surface = c.closure_input(n, "Surface")?;
+    Ok(())
+}
+
+fn background(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    // A world's Background is emission seen along the ray.
+    let (color, strength) = (c.input(n, "Color", C)?, c.input(n, "Strength", F)?);
+    c.closure(i, Closure::Emission { color, strength });
+    Ok(())
+}
+
+// Shader.
+
+fn emission(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (color, strength) = (c.input(n, "Color", C)?, c.input(n, "Strength", F)?);
+    c.closure(i, Closure::Emission { color, strength });
+    Ok(())
+}
+
+/// Metallic BSDF: its F82 Tint mode with GGX or Multiscatter GGX (render/metallic.rs).
+fn metallic_bsdf(c: &mut Compiler<'_, '_>, i: usize, s: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let fresnel = prop_str(n, "fresnel_type")?;
+    let distribution = prop_str(n, "distribution")?;
+    if fresnel != "F82" || distribution == "BECKMANN" {
+        return Err(CompileError(format!(
+            "node {:?}: Metallic BSDF with fresnel_type {fresnel:?} and distribution {distribution:?} is not supported yet (F82 with GGX or Multiscatter GGX is)",
+            n.path
+        )));
+    }
+    bsdf(c, i, s)
+}
+
+fn mix_shader(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let fac = c.input(n, "Fac", F)?;
+    let (a, b) = (
+        c.closure_input(n, "Shader")?,
+        c.closure_input(n, "Shader_001")?,
+    );
+    c.closure(i, Closure::Mix { fac, a, b });
+    Ok(())
+}
+
+fn add_shader(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (a, b) = (
+        c.closure_input(n, "Shader")?,
+        c.closure_input(n, "Shader_001")?,
+    );
+    c.closure(i, Closure::Add { a, b });
+    Ok(())
+}
+
+fn principled_bsdf(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (color, strength) = (
+        c.input(n, "Emission Color", C)?,
+        c.input(n, "Emission Strength", F)?,
+    );
+    c.closure(
+        i,
+        Closure::Bsdf {
+            emission: Some((color, strength)),
+        },
+    );
+    c.record_bsdf(i)?;
+    Ok(())
+}
+
+fn bsdf(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    // No emission; their scattering parameters are compiled with the renderer.
+    c.closure(i, Closure::Bsdf { emission: None });
+    c.record_bsdf(i)?;
+    Ok(())
+}
+
+// Texture.
+
+fn noise_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (dims, vector, w) = c.texture_point(n, Some("noise_dimensions"))?;
+    let kind = mode(n, "noise_type", NoiseType::from_blender)?;
+    let normalize = prop_bool(n, "normalize")?;
+    let ids = [
+        "Scale",
+        "Detail",
+        "Roughness",
+        "Lacunarity",
+        "Offset",
+        "Gain",
+        "Distortion",
+    ];
+    let args = c.inputs_n(n, ids, F)?;
+    let (fac, color) = (c.alloc(F), c.alloc(C));
+    // Without a link from Color only Fac is computed (as Cycles does).
+    let want_color = c.output_used(i, "Color");
+    c.ops.push(Op::TexNoise {
+        dims,
+        kind,
+        normalize,
+        vector,
+        w,
+        args,
+        fac,
+        color,
+        want_color,
+    });
+    c.outputs(i, n, &[("Fac", fac, F), ("Color", color, C)]);
+    Ok(())
+}
+
+fn voronoi_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (dims, vector, w) = c.texture_point(n, Some("voronoi_dimensions"))?;
+    let feature = mode(n, "feature", VoronoiFeature::from_blender)?;
+    let metric = mode(n, "distance", VoronoiMetric::from_blender)?;
+    let normalize = prop_bool(n, "normalize")?;
+    let ids = [
+        "Scale",
+        "Detail",
+        "Roughness",
+        "Lacunarity",
+        "Smoothness",
+        "Exponent",
+        "Randomness",
+    ];
+    let args = c.inputs_n(n, ids, F)?;
+    let (distance, color, position, w_out, radius) =
+        (c.alloc(F), c.alloc(C), c.alloc(V), c.alloc(F), c.alloc(F));
+    c.ops.push(Op::TexVoronoi {
+        dims,
+        feature,
+        metric,
+        normalize,
+        vector,
+        w,
+        args,
+        distance,
+        color,
+        position,
+        w_out,
+        radius,
+    });
+    c.outputs(
+        i,
+        n,
+        &[
+            ("Distance", distance, F),
+            ("Color", color, C),
+            ("Position", position, V),
+            ("W", w_out, F),
+            ("Radius", radius, F),
+        ],
+    );
+    Ok(())
+}
+
+fn wave_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (_, vector, _) = c.texture_point(n, None)?;
+    let settings = WaveSettings {
+        kind: mode(n, "wave_type", WaveType::from_blender)?,
+        bands: mode(n, "bands_direction", BandsDirection::from_blender)?,
+        rings: mode(n, "rings_direction", RingsDirection::from_blender)?,
+        profile: mode(n, "wave_profile", WaveProfile::from_blender)?,
+    };
+    let ids = [
+        "Scale",
+        "Distortion",
+        "Detail",
+        "Detail Scale",
+        "Detail Roughness",
+        "Phase Offset",
+    ];
+    let args = c.inputs_n(n, ids, F)?;
+    let (fac, color) = (c.alloc(F), c.alloc(C));
+    c.ops.push(Op::TexWave {
+        settings,
+        vector,
+        args,
+        fac,
+        color,
+    });
+    c.outputs(i, n, &[("Fac", fac, F), ("Color", color, C)]);
+    Ok(())
+}
+
+fn gradient_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (_, vector, _) = c.texture_point(n, None)?;
+    let kind = mode(n, "gradient_type", GradientType::from_blender)?;
+    let (fac, color) = (c.alloc(F), c.alloc(C));
+    c.ops.push(Op::TexGradient {
+        kind,
+        vector,
+        fac,
+        color,
+    });
+    c.outputs(i, n, &[("Fac", fac, F), ("Color", color, C)]);
+    Ok(())
+}
+
+fn magic_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (_, vector, _) = c.texture_point(n, None)?;
+    let depth = prop(n, "turbulence_depth")?.as_i64().ok_or_else(|| {
+        CompileError(format!(
+            "node {:?}: turbulence_depth is not an integer",
+            n.path
+        ))
+    })? as i32;
+    let (scale, distortion) = (c.input(n, "Scale", F)?, c.input(n, "Distortion", F)?);
+    let (fac, color) = (c.alloc(F), c.alloc(C));
+    c.ops.push(Op::TexMagic {
+        depth,
+        vector,
+        scale,
+        distortion,
+        fac,
+        color,
+    });
+    c.outputs(i, n, &[("Fac", fac, F), ("Color", color, C)]);
+    Ok(())
+}
+
+fn white_noise_texture(
+    c: &mut Compiler<'_, '_>,
+    i: usize,
+    _: &Schedule,
+) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let dims = dimensions(n, "noise_dimensions")?;
+    // An unlinked White Noise vector is the world position, not Generated.
+    let vector = if linked(n, "Vector") {
+        c.input(n, "Vector", V)?
+    } else {
+        let d = c.alloc(V);
+        c.ops.push(Op::Position { dst: d });
+        d
+    };
+    let w = c.opt_input(n, "W", F)?;
+    let (value, color) = (c.alloc(F), c.alloc(C));
+    c.ops.push(Op::TexWhiteNoise {
+        dims,
+        vector,
+        w,
+        value,
+        color,
+    });
+    c.outputs(i, n, &[("Value", value, F), ("Color", color, C)]);
+    Ok(())
+}
+
+fn checker_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (_, vector, _) = c.texture_point(n, None)?;
+    let (color1, color2, scale) = (
+        c.input(n, "Color1", C)?,
+        c.input(n, "Color2", C)?,
+        c.input(n, "Scale", F)?,
+    );
+    let (fac, color) = (c.alloc(F), c.alloc(C));
+    c.ops.push(Op::TexChecker {
+        vector,
+        color1,
+        color2,
+        scale,
+        fac,
+        color,
+    });
+    c.outputs(i, n, &[("Fac", fac, F), ("Color", color, C)]);
+    Ok(())
+}
+
+fn sky_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    c.sky_texture(i)
+}
+
+fn gabor_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (_, vector, _) = c.texture_point(n, None)?;
+    let kind = mode(n, "gabor_type", GaborType::from_blender)?;
+    let ids = ["Scale", "Frequency", "Anisotropy", "Orientation 2D"];
+    let args = c.inputs_n(n, ids, F)?;
+    let orientation = c.opt_input(n, "Orientation 3D", V)?;
+    let (value, phase, intensity) = (c.alloc(F), c.alloc(F), c.alloc(F));
+    c.ops.push(Op::TexGabor {
+        kind,
+        vector,
+        args,
+        orientation,
+        value,
+        phase,
+        intensity,
+    });
+    c.outputs(
+        i,
+        n,
+        &[
+            ("Value", value, F),
+            ("Phase", phase, F),
+            ("Intensity", intensity, F),
+        ],
+    );
+    Ok(())
+}
+
+fn brick_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    c.brick(i)
+}
+
+fn image_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    c.image_texture(i)
+}
+
+fn environment_texture(
+    c: &mut Compiler<'_, '_>,
+    i: usize,
+    _: &Schedule,
+) -> Result<(), CompileError> {
+    c.environment_texture(i)
+}
+
+// Color.
+
+fn mix(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    c.mix(i)
+}
+
+fn mix_rgb(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let blend = mode(n, "blend_type", MixBlend::from_blender)?;
+    let clamp = prop_bool(n, "use_clamp")?;
+    let (factor, a, b) = (
+        c.input(n, "Fac", F)?,
+        c.input(n, "Color1", C)?,
+        c.input(n, "Color2", C)?,
+    );
+    let d = c.alloc(C);
+    c.ops.push(Op::MixRgb {
+        blend,
+        clamp,
+        factor,
+        a,
+        b,
+        dst: d,
+    });
+    c.outputs(i, n, &[("Color", d, C)]);
+    Ok(())
+}
+
+fn invert(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (fac, color) = (c.input(n, "Fac", F)?, c.input(n, "Color", C)?);
+    let d = c.alloc(C);
+    c.ops.push(Op::Invert { fac, color, dst: d });
+    c.outputs(i, n, &[("Color", d, C)]);
+    Ok(())
+}
+
+fn gamma(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (color, gamma) = (c.input(n, "Color", C)?, c.input(n, "Gamma", F)?);
+    let d = c.alloc(C);
+    c.ops.push(Op::Gamma {
+        color,
+        gamma,
+        dst: d,
+    });
+    c.outputs(i, n, &[("Color", d, C)]);
+    Ok(())
+}
+
+fn bright_contrast(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (color, bright, contrast) = (
+        c.input(n, "Color", C)?,
+        c.input(n, "Bright", F)?,
+        c.input(n, "Contrast", F)?,
+    );
+    let d = c.alloc(C);
+    c.ops.push(Op::BrightContrast {
+        color,
+        bright,
+        contrast,
+        dst: d,
+    });
+    c.outputs(i, n, &[("Color", d, C)]);
+    Ok(())
+}
+
+fn hue_saturation(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let hue = c.input(n, "Hue", F)?;
+    let saturation = c.input(n, "Saturation", F)?;
+    let value = c.input(n, "Value", F)?;
+    let fac = c.input(n, "Fac", F)?;
+    let color = c.input(n, "Color", C)?;
+    let d = c.alloc(C);
+    c.ops.push(Op::HueSaturation {
+        hue,
+        saturation,
+        value,
+        fac,
+        color,
+        dst: d,
+    });
+    c.outputs(i, n, &[("Color", d, C)]);
+    Ok(())
+}
+
+fn rgb_vector_curves(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (kind, sock, k) = if n.node.bl_idname == "ShaderNodeRGBCurve" {
+        (CurveKind::Rgb, "Color", C)
+    } else {
+        (CurveKind::Vector, "Vector", V)
+    };
+    let table = c.curve_table(n, kind)?;
+    let (fac, v) = (c.input(n, "Fac", F)?, c.input(n, sock, k)?);
+    let d = c.alloc(k);
+    c.ops.push(Op::Curves3 {
+        table,
+        fac,
+        v,
+        dst: d,
+    });
+    c.outputs(i, n, &[(sock, d, k)]);
+    Ok(())
+}
+
+// Vector.
+
+fn mapping(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let kind = mode(n, "vector_type", MappingType::from_blender)?;
+    let vector = c.input(n, "Vector", V)?;
+    // Location is hidden (and unused) for Vector and Normal mappings.
+    let location = c.opt_input(n, "Location", V)?;
+    let rotation = c.input(n, "Rotation", V)?;
+    let scale = c.input(n, "Scale", V)?;
+    let d = c.alloc(V);
+    c.ops.push(Op::Mapping {
+        kind,
+        vector,
+        location,
+        rotation,
+        scale,
+        dst: d,
+    });
+    c.outputs(i, n, &[("Vector", d, V)]);
+    Ok(())
+}
+
+fn vector_transform(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let kind = mode(n, "vector_type", VectorTransformType::from_blender)?;
+    let from = mode(n, "convert_from", TransformSpace::from_blender)?;
+    let to = mode(n, "convert_to", TransformSpace::from_blender)?;
+    if c.world && from != to && (from == TransformSpace::Camera || to == TransformSpace::Camera) {
+        return Err(CompileError(format!(
+            "node {:?}: Vector Transform to or from camera space in a world shader is not supported yet",
+            n.path
+        )));
+    }
+    let vector = c.input(n, "Vector", V)?;
+    let dst = c.alloc(V);
+    c.ops.push(Op::VectorTransform {
+        kind,
+        from,
+        to,
+        object: !c.world,
+        vector,
+        dst,
+    });
+    c.outputs(i, n, &[("Vector", dst, V)]);
+    Ok(())
+}
+
+fn vector_rotate(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let kind = mode(n, "rotation_type", VectorRotateType::from_blender)?;
+    let invert = prop_bool(n, "invert")?;
+    let vector = c.input(n, "Vector", V)?;
+    let center = c.input(n, "Center", V)?;
+    // Inputs the rotation type hides are unused.
+    let axis = c.opt_input(n, "Axis", V)?;
+    let angle = c.opt_input(n, "Angle", F)?;
+    let rotation = c.opt_input(n, "Rotation", V)?;
+    let d = c.alloc(V);
+    c.ops.push(Op::VectorRotate {
+        kind,
+        invert,
+        vector,
+        center,
+        axis,
+        angle,
+        rotation,
+        dst: d,
+    });
+    c.outputs(i, n, &[("Vector", d, V)]);
+    Ok(())
+}
+
+fn bump(c: &mut Compiler<'_, '_>, i: usize, schedule: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let settings = BumpSettings {
+        invert: prop_bool(n, "invert")?,
+        object_space: false,
+        filter_width: bump_graph::filter_width(c.g, i).map_err(CompileError)?,
+    };
+    let (strength, distance) = (c.input(n, "Strength", F)?, c.input(n, "Distance", F)?);
+    let normal = if linked(n, "Normal") {
+        Some(c.input(n, "Normal", V)?)
+    } else {
+        None
+    };
+    let center = c.input(n, "Height", F)?;
+    let (dx, dy) = match schedule.bump_copies[i] {
+        Some((cx, cy)) => (
+            c.input_in_copy(cx, i, "Height", F)?,
+            c.input_in_copy(cy, i, "Height", F)?,
+        ),
+        None => (center, center),
+    };
+    let d = c.alloc(V);
+    c.ops.push(Op::Bump {
+        settings,
+        normal,
+        strength,
+        distance,
+        center,
+        dx,
+        dy,
+        dst: d,
+    });
+    c.outputs(i, n, &[("Normal", d, V)]);
+    Ok(())
+}
+
+fn displacement(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let object_space = match prop_str(n, "space")? {
+        "OBJECT" => true,
+        "WORLD" => false,
+        other => {
+            return Err(CompileError(format!(
+                "node {:?}: space {other:?} is not supported",
+                n.path
+            )))
+        }
+    };
+    let (height, midlevel, scale) = (
+        c.input(n, "Height", F)?,
+        c.input(n, "Midlevel", F)?,
+        c.input(n, "Scale", F)?,
+    );
+    let normal = if linked(n, "Normal") {
+        Some(c.input(n, "Normal", V)?)
+    } else {
+        None
+    };
+    let d = c.alloc(V);
+    c.ops.push(Op::Displacement {
+        object_space,
+        height,
+        midlevel,
+        scale,
+        normal,
+        dst: d,
+    });
+    c.outputs(i, n, &[("Displacement", d, V)]);
+    Ok(())
+}
+
+fn vector_displacement(
+    c: &mut Compiler<'_, '_>,
+    i: usize,
+    _: &Schedule,
+) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let space = mode(n, "space", MapSpace::from_blender)?;
+    if space == MapSpace::Tangent {
+        c.vector_displacement_tangent(i)?;
+        return Ok(());
+    }
+    let (vector, midlevel, scale) = (
+        c.input(n, "Vector", V)?,
+        c.input(n, "Midlevel", F)?,
+        c.input(n, "Scale", F)?,
+    );
+    let d = c.alloc(V);
+    c.ops.push(Op::VectorDisplacement {
+        space,
+        vector,
+        midlevel,
+        scale,
+        dst: d,
+    });
+    c.outputs(i, n, &[("Displacement", d, V)]);
+    Ok(())
+}
+
+fn normal_map(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let space = mode(n, "space", MapSpace::from_blender)?;
+    if space == MapSpace::Tangent {
+        c.normal_map_tangent(i)?;
+        return Ok(());
+    }
+    let (color, strength) = (c.input(n, "Color", C)?, c.input(n, "Strength", F)?);
+    let d = c.alloc(V);
+    c.ops.push(Op::NormalMap {
+        space,
+        color,
+        strength,
+        dst: d,
+    });
+    c.outputs(i, n, &[("Normal", d, V)]);
+    Ok(())
+}
+
+// Converter.
+
+fn math(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let op = mode(n, "operation", MathOp::from_blender)?;
+    let clamp = prop_bool(n, "use_clamp")?;
+    let (a, b, third) = (
+        c.input(n, "Value", F)?,
+        c.opt_input(n, "Value_001", F)?,
+        c.opt_input(n, "Value_002", F)?,
+    );
+    let d = c.alloc(F);
+    c.ops.push(Op::Math {
+        op,
+        clamp,
+        a,
+        b,
+        c: third,
+        dst: d,
+    });
+    c.outputs(i, n, &[("Value", d, F)]);
+    Ok(())
+}
+
+fn vector_math(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let op = mode(n, "operation", VectorMathOp::from_blender)?;
+    let a = c.input(n, "Vector", V)?;
+    let b = c.opt_input(n, "Vector_001", V)?;
+    let third = c.opt_input(n, "Vector_002", V)?;
+    let scale = c.opt_input(n, "Scale", F)?;
+    let (vector, value) = (c.alloc(V), c.alloc(F));
+    c.ops.push(Op::VectorMath {
+        op,
+        a,
+        b,
+        c: third,
+        scale,
+        vector,
+        value,
+    });
+    c.outputs(i, n, &[("Vector", vector, V), ("Value", value, F)]);
+    Ok(())
+}
+
+fn map_range(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let interp = mode(n, "interpolation_type", MapRangeInterpolation::from_blender)?;
+    let clamp = prop_bool(n, "clamp")?;
+    match prop_str(n, "data_type")? {
+        "FLOAT" => {
+            let ids = ["Value", "From Min", "From Max", "To Min", "To Max", "Steps"];
+            let args = c.inputs6(n, ids, F)?;
+            let d = c.alloc(F);
+            c.ops.push(Op::MapRangeFloat {
+                interp,
+                clamp,
+                args,
+                dst: d,
+            });
+            c.outputs(i, n, &[("Result", d, F)]);
+        }
+        "FLOAT_VECTOR" => {
+            let ids = [
+                "Vector",
+                "From_Min_FLOAT3",
+                "From_Max_FLOAT3",
+                "To_Min_FLOAT3",
+                "To_Max_FLOAT3",
+                "Steps_FLOAT3",
+            ];
+            let args = c.inputs6(n, ids, V)?;
+            let d = c.alloc(V);
+            c.ops.push(Op::MapRangeVector {
+                interp,
+                clamp,
+                args,
+                dst: d,
+            });
+            c.outputs(i, n, &[("Vector", d, V)]);
+        }
+        other => {
+            return Err(CompileError(format!(
+                "node {:?}: Map Range data type {other:?} is not supported",
+                n.path
+            )))
+        }
+    }
+    Ok(())
+}
+
+fn clamp(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let kind = mode(n, "clamp_type", ClampType::from_blender)?;
+    let (value, min, max) = (
+        c.input(n, "Value", F)?,
+        c.input(n, "Min", F)?,
+        c.input(n, "Max", F)?,
+    );
+    let d = c.alloc(F);
+    c.ops.push(Op::Clamp {
+        kind,
+        value,
+        min,
+        max,
+        dst: d,
+    });
+    c.outputs(i, n, &[("Result", d, F)]);
+    Ok(())
+}
+
+fn color_ramp(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let table = c.ramp(n)?;
+    let fac = c.input(n, "Fac", F)?;
+    let (color, alpha) = (c.alloc(C), c.alloc(F));
+    c.ops.push(Op::Ramp {
+        table,
+        fac,
+        color,
+        alpha,
+    });
+    c.outputs(i, n, &[("Color", color, C), ("Alpha", alpha, F)]);
+    Ok(())
+}
+
+fn float_curve(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let table = c.curve_table(n, CurveKind::Float)?;
+    let (fac, v) = (c.input(n, "Factor", F)?, c.input(n, "Value", F)?);
+    let d = c.alloc(F);
+    c.ops.push(Op::Curve1 {
+        table,
+        fac,
+        v,
+        dst: d,
+    });
+    c.outputs(i, n, &[("Value", d, F)]);
+    Ok(())
+}
+
+fn rgb_to_bw(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let color = c.input(n, "Color", C)?;
+    let d = c.alloc(F);
+    c.ops.push(Op::RgbToBw { color, dst: d });
+    c.outputs(i, n, &[("Val", d, F)]);
+    Ok(())
+}
+
+fn separate_xyz(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let v = c.input(n, "Vector", V)?;
+    let (x, y, z) = (c.alloc(F), c.alloc(F), c.alloc(F));
+    c.ops.push(Op::SeparateXyz { v, x, y, z });
+    c.outputs(i, n, &[("X", x, F), ("Y", y, F), ("Z", z, F)]);
+    Ok(())
+}
+
+fn combine_xyz(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let (x, y, z) = (
+        c.input(n, "X", F)?,
+        c.input(n, "Y", F)?,
+        c.input(n, "Z", F)?,
+    );
+    let d = c.alloc(V);
+    c.ops.push(Op::CombineXyz { x, y, z, dst: d });
+    c.outputs(i, n, &[("Vector", d, V)]);
+    Ok(())
+}
+
+fn separate_color(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let kind = c.g.nodes[i].node.bl_idname.as_str();
+    let (cm, input, outs) = match kind {
+        "ShaderNodeSeparateColor" => (
+            mode(n, "mode", ColorMode::from_blender)?,
+            "Color",
+            ["Red", "Green", "Blue"],
+        ),
+        "ShaderNodeSeparateRGB" => (ColorMode::Rgb, "Image", ["R", "G", "B"]),
+        _ => (ColorMode::Hsv, "Color", ["H", "S", "V"]),
+    };
+    let color = c.input(n, input, C)?;
+    let (a, b, third) = (c.alloc(F), c.alloc(F), c.alloc(F));
+    c.ops.push(Op::SeparateColor {
+        mode: cm,
+        color,
+        a,
+        b,
+        c: third,
+    });
+    c.outputs(
+        i,
+        n,
+        &[(outs[0], a, F), (outs[1], b, F), (outs[2], third, F)],
+    );
+    Ok(())
+}
+
+fn combine_color(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let kind = c.g.nodes[i].node.bl_idname.as_str();
+    let (cm, ins, out) = match kind {
+        "ShaderNodeCombineColor" => (
+            mode(n, "mode", ColorMode::from_blender)?,
+            ["Red", "Green", "Blue"],
+            "Color",
+        ),
+        "ShaderNodeCombineRGB" => (ColorMode::Rgb, ["R", "G", "B"], "Image"),
+        _ => (ColorMode::Hsv, ["H", "S", "V"], "Color"),
+    };
+    let (a, b, third) = (
+        c.input(n, ins[0], F)?,
+        c.input(n, ins[1], F)?,
+        c.input(n, ins[2], F)?,
+    );
+    let d = c.alloc(C);
+    c.ops.push(Op::CombineColor {
+        mode: cm,
+        a,
+        b,
+        c: third,
+        dst: d,
+    });
+    c.outputs(i, n, &[(out, d, C)]);
+    Ok(())
+}
+
+fn blackbody(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let temperature = c.input(n, "Temperature", F)?;
+    let d = c.alloc(C);
+    c.ops.push(Op::Blackbody {
+        temperature,
+        dst: d,
+    });
+    c.outputs(i, n, &[("Color", d, C)]);
+    Ok(())
+}
+
+fn wavelength(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let wavelength = c.input(n, "Wavelength", F)?;
+    let d = c.alloc(C);
+    c.ops.push(Op::Wavelength { wavelength, dst: d });
+    c.outputs(i, n, &[("Color", d, C)]);
+    Ok(())
+}
