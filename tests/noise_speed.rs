@@ -385,3 +385,99 @@ fn wave_matches_the_old_code() {
         check("wave", &[new], &[old], &(s, v, a));
     }
 }
+
+/// Voronoi settings as the node's sockets give them (before `VoronoiParams::new`).
+type VoronoiArgs = (
+    voronoi::VoronoiFeature,
+    voronoi::VoronoiMetric,
+    bool,
+    [f32; 7],
+);
+
+fn voronoi_args(r: &mut Rng) -> VoronoiArgs {
+    use voronoi::{VoronoiFeature, VoronoiMetric};
+    (
+        r.pick(VoronoiFeature::ALL),
+        r.pick(VoronoiMetric::ALL),
+        r.u64().is_multiple_of(2),
+        [
+            r.setting(0.5, 8.0, &[1.0, 5.0]),
+            r.setting(0.0, 2.0, &[0.0, 1.0]),
+            r.setting(0.0, 1.0, &[0.5]),
+            r.setting(1.0, 3.0, &[2.0]),
+            r.setting(0.0, 1.0, &[0.0, 1.0]),
+            r.setting(0.5, 3.0, &[1.0, 2.0]),
+            r.setting(0.0, 1.0, &[0.0, 1.0]),
+        ],
+    )
+}
+
+fn both_voronoi(a: &VoronoiArgs) -> (voronoi::VoronoiParams, old::voronoi::VoronoiParams) {
+    let (f, m, n, s) = *a;
+    (
+        voronoi::VoronoiParams::new(f, m, n, s[0], s[1], s[2], s[3], s[4], s[5], s[6]),
+        old::voronoi::VoronoiParams::new(f, m, n, s[0], s[1], s[2], s[3], s[4], s[5], s[6]),
+    )
+}
+
+/// The per-thread cache of hashed cell blocks returns what new hashing gives: each case
+/// evaluates a point, points a differential away (same cells), the point again, and the
+/// point with one input changed at a time (every setting, the mode enums, the dimension,
+/// w), interleaved so a cache keyed on too little would answer for the wrong input
+/// (with the randomness left out of the key, this test fails).
+#[test]
+fn repeated_and_nearby_voronoi_evaluations_match_the_old_code() {
+    use voronoi::{VoronoiFeature, VoronoiMetric};
+    let mut r = Rng(0x5eed_cace);
+    for i in 0..3_000 {
+        let base = voronoi_args(&mut r);
+        let dims = (i % 4 + 1) as u8;
+        let v = [r.range(-4.0, 4.0), r.range(-4.0, 4.0), r.range(-4.0, 4.0)];
+        let w = r.range(-4.0, 4.0);
+        let mut runs: Vec<(u8, [f32; 3], f32, VoronoiArgs)> = vec![(dims, v, w, base)];
+        for d in [1e-4f32, -2e-4, 3e-5] {
+            runs.push((dims, [v[0] + d, v[1], v[2] - d], w + d, base));
+            runs.push((dims, v, w, base));
+        }
+        for k in 0..7 {
+            let mut a = base;
+            a.3[k] = match k {
+                6 => r.pick(&[0.0, 0.25, 1.0]),
+                _ => a.3[k] + r.pick(&[0.5, 1.0, -0.25]),
+            };
+            runs.push((dims, v, w, a));
+            runs.push((dims, v, w, base));
+        }
+        let other = |f| {
+            VoronoiFeature::ALL
+                .iter()
+                .copied()
+                .find(|&x| x != f)
+                .unwrap()
+        };
+        let other_m = |m| {
+            VoronoiMetric::ALL
+                .iter()
+                .copied()
+                .find(|&x| x != m)
+                .unwrap()
+        };
+        for a in [
+            (other(base.0), base.1, base.2, base.3),
+            (base.0, other_m(base.1), base.2, base.3),
+            (base.0, base.1, !base.2, base.3),
+        ] {
+            runs.push((dims, v, w, a));
+            runs.push((dims, v, w, base));
+        }
+        runs.push((dims % 4 + 1, v, w, base));
+        runs.push((dims, v, w + 0.5, base));
+        runs.push((dims, v, w, base));
+        for (dims, v, w, a) in runs {
+            let (new, old) = both_voronoi(&a);
+            let x = voronoi_outputs(voronoi::voronoi_texture(dims, v, w, new));
+            let y = old_voronoi_outputs(old::voronoi::voronoi_texture(dims, v, w, old));
+            check("voronoi_texture (repeated)", &x, &y, &(dims, v, w, a));
+        }
+    }
+}

@@ -10,8 +10,10 @@
 //! dependencies between cells that the compiler vectorises (8 cells per AVX2
 //! instruction); only the choice of the winning cell (and Smooth F1's blend) runs cell
 //! by cell, in Cycles' order. Distance to Edge and N-Sphere Radius hash each cell once,
-//! and a 3D cell's colour is its jitter hash, reused. Every value is the same bits as
-//! the cell-by-cell evaluation (tests/noise_speed.rs).
+//! and a 3D cell's colour is its jitter hash, reused. Each thread keeps its last hashed
+//! blocks (`BlockCache`): the points a Bump node and displacement-as-bump evaluate lie in
+//! the same cells, so their hashes are computed once. Every value is the same bits as the
+//! cell-by-cell evaluation (tests/noise_speed.rs).
 
 use super::math::Vec3;
 use super::white_noise::{
@@ -210,6 +212,7 @@ fn at<const N: usize, const P: usize>(a: &Soa<N, P>, t: usize) -> [f32; N] {
 /// The (2r+1)^N cells around `cell`, x fastest (Cycles' loop nesting, which decides
 /// ties): their offsets `base + o` for o in [-r, r]^N, their jitter hashes and their
 /// jittered points relative to `cell`.
+#[derive(Clone, Copy)]
 struct Block<const N: usize, const P: usize> {
     /// The number of real cells, (2r+1)^N <= P.
     m: usize,
@@ -222,35 +225,36 @@ impl<const N: usize, const P: usize> Block<N, P>
 where
     D: Cell<N>,
 {
+    const EMPTY: Self = Block {
+        m: 0,
+        off: [[0.0; P]; N],
+        jitter: [[0.0; P]; N],
+        point: [[0.0; P]; N],
+    };
+
+    /// Hashes the block of radius `r` around `cell + base` in place.
     #[inline(always)]
-    fn new(cell: [f32; N], base: [f32; N], r: i32, randomness: f32) -> Self {
+    fn fill(&mut self, cell: [f32; N], base: [f32; N], r: i32, randomness: f32) {
         let side = 2 * r + 1;
         let m = side.pow(N as u32) as usize;
         debug_assert!(m <= P && P.is_multiple_of(8));
-        // Filled in place: building the arrays apart and moving them in costs a copy.
-        let mut b = Block {
-            m,
-            off: [[0.0f32; P]; N],
-            jitter: [[0.0f32; P]; N],
-            point: [[0.0f32; P]; N],
-        };
+        self.m = m;
         let mut stride = 1;
-        for (i, axis) in b.off.iter_mut().enumerate() {
+        for (i, axis) in self.off.iter_mut().enumerate() {
             for (t, o) in axis.iter_mut().enumerate().take(m) {
                 *o = base[i] + ((t as i32 / stride) % side - r) as f32;
             }
             stride *= side;
         }
         for t in 0..P {
-            let o = at(&b.off, t);
+            let o = at(&self.off, t);
             let j = D::jitter(add(cell, o));
             let q = add(o, scale(j, randomness));
             for i in 0..N {
-                b.jitter[i][t] = j[i];
-                b.point[i][t] = q[i];
+                self.jitter[i][t] = j[i];
+                self.point[i][t] = q[i];
             }
         }
-        b
     }
 
     /// `metric_distance(point, local)` of every cell.
@@ -288,6 +292,114 @@ where
     }
 }
 
+/// How many hashed blocks a thread keeps per block shape.
+const WAYS: usize = 4;
+
+/// What a block's hashes depend on, as bits (so -0 and NaN cells are keys like others).
+#[derive(Clone, Copy, PartialEq, Eq)]
+struct BlockKey<const N: usize> {
+    cell: [u32; N],
+    base: [u32; N],
+    r: i32,
+    randomness: u32,
+}
+
+/// The blocks a thread hashed last. A Bump node evaluates its height at the shading
+/// point and two points a ray differential away, and Cycles' displacement-as-bump does it
+/// again: those points almost always lie in the same cell, so the 3^N or 5^N cell hashes
+/// (most of a Voronoi evaluation) are computed once for all of them. Round-robin
+/// replacement; a hit returns the very values a new hashing would.
+struct BlockCache<const N: usize, const P: usize> {
+    keys: [Option<BlockKey<N>>; WAYS],
+    blocks: Vec<Block<N, P>>,
+    next: usize,
+}
+
+impl<const N: usize, const P: usize> BlockCache<N, P>
+where
+    D: Cell<N>,
+{
+    fn new() -> Box<Self> {
+        Box::new(BlockCache {
+            keys: [None; WAYS],
+            blocks: vec![Block::EMPTY; WAYS],
+            next: 0,
+        })
+    }
+
+    #[inline(always)]
+    fn get(&mut self, cell: [f32; N], base: [f32; N], r: i32, randomness: f32) -> &Block<N, P> {
+        let key = Some(BlockKey {
+            cell: bits(cell),
+            base: bits(base),
+            r,
+            randomness: randomness.to_bits(),
+        });
+        let i = match self.keys.iter().position(|k| *k == key) {
+            Some(i) => i,
+            None => {
+                let i = self.next;
+                self.next = (i + 1) % WAYS;
+                self.keys[i] = key;
+                self.blocks[i].fill(cell, base, r, randomness);
+                i
+            }
+        };
+        &self.blocks[i]
+    }
+}
+
+#[inline(always)]
+fn bits<const N: usize>(v: [f32; N]) -> [u32; N] {
+    v.map(f32::to_bits)
+}
+
+/// The hashed block of radius `r` around `cell + base`, from this thread's cache of
+/// blocks of its shape (a thread-local per (N, P), hence a trait per shape).
+trait Blocks<const N: usize, const P: usize> {
+    fn with<R>(
+        cell: [f32; N],
+        base: [f32; N],
+        r: i32,
+        randomness: f32,
+        f: impl FnOnce(&Block<N, P>) -> R,
+    ) -> R;
+}
+
+macro_rules! block_caches {
+    ($(($n:literal, $p:literal)),*) => {$(
+        impl Blocks<$n, $p> for D {
+            #[inline(always)]
+            fn with<R>(
+                cell: [f32; $n],
+                base: [f32; $n],
+                r: i32,
+                randomness: f32,
+                f: impl FnOnce(&Block<$n, $p>) -> R,
+            ) -> R {
+                thread_local! {
+                    static CACHE: std::cell::RefCell<Option<Box<BlockCache<$n, $p>>>> =
+                        const { std::cell::RefCell::new(None) };
+                }
+                CACHE.with(|c| {
+                    let mut c = c.borrow_mut();
+                    f(c.get_or_insert_with(BlockCache::new).get(cell, base, r, randomness))
+                })
+            }
+        }
+    )*};
+}
+// The shapes `voronoi_texture` uses: (N, 3^N) and (N, 5^N) rounded up to 8.
+block_caches!(
+    (1, 8),
+    (2, 16),
+    (2, 32),
+    (3, 32),
+    (3, 128),
+    (4, 88),
+    (4, 632)
+);
+
 /// The first index among the first `m` of the smallest value below `f32::MAX`, as a
 /// strict `<` scan in order finds it (NaN never wins).
 #[inline(always)]
@@ -317,79 +429,89 @@ fn split<const N: usize>(coord: [f32; N]) -> ([f32; N], [f32; N]) {
 
 fn f1<const N: usize, const P: usize>(p: &VoronoiParams, coord: [f32; N]) -> Octave
 where
-    D: Cell<N>,
+    D: Cell<N> + Blocks<N, P>,
 {
     let (cell, local) = split(coord);
-    let b = Block::<N, P>::new(cell, [0.0; N], 1, p.randomness);
-    let d = b.distances(local, p);
-    match first_min(&d, b.m) {
-        Some(t) => {
-            let target = add(cell, at(&b.off, t));
-            Octave {
-                distance: d[t],
-                color: D::color_with(target, at(&b.jitter, t)),
-                position: D::position(add(at(&b.point, t), cell)),
+    <D as Blocks<N, P>>::with(cell, [0.0; N], 1, p.randomness, |b| {
+        let d = b.distances(local, p);
+        match first_min(&d, b.m) {
+            Some(t) => {
+                let target = add(cell, at(&b.off, t));
+                Octave {
+                    distance: d[t],
+                    color: D::color_with(target, at(&b.jitter, t)),
+                    position: D::position(add(at(&b.point, t), cell)),
+                }
             }
+            // No cell nearer than f32::MAX (NaN input): the initial target, offset 0.
+            None => Octave {
+                distance: f32::MAX,
+                color: D::color(add(cell, [0.0; N])),
+                position: D::position(add([0.0; N], cell)),
+            },
         }
-        // No cell nearer than f32::MAX (NaN input): the initial target, offset 0.
-        None => Octave {
-            distance: f32::MAX,
-            color: D::color(add(cell, [0.0; N])),
-            position: D::position(add([0.0; N], cell)),
-        },
-    }
+    })
 }
 
 fn smooth_f1<const N: usize, const P: usize>(p: &VoronoiParams, coord: [f32; N]) -> Octave
 where
-    D: Cell<N>,
+    D: Cell<N> + Blocks<N, P>,
 {
     let (cell, local) = split(coord);
-    let b = Block::<N, P>::new(cell, [0.0; N], 2, p.randomness);
-    let dist = b.distances(local, p);
-    let mut color = [[0.0f32; P]; 3];
-    for t in 0..P {
-        let c = D::color_with(add(cell, at(&b.off, t)), at(&b.jitter, t));
-        for k in 0..3 {
-            color[k][t] = c[k];
-        }
-    }
-    let mut sd = 0.0f32;
-    let mut sc = [0.0f32; 3];
-    let mut sp = [0.0f32; N];
-    // Cells with smoothstep argument x < 0 (h = 0, most of the 5^N) leave every sum
-    // unchanged, so they are skipped, which takes them off the serial dependency chain.
-    // Exactly unchanged: with h = 0 both corrections are +0 and each sum s becomes
-    // (s + 0 * (v - s)) - 0, which is s when v - s is finite (all distances are, and the
-    // colours, points and sums are bounded) and s is not -0.
-    let finite = dist[..b.m].iter().all(|d| d.abs() < 1e30);
-    let neg_zero = |x: f32| x.to_bits() == (-0.0f32).to_bits();
-    let mut any_neg_zero = false;
-    for t in 0..b.m {
-        let d = dist[t];
-        // The first cell blends with h = 1; smoothstep never gives Cycles' marker -1.
-        let h = if t == 0 {
-            1.0
-        } else {
-            let x = 0.5 + 0.5 * (sd - d) / p.smoothness;
-            if x < 0.0 && finite && !any_neg_zero {
+    <D as Blocks<N, P>>::with(cell, [0.0; N], 2, p.randomness, |b| {
+        let dist = b.distances(local, p);
+        let mut sd = 0.0f32;
+        let mut sc = [0.0f32; 3];
+        let mut sp = [0.0f32; N];
+        // Cells with smoothstep argument x < 0 (h = 0, most of the 5^N) leave every sum
+        // unchanged, so they are skipped, which takes them off the serial dependency
+        // chain (and a cell's colour is only hashed when it blends; in 3D it is the
+        // jitter hash). Exactly unchanged: with h = 0 both corrections are +0 and each
+        // sum s becomes (s + 0 * (v - s)) - 0, which is s when v - s is finite (all
+        // distances are, and the colours, points and sums are bounded) and s is not -0.
+        // Non-short-circuit `all`, so it vectorises.
+        let finite = dist[..b.m].iter().fold(true, |a, d| a & (d.abs() < 1e30));
+        let neg_zero = |x: f32| x.to_bits() == (-0.0f32).to_bits();
+        let mut any_neg_zero = false;
+        // A cheaper sufficient test for that skip, without the division: the blend is a
+        // smooth minimum, never above the least distance so far (exactly; in floats by at
+        // most a few ulps per cell, under 5e-3 over 625 cells for distances below 16, which all
+        // metrics but Minkowski keep here), so a cell farther than `least + margin`
+        // has x < -0.49 and is skipped by the exact test too.
+        let bounded = finite && p.metric != VoronoiMetric::Minkowski;
+        let margin = 2.0 * p.smoothness + 0.01;
+        let mut least = f32::INFINITY;
+        for t in 0..b.m {
+            let d = dist[t];
+            if bounded && !any_neg_zero && d > least + margin {
                 continue;
             }
-            smoothstep(x)
-        };
-        let mut corr = p.smoothness * h * (1.0 - h);
-        sd = mix1(sd, d, h) - corr;
-        corr /= 1.0 + 3.0 * p.smoothness;
-        sc = mixn(sc, at(&color, t), h).map(|x| x - corr);
-        sp = mixn(sp, at(&b.point, t), h).map(|x| x - corr);
-        any_neg_zero =
-            neg_zero(sd) || sc.iter().any(|&x| neg_zero(x)) || sp.iter().any(|&x| neg_zero(x));
-    }
-    Octave {
-        distance: sd,
-        color: sc,
-        position: D::position(add(cell, sp)),
-    }
+            least = least.min(d);
+            // The first cell blends with h = 1; smoothstep never gives Cycles' marker -1.
+            let h = if t == 0 {
+                1.0
+            } else {
+                let x = 0.5 + 0.5 * (sd - d) / p.smoothness;
+                if x < 0.0 && finite && !any_neg_zero {
+                    continue;
+                }
+                smoothstep(x)
+            };
+            let color = D::color_with(add(cell, at(&b.off, t)), at(&b.jitter, t));
+            let mut corr = p.smoothness * h * (1.0 - h);
+            sd = mix1(sd, d, h) - corr;
+            corr /= 1.0 + 3.0 * p.smoothness;
+            sc = mixn(sc, color, h).map(|x| x - corr);
+            sp = mixn(sp, at(&b.point, t), h).map(|x| x - corr);
+            any_neg_zero =
+                neg_zero(sd) || sc.iter().any(|&x| neg_zero(x)) || sp.iter().any(|&x| neg_zero(x));
+        }
+        Octave {
+            distance: sd,
+            color: sc,
+            position: D::position(add(cell, sp)),
+        }
+    })
 }
 
 #[inline(always)]
@@ -405,44 +527,45 @@ fn smoothstep(x: f32) -> f32 {
 
 fn f2<const N: usize, const P: usize>(p: &VoronoiParams, coord: [f32; N]) -> Octave
 where
-    D: Cell<N>,
+    D: Cell<N> + Blocks<N, P>,
 {
     let (cell, local) = split(coord);
-    let b = Block::<N, P>::new(cell, [0.0; N], 1, p.randomness);
-    let dist = b.distances(local, p);
-    let (mut d1, mut d2) = (f32::MAX, f32::MAX);
-    let (mut t1, mut t2) = (None, None);
-    for (t, &d) in dist[..b.m].iter().enumerate() {
-        if d < d1 {
-            d2 = d1;
-            d1 = d;
-            t2 = t1;
-            t1 = Some(t);
-        } else if d < d2 {
-            d2 = d;
-            t2 = Some(t);
+    <D as Blocks<N, P>>::with(cell, [0.0; N], 1, p.randomness, |b| {
+        let dist = b.distances(local, p);
+        let (mut d1, mut d2) = (f32::MAX, f32::MAX);
+        let (mut t1, mut t2) = (None, None);
+        for (t, &d) in dist[..b.m].iter().enumerate() {
+            if d < d1 {
+                d2 = d1;
+                d1 = d;
+                t2 = t1;
+                t1 = Some(t);
+            } else if d < d2 {
+                d2 = d;
+                t2 = Some(t);
+            }
         }
-    }
-    // Without a second cell (NaN input) the target is the initial one, offset 0.
-    let (off2, pos2, jitter2) = match t2 {
-        Some(t) => (at(&b.off, t), at(&b.point, t), Some(at(&b.jitter, t))),
-        None => ([0.0; N], [0.0; N], None),
-    };
-    let target = add(cell, off2);
-    let color = match jitter2 {
-        Some(j) => D::color_with(target, j),
-        None => D::color(target),
-    };
-    Octave {
-        distance: d2,
-        color,
-        position: D::position(add(pos2, cell)),
-    }
+        // Without a second cell (NaN input) the target is the initial one, offset 0.
+        let (off2, pos2, jitter2) = match t2 {
+            Some(t) => (at(&b.off, t), at(&b.point, t), Some(at(&b.jitter, t))),
+            None => ([0.0; N], [0.0; N], None),
+        };
+        let target = add(cell, off2);
+        let color = match jitter2 {
+            Some(j) => D::color_with(target, j),
+            None => D::color(target),
+        };
+        Octave {
+            distance: d2,
+            color,
+            position: D::position(add(pos2, cell)),
+        }
+    })
 }
 
 fn distance_to_edge<const N: usize, const P: usize>(p: &VoronoiParams, coord: [f32; N]) -> f32
 where
-    D: Cell<N>,
+    D: Cell<N> + Blocks<N, P>,
 {
     let (cell, local) = split(coord);
     if N == 1 {
@@ -455,53 +578,56 @@ where
         return dl.min(dr);
     }
     // Both passes see the same cells: hash them once.
-    let b = Block::<N, P>::new(cell, [0.0; N], 1, p.randomness);
-    let mut v = [[0.0f32; P]; N];
-    let mut d = [0.0f32; P];
-    for t in 0..P {
-        let vt = sub(at(&b.point, t), local);
-        d[t] = dot(vt, vt);
-        for i in 0..N {
-            v[i][t] = vt[i];
+    <D as Blocks<N, P>>::with(cell, [0.0; N], 1, p.randomness, |b| {
+        let mut v = [[0.0f32; P]; N];
+        let mut d = [0.0f32; P];
+        for t in 0..P {
+            let vt = sub(at(&b.point, t), local);
+            d[t] = dot(vt, vt);
+            for i in 0..N {
+                v[i][t] = vt[i];
+            }
         }
-    }
-    let closest = first_min(&d, b.m).map_or([0.0; N], |t| at(&v, t));
-    // Distance to each bisector; cells too close to the nearest one give +inf, which
-    // `min` passes over exactly as the skipped cell.
-    let mut e = [0.0f32; P];
-    for (t, e) in e.iter_mut().enumerate() {
-        let vt = at(&v, t);
-        let perp = sub(vt, closest);
-        *e = if dot(perp, perp) > 0.0001 {
-            let len = dot(perp, perp).sqrt();
-            let n = perp.map(|x| x / len);
-            dot(add(closest, vt).map(|x| x / 2.0), n)
-        } else {
-            f32::INFINITY
-        };
-    }
-    e[..b.m].iter().fold(f32::MAX, |m, &x| m.min(x))
+        let closest = first_min(&d, b.m).map_or([0.0; N], |t| at(&v, t));
+        // Distance to each bisector; cells too close to the nearest one give +inf, which
+        // `min` passes over exactly as the skipped cell.
+        let mut e = [0.0f32; P];
+        for (t, e) in e.iter_mut().enumerate() {
+            let vt = at(&v, t);
+            let perp = sub(vt, closest);
+            *e = if dot(perp, perp) > 0.0001 {
+                let len = dot(perp, perp).sqrt();
+                let n = perp.map(|x| x / len);
+                dot(add(closest, vt).map(|x| x / 2.0), n)
+            } else {
+                f32::INFINITY
+            };
+        }
+        e[..b.m].iter().fold(f32::MAX, |m, &x| m.min(x))
+    })
 }
 
 fn n_sphere_radius<const N: usize, const P: usize>(p: &VoronoiParams, coord: [f32; N]) -> f32
 where
-    D: Cell<N>,
+    D: Cell<N> + Blocks<N, P>,
 {
     let (cell, local) = split(coord);
-    let b = Block::<N, P>::new(cell, [0.0; N], 1, p.randomness);
-    let mut d = [0.0f32; P];
-    for (t, d) in d.iter_mut().enumerate() {
-        *d = euclidean(at(&b.point, t), local);
-    }
-    let (closest, closest_off) =
-        first_min(&d, b.m).map_or(([0.0; N], [0.0; N]), |t| (at(&b.point, t), at(&b.off, t)));
+    let (closest, closest_off) = <D as Blocks<N, P>>::with(cell, [0.0; N], 1, p.randomness, |b| {
+        let mut d = [0.0f32; P];
+        for (t, d) in d.iter_mut().enumerate() {
+            *d = euclidean(at(&b.point, t), local);
+        }
+        first_min(&d, b.m).map_or(([0.0; N], [0.0; N]), |t| (at(&b.point, t), at(&b.off, t)))
+    });
     // The cells around the closest one, except itself (the middle of the block).
-    let b2 = Block::<N, P>::new(cell, closest_off, 1, p.randomness);
-    for (t, d) in d.iter_mut().enumerate() {
-        *d = euclidean(closest, at(&b2.point, t));
-    }
-    d[(b2.m - 1) / 2] = f32::NAN;
-    let next = first_min(&d, b2.m).map_or([0.0; N], |t| at(&b2.point, t));
+    let next = <D as Blocks<N, P>>::with(cell, closest_off, 1, p.randomness, |b2| {
+        let mut d = [0.0f32; P];
+        for (t, d) in d.iter_mut().enumerate() {
+            *d = euclidean(closest, at(&b2.point, t));
+        }
+        d[(b2.m - 1) / 2] = f32::NAN;
+        first_min(&d, b2.m).map_or([0.0; N], |t| at(&b2.point, t))
+    });
     euclidean(next, closest) / 2.0
 }
 
@@ -510,7 +636,7 @@ fn fractal_x_fx<const N: usize, const P3: usize, const P5: usize>(
     coord: [f32; N],
 ) -> Octave
 where
-    D: Cell<N>,
+    D: Cell<N> + Blocks<N, P3> + Blocks<N, P5>,
 {
     let mut amplitude = 1.0f32;
     let mut max_amplitude = 0.0f32;
@@ -578,7 +704,7 @@ fn fractal_distance_to_edge<const N: usize, const P3: usize>(
     coord: [f32; N],
 ) -> f32
 where
-    D: Cell<N>,
+    D: Cell<N> + Blocks<N, P3>,
 {
     let mut amplitude = 1.0f32;
     let mut max_amplitude = p.max_distance;
@@ -654,7 +780,7 @@ fn run<const N: usize, const P3: usize, const P5: usize>(
     coord: [f32; N],
 ) -> VoronoiOutput
 where
-    D: Cell<N>,
+    D: Cell<N> + Blocks<N, P3> + Blocks<N, P5>,
 {
     match p.feature {
         VoronoiFeature::DistanceToEdge => {
