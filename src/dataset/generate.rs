@@ -661,7 +661,7 @@ impl FrameContext<'_> {
                 .spec
                 .sequence
                 .as_ref()
-                .is_none_or(|q| i % q.length == 0);
+                .is_none_or(|q| i.is_multiple_of(q.length));
             if when == crate::label::MeshGlb::Frame || first {
                 let p = layout::motion_path(self.out, "meshes", split, i, "glb");
                 self.write_scene_mesh(&scene, fv.frame as f64, &p)?;
