@@ -517,13 +517,28 @@ impl FrameContext<'_> {
             .scene
             .with_overrides(&fv.overrides)
             .map_err(|e| e.to_string())?;
-        let r = self.renderer.render(
-            &scene,
-            fv.frame as f64,
-            fv.render_seed,
-            &self.spec.render,
-            opts.threads_per_frame,
-        )?;
+        let (r, motion) = if self.spec.labels.motion() {
+            // Flow goes to the neighbouring frames of the sequence's step (1 without one).
+            let step = self.spec.sequence.as_ref().map_or(1, |q| q.step);
+            let (r, m) = self.renderer.render_with_motion(
+                &scene,
+                fv.frame as f64,
+                fv.render_seed,
+                &self.spec.render,
+                opts.threads_per_frame,
+                step as f64,
+            )?;
+            (r, Some(m))
+        } else {
+            let r = self.renderer.render(
+                &scene,
+                fv.frame as f64,
+                fv.render_seed,
+                &self.spec.render,
+                opts.threads_per_frame,
+            )?;
+            (r, None)
+        };
         if r.color.len() != (r.width * r.height) as usize
             || r.ids.width != r.width
             || r.ids.height != r.height
@@ -638,6 +653,21 @@ impl FrameContext<'_> {
             write_atomic(&p, &layout::exr_rgb_bytes(r.width, r.height, &cam)?)?;
             hook(&p)?;
         }
+        if let Some(m) = &motion {
+            self.write_motion(m, &r, split, i, &hook)?;
+        }
+        if let Some(when) = labels_spec.mesh_glb {
+            let first = self
+                .spec
+                .sequence
+                .as_ref()
+                .is_none_or(|q| i.is_multiple_of(q.length));
+            if when == crate::label::MeshGlb::Frame || first {
+                let p = layout::motion_path(self.out, "meshes", split, i, "glb");
+                self.write_scene_mesh(&scene, fv.frame as f64, &p)?;
+                hook(&p)?;
+            }
+        }
         let txt = layout::label_path(self.out, split, i);
         write_atomic(&txt, yolo::label_text(&anns, r.width, r.height).as_bytes())?;
         hook(&txt)?;
@@ -671,6 +701,77 @@ impl FrameContext<'_> {
             format!("{}\n", serde_json::to_string(&record).unwrap()).as_bytes(),
         )?;
         hook(&rec)
+    }
+}
+
+impl FrameContext<'_> {
+    /// The evaluated scene at `frame` as a world-space glb at `path` (written beside it
+    /// as a `.partial` file, then renamed into place).
+    fn write_scene_mesh(&self, scene: &Scene, frame: f64, path: &Path) -> Result<(), String> {
+        let opts = crate::render::RenderOptions {
+            frame: Some(frame),
+            resolution: Some(super::renderer::resolution(scene, &self.spec.render)?),
+            ..Default::default()
+        };
+        let mesh = crate::render::evaluated_scene_mesh(scene, &opts, &[])
+            .map_err(|e| format!("the scene mesh: {e}"))?;
+        let dir = path.parent().ok_or("no folder")?;
+        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().to_string())
+            .unwrap_or_default();
+        let tmp = dir.join(format!(".{name}.{}.partial", std::process::id()));
+        crate::geometry::export::write_glb(&tmp, &mesh, "scene").map_err(|e| e.to_string())?;
+        std::fs::rename(&tmp, path).map_err(|e| format!("{}: {e}", path.display()))
+    }
+
+    /// A frame's optical flow (EXR, and .flo on request) and occlusion masks, as the
+    /// spec's `[labels]` ask.
+    fn write_motion(
+        &self,
+        m: &crate::render::flow::Motion,
+        r: &super::renderer::RenderedFrame,
+        split: &str,
+        i: u64,
+        hook: &dyn Fn(&Path) -> Result<(), String>,
+    ) -> Result<(), String> {
+        let l = &self.spec.labels;
+        let (w, h) = (r.width, r.height);
+        for (dir, f) in [("fw", &m.forward), ("bw", &m.backward)] {
+            if f.flow.len() != (w * h) as usize {
+                return Err(format!(
+                    "the renderer's flow has {} pixels, not {w}x{h}",
+                    f.flow.len()
+                ));
+            }
+            if l.flow {
+                let x = f.flow.iter().map(|v| v[0]).collect();
+                let y = f.flow.iter().map(|v| v[1]).collect();
+                let p = layout::motion_path(self.out, &format!("flow_{dir}"), split, i, "exr");
+                write_atomic(
+                    &p,
+                    &layout::exr_channels_bytes(w, h, &[("R", x), ("G", y)])?,
+                )?;
+                hook(&p)?;
+                if l.flow_flo {
+                    let p = layout::motion_path(self.out, &format!("flow_{dir}"), split, i, "flo");
+                    write_atomic(&p, &crate::render::flow::flo_bytes(w, h, &f.flow))?;
+                    hook(&p)?;
+                }
+            }
+            if l.occlusion {
+                let mask: Vec<u8> = f
+                    .occluded
+                    .iter()
+                    .map(|&o| if o { 255 } else { 0 })
+                    .collect();
+                let p = layout::motion_path(self.out, &format!("occlusion_{dir}"), split, i, "png");
+                write_atomic(&p, &layout::png_bytes(w, h, 1, &mask)?)?;
+                hook(&p)?;
+            }
+        }
+        Ok(())
     }
 }
 

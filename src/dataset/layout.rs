@@ -10,6 +10,11 @@
 //! OUT/depth/SPLIT/NNNNNNNNN.exr|npy     optional: metric depth, float32 (0: none)
 //! OUT/normals/SPLIT/NNNNNNNNN.exr       optional: world-space normals, float RGB
 //! OUT/normals_camera/SPLIT/NNNNNNNNN.exr optional: normals in OpenCV camera axes
+//! OUT/flow_fw|flow_bw/SPLIT/NNNNNNNNN.exr optional: optical flow to the next / previous
+//!                                       frame of the step, float R (x) G (y), pixels;
+//!                                       NaN where invalid (also .flo with flow_flo)
+//! OUT/occlusion_fw|occlusion_bw/SPLIT/NNNNNNNNN.png optional: 255 occluded, 0 visible
+//! OUT/meshes/SPLIT/NNNNNNNNN.glb        optional: the evaluated scene, world space
 //! OUT/sequences/SSSSSSSSS/             with [sequence]: trajectory.txt (TUM), COLMAP's
 //!                                       cameras.txt, images.txt, points3D.txt
 //! OUT/frames/NNNNNNNNN.json             per-frame record; written last: its presence
@@ -25,6 +30,7 @@
 
 use std::path::{Path, PathBuf};
 
+pub use crate::foundation::exr::channels_bytes as exr_channels_bytes;
 pub use crate::foundation::exr::rgb_bytes as exr_rgb_bytes;
 pub use crate::foundation::png::{png16_bytes, png_bytes};
 
@@ -87,15 +93,34 @@ pub fn normal_camera_path(out: &Path, split: &str, index: u64) -> PathBuf {
         .join(split)
         .join(format!("{}.exr", frame_name(index)))
 }
+/// Optical flow (`kind` "flow_fw" or "flow_bw"; `ext` "exr" or "flo") or an occlusion
+/// mask ("occlusion_fw", "occlusion_bw"; "png").
+pub fn motion_path(out: &Path, kind: &str, split: &str, index: u64, ext: &str) -> PathBuf {
+    out.join(kind)
+        .join(split)
+        .join(format!("{}.{ext}", frame_name(index)))
+}
 /// A frame's optional files (written when the spec asks for them).
 pub fn optional_frame_files(out: &Path, split: &str, index: u64) -> Vec<PathBuf> {
-    vec![
+    let mut v = vec![
         depth_path(out, split, index),
         depth_float_path(out, split, index, "exr"),
         depth_float_path(out, split, index, "npy"),
         normal_path(out, split, index),
         normal_camera_path(out, split, index),
-    ]
+    ];
+    for (kind, ext) in [
+        ("flow_fw", "exr"),
+        ("flow_bw", "exr"),
+        ("flow_fw", "flo"),
+        ("flow_bw", "flo"),
+        ("occlusion_fw", "png"),
+        ("occlusion_bw", "png"),
+        ("meshes", "glb"),
+    ] {
+        v.push(motion_path(out, kind, split, index, ext));
+    }
+    v
 }
 /// A sequence's folder: trajectory.txt (TUM) and COLMAP's cameras.txt, images.txt,
 /// points3D.txt.

@@ -31,6 +31,20 @@ pub trait FrameRenderer: Sync {
         settings: &RenderSettings,
         threads: usize,
     ) -> Result<RenderedFrame, String>;
+
+    /// `render` with optical flow and occlusion to the scene frames `step` after and
+    /// before `frame` (`render::flow`). Renderers without geometry give none.
+    fn render_with_motion(
+        &self,
+        _scene: &Scene,
+        _frame: f64,
+        _seed: u32,
+        _settings: &RenderSettings,
+        _threads: usize,
+        _step: f64,
+    ) -> Result<(RenderedFrame, crate::render::flow::Motion), String> {
+        Err("this renderer gives no optical flow or occlusion (the spec's [labels] ask for flow or occlusion)".into())
+    }
 }
 
 /// The output resolution: the spec's, else the scene's resolution x percentage / 100
@@ -59,6 +73,35 @@ impl FrameRenderer for PathTracer {
         s: &RenderSettings,
         threads: usize,
     ) -> Result<RenderedFrame, String> {
+        self.frame(scene, frame, seed, s, threads, None)
+            .map(|(f, _)| f)
+    }
+
+    fn render_with_motion(
+        &self,
+        scene: &Scene,
+        frame: f64,
+        seed: u32,
+        s: &RenderSettings,
+        threads: usize,
+        step: f64,
+    ) -> Result<(RenderedFrame, crate::render::flow::Motion), String> {
+        let (f, m) = self.frame(scene, frame, seed, s, threads, Some(step))?;
+        Ok((f, m.expect("asked for motion")))
+    }
+}
+
+impl PathTracer {
+    /// One frame, with its motion when `step` is set.
+    fn frame(
+        &self,
+        scene: &Scene,
+        frame: f64,
+        seed: u32,
+        s: &RenderSettings,
+        threads: usize,
+        step: Option<f64>,
+    ) -> Result<(RenderedFrame, Option<crate::render::flow::Motion>), String> {
         let opts = crate::render::RenderOptions {
             frame: Some(frame),
             samples: s.samples,
@@ -68,7 +111,17 @@ impl FrameRenderer for PathTracer {
             threads: Some(threads.max(1)),
             progress: false,
         };
-        let mut out = crate::render::render(scene, &opts).map_err(|e| e.to_string())?;
+        let (mut out, motion) = match step {
+            None => (
+                crate::render::render(scene, &opts).map_err(|e| e.to_string())?,
+                None,
+            ),
+            Some(step) => {
+                let (o, m) = crate::render::render_with_motion(scene, &opts, &[], None, step)
+                    .map_err(|e| e.to_string())?;
+                (o, Some(m))
+            }
+        };
         if s.denoise
             .unwrap_or_else(|| crate::denoise::scene_wants_denoising(scene))
         {
@@ -92,7 +145,7 @@ impl FrameRenderer for PathTracer {
                 world_transform: i.world_transform,
             })
             .collect();
-        Ok(RenderedFrame {
+        let frame = RenderedFrame {
             width: out.width,
             height: out.height,
             color: out.color,
@@ -104,7 +157,8 @@ impl FrameRenderer for PathTracer {
                 normal: Some(p.normal),
                 instances,
             },
-        })
+        };
+        Ok((frame, motion))
     }
 }
 

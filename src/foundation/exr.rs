@@ -64,6 +64,27 @@ pub fn grey_bytes(width: u32, height: u32, data: &[f32]) -> std::result::Result<
     encode(&Image::from_layer(layer))
 }
 
+/// Float32 channels with the given names (sorted by name in the file, as EXR requires)
+/// as EXR bytes; each channel row by row from the top.
+pub fn channels_bytes(
+    width: u32,
+    height: u32,
+    channels: &[(&str, Vec<f32>)],
+) -> std::result::Result<Vec<u8>, String> {
+    let mut list = Vec::new();
+    for (name, data) in channels {
+        check(width, height, data.len())?;
+        list.push(AnyChannel::new(*name, FlatSamples::F32(data.clone())));
+    }
+    let layer = Layer::new(
+        (width as usize, height as usize),
+        LayerAttributes::default(),
+        ENCODING,
+        AnyChannels::sort(list.into()),
+    );
+    encode(&Image::from_layer(layer))
+}
+
 /// The image's bytes, its blocks compressed and written one after another.
 fn encode<'i, L: ::exr::image::write::layers::WritableLayers<'i>>(
     image: &'i Image<L>,

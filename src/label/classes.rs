@@ -38,6 +38,24 @@ pub struct LabelSpec {
     pub depth_float_mm: bool,
     /// Also write normals in OpenCV camera axes (x right, y down, z forward).
     pub normals_camera: bool,
+    /// Optical flow to the next and previous frame of the sequence step (float EXR,
+    /// pixels, x right, y down; NaN where invalid): `flow_fw/`, `flow_bw/`.
+    pub flow: bool,
+    /// The flow also as Middlebury `.flo` files beside the EXRs.
+    pub flow_flo: bool,
+    /// Occlusion masks per direction (8-bit PNG, 255 where the pixel's surface point is
+    /// hidden or off the image at the other frame): `occlusion_fw/`, `occlusion_bw/`.
+    pub occlusion: bool,
+    /// The evaluated scene as a world-space glb (`meshes/SPLIT/N.glb`): for every frame,
+    /// or for each sequence's first frame.
+    pub mesh_glb: Option<MeshGlb>,
+}
+
+/// When `mesh_glb` writes the scene mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshGlb {
+    Frame,
+    Sequence,
 }
 
 /// A float32 file format for per-pixel values.
@@ -71,6 +89,10 @@ impl Default for LabelSpec {
             depth_float: None,
             depth_float_mm: false,
             normals_camera: false,
+            flow: false,
+            flow_flo: false,
+            occlusion: false,
+            mesh_glb: None,
         }
     }
 }
@@ -93,6 +115,16 @@ impl LabelSpec {
                 "depth" => s.depth = x.as_bool().ok_or("depth must be true or false")?,
                 "normals" => s.normals = x.as_bool().ok_or("normals must be true or false")?,
                 "normals_camera" => s.normals_camera = x.as_bool().ok_or("normals_camera must be true or false")?,
+                "flow" => s.flow = x.as_bool().ok_or("flow must be true or false")?,
+                "flow_flo" => s.flow_flo = x.as_bool().ok_or("flow_flo must be true or false")?,
+                "occlusion" => s.occlusion = x.as_bool().ok_or("occlusion must be true or false")?,
+                "mesh_glb" => {
+                    s.mesh_glb = match x.as_str() {
+                        Some("frame") => Some(MeshGlb::Frame),
+                        Some("sequence") => Some(MeshGlb::Sequence),
+                        _ => return Err("mesh_glb must be \"frame\" (every frame) or \"sequence\" (each sequence's first frame)".into()),
+                    }
+                }
                 "depth_png_max_mm" => {
                     s.depth_png_max_mm = match x {
                         Toml::Float(f) if f.is_finite() && *f > 0.0 => *f,
@@ -140,10 +172,20 @@ impl LabelSpec {
                         s.classes.push(ClassSpec { name, objects, mask });
                     }
                 }
-                other => return Err(format!("unknown key {other:?} (expected class, class_property, min_pixels, mm_per_unit, depth, depth_png_max_mm, depth_float, depth_float_unit, normals, normals_camera)")),
+                other => return Err(format!("unknown key {other:?} (expected class, class_property, min_pixels, mm_per_unit, depth, depth_png_max_mm, depth_float, depth_float_unit, normals, normals_camera, flow, flow_flo, occlusion, mesh_glb)")),
             }
         }
+        if s.flow_flo && !s.flow {
+            return Err(
+                "flow_flo = true writes the flow as .flo files too: it needs flow = true".into(),
+            );
+        }
         Ok(s)
+    }
+
+    /// Whether frames need the renderer's motion (flow or occlusion).
+    pub fn motion(&self) -> bool {
+        self.flow || self.occlusion
     }
 }
 

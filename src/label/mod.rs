@@ -19,7 +19,7 @@ pub mod rle;
 pub mod trajectory;
 pub mod yolo;
 
-pub use classes::{ClassMap, ClassSpec, FloatFormat, LabelSpec};
+pub use classes::{ClassMap, ClassSpec, FloatFormat, LabelSpec, MeshGlb};
 pub use instances::{extract, InstanceLabel};
 
 /// One rendered instance, as the renderer's `InstanceInfo` describes it.

@@ -302,6 +302,44 @@ impl Camera {
         p
     }
 
+    /// Where world point `w` lands on the image (the inverse of `ray`'s raster to
+    /// viewplane mapping; Cycles' worldtoraster): pixels, x right, y down from the top-left
+    /// corner, in f64. None behind a perspective camera's eye plane; panoramic cameras
+    /// have no inverse here (the caller names the camera).
+    pub fn raster_of(&self, w: V3) -> Option<[f64; 2]> {
+        if self.panorama.is_some() {
+            return None;
+        }
+        let m = &self.to_world.m;
+        let d = [
+            w[0] as f64 - m[0][3] as f64,
+            w[1] as f64 - m[1][3] as f64,
+            w[2] as f64 - m[2][3] as f64,
+        ];
+        // Camera space: the transpose of the (scale-free) rotation.
+        let c = |i: usize| m[0][i] as f64 * d[0] + m[1][i] as f64 * d[1] + m[2][i] as f64 * d[2];
+        let (x, y, z) = (c(0), c(1), c(2));
+        let (vx, vy) = if self.ortho {
+            (x, y)
+        } else {
+            if !(z < 0.0) {
+                return None;
+            }
+            let k = 1.0 / (-z * self.tan_half as f64);
+            (x * k, y * k)
+        };
+        let (l, r, b, t) = (
+            self.left as f64,
+            self.right as f64,
+            self.bottom as f64,
+            self.top as f64,
+        );
+        Some([
+            (vx - l) / (r - l) * self.width as f64,
+            (t - vy) / (t - b) * self.height as f64,
+        ])
+    }
+
     /// The camera-space Z distance of a world point (for the depth pass).
     pub fn depth(&self, w: V3) -> f32 {
         // Cycles' camera_z_depth: a panorama has no view axis, so its depth is the distance.

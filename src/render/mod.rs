@@ -24,6 +24,7 @@ pub mod default_surface;
 pub mod denoise_features;
 pub mod displace;
 pub mod filter;
+pub mod flow;
 pub mod integrator;
 pub mod light;
 pub mod light_tree;
@@ -37,6 +38,7 @@ pub mod oren_nayar;
 pub mod panorama;
 pub mod path_state;
 pub mod sampler;
+pub mod scene_mesh;
 pub mod shade;
 pub mod sheen;
 pub mod sheen_ltc;
@@ -129,6 +131,8 @@ pub struct Passes {
     /// Samples taken per pixel (Cycles' Debug Sample Count pass, unnormalised).
     pub sample_count: Vec<u32>,
     pub instances: Vec<InstanceInfo>,
+    /// What each pixel centre's primary ray hit (None: background), for `flow`.
+    pub hits: Vec<Option<flow::PixelHit>>,
 }
 
 #[derive(Debug, Clone)]
@@ -173,13 +177,80 @@ pub fn render_with_overrides(
 
 /// `render_with_overrides` that another thread can follow and stop through `control`
 /// (checked between pixels; the image is the same when it is not cancelled).
-// Long because the render driver still holds film, tiles, adaptive ranges and passes; separating them is open work (issue 25).
 pub fn render_controlled(
     scene: &Scene,
     opts: &RenderOptions,
     overrides: &[(String, Value)],
     control: Option<&control::Control>,
 ) -> Result<RenderOutput, RenderError> {
+    render_frame(scene, opts, overrides, control).map(|(out, ..)| out)
+}
+
+/// `render_controlled` with optical flow and occlusion (`flow`) to the scene frames
+/// `frame + step` (forward) and `frame - step` (backward; a sequence's step may be
+/// negative), from the primary hits the label passes use. Panoramic cameras are refused
+/// (their projection has no inverse here).
+pub fn render_with_motion(
+    scene: &Scene,
+    opts: &RenderOptions,
+    overrides: &[(String, Value)],
+    control: Option<&control::Control>,
+    step: f64,
+) -> Result<(RenderOutput, flow::Motion), RenderError> {
+    if !(step.is_finite() && step != 0.0) {
+        return Err(RenderError(format!(
+            "optical flow: the frame step is {step}: must be a non-zero number"
+        )));
+    }
+    let (out, camera, geo, frame) = render_frame(scene, opts, overrides, control)?;
+    if camera.panorama.is_some() {
+        return Err(RenderError(
+            "optical flow: the scene's camera is panoramic, which flow does not support \
+             (only perspective and orthographic cameras)"
+                .into(),
+        ));
+    }
+    let here = flow::FrameView {
+        camera: &camera,
+        geo: &geo,
+    };
+    let to = |f: f64| -> Result<flow::FlowField, RenderError> {
+        let at = RenderOptions {
+            frame: Some(f),
+            ..opts.clone()
+        };
+        let p = prepare(scene, &at, overrides)
+            .map_err(|e| RenderError(format!("optical flow to frame {f}: {e}")))?;
+        let there = flow::FrameView {
+            camera: &p.camera,
+            geo: &p.geo,
+        };
+        Ok(flow::flow_to(&here, &out.passes.hits, &there, f))
+    };
+    let forward = to(frame + step)?;
+    let backward = to(frame - step)?;
+    Ok((out, flow::Motion { forward, backward }))
+}
+
+/// The scene the render at `opts`' frame would trace, as one world-space mesh
+/// (`scene_mesh`): for reconstruction ground truth.
+pub fn evaluated_scene_mesh(
+    scene: &Scene,
+    opts: &RenderOptions,
+    overrides: &[(String, Value)],
+) -> Result<crate::geometry::mesh::Mesh, RenderError> {
+    prepare(scene, opts, overrides).map(|p| scene_mesh::scene_mesh(&p.geo))
+}
+
+/// The render, with the camera and geometry it traced and the frame it rendered.
+// Long because the render driver still holds film, tiles, adaptive ranges and passes; separating them is open work (issue 25).
+fn render_frame(
+    scene: &Scene,
+    opts: &RenderOptions,
+    overrides: &[(String, Value)],
+    control: Option<&control::Control>,
+) -> Result<(RenderOutput, camera::Camera, build::Geometry, f64), RenderError> {
+    let frame = opts.frame.unwrap_or(scene.file.scene.frame_current as f64);
     let Prepared {
         start,
         w,
@@ -450,6 +521,7 @@ pub fn render_controlled(
         denoise_normal: vec![[0.0; 3]; npix],
         uv: vec![[0.0; 2]; npix],
         sample_count,
+        hits: vec![None; npix],
         instances: geo
             .instances
             .iter()
@@ -480,24 +552,32 @@ pub fn render_controlled(
                 passes.albedo[i] = scale(p.feature_albedo[k], inv);
                 passes.denoise_normal[i] = scale(p.feature_normal[k], inv);
                 passes.uv[i] = p.uv[k];
+                passes.hits[i] = p.hits[k];
                 k += 1;
             }
         }
     }
-    Ok(RenderOutput {
-        width: w,
-        height: h,
-        color,
-        passes,
-        stats: RenderStats {
-            samples,
-            samples_taken: taken,
-            wall_seconds: start.elapsed().as_secs_f64(),
-            rays,
-            triangles: geo.tris.len(),
-            build_seconds,
+    let triangles = geo.tris.len();
+    drop(motion_accel);
+    Ok((
+        RenderOutput {
+            width: w,
+            height: h,
+            color,
+            passes,
+            stats: RenderStats {
+                samples,
+                samples_taken: taken,
+                wall_seconds: start.elapsed().as_secs_f64(),
+                rays,
+                triangles,
+                build_seconds,
+            },
         },
-    })
+        camera,
+        geo,
+        frame,
+    ))
 }
 
 /// Everything a render needs before it traces: the scene evaluated at the frame, its
@@ -896,6 +976,7 @@ struct TilePasses {
     material_index: Vec<u32>,
     normal: Vec<[f32; 3]>,
     uv: Vec<[f32; 2]>,
+    hits: Vec<Option<flow::PixelHit>>,
     /// Sums over the pixel's samples of the denoiser's guides (`denoise_features`).
     feature_normal: Vec<[f32; 3]>,
     feature_albedo: Vec<[f32; 3]>,
@@ -936,6 +1017,13 @@ fn primary_passes(
                 .push(hit.material.map(|m| m as u32 + 1).unwrap_or(0));
             out.normal.push(hit.sp.normal);
             out.uv.push([hit.sp.uv[0], hit.sp.uv[1]]);
+            let r = tracer.geo.refs[h.prim as usize];
+            out.hits.push(Some(flow::PixelHit {
+                inst: r.inst,
+                tri: r.tri,
+                u: h.u,
+                v: h.v,
+            }));
         }
         None => {
             out.depth.push(f32::INFINITY);
@@ -945,6 +1033,7 @@ fn primary_passes(
             out.material_index.push(0);
             out.normal.push([0.0; 3]);
             out.uv.push([0.0; 2]);
+            out.hits.push(None);
         }
     }
 }
