@@ -191,7 +191,7 @@ fn node_factor(l: &crate::scene::format::Light) -> Result<V3, RenderError> {
 pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
     let mut out = Vec::new();
     for (oi, obj) in eval.data.objects.iter().enumerate() {
-        if obj.kind != "LIGHT" || obj.hide_render {
+        if obj.kind != "LIGHT" || obj.hide_render || !obj.in_render_layer {
             continue;
         }
         let Some(data) = obj.data.as_deref() else {
