@@ -559,3 +559,46 @@ fn inspect_refuses_exactly_what_render_refuses() {
     assert!(!report.all_supported);
     assert_eq!(report.render_error.as_deref(), Some(e.as_str()));
 }
+
+/// A BSDF wired to a light's output emits nothing in Cycles (the shader's emission
+/// estimate is zero, so the light is left out): the frame renders as without the light,
+/// where it was refused (godot-blender-exporter's cycles_lights file).
+#[test]
+fn a_light_whose_tree_ends_in_a_bsdf_is_left_out() {
+    use serde_json::{json, Value};
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("scene");
+    copy_dir(&repo().join("fixtures/scenes/animated_camera"), &dir);
+    let p = dir.join("scene.json");
+    let mut v: Value = serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
+    let key = v["lights"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|l| l["name"] == "Key")
+        .unwrap();
+    let sock = |i: usize, id: &str, kind: &str| {
+        json!({"index": i, "identifier": id,
+        "name": id, "type": kind, "bl_idname": "NodeSocketShader"})
+    };
+    v["lights"][key]["properties"]["use_nodes"] = json!(true);
+    v["lights"][key]["node_tree"] = json!({"name": "Shader Nodetree",
+        "bl_idname": "ShaderNodeTree",
+        "nodes": [
+            {"name": "Diffuse BSDF", "bl_idname": "ShaderNodeBsdfDiffuse",
+             "inputs": [], "outputs": [sock(0, "BSDF", "SHADER")]},
+            {"name": "Light Output", "bl_idname": "ShaderNodeOutputLight",
+             "properties": {"is_active_output": true, "target": "ALL"},
+             "inputs": [sock(0, "Surface", "SHADER")], "outputs": []}],
+        "links": [{"from_node": "Diffuse BSDF", "from_socket": "BSDF", "from_index": 0,
+                   "to_node": "Light Output", "to_socket": "Surface", "to_index": 0}]});
+    std::fs::write(&p, serde_json::to_vec(&v).unwrap()).unwrap();
+    let scene = Scene::load(&dir).unwrap();
+    let with_bsdf = render(&scene, &small(None)).expect("a BSDF light renders black");
+    v["lights"][key]["node_tree"] = Value::Null;
+    v["lights"][key]["properties"]["energy"] = json!(0.0);
+    std::fs::write(&p, serde_json::to_vec(&v).unwrap()).unwrap();
+    let scene = Scene::load(&dir).unwrap();
+    let dark = render(&scene, &small(None)).unwrap();
+    assert_eq!(with_bsdf.color, dark.color);
+}
