@@ -546,6 +546,51 @@ ID_COLLECTIONS = {"OBJECT": "objects", "MESH": "meshes", "CURVE": "curves", "KEY
                   "NODETREE": "node_groups", "IMAGE": "images", "FONT": "fonts"}
 
 
+class RenderSettings:
+    """While active, the viewport settings Blender evaluates with are set to their render
+    values: the depsgraph Python gets is the viewport's, and Cycles renders with modifiers
+    shown in renders only, Subdivision Surface / Multires render levels, particle render
+    amounts and curve / metaball render resolutions. Restored on exit, so the export's
+    properties stay the file's. (A Geometry Nodes Is Viewport node still reads true.)"""
+
+    def __enter__(self):
+        self.saved = []
+        for o in bpy.data.objects:
+            for m in o.modifiers:
+                self.put(m, "show_viewport", m.show_render)
+                if m.type in ("SUBSURF", "MULTIRES"):
+                    self.put(m, "levels", m.render_levels)
+            for ps in getattr(o, "particle_systems", []):
+                st = ps.settings
+                self.put(st, "display_percentage", 100)
+                self.put(st, "child_nbr", st.rendered_child_count)
+        for c in bpy.data.curves:
+            if c.render_resolution_u > 0:
+                self.put(c, "resolution_u", c.render_resolution_u)
+            if c.render_resolution_v > 0:
+                self.put(c, "resolution_v", c.render_resolution_v)
+        for mb in bpy.data.metaballs:
+            if mb.render_resolution > 0:
+                self.put(mb, "resolution", mb.render_resolution)
+        bpy.context.view_layer.update()
+        return self
+
+    def put(self, owner, attr, value):
+        try:
+            old = getattr(owner, attr)
+            if old != value:
+                setattr(owner, attr, value)
+                self.saved.append((owner, attr, old))
+        except (AttributeError, TypeError, ValueError):
+            pass  # read-only here (linked data): Blender evaluates it as saved
+
+    def __exit__(self, *exc):
+        for owner, attr, old in reversed(self.saved):
+            setattr(owner, attr, old)
+        bpy.context.view_layer.update()
+        return False
+
+
 def frozen_target(o):
     """Whether blendsynth renders this object from its evaluated mesh (it does not build
     it itself): meshes with modifiers (the export keeps these as reference meshes too),
@@ -1072,7 +1117,9 @@ def main():
         index = {key(o): i for i, o in enumerate(data.objects)}
         by_key = {key(o): o for o in data.objects}
         targets = [o for o in data.objects if frozen_target(o) and in_view_layer(o, view_layer)]
-        for name, ((counts, arrays, attrs, uvs), n_inst, mats, (uv_layers, render_uv, color)) in evaluated_meshes(targets, depsgraph).items():
+        with RenderSettings():
+            frozen_meshes = evaluated_meshes(targets, bpy.context.evaluated_depsgraph_get())
+        for name, ((counts, arrays, attrs, uvs), n_inst, mats, (uv_layers, render_uv, color)) in frozen_meshes.items():
             rel = f"evaluated/{safe_name(index[name], name)}"
             write_mesh_glb(os.path.join(out, rel), name, counts, arrays, attrs, uvs)
             reads, animated, unsupported = frozen_inputs(by_key[name])
@@ -1143,7 +1190,8 @@ def main():
     }
     if args.frames is not None and not args.no_evaluated:
         # Last: frame_set flushes each frame's animated values into the data read above.
-        doc["evaluated"] += evaluated_frames(evaluated, by_key, index, out, args.frames)
+        with RenderSettings():
+            doc["evaluated"] += evaluated_frames(evaluated, by_key, index, out, args.frames)
     nan_warnings = []
     doc = sanitize(doc, "", nan_warnings)
     doc["warnings"] = WARNINGS + nan_warnings

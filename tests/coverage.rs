@@ -602,3 +602,42 @@ fn a_light_whose_tree_ends_in_a_bsdf_is_left_out() {
     let dark = render(&scene, &small(None)).unwrap();
     assert_eq!(with_bsdf.color, dark.color);
 }
+
+/// Blender-side: frozen meshes are Blender's evaluation with the render settings Cycles
+/// uses, not the viewport's (`fixtures/coverage/make_render_levels_scene.py`: Subdivision
+/// Surface at level 0 in the viewport, 2 in renders, under a Triangulate modifier): the
+/// cube at level 2 has 98 vertices and 96 quads, 192 triangles. The exported modifier
+/// keeps the file's viewport level.
+#[test]
+fn frozen_meshes_use_render_levels() {
+    let Some(py) = require("bpy", bpy_python()) else {
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let blend = tmp.path().join("levels.blend");
+    let export = tmp.path().join("export");
+    run_python(
+        &py,
+        &repo().join("fixtures/coverage/make_render_levels_scene.py"),
+        &["--", blend.to_str().unwrap()],
+    );
+    let o = run(
+        &[
+            "convert",
+            blend.to_str().unwrap(),
+            "-o",
+            export.to_str().unwrap(),
+        ],
+        &[("BLENDSYNTH_BPY_PYTHON", py.to_str().unwrap())],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let scene = Scene::load(&export).unwrap();
+    let set = blendsynth::geometry::evaluate_object(&scene, "Cube", 1.0, &[]).unwrap();
+    let m = blendsynth::geometry::realize_to_mesh(&set).unwrap();
+    assert_eq!((m.vertex_count(), m.face_count()), (98, 192));
+    let sub = &scene.object("Cube").unwrap().modifiers[0];
+    assert_eq!(
+        sub.properties.get("levels").and_then(|v| v.as_i64()),
+        Some(0)
+    );
+}
