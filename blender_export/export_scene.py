@@ -563,7 +563,7 @@ class RenderSettings:
             for ps in getattr(o, "particle_systems", []):
                 st = ps.settings
                 self.put(st, "display_percentage", 100)
-                self.put(st, "child_nbr", st.rendered_child_count)
+                self.put(st, "child_percent", st.rendered_child_count)
         for c in bpy.data.curves:
             if c.render_resolution_u > 0:
                 self.put(c, "resolution_u", c.render_resolution_u)
