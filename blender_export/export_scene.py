@@ -6,7 +6,9 @@ or with the bpy module:
     python export_scene.py --in F.blend --out DIR
 
 Options: --frame N (evaluate at frame N; default the file's current frame),
---no-evaluated (skip the evaluated reference meshes).
+--frames A..B (evaluate at frame A, and also write the evaluated meshes of objects whose
+evaluation is animated at every frame A+1..B), --no-evaluated (skip the evaluated
+reference meshes).
 
 The .blend is opened by this script with auto-run scripts disabled: a .blend can carry
 Python (registered text blocks, driver expressions) and none of it may run.
@@ -54,8 +56,15 @@ def q(name):
     return '"' + name.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 
+def key(idb):
+    """An ID's name in the export: its name, or for data linked from a library Blender's
+    name_full (`Cube [lib]`, the library ID's name in brackets), since linked data may
+    share its name with local data or with data from another library."""
+    return idb.name_full
+
+
 def id_ref(idb):
-    return {"id_type": idb.id_type, "name": idb.name}
+    return {"id_type": idb.id_type, "name": key(idb)}
 
 
 # ---------------------------------------------------------------- generic RNA values
@@ -180,7 +189,7 @@ def node_entry(n, where):
         "name": n.name, "bl_idname": n.bl_idname, "label": n.label, "mute": n.mute,
         "parent": n.parent.name if n.parent else None,
         "location": [n.location[0], n.location[1]], "hide": n.hide,
-        "node_tree": group.name if isinstance(group, bpy.types.NodeTree) else None,
+        "node_tree": key(group) if isinstance(group, bpy.types.NodeTree) else None,
         "properties": rna_value(n, 0, where, skip=NODE_BASE),
         "inputs": [socket_entry(s, i, f"{where}.inputs[{i}]") for i, s in enumerate(n.inputs)],
         "outputs": [socket_entry(s, i, f"{where}.outputs[{i}]") for i, s in enumerate(n.outputs)],
@@ -226,7 +235,7 @@ def node_tree_entry(tree, where):
     if getattr(tree, "interface", None) is not None:
         interface = [interface_entry(it, f"{where}.interface.items_tree[{i}]") for i, it in enumerate(tree.interface.items_tree)]
     return {
-        "name": tree.name, "bl_idname": tree.bl_idname, "interface": interface,
+        "name": key(tree), "bl_idname": tree.bl_idname, "interface": interface,
         "nodes": [node_entry(n, f"{where}.nodes[{q(n.name)}]") for n in tree.nodes],
         "links": [link_entry(l, out_index, in_index) for l in tree.links],
     }
@@ -469,8 +478,8 @@ def with_materials(part, materials, slots):
 def slot_materials(ob, me):
     """An evaluated object's material per slot, object-linked slots included."""
     if ob is not None and len(ob.material_slots):
-        return [s.material.name if s.material else None for s in ob.material_slots]
-    return [m.name if m else None for m in me.materials]
+        return [key(s.material) if s.material else None for s in ob.material_slots]
+    return [key(m) if m else None for m in me.materials]
 
 
 def evaluated_meshes(objs, depsgraph):
@@ -481,7 +490,7 @@ def evaluated_meshes(objs, depsgraph):
     parts, n_inst, inverse, mats, uvinfo = {}, {}, {}, {}, {}
     for o in objs:
         ev = o.evaluated_get(depsgraph)
-        mats[o.name] = []
+        mats[key(o)] = []
         try:
             me = ev.to_mesh()
         except RuntimeError:
@@ -492,23 +501,23 @@ def evaluated_meshes(objs, depsgraph):
             ev.to_mesh_clear()
             me = None
         if me is None:
-            parts[o.name] = [empty_part()]
-            uvinfo[o.name] = ([], None, None)
+            parts[key(o)] = [empty_part()]
+            uvinfo[key(o)] = ([], None, None)
         else:
             try:
-                part = mesh_arrays(me, f"evaluated[{q(o.name)}]")
-                parts[o.name] = [with_materials(part, mats[o.name], slot_materials(ev, me))]
-                uvinfo[o.name] = ([uv.name for uv in me.uv_layers],
+                part = mesh_arrays(me, f"evaluated[{q(key(o))}]")
+                parts[key(o)] = [with_materials(part, mats[key(o)], slot_materials(ev, me))]
+                uvinfo[key(o)] = ([uv.name for uv in me.uv_layers],
                                   next((uv.name for uv in me.uv_layers if uv.active_render), None),
                                   getattr(me.attributes, "default_color_name", None) or None)
             finally:
                 ev.to_mesh_clear()
-        n_inst[o.name] = 0
-        inverse[o.name] = np.linalg.inv(np.array(ev.matrix_world, dtype=np.float64))
+        n_inst[key(o)] = 0
+        inverse[key(o)] = np.linalg.inv(np.array(ev.matrix_world, dtype=np.float64))
     for inst in depsgraph.object_instances:
         if not inst.is_instance or inst.parent is None:
             continue
-        owner = inst.parent.original.name
+        owner = key(inst.parent.original)
         if owner not in parts:
             continue
         io = inst.object  # the instanced geometry (inst.parent is the instancer)
@@ -537,6 +546,51 @@ ID_COLLECTIONS = {"OBJECT": "objects", "MESH": "meshes", "CURVE": "curves", "KEY
                   "NODETREE": "node_groups", "IMAGE": "images", "FONT": "fonts"}
 
 
+class RenderSettings:
+    """While active, the viewport settings Blender evaluates with are set to their render
+    values: the depsgraph Python gets is the viewport's, and Cycles renders with modifiers
+    shown in renders only, Subdivision Surface / Multires render levels, particle render
+    amounts and curve / metaball render resolutions. Restored on exit, so the export's
+    properties stay the file's. (A Geometry Nodes Is Viewport node still reads true.)"""
+
+    def __enter__(self):
+        self.saved = []
+        for o in bpy.data.objects:
+            for m in o.modifiers:
+                self.put(m, "show_viewport", m.show_render)
+                if m.type in ("SUBSURF", "MULTIRES"):
+                    self.put(m, "levels", m.render_levels)
+            for ps in getattr(o, "particle_systems", []):
+                st = ps.settings
+                self.put(st, "display_percentage", 100)
+                self.put(st, "child_percent", st.rendered_child_count)
+        for c in bpy.data.curves:
+            if c.render_resolution_u > 0:
+                self.put(c, "resolution_u", c.render_resolution_u)
+            if c.render_resolution_v > 0:
+                self.put(c, "resolution_v", c.render_resolution_v)
+        for mb in bpy.data.metaballs:
+            if mb.render_resolution > 0:
+                self.put(mb, "resolution", mb.render_resolution)
+        bpy.context.view_layer.update()
+        return self
+
+    def put(self, owner, attr, value):
+        try:
+            old = getattr(owner, attr)
+            if old != value:
+                setattr(owner, attr, value)
+                self.saved.append((owner, attr, old))
+        except (AttributeError, TypeError, ValueError):
+            pass  # read-only here (linked data): Blender evaluates it as saved
+
+    def __exit__(self, *exc):
+        for owner, attr, old in reversed(self.saved):
+            setattr(owner, attr, old)
+        bpy.context.view_layer.update()
+        return False
+
+
 def frozen_target(o):
     """Whether blendsynth renders this object from its evaluated mesh (it does not build
     it itself): meshes with modifiers (the export keeps these as reference meshes too),
@@ -551,7 +605,7 @@ def frozen_target(o):
 
 
 def id_path(idb):
-    return f"{ID_COLLECTIONS.get(idb.id_type, idb.id_type.lower() + 's')}[{q(idb.name)}]"
+    return f"{ID_COLLECTIONS.get(idb.id_type, idb.id_type.lower() + 's')}[{q(key(idb))}]"
 
 
 def under(path, prefix):
@@ -565,9 +619,9 @@ TIME_NODES = {"GeometryNodeInputSceneTime", "GeometryNodeSimulationInput", "Geom
 
 def tree_reads_time(tree, seen):
     """Whether a Geometry Nodes tree (groups included) reads the scene time or simulates."""
-    if tree.name in seen:
+    if key(tree) in seen:
         return False
-    seen.add(tree.name)
+    seen.add(key(tree))
     for n in tree.nodes:
         if n.bl_idname in TIME_NODES:
             return True
@@ -681,18 +735,47 @@ def modifier_entry(m, where):
          "properties": rna_value(m, 0, where, skip={"name", "type", "show_render", "show_viewport"}),
          "node_group": None, "inputs": {}}
     if m.type == "NODES":
-        d["node_group"] = m.node_group.name if m.node_group else None
+        d["node_group"] = key(m.node_group) if m.node_group else None
         # Group input values live in the modifier's ID properties, keyed by the group's
         # interface identifiers (Socket_2, Socket_2_use_attribute, ...).
         d["inputs"] = {k: py_value(m[k], f"{where}[{q(k)}]", 0) for k in m.keys()}
     return d
 
 
+RENDER_LAYER = set()  # as_pointer() of the objects the view layer renders (render_layer_objects)
+
+
+def render_layer_objects(view_layer):
+    """The objects the view layer renders through its collections: in a collection that
+    is neither excluded from the view layer nor disabled in renders, nor is any collection
+    above it. Others (in no scene collection, only in an excluded or render-disabled one,
+    in another scene, or only in a library collection an empty instances) Cycles does not
+    render themselves."""
+    found = set()
+
+    def walk(lc):
+        if lc.exclude or lc.collection.hide_render:
+            return
+        found.update(o.as_pointer() for o in lc.collection.objects)
+        for child in lc.children:
+            walk(child)
+
+    walk(view_layer.layer_collection)
+    return found
+
+
+def in_view_layer(o, view_layer):
+    """Whether object O is in the view layer (by identity: a linked object may share its
+    name with a local one)."""
+    x = view_layer.objects.get(o.name)
+    return x is not None and (x == o or any(v == o for v in view_layer.objects))
+
+
 def object_entry(o, view_layer):
-    w = f"objects[{q(o.name)}]"
+    w = f"objects[{q(key(o))}]"
     return {
-        "name": o.name, "type": o.type, "data": o.data.name if o.data else None,
-        "parent": o.parent.name if o.parent else None, "parent_type": o.parent_type,
+        "name": key(o), "type": o.type, "data": key(o.data) if o.data else None,
+        "parent": key(o.parent) if o.parent else None, "parent_type": o.parent_type,
         "parent_bone": o.parent_bone or None,
         "matrix_world": matrix(o.matrix_world), "matrix_local": matrix(o.matrix_local),
         "matrix_basis": matrix(o.matrix_basis), "matrix_parent_inverse": matrix(o.matrix_parent_inverse),
@@ -702,8 +785,9 @@ def object_entry(o, view_layer):
         "delta_location": vec(o.delta_location), "delta_rotation_euler": vec(o.delta_rotation_euler),
         "delta_rotation_quaternion": vec(o.delta_rotation_quaternion), "delta_scale": vec(o.delta_scale),
         "hide_render": o.hide_render, "hide_viewport": o.hide_viewport,
-        "visible": o.visible_get(view_layer=view_layer) if view_layer.objects.get(o.name) else False,
-        "pass_index": o.pass_index, "collections": [c.name for c in o.users_collection],
+        "in_render_layer": o.as_pointer() in RENDER_LAYER,
+        "visible": o.visible_get(view_layer=view_layer) if in_view_layer(o, view_layer) else False,
+        "pass_index": o.pass_index, "collections": [key(c) for c in o.users_collection],
         # Cycles' ray visibility (Object > Visibility > Ray Visibility); light objects
         # default to hidden from the camera in Blender 4.x.
         "visibility": {k: getattr(o, "visible_" + k) for k in ("camera", "diffuse", "glossy", "transmission", "volume_scatter", "shadow")},
@@ -712,7 +796,7 @@ def object_entry(o, view_layer):
         "shadow_terminator_geometry_offset": o.shadow_terminator_geometry_offset,
         "shadow_terminator_shading_offset": o.shadow_terminator_shading_offset,
         "color": vec(o.color),
-        "material_slots": [{"material": s.material.name if s.material else None, "link": s.link} for s in o.material_slots],
+        "material_slots": [{"material": key(s.material) if s.material else None, "link": s.link} for s in o.material_slots],
         "modifiers": [modifier_entry(m, f"{w}.modifiers[{q(m.name)}]") for m in o.modifiers],
         "constraints": [{"name": c.name, "type": c.type, "mute": c.mute, "influence": c.influence,
                          "properties": rna_value(c, 0, f"{w}.constraints[{q(c.name)}]")} for c in o.constraints],
@@ -720,7 +804,7 @@ def object_entry(o, view_layer):
         # Extra keys: Follow Path orients a child of a path by the object's own axes.
         "track_axis": o.track_axis, "up_axis": o.up_axis,
         "instance_type": o.instance_type,
-        "instance_collection": o.instance_collection.name if o.instance_collection else None,
+        "instance_collection": key(o.instance_collection) if o.instance_collection else None,
         # Cycles' per-object motion blur settings (Object Properties > Motion Blur).
         "cycles": {"use_motion_blur": o.cycles.use_motion_blur, "use_deform_motion": o.cycles.use_deform_motion,
                    "motion_steps": o.cycles.motion_steps} if hasattr(o, "cycles") else None,
@@ -741,9 +825,9 @@ def curve_entry(c):
                               for p in s.bezier_points],
             "points": [{"co": vec(p.co), "radius": p.radius, "tilt": p.tilt, "weight": p.weight} for p in s.points],
         })
-    return {"name": c.name,
-            "properties": rna_value(c, 0, f"curves[{q(c.name)}]", skip={"splines", "materials", "animation_data", "shape_keys"}),
-            "materials": [m.name if m else None for m in c.materials], "splines": splines}
+    return {"name": key(c),
+            "properties": rna_value(c, 0, f"curves[{q(key(c))}]", skip={"splines", "materials", "animation_data", "shape_keys"}),
+            "materials": [key(m) if m else None for m in c.materials], "splines": splines}
 
 
 def save_generated(im, target):
@@ -774,7 +858,7 @@ def save_generated(im, target):
 
 
 def image_entry(im, out_dir, used_names):
-    d = {"name": im.name, "source": im.source, "filepath": im.filepath, "file": None,
+    d = {"name": key(im), "source": im.source, "filepath": im.filepath, "file": None,
          "packed": im.packed_file is not None, "missing": False,
          "colorspace": im.colorspace_settings.name, "alpha_mode": im.alpha_mode, "size": [int(x) for x in im.size]}
     generated = im.packed_file is None and im.source == "GENERATED"
@@ -799,7 +883,7 @@ def image_entry(im, out_dir, used_names):
         try:
             save_generated(im, target)
         except Exception as e:
-            WARNINGS.append(f"images[{q(im.name)}]: generated image not exported ({e})")
+            WARNINGS.append(f"images[{q(key(im))}]: generated image not exported ({e})")
             return d
     elif im.packed_file is not None:
         os.makedirs(os.path.dirname(target), exist_ok=True)
@@ -811,19 +895,19 @@ def image_entry(im, out_dir, used_names):
         # missing files (magenta, as in Cycles), never read.
         if not (src and os.path.isfile(src)):
             d["missing"] = True
-            WARNINGS.append(f"images[{q(im.name)}]: file {im.filepath!r} not found and not packed")
+            WARNINGS.append(f"images[{q(key(im))}]: file {im.filepath!r} not found and not packed")
             return d
         # The path policy: a .blend may name any file on the machine (an absolute path,
         # //../../..), and the export is meant to be shared, so only files under the
         # .blend's folder (or a folder the user allowed) are copied. Symlinks resolved.
         real = os.path.realpath(src)
         if not any(os.path.commonpath([real, root]) == root for root in ALLOWED_ROOTS):
-            fail(f"images[{q(im.name)}]: file {im.filepath!r} resolves to {real}, outside the .blend's folder "
+            fail(f"images[{q(key(im))}]: file {im.filepath!r} resolves to {real}, outside the .blend's folder "
                  f"{ALLOWED_ROOTS[0]}; if you trust this file, allow its folder with --allow-path "
                  f"{os.path.dirname(real)} (or pack the image into the .blend)")
         os.makedirs(os.path.dirname(target), exist_ok=True)
         shutil.copyfile(real, target)
-        COPIED.append({"image": im.name, "from": real, "to": f"images/{name}"})
+        COPIED.append({"image": key(im), "from": real, "to": f"images/{name}"})
     used_names.add(name)
     d["file"] = f"images/{name}"
     return d
@@ -879,15 +963,15 @@ def anim_entry(idb, id_path, id_type):
         drivers.append(d)
     if not fcs and not drivers and anim.action is None:
         return None
-    return {"id_type": id_type, "id_name": idb.name, "id_path": id_path,
-            "action": anim.action.name if anim.action else None, "fcurves": fcs, "drivers": drivers}
+    return {"id_type": id_type, "id_name": key(idb), "id_path": id_path,
+            "action": key(anim.action) if anim.action else None, "fcurves": fcs, "drivers": drivers}
 
 
 def animation(data):
     out = []
     for coll_name in ("objects", "meshes", "curves", "cameras", "lights", "materials", "worlds", "scenes", "node_groups"):
         for idb in getattr(data, coll_name):
-            path = f"{coll_name}[{q(idb.name)}]"
+            path = f"{coll_name}[{q(key(idb))}]"
             e = anim_entry(idb, path, idb.id_type)
             if e:
                 out.append(e)
@@ -918,6 +1002,45 @@ def open_blend(path):
         WARNINGS.append(f"Blender opened {path} with an error: {str(e).strip()}")
 
 
+MAX_FRAMES = 10000
+
+
+def frame_range(text):
+    """`A..B` (inclusive, A <= B) for --frames."""
+    try:
+        a, b = (int(x) for x in text.split(".."))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a frame range A..B")
+    if b < a or b - a >= MAX_FRAMES:
+        raise argparse.ArgumentTypeError(f"{text!r}: need A <= B and at most {MAX_FRAMES} frames")
+    return a, b
+
+
+def evaluated_frames(evaluated, by_key, index, out, frames):
+    """--frames A..B: Blender's evaluated mesh at every frame A+1..B of each object whose
+    evaluation reads something animated (the entries at A are EVALUATED), one entry per
+    object and frame, with the same reads and animated inputs."""
+    scene = bpy.context.scene
+    moving = [e for e in evaluated if e["animated"]]
+    extra = []
+    for f in range(frames[0] + 1, frames[1] + 1):
+        if not moving:
+            break
+        scene.frame_set(f)
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        got = evaluated_meshes([by_key[e["object"]] for e in moving], depsgraph)
+        for e in moving:
+            name = e["object"]
+            (counts, arrays, attrs, uvs), n_inst, mats, (uv_layers, render_uv, color) = got[name]
+            rel = f"evaluated/{safe_name(index[name], name)[:-4]}.f{f}.glb"
+            write_mesh_glb(os.path.join(out, rel), name, counts, arrays, attrs, uvs)
+            extra.append(dict(e, frame=scene.frame_current + scene.frame_subframe, file=rel,
+                              vertex_count=counts[0], face_count=counts[2], instances_realized=n_inst,
+                              materials=mats, uv_layers=uv_layers, active_render_uv=render_uv,
+                              default_color_attribute=color))
+    return extra
+
+
 def main():
     t0 = time.time()
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
@@ -925,6 +1048,8 @@ def main():
     ap.add_argument("--in", dest="input", help="the .blend to export (default: the file Blender already opened)")
     ap.add_argument("--out", required=True, help="output folder")
     ap.add_argument("--frame", type=int, help="frame to evaluate at (default: the file's current frame)")
+    ap.add_argument("--frames", type=frame_range, metavar="A..B",
+                    help="evaluate at frame A; also write the evaluated meshes of animated objects at A+1..B")
     ap.add_argument("--no-evaluated", action="store_true", help="skip the evaluated reference meshes")
     ap.add_argument("--allow-path", action="append", default=[], metavar="DIR",
                     help="a folder outside the .blend's own whose files (images) may be copied into the export")
@@ -959,6 +1084,10 @@ def main():
     data = bpy.data
     scene = bpy.context.scene
     view_layer = bpy.context.view_layer
+    if args.frame is not None and args.frames is not None:
+        fail("--frame and --frames exclude each other")
+    if args.frames is not None:
+        args.frame = args.frames[0]
     if args.frame is not None:
         scene.frame_set(args.frame)
     # Evaluates animation, drivers and constraints at the current frame and flushes the
@@ -967,12 +1096,12 @@ def main():
 
     meshes = []
     for i, me in enumerate(data.meshes):
-        rel = f"meshes/{safe_name(i, me.name)}"
-        counts, arrays, attrs, uvs = mesh_arrays(me, f"meshes[{q(me.name)}]")
-        write_mesh_glb(os.path.join(out, rel), me.name, counts, arrays, attrs, uvs)
+        rel = f"meshes/{safe_name(i, key(me))}"
+        counts, arrays, attrs, uvs = mesh_arrays(me, f"meshes[{q(key(me))}]")
+        write_mesh_glb(os.path.join(out, rel), key(me), counts, arrays, attrs, uvs)
         nv, ne, nf, nc, _ = counts
-        meshes.append({"name": me.name, "file": rel, "vertex_count": nv, "edge_count": ne, "face_count": nf,
-                       "corner_count": nc, "materials": [m.name if m else None for m in me.materials],
+        meshes.append({"name": key(me), "file": rel, "vertex_count": nv, "edge_count": ne, "face_count": nf,
+                       "corner_count": nc, "materials": [key(m) if m else None for m in me.materials],
                        "uv_layers": [uv.name for uv in me.uv_layers],
                        "active_uv": me.uv_layers.active.name if me.uv_layers.active else None,
                        "active_render_uv": next((uv.name for uv in me.uv_layers if uv.active_render), None),
@@ -985,18 +1114,22 @@ def main():
 
     evaluated = []
     if not args.no_evaluated:
-        index = {o.name: i for i, o in enumerate(data.objects)}
-        targets = [o for o in data.objects if frozen_target(o) and view_layer.objects.get(o.name)]
-        for name, ((counts, arrays, attrs, uvs), n_inst, mats, (uv_layers, render_uv, color)) in evaluated_meshes(targets, depsgraph).items():
+        index = {key(o): i for i, o in enumerate(data.objects)}
+        by_key = {key(o): o for o in data.objects}
+        targets = [o for o in data.objects if frozen_target(o) and in_view_layer(o, view_layer)]
+        with RenderSettings():
+            frozen_meshes = evaluated_meshes(targets, bpy.context.evaluated_depsgraph_get())
+        for name, ((counts, arrays, attrs, uvs), n_inst, mats, (uv_layers, render_uv, color)) in frozen_meshes.items():
             rel = f"evaluated/{safe_name(index[name], name)}"
             write_mesh_glb(os.path.join(out, rel), name, counts, arrays, attrs, uvs)
-            reads, animated, unsupported = frozen_inputs(data.objects[name])
+            reads, animated, unsupported = frozen_inputs(by_key[name])
             evaluated.append({"object": name, "frame": scene.frame_current + scene.frame_subframe, "file": rel,
                               "vertex_count": counts[0], "face_count": counts[2], "instances_realized": n_inst,
                               "reads": reads, "animated": animated, "unsupported": unsupported,
                               "materials": mats, "uv_layers": uv_layers, "active_render_uv": render_uv,
                               "default_color_attribute": color})
 
+    RENDER_LAYER.update(render_layer_objects(view_layer))
     used_images = set()
     images = [image_entry(im, out, used_images) for im in data.images
               if im.source != "VIEWER" and im.type not in ("RENDER_RESULT", "COMPOSITING")]
@@ -1025,7 +1158,7 @@ def main():
             "name": scene.name, "frame_start": scene.frame_start, "frame_end": scene.frame_end,
             "frame_current": scene.frame_current, "frame_step": scene.frame_step,
             "fps": scene.render.fps, "fps_base": scene.render.fps_base,
-            "camera": scene.camera.name if scene.camera else None, "world": scene.world.name if scene.world else None,
+            "camera": key(scene.camera) if scene.camera else None, "world": key(scene.world) if scene.world else None,
             "render": rna_value(scene.render, 0, "scene.render"),
             "cycles": rna_value(scene.cycles, 0, "scene.cycles") if hasattr(scene, "cycles") else {},
             "view_settings": rna_value(scene.view_settings, 0, "scene.view_settings"),
@@ -1035,26 +1168,30 @@ def main():
         "objects": [object_entry(o, view_layer) for o in data.objects],
         "meshes": meshes,
         "curves": [curve_entry(c) for c in data.curves],
-        "materials": [{"name": m.name, "use_nodes": m.use_nodes, "pass_index": m.pass_index,
-                       "node_tree": node_tree_entry(m.node_tree, f"materials[{q(m.name)}].node_tree") if m.node_tree else None,
-                       "properties": rna_value(m, 0, f"materials[{q(m.name)}]", skip={"node_tree", "animation_data", "grease_pencil"})}
+        "materials": [{"name": key(m), "use_nodes": m.use_nodes, "pass_index": m.pass_index,
+                       "node_tree": node_tree_entry(m.node_tree, f"materials[{q(key(m))}].node_tree") if m.node_tree else None,
+                       "properties": rna_value(m, 0, f"materials[{q(key(m))}]", skip={"node_tree", "animation_data", "grease_pencil"})}
                       for m in data.materials],
-        "worlds": [{"name": w.name, "color": vec(w.color), "use_nodes": w.use_nodes,
-                    "node_tree": node_tree_entry(w.node_tree, f"worlds[{q(w.name)}].node_tree") if w.node_tree else None,
-                    "properties": rna_value(w, 0, f"worlds[{q(w.name)}]", skip={"node_tree", "animation_data"})}
+        "worlds": [{"name": key(w), "color": vec(w.color), "use_nodes": w.use_nodes,
+                    "node_tree": node_tree_entry(w.node_tree, f"worlds[{q(key(w))}].node_tree") if w.node_tree else None,
+                    "properties": rna_value(w, 0, f"worlds[{q(key(w))}]", skip={"node_tree", "animation_data"})}
                    for w in data.worlds],
-        "node_groups": [node_tree_entry(g, f"node_groups[{q(g.name)}]") for g in data.node_groups],
-        "cameras": [{"name": c.name, "properties": rna_value(c, 0, f"cameras[{q(c.name)}]", skip={"animation_data"})}
+        "node_groups": [node_tree_entry(g, f"node_groups[{q(key(g))}]") for g in data.node_groups],
+        "cameras": [{"name": key(c), "properties": rna_value(c, 0, f"cameras[{q(key(c))}]", skip={"animation_data"})}
                     for c in data.cameras],
-        "lights": [{"name": l.name, "type": l.type,
-                    "node_tree": node_tree_entry(l.node_tree, f"lights[{q(l.name)}].node_tree") if l.node_tree else None,
-                    "properties": rna_value(l, 0, f"lights[{q(l.name)}]", skip={"node_tree", "animation_data"})}
+        "lights": [{"name": key(l), "type": l.type,
+                    "node_tree": node_tree_entry(l.node_tree, f"lights[{q(key(l))}].node_tree") if l.node_tree else None,
+                    "properties": rna_value(l, 0, f"lights[{q(key(l))}]", skip={"node_tree", "animation_data"})}
                    for l in data.lights],
         "images": images,
         "animation": animation(data),
         "evaluated": evaluated,
         "color_management": cm,
     }
+    if args.frames is not None and not args.no_evaluated:
+        # Last: frame_set flushes each frame's animated values into the data read above.
+        with RenderSettings():
+            doc["evaluated"] += evaluated_frames(evaluated, by_key, index, out, args.frames)
     nan_warnings = []
     doc = sanitize(doc, "", nan_warnings)
     doc["warnings"] = WARNINGS + nan_warnings

@@ -290,6 +290,7 @@ pub fn convert(
     let opts = crate::blender::ConvertOptions {
         blender,
         frame,
+        frames: None,
         no_evaluated,
         allow_paths,
     };

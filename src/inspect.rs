@@ -1,7 +1,10 @@
 //! `blendsynth inspect`: a readable account of an exported scene, of which node types
 //! blendsynth can evaluate, and the result of every check `render` and `mesh` make at
 //! the frame (the same code: `render::check`, `geometry::evaluate_object`), so exit 0
-//! means both succeed.
+//! means both succeed. Its verdict is those checks only: a node type blendsynth does not
+//! evaluate, in a tree or material nothing renders (an add-on's trees, an unused
+//! material, a Geometry Nodes group whose object renders Blender's evaluated mesh), is
+//! listed but refuses nothing, as in `render`.
 
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -36,8 +39,9 @@ pub struct Report {
     pub render_error: Option<String>,
     /// Per object with geometry, `mesh`'s error at the frame.
     pub mesh_errors: Vec<ObjectError>,
-    /// True when every node type used is supported or structural, every material
-    /// compiles, and `render` and `mesh` would succeed at the frame.
+    /// True when `render` and `mesh` would succeed at the frame: `render_error` is None
+    /// and `mesh_errors` is empty (`inspect` exits 0). Unsupported node types and
+    /// materials that do not compile count only where the render uses them.
     pub all_supported: bool,
     pub warnings: Vec<String>,
 }
@@ -194,7 +198,7 @@ pub fn report_at(scene: &Scene, frame: Option<f64>) -> Report {
             kind: o.kind.clone(),
             data: o.data.clone(),
             parent: o.parent.clone(),
-            renders: !o.hide_render,
+            renders: !o.hide_render && o.in_render_layer,
             materials: o
                 .material_slots
                 .iter()
@@ -325,10 +329,9 @@ pub fn report_at(scene: &Scene, frame: Option<f64>) -> Report {
     let render_error = crate::render::check(scene, &opts, &[])
         .err()
         .map(|e| e.to_string());
-    let all_supported = coverage.iter().all(|r| r.support != Support::Unsupported)
-        && material_status.iter().all(|m| m.error.is_none())
-        && render_error.is_none()
-        && mesh_errors.is_empty();
+    // The render's verdict and mesh's, nothing else: the coverage table and material
+    // list also show what nothing renders, which refuses nothing.
+    let all_supported = render_error.is_none() && mesh_errors.is_empty();
 
     Report {
         source_file: f.source_file.clone(),
@@ -499,7 +502,7 @@ impl Report {
                 write!(o, " parent {p:?}")?;
             }
             if !ob.renders {
-                write!(o, " (hidden in render)")?;
+                write!(o, " (not rendered: hidden in render or not in a collection the view layer renders)")?;
             }
             writeln!(o)?;
             let mats: Vec<String> = ob.materials.iter().map(opt).collect();
@@ -605,7 +608,7 @@ impl Report {
             .count();
         writeln!(
             o,
-            "\nNode coverage: {} node types used, {} unsupported",
+            "\nNode coverage: {} node types used, {} unsupported (refusing the render only where it uses them: see the checks at the end)",
             self.coverage.len(),
             unsupported
         )?;
@@ -631,11 +634,14 @@ impl Report {
             )?;
         }
         if !self.material_status.is_empty() {
-            writeln!(o, "\nMaterials for the renderer")?;
+            writeln!(
+                o,
+                "\nMaterials for the renderer (one that does not compile refuses the render only if something that renders uses it)"
+            )?;
             for m in &self.material_status {
                 match &m.error {
                     None => writeln!(o, "  {:?}: compiles", m.name)?,
-                    Some(e) => writeln!(o, "  {:?}: NOT YET: {e}", m.name)?,
+                    Some(e) => writeln!(o, "  {:?}: does not compile: {e}", m.name)?,
                 }
             }
         }

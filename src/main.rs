@@ -1,8 +1,7 @@
 //! The `blendsynth` command line: parses arguments and calls the library.
 //!
 //! Exit codes: 0 success, 1 failure (one line naming what was wrong), 2 bad usage,
-//! 3 `inspect` found something `render` or `mesh` would refuse, or node types
-//! blendsynth does not support yet.
+//! 3 `inspect` found something `render` or `mesh` would refuse.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -46,8 +45,13 @@ enum Command {
         #[arg(long)]
         blender: Option<PathBuf>,
         /// Frame at which to write the evaluated reference meshes (default: the file's current frame).
-        #[arg(long, allow_negative_numbers = true)]
+        #[arg(long, allow_negative_numbers = true, conflicts_with = "frames")]
         frame: Option<i32>,
+        /// Evaluate at frame A, and also write Blender's evaluated meshes of objects whose
+        /// evaluation is animated (shape keys, armatures, simulations, ...) at every frame
+        /// A+1..B, so `render --frame F` and `generate` work on them for F in A..B.
+        #[arg(long, value_name = "A..B", value_parser = parse_frame_range, allow_hyphen_values = true)]
+        frames: Option<(i32, i32)>,
         /// Do not write evaluated reference meshes.
         #[arg(long)]
         no_evaluated: bool,
@@ -495,6 +499,24 @@ enum Outcome {
     Unsupported,
 }
 
+/// `A..B` for `convert --frames`: inclusive, A <= B, at most 10000 frames (the exporter's
+/// limit).
+fn parse_frame_range(s: &str) -> Result<(i32, i32), String> {
+    let (a, b) = s
+        .split_once("..")
+        .ok_or_else(|| format!("{s:?} is not a frame range A..B"))?;
+    let p = |x: &str| {
+        x.trim()
+            .parse::<i32>()
+            .map_err(|_| format!("{s:?}: {x:?} is not a whole frame number"))
+    };
+    let (a, b) = (p(a)?, p(b)?);
+    if b < a || (b as i64 - a as i64) >= 10000 {
+        return Err(format!("{s:?}: need A <= B and at most 10000 frames"));
+    }
+    Ok((a, b))
+}
+
 // Long because one arm per subcommand; each only maps arguments to library calls.
 fn run(cli: Cli) -> Result<Outcome> {
     match cli.command {
@@ -503,12 +525,14 @@ fn run(cli: Cli) -> Result<Outcome> {
             output,
             blender,
             frame,
+            frames,
             no_evaluated,
             allow_path,
         } => {
             let opts = blender::ConvertOptions {
                 blender,
                 frame,
+                frames,
                 no_evaluated,
                 allow_paths: allow_path,
             };

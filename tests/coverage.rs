@@ -347,6 +347,8 @@ fn files_with_add_on_nodes_convert_and_name_them() {
     let o = run(&["inspect", export.to_str().unwrap()], &[]);
     assert!(stdout(&o).contains("NodeUndefined"), "{}", stdout(&o));
     assert!(stdout(&o).contains("render: ok"), "{}", stdout(&o));
+    // The add-on's tree renders nothing: it refuses nothing.
+    assert_eq!(o.status.code(), Some(0), "{}", stdout(&o));
     render(&scene, &small(None)).unwrap();
 }
 
@@ -383,5 +385,259 @@ fn constraints_on_other_cameras_do_not_block_the_render() {
     assert!(
         e.contains("\"Camera\"") && e.contains("LIMIT_DISTANCE"),
         "{e}"
+    );
+}
+
+/// Blender-side: data linked from a library under the names of the scene's own data
+/// (`fixtures/coverage/make_linked_scene.py`, as in BlendLuxCore's full-export file)
+/// converts with each linked ID named by Blender's `name_full` ("Cube [lib.blend]"), and
+/// the local cube, the linked cube and the instanced library collection all render.
+#[test]
+fn linked_data_sharing_local_names_converts_and_renders() {
+    let Some(py) = require("bpy", bpy_python()) else {
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let export = tmp.path().join("export");
+    run_python(
+        &py,
+        &repo().join("fixtures/coverage/make_linked_scene.py"),
+        &["--", tmp.path().to_str().unwrap()],
+    );
+    let blend = tmp.path().join("linked.blend");
+    let o = run(
+        &[
+            "convert",
+            blend.to_str().unwrap(),
+            "-o",
+            export.to_str().unwrap(),
+        ],
+        &[("BLENDSYNTH_BPY_PYTHON", py.to_str().unwrap())],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let scene = Scene::load(&export).unwrap();
+    let names: Vec<&str> = scene.file.objects.iter().map(|o| o.name.as_str()).collect();
+    for n in [
+        "Cube",
+        "Cube [lib.blend]",
+        "Ball [lib.blend]",
+        "Group instance",
+    ] {
+        assert!(names.contains(&n), "{n} in {names:?}");
+    }
+    let linked = scene.object("Cube [lib.blend]").unwrap();
+    assert_eq!(linked.data.as_deref(), Some("Cube [lib.blend]"));
+    assert_eq!(
+        linked.material_slots[0].material.as_deref(),
+        Some("Cube [lib.blend]")
+    );
+    let o = run(&["inspect", export.to_str().unwrap()], &[]);
+    assert!(o.status.success(), "{}", stdout(&o));
+    let opts = RenderOptions {
+        resolution: Some((32, 32)),
+        ..small(None)
+    };
+    let out = render(&scene, &opts).unwrap();
+    let seen: std::collections::BTreeSet<&str> = out
+        .passes
+        .object_index
+        .iter()
+        .filter(|&&i| i > 0)
+        .map(|&i| scene.file.objects[i as usize - 1].name.as_str())
+        .collect();
+    let want: std::collections::BTreeSet<&str> = ["Cube", "Cube [lib.blend]", "Group instance"]
+        .into_iter()
+        .collect();
+    assert_eq!(seen, want);
+}
+
+/// Blender-side: `convert --frames 1..3` writes Blender's evaluated mesh of an object
+/// with an animated shape key at every frame (`fixtures/coverage/make_frames_scene.py`);
+/// `mesh` and `render` use the one at the frame (the key at 0.5 on frame 2 lifts the
+/// vertex half way), and a frame outside the range is an error naming the animated path,
+/// as every frame but the first is without `--frames`.
+#[test]
+fn convert_frames_exports_animated_frozen_meshes_per_frame() {
+    let Some(py) = require("bpy", bpy_python()) else {
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let blend = tmp.path().join("frames.blend");
+    run_python(
+        &py,
+        &repo().join("fixtures/coverage/make_frames_scene.py"),
+        &["--", blend.to_str().unwrap()],
+    );
+    let env = [("BLENDSYNTH_BPY_PYTHON", py.to_str().unwrap())];
+    let convert = |extra: &[&str], out: &std::path::Path| {
+        let mut args = vec![
+            "convert",
+            blend.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = run(&args, &env);
+        assert!(o.status.success(), "{}", stderr(&o));
+        Scene::load(out).unwrap()
+    };
+    let lifted = |scene: &Scene, frame: f64| -> Result<f32, String> {
+        let set = blendsynth::geometry::evaluate_object(scene, "Sheet", frame, &[])
+            .map_err(|e| e.to_string())?;
+        let m = blendsynth::geometry::realize_to_mesh(&set).map_err(|e| e.to_string())?;
+        Ok(m.positions[2][2])
+    };
+    let ranged = convert(&["--frames", "1..3"], &tmp.path().join("ranged"));
+    let frames: Vec<f64> = ranged
+        .file
+        .evaluated
+        .iter()
+        .filter(|e| e.object == "Sheet")
+        .map(|e| e.frame)
+        .collect();
+    assert_eq!(frames, [1.0, 2.0, 3.0]);
+    for (frame, z) in [(1.0, 0.0), (2.0, 0.5), (3.0, 1.0)] {
+        let got = lifted(&ranged, frame).unwrap();
+        assert!((got - z).abs() < 1e-6, "frame {frame}: z {got}, want {z}");
+        render(&ranged, &small(Some(frame))).unwrap();
+    }
+    let e = lifted(&ranged, 4.0).unwrap_err();
+    assert!(e.contains("key_blocks") && e.contains("--frames"), "{e}");
+
+    let single = convert(&[], &tmp.path().join("single"));
+    assert!(lifted(&single, 1.0).is_ok());
+    let e = render(&single, &small(Some(2.0))).unwrap_err().to_string();
+    assert!(e.contains("\"Sheet\"") && e.contains("key_blocks"), "{e}");
+    let o = run(
+        &["inspect", single.dir.to_str().unwrap(), "--frame", "2"],
+        &[],
+    );
+    assert_eq!(o.status.code(), Some(3), "{}", stdout(&o));
+}
+
+/// `inspect`'s verdict is the render's, both ways (issue 26): a material with an add-on
+/// node that nothing renders is listed (the node as unsupported, the material as not
+/// compiling) and refuses nothing, so inspect exits 0 and the frame renders; once an
+/// object that renders uses it, inspect refuses it with the render's own words.
+#[test]
+fn inspect_refuses_exactly_what_render_refuses() {
+    use serde_json::{json, Value};
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("scene");
+    copy_dir(&repo().join("fixtures/scenes/animated_camera"), &dir);
+    let p = dir.join("scene.json");
+    let mut v: Value = serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
+    let node = json!({"name": "Lux Matte", "bl_idname": "NodeUndefined",
+        "inputs": [], "outputs": [{"index": 0, "identifier": "Material", "name": "Material",
+        "type": "CUSTOM", "bl_idname": "NodeSocketUndefined"}]});
+    v["materials"] = json!([{"name": "Add-on", "use_nodes": true,
+        "node_tree": {"name": "Shader Nodetree", "bl_idname": "ShaderNodeTree",
+                      "nodes": [node], "links": []}}]);
+    std::fs::write(&p, serde_json::to_vec(&v).unwrap()).unwrap();
+    let scene = Scene::load(&dir).unwrap();
+    let report = blendsynth::inspect::report(&scene);
+    assert!(report
+        .coverage
+        .iter()
+        .any(|r| r.bl_idname == "NodeUndefined"
+            && r.support == blendsynth::nodes::Support::Unsupported));
+    assert!(report.material_status[0].error.is_some());
+    assert!(report.all_supported, "{}", report.to_text());
+    render(&scene, &small(None)).expect("an unused material refuses nothing");
+
+    let subject = v["objects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|o| o["name"] == "Subject")
+        .unwrap();
+    v["objects"][subject]["material_slots"] = json!([{"material": "Add-on", "link": "OBJECT"}]);
+    std::fs::write(&p, serde_json::to_vec(&v).unwrap()).unwrap();
+    let scene = Scene::load(&dir).unwrap();
+    let e = render(&scene, &small(None)).unwrap_err().to_string();
+    let report = blendsynth::inspect::report(&scene);
+    assert!(!report.all_supported);
+    assert_eq!(report.render_error.as_deref(), Some(e.as_str()));
+}
+
+/// A BSDF wired to a light's output emits nothing in Cycles (the shader's emission
+/// estimate is zero, so the light is left out): the frame renders as without the light,
+/// where it was refused (godot-blender-exporter's cycles_lights file).
+#[test]
+fn a_light_whose_tree_ends_in_a_bsdf_is_left_out() {
+    use serde_json::{json, Value};
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path().join("scene");
+    copy_dir(&repo().join("fixtures/scenes/animated_camera"), &dir);
+    let p = dir.join("scene.json");
+    let mut v: Value = serde_json::from_slice(&std::fs::read(&p).unwrap()).unwrap();
+    let key = v["lights"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .position(|l| l["name"] == "Key")
+        .unwrap();
+    let sock = |i: usize, id: &str, kind: &str| {
+        json!({"index": i, "identifier": id,
+        "name": id, "type": kind, "bl_idname": "NodeSocketShader"})
+    };
+    v["lights"][key]["properties"]["use_nodes"] = json!(true);
+    v["lights"][key]["node_tree"] = json!({"name": "Shader Nodetree",
+        "bl_idname": "ShaderNodeTree",
+        "nodes": [
+            {"name": "Diffuse BSDF", "bl_idname": "ShaderNodeBsdfDiffuse",
+             "inputs": [], "outputs": [sock(0, "BSDF", "SHADER")]},
+            {"name": "Light Output", "bl_idname": "ShaderNodeOutputLight",
+             "properties": {"is_active_output": true, "target": "ALL"},
+             "inputs": [sock(0, "Surface", "SHADER")], "outputs": []}],
+        "links": [{"from_node": "Diffuse BSDF", "from_socket": "BSDF", "from_index": 0,
+                   "to_node": "Light Output", "to_socket": "Surface", "to_index": 0}]});
+    std::fs::write(&p, serde_json::to_vec(&v).unwrap()).unwrap();
+    let scene = Scene::load(&dir).unwrap();
+    let with_bsdf = render(&scene, &small(None)).expect("a BSDF light renders black");
+    v["lights"][key]["node_tree"] = Value::Null;
+    v["lights"][key]["properties"]["energy"] = json!(0.0);
+    std::fs::write(&p, serde_json::to_vec(&v).unwrap()).unwrap();
+    let scene = Scene::load(&dir).unwrap();
+    let dark = render(&scene, &small(None)).unwrap();
+    assert_eq!(with_bsdf.color, dark.color);
+}
+
+/// Blender-side: frozen meshes are Blender's evaluation with the render settings Cycles
+/// uses, not the viewport's (`fixtures/coverage/make_render_levels_scene.py`: Subdivision
+/// Surface at level 0 in the viewport, 2 in renders, under a Triangulate modifier): the
+/// cube at level 2 has 98 vertices and 96 quads, 192 triangles. The exported modifier
+/// keeps the file's viewport level.
+#[test]
+fn frozen_meshes_use_render_levels() {
+    let Some(py) = require("bpy", bpy_python()) else {
+        return;
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let blend = tmp.path().join("levels.blend");
+    let export = tmp.path().join("export");
+    run_python(
+        &py,
+        &repo().join("fixtures/coverage/make_render_levels_scene.py"),
+        &["--", blend.to_str().unwrap()],
+    );
+    let o = run(
+        &[
+            "convert",
+            blend.to_str().unwrap(),
+            "-o",
+            export.to_str().unwrap(),
+        ],
+        &[("BLENDSYNTH_BPY_PYTHON", py.to_str().unwrap())],
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let scene = Scene::load(&export).unwrap();
+    let set = blendsynth::geometry::evaluate_object(&scene, "Cube", 1.0, &[]).unwrap();
+    let m = blendsynth::geometry::realize_to_mesh(&set).unwrap();
+    assert_eq!((m.vertex_count(), m.face_count()), (98, 192));
+    let sub = &scene.object("Cube").unwrap().modifiers[0];
+    assert_eq!(
+        sub.properties.get("levels").and_then(|v| v.as_i64()),
+        Some(0)
     );
 }

@@ -115,6 +115,9 @@ pub struct ConvertOptions {
     pub blender: Option<PathBuf>,
     /// Frame to evaluate the reference meshes at (default: the file's current frame).
     pub frame: Option<i32>,
+    /// `--frames A..B`: evaluate at frame A and also write the evaluated meshes of
+    /// objects whose evaluation is animated at every frame A+1..B (excludes `frame`).
+    pub frames: Option<(i32, i32)>,
     /// Skip writing evaluated reference meshes.
     pub no_evaluated: bool,
     /// Folders outside the .blend's own whose files (images) may be copied into the
@@ -189,6 +192,7 @@ pub fn convert_listing(
     let input_abs = std::fs::canonicalize(input)
         .with_context(|| format!("cannot resolve {}", input.display()))?;
     let frame_s = opts.frame.map(|f| f.to_string());
+    let frames_s = opts.frames.map(|(a, b)| format!("{a}..{b}"));
     let mut args: Vec<&std::ffi::OsStr> = vec![
         "--in".as_ref(),
         input_abs.as_os_str(),
@@ -197,6 +201,10 @@ pub fn convert_listing(
     ];
     if let Some(f) = &frame_s {
         args.push("--frame".as_ref());
+        args.push(f.as_ref());
+    }
+    if let Some(f) = &frames_s {
+        args.push("--frames".as_ref());
         args.push(f.as_ref());
     }
     if opts.no_evaluated {

@@ -224,12 +224,20 @@ fn frozen(
     reason: &str,
 ) -> Result<usize, GeometryError> {
     let here = format!("object {:?} ({reason})", o.name);
-    let Some((i, e)) = scene
-        .file
-        .evaluated
-        .iter()
-        .enumerate()
-        .find(|(_, e)| e.object == o.name && e.reads.is_some())
+    // `convert --frames A..B` writes one entry per frame for objects whose evaluation is
+    // animated: the one at the frame, else the first (valid at any frame when nothing it
+    // reads is animated).
+    let entries = || {
+        scene
+            .file
+            .evaluated
+            .iter()
+            .enumerate()
+            .filter(|(_, e)| e.object == o.name && e.reads.is_some())
+    };
+    let Some((i, e)) = entries()
+        .find(|(_, e)| (e.frame - frame).abs() <= 1e-6)
+        .or_else(|| entries().next())
     else {
         return Err(GeometryError::new(format!(
             "{here}: blendsynth does not evaluate this and the export has no frozen mesh of it (convert the .blend again with this version)"
@@ -264,7 +272,7 @@ pub fn check_frozen(
     if (frame - e.frame).abs() > 1e-6 {
         if let Some(p) = e.animated.first() {
             return Err(format!(
-                "its geometry is frozen (Blender's evaluated mesh at frame {}) and reads animated {p}; frame {frame} would need Blender to evaluate it again (convert with --frame {frame})",
+                "its geometry is frozen (Blender's evaluated mesh at frame {}) and reads animated {p}; frame {frame} would need Blender to evaluate it again (convert with --frame {frame}, or --frames A..B over the frames to render)",
                 e.frame
             ));
         }

@@ -127,10 +127,11 @@ impl<'a> MeshInfo<'a> {
     }
 }
 
-/// Whether Blender renders the object itself: not hidden in render, seen by some ray,
-/// and not the child of a vertex or face instancer (Blender renders only its instances).
+/// Whether Blender renders the object itself: in a collection the view layer renders,
+/// not hidden in render, seen by some ray, and not the child of a vertex or face
+/// instancer (Blender renders only its instances).
 pub fn renders_itself(eval: &EvaluatedScene, obj: &crate::scene::Object) -> bool {
-    if obj.hide_render || object_visibility(obj) == 0 {
+    if !obj.in_render_layer || obj.hide_render || object_visibility(obj) == 0 {
         return false;
     }
     let instanced_by_parent = obj.parent.as_deref().is_some_and(|p| {

@@ -129,6 +129,22 @@ pub struct LightHit {
     pub pdf: f32,
 }
 
+/// Shader nodes whose closures never emit, whatever their inputs.
+const NON_EMITTING_CLOSURES: &[&str] = &[
+    "ShaderNodeBsdfDiffuse",
+    "ShaderNodeBsdfGlossy",
+    "ShaderNodeBsdfAnisotropic",
+    "ShaderNodeBsdfGlass",
+    "ShaderNodeBsdfRefraction",
+    "ShaderNodeBsdfTranslucent",
+    "ShaderNodeBsdfTransparent",
+    "ShaderNodeBsdfSheen",
+    "ShaderNodeBsdfToon",
+    "ShaderNodeBsdfHair",
+    "ShaderNodeBsdfHairPrincipled",
+    "ShaderNodeSubsurfaceScattering",
+];
+
 /// The factor a light's node tree puts on its colour and power: Cycles multiplies the
 /// light's strength by the emission its shader evaluates to. Only a tree that reduces to a
 /// constant (an Emission node with unlinked inputs into the active Light Output) is
@@ -165,6 +181,11 @@ fn node_factor(l: &crate::scene::format::Light) -> Result<V3, RenderError> {
     if node.bl_idname == "ShaderNodeEmission" && node.mute {
         return Ok([0.0; 3]);
     }
+    // A closure that cannot emit (a BSDF wired to the Light Output): Cycles' estimate of
+    // the shader's emission is zero, so the light has no contribution and is left out.
+    if NON_EMITTING_CLOSURES.contains(&node.bl_idname.as_str()) {
+        return Ok([0.0; 3]);
+    }
     if node.bl_idname != "ShaderNodeEmission" {
         return Err(RenderError(format!("light {name:?}: node {:?} ({}) feeding the Light Output is not supported yet (only a constant Emission)", node.name, node.bl_idname)));
     }
@@ -191,7 +212,7 @@ fn node_factor(l: &crate::scene::format::Light) -> Result<V3, RenderError> {
 pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
     let mut out = Vec::new();
     for (oi, obj) in eval.data.objects.iter().enumerate() {
-        if obj.kind != "LIGHT" || obj.hide_render {
+        if obj.kind != "LIGHT" || obj.hide_render || !obj.in_render_layer {
             continue;
         }
         let Some(data) = obj.data.as_deref() else {

@@ -145,6 +145,11 @@ pub struct Object {
     pub hide_viewport: bool,
     #[serde(default = "yes")]
     pub visible: bool,
+    /// In a view-layer collection that is neither excluded nor disabled in renders (nor
+    /// any collection above it): false for objects in no scene collection, in another
+    /// scene, or only in a library collection an empty instances. True in older exports.
+    #[serde(default = "yes")]
+    pub in_render_layer: bool,
     /// Cycles' ray visibility; absent in exports made before it was written (then
     /// Blender 4.5's defaults apply: everything visible but lights to the camera).
     #[serde(default)]
