@@ -294,9 +294,6 @@ pub fn read_glb(path: &Path) -> Result<MeshData, SceneError> {
     parse_glb(&bytes, path)
 }
 
-/// The accessor references of every mesh primitive are in range. The `gltf` crate's
-/// validation indexes the POSITION accessor before checking it exists (a panic on a
-/// corrupt file, found by tests/fuzz_mutations.rs), so this runs first.
 /// The 12-byte GLB header of the glTF 2.0 specification: magic `glTF`, version, total
 /// length. The gltf crate subtracts the header's size from the length unchecked (an
 /// overflow panic where overflow checks are on: found by `cargo fuzz run glb`), so the
@@ -316,6 +313,9 @@ fn check_glb_header(bytes: &[u8]) -> Result<(), String> {
     Ok(())
 }
 
+/// The accessor references of every mesh primitive are in range. The `gltf` crate's
+/// validation indexes the POSITION accessor before checking it exists (a panic on a
+/// corrupt file, found by tests/fuzz_mutations.rs), so this runs first.
 fn check_primitive_accessors(bytes: &[u8]) -> Result<(), String> {
     // A file this cannot read is left to the full reader, for its error message.
     let Ok(glb) = gltf::Glb::from_slice(bytes) else {
