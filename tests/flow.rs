@@ -6,6 +6,9 @@
 //! raster space (y up), xy = raster(previous) - raster(now) and zw = raster(now) -
 //! raster(next): with y down, backward flow is (X, -Y) and forward flow (-Z, W).
 
+mod common;
+use common::exr_channels;
+
 use blendsynth::render::{flow::Motion, render_with_motion, RenderOptions, RenderOutput};
 use blendsynth::scene::Scene;
 
@@ -13,31 +16,6 @@ fn fixture(p: &str) -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("fixtures/ground_truth/flow")
         .join(p)
-}
-
-fn exr_channels(
-    path: &std::path::Path,
-) -> (usize, usize, std::collections::HashMap<String, Vec<f32>>) {
-    use exr::prelude::*;
-    let img = read_all_flat_layers_from_file(path).unwrap();
-    let mut channels = std::collections::HashMap::new();
-    let mut size = (0, 0);
-    for layer in &img.layer_data {
-        size = (layer.size.width(), layer.size.height());
-        let prefix = layer
-            .attributes
-            .layer_name
-            .as_ref()
-            .map(|n| format!("{n}."))
-            .unwrap_or_default();
-        for ch in &layer.channel_data.list {
-            channels.insert(
-                format!("{prefix}{}", ch.name),
-                ch.sample_data.values_as_f32().collect(),
-            );
-        }
-    }
-    (size.0, size.1, channels)
 }
 
 fn render(name: &str, w: usize, h: usize) -> (RenderOutput, Motion) {

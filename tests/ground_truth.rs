@@ -3,6 +3,7 @@
 //! projection, depth against Cycles' Z pass.
 
 mod common;
+use common::exr_channels;
 
 use blendsynth::scene::{Override, Scene};
 use serde_json::Value;
@@ -89,32 +90,6 @@ fn k_and_opencv_pose_reproject_blenders_pixels() {
         }
     }
     eprintln!("worst reprojection difference {worst:.2e} px");
-}
-
-/// The named channels of a multilayer EXR (top row first).
-fn exr_channels(
-    path: &std::path::Path,
-) -> (usize, usize, std::collections::HashMap<String, Vec<f32>>) {
-    use exr::prelude::*;
-    let img = read_all_flat_layers_from_file(path).unwrap();
-    let mut channels = std::collections::HashMap::new();
-    let mut size = (0, 0);
-    for layer in &img.layer_data {
-        size = (layer.size.width(), layer.size.height());
-        let prefix = layer
-            .attributes
-            .layer_name
-            .as_ref()
-            .map(|n| format!("{n}."))
-            .unwrap_or_default();
-        for ch in &layer.channel_data.list {
-            channels.insert(
-                format!("{prefix}{}", ch.name),
-                ch.sample_data.values_as_f32().collect(),
-            );
-        }
-    }
-    (size.0, size.1, channels)
 }
 
 /// blendsynth's label passes of the fixture at its frame and resolution.

@@ -241,3 +241,29 @@ pub fn assert_same_tree(a: &Path, b: &Path) {
         );
     }
 }
+
+/// The named channels of a multilayer EXR (`layer.channel`, top row first) and its size.
+pub fn exr_channels(
+    path: &std::path::Path,
+) -> (usize, usize, std::collections::HashMap<String, Vec<f32>>) {
+    use exr::prelude::*;
+    let img = read_all_flat_layers_from_file(path).unwrap();
+    let mut channels = std::collections::HashMap::new();
+    let mut size = (0, 0);
+    for layer in &img.layer_data {
+        size = (layer.size.width(), layer.size.height());
+        let prefix = layer
+            .attributes
+            .layer_name
+            .as_ref()
+            .map(|n| format!("{n}."))
+            .unwrap_or_default();
+        for ch in &layer.channel_data.list {
+            channels.insert(
+                format!("{prefix}{}", ch.name),
+                ch.sample_data.values_as_f32().collect(),
+            );
+        }
+    }
+    (size.0, size.1, channels)
+}
