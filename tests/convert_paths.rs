@@ -7,22 +7,9 @@
 
 mod common;
 
-use std::path::Path;
-
 use common::*;
 
 const SECRET: &str = "OPENSSH PRIVATE KEY";
-
-fn convert(py: &Path, blend: &Path, out: &Path, extra: &[&str]) -> std::process::Output {
-    let mut args = vec![
-        "convert",
-        blend.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ];
-    args.extend_from_slice(extra);
-    run(&args, &[("BLENDSYNTH_BPY_PYTHON", py.to_str().unwrap())])
-}
 
 #[test]
 fn convert_copies_only_files_inside_the_blends_folder_unless_allowed() {
@@ -45,7 +32,7 @@ fn convert_copies_only_files_inside_the_blends_folder_unless_allowed() {
         ("symlink", "key_link", "//textures/link.png".into()),
     ] {
         let out = root.join(format!("out-{blend}"));
-        let o = convert(&py, &proj.join(format!("{blend}.blend")), &out, &[]);
+        let o = convert_blend(&py, &proj.join(format!("{blend}.blend")), &out, &[]);
         let err = stderr(&o);
         assert_eq!(o.status.code(), Some(1), "{blend}: {err}");
         for want in [
@@ -67,7 +54,7 @@ fn convert_copies_only_files_inside_the_blends_folder_unless_allowed() {
 
     // Inside the folder: copied and listed; a missing file stays missing (magenta).
     let out = root.join("out-inside");
-    let o = convert(&py, &proj.join("inside.blend"), &out, &[]);
+    let o = convert_blend(&py, &proj.join("inside.blend"), &out, &[]);
     assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
     let listed: Vec<String> = stdout(&o)
         .lines()
@@ -85,7 +72,7 @@ fn convert_copies_only_files_inside_the_blends_folder_unless_allowed() {
 
     // Allowed: every file copied and listed, one line each.
     let out = root.join("out-all");
-    let o = convert(
+    let o = convert_blend(
         &py,
         &proj.join("all.blend"),
         &out,
@@ -107,7 +94,7 @@ fn convert_copies_only_files_inside_the_blends_folder_unless_allowed() {
     assert_eq!(copied, 4);
 
     // An --allow-path that is not a folder is an error before Blender runs.
-    let o = convert(
+    let o = convert_blend(
         &py,
         &proj.join("all.blend"),
         &root.join("out-bad"),

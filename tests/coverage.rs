@@ -77,15 +77,7 @@ fn objects_blendsynth_does_not_build_render_frozen_or_are_refused_by_name() {
         &repo().join("fixtures/coverage/make_coverage_scene.py"),
         &["--", blend.to_str().unwrap()],
     );
-    let o = run(
-        &[
-            "convert",
-            blend.to_str().unwrap(),
-            "-o",
-            export.to_str().unwrap(),
-        ],
-        &[("BLENDSYNTH_BPY_PYTHON", py.to_str().unwrap())],
-    );
+    let o = convert_blend(&py, &blend, &export, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let dir = export.to_str().unwrap();
 
@@ -259,15 +251,7 @@ fn bone_parents_follow_blender_while_the_pose_is_known() {
         &repo().join("fixtures/coverage/make_bone_scene.py"),
         &["--", blend.to_str().unwrap(), want.to_str().unwrap()],
     );
-    let o = run(
-        &[
-            "convert",
-            blend.to_str().unwrap(),
-            "-o",
-            export.to_str().unwrap(),
-        ],
-        &[("BLENDSYNTH_BPY_PYTHON", py.to_str().unwrap())],
-    );
+    let o = convert_blend(&py, &blend, &export, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let want: serde_json::Value = serde_json::from_slice(&std::fs::read(&want).unwrap()).unwrap();
     let scene = Scene::load(&export).unwrap();
@@ -319,15 +303,7 @@ fn files_with_add_on_nodes_convert_and_name_them() {
         &repo().join("fixtures/coverage/make_addon_nodes_scene.py"),
         &["--", blend.to_str().unwrap()],
     );
-    let o = run(
-        &[
-            "convert",
-            blend.to_str().unwrap(),
-            "-o",
-            export.to_str().unwrap(),
-        ],
-        &[("BLENDSYNTH_BPY_PYTHON", py.to_str().unwrap())],
-    );
+    let o = convert_blend(&py, &blend, &export, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let scene = Scene::load(&export).unwrap();
     let tree = scene
@@ -405,15 +381,7 @@ fn linked_data_sharing_local_names_converts_and_renders() {
         &["--", tmp.path().to_str().unwrap()],
     );
     let blend = tmp.path().join("linked.blend");
-    let o = run(
-        &[
-            "convert",
-            blend.to_str().unwrap(),
-            "-o",
-            export.to_str().unwrap(),
-        ],
-        &[("BLENDSYNTH_BPY_PYTHON", py.to_str().unwrap())],
-    );
+    let o = convert_blend(&py, &blend, &export, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let scene = Scene::load(&export).unwrap();
     let names: Vec<&str> = scene.file.objects.iter().map(|o| o.name.as_str()).collect();
@@ -468,16 +436,8 @@ fn convert_frames_exports_animated_frozen_meshes_per_frame() {
         &repo().join("fixtures/coverage/make_frames_scene.py"),
         &["--", blend.to_str().unwrap()],
     );
-    let env = [("BLENDSYNTH_BPY_PYTHON", py.to_str().unwrap())];
     let convert = |extra: &[&str], out: &std::path::Path| {
-        let mut args = vec![
-            "convert",
-            blend.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-        ];
-        args.extend_from_slice(extra);
-        let o = run(&args, &env);
+        let o = convert_blend(&py, &blend, out, extra);
         assert!(o.status.success(), "{}", stderr(&o));
         Scene::load(out).unwrap()
     };
@@ -621,15 +581,7 @@ fn frozen_meshes_use_render_levels() {
         &repo().join("fixtures/coverage/make_render_levels_scene.py"),
         &["--", blend.to_str().unwrap()],
     );
-    let o = run(
-        &[
-            "convert",
-            blend.to_str().unwrap(),
-            "-o",
-            export.to_str().unwrap(),
-        ],
-        &[("BLENDSYNTH_BPY_PYTHON", py.to_str().unwrap())],
-    );
+    let o = convert_blend(&py, &blend, &export, &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     let scene = Scene::load(&export).unwrap();
     let set = blendsynth::geometry::evaluate_object(&scene, "Cube", 1.0, &[]).unwrap();

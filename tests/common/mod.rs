@@ -267,3 +267,15 @@ pub fn exr_channels(
     }
     (size.0, size.1, channels)
 }
+
+/// `blendsynth convert BLEND -o OUT EXTRA...` with the given bpy Python.
+pub fn convert_blend(py: &Path, blend: &Path, out: &Path, extra: &[&str]) -> Output {
+    let mut args = vec![
+        "convert",
+        blend.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    run(&args, &[("BLENDSYNTH_BPY_PYTHON", py.to_str().unwrap())])
+}
