@@ -481,5 +481,13 @@ fn metallic_modes_not_evaluated_are_refused_by_name() {
         );
         assert_clean_error(&o, 1, &["Metallic BSDF", "is not supported yet"]);
         assert!(!out.exists(), "no half-written output");
+        // inspect says so first, with the same words.
+        let o = run(&["inspect", dir.to_str().unwrap()], &[]);
+        assert_eq!(o.status.code(), Some(3), "{}", stdout(&o));
+        assert!(
+            stdout(&o).contains("Metallic BSDF") && stdout(&o).contains("is not supported yet"),
+            "{}",
+            stdout(&o)
+        );
     }
 }
