@@ -2,11 +2,11 @@
 //! evaluation (same value and pdf), and the energy-preserving closures keep a white
 //! furnace white (Cycles' Multiscatter GGX glass and its Oren-Nayar both promise this).
 
+use blendsynth::render::bsdf::microfacet::{glass_closure, Dielectric, Distribution};
+use blendsynth::render::bsdf::oren_nayar::OrenNayar;
+use blendsynth::render::bsdf::tables::Tables;
 use blendsynth::render::math::{basis, dot, normalize};
-use blendsynth::render::microfacet::{glass_closure, Dielectric, Distribution};
-use blendsynth::render::oren_nayar::OrenNayar;
 use blendsynth::render::sampler::PixelSampler;
-use blendsynth::render::tables::Tables;
 
 fn view(mu: f32) -> [f32; 3] {
     [(1.0 - mu * mu).sqrt(), 0.0, mu]
@@ -192,7 +192,7 @@ fn ggx_albedo_tables_match_cycles() {
     }
 }
 
-/// Our integrated glass albedo tables (render/tables.rs) against Cycles' own: light
+/// Our integrated glass albedo tables (render/bsdf/tables.rs) against Cycles' own: light
 /// entering glass (ggx_glass_E) and leaving it (ggx_glass_inv_E), at each grid point of
 /// the slices kept.
 #[test]

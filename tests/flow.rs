@@ -9,7 +9,7 @@
 mod common;
 use common::exr_channels;
 
-use blendsynth::render::{flow::Motion, render_with_motion, RenderOptions, RenderOutput};
+use blendsynth::render::{film::flow::Motion, render_with_motion, RenderOptions, RenderOutput};
 use blendsynth::scene::Scene;
 
 fn fixture(p: &str) -> std::path::PathBuf {
@@ -288,7 +288,7 @@ fn occlusion_matches_blenders_object_index_at_the_other_frames() {
 /// The Middlebury file: header, then (u, v) pairs, 1e10 for unknown flow.
 #[test]
 fn flo_file_layout() {
-    let b = blendsynth::render::flow::flo_bytes(2, 1, &[[1.5, -2.0], [f32::NAN, f32::NAN]]);
+    let b = blendsynth::render::film::flow::flo_bytes(2, 1, &[[1.5, -2.0], [f32::NAN, f32::NAN]]);
     assert_eq!(&b[..4], b"PIEH");
     assert_eq!(u32::from_le_bytes(b[4..8].try_into().unwrap()), 2);
     assert_eq!(u32::from_le_bytes(b[8..12].try_into().unwrap()), 1);

@@ -36,7 +36,7 @@ fn shared_maths_counts_only_where_an_evaluator_runs_it() {
     assert_eq!(row(&r, "ShaderNodeBsdfPrincipled")["support"], "supported");
     assert_eq!(row(&r, "ShaderNodeMath")["support"], "supported");
     assert_eq!(row(&r, "ShaderNodeCombineXYZ")["support"], "supported");
-    // World surfaces compile since the world shader (render/world.rs, tests/world.rs).
+    // World surfaces compile since the world shader (render/light/world.rs, tests/world.rs).
     assert_eq!(row(&r, "ShaderNodeOutputWorld")["support"], "supported");
     // In a Geometry Nodes tree only what the geometry evaluator implements counts.
     use blendsynth::geometry::support_in;

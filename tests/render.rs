@@ -54,11 +54,11 @@ const ASSERTED: &[&str] = &[
     // Anisotropic GGX: Glossy BSDF (default radial tangent), Principled (linked tangent).
     "anisotropic",
     "principled_aniso",
-    // Metallic BSDF (render/metallic.rs), F82 Tint: Multiscatter GGX and anisotropic GGX.
+    // Metallic BSDF (render/bsdf/metallic.rs), F82 Tint: Multiscatter GGX and anisotropic GGX.
     "metallic_bsdf",
-    // Toon BSDF (render/toon.rs): Diffuse and Glossy components.
+    // Toon BSDF (render/bsdf/toon.rs): Diffuse and Glossy components.
     "toon",
-    // Subsurface Scattering node, Burley method: disk projection (render/subsurface_disk.rs).
+    // Subsurface Scattering node, Burley method: disk projection (render/subsurface/disk.rs).
     "sss_node",
     // The colon's material in small: Principled Burley under a strong bump in a Mix with a
     // sharp Glossy (bump map correction, bumped BSSRDF exit normal, bump shadowing term).
@@ -117,7 +117,7 @@ const ASSERTED: &[&str] = &[
     // near its light, where the default indirect clamp (10) cut 3% of the red.
     "clamp",
     "sss_burley_tube",
-    // Principled thin film (render/thin_film.rs): over the dielectric specular layer, and over
+    // Principled thin film (render/bsdf/thin_film.rs): over the dielectric specular layer, and over
     // the transmission (glass).
     "thin_film",
     "thin_film_glass",
@@ -154,7 +154,7 @@ const ASSERTED: &[&str] = &[
     // a sharp Principled specular inside a tube.
     "bump_on_displacement_bump",
     // Several emitters under the default indirect clamp: one light sample per vertex from
-    // the emitter Cycles' light tree picks (render/light_tree.rs), whose probability the
+    // the emitter Cycles' light tree picks (render/light/tree.rs), whose probability the
     // clamp acts through. A closed room with an area, a point, a spot, a spread disk and an
     // emissive panel; the stage under a sky sampled by its map, a sun, a point and a
     // spread disk.
@@ -164,7 +164,7 @@ const ASSERTED: &[&str] = &[
     "many_lights_room_flat",
     // The sky scene with the world's Sampling set to None (not light-sampled).
     "world_sampling_none",
-    // Emissive triangles sampled as Cycles does (render/triangle_light.rs): by solid angle
+    // Emissive triangles sampled as Cycles does (render/light/triangle.rs): by solid angle
     // near a large panel, by area far from it, and only from the side its material's
     // Emission Sampling names (Front here), under a direct clamp of 1 (ratio 1.67 with
     // area sampling from both sides).

@@ -730,7 +730,7 @@ impl FrameContext<'_> {
     /// spec's `[labels]` ask.
     fn write_motion(
         &self,
-        m: &crate::render::flow::Motion,
+        m: &crate::render::film::flow::Motion,
         r: &super::renderer::RenderedFrame,
         split: &str,
         i: u64,
@@ -756,7 +756,7 @@ impl FrameContext<'_> {
                 hook(&p)?;
                 if l.flow_flo {
                     let p = layout::motion_path(self.out, &format!("flow_{dir}"), split, i, "flo");
-                    write_atomic(&p, &crate::render::flow::flo_bytes(w, h, &f.flow))?;
+                    write_atomic(&p, &crate::render::film::flow::flo_bytes(w, h, &f.flow))?;
                     hook(&p)?;
                 }
             }

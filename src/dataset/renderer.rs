@@ -42,7 +42,7 @@ pub trait FrameRenderer: Sync {
         _settings: &RenderSettings,
         _threads: usize,
         _step: f64,
-    ) -> Result<(RenderedFrame, crate::render::flow::Motion), String> {
+    ) -> Result<(RenderedFrame, crate::render::film::flow::Motion), String> {
         Err("this renderer gives no optical flow or occlusion (the spec's [labels] ask for flow or occlusion)".into())
     }
 }
@@ -85,7 +85,7 @@ impl FrameRenderer for PathTracer {
         s: &RenderSettings,
         threads: usize,
         step: f64,
-    ) -> Result<(RenderedFrame, crate::render::flow::Motion), String> {
+    ) -> Result<(RenderedFrame, crate::render::film::flow::Motion), String> {
         let (f, m) = self.frame(scene, frame, seed, s, threads, Some(step))?;
         Ok((f, m.expect("asked for motion")))
     }
@@ -101,7 +101,7 @@ impl PathTracer {
         s: &RenderSettings,
         threads: usize,
         step: Option<f64>,
-    ) -> Result<(RenderedFrame, Option<crate::render::flow::Motion>), String> {
+    ) -> Result<(RenderedFrame, Option<crate::render::film::flow::Motion>), String> {
         let opts = crate::render::RenderOptions {
             frame: Some(frame),
             samples: s.samples,

@@ -9,8 +9,8 @@ use crate::anim::EvaluatedScene;
 use crate::scene::{AttributeData, MeshData, Scene};
 use crate::shader::attributes::BoundAttributes;
 
-use super::math::*;
 use super::RenderError;
+use crate::render::math::*;
 
 /// One renderable mesh instance.
 pub struct MeshInstance {
@@ -32,7 +32,7 @@ pub struct MeshInstance {
     /// Object Info values and the world-to-object transform the shader reads.
     pub info: crate::shader::point::ObjectInfo,
     /// Transforms across the shutter when the object moves within it (`object_motion`).
-    pub motion: Option<Arc<super::object_motion::ObjectMotion>>,
+    pub motion: Option<Arc<crate::render::motion::object::ObjectMotion>>,
     /// Object-space vertex positions before true displacement (`displace`), which
     /// Generated coordinates and the displacement bump read.
     pub undisplaced: Option<Arc<Vec<V3>>>,
@@ -314,7 +314,7 @@ pub fn build(
 pub fn object_visibility(obj: &crate::scene::Object) -> u32 {
     use crate::shader::point::ray;
     let Some(v) = &obj.visibility else {
-        return super::accel::visibility::ALL;
+        return crate::render::accel::visibility::ALL;
     };
     [
         (v.camera, ray::CAMERA),
@@ -492,7 +492,7 @@ fn push_instance(
 /// Call before true displacement, which Cycles also runs after the attributes are made.
 pub fn bind_attributes(
     geo: &mut Geometry,
-    materials: &[super::shade::Material],
+    materials: &[crate::render::integrator::shade::Material],
 ) -> Result<(), RenderError> {
     let mut done: HashMap<(*const MeshData, usize), Arc<BoundAttributes>> = HashMap::new();
     for inst in &mut geo.instances {
@@ -511,7 +511,7 @@ pub fn bind_attributes(
                 per_slot.push(None);
                 continue;
             }
-            if super::shade::displacement_reads_attributes(p) {
+            if crate::render::integrator::shade::displacement_reads_attributes(p) {
                 return Err(RenderError(format!("object {:?}: material {:?} truly displaces by mesh attributes or tangents, which the renderer does not support yet", inst.name, materials[mi].name)));
             }
             let key = (Arc::as_ptr(&inst.mesh), mi);

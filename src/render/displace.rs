@@ -17,9 +17,9 @@ use crate::scene::{AttributeData, MeshData};
 use crate::shader::bump::ObjectTransform;
 use crate::shader::ShadingPoint;
 
-use super::build::{Geometry, MeshInstance};
-use super::math::*;
-use super::shade::Material;
+use crate::render::build::{Geometry, MeshInstance};
+use crate::render::integrator::shade::Material;
+use crate::render::math::*;
 
 /// Displaces every mesh that uses a truly displacing material; returns how many vertices
 /// moved. The caller rebuilds the world triangles afterwards.
@@ -43,7 +43,8 @@ pub fn apply(geo: &mut Geometry, materials: &[Material]) -> usize {
         let (mesh, undisplaced) = done[&key].clone();
         inst.mesh = mesh;
         inst.undisplaced = Some(undisplaced);
-        inst.world_bounds = super::build::world_bounds(&inst.mesh.positions, &inst.to_world);
+        inst.world_bounds =
+            crate::render::build::world_bounds(&inst.mesh.positions, &inst.to_world);
     }
     moved
 }

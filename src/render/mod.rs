@@ -1,10 +1,11 @@
 //! Rendering an exported scene with a Cycles-compatible path tracer.
 //!
-//! One idea per file: `build` (the scene at a frame as triangles and instances),
-//! `accel` (ray queries: trait and BVH), `camera`, `sampler` (Owen-scrambled Sobol),
-//! `filter` (Blackman-Harris importance sampling), `bsdf` (closures), `tables` (GGX
-//! albedo tables), `shade` (materials to closures), `light`, `world`, `integrator`.
-//! The film (tiles, passes, progress) is here.
+//! Laid out as Cycles' kernel is: `bsdf/` (closures), `light/` (lights, the world, the
+//! light tree), `subsurface/`, `camera/`, `motion/`, `integrator/` (the path loop and
+//! `shade`, materials to closures), `film/` (filter, adaptive sampling, denoiser features,
+//! flow). `build` is the scene at a frame as triangles and instances, `accel` the ray
+//! queries, `sampler` the Owen-scrambled Sobol pattern. The film's tiles, passes and
+//! progress are here.
 //!
 //! Determinism: every random number comes from (pixel, sample index, seed), tiles are
 //! independent, and pixels are summed in sample order, so the image has the same bits
@@ -12,44 +13,21 @@
 
 /// The BVH lives in the foundation (Geometry Nodes' Raycast uses it too).
 pub use crate::foundation::bvh as accel;
-pub mod adaptive;
-pub mod anisotropic;
-pub mod area_light;
 pub mod bsdf;
 pub mod build;
-pub mod bump_correction;
 pub mod camera;
 pub mod control;
 pub mod default_surface;
-pub mod denoise_features;
 pub mod displace;
-pub mod filter;
-pub mod flow;
+pub mod film;
 pub mod integrator;
 pub mod light;
-pub mod light_tree;
 pub mod limits;
 pub use crate::foundation::math;
-pub mod metallic;
-pub mod microfacet;
 pub mod motion;
-pub mod object_motion;
-pub mod oren_nayar;
-pub mod panorama;
-pub mod path_state;
 pub mod sampler;
 pub mod scene_mesh;
-pub mod shade;
-pub mod sheen;
-pub mod sheen_ltc;
 pub mod subsurface;
-pub mod subsurface_disk;
-pub mod tables;
-pub mod terminator;
-pub mod thin_film;
-pub mod toon;
-pub mod triangle_light;
-pub mod world;
 
 use std::time::Instant;
 
@@ -59,7 +37,7 @@ use serde_json::Value;
 use crate::scene::{settings, Scene};
 use accel::Accel;
 use integrator::{Scratch, Settings};
-use light_tree::LightSelect;
+use light::tree::LightSelect;
 use math::*;
 use sampler::PixelSampler;
 
@@ -132,7 +110,7 @@ pub struct Passes {
     pub sample_count: Vec<u32>,
     pub instances: Vec<InstanceInfo>,
     /// What each pixel centre's primary ray hit (None: background), for `flow`.
-    pub hits: Vec<Option<flow::PixelHit>>,
+    pub hits: Vec<Option<film::flow::PixelHit>>,
 }
 
 #[derive(Debug, Clone)]
@@ -196,7 +174,7 @@ pub fn render_with_motion(
     overrides: &[(String, Value)],
     control: Option<&control::Control>,
     step: f64,
-) -> Result<(RenderOutput, flow::Motion), RenderError> {
+) -> Result<(RenderOutput, film::flow::Motion), RenderError> {
     if !(step.is_finite() && step != 0.0) {
         return Err(RenderError(format!(
             "optical flow: the frame step is {step}: must be a non-zero number"
@@ -210,26 +188,26 @@ pub fn render_with_motion(
                 .into(),
         ));
     }
-    let here = flow::FrameView {
+    let here = film::flow::FrameView {
         camera: &camera,
         geo: &geo,
     };
-    let to = |f: f64| -> Result<flow::FlowField, RenderError> {
+    let to = |f: f64| -> Result<film::flow::FlowField, RenderError> {
         let at = RenderOptions {
             frame: Some(f),
             ..opts.clone()
         };
         let p = prepare(scene, &at, overrides)
             .map_err(|e| RenderError(format!("optical flow to frame {f}: {e}")))?;
-        let there = flow::FrameView {
+        let there = film::flow::FrameView {
             camera: &p.camera,
             geo: &p.geo,
         };
-        Ok(flow::flow_to(&here, &out.passes.hits, &there, f))
+        Ok(film::flow::flow_to(&here, &out.passes.hits, &there, f))
     };
     let forward = to(frame + step)?;
     let backward = to(frame - step)?;
-    Ok((out, flow::Motion { forward, backward }))
+    Ok((out, film::flow::Motion { forward, backward }))
 }
 
 /// The scene the render at `opts`' frame would trace, as one world-space mesh
@@ -267,19 +245,19 @@ fn render_frame(
         moving,
     } = prepare(scene, opts, overrides)?;
     let integrator = settings::Integrator::of(&scene.file.scene);
-    let tables = tables::Tables::shared();
+    let tables = bsdf::tables::Tables::shared();
     if materials.iter().any(|m| m.multiscatter_glass) {
         tables.warm_glass();
     }
     // With moving objects the static rest goes in a BVH of its own (`object_motion`).
-    let motion_accel = (moving > 0).then(|| object_motion::MotionAccel::build(&geo));
+    let motion_accel = (moving > 0).then(|| motion::object::MotionAccel::build(&geo));
     let backend = accel::Backend::from_env().map_err(RenderError)?;
     let bvh = if motion_accel.is_some() {
         backend.build_masked(&[], &[])
     } else {
         backend.build_masked(&geo.tris, &build::triangle_masks(&geo))
     };
-    let filter = filter::FilterTable::blackman_harris(integrator.filter_width as f32);
+    let filter = film::filter::FilterTable::blackman_harris(integrator.filter_width as f32);
     let i = &integrator;
     let settings = Settings {
         max_bounces: i.max_bounces,
@@ -319,14 +297,14 @@ fn render_frame(
         materials: &materials,
         lights: &lights,
         background,
-        world_exclude: world::excluded_rays(scene),
+        world_exclude: light::world::excluded_rays(scene),
         tables,
         settings,
         world: world_shader.as_ref(),
         view: camera.view(),
     };
 
-    let adaptive = adaptive::Adaptive::from_settings(&integrator, samples, opts.threshold);
+    let adaptive = film::adaptive::Adaptive::from_settings(&integrator, samples, opts.threshold);
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);
     let n_tiles = (tiles_x * tiles_y) as usize;
@@ -350,7 +328,7 @@ fn render_frame(
     }
     let cancelled = || control.is_some_and(|c| c.is_cancelled());
     // Per-pixel accumulators live in image order; tiles read and write disjoint pixels.
-    let mut film = adaptive::Film::new(npix);
+    let mut film = film::adaptive::Film::new(npix);
     let mut tiles: Vec<TileWork> = (0..n_tiles)
         .map(|t| {
             let tx = (t as u32 % tiles_x) * TILE;
@@ -425,7 +403,7 @@ fn render_frame(
                                 let fx = x as f32 + 0.5 + filter.sample(u[0]);
                                 let fy = y as f32 + 0.5 + filter.sample(u[1]);
                                 scratch.time =
-                                    shutter.as_ref().map_or(object_motion::CENTRE_TIME, |sh| {
+                                    shutter.as_ref().map_or(motion::object::CENTRE_TIME, |sh| {
                                         sh.time(rng.get4(i, TIME_SET)[0])
                                     });
                                 let (o, d, t0, t1) = match &shutter {
@@ -591,10 +569,10 @@ struct Prepared {
     seed: u32,
     camera: camera::Camera,
     geo: build::Geometry,
-    materials: Vec<shade::Material>,
+    materials: Vec<integrator::shade::Material>,
     lights: Vec<light::Light>,
     background: V3,
-    world_shader: Option<world::WorldShader>,
+    world_shader: Option<light::world::WorldShader>,
     moving: usize,
 }
 
@@ -667,7 +645,7 @@ fn prepare(
     let eval = crate::anim::evaluate_scene(scene, centre)
         .map_err(|e| RenderError(format!("evaluating the scene at frame {centre}: {e}")))?;
     let mut camera = camera::Camera::new(scene, &eval, w, h)?;
-    // Objects' world matrices at the motion steps (`object_motion::evaluate_steps`).
+    // Objects' world matrices at the motion steps (`motion::object::evaluate_steps`).
     let mut object_steps: Vec<Vec<crate::anim::Mat4>> = Vec::new();
     if let Some(sh) = &shutter {
         let mut steps = Vec::new();
@@ -684,8 +662,8 @@ fn prepare(
             let at = e.as_ref().unwrap_or(&eval);
             steps.push(camera::Camera::new(scene, at, w, h)?.to_world);
         }
-        object_steps = object_motion::evaluate_steps(scene, &eval, sh)?;
-        object_motion::warn_deformation(&eval);
+        object_steps = motion::object::evaluate_steps(scene, &eval, sh)?;
+        motion::object::warn_deformation(&eval);
         camera.set_motion(&steps);
     }
     let mut geo = build::build(scene, &eval, overrides)?;
@@ -695,20 +673,20 @@ fn prepare(
             used[*m] = true;
         }
     }
-    let materials = shade::compile_all(scene, &used)?;
+    let materials = integrator::shade::compile_all(scene, &used)?;
     build::bind_attributes(&mut geo, &materials)?;
     if displace::apply(&mut geo, &materials) > 0 {
         (geo.tris, geo.refs) = build::world_triangles(&geo.instances);
     }
-    let moving = object_motion::attach(
+    let moving = motion::object::attach(
         &mut geo,
         &eval.data.objects,
         &eval.world_matrices,
         &object_steps,
     );
     let lights = light::collect(&eval)?;
-    let background = world::background(scene)?;
-    let world_shader = world::shader(scene)?;
+    let background = light::world::background(scene)?;
+    let world_shader = light::world::shader(scene)?;
     Ok(Prepared {
         start,
         w,
@@ -735,12 +713,12 @@ fn prepare(
 // Long because it collects every kind of emitter (lights, world, emissive triangles) as Cycles' LightManager does, in its order.
 fn light_select(
     geo: &build::Geometry,
-    materials: &[shade::Material],
+    materials: &[integrator::shade::Material],
     lights: &[light::Light],
-    world: Option<&world::WorldShader>,
+    world: Option<&light::world::WorldShader>,
     use_tree: bool,
 ) -> LightSelect {
-    use light_tree::{Cone, Emitter, Measure, Pick, Shape};
+    use light::tree::{Cone, Emitter, Measure, Pick, Shape};
     use std::f32::consts::{FRAC_PI_2, PI};
     let mut local = Vec::new();
     let mut distant = Vec::new();
@@ -917,7 +895,7 @@ fn light_select(
         };
         let centroid = scale(add(add(v[0], v[1]), v[2]), 1.0 / 3.0);
         let e = Emitter {
-            pick: Some(light_tree::Pick::Triangle(prim as u32)),
+            pick: Some(light::tree::Pick::Triangle(prim as u32)),
             shape: Shape::Triangle { v },
             centroid,
             measure: Measure::new(&v, cone, area * estimate),
@@ -934,9 +912,9 @@ fn light_select(
         return LightSelect::None;
     }
     if use_tree {
-        LightSelect::Tree(light_tree::LightTree::build(local, distant, meshes))
+        LightSelect::Tree(light::tree::LightTree::build(local, distant, meshes))
     } else {
-        LightSelect::Flat(light_tree::Distribution::build(&flat_tris, &flat_lights))
+        LightSelect::Flat(light::tree::Distribution::build(&flat_tris, &flat_lights))
     }
 }
 
@@ -962,7 +940,7 @@ struct TileWork {
     ty: u32,
     tw: u32,
     th: u32,
-    acc: Vec<adaptive::PixelAcc>,
+    acc: Vec<film::adaptive::PixelAcc>,
     passes: TilePasses,
     rays: u64,
 }
@@ -976,7 +954,7 @@ struct TilePasses {
     material_index: Vec<u32>,
     normal: Vec<[f32; 3]>,
     uv: Vec<[f32; 2]>,
-    hits: Vec<Option<flow::PixelHit>>,
+    hits: Vec<Option<film::flow::PixelHit>>,
     /// Sums over the pixel's samples of the denoiser's guides (`denoise_features`).
     feature_normal: Vec<[f32; 3]>,
     feature_albedo: Vec<[f32; 3]>,
@@ -1001,7 +979,7 @@ fn primary_passes(
         d,
         t0,
         t1,
-        object_motion::CENTRE_TIME,
+        motion::object::CENTRE_TIME,
         accel::visibility::of_path(crate::shader::point::ray::CAMERA),
     ) {
         Some(h) => {
@@ -1018,7 +996,7 @@ fn primary_passes(
             out.normal.push(hit.sp.normal);
             out.uv.push([hit.sp.uv[0], hit.sp.uv[1]]);
             let r = tracer.geo.refs[h.prim as usize];
-            out.hits.push(Some(flow::PixelHit {
+            out.hits.push(Some(film::flow::PixelHit {
                 inst: r.inst,
                 tri: r.tri,
                 u: h.u,

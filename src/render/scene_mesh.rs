@@ -4,10 +4,10 @@
 
 use std::collections::HashMap;
 
-use super::build::Geometry;
 use crate::geometry::attribute::AttrId;
 use crate::geometry::mesh::Mesh;
 use crate::geometry::types::{Array, Domain};
+use crate::render::build::Geometry;
 
 /// One mesh of the geometry's instances in world space: each instance's vertices
 /// (transformed, in its mesh's order, instances one after another), one triangular face

@@ -85,14 +85,14 @@ const INFO_ON_MESH: &str =
 const AOV: &str =
     "Cycles writes it to its AOV pass only, never the image: nothing to evaluate (blendsynth writes no AOV passes)";
 const LIGHT_OUTPUT: &str =
-    "the output of a light's node tree (render/light.rs: a constant Emission scales the light, anything else is an error naming the light and node); in a material Cycles renders only the Material Output (fixtures/bake/nodes, case freestyle_and_light_nodes)";
+    "the output of a light's node tree (render/light/mod.rs: a constant Emission scales the light, anything else is an error naming the light and node); in a material Cycles renders only the Material Output (fixtures/bake/nodes, case freestyle_and_light_nodes)";
 const METALLIC: &str =
-    "render/metallic.rs: F82 Tint with GGX and Multiscatter GGX, a Cycles parity scene in tests/render.rs (metallic_bsdf); Physical Conductor and Beckmann are compile errors naming the node";
+    "render/bsdf/metallic.rs: F82 Tint with GGX and Multiscatter GGX, a Cycles parity scene in tests/render.rs (metallic_bsdf); Physical Conductor and Beckmann are compile errors naming the node";
 const TOON: &str =
-    "render/toon.rs (closure/bsdf_toon.h): Diffuse and Glossy components, a Cycles parity scene in tests/render.rs (toon)";
+    "render/bsdf/toon.rs (closure/bsdf_toon.h): Diffuse and Glossy components, a Cycles parity scene in tests/render.rs (toon)";
 const OUTPUT: &str =
     "closure weights and emission, whole-material bakes (tests/bake.rs); a Displacement the material's method does not use is a compile error";
-const WORLD: &str = "world surfaces (render/world.rs); tests/world.rs";
+const WORLD: &str = "world surfaces (render/light/world.rs); tests/world.rs";
 const SHADER_STRUCTURE: &str = "closure weights and emission, whole-material bakes (tests/bake.rs)";
 const CLOSURE: &str =
     "light transport in render/ (bsdf.rs and the closure files), a Cycles parity scene in tests/render.rs";
@@ -366,7 +366,7 @@ fn aov_output(_: &mut Compiler<'_, '_>, _: usize, _: &Schedule) -> Result<(), Co
     Ok(())
 }
 
-/// A light's output: render/light.rs reads a light's tree; in a material or world only
+/// A light's output: render/light/mod.rs reads a light's tree; in a material or world only
 /// their own output node is compiled, so this is never reached there.
 fn light_output(_: &mut Compiler<'_, '_>, _: usize, _: &Schedule) -> Result<(), CompileError> {
     Ok(())
@@ -401,7 +401,7 @@ fn emission(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), Comp
     Ok(())
 }
 
-/// Metallic BSDF: its F82 Tint mode with GGX or Multiscatter GGX (render/metallic.rs).
+/// Metallic BSDF: its F82 Tint mode with GGX or Multiscatter GGX (render/bsdf/metallic.rs).
 fn metallic_bsdf(c: &mut Compiler<'_, '_>, i: usize, s: &Schedule) -> Result<(), CompileError> {
     let n = &c.g.nodes[i];
     let fresnel = prop_str(n, "fresnel_type")?;

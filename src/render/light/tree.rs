@@ -11,7 +11,7 @@
 
 use std::f32::consts::{FRAC_PI_2, PI};
 
-use super::math::*;
+use crate::render::math::*;
 
 /// Cycles' max_lights_in_leaf (LightManager::device_update_tree).
 const MAX_IN_LEAF: usize = 8;

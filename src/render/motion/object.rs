@@ -12,11 +12,11 @@
 
 use std::sync::Arc;
 
-use super::accel::{visibility, Accel, Bvh, Hit};
-use super::build::{Geometry, MeshInstance};
-use super::math::*;
-use super::motion::{decompose, interpolate, Decomposed};
 use crate::anim::Mat4;
+use crate::render::accel::{visibility, Accel, Bvh, Hit};
+use crate::render::build::{Geometry, MeshInstance};
+use crate::render::math::*;
+use crate::render::motion::{decompose, interpolate, Decomposed};
 
 /// The ray time at the shutter's centre, where the scene was synced (and the time of
 /// every ray when motion blur is off).
@@ -107,8 +107,8 @@ const MAX_MOTION_STEPS: usize = 129;
 pub fn evaluate_steps(
     scene: &crate::scene::Scene,
     centre: &crate::anim::EvaluatedScene,
-    shutter: &super::motion::Shutter,
-) -> Result<Vec<Vec<Mat4>>, super::RenderError> {
+    shutter: &crate::render::motion::Shutter,
+) -> Result<Vec<Vec<Mat4>>, crate::render::RenderError> {
     let n = centre
         .data
         .objects
@@ -130,7 +130,7 @@ pub fn evaluate_steps(
             crate::anim::evaluate_scene(scene, f)
                 .map(|e| e.world_matrices)
                 .map_err(|e| {
-                    super::RenderError(format!(
+                    crate::render::RenderError(format!(
                         "evaluating the scene at frame {f} (motion blur): {e}"
                     ))
                 })

@@ -10,7 +10,7 @@
 //!   reaching a bumped closure from across the smooth surface is cut, and diffuse closures
 //!   are darkened toward grazing light.
 
-use super::math::*;
+use crate::render::math::*;
 
 /// The corrected normal for geometric normal `ng`, direction toward the viewer `i` (on
 /// `ng`'s side) and shading normal `n`; `n` itself when its reflection is valid.

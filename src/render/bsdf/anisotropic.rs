@@ -8,8 +8,8 @@
 //!
 //! Directions: `v` toward the viewer, `l` toward the light.
 
-use super::math::*;
-use super::microfacet::{sample_ggx_vndf, ROUGHNESS_SQ_THRESH};
+use crate::render::bsdf::microfacet::{sample_ggx_vndf, ROUGHNESS_SQ_THRESH};
+use crate::render::math::*;
 use std::f32::consts::PI;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -154,10 +154,10 @@ mod tests {
         let (f, pdf, _) = g.eval(n, v, l, n);
         let h = normalize(add(v, l));
         let a2 = 0.09;
-        let d = super::super::bsdf::ggx_d(h[2], a2);
+        let d = crate::render::bsdf::ggx_d(h[2], a2);
         let (lv, ll) = (
-            super::super::bsdf::ggx_lambda(v[2], a2),
-            super::super::bsdf::ggx_lambda(l[2], a2),
+            crate::render::bsdf::ggx_lambda(v[2], a2),
+            crate::render::bsdf::ggx_lambda(l[2], a2),
         );
         assert!((f - d / (4.0 * v[2]) / (1.0 + lv + ll)).abs() < 1e-5 * f.max(1.0));
         assert!((pdf - d / (4.0 * v[2]) / (1.0 + lv)).abs() < 1e-5 * pdf.max(1.0));
@@ -169,7 +169,7 @@ mod tests {
         let n = [0.0, 0.0, 1.0];
         let g = AnisoGgx::new(n, [0.6, 0.8, 0.0], 0.15, 0.6);
         let v = normalize([0.5, -0.2, 0.6]);
-        let s = super::super::sampler::PixelSampler::new(4, 5, 6);
+        let s = crate::render::sampler::PixelSampler::new(4, 5, 6);
         let count = 40000;
         let (mut by_sample, mut uniform) = (0.0f64, 0.0f64);
         for i in 0..count {

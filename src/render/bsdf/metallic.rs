@@ -8,8 +8,8 @@
 use crate::shader::program::BsdfNode;
 use crate::shader::ShadingPoint;
 
-use super::bsdf::{Fresnel, LobeKind, LobeSet};
-use super::shade::{
+use crate::render::bsdf::{Fresnel, LobeKind, LobeSet};
+use crate::render::integrator::shade::{
     input_c, input_f, input_n, is_multiggx, multiscatter_energy, push_glossy, tangent_input,
     valid_n, Context,
 };
@@ -28,7 +28,7 @@ pub fn f82_tint(f0: [f32; 3], tint: [f32; 3]) -> Fresnel {
 }
 
 /// The Metallic BSDF node's lobe, weighted `w`.
-pub(super) fn metallic(
+pub(crate) fn metallic(
     b: &BsdfNode,
     w: f32,
     s: &[f32],
@@ -47,14 +47,16 @@ pub(super) fn metallic(
     // The lobe's sampling weight, as the Principled's metallic layer estimates it.
     let avg_f0 = (color[0] + color[1] + color[2]) / 3.0;
     let albedo = (avg_f0 + (1.0 - avg_f0) / 21.0).clamp(0.0, 1.0).max(1e-3);
-    let (ax, ay) =
-        super::anisotropic::principled_alphas(roughness, input_f(b, s, "Anisotropy", 0.0));
+    let (ax, ay) = crate::render::bsdf::anisotropic::principled_alphas(
+        roughness,
+        input_f(b, s, "Anisotropy", 0.0),
+    );
     if ax != ay {
         let t = tangent_input(b, s, sp, "Tangent", input_f(b, s, "Rotation", 0.0), n);
         push_glossy(out, ctx, ax, ay, t, fresnel, multi, [w; 3], vn, albedo);
         return;
     }
-    let mu = super::math::dot(vn, ctx.wo).clamp(0.0, 1.0);
+    let mu = crate::render::math::dot(vn, ctx.wo).clamp(0.0, 1.0);
     let energy = if multi {
         multiscatter_energy(ctx.tables, mu, roughness)
     } else {

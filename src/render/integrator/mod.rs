@@ -5,20 +5,23 @@
 //! bounce limits (terminating after the next surface, as Cycles does), Russian roulette on sqrt of throughput, and
 //! Cycles' clamping (direct and indirect limits on the sum of a contribution).
 
+pub mod path_state;
+pub mod shade;
+
 use crate::scene::AttributeData;
 use crate::shader::point::{ray, PathState, Undisplaced};
 use crate::shader::ShadingPoint;
 
-use super::accel::{visibility, Accel};
-use super::bsdf::{LobeKind, LobeSet};
-use super::build::Geometry;
-use super::light::Light;
-use super::light_tree::{LightSelect, Pick};
-use super::math::*;
-use super::path_state::{Next, Path, SETS_PER_VERTEX};
-use super::sampler::PixelSampler;
-use super::shade::{Context, Material};
-use super::tables::Tables;
+use crate::render::accel::{visibility, Accel};
+use crate::render::bsdf::tables::Tables;
+use crate::render::bsdf::{LobeKind, LobeSet};
+use crate::render::build::Geometry;
+use crate::render::integrator::path_state::{Next, Path, SETS_PER_VERTEX};
+use crate::render::integrator::shade::{Context, Material};
+use crate::render::light::tree::{LightSelect, Pick};
+use crate::render::light::Light;
+use crate::render::math::*;
+use crate::render::sampler::PixelSampler;
 
 #[derive(Debug, Clone, Copy)]
 pub struct Settings {
@@ -73,7 +76,7 @@ pub struct Scene<'a> {
     pub tables: &'a Tables,
     pub settings: Settings,
     /// The world's node program when it varies with direction (else `background`).
-    pub world: Option<&'a super::world::WorldShader>,
+    pub world: Option<&'a crate::render::light::world::WorldShader>,
     /// The camera as Texture Coordinate > Camera/Window and Camera Data see it.
     pub view: crate::shader::view::View,
 }
@@ -92,7 +95,7 @@ pub struct Scratch {
     /// the caller before `radiance`, like the differentials).
     pub time: f32,
     /// The denoiser's guides of the sample `radiance` last traced.
-    pub features: super::denoise_features::Features,
+    pub features: crate::render::film::denoise_features::Features,
     /// The transparency (1 - alpha) of the sample `radiance` last traced: transparent
     /// background and holdouts seen by the camera, as Cycles accumulates it in the
     /// combined pass's alpha.
@@ -108,7 +111,7 @@ impl Scratch {
             rays: 0,
             ray_dp: 0.0,
             ray_dd: 0.0,
-            time: super::object_motion::CENTRE_TIME,
+            time: crate::render::motion::object::CENTRE_TIME,
             features: Default::default(),
             transparent: 0.0,
         }
@@ -142,7 +145,7 @@ fn clamp_contrib(l: V3, limit: f32) -> V3 {
 
 impl Scene<'_> {
     pub fn surface(&self, prim: u32, u: f32, v: f32, wo: V3) -> SurfaceHit {
-        self.surface_at(prim, u, v, wo, super::object_motion::CENTRE_TIME)
+        self.surface_at(prim, u, v, wo, crate::render::motion::object::CENTRE_TIME)
     }
 
     /// `surface` with a moving object posed at shutter time `time`.
@@ -315,7 +318,7 @@ impl Scene<'_> {
             scratch.lobes.terminator_frequency =
                 self.geo.instances[hit.inst as usize].terminator_frequency;
             if path.diffuse_ancestor {
-                super::subsurface::to_diffuse(&mut scratch.lobes);
+                crate::render::subsurface::to_diffuse(&mut scratch.lobes);
             }
             filter_glossy(&mut scratch.lobes, path.min_ray_pdf, st.filter_glossy);
             self.emission_at_hit(&mut path, &h, &hit, clamp_limit, scratch);
@@ -365,7 +368,7 @@ impl Scene<'_> {
             path.throughput = mul(path.throughput, bs.weight);
             if let LobeKind::Subsurface(b) = bs.kind {
                 // Not a bounce of its own: the walk's exit is the next vertex.
-                let exit = super::subsurface::enter_and_walk(
+                let exit = crate::render::subsurface::enter_and_walk(
                     self,
                     &b,
                     &hit,
@@ -443,7 +446,7 @@ impl Scene<'_> {
         }
         // A world hidden from this ray type gives it nothing (Cycles'
         // integrator_eval_background_shader).
-        if !super::light::visible_to(self.world_exclude, path.state.flags) {
+        if !crate::render::light::visible_to(self.world_exclude, path.state.flags) {
             return;
         }
         let d = path.d;
@@ -468,7 +471,7 @@ impl Scene<'_> {
     fn vertex(
         &self,
         path: &mut Path,
-        h: &super::accel::Hit,
+        h: &crate::render::accel::Hit,
         wo: V3,
         scratch: &Scratch,
     ) -> SurfaceHit {
@@ -497,7 +500,7 @@ impl Scene<'_> {
                     self.shade(hit, wo, scratch);
                     let smooth = scratch.lobes.smooth_n;
                     (
-                        super::subsurface::exit_normal(&scratch.lobes, smooth),
+                        crate::render::subsurface::exit_normal(&scratch.lobes, smooth),
                         smooth,
                     )
                 }
@@ -544,7 +547,7 @@ impl Scene<'_> {
     fn emission_at_hit(
         &self,
         path: &mut Path,
-        h: &super::accel::Hit,
+        h: &crate::render::accel::Hit,
         hit: &SurfaceHit,
         clamp: f32,
         scratch: &mut Scratch,
@@ -563,7 +566,7 @@ impl Scene<'_> {
             if pick > 0.0 {
                 power_heuristic(
                     path.prev_pdf,
-                    pick * super::triangle_light::pdf(
+                    pick * crate::render::light::triangle::pdf(
                         &self.geo.tris[h.prim as usize],
                         path.o,
                         path.d,
@@ -638,7 +641,7 @@ impl Scene<'_> {
             }
             Some((Pick::Triangle(tri), p_sel)) if tri != prim => {
                 let (front, back) = self.emission_sides(tri);
-                let ts = super::triangle_light::sample(
+                let ts = crate::render::light::triangle::sample(
                     &self.geo.tris[tri as usize],
                     hit.p,
                     [u[0], u[1]],
@@ -800,7 +803,8 @@ impl Scene<'_> {
             } else {
                 smooth_n
             };
-            let (amount, ng) = super::terminator::amount(inst.shadow_terminator, n, hit.ng, wi);
+            let (amount, ng) =
+                crate::render::bsdf::terminator::amount(inst.shadow_terminator, n, hit.ng, wi);
             let r = self.geo.refs[hit.prim as usize];
             let flat = || {
                 let face = m.triangle_faces[r.tri as usize] as usize;
@@ -819,7 +823,12 @@ impl Scene<'_> {
                     ))
                 });
                 let [u, w] = hit.uv;
-                let lift = super::terminator::smooth_surface_offset(v, n, [1.0 - u - w, u, w], ng);
+                let lift = crate::render::bsdf::terminator::smooth_surface_offset(
+                    v,
+                    n,
+                    [1.0 - u - w, u, w],
+                    ng,
+                );
                 if finite(lift) {
                     p = madd(p, lift, amount);
                 }
@@ -963,7 +972,7 @@ impl Scene<'_> {
     fn fill_context(
         &self,
         sp: &mut ShadingPoint,
-        inst: &super::build::MeshInstance,
+        inst: &crate::render::build::MeshInstance,
         wo: V3,
         ng: V3,
         backfacing: bool,

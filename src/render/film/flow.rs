@@ -16,10 +16,10 @@
 
 use rayon::prelude::*;
 
-use super::accel::{self, Accel};
-use super::build::Geometry;
-use super::camera::Camera;
-use super::math::*;
+use crate::render::accel::{self, Accel};
+use crate::render::build::Geometry;
+use crate::render::camera::Camera;
+use crate::render::math::*;
 
 /// What the primary ray through a pixel centre hit: an instance of the frame's geometry,
 /// a triangle of its mesh, and the hit's barycentrics (the corner weights are 1 - u - v,
@@ -79,7 +79,7 @@ fn point(geo: &Geometry, inst: usize, tri: u32, u: f32, v: f32) -> Option<V3> {
 /// with the same mesh topology.
 fn match_instances(here: &Geometry, there: &Geometry) -> Vec<Option<usize>> {
     use std::collections::HashMap;
-    let key = |i: &super::build::MeshInstance| (i.object, i.instance_index);
+    let key = |i: &crate::render::build::MeshInstance| (i.object, i.instance_index);
     let mut count: HashMap<_, (usize, usize)> = HashMap::new();
     for (k, i) in there.instances.iter().enumerate() {
         count.entry(key(i)).or_insert((k, 0)).1 += 1;
@@ -114,7 +114,10 @@ pub fn flow_to(
 ) -> FlowField {
     let matched = match_instances(here.geo, there.geo);
     let backend = accel::Backend::from_env().unwrap_or(accel::Backend::DEFAULT);
-    let accel = backend.build_masked(&there.geo.tris, &super::build::triangle_masks(there.geo));
+    let accel = backend.build_masked(
+        &there.geo.tris,
+        &crate::render::build::triangle_masks(there.geo),
+    );
     let (w, h) = (there.camera.width as f64, there.camera.height as f64);
     let per_pixel: Vec<([f32; 2], bool)> = hits
         .par_iter()
@@ -160,7 +163,14 @@ fn visible(accel: &dyn Accel, there: &FrameView, inst: u32, tri: u32, p: V3, r: 
         return false;
     }
     let camera = accel::visibility::of_path(crate::shader::point::ray::CAMERA);
-    match accel.intersect_vis(o, d, t0, t1, super::object_motion::CENTRE_TIME, camera) {
+    match accel.intersect_vis(
+        o,
+        d,
+        t0,
+        t1,
+        crate::render::motion::object::CENTRE_TIME,
+        camera,
+    ) {
         None => true,
         Some(h) => {
             let r = there.geo.refs[h.prim as usize];

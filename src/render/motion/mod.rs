@@ -7,8 +7,10 @@
 //! Objects use the same decomposition and interpolation (`object_motion` keeps moving
 //! objects in object space and moves each ray into it at the ray's time).
 
-use super::math::*;
+pub mod object;
+
 use crate::nodes::curves::{mapping_from_json, CurveKind, CurveTable};
+use crate::render::math::*;
 use crate::scene::settings::{MotionBlur, ShutterPosition};
 
 /// Cycles' SHUTTER_TABLE_SIZE and the resolution Blender samples the curve at.

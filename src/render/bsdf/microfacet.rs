@@ -7,7 +7,7 @@
 //! Directions: `v` points toward the viewer (Cycles' `wi`), `l` is the scattered or light
 //! direction (Cycles' `wo`). `eval` returns BSDF times |cos| as Cycles' closures do.
 
-use super::math::*;
+use crate::render::math::*;
 use std::f32::consts::PI;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -105,7 +105,7 @@ pub fn sample_ggx_vndf(v: V3, ax: f32, ay: f32, u: [f32; 2]) -> V3 {
     } else {
         ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
     };
-    let t = super::camera::concentric_disk(u);
+    let t = crate::render::camera::concentric_disk(u);
     let (tx, mut ty) = (t[0], t[1]);
     let s = 0.5 * (1.0 + vh[2]);
     ty = (1.0 - tx * tx).max(0.0).sqrt() * (1.0 - s) + ty * s;
@@ -215,7 +215,7 @@ pub struct Dielectric {
     pub energy: f32,
     /// Principled transmission's thin film: its reflectance replaces the bare Fresnel
     /// (refraction takes the rest; the refracted direction is Snell's either way).
-    pub film: Option<super::thin_film::ThinFilm>,
+    pub film: Option<crate::render::bsdf::thin_film::ThinFilm>,
 }
 
 /// Result of sampling a dielectric: direction, eval / pdf (without the closure weight)
@@ -429,7 +429,7 @@ pub fn glass_albedo(mu: f32, alpha: f32, eta: f32, samples: &[[f32; 2]]) -> f32 
 /// inverted on back faces, Multiscatter GGX glass scaled by 1 / E from the glass albedo
 /// table. `mu` is cos(N, view). Tints are one: the colour is the closure weight.
 pub fn glass_closure(
-    tables: &super::tables::Tables,
+    tables: &crate::render::bsdf::tables::Tables,
     distribution: Option<&str>,
     refract_only: bool,
     roughness: f32,

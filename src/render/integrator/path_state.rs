@@ -5,10 +5,10 @@
 
 use crate::shader::point::{ray, PathState};
 
-use super::accel::Hit;
-use super::bsdf::{BsdfSample, LobeKind};
-use super::integrator::Settings;
-use super::math::*;
+use crate::render::accel::Hit;
+use crate::render::bsdf::{BsdfSample, LobeKind};
+use crate::render::integrator::Settings;
+use crate::render::math::*;
 
 /// Sampler dimensions a vertex uses, from its `set`: the BSDF sample at `set`, the light
 /// sample at `set + 1`; `set + 2` is left free (Cycles reserves one for the BSSRDF, whose

@@ -6,7 +6,7 @@
 //! colon's wall) show each triangle's own shadow terminator as dark facets, and the light
 //! reaching their lit side at grazing angles is lower than Cycles'.
 
-use super::math::*;
+use crate::render::math::*;
 
 /// Cycles' shadow terminator shading offset (Object > Shading > Shadow Terminator >
 /// Shading Offset; kernel/closure/bsdf.h, after appleseed): every closure's value toward a

@@ -2,7 +2,7 @@
 //! Oren-Nayar model plus the energy-preserving multiple-scattering term of OpenPBR.
 //! Sampled like Lambert (cosine hemisphere).
 
-use super::math::*;
+use crate::render::math::*;
 use std::f32::consts::{FRAC_PI_2, PI};
 
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -5,7 +5,7 @@
 //! Either is unbiased; matching Cycles' choice matches its noise, and with clamping on, what
 //! the clamp cuts.
 
-use super::math::*;
+use crate::render::math::*;
 
 pub struct TriangleSample {
     pub wi: V3,

@@ -6,8 +6,8 @@
 //! it to the Principled dielectric specular layer and its transmission (glass), not to
 //! the metallic layer.
 
-use super::bsdf::f0_from_ior;
-use super::math::*;
+use crate::render::bsdf::f0_from_ior;
+use crate::render::math::*;
 use std::f32::consts::PI;
 
 /// Cycles' THINFILM_THICKNESS_CUTOFF: thinner films (nm) are no film at all.
@@ -154,7 +154,7 @@ mod tests {
     use super::*;
 
     fn fresnel(cos_i: f32, eta: f32) -> f32 {
-        super::super::bsdf::fresnel_dielectric(cos_i, eta)
+        crate::render::bsdf::fresnel_dielectric(cos_i, eta)
     }
 
     #[test]

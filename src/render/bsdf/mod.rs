@@ -3,11 +3,23 @@
 //! compensation), Fresnel models (constant colour, dielectric, F82-tinted Schlick, thin
 //! film), transparent. `eval` returns BSDF times the cosine, as Cycles' closures do.
 
-use super::math::*;
-use super::microfacet::{Dielectric, Reflection};
-use super::oren_nayar::OrenNayar;
-use super::subsurface::Bssrdf;
-use super::tables::Tables;
+pub mod anisotropic;
+pub mod bump_correction;
+pub mod metallic;
+pub mod microfacet;
+pub mod oren_nayar;
+pub mod sheen;
+pub mod sheen_ltc;
+pub mod tables;
+pub mod terminator;
+pub mod thin_film;
+pub mod toon;
+
+use crate::render::bsdf::microfacet::{Dielectric, Reflection};
+use crate::render::bsdf::oren_nayar::OrenNayar;
+use crate::render::bsdf::tables::Tables;
+use crate::render::math::*;
+use crate::render::subsurface::Bssrdf;
 use std::f32::consts::PI;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -19,7 +31,7 @@ pub enum Fresnel {
     /// Metals: F0 colour, F82 tint factor `b` (precomputed).
     F82 { f0: V3, b: V3 },
     /// Dielectric under a thin film (Principled specular layer): coloured by interference.
-    ThinFilm(super::thin_film::ThinFilm),
+    ThinFilm(crate::render::bsdf::thin_film::ThinFilm),
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -43,14 +55,14 @@ pub enum LobeKind {
     /// Glossy reflection with the Beckmann distribution.
     Reflection(Reflection),
     /// Microfiber sheen (Sheen BSDF, Principled sheen); scatters like diffuse.
-    Sheen(super::sheen::Sheen),
+    Sheen(crate::render::bsdf::sheen::Sheen),
     /// Ashikhmin velvet (Sheen BSDF, Ashikhmin distribution); scatters like diffuse.
-    Velvet(super::sheen::Velvet),
+    Velvet(crate::render::bsdf::sheen::Velvet),
     /// Toon BSDF, Diffuse or Glossy component.
-    Toon(super::toon::Toon),
+    Toon(crate::render::bsdf::toon::Toon),
     /// Anisotropic GGX reflection (Glossy BSDF anisotropy, Principled anisotropic).
     GlossyAniso {
-        lobe: super::anisotropic::AnisoGgx,
+        lobe: crate::render::bsdf::anisotropic::AnisoGgx,
         fresnel: Fresnel,
         energy: f32,
     },
@@ -228,7 +240,7 @@ impl LobeSet {
                     l.kind,
                     LobeKind::Diffuse | LobeKind::OrenNayar(_) | LobeKind::Translucent
                 );
-                super::bump_correction::bump_shadowing_term(
+                crate::render::bsdf::bump_correction::bump_shadowing_term(
                     self.smooth_n,
                     l.n,
                     wi,
@@ -246,7 +258,7 @@ impl LobeSet {
                 if c >= 0.0 {
                     e = scale(
                         e,
-                        super::terminator::shift_cos_in(c, self.terminator_frequency),
+                        crate::render::bsdf::terminator::shift_cos_in(c, self.terminator_frequency),
                     );
                 }
             }
@@ -294,7 +306,10 @@ impl LobeSet {
             let (glossy, transmit) = (!ds.transmit, ds.transmit);
             if ds.singular {
                 let shift = if self.terminator_frequency > 1.0 && !transmit {
-                    super::terminator::shift_cos_in(dot(ds.l, l.n), self.terminator_frequency)
+                    crate::render::bsdf::terminator::shift_cos_in(
+                        dot(ds.l, l.n),
+                        self.terminator_frequency,
+                    )
                 } else {
                     1.0
                 };
@@ -348,7 +363,10 @@ impl LobeSet {
             let w = if self.terminator_frequency > 1.0 && !transmit {
                 scale(
                     w,
-                    super::terminator::shift_cos_in(dot(wi, l.n), self.terminator_frequency),
+                    crate::render::bsdf::terminator::shift_cos_in(
+                        dot(wi, l.n),
+                        self.terminator_frequency,
+                    ),
                 )
             } else {
                 w
@@ -571,7 +589,7 @@ fn eval_lobe(l: &Lobe, wo: V3, wi: V3, _ng: V3, _tables: &Tables) -> (V3, f32) {
 fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
     match l.kind {
         LobeKind::Diffuse | LobeKind::Translucent | LobeKind::OrenNayar(_) => {
-            let d = super::camera::concentric_disk(u);
+            let d = crate::render::camera::concentric_disk(u);
             let z = (1.0 - d[0] * d[0] - d[1] * d[1]).max(0.0).sqrt();
             let n = if let LobeKind::Translucent = l.kind {
                 neg(l.n)

@@ -7,8 +7,8 @@
 //! resampled by weight. The path leaves from there with a white diffuse closure, as
 //! after a random walk.
 
-use super::math::*;
-use super::subsurface::Bssrdf;
+use crate::render::math::*;
+use crate::render::subsurface::Bssrdf;
 
 /// Profile truncation in units of d, and the profile's CDF there.
 const TRUNCATE: f32 = 16.0;
@@ -102,16 +102,16 @@ struct ProbeHit {
 /// direction the exit is seen from (outward), like the random walk.
 #[allow(clippy::too_many_arguments)]
 pub fn disk_exit(
-    scene: &super::integrator::Scene,
+    scene: &crate::render::integrator::Scene,
     b: &Bssrdf,
-    hit: &super::integrator::SurfaceHit,
-    rng: &super::sampler::PixelSampler,
+    hit: &crate::render::integrator::SurfaceHit,
+    rng: &crate::render::sampler::PixelSampler,
     index: u32,
     set: u32,
     throughput: &mut V3,
     rays: &mut u64,
-) -> Option<(super::accel::Hit, V3)> {
-    let base = super::subsurface::bssrdf_dimensions(set);
+) -> Option<(crate::render::accel::Hit, V3)> {
+    let base = crate::render::subsurface::bssrdf_dimensions(set);
     let u = rng.get4(index, base);
     let (xi_r, mut xi_axis, xi_resample) = (u[0], u[1], u[2]);
     // Axis: the normal with probability 1/2, each tangent 1/4.
@@ -225,7 +225,7 @@ pub fn disk_exit(
             *throughput = mul(*throughput, scale(weights[k], sum / sw));
             let h = kept[k];
             return Some((
-                super::accel::Hit {
+                crate::render::accel::Hit {
                     t: 0.0,
                     prim: h.prim,
                     u: h.u,

@@ -4,8 +4,8 @@
 //! Fresnel-weighted albedo over the Fresnel-one albedo, stored as a blend from F0 to 1)
 //! for layering Principled's specular and coat over what lies beneath.
 
-use super::bsdf::{f0_from_ior, fresnel_dielectric, ggx_lambda, sample_vndf};
-use super::sampler::PixelSampler;
+use crate::render::bsdf::{f0_from_ior, fresnel_dielectric, ggx_lambda, sample_vndf};
+use crate::render::sampler::PixelSampler;
 
 const N1: usize = 32;
 const N3: usize = 16;
@@ -243,8 +243,8 @@ fn glass_tables(parallel: bool) -> (Vec<f32>, Vec<f32>) {
         let alpha = rough_to_alpha(ri as f32 / (N3 - 1) as f32);
         let mu = mi as f32 / (N3 - 1) as f32;
         (
-            super::microfacet::glass_albedo(mu, alpha, eta, &samples),
-            super::microfacet::glass_albedo(mu, alpha, 1.0 / eta, &samples),
+            crate::render::bsdf::microfacet::glass_albedo(mu, alpha, eta, &samples),
+            crate::render::bsdf::microfacet::glass_albedo(mu, alpha, 1.0 / eta, &samples),
         )
     };
     let entries: Vec<(f32, f32)> = if parallel {

@@ -5,7 +5,7 @@
 
 use std::f32::consts::PI;
 
-use super::math::*;
+use crate::render::math::*;
 
 /// The region of an area light that light sampling draws from: the whole light, or (with
 /// a spread) a smaller rectangle, ellipse or circle in its plane.

@@ -3,9 +3,11 @@
 //! f-stop, focus distance or focus object, aperture blades and rotation; panoramic
 //! cameras (`panorama`: equirectangular, fisheyes, mirror ball, cube face, cylindrical).
 
-use super::math::*;
-use super::RenderError;
+pub mod panorama;
+
 use crate::anim::EvaluatedScene;
+use crate::render::math::*;
+use crate::render::RenderError;
 use crate::scene::settings::{CameraSettings, Output, Projection};
 use crate::scene::Scene;
 
@@ -31,9 +33,9 @@ pub struct Camera {
     pub width: u32,
     pub height: u32,
     /// Camera-to-world at the motion steps across the shutter, when motion blur is on.
-    motion: Option<Vec<super::motion::Decomposed>>,
+    motion: Option<Vec<crate::render::motion::Decomposed>>,
     /// A panoramic camera's projection (viewplane [0, 1]^2 plus shift).
-    pub panorama: Option<super::panorama::Panorama>,
+    pub panorama: Option<crate::render::camera::panorama::Panorama>,
 }
 
 impl Camera {
@@ -80,7 +82,7 @@ impl Camera {
         let yratio = height as f32 * pay;
         let panorama = if projection == Projection::Panoramic {
             Some(
-                super::panorama::Panorama::from_camera(&p, xratio, yratio)
+                crate::render::camera::panorama::Panorama::from_camera(&p, xratio, yratio)
                     .map_err(|e| RenderError(format!("camera {data:?}: {e}")))?,
             )
         } else {
@@ -172,7 +174,7 @@ impl Camera {
     /// for the centre transform); rays then take a time.
     pub fn set_motion(&mut self, steps: &[Affine]) {
         let unscaled: Vec<Affine> = steps.iter().map(without_scale).collect();
-        self.motion = Some(super::motion::decompose(&unscaled));
+        self.motion = Some(crate::render::motion::decompose(&unscaled));
     }
 
     pub fn has_motion(&self) -> bool {
@@ -182,7 +184,9 @@ impl Camera {
     /// `ray` at shutter time `time` in [0, 1] (ignored without motion blur).
     pub fn ray_at(&self, x: f32, y: f32, lens: [f32; 2], time: f32) -> (V3, V3, f32, f32) {
         match &self.motion {
-            Some(steps) => self.ray_with(&super::motion::interpolate(steps, time), x, y, lens),
+            Some(steps) => {
+                self.ray_with(&crate::render::motion::interpolate(steps, time), x, y, lens)
+            }
             None => self.ray(x, y, lens),
         }
     }
@@ -241,7 +245,7 @@ impl Camera {
     /// tmax 0 (the sample sees nothing).
     fn panorama_ray(
         &self,
-        pano: &super::panorama::Panorama,
+        pano: &crate::render::camera::panorama::Panorama,
         to_world: &Affine,
         u: f32,
         v: f32,

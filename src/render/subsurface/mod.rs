@@ -9,8 +9,10 @@
 //! The Burley method samples by disk projection instead (`subsurface_disk`). Not done:
 //! the quarter-pixel radius fallback (needs ray differentials).
 
-use super::math::*;
-use super::microfacet::sample_ggx_vndf;
+pub mod disk;
+
+use crate::render::bsdf::microfacet::sample_ggx_vndf;
+use crate::render::math::*;
 use std::f32::consts::PI;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -221,7 +223,7 @@ pub fn entry_direction(b: &Bssrdf, n: V3, v: V3, mut u: [f32; 2]) -> Option<V3> 
     if b.method == Method::RandomWalkSkin {
         if u[0] < 0.5 {
             u[0] *= 2.0;
-            let d = super::camera::concentric_disk(u);
+            let d = crate::render::camera::concentric_disk(u);
             let z = (1.0 - d[0] * d[0] - d[1] * d[1]).max(0.0).sqrt();
             let (t, bb) = basis(n);
             return Some(add(add(scale(t, d[0]), scale(bb, d[1])), scale(n, -z)));
@@ -467,10 +469,10 @@ pub fn random_walk(
 /// (Cycles' `surface_shader_bssrdf_normal`): the BSSRDF closures' normals (already bump
 /// corrected for the exit, whose incoming direction is the true normal) weighted by
 /// their mean weight; `fallback` (the shading normal) when there is none.
-pub fn exit_normal(lobes: &super::bsdf::LobeSet, fallback: V3) -> V3 {
+pub fn exit_normal(lobes: &crate::render::bsdf::LobeSet, fallback: V3) -> V3 {
     let mut n = [0.0; 3];
     for l in &lobes.lobes[..lobes.len] {
-        if let super::bsdf::LobeKind::Subsurface(_) = l.kind {
+        if let crate::render::bsdf::LobeKind::Subsurface(_) = l.kind {
             let w = ((l.weight[0] + l.weight[1] + l.weight[2]) / 3.0).abs();
             n = madd(n, l.n, w);
         }
@@ -483,19 +485,19 @@ pub fn exit_normal(lobes: &super::bsdf::LobeSet, fallback: V3) -> V3 {
 }
 
 /// After a diffuse bounce Cycles replaces every BSSRDF by a diffuse closure of its weight.
-pub fn to_diffuse(lobes: &mut super::bsdf::LobeSet) {
+pub fn to_diffuse(lobes: &mut crate::render::bsdf::LobeSet) {
     let n = lobes.len;
     for l in &mut lobes.lobes[..n] {
-        if let super::bsdf::LobeKind::Subsurface(b) = l.kind {
+        if let crate::render::bsdf::LobeKind::Subsurface(b) = l.kind {
             let channels = b.radius.iter().filter(|r| **r > 0.0).count().max(1) as f32;
-            l.kind = super::bsdf::LobeKind::Diffuse;
+            l.kind = crate::render::bsdf::LobeKind::Diffuse;
             l.sample_weight /= channels;
         }
     }
 }
 
 struct Local<'a, 'b> {
-    scene: &'a super::integrator::Scene<'b>,
+    scene: &'a crate::render::integrator::Scene<'b>,
     rays: u64,
     /// The path's shutter time (moving objects are posed at it).
     time: f32,
@@ -533,20 +535,22 @@ impl LocalTrace for Local<'_, '_> {
 /// then the walk. Returns the exit as a hit and the direction the walk left along.
 #[allow(clippy::too_many_arguments)]
 pub fn enter_and_walk(
-    scene: &super::integrator::Scene,
+    scene: &crate::render::integrator::Scene,
     b: &Bssrdf,
-    hit: &super::integrator::SurfaceHit,
+    hit: &crate::render::integrator::SurfaceHit,
     wo: V3,
     n: V3,
-    rng: &super::sampler::PixelSampler,
+    rng: &crate::render::sampler::PixelSampler,
     index: u32,
     set: u32,
     throughput: &mut V3,
     rays: &mut u64,
-) -> Option<(super::accel::Hit, V3)> {
+) -> Option<(crate::render::accel::Hit, V3)> {
     // The Burley method samples by disk projection instead of walking.
     if b.method == Method::Burley {
-        return super::subsurface_disk::disk_exit(scene, b, hit, rng, index, set, throughput, rays);
+        return crate::render::subsurface::disk::disk_exit(
+            scene, b, hit, rng, index, set, throughput, rays,
+        );
     }
     let base = bssrdf_dimensions(set);
     let ue = rng.get4(index, base);
@@ -572,7 +576,7 @@ pub fn enter_and_walk(
     *rays += local.rays;
     let e = exit?;
     Some((
-        super::accel::Hit {
+        crate::render::accel::Hit {
             t: 0.0,
             prim: e.prim,
             u: e.u,

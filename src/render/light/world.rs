@@ -5,8 +5,8 @@
 
 use serde_json::Value;
 
-use super::math::V3;
-use super::RenderError;
+use crate::render::math::V3;
+use crate::render::RenderError;
 use crate::scene::Scene;
 
 pub fn background(scene: &Scene) -> Result<V3, RenderError> {

@@ -6,7 +6,7 @@
 
 use crate::scene::settings::CameraSettings;
 
-use super::math::*;
+use crate::render::math::*;
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum Panorama {

@@ -6,11 +6,11 @@ use crate::scene::Scene;
 use crate::shader::program::{BsdfNode, Closure, Program};
 use crate::shader::{compile_material, ShadingPoint};
 
-use super::bsdf::{Fresnel, LobeKind, LobeSet};
-use super::math::*;
-use super::subsurface::Method;
-use super::tables::Tables;
-use super::RenderError;
+use crate::render::bsdf::tables::Tables;
+use crate::render::bsdf::{Fresnel, LobeKind, LobeSet};
+use crate::render::math::*;
+use crate::render::subsurface::Method;
+use crate::render::RenderError;
 
 pub struct Material {
     pub program: Option<Program>,
@@ -116,7 +116,7 @@ fn linked_or_constant(
 /// Whether a microfacet node compensates multiple scattering (Cycles' is_multiggx): the
 /// Principled BSDF unless its distribution is GGX (Multiscatter GGX is its default), the
 /// other nodes only when theirs is Multiscatter GGX.
-pub(super) fn is_multiggx(b: &BsdfNode) -> bool {
+pub(crate) fn is_multiggx(b: &BsdfNode) -> bool {
     match b.bl_idname.as_str() {
         "ShaderNodeBsdfPrincipled" => b.property("distribution") != Some("GGX"),
         _ => b.property("distribution") == Some("MULTI_GGX"),
@@ -176,9 +176,13 @@ pub struct Context<'a> {
 /// Cycles' `maybe_ensure_valid_specular_reflection`: the normal of the closures whose
 /// mirror direction must stay above the surface (microfacet, glass, translucent, BSSRDF),
 /// raised toward the true normal when the material's Bump Map Correction is on.
-pub(super) fn valid_n(sp: &ShadingPoint, ctx: &Context, n: V3) -> V3 {
+pub(crate) fn valid_n(sp: &ShadingPoint, ctx: &Context, n: V3) -> V3 {
     if ctx.bump_correction && n != sp.true_normal {
-        super::bump_correction::ensure_valid_specular_reflection(sp.true_normal, ctx.wo, n)
+        crate::render::bsdf::bump_correction::ensure_valid_specular_reflection(
+            sp.true_normal,
+            ctx.wo,
+            n,
+        )
     } else {
         n
     }
@@ -283,17 +287,17 @@ impl Material {
     }
 }
 
-pub(super) fn input_f(b: &BsdfNode, s: &[f32], id: &str, d: f32) -> f32 {
+pub(crate) fn input_f(b: &BsdfNode, s: &[f32], id: &str, d: f32) -> f32 {
     b.input(id)
         .map(|(slot, _)| finite_or(s[slot as usize], d))
         .unwrap_or(d)
 }
-pub(super) fn input_c(b: &BsdfNode, s: &[f32], id: &str, d: V3) -> V3 {
+pub(crate) fn input_c(b: &BsdfNode, s: &[f32], id: &str, d: V3) -> V3 {
     b.input(id)
         .map(|(slot, _)| finite3(v3(s, slot)))
         .unwrap_or(d)
 }
-pub(super) fn input_n(b: &BsdfNode, s: &[f32], id: &str, sp: &ShadingPoint) -> V3 {
+pub(crate) fn input_n(b: &BsdfNode, s: &[f32], id: &str, sp: &ShadingPoint) -> V3 {
     match b.input(id) {
         Some((slot, true)) => {
             let n = normalize(finite3(v3(s, slot)));
@@ -307,7 +311,7 @@ pub(super) fn input_n(b: &BsdfNode, s: &[f32], id: &str, sp: &ShadingPoint) -> V
     }
 }
 
-pub(super) fn multiscatter_energy(tables: &Tables, mu: f32, roughness: f32) -> f32 {
+pub(crate) fn multiscatter_energy(tables: &Tables, mu: f32, roughness: f32) -> f32 {
     let e = tables.ggx_e(mu, roughness).max(1e-3);
     1.0 / e
 }
@@ -319,7 +323,7 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             let n = input_n(b, s, "Normal", sp);
             let r = input_f(b, s, "Roughness", 0.0);
             if r >= 1e-5 {
-                let on = super::oren_nayar::OrenNayar::new(r, c, dot(n, ctx.wo));
+                let on = crate::render::bsdf::oren_nayar::OrenNayar::new(r, c, dot(n, ctx.wo));
                 out.push(LobeKind::OrenNayar(on), scale(c, w), n);
             } else {
                 out.push(LobeKind::Diffuse, scale(c, w), n);
@@ -345,8 +349,8 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             let r = input_f(b, s, "Roughness", 0.5).clamp(0.0, 1.0);
             let n = valid_n(sp, ctx, input_n(b, s, "Normal", sp));
             if b.property("distribution") == Some("BECKMANN") {
-                let r = super::microfacet::Reflection {
-                    dist: super::microfacet::Distribution::Beckmann,
+                let r = crate::render::bsdf::microfacet::Reflection {
+                    dist: crate::render::bsdf::microfacet::Distribution::Beckmann,
                     alpha: r * r,
                 };
                 out.push(LobeKind::Reflection(r), scale(c, w), n);
@@ -356,7 +360,7 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
             let aniso = input_f(b, s, "Anisotropy", 0.0).clamp(-0.99, 0.99);
             if aniso.abs() > 1e-4 {
-                let (ax, ay) = super::anisotropic::glossy_alphas(r, aniso);
+                let (ax, ay) = crate::render::bsdf::anisotropic::glossy_alphas(r, aniso);
                 let t = tangent_input(b, s, sp, "Tangent", input_f(b, s, "Rotation", 0.0), n);
                 push_glossy(
                     out,
@@ -388,10 +392,10 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             );
         }
         "ShaderNodeBsdfPrincipled" => principled(b, w, s, sp, ctx, out),
-        "ShaderNodeBsdfMetallic" => super::metallic::metallic(b, w, s, sp, ctx, out),
+        "ShaderNodeBsdfMetallic" => crate::render::bsdf::metallic::metallic(b, w, s, sp, ctx, out),
         "ShaderNodeBsdfToon" => {
             let c = input_c(b, s, "Color", [0.8; 3]);
-            let toon = super::toon::Toon::new(
+            let toon = crate::render::bsdf::toon::Toon::new(
                 input_f(b, s, "Size", 0.5),
                 input_f(b, s, "Smooth", 0.0),
                 b.property("component") == Some("GLOSSY"),
@@ -409,7 +413,7 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             let r = input_f(b, s, "Roughness", 0.0);
             let n = valid_n(sp, ctx, input_n(b, s, "Normal", sp));
             let refract_only = b.bl_idname == "ShaderNodeBsdfRefraction";
-            let g = super::microfacet::glass_closure(
+            let g = crate::render::bsdf::microfacet::glass_closure(
                 ctx.tables,
                 b.property("distribution"),
                 refract_only,
@@ -497,8 +501,10 @@ fn principled(
     };
     let a = roughness * roughness;
     // Anisotropic metallic and specular layers (alphas stretched along the tangent).
-    let (ax, ay) =
-        super::anisotropic::principled_alphas(roughness, input_f(b, s, "Anisotropic", 0.0));
+    let (ax, ay) = crate::render::bsdf::anisotropic::principled_alphas(
+        roughness,
+        input_f(b, s, "Anisotropic", 0.0),
+    );
     let tangent = if ax != ay {
         tangent_input(
             b,
@@ -516,7 +522,7 @@ fn principled(
     // leaves the metallic layer without it.
     let film_thickness = input_f(b, s, "Thin Film Thickness", 0.0).max(1e-5);
     let film_ior = input_f(b, s, "Thin Film IOR", 1.33).max(1e-5);
-    let film = film_thickness > super::thin_film::CUTOFF;
+    let film = film_thickness > crate::render::bsdf::thin_film::CUTOFF;
     weight = principled_sheen(b, s, sp, ctx, out, weight, n, coat);
     if coat > 0.0 {
         weight = principled_coat(b, s, sp, ctx, out, weight, coat);
@@ -562,7 +568,7 @@ fn principled(
     if transmission > 0.0 {
         // Rough glass: reflection tinted by the specular tint, refraction by sqrt of the base
         // colour (light crosses the surface twice), as Cycles' Principled sets it up.
-        let mut g = super::microfacet::glass_closure(
+        let mut g = crate::render::bsdf::microfacet::glass_closure(
             ctx.tables,
             Some(if multi { "MULTI_GGX" } else { "GGX" }),
             false,
@@ -576,13 +582,13 @@ fn principled(
         if film {
             // Cycles' film IOR is relative to the side the light comes from: film / ior
             // seen from inside. The specular tint scales the film's reflectance instead.
-            let f0 = super::bsdf::f0_from_ior(ior);
+            let f0 = crate::render::bsdf::f0_from_ior(ior);
             let film_eta = if ctx.backfacing {
                 film_ior / ior
             } else {
                 film_ior
             };
-            g.film = Some(super::thin_film::ThinFilm {
+            g.film = Some(crate::render::bsdf::thin_film::ThinFilm {
                 thickness: film_thickness,
                 ior: film_eta,
                 eta: g.eta,
@@ -596,7 +602,7 @@ fn principled(
     // Dielectric specular: IOR adjusted by the specular IOR level as Cycles does.
     let mut eta = ior;
     if spec_level != 0.5 {
-        let f0 = (super::bsdf::f0_from_ior(ior) * 2.0 * spec_level).min(0.9999);
+        let f0 = (crate::render::bsdf::f0_from_ior(ior) * 2.0 * spec_level).min(0.9999);
         let sq = f0.sqrt();
         eta = (1.0 + sq) / (1.0 - sq);
         if ior < 1.0 {
@@ -686,7 +692,11 @@ fn principled(
     }
     let diffuse_roughness = input_f(b, s, "Diffuse Roughness", 0.0);
     if diffuse_roughness >= 1e-5 {
-        let on = super::oren_nayar::OrenNayar::new(diffuse_roughness, base, dot(n, ctx.wo));
+        let on = crate::render::bsdf::oren_nayar::OrenNayar::new(
+            diffuse_roughness,
+            base,
+            dot(n, ctx.wo),
+        );
         out.push(LobeKind::OrenNayar(on), mul(weight, base), n);
         return;
     }
@@ -712,14 +722,14 @@ fn principled_film_specular(
     vn: V3,
     mu: f32,
 ) {
-    let f0_real = super::bsdf::f0_from_ior(eta);
-    let f0 = super::bsdf::f0_from_ior(ior) * 2.0 * spec_level;
+    let f0_real = crate::render::bsdf::f0_from_ior(eta);
+    let f0 = crate::render::bsdf::f0_from_ior(ior) * 2.0 * spec_level;
     let f0_scale = if f0_real > 0.0 {
         spec_tint.map(|t| (f0 * t).clamp(0.0, 1.0) / f0_real)
     } else {
         [1.0; 3]
     };
-    let tf = super::thin_film::ThinFilm {
+    let tf = crate::render::bsdf::thin_film::ThinFilm {
         thickness,
         ior: film_ior,
         eta,
@@ -770,7 +780,7 @@ fn push_bssrdf(
     n: V3,
 ) {
     let (bssrdf, diffuse, channels) =
-        super::subsurface::setup(weight, radius, albedo, aniso, ior, roughness, method);
+        crate::render::subsurface::setup(weight, radius, albedo, aniso, ior, roughness, method);
     if !is_zero(diffuse) {
         out.push(LobeKind::Diffuse, diffuse, n);
     }
@@ -837,10 +847,14 @@ fn push_sheen_node(
 ) {
     let r = roughness.clamp(0.0, 1.0);
     if distribution == Some("ASHIKHMIN") {
-        out.push(LobeKind::Velvet(super::sheen::Velvet::new(r)), weight, n);
+        out.push(
+            LobeKind::Velvet(crate::render::bsdf::sheen::Velvet::new(r)),
+            weight,
+            n,
+        );
         return;
     }
-    let (sheen, albedo) = super::sheen::Sheen::new(n, wo, r);
+    let (sheen, albedo) = crate::render::bsdf::sheen::Sheen::new(n, wo, r);
     out.push(LobeKind::Sheen(sheen), scale(weight, albedo), n);
 }
 
@@ -875,7 +889,7 @@ fn principled_sheen(
     if lobe_w[0].abs() + lobe_w[1].abs() + lobe_w[2].abs() <= 1e-5 {
         return weight;
     }
-    let (sheen, albedo) = super::sheen::Sheen::new(sn, ctx.wo, r);
+    let (sheen, albedo) = crate::render::bsdf::sheen::Sheen::new(sn, ctx.wo, r);
     out.push(LobeKind::Sheen(sheen), scale(lobe_w, albedo), sn);
     // Cycles' closure_layering_weight: albedo over weight is sheen weight x tint x albedo.
     let layer = scale(tint, sheen_w * albedo);
@@ -885,7 +899,7 @@ fn principled_sheen(
 /// The tangent of an anisotropic closure: the node's Tangent input when linked, else
 /// Cycles' default (Geometry > Tangent: radial about the object's Z), rotated about the
 /// closure normal `n` by `rotation` turns.
-pub(super) fn tangent_input(
+pub(crate) fn tangent_input(
     b: &BsdfNode,
     s: &[f32],
     sp: &ShadingPoint,
@@ -898,7 +912,7 @@ pub(super) fn tangent_input(
         _ => crate::shader::inputs::radial_tangent(sp, 2),
     };
     if rotation != 0.0 {
-        super::anisotropic::rotate_around_axis(t, n, rotation * std::f32::consts::TAU)
+        crate::render::bsdf::anisotropic::rotate_around_axis(t, n, rotation * std::f32::consts::TAU)
     } else {
         t
     }
@@ -907,7 +921,7 @@ pub(super) fn tangent_input(
 /// A GGX reflection lobe with alphas (`ax`, `ay`) along tangent `t`: anisotropic unless
 /// singular, Multiscatter energy from the isotropic table at (ax ay)^(1/4) when `multi`.
 #[allow(clippy::too_many_arguments)]
-pub(super) fn push_glossy(
+pub(crate) fn push_glossy(
     out: &mut LobeSet,
     ctx: &Context,
     ax: f32,
@@ -919,7 +933,7 @@ pub(super) fn push_glossy(
     n: V3,
     albedo: f32,
 ) {
-    let lobe = super::anisotropic::AnisoGgx::new(n, t, ax, ay);
+    let lobe = crate::render::bsdf::anisotropic::AnisoGgx::new(n, t, ax, ay);
     let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
     let energy = if multi {
         multiscatter_energy(ctx.tables, mu, lobe.table_roughness())

@@ -4,13 +4,18 @@
 //! sun (W/m^2; cone of `angle`).
 //! Sampling returns direction, distance and the contribution divided by the pdf.
 
+pub mod area;
+pub mod tree;
+pub mod triangle;
+pub mod world;
+
 use serde_json::Value;
 use std::f32::consts::PI;
 
-use super::area_light::{rect_solid_angle, Region, Spread};
-use super::math::*;
-use super::RenderError;
 use crate::anim::EvaluatedScene;
+use crate::render::light::area::{rect_solid_angle, Region, Spread};
+use crate::render::math::*;
+use crate::render::RenderError;
 use crate::scene::settings::{AreaShape, LightSettings};
 
 #[derive(Debug, Clone)]
@@ -388,7 +393,7 @@ fn one_minus_cos_from_sin2(s2: f32) -> f32 {
 /// A direction uniform in the cone about `axis` with 1 - cos(half angle) = `omc`
 /// (Cycles' concentric cone mapping), and its cosine to the axis.
 fn sample_cone(axis: V3, omc: f32, u: [f32; 2]) -> (V3, f32) {
-    let xy = super::camera::concentric_disk(u);
+    let xy = crate::render::camera::concentric_disk(u);
     let r2 = xy[0] * xy[0] + xy[1] * xy[1];
     let cos_theta = 1.0 - r2 * omc;
     let k = (omc * (2.0 - omc * r2)).max(0.0).sqrt();
@@ -468,7 +473,7 @@ impl Light {
                     // point, the spot cone weighing the sampled direction. (Inside a sphere
                     // light Cycles samples the hemisphere, unweighted by the cone; rare,
                     // done here as the disk.)
-                    let disk = super::camera::concentric_disk(u);
+                    let disk = crate::render::camera::concentric_disk(u);
                     let (t, b) = basis(w);
                     let q = add(
                         self.pos,
@@ -546,7 +551,7 @@ impl Light {
                     let (s, q) = rect_solid_angle(p, &region, Some(u));
                     (q?, 1.0 / s)
                 } else {
-                    let d = super::camera::concentric_disk(u);
+                    let d = crate::render::camera::concentric_disk(u);
                     let q = add(
                         region.centre,
                         add(

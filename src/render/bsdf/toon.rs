@@ -5,7 +5,7 @@
 
 use std::f32::consts::{FRAC_PI_2, PI};
 
-use super::math::*;
+use crate::render::math::*;
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Toon {
@@ -83,7 +83,7 @@ impl Toon {
     pub fn sample(&self, n: V3, wo: V3, ng: V3, u: [f32; 2]) -> Option<V3> {
         let axis = self.axis(n, wo)?;
         let one_minus_cos = 1.0 - self.sample_angle().cos();
-        let d = super::camera::concentric_disk(u);
+        let d = crate::render::camera::concentric_disk(u);
         let r2 = d[0] * d[0] + d[1] * d[1];
         let cos_theta = 1.0 - r2 * one_minus_cos;
         let k = (one_minus_cos * (2.0 - one_minus_cos * r2)).max(0.0).sqrt();

@@ -7,8 +7,8 @@
 //!
 //! Directions: `v` toward the viewer, `l` toward the light.
 
-use super::math::*;
-use super::sheen_ltc::SHEEN_LTC;
+use crate::render::bsdf::sheen_ltc::SHEEN_LTC;
+use crate::render::math::*;
 use std::f32::consts::PI;
 
 const TABLE: usize = 32;
@@ -103,7 +103,7 @@ impl Sheen {
         if self.a <= 0.0 {
             return None;
         }
-        let d = super::camera::concentric_disk(u);
+        let d = crate::render::camera::concentric_disk(u);
         let dz = (1.0 - d[0] * d[0] - d[1] * d[1]).max(0.0).sqrt();
         let local = normalize([(d[0] - dz * self.b) / self.a, d[1] / self.a, dz]);
         let l = add(
@@ -205,7 +205,7 @@ mod tests {
         for (mu, r) in [(0.9f32, 0.3f32), (0.4, 0.7), (0.15, 1.0)] {
             let v = [(1.0 - mu * mu).sqrt(), 0.0, mu];
             let (s, _) = Sheen::new(n, v, r);
-            let sampler = super::super::sampler::PixelSampler::new(1, 2, 3);
+            let sampler = crate::render::sampler::PixelSampler::new(1, 2, 3);
             let count = 20000;
             let (mut hits, mut integral) = (0, 0.0f64);
             for i in 0..count {

@@ -11,8 +11,8 @@
 //! only multiplies that throughput. Emission and background met on the way add to the
 //! albedo. A path that never writes leaves zero.
 
-use super::bsdf::{LobeKind, LobeSet};
-use super::math::*;
+use crate::render::bsdf::{LobeKind, LobeSet};
+use crate::render::math::*;
 
 /// One sample's guide values and the state of their path.
 #[derive(Debug, Clone, Copy)]

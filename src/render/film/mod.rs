@@ -1,0 +1,8 @@
+//! The film: what a camera sample leaves in a pixel besides its colour. The pixel filter
+//! (`filter`), adaptive sampling's per-pixel error (`adaptive`), the denoiser's albedo and
+//! normal features (`denoise_features`) and optical flow (`flow`).
+
+pub mod adaptive;
+pub mod denoise_features;
+pub mod filter;
+pub mod flow;
