@@ -488,6 +488,52 @@ fn masks_are_16_bit_beyond_254_classes() {
 }
 
 #[test]
+fn a_kill_at_every_write_then_resume_equals_an_uninterrupted_run() {
+    // Every point at which a kill can leave the folder different: after each atomic
+    // write's rename, and with each write's temporary file complete but not renamed
+    // (BLENDSYNTH_KILL_AT_WRITE, foundation/files.rs). That includes the final step
+    // (frames.jsonl, COCO, data.yaml), which a kill timed from outside rarely hits.
+    use std::os::unix::process::ExitStatusExt;
+    let clean = tmp("every-clean");
+    ok(generate(&clean, "4", &[]).output().unwrap());
+    let files = tree(&clean).len() as u64;
+    let killed = tmp("every-killed");
+    let mut kills = 0;
+    for when in ["", ":before-rename"] {
+        for n in 1.. {
+            let _ = std::fs::remove_dir_all(&killed);
+            let o = generate(&killed, "4", &[])
+                .env("BLENDSYNTH_KILL_AT_WRITE", format!("{n}{when}"))
+                .output()
+                .unwrap();
+            if o.status.success() {
+                // Past the run's last write: every file is written once.
+                assert_eq!(n, files + 1, "{n}{when}: the run wrote {files} files");
+                break;
+            }
+            assert_eq!(
+                o.status.signal(),
+                Some(9),
+                "{n}{when}: {}",
+                common::stderr(&o)
+            );
+            kills += 1;
+            let partials = tree(&killed)
+                .into_keys()
+                .filter(|k| k.ends_with(".partial"))
+                .count();
+            // The other worker (--jobs 2) may be inside a write of its own.
+            assert!(partials >= usize::from(!when.is_empty()), "{n}{when}");
+            ok(generate(&killed, "4", &["--resume"]).output().unwrap());
+            assert_same_tree(&clean, &killed);
+        }
+    }
+    assert_eq!(kills, 2 * files);
+    std::fs::remove_dir_all(&clean).unwrap();
+    std::fs::remove_dir_all(&killed).unwrap();
+}
+
+#[test]
 fn kills_at_random_moments_then_resume_equal_an_uninterrupted_run() {
     // The quick version of fixtures/dataset/kill_resume.sh (the report runs 100 kills).
     let o = Command::new("bash")
