@@ -715,15 +715,8 @@ impl FrameContext<'_> {
         };
         let mesh = crate::render::evaluated_scene_mesh(scene, &opts, &[])
             .map_err(|e| format!("the scene mesh: {e}"))?;
-        let dir = path.parent().ok_or("no folder")?;
-        std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().to_string())
-            .unwrap_or_default();
-        let tmp = dir.join(format!(".{name}.{}.partial", std::process::id()));
-        crate::geometry::export::write_glb(&tmp, &mesh, "scene").map_err(|e| e.to_string())?;
-        std::fs::rename(&tmp, path).map_err(|e| format!("{}: {e}", path.display()))
+        let glb = crate::geometry::export::glb_bytes(&mesh, "scene").map_err(|e| e.to_string())?;
+        write_atomic(path, &glb)
     }
 
     /// A frame's optical flow (EXR, and .flo on request) and occlusion masks, as the

@@ -2,16 +2,11 @@
 //! `scene::read_glb` reads it back). Vertices stay one to one with Blender's: UVs are
 //! per corner (OBJ `vt` per corner, glb corner attributes), nothing is split.
 
-use std::io::Write;
 use std::path::Path;
 
 use super::error::GeometryError;
 use super::mesh::Mesh;
 use super::types::{Array, Domain};
-
-fn io_err(path: &Path, e: std::io::Error) -> GeometryError {
-    GeometryError::new(format!("{}: {e}", path.display()))
-}
 
 /// The first named FLOAT2 corner attribute (the UV map).
 fn uv_map(m: &Mesh) -> Option<(&str, &Vec<[f32; 2]>)> {
@@ -32,7 +27,7 @@ fn material_indices(m: &Mesh) -> Vec<i32> {
 
 /// Binary little-endian PLY: vertices (x, y, z), faces (vertex indices and
 /// `material_index`), loose edges as an `edge` element.
-pub fn write_ply(path: &Path, m: &Mesh) -> Result<(), GeometryError> {
+pub fn ply_bytes(m: &Mesh) -> Result<Vec<u8>, GeometryError> {
     let mut used = vec![false; m.edge_count()];
     for &e in &m.corner_edges {
         if let Some(u) = used.get_mut(e as usize) {
@@ -64,8 +59,7 @@ pub fn write_ply(path: &Path, m: &Mesh) -> Result<(), GeometryError> {
         let r = m.face(f);
         if r.len() > 255 {
             return Err(GeometryError::new(format!(
-                "{}: face {f} has {} corners, more than PLY's uchar count holds",
-                path.display(),
+                "face {f} has {} corners, more than PLY's uchar count holds",
                 r.len()
             )));
         }
@@ -79,12 +73,12 @@ pub fn write_ply(path: &Path, m: &Mesh) -> Result<(), GeometryError> {
         out.extend_from_slice(&(e[0] as i32).to_le_bytes());
         out.extend_from_slice(&(e[1] as i32).to_le_bytes());
     }
-    std::fs::write(path, out).map_err(|e| io_err(path, e))
+    Ok(out)
 }
 
 /// OBJ: `v` per vertex in Blender's order, `vt` per face corner when there is a UV map,
 /// `usemtl` where the material changes, `l` for loose edges.
-pub fn write_obj(path: &Path, m: &Mesh) -> Result<(), GeometryError> {
+pub fn obj_bytes(m: &Mesh) -> Vec<u8> {
     let mut s = String::new();
     s.push_str("# blendsynth: Blender vertex order, one vt per face corner\n");
     for p in &m.positions {
@@ -130,8 +124,7 @@ pub fn write_obj(path: &Path, m: &Mesh) -> Result<(), GeometryError> {
             s.push_str(&format!("l {} {}\n", e[0] + 1, e[1] + 1));
         }
     }
-    let mut f = std::fs::File::create(path).map_err(|e| io_err(path, e))?;
-    f.write_all(s.as_bytes()).map_err(|e| io_err(path, e))
+    s.into_bytes()
 }
 
 struct GlbBuilder {
@@ -199,7 +192,7 @@ fn u32s(v: impl Iterator<Item = u32>) -> Vec<u8> {
 /// glb in the exporter's layout (FORMAT.md, "The mesh glb"): the exact mesh in
 /// `extras.blendsynth` plus a corner-split triangle primitive for viewers.
 // Long because it writes the glb's JSON and binary chunks in one pass, in the exporter's layout.
-pub fn write_glb(path: &Path, m: &Mesh, name: &str) -> Result<(), GeometryError> {
+pub fn glb_bytes(m: &Mesh, name: &str) -> Result<Vec<u8>, GeometryError> {
     let md = m.to_scene(name);
     let mut b = GlbBuilder {
         bin: Vec::new(),
@@ -386,24 +379,52 @@ pub fn write_glb(path: &Path, m: &Mesh, name: &str) -> Result<(), GeometryError>
     out.extend_from_slice(&(b.bin.len() as u32).to_le_bytes());
     out.extend_from_slice(b"BIN\0");
     out.extend_from_slice(&b.bin);
-    std::fs::write(path, out).map_err(|e| io_err(path, e))
+    Ok(out)
 }
 
-/// Writes `m` in the format `path`'s extension names (`glb`, `ply` or `obj`), through a
-/// temporary file in the same folder renamed into place, so a failure never leaves a
-/// half-written output.
+/// Writes `m` as binary PLY (`ply_bytes`), atomically.
+pub fn write_ply(path: &Path, m: &Mesh) -> Result<(), GeometryError> {
+    write_atomic(path, &ply_bytes(m).map_err(|e| in_file(path, e))?)
+}
+
+/// Writes `m` as OBJ (`obj_bytes`), atomically.
+pub fn write_obj(path: &Path, m: &Mesh) -> Result<(), GeometryError> {
+    write_atomic(path, &obj_bytes(m))
+}
+
+/// Writes `m` as glTF binary (`glb_bytes`), atomically.
+pub fn write_glb(path: &Path, m: &Mesh, name: &str) -> Result<(), GeometryError> {
+    write_atomic(path, &glb_bytes(m, name).map_err(|e| in_file(path, e))?)
+}
+
+fn in_file(path: &Path, e: GeometryError) -> GeometryError {
+    GeometryError::new(format!("{}: {e}", path.display()))
+}
+
+/// The one atomic writer (a temporary file beside `path`, synced, renamed over it), so a
+/// failure never leaves a half-written output.
+fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), GeometryError> {
+    crate::foundation::files::write_atomic(path, bytes).map_err(GeometryError::new)
+}
+
+/// Writes `m` in the format `path`'s extension names (`glb`, `ply` or `obj`), atomically.
 pub fn write_mesh(path: &Path, m: &Mesh, name: &str) -> Result<(), GeometryError> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase)
         .unwrap_or_default();
-    if !matches!(ext.as_str(), "glb" | "ply" | "obj") {
-        return Err(GeometryError::new(format!(
-            "{}: unknown mesh format (use .glb, .ply or .obj)",
-            path.display()
-        )));
-    }
+    let bytes = match ext.as_str() {
+        "glb" => glb_bytes(m, name).map_err(|e| in_file(path, e))?,
+        "ply" => ply_bytes(m).map_err(|e| in_file(path, e))?,
+        "obj" => obj_bytes(m),
+        _ => {
+            return Err(GeometryError::new(format!(
+                "{}: unknown mesh format (use .glb, .ply or .obj)",
+                path.display()
+            )))
+        }
+    };
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -415,19 +436,5 @@ pub fn write_mesh(path: &Path, m: &Mesh, name: &str) -> Result<(), GeometryError
             dir.display()
         )));
     }
-    let file_name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{file_name}.{}.part.{ext}", std::process::id()));
-    let written = match ext.as_str() {
-        "glb" => write_glb(&tmp, m, name),
-        "ply" => write_ply(&tmp, m),
-        _ => write_obj(&tmp, m),
-    };
-    if let Err(e) = written.and_then(|_| std::fs::rename(&tmp, path).map_err(|e| io_err(path, e))) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(e);
-    }
-    Ok(())
+    write_atomic(path, &bytes)
 }
