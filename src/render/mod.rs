@@ -1016,17 +1016,5 @@ fn primary_passes(
     }
 }
 
-/// Writes linear RGBA to a float EXR atomically (temp file + rename).
-pub fn write_exr(
-    path: &std::path::Path,
-    width: u32,
-    height: u32,
-    pixels: &[[f32; 4]],
-) -> Result<(), RenderError> {
-    let bytes = crate::foundation::exr::rgba_bytes(width, height, pixels)
-        .map_err(|e| RenderError(format!("{}: {e}", path.display())))?;
-    crate::foundation::files::write_atomic(path, &bytes).map_err(RenderError)
-}
-
 #[doc(hidden)]
 pub fn _assert_accel_object_safe(_: &dyn Accel) {}

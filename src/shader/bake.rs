@@ -282,9 +282,7 @@ pub fn write_exr(b: &Baked, path: &Path) -> Result<(), String> {
     for y in 0..n {
         rows[(n - 1 - y) * n..(n - y) * n].copy_from_slice(&b.pixels[y * n..(y + 1) * n]);
     }
-    let bytes = crate::foundation::exr::rgba_bytes(b.size, b.size, &rows)
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    crate::foundation::files::write_atomic(path, &bytes)
+    crate::color::write_exr(path, b.size, b.size, &rows).map_err(|e| e.to_string())
 }
 
 /// The transpose of the 3x3 part of `m` times `v` (world to object for normals).
