@@ -408,29 +408,58 @@ impl Bvh {
     }
 }
 
-impl Accel for Bvh {
-    fn intersect(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.traverse::<false>(org, dir, tmin, tmax, visibility::ALL)
-    }
-    fn occluded(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> bool {
-        self.traverse::<true>(org, dir, tmin, tmax, visibility::ALL)
-            .is_some()
-    }
-    fn intersect_vis(
-        &self,
-        org: V3,
-        dir: V3,
-        tmin: f32,
-        tmax: f32,
-        _time: f32,
-        mask: u32,
-    ) -> Option<Hit> {
-        self.traverse::<false>(org, dir, tmin, tmax, mask)
-    }
-    fn occluded_vis(&self, org: V3, dir: V3, tmin: f32, tmax: f32, _time: f32, mask: u32) -> bool {
-        self.traverse::<true>(org, dir, tmin, tmax, mask).is_some()
-    }
+/// `Accel` for a BVH with `traverse::<ANY_HIT>(org, dir, tmin, tmax, mask)`: both BVH
+/// layouts answer every query by it (static geometry: the shutter time is ignored).
+macro_rules! accel_by_traverse {
+    ($t:ty) => {
+        impl $crate::foundation::bvh::Accel for $t {
+            fn intersect(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> Option<Hit> {
+                self.traverse::<false>(
+                    org,
+                    dir,
+                    tmin,
+                    tmax,
+                    $crate::foundation::bvh::visibility::ALL,
+                )
+            }
+            fn occluded(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> bool {
+                self.traverse::<true>(
+                    org,
+                    dir,
+                    tmin,
+                    tmax,
+                    $crate::foundation::bvh::visibility::ALL,
+                )
+                .is_some()
+            }
+            fn intersect_vis(
+                &self,
+                org: V3,
+                dir: V3,
+                tmin: f32,
+                tmax: f32,
+                _time: f32,
+                mask: u32,
+            ) -> Option<Hit> {
+                self.traverse::<false>(org, dir, tmin, tmax, mask)
+            }
+            fn occluded_vis(
+                &self,
+                org: V3,
+                dir: V3,
+                tmin: f32,
+                tmax: f32,
+                _time: f32,
+                mask: u32,
+            ) -> bool {
+                self.traverse::<true>(org, dir, tmin, tmax, mask).is_some()
+            }
+        }
+    };
 }
+pub(crate) use accel_by_traverse;
+
+accel_by_traverse!(Bvh);
 
 #[inline(always)]
 fn slab(n: &Node, org: V3, inv: V3, tmin: f32, tmax: f32) -> Option<f32> {

@@ -7,7 +7,7 @@
 //! the same watertight test and tie rule (`Bvh::leaf`), so every query returns exactly
 //! the hit the binary BVH returns and images are bit-identical.
 
-use super::bvh::{Accel, Bvh, Hit, Watertight};
+use super::bvh::{Bvh, Hit, Watertight};
 use super::math::*;
 use std::mem::MaybeUninit;
 
@@ -273,26 +273,4 @@ fn slab4(n: &Node4, r: &RaySlab, tmin: f32, tmax: f32) -> ([f32; 4], u32) {
     }
 }
 
-impl Accel for Bvh4 {
-    fn intersect(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> Option<Hit> {
-        self.traverse::<false>(org, dir, tmin, tmax, super::bvh::visibility::ALL)
-    }
-    fn occluded(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> bool {
-        self.traverse::<true>(org, dir, tmin, tmax, super::bvh::visibility::ALL)
-            .is_some()
-    }
-    fn intersect_vis(
-        &self,
-        org: V3,
-        dir: V3,
-        tmin: f32,
-        tmax: f32,
-        _time: f32,
-        mask: u32,
-    ) -> Option<Hit> {
-        self.traverse::<false>(org, dir, tmin, tmax, mask)
-    }
-    fn occluded_vis(&self, org: V3, dir: V3, tmin: f32, tmax: f32, _time: f32, mask: u32) -> bool {
-        self.traverse::<true>(org, dir, tmin, tmax, mask).is_some()
-    }
-}
+super::bvh::accel_by_traverse!(Bvh4);
