@@ -181,13 +181,6 @@ pub fn render_with_motion(
         )));
     }
     let (out, camera, geo, frame) = render_frame(scene, opts, overrides, control)?;
-    if camera.panorama.is_some() {
-        return Err(RenderError(
-            "optical flow: the scene's camera is panoramic, which flow does not support \
-             (only perspective and orthographic cameras)"
-                .into(),
-        ));
-    }
     let here = film::flow::FrameView {
         camera: &camera,
         geo: &geo,

@@ -307,14 +307,19 @@ impl Camera {
     }
 
     /// Where world point `w` lands on the image (the inverse of `ray`'s raster to
-    /// viewplane mapping; Cycles' worldtoraster): pixels, x right, y down from the top-left
-    /// corner, in f64. None behind a perspective camera's eye plane; panoramic cameras
-    /// have no inverse here (the caller names the camera).
+    /// viewplane mapping; Cycles' worldtoraster, or for a panorama its direction from the
+    /// eye through direction_to_panorama): pixels, x right, y down from the top-left
+    /// corner, in f64. None behind a perspective camera's eye plane and outside a
+    /// panorama's lens.
     pub fn raster_of(&self, w: V3) -> Option<[f64; 2]> {
-        if self.panorama.is_some() {
-            return None;
-        }
         let m = &self.to_world.m;
+        if let Some(pano) = &self.panorama {
+            let d = sub(w, self.to_world.column(3));
+            // Camera space: the transpose of the (scale-free) rotation.
+            let c = |i: usize| m[0][i] * d[0] + m[1][i] * d[1] + m[2][i] * d[2];
+            let [u, v] = pano.uv_of(pano.from_blender_camera([c(0), c(1), c(2)]))?;
+            return Some(self.raster_of_viewplane(u as f64, v as f64));
+        }
         let d = [
             w[0] as f64 - m[0][3] as f64,
             w[1] as f64 - m[1][3] as f64,
@@ -332,16 +337,21 @@ impl Camera {
             let k = 1.0 / (-z * self.tan_half as f64);
             (x * k, y * k)
         };
+        Some(self.raster_of_viewplane(vx, vy))
+    }
+
+    /// Raster position (pixels, y down) of viewplane point (vx, vy): `ray`'s mapping inverted.
+    fn raster_of_viewplane(&self, vx: f64, vy: f64) -> [f64; 2] {
         let (l, r, b, t) = (
             self.left as f64,
             self.right as f64,
             self.bottom as f64,
             self.top as f64,
         );
-        Some([
+        [
             (vx - l) / (r - l) * self.width as f64,
             (t - vy) / (t - b) * self.height as f64,
-        ])
+        ]
     }
 
     /// The camera-space Z distance of a world point (for the depth pass).

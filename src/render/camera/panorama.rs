@@ -144,6 +144,100 @@ impl Panorama {
         }
     }
 
+    /// The viewplane point (u, v) a direction in panorama space projects to: the inverse
+    /// of `direction`, as Cycles' direction_to_panorama (which its Vector pass uses). None
+    /// for a zero direction and, for the fisheyes and the mirror ball, outside the lens.
+    pub fn uv_of(&self, d: V3) -> Option<[f32; 2]> {
+        let l = len(d);
+        if !(l > 0.0) {
+            return None;
+        }
+        let d = scale(d, 1.0 / l);
+        // The (y, z) direction of a fisheye's image radius.
+        let yz = || {
+            let r = (d[1] * d[1] + d[2] * d[2]).sqrt();
+            if r > 0.0 {
+                [d[1] / r, d[2] / r]
+            } else {
+                [0.0, 0.0]
+            }
+        };
+        let uv = match *self {
+            Panorama::Equirectangular(r) => [
+                (d[1].atan2(d[0]) - r[1]) / r[0],
+                (d[2].clamp(-1.0, 1.0).acos() - r[3]) / r[2],
+            ],
+            Panorama::EquiangularCubemapFace => {
+                if !(d[0] > 0.0) {
+                    return None;
+                }
+                let k = 2.0 / std::f32::consts::PI;
+                [0.5 - d[1].atan2(d[0]) * k, d[2].atan2(d[0]) * k + 0.5]
+            }
+            Panorama::MirrorBall => {
+                // The ball's normal halfway between the view ray (0, -1, 0) reversed and d.
+                let h = [d[0], d[1] - 1.0, d[2]];
+                let div = 2.0 * (-0.5 * h[1]).max(0.0).sqrt();
+                if !(div > 0.0) {
+                    return None;
+                }
+                [0.5 * (h[0] / div + 1.0), 0.5 * (h[2] / div + 1.0)]
+            }
+            Panorama::FisheyeEquidistant { fov } => {
+                let theta = (d[1] * d[1] + d[2] * d[2]).sqrt().atan2(d[0]);
+                if theta > 0.5 * fov {
+                    return None;
+                }
+                let r = theta / fov;
+                let n = yz();
+                [0.5 - r * n[0], r * n[1] + 0.5]
+            }
+            Panorama::FisheyeEquisolid { lens, fov, sensor } => {
+                let theta = d[0].clamp(-1.0, 1.0).acos();
+                if theta > 0.5 * fov {
+                    return None;
+                }
+                let r = 2.0 * lens * (0.5 * theta).sin();
+                let n = yz();
+                [0.5 - r * n[0] / sensor[0], r * n[1] / sensor[1] + 0.5]
+            }
+            Panorama::FisheyeLensPolynomial { k0, k, fov, sensor } => {
+                // Newton's method on theta = -(k0 + k1 r + k2 r^2 + k3 r^3 + k4 r^4), from the
+                // linear model's root, as Cycles' direction_to_fisheye_lens_polynomial.
+                let theta = -d[0].clamp(-1.0, 1.0).acos();
+                if theta.abs() > 0.5 * fov {
+                    return None;
+                }
+                let mut r = (theta - k0) / k[0];
+                for _ in 0..20 {
+                    let (r2, old) = (r * r, r);
+                    let f = theta - (k0 + k[0] * r + k[1] * r2 + k[2] * r2 * r + k[3] * r2 * r2);
+                    let df = k[0] + 2.0 * k[1] * r + 3.0 * k[2] * r2 + 4.0 * k[3] * r2 * r;
+                    r += f / df;
+                    if (r - old).abs() < 1e-6 {
+                        break;
+                    }
+                }
+                let n = yz();
+                [0.5 - r * n[0] / sensor[0], r * n[1] / sensor[1] + 0.5]
+            }
+            Panorama::CentralCylindrical(r) => {
+                let z = d[2] / (d[0] * d[0] + d[1] * d[1]).sqrt();
+                let theta = d[1].atan2(d[0]);
+                [(theta - r[0]) / (r[1] - r[0]), (z - r[2]) / (r[3] - r[2])]
+            }
+        };
+        uv.iter().all(|x| x.is_finite()).then_some(uv)
+    }
+
+    /// Blender's camera space to panorama space (the inverse of `to_blender_camera`).
+    pub fn from_blender_camera(&self, b: V3) -> V3 {
+        match self {
+            Panorama::MirrorBall => [b[0], b[2], b[1]],
+            _ => [-b[2], -b[0], b[1]],
+        }
+    }
+
     /// Panorama space to Blender's camera space: Cycles' camera matrix points +X (or -Y
     /// for the mirror ball) down the Blender camera's -Z.
     pub fn to_blender_camera(&self, d: V3) -> V3 {
@@ -200,6 +294,60 @@ mod tests {
                 (d[2] + 1.0).abs() < 1e-5 && d[0].abs() < 1e-5 && d[1].abs() < 1e-5,
                 "{k:?}: {d:?}"
             );
+        }
+    }
+
+    /// `uv_of` inverts `direction` wherever the lens sees (Cycles' direction_to_panorama
+    /// and panorama_to_direction are each other's inverse).
+    #[test]
+    fn uv_of_inverts_direction() {
+        let pi = std::f32::consts::PI;
+        let kinds = [
+            Panorama::Equirectangular([-2.0 * pi, pi, -pi, pi]),
+            Panorama::Equirectangular([-1.2, 0.4, -0.9, 1.9]),
+            Panorama::EquiangularCubemapFace,
+            Panorama::MirrorBall,
+            Panorama::FisheyeEquidistant { fov: pi },
+            Panorama::FisheyeEquidistant { fov: 2.2 },
+            Panorama::FisheyeEquisolid {
+                lens: 10.5,
+                fov: pi,
+                sensor: [36.0, 24.0],
+            },
+            Panorama::FisheyeLensPolynomial {
+                k0: -1e-5,
+                k: [-0.0526, -2.1e-5, 3.6e-7, -1.2e-9],
+                fov: pi,
+                sensor: [36.0, 24.0],
+            },
+            Panorama::CentralCylindrical([-pi / 2.0, pi / 2.0, -1.0, 1.0]),
+        ];
+        for k in kinds {
+            let mut checked = 0;
+            for i in 1..20 {
+                for j in 1..20 {
+                    let (u, v) = (i as f32 / 20.0, j as f32 / 20.0);
+                    let d = k.direction(u, v);
+                    let (x, z) = (2.0 * u - 1.0, 2.0 * v - 1.0);
+                    if matches!(k, Panorama::MirrorBall) && x * x + z * z > 0.95 {
+                        // The ball's rim reflects every point to straight behind.
+                        continue;
+                    }
+                    if d == [0.0; 3] {
+                        assert_eq!(k.uv_of(d), None);
+                        continue;
+                    }
+                    let back = k
+                        .uv_of(k.from_blender_camera(k.to_blender_camera(d)))
+                        .unwrap_or_else(|| panic!("{k:?} ({u}, {v}): {d:?} has no uv"));
+                    assert!(
+                        (back[0] - u).abs() < 2e-4 && (back[1] - v).abs() < 2e-4,
+                        "{k:?} ({u}, {v}) -> {d:?} -> {back:?}"
+                    );
+                    checked += 1;
+                }
+            }
+            assert!(checked > 150, "{k:?}: {checked}");
         }
     }
 }
