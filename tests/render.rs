@@ -180,11 +180,29 @@ const ASSERTED: &[&str] = &[
     "sss_rw_plane",
     "sss_rw_thin_shell",
     "sss_rw_skin_thin_shell",
+    // Scale invariance (issue 26): existing scenes with every length times 1/100 and 100
+    // and light power times the square (make_render_refs.py `scaled`); their means must
+    // also agree with the original's, see SCALED_SCENES.
+    "diffuse_point_1_100",
+    "diffuse_point_100x",
+    "glass_1_100",
+    "glass_100x",
+    "area_room_clamp_1_100",
+    "area_room_clamp_100x",
 ];
 
-/// One scene at several scales (lengths, radii and light energy scaled alike: Cycles' image
-/// is the same): our channel means must agree within MAX_SCALE_REL of each other.
-const SCALED_SCENES: &[&str] = &["sss_rw_tube_3cm", "sss_rw_tube_30cm", "sss_rw_tube_3m"];
+/// Scenes at several scales (lengths, radii and light energy scaled alike: Cycles' image
+/// is the same): within each group our channel means must agree within MAX_SCALE_REL.
+const SCALED_SCENES: &[&[&str]] = &[
+    &["sss_rw_tube_3cm", "sss_rw_tube_30cm", "sss_rw_tube_3m"],
+    &["diffuse_point", "diffuse_point_1_100", "diffuse_point_100x"],
+    &["glass", "glass_1_100", "glass_100x"],
+    &[
+        "area_room_clamp",
+        "area_room_clamp_1_100",
+        "area_room_clamp_100x",
+    ],
+];
 const MAX_SCALE_REL: f64 = 0.003;
 
 /// Scenes that do not pass yet, with the reason.
@@ -355,7 +373,7 @@ fn parity_with_cycles() {
     println!("(spp: mean samples per pixel, ours / Cycles A, for adaptive scenes)");
     for d in &dirs {
         let r = evaluate(d);
-        if SCALED_SCENES.contains(&r.name.as_str()) {
+        if SCALED_SCENES.iter().any(|g| g.contains(&r.name.as_str())) {
             scaled.push((r.name.clone(), r.ours));
         }
         let pass = r.ratio <= MAX_RATIO && r.worst_mean <= MAX_MEAN_REL;
@@ -428,22 +446,29 @@ fn parity_with_cycles() {
             r.seconds
         );
     }
-    // The scaled scenes' means against each other (when all of them ran).
-    if scaled.len() == SCALED_SCENES.len() {
+    // Each scaled group's means against each other (when all of the group ran).
+    for group in SCALED_SCENES {
+        let runs: Vec<&(String, [f64; 3])> = scaled
+            .iter()
+            .filter(|s| group.contains(&s.0.as_str()))
+            .collect();
+        if runs.len() != group.len() {
+            continue;
+        }
         for c in 0..3 {
-            let lo = scaled.iter().map(|s| s.1[c]).fold(f64::INFINITY, f64::min);
-            let hi = scaled
+            let lo = runs.iter().map(|s| s.1[c]).fold(f64::INFINITY, f64::min);
+            let hi = runs
                 .iter()
                 .map(|s| s.1[c])
                 .fold(f64::NEG_INFINITY, f64::max);
             let spread = hi / lo - 1.0;
             println!(
-                "scales {SCALED_SCENES:?}: channel {c} means spread {:.3}%",
+                "scales {group:?}: channel {c} means spread {:.3}%",
                 100.0 * spread
             );
             if spread.is_nan() || spread > MAX_SCALE_REL {
                 failures.push(format!(
-                    "{SCALED_SCENES:?}: channel {c} means differ by {:.3}% across scales ({scaled:?})",
+                    "{group:?}: channel {c} means differ by {:.3}% across scales ({runs:?})",
                     100.0 * spread
                 ));
             }
