@@ -180,6 +180,9 @@ const ASSERTED: &[&str] = &[
     "sss_rw_plane",
     "sss_rw_thin_shell",
     "sss_rw_skin_thin_shell",
+    // Materials with no Material Output Cycles uses (no output at all, an EEVEE-only one):
+    // Cycles' empty surface, black and opaque.
+    "material_no_cycles_output",
 ];
 
 /// One scene at several scales (lengths, radii and light energy scaled alike: Cycles' image
