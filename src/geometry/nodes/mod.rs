@@ -35,6 +35,7 @@ pub mod raycast;
 pub mod rotation;
 pub mod sample_curve;
 pub mod sample_nearest;
+pub mod split_edges;
 pub mod subdivide;
 pub mod subdivision_surface;
 pub mod texture;
@@ -233,6 +234,7 @@ pub const NODES: &[(&str, Evaluate)] = &[
         "GeometryNodeCollectionInfo",
         collection_info::collection_info,
     ),
+    ("GeometryNodeSplitEdges", split_edges::split_edges),
 ];
 
 /// The `bl_idname`s of `NODES`.
