@@ -77,7 +77,10 @@ NODE_BASE = frozenset(p.identifier for p in bpy.types.Node.bl_rna.properties)
 # Properties whose read crashes Blender: a fluid domain's grids read the simulation's cache
 # (SIGSEGV when it is not baked or not found). They are simulation output, not settings.
 UNSAFE_RNA = {"FluidDomainSettings": frozenset({
-    "density_grid", "velocity_grid", "flame_grid", "color_grid", "heat_grid", "temperature_grid"})}
+    "density_grid", "velocity_grid", "flame_grid", "color_grid", "heat_grid", "temperature_grid"}),
+    # The Menu Switch's `enum_definition` is the node itself (kept for old scripts):
+    # walking it writes the node into itself five levels deep.
+    "GeometryNodeMenuSwitch": frozenset({"enum_definition"})}
 
 
 def py_value(v, where, depth):
@@ -1177,6 +1180,10 @@ def main():
                     "properties": rna_value(w, 0, f"worlds[{q(key(w))}]", skip={"node_tree", "animation_data"})}
                    for w in data.worlds],
         "node_groups": [node_tree_entry(g, f"node_groups[{q(key(g))}]") for g in data.node_groups],
+        "collections": [{"name": key(c), "objects": [key(o) for o in c.objects],
+                         "children": [key(ch) for ch in c.children],
+                         "instance_offset": vec(c.instance_offset)}
+                        for c in data.collections],
         "cameras": [{"name": key(c), "properties": rna_value(c, 0, f"cameras[{q(key(c))}]", skip={"animation_data"})}
                     for c in data.cameras],
         "lights": [{"name": key(l), "type": l.type,

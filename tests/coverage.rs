@@ -490,9 +490,19 @@ fn inspect_refuses_exactly_what_render_refuses() {
     let node = json!({"name": "Lux Matte", "bl_idname": "NodeUndefined",
         "inputs": [], "outputs": [{"index": 0, "identifier": "Material", "name": "Material",
         "type": "CUSTOM", "bl_idname": "NodeSocketUndefined"}]});
+    // Linked into a Cycles output: a tree with no Cycles output at all is Cycles' empty
+    // surface, which renders (fixture material_no_cycles_output).
+    let output = json!({"name": "Material Output", "bl_idname": "ShaderNodeOutputMaterial",
+        "properties": {"is_active_output": true, "target": "ALL"},
+        "inputs": [{"index": 0, "identifier": "Surface", "name": "Surface", "type": "SHADER",
+                    "bl_idname": "NodeSocketShader", "is_linked": true, "enabled": true}],
+        "outputs": []});
+    let link = json!({"from_node": "Lux Matte", "from_socket": "Material", "from_index": 0,
+        "to_node": "Material Output", "to_socket": "Surface", "to_index": 0,
+        "is_muted": false, "is_valid": true});
     v["materials"] = json!([{"name": "Add-on", "use_nodes": true,
         "node_tree": {"name": "Shader Nodetree", "bl_idname": "ShaderNodeTree",
-                      "nodes": [node], "links": []}}]);
+                      "nodes": [node, output], "links": [link]}}]);
     std::fs::write(&p, serde_json::to_vec(&v).unwrap()).unwrap();
     let scene = Scene::load(&dir).unwrap();
     let report = blendsynth::inspect::report(&scene);

@@ -189,6 +189,9 @@ const ASSERTED: &[&str] = &[
     "glass_100x",
     "area_room_clamp_1_100",
     "area_room_clamp_100x",
+    // Materials with no Material Output Cycles uses (no output at all, an EEVEE-only one):
+    // Cycles' empty surface, black and opaque.
+    "material_no_cycles_output",
 ];
 
 /// Scenes at several scales (lengths, radii and light energy scaled alike: Cycles' image

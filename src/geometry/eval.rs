@@ -164,8 +164,14 @@ impl<'s> Session<'s> {
                     .map_err(|e| GeometryError::new(format!("{here}: {e}")))?;
                 continue;
             }
+            if m.kind == "ARRAY" {
+                let world = |n: &str| self.world_matrix(n);
+                g = super::array_modifier::apply(&m.properties, &o.name, &world, g)
+                    .map_err(|e| GeometryError::new(format!("{here}: {e}")))?;
+                continue;
+            }
             if m.kind != "NODES" {
-                return Err(GeometryError::new(format!("{here}: {} modifiers are not supported (only Geometry Nodes and Subdivision Surface)", m.kind)));
+                return Err(GeometryError::new(format!("{here}: {} modifiers are not supported (only Geometry Nodes, Subdivision Surface and Array)", m.kind)));
             }
             g = self
                 .evaluate_modifier(o, m, g)

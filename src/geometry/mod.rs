@@ -24,6 +24,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod animated;
+pub mod array_modifier;
 pub mod attribute;
 pub mod catmull_clark;
 pub mod cdt;

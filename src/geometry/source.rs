@@ -39,6 +39,13 @@ pub enum Source {
 }
 
 /// Why an object needs Blender's evaluated mesh, or None when blendsynth builds it.
+/// Whether blendsynth evaluates this modifier itself (an Array modifier only with the
+/// options `array_modifier` evaluates).
+fn native(m: &crate::scene::Modifier) -> bool {
+    NATIVE_MODIFIERS.contains(&m.kind.as_str())
+        || (m.kind == "ARRAY" && super::array_modifier::unsupported(&m.properties).is_none())
+}
+
 pub fn frozen_reason(scene: &Scene, o: &Object) -> Option<String> {
     let mods: Vec<_> = o.modifiers.iter().filter(|m| m.show_render).collect();
     match o.kind.as_str() {
@@ -55,8 +62,15 @@ pub fn frozen_reason(scene: &Scene, o: &Object) -> Option<String> {
             let mut why = Vec::new();
             let other: Vec<String> = mods
                 .iter()
-                .filter(|m| !NATIVE_MODIFIERS.contains(&m.kind.as_str()))
-                .map(|m| format!("{} {:?}", m.kind, m.name))
+                .filter(|m| !native(m))
+                .map(
+                    |m| match super::array_modifier::unsupported(&m.properties) {
+                        Some(why) if m.kind == "ARRAY" => {
+                            format!("{} {:?} ({why})", m.kind, m.name)
+                        }
+                        _ => format!("{} {:?}", m.kind, m.name),
+                    },
+                )
                 .collect();
             if !other.is_empty() {
                 why.push(format!("modifier(s) {}", other.join(", ")));

@@ -41,6 +41,9 @@ pub struct SceneFile {
     #[serde(default)]
     pub worlds: Vec<World>,
     pub node_groups: Vec<NodeTree>,
+    /// `bpy.data.collections` (older exports have none).
+    #[serde(default)]
+    pub collections: Vec<Collection>,
     #[serde(default)]
     pub cameras: Vec<Camera>,
     #[serde(default)]
@@ -480,6 +483,19 @@ pub struct Link {
     /// 0 when the exporter did not write it.
     #[serde(default)]
     pub multi_input_sort_id: i64,
+}
+
+/// A collection: its objects and child collections in Blender's order, and the offset
+/// instancing subtracts.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Collection {
+    pub name: String,
+    #[serde(default)]
+    pub objects: Vec<String>,
+    #[serde(default)]
+    pub children: Vec<String>,
+    #[serde(default)]
+    pub instance_offset: [f32; 3],
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]

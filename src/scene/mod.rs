@@ -72,6 +72,9 @@ impl Scene {
     pub fn material(&self, name: &str) -> Option<&Material> {
         self.file.materials.iter().find(|m| m.name == name)
     }
+    pub fn collection(&self, name: &str) -> Option<&format::Collection> {
+        self.file.collections.iter().find(|c| c.name == name)
+    }
     pub fn node_group(&self, name: &str) -> Option<&NodeTree> {
         self.file.node_groups.iter().find(|g| g.name == name)
     }

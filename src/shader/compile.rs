@@ -43,11 +43,11 @@ pub fn compile_material(scene: &Scene, name: &str) -> Result<Program, CompileErr
             "material {name:?} has no node tree (use_nodes off)"
         ))
     })?;
-    let out = active_output(tree, "ShaderNodeOutputMaterial", "CYCLES").ok_or_else(|| {
-        CompileError(format!(
-            "material {name:?} has no Material Output for Cycles"
-        ))
-    })?;
+    // No output Cycles uses (a tree made for another engine): Cycles syncs no nodes and
+    // the surface is empty, black and opaque (fixture `material_no_cycles_output`).
+    let Some(out) = active_output(tree, "ShaderNodeOutputMaterial", "CYCLES") else {
+        return Ok(empty_surface());
+    };
     let graph = flatten(tree, &scene.file.node_groups, &out.name)
         .map_err(|e| CompileError(format!("material {name:?}: {e}")))?;
     let mut c = Compiler::new(&graph);
@@ -61,6 +61,23 @@ pub fn compile_material(scene: &Scene, name: &str) -> Result<Program, CompileErr
     c.material_pass_index = mat.pass_index as f32;
     c.run()
         .map_err(|e| CompileError(format!("material {name:?}: {}", e.0)))
+}
+
+/// The program of a material with no surface: no closure, no displacement.
+fn empty_surface() -> Program {
+    Program {
+        ops: Vec::new(),
+        initial: Vec::new(),
+        ramps: Vec::new(),
+        curves: Vec::new(),
+        closures: Vec::new(),
+        surface: None,
+        bsdfs: Vec::new(),
+        displaced_normal: None,
+        attributes: Vec::new(),
+        displacement: None,
+        emission_estimate: [0.0; 3],
+    }
 }
 
 /// How the Material Output's Displacement is compiled, after Cycles' displacement methods:

@@ -472,6 +472,22 @@ fn sweep(
         m.attributes
             .set(a.id.clone(), Domain::Point, evaluated.gather(&idx));
     }
+    // Main curves' own curve attributes on every vertex of the curve's rings (Blender puts
+    // generic attributes on the mesh's point domain).
+    for a in main.attributes.iter() {
+        if a.domain != Domain::Curve || a.id.name().is_some_and(is_builtin_curve_attribute) {
+            continue;
+        }
+        let mut idx = Vec::with_capacity(m.vertex_count());
+        for im in 0..main.curve_count() {
+            for ip in 0..profile.curve_count() {
+                let n = pev.range(ip).len() * mev.range(im).len();
+                idx.extend(std::iter::repeat_n(im, n));
+            }
+        }
+        m.attributes
+            .set(a.id.clone(), Domain::Point, a.data.gather(&idx));
+    }
     if !sharp_faces.is_empty() {
         let mut e = vec![false; m.edge_count()];
         for i in sharp_edges {

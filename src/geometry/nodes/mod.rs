@@ -2,11 +2,15 @@
 //! here is an error naming the tree and node: it is never evaluated as something else.
 
 pub mod attribute;
+pub mod attribute_statistic;
 pub mod bounding_box;
+pub mod collection_info;
 pub mod color;
 pub mod curve;
+pub mod curve_arc;
 pub mod curve_fields;
 pub mod curve_primitives;
+pub mod curve_tangent;
 pub mod curve_to_points;
 pub mod delete;
 pub mod distribute;
@@ -21,14 +25,17 @@ pub mod geometry_ops;
 pub mod image_texture;
 pub mod input;
 pub mod instance_transform;
+pub mod menu_switch;
 pub mod merge_by_distance;
 pub mod mesh_to_curve;
 pub mod primitives;
 pub mod proximity;
+pub mod radius;
 pub mod raycast;
 pub mod rotation;
 pub mod sample_curve;
 pub mod sample_nearest;
+pub mod split_edges;
 pub mod subdivide;
 pub mod subdivision_surface;
 pub mod texture;
@@ -215,6 +222,19 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ("FunctionNodeFloatToInt", color::float_to_int),
     ("ShaderNodeBlackbody", color::blackbody_node),
     ("GeometryNodeImageTexture", image_texture::image_texture),
+    ("GeometryNodeMenuSwitch", menu_switch::menu_switch),
+    ("GeometryNodeCurveArc", curve_arc::arc),
+    ("GeometryNodeInputTangent", curve_tangent::curve_tangent),
+    ("GeometryNodeInputRadius", radius::radius),
+    (
+        "GeometryNodeAttributeStatistic",
+        attribute_statistic::attribute_statistic,
+    ),
+    (
+        "GeometryNodeCollectionInfo",
+        collection_info::collection_info,
+    ),
+    ("GeometryNodeSplitEdges", split_edges::split_edges),
 ];
 
 /// The `bl_idname`s of `NODES`.
