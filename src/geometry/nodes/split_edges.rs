@@ -62,6 +62,8 @@ fn corner_at_vert(m: &Mesh, face: usize, corner: usize, vert: u32) -> usize {
     }
 }
 
+// Long because it follows Blender 4.5's geometry::split_edges step by step (corner groups
+// per vertex, new vertices, deduplicated edges, attributes), which tests compare exactly.
 fn split(m: &Mesh, split_edge: &[bool]) -> Mesh {
     let nv = m.vertex_count();
     let ne = m.edge_count();
