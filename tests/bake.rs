@@ -491,3 +491,73 @@ fn metallic_modes_not_evaluated_are_refused_by_name() {
         );
     }
 }
+
+/// Ambient Occlusion with an unlinked Distance of 0 reads the world's AO distance in
+/// Cycles (NODE_AO_GLOBAL_RADIUS), which blendsynth does not have: refused by name before
+/// any render. And the EMIT bake cannot trace AO or Bevel (Cycles' bake traces the whole
+/// scene), so a material using them is refused there rather than baked as AO 1.
+#[test]
+fn ambient_occlusion_cases_not_evaluated_are_refused_by_name() {
+    let t = tempfile::tempdir().unwrap();
+    let dir = t.path().join("ao");
+    copy_dir(
+        &repo().join("fixtures/render/scenes/ambient_occlusion"),
+        &dir,
+    );
+    let out = t.path().join("floor.exr");
+    let o = run(
+        &[
+            "bake",
+            dir.to_str().unwrap(),
+            "--object",
+            "Floor",
+            "--size",
+            "8",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_clean_error(&o, 1, &["material \"AOFloor\"", "trace rays"]);
+    assert!(!out.exists(), "no half-written output");
+
+    let path = dir.join("scene.json");
+    let mut json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    let floor = json["materials"]
+        .as_array_mut()
+        .unwrap()
+        .iter_mut()
+        .find(|m| m["name"] == "AOFloor")
+        .unwrap();
+    let ao = floor["node_tree"]["nodes"]
+        .as_array_mut()
+        .unwrap()
+        .iter_mut()
+        .find(|n| n["bl_idname"] == "ShaderNodeAmbientOcclusion")
+        .unwrap();
+    let distance = ao["inputs"]
+        .as_array_mut()
+        .unwrap()
+        .iter_mut()
+        .find(|i| i["identifier"] == "Distance")
+        .unwrap();
+    distance["default_value"] = serde_json::Value::from(0.0);
+    std::fs::write(&path, serde_json::to_string(&json).unwrap()).unwrap();
+    let out = t.path().join("ao.exr");
+    let o = run(
+        &[
+            "render",
+            dir.to_str().unwrap(),
+            "--samples",
+            "1",
+            "--resolution",
+            "8x8",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    assert_clean_error(&o, 1, &["Ambient Occlusion", "world's AO distance"]);
+    assert!(!out.exists(), "no half-written output");
+}

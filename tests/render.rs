@@ -58,6 +58,11 @@ const ASSERTED: &[&str] = &[
     "metallic_bsdf",
     // Toon BSDF (render/toon.rs): Diffuse and Glossy components.
     "toon",
+    // Ray-traced shader nodes (render/shader_rays.rs): Ambient Occlusion (all objects,
+    // Inside, Only Local) and Bevel (flat cube edges, a bumped base normal), each failing
+    // without the tracing (ratios 8.9 and 12.7 with AO 1 and Bevel the shading normal).
+    "ambient_occlusion",
+    "bevel",
     // Subsurface Scattering node, Burley method: disk projection (render/subsurface_disk.rs).
     "sss_node",
     // The colon's material in small: Principled Burley under a strong bump in a Mix with a

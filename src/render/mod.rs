@@ -40,6 +40,7 @@ pub mod path_state;
 pub mod sampler;
 pub mod scene_mesh;
 pub mod shade;
+pub mod shader_rays;
 pub mod sheen;
 pub mod sheen_ltc;
 pub mod subsurface;
@@ -312,7 +313,9 @@ fn render_frame(
         Some(m) => m,
         None => bvh.as_ref(),
     };
+    let local = shader_rays::LocalAccels::new(&geo);
     let tracer = integrator::Scene {
+        local: &local,
         light_select: &light_select,
         accel,
         geo: &geo,

@@ -78,6 +78,8 @@ const ATTRIBUTE: &str =
     "mesh attributes (shader/attributes.rs, tangent.rs); tests/attributes.rs; types Object/Instancer/View Layer are compile errors naming the node";
 const WIREFRAME: &str =
     "shader/inputs.rs (the hit triangle's world-space corners): Size in world units and in pixels, Cycles' EMIT bakes in tests/bake.rs";
+const RAY_TRACED: &str =
+    "ray-traced at the shading point (shader/trace.rs, render/shader_rays.rs: Cycles' svm/ao.h and svm/bevel.h; 1 and the shading normal where Cycles cannot trace: displacement, shadow and light shading, the world); Cycles parity scenes in tests/render.rs (ambient_occlusion*, bevel*); AO's Distance 0 (the world's AO distance) and `bake` of such a material are errors naming the node";
 const PARTICLE_INFO: &str =
     "on a mesh not instanced by particles, Cycles' dummy particle (all zero, Random the hash of index 0), Cycles' EMIT bakes in tests/bake.rs; in a scene with a particle system a compile error (particle instances are frozen meshes without their particle data)";
 const INFO_ON_MESH: &str =
@@ -132,6 +134,8 @@ pub const NODES: &[ShaderNode] = &[
     node("ShaderNodeAttribute", attribute, ATTRIBUTE),
     node("ShaderNodeVertexColor", attribute, ATTRIBUTE),
     node("ShaderNodeWireframe", wireframe, WIREFRAME),
+    node("ShaderNodeAmbientOcclusion", ambient_occlusion, RAY_TRACED),
+    node("ShaderNodeBevel", bevel, RAY_TRACED),
     node("ShaderNodeParticleInfo", info_on_mesh, PARTICLE_INFO),
     node("ShaderNodePointInfo", info_on_mesh, INFO_ON_MESH),
     node("ShaderNodeHairInfo", info_on_mesh, INFO_ON_MESH),
@@ -298,6 +302,78 @@ fn wireframe(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), Com
         dst,
     });
     c.outputs(i, n, &[("Fac", dst, F)]);
+    Ok(())
+}
+
+/// A node's integer property (AO and Bevel Samples: Cycles packs them in a byte).
+fn prop_samples(n: &crate::nodes::graph::FlatNode, key: &str) -> Result<u32, CompileError> {
+    prop(n, key)?
+        .as_i64()
+        .and_then(|v| u8::try_from(v).ok())
+        .map(u32::from)
+        .ok_or_else(|| {
+            CompileError(format!(
+                "node {:?}: property {key:?} is not an integer in 0..=255",
+                n.path
+            ))
+        })
+}
+
+/// Ambient Occlusion. An unlinked Distance of 0 is Cycles' global-radius flag (the
+/// world's AO distance, which the exchange format does not carry): refused by name.
+fn ambient_occlusion(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let samples = prop_samples(n, "samples")?;
+    let (inside, only_local) = (prop_bool(n, "inside")?, prop_bool(n, "only_local")?);
+    if !linked(n, "Distance") {
+        if let Some(Source::Default(sock)) = n.input("Distance").and_then(|x| x.sources.first()) {
+            if sock.default_value.as_ref().map(floats).map(|f| f[0]) == Some(0.0) {
+                return Err(CompileError(format!(
+                    "node {:?}: Ambient Occlusion with Distance 0 uses the world's AO distance, which is not supported",
+                    n.path
+                )));
+            }
+        }
+    }
+    let color = c.input(n, "Color", C)?;
+    let distance = c.input(n, "Distance", F)?;
+    let normal = if linked(n, "Normal") {
+        Some(c.input(n, "Normal", V)?)
+    } else {
+        None
+    };
+    let (ao, color_out) = (c.alloc(F), c.alloc(C));
+    c.ops.push(Op::AmbientOcclusion {
+        color,
+        distance,
+        normal,
+        samples,
+        inside,
+        only_local,
+        ao,
+        color_out,
+    });
+    c.outputs(i, n, &[("Color", color_out, C), ("AO", ao, F)]);
+    Ok(())
+}
+
+fn bevel(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let samples = prop_samples(n, "samples")?;
+    let radius = c.input(n, "Radius", F)?;
+    let normal = if linked(n, "Normal") {
+        Some(c.input(n, "Normal", V)?)
+    } else {
+        None
+    };
+    let dst = c.alloc(V);
+    c.ops.push(Op::Bevel {
+        radius,
+        normal,
+        samples,
+        dst,
+    });
+    c.outputs(i, n, &[("Normal", dst, V)]);
     Ok(())
 }
 
