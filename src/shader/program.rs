@@ -394,11 +394,14 @@ pub enum Op {
         color: Slot,
         alpha: Slot,
     },
-    /// Sky Texture, precomputed per node.
+    /// Sky Texture, precomputed per node. `generated`: its Vector is the unlinked
+    /// Generated coordinate (for a world, the ray direction), so Cycles can guide light
+    /// samples toward its sun disc.
     TexSky {
         sky: std::sync::Arc<crate::nodes::sky::Sky>,
         vector: Slot,
         color: Slot,
+        generated: bool,
     },
     /// Environment Texture (the vector is a direction).
     TexEnvironment {
@@ -638,6 +641,28 @@ impl Program {
     /// Runs the program for one shading point, with no ray tracing (`NoTrace`).
     pub fn run(&self, sp: &ShadingPoint, s: &mut [f32]) {
         self.run_traced(sp, s, &NoTrace)
+    }
+
+    /// The sun disc Cycles' world light samples directly: the one Nishita sky with its
+    /// disc read at the ray direction (None with none, or with several: Cycles then falls
+    /// back to its importance map alone).
+    pub fn sun_guide(&self) -> Option<crate::nodes::sky::SunGuide> {
+        let mut suns = self.ops.iter().filter_map(|op| match op {
+            Op::TexSky { sky, .. } => sky.sun_guide().map(|g| (g, op)),
+            _ => None,
+        });
+        let (guide, op) = suns.next()?;
+        if suns.next().is_some() {
+            return None;
+        }
+        matches!(
+            op,
+            Op::TexSky {
+                generated: true,
+                ..
+            }
+        )
+        .then_some(guide)
     }
 
     /// Whether the program traces rays at its shading point (Ambient Occlusion, Bevel).
@@ -1284,6 +1309,7 @@ impl Program {
                     ref sky,
                     vector,
                     color,
+                    ..
                 } => put3(s, color, sky.eval(v3(s, vector), &LINEAR_REC709)),
                 Op::TexEnvironment {
                     ref image,
