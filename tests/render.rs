@@ -56,6 +56,9 @@ const ASSERTED: &[&str] = &[
     "principled_aniso",
     // Metallic BSDF (render/metallic.rs), F82 Tint: Multiscatter GGX and anisotropic GGX.
     "metallic_bsdf",
+    // Metallic BSDF, Physical Conductor (complex IOR) with Multiscatter GGX and Beckmann,
+    // F82 Tint with Beckmann.
+    "metallic_conductor",
     // Toon BSDF (render/toon.rs): Diffuse and Glossy components.
     "toon",
     // Ray-traced shader nodes (render/shader_rays.rs): Ambient Occlusion (all objects,

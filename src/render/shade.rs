@@ -351,6 +351,7 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
                 let r = super::microfacet::Reflection {
                     dist: super::microfacet::Distribution::Beckmann,
                     alpha: r * r,
+                    fresnel: Fresnel::Constant,
                 };
                 out.push(LobeKind::Reflection(r), scale(c, w), n);
                 return;

@@ -89,7 +89,7 @@ const AOV: &str =
 const LIGHT_OUTPUT: &str =
     "the output of a light's node tree (render/light.rs: a constant Emission scales the light, anything else is an error naming the light and node); in a material Cycles renders only the Material Output (fixtures/bake/nodes, case freestyle_and_light_nodes)";
 const METALLIC: &str =
-    "render/metallic.rs: F82 Tint with GGX and Multiscatter GGX, a Cycles parity scene in tests/render.rs (metallic_bsdf); Physical Conductor and Beckmann are compile errors naming the node";
+    "render/metallic.rs: F82 Tint and Physical Conductor (Cycles' fresnel_conductor) with GGX, Multiscatter GGX and Beckmann, Cycles parity scenes in tests/render.rs (metallic_bsdf, metallic_conductor); anisotropic Beckmann is a compile error naming the node";
 const TOON: &str =
     "render/toon.rs (closure/bsdf_toon.h): Diffuse and Glossy components, a Cycles parity scene in tests/render.rs (toon)";
 const OUTPUT: &str =
@@ -477,16 +477,32 @@ fn emission(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), Comp
     Ok(())
 }
 
-/// Metallic BSDF: its F82 Tint mode with GGX or Multiscatter GGX (render/metallic.rs).
+/// Metallic BSDF: F82 Tint and Physical Conductor, GGX, Multiscatter GGX and isotropic
+/// Beckmann (render/metallic.rs).
 fn metallic_bsdf(c: &mut Compiler<'_, '_>, i: usize, s: &Schedule) -> Result<(), CompileError> {
     let n = &c.g.nodes[i];
     let fresnel = prop_str(n, "fresnel_type")?;
     let distribution = prop_str(n, "distribution")?;
-    if fresnel != "F82" || distribution == "BECKMANN" {
+    if !matches!(fresnel, "F82" | "PHYSICAL_CONDUCTOR")
+        || !matches!(distribution, "GGX" | "MULTI_GGX" | "BECKMANN")
+    {
         return Err(CompileError(format!(
-            "node {:?}: Metallic BSDF with fresnel_type {fresnel:?} and distribution {distribution:?} is not supported yet (F82 with GGX or Multiscatter GGX is)",
+            "node {:?}: Metallic BSDF with fresnel_type {fresnel:?} and distribution {distribution:?} is not supported",
             n.path
         )));
+    }
+    if distribution == "BECKMANN" {
+        let anisotropic = linked(n, "Anisotropy")
+            || matches!(
+                n.input("Anisotropy").and_then(|x| x.sources.first()),
+                Some(Source::Default(sock)) if sock.default_value.as_ref().map(floats).is_some_and(|f| f[0] != 0.0)
+            );
+        if anisotropic {
+            return Err(CompileError(format!(
+                "node {:?}: Metallic BSDF with the Beckmann distribution and Anisotropy is not supported yet",
+                n.path
+            )));
+        }
     }
     bsdf(c, i, s)
 }
