@@ -934,6 +934,10 @@ fn closures_same_bits_for_any_thread_count() {
         "principled_sheen",
         "principled_aniso",
         "sss_node",
+        // Ray-traced shader nodes (their branch samples and lazily built local BVHs).
+        "ambient_occlusion",
+        "bevel",
+        "metallic_conductor",
     ] {
         let dir = common::repo()
             .join("fixtures/render/scenes")
