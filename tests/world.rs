@@ -60,20 +60,20 @@ fn fresh_cycles_renders_match() {
 }
 
 /// Nishita Sky Texture worlds (`make_world_refs.py --sky`, the same stage at 64x64): the
-/// sun just below the horizon with its disc on, and a sky without its disc.
-/// Skies whose sun is below the horizon or has no disc: the sky image alone.
-const NISHITA_SCENES: &[&str] = &["nishita_dusk", "nishita_no_disc"];
+/// sun high (45 degrees) with its disc, just below the horizon with its disc on (dusk),
+/// and a sky without its disc. A disc in the sky is sampled as Cycles samples it (the
+/// world light's sun guiding: 4/5 of the world's light samples uniformly in the sun's
+/// cone, render/world.rs); without it the high sun was 513 times Cycles' noise.
+const NISHITA_SCENES: &[&str] = &["nishita_sun_high", "nishita_dusk", "nishita_no_disc"];
 
-/// Skies with the sun's disc in the sky: Cycles samples the disc directly (the world
-/// light's sun guiding, `use_sun_guiding`), blendsynth only through the importance map and
-/// BSDF rays, so at 64 samples ours is far noisier (RMSE ratio 513 and 33, channel means
-/// off by 25% and 1.4%). Kept as references for that work; ignored until it lands.
+/// The sun 4 degrees up: with sun guiding ours is 1.159 (seed 0; 1.136 and 1.201 at
+/// seeds 3 and 7) against the 1.15 bound, was 33 without it; the sky itself matches, the
+/// excess noise is on surfaces lit by the grazing sun (blocks 1.2-2.6 times Cycles'
+/// error there), cause not found yet. Means within 0.14%.
 #[test]
-#[ignore = "needs the world light's sun guiding for a Nishita sun disc"]
-fn nishita_sun_disc_worlds_match_cycles() {
-    for name in ["nishita_sun_high", "nishita_sun_low"] {
-        check(&common::repo().join("fixtures/world/scenes").join(name));
-    }
+#[ignore = "low sun: 1.16 against the 1.15 bound, excess noise on sunlit surfaces"]
+fn nishita_low_sun_world_matches_cycles() {
+    check(&common::repo().join("fixtures/world/scenes/nishita_sun_low"));
 }
 
 #[test]

@@ -85,7 +85,45 @@ pub struct Nishita {
     texels: Vec<[f32; 4]>,
 }
 
+/// What Cycles' world light needs to sample a Nishita sun disc directly
+/// (`LightManager::device_update_background`'s sun guiding).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SunGuide {
+    /// Unit direction toward the sun's centre.
+    pub direction: Vec3,
+    /// Half the sun's angular diameter (radians).
+    pub half_angle: f32,
+    /// Cycles' `get_sun_average_radiance`: the disc centre's mean XYZ times the squared
+    /// angular diameter, scaled by its empirical piecewise factor.
+    pub average_radiance: f32,
+}
+
 impl Sky {
+    /// The sun disc of a Nishita sky with its disc on (None otherwise).
+    pub fn sun_guide(&self) -> Option<SunGuide> {
+        let Sky::Nishita(n) = self else { return None };
+        if n.angular_diameter < 0.0 {
+            return None;
+        }
+        let d = n.angular_diameter;
+        let centre = scale(add(n.pixel_bottom, n.pixel_top), 0.5 * n.sun_intensity);
+        let mut average = (centre[0] + centre[1] + centre[2]) / 3.0 * d * d;
+        let (first, second) = (0.8f32.to_radians(), 1.0f32.to_radians());
+        average *= if d < first {
+            1.0
+        } else if d < second {
+            1.0 + (0.8 - 1.0) / (second - first) * (d - first)
+        } else {
+            0.8 + (0.45 - 0.8) / (FRAC_PI_2 - second) * (d - second)
+        };
+        // The kernel's sun direction (longitude = simplified rotation + pi / 2).
+        Some(SunGuide {
+            direction: geographical_to_direction(n.sun_elevation, n.sun_rotation + FRAC_PI_2),
+            half_angle: d * 0.5,
+            average_radiance: average,
+        })
+    }
+
     /// The node precomputed as Cycles' `SkyTextureNode::compile` does.
     pub fn new(s: &SkySettings) -> Result<Sky, String> {
         match s.sky_type {

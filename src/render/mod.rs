@@ -27,6 +27,7 @@ pub use crate::foundation::math;
 pub mod motion;
 pub mod sampler;
 pub mod scene_mesh;
+pub mod shader_rays;
 pub mod subsurface;
 
 use std::time::Instant;
@@ -283,7 +284,9 @@ fn render_frame(
         Some(m) => m,
         None => bvh.as_ref(),
     };
+    let local = shader_rays::LocalAccels::new(&geo);
     let tracer = integrator::Scene {
+        local: &local,
         light_select: &light_select,
         accel,
         geo: &geo,

@@ -103,7 +103,16 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
     };
     for m in &slots {
         programs.push(match m {
-            Some(name) => Some(compile_material(scene, name).map_err(|e| e.to_string())?),
+            Some(name) => {
+                let p = compile_material(scene, name).map_err(|e| e.to_string())?;
+                // Cycles' bake traces them against the whole scene; this bake has none.
+                if p.traces_rays() {
+                    return Err(format!(
+                        "material {name:?}: Ambient Occlusion and Bevel nodes trace rays, which the bake does not support (render the scene instead)"
+                    ));
+                }
+                Some(p)
+            }
             None => None,
         });
     }

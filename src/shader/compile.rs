@@ -956,6 +956,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
             sky: std::sync::Arc::new(sky),
             vector,
             color,
+            generated: !linked(n, "Vector"),
         });
         self.outputs(i, n, &[("Color", color, Kind::Color)]);
         Ok(())

@@ -13,6 +13,7 @@ pub mod inputs;
 pub mod point;
 pub mod program;
 pub mod tangent;
+pub mod trace;
 pub mod view;
 
 pub use compile::{compile_material, CompileError};

@@ -42,6 +42,7 @@ use super::bump::{
 use super::images::TexImage;
 use super::inputs::{self, Input};
 use super::point::ShadingPoint;
+use super::trace::{NoTrace, Trace};
 
 /// A float's position on the stack; vectors and colours take three in a row.
 pub type Slot = u32;
@@ -334,6 +335,26 @@ pub enum Op {
         pixel_size: bool,
         dst: Slot,
     },
+    /// Ambient Occlusion (svm/ao.h), traced through the `Trace` the program runs with
+    /// (`inside` turns the normal around before tracing).
+    AmbientOcclusion {
+        color: Slot,
+        distance: Slot,
+        normal: Option<Slot>,
+        samples: u32,
+        inside: bool,
+        only_local: bool,
+        ao: Slot,
+        color_out: Slot,
+    },
+    /// Bevel (svm/bevel.h): the traced normal, with a linked Normal input kept as the
+    /// base the bevel's change is added to.
+    Bevel {
+        radius: Slot,
+        normal: Option<Slot>,
+        samples: u32,
+        dst: Slot,
+    },
     /// Gabor Texture: args are Scale, Frequency, Anisotropy, Orientation 2D.
     TexGabor {
         kind: GaborType,
@@ -373,11 +394,14 @@ pub enum Op {
         color: Slot,
         alpha: Slot,
     },
-    /// Sky Texture, precomputed per node.
+    /// Sky Texture, precomputed per node. `generated`: its Vector is the unlinked
+    /// Generated coordinate (for a world, the ray direction), so Cycles can guide light
+    /// samples toward its sun disc.
     TexSky {
         sky: std::sync::Arc<crate::nodes::sky::Sky>,
         vector: Slot,
         color: Slot,
+        generated: bool,
     },
     /// Environment Texture (the vector is a direction).
     TexEnvironment {
@@ -614,11 +638,47 @@ impl Program {
         self.initial.clone()
     }
 
-    /// Runs the program for one shading point.
+    /// Runs the program for one shading point, with no ray tracing (`NoTrace`).
     pub fn run(&self, sp: &ShadingPoint, s: &mut [f32]) {
+        self.run_traced(sp, s, &NoTrace)
+    }
+
+    /// The sun disc Cycles' world light samples directly: the one Nishita sky with its
+    /// disc read at the ray direction (None with none, or with several: Cycles then falls
+    /// back to its importance map alone).
+    pub fn sun_guide(&self) -> Option<crate::nodes::sky::SunGuide> {
+        let mut suns = self.ops.iter().filter_map(|op| match op {
+            Op::TexSky { sky, .. } => sky.sun_guide().map(|g| (g, op)),
+            _ => None,
+        });
+        let (guide, op) = suns.next()?;
+        if suns.next().is_some() {
+            return None;
+        }
+        matches!(
+            op,
+            Op::TexSky {
+                generated: true,
+                ..
+            }
+        )
+        .then_some(guide)
+    }
+
+    /// Whether the program traces rays at its shading point (Ambient Occlusion, Bevel).
+    pub fn traces_rays(&self) -> bool {
+        self.ops
+            .iter()
+            .any(|op| matches!(op, Op::AmbientOcclusion { .. } | Op::Bevel { .. }))
+    }
+
+    /// Runs the program for one shading point, its Ambient Occlusion and Bevel nodes
+    /// tracing through `trace`. True displacement's ops never trace (Cycles has no BVH
+    /// yet when it displaces; its displacement bump runs with the surface, and does).
+    pub fn run_traced(&self, sp: &ShadingPoint, s: &mut [f32], trace: &dyn Trace) {
         s.copy_from_slice(&self.initial);
         let Some(d) = self.displacement else {
-            self.exec(*sp, s, &self.ops);
+            self.exec(*sp, s, &self.ops, trace);
             return;
         };
         match (d.bump_end, self.displaced_normal) {
@@ -642,16 +702,16 @@ impl Program {
                         ..*sp
                     }
                 });
-                self.exec(before, s, &self.ops[..end]);
+                self.exec(before, s, &self.ops[..end], trace);
                 let n = v3(s, normal);
                 let after = ShadingPoint {
                     normal: n,
                     object_normal: sp.transform.inverse_normal(n),
                     ..*sp
                 };
-                self.exec(after, s, &self.ops[end..]);
+                self.exec(after, s, &self.ops[end..], trace);
             }
-            _ => self.exec(*sp, s, &self.ops[d.center_end..]),
+            _ => self.exec(*sp, s, &self.ops[d.center_end..], trace),
         }
     }
 
@@ -660,12 +720,12 @@ impl Program {
     pub fn displacement_at(&self, sp: &ShadingPoint, s: &mut [f32]) -> Option<Vec3> {
         let d = self.displacement?;
         s.copy_from_slice(&self.initial);
-        self.exec(*sp, s, &self.ops[..d.center_end]);
+        self.exec(*sp, s, &self.ops[..d.center_end], &NoTrace);
         Some(v3(s, d.value))
     }
 
     // Long because one arm per op, kept in one function so the interpreter's loop stays one jump table.
-    fn exec(&self, sp: ShadingPoint, s: &mut [f32], ops: &[Op]) {
+    fn exec(&self, sp: ShadingPoint, s: &mut [f32], ops: &[Op], trace: &dyn Trace) {
         // `sp` is what the ops read: `base`, or a bump copy's offset point.
         let mut base = sp;
         let mut sp = sp;
@@ -1056,6 +1116,55 @@ impl Program {
                     pixel_size,
                     dst,
                 } => s[dst as usize] = inputs::wireframe_node(&sp, s[size as usize], pixel_size),
+                Op::AmbientOcclusion {
+                    color,
+                    distance,
+                    normal,
+                    samples,
+                    inside,
+                    only_local,
+                    ao,
+                    color_out,
+                } => {
+                    let n = safe_normalize(normal.map_or(sp.normal, |n| v3(s, n)));
+                    let n = if inside { n.map(|x| -x) } else { n };
+                    let dist = s[distance as usize];
+                    // Cycles' early out: nothing to trace.
+                    let f = if dist > 0.0 && samples >= 1 {
+                        trace.ambient_occlusion(&sp, n, dist, samples, only_local)
+                    } else {
+                        1.0
+                    };
+                    s[ao as usize] = f;
+                    let c = v3(s, color);
+                    put3(s, color_out, c.map(|x| x * f));
+                }
+                Op::Bevel {
+                    radius,
+                    normal,
+                    samples,
+                    dst,
+                } => {
+                    let r = s[radius as usize];
+                    let b = if r > 0.0 && samples >= 1 {
+                        trace.bevel(&sp, r, samples)
+                    } else {
+                        sp.normal
+                    };
+                    // A linked Normal keeps its own direction plus the bevel's change.
+                    let out = match normal {
+                        Some(n) => {
+                            let base = v3(s, n);
+                            crate::nodes::math::normalize3([
+                                base[0] + b[0] - sp.normal[0],
+                                base[1] + b[1] - sp.normal[1],
+                                base[2] + b[2] - sp.normal[2],
+                            ])
+                        }
+                        None => b,
+                    };
+                    put3(s, dst, out);
+                }
                 Op::TexGabor {
                     kind,
                     vector,
@@ -1200,6 +1309,7 @@ impl Program {
                     ref sky,
                     vector,
                     color,
+                    ..
                 } => put3(s, color, sky.eval(v3(s, vector), &LINEAR_REC709)),
                 Op::TexEnvironment {
                     ref image,

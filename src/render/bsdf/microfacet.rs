@@ -461,12 +461,14 @@ pub fn glass_closure(
     g
 }
 
-/// Microfacet reflection without Fresnel (Glossy BSDF: the colour is the closure
-/// weight), for the Beckmann distribution (isotropic GGX keeps `LobeKind::Glossy`).
+/// Microfacet reflection for the Beckmann distribution (isotropic GGX keeps
+/// `LobeKind::Glossy`): the Glossy BSDF's (Fresnel constant: the colour is the closure
+/// weight) and the Metallic BSDF's (F82 tint or physical conductor).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Reflection {
     pub dist: Distribution,
     pub alpha: f32,
+    pub fresnel: crate::render::bsdf::Fresnel,
 }
 
 impl Reflection {

@@ -32,6 +32,8 @@ pub enum Fresnel {
     F82 { f0: V3, b: V3 },
     /// Dielectric under a thin film (Principled specular layer): coloured by interference.
     ThinFilm(crate::render::bsdf::thin_film::ThinFilm),
+    /// Physical conductor with complex IOR `eta` + i `k` per channel (Metallic BSDF).
+    Conductor { eta: V3, k: V3 },
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -357,6 +359,7 @@ impl LobeSet {
                     let h = l.n;
                     scale(fresnel_eval(fresnel, dot(wo, h), l.weight), energy)
                 }
+                LobeKind::Reflection(r) => fresnel_eval(r.fresnel, dot(wo, l.n), l.weight),
                 _ => l.weight,
             };
             // Cycles' bsdf_sample shifts every sample that does not transmit.
@@ -440,7 +443,27 @@ fn fresnel_eval(f: Fresnel, cos_h: f32, tint: V3) -> V3 {
             out
         }
         Fresnel::ThinFilm(tf) => mul(tint, tf.eval(cos_h)),
+        Fresnel::Conductor { eta, k } => {
+            let f = fresnel_conductor(cos_h, eta, k);
+            [f[0] * tint[0], f[1] * tint[1], f[2] * tint[2]]
+        }
     }
+}
+
+/// Cycles' fresnel_conductor: unpolarised reflectance of a conductor with complex IOR
+/// `eta` + i `k` at incidence cosine `cosi`.
+pub fn fresnel_conductor(cosi: f32, eta: V3, k: V3) -> V3 {
+    let c2 = cosi * cosi;
+    let mut out = [0.0; 3];
+    for i in 0..3 {
+        let tmp_f = eta[i] * eta[i] + k[i] * k[i];
+        let tmp = tmp_f * c2;
+        let two_ec = 2.0 * eta[i] * cosi;
+        let parl = (tmp - two_ec + 1.0) / (tmp + two_ec + 1.0);
+        let perp = (tmp_f - two_ec + c2) / (tmp_f + two_ec + c2);
+        out[i] = (parl + perp) * 0.5;
+    }
+    out
 }
 
 #[inline]
@@ -522,7 +545,8 @@ fn eval_lobe(l: &Lobe, wo: V3, wi: V3, _ng: V3, _tables: &Tables) -> (V3, f32) {
         LobeKind::Transparent | LobeKind::Subsurface(_) => ([0.0; 3], 0.0),
         LobeKind::Reflection(r) => {
             let (f, p) = r.eval(l.n, wo, wi, ng);
-            ([f; 3], p)
+            let h = normalize(add(wo, wi));
+            (fresnel_eval(r.fresnel, dot(wo, h), [f; 3]), p)
         }
         LobeKind::OrenNayar(on) => {
             if cos_i > 0.0 && same_side {

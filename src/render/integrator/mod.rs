@@ -22,6 +22,9 @@ use crate::render::light::tree::{LightSelect, Pick};
 use crate::render::light::Light;
 use crate::render::math::*;
 use crate::render::sampler::PixelSampler;
+use crate::render::shader_rays::ShaderRays;
+use crate::shader::trace::{NoTrace, Trace};
+use std::cell::Cell;
 
 #[derive(Debug, Clone, Copy)]
 pub struct Settings {
@@ -79,6 +82,8 @@ pub struct Scene<'a> {
     pub world: Option<&'a crate::render::light::world::WorldShader>,
     /// The camera as Texture Coordinate > Camera/Window and Camera Data see it.
     pub view: crate::shader::view::View,
+    /// Each object's own BVH for the shaders' local ray queries (Bevel, AO Only Local).
+    pub local: &'a crate::render::shader_rays::LocalAccels,
 }
 
 /// Per-thread scratch, reused across samples (no allocation per ray).
@@ -247,16 +252,50 @@ impl Scene<'_> {
         }
     }
 
+    /// Shades `hit` without ray tracing (Ambient Occlusion 1, Bevel the shading normal):
+    /// the label passes' pixel-centre shading.
     pub fn shade(&self, hit: &SurfaceHit, wo: V3, scratch: &mut Scratch) {
-        self.shade_into(hit, wo, &mut scratch.stacks, &mut scratch.lobes);
+        self.shade_into(hit, wo, &mut scratch.stacks, &mut scratch.lobes, &NoTrace);
     }
 
-    fn shade_into(&self, hit: &SurfaceHit, wo: V3, stacks: &mut [Vec<f32>], lobes: &mut LobeSet) {
+    /// Shades a path vertex, its Ambient Occlusion and Bevel nodes tracing from it with
+    /// the vertex's free sampler set.
+    fn shade_path(
+        &self,
+        hit: &SurfaceHit,
+        wo: V3,
+        path: &Path,
+        rng: &PixelSampler,
+        index: u32,
+        scratch: &mut Scratch,
+    ) {
+        let rays = ShaderRays {
+            scene: self,
+            hit,
+            rng,
+            index,
+            set: path.set + 2,
+            min_ray_pdf: path.min_ray_pdf,
+            rays: Cell::new(0),
+        };
+        self.shade_into(hit, wo, &mut scratch.stacks, &mut scratch.lobes, &rays);
+        scratch.rays += rays.rays.get();
+    }
+
+    fn shade_into(
+        &self,
+        hit: &SurfaceHit,
+        wo: V3,
+        stacks: &mut [Vec<f32>],
+        lobes: &mut LobeSet,
+        trace: &dyn Trace,
+    ) {
         let ctx = Context {
             tables: self.tables,
             wo,
             backfacing: hit.backfacing,
             bump_correction: true,
+            trace,
         };
         match hit.material {
             Some(mi) => self.materials[mi].shade(&hit.sp, &mut stacks[mi], &ctx, lobes),
@@ -312,7 +351,7 @@ impl Scene<'_> {
             };
             let wo = neg(path.d);
             let hit = self.vertex(&mut path, &h, wo, scratch);
-            if !self.shade_vertex(&path, &hit, wo, from_sss.is_some(), scratch) {
+            if !self.shade_vertex(&path, &hit, wo, from_sss.is_some(), rng, index, scratch) {
                 break;
             }
             scratch.lobes.terminator_frequency =
@@ -484,12 +523,15 @@ impl Scene<'_> {
     }
 
     /// Runs the vertex's shader into `scratch.lobes`; false when a holdout ends the path.
+    #[allow(clippy::too_many_arguments)]
     fn shade_vertex(
         &self,
         path: &Path,
         hit: &SurfaceHit,
         wo: V3,
         sss_exit: bool,
+        rng: &PixelSampler,
+        index: u32,
         scratch: &mut Scratch,
     ) -> bool {
         if sss_exit {
@@ -497,7 +539,7 @@ impl Scene<'_> {
             // with the BSSRDF's normal there (corrected as seen along the true normal).
             let (n, smooth) = match hit.material {
                 Some(mi) if self.materials[mi].bssrdf_bump => {
-                    self.shade(hit, wo, scratch);
+                    self.shade_path(hit, wo, path, rng, index, scratch);
                     let smooth = scratch.lobes.smooth_n;
                     (
                         crate::render::subsurface::exit_normal(&scratch.lobes, smooth),
@@ -516,7 +558,7 @@ impl Scene<'_> {
             scratch.lobes.push(LobeKind::Diffuse, [1.0; 3], n);
             return true;
         }
-        self.shade(hit, wo, scratch);
+        self.shade_path(hit, wo, path, rng, index, scratch);
         // A holdout object seen by the camera (directly or through transparent
         // surfaces: Cycles' PATH_RAY_TRANSPARENT_BACKGROUND) keeps only its
         // transparency; the rest is a hole in the film.
@@ -879,6 +921,7 @@ impl Scene<'_> {
                 neg(dir),
                 &mut scratch.stacks,
                 &mut scratch.light_lobes,
+                &NoTrace,
             );
             through = mul(through, scratch.light_lobes.transparent);
             if is_zero(through) {
@@ -1027,7 +1070,13 @@ impl Scene<'_> {
             bounce,
             ..PathState::default()
         };
-        self.shade_into(&hit, wo, &mut scratch.stacks, &mut scratch.light_lobes);
+        self.shade_into(
+            &hit,
+            wo,
+            &mut scratch.stacks,
+            &mut scratch.light_lobes,
+            &NoTrace,
+        );
         scratch.light_lobes.emission
     }
 }

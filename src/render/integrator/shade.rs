@@ -171,6 +171,9 @@ pub struct Context<'a> {
     pub backfacing: bool,
     /// The material's Bump Map Correction (set by `Material::shade`).
     pub bump_correction: bool,
+    /// The ray queries its Ambient Occlusion and Bevel nodes make (`NoTrace` where
+    /// Cycles shades without ray tracing: shadow and light-emission shading).
+    pub trace: &'a dyn crate::shader::trace::Trace,
 }
 
 /// Cycles' `maybe_ensure_valid_specular_reflection`: the normal of the closures whose
@@ -217,7 +220,7 @@ impl Material {
             stack.clear();
             stack.extend_from_slice(&p.initial);
         }
-        p.run(sp, stack);
+        p.run_traced(sp, stack, ctx.trace);
         let ctx = &Context {
             bump_correction: self.bump_correction,
             ..*ctx
@@ -352,6 +355,7 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
                 let r = crate::render::bsdf::microfacet::Reflection {
                     dist: crate::render::bsdf::microfacet::Distribution::Beckmann,
                     alpha: r * r,
+                    fresnel: Fresnel::Constant,
                 };
                 out.push(LobeKind::Reflection(r), scale(c, w), n);
                 return;

@@ -392,7 +392,7 @@ fn one_minus_cos_from_sin2(s2: f32) -> f32 {
 
 /// A direction uniform in the cone about `axis` with 1 - cos(half angle) = `omc`
 /// (Cycles' concentric cone mapping), and its cosine to the axis.
-fn sample_cone(axis: V3, omc: f32, u: [f32; 2]) -> (V3, f32) {
+pub(super) fn sample_cone(axis: V3, omc: f32, u: [f32; 2]) -> (V3, f32) {
     let xy = crate::render::camera::concentric_disk(u);
     let r2 = xy[0] * xy[0] + xy[1] * xy[1];
     let cos_theta = 1.0 - r2 * omc;
@@ -409,7 +409,7 @@ fn sample_cone(axis: V3, omc: f32, u: [f32; 2]) -> (V3, f32) {
 
 /// 1 - cos(half angle) of a sun's cone, without the cancellation of `1.0 - cos` at
 /// small angles (Cycles passes one_minus_cos for the same reason).
-fn sun_one_minus_cos(half_angle: f32) -> f32 {
+pub(super) fn sun_one_minus_cos(half_angle: f32) -> f32 {
     let s = (0.5 * half_angle).sin();
     2.0 * s * s
 }

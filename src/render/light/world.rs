@@ -5,7 +5,8 @@
 
 use serde_json::Value;
 
-use crate::render::math::V3;
+use crate::nodes::sky::SunGuide;
+use crate::render::math::{add, len, normalize, sub, V3};
 use crate::render::RenderError;
 use crate::scene::Scene;
 
@@ -157,7 +158,12 @@ pub fn shader(scene: &Scene) -> Result<Option<WorldShader>, RenderError> {
     // (its background light is off); BSDF rays alone find it.
     let sampled = crate::scene::settings::WorldSettings::of(w).sampled;
     if sampled {
-        shader.map = WorldMap::build(&shader, MAP_WIDTH, MAP_WIDTH / 2);
+        shader.map = WorldMap::build(&shader, MAP_WIDTH, MAP_WIDTH / 2).map(|mut m| {
+            if let Some(sun) = shader.program.sun_guide() {
+                m.guide_sun(sun);
+            }
+            m
+        });
     }
     Ok(Some(shader))
 }
@@ -203,8 +209,8 @@ fn is_constant(tree: &crate::scene::NodeTree) -> bool {
 }
 
 /// Importance sampling of a world that varies with direction: a piecewise-constant
-/// distribution over the equirectangular square, each cell weighted by the luminance of
-/// the world at its centre times the cell's solid angle (sin theta), as Cycles builds
+/// distribution over the equirectangular square, each cell weighted by the mean of the
+/// world's channels at its centre times the cell's solid angle (sin theta), as Cycles builds
 /// its background map. The pdf is exact for the distribution it samples, so any map
 /// gives unbiased results; a better map only lowers noise.
 pub struct WorldMap {
@@ -217,9 +223,17 @@ pub struct WorldMap {
     /// Cell weights, normalised so that the mean is 1 (pdf over the unit square).
     pdf: Vec<f32>,
     /// Cycles' average radiance of the map (its light tree energy of the world): the
-    /// mean over cells of the channels' mean times sin theta, times pi / 2.
+    /// mean over cells of the channels' mean times sin theta, times pi / 2 (with a sun
+    /// guided, 0.8 of that plus 0.2 of the sun's).
     pub average_radiance: f32,
+    /// A Nishita sun disc sampled directly (Cycles' sun guiding), with its share of the
+    /// samples.
+    sun: Option<(SunGuide, f32)>,
 }
+
+/// Cycles' sun and map method weights (`sun_weight` 4, `map_weight` 1: empirical).
+const SUN_WEIGHT: f32 = 4.0;
+const MAP_WEIGHT: f32 = 1.0;
 
 fn equirect_direction(u: f32, v: f32) -> (V3, f32) {
     use std::f32::consts::PI;
@@ -257,13 +271,14 @@ impl WorldMap {
                 let (d, st) =
                     equirect_direction((i as f32 + 0.5) / w as f32, (j as f32 + 0.5) / h as f32);
                 let c = shader.eval(d, &mut stack);
-                let lum = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+                // Cycles weighs each cell by the mean of its channels' magnitudes
+                // (background_cdf's `average(fabs(color))`), not by luminance.
                 let mean = (c[0].abs() + c[1].abs() + c[2].abs()) / 3.0;
                 if mean.is_finite() {
                     radiance += mean as f64 * st as f64;
                 }
-                f[j * w + i] = if lum.is_finite() && lum > 0.0 {
-                    lum as f64 * st as f64
+                f[j * w + i] = if mean.is_finite() && mean > 0.0 {
+                    mean as f64 * st as f64
                 } else {
                     0.0
                 };
@@ -299,11 +314,61 @@ impl WorldMap {
             marginal,
             pdf,
             average_radiance,
+            sun: None,
         })
     }
 
-    /// A direction drawn from the map and its solid-angle pdf.
+    /// Samples the sun disc directly too, as Cycles does for one Nishita sun: a share
+    /// 4 / 5 of the samples goes uniformly into its cone, the rest to the map, and every
+    /// direction's pdf is the mixture of both.
+    pub fn guide_sun(&mut self, sun: SunGuide) {
+        let share = SUN_WEIGHT / (SUN_WEIGHT + MAP_WEIGHT);
+        self.average_radiance = 0.8 * self.average_radiance + 0.2 * sun.average_radiance;
+        self.sun = Some((sun, share));
+    }
+
+    /// The pdf of the sun cone toward `d` (Cycles' pdf_uniform_cone).
+    fn sun_pdf(sun: &SunGuide, d: V3) -> f32 {
+        let angle = 2.0 * len(sub(d, sun.direction)).atan2(len(add(d, sun.direction)));
+        if angle < sun.half_angle {
+            1.0 / (2.0
+                * std::f32::consts::PI
+                * crate::render::light::sun_one_minus_cos(sun.half_angle))
+        } else {
+            0.0
+        }
+    }
+
+    /// A direction drawn from the map (and the sun, when guided) and its solid-angle
+    /// pdf over both methods.
     pub fn sample(&self, u: [f32; 2]) -> Option<(V3, f32)> {
+        let Some((sun, share)) = self.sun else {
+            return self.sample_map(u);
+        };
+        if u[0] < share {
+            let omc = crate::render::light::sun_one_minus_cos(sun.half_angle);
+            let (d, _) =
+                crate::render::light::sample_cone(sun.direction, omc, [u[0] / share, u[1]]);
+            let d = normalize(d);
+            // The cone's own pdf, as Cycles takes it for the direction it sampled (an
+            // angle test at the cone's rim could drop it).
+            let cone = 1.0 / (2.0 * std::f32::consts::PI * omc);
+            return Some((d, share * cone + (1.0 - share) * self.map_pdf(d)));
+        }
+        let (d, p) = self.sample_map([(u[0] - share) / (1.0 - share), u[1]])?;
+        Some((d, (1.0 - share) * p + share * Self::sun_pdf(&sun, d)))
+    }
+
+    /// The solid-angle pdf with which `sample` draws direction `d` (unit).
+    pub fn pdf(&self, d: V3) -> f32 {
+        match self.sun {
+            Some((sun, share)) => share * Self::sun_pdf(&sun, d) + (1.0 - share) * self.map_pdf(d),
+            None => self.map_pdf(d),
+        }
+    }
+
+    /// A direction drawn from the map alone and its solid-angle pdf.
+    fn sample_map(&self, u: [f32; 2]) -> Option<(V3, f32)> {
         let (j, tv) = pick(&self.marginal, u[0]);
         let row = &self.rows[j * (self.w + 1)..(j + 1) * (self.w + 1)];
         let (i, tu) = pick(row, u[1]);
@@ -324,8 +389,8 @@ impl WorldMap {
         ))
     }
 
-    /// The solid-angle pdf with which `sample` draws direction `d` (unit).
-    pub fn pdf(&self, d: V3) -> f32 {
+    /// The solid-angle pdf with which `sample_map` draws direction `d` (unit).
+    fn map_pdf(&self, d: V3) -> f32 {
         let uv = crate::nodes::image::direction_to_equirectangular(d);
         let u = uv[0] - uv[0].floor();
         let i = ((u * self.w as f32) as usize).min(self.w - 1);

@@ -78,6 +78,8 @@ const ATTRIBUTE: &str =
     "mesh attributes (shader/attributes.rs, tangent.rs); tests/attributes.rs; types Object/Instancer/View Layer are compile errors naming the node";
 const WIREFRAME: &str =
     "shader/inputs.rs (the hit triangle's world-space corners): Size in world units and in pixels, Cycles' EMIT bakes in tests/bake.rs";
+const RAY_TRACED: &str =
+    "ray-traced at the shading point (shader/trace.rs, render/shader_rays.rs: Cycles' svm/ao.h and svm/bevel.h; 1 and the shading normal where Cycles cannot trace: displacement, shadow and light shading, the world); Cycles parity scenes in tests/render.rs (ambient_occlusion*, bevel*); AO's Distance 0 (the world's AO distance) and `bake` of such a material are errors naming the node";
 const PARTICLE_INFO: &str =
     "on a mesh not instanced by particles, Cycles' dummy particle (all zero, Random the hash of index 0), Cycles' EMIT bakes in tests/bake.rs; in a scene with a particle system a compile error (particle instances are frozen meshes without their particle data)";
 const INFO_ON_MESH: &str =
@@ -87,7 +89,7 @@ const AOV: &str =
 const LIGHT_OUTPUT: &str =
     "the output of a light's node tree (render/light/mod.rs: a constant Emission scales the light, anything else is an error naming the light and node); in a material Cycles renders only the Material Output (fixtures/bake/nodes, case freestyle_and_light_nodes)";
 const METALLIC: &str =
-    "render/bsdf/metallic.rs: F82 Tint with GGX and Multiscatter GGX, a Cycles parity scene in tests/render.rs (metallic_bsdf); Physical Conductor and Beckmann are compile errors naming the node";
+    "render/bsdf/metallic.rs: F82 Tint and Physical Conductor (Cycles' fresnel_conductor) with GGX, Multiscatter GGX and Beckmann, Cycles parity scenes in tests/render.rs (metallic_bsdf, metallic_conductor); anisotropic Beckmann is a compile error naming the node";
 const TOON: &str =
     "render/bsdf/toon.rs (closure/bsdf_toon.h): Diffuse and Glossy components, a Cycles parity scene in tests/render.rs (toon)";
 const OUTPUT: &str =
@@ -132,6 +134,8 @@ pub const NODES: &[ShaderNode] = &[
     node("ShaderNodeAttribute", attribute, ATTRIBUTE),
     node("ShaderNodeVertexColor", attribute, ATTRIBUTE),
     node("ShaderNodeWireframe", wireframe, WIREFRAME),
+    node("ShaderNodeAmbientOcclusion", ambient_occlusion, RAY_TRACED),
+    node("ShaderNodeBevel", bevel, RAY_TRACED),
     node("ShaderNodeParticleInfo", info_on_mesh, PARTICLE_INFO),
     node("ShaderNodePointInfo", info_on_mesh, INFO_ON_MESH),
     node("ShaderNodeHairInfo", info_on_mesh, INFO_ON_MESH),
@@ -301,6 +305,78 @@ fn wireframe(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), Com
     Ok(())
 }
 
+/// A node's integer property (AO and Bevel Samples: Cycles packs them in a byte).
+fn prop_samples(n: &crate::nodes::graph::FlatNode, key: &str) -> Result<u32, CompileError> {
+    prop(n, key)?
+        .as_i64()
+        .and_then(|v| u8::try_from(v).ok())
+        .map(u32::from)
+        .ok_or_else(|| {
+            CompileError(format!(
+                "node {:?}: property {key:?} is not an integer in 0..=255",
+                n.path
+            ))
+        })
+}
+
+/// Ambient Occlusion. An unlinked Distance of 0 is Cycles' global-radius flag (the
+/// world's AO distance, which the exchange format does not carry): refused by name.
+fn ambient_occlusion(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let samples = prop_samples(n, "samples")?;
+    let (inside, only_local) = (prop_bool(n, "inside")?, prop_bool(n, "only_local")?);
+    if !linked(n, "Distance") {
+        if let Some(Source::Default(sock)) = n.input("Distance").and_then(|x| x.sources.first()) {
+            if sock.default_value.as_ref().map(floats).map(|f| f[0]) == Some(0.0) {
+                return Err(CompileError(format!(
+                    "node {:?}: Ambient Occlusion with Distance 0 uses the world's AO distance, which is not supported",
+                    n.path
+                )));
+            }
+        }
+    }
+    let color = c.input(n, "Color", C)?;
+    let distance = c.input(n, "Distance", F)?;
+    let normal = if linked(n, "Normal") {
+        Some(c.input(n, "Normal", V)?)
+    } else {
+        None
+    };
+    let (ao, color_out) = (c.alloc(F), c.alloc(C));
+    c.ops.push(Op::AmbientOcclusion {
+        color,
+        distance,
+        normal,
+        samples,
+        inside,
+        only_local,
+        ao,
+        color_out,
+    });
+    c.outputs(i, n, &[("Color", color_out, C), ("AO", ao, F)]);
+    Ok(())
+}
+
+fn bevel(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let samples = prop_samples(n, "samples")?;
+    let radius = c.input(n, "Radius", F)?;
+    let normal = if linked(n, "Normal") {
+        Some(c.input(n, "Normal", V)?)
+    } else {
+        None
+    };
+    let dst = c.alloc(V);
+    c.ops.push(Op::Bevel {
+        radius,
+        normal,
+        samples,
+        dst,
+    });
+    c.outputs(i, n, &[("Normal", dst, V)]);
+    Ok(())
+}
+
 /// Particle, Point, Curves and Volume Info on a triangle mesh, as Cycles evaluates them
 /// there: the point, curve and volume data are absent (zero), and the particle is Cycles'
 /// dummy particle 0, whose Random is the hash of its index.
@@ -401,16 +477,32 @@ fn emission(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), Comp
     Ok(())
 }
 
-/// Metallic BSDF: its F82 Tint mode with GGX or Multiscatter GGX (render/bsdf/metallic.rs).
+/// Metallic BSDF: F82 Tint and Physical Conductor, GGX, Multiscatter GGX and isotropic
+/// Beckmann (render/bsdf/metallic.rs).
 fn metallic_bsdf(c: &mut Compiler<'_, '_>, i: usize, s: &Schedule) -> Result<(), CompileError> {
     let n = &c.g.nodes[i];
     let fresnel = prop_str(n, "fresnel_type")?;
     let distribution = prop_str(n, "distribution")?;
-    if fresnel != "F82" || distribution == "BECKMANN" {
+    if !matches!(fresnel, "F82" | "PHYSICAL_CONDUCTOR")
+        || !matches!(distribution, "GGX" | "MULTI_GGX" | "BECKMANN")
+    {
         return Err(CompileError(format!(
-            "node {:?}: Metallic BSDF with fresnel_type {fresnel:?} and distribution {distribution:?} is not supported yet (F82 with GGX or Multiscatter GGX is)",
+            "node {:?}: Metallic BSDF with fresnel_type {fresnel:?} and distribution {distribution:?} is not supported",
             n.path
         )));
+    }
+    if distribution == "BECKMANN" {
+        let anisotropic = linked(n, "Anisotropy")
+            || matches!(
+                n.input("Anisotropy").and_then(|x| x.sources.first()),
+                Some(Source::Default(sock)) if sock.default_value.as_ref().map(floats).is_some_and(|f| f[0] != 0.0)
+            );
+        if anisotropic {
+            return Err(CompileError(format!(
+                "node {:?}: Metallic BSDF with the Beckmann distribution and Anisotropy is not supported yet",
+                n.path
+            )));
+        }
     }
     bsdf(c, i, s)
 }
