@@ -180,6 +180,17 @@ const ASSERTED: &[&str] = &[
     "sss_rw_plane",
     "sss_rw_thin_shell",
     "sss_rw_skin_thin_shell",
+    // Volumes in closed meshes (render/volume.rs): an absorbing volume-only cube before an
+    // emissive panel and in a light's shadow path, a scattering cube under a spot with
+    // single and multiple scattering, Principled Volume with absorption colour, emission
+    // and blackbody, a glass sphere with absorption inside, and a noise-texture density
+    // ray-marched at the object's step size.
+    "volume_absorb_cube",
+    "volume_scatter_spot",
+    "volume_scatter_bounces",
+    "volume_principled_emission",
+    "volume_glass_absorb",
+    "volume_noise_density",
 ];
 
 /// One scene at several scales (lengths, radii and light energy scaled alike: Cycles' image

@@ -49,6 +49,7 @@ pub mod terminator;
 pub mod thin_film;
 pub mod toon;
 pub mod triangle_light;
+pub mod volume;
 pub mod world;
 
 use std::time::Instant;
@@ -312,6 +313,7 @@ fn render_frame(
         Some(m) => m,
         None => bvh.as_ref(),
     };
+    let volumes = volume::Volumes::build(scene, &geo, &materials, &integrator);
     let tracer = integrator::Scene {
         light_select: &light_select,
         accel,
@@ -324,6 +326,7 @@ fn render_frame(
         settings,
         world: world_shader.as_ref(),
         view: camera.view(),
+        volumes: &volumes,
     };
 
     let adaptive = adaptive::Adaptive::from_settings(&integrator, samples, opts.threshold);

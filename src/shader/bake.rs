@@ -103,7 +103,17 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
     };
     for m in &slots {
         programs.push(match m {
-            Some(name) => Some(compile_material(scene, name).map_err(|e| e.to_string())?),
+            Some(name) => {
+                let p = compile_material(scene, name).map_err(|e| e.to_string())?;
+                // A bake evaluates surfaces; a volume is rendered (render/volume.rs), not
+                // baked.
+                if p.volume.is_some() {
+                    return Err(format!(
+                        "material {name:?}: Material Output: volume shading (its Volume input is linked) is not supported by bake"
+                    ));
+                }
+                Some(p)
+            }
             None => None,
         });
     }
