@@ -199,7 +199,10 @@ const SCALED_SCENES: &[&str] = &["sss_rw_tube_3cm", "sss_rw_tube_30cm", "sss_rw_
 const MAX_SCALE_REL: f64 = 0.003;
 
 /// Scenes that do not pass yet, with the reason.
-const KNOWN_FAILURES: &[(&str, &str)] = &[];
+const KNOWN_FAILURES: &[(&str, &str)] = &[(
+    "volume_camera_inside",
+    "camera and point light inside a fog box: the stack found at the camera is right (without it the image is far off), but light inside a medium is sampled at the distance-sampled point only (no equiangular sampling): ratio 1.27, means 0.7% low",
+)];
 
 /// Scenes whose one-seed figures are no parity criterion, with the test that compares them
 /// instead (their figures are still printed).

@@ -290,7 +290,7 @@ impl Scene<'_> {
         let st = &self.settings;
         scratch.features = Default::default();
         scratch.transparent = 0.0;
-        scratch.volume_stack.clear();
+        self.volume_stack_init(org, scratch);
         scratch.volume_bounce = 0;
         let mut path = Path::camera(org, dir, tmin, tmax, scratch.ray_dp, scratch.ray_dd);
         loop {
@@ -313,11 +313,24 @@ impl Scene<'_> {
             if from_sss.is_none() && !scratch.volume_stack.is_empty() {
                 match hit_opt {
                     None => scratch.volume_stack.clear(),
-                    Some(h) => match self.volume_segment(&mut path, h.t, rng, index, scratch) {
-                        super::volume::Segment::Passed => {}
-                        super::volume::Segment::Scattered => continue,
-                        super::volume::Segment::Stop => break,
-                    },
+                    Some(h) => {
+                        // A light inside the volume ends the segment: it is reached with
+                        // the transmittance up to it, and the ray goes on past it (Cycles'
+                        // shade_light continues the path).
+                        let t_light = self.light_in_segment(&path, h.t);
+                        let t_end = t_light.unwrap_or(h.t);
+                        match self.volume_segment(&mut path, t_end, rng, index, scratch) {
+                            super::volume::Segment::Passed => {}
+                            super::volume::Segment::Scattered => continue,
+                            super::volume::Segment::Stop => break,
+                        }
+                        if let Some(t) = t_light {
+                            let clamp = path.hit_clamp(st);
+                            self.lights_along(&mut path, Some(t), clamp, scratch);
+                            self.past_light(&mut path, t);
+                            continue;
+                        }
+                    }
                 }
             }
             let clamp_limit = path.hit_clamp(st);

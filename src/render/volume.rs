@@ -97,6 +97,8 @@ pub struct Volumes {
     max_steps: u32,
     /// Some material has a volume.
     pub any: bool,
+    /// World bounds of the instances with a volume (where a camera may be inside one).
+    bounds: Vec<(V3, V3)>,
 }
 
 impl Volumes {
@@ -136,6 +138,14 @@ impl Volumes {
                 .fold(f32::INFINITY, f32::min);
             let (lo, hi) = inst.world_bounds;
             let size = average(sub(hi, lo));
+            if inst
+                .slots
+                .iter()
+                .flatten()
+                .any(|&m| v.materials.get(m).copied().flatten().is_some())
+            {
+                v.bounds.push(inst.world_bounds);
+            }
             v.step.push(if rate.is_finite() {
                 0.1 * size * rate * render_rate
             } else {
@@ -143,6 +153,13 @@ impl Volumes {
             });
         }
         v
+    }
+
+    /// Whether `p` is within the bounds of an instance with a volume.
+    fn near_volume(&self, p: V3) -> bool {
+        self.bounds
+            .iter()
+            .any(|(lo, hi)| (0..3).all(|k| p[k] >= lo[k] && p[k] <= hi[k]))
     }
 
     /// Whether material `m` has a volume.
@@ -499,6 +516,72 @@ fn transmittance(sigma_t: V3, t: f32) -> V3 {
 }
 
 impl Scene<'_> {
+    /// The volumes a camera ray starting at `org` is inside, as Cycles'
+    /// integrator_volume_stack_init finds them: along +Z from the origin, a volume whose
+    /// boundary is crossed from the inside before it was entered encloses the origin.
+    pub(super) fn volume_stack_init(&self, org: V3, scratch: &mut Scratch) {
+        scratch.volume_stack.clear();
+        if !self.volumes.any || !self.volumes.near_volume(org) {
+            return;
+        }
+        let dir = [0.0, 0.0, 1.0];
+        let mut o = org;
+        let mut entered = [u32::MAX; 2 * STACK_SIZE];
+        let mut n_entered = 0;
+        // Surfaces without a volume are stepped over too; the bound only guards
+        // against a degenerate mesh.
+        for _ in 0..256 {
+            scratch.rays += 1;
+            let Some(h) = self.accel.intersect_vis(
+                o,
+                dir,
+                0.0,
+                f32::INFINITY,
+                scratch.time,
+                super::accel::visibility::ALL,
+            ) else {
+                break;
+            };
+            let hit = self.surface_at(h.prim, h.u, h.v, neg(dir), scratch.time);
+            o = offset_origin(hit.p, hit.ng, dir);
+            let Some(mi) = hit.material.filter(|&m| self.volumes.has_volume(m)) else {
+                continue;
+            };
+            if !hit.backfacing {
+                if n_entered < entered.len() {
+                    entered[n_entered] = hit.inst;
+                    n_entered += 1;
+                }
+            } else if !entered[..n_entered].contains(&hit.inst) {
+                scratch.volume_stack.enter_exit(hit.inst, mi as u32, false);
+            }
+        }
+    }
+
+    /// The distance along `path`'s ray to the nearest light it can hit before
+    /// `t_surface`, slightly past it (so `lights_along` to there gathers it).
+    pub(super) fn light_in_segment(&self, path: &Path, t_surface: f32) -> Option<f32> {
+        let flags = path.state.flags;
+        self.lights
+            .iter()
+            .filter(|l| l.visible_to(flags) && (l.mis || flags & ray::CAMERA != 0))
+            .filter_map(|l| l.intersect(path.o, path.d, t_surface).map(|h| h.t))
+            .min_by(f32::total_cmp)
+            .map(|t| t * (1.0 + 1e-5) + 1e-7)
+            .filter(|&t| t < t_surface)
+    }
+
+    /// The path goes on past the light at `t` along its ray, with fresh sampler
+    /// dimensions for the rest of the segment.
+    pub(super) fn past_light(&self, path: &mut Path, t: f32) {
+        path.o = madd(path.o, path.d, t);
+        path.t0 = 0.0;
+        if path.t1.is_finite() {
+            path.t1 -= t;
+        }
+        path.set += SETS_PER_VERTEX;
+    }
+
     /// The volume coefficients of every volume in `stack` at `p` on a ray along `d`
     /// (Cycles' volume_shader_eval: each material's program run at the point; shadow
     /// rays skip emission).
