@@ -691,6 +691,7 @@ fn prepare(
         object_motion::warn_deformation(&eval);
         camera.set_motion(&steps);
     }
+    volume::check_objects(scene)?;
     let mut geo = build::build(scene, &eval, overrides)?;
     let mut used = vec![false; scene.file.materials.len()];
     for inst in &geo.instances {
