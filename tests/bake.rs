@@ -289,8 +289,8 @@ fn fresh_cycles_node_bakes_match() {
     check_node_cases(t.path());
 }
 
-/// A linked Volume (Cycles renders volumes; blendsynth does not yet) is an error naming
-/// the material and its output node, never a surface-only render.
+/// A linked Volume (rendered by render/volume.rs, not baked) is a bake error naming the
+/// material and its output node, never a surface-only bake.
 #[test]
 fn volume_shading_is_refused_by_name() {
     let t = tempfile::tempdir().unwrap();

@@ -11,6 +11,6 @@ pub const TRANSPARENT: u32 = 1 << 6;
 pub const SHADOW: u32 = 1 << 7;
 /// Emission evaluated for a light sample (Cycles counts it one bounce further).
 pub const EMISSION: u32 = 1 << 8;
-/// Never set: blendsynth has no volumes (Is Volume Scatter Ray reads 0, as Cycles
-/// does for surfaces reached without volume scattering).
+/// A ray leaving a volume scatter point (render/volume.rs), as Is Volume Scatter Ray
+/// reads it.
 pub const VOLUME_SCATTER: u32 = 1 << 9;

@@ -29,6 +29,7 @@ pub mod sampler;
 pub mod scene_mesh;
 pub mod shader_rays;
 pub mod subsurface;
+pub mod volume;
 
 use std::time::Instant;
 
@@ -285,6 +286,7 @@ fn render_frame(
         None => bvh.as_ref(),
     };
     let local = shader_rays::LocalAccels::new(&geo);
+    let volumes = volume::Volumes::build(scene, &geo, &materials, &integrator);
     let tracer = integrator::Scene {
         local: &local,
         light_select: &light_select,
@@ -298,6 +300,7 @@ fn render_frame(
         settings,
         world: world_shader.as_ref(),
         view: camera.view(),
+        volumes: &volumes,
     };
 
     let adaptive = film::adaptive::Adaptive::from_settings(&integrator, samples, opts.threshold);
@@ -662,6 +665,7 @@ fn prepare(
         motion::object::warn_deformation(&eval);
         camera.set_motion(&steps);
     }
+    volume::check_objects(scene)?;
     let mut geo = build::build(scene, &eval, overrides)?;
     let mut used = vec![false; scene.file.materials.len()];
     for inst in &geo.instances {

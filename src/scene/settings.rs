@@ -110,6 +110,11 @@ pub struct Integrator {
     pub use_denoising: bool,
     /// The sampling pattern's seed.
     pub seed: f64,
+    /// Light Paths > Max Bounces > Volume (0: single scattering).
+    pub volume_bounces: u32,
+    /// Volumes > Step Rate (render) and Max Steps: the ray marching of varying volumes.
+    pub volume_step_rate: f64,
+    pub volume_max_steps: u32,
 }
 
 impl Integrator {
@@ -140,6 +145,9 @@ impl Integrator {
             adaptive_min_samples: num(cy, "adaptive_min_samples").unwrap_or(0.0),
             use_denoising: flag(cy, "use_denoising").unwrap_or(false),
             seed: num(cy, "seed").unwrap_or(0.0),
+            volume_bounces: count("volume_bounces", 0.0),
+            volume_step_rate: num(cy, "volume_step_rate").unwrap_or(1.0),
+            volume_max_steps: count("volume_max_steps", 1024.0),
         }
     }
 }
@@ -482,6 +490,13 @@ pub struct MaterialSettings {
     pub use_bump_map_correction: bool,
     /// Viewport Display colour, which Cycles renders when Use Nodes is off.
     pub diffuse_color: Option<[f64; 3]>,
+    /// Volume > Homogeneous: the volume is evaluated once per ray segment even when it
+    /// varies.
+    pub homogeneous_volume: bool,
+    /// Volume > Sampling ("DISTANCE", "EQUIANGULAR", "MULTIPLE_IMPORTANCE").
+    pub volume_sampling: String,
+    /// Volume > Step Rate: scales the object's ray-marching step.
+    pub volume_step_rate: f64,
 }
 
 impl MaterialSettings {
@@ -497,6 +512,14 @@ impl MaterialSettings {
                 .and_then(|c| flag(c, "use_bump_map_correction"))
                 .unwrap_or(true),
             diffuse_color: rgb_strict(p.get("diffuse_color")),
+            homogeneous_volume: cy
+                .and_then(|c| flag(c, "homogeneous_volume"))
+                .unwrap_or(false),
+            volume_sampling: cy
+                .and_then(|c| text(c, "volume_sampling"))
+                .unwrap_or("MULTIPLE_IMPORTANCE")
+                .to_string(),
+            volume_step_rate: cy.and_then(|c| num(c, "volume_step_rate")).unwrap_or(1.0),
         }
     }
 }

@@ -111,6 +111,13 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
                         "material {name:?}: Ambient Occlusion and Bevel nodes trace rays, which the bake does not support (render the scene instead)"
                     ));
                 }
+                // A bake evaluates surfaces; a volume is rendered (render/volume.rs), not
+                // baked.
+                if p.volume.is_some() {
+                    return Err(format!(
+                        "material {name:?}: Material Output: volume shading (its Volume input is linked) is not supported by bake"
+                    ));
+                }
                 Some(p)
             }
             None => None,

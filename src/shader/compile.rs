@@ -77,6 +77,8 @@ fn empty_surface() -> Program {
         attributes: Vec::new(),
         displacement: None,
         emission_estimate: [0.0; 3],
+        volume: None,
+        volume_varying: false,
     }
 }
 
@@ -113,6 +115,7 @@ struct Compiler<'g, 'a> {
     /// Per flat node: the closure its (single) shader output makes.
     closure_of: Vec<Option<u32>>,
     surface: Option<u32>,
+    volume: Option<u32>,
     bsdfs: Vec<BsdfNode>,
     /// The scene, for the images texture nodes name (None: no images available).
     scene: Option<&'a Scene>,
@@ -243,6 +246,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
             values: vec![Vec::new(); g.nodes.len()],
             closure_of: vec![None; g.nodes.len()],
             surface: None,
+            volume: None,
             bsdfs: Vec::new(),
             scene: None,
             displace: None,
@@ -316,6 +320,29 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 } else {
                     [x[0] + y[0], x[1] + y[1], x[2] + y[2]]
                 }
+            }
+        }
+    }
+
+    /// Whether closure `c`'s tree reads a value that is not a constant (a mix factor, an
+    /// emission or a node input computed by ops).
+    fn closure_varies(&self, c: u32) -> bool {
+        let computed = |slot: Slot| !self.constants.contains(&slot);
+        match self.closures[c as usize] {
+            Closure::Emission { color, strength } => computed(color) || computed(strength),
+            Closure::Bsdf { .. } => self
+                .bsdfs
+                .iter()
+                .filter(|b| b.closure == c)
+                .any(|b| b.inputs.iter().any(|(_, slot, _)| computed(*slot))),
+            Closure::Mix { fac, a, b } => {
+                computed(fac)
+                    || a.is_some_and(|a| self.closure_varies(a))
+                    || b.is_some_and(|b| self.closure_varies(b))
+            }
+            Closure::Add { a, b } => {
+                a.is_some_and(|a| self.closure_varies(a))
+                    || b.is_some_and(|b| self.closure_varies(b))
             }
         }
     }
@@ -427,6 +454,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
         }
         self.switch_copy(&schedule, 0);
         let emission_estimate = self.emission_estimate(self.surface);
+        let volume_varying = self.volume.is_some_and(|v| self.closure_varies(v));
         Ok(Program {
             ops: self.ops,
             initial: self.initial,
@@ -434,6 +462,8 @@ impl<'g, 'a> Compiler<'g, 'a> {
             curves: self.curves,
             closures: self.closures,
             surface: self.surface,
+            volume: self.volume,
+            volume_varying,
             bsdfs: self.bsdfs,
             displaced_normal: self.displaced_normal,
             attributes: self.attributes,

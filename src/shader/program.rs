@@ -573,6 +573,12 @@ pub struct Program {
     pub closures: Vec<Closure>,
     /// The closure plugged into the Material Output's Surface.
     pub surface: Option<u32>,
+    /// The closure plugged into the Material Output's Volume (render/volume.rs runs it
+    /// at points inside the mesh).
+    pub volume: Option<u32>,
+    /// The volume's coefficients can vary from point to point (some value its closures
+    /// read is computed, not constant): the renderer ray-marches it.
+    pub volume_varying: bool,
     /// Every BSDF node's inputs, for the renderer to build its closures from.
     pub bsdfs: Vec<BsdfNode>,
     /// Where the normal bumped by the material's displacement lands after `run` (the

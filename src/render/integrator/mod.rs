@@ -54,7 +54,7 @@ pub struct Settings {
 }
 
 #[inline]
-fn power_heuristic(a: f32, b: f32) -> f32 {
+pub(super) fn power_heuristic(a: f32, b: f32) -> f32 {
     if a.is_infinite() {
         return 1.0;
     }
@@ -84,6 +84,8 @@ pub struct Scene<'a> {
     pub view: crate::shader::view::View,
     /// Each object's own BVH for the shaders' local ray queries (Bevel, AO Only Local).
     pub local: &'a crate::render::shader_rays::LocalAccels,
+    /// The materials' volumes (render/volume.rs).
+    pub volumes: &'a crate::render::volume::Volumes,
 }
 
 /// Per-thread scratch, reused across samples (no allocation per ray).
@@ -105,6 +107,9 @@ pub struct Scratch {
     /// background and holdouts seen by the camera, as Cycles accumulates it in the
     /// combined pass's alpha.
     pub transparent: f32,
+    /// The volumes the path being traced is inside, and its volume bounces so far.
+    pub volume_stack: super::volume::Stack,
+    pub volume_bounce: u32,
 }
 
 impl Scratch {
@@ -119,6 +124,8 @@ impl Scratch {
             time: crate::render::motion::object::CENTRE_TIME,
             features: Default::default(),
             transparent: 0.0,
+            volume_stack: Default::default(),
+            volume_bounce: 0,
         }
     }
 }
@@ -138,7 +145,7 @@ pub struct SurfaceHit {
     pub uv: [f32; 2],
 }
 
-fn clamp_contrib(l: V3, limit: f32) -> V3 {
+pub(super) fn clamp_contrib(l: V3, limit: f32) -> V3 {
     if limit > 0.0 {
         let s = l[0].abs() + l[1].abs() + l[2].abs();
         if s > limit {
@@ -325,6 +332,8 @@ impl Scene<'_> {
         let st = &self.settings;
         scratch.features = Default::default();
         scratch.transparent = 0.0;
+        self.volume_stack_init(org, scratch);
+        scratch.volume_bounce = 0;
         let mut path = Path::camera(org, dir, tmin, tmax, scratch.ray_dp, scratch.ray_dd);
         loop {
             let from_sss = path.sss_exit.take();
@@ -341,6 +350,31 @@ impl Scene<'_> {
                     visibility::of_path(path.state.flags),
                 )
             };
+            // Inside volumes the segment to the hit runs first (render/volume.rs); a ray
+            // leaving the scene leaves every volume (Cycles' volume_stack_clean).
+            if from_sss.is_none() && !scratch.volume_stack.is_empty() {
+                match hit_opt {
+                    None => scratch.volume_stack.clear(),
+                    Some(h) => {
+                        // A light inside the volume ends the segment: it is reached with
+                        // the transmittance up to it, and the ray goes on past it (Cycles'
+                        // shade_light continues the path).
+                        let t_light = self.light_in_segment(&path, h.t);
+                        let t_end = t_light.unwrap_or(h.t);
+                        match self.volume_segment(&mut path, t_end, rng, index, scratch) {
+                            super::volume::Segment::Passed => {}
+                            super::volume::Segment::Scattered => continue,
+                            super::volume::Segment::Stop => break,
+                        }
+                        if let Some(t) = t_light {
+                            let clamp = path.hit_clamp(st);
+                            self.lights_along(&mut path, Some(t), clamp, scratch);
+                            self.past_light(&mut path, t);
+                            continue;
+                        }
+                    }
+                }
+            }
             let clamp_limit = path.hit_clamp(st);
             if from_sss.is_none() {
                 self.lights_along(&mut path, hit_opt.map(|h| h.t), clamp_limit, scratch);
@@ -351,6 +385,9 @@ impl Scene<'_> {
             };
             let wo = neg(path.d);
             let hit = self.vertex(&mut path, &h, wo, scratch);
+            if from_sss.is_none() && self.volume_boundary(&mut path, &hit, scratch) {
+                continue;
+            }
             if !self.shade_vertex(&path, &hit, wo, from_sss.is_some(), rng, index, scratch) {
                 break;
             }
@@ -422,6 +459,9 @@ impl Scene<'_> {
                 let Some((exit_hit, dir)) = exit else { break };
                 path.leave_subsurface(exit_hit, dir);
                 continue;
+            }
+            if bs.transmit || matches!(bs.kind, LobeKind::Transparent) {
+                self.volume_cross(&hit, scratch);
             }
             if path.next(&bs, hit.p, hit.ng, n_sel, trans_sel, st) == Next::Stop {
                 break;
@@ -666,6 +706,7 @@ impl Scene<'_> {
                 }
                 let start = self.shadow_origin(hit, scratch.lobes.smooth_n, ls.wi);
                 let tr = if light.cast_shadow {
+                    let stack = self.shadow_stack(hit, ls.wi, scratch);
                     self.shadow_transmittance(
                         start,
                         ls.wi,
@@ -674,6 +715,7 @@ impl Scene<'_> {
                         } else {
                             f32::INFINITY
                         },
+                        stack,
                         scratch,
                     )
                 } else {
@@ -708,7 +750,9 @@ impl Scene<'_> {
                 }
                 let pdf_l = p_sel * ts.pdf;
                 let start = self.shadow_origin(hit, scratch.lobes.smooth_n, ts.wi);
-                let tr = self.shadow_transmittance(start, ts.wi, ts.dist * (1.0 - 1e-4), scratch);
+                let stack = self.shadow_stack(hit, ts.wi, scratch);
+                let tr =
+                    self.shadow_transmittance(start, ts.wi, ts.dist * (1.0 - 1e-4), stack, scratch);
                 if is_zero(tr) {
                     return None;
                 }
@@ -820,7 +864,8 @@ impl Scene<'_> {
             return [0.0; 3];
         }
         let start = self.shadow_origin(hit, scratch.lobes.smooth_n, wi);
-        let tr = self.shadow_transmittance(start, wi, f32::INFINITY, scratch);
+        let stack = self.shadow_stack(hit, wi, scratch);
+        let tr = self.shadow_transmittance(start, wi, f32::INFINITY, stack, scratch);
         if is_zero(tr) {
             return [0.0; 3];
         }
@@ -885,10 +930,18 @@ impl Scene<'_> {
     /// What a shadow ray from `start` along `dir` (unit) lets through up to `tmax`: zero at
     /// the first opaque surface; through surfaces whose material can be transparent, the
     /// product of their transparent closures' weights (Cycles' transparent shadows), and
-    /// opaque past the transparent bounce limit.
-    fn shadow_transmittance(&self, start: V3, dir: V3, tmax: f32, scratch: &mut Scratch) -> V3 {
+    /// opaque past the transparent bounce limit. Inside volumes (`stack`: those it starts
+    /// in) each segment is attenuated by them; a volume-only boundary is passed freely.
+    pub(super) fn shadow_transmittance(
+        &self,
+        start: V3,
+        dir: V3,
+        tmax: f32,
+        mut stack: super::volume::Stack,
+        scratch: &mut Scratch,
+    ) -> V3 {
         scratch.rays += 1;
-        if !self.settings.transparent_shadows {
+        if !self.settings.transparent_shadows && !self.volumes.any {
             let blocked =
                 self.accel
                     .occluded_vis(start, dir, 0.0, tmax, scratch.time, visibility::SHADOW);
@@ -896,41 +949,56 @@ impl Scene<'_> {
         }
         let mut through = [1.0f32; 3];
         let (mut o, mut left) = (start, tmax);
-        for crossed in 0..=self.settings.max_transparent {
-            if crossed > 0 {
-                scratch.rays += 1;
-            }
-            let Some(h) =
+        let mut crossed = 0;
+        loop {
+            let found =
                 self.accel
-                    .intersect_vis(o, dir, 0.0, left, scratch.time, visibility::SHADOW)
-            else {
+                    .intersect_vis(o, dir, 0.0, left, scratch.time, visibility::SHADOW);
+            let seg = found.map_or(left, |h| h.t);
+            if !stack.is_empty() && seg.is_finite() {
+                let tr = self.volume_transmittance(o, dir, seg, &stack, scratch);
+                through = mul(through, tr);
+                if is_zero(through) {
+                    return [0.0; 3];
+                }
+            }
+            let Some(h) = found else {
                 return through;
             };
             let mut hit = self.surface_at(h.prim, h.u, h.v, neg(dir), scratch.time);
             match hit.material {
-                Some(mi) if self.materials[mi].transparent_shadow => {}
+                Some(mi) if self.volumes.only_volume(mi) => {}
+                Some(mi) if self.materials[mi].transparent_shadow => {
+                    if crossed >= self.settings.max_transparent {
+                        return [0.0; 3];
+                    }
+                    crossed += 1;
+                    hit.sp.ray_length = h.t;
+                    hit.sp.path = PathState {
+                        flags: ray::SHADOW,
+                        ..Default::default()
+                    };
+                    self.shade_into(
+                        &hit,
+                        neg(dir),
+                        &mut scratch.stacks,
+                        &mut scratch.light_lobes,
+                        &NoTrace,
+                    );
+                    through = mul(through, scratch.light_lobes.transparent);
+                    if is_zero(through) {
+                        return [0.0; 3];
+                    }
+                }
                 _ => return [0.0; 3],
             }
-            hit.sp.ray_length = h.t;
-            hit.sp.path = PathState {
-                flags: ray::SHADOW,
-                ..Default::default()
-            };
-            self.shade_into(
-                &hit,
-                neg(dir),
-                &mut scratch.stacks,
-                &mut scratch.light_lobes,
-                &NoTrace,
-            );
-            through = mul(through, scratch.light_lobes.transparent);
-            if is_zero(through) {
-                return [0.0; 3];
+            if let Some(mi) = hit.material.filter(|&m| self.volumes.has_volume(m)) {
+                stack.enter_exit(hit.inst, mi as u32, hit.backfacing);
             }
             o = offset_origin(hit.p, hit.ng, dir);
             left -= h.t;
+            scratch.rays += 1;
         }
-        [0.0; 3]
     }
 }
 
@@ -1039,7 +1107,7 @@ impl Scene<'_> {
     /// Ray Depth reads one more) and the sample distance as the ray length.
     /// The sides of triangle `prim` light sampling draws from: its material's Emission
     /// Sampling (Front, Back, or both for Auto and Front and Back).
-    fn emission_sides(&self, prim: u32) -> (bool, bool) {
+    pub(super) fn emission_sides(&self, prim: u32) -> (bool, bool) {
         let r = self.geo.refs[prim as usize];
         match self.geo.instances[r.inst as usize]
             .material_of(r.tri as usize)

@@ -53,7 +53,12 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
         }
         let p = compile_material(scene, &m.name).map_err(|e| RenderError(format!("{e}")))?;
         let mut bsdf_of = vec![None; p.closures.len()];
+        // Volume nodes shade only a Volume (render/volume.rs): in a Surface they do
+        // nothing, as in Cycles.
         for (bi, b) in p.bsdfs.iter().enumerate() {
+            if b.bl_idname.starts_with("ShaderNodeVolume") {
+                continue;
+            }
             if let Some(slot) = bsdf_of.get_mut(b.closure as usize) {
                 *slot = Some(bi as u32);
             }

@@ -98,6 +98,8 @@ const WORLD: &str = "world surfaces (render/light/world.rs); tests/world.rs";
 const SHADER_STRUCTURE: &str = "closure weights and emission, whole-material bakes (tests/bake.rs)";
 const CLOSURE: &str =
     "light transport in render/ (bsdf.rs and the closure files), a Cycles parity scene in tests/render.rs";
+const VOLUME: &str =
+    "in a material's Volume: render/volume.rs (Cycles' svm_node_closure_volume, principled_volume, volume_coefficients; Henyey-Greenstein and Rayleigh phases, other phase functions are compile errors naming the node), Cycles parity scenes volume_* in tests/render.rs; in a Surface it does nothing, as in Cycles; a world's Volume is a compile error";
 const TEXTURE: &str =
     "nodes/<texture>.rs (Cycles flavour); every mode in tests/shader_conformance.rs";
 const GABOR: &str =
@@ -163,6 +165,10 @@ pub const NODES: &[ShaderNode] = &[
     node("ShaderNodeBsdfSheen", bsdf, CLOSURE),
     node("ShaderNodeBsdfMetallic", metallic_bsdf, METALLIC),
     node("ShaderNodeBsdfToon", bsdf, TOON),
+    node("ShaderNodeVolumeAbsorption", volume, VOLUME),
+    node("ShaderNodeVolumeScatter", volume, VOLUME),
+    node("ShaderNodeVolumePrincipled", volume, VOLUME),
+    node("ShaderNodeVolumeCoefficients", volume, VOLUME),
     // Texture
     node("ShaderNodeTexNoise", noise_texture, TEXTURE),
     node("ShaderNodeTexVoronoi", voronoi_texture, TEXTURE),
@@ -425,14 +431,9 @@ fn material_output(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(
             n.path
         )));
     }
-    // Cycles renders a linked Volume; blendsynth has no volume rendering yet.
-    if linked(n, "Volume") {
-        return Err(CompileError(format!(
-            "node {:?}: volume shading (its Volume input is linked) is not supported yet",
-            n.path
-        )));
-    }
     c.surface = c.closure_input(n, "Surface")?;
+    // The mesh's inside, rendered by render/volume.rs.
+    c.volume = c.closure_input(n, "Volume")?;
     Ok(())
 }
 
@@ -452,7 +453,7 @@ fn world_output(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), 
     let n = &c.g.nodes[i];
     if linked(n, "Volume") {
         return Err(CompileError(format!(
-            "node {:?}: volume shading (its Volume input is linked) is not supported yet",
+            "node {:?}: a world volume (volume shading of the World Output: its Volume input is linked) is not supported yet",
             n.path
         )));
     }
@@ -549,6 +550,22 @@ fn bsdf(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileE
     c.closure(i, Closure::Bsdf { emission: None });
     c.record_bsdf(i)?;
     Ok(())
+}
+
+/// A volume closure (render/volume.rs builds its coefficients). Cycles 4.5's phase
+/// functions other than Henyey-Greenstein and Rayleigh are refused by name.
+fn volume(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    if let Some(phase) = n.node.properties.get("phase").and_then(Value::as_str) {
+        if !matches!(phase, "HENYEY_GREENSTEIN" | "RAYLEIGH") {
+            return Err(CompileError(format!(
+                "node {:?}: phase function {phase:?} is not supported yet (Henyey-Greenstein and Rayleigh are)",
+                n.path
+            )));
+        }
+    }
+    c.closure(i, Closure::Bsdf { emission: None });
+    c.record_bsdf(i)
 }
 
 // Texture.

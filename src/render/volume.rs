@@ -1,0 +1,1115 @@
+//! Volumes inside closed meshes, as Cycles 4.5 integrates them (kernel/integrator/
+//! shade_volume.h, volume_stack.h, volume_shader.h): the stack of volumes a path is
+//! inside, entered and left where it transmits through a surface whose material has a
+//! Volume; along each ray segment inside them, the material's volume closures summed into
+//! extinction, scattering and emission, one step for a constant medium (analytic
+//! transmittance) and ray-marched steps for a varying one; a scattering distance drawn by
+//! Cycles' spectral distance sampling, light sampled there through the phase function
+//! (MIS with phase sampling) and the path continued in a phase-sampled direction. Shadow
+//! rays are attenuated by the volumes they cross.
+//!
+//! Direct light at a scatter point is sampled at the distance-sampled point only (Cycles'
+//! DISTANCE method); its equiangular strategy (and MIS between the two) is not built: the
+//! estimate converges to the same image, with more noise near lights inside a medium.
+
+use crate::scene::settings::{Integrator, MaterialSettings};
+use crate::scene::Scene as BlendScene;
+use crate::shader::point::{ray, PathState};
+use crate::shader::program::{Closure, Program};
+use crate::shader::ShadingPoint;
+
+use super::build::Geometry;
+use super::integrator::{Scene, Scratch, SurfaceHit};
+use super::light::tree::Pick;
+use super::math::*;
+use super::integrator::path_state::{Path, SETS_PER_VERTEX};
+use super::sampler::PixelSampler;
+use super::integrator::shade::Material;
+
+/// Volumes a path can be inside at once (Cycles sizes its stack from the scene; deeper
+/// nesting is ignored, as Cycles ignores entries past its stack).
+pub const STACK_SIZE: usize = 8;
+
+/// Cycles' VOLUME_THROUGHPUT_EPSILON: a segment that lets less through ends the path.
+const THROUGHPUT_EPSILON: f32 = 1e-6;
+
+/// The volumes a ray segment is inside: (mesh instance, material) pairs, in the order
+/// they were entered.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Stack {
+    entries: [(u32, u32); STACK_SIZE],
+    len: usize,
+}
+
+impl Stack {
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    pub fn clear(&mut self) {
+        self.len = 0;
+    }
+
+    pub fn entries(&self) -> &[(u32, u32)] {
+        &self.entries[..self.len]
+    }
+
+    /// Cycles' volume_stack_enter_exit at a surface of instance `inst` with a volume
+    /// material: seen from its back the ray leaves the volume, else it enters it (once).
+    pub fn enter_exit(&mut self, inst: u32, material: u32, backfacing: bool) {
+        let at = self.entries().iter().position(|e| *e == (inst, material));
+        if backfacing {
+            if let Some(i) = at {
+                self.entries.copy_within(i + 1..self.len, i);
+                self.len -= 1;
+            }
+        } else if at.is_none() && self.len < STACK_SIZE - 1 {
+            self.entries[self.len] = (inst, material);
+            self.len += 1;
+        }
+    }
+}
+
+/// A material's volume as the renderer runs it.
+#[derive(Debug, Clone, Copy)]
+struct VolumeMaterial {
+    /// Ray-marched: its closures read computed values and Volume > Homogeneous is off
+    /// (Cycles: heterogeneous_volume with spatially varying nodes).
+    varying: bool,
+    /// Volume > Step Rate.
+    step_rate: f32,
+}
+
+/// Every volume of the scene and the render's volume settings.
+#[derive(Debug, Clone, Default)]
+pub struct Volumes {
+    /// Per material (scene order): its volume, if its Volume output is linked.
+    materials: Vec<Option<VolumeMaterial>>,
+    /// Per material: a volume and no surface (Cycles' SD_HAS_ONLY_VOLUME): rays pass its
+    /// boundary without a bounce.
+    only_volume: Vec<bool>,
+    /// Per mesh instance: its ray-marching step (Cycles' object volume step size times
+    /// the render's step rate), infinite when none of its volumes varies.
+    step: Vec<f32>,
+    /// Light Paths > Volume bounces.
+    pub max_bounces: u32,
+    /// Volumes > Max Steps.
+    max_steps: u32,
+    /// Some material has a volume.
+    pub any: bool,
+    /// World bounds of the instances with a volume (where a camera may be inside one).
+    bounds: Vec<(V3, V3)>,
+}
+
+impl Volumes {
+    pub fn build(
+        scene: &BlendScene,
+        geo: &Geometry,
+        materials: &[Material],
+        integrator: &Integrator,
+    ) -> Volumes {
+        let mut v = Volumes {
+            max_bounces: integrator.volume_bounces,
+            max_steps: integrator.volume_max_steps.max(1),
+            ..Volumes::default()
+        };
+        for (i, m) in materials.iter().enumerate() {
+            let p = m.program.as_ref().filter(|p| p.volume.is_some());
+            let settings = scene.file.materials.get(i).map(MaterialSettings::of);
+            v.materials.push(p.map(|p| VolumeMaterial {
+                varying: p.volume_varying
+                    && !settings.as_ref().is_some_and(|s| s.homogeneous_volume),
+                step_rate: settings.as_ref().map_or(1.0, |s| s.volume_step_rate as f32),
+            }));
+            v.only_volume.push(p.is_some_and(|p| p.surface.is_none()));
+        }
+        v.any = v.materials.iter().any(Option::is_some);
+        let render_rate = integrator.volume_step_rate as f32;
+        for inst in &geo.instances {
+            // Cycles' Object::compute_volume_step_size: the smallest step rate of its
+            // varying volumes times a tenth of the average size of its world bounds.
+            let rate = inst
+                .slots
+                .iter()
+                .flatten()
+                .filter_map(|&m| v.materials.get(m).copied().flatten())
+                .filter(|m| m.varying)
+                .map(|m| m.step_rate)
+                .fold(f32::INFINITY, f32::min);
+            let (lo, hi) = inst.world_bounds;
+            let size = average(sub(hi, lo));
+            if inst
+                .slots
+                .iter()
+                .flatten()
+                .any(|&m| v.materials.get(m).copied().flatten().is_some())
+            {
+                v.bounds.push(inst.world_bounds);
+            }
+            v.step.push(if rate.is_finite() {
+                0.1 * size * rate * render_rate
+            } else {
+                f32::INFINITY
+            });
+        }
+        v
+    }
+
+    /// Whether `p` is within the bounds of an instance with a volume.
+    fn near_volume(&self, p: V3) -> bool {
+        self.bounds
+            .iter()
+            .any(|(lo, hi)| (0..3).all(|k| p[k] >= lo[k] && p[k] <= hi[k]))
+    }
+
+    /// Whether material `m` has a volume.
+    pub fn has_volume(&self, m: usize) -> bool {
+        matches!(self.materials.get(m), Some(Some(_)))
+    }
+
+    /// Whether material `m` is a volume with no surface.
+    pub fn only_volume(&self, m: usize) -> bool {
+        self.only_volume.get(m).copied().unwrap_or(false)
+    }
+
+    /// Cycles' volume_stack_step_size: the smallest step of the varying volumes in the
+    /// stack, infinite when every one is constant.
+    fn step_size(&self, stack: &Stack) -> f32 {
+        stack
+            .entries()
+            .iter()
+            .map(|&(inst, _)| {
+                self.step
+                    .get(inst as usize)
+                    .copied()
+                    .unwrap_or(f32::INFINITY)
+            })
+            .fold(f32::INFINITY, f32::min)
+    }
+}
+
+/// Volumes blendsynth cannot render, refused by name (for `render` and `inspect`): a
+/// fluid (smoke or fire) domain whose material has a Volume, which Cycles renders from
+/// the simulation's grids (density, flame, temperature, velocity); the export does not
+/// carry them, and its material over the bare domain box would be a stand-in. Checked
+/// before the geometry (a domain's mesh is frozen, which is not the reason it fails).
+pub fn check_objects(scene: &BlendScene) -> Result<(), super::RenderError> {
+    let has_volume = |name: &str| {
+        scene
+            .material(name)
+            .and_then(|m| m.node_tree.as_ref())
+            .is_some_and(|t| {
+                t.links
+                    .iter()
+                    .any(|l| l.to_socket == "Volume" && !l.is_muted)
+            })
+    };
+    for obj in scene.file.objects.iter().filter(|o| !o.hide_render) {
+        let domain = obj.modifiers.iter().find(|md| {
+            md.show_render
+                && md.kind == "FLUID"
+                && md.properties.get("fluid_type").and_then(|v| v.as_str()) == Some("DOMAIN")
+        });
+        let Some(md) = domain else { continue };
+        let mesh_materials = obj
+            .data
+            .as_deref()
+            .and_then(|d| scene.file.meshes.iter().find(|m| m.name == d))
+            .map(|m| m.materials.clone())
+            .unwrap_or_default();
+        let volume = obj
+            .material_slots
+            .iter()
+            .filter_map(|s| s.material.clone())
+            .chain(mesh_materials.into_iter().flatten())
+            .find(|m| has_volume(m));
+        if let Some(m) = volume {
+            return Err(super::RenderError(format!(
+                "object {:?}: the volume of its fluid domain (modifier {:?}, material {m:?}) is rendered from the simulation's grids, which blendsynth does not read: smoke and fire domains are not supported yet",
+                obj.name, md.name
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// A phase function of Cycles 4.5 (closure/volume_*.h).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Phase {
+    HenyeyGreenstein(f32),
+    Rayleigh,
+}
+
+impl Phase {
+    /// Cycles' setup: g kept within (-1, 1), near-zero g isotropic.
+    fn henyey_greenstein(g: f32) -> Phase {
+        let g = if g.is_finite() { g } else { 0.0 };
+        Phase::HenyeyGreenstein(g.signum() * g.abs().min(1.0 - 1e-3))
+    }
+
+    /// The phase function (its own pdf) for light travelling along `d` and leaving
+    /// toward `wi`.
+    pub fn eval(&self, d: V3, wi: V3) -> f32 {
+        let cos = dot(d, wi);
+        match *self {
+            Phase::HenyeyGreenstein(g) => hg(cos, g),
+            Phase::Rayleigh => 3.0 / (16.0 * std::f32::consts::PI) * (1.0 + cos * cos),
+        }
+    }
+
+    /// A direction for light travelling along `d`, and its pdf.
+    pub fn sample(&self, d: V3, u: [f32; 2]) -> (V3, f32) {
+        let cos = match *self {
+            Phase::HenyeyGreenstein(g) if g.abs() >= 1e-3 => {
+                let k = (1.0 - g * g) / (1.0 - g + 2.0 * g * u[0]);
+                ((1.0 + g * g - k * k) / (2.0 * g)).clamp(-1.0, 1.0)
+            }
+            Phase::HenyeyGreenstein(_) => 1.0 - 2.0 * u[0],
+            Phase::Rayleigh => {
+                // The inverse of the cdf (cos^3 + 3 cos + 4) / 8, by Cardano.
+                let a = 4.0 * u[0] - 2.0;
+                let s = (a + (a * a + 1.0).sqrt()).cbrt();
+                (s - 1.0 / s).clamp(-1.0, 1.0)
+            }
+        };
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        let phi = 2.0 * std::f32::consts::PI * u[1];
+        let (t, b) = basis(d);
+        let wi = normalize(add(
+            scale(d, cos),
+            add(scale(t, sin * phi.cos()), scale(b, sin * phi.sin())),
+        ));
+        (wi, self.eval(d, wi))
+    }
+}
+
+/// The Henyey-Greenstein phase function at cosine `cos` from the forward direction.
+fn hg(cos: f32, g: f32) -> f32 {
+    if g.abs() < 1e-3 {
+        return 0.25 * std::f32::consts::FRAC_1_PI;
+    }
+    let d = 1.0 + g * g - 2.0 * g * cos;
+    (1.0 - g * g) / (4.0 * std::f32::consts::PI * d * d.sqrt())
+}
+
+/// The phase closures at a point, each with its sample weight (Cycles: |average of the
+/// closure weight|).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Phases {
+    items: [(f32, Option<Phase>); 8],
+    n: usize,
+}
+
+impl Phases {
+    fn push(&mut self, weight: V3, phase: Phase) {
+        let w = average(weight).abs();
+        // Cycles' bsdf_alloc drops closures below its weight cutoff.
+        if max3(weight.map(f32::abs)) < 1e-5 || self.n == self.items.len() {
+            return;
+        }
+        self.items[self.n] = (w, Some(phase));
+        self.n += 1;
+    }
+
+    fn iter(&self) -> impl Iterator<Item = (f32, Phase)> + '_ {
+        self.items[..self.n]
+            .iter()
+            .filter_map(|(w, p)| p.map(|p| (*w, p)))
+    }
+
+    /// Cycles' _volume_shader_phase_eval_mis: the phases averaged by sample weight, and
+    /// the pdf of sampling `wi` the same way.
+    pub fn eval(&self, d: V3, wi: V3) -> (f32, f32) {
+        let (mut f, mut sum) = (0.0, 0.0);
+        for (w, p) in self.iter() {
+            f += w * p.eval(d, wi);
+            sum += w;
+        }
+        if sum > 0.0 {
+            (f / sum, f / sum)
+        } else {
+            (0.0, 0.0)
+        }
+    }
+
+    /// Cycles' volume_shader_phase_pick and sample: one phase by sample weight, its
+    /// direction; weight and pdf of that phase alone.
+    pub fn sample(&self, d: V3, u: [f32; 2]) -> Option<(V3, f32)> {
+        let mut u = u;
+        let mut picked = None;
+        let mut sum = 0.0;
+        for (w, p) in self.iter() {
+            sum += w;
+            if picked.is_none() {
+                picked = Some(p);
+                continue;
+            }
+            let thresh = w / sum;
+            if u[0] < thresh {
+                picked = Some(p);
+                u[0] /= thresh;
+            } else {
+                u[0] = (u[0] - thresh) / (1.0 - thresh);
+            }
+        }
+        let (wi, pdf) = picked?.sample(d, u);
+        (pdf > 0.0).then_some((wi, pdf))
+    }
+}
+
+/// The volume coefficients at a point: the sum over the stack (Cycles'
+/// VolumeShaderCoefficients).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Coefficients {
+    pub sigma_t: V3,
+    pub sigma_s: V3,
+    pub emission: V3,
+    pub phases: Phases,
+    /// Some closure set extinction, scattering or emission.
+    extinction: bool,
+    scatter: bool,
+    emit: bool,
+}
+
+fn v3(s: &[f32], at: u32) -> V3 {
+    let i = at as usize;
+    [s[i], s[i + 1], s[i + 2]]
+}
+
+fn finite_or(v: f32, d: f32) -> f32 {
+    if v.is_finite() {
+        v
+    } else {
+        d
+    }
+}
+
+impl Coefficients {
+    fn add_extinction(&mut self, w: V3) {
+        self.sigma_t = add(self.sigma_t, w);
+        self.extinction = true;
+    }
+
+    fn add_scatter(&mut self, w: V3, phase: Phase) {
+        if max3(w.map(f32::abs)) < 1e-5 {
+            return;
+        }
+        self.sigma_s = add(self.sigma_s, w);
+        self.phases.push(w, phase);
+        self.scatter = true;
+    }
+
+    fn add_emission(&mut self, e: V3) {
+        self.emission = add(self.emission, e);
+        self.emit = true;
+    }
+
+    /// Adds closure `c` of program `p` (stack `s`, already run) with mix weight `w`.
+    fn closure(&mut self, p: &Program, c: u32, w: f32, s: &[f32], shadow: bool) {
+        match p.closures[c as usize] {
+            Closure::Emission { color, strength } => {
+                if !shadow {
+                    let e = scale(v3(s, color), finite_or(s[strength as usize], 0.0) * w);
+                    self.add_emission(e.map(|x| finite_or(x, 0.0)));
+                }
+            }
+            Closure::Mix { fac, a, b } => {
+                let f = finite_or(s[fac as usize], 0.0).clamp(0.0, 1.0);
+                if let Some(a) = a.filter(|_| w * (1.0 - f) > 0.0) {
+                    self.closure(p, a, w * (1.0 - f), s, shadow);
+                }
+                if let Some(b) = b.filter(|_| w * f > 0.0) {
+                    self.closure(p, b, w * f, s, shadow);
+                }
+            }
+            Closure::Add { a, b } => {
+                for x in [a, b].into_iter().flatten() {
+                    self.closure(p, x, w, s, shadow);
+                }
+            }
+            Closure::Bsdf { .. } => {
+                if let Some(b) = p.bsdfs.iter().find(|b| b.closure == c) {
+                    self.volume_node(b, w, s, shadow);
+                }
+            }
+        }
+    }
+
+    /// One volume node (surface BSDFs in a Volume do nothing, as in Cycles).
+    fn volume_node(
+        &mut self,
+        b: &crate::shader::program::BsdfNode,
+        w: f32,
+        s: &[f32],
+        shadow: bool,
+    ) {
+        let f = |id: &str, d: f32| {
+            b.input(id)
+                .map_or(d, |(at, _)| finite_or(s[at as usize], d))
+        };
+        let c = |id: &str, d: V3| {
+            b.input(id)
+                .map_or(d, |(at, _)| v3(s, at).map(|x| finite_or(x, 0.0)))
+        };
+        let phase = || match b.property("phase") {
+            Some("RAYLEIGH") => Phase::Rayleigh,
+            _ => Phase::henyey_greenstein(f("Anisotropy", 0.0)),
+        };
+        match b.bl_idname.as_str() {
+            // svm_node_closure_volume: the colour is the closure weight; absorption
+            // takes its complement; both scaled by the mix weight times the density.
+            "ShaderNodeVolumeAbsorption" => {
+                let density = w * f("Density", 1.0).max(0.0);
+                let col = c("Color", [0.8; 3]);
+                self.add_extinction(scale(sub([1.0; 3], col), density));
+            }
+            "ShaderNodeVolumeScatter" => {
+                let density = w * f("Density", 1.0).max(0.0);
+                let sigma = scale(c("Color", [0.8; 3]), density);
+                self.add_scatter(sigma, phase());
+                self.add_extinction(sigma);
+            }
+            // svm_node_volume_coefficients.
+            "ShaderNodeVolumeCoefficients" => {
+                let scatter = c("Scatter Coefficients", [1.0; 3]);
+                if !is_zero(scatter) {
+                    self.add_scatter(scale(scatter, w), phase());
+                }
+                let absorption = c("Absorption Coefficients", [1.0; 3]);
+                self.add_extinction(scale(add(scatter, absorption), w));
+                let emission = c("Emission Coefficients", [0.0; 3]);
+                if !shadow && !is_zero(emission) {
+                    self.add_emission(scale(emission, w));
+                }
+            }
+            // svm_node_principled_volume (no density, colour or temperature attribute on
+            // a mesh: Cycles finds none there).
+            "ShaderNodeVolumePrincipled" => {
+                let density = w * f("Density", 1.0).max(0.0);
+                if density > 0.0 {
+                    let color = c("Color", [0.5; 3]);
+                    self.add_scatter(
+                        scale(color, density),
+                        Phase::henyey_greenstein(f("Anisotropy", 0.0)),
+                    );
+                    let absorption_color =
+                        c("Absorption Color", [0.0; 3]).map(|x| x.sqrt().max(0.0));
+                    let absorption: V3 = [0, 1, 2]
+                        .map(|k| (1.0 - color[k]).max(0.0) * (1.0 - absorption_color[k]).max(0.0));
+                    self.add_extinction(scale(add(color, absorption), density));
+                }
+                if shadow {
+                    return;
+                }
+                let emission = f("Emission Strength", 0.0);
+                if emission > 0.0 {
+                    self.add_emission(scale(c("Emission Color", [1.0; 3]), emission * w));
+                }
+                let blackbody = f("Blackbody Intensity", 0.0);
+                if blackbody > 0.0 {
+                    let t = f("Temperature", 1000.0).max(0.0);
+                    let t4 = (t * t) * (t * t);
+                    // Stefan-Boltzmann, in Cycles' units.
+                    let sigma = 5.670373e-8 * 1e-6 / std::f32::consts::PI;
+                    let intensity = sigma * (1.0 + blackbody * (t4 - 1.0));
+                    if intensity > 0.0 {
+                        let tint = c("Blackbody Tint", [1.0; 3]);
+                        let bb = crate::nodes::blackbody::blackbody_rec709(t);
+                        self.add_emission(scale(mul(tint, bb), intensity * w));
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+}
+
+/// What a ray segment inside volumes did to the path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Segment {
+    /// The path went through (its throughput attenuated) to what ends the segment.
+    Passed,
+    /// It scattered: the path's next ray leaves from the scatter point.
+    Scattered,
+    /// The path ends here.
+    Stop,
+}
+
+/// Cycles' volume_sample_channel: a colour channel in proportion to throughput times
+/// albedo; the channel, the three probabilities, and `u` rescaled for reuse.
+fn sample_channel(albedo: V3, throughput: V3, u: &mut f32) -> (usize, V3) {
+    let w = mul(throughput, albedo).map(f32::abs);
+    let sum = w[0] + w[1] + w[2];
+    let pdf = if (1.0 - sum) < 1.0 {
+        scale(w, 1.0 / sum)
+    } else {
+        [1.0 / 3.0; 3]
+    };
+    let mut acc = 0.0;
+    for (k, &p) in pdf.iter().enumerate() {
+        if *u < acc + p {
+            *u = (*u - acc) / p;
+            return (k, pdf);
+        }
+        acc += p;
+    }
+    (2, pdf)
+}
+
+fn transmittance(sigma_t: V3, t: f32) -> V3 {
+    sigma_t.map(|s| (-s * t).exp())
+}
+
+impl Scene<'_> {
+    /// The volumes a camera ray starting at `org` is inside, as Cycles'
+    /// integrator_volume_stack_init finds them: along +Z from the origin, a volume whose
+    /// boundary is crossed from the inside before it was entered encloses the origin.
+    pub(super) fn volume_stack_init(&self, org: V3, scratch: &mut Scratch) {
+        scratch.volume_stack.clear();
+        if !self.volumes.any || !self.volumes.near_volume(org) {
+            return;
+        }
+        let dir = [0.0, 0.0, 1.0];
+        let mut o = org;
+        let mut entered = [u32::MAX; 2 * STACK_SIZE];
+        let mut n_entered = 0;
+        // Surfaces without a volume are stepped over too; the bound only guards
+        // against a degenerate mesh.
+        for _ in 0..256 {
+            scratch.rays += 1;
+            let Some(h) = self.accel.intersect_vis(
+                o,
+                dir,
+                0.0,
+                f32::INFINITY,
+                scratch.time,
+                super::accel::visibility::ALL,
+            ) else {
+                break;
+            };
+            let hit = self.surface_at(h.prim, h.u, h.v, neg(dir), scratch.time);
+            o = offset_origin(hit.p, hit.ng, dir);
+            let Some(mi) = hit.material.filter(|&m| self.volumes.has_volume(m)) else {
+                continue;
+            };
+            if !hit.backfacing {
+                if n_entered < entered.len() {
+                    entered[n_entered] = hit.inst;
+                    n_entered += 1;
+                }
+            } else if !entered[..n_entered].contains(&hit.inst) {
+                scratch.volume_stack.enter_exit(hit.inst, mi as u32, false);
+            }
+        }
+    }
+
+    /// The distance along `path`'s ray to the nearest light it can hit before
+    /// `t_surface`, slightly past it (so `lights_along` to there gathers it).
+    pub(super) fn light_in_segment(&self, path: &Path, t_surface: f32) -> Option<f32> {
+        let flags = path.state.flags;
+        self.lights
+            .iter()
+            .filter(|l| l.visible_to(flags) && (l.mis || flags & ray::CAMERA != 0))
+            .filter_map(|l| l.intersect(path.o, path.d, t_surface).map(|h| h.t))
+            .min_by(f32::total_cmp)
+            .map(|t| t * (1.0 + 1e-5) + 1e-7)
+            .filter(|&t| t < t_surface)
+    }
+
+    /// The path goes on past the light at `t` along its ray, with fresh sampler
+    /// dimensions for the rest of the segment.
+    pub(super) fn past_light(&self, path: &mut Path, t: f32) {
+        path.o = madd(path.o, path.d, t);
+        path.t0 = 0.0;
+        if path.t1.is_finite() {
+            path.t1 -= t;
+        }
+        path.set += SETS_PER_VERTEX;
+    }
+
+    /// The volume coefficients of every volume in `stack` at `p` on a ray along `d`
+    /// (Cycles' volume_shader_eval: each material's program run at the point; shadow
+    /// rays skip emission).
+    fn volume_coefficients(
+        &self,
+        stack: &Stack,
+        p: V3,
+        d: V3,
+        state: PathState,
+        scratch: &mut Scratch,
+    ) -> Coefficients {
+        let mut co = Coefficients::default();
+        let shadow = state.flags & ray::SHADOW != 0;
+        for &(inst_i, mi) in stack.entries() {
+            let Some(prog) = self.materials[mi as usize].program.as_ref() else {
+                continue;
+            };
+            let Some(vc) = prog.volume else { continue };
+            let inst = &self.geo.instances[inst_i as usize];
+            let (to_world, to_object) = inst.pose_at(scratch.time);
+            let local = to_object.point(p);
+            // Cycles' shader_setup_from_volume: the normals face back along the ray.
+            let n = neg(d);
+            let camera_position = self.view.camera_space(p);
+            let mut sp = ShadingPoint {
+                position: p,
+                normal: n,
+                true_normal: n,
+                object_position: local,
+                object_normal: normalize(Affine::normal_by_inverse(&to_world, n)),
+                incoming: n,
+                camera_position,
+                camera: self.view.camera(),
+                window: self.view.window(camera_position),
+                object: inst.info,
+                path: state,
+                ray_length: 1.0,
+                ..Default::default()
+            };
+            sp.generated = inst.generated(local);
+            sp.transform = crate::shader::bump::ObjectTransform {
+                to_world: to_world.m,
+                to_object: to_object.m,
+            };
+            let stack = &mut scratch.stacks[mi as usize];
+            if stack.len() != prog.initial.len() {
+                stack.clear();
+                stack.extend_from_slice(&prog.initial);
+            }
+            prog.run(&sp, stack);
+            co.closure(prog, vc, 1.0, stack, shadow);
+        }
+        co
+    }
+
+    /// The transmittance of the volumes in `stack` along `dist` of the ray from `o` along
+    /// `d` (Cycles' volume_shadow_heterogeneous; a varying medium is sampled at the middle
+    /// of each step).
+    pub(super) fn volume_transmittance(
+        &self,
+        o: V3,
+        d: V3,
+        dist: f32,
+        stack: &Stack,
+        scratch: &mut Scratch,
+    ) -> V3 {
+        let state = PathState {
+            flags: ray::SHADOW,
+            ..PathState::default()
+        };
+        let step = self.volumes.step_size(stack);
+        let (size, steps, shade) = if step.is_finite() {
+            let mut size = step.min(dist);
+            let max = self.volumes.max_steps;
+            if dist > max as f32 * size {
+                size = dist / max as f32;
+            }
+            (size, max, 0.5)
+        } else {
+            (dist, 1, 0.0)
+        };
+        let mut sum = [0.0f32; 3];
+        let mut t1 = 0.0f32;
+        for i in 0..steps {
+            if t1 >= dist {
+                break;
+            }
+            let t0 = t1;
+            t1 = dist.min((i + 1) as f32 * size);
+            let p = madd(o, d, t0 + (t1 - t0) * shade);
+            let co = self.volume_coefficients(stack, p, d, state, scratch);
+            if co.extinction {
+                sum = madd(sum, co.sigma_t, t1 - t0);
+                if max3(sum) > 50.0 {
+                    return [0.0; 3];
+                }
+            }
+        }
+        sum.map(|s| (-s).exp())
+    }
+
+    /// Cycles' volume_integrate for the ray segment of `path` up to `t_hit` inside the
+    /// volumes of `scratch.volume_stack`: emission added, the throughput attenuated, and,
+    /// if the path scatters, light sampled at the scatter point and the next ray set up.
+    pub(super) fn volume_segment(
+        &self,
+        path: &mut Path,
+        t_hit: f32,
+        rng: &PixelSampler,
+        index: u32,
+        scratch: &mut Scratch,
+    ) -> Segment {
+        let stack = scratch.volume_stack;
+        let st = &self.settings;
+        let r = rng.get4(index, path.set + 2);
+        let (mut rscatter, mut rchannel) = (r[0], r[1]);
+        let (tmin, tmax) = (path.t0, t_hit);
+        let step = self.volumes.step_size(&stack);
+        let (size, max_steps, offset, shade_offset) = if step.is_finite() {
+            let t = tmax - tmin;
+            let mut size = step.min(t);
+            let max = self.volumes.max_steps;
+            if t > max as f32 * size {
+                size = t / max as f32;
+            }
+            (size, max, r[3], r[2])
+        } else {
+            (tmax - tmin, 1, 1.0, 0.0)
+        };
+        let mut throughput = path.throughput;
+        let mut emission = [0.0f32; 3];
+        let mut scatter: Option<(f32, Phases)> = None;
+        let mut t1 = tmin;
+        let mut stepi = 0u32;
+        while t1 < tmax && stepi < max_steps {
+            let t0 = t1;
+            t1 = tmax.min(tmin + (stepi as f32 + offset) * size);
+            stepi += 1;
+            let p = madd(path.o, path.d, t0 + (t1 - t0) * shade_offset);
+            let co = self.volume_coefficients(&stack, p, path.d, path.state, scratch);
+            let dt = t1 - t0;
+            let tr = if co.extinction {
+                transmittance(co.sigma_t, dt)
+            } else {
+                [1.0; 3]
+            };
+            if co.emit {
+                // The emission integrated over the step: E (1 - T) / sigma_t, E dt where
+                // nothing absorbs.
+                let e: V3 = [0, 1, 2].map(|k| {
+                    if co.extinction && co.sigma_t[k] > 0.0 {
+                        co.emission[k] * (1.0 - tr[k]) / co.sigma_t[k]
+                    } else {
+                        co.emission[k] * dt
+                    }
+                });
+                emission = add(emission, mul(throughput, e));
+            }
+            // Past a bounce limit (Cycles' PATH_RAY_TERMINATE_AFTER_TRANSPARENT) the
+            // volume keeps no scattering closures: it only absorbs (its whole extinction)
+            // and emits, and the path goes on to what lies beyond, for MIS.
+            if co.scatter && !path.terminate_next {
+                // Cycles' volume_sample_indirect_scatter with the distance method: the
+                // channel by the balance heuristic over channels.
+                let albedo: V3 = [0, 1, 2].map(|k| {
+                    if co.sigma_t[k] != 0.0 {
+                        co.sigma_s[k] / co.sigma_t[k]
+                    } else {
+                        1.0
+                    }
+                });
+                let (ch, pdf) = sample_channel(albedo, throughput, &mut rchannel);
+                let sample_tr = tr[ch];
+                if 1.0 - rscatter >= sample_tr {
+                    let new_dt = -(1.0 - rscatter).ln() / co.sigma_t[ch];
+                    let new_tr = transmittance(co.sigma_t, new_dt);
+                    let distance_pdf = dot(pdf, mul(co.sigma_t, new_tr));
+                    if distance_pdf > 0.0 {
+                        throughput =
+                            scale(mul(throughput, mul(co.sigma_s, new_tr)), 1.0 / distance_pdf);
+                        scatter = Some((t0 + new_dt, co.phases));
+                        break;
+                    }
+                } else {
+                    let distance_pdf = dot(pdf, tr);
+                    throughput = scale(mul(throughput, tr), 1.0 / distance_pdf);
+                    rscatter = 1.0 - (1.0 - rscatter) / sample_tr;
+                }
+            } else if co.extinction {
+                throughput = mul(throughput, tr);
+            }
+            if max3(throughput) < THROUGHPUT_EPSILON {
+                throughput = [0.0; 3];
+                break;
+            }
+        }
+        if !is_zero(emission) {
+            scratch.features.add_emission(emission);
+            let c = super::integrator::clamp_contrib(emission, path.hit_clamp(st));
+            if finite(c) {
+                path.l = add(path.l, c);
+            }
+        }
+        let Some((t, phases)) = scatter else {
+            path.throughput = throughput;
+            return if is_zero(throughput) {
+                Segment::Stop
+            } else {
+                Segment::Passed
+            };
+        };
+        path.throughput = throughput;
+        let u_phase = rng.get4(index, path.set);
+        let u_light = rng.get4(index, path.set + 1);
+        if !path.survives_roulette(st, u_light[3]) {
+            return Segment::Stop;
+        }
+        let p = madd(path.o, path.d, t);
+        if let Some(c) = self.volume_direct_light(path, p, &phases, u_light, scratch) {
+            path.l = add(path.l, c);
+        }
+        let Some((wi, pdf)) = phases.sample(path.d, [u_phase[0], u_phase[1]]) else {
+            return Segment::Stop;
+        };
+        self.volume_bounce(path, p, wi, pdf, scratch);
+        Segment::Scattered
+    }
+
+    /// Cycles' path_state_next after a volume scatter, and the next ray from `p` along
+    /// `wi` (phase-sampled with `pdf`; its weight is 1).
+    fn volume_bounce(&self, path: &mut Path, p: V3, wi: V3, pdf: f32, scratch: &mut Scratch) {
+        let st = &self.settings;
+        if path.state.bounce >= st.max_bounces {
+            path.terminate_next = true;
+        }
+        path.state.bounce += 1;
+        if scratch.volume_bounce >= self.volumes.max_bounces {
+            path.terminate_next = true;
+        }
+        scratch.volume_bounce += 1;
+        path.state.flags = ray::VOLUME_SCATTER;
+        path.transparent_bg = false;
+        // Light selection at a scatter point sees no normal and both sides.
+        path.mis_n = [0.0; 3];
+        path.mis_trans = true;
+        path.prev_pdf = pdf;
+        path.prev_singular = false;
+        path.min_ray_pdf = path.min_ray_pdf.min(pdf);
+        path.o = p;
+        path.d = wi;
+        path.t0 = 0.0;
+        path.t1 = f32::INFINITY;
+        path.set += SETS_PER_VERTEX;
+    }
+
+    /// Next-event estimation at a volume scatter point `p`: one emitter picked as at a
+    /// surface without a normal, weighted by the phase functions, MIS against phase
+    /// sampling for emitters shared with it, the shadow ray attenuated by the volumes.
+    fn volume_direct_light(
+        &self,
+        path: &Path,
+        p: V3,
+        phases: &Phases,
+        u: [f32; 4],
+        scratch: &mut Scratch,
+    ) -> Option<V3> {
+        let clamp = path.light_clamp(&self.settings);
+        let d = path.d;
+        let bounce = path.state.bounce;
+        let stack = scratch.volume_stack;
+        let c = match self.light_select.select(p, [0.0; 3], true, u[2])? {
+            (Pick::Lamp(li), p_sel) => {
+                let light = &self.lights[li as usize];
+                if bounce > light.max_bounces || light.exclude & ray::VOLUME_SCATTER != 0 {
+                    return None;
+                }
+                let ls = light.sample(p, [u[0], u[1]])?;
+                let (f, pdf) = phases.eval(d, ls.wi);
+                let w = if light.mis {
+                    super::integrator::power_heuristic(ls.pdf * p_sel, pdf)
+                } else {
+                    1.0
+                };
+                let c = scale(mul(path.throughput, ls.value), f * w / p_sel);
+                if is_zero(c) || !finite(c) {
+                    return None;
+                }
+                let tr = if light.cast_shadow {
+                    let dist = if ls.dist.is_finite() {
+                        ls.dist * (1.0 - 1e-4)
+                    } else {
+                        f32::INFINITY
+                    };
+                    self.shadow_transmittance(p, ls.wi, dist, stack, scratch)
+                } else {
+                    [1.0; 3]
+                };
+                mul(c, tr)
+            }
+            (Pick::Triangle(tri), p_sel) => {
+                let r = self.geo.refs[tri as usize];
+                if self.geo.instances[r.inst as usize].visibility & ray::VOLUME_SCATTER == 0 {
+                    return None;
+                }
+                let (front, back) = self.emission_sides(tri);
+                let ts = super::light::triangle::sample(
+                    &self.geo.tris[tri as usize],
+                    p,
+                    [u[0], u[1]],
+                    front,
+                    back,
+                )?;
+                let (f, pdf_b) = phases.eval(d, ts.wi);
+                if f <= 0.0 {
+                    return None;
+                }
+                let pdf_l = p_sel * ts.pdf;
+                let tr =
+                    self.shadow_transmittance(p, ts.wi, ts.dist * (1.0 - 1e-4), stack, scratch);
+                if is_zero(tr) {
+                    return None;
+                }
+                let le =
+                    self.light_emission(tri, ts.b1, ts.b2, neg(ts.wi), ts.dist, bounce, scratch);
+                let w = super::integrator::power_heuristic(pdf_l, pdf_b);
+                mul(scale(mul(path.throughput, le), f * w / pdf_l), tr)
+            }
+            (Pick::World, p_sel) => {
+                if self.world_exclude & ray::VOLUME_SCATTER != 0 {
+                    return None;
+                }
+                let map = self.world.and_then(|w| w.map.as_ref())?;
+                let (wi, pdf_l) = map.sample([u[0], u[1]])?;
+                let pdf_l = pdf_l * p_sel;
+                let (f, pdf_b) = phases.eval(d, wi);
+                if f <= 0.0 || pdf_l.is_nan() || pdf_l <= 0.0 {
+                    return None;
+                }
+                let tr = self.shadow_transmittance(p, wi, f32::INFINITY, stack, scratch);
+                if is_zero(tr) {
+                    return None;
+                }
+                let le = self.background_toward(wi, scratch);
+                let w = super::integrator::power_heuristic(pdf_l, pdf_b);
+                mul(scale(mul(path.throughput, le), f * w / pdf_l), tr)
+            }
+        };
+        (finite(c) && !is_zero(c)).then(|| super::integrator::clamp_contrib(c, clamp))
+    }
+
+    /// The volume stack a shadow ray from surface `hit` toward `wi` starts with: the
+    /// path's, with the surface's volume entered or left when the ray goes through it
+    /// (Cycles' shadow_volume_stack_enter_exit for transmission).
+    pub(super) fn shadow_stack(&self, hit: &SurfaceHit, wi: V3, scratch: &Scratch) -> Stack {
+        let mut s = scratch.volume_stack;
+        if let Some(mi) = hit.material {
+            if dot(wi, hit.ng) < 0.0 && self.volumes.has_volume(mi) {
+                s.enter_exit(hit.inst, mi as u32, hit.backfacing);
+            }
+        }
+        s
+    }
+
+    /// At a surface of the path: a material with a volume and no surface is passed
+    /// through without a bounce (Cycles' integrate_surface_volume_only_bounce), even past
+    /// a bounce limit; true when it was (the path's next ray is set up).
+    pub(super) fn volume_boundary(
+        &self,
+        path: &mut Path,
+        hit: &SurfaceHit,
+        scratch: &mut Scratch,
+    ) -> bool {
+        let Some(mi) = hit.material else {
+            return false;
+        };
+        if !self.volumes.only_volume(mi) {
+            return false;
+        }
+        scratch
+            .volume_stack
+            .enter_exit(hit.inst, mi as u32, hit.backfacing);
+        path.o = offset_origin(hit.p, hit.ng, path.d);
+        path.t0 = 0.0;
+        path.t1 = f32::INFINITY;
+        // Fresh dimensions for what lies beyond: the segment's own were drawn from
+        // this set's spare one.
+        path.set += SETS_PER_VERTEX;
+        true
+    }
+
+    /// After the path transmitted through `hit` (refraction or transparency): its
+    /// volume entered or left.
+    pub(super) fn volume_cross(&self, hit: &SurfaceHit, scratch: &mut Scratch) {
+        if let Some(mi) = hit.material.filter(|&m| self.volumes.has_volume(m)) {
+            scratch
+                .volume_stack
+                .enter_exit(hit.inst, mi as u32, hit.backfacing);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stack_enters_once_and_leaves_by_the_back() {
+        let mut s = Stack::default();
+        s.enter_exit(3, 1, false);
+        s.enter_exit(3, 1, false);
+        s.enter_exit(5, 2, false);
+        assert_eq!(s.entries(), &[(3, 1), (5, 2)]);
+        s.enter_exit(3, 1, true);
+        assert_eq!(s.entries(), &[(5, 2)]);
+        // Leaving a volume never entered changes nothing.
+        s.enter_exit(9, 9, true);
+        assert_eq!(s.entries(), &[(5, 2)]);
+        for i in 0..20 {
+            s.enter_exit(100 + i, 0, false);
+        }
+        assert_eq!(s.entries().len(), STACK_SIZE - 1);
+    }
+
+    /// Each phase function integrates to 1 over the sphere, and sampling draws
+    /// directions with the pdf it reports (a histogram of cosines against the pdf).
+    #[test]
+    fn phase_functions_are_normalised_and_sampled_by_their_pdf() {
+        let d = normalize([0.3, -0.2, 0.9]);
+        for ph in [
+            Phase::henyey_greenstein(0.0),
+            Phase::henyey_greenstein(0.6),
+            Phase::henyey_greenstein(-0.8),
+            Phase::Rayleigh,
+        ] {
+            // Integral over cos in [-1, 1] times 2 pi.
+            let n = 20000;
+            let (t, _) = basis(d);
+            let mut sum = 0.0f64;
+            for i in 0..n {
+                let c = -1.0 + (i as f32 + 0.5) * 2.0 / n as f32;
+                let s = (1.0 - c * c).sqrt();
+                let wi = add(scale(d, c), scale(t, s));
+                sum += ph.eval(d, wi) as f64 * 2.0 / n as f64;
+            }
+            let integral = sum * 2.0 * std::f64::consts::PI;
+            assert!((integral - 1.0).abs() < 1e-3, "{ph:?}: {integral}");
+            // Histogram of sampled cosines in 8 bins against the pdf's mass per bin.
+            let bins = 8;
+            let mut hist = vec![0usize; bins];
+            // A stratified first dimension (the cosine), a golden-ratio second.
+            let m = 8192;
+            for i in 0..m {
+                let u = [(i as f32 + 0.5) / m as f32, (i as f32 * 0.618_034).fract()];
+                let (wi, pdf) = ph.sample(d, u);
+                assert!((pdf - ph.eval(d, wi)).abs() <= 1e-4 * pdf.max(1.0));
+                let c = dot(d, wi).clamp(-1.0, 0.999_999);
+                hist[((c + 1.0) * 0.5 * bins as f32) as usize] += 1;
+            }
+            for (b, &h) in hist.iter().enumerate() {
+                let k = 200;
+                let mut mass = 0.0f64;
+                for i in 0..k {
+                    let c = -1.0 + (b as f32 + (i as f32 + 0.5) / k as f32) * 2.0 / bins as f32;
+                    let s = (1.0 - c * c).sqrt();
+                    let wi = add(scale(d, c), scale(t, s));
+                    mass += ph.eval(d, wi) as f64 * (2.0 / bins as f64) / k as f64;
+                }
+                mass *= 2.0 * std::f64::consts::PI;
+                let got = h as f64 / m as f64;
+                assert!((got - mass).abs() < 0.01, "{ph:?} bin {b}: {got} vs {mass}");
+            }
+        }
+    }
+
+    #[test]
+    fn channel_sampling_follows_throughput_times_albedo() {
+        let mut u = 0.7;
+        let (ch, pdf) = sample_channel([1.0, 1.0, 1.0], [1.0, 1.0, 2.0], &mut u);
+        assert_eq!(pdf, [0.25, 0.25, 0.5]);
+        assert_eq!(ch, 2);
+        assert!((u - 0.4).abs() < 1e-6);
+        let mut u = 0.1;
+        let (_, pdf) = sample_channel([0.0; 3], [1.0; 3], &mut u);
+        assert_eq!(pdf, [1.0 / 3.0; 3]);
+    }
+}
