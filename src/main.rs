@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 
-use blendsynth::shader::bake::{bake_emission, write_exr, BakeOptions};
+use blendsynth::render::bake::{bake_emission, write_exr, BakeOptions};
 use blendsynth::{blender, inspect, scene::Override, scene::Scene};
 
 /// The crate version and the exchange format it reads (`tests/cli.rs` keeps the number

@@ -4,8 +4,8 @@
 mod common;
 use common::*;
 
+use blendsynth::render::bake::{bake_emission, BakeOptions};
 use blendsynth::scene::Scene;
-use blendsynth::shader::bake::{bake_emission, BakeOptions};
 
 /// Arithmetic and colour nodes only: Cycles and blendsynth run the same float maths.
 const TOL: f32 = 1e-5;

@@ -5,8 +5,8 @@
 mod common;
 use common::*;
 
+use blendsynth::render::bake::{bake_emission, BakeOptions};
 use blendsynth::scene::Scene;
-use blendsynth::shader::bake::{bake_emission, BakeOptions};
 
 /// The project bound for texture-driven values.
 const TOL: f32 = 1e-4;

@@ -8,8 +8,8 @@ use common::*;
 
 use std::path::Path;
 
+use blendsynth::render::bake::{bake_emission, BakeOptions};
 use blendsynth::scene::Scene;
-use blendsynth::shader::bake::{bake_emission, BakeOptions};
 
 const TOL: f32 = 1e-4;
 

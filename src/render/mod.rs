@@ -13,6 +13,7 @@
 
 /// The BVH lives in the foundation (Geometry Nodes' Raycast uses it too).
 pub use crate::foundation::bvh as accel;
+pub mod bake;
 pub mod bsdf;
 pub mod build;
 pub mod camera;

@@ -19,12 +19,12 @@ use crate::shader::program::{Closure, Program};
 use crate::shader::ShadingPoint;
 
 use super::build::Geometry;
+use super::integrator::path_state::{Path, SETS_PER_VERTEX};
+use super::integrator::shade::Material;
 use super::integrator::{Scene, Scratch, SurfaceHit};
 use super::light::tree::Pick;
 use super::math::*;
-use super::integrator::path_state::{Path, SETS_PER_VERTEX};
 use super::sampler::PixelSampler;
-use super::integrator::shade::Material;
 
 /// Volumes a path can be inside at once (Cycles sizes its stack from the scene; deeper
 /// nesting is ignored, as Cycles ignores entries past its stack).

@@ -3,7 +3,6 @@
 //! map the way Cycles' EMIT bake does (`bake`).
 
 pub mod attributes;
-pub mod bake;
 pub mod bump;
 pub mod bump_graph;
 pub mod compile;

@@ -195,17 +195,3 @@ pub fn invert_affine(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
     out[3][3] = 1.0;
     Some(out)
 }
-
-/// The scene camera's view at the scene's current frame and render resolution, for an
-/// EMIT bake (None: the scene has no camera, and the default view stands in as Cycles'
-/// default camera does).
-pub fn scene_view(scene: &crate::scene::Scene) -> Result<Option<View>, String> {
-    if scene.file.scene.camera.is_none() {
-        return Ok(None);
-    }
-    let (w, h) = crate::scene::settings::Output::of(&scene.file.scene).size()?;
-    let eval = crate::anim::evaluate_scene(scene, scene.file.scene.frame_current as f64)
-        .map_err(|e| format!("evaluating the scene for its camera: {e}"))?;
-    let cam = crate::render::camera::Camera::new(scene, &eval, w, h).map_err(|e| e.0)?;
-    Ok(Some(cam.view()))
-}

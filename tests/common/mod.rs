@@ -172,9 +172,9 @@ pub fn bake_cases_worst(dir: &Path) -> Vec<(String, f32)> {
             .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
             .collect();
         assert_eq!(reference.len(), (size * size * 4) as usize);
-        let ours = blendsynth::shader::bake::bake_emission(
+        let ours = blendsynth::render::bake::bake_emission(
             &scene,
-            &blendsynth::shader::bake::BakeOptions {
+            &blendsynth::render::bake::BakeOptions {
                 object: object.as_str().unwrap().into(),
                 uv: None,
                 size,

@@ -7,13 +7,13 @@ use std::path::Path;
 use crate::nodes::math::{normalize3, Vec3};
 use crate::scene::{AttributeData, Scene};
 
-use super::bump::{
+use crate::shader::bump::{
     attribute_differential, differential_dudv, differential_from_compact,
     differential_make_compact, ObjectTransform,
 };
-use super::compile::compile_material;
-use super::point::ShadingPoint;
-use super::program::Program;
+use crate::shader::compile::compile_material;
+use crate::shader::point::ShadingPoint;
+use crate::shader::program::Program;
 
 #[derive(Debug, Clone)]
 pub struct BakeOptions {
@@ -79,7 +79,7 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
     };
     // Cycles shades smooth triangles with Blender's vertex normals, unless the mesh has
     // custom normals (then its corner normals).
-    let vertex_normals = super::tangent::vertex_normals(&mesh);
+    let vertex_normals = crate::shader::tangent::vertex_normals(&mesh);
     let custom = mesh.attribute("custom_normal").is_some();
     let smooth_normal = |c: usize| -> Vec3 {
         if custom {
@@ -142,14 +142,14 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
     };
 
     // What Cycles' EMIT bake gives the context-reading nodes: the scene camera, the object.
-    let view = super::view::scene_view(scene)?.unwrap_or_default();
-    let object = super::view::object_info(obj, &world);
+    let view = scene_view(scene)?.unwrap_or_default();
+    let object = crate::shader::view::object_info(obj, &world);
     let n = size as usize;
     let mut pixels = vec![[0.0f32; 4]; n * n];
     let bound = programs
         .iter()
         .map(|p| match p {
-            Some(p) => super::attributes::BoundAttributes::bind(
+            Some(p) => crate::shader::attributes::BoundAttributes::bind(
                 &mesh,
                 &p.attributes,
                 info.active_render_uv.as_deref(),
@@ -400,8 +400,8 @@ impl TriangleDifferentials {
 /// them, and the scene camera's view of the point.
 fn bake_context(
     mut sp: ShadingPoint,
-    view: &super::view::View,
-    object: super::point::ObjectInfo,
+    view: &crate::shader::view::View,
+    object: crate::shader::point::ObjectInfo,
     tri: [Vec3; 3],
     w: [f32; 3],
 ) -> ShadingPoint {
@@ -423,7 +423,7 @@ fn bake_context(
     // Cycles' (u, v) are the weights of the triangle's second and third corners.
     sp.parametric = [w[1], w[2]];
     sp.ray_length = 1.0;
-    sp.path = super::point::PathState::CAMERA;
+    sp.path = crate::shader::point::PathState::CAMERA;
     sp.camera_position = view.camera_space(sp.position);
     sp.camera = view.camera();
     sp.triangle = tri;
@@ -437,4 +437,18 @@ fn flat_normal(p: [Vec3; 3]) -> Vec3 {
     let e1: Vec3 = std::array::from_fn(|k| p[1][k] - p[0][k]);
     let e2: Vec3 = std::array::from_fn(|k| p[2][k] - p[0][k]);
     normalize3(crate::nodes::math::cross3(e1, e2))
+}
+
+/// The scene camera's view at the scene's current frame and render resolution, for an
+/// EMIT bake (None: the scene has no camera, and the default view stands in as Cycles'
+/// default camera does).
+fn scene_view(scene: &crate::scene::Scene) -> Result<Option<crate::shader::view::View>, String> {
+    if scene.file.scene.camera.is_none() {
+        return Ok(None);
+    }
+    let (w, h) = crate::scene::settings::Output::of(&scene.file.scene).size()?;
+    let eval = crate::anim::evaluate_scene(scene, scene.file.scene.frame_current as f64)
+        .map_err(|e| format!("evaluating the scene for its camera: {e}"))?;
+    let cam = crate::render::camera::Camera::new(scene, &eval, w, h).map_err(|e| e.0)?;
+    Ok(Some(cam.view()))
 }
