@@ -19,6 +19,7 @@ use super::build::Geometry;
 use super::integrator::{Scene, SurfaceHit};
 use super::math::*;
 use super::sampler::{hash_combine, PixelSampler};
+use super::subsurface::disk::ProbeAxis;
 
 /// Cycles' LOCAL_MAX_HITS: the Bevel probe keeps a random subset of this many hits.
 const LOCAL_MAX_HITS: usize = 4;
@@ -197,28 +198,12 @@ impl Trace for ShaderRays<'_, '_> {
         let mut sum = [0.0f32; 3];
         for k in 0..samples {
             let u = self.sample(k, samples, self.set ^ BEVEL_SET);
-            let (mut xi_axis, xi_r) = (u[0], u[1]);
+            let (xi_axis, xi_r) = (u[0], u[1]);
             // A disk about the geometric normal half the time, each tangent a quarter.
-            let n0 = self.hit.ng;
-            let (t0, b0) = basis(n0);
-            let (disk_n, disk_t, disk_b, pick) = if xi_axis < 0.5 {
-                xi_axis *= 2.0;
-                (n0, t0, b0, [0.5, 0.25, 0.25])
-            } else if xi_axis < 0.75 {
-                xi_axis = (xi_axis - 0.5) * 4.0;
-                (t0, n0, b0, [0.25, 0.5, 0.25])
-            } else {
-                xi_axis = (xi_axis - 0.75) * 4.0;
-                (b0, t0, n0, [0.25, 0.25, 0.5])
-            };
-            let phi = std::f32::consts::TAU * xi_axis;
+            let (axis, xi_phi) = ProbeAxis::pick(self.hit.ng, xi_axis);
             let (disk_r, height) = cubic_sample(radius, xi_r);
-            let disk_p = add(
-                scale(disk_t, disk_r * phi.cos()),
-                scale(disk_b, disk_r * phi.sin()),
-            );
-            let o = add(madd(sp.position, disk_n, height), disk_p);
-            let dir = neg(disk_n);
+            let o = axis.origin(sp.position, xi_phi, disk_r, height);
+            let dir = neg(axis.n);
             let tmax = 2.0 * height;
             // Every hit on the shaded object along the probe; a uniformly random subset
             // of LOCAL_MAX_HITS kept (reservoir sampling, as Cycles' local intersection).
@@ -255,10 +240,7 @@ impl Trace for ShaderRays<'_, '_> {
                 } else {
                     (s.ng, s.sp.normal)
                 };
-                let pn = pick[0] * dot(disk_n, ng).abs();
-                let pt = pick[1] * dot(disk_t, ng).abs();
-                let pb = pick[2] * dot(disk_b, ng).abs();
-                let denom = pn * pn + pt * pt + pb * pb;
+                let (pn, denom) = axis.mis(ng);
                 if !(denom > 0.0) || !(disk_pdf > 0.0) {
                     continue;
                 }

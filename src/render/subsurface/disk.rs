@@ -97,6 +97,55 @@ struct ProbeHit {
     v: f32,
 }
 
+/// The disk a probe ray is cast through, as Cycles' subsurface_disk and svm_bevel choose
+/// it: about the geometric normal with probability 1/2, about each tangent 1/4.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ProbeAxis {
+    /// The disk's normal (the probe runs along it) and its two in-plane axes.
+    pub n: V3,
+    t: V3,
+    b: V3,
+    /// The probabilities of the three axes, in the order normal, first, second tangent.
+    pick: [f32; 3],
+}
+
+impl ProbeAxis {
+    /// The axis `xi` picks about geometric normal `ng`, and `xi` rescaled to [0, 1) within
+    /// its choice (Cycles reuses it for the angle on the disk).
+    pub(crate) fn pick(ng: V3, mut xi: f32) -> (ProbeAxis, f32) {
+        let (t0, b0) = basis(ng);
+        let (n, t, b, pick) = if xi < 0.5 {
+            xi *= 2.0;
+            (ng, t0, b0, [0.5, 0.25, 0.25])
+        } else if xi < 0.75 {
+            xi = (xi - 0.5) * 4.0;
+            (t0, ng, b0, [0.25, 0.5, 0.25])
+        } else {
+            xi = (xi - 0.75) * 4.0;
+            (b0, t0, ng, [0.25, 0.25, 0.5])
+        };
+        (ProbeAxis { n, t, b, pick }, xi)
+    }
+
+    /// The probe's origin: `h` above `p` along the axis, at radius `r` and angle 2 pi
+    /// `xi_phi` on the disk.
+    pub(crate) fn origin(&self, p: V3, xi_phi: f32, r: f32, h: f32) -> V3 {
+        let phi = std::f32::consts::TAU * xi_phi;
+        let disk_p = add(scale(self.t, r * phi.cos()), scale(self.b, r * phi.sin()));
+        add(madd(p, self.n, h), disk_p)
+    }
+
+    /// The multiple-importance terms of a hit with normal `ng` over the three axes: this
+    /// axis's pdf factor and the sum of the squared factors (the power heuristic's
+    /// denominator).
+    pub(crate) fn mis(&self, ng: V3) -> (f32, f32) {
+        let pn = self.pick[0] * dot(self.n, ng).abs();
+        let pt = self.pick[1] * dot(self.t, ng).abs();
+        let pb = self.pick[2] * dot(self.b, ng).abs();
+        (pn, pn * pn + pt * pt + pb * pb)
+    }
+}
+
 /// Finds the exit of a Burley BSSRDF entered at `hit` (whose geometric normal faces the
 /// viewer), multiplying `throughput` by the resampled weight. Returns the exit and the
 /// direction the exit is seen from (outward), like the random walk.
@@ -113,31 +162,15 @@ pub fn disk_exit(
 ) -> Option<(crate::render::accel::Hit, V3)> {
     let base = crate::render::subsurface::bssrdf_dimensions(set);
     let u = rng.get4(index, base);
-    let (xi_r, mut xi_axis, xi_resample) = (u[0], u[1], u[2]);
+    let (xi_r, xi_axis, xi_resample) = (u[0], u[1], u[2]);
     // Axis: the normal with probability 1/2, each tangent 1/4.
-    let n0 = hit.ng;
-    let (t0, b0) = basis(n0);
-    let (disk_n, disk_t, disk_b, pick) = if xi_axis < 0.5 {
-        xi_axis *= 2.0;
-        (n0, t0, b0, [0.5, 0.25, 0.25])
-    } else if xi_axis < 0.75 {
-        xi_axis = (xi_axis - 0.5) * 4.0;
-        (t0, n0, b0, [0.25, 0.5, 0.25])
-    } else {
-        xi_axis = (xi_axis - 0.75) * 4.0;
-        (b0, t0, n0, [0.25, 0.25, 0.5])
-    };
-    let phi = 2.0 * std::f32::consts::PI * xi_axis;
+    let (axis, xi_phi) = ProbeAxis::pick(hit.ng, xi_axis);
     let (disk_r, h) = sample(b.radius, xi_r);
     if !(h > 0.0) {
         return None;
     }
-    let disk_p = add(
-        scale(disk_t, disk_r * phi.cos()),
-        scale(disk_b, disk_r * phi.sin()),
-    );
-    let org = add(madd(hit.p, disk_n, h), disk_p);
-    let dir = neg(disk_n);
+    let org = axis.origin(hit.p, xi_phi, disk_r, h);
+    let dir = neg(axis.n);
     let tmax = 2.0 * h;
 
     // Every hit on the entry object along the probe (up to MAX_PROBE_HITS), in order.
@@ -194,10 +227,7 @@ pub fn disk_exit(
         if hit.backfacing {
             ng = neg(ng);
         }
-        let pn = pick[0] * dot(disk_n, ng).abs();
-        let pt = pick[1] * dot(disk_t, ng).abs();
-        let pb = pick[2] * dot(disk_b, ng).abs();
-        let denom = pn * pn + pt * pt + pb * pb;
+        let (pn, denom) = axis.mis(ng);
         let mut w = if denom > 0.0 { pn / denom } else { 0.0 };
         if n_found > MAX_HITS {
             w *= n_found as f32 / MAX_HITS as f32;
