@@ -155,30 +155,13 @@ fn camera_motion_flow_matches_cycles_vector_pass() {
 #[test]
 fn object_motion_flow_matches_cycles_vector_pass() {
     check("object", &[], 0.15);
-    let (w, _, ch) = exr_channels(&fixture("object/passes.exr"));
-    let (out, motion) = render("object", w, 48);
-    let p = &out.passes;
-    let boxed = p.instances.iter().position(|i| i.object == "Box").unwrap() as u32 + 1;
-    let ours: Vec<f32> = motion.forward.flow.iter().map(|f| f[0]).collect();
-    let cycles: Vec<f32> = ch["ViewLayer.Vector.Z"].iter().map(|z| -z).collect();
-    let (r_ours, r_cycles) = (
-        roughness(&ours, &p.instance_id, boxed, w),
-        roughness(&cycles, &p.instance_id, boxed, w),
-    );
-    eprintln!(
-        "box: median |second difference| of flow x: ours {r_ours:.4} px, Cycles' {r_cycles:.4} px"
-    );
+    let (r_ours, r_cycles) = box_roughness("object");
     assert!(r_cycles > 3.0 * r_ours, "{r_ours} {r_cycles}");
 }
 
-/// Panoramic cameras: Cycles' Vector pass maps through direction_to_panorama, times the
-/// image size; a moving, turning camera and a moving ball (make_flow_refs.py). The flow
-/// is large here (up to 6 px at 64x48) and Cycles' pass is rough again: on the box its
-/// median |second difference| is 3 to 4 times ours (asserted below), as in the object
-/// scene, so the worst pixels (up to 0.09 px) are that roughness; the mean stays below
-/// 0.01 px.
-fn check_panoramic(name: &str) {
-    check(name, &[], 0.1);
+/// The median |second difference along x| of the box's forward flow x in scene `name`:
+/// (ours, Cycles' Vector pass).
+fn box_roughness(name: &str) -> (f64, f64) {
     let (w, h, ch) = exr_channels(&fixture(&format!("{name}/passes.exr")));
     let (out, motion) = render(name, w, h);
     let p = &out.passes;
@@ -189,7 +172,21 @@ fn check_panoramic(name: &str) {
         roughness(&ours, &p.instance_id, boxed, w),
         roughness(&cycles, &p.instance_id, boxed, w),
     );
-    eprintln!("{name}: box flow x roughness ours {r_ours:.4} px, Cycles' {r_cycles:.4} px");
+    eprintln!(
+        "{name}: box, median |second difference| of flow x: ours {r_ours:.4} px, Cycles' {r_cycles:.4} px"
+    );
+    (r_ours, r_cycles)
+}
+
+/// Panoramic cameras: Cycles' Vector pass maps through direction_to_panorama, times the
+/// image size; a moving, turning camera and a moving ball (make_flow_refs.py). The flow
+/// is large here (up to 6 px at 64x48) and Cycles' pass is rough again: on the box its
+/// median |second difference| is 2.3 to 4.3 times ours (more than twice, asserted below), as in the object
+/// scene, so the worst pixels (up to 0.09 px) are that roughness; the mean stays below
+/// 0.01 px.
+fn check_panoramic(name: &str) {
+    check(name, &[], 0.1);
+    let (r_ours, r_cycles) = box_roughness(name);
     assert!(r_cycles > 2.0 * r_ours, "{r_ours} {r_cycles}");
 }
 
