@@ -8,11 +8,11 @@
 //! (MIS with phase sampling) and the path continued in a phase-sampled direction. Shadow
 //! rays are attenuated by the volumes they cross.
 //!
-//! Direct light at a scatter point is sampled at the distance-sampled point only (Cycles'
-//! DISTANCE method); its equiangular strategy (and MIS between the two) is not built: the
-//! estimate converges to the same image, with more noise near lights inside a medium.
+//! Direct light is sampled as Cycles does: one light picked ahead of each segment, and
+//! the scatter point for it drawn by distance sampling, by equiangular sampling toward a
+//! point on that light, or by either with MIS (the material's Volume > Sampling).
 
-use crate::scene::settings::{Integrator, MaterialSettings};
+use crate::scene::settings::{Integrator, MaterialSettings, VolumeSampling};
 use crate::scene::Scene as BlendScene;
 use crate::shader::point::{ray, PathState};
 use crate::shader::program::{Closure, Program};
@@ -22,7 +22,7 @@ use super::build::Geometry;
 use super::integrator::path_state::{Path, SETS_PER_VERTEX};
 use super::integrator::shade::Material;
 use super::integrator::{Scene, Scratch, SurfaceHit};
-use super::light::tree::Pick;
+use super::light::tree::{Pick, Viewer};
 use super::math::*;
 use super::sampler::PixelSampler;
 
@@ -78,6 +78,8 @@ struct VolumeMaterial {
     varying: bool,
     /// Volume > Step Rate.
     step_rate: f32,
+    /// Volume > Sampling.
+    sampling: VolumeSampling,
 }
 
 /// Every volume of the scene and the render's volume settings.
@@ -116,10 +118,15 @@ impl Volumes {
         for (i, m) in materials.iter().enumerate() {
             let p = m.program.as_ref().filter(|p| p.volume.is_some());
             let settings = scene.file.materials.get(i).map(MaterialSettings::of);
-            v.materials.push(p.map(|p| VolumeMaterial {
-                varying: p.volume_varying
-                    && !settings.as_ref().is_some_and(|s| s.homogeneous_volume),
-                step_rate: settings.as_ref().map_or(1.0, |s| s.volume_step_rate as f32),
+            v.materials.push(p.map(|p| {
+                VolumeMaterial {
+                    varying: p.volume_varying
+                        && !settings.as_ref().is_some_and(|s| s.homogeneous_volume),
+                    step_rate: settings.as_ref().map_or(1.0, |s| s.volume_step_rate as f32),
+                    sampling: settings
+                        .as_ref()
+                        .map_or(VolumeSampling::MultipleImportance, |s| s.volume_sampling),
+                }
             }));
             v.only_volume.push(p.is_some_and(|p| p.surface.is_none()));
         }
@@ -186,6 +193,94 @@ impl Volumes {
             })
             .fold(f32::INFINITY, f32::min)
     }
+
+    /// Cycles' volume_stack_sample_method: MIS when some volume in the stack asks for it
+    /// or the volumes disagree, otherwise what they all ask for.
+    fn sample_method(&self, stack: &Stack) -> Method {
+        let mut method = None;
+        for &(_, mi) in stack.entries() {
+            let Some(Some(m)) = self.materials.get(mi as usize) else {
+                continue;
+            };
+            let this = match m.sampling {
+                VolumeSampling::MultipleImportance => return Method::Mis,
+                VolumeSampling::Equiangular => Method::Equiangular,
+                VolumeSampling::Distance => Method::Distance,
+            };
+            match method {
+                Some(other) if other != this => return Method::Mis,
+                _ => method = Some(this),
+            }
+        }
+        method.unwrap_or(Method::Distance)
+    }
+}
+
+/// How the scatter point for direct light is drawn along a segment (Cycles'
+/// VolumeSampleMethod).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Method {
+    Distance,
+    Equiangular,
+    Mis,
+}
+
+/// Cycles' VOLUME_SAMPLE_PDF_CUTOFF: scatter distances less likely than this are
+/// skipped (they contribute next to nothing and lead far away).
+const PDF_CUTOFF: f32 = 1e-8;
+
+/// Equiangular sampling of a distance along the ray `o + t d`, t in [tmin, tmax], in
+/// proportion to the inverse squared distance to `light` (Cycles'
+/// volume_equiangular_sample and _pdf).
+#[derive(Debug, Clone, Copy)]
+struct Equiangular {
+    delta: f32,
+    d: f32,
+    theta_a: f32,
+    theta_b: f32,
+    tmin: f32,
+    tmax: f32,
+}
+
+impl Equiangular {
+    fn new(o: V3, dir: V3, light: V3, tmin: f32, tmax: f32) -> Option<Equiangular> {
+        let to = sub(light, o);
+        let delta = dot(to, dir);
+        let d = (dot(to, to) - delta * delta).max(0.0).sqrt();
+        let theta_a = (tmin - delta).atan2(d);
+        let theta_b = (tmax - delta).atan2(d);
+        (d > 0.0 && theta_b != theta_a).then_some(Equiangular {
+            delta,
+            d,
+            theta_a,
+            theta_b,
+            tmin,
+            tmax,
+        })
+    }
+
+    /// A distance and its pdf.
+    fn sample(&self, xi: f32) -> (f32, f32) {
+        let t = self.d * (xi * self.theta_b + (1.0 - xi) * self.theta_a).tan();
+        let pdf = self.d / ((self.theta_b - self.theta_a) * (self.d * self.d + t * t));
+        ((self.delta + t).clamp(self.tmin, self.tmax), pdf)
+    }
+
+    fn pdf(&self, t: f32) -> f32 {
+        let x = t - self.delta;
+        self.d / ((self.theta_b - self.theta_a) * (self.d * self.d + x * x))
+    }
+}
+
+/// The light a segment's direct light comes from, picked before stepping as Cycles'
+/// integrate_volume_equiangular_sample_light does: what light selection chose at the
+/// segment's start, its selection probability, and a point on it to sample distances
+/// toward (none for the world and suns).
+#[derive(Debug, Clone, Copy)]
+struct AheadLight {
+    pick: Pick,
+    p_sel: f32,
+    toward: Option<V3>,
 }
 
 /// Volumes blendsynth cannot render, refused by name (for `render` and `inspect`): a
@@ -730,7 +825,9 @@ impl Scene<'_> {
 
     /// Cycles' volume_integrate for the ray segment of `path` up to `t_hit` inside the
     /// volumes of `scratch.volume_stack`: emission added, the throughput attenuated, and,
-    /// if the path scatters, light sampled at the scatter point and the next ray set up.
+    /// where the path scatters, light sampled at the direct-light scatter point and the
+    /// next ray set up from the indirect one (the two are one point under distance
+    /// sampling, two under equiangular sampling).
     pub(super) fn volume_segment(
         &self,
         path: &mut Path,
@@ -742,6 +839,7 @@ impl Scene<'_> {
         let stack = scratch.volume_stack;
         let st = &self.settings;
         let r = rng.get4(index, path.set + 2);
+        let u_light = rng.get4(index, path.set + 1);
         let (mut rscatter, mut rchannel) = (r[0], r[1]);
         let (tmin, tmax) = (path.t0, t_hit);
         let step = self.volumes.step_size(&stack);
@@ -756,9 +854,44 @@ impl Scene<'_> {
         } else {
             (tmax - tmin, 1, 1.0, 0.0)
         };
-        let mut throughput = path.throughput;
+        // The light is picked before stepping, so that the direct-light scatter point can
+        // be drawn toward it; a world or sun light keeps distance sampling.
+        let ahead = if path.terminate_next {
+            None
+        } else {
+            self.volume_light_ahead(path, tmax - tmin, u_light)
+        };
+        let equiangular = ahead
+            .and_then(|a| a.toward)
+            .and_then(|p| Equiangular::new(path.o, path.d, p, tmin, tmax));
+        let mut method = match equiangular {
+            Some(_) => self.volumes.sample_method(&stack),
+            None => Method::Distance,
+        };
+        let use_mis = method == Method::Mis;
+        if use_mis {
+            // One strategy per sample, each half the time (the factor 2 in the weights).
+            if rscatter < 0.5 {
+                rscatter *= 2.0;
+                method = Method::Distance;
+            } else {
+                rscatter = (rscatter - 0.5) * 2.0;
+                method = Method::Equiangular;
+            }
+        }
+        let (mut direct_t, mut equiangular_pdf) = (0.0f32, 0.0f32);
+        if method == Method::Equiangular {
+            if let Some(e) = &equiangular {
+                (direct_t, equiangular_pdf) = e.sample(rscatter);
+            }
+        }
+        // The pdf of distance sampling reaching where the path is (for the MIS weights).
+        let mut distance_pdf = 1.0f32;
+        let mut indirect_tp = path.throughput;
+        let mut direct_tp = path.throughput;
+        let mut indirect: Option<(f32, Phases)> = None;
+        let mut direct: Option<(f32, Phases)> = None;
         let mut emission = [0.0f32; 3];
-        let mut scatter: Option<(f32, Phases)> = None;
         let mut t1 = tmin;
         let mut stepi = 0u32;
         while t1 < tmax && stepi < max_steps {
@@ -773,7 +906,9 @@ impl Scene<'_> {
             } else {
                 [1.0; 3]
             };
-            if co.emit {
+            // Emission up to the indirect scatter point only: stepping past it goes on
+            // for the direct one alone.
+            if co.emit && indirect.is_none() {
                 // The emission integrated over the step: E (1 - T) / sigma_t, E dt where
                 // nothing absorbs.
                 let e: V3 = [0, 1, 2].map(|k| {
@@ -783,14 +918,14 @@ impl Scene<'_> {
                         co.emission[k] * dt
                     }
                 });
-                emission = add(emission, mul(throughput, e));
+                emission = add(emission, mul(indirect_tp, e));
             }
             // Past a bounce limit (Cycles' PATH_RAY_TERMINATE_AFTER_TRANSPARENT) the
             // volume keeps no scattering closures: it only absorbs (its whole extinction)
             // and emits, and the path goes on to what lies beyond, for MIS.
             if co.scatter && !path.terminate_next {
-                // Cycles' volume_sample_indirect_scatter with the distance method: the
-                // channel by the balance heuristic over channels.
+                // Cycles' volume_integrate_step_scattering: the channel by the balance
+                // heuristic over channels.
                 let albedo: V3 = [0, 1, 2].map(|k| {
                     if co.sigma_t[k] != 0.0 {
                         co.sigma_s[k] / co.sigma_t[k]
@@ -798,28 +933,72 @@ impl Scene<'_> {
                         1.0
                     }
                 });
-                let (ch, pdf) = sample_channel(albedo, throughput, &mut rchannel);
-                let sample_tr = tr[ch];
-                if 1.0 - rscatter >= sample_tr {
-                    let new_dt = -(1.0 - rscatter).ln() / co.sigma_t[ch];
-                    let new_tr = transmittance(co.sigma_t, new_dt);
-                    let distance_pdf = dot(pdf, mul(co.sigma_t, new_tr));
-                    if distance_pdf > 0.0 {
-                        throughput =
-                            scale(mul(throughput, mul(co.sigma_s, new_tr)), 1.0 / distance_pdf);
-                        scatter = Some((t0 + new_dt, co.phases));
-                        break;
+                let (ch, pdf) = sample_channel(albedo, indirect_tp, &mut rchannel);
+                if method == Method::Equiangular && direct.is_none() {
+                    if t0 <= direct_t && direct_t <= t1 && equiangular_pdf > PDF_CUTOFF {
+                        let new_tr = transmittance(co.sigma_t, direct_t - t0);
+                        direct_tp = scale(
+                            mul(direct_tp, mul(co.sigma_s, new_tr)),
+                            1.0 / equiangular_pdf,
+                        );
+                        if use_mis {
+                            let dpdf = distance_pdf * dot(pdf, mul(co.sigma_t, new_tr));
+                            let w = super::integrator::power_heuristic(equiangular_pdf, dpdf);
+                            direct_tp = scale(direct_tp, 2.0 * w);
+                        }
+                        direct = Some((direct_t, co.phases));
+                    } else {
+                        direct_tp = mul(direct_tp, tr);
+                        distance_pdf *= dot(pdf, tr);
                     }
-                } else {
-                    let distance_pdf = dot(pdf, tr);
-                    throughput = scale(mul(throughput, tr), 1.0 / distance_pdf);
-                    rscatter = 1.0 - (1.0 - rscatter) / sample_tr;
+                }
+                if indirect.is_none() {
+                    // Cycles' volume_sample_indirect_scatter.
+                    let sample_tr = tr[ch];
+                    if 1.0 - rscatter >= sample_tr {
+                        let new_dt = -(1.0 - rscatter).ln() / co.sigma_t[ch];
+                        let new_tr = transmittance(co.sigma_t, new_dt);
+                        let dpdf = dot(pdf, mul(co.sigma_t, new_tr));
+                        if distance_pdf * dpdf > PDF_CUTOFF {
+                            let t = t0 + new_dt;
+                            indirect_tp =
+                                scale(mul(indirect_tp, mul(co.sigma_s, new_tr)), 1.0 / dpdf);
+                            if method != Method::Equiangular {
+                                distance_pdf *= dpdf;
+                                // Direct light at the same point.
+                                direct_tp = indirect_tp;
+                                if use_mis {
+                                    let e = equiangular.map_or(0.0, |e| e.pdf(t));
+                                    let w = super::integrator::power_heuristic(distance_pdf, e);
+                                    direct_tp = scale(direct_tp, 2.0 * w);
+                                }
+                                direct = Some((t, co.phases));
+                            }
+                            indirect = Some((t, co.phases));
+                        }
+                    } else {
+                        let dpdf = dot(pdf, tr);
+                        indirect_tp = scale(mul(indirect_tp, tr), 1.0 / dpdf);
+                        if method != Method::Equiangular {
+                            distance_pdf *= dpdf;
+                        }
+                        rscatter = 1.0 - (1.0 - rscatter) / sample_tr;
+                    }
                 }
             } else if co.extinction {
-                throughput = mul(throughput, tr);
+                indirect_tp = mul(indirect_tp, tr);
+                direct_tp = mul(direct_tp, tr);
             }
-            if max3(throughput) < THROUGHPUT_EPSILON {
-                throughput = [0.0; 3];
+            // Cycles' volume_integrate_should_stop.
+            if indirect.is_none() {
+                if max3(indirect_tp) < THROUGHPUT_EPSILON {
+                    indirect_tp = [0.0; 3];
+                    break;
+                }
+            } else if direct.is_none() && max3(direct_tp) < THROUGHPUT_EPSILON {
+                break;
+            }
+            if direct.is_some() && indirect.is_some() {
                 break;
             }
         }
@@ -830,34 +1009,112 @@ impl Scene<'_> {
                 path.l = add(path.l, c);
             }
         }
-        let Some((t, phases)) = scatter else {
-            path.throughput = throughput;
-            return if is_zero(throughput) {
+        if direct.is_none() && indirect.is_none() {
+            path.throughput = indirect_tp;
+            return if is_zero(indirect_tp) {
+                Segment::Stop
+            } else {
+                Segment::Passed
+            };
+        }
+        // Russian roulette on what the path carried into the segment (Cycles' continuation
+        // probability), for the direct and the indirect estimate alike.
+        let Some(q) = path.continuation(st, u_light[3]) else {
+            return Segment::Stop;
+        };
+        let segment = (path.o, path.d, tmax - tmin);
+        if let (Some((t, phases)), Some(light)) = (direct, ahead) {
+            let p = madd(path.o, path.d, t);
+            let tp = scale(direct_tp, 1.0 / q);
+            if let Some(c) = self.volume_direct_light(path, tp, p, &phases, u_light, light, scratch)
+            {
+                path.l = add(path.l, c);
+            }
+        }
+        path.throughput = scale(indirect_tp, 1.0 / q);
+        let Some((t, phases)) = indirect else {
+            return if is_zero(path.throughput) {
                 Segment::Stop
             } else {
                 Segment::Passed
             };
         };
-        path.throughput = throughput;
         let u_phase = rng.get4(index, path.set);
-        let u_light = rng.get4(index, path.set + 1);
-        if !path.survives_roulette(st, u_light[3]) {
-            return Segment::Stop;
-        }
         let p = madd(path.o, path.d, t);
-        if let Some(c) = self.volume_direct_light(path, p, &phases, u_light, scratch) {
-            path.l = add(path.l, c);
-        }
         let Some((wi, pdf)) = phases.sample(path.d, [u_phase[0], u_phase[1]]) else {
             return Segment::Stop;
         };
-        self.volume_bounce(path, p, wi, pdf, scratch);
+        self.volume_bounce(path, p, wi, pdf, segment, scratch);
         Segment::Scattered
+    }
+
+    /// The light a segment's direct light comes from (Cycles'
+    /// integrate_volume_equiangular_sample_light): picked for the segment of length `t`
+    /// (Cycles' in_volume_segment light selection), with a point on it from the same
+    /// random numbers the light sample at the scatter point will use. None when it cannot
+    /// light a volume scatter.
+    fn volume_light_ahead(&self, path: &Path, t: f32, u: [f32; 4]) -> Option<AheadLight> {
+        let o = path.o;
+        let (pick, p_sel) = self
+            .light_select
+            .select_for(Viewer::Segment { p: o, d: path.d, t }, u[2])?;
+        let toward = match pick {
+            Pick::Lamp(li) => {
+                let light = &self.lights[li as usize];
+                if light.exclude & ray::VOLUME_SCATTER != 0 {
+                    return None;
+                }
+                match light.shape {
+                    super::light::Shape::Sun { .. } => None,
+                    // Any point that does not depend on the scatter point will do; the
+                    // sampled one where the light can be sampled from the start.
+                    _ => Some(
+                        light
+                            .sample(o, [u[0], u[1]])
+                            .filter(|ls| ls.dist.is_finite())
+                            .map_or(light.pos, |ls| madd(o, ls.wi, ls.dist)),
+                    ),
+                }
+            }
+            Pick::Triangle(tri) => {
+                let r = self.geo.refs[tri as usize];
+                if self.geo.instances[r.inst as usize].visibility & ray::VOLUME_SCATTER == 0 {
+                    return None;
+                }
+                let v = &self.geo.tris[tri as usize];
+                let (front, back) = self.emission_sides(tri);
+                Some(
+                    super::light::triangle::sample(v, o, [u[0], u[1]], front, back)
+                        .map_or(scale(add(add(v[0], v[1]), v[2]), 1.0 / 3.0), |ts| {
+                            madd(o, ts.wi, ts.dist)
+                        }),
+                )
+            }
+            Pick::World => {
+                if self.world_exclude & ray::VOLUME_SCATTER != 0 {
+                    return None;
+                }
+                None
+            }
+        };
+        Some(AheadLight {
+            pick,
+            p_sel,
+            toward,
+        })
     }
 
     /// Cycles' path_state_next after a volume scatter, and the next ray from `p` along
     /// `wi` (phase-sampled with `pdf`; its weight is 1).
-    fn volume_bounce(&self, path: &mut Path, p: V3, wi: V3, pdf: f32, scratch: &mut Scratch) {
+    fn volume_bounce(
+        &self,
+        path: &mut Path,
+        p: V3,
+        wi: V3,
+        pdf: f32,
+        segment: (V3, V3, f32),
+        scratch: &mut Scratch,
+    ) {
         let st = &self.settings;
         if path.state.bounce >= st.max_bounces {
             path.terminate_next = true;
@@ -869,9 +1126,10 @@ impl Scene<'_> {
         scratch.volume_bounce += 1;
         path.state.flags = ray::VOLUME_SCATTER;
         path.transparent_bg = false;
-        // Light selection at a scatter point sees no normal and both sides.
+        // Light selection for the segment saw no normal and both sides, at its start.
         path.mis_n = [0.0; 3];
         path.mis_trans = true;
+        path.mis_segment = Some(segment);
         path.prev_pdf = pdf;
         path.prev_singular = false;
         path.min_ray_pdf = path.min_ray_pdf.min(pdf);
@@ -882,22 +1140,26 @@ impl Scene<'_> {
         path.set += SETS_PER_VERTEX;
     }
 
-    /// Next-event estimation at a volume scatter point `p`: one emitter picked as at a
-    /// surface without a normal, weighted by the phase functions, MIS against phase
-    /// sampling for emitters shared with it, the shadow ray attenuated by the volumes.
+    /// Next-event estimation at a volume scatter point `p` with path throughput
+    /// `throughput`: the segment's light sampled again from `p`, weighted by the phase
+    /// functions, MIS against phase sampling for emitters shared with it, the shadow ray
+    /// attenuated by the volumes.
+    #[allow(clippy::too_many_arguments)]
     fn volume_direct_light(
         &self,
         path: &Path,
+        throughput: V3,
         p: V3,
         phases: &Phases,
         u: [f32; 4],
+        light: AheadLight,
         scratch: &mut Scratch,
     ) -> Option<V3> {
         let clamp = path.light_clamp(&self.settings);
         let d = path.d;
         let bounce = path.state.bounce;
         let stack = scratch.volume_stack;
-        let c = match self.light_select.select(p, [0.0; 3], true, u[2])? {
+        let c = match (light.pick, light.p_sel) {
             (Pick::Lamp(li), p_sel) => {
                 let light = &self.lights[li as usize];
                 if bounce > light.max_bounces || light.exclude & ray::VOLUME_SCATTER != 0 {
@@ -910,7 +1172,7 @@ impl Scene<'_> {
                 } else {
                     1.0
                 };
-                let c = scale(mul(path.throughput, ls.value), f * w / p_sel);
+                let c = scale(mul(throughput, ls.value), f * w / p_sel);
                 if is_zero(c) || !finite(c) {
                     return None;
                 }
@@ -952,7 +1214,7 @@ impl Scene<'_> {
                 let le =
                     self.light_emission(tri, ts.b1, ts.b2, neg(ts.wi), ts.dist, bounce, scratch);
                 let w = super::integrator::power_heuristic(pdf_l, pdf_b);
-                mul(scale(mul(path.throughput, le), f * w / pdf_l), tr)
+                mul(scale(mul(throughput, le), f * w / pdf_l), tr)
             }
             (Pick::World, p_sel) => {
                 if self.world_exclude & ray::VOLUME_SCATTER != 0 {
@@ -971,7 +1233,7 @@ impl Scene<'_> {
                 }
                 let le = self.background_toward(wi, scratch);
                 let w = super::integrator::power_heuristic(pdf_l, pdf_b);
-                mul(scale(mul(path.throughput, le), f * w / pdf_l), tr)
+                mul(scale(mul(throughput, le), f * w / pdf_l), tr)
             }
         };
         (finite(c) && !is_zero(c)).then(|| super::integrator::clamp_contrib(c, clamp))

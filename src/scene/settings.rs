@@ -493,8 +493,8 @@ pub struct MaterialSettings {
     /// Volume > Homogeneous: the volume is evaluated once per ray segment even when it
     /// varies.
     pub homogeneous_volume: bool,
-    /// Volume > Sampling ("DISTANCE", "EQUIANGULAR", "MULTIPLE_IMPORTANCE").
-    pub volume_sampling: String,
+    /// Volume > Sampling.
+    pub volume_sampling: VolumeSampling,
     /// Volume > Step Rate: scales the object's ray-marching step.
     pub volume_step_rate: f64,
 }
@@ -515,13 +515,23 @@ impl MaterialSettings {
             homogeneous_volume: cy
                 .and_then(|c| flag(c, "homogeneous_volume"))
                 .unwrap_or(false),
-            volume_sampling: cy
-                .and_then(|c| text(c, "volume_sampling"))
-                .unwrap_or("MULTIPLE_IMPORTANCE")
-                .to_string(),
+            volume_sampling: match cy.and_then(|c| text(c, "volume_sampling")) {
+                Some("DISTANCE") => VolumeSampling::Distance,
+                Some("EQUIANGULAR") => VolumeSampling::Equiangular,
+                _ => VolumeSampling::MultipleImportance,
+            },
             volume_step_rate: cy.and_then(|c| num(c, "volume_step_rate")).unwrap_or(1.0),
         }
     }
+}
+
+/// A material's Volume > Sampling: how a scatter point for direct light is chosen along
+/// a ray inside the volume (Blender's default is Multiple Importance).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VolumeSampling {
+    Distance,
+    Equiangular,
+    MultipleImportance,
 }
 
 /// An object's Cycles settings.

@@ -18,7 +18,7 @@ use crate::render::bsdf::{LobeKind, LobeSet};
 use crate::render::build::Geometry;
 use crate::render::integrator::path_state::{Next, Path, SETS_PER_VERTEX};
 use crate::render::integrator::shade::{Context, Material};
-use crate::render::light::tree::{LightSelect, Pick};
+use crate::render::light::tree::{LightSelect, Pick, Viewer};
 use crate::render::light::Light;
 use crate::render::math::*;
 use crate::render::sampler::PixelSampler;
@@ -497,12 +497,9 @@ impl Scene<'_> {
                     power_heuristic(
                         path.prev_pdf,
                         lh.pdf
-                            * self.light_select.pdf(
-                                path.o,
-                                path.mis_n,
-                                path.mis_trans,
-                                Pick::Lamp(li as u32),
-                            ),
+                            * self
+                                .light_select
+                                .pdf_for(path.mis_viewer(), Pick::Lamp(li as u32)),
                     )
                 };
                 scratch
@@ -529,14 +526,7 @@ impl Scene<'_> {
             return;
         }
         let d = path.d;
-        let w = self.world_mis_weight(
-            d,
-            path.prev_singular,
-            path.prev_pdf,
-            path.o,
-            path.mis_n,
-            path.mis_trans,
-        );
+        let w = self.world_mis_weight(d, path.prev_singular, path.prev_pdf, path.mis_viewer());
         let bg = scale(mul(path.throughput, self.background_toward(d, scratch)), w);
         scratch.features.add_emission(bg);
         let c = clamp_contrib(bg, clamp);
@@ -642,9 +632,9 @@ impl Scene<'_> {
         let w = if path.prev_singular || !(if hit.backfacing { back } else { front }) {
             1.0
         } else {
-            let pick =
-                self.light_select
-                    .pdf(path.o, path.mis_n, path.mis_trans, Pick::Triangle(h.prim));
+            let pick = self
+                .light_select
+                .pdf_for(path.mis_viewer(), Pick::Triangle(h.prim));
             if pick > 0.0 {
                 power_heuristic(
                     path.prev_pdf,
@@ -819,19 +809,11 @@ impl Scene<'_> {
 impl Scene<'_> {
     /// MIS weight of world radiance reached by a BSDF-sampled ray (1 when the world is
     /// not light-sampled or the ray came from a singular lobe or the camera).
-    fn world_mis_weight(
-        &self,
-        d: V3,
-        prev_singular: bool,
-        prev_pdf: f32,
-        o: V3,
-        mis_n: V3,
-        mis_trans: bool,
-    ) -> f32 {
+    fn world_mis_weight(&self, d: V3, prev_singular: bool, prev_pdf: f32, from: Viewer) -> f32 {
         match self.world.and_then(|w| w.map.as_ref()) {
             Some(map) if !prev_singular => power_heuristic(
                 prev_pdf,
-                map.pdf(d) * self.light_select.pdf(o, mis_n, mis_trans, Pick::World),
+                map.pdf(d) * self.light_select.pdf_for(from, Pick::World),
             ),
             _ => 1.0,
         }

@@ -8,6 +8,7 @@ use crate::shader::point::{ray, PathState};
 use crate::render::accel::Hit;
 use crate::render::bsdf::{BsdfSample, LobeKind};
 use crate::render::integrator::Settings;
+use crate::render::light::tree::Viewer;
 use crate::render::math::*;
 
 /// Sampler dimensions a vertex uses, from its `set`: the BSDF sample at `set`, the light
@@ -81,6 +82,10 @@ pub struct Path {
     /// the ray finds, for its MIS weight, is computed there.
     pub mis_n: V3,
     pub mis_trans: bool,
+    /// After a volume scatter, the segment it scattered in (origin, direction, length):
+    /// its light was picked for the whole segment (Cycles' in_volume_segment light
+    /// selection), and what the next ray hits is weighted by that selection's pdf.
+    pub mis_segment: Option<(V3, V3, f32)>,
     /// Where a subsurface random walk left the object: the next vertex, shaded white
     /// diffuse (Cycles' subsurface_shader_data_setup).
     pub sss_exit: Option<Hit>,
@@ -116,11 +121,26 @@ impl Path {
             min_ray_pdf: f32::INFINITY,
             mis_n: [0.0; 3],
             mis_trans: false,
+            mis_segment: None,
             sss_exit: None,
             diffuse_ancestor: false,
             transparent_bg: true,
             ray_dp,
             ray_dd,
+        }
+    }
+
+    /// What light selection saw where the ray being traced was sampled, for the MIS
+    /// weight of what it hits.
+    #[inline]
+    pub fn mis_viewer(&self) -> Viewer {
+        match self.mis_segment {
+            Some((p, d, t)) => Viewer::Segment { p, d, t },
+            None => Viewer::Point {
+                p: self.o,
+                n: self.mis_n,
+                trans: self.mis_trans,
+            },
         }
     }
 
@@ -146,23 +166,34 @@ impl Path {
     /// Russian roulette as Cycles (path_state_continuation_probability): sqrt of the
     /// throughput, but never within the minimum bounces, which Cycles' kernel takes as
     /// the setting plus one (so the first indirect hit always continues), counted in
-    /// transparent bounces when the ray just passed a transparent surface. False ends
-    /// the path; a survivor's throughput is divided by its probability.
-    pub fn survives_roulette(&mut self, st: &Settings, u: f32) -> bool {
+    /// transparent bounces when the ray just passed a transparent surface. None ends the
+    /// path; otherwise the probability it went on with (1 where no roulette applies), by
+    /// which a survivor's throughput is divided.
+    pub fn continuation(&self, st: &Settings, u: f32) -> Option<f32> {
         let s = &self.state;
         let roulette = if s.flags & ray::TRANSPARENT != 0 {
             s.transparent > st.min_transparent_bounces + 1
         } else {
             s.bounce > st.min_light_bounces + 1
         };
-        if roulette {
-            let q = max3(self.throughput.map(f32::abs)).sqrt().min(1.0);
-            if q <= 0.0 || u >= q {
-                return false;
-            }
-            self.throughput = scale(self.throughput, 1.0 / q);
+        if !roulette {
+            return Some(1.0);
         }
-        true
+        let q = max3(self.throughput.map(f32::abs)).sqrt().min(1.0);
+        (q > 0.0 && u < q).then_some(q)
+    }
+
+    /// `continuation`, the survivor's throughput divided by its probability.
+    pub fn survives_roulette(&mut self, st: &Settings, u: f32) -> bool {
+        match self.continuation(st, u) {
+            Some(q) => {
+                if q != 1.0 {
+                    self.throughput = scale(self.throughput, 1.0 / q);
+                }
+                true
+            }
+            None => false,
+        }
     }
 
     /// Cycles' path_state_next after the BSDF sample `bs` (its weight already in the
@@ -222,6 +253,7 @@ impl Path {
         self.state.flags = bounce_flags(bs.kind, bs.transmit, bs.singular);
         self.mis_n = n_sel;
         self.mis_trans = trans_sel;
+        self.mis_segment = None;
         self.prev_pdf = bs.pdf;
         self.prev_singular = bs.singular;
         if !bs.singular {

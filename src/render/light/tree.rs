@@ -29,6 +29,16 @@ pub enum Pick {
     Triangle(u32),
 }
 
+/// Where light selection looks from (Cycles' light tree `P` and `N_or_D`).
+#[derive(Clone, Copy, Debug)]
+pub enum Viewer {
+    /// A shading point with its normal (zero for none); `trans`: its BSDF transmits.
+    Point { p: V3, n: V3, trans: bool },
+    /// A ray segment in a volume from `p` along unit `d` for `t` (Cycles'
+    /// in_volume_segment): direct light is sampled somewhere along it.
+    Segment { p: V3, d: V3, t: f32 },
+}
+
 /// The geometry an emitter's importance is computed from (Cycles' *_light_tree_parameters).
 #[derive(Clone, Copy, Debug)]
 pub enum Shape {
@@ -301,7 +311,9 @@ fn smoothstep(x: f32) -> f32 {
 }
 
 /// Cycles' light_tree_importance: upper and lower bounds of what a cluster can send to a
-/// point with normal `n` (a surface; `trans` if it transmits too).
+/// point with normal `n` (a surface; `trans` if it transmits too), or, with `theta_d`
+/// (the angle the segment spans as seen from the cluster), to a volume ray segment:
+/// no incidence term, the distance term theta_d / distance, and no lower bound.
 #[allow(clippy::too_many_arguments)]
 fn importance(
     n: V3,
@@ -312,23 +324,28 @@ fn importance(
     max_d: f32,
     min_d: f32,
     energy: f32,
+    theta_d: Option<f32>,
 ) -> (f32, f32) {
     let sin_u = sin_from_cos(cos_u);
-    let cos_i = if trans {
-        dot(ptc, n).abs()
+    let (cos_min_incidence, cos_max_incidence) = if theta_d.is_some() {
+        (1.0, 1.0)
     } else {
-        dot(ptc, n)
+        let cos_i = if trans {
+            dot(ptc, n).abs()
+        } else {
+            dot(ptc, n)
+        };
+        let sin_i = sin_from_cos(cos_i);
+        let cos_min_incidence = if cos_i >= cos_u {
+            1.0
+        } else {
+            cos_i * cos_u + sin_i * sin_u
+        };
+        if !trans && cos_min_incidence < 0.0 {
+            return (0.0, 0.0);
+        }
+        (cos_min_incidence, (cos_i * cos_u - sin_i * sin_u).max(0.0))
     };
-    let sin_i = sin_from_cos(cos_i);
-    let cos_min_incidence = if cos_i >= cos_u {
-        1.0
-    } else {
-        cos_i * cos_u + sin_i * sin_u
-    };
-    if !trans && cos_min_incidence < 0.0 {
-        return (0.0, 0.0);
-    }
-    let cos_max_incidence = (cos_i * cos_u - sin_i * sin_u).max(0.0);
     let (cos_t, sin_t) = if cone.axis == neg(ptc) {
         (1.0, 0.0)
     } else {
@@ -347,6 +364,9 @@ fn importance(
     } else {
         return (0.0, 0.0);
     };
+    if let Some(theta_d) = theta_d {
+        return ((energy * cos_min_outgoing * theta_d / min_d).abs(), 0.0);
+    }
     let max_imp = (cos_min_incidence * energy * cos_min_outgoing / (min_d * min_d)).abs();
     let cos_t_plus_u = cos_t * cos_u - sin_t * sin_u;
     let min_imp = if cone.theta_e - cone.theta_o < 0.0
@@ -379,6 +399,53 @@ fn cos_box_angle(bmin: V3, bmax: V3, p: V3, ptc: V3) -> f32 {
         c = c.min(dot(ptc, normalize(sub(corner, p))));
     }
     c
+}
+
+/// Cycles' light_tree_cos_bound_subtended_angle: the cosine of the half-angle under
+/// which the box's bounding sphere is seen from `p` (-1 from inside it).
+fn cos_sphere_angle(bmax: V3, centroid: V3, p: V3) -> f32 {
+    let d2 = dot(sub(p, centroid), sub(p, centroid));
+    let r2 = dot(sub(bmax, centroid), sub(bmax, centroid));
+    if d2 <= r2 {
+        -1.0
+    } else {
+        (1.0 - r2 / d2).max(0.0).sqrt()
+    }
+}
+
+/// Cycles' compute_v (Fig. 8 of the paper): of the directions from the segment `p + s d`,
+/// s in [0, t], toward `centroid`, the one closest to the cone's axis, negated.
+fn compute_v(centroid: V3, p: V3, d: V3, axis: V3, t: f32) -> V3 {
+    let u0 = sub(p, centroid);
+    let u1 = madd(u0, d, t.min(1e12));
+    let v0 = normalize(u0);
+    let v1 = normalize(u1);
+    // Cycles' make_orthonormals_tangent(o0, v1): o1 in the plane of v0 and v1.
+    let o0 = v0;
+    let o1 = normalize(cross(cross(o0, v1), o0));
+    let a0 = dot(o0, axis);
+    let a1 = dot(o1, axis);
+    let inv_len = 1.0 / (a0 * a0 + a1 * a1).sqrt();
+    let cos_phi0 = a0 * inv_len;
+    if a1 < 0.0 || dot(v0, v1) > cos_phi0 {
+        if a0 > dot(v1, axis) {
+            v0
+        } else {
+            v1
+        }
+    } else {
+        add(scale(o0, cos_phi0), scale(o1, a1 * inv_len))
+    }
+}
+
+/// The segment's point nearest `centroid` (clamped to the segment), the distance from
+/// the segment's line to `centroid`, and the angle the segment spans seen from it.
+fn segment_view(p: V3, d: V3, t: f32, centroid: V3) -> (V3, f32, f32) {
+    let closest_t = dot(sub(centroid, p), d);
+    let closest = madd(p, d, closest_t.clamp(0.0, t));
+    let dist = len(sub(sub(centroid, p), scale(d, closest_t)));
+    let theta_d = (t - closest_t).atan2(dist) + closest_t.atan2(dist);
+    (closest, dist, theta_d)
 }
 
 impl LightTree {
@@ -611,8 +678,42 @@ impl LightTree {
     }
 
     /// Cycles' light_tree_node_importance.
-    fn node_importance(&self, p: V3, n: V3, trans: bool, node: &Node) -> (f32, f32) {
+    fn node_importance(&self, v: Viewer, node: &Node) -> (f32, f32) {
         let m = &node.m;
+        let (p, n, trans) = match v {
+            Viewer::Point { p, n, trans } => (p, n, trans),
+            Viewer::Segment { p, d, t } => {
+                let (ptc, cos_u, distance, theta_d) = if let NodeKind::Distant { .. } = node.kind {
+                    let theta_d = if t.is_finite() { t } else { 1.0 };
+                    (
+                        neg(m.cone.axis),
+                        (m.cone.theta_o + m.cone.theta_e).cos(),
+                        1.0,
+                        theta_d,
+                    )
+                } else {
+                    let centroid = m.centre();
+                    let (closest, dist, theta_d) = segment_view(p, d, t, centroid);
+                    (
+                        neg(compute_v(centroid, p, d, m.cone.axis, t)),
+                        cos_sphere_angle(m.bmax, centroid, closest),
+                        (0.5 * len(sub(centroid, m.bmax))).max(dist),
+                        theta_d,
+                    )
+                };
+                return importance(
+                    d,
+                    true,
+                    ptc,
+                    cos_u,
+                    m.cone,
+                    distance,
+                    distance,
+                    m.energy,
+                    Some(theta_d),
+                );
+            }
+        };
         let (ptc, cos_u, distance) = if let NodeKind::Distant { .. } = node.kind {
             (
                 neg(m.cone.axis),
@@ -631,19 +732,23 @@ impl LightTree {
             let cos_u = cos_box_angle(m.bmin, m.bmax, p, ptc);
             (ptc, cos_u, (0.5 * len(sub(centroid, m.bmax))).max(d))
         };
-        importance(n, trans, ptc, cos_u, m.cone, distance, distance, m.energy)
+        importance(
+            n, trans, ptc, cos_u, m.cone, distance, distance, m.energy, None,
+        )
     }
 
     /// Cycles' light_tree_emitter_importance.
-    fn emitter_importance(&self, p: V3, n: V3, trans: bool, e: &Emitter) -> (f32, f32) {
+    fn emitter_importance(&self, v: Viewer, e: &Emitter) -> (f32, f32) {
+        let (p, n, trans) = match v {
+            Viewer::Point { p, n, trans } => (p, n, trans),
+            Viewer::Segment { p, d, t } => return self.emitter_importance_segment(p, d, t, e),
+        };
         let m = &e.measure;
         let mut cone = m.cone;
         let mut energy = m.energy;
         let centroid = e.centroid;
         let (visible, ptc, cos_u, dist) = match e.shape {
-            Shape::Mesh { root } => {
-                return self.node_importance(p, n, trans, &self.nodes[root as usize])
-            }
+            Shape::Mesh { root } => return self.node_importance(v, &self.nodes[root as usize]),
             Shape::Point {
                 pos,
                 radius,
@@ -731,25 +836,124 @@ impl LightTree {
         if !(visible || trans) {
             return (0.0, 0.0);
         }
-        importance(n, trans, ptc, cos_u, cone, dist[0], dist[1], energy)
+        importance(n, trans, ptc, cos_u, cone, dist[0], dist[1], energy, None)
+    }
+
+    /// Cycles' light_tree_emitter_importance<in_volume_segment = true> for the segment
+    /// from `p` along `d` for `t`: the emitter's parameters seen from the segment's point
+    /// nearest it, its direction term from the segment's best-aligned point.
+    fn emitter_importance_segment(&self, p: V3, d: V3, t: f32, e: &Emitter) -> (f32, f32) {
+        let m = &e.measure;
+        let mut cone = m.cone;
+        let ray_length = if t.is_finite() { t } else { 1.0 };
+        let (centroid, cos_u, dist, theta_d) = match e.shape {
+            Shape::Mesh { root } => {
+                return self
+                    .node_importance(Viewer::Segment { p, d, t }, &self.nodes[root as usize])
+            }
+            Shape::Distant => {
+                let cos_u = cone.theta_e.cos();
+                let ptc = neg(e.centroid);
+                return importance(
+                    d,
+                    true,
+                    ptc,
+                    cos_u,
+                    cone,
+                    1.0 / cos_u,
+                    1.0,
+                    m.energy,
+                    Some(ray_length),
+                );
+            }
+            Shape::World => {
+                // Cycles' arbitrary centroid and direction for the background.
+                cone.axis = [0.0, 0.0, -1.0];
+                ([0.0, 0.0, 1.0], -1.0, [1.0, 1.0], ray_length)
+            }
+            Shape::Point {
+                pos,
+                radius,
+                sphere,
+                spot_smooth,
+            } => {
+                let (pc, _, theta_d) = segment_view(p, d, t, pos);
+                let min_d = len(sub(pos, pc));
+                let cos_u = match spot_smooth {
+                    None => {
+                        // Disk-oriented, facing the segment's start.
+                        cone.axis = normalize(sub(p, pos));
+                        cone.theta_o = 0.0;
+                        1.0
+                    }
+                    Some(_) if sphere => {
+                        if min_d > radius {
+                            sin_from_cos(radius / min_d)
+                        } else {
+                            -1.0
+                        }
+                    }
+                    Some(_) => min_d / (radius * radius + min_d * min_d).sqrt(),
+                };
+                (pos, cos_u, [min_d, min_d], theta_d)
+            }
+            Shape::Area { pos, eu, ev } => {
+                let (pc, _, theta_d) = segment_view(p, d, t, pos);
+                let (ptc, min_d) = normalize_len(sub(pos, pc));
+                let mut cos_u = f32::MAX;
+                for i in 0..4 {
+                    let corner = add(
+                        add(
+                            scale(eu, (i & 1) as f32 - 0.5),
+                            scale(ev, 0.5 * ((i & 2) as f32 - 1.0)),
+                        ),
+                        pos,
+                    );
+                    cos_u = cos_u.min(dot(ptc, normalize_len(sub(corner, pc)).0));
+                }
+                (pos, cos_u, [min_d, min_d], theta_d)
+            }
+            Shape::Triangle { v } => {
+                let centroid = e.centroid;
+                let (pc, _, theta_d) = segment_view(p, d, t, centroid);
+                let (ptc, min_d) = normalize_len(sub(centroid, pc));
+                let mut cos_u = f32::MAX;
+                for c in v {
+                    cos_u = cos_u.min(dot(ptc, normalize_len(sub(c, pc)).0));
+                }
+                (centroid, cos_u, [min_d, min_d], theta_d)
+            }
+        };
+        let ptc = neg(compute_v(centroid, p, d, cone.axis, t));
+        importance(
+            d,
+            true,
+            ptc,
+            cos_u,
+            cone,
+            dist[0],
+            dist[1],
+            m.energy,
+            Some(theta_d),
+        )
     }
 
     /// Cycles' light_tree_child_importance.
-    fn child_importance(&self, p: V3, n: V3, trans: bool, node: u32) -> (f32, f32) {
+    fn child_importance(&self, v: Viewer, node: u32) -> (f32, f32) {
         let nd = &self.nodes[node as usize];
         match nd.kind {
             NodeKind::Leaf { first, count } | NodeKind::Distant { first, count } if count == 1 => {
-                self.emitter_importance(p, n, trans, &self.emitters[first as usize].e)
+                self.emitter_importance(v, &self.emitters[first as usize].e)
             }
             NodeKind::Leaf { count: 0, .. } | NodeKind::Distant { count: 0, .. } => (0.0, 0.0),
-            _ => self.node_importance(p, n, trans, nd),
+            _ => self.node_importance(v, nd),
         }
     }
 
     /// Cycles' get_left_probability; None when neither child can contribute.
-    fn left_probability(&self, p: V3, n: V3, trans: bool, left: u32, right: u32) -> Option<f32> {
-        let (lmax, lmin) = self.child_importance(p, n, trans, left);
-        let (rmax, rmin) = self.child_importance(p, n, trans, right);
+    fn left_probability(&self, v: Viewer, left: u32, right: u32) -> Option<f32> {
+        let (lmax, lmin) = self.child_importance(v, left);
+        let (rmax, rmin) = self.child_importance(v, right);
         let total_max = lmax + rmax;
         if total_max == 0.0 {
             return None;
@@ -764,9 +968,9 @@ impl LightTree {
         Some(0.5 * (pmax + pmin))
     }
 
-    /// Picks an emitter for a shading point at `p` with shading normal `n` (`trans`: its
-    /// BSDF transmits): what to sample and the probability of having picked it.
-    pub fn select(&self, p: V3, n: V3, trans: bool, rand: f32) -> Option<(Pick, f32)> {
+    /// Picks an emitter for what `v` sees: what to sample and the probability of having
+    /// picked it.
+    pub fn select(&self, v: Viewer, rand: f32) -> Option<(Pick, f32)> {
         let mut rand = rand;
         let mut node = 0u32;
         let mut pdf_leaf = 1.0f32;
@@ -774,8 +978,7 @@ impl LightTree {
         loop {
             match self.nodes[node as usize].kind {
                 NodeKind::Leaf { first, count } | NodeKind::Distant { first, count } => {
-                    let e =
-                        self.select_in_leaf(p, n, trans, first, count, &mut rand, &mut pdf_sel)?;
+                    let e = self.select_in_leaf(v, first, count, &mut rand, &mut pdf_sel)?;
                     let st = &self.emitters[e];
                     match st.e.shape {
                         Shape::Mesh { root } => node = root,
@@ -783,7 +986,7 @@ impl LightTree {
                     }
                 }
                 NodeKind::Inner { left, right } => {
-                    let lp = self.left_probability(p, n, trans, left, right)?;
+                    let lp = self.left_probability(v, left, right)?;
                     // Cycles' sample_reservoir of the right child against the left.
                     let wr = 1.0 - lp;
                     let mut go_right = false;
@@ -811,13 +1014,9 @@ impl LightTree {
 
     /// Cycles' light_tree_cluster_select_emitter: two reservoirs, by the upper and by the
     /// lower bound of each emitter's importance, one chosen by the random number.
-    // The shading state is passed apart, as Cycles passes it to its kernels.
-    #[allow(clippy::too_many_arguments)]
     fn select_in_leaf(
         &self,
-        p: V3,
-        n: V3,
-        trans: bool,
+        v: Viewer,
         first: u32,
         count: u32,
         rand: &mut f32,
@@ -834,7 +1033,7 @@ impl LightTree {
         }
         let range = first as usize..(first + count) as usize;
         for (i, ei) in range.clone().enumerate() {
-            let (imax, imin) = self.emitter_importance(p, n, trans, &self.emitters[ei].e);
+            let (imax, imin) = self.emitter_importance(v, &self.emitters[ei].e);
             let imp = [imax, imin];
             reservoir(
                 ei,
@@ -874,18 +1073,16 @@ impl LightTree {
                     );
                     hi >>= 1;
                 }
-                sel_imp[0] = self
-                    .emitter_importance(p, n, trans, &self.emitters[selected?].e)
-                    .0;
+                sel_imp[0] = self.emitter_importance(v, &self.emitters[selected?].e).0;
             }
         }
         *pdf *= 0.5 * (sel_imp[0] / total[0] + sel_imp[1] / total[1]);
         selected
     }
 
-    /// The probability that `select` at (`p`, `n`, `trans`) picks `pick` (Cycles'
-    /// light_tree_pdf), for MIS of what BSDF rays find; 0 if it is not an emitter.
-    pub fn pdf(&self, p: V3, n: V3, trans: bool, pick: Pick) -> f32 {
+    /// The probability that `select` for `v` picks `pick` (Cycles' light_tree_pdf), for
+    /// MIS of what BSDF rays find; 0 if it is not an emitter.
+    pub fn pdf(&self, v: Viewer, pick: Pick) -> f32 {
         let target = match pick {
             Pick::Lamp(l) => self
                 .lamp_emitter
@@ -918,7 +1115,7 @@ impl LightTree {
                         (0.0f32, 0.0f32, 0.0f32, 0.0f32, 0u32);
                     for ei in first..first + count {
                         let (imax, imin) =
-                            self.emitter_importance(p, n, trans, &self.emitters[ei as usize].e);
+                            self.emitter_importance(v, &self.emitters[ei as usize].e);
                         num += (imax > 0.0) as u32;
                         if ei == target {
                             tmax = imax;
@@ -951,7 +1148,7 @@ impl LightTree {
                     }
                 }
                 NodeKind::Inner { left, right } => {
-                    let Some(lp) = self.left_probability(p, n, trans, left, right) else {
+                    let Some(lp) = self.left_probability(v, left, right) else {
                         return 0.0;
                     };
                     let go_left = bits & 1 == 0;
@@ -1061,20 +1258,32 @@ pub enum LightSelect {
 }
 
 impl LightSelect {
+    /// Picks an emitter for a shading point at `p` with shading normal `n` (`trans`: its
+    /// BSDF transmits).
     #[inline]
     pub fn select(&self, p: V3, n: V3, trans: bool, rand: f32) -> Option<(Pick, f32)> {
+        self.select_for(Viewer::Point { p, n, trans }, rand)
+    }
+
+    #[inline]
+    pub fn select_for(&self, v: Viewer, rand: f32) -> Option<(Pick, f32)> {
         match self {
             LightSelect::None => None,
-            LightSelect::Tree(t) => t.select(p, n, trans, rand),
+            LightSelect::Tree(t) => t.select(v, rand),
             LightSelect::Flat(d) => d.select(rand),
         }
     }
 
     #[inline]
     pub fn pdf(&self, p: V3, n: V3, trans: bool, k: Pick) -> f32 {
+        self.pdf_for(Viewer::Point { p, n, trans }, k)
+    }
+
+    #[inline]
+    pub fn pdf_for(&self, v: Viewer, k: Pick) -> f32 {
         match self {
             LightSelect::None => 0.0,
-            LightSelect::Tree(t) => t.pdf(p, n, trans, k),
+            LightSelect::Tree(t) => t.pdf(v, k),
             LightSelect::Flat(d) => d.pdf(k),
         }
     }
@@ -1166,19 +1375,42 @@ mod tests {
         let t = LightTree::build(local, vec![sun], vec![mesh]);
         let mut picks: Vec<Pick> = (0..14).map(Pick::Lamp).collect();
         picks.extend((100..120).map(Pick::Triangle));
-        for (p, n, trans) in [
-            ([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], false),
-            ([1.0, 0.5, 2.5], normalize([0.2, -0.5, 0.4]), true),
-            ([-1.0, -1.0, 1.0], [0.0, 1.0, 0.0], false),
+        // Shading points, and volume segments (Cycles' in_volume_segment selection).
+        for v in [
+            Viewer::Point {
+                p: [0.0, 0.0, 0.0],
+                n: [0.0, 0.0, 1.0],
+                trans: false,
+            },
+            Viewer::Point {
+                p: [1.0, 0.5, 2.5],
+                n: normalize([0.2, -0.5, 0.4]),
+                trans: true,
+            },
+            Viewer::Point {
+                p: [-1.0, -1.0, 1.0],
+                n: [0.0, 1.0, 0.0],
+                trans: false,
+            },
+            Viewer::Segment {
+                p: [-3.0, -2.0, 1.0],
+                d: normalize([1.0, 0.6, 0.3]),
+                t: 7.0,
+            },
+            Viewer::Segment {
+                p: [0.5, 0.5, 4.0],
+                d: [0.0, 0.0, -1.0],
+                t: f32::INFINITY,
+            },
         ] {
-            let sum: f32 = picks.iter().map(|&k| t.pdf(p, n, trans, k)).sum();
+            let sum: f32 = picks.iter().map(|&k| t.pdf(v, k)).sum();
             assert!((sum - 1.0).abs() < 1e-4, "pdfs sum to {sum}");
             let draws = 200_000;
             let mut counts = std::collections::HashMap::new();
             for i in 0..draws {
                 let u = (i as f32 + 0.5) / draws as f32;
-                let (k, pr) = t.select(p, n, trans, u).expect("something is picked");
-                let want = t.pdf(p, n, trans, k);
+                let (k, pr) = t.select(v, u).expect("something is picked");
+                let want = t.pdf(v, k);
                 assert!(
                     (pr - want).abs() <= 1e-4 * want.max(1e-3),
                     "{k:?}: select says {pr}, pdf {want}"
@@ -1187,10 +1419,10 @@ mod tests {
             }
             for &k in &picks {
                 let got = *counts.get(&k).unwrap_or(&0) as f32 / draws as f32;
-                let want = t.pdf(p, n, trans, k);
+                let want = t.pdf(v, k);
                 assert!(
                     (got - want).abs() < 0.003 + 0.02 * want,
-                    "{k:?} at {p:?}: picked {got}, pdf {want}"
+                    "{k:?} for {v:?}: picked {got}, pdf {want}"
                 );
             }
         }
@@ -1224,13 +1456,12 @@ mod tests {
         picks.extend((0..6u32).flat_map(|m| (0..4u32).map(move |i| Pick::Triangle(10 * m + i))));
         for p in [[0.0f32, 0.0, 0.0], [2.0, 1.0, 0.5]] {
             let n = [0.0, 0.0, 1.0];
-            let sum: f32 = picks.iter().map(|&k| t.pdf(p, n, false, k)).sum();
+            let v = Viewer::Point { p, n, trans: false };
+            let sum: f32 = picks.iter().map(|&k| t.pdf(v, k)).sum();
             assert!((sum - 1.0).abs() < 1e-4, "pdfs sum to {sum}");
             for i in 0..2000 {
-                let (k, pr) = t
-                    .select(p, n, false, (i as f32 + 0.5) / 2000.0)
-                    .expect("a pick");
-                let want = t.pdf(p, n, false, k);
+                let (k, pr) = t.select(v, (i as f32 + 0.5) / 2000.0).expect("a pick");
+                let want = t.pdf(v, k);
                 assert!(
                     (pr - want).abs() <= 1e-4 * want.max(1e-3),
                     "{k:?}: select says {pr}, pdf {want}"
