@@ -861,9 +861,10 @@ impl Scene<'_> {
         } else {
             self.volume_light_ahead(path, tmax - tmin, u_light)
         };
-        let equiangular = ahead
-            .and_then(|a| a.toward)
-            .and_then(|p| Equiangular::new(path.o, path.d, p, tmin, tmax));
+        let equiangular = ahead.and_then(|a| {
+            let (t0, t1) = self.lit_range(a.pick, path.o, path.d, tmin, tmax)?;
+            Equiangular::new(path.o, path.d, a.toward?, t0, t1)
+        });
         let mut method = match equiangular {
             Some(_) => self.volumes.sample_method(&stack),
             None => Method::Distance,
@@ -1046,6 +1047,43 @@ impl Scene<'_> {
         };
         self.volume_bounce(path, p, wi, pdf, segment, scratch);
         Segment::Scattered
+    }
+
+    /// The part of the ray `o + t d`, t in [`tmin`, `tmax`], on the side light `pick`
+    /// emits to (Cycles' volume_equiangular_valid_ray_segment, less its narrowing to a
+    /// spot's cone or an area light's spread): the whole range for points and spots, in
+    /// front of an area light, on the sampled side of a one-sided emissive triangle. None
+    /// when nothing of it is lit (distance sampling then).
+    fn lit_range(&self, pick: Pick, o: V3, d: V3, tmin: f32, tmax: f32) -> Option<(f32, f32)> {
+        let (on_plane, n) = match pick {
+            Pick::Lamp(li) => {
+                let light = &self.lights[li as usize];
+                match light.shape {
+                    super::light::Shape::Area { .. } => (light.pos, light.dir),
+                    _ => return Some((tmin, tmax)),
+                }
+            }
+            Pick::Triangle(tri) => {
+                let v = &self.geo.tris[tri as usize];
+                let n = cross(sub(v[1], v[0]), sub(v[2], v[0]));
+                match self.emission_sides(tri) {
+                    (true, false) => (v[0], n),
+                    (false, true) => (v[0], neg(n)),
+                    _ => return Some((tmin, tmax)),
+                }
+            }
+            Pick::World => return Some((tmin, tmax)),
+        };
+        // Cycles' ray_plane_intersect: keep the part on the side `n` points to.
+        let dn = dot(d, n);
+        let t = -dot(sub(o, on_plane), n) / dn;
+        let (mut t0, mut t1) = (tmin, tmax);
+        if dn > 0.0 {
+            t0 = t0.max(t);
+        } else {
+            t1 = t1.min(t);
+        }
+        (t0 < t1).then_some((t0, t1))
     }
 
     /// The light a segment's direct light comes from (Cycles'
