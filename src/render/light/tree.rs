@@ -401,6 +401,28 @@ fn cos_box_angle(bmin: V3, bmax: V3, p: V3, ptc: V3) -> f32 {
     c
 }
 
+/// The corners of an area light at `pos` with full extents `eu`, `ev`, in Cycles' order.
+fn area_corners(pos: V3, eu: V3, ev: V3) -> [V3; 4] {
+    [0, 1, 2, 3].map(|i| {
+        add(
+            add(
+                scale(eu, (i & 1) as f32 - 0.5),
+                scale(ev, 0.5 * ((i & 2) as f32 - 1.0)),
+            ),
+            pos,
+        )
+    })
+}
+
+/// Seen from `p` looking along `ptc`: the smallest cosine to any of `points`, and the
+/// largest distance to one (Cycles' cos_theta_u and max distance of a polygon emitter).
+fn subtended(p: V3, ptc: V3, points: &[V3]) -> (f32, f32) {
+    points.iter().fold((f32::MAX, 0.0f32), |(c, d), &q| {
+        let (ptq, dq) = normalize_len(sub(q, p));
+        (c.min(dot(ptc, ptq)), d.max(dq))
+    })
+}
+
 /// Cycles' light_tree_cos_bound_subtended_angle: the cosine of the half-angle under
 /// which the box's bounding sphere is seen from `p` (-1 from inside it).
 fn cos_sphere_angle(bmax: V3, centroid: V3, p: V3) -> f32 {
@@ -792,20 +814,8 @@ impl LightTree {
             }
             Shape::Area { pos, eu, ev } => {
                 let (ptc, min_d) = normalize_len(sub(pos, p));
-                let mut dist = [min_d, min_d];
-                let mut cos_u = f32::MAX;
-                for i in 0..4 {
-                    let corner = add(
-                        add(
-                            scale(eu, (i & 1) as f32 - 0.5),
-                            scale(ev, 0.5 * ((i & 2) as f32 - 1.0)),
-                        ),
-                        pos,
-                    );
-                    let (ptk, dk) = normalize_len(sub(corner, p));
-                    cos_u = cos_u.min(dot(ptc, ptk));
-                    dist[0] = dist[0].max(dk);
-                }
+                let (cos_u, max_d) = subtended(p, ptc, &area_corners(pos, eu, ev));
+                let dist = [max_d.max(min_d), min_d];
                 let front = dot(cone.axis, ptc) < 0.0;
                 let above = dot(n, sub(pos, p)) + dot(n, eu).abs() + dot(n, ev).abs() > 0.0;
                 (front && above, ptc, cos_u, dist)
@@ -900,27 +910,14 @@ impl LightTree {
             Shape::Area { pos, eu, ev } => {
                 let (pc, _, theta_d) = segment_view(p, d, t, pos);
                 let (ptc, min_d) = normalize_len(sub(pos, pc));
-                let mut cos_u = f32::MAX;
-                for i in 0..4 {
-                    let corner = add(
-                        add(
-                            scale(eu, (i & 1) as f32 - 0.5),
-                            scale(ev, 0.5 * ((i & 2) as f32 - 1.0)),
-                        ),
-                        pos,
-                    );
-                    cos_u = cos_u.min(dot(ptc, normalize_len(sub(corner, pc)).0));
-                }
+                let (cos_u, _) = subtended(pc, ptc, &area_corners(pos, eu, ev));
                 (pos, cos_u, [min_d, min_d], theta_d)
             }
             Shape::Triangle { v } => {
                 let centroid = e.centroid;
                 let (pc, _, theta_d) = segment_view(p, d, t, centroid);
                 let (ptc, min_d) = normalize_len(sub(centroid, pc));
-                let mut cos_u = f32::MAX;
-                for c in v {
-                    cos_u = cos_u.min(dot(ptc, normalize_len(sub(c, pc)).0));
-                }
+                let (cos_u, _) = subtended(pc, ptc, &v);
                 (centroid, cos_u, [min_d, min_d], theta_d)
             }
         };
