@@ -383,24 +383,6 @@ fn importance(
     (max_imp, min_imp)
 }
 
-/// Cycles' light_tree_cos_bounding_box_angle: the cosine of the half-angle under which a
-/// box is seen from `p` (-1 from inside it).
-fn cos_box_angle(bmin: V3, bmax: V3, p: V3, ptc: V3) -> f32 {
-    if (0..3).all(|k| p[k] > bmin[k] && p[k] < bmax[k]) {
-        return -1.0;
-    }
-    let mut c = 1.0f32;
-    for i in 0..8 {
-        let corner = [
-            if i & 1 != 0 { bmax[0] } else { bmin[0] },
-            if i & 2 != 0 { bmax[1] } else { bmin[1] },
-            if i & 4 != 0 { bmax[2] } else { bmin[2] },
-        ];
-        c = c.min(dot(ptc, normalize(sub(corner, p))));
-    }
-    c
-}
-
 /// The corners of an area light at `pos` with full extents `eu`, `ev`, in Cycles' order.
 fn area_corners(pos: V3, eu: V3, ev: V3) -> [V3; 4] {
     [0, 1, 2, 3].map(|i| {
@@ -751,7 +733,7 @@ impl LightTree {
                 return (0.0, 0.0);
             }
             let (ptc, d) = normalize_len(sub(centroid, p));
-            let cos_u = cos_box_angle(m.bmin, m.bmax, p, ptc);
+            let cos_u = cos_sphere_angle(m.bmax, centroid, p);
             (ptc, cos_u, (0.5 * len(sub(centroid, m.bmax))).max(d))
         };
         importance(
