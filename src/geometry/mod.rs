@@ -24,7 +24,6 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod animated;
-pub mod array_modifier;
 pub mod attribute;
 pub mod catmull_clark;
 pub mod cdt;
@@ -41,6 +40,7 @@ pub mod limits;
 pub mod math;
 pub mod mesh;
 pub mod mesh_sample;
+pub mod modifiers;
 pub mod nearest;
 pub mod nodes;
 pub mod pointcloud;
