@@ -25,6 +25,7 @@
 
 pub mod animated;
 pub mod attribute;
+pub mod beautify;
 pub mod catmull_clark;
 pub mod cdt;
 pub mod curve_eval;

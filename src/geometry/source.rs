@@ -24,7 +24,16 @@ pub const NO_GEOMETRY: &[&str] = &[
 
 /// Modifiers blendsynth evaluates itself (`eval::Session::evaluate_stack`); those with
 /// a module in `geometry::modifiers` only with the options it evaluates.
-pub const NATIVE_MODIFIERS: &[&str] = &["NODES", "SUBSURF", "ARRAY", "MIRROR"];
+pub const NATIVE_MODIFIERS: &[&str] = &[
+    "NODES",
+    "SUBSURF",
+    "ARRAY",
+    "MIRROR",
+    "TRIANGULATE",
+    "SMOOTH",
+    "WELD",
+    "DISPLACE",
+];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Source {

@@ -9,12 +9,23 @@ use super::math::Mat4f;
 use super::set::GeometrySet;
 
 pub mod array;
+pub mod displace;
 pub mod mirror;
+pub mod smooth;
+pub mod triangulate;
+pub mod weld;
 
 pub type Props = Map<String, Json>;
 
 /// Modifier types (`Modifier.kind`) with a module here.
-pub const KINDS: &[&str] = &["ARRAY", "MIRROR"];
+pub const KINDS: &[&str] = &[
+    "ARRAY",
+    "MIRROR",
+    "TRIANGULATE",
+    "SMOOTH",
+    "WELD",
+    "DISPLACE",
+];
 
 /// What a modifier may read besides its mesh: the object's name and objects' world
 /// matrices (offset and mirror objects).
@@ -29,6 +40,10 @@ pub fn unsupported(kind: &str, p: &Props) -> Option<String> {
     match kind {
         "ARRAY" => array::unsupported(p),
         "MIRROR" => mirror::unsupported(p),
+        "TRIANGULATE" => triangulate::unsupported(p),
+        "SMOOTH" => smooth::unsupported(p),
+        "WELD" => weld::unsupported(p),
+        "DISPLACE" => displace::unsupported(p),
         _ => Some("not evaluated by blendsynth".into()),
     }
 }
@@ -41,6 +56,10 @@ pub fn apply(kind: &str, p: &Props, ctx: &Context, g: GeometrySet) -> Result<Geo
     match kind {
         "ARRAY" => array::apply(p, ctx.object, ctx.world, g),
         "MIRROR" => mirror::apply(p, ctx, g),
+        "TRIANGULATE" => triangulate::apply(p, g),
+        "SMOOTH" => smooth::apply(p, g),
+        "WELD" => weld::apply(p, g),
+        "DISPLACE" => displace::apply(p, ctx, g),
         _ => unreachable!("unsupported() refuses other kinds"),
     }
 }
