@@ -33,6 +33,7 @@ pub const NATIVE_MODIFIERS: &[&str] = &[
     "SMOOTH",
     "WELD",
     "DISPLACE",
+    "SOLIDIFY",
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -12,6 +12,7 @@ pub mod array;
 pub mod displace;
 pub mod mirror;
 pub mod smooth;
+pub mod solidify;
 pub mod triangulate;
 pub mod weld;
 
@@ -25,6 +26,7 @@ pub const KINDS: &[&str] = &[
     "SMOOTH",
     "WELD",
     "DISPLACE",
+    "SOLIDIFY",
 ];
 
 /// What a modifier may read besides its mesh: the object's name and objects' world
@@ -44,6 +46,7 @@ pub fn unsupported(kind: &str, p: &Props) -> Option<String> {
         "SMOOTH" => smooth::unsupported(p),
         "WELD" => weld::unsupported(p),
         "DISPLACE" => displace::unsupported(p),
+        "SOLIDIFY" => solidify::unsupported(p),
         _ => Some("not evaluated by blendsynth".into()),
     }
 }
@@ -60,6 +63,7 @@ pub fn apply(kind: &str, p: &Props, ctx: &Context, g: GeometrySet) -> Result<Geo
         "SMOOTH" => smooth::apply(p, g),
         "WELD" => weld::apply(p, g),
         "DISPLACE" => displace::apply(p, ctx, g),
+        "SOLIDIFY" => solidify::apply(p, g),
         _ => unreachable!("unsupported() refuses other kinds"),
     }
 }
