@@ -608,3 +608,117 @@ fn modifier_overrides_evaluate_or_are_refused_by_name() {
         "{why}"
     );
 }
+
+/// Every option a native modifier does not evaluate is named (in the words `inspect` and
+/// `render` print), starting from each fixture case's own settings, which are evaluated.
+#[test]
+fn unevaluated_modifier_options_are_named() {
+    use serde_json::json;
+    let cases: &[(&str, &str, &str, serde_json::Value, &str)] = &[
+        (
+            "mirror",
+            "mirror_x",
+            "use_bisect_axis",
+            json!([true, false, false]),
+            "Bisect X",
+        ),
+        (
+            "triangulate",
+            "tri_beauty",
+            "keep_custom_normals",
+            json!(true),
+            "Keep Normals",
+        ),
+        (
+            "deform",
+            "smooth_default",
+            "vertex_group",
+            json!("Group"),
+            "Vertex Group \"Group\"",
+        ),
+        (
+            "deform",
+            "weld_connected",
+            "loose_edges",
+            json!(true),
+            "Only Loose Edges",
+        ),
+        (
+            "deform",
+            "weld_all",
+            "vertex_group",
+            json!("Group"),
+            "Vertex Group \"Group\"",
+        ),
+        (
+            "deform",
+            "displace_normal",
+            "direction",
+            json!("CUSTOM_NORMAL"),
+            "Custom Normal",
+        ),
+        (
+            "deform",
+            "displace_normal",
+            "texture",
+            json!({"name": "Tex"}),
+            "Texture \"Tex\"",
+        ),
+        (
+            "solidify",
+            "solid_thick",
+            "solidify_mode",
+            json!("NON_MANIFOLD"),
+            "Complex",
+        ),
+        (
+            "solidify",
+            "solid_thick",
+            "use_quality_normals",
+            json!(true),
+            "High Quality Normals",
+        ),
+        (
+            "solidify",
+            "solid_thick",
+            "thickness_clamp",
+            json!(0.5),
+            "Clamp",
+        ),
+        (
+            "solidify",
+            "solid_thick",
+            "material_offset",
+            json!(1),
+            "Material Offset",
+        ),
+        (
+            "solidify",
+            "solid_thick",
+            "edge_crease_rim",
+            json!(0.3),
+            "Crease Rim",
+        ),
+        (
+            "array",
+            "array_relative",
+            "use_merge_vertices",
+            json!(true),
+            "Merge",
+        ),
+    ];
+    for (scene, object, key, value, want) in cases {
+        let s = load(scene);
+        let m = &s.object(object).expect("case object").modifiers[0];
+        assert_eq!(
+            geometry::modifiers::unsupported(&m.kind, &m.properties),
+            None,
+            "{object}: the fixture's own settings are evaluated"
+        );
+        let mut p = m.properties.clone();
+        p.insert(key.to_string(), value.clone());
+        let why = geometry::modifiers::unsupported(&m.kind, &p)
+            .unwrap_or_else(|| panic!("{object}: {key}={value} should keep it frozen"));
+        assert!(why.contains(want), "{object}: {key}: {why}");
+    }
+}
