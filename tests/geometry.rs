@@ -693,13 +693,6 @@ fn unevaluated_modifier_options_are_named() {
             "Material Offset",
         ),
         (
-            "solidify",
-            "solid_thick",
-            "edge_crease_rim",
-            json!(0.3),
-            "Crease Rim",
-        ),
-        (
             "array",
             "array_relative",
             "use_merge_vertices",

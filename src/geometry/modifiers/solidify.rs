@@ -5,13 +5,16 @@
 //! edges with quads (Only Rim drops the copy's faces). Flip swaps which layer moves by
 //! which part. Element order is Blender's: originals, copies, rim edges, rim faces.
 //!
-//! Not evaluated (named by `unsupported`): Complex mode, High Quality Normals, thickness
-//! clamping, convex bevel weights, material offsets, creases and vertex groups.
+//! The rim's creases (inner, outer, rim edges) go to `crease_edge` as in Blender, for a
+//! Subdivision Surface after it. Not evaluated (named by `unsupported`): Complex mode,
+//! High Quality Normals, thickness clamping, convex bevel weights, material offsets and
+//! vertex groups.
 
+use super::super::attribute::AttrId;
 use super::super::math::{dot, normalize_v3, sub, V3};
 use super::super::mesh::Mesh;
 use super::super::set::GeometrySet;
-use super::super::types::Domain;
+use super::super::types::{Array, Domain};
 use super::{flag, float, text, Props};
 
 pub fn unsupported(p: &Props) -> Option<String> {
@@ -32,9 +35,6 @@ pub fn unsupported(p: &Props) -> Option<String> {
     for (k, name) in [
         ("thickness_clamp", "Clamp"),
         ("bevel_convex", "Bevel Convex"),
-        ("edge_crease_inner", "Crease Inner"),
-        ("edge_crease_outer", "Crease Outer"),
-        ("edge_crease_rim", "Crease Rim"),
     ] {
         if p.get(k).and_then(|v| v.as_f64()).unwrap_or(0.0) != 0.0 {
             out.push(format!("{name} ({k})"));
@@ -98,6 +98,11 @@ pub fn apply(p: &Props, mut g: GeometrySet) -> Result<GeometrySet, String> {
         even: flag(p, "use_even_offset"),
         rim: flag(p, "use_rim"),
         shell: !(flag(p, "use_rim") && flag(p, "use_rim_only")),
+        crease: [
+            float(p, "edge_crease_inner").unwrap_or(0.0),
+            float(p, "edge_crease_outer").unwrap_or(0.0),
+            float(p, "edge_crease_rim").unwrap_or(0.0),
+        ],
     };
     let opts = Opts {
         ofs_new: offset + opts.ofs_orig,
@@ -114,6 +119,8 @@ struct Opts {
     even: bool,
     rim: bool,
     shell: bool,
+    /// Inner, outer and rim edge creases.
+    crease: [f32; 3],
 }
 
 // Long because it follows Blender's function step by step.
@@ -340,6 +347,31 @@ fn solidify(m: &Mesh, o: &Opts) -> Mesh {
             _ => continue,
         };
         out.attributes.set(a.id.clone(), a.domain, data);
+    }
+    if o.rim && o.crease.iter().any(|&c| c != 0.0) {
+        let id = AttrId::named("crease_edge");
+        let mut crease = match out.attributes.get(&id) {
+            Some(a) if a.domain == Domain::Edge => a.data.as_float().into_owned(),
+            _ => vec![0.0; out.edges.len()],
+        };
+        let [inner, outer, rim] = o.crease;
+        let edge_base = ne * if o.shell { 2 } else { 1 } + new_edges;
+        if rim != 0.0 {
+            for c in &mut crease[edge_base..edge_base + rim_verts.len()] {
+                *c = rim;
+            }
+        }
+        for (i, &e) in rim_edges.iter().enumerate() {
+            // Added without wrapping: capped at 1, not clamped below.
+            if outer != 0.0 {
+                crease[e] = (crease[e] + outer).min(1.0);
+            }
+            if inner != 0.0 {
+                let k = ne + if o.shell { e } else { i };
+                crease[k] = (crease[k] + inner).min(1.0);
+            }
+        }
+        out.attributes.set(id, Domain::Edge, Array::Float(crease));
     }
     out
 }
