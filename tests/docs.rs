@@ -34,7 +34,8 @@ fn features_page() -> String {
         list(blendsynth::geometry::source::NO_GEOMETRY)
     ));
     o.push_str(&format!(
-        "- modifiers evaluated by blendsynth: {}\n",
+        "- modifiers evaluated by blendsynth (an option one does not evaluate keeps the \
+         object frozen, named by `inspect`; see coverage.md): {}\n",
         list(blendsynth::geometry::source::NATIVE_MODIFIERS)
     ));
     o.push_str(

@@ -17,6 +17,8 @@ const MAX_MEAN_REL: f64 = 0.01;
 
 /// Scenes that must pass.
 const ASSERTED: &[&str] = &[
+    // A Solidify modifier evaluated natively: shell, rim and even-thickness normals.
+    "solidify",
     "adaptive",
     "motion_blur",
     "motion_blur_start",

@@ -164,14 +164,18 @@ impl<'s> Session<'s> {
                     .map_err(|e| GeometryError::new(format!("{here}: {e}")))?;
                 continue;
             }
-            if m.kind == "ARRAY" {
+            if super::modifiers::KINDS.contains(&m.kind.as_str()) {
                 let world = |n: &str| self.world_matrix(n);
-                g = super::array_modifier::apply(&m.properties, &o.name, &world, g)
+                let ctx = super::modifiers::Context {
+                    object: &o.name,
+                    world: &world,
+                };
+                g = super::modifiers::apply(&m.kind, &m.properties, &ctx, g)
                     .map_err(|e| GeometryError::new(format!("{here}: {e}")))?;
                 continue;
             }
             if m.kind != "NODES" {
-                return Err(GeometryError::new(format!("{here}: {} modifiers are not supported (only Geometry Nodes, Subdivision Surface and Array)", m.kind)));
+                return Err(GeometryError::new(format!("{here}: {} modifiers are not supported (only Geometry Nodes, Subdivision Surface and {})", m.kind, super::modifiers::KINDS.join(", "))));
             }
             g = self
                 .evaluate_modifier(o, m, g)

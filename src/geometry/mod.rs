@@ -24,8 +24,8 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod animated;
-pub mod array_modifier;
 pub mod attribute;
+pub mod beautify;
 pub mod catmull_clark;
 pub mod cdt;
 pub mod curve_eval;
@@ -41,6 +41,7 @@ pub mod limits;
 pub mod math;
 pub mod mesh;
 pub mod mesh_sample;
+pub mod modifiers;
 pub mod nearest;
 pub mod nodes;
 pub mod pointcloud;

@@ -22,8 +22,19 @@ pub const NO_GEOMETRY: &[&str] = &[
     "GREASEPENCIL",
 ];
 
-/// Modifiers blendsynth evaluates itself (`eval::Session::evaluate_stack`).
-pub const NATIVE_MODIFIERS: &[&str] = &["NODES", "SUBSURF"];
+/// Modifiers blendsynth evaluates itself (`eval::Session::evaluate_stack`); those with
+/// a module in `geometry::modifiers` only with the options it evaluates.
+pub const NATIVE_MODIFIERS: &[&str] = &[
+    "NODES",
+    "SUBSURF",
+    "ARRAY",
+    "MIRROR",
+    "TRIANGULATE",
+    "SMOOTH",
+    "WELD",
+    "DISPLACE",
+    "SOLIDIFY",
+];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Source {
@@ -39,11 +50,12 @@ pub enum Source {
 }
 
 /// Why an object needs Blender's evaluated mesh, or None when blendsynth builds it.
-/// Whether blendsynth evaluates this modifier itself (an Array modifier only with the
-/// options `array_modifier` evaluates).
+/// Whether blendsynth evaluates this modifier itself (one of `modifiers::KINDS` only
+/// with the options its module evaluates).
 fn native(m: &crate::scene::Modifier) -> bool {
     NATIVE_MODIFIERS.contains(&m.kind.as_str())
-        || (m.kind == "ARRAY" && super::array_modifier::unsupported(&m.properties).is_none())
+        && !(super::modifiers::KINDS.contains(&m.kind.as_str())
+            && super::modifiers::unsupported(&m.kind, &m.properties).is_some())
 }
 
 pub fn frozen_reason(scene: &Scene, o: &Object) -> Option<String> {
@@ -63,14 +75,16 @@ pub fn frozen_reason(scene: &Scene, o: &Object) -> Option<String> {
             let other: Vec<String> = mods
                 .iter()
                 .filter(|m| !native(m))
-                .map(
-                    |m| match super::array_modifier::unsupported(&m.properties) {
-                        Some(why) if m.kind == "ARRAY" => {
-                            format!("{} {:?} ({why})", m.kind, m.name)
-                        }
-                        _ => format!("{} {:?}", m.kind, m.name),
-                    },
-                )
+                .map(|m| {
+                    match super::modifiers::KINDS
+                        .contains(&m.kind.as_str())
+                        .then(|| super::modifiers::unsupported(&m.kind, &m.properties))
+                        .flatten()
+                    {
+                        Some(why) => format!("{} {:?} ({why})", m.kind, m.name),
+                        None => format!("{} {:?}", m.kind, m.name),
+                    }
+                })
                 .collect();
             if !other.is_empty() {
                 why.push(format!("modifier(s) {}", other.join(", ")));

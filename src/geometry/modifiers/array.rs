@@ -4,41 +4,12 @@
 //! UV offsets. Merge, caps and Fit Curve are not evaluated: `unsupported` names them and
 //! the object stays frozen (Blender's evaluated mesh) while they are on.
 
-use serde_json::{Map, Value as Json};
+use serde_json::Value as Json;
 
-use super::math::{mat4_invert, mat4_mul, transform_point, Mat4f, MAT4_IDENTITY};
-use super::set::GeometrySet;
-use super::types::{Array, Domain};
-
-type Props = Map<String, Json>;
-
-fn flag(p: &Props, k: &str) -> bool {
-    p.get(k).and_then(Json::as_bool).unwrap_or(false)
-}
-
-fn vec3(p: &Props, k: &str) -> Result<[f32; 3], String> {
-    let a = p
-        .get(k)
-        .and_then(Json::as_array)
-        .ok_or_else(|| format!("property {k:?} missing"))?;
-    let f = |i: usize| a.get(i).and_then(Json::as_f64).unwrap_or(0.0) as f32;
-    Ok([f(0), f(1), f(2)])
-}
-
-fn float(p: &Props, k: &str) -> Result<f32, String> {
-    p.get(k)
-        .and_then(Json::as_f64)
-        .map(|v| v as f32)
-        .ok_or_else(|| format!("property {k:?} missing"))
-}
-
-fn set_obj(p: &Props, k: &str) -> Option<String> {
-    match p.get(k)? {
-        Json::Object(o) => o.get("name").and_then(Json::as_str).map(str::to_string),
-        Json::String(s) => Some(s.clone()),
-        _ => None,
-    }
-}
+use super::super::math::{mat4_invert, mat4_mul, transform_point, Mat4f, MAT4_IDENTITY};
+use super::super::set::GeometrySet;
+use super::super::types::{Array, Domain};
+use super::{flag, float, id_name as set_obj, vec3, Props};
 
 /// The options of an Array modifier blendsynth does not evaluate, by name (None: all of
 /// its settings are evaluated).
