@@ -715,3 +715,29 @@ fn unevaluated_modifier_options_are_named() {
         assert!(why.contains(want), "{object}: {key}: {why}");
     }
 }
+
+/// A Subdivision Surface after a Solidify rim keeps the object frozen and is named:
+/// blendsynth's subdivision of the rim is not Blender's yet (make_gn_refs.py,
+/// scene_solidify); without a rim the same stack is evaluated natively.
+#[test]
+fn subdivision_after_a_solidify_rim_is_frozen_by_name() {
+    let s = load("solidify");
+    for (object, frozen) in [("solid_rim_only", true), ("solid_no_rim", false)] {
+        let mut o = s.object(object).expect("case object").clone();
+        let mut sub = o.modifiers[0].clone();
+        sub.name = "Subdivision".into();
+        sub.kind = "SUBSURF".into();
+        sub.properties = Default::default();
+        o.modifiers.push(sub);
+        let why = geometry::source::frozen_reason(&s, &o);
+        if frozen {
+            let why = why.unwrap_or_else(|| panic!("{object}: a subdivided rim should be frozen"));
+            assert!(
+                why.contains("SUBSURF \"Subdivision\" after the rim of SOLIDIFY"),
+                "{object}: {why}"
+            );
+        } else {
+            assert_eq!(why, None, "{object}: no rim, evaluated natively");
+        }
+    }
+}

@@ -89,6 +89,19 @@ pub fn frozen_reason(scene: &Scene, o: &Object) -> Option<String> {
             if !other.is_empty() {
                 why.push(format!("modifier(s) {}", other.join(", ")));
             }
+            // blendsynth's Catmull-Clark does not yet give Blender's mesh on a Solidify
+            // rim (the rim's degenerate UV quads, its creases on meshes with loose
+            // parts): such a stack keeps Blender's mesh.
+            let rim = mods.iter().position(|m| {
+                m.kind == "SOLIDIFY" && super::modifiers::solidify::fills_rim(&m.properties)
+            });
+            if let Some(sub) = rim.and_then(|r| mods[r..].iter().find(|m| m.kind == "SUBSURF")) {
+                why.push(format!(
+                    "SUBSURF {:?} after the rim of SOLIDIFY {:?} (not evaluated natively yet)",
+                    sub.name,
+                    mods[rim.unwrap_or(0)].name
+                ));
+            }
             let shape_keys = o
                 .data
                 .as_deref()

@@ -85,6 +85,12 @@ fn shell_dist(a: V3, b: V3) -> f32 {
     }
 }
 
+/// Whether the modifier fills a rim (Fill Rim, or Only Rim): a Subdivision Surface after
+/// such a rim is not evaluated natively (see `source::frozen_reason`).
+pub fn fills_rim(p: &Props) -> bool {
+    flag(p, "use_rim")
+}
+
 pub fn apply(p: &Props, mut g: GeometrySet) -> Result<GeometrySet, String> {
     let Some(m) = g.mesh.clone() else {
         return Ok(g);
