@@ -56,6 +56,10 @@ const ASSERTED: &[&str] = &[
     "principled_aniso",
     // Metallic BSDF (render/bsdf/metallic.rs), F82 Tint: Multiscatter GGX and anisotropic GGX.
     "metallic_bsdf",
+    // Multiscatter GGX at roughness 1 on closures whose Fresnel is below one (a black
+    // Principled, a coloured Glossy, a tinted Principled metal): the compensation is
+    // darkened by the average Fresnel (Cycles' Fms).
+    "multiscatter_fresnel",
     // Metallic BSDF, Physical Conductor (complex IOR) with Multiscatter GGX and Beckmann,
     // F82 Tint with Beckmann.
     "metallic_conductor",
