@@ -60,6 +60,9 @@ const ASSERTED: &[&str] = &[
     // Principled, a coloured Glossy, a tinted Principled metal): the compensation is
     // darkened by the average Fresnel (Cycles' Fms).
     "multiscatter_fresnel",
+    // Mesh attributes inside Bump heights (Attribute, Color Attribute, a named UV Map),
+    // read at the offset points moved along the triangle (shader/bump.rs offset_point).
+    "bump_attribute",
     // Metallic BSDF, Physical Conductor (complex IOR) with Multiscatter GGX and Beckmann,
     // F82 Tint with Beckmann.
     "metallic_conductor",

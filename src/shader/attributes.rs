@@ -42,6 +42,15 @@ enum FacMode {
     Average,
 }
 
+impl FacMode {
+    fn of(self, v: [f32; 4]) -> f32 {
+        match self {
+            FacMode::X => v[0],
+            FacMode::Average => (v[0] + v[1] + v[2]) * (1.0 / 3.0),
+        }
+    }
+}
+
 #[derive(Debug, Clone)]
 enum Values {
     Missing,
@@ -268,10 +277,39 @@ impl BoundAttributes {
                 }
             };
             sp.attrs[i] = v;
-            sp.attr_fac[i] = match b.fac {
-                FacMode::X => v[0],
-                FacMode::Average => (v[0] + v[1] + v[2]) * (1.0 / 3.0),
+            sp.attr_fac[i] = b.fac.of(v);
+        }
+    }
+
+    /// Writes the attributes' differentials into `sp.attrs_d` / `sp.attr_fac_d` for the
+    /// hit's barycentric differentials `d` ([du, dv] along x and along y, as
+    /// `bump::differential_dudv` gives them), for a Bump's offset points. Per-face values
+    /// and normals do not change across the triangle.
+    pub fn fill_differentials(
+        &self,
+        mesh: &MeshData,
+        tri: usize,
+        c: [usize; 3],
+        d: [[f32; 2]; 2],
+        sp: &mut ShadingPoint,
+    ) {
+        for (i, b) in self.items.iter().enumerate() {
+            let corners = match &b.values {
+                Values::Point(p) => Some(c.map(|c| p[mesh.corner_verts[c] as usize])),
+                Values::Corner(p) => Some(c.map(|c| p[c])),
+                Values::TriangleCorner(p) => Some([p[3 * tri], p[3 * tri + 1], p[3 * tri + 2]]),
+                Values::Missing | Values::Face(_) | Values::MapNormal { .. } => None,
             };
+            for (k, dk) in d.iter().enumerate() {
+                let dv: [f32; 4] = match corners {
+                    Some(v) => std::array::from_fn(|j| {
+                        (v[1][j] - v[0][j]) * dk[0] + (v[2][j] - v[0][j]) * dk[1]
+                    }),
+                    None => [0.0; 4],
+                };
+                sp.attrs_d[i][k] = dv;
+                sp.attr_fac_d[i][k] = b.fac.of(dv);
+            }
         }
     }
 }

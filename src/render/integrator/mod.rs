@@ -1052,6 +1052,11 @@ impl Scene<'_> {
             sp.uv_dx = attribute_differential(t, d[0]);
             sp.uv_dy = attribute_differential(t, d[1]);
         }
+        let face = m.triangle_faces[r.tri as usize] as usize;
+        let slot = inst.face_slot.get(face).copied().unwrap_or(0) as usize;
+        if let Some(Some(bound)) = inst.attributes.get(slot) {
+            bound.fill_differentials(m, r.tri as usize, c, d, sp);
+        }
     }
 }
 
