@@ -63,6 +63,9 @@ const ASSERTED: &[&str] = &[
     // Mesh attributes inside Bump heights (Attribute, Color Attribute, a named UV Map),
     // read at the offset points moved along the triangle (shader/bump.rs offset_point).
     "bump_attribute",
+    // Attribute nodes of type Instancer: Geometry Nodes instance attributes, an object's
+    // custom property, an RNA path (the object colour), a name found nowhere (zero).
+    "instancer_attribute",
     // Metallic BSDF, Physical Conductor (complex IOR) with Multiscatter GGX and Beckmann,
     // F82 Tint with Beckmann.
     "metallic_conductor",

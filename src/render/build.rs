@@ -43,6 +43,11 @@ pub struct MeshInstance {
     /// Per slot: the attributes its material reads, bound to this mesh (`bind_attributes`);
     /// empty until then and for materials that read none.
     pub attributes: Vec<Option<Arc<BoundAttributes>>>,
+    /// What an Instancer Attribute node reads on this instance, per name the file's
+    /// nodes ask for (Blender's BKE_object_dupli_find_rgba_attribute): the Geometry
+    /// Nodes instance attribute, else the object's then its data's custom property or
+    /// RNA path, else zero.
+    pub instancer_values: Vec<(String, [f32; 4])>,
     /// The rays that see the instance, as `accel::visibility` bits (its object's Cycles
     /// ray visibility).
     pub visibility: u32,
@@ -286,6 +291,7 @@ pub fn build(
                             default_color: base.default_color.clone(),
                             texspace: None,
                         };
+                        let before = instances.len();
                         push_instance(
                             &mut instances,
                             scene,
@@ -296,6 +302,16 @@ pub fn build(
                             world,
                             Some(i as u32),
                         )?;
+                        if instances.len() > before {
+                            let pushed = instances.last_mut().expect("pushed");
+                            for (name, value) in &mut pushed.instancer_values {
+                                if let Some(v) = inst.attributes.named(name).and_then(|a| {
+                                    crate::geometry::instances::instance_rgba(&a.data, i)
+                                }) {
+                                    *value = v;
+                                }
+                            }
+                        }
                     }
                 }
             }
@@ -478,6 +494,11 @@ fn push_instance(
         uv_name,
         default_color: info.default_color.clone(),
         attributes: Vec::new(),
+        instancer_values: obj
+            .attribute_lookups
+            .iter()
+            .map(|(n, l)| (n.clone(), l.object.or(l.data).unwrap_or([0.0; 4])))
+            .collect(),
         visibility: object_visibility(obj),
         holdout: obj.is_holdout,
         shadow_terminator: obj.shadow_terminator_geometry_offset,

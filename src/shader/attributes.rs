@@ -32,6 +32,9 @@ pub enum AttributeRequest {
     /// Cycles' Random Per Island (Geometry node, or an Attribute named
     /// "random_per_island"): per face, see `derived::random_per_island`.
     RandomPerIsland,
+    /// An Attribute node of type Instancer: one value per rendered instance (see
+    /// `render::build::MeshInstance::instancer_values`), by name.
+    Instancer(String),
 }
 
 /// How the Attribute node's Fac reads a value (Cycles: float2 gives x, wider types the
@@ -65,6 +68,8 @@ enum Values {
         normals: Vec<Vec3>,
         flat: Vec<bool>,
     },
+    /// The instance's value of this name (constant over the mesh).
+    Instancer(String),
 }
 
 #[derive(Debug, Clone)]
@@ -172,6 +177,10 @@ impl BoundAttributes {
             };
             items.push(match r {
                 AttributeRequest::Named(name) => named(name)?,
+                AttributeRequest::Instancer(name) => Bound {
+                    values: Values::Instancer(name.clone()),
+                    fac: FacMode::Average,
+                },
                 AttributeRequest::DefaultColor => match default_color {
                     Some(name) => named(name)?,
                     None => Bound {
@@ -236,7 +245,9 @@ impl BoundAttributes {
     }
 
     /// Writes the attribute values at a point of triangle `tri` (Blender corners `c`, face
-    /// `face`, barycentric weights `w` of its corners) into `sp`.
+    /// `face`, barycentric weights `w` of its corners) into `sp`; Instancer attributes
+    /// from the instance's `instancer` values.
+    #[allow(clippy::too_many_arguments)]
     pub fn fill(
         &self,
         mesh: &MeshData,
@@ -244,6 +255,7 @@ impl BoundAttributes {
         c: [usize; 3],
         face: usize,
         w: [f32; 3],
+        instancer: &[(String, [f32; 4])],
         sp: &mut ShadingPoint,
     ) {
         sp.attr_missing = 0;
@@ -260,6 +272,11 @@ impl BoundAttributes {
                 Values::Corner(p) => lerp(c.map(|c| p[c])),
                 Values::Face(p) => p[face],
                 Values::TriangleCorner(p) => lerp([p[3 * tri], p[3 * tri + 1], p[3 * tri + 2]]),
+                Values::Instancer(name) => instancer
+                    .iter()
+                    .find(|(n, _)| n == name)
+                    .map(|(_, v)| *v)
+                    .unwrap_or([0.0; 4]),
                 Values::MapNormal { normals, flat } => {
                     if flat.get(face).copied().unwrap_or(false) {
                         let p = c.map(|c| mesh.positions[mesh.corner_verts[c] as usize]);
@@ -298,7 +315,10 @@ impl BoundAttributes {
                 Values::Point(p) => Some(c.map(|c| p[mesh.corner_verts[c] as usize])),
                 Values::Corner(p) => Some(c.map(|c| p[c])),
                 Values::TriangleCorner(p) => Some([p[3 * tri], p[3 * tri + 1], p[3 * tri + 2]]),
-                Values::Missing | Values::Face(_) | Values::MapNormal { .. } => None,
+                Values::Missing
+                | Values::Face(_)
+                | Values::MapNormal { .. }
+                | Values::Instancer(_) => None,
             };
             for (k, dk) in d.iter().enumerate() {
                 let dv: [f32; 4] = match corners {

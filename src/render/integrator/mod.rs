@@ -239,7 +239,15 @@ impl Scene<'_> {
             to_object: to_object.m,
         };
         if let Some(Some(bound)) = inst.attributes.get(slot) {
-            bound.fill(m, r.tri as usize, c, face, [w0, u, v], &mut sp);
+            bound.fill(
+                m,
+                r.tri as usize,
+                c,
+                face,
+                [w0, u, v],
+                &inst.instancer_values,
+                &mut sp,
+            );
         }
         if inst.motion.is_some() {
             // Object Info reads the object's transform at the ray's time, as in Cycles.

@@ -69,10 +69,34 @@ impl<'g, 'a> Compiler<'g, 'a> {
             return Ok(());
         }
         let kind = prop_str(n, "attribute_type")?;
-        if kind != "GEOMETRY" {
-            return Err(CompileError(format!("node {:?}: Attribute type {kind} is not supported (only Geometry: object and instancer custom properties are not exported)", n.path)));
-        }
         let name = prop_str(n, "attribute_name")?;
+        if kind == "INSTANCER" {
+            let attr = self.request(&n.path, AttributeRequest::Instancer(name.to_string()))?;
+            let (vector, fac, alpha) = (self.alloc(V), self.alloc(F), self.alloc(F));
+            self.ops.push(Op::Attribute {
+                attr,
+                vector,
+                fac,
+                alpha,
+            });
+            self.outputs(
+                i,
+                n,
+                &[
+                    ("Color", vector, C),
+                    ("Vector", vector, V),
+                    ("Fac", fac, F),
+                    ("Alpha", alpha, F),
+                ],
+            );
+            return Ok(());
+        }
+        if kind != "GEOMETRY" {
+            return Err(CompileError(format!(
+                "node {:?}: Attribute type {kind} is not supported (only Geometry and Instancer)",
+                n.path
+            )));
+        }
         let derived = match name {
             "pointiness" => Some(AttributeRequest::Pointiness),
             "random_per_island" => Some(AttributeRequest::RandomPerIsland),
