@@ -774,6 +774,44 @@ def in_view_layer(o, view_layer):
     return x is not None and (x == o or any(v == o for v in view_layer.objects))
 
 
+def attribute_lookup_names():
+    """Names read by Attribute nodes of type Object or Instancer in any node tree."""
+    names = set()
+    for t in list(bpy.data.node_groups) + [m.node_tree for m in bpy.data.materials if m.node_tree] + \
+            [w.node_tree for w in bpy.data.worlds if w.node_tree] + [l.node_tree for l in bpy.data.lights if l.node_tree]:
+        for n in t.nodes:
+            if n.bl_idname == "ShaderNodeAttribute" and n.attribute_type in {"OBJECT", "INSTANCER"} and n.attribute_name:
+                names.add(n.attribute_name)
+    return sorted(names)
+
+
+def rna_rgba(idb, name):
+    """Blender's find_rna_property_rgba: a custom property of ID IDB named NAME, else the
+    RNA path NAME on it, as RGBA (a number n as (n, n, n, 1); an array's first four
+    values, alpha 1 when it has fewer); None when neither exists or it is not numeric."""
+    if idb is None:
+        return None
+    try:
+        v = idb[name] if name in idb.keys() else idb.path_resolve(name)
+    except Exception:
+        return None
+    if isinstance(v, (bool, int, float)):
+        return [float(v)] * 3 + [1.0]
+    try:
+        items = list(v)
+    except Exception:
+        return None
+    if not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in items):
+        return None  # Blender converts float and int arrays only
+    xs = [float(x) for x in items]
+    if not 1 <= len(xs) <= 4:
+        return None
+    return (xs + [0.0, 0.0, 0.0, 1.0][len(xs):])[:4]
+
+
+ATTRIBUTE_LOOKUP_NAMES = []
+
+
 def object_entry(o, view_layer):
     w = f"objects[{q(key(o))}]"
     return {
@@ -804,6 +842,10 @@ def object_entry(o, view_layer):
         "constraints": [{"name": c.name, "type": c.type, "mute": c.mute, "influence": c.influence,
                          "properties": rna_value(c, 0, f"{w}.constraints[{q(c.name)}]")} for c in o.constraints],
         "custom_properties": custom_props(o, w),
+        # What an Attribute node of type Object / Instancer named NAME finds on the object
+        # and on its data (custom property or RNA path; null where neither has it).
+        "attribute_lookups": {n: {"object": rna_rgba(o, n), "data": rna_rgba(o.data, n)}
+                              for n in ATTRIBUTE_LOOKUP_NAMES},
         # Extra keys: Follow Path orients a child of a path by the object's own axes.
         "track_axis": o.track_axis, "up_axis": o.up_axis,
         "instance_type": o.instance_type,
@@ -1087,6 +1129,7 @@ def main():
     data = bpy.data
     scene = bpy.context.scene
     view_layer = bpy.context.view_layer
+    ATTRIBUTE_LOOKUP_NAMES[:] = attribute_lookup_names()
     if args.frame is not None and args.frames is not None:
         fail("--frame and --frames exclude each other")
     if args.frames is not None:

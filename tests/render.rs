@@ -58,6 +58,16 @@ const ASSERTED: &[&str] = &[
     "principled_aniso",
     // Metallic BSDF (render/bsdf/metallic.rs), F82 Tint: Multiscatter GGX and anisotropic GGX.
     "metallic_bsdf",
+    // Multiscatter GGX at roughness 1 on closures whose Fresnel is below one (a black
+    // Principled, a coloured Glossy, a tinted Principled metal): the compensation is
+    // darkened by the average Fresnel (Cycles' Fms).
+    "multiscatter_fresnel",
+    // Mesh attributes inside Bump heights (Attribute, Color Attribute, a named UV Map),
+    // read at the offset points moved along the triangle (shader/bump.rs offset_point).
+    "bump_attribute",
+    // Attribute nodes of type Instancer: Geometry Nodes instance attributes, an object's
+    // custom property, an RNA path (the object colour), a name found nowhere (zero).
+    "instancer_attribute",
     // Metallic BSDF, Physical Conductor (complex IOR) with Multiscatter GGX and Beckmann,
     // F82 Tint with Beckmann.
     "metallic_conductor",

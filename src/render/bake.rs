@@ -144,6 +144,12 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
     // What Cycles' EMIT bake gives the context-reading nodes: the scene camera, the object.
     let view = scene_view(scene)?.unwrap_or_default();
     let object = crate::shader::view::object_info(obj, &world);
+    // Instancer attributes of an object that is no instance: its own and its data's.
+    let instancer_values: Vec<(String, [f32; 4])> = obj
+        .attribute_lookups
+        .iter()
+        .map(|(n, l)| (n.clone(), l.object.or(l.data).unwrap_or([0.0; 4])))
+        .collect();
     let n = size as usize;
     let mut pixels = vec![[0.0f32; 4]; n * n];
     let bound = programs
@@ -249,7 +255,7 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
                     }),
                     w,
                 );
-                bound[slot].fill(&mesh, t, c, face, w, &mut sp);
+                bound[slot].fill(&mesh, t, c, face, w, &instancer_values, &mut sp);
                 program.run(&sp, stack);
                 let e = program.surface_emission(stack);
                 pixels[y * n + x] = [e[0], e[1], e[2], 1.0];

@@ -43,6 +43,14 @@ pub struct MeshInstance {
     /// Per slot: the attributes its material reads, bound to this mesh (`bind_attributes`);
     /// empty until then and for materials that read none.
     pub attributes: Vec<Option<Arc<BoundAttributes>>>,
+    /// What an Instancer Attribute node reads on this instance, per name the file's
+    /// nodes ask for (Blender's BKE_object_dupli_find_rgba_attribute): the Geometry
+    /// Nodes instance attribute, else the object's then its data's custom property or
+    /// RNA path, else zero.
+    pub instancer_values: Vec<(String, [f32; 4])>,
+    /// Names among those that sit on instances nested inside this instance's geometry
+    /// (realised into its mesh here, where Cycles would read them per nested instance).
+    pub nested_instancer_names: Vec<String>,
     /// The rays that see the instance, as `accel::visibility` bits (its object's Cycles
     /// ray visibility).
     pub visibility: u32,
@@ -218,7 +226,14 @@ pub fn build(
                     default_color: e.default_color_attribute.clone(),
                     texspace,
                 };
+                let before = instances.len();
                 push_instance(&mut instances, scene, oi, obj, &info, m, to_world, None)?;
+                if e.instances_realized.unwrap_or(0) > 0 && instances.len() > before {
+                    // Blender realised instances into this mesh; Cycles would read an
+                    // Instancer attribute per instance (refused in bind_attributes).
+                    let pushed = instances.last_mut().expect("pushed");
+                    pushed.nested_instancer_names = obj.attribute_lookups.keys().cloned().collect();
+                }
             }
             Source::Evaluate => {
                 let curve_materials = obj
@@ -255,7 +270,19 @@ pub fn build(
                     // Generated geometry: the bounds.
                     texspace: None,
                 };
+                let before = instances.len();
                 push_instance(&mut instances, scene, oi, obj, &info, mesh, to_world, None)?;
+                let has_nodes = obj
+                    .modifiers
+                    .iter()
+                    .any(|m| m.kind == "NODES" && m.show_render);
+                if has_nodes && instances.len() > before {
+                    // Geometry Nodes output other than its top-level instances may hold
+                    // realised instances whose attributes Blender would read per nested
+                    // instance: an Instancer read there is refused (see bind_attributes).
+                    let pushed = instances.last_mut().expect("pushed");
+                    pushed.nested_instancer_names = obj.attribute_lookups.keys().cloned().collect();
+                }
                 if let Some(inst) = instances_component {
                     let mut by_handle: HashMap<u32, (Arc<MeshData>, Vec<Option<String>>)> =
                         HashMap::new();
@@ -286,6 +313,7 @@ pub fn build(
                             default_color: base.default_color.clone(),
                             texspace: None,
                         };
+                        let before = instances.len();
                         push_instance(
                             &mut instances,
                             scene,
@@ -296,6 +324,22 @@ pub fn build(
                             world,
                             Some(i as u32),
                         )?;
+                        if instances.len() > before {
+                            let pushed = instances.last_mut().expect("pushed");
+                            pushed.nested_instancer_names = obj
+                                .attribute_lookups
+                                .keys()
+                                .filter(|n| nested_instance_attribute(g, n))
+                                .cloned()
+                                .collect();
+                            for (name, value) in &mut pushed.instancer_values {
+                                if let Some(v) = inst.attributes.named(name).and_then(|a| {
+                                    crate::geometry::instances::instance_rgba(&a.data, i)
+                                }) {
+                                    *value = v;
+                                }
+                            }
+                        }
                     }
                 }
             }
@@ -478,6 +522,12 @@ fn push_instance(
         uv_name,
         default_color: info.default_color.clone(),
         attributes: Vec::new(),
+        instancer_values: obj
+            .attribute_lookups
+            .iter()
+            .map(|(n, l)| (n.clone(), l.object.or(l.data).unwrap_or([0.0; 4])))
+            .collect(),
+        nested_instancer_names: Vec::new(),
         visibility: object_visibility(obj),
         holdout: obj.is_holdout,
         shadow_terminator: obj.shadow_terminator_geometry_offset,
@@ -485,6 +535,17 @@ fn push_instance(
         terminator_frequency: 1.0 / (1.0 - 0.5 * obj.shadow_terminator_shading_offset),
     });
     Ok(())
+}
+
+/// Whether instances inside `g` (at any depth) carry an attribute named `name`.
+fn nested_instance_attribute(g: &crate::geometry::GeometrySet, name: &str) -> bool {
+    g.instances.as_ref().is_some_and(|i| {
+        i.attributes.named(name).is_some()
+            || i.references
+                .iter()
+                .filter_map(|r| r.geometry())
+                .any(|r| nested_instance_attribute(r, name))
+    })
 }
 
 /// Binds, for every instance and slot, the mesh attributes its material reads (Cycles
@@ -510,6 +571,13 @@ pub fn bind_attributes(
             if p.attributes.is_empty() {
                 per_slot.push(None);
                 continue;
+            }
+            for r in &p.attributes {
+                if let crate::shader::attributes::AttributeRequest::Instancer(name) = r {
+                    if inst.nested_instancer_names.contains(name) {
+                        return Err(RenderError(format!("object {:?}: material {:?} reads the Instancer attribute {name:?}, on instances realised into its mesh (not supported: Blender reads it per instance, blendsynth renders them as one mesh)", inst.name, materials[mi].name)));
+                    }
+                }
             }
             if crate::render::integrator::shade::displacement_reads_attributes(p) {
                 return Err(RenderError(format!("object {:?}: material {:?} truly displaces by mesh attributes or tangents, which the renderer does not support yet", inst.name, materials[mi].name)));

@@ -169,6 +169,11 @@ pub struct Object {
     pub constraints: Vec<Constraint>,
     #[serde(default)]
     pub custom_properties: Rna,
+    /// Per name an Object or Instancer Attribute node reads: what Blender's
+    /// find_rna_property_rgba finds on the object and on its data (a custom property or an
+    /// RNA path of that name, as RGBA). Absent in older exports.
+    #[serde(default)]
+    pub attribute_lookups: std::collections::BTreeMap<String, AttributeLookup>,
     /// The object's own track and up axes (POS_X.., X/Y/Z): a child of a path curve
     /// with "Follow" on is oriented by them.
     #[serde(default)]
@@ -634,4 +639,13 @@ pub struct ColorManagement {
     pub dir: Option<String>,
     #[serde(default)]
     pub config: Option<String>,
+}
+
+/// What an Object / Instancer Attribute node finds on an object and on its data.
+#[derive(Debug, Clone, Default, Serialize, Deserialize)]
+pub struct AttributeLookup {
+    #[serde(default)]
+    pub object: Option<[f32; 4]>,
+    #[serde(default)]
+    pub data: Option<[f32; 4]>,
 }

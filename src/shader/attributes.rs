@@ -32,6 +32,9 @@ pub enum AttributeRequest {
     /// Cycles' Random Per Island (Geometry node, or an Attribute named
     /// "random_per_island"): per face, see `derived::random_per_island`.
     RandomPerIsland,
+    /// An Attribute node of type Instancer: one value per rendered instance (see
+    /// `render::build::MeshInstance::instancer_values`), by name.
+    Instancer(String),
 }
 
 /// How the Attribute node's Fac reads a value (Cycles: float2 gives x, wider types the
@@ -40,6 +43,15 @@ pub enum AttributeRequest {
 enum FacMode {
     X,
     Average,
+}
+
+impl FacMode {
+    fn of(self, v: [f32; 4]) -> f32 {
+        match self {
+            FacMode::X => v[0],
+            FacMode::Average => (v[0] + v[1] + v[2]) * (1.0 / 3.0),
+        }
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -56,6 +68,8 @@ enum Values {
         normals: Vec<Vec3>,
         flat: Vec<bool>,
     },
+    /// The instance's value of this name (constant over the mesh).
+    Instancer(String),
 }
 
 #[derive(Debug, Clone)]
@@ -163,6 +177,10 @@ impl BoundAttributes {
             };
             items.push(match r {
                 AttributeRequest::Named(name) => named(name)?,
+                AttributeRequest::Instancer(name) => Bound {
+                    values: Values::Instancer(name.clone()),
+                    fac: FacMode::Average,
+                },
                 AttributeRequest::DefaultColor => match default_color {
                     Some(name) => named(name)?,
                     None => Bound {
@@ -227,7 +245,9 @@ impl BoundAttributes {
     }
 
     /// Writes the attribute values at a point of triangle `tri` (Blender corners `c`, face
-    /// `face`, barycentric weights `w` of its corners) into `sp`.
+    /// `face`, barycentric weights `w` of its corners) into `sp`; Instancer attributes
+    /// from the instance's `instancer` values.
+    #[allow(clippy::too_many_arguments)]
     pub fn fill(
         &self,
         mesh: &MeshData,
@@ -235,6 +255,7 @@ impl BoundAttributes {
         c: [usize; 3],
         face: usize,
         w: [f32; 3],
+        instancer: &[(String, [f32; 4])],
         sp: &mut ShadingPoint,
     ) {
         sp.attr_missing = 0;
@@ -251,6 +272,11 @@ impl BoundAttributes {
                 Values::Corner(p) => lerp(c.map(|c| p[c])),
                 Values::Face(p) => p[face],
                 Values::TriangleCorner(p) => lerp([p[3 * tri], p[3 * tri + 1], p[3 * tri + 2]]),
+                Values::Instancer(name) => instancer
+                    .iter()
+                    .find(|(n, _)| n == name)
+                    .map(|(_, v)| *v)
+                    .unwrap_or([0.0; 4]),
                 Values::MapNormal { normals, flat } => {
                     if flat.get(face).copied().unwrap_or(false) {
                         let p = c.map(|c| mesh.positions[mesh.corner_verts[c] as usize]);
@@ -268,10 +294,42 @@ impl BoundAttributes {
                 }
             };
             sp.attrs[i] = v;
-            sp.attr_fac[i] = match b.fac {
-                FacMode::X => v[0],
-                FacMode::Average => (v[0] + v[1] + v[2]) * (1.0 / 3.0),
+            sp.attr_fac[i] = b.fac.of(v);
+        }
+    }
+
+    /// Writes the attributes' differentials into `sp.attrs_d` / `sp.attr_fac_d` for the
+    /// hit's barycentric differentials `d` ([du, dv] along x and along y, as
+    /// `bump::differential_dudv` gives them), for a Bump's offset points. Per-face values
+    /// and normals do not change across the triangle.
+    pub fn fill_differentials(
+        &self,
+        mesh: &MeshData,
+        tri: usize,
+        c: [usize; 3],
+        d: [[f32; 2]; 2],
+        sp: &mut ShadingPoint,
+    ) {
+        for (i, b) in self.items.iter().enumerate() {
+            let corners = match &b.values {
+                Values::Point(p) => Some(c.map(|c| p[mesh.corner_verts[c] as usize])),
+                Values::Corner(p) => Some(c.map(|c| p[c])),
+                Values::TriangleCorner(p) => Some([p[3 * tri], p[3 * tri + 1], p[3 * tri + 2]]),
+                Values::Missing
+                | Values::Face(_)
+                | Values::MapNormal { .. }
+                | Values::Instancer(_) => None,
             };
+            for (k, dk) in d.iter().enumerate() {
+                let dv: [f32; 4] = match corners {
+                    Some(v) => std::array::from_fn(|j| {
+                        (v[1][j] - v[0][j]) * dk[0] + (v[2][j] - v[0][j]) * dk[1]
+                    }),
+                    None => [0.0; 4],
+                };
+                sp.attrs_d[i][k] = dv;
+                sp.attr_fac_d[i][k] = b.fac.of(dv);
+            }
         }
     }
 }

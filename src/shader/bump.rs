@@ -163,16 +163,26 @@ pub enum BumpPoint {
 /// object coordinates, Generated and UV moved by `width` times the differential (Cycles'
 /// svm_node_bump_P_dx and the attribute nodes' bump variants). The normal stays.
 pub fn offset_point(sp: &ShadingPoint, which: BumpPoint, width: f32) -> ShadingPoint {
-    let (dp, dg, duv) = match which {
+    let (dp, dg, duv, d) = match which {
         BumpPoint::Center => return *sp,
-        BumpPoint::Dx => (sp.dp_dx, sp.generated_dx, sp.uv_dx),
-        BumpPoint::Dy => (sp.dp_dy, sp.generated_dy, sp.uv_dy),
+        BumpPoint::Dx => (sp.dp_dx, sp.generated_dx, sp.uv_dx, 0),
+        BumpPoint::Dy => (sp.dp_dy, sp.generated_dy, sp.uv_dy, 1),
     };
     let mut o = *sp;
     o.position = add3(sp.position, scale3(dp, width));
     o.object_position = sp.transform.inverse_point(o.position);
     o.generated = add3(sp.generated, scale3(dg, width));
     o.uv = add3(sp.uv, scale3(duv, width));
+    // Mesh attributes extrapolated along the triangle, as Cycles' attribute bump nodes do
+    // (f + df * width).
+    for (a, da) in o.attrs.iter_mut().zip(&sp.attrs_d) {
+        for k in 0..4 {
+            a[k] += da[d][k] * width;
+        }
+    }
+    for (f, df) in o.attr_fac.iter_mut().zip(&sp.attr_fac_d) {
+        *f += df[d] * width;
+    }
     o
 }
 

@@ -135,8 +135,6 @@ struct Compiler<'g, 'a> {
     material_pass_index: f32,
     /// Mesh attributes the program reads (`Program::attributes`).
     attributes: Vec<super::attributes::AttributeRequest>,
-    /// The current graph copy evaluates at a bump offset point (dx or dy).
-    offset_copy: bool,
     /// Compiling a world's shader: no object, no camera-space view of the point.
     world: bool,
 }
@@ -258,7 +256,6 @@ impl<'g, 'a> Compiler<'g, 'a> {
             displaced_normal: None,
             material_pass_index: 0.0,
             attributes: Vec::new(),
-            offset_copy: false,
             world: false,
         }
     }
@@ -696,7 +693,6 @@ impl<'g, 'a> Compiler<'g, 'a> {
             });
         }
         self.copy = c;
-        self.offset_copy = new.point != super::bump::BumpPoint::Center;
     }
 
     /// Prepares a schedule step; returns the node to compile, if it is one.

@@ -65,6 +65,10 @@ pub struct ShadingPoint {
     pub attr_fac: [f32; super::attributes::MAX_ATTRIBUTES],
     /// Bit i set: request i is not on the mesh (Cycles' "attribute not found").
     pub attr_missing: u32,
+    /// Changes of `attrs` and `attr_fac` along `dp_dx` ([0]) and `dp_dy` ([1]): the
+    /// attribute differentials a Bump's dx/dy copy reads (Cycles' svm_node_attr_bump_dx).
+    pub attrs_d: [[[f32; 4]; 2]; super::attributes::MAX_ATTRIBUTES],
+    pub attr_fac_d: [[f32; 2]; super::attributes::MAX_ATTRIBUTES],
     /// On a truly displaced mesh: the point before displacement, which the material's
     /// displacement bump reads ("Both").
     pub undisplaced: Option<Undisplaced>,

@@ -12,8 +12,8 @@ use crate::shader::ShadingPoint;
 
 use crate::render::bsdf::{fresnel_conductor, Fresnel, LobeKind, LobeSet};
 use crate::render::integrator::shade::{
-    input_c, input_f, input_n, is_multiggx, multiscatter_energy, push_glossy, tangent_input,
-    valid_n, Context,
+    input_c, input_f, input_n, is_multiggx, multiscatter_darkening, multiscatter_energy,
+    push_glossy, tangent_input, valid_n, Context,
 };
 
 /// F82-tint Schlick (Cycles' bsdf_microfacet_setup_fresnel_f82_tint): `b` chosen so that
@@ -37,7 +37,7 @@ fn f82_b(f0: [f32; 3], f82: [f32; 3]) -> [f32; 3] {
 }
 
 /// Cycles' fresnel_f82_Fss: the F82 model's average single-scattering Fresnel.
-fn f82_fss(f0: [f32; 3], b: [f32; 3]) -> [f32; 3] {
+pub(crate) fn f82_fss(f0: [f32; 3], b: [f32; 3]) -> [f32; 3] {
     std::array::from_fn(|k| f0[k] + (1.0 - f0[k]) / 21.0 - b[k] / 126.0)
 }
 
@@ -61,18 +61,6 @@ fn fresnel_of(b: &BsdfNode, s: &[f32]) -> (Fresnel, [f32; 3]) {
         unreachable!("f82_tint gives an F82 Fresnel")
     };
     (fresnel, f82_fss(f0, bb))
-}
-
-/// Cycles' microfacet_ggx_preserve_energy beyond the energy scale: the colour the
-/// missing multiple scattering takes from the Fresnel (Fms, Imageworks' appendix), as a
-/// factor on the closure weight. `energy` is 1 / E.
-fn multiscatter_tint(fss: [f32; 3], energy: f32) -> [f32; 3] {
-    let e = 1.0 / energy;
-    let missing = energy - 1.0;
-    fss.map(|f| {
-        let fms = f * e / (1.0 - f * (1.0 - e));
-        (1.0 + fms * missing) / (1.0 + missing)
-    })
 }
 
 /// The Metallic BSDF node's lobe, weighted `w`.
@@ -108,7 +96,7 @@ pub(crate) fn metallic(
     );
     let weight = if multi {
         let rough = (ax * ay).sqrt().sqrt();
-        multiscatter_tint(fss, multiscatter_energy(ctx.tables, mu, rough)).map(|x| x * w)
+        multiscatter_darkening(ctx.tables, mu, rough, fss).map(|x| x * w)
     } else {
         [w; 3]
     };

@@ -239,7 +239,15 @@ impl Scene<'_> {
             to_object: to_object.m,
         };
         if let Some(Some(bound)) = inst.attributes.get(slot) {
-            bound.fill(m, r.tri as usize, c, face, [w0, u, v], &mut sp);
+            bound.fill(
+                m,
+                r.tri as usize,
+                c,
+                face,
+                [w0, u, v],
+                &inst.instancer_values,
+                &mut sp,
+            );
         }
         if inst.motion.is_some() {
             // Object Info reads the object's transform at the ray's time, as in Cycles.
@@ -1033,6 +1041,11 @@ impl Scene<'_> {
             let t = c.map(|c| [uv[c][0], uv[c][1], 0.0]);
             sp.uv_dx = attribute_differential(t, d[0]);
             sp.uv_dy = attribute_differential(t, d[1]);
+        }
+        let face = m.triangle_faces[r.tri as usize] as usize;
+        let slot = inst.face_slot.get(face).copied().unwrap_or(0) as usize;
+        if let Some(Some(bound)) = inst.attributes.get(slot) {
+            bound.fill_differentials(m, r.tri as usize, c, d, sp);
         }
     }
 }

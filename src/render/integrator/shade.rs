@@ -324,6 +324,30 @@ pub(crate) fn multiscatter_energy(tables: &Tables, mu: f32, roughness: f32) -> f
     1.0 / e
 }
 
+/// Cycles' microfacet_ggx_preserve_energy beyond the energy scale 1 / E: light lost
+/// between microfacets returns only after more Fresnel bounces, so a closure whose
+/// average Fresnel `fss` is below one gets back less (Fms, the appendix of Kulla and
+/// Conty's "Revisiting Physically Based Shading at Imageworks", with the cosine-weighted
+/// mean albedo E_avg). A factor on the closure weight, one where `fss` is one.
+pub(crate) fn multiscatter_darkening(tables: &Tables, mu: f32, roughness: f32, fss: V3) -> V3 {
+    let e = tables.ggx_e(mu, roughness).max(1e-3);
+    let e_avg = tables.ggx_e_avg(roughness);
+    let missing = (1.0 - e) / e;
+    fss.map(|f| {
+        let fms = f * e_avg / (1.0 - f * (1.0 - e_avg));
+        (1.0 + fms * missing) / (1.0 + missing)
+    })
+}
+
+/// Cycles' fresnel_dielectric_Fss: the average dielectric Fresnel of relative IOR `eta`.
+pub(crate) fn dielectric_fss(eta: f32) -> f32 {
+    if eta < 1.0 {
+        0.997118 + eta * (0.1014 - eta * (0.965241 + eta * 0.130607))
+    } else {
+        (eta - 1.0) / (4.08567 + 1.00071 * eta)
+    }
+}
+
 fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet) {
     match b.bl_idname.as_str() {
         "ShaderNodeBsdfDiffuse" => {
@@ -368,6 +392,21 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             let multi = is_multiggx(b);
             let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
             let aniso = input_f(b, s, "Anisotropy", 0.0).clamp(-0.99, 0.99);
+            // Multiscatter GGX takes the colour as its Fresnel (Cycles'
+            // bsdf_microfacet_setup_fresnel_constant): a colour below white gets back less
+            // of the energy lost between microfacets.
+            let darkened = |table_roughness: f32| {
+                let weight = scale(c, w);
+                if multi {
+                    let fss = c.map(|x| x.max(0.0));
+                    mul(
+                        weight,
+                        multiscatter_darkening(ctx.tables, mu, table_roughness, fss),
+                    )
+                } else {
+                    weight
+                }
+            };
             if aniso.abs() > 1e-4 {
                 let (ax, ay) = crate::render::bsdf::anisotropic::glossy_alphas(r, aniso);
                 let t = tangent_input(b, s, sp, "Tangent", input_f(b, s, "Rotation", 0.0), n);
@@ -379,7 +418,7 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
                     t,
                     Fresnel::Constant,
                     multi,
-                    scale(c, w),
+                    darkened((ax * ay).sqrt().sqrt()),
                     n,
                     1.0,
                 );
@@ -396,7 +435,7 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
                     fresnel: Fresnel::Constant,
                     energy,
                 },
-                scale(c, w),
+                darkened(r),
                 n,
             );
         }
@@ -547,6 +586,16 @@ fn principled(
         }
         let avg_f0 = (clamped[0] + clamped[1] + clamped[2]) / 3.0;
         let albedo = (avg_f0 + (1.0 - avg_f0) / 21.0).clamp(0.0, 1.0);
+        let mut metal_weight = scale(weight, metallic);
+        if multi {
+            // Cycles darkens the compensation by the F82 model's average Fresnel.
+            let fss = crate::render::bsdf::metallic::f82_fss(clamped, bb);
+            let table_roughness = (ax * ay).sqrt().sqrt();
+            metal_weight = mul(
+                metal_weight,
+                multiscatter_darkening(ctx.tables, mu, table_roughness, fss),
+            );
+        }
         if ax != ay {
             push_glossy(
                 out,
@@ -556,7 +605,7 @@ fn principled(
                 tangent,
                 Fresnel::F82 { f0: clamped, b: bb },
                 multi,
-                scale(weight, metallic),
+                metal_weight,
                 vn,
                 albedo.max(1e-3),
             );
@@ -567,7 +616,7 @@ fn principled(
                     fresnel: Fresnel::F82 { f0: clamped, b: bb },
                     energy,
                 },
-                scale(weight, metallic),
+                metal_weight,
                 vn,
                 albedo.max(1e-3),
             );
@@ -643,6 +692,22 @@ fn principled(
             .tables
             .dielectric_fresnel_avg(mu, table_roughness, eta)
             .clamp(0.0, 1.0);
+        // Multiscatter: Cycles' generalized-Schlick Fss, the lobe's F0 (tinted) blended
+        // towards one as far as the dielectric's average Fresnel lies from its F0.
+        let lobe_weight = if multi {
+            let f0 = crate::render::bsdf::f0_from_ior(eta);
+            let s_blend = ((dielectric_fss(eta) - f0) / (1.0 - f0)).clamp(0.0, 1.0);
+            let fss = spec_tint.map(|t| {
+                let tf0 = (f0 * t).clamp(0.0, 1.0);
+                tf0 + (1.0 - tf0) * s_blend
+            });
+            mul(
+                mul(weight, spec_tint),
+                multiscatter_darkening(ctx.tables, mu, table_roughness, fss),
+            )
+        } else {
+            mul(weight, spec_tint)
+        };
         if ax != ay {
             push_glossy(
                 out,
@@ -652,7 +717,7 @@ fn principled(
                 tangent,
                 Fresnel::Dielectric { eta },
                 multi,
-                mul(weight, spec_tint),
+                lobe_weight,
                 vn,
                 e.max(1e-3),
             );
@@ -663,7 +728,7 @@ fn principled(
                     fresnel: Fresnel::Dielectric { eta },
                     energy,
                 },
-                mul(weight, spec_tint),
+                lobe_weight,
                 vn,
                 e.max(1e-3),
             );
@@ -824,13 +889,15 @@ fn principled_coat(
         .tables
         .dielectric_fresnel_avg(mu, rough, coat_ior)
         .clamp(0.0, 1.0);
+    // Cycles always compensates the coat, darkened by its dielectric Fss.
+    let darkening = multiscatter_darkening(ctx.tables, mu, rough, [dielectric_fss(coat_ior); 3]);
     out.push_scaled(
         LobeKind::Glossy {
             alpha: rough * rough,
             fresnel: Fresnel::Dielectric { eta: coat_ior },
             energy,
         },
-        scale(weight, coat),
+        mul(scale(weight, coat), darkening),
         n,
         e.max(1e-3),
     );

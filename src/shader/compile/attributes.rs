@@ -39,14 +39,6 @@ impl<'g, 'a> Compiler<'g, 'a> {
         Ok(self.attributes.len() as u8 - 1)
     }
 
-    /// Attribute values at a bump's offset points need attribute differentials.
-    fn no_offset(&self, path: &str, what: &str) -> Result<(), CompileError> {
-        if self.offset_copy {
-            return Err(CompileError(format!("node {path:?}: {what} inside a Bump height or displacement is not supported yet (needs attribute differentials)")));
-        }
-        Ok(())
-    }
-
     /// The tangent request of a node's `uv_map` (empty: the active render UV map).
     fn tangent_request(&mut self, i: usize, uv_key: Option<&str>) -> Result<u8, CompileError> {
         let n = &self.g.nodes[i];
@@ -60,8 +52,9 @@ impl<'g, 'a> Compiler<'g, 'a> {
 
     pub(super) fn attribute_node(&mut self, i: usize) -> Result<(), CompileError> {
         use Kind::{Color as C, Float as F, Vector as V};
+        // At a bump's offset points the same ops read the attribute moved along the
+        // triangle (`bump::offset_point`, Cycles' svm_node_attr_bump_dx).
         let n = &self.g.nodes[i];
-        self.no_offset(&n.path, &n.node.bl_idname)?;
         if n.node.bl_idname == "ShaderNodeVertexColor" {
             let name = prop_str(n, "layer_name")?;
             let r = if name.is_empty() {
@@ -76,10 +69,34 @@ impl<'g, 'a> Compiler<'g, 'a> {
             return Ok(());
         }
         let kind = prop_str(n, "attribute_type")?;
-        if kind != "GEOMETRY" {
-            return Err(CompileError(format!("node {:?}: Attribute type {kind} is not supported (only Geometry: object and instancer custom properties are not exported)", n.path)));
-        }
         let name = prop_str(n, "attribute_name")?;
+        if kind == "INSTANCER" {
+            let attr = self.request(&n.path, AttributeRequest::Instancer(name.to_string()))?;
+            let (vector, fac, alpha) = (self.alloc(V), self.alloc(F), self.alloc(F));
+            self.ops.push(Op::Attribute {
+                attr,
+                vector,
+                fac,
+                alpha,
+            });
+            self.outputs(
+                i,
+                n,
+                &[
+                    ("Color", vector, C),
+                    ("Vector", vector, V),
+                    ("Fac", fac, F),
+                    ("Alpha", alpha, F),
+                ],
+            );
+            return Ok(());
+        }
+        if kind != "GEOMETRY" {
+            return Err(CompileError(format!(
+                "node {:?}: Attribute type {kind} is not supported (only Geometry and Instancer)",
+                n.path
+            )));
+        }
         let derived = match name {
             "pointiness" => Some(AttributeRequest::Pointiness),
             "random_per_island" => Some(AttributeRequest::RandomPerIsland),
@@ -144,9 +161,9 @@ impl<'g, 'a> Compiler<'g, 'a> {
             let Some(k) = n.node.outputs.iter().position(|o| o.identifier == id) else {
                 continue;
             };
-            // At a bump's offset points the output stays unset (a use there is an
-            // error): that needs attribute differentials.
-            if !self.output_used(i, id) || self.offset_copy {
+            // At a bump's offset points the read sees the value moved along the
+            // triangle (`bump::offset_point`).
+            if !self.output_used(i, id) {
                 continue;
             }
             let path = n.path.clone();
@@ -175,7 +192,6 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 n.path
             )));
         }
-        self.no_offset(&n.path, "a named UV Map")?;
         let name = prop_str(n, "uv_map")?.to_string();
         let attr = self.request(&n.path, AttributeRequest::Named(name))?;
         let dst = self.alloc(Kind::Vector);
