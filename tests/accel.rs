@@ -306,3 +306,28 @@ fn embree_small_and_empty_scenes() {
         .is_none());
     assert!(!empty.occluded([0.0; 3], [0.0, 0.0, 1.0], 0.0, f32::INFINITY));
 }
+
+/// A triangle with an infinite vertex (never hit by our test) does not hide the finite
+/// triangles of its leaf from Embree: its hits are the binary BVH's.
+#[test]
+fn embree_with_a_non_finite_triangle() {
+    if !backends().contains(&"embree") {
+        return;
+    }
+    let mut rng = Lcg(11);
+    let mut tris = scene(6, 20, &mut rng);
+    tris.push([[0.5, 0.5, 0.0], [f32::INFINITY, 0.5, 0.0], [0.5, 0.6, 0.0]]);
+    tris.push([[0.2, 0.2, 0.1], [0.3, f32::NAN, 0.1], [0.2, 0.3, 0.1]]);
+    let bin = Bvh::build(&tris);
+    let e = EmbreeAccel::build_masked(&tris, &[]).unwrap();
+    let mut hits = 0;
+    for k in 0..2000 {
+        let org = [rng.f() * 2.0 - 0.5, rng.f() * 2.0 - 0.5, 1.5];
+        let dir = [rng.f() - 0.5, rng.f() - 0.5, -1.0];
+        let a = bin.intersect(org, dir, 0.0, f32::INFINITY);
+        let b = e.intersect(org, dir, 0.0, f32::INFINITY);
+        assert!(same(a, b), "ray {k}: binary {a:?}, Embree {b:?}");
+        hits += a.is_some() as usize;
+    }
+    assert!(hits > 300, "only {hits} hits");
+}

@@ -36,6 +36,8 @@ const GEOMETRY_TYPE_USER: c_int = 120;
 const SCENE_FLAG_ROBUST: c_int = 1 << 2;
 const BUILD_QUALITY_HIGH: c_int = 2;
 const INVALID_ID: c_uint = u32::MAX;
+/// The largest box coordinate given to Embree (below its FLT_LARGE, 1.844e18).
+const LARGE: f32 = 1e18;
 
 /// `struct RTCIntersectContext` of a 3.13 build with `RTC_MAX_INSTANCE_LEVEL_COUNT` 1 and
 /// no minimum width (Debian's `rtcore_config.h`).
@@ -312,18 +314,27 @@ impl EmbreeAccel {
     pub fn build_masked(tris: &[[V3; 3]], masks: &[u32]) -> Result<EmbreeAccel, String> {
         let api = api()?;
         let bvh = Bvh::build_masked(tris, masks);
-        let root = bvh.nodes.first();
-        let extent = root.map_or(0.0, |n| {
-            (0..3).fold(0.0f32, |m, a| m.max(n.min[a].abs()).max(n.max[a].abs()))
-        });
+        // The largest finite coordinate: a triangle with an infinite or NaN vertex (which
+        // our test never hits) must not make every box infinite.
+        let finite = |x: f32| if x.is_finite() { x.abs() } else { 0.0 };
+        let extent = bvh
+            .nodes
+            .iter()
+            .filter(|n| n.count > 0)
+            .fold(0.0f32, |m, n| {
+                (0..3).fold(m, |m, a| m.max(finite(n.min[a])).max(finite(n.max[a])))
+            });
         let pad = extent * (1.0 / 1048576.0) + f32::MIN_POSITIVE;
+        // Embree drops a primitive whose box reaches beyond its FLT_LARGE (1.844e18) or
+        // is not finite; such a leaf (which may hold other, finite triangles) is clamped
+        // to +-1e18 instead (so only hits farther than that could differ).
         let leaves: Vec<(u32, u32, V3, V3)> = bvh
             .nodes
             .iter()
             .filter(|n| n.count > 0)
             .map(|n| {
-                let lo = [n.min[0] - pad, n.min[1] - pad, n.min[2] - pad];
-                let hi = [n.max[0] + pad, n.max[1] + pad, n.max[2] + pad];
+                let lo = n.min.map(|x| (x - pad).max(-LARGE));
+                let hi = n.max.map(|x| (x + pad).min(LARGE));
                 (n.start, n.count, lo, hi)
             })
             .collect();
