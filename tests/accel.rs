@@ -1,12 +1,32 @@
 //! Every ray acceleration backend renders the same image, bit for bit: the CLI renders
-//! fixture scenes with `BLENDSYNTH_ACCEL=bvh2` (binary BVH) and `bvh4` (4-wide BVH) and
-//! the EXRs must be byte-identical. Subsurface (many short walk rays), depth of field
-//! and a light with soft shadows cover the query kinds (nearest hit, occlusion).
+//! fixture scenes with `BLENDSYNTH_ACCEL=bvh2` (binary BVH), `bvh4` (4-wide BVH) and
+//! `embree` (where `libembree3.so.3` loads; required in CI, which installs it with
+//! `.ci/embree.sh`) and the EXRs must be byte-identical. Subsurface (many short walk
+//! rays), depth of field, a light with soft shadows, object visibility, a holdout,
+//! motion blur and Geometry Nodes instances cover the query kinds (nearest hit,
+//! occlusion, visibility masks).
 
 mod common;
 
+/// The backends to compare: the two BVHs, and Embree where it loads (in CI it must).
+fn backends() -> Vec<&'static str> {
+    let mut v = vec!["bvh2", "bvh4"];
+    match Backend::parse("embree") {
+        Ok(_) => v.push("embree"),
+        Err(e) => {
+            assert!(
+                !common::in_ci(),
+                "Embree is required in CI (CI=true; .ci/embree.sh installs it): {e}"
+            );
+            eprintln!("SKIPPED Embree: {e}");
+        }
+    }
+    v
+}
+
+/// `scene` is a folder under `fixtures/`.
 fn render(scene: &str, backend: &str, out: &std::path::Path) -> Vec<u8> {
-    let dir = common::repo().join("fixtures/render/scenes").join(scene);
+    let dir = common::repo().join("fixtures").join(scene);
     let o = common::run(
         &[
             "render",
@@ -35,15 +55,24 @@ fn render(scene: &str, backend: &str, out: &std::path::Path) -> Vec<u8> {
 #[test]
 fn every_backend_renders_identical_images() {
     let tmp = tempfile::tempdir().unwrap();
+    let backends = backends();
     for scene in [
-        "sss_principled",
-        "dof",
-        "area_glossy_mis",
-        "object_visibility",
+        "render/scenes/sss_principled",
+        "render/scenes/sss_rw_tube_3cm",
+        "render/scenes/dof",
+        "render/scenes/area_glossy_mis",
+        "render/scenes/object_visibility",
+        "render/scenes/holdout_object",
+        "render/scenes/motion_blur",
+        "render/scenes/object_motion",
+        "scenes/geonodes",
     ] {
-        let a = render(scene, "bvh2", &tmp.path().join(format!("{scene}_2.exr")));
-        let b = render(scene, "bvh4", &tmp.path().join(format!("{scene}_4.exr")));
-        assert!(a == b, "{scene}: bvh2 and bvh4 images differ");
+        let name = scene.replace('/', "_");
+        let a = render(scene, "bvh2", &tmp.path().join(format!("{name}_bvh2.exr")));
+        for b in &backends[1..] {
+            let img = render(scene, b, &tmp.path().join(format!("{name}_{b}.exr")));
+            assert!(a == img, "{scene}: bvh2 and {b} images differ");
+        }
     }
 }
 
@@ -63,19 +92,17 @@ fn an_unknown_backend_is_refused_by_name() {
             "-o",
             out.to_str().unwrap(),
         ],
-        &[("BLENDSYNTH_ACCEL", "embree")],
+        &[("BLENDSYNTH_ACCEL", "optix")],
     );
     assert!(!o.status.success());
     let e = common::stderr(&o);
-    assert!(
-        e.contains("BLENDSYNTH_ACCEL") && e.contains("embree"),
-        "{e}"
-    );
+    assert!(e.contains("BLENDSYNTH_ACCEL") && e.contains("optix"), "{e}");
     assert!(!out.exists(), "no output on an error");
 }
 
 use blendsynth::foundation::bvh::{visibility, Accel, Backend, Bvh, Hit};
 use blendsynth::foundation::bvh4::Bvh4;
+use blendsynth::foundation::embree::EmbreeAccel;
 use blendsynth::foundation::math::V3;
 
 /// A fixed-seed generator (no dependence on a random draw).
@@ -136,12 +163,13 @@ fn same(a: Option<Hit>, b: Option<Hit>) -> bool {
     }
 }
 
-/// Every query of the wide BVH returns exactly the binary BVH's hit: rays aimed at the
+/// Every query of the wide BVH and of Embree (where it loads) returns exactly the binary
+/// BVH's hit: rays aimed at the
 /// grid's shared vertices and edges (where two or more triangles tie at the same
 /// distance, so the visiting order would pick one if the tie rule, least triangle index,
 /// did not), random rays, with visibility masks and finite ranges.
 #[test]
-fn wide_bvh_returns_the_binary_bvh_hits() {
+fn every_backend_returns_the_binary_bvh_hits() {
     let mut rng = Lcg(7);
     let n = 24;
     let tris = scene(n, 600, &mut rng);
@@ -156,6 +184,9 @@ fn wide_bvh_returns_the_binary_bvh_hits() {
         .collect();
     let bin = Bvh::build_masked(&tris, &masks);
     let wide = Bvh4::build_masked(&tris, &masks);
+    let embree = backends()
+        .contains(&"embree")
+        .then(|| EmbreeAccel::build_masked(&tris, &masks).unwrap());
     // One structure per triangle, to find ties by brute force.
     let singles: Vec<Bvh> = tris.iter().map(|t| Bvh::build(&[*t])).collect();
     let mut ties = 0;
@@ -193,6 +224,15 @@ fn wide_bvh_returns_the_binary_bvh_hits() {
             wide.occluded_vis(org, dir, tmin, tmax, 0.5, mask),
             "ray {k} occlusion"
         );
+        if let Some(e) = &embree {
+            let c = e.intersect_vis(org, dir, tmin, tmax, 0.5, mask);
+            assert!(same(a, c), "ray {k}: binary {a:?}, Embree {c:?}");
+            assert_eq!(
+                bin.occluded_vis(org, dir, tmin, tmax, 0.5, mask),
+                e.occluded_vis(org, dir, tmin, tmax, 0.5, mask),
+                "ray {k} occlusion (Embree)"
+            );
+        }
         if k < 3000 && mask == visibility::ALL {
             if let Some(h) = a {
                 let tied = singles.iter().enumerate().any(|(i, s)| {
@@ -231,9 +271,63 @@ fn backend_names() {
     assert_eq!(Backend::parse("bvh2"), Ok(Backend::Binary));
     assert_eq!(Backend::parse("bvh4"), Ok(Backend::Wide4));
     assert_eq!(Backend::parse(""), Ok(Backend::DEFAULT));
-    let e = Backend::parse("embree").unwrap_err();
-    assert!(
-        e.contains("BLENDSYNTH_ACCEL") && e.contains("embree"),
-        "{e}"
-    );
+    let e = Backend::parse("optix").unwrap_err();
+    assert!(e.contains("BLENDSYNTH_ACCEL") && e.contains("optix"), "{e}");
+    // Embree is a backend where its library loads, and otherwise an error naming it.
+    match Backend::parse("embree") {
+        Ok(b) => assert_eq!(b, Backend::Embree),
+        Err(e) => assert!(
+            e.contains("BLENDSYNTH_ACCEL=embree") && e.contains("libembree3.so.3"),
+            "{e}"
+        ),
+    }
+}
+
+/// Embree's small cases: one triangle, a miss, and an empty scene.
+#[test]
+fn embree_small_and_empty_scenes() {
+    if !backends().contains(&"embree") {
+        return;
+    }
+    let one = [[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]];
+    let e = EmbreeAccel::build_masked(&one, &[]).unwrap();
+    let h = e
+        .intersect([0.2, 0.2, 1.0], [0.0, 0.0, -1.0], 0.0, f32::INFINITY)
+        .unwrap();
+    assert_eq!(h.prim, 0);
+    assert!(e
+        .intersect([2.0, 2.0, 1.0], [0.0, 0.0, -1.0], 0.0, f32::INFINITY)
+        .is_none());
+    assert!(e.occluded([0.2, 0.2, 1.0], [0.0, 0.0, -1.0], 0.0, 2.0));
+    assert!(!e.occluded([0.2, 0.2, 1.0], [0.0, 0.0, -1.0], 0.0, 0.5));
+    let empty = EmbreeAccel::build_masked(&[], &[]).unwrap();
+    assert!(empty
+        .intersect([0.0; 3], [0.0, 0.0, 1.0], 0.0, f32::INFINITY)
+        .is_none());
+    assert!(!empty.occluded([0.0; 3], [0.0, 0.0, 1.0], 0.0, f32::INFINITY));
+}
+
+/// A triangle with an infinite vertex (never hit by our test) does not hide the finite
+/// triangles of its leaf from Embree: its hits are the binary BVH's.
+#[test]
+fn embree_with_a_non_finite_triangle() {
+    if !backends().contains(&"embree") {
+        return;
+    }
+    let mut rng = Lcg(11);
+    let mut tris = scene(6, 20, &mut rng);
+    tris.push([[0.5, 0.5, 0.0], [f32::INFINITY, 0.5, 0.0], [0.5, 0.6, 0.0]]);
+    tris.push([[0.2, 0.2, 0.1], [0.3, f32::NAN, 0.1], [0.2, 0.3, 0.1]]);
+    let bin = Bvh::build(&tris);
+    let e = EmbreeAccel::build_masked(&tris, &[]).unwrap();
+    let mut hits = 0;
+    for k in 0..2000 {
+        let org = [rng.f() * 2.0 - 0.5, rng.f() * 2.0 - 0.5, 1.5];
+        let dir = [rng.f() - 0.5, rng.f() - 0.5, -1.0];
+        let a = bin.intersect(org, dir, 0.0, f32::INFINITY);
+        let b = e.intersect(org, dir, 0.0, f32::INFINITY);
+        assert!(same(a, b), "ray {k}: binary {a:?}, Embree {b:?}");
+        hits += a.is_some() as usize;
+    }
+    assert!(hits > 300, "only {hits} hits");
 }

@@ -81,18 +81,21 @@ pub mod visibility {
 }
 
 /// Which acceleration structure renders build: the 4-wide BVH (`bvh4`, the default, the
-/// faster one measured in docs/speed.md) or the binary one (`bvh2`). Both return the
-/// same hits, so images are identical; `BLENDSYNTH_ACCEL` chooses.
+/// faster one measured in docs/speed.md), the binary one (`bvh2`) or Embree's (`embree`,
+/// when `libembree3.so.3` is installed: `foundation/embree.rs`). All return the same hits,
+/// so images are identical; `BLENDSYNTH_ACCEL` chooses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Backend {
     Binary,
     Wide4,
+    Embree,
 }
 
 impl Backend {
     pub const DEFAULT: Backend = Backend::Wide4;
 
-    /// `BLENDSYNTH_ACCEL` (`bvh4` or `bvh2`), or the default when it is unset or empty.
+    /// `BLENDSYNTH_ACCEL` (`bvh4`, `bvh2` or `embree`), or the default when it is unset or
+    /// empty; `embree` is an error naming the library where Embree cannot be loaded.
     pub fn from_env() -> Result<Backend, String> {
         match std::env::var("BLENDSYNTH_ACCEL") {
             Ok(v) => Backend::parse(&v),
@@ -105,18 +108,24 @@ impl Backend {
             "" => Ok(Backend::DEFAULT),
             "bvh4" => Ok(Backend::Wide4),
             "bvh2" => Ok(Backend::Binary),
+            "embree" => match super::embree::available() {
+                Ok(()) => Ok(Backend::Embree),
+                Err(e) => Err(format!("BLENDSYNTH_ACCEL=embree: {e}")),
+            },
             other => Err(format!(
-                "BLENDSYNTH_ACCEL={other:?} is not a ray acceleration backend (bvh4 or bvh2)"
+                "BLENDSYNTH_ACCEL={other:?} is not a ray acceleration backend (bvh4, bvh2 or embree)"
             )),
         }
     }
 
-    /// The structure over `tris` with visibility `masks` (as `Bvh::build_masked`).
-    pub fn build_masked(self, tris: &[[V3; 3]], masks: &[u32]) -> Box<dyn Accel> {
-        match self {
+    /// The structure over `tris` with visibility `masks` (as `Bvh::build_masked`); only
+    /// Embree's can fail (its error names the library).
+    pub fn build_masked(self, tris: &[[V3; 3]], masks: &[u32]) -> Result<Box<dyn Accel>, String> {
+        Ok(match self {
             Backend::Binary => Box::new(Bvh::build_masked(tris, masks)),
             Backend::Wide4 => Box::new(super::bvh4::Bvh4::build_masked(tris, masks)),
-        }
+            Backend::Embree => Box::new(super::embree::EmbreeAccel::build_masked(tris, masks)?),
+        })
     }
 }
 

@@ -5,6 +5,7 @@
 
 pub mod bvh;
 pub mod bvh4;
+pub mod embree;
 pub mod exr;
 pub mod files;
 pub mod math;

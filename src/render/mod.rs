@@ -252,7 +252,8 @@ fn render_frame(
         backend.build_masked(&[], &[])
     } else {
         backend.build_masked(&geo.tris, &build::triangle_masks(&geo))
-    };
+    }
+    .map_err(RenderError)?;
     let filter = film::filter::FilterTable::blackman_harris(integrator.filter_width as f32);
     let i = &integrator;
     let settings = Settings {

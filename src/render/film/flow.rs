@@ -114,10 +114,17 @@ pub fn flow_to(
 ) -> FlowField {
     let matched = match_instances(here.geo, there.geo);
     let backend = accel::Backend::from_env().unwrap_or(accel::Backend::DEFAULT);
-    let accel = backend.build_masked(
-        &there.geo.tris,
-        &crate::render::build::triangle_masks(there.geo),
-    );
+    let masks = crate::render::build::triangle_masks(there.geo);
+    // The render itself already reported an Embree that cannot build; every backend
+    // returns the same hits, so the default serves the flow then.
+    let accel = backend
+        .build_masked(&there.geo.tris, &masks)
+        .unwrap_or_else(|_| {
+            Box::new(crate::foundation::bvh4::Bvh4::build_masked(
+                &there.geo.tris,
+                &masks,
+            ))
+        });
     let (w, h) = (there.camera.width as f64, there.camera.height as f64);
     let per_pixel: Vec<([f32; 2], bool)> = hits
         .par_iter()
