@@ -694,20 +694,18 @@ fn principled(
             .clamp(0.0, 1.0);
         // Multiscatter: Cycles' generalized-Schlick Fss, the lobe's F0 (tinted) blended
         // towards one as far as the dielectric's average Fresnel lies from its F0.
-        let lobe_weight = if multi {
+        let darkening = if multi {
             let f0 = crate::render::bsdf::f0_from_ior(eta);
             let s_blend = ((dielectric_fss(eta) - f0) / (1.0 - f0)).clamp(0.0, 1.0);
             let fss = spec_tint.map(|t| {
                 let tf0 = (f0 * t).clamp(0.0, 1.0);
                 tf0 + (1.0 - tf0) * s_blend
             });
-            mul(
-                mul(weight, spec_tint),
-                multiscatter_darkening(ctx.tables, mu, table_roughness, fss),
-            )
+            multiscatter_darkening(ctx.tables, mu, table_roughness, fss)
         } else {
-            mul(weight, spec_tint)
+            [1.0; 3]
         };
+        let lobe_weight = mul(mul(weight, spec_tint), darkening);
         if ax != ay {
             push_glossy(
                 out,
@@ -733,8 +731,9 @@ fn principled(
                 e.max(1e-3),
             );
         }
-        // Attenuate the layers below by the specular layer's albedo.
-        let albedo = scale(spec_tint, e);
+        // Attenuate the layers below by the specular layer's albedo (Cycles' bsdf_albedo:
+        // the closure weight, darkening included, times the estimated albedo).
+        let albedo = mul(scale(spec_tint, e), darkening);
         weight = scale(weight, (1.0 - max3(albedo)).clamp(0.0, 1.0));
     }
     let ss = input_f(b, s, "Subsurface Weight", 0.0).clamp(0.0, 1.0);
@@ -901,7 +900,8 @@ fn principled_coat(
         n,
         e.max(1e-3),
     );
-    let mut below = scale(weight, (1.0 - coat * e).clamp(0.0, 1.0));
+    // The layers below see the coat's albedo, darkening included (Cycles' bsdf_albedo).
+    let mut below = scale(weight, (1.0 - coat * e * darkening[0]).clamp(0.0, 1.0));
     if tint != [1.0; 3] {
         let cos_t = (1.0 - (1.0 - mu * mu) / (coat_ior * coat_ior))
             .max(1e-6)
