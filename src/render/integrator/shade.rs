@@ -376,69 +376,7 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
         "ShaderNodeHoldout" => {
             out.holdout = add(out.holdout, [w; 3]);
         }
-        "ShaderNodeBsdfAnisotropic" | "ShaderNodeBsdfGlossy" => {
-            let c = input_c(b, s, "Color", [0.8; 3]);
-            let r = input_f(b, s, "Roughness", 0.5).clamp(0.0, 1.0);
-            let n = valid_n(sp, ctx, input_n(b, s, "Normal", sp));
-            if b.property("distribution") == Some("BECKMANN") {
-                let r = crate::render::bsdf::microfacet::Reflection {
-                    dist: crate::render::bsdf::microfacet::Distribution::Beckmann,
-                    alpha: r * r,
-                    fresnel: Fresnel::Constant,
-                };
-                out.push(LobeKind::Reflection(r), scale(c, w), n);
-                return;
-            }
-            let multi = is_multiggx(b);
-            let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
-            let aniso = input_f(b, s, "Anisotropy", 0.0).clamp(-0.99, 0.99);
-            // Multiscatter GGX takes the colour as its Fresnel (Cycles'
-            // bsdf_microfacet_setup_fresnel_constant): a colour below white gets back less
-            // of the energy lost between microfacets.
-            let darkened = |table_roughness: f32| {
-                let weight = scale(c, w);
-                if multi {
-                    let fss = c.map(|x| x.max(0.0));
-                    mul(
-                        weight,
-                        multiscatter_darkening(ctx.tables, mu, table_roughness, fss),
-                    )
-                } else {
-                    weight
-                }
-            };
-            if aniso.abs() > 1e-4 {
-                let (ax, ay) = crate::render::bsdf::anisotropic::glossy_alphas(r, aniso);
-                let t = tangent_input(b, s, sp, "Tangent", input_f(b, s, "Rotation", 0.0), n);
-                push_glossy(
-                    out,
-                    ctx,
-                    ax,
-                    ay,
-                    t,
-                    Fresnel::Constant,
-                    multi,
-                    darkened((ax * ay).sqrt().sqrt()),
-                    n,
-                    1.0,
-                );
-                return;
-            }
-            let energy = if multi {
-                multiscatter_energy(ctx.tables, mu, r)
-            } else {
-                1.0
-            };
-            out.push(
-                LobeKind::Glossy {
-                    alpha: r * r,
-                    fresnel: Fresnel::Constant,
-                    energy,
-                },
-                darkened(r),
-                n,
-            );
-        }
+        "ShaderNodeBsdfAnisotropic" | "ShaderNodeBsdfGlossy" => glossy(b, w, s, sp, ctx, out),
         "ShaderNodeBsdfPrincipled" => principled(b, w, s, sp, ctx, out),
         "ShaderNodeBsdfMetallic" => crate::render::bsdf::metallic::metallic(b, w, s, sp, ctx, out),
         "ShaderNodeBsdfToon" => {
@@ -506,6 +444,72 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             out.push(LobeKind::Diffuse, scale(c, w), sp.normal);
         }
     }
+}
+
+/// The Glossy BSDF node (and the legacy Anisotropic BSDF): GGX, Multiscatter GGX or
+/// Beckmann, isotropic or anisotropic.
+fn glossy(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet) {
+    let c = input_c(b, s, "Color", [0.8; 3]);
+    let r = input_f(b, s, "Roughness", 0.5).clamp(0.0, 1.0);
+    let n = valid_n(sp, ctx, input_n(b, s, "Normal", sp));
+    if b.property("distribution") == Some("BECKMANN") {
+        let r = crate::render::bsdf::microfacet::Reflection {
+            dist: crate::render::bsdf::microfacet::Distribution::Beckmann,
+            alpha: r * r,
+            fresnel: Fresnel::Constant,
+        };
+        out.push(LobeKind::Reflection(r), scale(c, w), n);
+        return;
+    }
+    let multi = is_multiggx(b);
+    let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
+    let aniso = input_f(b, s, "Anisotropy", 0.0).clamp(-0.99, 0.99);
+    // Multiscatter GGX takes the colour as its Fresnel (Cycles'
+    // bsdf_microfacet_setup_fresnel_constant): a colour below white gets back less
+    // of the energy lost between microfacets.
+    let darkened = |table_roughness: f32| {
+        let weight = scale(c, w);
+        if multi {
+            let fss = c.map(|x| x.max(0.0));
+            mul(
+                weight,
+                multiscatter_darkening(ctx.tables, mu, table_roughness, fss),
+            )
+        } else {
+            weight
+        }
+    };
+    if aniso.abs() > 1e-4 {
+        let (ax, ay) = crate::render::bsdf::anisotropic::glossy_alphas(r, aniso);
+        let t = tangent_input(b, s, sp, "Tangent", input_f(b, s, "Rotation", 0.0), n);
+        push_glossy(
+            out,
+            ctx,
+            ax,
+            ay,
+            t,
+            Fresnel::Constant,
+            multi,
+            darkened((ax * ay).sqrt().sqrt()),
+            n,
+            1.0,
+        );
+        return;
+    }
+    let energy = if multi {
+        multiscatter_energy(ctx.tables, mu, r)
+    } else {
+        1.0
+    };
+    out.push(
+        LobeKind::Glossy {
+            alpha: r * r,
+            fresnel: Fresnel::Constant,
+            energy,
+        },
+        darkened(r),
+        n,
+    );
 }
 
 // Long because it follows Cycles' Principled BSDF node layer by layer.
