@@ -25,21 +25,8 @@ pub fn background(scene: &Scene) -> Result<V3, RenderError> {
         // Varies with direction: `shader` evaluates it per ray.
         return Ok([0.0; 3]);
     }
-    let out = tree
-        .nodes
-        .iter()
-        .filter(|n| n.bl_idname == "ShaderNodeOutputWorld")
-        .find(|n| {
-            n.properties
-                .get("is_active_output")
-                .and_then(Value::as_bool)
-                .unwrap_or(true)
-        })
-        .or_else(|| {
-            tree.nodes
-                .iter()
-                .find(|n| n.bl_idname == "ShaderNodeOutputWorld")
-        });
+    // The output the world's program is compiled from (shader::compile), so the two agree.
+    let out = crate::nodes::graph::active_output(tree, "ShaderNodeOutputWorld", "CYCLES");
     let Some(out) = out else { return Ok([0.0; 3]) };
     let Some(link) = tree
         .links
@@ -184,21 +171,8 @@ const MAP_WIDTH: usize = 512;
 /// True when the world output is fed by a Background or Emission node with unlinked
 /// inputs (or by nothing): `background` handles that without a program.
 fn is_constant(tree: &crate::scene::NodeTree) -> bool {
-    let out = tree
-        .nodes
-        .iter()
-        .filter(|n| n.bl_idname == "ShaderNodeOutputWorld")
-        .find(|n| {
-            n.properties
-                .get("is_active_output")
-                .and_then(Value::as_bool)
-                .unwrap_or(true)
-        })
-        .or_else(|| {
-            tree.nodes
-                .iter()
-                .find(|n| n.bl_idname == "ShaderNodeOutputWorld")
-        });
+    // The output the world's program is compiled from (shader::compile), so the two agree.
+    let out = crate::nodes::graph::active_output(tree, "ShaderNodeOutputWorld", "CYCLES");
     let Some(out) = out else { return true };
     let Some(link) = tree
         .links
