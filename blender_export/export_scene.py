@@ -186,9 +186,32 @@ def socket_entry(s, index, where):
     return d
 
 
+def ies_content(n, where):
+    """The photometric data Cycles loads for an IES Texture node: the Text's content, or
+    the file's, read under the same path policy as images; "\n" (which Cycles fails to
+    parse, so every lookup is 100) where it finds none."""
+    if n.mode == "INTERNAL":
+        return (n.ies.as_string() if n.ies is not None else "") or "\n"
+    src = bpy.path.abspath(n.filepath, library=n.id_data.library) if n.filepath else ""
+    if not (src and os.path.isfile(src)):
+        WARNINGS.append(f"{where}: IES file {n.filepath!r} not found (Cycles renders such a texture as 100)")
+        return "\n"
+    real = os.path.realpath(src)
+    if not any(os.path.commonpath([real, root]) == root for root in ALLOWED_ROOTS):
+        fail(f"{where}: IES file {n.filepath!r} resolves to {real}, outside the .blend's folder "
+             f"{ALLOWED_ROOTS[0]}; if you trust this file, allow its folder with --allow-path "
+             f"{os.path.dirname(real)} (or load it into a Text in the .blend)")
+    if os.path.getsize(real) > (16 << 20):
+        fail(f"{where}: IES file {real} is over 16 MB: not photometric data")
+    # Bytes as Latin-1 characters: Cycles parses bytes, and only ASCII digits matter.
+    with open(real, "rb") as f:
+        return f.read().decode("latin-1")
+
+
 def node_entry(n, where):
     group = getattr(n, "node_tree", None)
-    return {
+    extra = {"ies": ies_content(n, where)} if n.bl_idname == "ShaderNodeTexIES" else {}
+    return extra | {
         "name": n.name, "bl_idname": n.bl_idname, "label": n.label, "mute": n.mute,
         "parent": n.parent.name if n.parent else None,
         "location": [n.location[0], n.location[1]], "hide": n.hide,

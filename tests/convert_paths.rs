@@ -102,3 +102,49 @@ fn convert_copies_only_files_inside_the_blends_folder_unless_allowed() {
     );
     assert_clean_error(&o, 1, &["--allow-path", "nope"]);
 }
+
+/// An IES Texture's External file goes by the same policy as images: outside the .blend's
+/// folder an error naming the node and flag; inside, its bytes travel in the export; a
+/// missing one is the "\n" Cycles falls back to (every lookup 100).
+#[test]
+fn ies_files_follow_the_path_policy() {
+    let Some(py) = require("a Python with bpy 4.5.4", bpy_python()) else {
+        return;
+    };
+    let t = tempfile::tempdir().unwrap();
+    let root = t.path();
+    run_python(
+        &py,
+        &repo().join("fixtures/convert_paths/make_blends.py"),
+        &[root.to_str().unwrap()],
+    );
+    let proj = root.join("proj");
+    let out = root.join("out-ies-outside");
+    let o = convert_blend(&py, &proj.join("ies_outside.blend"), &out, &[]);
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    for want in ["IES file", "//../secret/id_rsa", "--allow-path"] {
+        assert!(err.contains(want), "{want:?} not in {err}");
+    }
+    assert!(!err.contains(SECRET), "the error shows the file: {err}");
+    assert!(!out.exists());
+
+    let out = root.join("out-ies-inside");
+    let o = convert_blend(&py, &proj.join("ies_inside.blend"), &out, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let scene = blendsynth::scene::Scene::load(&out).unwrap();
+    let tree = scene.file.lights[0].node_tree.as_ref().unwrap();
+    let ies = |name: &str| {
+        tree.nodes
+            .iter()
+            .find(|n| n.name == name)
+            .and_then(|n| n.ies.clone())
+            .unwrap()
+    };
+    let inside = ies("//lamp.ies");
+    assert!(
+        inside.starts_with("IESNA:LM-63-2002\nTILT=NONE"),
+        "{inside:?}"
+    );
+    assert_eq!(ies("//nope.ies"), "\n");
+}

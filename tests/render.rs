@@ -160,6 +160,9 @@ const ASSERTED: &[&str] = &[
     "light_temperature_normalize",
     // Light node trees: a constant Emission's colour and strength scale the light.
     "light_nodes",
+    // Light node trees that vary, evaluated per light sample: IES Texture on a point and
+    // a spot, Light Falloff on an area light.
+    "light_ies",
     // Per-light Max Bounces (light sampling only; BSDF rays still find the light).
     "light_max_bounces",
     // Cast Shadow off (light.use_shadow in Blender 4.x).
@@ -641,49 +644,44 @@ fn bad_input_is_a_clear_error() {
     assert!(m.contains("no active camera"), "{m}");
 }
 
-/// A light node tree other than a constant Emission is refused by name, never rendered
-/// as if it were absent.
+/// A light node tree is evaluated per sample; a node that reads what a light sample does
+/// not give (here an Attribute) is refused by name, never rendered as if it were absent.
 #[test]
-fn varying_light_node_tree_is_a_clear_error() {
-    let dir = common::repo().join("fixtures/render/scenes/light_nodes");
-    let mut scene = Scene::load(&dir).unwrap();
+fn light_node_tree_refuses_by_name_what_a_light_lacks() {
     let opts = RenderOptions {
         samples: Some(1),
         resolution: Some((8, 8)),
         ..Default::default()
     };
-    assert!(render(&scene, &opts).is_ok());
-    let light = scene
+    let mut ies = Scene::load(&common::repo().join("fixtures/render/scenes/light_ies")).unwrap();
+    assert!(render(&ies, &opts).is_ok());
+    let light = ies
         .file
         .lights
         .iter_mut()
-        .find(|l| l.name == "NodeSpot")
+        .find(|l| l.name == "IesPoint")
         .unwrap();
     let tree = light.node_tree.as_mut().unwrap();
-    let mut link = tree.links[0].clone();
-    link.from_node = "Light Falloff".into();
-    link.from_socket = "Quadratic".into();
-    link.to_node = "Emission".into();
-    link.to_socket = "Strength".into();
-    tree.links.push(link);
-    let RenderError(m) = render(&scene, &opts).expect_err("a linked Emission input is refused");
+    let node = tree
+        .nodes
+        .iter_mut()
+        .find(|n| n.bl_idname == "ShaderNodeTexIES")
+        .unwrap();
+    node.bl_idname = "ShaderNodeAttribute".into();
+    let name = node.name.clone();
+    let RenderError(m) = render(&ies, &opts).expect_err("an Attribute in a light is refused");
     assert!(
-        m.contains("NodeSpot") && m.contains("Strength") && m.contains("Light Falloff"),
+        m.contains("IesPoint") && m.contains(&name) && m.contains("ShaderNodeAttribute"),
         "{m}"
     );
+    let dir = common::repo().join("fixtures/render/scenes/light_nodes");
+    let mut scene = Scene::load(&dir).unwrap();
     // A muted Emission passes nothing (it has no closure input): the spot goes dark.
     let opts = RenderOptions {
         samples: Some(8),
         resolution: Some((24, 24)),
         ..Default::default()
     };
-    let light = scene
-        .file
-        .lights
-        .iter_mut()
-        .find(|l| l.name == "NodeSpot")
-        .unwrap();
-    light.node_tree.as_mut().unwrap().links.pop();
     let mean = |o: &blendsynth::render::RenderOutput| {
         o.color.iter().map(|p| p[0] as f64).sum::<f64>() / o.color.len() as f64
     };

@@ -70,6 +70,8 @@ pub mod sky_hosek;
 // Brick, Image and Environment Textures.
 pub mod brick;
 pub mod image;
+// IES Texture.
+pub mod ies;
 // Input nodes that read the shading context.
 pub mod fresnel;
 pub mod light_falloff;

@@ -686,7 +686,7 @@ fn prepare(
         &eval.world_matrices,
         &object_steps,
     );
-    let lights = light::collect(&eval)?;
+    let lights = light::collect(scene, &eval)?;
     let background = light::world::background(scene)?;
     let world_shader = light::world::shader(scene)?;
     Ok(Prepared {

@@ -439,6 +439,10 @@ pub struct Node {
     /// (`from`) to output identifier (`to`).
     #[serde(default)]
     pub internal_links: Vec<InternalLink>,
+    /// The IES Texture node's photometric data as Cycles loads it: the Text's content
+    /// (Internal) or the file's (External); "\n" where Cycles finds none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ies: Option<String>,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]

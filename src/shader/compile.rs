@@ -786,6 +786,117 @@ pub fn compile_world(scene: &Scene, name: &str) -> Result<Program, CompileError>
         .map_err(|e| CompileError(format!("world {name:?}: {}", e.0)))
 }
 
+/// Node types a light's tree may use: what reads only the light sample's position, normal,
+/// incoming direction and distance (the shading point Cycles sets up for a light), or
+/// nothing at all. Others read context blendsynth does not model at a light (UV, path
+/// state, attributes) and are refused by name.
+const LIGHT_NODES: &[&str] = &[
+    "ShaderNodeOutputLight",
+    "ShaderNodeEmission",
+    "ShaderNodeAddShader",
+    "ShaderNodeMixShader",
+    "ShaderNodeValue",
+    "ShaderNodeRGB",
+    "ShaderNodeTexCoord",
+    "ShaderNodeNewGeometry",
+    "ShaderNodeLightFalloff",
+    "ShaderNodeFresnel",
+    "ShaderNodeLayerWeight",
+    "ShaderNodeTexIES",
+    "ShaderNodeTexNoise",
+    "ShaderNodeTexVoronoi",
+    "ShaderNodeTexWave",
+    "ShaderNodeTexGradient",
+    "ShaderNodeTexMagic",
+    "ShaderNodeTexWhiteNoise",
+    "ShaderNodeTexChecker",
+    "ShaderNodeTexGabor",
+    "ShaderNodeTexBrick",
+    "ShaderNodeTexImage",
+    "ShaderNodeMix",
+    "ShaderNodeMixRGB",
+    "ShaderNodeInvert",
+    "ShaderNodeGamma",
+    "ShaderNodeBrightContrast",
+    "ShaderNodeHueSaturation",
+    "ShaderNodeRGBCurve",
+    "ShaderNodeMapping",
+    "ShaderNodeVectorRotate",
+    "ShaderNodeVectorCurve",
+    "ShaderNodeMath",
+    "ShaderNodeVectorMath",
+    "ShaderNodeMapRange",
+    "ShaderNodeClamp",
+    "ShaderNodeValToRGB",
+    "ShaderNodeFloatCurve",
+    "ShaderNodeRGBToBW",
+    "ShaderNodeSeparateXYZ",
+    "ShaderNodeCombineXYZ",
+    "ShaderNodeSeparateColor",
+    "ShaderNodeCombineColor",
+    "ShaderNodeSeparateRGB",
+    "ShaderNodeCombineRGB",
+    "ShaderNodeSeparateHSV",
+    "ShaderNodeCombineHSV",
+    "ShaderNodeBlackbody",
+    "ShaderNodeWavelength",
+];
+
+/// The outputs of the coordinate nodes a light sample gives (Generated falls back to the
+/// object-space position, as Cycles does for geometry without the attribute).
+const LIGHT_COORDINATES: &[(&str, &[&str])] = &[
+    ("ShaderNodeTexCoord", &["Generated", "Normal", "Object"]),
+    (
+        "ShaderNodeNewGeometry",
+        &["Position", "Normal", "True Normal", "Incoming"],
+    ),
+];
+
+/// Compiles the node tree of light `light` (its evaluated datablock), whose active Light
+/// Output's Surface Cycles evaluates at every light sample; None when it has no Light
+/// Output for Cycles (the light is then black).
+pub fn compile_light(
+    scene: &Scene,
+    light: &crate::scene::format::Light,
+) -> Result<Option<Program>, CompileError> {
+    let name = &light.name;
+    let Some(tree) = light.node_tree.as_ref() else {
+        return Ok(None);
+    };
+    let Some(out) = active_output(tree, "ShaderNodeOutputLight", "CYCLES") else {
+        return Ok(None);
+    };
+    let graph = flatten(tree, &scene.file.node_groups, &out.name)
+        .map_err(|e| CompileError(format!("light {name:?}: {e}")))?;
+    let mut c = Compiler::new(&graph);
+    c.scene = Some(scene);
+    for (i, n) in graph.nodes.iter().enumerate() {
+        let id = n.node.bl_idname.as_str();
+        if !LIGHT_NODES.contains(&id) && !crate::nodes::STRUCTURAL.contains(&id) {
+            return Err(CompileError(format!(
+                "light {name:?}: node {:?} ({id}) in a light's node tree is not supported yet",
+                n.path
+            )));
+        }
+        for (node, allowed) in LIGHT_COORDINATES {
+            if id != *node {
+                continue;
+            }
+            if let Some(o) = n.node.outputs.iter().find(|o| {
+                !allowed.contains(&o.identifier.as_str()) && c.output_used(i, &o.identifier)
+            }) {
+                return Err(CompileError(format!(
+                    "light {name:?}: output {:?} of node {:?} is not supported in a light's node tree yet",
+                    o.identifier, n.path
+                )));
+            }
+        }
+    }
+    c.run()
+        .map(Some)
+        .map_err(|e| CompileError(format!("light {name:?}: {}", e.0)))
+}
+
 /// A world shading point for direction `d` (unit, world space), as Cycles sets up the
 /// background: position, Generated and Object coordinates are the direction, the
 /// normal faces back along the ray, no UV.

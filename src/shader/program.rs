@@ -403,6 +403,13 @@ pub enum Op {
         color: Slot,
         generated: bool,
     },
+    /// IES Texture: Fac from the photometric table at the vector's direction.
+    TexIes {
+        table: std::sync::Arc<crate::nodes::ies::IesTable>,
+        vector: Slot,
+        strength: Slot,
+        fac: Slot,
+    },
     /// Environment Texture (the vector is a direction).
     TexEnvironment {
         image: std::sync::Arc<TexImage>,
@@ -1317,6 +1324,15 @@ impl Program {
                     color,
                     ..
                 } => put3(s, color, sky.eval(v3(s, vector), &LINEAR_REC709)),
+                Op::TexIes {
+                    ref table,
+                    vector,
+                    strength,
+                    fac,
+                } => {
+                    s[fac as usize] =
+                        crate::nodes::ies::ies(table, v3(s, vector), s[strength as usize]);
+                }
                 Op::TexEnvironment {
                     ref image,
                     projection,

@@ -5,6 +5,7 @@
 //! Sampling returns direction, distance and the contribution divided by the pdf.
 
 pub mod area;
+pub mod shader;
 pub mod tree;
 pub mod triangle;
 pub mod world;
@@ -17,6 +18,11 @@ use crate::render::light::area::{rect_solid_angle, Region, Spread};
 use crate::render::math::*;
 use crate::render::RenderError;
 use crate::scene::settings::{AreaShape, LightSettings};
+use crate::scene::Scene;
+use crate::shader::compile::compile_light;
+use crate::shader::view::object_info;
+use shader::LightShader;
+use std::sync::Arc;
 
 #[derive(Debug, Clone)]
 pub enum Shape {
@@ -74,6 +80,9 @@ pub struct Light {
     pub tree_energy: f32,
     /// Area lights' Spread (radians; pi when not set).
     pub spread: f32,
+    /// A node tree that varies, evaluated at every sample (a constant one is folded into
+    /// `strength`).
+    pub shader: Option<std::sync::Arc<shader::LightShader>>,
 }
 
 impl Light {
@@ -150,26 +159,26 @@ const NON_EMITTING_CLOSURES: &[&str] = &[
     "ShaderNodeSubsurfaceScattering",
 ];
 
-/// The factor a light's node tree puts on its colour and power: Cycles multiplies the
-/// light's strength by the emission its shader evaluates to. Only a tree that reduces to a
-/// constant (an Emission node with unlinked inputs into the active Light Output) is
-/// supported; any other is an error naming the light and node, never a stand-in.
-fn node_factor(l: &crate::scene::format::Light) -> Result<V3, RenderError> {
+/// The factor a light's node tree puts on its colour and power when the tree reduces to a
+/// constant (an Emission node with unlinked inputs into the active Light Output, or
+/// nothing that emits): Cycles multiplies the light's strength by the emission its shader
+/// evaluates to. None: the tree varies, and is evaluated per sample (`shader`).
+fn node_factor(l: &crate::scene::format::Light) -> Result<Option<V3>, RenderError> {
     let use_nodes = LightSettings::of(l).use_nodes;
     let Some(tree) = l.node_tree.as_ref().filter(|_| use_nodes) else {
-        return Ok([1.0; 3]);
+        return Ok(Some([1.0; 3]));
     };
     // No output, or nothing linked to it: Cycles renders the light black.
     let Some(out) = crate::nodes::graph::active_output(tree, "ShaderNodeOutputLight", "CYCLES")
     else {
-        return Ok([0.0; 3]);
+        return Ok(Some([0.0; 3]));
     };
     let Some(link) = tree
         .links
         .iter()
         .find(|k| k.to_node == out.name && k.to_socket == "Surface" && !k.is_muted)
     else {
-        return Ok([0.0; 3]);
+        return Ok(Some([0.0; 3]));
     };
     let name = &l.name;
     let node = tree
@@ -184,22 +193,20 @@ fn node_factor(l: &crate::scene::format::Light) -> Result<V3, RenderError> {
         })?;
     // A muted Emission has no closure input to pass through: nothing reaches the output.
     if node.bl_idname == "ShaderNodeEmission" && node.mute {
-        return Ok([0.0; 3]);
+        return Ok(Some([0.0; 3]));
     }
     // A closure that cannot emit (a BSDF wired to the Light Output): Cycles' estimate of
     // the shader's emission is zero, so the light has no contribution and is left out.
     if NON_EMITTING_CLOSURES.contains(&node.bl_idname.as_str()) {
-        return Ok([0.0; 3]);
+        return Ok(Some([0.0; 3]));
     }
-    if node.bl_idname != "ShaderNodeEmission" {
-        return Err(RenderError(format!("light {name:?}: node {:?} ({}) feeding the Light Output is not supported yet (only a constant Emission)", node.name, node.bl_idname)));
-    }
-    if let Some(k) = tree
-        .links
-        .iter()
-        .find(|k| k.to_node == node.name && !k.is_muted)
+    if node.bl_idname != "ShaderNodeEmission"
+        || tree
+            .links
+            .iter()
+            .any(|k| k.to_node == node.name && !k.is_muted)
     {
-        return Err(RenderError(format!("light {name:?}: the linked {:?} input of {:?} (from {:?}) is not supported yet (only a constant Emission)", k.to_socket, node.name, k.from_node)));
+        return Ok(None);
     }
     let input = |id: &str| {
         node.inputs
@@ -210,11 +217,11 @@ fn node_factor(l: &crate::scene::format::Light) -> Result<V3, RenderError> {
     let color =
         crate::scene::settings::rgb(input("Color")).map_or([1.0; 3], |c| c.map(|x| x as f32));
     let strength = input("Strength").and_then(Value::as_f64).unwrap_or(1.0) as f32;
-    Ok(scale(color, strength))
+    Ok(Some(scale(color, strength)))
 }
 
 // Long because one arm per light type, reading its settings as Cycles' light sync does.
-pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
+pub fn collect(scene: &Scene, eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
     let mut out = Vec::new();
     for (oi, obj) in eval.data.objects.iter().enumerate() {
         if obj.kind != "LIGHT" || obj.hide_render || !obj.in_render_layer {
@@ -231,7 +238,22 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
         let color = p.color.map_or([1.0; 3], |c| c.map(|x| x as f32));
         let energy = p.energy as f32;
         let exposure = p.exposure as f32;
-        let mut strength = mul(scale(color, energy * 2f32.powf(exposure)), node_factor(l)?);
+        let (factor, shader) = match node_factor(l)? {
+            Some(f) => (f, None),
+            None => match compile_light(scene, l).map_err(|e| RenderError(e.0))? {
+                // No Light Output for Cycles: the light is black.
+                None => ([0.0; 3], None),
+                Some(program) => {
+                    let info = object_info(obj, &eval.world_matrices[oi]);
+                    let to_world = Affine::from_rows(&eval.world_matrices[oi]).m;
+                    (
+                        [1.0; 3],
+                        Some(Arc::new(LightShader::new(program, info, to_world))),
+                    )
+                }
+            },
+        };
+        let mut strength = mul(scale(color, energy * 2f32.powf(exposure)), factor);
         // Blender 4.5's light temperature: the colour is multiplied by the blackbody colour
         // Blender computed (`temperature_color`, in the scene's working space).
         if p.use_temperature {
@@ -239,7 +261,9 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
                 strength = mul(strength, t.map(|x| x as f32));
             }
         }
-        let tree_energy = average(strength).abs()
+        // Cycles weighs a light in its tree by its shader's emission estimate.
+        let estimate = shader.as_ref().map_or([1.0; 3], |s| s.estimate());
+        let tree_energy = average(mul(strength, estimate)).abs()
             * match l.kind.as_str() {
                 "AREA" => 0.25,
                 "SUN" => 1.0,
@@ -362,6 +386,7 @@ pub fn collect(eval: &EvaluatedScene) -> Result<Vec<Light>, RenderError> {
             exclude,
             tree_energy,
             spread,
+            shader,
         });
     }
     Ok(out)
@@ -459,6 +484,7 @@ impl Light {
                     }
                     // Intensity power / (4 pi) over squared distance.
                     let v = scale(self.strength, atten / (4.0 * PI * d2));
+                    let v = self.shaded(v, self.pos, neg(w), w, d);
                     return Some(LightSample {
                         wi: w,
                         dist: d,
@@ -492,6 +518,7 @@ impl Light {
                         return None;
                     }
                     let v = scale(self.strength, atten * radiance * cos_l * PI * r2 / dq2);
+                    let v = self.shaded(v, q, neg(wi), wi, dq);
                     let pdf = dq2 / (cos_l.max(1e-8) * PI * r2);
                     return Some(LightSample {
                         wi,
@@ -528,6 +555,8 @@ impl Light {
                 }
                 let pdf = 1.0 / (2.0 * PI * omc);
                 let v = scale(self.strength, atten * radiance / pdf);
+                let q = madd(p, wi, dist);
+                let v = self.shaded(v, q, normalize(sub(q, self.pos)), wi, dist);
                 Some(LightSample {
                     wi,
                     dist,
@@ -588,10 +617,11 @@ impl Light {
                     pdf_region * d2 / cos_l
                 };
                 let radiance = atten / (PI * area);
+                let v = scale(self.strength, radiance / pdf);
                 Some(LightSample {
                     wi,
                     dist: d,
-                    value: scale(self.strength, radiance / pdf),
+                    value: self.shaded(v, q, self.dir, wi, d),
                     pdf,
                 })
             }
@@ -601,7 +631,7 @@ impl Light {
                     return Some(LightSample {
                         wi: toward,
                         dist: f32::INFINITY,
-                        value: self.strength,
+                        value: self.shaded_sun(self.strength, toward),
                         pdf: f32::INFINITY,
                     });
                 }
@@ -617,7 +647,7 @@ impl Light {
                 Some(LightSample {
                     wi,
                     dist: f32::INFINITY,
-                    value: scale(self.strength, radiance / pdf),
+                    value: self.shaded_sun(scale(self.strength, radiance / pdf), wi),
                     pdf,
                 })
             }
@@ -658,6 +688,7 @@ impl Light {
                     }
                     let atten = spot.map(|s| s.attenuation(neg(d))).unwrap_or(1.0);
                     let radiance = scale(self.strength, atten / (4.0 * PI * PI * radius * radius));
+                    let radiance = self.shaded(radiance, madd(o, d, t), neg(d), d, t);
                     return Some(LightHit {
                         t,
                         radiance,
@@ -680,6 +711,8 @@ impl Light {
                     }
                 }
                 let radiance = scale(self.strength, atten / (4.0 * PI * PI * r2));
+                let q = madd(o, d, t);
+                let radiance = self.shaded(radiance, q, normalize(sub(q, self.pos)), d, t);
                 Some(LightHit {
                     t,
                     radiance,
@@ -716,9 +749,10 @@ impl Light {
                 if atten <= 0.0 || !pdf.is_finite() {
                     return None;
                 }
+                let radiance = scale(self.strength, atten / (PI * area));
                 Some(LightHit {
                     t,
-                    radiance: scale(self.strength, atten / (PI * area)),
+                    radiance: self.shaded(radiance, q, self.dir, d, t),
                     pdf,
                 })
             }
@@ -733,7 +767,7 @@ impl Light {
                 let s = half_angle.sin();
                 Some(LightHit {
                     t: f32::INFINITY,
-                    radiance: scale(self.strength, 1.0 / (PI * s * s)),
+                    radiance: self.shaded_sun(scale(self.strength, 1.0 / (PI * s * s)), d),
                     pdf: 1.0 / (2.0 * PI * sun_one_minus_cos(*half_angle)),
                 })
             }
@@ -742,6 +776,24 @@ impl Light {
 }
 
 impl Light {
+    /// `v` times the light's varying node tree at light point `q` with normal `ng`, lighting
+    /// a point `t` away along -`wi` (`wi` from the lit point toward the light).
+    #[inline]
+    fn shaded(&self, v: V3, q: V3, ng: V3, wi: V3, t: f32) -> V3 {
+        match &self.shader {
+            None => v,
+            Some(s) => mul(v, s.emission(q, ng, neg(wi), t)),
+        }
+    }
+
+    /// The same for a sun seen along `wi`: Cycles' light point and normal are then the
+    /// direction away from the sun, and its distance f32::MAX.
+    #[inline]
+    fn shaded_sun(&self, v: V3, wi: V3) -> V3 {
+        let away = neg(wi);
+        self.shaded(v, away, away, wi, f32::MAX)
+    }
+
     /// The part of an area light that light sampling from `p` draws from: the whole light
     /// (a rectangle by solid angle, an ellipse by area), or what its spread lets reach `p`.
     fn area_region(
@@ -808,6 +860,7 @@ mod tests {
             exclude: 0,
             tree_energy: 25.0,
             spread: PI,
+            shader: None,
         }
     }
 

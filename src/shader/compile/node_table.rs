@@ -87,7 +87,7 @@ const INFO_ON_MESH: &str =
 const AOV: &str =
     "Cycles writes it to its AOV pass only, never the image: nothing to evaluate (blendsynth writes no AOV passes)";
 const LIGHT_OUTPUT: &str =
-    "the output of a light's node tree (render/light/mod.rs: a constant Emission scales the light, anything else is an error naming the light and node); in a material Cycles renders only the Material Output (fixtures/bake/nodes, case freestyle_and_light_nodes)";
+    "the output of a light's node tree (shader::compile_light, evaluated at every light sample by render/light/shader.rs; nodes that read what a light sample lacks are errors naming the light and node); Cycles parity scene light_ies in tests/render.rs; in a material Cycles renders only the Material Output (fixtures/bake/nodes, case freestyle_and_light_nodes)";
 const METALLIC: &str =
     "render/bsdf/metallic.rs: F82 Tint and Physical Conductor (Cycles' fresnel_conductor) with GGX, Multiscatter GGX and Beckmann, Cycles parity scenes in tests/render.rs (metallic_bsdf, metallic_conductor); anisotropic Beckmann is a compile error naming the node";
 const TOON: &str =
@@ -106,6 +106,8 @@ const GABOR: &str =
     "nodes/gabor.rs: 2D and 3D, isotropic and anisotropic, within 1e-4 of Cycles' EMIT bakes (tests/bake.rs, fixtures/bake/nodes)";
 const SKY: &str =
     "nodes/sky.rs, sky_hosek.rs: Nishita, Preetham and Hosek/Wilkie, every option, within 1e-4 of Cycles' bakes (tests/sky_texture.rs)";
+const IES: &str =
+    "nodes/ies.rs: Cycles' IES parsing and processing (types B and C) and its bicubic lookup; unit tests there, and lights in Cycles parity scenes in tests/render.rs (light_ies)";
 const IMAGE: &str =
     "nodes/brick.rs, image.rs, shader/images.rs: every interpolation, extension, projection and alpha mode in tests/textures.rs; colour spaces other than sRGB, Non-Color and Linear Rec.709, sequences and UDIM are compile errors naming the image";
 const COLOR: &str = "nodes/color.rs, mix.rs, curves.rs; tests/shader_conformance.rs";
@@ -179,6 +181,7 @@ pub const NODES: &[ShaderNode] = &[
     node("ShaderNodeTexChecker", checker_texture, TEXTURE),
     node("ShaderNodeTexGabor", gabor_texture, GABOR),
     node("ShaderNodeTexSky", sky_texture, SKY),
+    node("ShaderNodeTexIES", ies_texture, IES),
     node("ShaderNodeTexBrick", brick_texture, IMAGE),
     node("ShaderNodeTexImage", image_texture, IMAGE),
     node("ShaderNodeTexEnvironment", environment_texture, IMAGE),
@@ -443,9 +446,11 @@ fn aov_output(_: &mut Compiler<'_, '_>, _: usize, _: &Schedule) -> Result<(), Co
     Ok(())
 }
 
-/// A light's output: render/light/mod.rs reads a light's tree; in a material or world only
-/// their own output node is compiled, so this is never reached there.
-fn light_output(_: &mut Compiler<'_, '_>, _: usize, _: &Schedule) -> Result<(), CompileError> {
+/// A light's output (`compile_light`); in a material or world only their own output node
+/// is compiled, so this is never reached there.
+fn light_output(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    c.surface = c.closure_input(n, "Surface")?;
     Ok(())
 }
 
@@ -768,6 +773,40 @@ fn checker_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(
 
 fn sky_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
     c.sky_texture(i)
+}
+
+fn ies_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    // Cycles' default vector is the texture Normal (object space), with no mapping.
+    let vector = if linked(n, "Vector") {
+        c.input(n, "Vector", V)?
+    } else {
+        let d = c.alloc(V);
+        c.ops.push(Op::TexCoord {
+            generated: None,
+            normal: Some(d),
+            uv: None,
+            object: None,
+        });
+        d
+    };
+    let strength = c.input(n, "Strength", F)?;
+    let text = n.node.ies.as_deref().ok_or_else(|| {
+        CompileError(format!(
+            "node {:?}: the export has no IES data for it (convert the .blend again)",
+            n.path
+        ))
+    })?;
+    let table = std::sync::Arc::new(crate::nodes::ies::IesTable::new(text));
+    let fac = c.alloc(F);
+    c.ops.push(Op::TexIes {
+        table,
+        vector,
+        strength,
+        fac,
+    });
+    c.outputs(i, n, &[("Fac", fac, F)]);
+    Ok(())
 }
 
 fn gabor_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
