@@ -347,9 +347,8 @@ fn process_type_b(h: Vec<f32>, v: Vec<f32>, rows: Vec<Vec<f32>>) -> Option<Proce
     } else if h[0] == -90.0 {
         h.iter_mut().for_each(|a| *a += 90.0);
     }
-    // The cubic lookup needs the full circle: 360° repeats 0°.
-    h.push(360.0);
-    rows.push(rows[0].clone());
+    // Later Cycles copies 0° to 360° here; 4.5 does not, so its type B lookups beyond 180°
+    // are zero (fixture case ies_type_b).
     if *v.last()? != 90.0 {
         return None;
     }
@@ -363,7 +362,8 @@ fn process_type_b(h: Vec<f32>, v: Vec<f32>, rows: Vec<Vec<f32>>) -> Option<Proce
             nv.push(90.0 + a);
         }
         for r in rows.iter_mut() {
-            let mut nr: Vec<f32> = r[..n - 1].iter().rev().copied().collect();
+            // Angle 90° - v[i] takes row value i (later Cycles pairs it with i - 1).
+            let mut nr: Vec<f32> = r[1..].iter().rev().copied().collect();
             nr.extend_from_slice(r);
             *r = nr;
         }

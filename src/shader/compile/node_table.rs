@@ -107,7 +107,7 @@ const GABOR: &str =
 const SKY: &str =
     "nodes/sky.rs, sky_hosek.rs: Nishita, Preetham and Hosek/Wilkie, every option, within 1e-4 of Cycles' bakes (tests/sky_texture.rs)";
 const IES: &str =
-    "nodes/ies.rs: Cycles' IES parsing and processing (types B and C) and its bicubic lookup; unit tests there, and lights in Cycles parity scenes in tests/render.rs (light_ies)";
+    "nodes/ies.rs: Cycles 4.5's IES parsing and processing (types B and C, TILT, half and quarter files) and its bicubic lookup: within 1e-4 of Cycles' EMIT bakes (tests/bake.rs, fixtures/bake/nodes, cases ies_*), and on lights the Cycles parity scene light_ies in tests/render.rs";
 const IMAGE: &str =
     "nodes/brick.rs, image.rs, shader/images.rs: every interpolation, extension, projection and alpha mode in tests/textures.rs; colour spaces other than sRGB, Non-Color and Linear Rec.709, sequences and UDIM are compile errors naming the image";
 const COLOR: &str = "nodes/color.rs, mix.rs, curves.rs; tests/shader_conformance.rs";
