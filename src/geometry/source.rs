@@ -34,6 +34,7 @@ pub const NATIVE_MODIFIERS: &[&str] = &[
     "WELD",
     "DISPLACE",
     "SOLIDIFY",
+    "EDGE_SPLIT",
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -10,6 +10,7 @@ use super::set::GeometrySet;
 
 pub mod array;
 pub mod displace;
+pub mod edge_split;
 pub mod mirror;
 pub mod smooth;
 pub mod solidify;
@@ -27,6 +28,7 @@ pub const KINDS: &[&str] = &[
     "WELD",
     "DISPLACE",
     "SOLIDIFY",
+    "EDGE_SPLIT",
 ];
 
 /// What a modifier may read besides its mesh: the object's name and objects' world
@@ -47,6 +49,7 @@ pub fn unsupported(kind: &str, p: &Props) -> Option<String> {
         "WELD" => weld::unsupported(p),
         "DISPLACE" => displace::unsupported(p),
         "SOLIDIFY" => solidify::unsupported(p),
+        "EDGE_SPLIT" => edge_split::unsupported(p),
         _ => Some("not evaluated by blendsynth".into()),
     }
 }
@@ -64,6 +67,7 @@ pub fn apply(kind: &str, p: &Props, ctx: &Context, g: GeometrySet) -> Result<Geo
         "WELD" => weld::apply(p, g),
         "DISPLACE" => displace::apply(p, ctx, g),
         "SOLIDIFY" => solidify::apply(p, g),
+        "EDGE_SPLIT" => edge_split::apply(p, g),
         _ => unreachable!("unsupported() refuses other kinds"),
     }
 }
