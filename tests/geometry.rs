@@ -571,9 +571,10 @@ fn parity_fixtures_stay_small() {
 }
 
 /// Modifiers users randomise take `--set` overrides natively: an override of a Mirror's
-/// merge gives what Blender gave the case authored that way; an override turning on an
-/// option blendsynth does not evaluate (Bisect) is an error naming the object, the
-/// modifier's option and the path, never Blender's mesh for other settings.
+/// merge or Bisect Flip gives what Blender gave the case authored that way; an override
+/// turning on an option blendsynth does not evaluate (Triangulate's Keep Normals) is an
+/// error naming the object, the modifier's option and the path, never Blender's mesh for
+/// other settings.
 #[test]
 fn modifier_overrides_evaluate_or_are_refused_by_name() {
     let scene = load("mirror");
@@ -591,16 +592,39 @@ fn modifier_overrides_evaluate_or_are_refused_by_name() {
     .unwrap();
     assert_eq!(m.vertex_count(), want.vertex_count());
     assert!(max_diff(&m.positions, &want.positions) <= POS_TOL);
-    let path = "objects[\"mirror_x\"].modifiers[\"Mirror0\"].use_bisect_axis";
+    // Turning on Bisect Flip (and off the merge) gives Blender's mesh for those settings.
+    let scene = load("issue26_geo");
+    let want = evaluated(&scene, "bisect_flip_x");
+    let m = mesh_of(
+        &scene,
+        "bisect_x",
+        frame,
+        &[
+            (
+                "objects[\"bisect_x\"].modifiers[\"Mirror0\"].use_bisect_flip_axis".into(),
+                serde_json::json!([true, false, false]),
+            ),
+            (
+                "objects[\"bisect_x\"].modifiers[\"Mirror0\"].use_mirror_merge".into(),
+                serde_json::json!(false),
+            ),
+        ],
+    )
+    .unwrap();
+    assert_eq!(m.corner_verts, want.corner_verts);
+    assert!(max_diff(&m.positions, &want.positions) <= POS_TOL);
+    // An option blendsynth does not evaluate is refused naming object, option and path.
+    let scene = load("triangulate");
+    let path = "objects[\"tri_beauty\"].modifiers[\"Triangulate0\"].keep_custom_normals";
     let e = mesh_of(
         &scene,
-        "mirror_x",
+        "tri_beauty",
         frame,
-        &[(path.into(), serde_json::json!([true, false, false]))],
+        &[(path.into(), serde_json::json!(true))],
     )
     .unwrap_err();
     assert!(
-        e.contains("mirror_x") && e.contains("Bisect X") && e.contains("use_bisect_axis"),
+        e.contains("tri_beauty") && e.contains("Keep Normals") && e.contains("keep_custom_normals"),
         "{e}"
     );
     // A Displace with a legacy texture is refused by name too.
@@ -621,13 +645,6 @@ fn modifier_overrides_evaluate_or_are_refused_by_name() {
 fn unevaluated_modifier_options_are_named() {
     use serde_json::json;
     let cases: &[(&str, &str, &str, serde_json::Value, &str)] = &[
-        (
-            "mirror",
-            "mirror_x",
-            "use_bisect_axis",
-            json!([true, false, false]),
-            "Bisect X",
-        ),
         (
             "triangulate",
             "tri_beauty",
