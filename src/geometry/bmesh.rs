@@ -52,6 +52,10 @@ pub struct BMesh {
     pub edges: Vec<Edge>,
     /// The input edge each edge copies (NONE: defaults).
     pub edge_src: Vec<u32>,
+    /// A tag per edge (`BM_ELEM_TAG`), copied to edges made from it.
+    pub edge_tag: Vec<bool>,
+    /// Freed edge slots, the last freed first (`BLI_mempool` reuses them so).
+    free_edges: Vec<u32>,
     pub loops: Vec<Loop>,
     pub loop_src: Vec<Src>,
     pub faces: Vec<Face>,
@@ -71,6 +75,8 @@ impl BMesh {
             vert_src: (0..nv as u32).map(|v| vec![(v, 1.0)]).collect(),
             edges: Vec::with_capacity(m.edge_count()),
             edge_src: Vec::with_capacity(m.edge_count()),
+            edge_tag: Vec::with_capacity(m.edge_count()),
+            free_edges: Vec::new(),
             loops: Vec::with_capacity(m.corner_count()),
             loop_src: (0..m.corner_count() as u32)
                 .map(|c| vec![(c, 1.0)])
@@ -153,19 +159,48 @@ impl BMesh {
         self.edges[e as usize].disk[s] = (NONE, NONE);
     }
 
-    /// `BM_edge_create` without the double check; `src` is the input edge it copies.
+    /// `BM_edge_create` without the double check; `src` is the input edge it copies. A
+    /// freed slot is taken first.
     pub fn edge_create(&mut self, a: u32, b: u32, src: u32) -> u32 {
-        self.edges.push(Edge {
+        let e = Edge {
             v: [a, b],
             disk: [(NONE, NONE); 2],
             l: NONE,
             alive: true,
-        });
-        self.edge_src.push(src);
-        let id = (self.edges.len() - 1) as u32;
+        };
+        let id = match self.free_edges.pop() {
+            Some(id) => {
+                self.edges[id as usize] = e;
+                self.edge_src[id as usize] = src;
+                self.edge_tag[id as usize] = false;
+                id
+            }
+            None => {
+                self.edges.push(e);
+                self.edge_src.push(src);
+                self.edge_tag.push(false);
+                (self.edges.len() - 1) as u32
+            }
+        };
         self.disk_append(id, a);
         self.disk_append(id, b);
         id
+    }
+
+    /// An edge copying `example` (attributes and tag), as `BM_edge_create` with one.
+    fn edge_create_like(&mut self, a: u32, b: u32, example: u32) -> u32 {
+        let e = self.edge_create(a, b, self.edge_src[example as usize]);
+        self.edge_tag[e as usize] = self.edge_tag[example as usize];
+        e
+    }
+
+    /// Frees an edge without faces (`BM_edge_kill` once its faces are gone).
+    fn edge_kill(&mut self, e: u32) {
+        let [a, b] = self.edges[e as usize].v;
+        self.disk_remove(e, a);
+        self.disk_remove(e, b);
+        self.edges[e as usize].alive = false;
+        self.free_edges.push(e);
     }
 
     /// The edge joining `a` and `b`, if any.
@@ -270,7 +305,7 @@ impl BMesh {
             a[2] + (b[2] - a[2]) * fac,
         ];
         let v_new = self.add_vert(co, src);
-        let e_new = self.edge_create(tv, v_new, self.edge_src[e as usize]);
+        let e_new = self.edge_create_like(tv, v_new, e);
         // `bmesh_disk_vert_replace(e, v_new, tv)`.
         self.disk_remove(e, tv);
         let s = self.slot(e, tv);
@@ -484,6 +519,116 @@ impl BMesh {
         out
     }
 
+    /// Two or more faces (`bm_edge_supports_separate`).
+    pub fn separable(&self, e: u32) -> bool {
+        let l = self.edges[e as usize].l;
+        l != NONE && self.loops[l as usize].radial_next != l
+    }
+
+    /// `bmesh_kernel_edge_separate`: `l_sep` moves to a new copy of `e`.
+    pub fn edge_separate(&mut self, e: u32, l_sep: u32) -> u32 {
+        if self.edges[e as usize].l == l_sep {
+            self.edges[e as usize].l = self.loops[l_sep as usize].radial_next;
+        }
+        let [a, b] = self.edges[e as usize].v;
+        let e_new = self.edge_create_like(a, b, e);
+        self.radial_remove(e, l_sep);
+        self.radial_append(e_new, l_sep);
+        e_new
+    }
+
+    /// `bmesh_edge_vert_swap`: `e` and its loops move from `v_src` to `v_dst`.
+    fn edge_vert_swap(&mut self, e: u32, v_dst: u32, v_src: u32) {
+        let first = self.edges[e as usize].l;
+        if first != NONE {
+            let mut l = first;
+            loop {
+                let lp = self.loops[l as usize];
+                if lp.v == v_src {
+                    self.loops[l as usize].v = v_dst;
+                } else if self.loops[lp.next as usize].v == v_src {
+                    self.loops[lp.next as usize].v = v_dst;
+                }
+                l = lp.radial_next;
+                if l == first {
+                    break;
+                }
+            }
+        }
+        self.disk_remove(e, v_src);
+        let s = self.slot(e, v_src);
+        self.edges[e as usize].v[s] = v_dst;
+        self.disk_append(e, v_dst);
+    }
+
+    /// `BM_edge_splice`: `e_src`'s loops join `e_dst`, `e_src` is freed.
+    pub fn edge_splice(&mut self, e_dst: u32, e_src: u32) {
+        while self.edges[e_src as usize].l != NONE {
+            let l = self.edges[e_src as usize].l;
+            self.radial_remove(e_src, l);
+            self.radial_append(e_dst, l);
+        }
+        self.edge_kill(e_src);
+    }
+
+    /// `bmesh_kernel_vert_separate`: one vertex per fan of edges connected through faces
+    /// around `v`; fans are found from `v`'s first edge, depth first, and each but the
+    /// last moves to a new vertex (a copy of `v`).
+    pub fn vert_separate(&mut self, v: u32) {
+        let first = self.vert_e[v as usize];
+        if first == NONE {
+            return;
+        }
+        let mut visit = std::collections::HashSet::new();
+        let mut e = first;
+        loop {
+            visit.insert(e);
+            e = self.disk_next(e, v);
+            if e == first {
+                break;
+            }
+        }
+        let total = visit.len();
+        let mut found = 0;
+        loop {
+            let mut fan = Vec::new();
+            let mut search = Vec::new();
+            let mut e = self.vert_e[v as usize];
+            visit.remove(&e);
+            loop {
+                fan.push(e);
+                found += 1;
+                let l0 = self.edges[e as usize].l;
+                if l0 != NONE {
+                    let mut l = l0;
+                    loop {
+                        let lp = self.loops[l as usize];
+                        let adj = if lp.v == v { lp.prev } else { lp.next };
+                        let ae = self.loops[adj as usize].e;
+                        if visit.remove(&ae) {
+                            search.push(ae);
+                        }
+                        l = lp.radial_next;
+                        if l == l0 {
+                            break;
+                        }
+                    }
+                }
+                match search.pop() {
+                    Some(x) => e = x,
+                    None => break,
+                }
+            }
+            if found == total {
+                break;
+            }
+            let v_new = self.add_vert(self.co[v as usize], self.vert_src[v as usize].clone());
+            while let Some(e) = fan.pop() {
+                self.edge_vert_swap(e, v_new, v);
+            }
+        }
+    }
+
     /// `BM_vert_kill`: the vertex, its edges and their faces.
     pub fn kill_vert(&mut self, v: u32) {
         while self.vert_e[v as usize] != NONE {
@@ -492,10 +637,7 @@ impl BMesh {
                 let f = self.loops[self.edges[e as usize].l as usize].f;
                 self.kill_face(f);
             }
-            let [a, b] = self.edges[e as usize].v;
-            self.disk_remove(e, a);
-            self.disk_remove(e, b);
-            self.edges[e as usize].alive = false;
+            self.edge_kill(e);
         }
         self.vert_alive[v as usize] = false;
     }
