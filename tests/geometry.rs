@@ -722,6 +722,20 @@ fn unevaluated_modifier_options_are_named() {
             json!(true),
             "Merge",
         ),
+        (
+            "issue26_geo",
+            "wire_default",
+            "use_relative_offset",
+            json!(true),
+            "Offset Relative",
+        ),
+        (
+            "issue26_geo",
+            "wire_default",
+            "vertex_group",
+            json!("Group"),
+            "Vertex Group \"Group\"",
+        ),
     ];
     for (scene, object, key, value, want) in cases {
         let s = load(scene);

@@ -35,6 +35,7 @@ pub const NATIVE_MODIFIERS: &[&str] = &[
     "DISPLACE",
     "SOLIDIFY",
     "EDGE_SPLIT",
+    "WIREFRAME",
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -16,6 +16,7 @@ pub mod smooth;
 pub mod solidify;
 pub mod triangulate;
 pub mod weld;
+pub mod wireframe;
 
 pub type Props = Map<String, Json>;
 
@@ -29,6 +30,7 @@ pub const KINDS: &[&str] = &[
     "DISPLACE",
     "SOLIDIFY",
     "EDGE_SPLIT",
+    "WIREFRAME",
 ];
 
 /// What a modifier may read besides its mesh: the object's name and objects' world
@@ -50,6 +52,7 @@ pub fn unsupported(kind: &str, p: &Props) -> Option<String> {
         "DISPLACE" => displace::unsupported(p),
         "SOLIDIFY" => solidify::unsupported(p),
         "EDGE_SPLIT" => edge_split::unsupported(p),
+        "WIREFRAME" => wireframe::unsupported(p),
         _ => Some("not evaluated by blendsynth".into()),
     }
 }
@@ -68,6 +71,7 @@ pub fn apply(kind: &str, p: &Props, ctx: &Context, g: GeometrySet) -> Result<Geo
         "DISPLACE" => displace::apply(p, ctx, g),
         "SOLIDIFY" => solidify::apply(p, g),
         "EDGE_SPLIT" => edge_split::apply(p, g),
+        "WIREFRAME" => wireframe::apply(p, g),
         _ => unreachable!("unsupported() refuses other kinds"),
     }
 }
