@@ -488,32 +488,78 @@ impl BMesh {
             .find(|&l| self.loops[l as usize].v == v)
     }
 
-    /// `BM_LOOPS_OF_VERT`: `v`'s edges with faces in disk order, each edge's loops at `v`
-    /// in radial order.
+    /// `BM_LOOPS_OF_VERT` (`bmiter__loop_of_vert_*`): from the first disk edge with faces
+    /// (its loop at `v`, which may sit on the face's next edge), each edge's loops at `v`
+    /// in radial order, then the following disk edges with loops at `v`, until every loop
+    /// at `v` was given.
     pub fn vert_loops(&self, v: u32) -> Vec<u32> {
         let mut out = Vec::new();
-        let first = self.vert_e[v as usize];
-        if first == NONE {
+        let start = self.vert_e[v as usize];
+        if start == NONE {
             return out;
         }
-        let mut e = first;
+        let at_v = |l: u32| self.loops[l as usize].v == v;
+        let radial = |l0: u32| {
+            let mut r = vec![l0];
+            let mut l = self.loops[l0 as usize].radial_next;
+            while l != l0 {
+                r.push(l);
+                l = self.loops[l as usize].radial_next;
+            }
+            r
+        };
+        let mut count = 0;
+        let mut l_first = NONE;
+        let mut e = start;
         loop {
-            let l0 = self.edges[e as usize].l;
-            if l0 != NONE {
-                let mut l = l0;
-                loop {
-                    if self.loops[l as usize].v == v {
-                        out.push(l);
-                    }
-                    l = self.loops[l as usize].radial_next;
-                    if l == l0 {
-                        break;
-                    }
+            let l = self.edges[e as usize].l;
+            if l != NONE {
+                count += radial(l).into_iter().filter(|&x| at_v(x)).count();
+                if l_first == NONE {
+                    l_first = if at_v(l) {
+                        l
+                    } else {
+                        self.loops[l as usize].next
+                    };
                 }
             }
             e = self.disk_next(e, v);
-            if e == first {
+            if e == start {
                 break;
+            }
+        }
+        if count == 0 {
+            return out;
+        }
+        let mut e_next = self.loops[l_first as usize].e;
+        let mut l_next = l_first;
+        while out.len() < count {
+            out.push(l_next);
+            // `bmesh_radial_faceloop_find_next`.
+            let mut it = self.loops[l_next as usize].radial_next;
+            while it != l_next && !at_v(it) {
+                it = self.loops[it as usize].radial_next;
+            }
+            l_next = it;
+            if l_next == l_first {
+                // `bmesh_disk_faceedge_find_next`, then the edge's first loop at `v`.
+                let mut f = self.disk_next(e_next, v);
+                while f != e_next {
+                    let l = self.edges[f as usize].l;
+                    if l != NONE && radial(l).into_iter().any(at_v) {
+                        break;
+                    }
+                    f = self.disk_next(f, v);
+                }
+                e_next = f;
+                let l = self.edges[e_next as usize].l;
+                match radial(l).into_iter().find(|&x| at_v(x)) {
+                    Some(x) => {
+                        l_first = x;
+                        l_next = x;
+                    }
+                    None => break,
+                }
             }
         }
         out
