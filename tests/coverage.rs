@@ -180,8 +180,8 @@ fn objects_blendsynth_does_not_build_render_frozen_or_are_refused_by_name() {
         "{}",
         stdout(&o)
     );
-    // An override into a frozen object's modifiers is refused (X keeps the Bisect that
-    // blendsynth does not evaluate); moving it is not.
+    // An override into a frozen object's modifiers is refused (its Cast modifier is not
+    // evaluated by blendsynth); moving it is not.
     let o = run(
         &[
             "render",

@@ -499,12 +499,18 @@ fn unsupported_nodes_are_errors_naming_tree_and_node() {
     let scene =
         Scene::load(&PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/scenes/geonodes"))
             .unwrap();
-    let over = [("node_groups[\"Terrain Builder\"].nodes[\"Ico Sphere\"].inputs[\"Subdivisions\"].default_value".to_string(), serde_json::json!(3))];
+    let over = [(
+        "node_groups[\"Terrain Builder\"].nodes[\"Noise Texture\"].noise_dimensions".to_string(),
+        serde_json::json!("5D"),
+    )];
     let e = mesh_of(&scene, "Terrain", 1.0, &over).unwrap_err();
     assert!(
-        e.contains("Terrain Builder") && e.contains("Ico Sphere"),
+        e.contains("Terrain Builder") && e.contains("Noise Texture") && e.contains("5D"),
         "{e}"
     );
+    // (The Ico Sphere above level 1, this test's example until it was evaluated.)
+    let over = [("node_groups[\"Terrain Builder\"].nodes[\"Ico Sphere\"].inputs[\"Subdivisions\"].default_value".to_string(), serde_json::json!(3))];
+    mesh_of(&scene, "Terrain", 1.0, &over).unwrap();
     let e = mesh_of(&scene, "No Such Object", 1.0, &[]).unwrap_err();
     assert!(e.contains("No Such Object"), "{e}");
 }
@@ -565,9 +571,10 @@ fn parity_fixtures_stay_small() {
 }
 
 /// Modifiers users randomise take `--set` overrides natively: an override of a Mirror's
-/// merge gives what Blender gave the case authored that way; an override turning on an
-/// option blendsynth does not evaluate (Bisect) is an error naming the object, the
-/// modifier's option and the path, never Blender's mesh for other settings.
+/// merge or Bisect Flip gives what Blender gave the case authored that way; an override
+/// turning on an option blendsynth does not evaluate (Triangulate's Keep Normals) is an
+/// error naming the object, the modifier's option and the path, never Blender's mesh for
+/// other settings.
 #[test]
 fn modifier_overrides_evaluate_or_are_refused_by_name() {
     let scene = load("mirror");
@@ -585,16 +592,39 @@ fn modifier_overrides_evaluate_or_are_refused_by_name() {
     .unwrap();
     assert_eq!(m.vertex_count(), want.vertex_count());
     assert!(max_diff(&m.positions, &want.positions) <= POS_TOL);
-    let path = "objects[\"mirror_x\"].modifiers[\"Mirror0\"].use_bisect_axis";
+    // Turning on Bisect Flip (and off the merge) gives Blender's mesh for those settings.
+    let scene = load("issue26_geo");
+    let want = evaluated(&scene, "bisect_flip_x");
+    let m = mesh_of(
+        &scene,
+        "bisect_x",
+        frame,
+        &[
+            (
+                "objects[\"bisect_x\"].modifiers[\"Mirror0\"].use_bisect_flip_axis".into(),
+                serde_json::json!([true, false, false]),
+            ),
+            (
+                "objects[\"bisect_x\"].modifiers[\"Mirror0\"].use_mirror_merge".into(),
+                serde_json::json!(false),
+            ),
+        ],
+    )
+    .unwrap();
+    assert_eq!(m.corner_verts, want.corner_verts);
+    assert!(max_diff(&m.positions, &want.positions) <= POS_TOL);
+    // An option blendsynth does not evaluate is refused naming object, option and path.
+    let scene = load("triangulate");
+    let path = "objects[\"tri_beauty\"].modifiers[\"Triangulate0\"].keep_custom_normals";
     let e = mesh_of(
         &scene,
-        "mirror_x",
+        "tri_beauty",
         frame,
-        &[(path.into(), serde_json::json!([true, false, false]))],
+        &[(path.into(), serde_json::json!(true))],
     )
     .unwrap_err();
     assert!(
-        e.contains("mirror_x") && e.contains("Bisect X") && e.contains("use_bisect_axis"),
+        e.contains("tri_beauty") && e.contains("Keep Normals") && e.contains("keep_custom_normals"),
         "{e}"
     );
     // A Displace with a legacy texture is refused by name too.
@@ -615,13 +645,6 @@ fn modifier_overrides_evaluate_or_are_refused_by_name() {
 fn unevaluated_modifier_options_are_named() {
     use serde_json::json;
     let cases: &[(&str, &str, &str, serde_json::Value, &str)] = &[
-        (
-            "mirror",
-            "mirror_x",
-            "use_bisect_axis",
-            json!([true, false, false]),
-            "Bisect X",
-        ),
         (
             "triangulate",
             "tri_beauty",
@@ -699,6 +722,20 @@ fn unevaluated_modifier_options_are_named() {
             json!(true),
             "Merge",
         ),
+        (
+            "issue26_geo",
+            "wire_default",
+            "use_relative_offset",
+            json!(true),
+            "Offset Relative",
+        ),
+        (
+            "issue26_geo",
+            "wire_default",
+            "vertex_group",
+            json!("Group"),
+            "Vertex Group \"Group\"",
+        ),
     ];
     for (scene, object, key, value, want) in cases {
         let s = load(scene);
@@ -738,6 +775,110 @@ fn subdivision_after_a_solidify_rim_is_frozen_by_name() {
             );
         } else {
             assert_eq!(why, None, "{object}: no rim, evaluated natively");
+        }
+    }
+}
+
+/// FNV-1a 64 of u32s as little-endian bytes (make_ico_digest.py's).
+fn fnv1a64(v: impl IntoIterator<Item = u32>) -> String {
+    let mut h: u64 = 0xcbf29ce484222325;
+    for x in v {
+        for b in x.to_le_bytes() {
+            h ^= b as u64;
+            h = h.wrapping_mul(0x100000001b3);
+        }
+    }
+    format!("{h:016x}")
+}
+
+/// The Ico Sphere at Subdivisions 1 to 5 against Blender's, held to digests
+/// (fixtures/geometry/make_ico_digest.py; levels 4 and 5 whole would not fit the fixture
+/// budget): counts, the topology by hash (so faces, corners and edges in Blender's
+/// order), every STRIDE-th position and UV within 1e-5, and the sums of all of them.
+#[test]
+fn ico_sphere_levels_match_blender_digests() {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/geometry/ico_digest.json");
+    let doc: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let scene = load("issue26_geo");
+    let node = "node_groups[\"ico_sub2\"].nodes[\"Ico Sphere\"].inputs";
+    let levels = doc["levels"].as_array().unwrap();
+    assert_eq!(levels.len(), 5);
+    let f = |v: &serde_json::Value| v.as_f64().unwrap();
+    for lv in levels {
+        let n = lv["subdivisions"].as_i64().unwrap();
+        let over = [
+            (
+                format!("{node}[\"Subdivisions\"].default_value"),
+                serde_json::json!(n),
+            ),
+            (
+                format!("{node}[\"Radius\"].default_value"),
+                lv["radius"].clone(),
+            ),
+        ];
+        let m = mesh_of(&scene, "ico_sub2", 1.0, &over).unwrap();
+        let counts: Vec<u64> = lv["counts"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_u64().unwrap())
+            .collect();
+        let ours = [
+            m.vertex_count(),
+            m.edge_count(),
+            m.face_count(),
+            m.corner_count(),
+        ]
+        .map(|c| c as u64);
+        assert_eq!(ours.to_vec(), counts, "level {n}: counts");
+        for (key, got) in [
+            ("corner_verts", fnv1a64(m.corner_verts.iter().copied())),
+            ("corner_edges", fnv1a64(m.corner_edges.iter().copied())),
+            ("edges", fnv1a64(m.edges.iter().flatten().copied())),
+            ("face_offsets", fnv1a64(m.face_offsets.iter().copied())),
+        ] {
+            assert_eq!(got, lv[key].as_str().unwrap(), "level {n}: {key}");
+        }
+        let uv = match &m.attributes.named("UVMap").expect("UVMap").data {
+            Array::Float2(v) => v.clone(),
+            _ => panic!("UVMap is not FLOAT2"),
+        };
+        let stride = lv["position_stride"].as_u64().unwrap() as usize;
+        for (i, want) in lv["positions"].as_array().unwrap().iter().enumerate() {
+            let p = m.positions[i * stride];
+            for k in 0..3 {
+                let w = f(&want[k]);
+                assert!(
+                    (p[k] as f64 - w).abs() <= POS_TOL as f64,
+                    "level {n}: vertex {}: {p:?} vs {want}",
+                    i * stride
+                );
+            }
+        }
+        let stride = lv["uv_stride"].as_u64().unwrap() as usize;
+        for (i, want) in lv["uvs"].as_array().unwrap().iter().enumerate() {
+            let u = uv[i * stride];
+            for k in 0..2 {
+                assert!(
+                    (u[k] as f64 - f(&want[k])).abs() <= 1e-5,
+                    "level {n}: corner {} UV {u:?} vs {want}",
+                    i * stride
+                );
+            }
+        }
+        for k in 0..3 {
+            let sum: f64 = m.positions.iter().map(|p| p[k] as f64).sum();
+            let w = f(&lv["position_sum"][k]);
+            assert!(
+                (sum - w).abs() <= 1e-4,
+                "level {n}: position sum {sum} vs {w}"
+            );
+        }
+        for k in 0..2 {
+            let sum: f64 = uv.iter().map(|u| u[k] as f64).sum();
+            let w = f(&lv["uv_sum"][k]);
+            assert!((sum - w).abs() <= 1e-3, "level {n}: UV sum {sum} vs {w}");
         }
     }
 }

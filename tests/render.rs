@@ -19,6 +19,8 @@ const MAX_MEAN_REL: f64 = 0.01;
 const ASSERTED: &[&str] = &[
     // A Solidify modifier evaluated natively: shell, rim and even-thickness normals.
     "solidify",
+    // Issue 26's second part: Ico Sphere at Subdivisions 3, Edge Split, Mirror Bisect (64 px).
+    "issue26_geo",
     "adaptive",
     "motion_blur",
     "motion_blur_start",

@@ -26,6 +26,8 @@
 pub mod animated;
 pub mod attribute;
 pub mod beautify;
+pub mod bisect_plane;
+pub mod bmesh;
 pub mod catmull_clark;
 pub mod cdt;
 pub mod curve_eval;

@@ -34,6 +34,8 @@ pub const NATIVE_MODIFIERS: &[&str] = &[
     "WELD",
     "DISPLACE",
     "SOLIDIFY",
+    "EDGE_SPLIT",
+    "WIREFRAME",
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

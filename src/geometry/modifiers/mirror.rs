@@ -4,12 +4,14 @@
 //! its UV maps mirrored and offset; a copied vertex within the merge distance of its source
 //! merges into it (both at their midpoint) with Blender's vertex merge (`weld::merge`).
 //!
-//! Bisect is not evaluated (`unsupported` names it). Clipping only constrains edit-mode
+//! Bisect (and Bisect Flip) first cuts the mesh at the mirror plane and removes the
+//! mirrored side, through BMesh as Blender does (`bisect_plane`). Clipping only constrains edit-mode
 //! transforms and changes nothing here. Vertex groups are not exported, so their mirroring
 //! has nothing to act on. Merging follows modifiers made since Blender 3.0 (copies merge
 //! into their sources); an older modifier merges the other way round, which gives the same
 //! geometry with vertices in another order.
 
+use super::super::bisect_plane::bisect_and_keep_negative;
 use super::super::math::{mat4_invert, mat4_mul, transform_point, MAT4_IDENTITY};
 use super::super::mesh::Mesh;
 use super::super::set::GeometrySet;
@@ -17,14 +19,8 @@ use super::super::types::{Array, Domain};
 use super::super::weld;
 use super::{flag, flags3, float, id_name, Context, Props};
 
-pub fn unsupported(p: &Props) -> Option<String> {
-    let b = flags3(p, "use_bisect_axis");
-    let axes = flags3(p, "use_axis");
-    let names: Vec<&str> = (0..3)
-        .filter(|&k| b[k] && axes[k])
-        .map(|k| ["Bisect X", "Bisect Y", "Bisect Z"][k])
-        .collect();
-    (!names.is_empty()).then(|| format!("{} (use_bisect_axis)", names.join(", ")))
+pub fn unsupported(_p: &Props) -> Option<String> {
+    None
 }
 
 pub fn apply(p: &Props, ctx: &Context, mut g: GeometrySet) -> Result<GeometrySet, String> {
@@ -58,6 +54,8 @@ pub fn apply(p: &Props, ctx: &Context, mut g: GeometrySet) -> Result<GeometrySet
         }
         None => None,
     };
+    let bisect = flags3(p, "use_bisect_axis");
+    let flip = flags3(p, "use_bisect_flip_axis");
     let mut mesh = m.as_ref().clone();
     for axis in 0..3 {
         if !axes[axis] {
@@ -67,6 +65,37 @@ pub fn apply(p: &Props, ctx: &Context, mut g: GeometrySet) -> Result<GeometrySet
         mtx[axis][axis] = -1.0;
         if let Some((tmp, itmp)) = &space {
             mtx = mat4_mul(&mat4_mul(itmp, &mtx), tmp);
+        }
+        if bisect[axis] {
+            let (co, mut no) = match &space {
+                Some((_, itmp)) => {
+                    let mut no = [itmp[axis][0], itmp[axis][1], itmp[axis][2]];
+                    // Non-uniform object scale (Blender's #87592 fix), scaled to its largest.
+                    let ow = (ctx.world)(ctx.object).unwrap_or(MAT4_IDENTITY);
+                    let s: Vec<f32> = (0..3)
+                        .map(|k| ow[k][0] * ow[k][0] + ow[k][1] * ow[k][1] + ow[k][2] * ow[k][2])
+                        .collect();
+                    let max = s[0].max(s[1]).max(s[2]);
+                    if max != 0.0 {
+                        for k in 0..3 {
+                            no[k] *= s[k] * (1.0 / max);
+                        }
+                    }
+                    ([itmp[3][0], itmp[3][1], itmp[3][2]], no)
+                }
+                None => {
+                    let mut no = [0.0f32; 3];
+                    no[axis] = 1.0;
+                    ([mtx[3][0], mtx[3][1], mtx[3][2]], no)
+                }
+            };
+            // Keeps the side not mirrored onto, unless flipped.
+            if !flip[axis] {
+                no = [-no[0], -no[1], -no[2]];
+            }
+            let d = -(no[0] * co[0] + no[1] * co[1] + no[2] * co[2]);
+            let eps = float(p, "bisect_threshold")?;
+            mesh = bisect_and_keep_negative(&mesh, [no[0], no[1], no[2], d], eps)?;
         }
         mesh = mirror_axis(&mesh, &mtx, merge, &uv)?;
     }

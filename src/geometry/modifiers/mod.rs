@@ -10,11 +10,13 @@ use super::set::GeometrySet;
 
 pub mod array;
 pub mod displace;
+pub mod edge_split;
 pub mod mirror;
 pub mod smooth;
 pub mod solidify;
 pub mod triangulate;
 pub mod weld;
+pub mod wireframe;
 
 pub type Props = Map<String, Json>;
 
@@ -27,6 +29,8 @@ pub const KINDS: &[&str] = &[
     "WELD",
     "DISPLACE",
     "SOLIDIFY",
+    "EDGE_SPLIT",
+    "WIREFRAME",
 ];
 
 /// What a modifier may read besides its mesh: the object's name and objects' world
@@ -47,6 +51,8 @@ pub fn unsupported(kind: &str, p: &Props) -> Option<String> {
         "WELD" => weld::unsupported(p),
         "DISPLACE" => displace::unsupported(p),
         "SOLIDIFY" => solidify::unsupported(p),
+        "EDGE_SPLIT" => edge_split::unsupported(p),
+        "WIREFRAME" => wireframe::unsupported(p),
         _ => Some("not evaluated by blendsynth".into()),
     }
 }
@@ -64,6 +70,8 @@ pub fn apply(kind: &str, p: &Props, ctx: &Context, g: GeometrySet) -> Result<Geo
         "WELD" => weld::apply(p, g),
         "DISPLACE" => displace::apply(p, ctx, g),
         "SOLIDIFY" => solidify::apply(p, g),
+        "EDGE_SPLIT" => edge_split::apply(p, g),
+        "WIREFRAME" => wireframe::apply(p, g),
         _ => unreachable!("unsupported() refuses other kinds"),
     }
 }

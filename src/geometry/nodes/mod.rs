@@ -22,6 +22,7 @@ pub mod flip_faces;
 pub mod float_curve;
 pub mod function;
 pub mod geometry_ops;
+pub mod ico_sphere;
 pub mod image_texture;
 pub mod input;
 pub mod instance_transform;
@@ -90,7 +91,7 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ("GeometryNodeMeshGrid", primitives::grid),
     ("GeometryNodeMeshCube", primitives::cube),
     ("GeometryNodeMeshUVSphere", primitives::uv_sphere),
-    ("GeometryNodeMeshIcoSphere", primitives::ico_sphere),
+    ("GeometryNodeMeshIcoSphere", ico_sphere::ico_sphere),
     ("GeometryNodeMeshCylinder", primitives::cylinder),
     ("GeometryNodeMeshCone", primitives::cone),
     ("GeometryNodeMeshCircle", primitives::circle),

@@ -16,7 +16,7 @@ use super::super::set::GeometrySet;
 use super::super::types::{Array, DataType, Domain};
 use super::super::value::SocketValue;
 
-fn mesh_out(mesh: Mesh, extra: Vec<(&str, SocketValue)>) -> Outputs {
+pub(super) fn mesh_out(mesh: Mesh, extra: Vec<(&str, SocketValue)>) -> Outputs {
     let mut o = outputs([("Mesh", SocketValue::Geometry(GeometrySet::from_mesh(mesh)))]);
     for (k, v) in extra {
         o.insert(k.to_string(), v);
@@ -37,7 +37,7 @@ fn empty_out(ctx: &NodeCtx) -> Outputs {
 }
 
 /// Stores `uvs` as the anonymous UV Map attribute when the output is used.
-fn with_uv(
+pub(super) fn with_uv(
     ctx: &NodeCtx,
     mesh: &mut Mesh,
     uvs: impl FnOnce(&Mesh) -> Vec<[f32; 2]>,
@@ -1178,151 +1178,6 @@ pub fn cylinder(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
 pub fn cone(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let (t, b) = (ctx.float("Radius Top")?, ctx.float("Radius Bottom")?);
     cone_like(ctx, t, b, true)
-}
-
-// --- Ico Sphere -------------------------------------------------------------------------
-
-/// The icosahedron of BMesh's `create_icosphere` (vertices in units of 1/200 radius).
-const ICO_VERTS: [[f32; 3]; 12] = [
-    [0.0, 0.0, -200.0],
-    [144.72, -105.144, -89.443],
-    [-55.277, -170.128, -89.443],
-    [-178.885, 0.0, -89.443],
-    [-55.277, 170.128, -89.443],
-    [144.72, 105.144, -89.443],
-    [55.277, -170.128, 89.443],
-    [-144.72, -105.144, 89.443],
-    [-144.72, 105.144, 89.443],
-    [55.277, 170.128, 89.443],
-    [178.885, 0.0, 89.443],
-    [0.0, 0.0, 200.0],
-];
-const ICO_FACES: [[u32; 3]; 20] = [
-    [0, 1, 2],
-    [1, 0, 5],
-    [0, 2, 3],
-    [0, 3, 4],
-    [0, 4, 5],
-    [1, 5, 10],
-    [2, 1, 6],
-    [3, 2, 7],
-    [4, 3, 8],
-    [5, 4, 9],
-    [1, 10, 6],
-    [2, 6, 7],
-    [3, 7, 8],
-    [4, 8, 9],
-    [5, 9, 10],
-    [6, 10, 11],
-    [7, 6, 11],
-    [8, 7, 11],
-    [9, 8, 11],
-    [10, 9, 11],
-];
-const ICO_UVS: [[f32; 2]; 60] = [
-    [0.181819, 0.0],
-    [0.272728, 0.157461],
-    [0.090910, 0.157461],
-    [0.272728, 0.157461],
-    [0.363637, 0.0],
-    [0.454546, 0.157461],
-    [0.909091, 0.0],
-    [1.0, 0.157461],
-    [0.818182, 0.157461],
-    [0.727273, 0.0],
-    [0.818182, 0.157461],
-    [0.636364, 0.157461],
-    [0.545455, 0.0],
-    [0.636364, 0.157461],
-    [0.454546, 0.157461],
-    [0.272728, 0.157461],
-    [0.454546, 0.157461],
-    [0.363637, 0.314921],
-    [0.090910, 0.157461],
-    [0.272728, 0.157461],
-    [0.181819, 0.314921],
-    [0.818182, 0.157461],
-    [1.0, 0.157461],
-    [0.909091, 0.314921],
-    [0.636364, 0.157461],
-    [0.818182, 0.157461],
-    [0.727273, 0.314921],
-    [0.454546, 0.157461],
-    [0.636364, 0.157461],
-    [0.545455, 0.314921],
-    [0.272728, 0.157461],
-    [0.363637, 0.314921],
-    [0.181819, 0.314921],
-    [0.090910, 0.157461],
-    [0.181819, 0.314921],
-    [0.0, 0.314921],
-    [0.818182, 0.157461],
-    [0.909091, 0.314921],
-    [0.727273, 0.314921],
-    [0.636364, 0.157461],
-    [0.727273, 0.314921],
-    [0.545455, 0.314921],
-    [0.454546, 0.157461],
-    [0.545455, 0.314921],
-    [0.363637, 0.314921],
-    [0.181819, 0.314921],
-    [0.363637, 0.314921],
-    [0.272728, 0.472382],
-    [0.0, 0.314921],
-    [0.181819, 0.314921],
-    [0.090910, 0.472382],
-    [0.727273, 0.314921],
-    [0.909091, 0.314921],
-    [0.818182, 0.472382],
-    [0.545455, 0.314921],
-    [0.727273, 0.314921],
-    [0.636364, 0.472382],
-    [0.363637, 0.314921],
-    [0.545455, 0.314921],
-    [0.454546, 0.472382],
-];
-
-/// Ico Sphere with one subdivision (the icosahedron), in BMesh's creation order: faces as
-/// listed, each face's missing edges created in corner order.
-pub fn ico_sphere(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
-    let radius = ctx.float("Radius")?;
-    let subdivisions = ctx.int("Subdivisions")?;
-    if subdivisions < 1 {
-        return Ok(empty_out(ctx));
-    }
-    if subdivisions > 1 {
-        return Err(
-            ctx.err("Subdivisions above 1 (BMesh sphere subdivision) are not supported yet")
-        );
-    }
-    let div = radius.abs() / 200.0;
-    let mut m = Mesh::new();
-    m.positions = ICO_VERTS
-        .iter()
-        .map(|v| [div * v[0], div * v[1], div * v[2]])
-        .collect();
-    let mut edge_of = std::collections::HashMap::new();
-    for f in ICO_FACES {
-        // `BM_edges_from_verts_ensure`: edges (prev, this) from (last, first) on.
-        let mut ids = [0u32; 3];
-        for k in 0..3 {
-            let (a, b) = (f[(k + 2) % 3], f[k]);
-            let key = (a.min(b), a.max(b));
-            ids[(k + 2) % 3] = *edge_of.entry(key).or_insert_with(|| {
-                m.edges.push([a, b]);
-                (m.edges.len() - 1) as u32
-            });
-        }
-        for k in 0..3 {
-            m.corner_verts.push(f[k]);
-            m.corner_edges.push(ids[k]);
-        }
-        m.face_offsets.push(m.corner_verts.len() as u32);
-    }
-    m.set_smooth(false);
-    m.materials = vec![None];
-    let extra = with_uv(ctx, &mut m, |_| ICO_UVS.to_vec());
-    Ok(mesh_out(m, extra))
 }
 
 /// Blender's `create_cuboid_mesh` without a UV map (Bounding Box uses it): `size`
