@@ -19,6 +19,8 @@ const MAX_MEAN_REL: f64 = 0.01;
 const ASSERTED: &[&str] = &[
     // A Solidify modifier evaluated natively: shell, rim and even-thickness normals.
     "solidify",
+    // Particle hair (children) as Cycles' default Rounded Ribbons (render/curves.rs).
+    "hair",
     "adaptive",
     "motion_blur",
     "motion_blur_start",
