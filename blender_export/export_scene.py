@@ -565,6 +565,85 @@ def evaluated_meshes(objs, depsgraph):
     return {name: (concat_meshes(p), n_inst[name], mats[name], uvinfo[name]) for name, p in parts.items()}
 
 
+def hair_strands(o, depsgraph, path):
+    """The strands Cycles renders for an object's hair particle systems (render type Path),
+    as Cycles' blender/curves.cpp syncs them: children only when the system has children,
+    else the parents; (1 << render_step) + 1 keys each (plus the spiral kink's extra
+    steps), from the evaluated path cache (BKE_particle_co_hair) in object space; per key
+    the radius of the shape between the root and tip radii by the key's length fraction.
+    Writes x, y, z, radius per key (little-endian float32) to `path`; returns the
+    systems' entries, or None when the object has no strands."""
+    ev = o.evaluated_get(depsgraph)
+    inverse = np.linalg.inv(np.array(ev.matrix_world, dtype=np.float64))
+    n_slots = max(len(ev.material_slots), 1)
+    systems, chunks = [], []
+    for m in ev.modifiers:
+        if m.type != "PARTICLE_SYSTEM" or not m.show_render:
+            continue
+        psys = m.particle_system
+        st = psys.settings
+        if st.type != "HAIR" or st.render_type != "PATH":
+            continue
+        totpart, totchild = len(psys.particles), len(psys.child_particles)
+        first = totpart if (st.child_type != "NONE" and totchild) else 0
+        count = totpart + totchild - first
+        if count <= 0:
+            continue
+        steps = (1 << st.render_step) + 1
+        if st.kink == "SPIRAL":
+            steps += st.kink_extra_steps
+        root = st.radius_scale * 0.5 * st.root_radius
+        tip = st.radius_scale * 0.5 * st.tip_radius
+        keys = np.zeros((count, steps, 4), dtype=np.float64)
+        for c in range(count):
+            prev = (0.0, 0.0, 0.0)
+            for s in range(steps):
+                co = psys.co_hair(ev, particle_no=first + c, step=s)
+                # co_hair leaves a step the cache lacks unset: Cycles keeps the previous key.
+                w = tuple(co) if co is not None else prev
+                keys[c, s, :3] = w
+                prev = w
+        pts = keys[:, :, :3] @ inverse[:3, :3].T + inverse[:3, 3]
+        keys[:, :, :3] = pts
+        seg = np.linalg.norm(np.diff(pts, axis=1), axis=2)
+        along = np.concatenate([np.zeros((count, 1)), np.cumsum(seg, axis=1)], axis=1)
+        total = along[:, -1:]
+        time_ = np.where(total > 0.0, along / np.where(total > 0.0, total, 1.0), 0.0)
+        radius = 1.0 - time_
+        if st.shape < 0.0:
+            radius = radius ** (1.0 + st.shape)
+        elif st.shape > 0.0:
+            radius = radius ** (1.0 / (1.0 - st.shape))
+        radius = radius * (root - tip) + tip
+        if st.use_close_tip:
+            radius[:, -1] = 0.0
+        keys[:, :, 3] = radius
+        chunks.append(keys.astype("<f4").reshape(-1))
+        systems.append({"name": psys.name, "material_slot": min(max(st.material - 1, 0), n_slots - 1),
+                        "curve_count": count, "keys_per_curve": steps, "children": first > 0})
+    if not systems:
+        return None
+    with open(path, "wb") as f:
+        f.write(np.concatenate(chunks).tobytes())
+    return systems
+
+
+def export_hair(objs, out, index):
+    """Each object's hair strands (`hair_strands`) in hair/, by object name: the file and
+    its systems."""
+    got = {}
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    for o in objs:
+        if not any(m.type == "PARTICLE_SYSTEM" for m in o.modifiers):
+            continue
+        rel = f"hair/{safe_name(index[key(o)], key(o))[:-4]}.bin"
+        os.makedirs(os.path.join(out, "hair"), exist_ok=True)
+        systems = hair_strands(o, depsgraph, os.path.join(out, rel))
+        if systems is not None:
+            got[key(o)] = {"file": rel, "systems": systems}
+    return got
+
+
 FROZEN_TYPES = {"CURVE", "SURFACE", "FONT", "META"}
 ID_COLLECTIONS = {"OBJECT": "objects", "MESH": "meshes", "CURVE": "curves", "KEY": "shape_keys",
                   "ARMATURE": "armatures", "META": "metaballs", "METABALL": "metaballs", "LATTICE": "lattices",
@@ -590,6 +669,7 @@ class RenderSettings:
                 st = ps.settings
                 self.put(st, "display_percentage", 100)
                 self.put(st, "child_percent", st.rendered_child_count)
+                self.put(st, "display_step", st.render_step)  # hair paths at Cycles' render steps
         for c in bpy.data.curves:
             if c.render_resolution_u > 0:
                 self.put(c, "resolution_u", c.render_resolution_u)
@@ -691,8 +771,7 @@ def frozen_inputs(o):
         if m.type == "PARTICLE_SYSTEM":
             st = m.particle_system.settings
             add(st)
-            if st.type == "HAIR" and st.render_type == "PATH":
-                unsupported.append(f"hair particle system {q(m.particle_system.name)}")
+            # Hair paths are exported as strands (`hair_strands`).
             if st.instance_object is not None:
                 others.append(st.instance_object)
             if st.instance_collection is not None:
@@ -1188,6 +1267,7 @@ def main():
         targets = [o for o in data.objects if frozen_target(o) and in_view_layer(o, view_layer)]
         with RenderSettings():
             frozen_meshes = evaluated_meshes(targets, bpy.context.evaluated_depsgraph_get())
+            hair = export_hair(targets, out, index)
         for name, ((counts, arrays, attrs, uvs), n_inst, mats, (uv_layers, render_uv, color)) in frozen_meshes.items():
             rel = f"evaluated/{safe_name(index[name], name)}"
             write_mesh_glb(os.path.join(out, rel), name, counts, arrays, attrs, uvs)
@@ -1196,7 +1276,7 @@ def main():
                               "vertex_count": counts[0], "face_count": counts[2], "instances_realized": n_inst,
                               "reads": reads, "animated": animated, "unsupported": unsupported,
                               "materials": mats, "uv_layers": uv_layers, "active_render_uv": render_uv,
-                              "default_color_attribute": color})
+                              "default_color_attribute": color, "hair": hair.get(name)})
 
     RENDER_LAYER.update(render_layer_objects(view_layer))
     used_images = set()
@@ -1230,6 +1310,7 @@ def main():
             "camera": key(scene.camera) if scene.camera else None, "world": key(scene.world) if scene.world else None,
             "render": rna_value(scene.render, 0, "scene.render"),
             "cycles": rna_value(scene.cycles, 0, "scene.cycles") if hasattr(scene, "cycles") else {},
+            "cycles_curves": rna_value(scene.cycles_curves, 0, "scene.cycles_curves") if hasattr(scene, "cycles_curves") else {},
             "view_settings": rna_value(scene.view_settings, 0, "scene.view_settings"),
             "display_settings": rna_value(scene.display_settings, 0, "scene.display_settings"),
             "unit_settings": rna_value(scene.unit_settings, 0, "scene.unit_settings"),

@@ -21,6 +21,8 @@ const ASSERTED: &[&str] = &[
     "solidify",
     // Issue 26's second part: Ico Sphere at Subdivisions 3, Edge Split, Mirror Bisect (64 px).
     "issue26_geo",
+    // Particle hair (children) as Cycles' default Rounded Ribbons (render/curves.rs).
+    "hair",
     "adaptive",
     "motion_blur",
     "motion_blur_start",
@@ -1544,5 +1546,72 @@ fn unsupported_volumes_are_refused_by_name() {
             }]);
         },
         &["object \"Cube\"", "fluid domain", "\"Fluid\"", "\"Fog\""],
+    );
+}
+
+/// What blendsynth does not render on hair is an error naming the object and what it
+/// has, the same from `inspect` (render::check) and `render`.
+#[test]
+fn unsupported_hair_is_refused_by_name() {
+    let dir = common::repo().join("fixtures/render/scenes/hair");
+    let base: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("scene.json")).unwrap()).unwrap();
+    let refused = |edit: &dyn Fn(&mut serde_json::Value), words: &[&str]| {
+        let mut json = base.clone();
+        edit(&mut json);
+        let scene = Scene::from_json(&dir, json.to_string().as_bytes()).unwrap();
+        let opts = RenderOptions {
+            samples: Some(1),
+            resolution: Some((8, 8)),
+            ..Default::default()
+        };
+        let checked = blendsynth::render::check(&scene, &opts, &[])
+            .err()
+            .map(|RenderError(m)| m)
+            .unwrap_or_default();
+        let rendered = render(&scene, &opts)
+            .err()
+            .map(|RenderError(m)| m)
+            .unwrap_or_default();
+        assert_eq!(checked, rendered, "inspect and render disagree");
+        for w in words {
+            assert!(checked.contains(w), "{checked:?} lacks {w:?}");
+        }
+    };
+    // The export as made renders.
+    let scene = Scene::from_json(&dir, base.to_string().as_bytes()).unwrap();
+    let opts = RenderOptions {
+        samples: Some(1),
+        resolution: Some((8, 8)),
+        ..Default::default()
+    };
+    assert!(blendsynth::render::check(&scene, &opts, &[]).is_ok());
+    // Render > Curves > Shape 3D Curves.
+    refused(
+        &|j| j["scene"]["cycles_curves"]["shape"] = "THICK".into(),
+        &["\"Emitter\"", "THICK"],
+    );
+    // A Hair Info node in the hair's material.
+    refused(
+        &|j| {
+            let ms = j["materials"].as_array_mut().unwrap();
+            let m = ms.iter_mut().find(|m| m["name"] == "Hair").unwrap();
+            let nodes = m["node_tree"]["nodes"].as_array_mut().unwrap();
+            let mut info = nodes[0].clone();
+            info["name"] = "Hair Info".into();
+            info["bl_idname"] = "ShaderNodeHairInfo".into();
+            info["inputs"] = serde_json::json!([]);
+            info["outputs"] = serde_json::json!([]);
+            nodes.push(info);
+        },
+        &["\"Emitter\"", "material \"Hair\"", "Hair Info"],
+    );
+    // A hair file that does not hold what scene.json declares.
+    refused(
+        &|j| {
+            let e = j["evaluated"].as_array_mut().unwrap();
+            e[0]["hair"]["systems"][0]["curve_count"] = 481.into();
+        },
+        &["evaluated[0].hair.file", "\"Emitter\"", "bytes"],
     );
 }

@@ -5,6 +5,7 @@
 
 pub mod bvh;
 pub mod bvh4;
+pub mod bvh_boxes;
 pub mod embree;
 pub mod exr;
 pub mod files;

@@ -61,6 +61,9 @@ pub struct MeshInstance {
     /// Cycles' shadow terminator shading offset as its kernel keeps it, 1 / (1 - offset / 2)
     /// (1: none); see `terminator::shift_cos_in`.
     pub terminator_frequency: f32,
+    /// Hair: the object's curves (`render::curves`); the instance then has no triangles
+    /// and its prims are curve segments.
+    pub curves: Option<Arc<crate::render::curves::ObjectCurves>>,
 }
 
 impl MeshInstance {
@@ -68,6 +71,12 @@ impl MeshInstance {
     /// per-face slots), None for an empty slot.
     #[inline]
     pub fn material_of(&self, tri: usize) -> Option<usize> {
+        if let Some(c) = &self.curves {
+            // A curve segment: its curve's slot.
+            let curve = c.segments.get(tri).map_or(0, |s| s.0 as usize);
+            let slot = c.slot.get(curve).copied().unwrap_or(0) as usize;
+            return self.slots.get(slot).copied().flatten();
+        }
         let face = self.mesh.triangle_faces[tri] as usize;
         let slot = self.face_slot.get(face).copied().unwrap_or(0) as usize;
         self.slots.get(slot).copied().flatten()
@@ -234,6 +243,12 @@ pub fn build(
                     let pushed = instances.last_mut().expect("pushed");
                     pushed.nested_instancer_names = obj.attribute_lookups.keys().cloned().collect();
                 }
+                let hair = scene
+                    .load_hair(ei)
+                    .map_err(|err| RenderError(format!("object {:?}: {err}", obj.name)))?;
+                if let Some(h) = hair {
+                    push_curves(&mut instances, scene, oi, obj, &info, &h, to_world)?;
+                }
             }
             Source::Evaluate => {
                 let curve_materials = obj
@@ -387,11 +402,52 @@ fn warn_shadow_catcher(name: &str) {
     WARN.call_once(|| eprintln!("warning: object {name:?} is a shadow catcher, which the renderer does not support: it is rendered as an ordinary object"));
 }
 
-/// Every instance's triangles in world space, skipping those with non-finite corners.
+/// Every instance's triangles in world space, skipping those with non-finite corners;
+/// then every curve segment (a degenerate triangle at its first key, so that per-prim
+/// arrays line up: `render::curves`).
 pub fn world_triangles(instances: &[MeshInstance]) -> (Vec<[V3; 3]>, Vec<TriRef>) {
     let mut tris = Vec::new();
     let mut refs = Vec::new();
     for (ii, inst) in instances.iter().enumerate() {
+        let Some(c) = &inst.curves else {
+            continue;
+        };
+        for (s, &(_, k0)) in c.segments.iter().enumerate() {
+            let k = c.keys[k0 as usize];
+            tris.push([[k[0], k[1], k[2]]; 3]);
+            refs.push(TriRef {
+                inst: ii as u32,
+                tri: s as u32,
+            });
+        }
+    }
+    let (mut tris, mut refs) = {
+        let (t, r) = (tris, refs);
+        let (mut mt, mut mr) = mesh_triangles(instances);
+        mt.extend(t);
+        mr.extend(r);
+        (mt, mr)
+    };
+    tris.shrink_to_fit();
+    refs.shrink_to_fit();
+    (tris, refs)
+}
+
+/// How many of `geo`'s prims are triangles (the curve segments follow them).
+pub fn triangle_count(geo: &Geometry) -> usize {
+    geo.refs
+        .iter()
+        .position(|r| geo.instances[r.inst as usize].curves.is_some())
+        .unwrap_or(geo.refs.len())
+}
+
+fn mesh_triangles(instances: &[MeshInstance]) -> (Vec<[V3; 3]>, Vec<TriRef>) {
+    let mut tris = Vec::new();
+    let mut refs = Vec::new();
+    for (ii, inst) in instances.iter().enumerate() {
+        if inst.curves.is_some() {
+            continue;
+        }
         let m = &inst.mesh;
         let world: Vec<V3> = m
             .positions
@@ -441,6 +497,79 @@ fn push_instance(
     if mesh.triangles.is_empty() {
         return Ok(());
     }
+    instances.push(new_instance(
+        scene,
+        oi,
+        obj,
+        info,
+        mesh,
+        to_world,
+        instance_index,
+    )?);
+    Ok(())
+}
+
+/// An object's hair as an instance of its own: the object's material slots, no mesh.
+fn push_curves(
+    instances: &mut Vec<MeshInstance>,
+    scene: &Scene,
+    oi: usize,
+    obj: &crate::scene::Object,
+    info: &MeshInfo,
+    hair: &crate::scene::hair::HairData,
+    to_world: Affine,
+) -> Result<(), RenderError> {
+    if hair.curves.is_empty() {
+        return Ok(());
+    }
+    let c = crate::scene::settings::CurveSettings::of(&scene.file.scene);
+    if c.shape != "RIBBONS" {
+        return Err(RenderError(format!(
+            "object {:?}: hair curve shape {:?} (Render > Curves > Shape) is not supported: only Rounded Ribbons (RIBBONS) is rendered",
+            obj.name, c.shape
+        )));
+    }
+    let curves = crate::render::curves::ObjectCurves::new(hair, &to_world, c.subdivisions);
+    let mut inst = new_instance(
+        scene,
+        oi,
+        obj,
+        info,
+        Arc::new(MeshData::default()),
+        to_world,
+        None,
+    )?;
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for s in 0..curves.segments.len() {
+        let (a, b) = curves.segment_bounds(s as u32);
+        lo = vmin(lo, a);
+        hi = vmax(hi, b);
+    }
+    inst.world_bounds = (lo, hi);
+    if info.texspace.is_none() {
+        // No mesh texture space: Generated spans the strands' object-space bounds.
+        let (mut a, mut b) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for k in &hair.keys {
+            a = vmin(a, [k[0], k[1], k[2]]);
+            b = vmax(b, [k[0], k[1], k[2]]);
+        }
+        inst.tex_loc = scale(add(a, b), 0.5);
+        inst.tex_size = scale(sub(b, a), 0.5).map(|x| if x > 0.0 { x } else { 1.0 });
+    }
+    inst.curves = Some(Arc::new(curves));
+    instances.push(inst);
+    Ok(())
+}
+
+fn new_instance(
+    scene: &Scene,
+    oi: usize,
+    obj: &crate::scene::Object,
+    info: &MeshInfo,
+    mesh: Arc<MeshData>,
+    to_world: Affine,
+    instance_index: Option<u32>,
+) -> Result<MeshInstance, RenderError> {
     // Object-linked slots override the mesh's materials (Blender's slot link).
     let mesh_materials = info.materials;
     let nslots = mesh_materials.len().max(obj.material_slots.len()).max(1);
@@ -493,7 +622,7 @@ fn push_instance(
             scale(sub(hi, lo), 0.5).map(|x| if x == 0.0 { 1.0 } else { x }),
         ),
     };
-    instances.push(MeshInstance {
+    Ok(MeshInstance {
         object: oi,
         name: obj.name.clone(),
         instance_index,
@@ -533,8 +662,8 @@ fn push_instance(
         shadow_terminator: obj.shadow_terminator_geometry_offset,
         // Cycles' kernel keeps the shading offset as a frequency multiplier (object.cpp).
         terminator_frequency: 1.0 / (1.0 - 0.5 * obj.shadow_terminator_shading_offset),
-    });
-    Ok(())
+        curves: None,
+    })
 }
 
 /// Whether instances inside `g` (at any depth) carry an attribute named `name`.
@@ -571,6 +700,9 @@ pub fn bind_attributes(
             if p.attributes.is_empty() {
                 per_slot.push(None);
                 continue;
+            }
+            if inst.curves.is_some() {
+                return Err(RenderError(format!("object {:?}: material {:?} on its hair reads attributes ({:?}), which the export does not carry for hair strands (not supported yet)", inst.name, materials[mi].name, p.attributes)));
             }
             for r in &p.attributes {
                 if let crate::shader::attributes::AttributeRequest::Instancer(name) = r {

@@ -18,6 +18,7 @@ pub mod bsdf;
 pub mod build;
 pub mod camera;
 pub mod control;
+pub mod curves;
 pub mod default_surface;
 pub mod displace;
 pub mod film;
@@ -251,7 +252,7 @@ fn render_frame(
     let bvh = if motion_accel.is_some() {
         backend.build_masked(&[], &[])
     } else {
-        backend.build_masked(&geo.tris, &build::triangle_masks(&geo))
+        with_curves(backend, &geo)
     }
     .map_err(RenderError)?;
     let filter = film::filter::FilterTable::blackman_harris(integrator.filter_width as f32);
@@ -536,7 +537,7 @@ fn render_frame(
             }
         }
     }
-    let triangles = geo.tris.len();
+    let triangles = build::triangle_count(&geo);
     drop(motion_accel);
     Ok((
         RenderOutput {
@@ -586,7 +587,7 @@ pub fn check(
     opts: &RenderOptions,
     overrides: &[(String, Value)],
 ) -> Result<usize, RenderError> {
-    prepare(scene, opts, overrides).map(|p| p.geo.tris.len())
+    prepare(scene, opts, overrides).map(|p| build::triangle_count(&p.geo))
 }
 
 fn prepare(
@@ -676,6 +677,7 @@ fn prepare(
         }
     }
     let materials = integrator::shade::compile_all(scene, &used)?;
+    curves::check(scene, &geo, &materials)?;
     build::bind_attributes(&mut geo, &materials)?;
     if displace::apply(&mut geo, &materials) > 0 {
         (geo.tris, geo.refs) = build::world_triangles(&geo.instances);
@@ -686,6 +688,11 @@ fn prepare(
         &eval.world_matrices,
         &object_steps,
     );
+    if moving > 0 {
+        if let Some(h) = geo.instances.iter().find(|i| i.curves.is_some()) {
+            return Err(RenderError(format!("object {:?}: hair curves with motion blur (moving objects in the shutter) are not supported: turn motion blur off", h.name)));
+        }
+    }
     let lights = light::collect(scene, &eval)?;
     let background = light::world::background(scene)?;
     let world_shader = light::world::shader(scene)?;
@@ -1020,3 +1027,27 @@ fn primary_passes(
 
 #[doc(hidden)]
 pub fn _assert_accel_object_safe(_: &dyn Accel) {}
+
+/// The scene's ray structure: `backend`'s over the triangles, beside the hair curves'
+/// (`curves::WithCurves`) when there are any; Embree is refused with curves (blendsynth
+/// gives it triangles only).
+fn with_curves(backend: accel::Backend, geo: &build::Geometry) -> Result<Box<dyn Accel>, String> {
+    let n = build::triangle_count(geo);
+    let masks = build::triangle_masks(geo);
+    let Some(c) = curves::CurveAccel::build(geo) else {
+        return backend.build_masked(&geo.tris, &masks);
+    };
+    if backend == accel::Backend::Embree {
+        let name = geo
+            .instances
+            .iter()
+            .find(|i| i.curves.is_some())
+            .map(|i| i.name.clone())
+            .unwrap_or_default();
+        return Err(format!("BLENDSYNTH_ACCEL=embree: object {name:?} has hair curves, which blendsynth's Embree backend does not take yet (use bvh4 or bvh2)"));
+    }
+    Ok(Box::new(curves::WithCurves {
+        tris: backend.build_masked(&geo.tris[..n], &masks[..n])?,
+        curves: std::sync::Arc::new(c),
+    }))
+}

@@ -82,6 +82,10 @@ pub struct SceneSettings {
     pub render: Rna,
     #[serde(default)]
     pub cycles: Rna,
+    /// Cycles' Curves panel (`scene.cycles_curves`: shape, subdivisions); absent in older
+    /// exports, whose defaults then apply.
+    #[serde(default)]
+    pub cycles_curves: Rna,
     #[serde(default)]
     pub view_settings: Rna,
     #[serde(default)]
@@ -635,6 +639,31 @@ pub struct Evaluated {
     /// ...), named: such an object is refused.
     #[serde(default)]
     pub unsupported: Vec<String>,
+    /// The hair strands Cycles renders with the object (its Path hair particle
+    /// systems), None when it has none (`scene::hair`).
+    #[serde(default)]
+    pub hair: Option<HairRef>,
+}
+
+/// An object's hair strands: a file of x, y, z, radius per key (little-endian f32,
+/// object space), curve after curve, system after system.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct HairRef {
+    pub file: String,
+    pub systems: Vec<HairSystem>,
+}
+
+/// One hair particle system's strands as Cycles syncs them.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct HairSystem {
+    pub name: String,
+    /// The object's material slot the strands use (Cycles' omat - 1, clamped).
+    pub material_slot: usize,
+    pub curve_count: usize,
+    pub keys_per_curve: usize,
+    /// Whether the strands are the children (the parents then do not render).
+    #[serde(default)]
+    pub children: bool,
 }
 
 #[derive(Debug, Clone, Default, Serialize, Deserialize)]

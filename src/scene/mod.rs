@@ -7,6 +7,7 @@ pub mod datapath;
 pub mod error;
 pub mod file;
 pub mod format;
+pub mod hair;
 pub mod limits;
 pub mod mesh;
 pub mod overrides;

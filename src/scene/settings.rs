@@ -28,6 +28,25 @@ fn group<'a>(m: &'a Rna, k: &str) -> Option<&'a Rna> {
     m.get(k).and_then(Value::as_object)
 }
 
+/// How Cycles renders hair curves (Render Properties > Curves, `scene.cycles_curves`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurveSettings {
+    /// `RIBBONS` (Rounded Ribbons, the add-on's default) or `THICK` (3D Curves).
+    pub shape: String,
+    /// Ribbons: 2^subdivisions straight pieces per curve segment (default 2).
+    pub subdivisions: u32,
+}
+
+impl CurveSettings {
+    pub fn of(s: &SceneSettings) -> CurveSettings {
+        let c = &s.cycles_curves;
+        CurveSettings {
+            shape: text(c, "shape").unwrap_or("RIBBONS").to_string(),
+            subdivisions: num(c, "subdivisions").unwrap_or(2.0).clamp(0.0, 24.0) as u32,
+        }
+    }
+}
+
 /// The render output (`scene.render`): resolution and pixel aspect.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Output {

@@ -97,6 +97,10 @@ pub struct LobeSet {
     /// The object's shadow terminator shading offset as a frequency (1: none), set by the
     /// integrator after shading.
     pub terminator_frequency: f32,
+    /// Sampling checks each lobe's direction against the lobe's own normal instead of the
+    /// true normal: Cycles does so on curves, whose ribbons' true normal faces the ray
+    /// ("the geometric normal gives too much darkening otherwise", bsdf_sample).
+    pub own_normal_as_ng: bool,
 }
 
 pub struct BsdfSample {
@@ -129,6 +133,7 @@ impl Default for LobeSet {
             smooth_n: [0.0; 3],
             bump_correction: true,
             terminator_frequency: 1.0,
+            own_normal_as_ng: false,
         }
     }
 }
@@ -174,6 +179,7 @@ impl LobeSet {
         self.smooth_n = [0.0; 3];
         self.bump_correction = true;
         self.terminator_frequency = 1.0;
+        self.own_normal_as_ng = false;
     }
 
     pub fn push(&mut self, kind: LobeKind, weight: V3, n: V3) {
@@ -290,6 +296,7 @@ impl LobeSet {
             x -= l.sample_weight;
         }
         let l = &self.lobes[pick];
+        let ng = if self.own_normal_as_ng { l.n } else { ng };
         let sel = l.sample_weight / total;
         if let LobeKind::Subsurface(_) = l.kind {
             return Some(BsdfSample {

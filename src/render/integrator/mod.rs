@@ -164,6 +164,9 @@ impl Scene<'_> {
     pub fn surface_at(&self, prim: u32, u: f32, v: f32, wo: V3, time: f32) -> SurfaceHit {
         let r = self.geo.refs[prim as usize];
         let inst = &self.geo.instances[r.inst as usize];
+        if let Some(c) = &inst.curves {
+            return self.curve_surface(c, prim, u, v, wo, time);
+        }
         let m = &inst.mesh;
         let c = m.triangles[r.tri as usize].map(|c| c as usize);
         let w0 = 1.0 - u - v;
@@ -267,6 +270,53 @@ impl Scene<'_> {
         }
     }
 
+    /// A hair ribbon hit (`render::curves`) as Cycles' curve_shader_setup gives it: the
+    /// rounded normal, the true normal facing the ray (never backfacing), the object
+    /// position of the hit and Generated from the curve's root in the emitter's texture
+    /// space (Cycles' hair Generated attribute).
+    fn curve_surface(
+        &self,
+        c: &crate::render::curves::ObjectCurves,
+        prim: u32,
+        u: f32,
+        v: f32,
+        wo: V3,
+        time: f32,
+    ) -> SurfaceHit {
+        let r = self.geo.refs[prim as usize];
+        let inst = &self.geo.instances[r.inst as usize];
+        let cp = c.control_points(r.tri);
+        let (p, n, _dpdu) = crate::render::curves::ribbon_shading(&cp, c.pieces, u, v, neg(wo));
+        let ng = wo;
+        let (to_world, to_object) = (&inst.to_world, &inst.to_object);
+        let curve = c.segments[r.tri as usize].0 as usize;
+        let root = c.keys[c.curves[curve].0 as usize];
+        let mut sp = ShadingPoint {
+            position: p,
+            normal: n,
+            object_position: to_object.point(p),
+            object_normal: normalize(Affine::normal_by_inverse(to_world, n)),
+            generated: inst.generated(to_object.point([root[0], root[1], root[2]])),
+            ..Default::default()
+        };
+        self.fill_context(&mut sp, inst, wo, ng, false, u, v);
+        sp.transform = crate::shader::bump::ObjectTransform {
+            to_world: to_world.m,
+            to_object: to_object.m,
+        };
+        SurfaceHit {
+            p,
+            ng,
+            sp,
+            inst: r.inst,
+            material: inst.material_of(r.tri as usize),
+            backfacing: false,
+            time,
+            prim,
+            uv: [u, v],
+        }
+    }
+
     /// Shades `hit` without ray tracing (Ambient Occlusion 1, Bevel the shading normal):
     /// the label passes' pixel-centre shading.
     pub fn shade(&self, hit: &SurfaceHit, wo: V3, scratch: &mut Scratch) {
@@ -305,11 +355,13 @@ impl Scene<'_> {
         lobes: &mut LobeSet,
         trace: &dyn Trace,
     ) {
+        let curve = self.geo.instances[hit.inst as usize].curves.is_some();
         let ctx = Context {
             tables: self.tables,
             wo,
             backfacing: hit.backfacing,
-            bump_correction: true,
+            // Cycles raises no specular normal on curves (maybe_ensure_valid_specular_reflection).
+            bump_correction: !curve,
             trace,
         };
         match hit.material {
@@ -319,6 +371,9 @@ impl Scene<'_> {
                 lobes.push(LobeKind::Diffuse, [0.8; 3], hit.sp.normal);
             }
         }
+        // Sampled directions are checked against each closure's normal on curves (Cycles'
+        // bsdf_sample), whose ribbons' true normal faces the ray.
+        lobes.own_normal_as_ng = curve;
     }
 
     /// One path sample: radiance along the camera ray. Each vertex runs the steps Cycles'
@@ -873,7 +928,11 @@ impl Scene<'_> {
         let mut skip_self = true;
         let inst = &self.geo.instances[hit.inst as usize];
         let m = &inst.mesh;
-        if inst.shadow_terminator > 0.0 && m.corner_normals.len() == m.corner_verts.len() {
+        // Cycles' shadow terminator offset is for triangles only (not hair).
+        if inst.shadow_terminator > 0.0
+            && inst.curves.is_none()
+            && m.corner_normals.len() == m.corner_verts.len()
+        {
             // Cycles' sd->N: the shading normal after the material's displacement bump.
             let n = if is_zero(smooth_n) {
                 hit.sp.normal
@@ -1002,6 +1061,15 @@ impl Scene<'_> {
         };
         let r = self.geo.refs[prim as usize];
         let inst = &self.geo.instances[r.inst as usize];
+        if inst.curves.is_some() {
+            // Hair: the position's differentials only; Cycles gives curves no du, dv, so
+            // no attribute differentials.
+            let (dx, dy) = differential_from_compact(hit.ng, dp);
+            hit.sp.ng = hit.ng;
+            hit.sp.dp_dx = dx;
+            hit.sp.dp_dy = dy;
+            return;
+        }
         let m = &inst.mesh;
         let c = m.triangles[r.tri as usize].map(|c| c as usize);
         let (to_world, to_object) = inst.pose_at(hit.time);

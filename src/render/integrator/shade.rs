@@ -226,8 +226,9 @@ impl Material {
             stack.extend_from_slice(&p.initial);
         }
         p.run_traced(sp, stack, ctx.trace);
+        // The caller's false (a curve hit) keeps normals as they are.
         let ctx = &Context {
-            bump_correction: self.bump_correction,
+            bump_correction: self.bump_correction && ctx.bump_correction,
             ..*ctx
         };
         // The material's displacement, bumped, is the shading normal of every closure.
