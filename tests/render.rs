@@ -104,6 +104,9 @@ const ASSERTED: &[&str] = &[
     "normal_map_scaled",
     "attribute_color",
     "generated_images",
+    // The Principled BSDF's emission: an image texture into Emission Color, and a constant
+    // one under a tinted coat and sheen that attenuate it (corpus VRM material file).
+    "principled_emission",
     // Geometry Pointiness and Random Per Island as base colour on a mesh of four islands.
     "pointiness_islands",
     // Mesh objects' ray visibility (camera, shadow, glossy, and an emitter hidden from
