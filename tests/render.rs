@@ -107,6 +107,9 @@ const ASSERTED: &[&str] = &[
     // The Principled BSDF's emission: an image texture into Emission Color, and a constant
     // one under a tinted coat and sheen that attenuate it (corpus VRM material file).
     "principled_emission",
+    // Geometry Nodes meshes made anew have no material in a data-linked slot (Cycles'
+    // default surface); object-linked slots and the object's own mesh keep theirs.
+    "geonodes_material_slots",
     // Geometry Pointiness and Random Per Island as base colour on a mesh of four islands.
     "pointiness_islands",
     // Mesh objects' ray visibility (camera, shadow, glossy, and an emitter hidden from

@@ -441,7 +441,10 @@ fn push_instance(
     if mesh.triangles.is_empty() {
         return Ok(());
     }
-    // Object-linked slots override the mesh's materials (Blender's slot link).
+    // Object-linked slots override the mesh's materials (Blender's slot link). A slot
+    // linked to the data takes the (evaluated) geometry's material only: a mesh Geometry
+    // Nodes made anew has none there, and Cycles gives it the default surface, not the
+    // material the object's original mesh had (BKE_object_material_get_eval).
     let mesh_materials = info.materials;
     let nslots = mesh_materials.len().max(obj.material_slots.len()).max(1);
     let slots: Vec<Option<usize>> = (0..nslots)
@@ -451,13 +454,7 @@ fn push_instance(
                 .get(s)
                 .filter(|sl| sl.link.as_deref() == Some("OBJECT"))
                 .map(|sl| sl.material.clone());
-            let name = from_obj.unwrap_or_else(|| {
-                mesh_materials
-                    .get(s)
-                    .cloned()
-                    .flatten()
-                    .or_else(|| obj.material_slots.get(s).and_then(|sl| sl.material.clone()))
-            });
+            let name = from_obj.unwrap_or_else(|| mesh_materials.get(s).cloned().flatten());
             material_index(scene, &name)
         })
         .collect();
