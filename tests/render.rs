@@ -110,6 +110,9 @@ const ASSERTED: &[&str] = &[
     // Geometry Nodes meshes made anew have no material in a data-linked slot (Cycles'
     // default surface); object-linked slots and the object's own mesh keep theirs.
     "geonodes_material_slots",
+    // Closure colours below zero (a Mapping node's vector as Color): clamped at zero per
+    // channel as Cycles' bsdf_alloc does, never negative light.
+    "negative_color",
     // Geometry Pointiness and Random Per Island as base colour on a mesh of four islands.
     "pointiness_islands",
     // Mesh objects' ray visibility (camera, shadow, glossy, and an emitter hidden from
