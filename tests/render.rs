@@ -68,6 +68,9 @@ const ASSERTED: &[&str] = &[
     // Attribute nodes of type Instancer: Geometry Nodes instance attributes, an object's
     // custom property, an RNA path (the object colour), a name found nowhere (zero).
     "instancer_attribute",
+    // Instancer attributes on Geometry Nodes instances nested two deep, realised into
+    // Blender's evaluated mesh: the innermost level that has the name, per instance.
+    "nested_instancer_attribute",
     // Metallic BSDF, Physical Conductor (complex IOR) with Multiscatter GGX and Beckmann,
     // F82 Tint with Beckmann.
     "metallic_conductor",

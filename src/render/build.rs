@@ -571,7 +571,14 @@ pub fn bind_attributes(
             }
             for r in &p.attributes {
                 if let crate::shader::attributes::AttributeRequest::Instancer(name) = r {
-                    if inst.nested_instancer_names.contains(name) {
+                    let carried = inst
+                        .mesh
+                        .attribute(&format!(
+                            "{}{name}",
+                            crate::shader::attributes::NESTED_INSTANCER_PREFIX
+                        ))
+                        .is_some();
+                    if inst.nested_instancer_names.contains(name) && !carried {
                         return Err(RenderError(format!("object {:?}: material {:?} reads the Instancer attribute {name:?}, on instances realised into its mesh (not supported: Blender reads it per instance, blendsynth renders them as one mesh)", inst.name, materials[mi].name)));
                     }
                 }
