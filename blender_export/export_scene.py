@@ -508,15 +508,109 @@ def slot_materials(ob, me):
     return [key(m) if m else None for m in me.materials]
 
 
+NESTED_INSTANCER_PREFIX = ".instancer."
+
+
+class InstancerValues:
+    """Instancer attribute values (Attribute node, type Instancer) of the instances an
+    object's Geometry Nodes make, as Blender's find_geonode_attribute_rgba reads them: the
+    instance-domain attribute of the innermost nesting level that has it, at that level's
+    instance index (DepsgraphObjectInstance.persistent_id); else the instancer object's,
+    then its data's, custom property or RNA path (find_rna_property_rgba); else zero."""
+
+    def __init__(self, ob, ev, names):
+        self.names = names
+        self.fallback = {n: rna_rgba(ob, n) or rna_rgba(ob.data, n) or (0.0, 0.0, 0.0, 0.0) for n in names}
+        try:
+            self.root = ev.evaluated_geometry() if names else None
+        except (AttributeError, RuntimeError):
+            self.root = None
+        self.levels = {}
+
+    def level(self, path):
+        """(instance attributes by name, references) of the instances at reference path."""
+        if path not in self.levels:
+            gs = self.root
+            for r in path:
+                gs = gs.instance_references()[r] if gs is not None else None
+                if not isinstance(gs, bpy.types.GeometrySet):
+                    gs = None
+                    break
+            pc = gs.instances_pointcloud() if gs is not None else None
+            attrs, ref = {}, None
+            if pc is not None:
+                n = len(pc.points)
+                for name in self.names + [".reference_index"]:
+                    a = pc.attributes.get(name)
+                    if a is None or a.domain != "POINT":
+                        continue
+                    if name == ".reference_index":
+                        ref = np.zeros(n, np.int32)
+                        a.data.foreach_get("value", ref)
+                        continue
+                    v = np.zeros(n * 4, np.float32)
+                    if a.data_type in ("FLOAT_COLOR", "BYTE_COLOR"):
+                        a.data.foreach_get("color", v)
+                        v = v.reshape(n, 4)
+                    elif a.data_type == "FLOAT_VECTOR":
+                        w = np.zeros(n * 3, np.float32)
+                        a.data.foreach_get("vector", w)
+                        v = np.concatenate([w.reshape(n, 3), np.ones((n, 1), np.float32)], 1)
+                    elif a.data_type in ("FLOAT", "INT", "BOOLEAN"):
+                        w = np.zeros(n, np.float32 if a.data_type == "FLOAT" else np.int32 if a.data_type == "INT" else bool)
+                        a.data.foreach_get("value", w)
+                        w = w.astype(np.float32)
+                        v = np.stack([w, w, w, np.ones(n, np.float32)], 1)
+                    else:
+                        continue
+                    attrs[name] = v
+            self.levels[path] = (attrs, ref)
+        return self.levels[path]
+
+    def of(self, persistent_id):
+        """name -> RGBA for the instance with this persistent id (Blender orders it
+        innermost level first, INT_MAX past the last level)."""
+        ids = []
+        for idx in persistent_id:
+            if idx < 0 or idx == 2147483647:
+                break
+            ids.append(idx)
+        found, path = {}, ()
+        for idx in reversed(ids):
+            attrs, ref = self.level(path)
+            if not attrs and ref is None:
+                break
+            for name, v in attrs.items():
+                if idx < len(v):
+                    found[name] = tuple(float(x) for x in v[idx])  # inner levels overwrite outer
+            if ref is None or idx >= len(ref):
+                break
+            path = path + (int(ref[idx]),)
+        return {n: found.get(n, self.fallback[n]) for n in self.names}
+
+
+def with_instancer_values(part, values):
+    """The part with one constant point attribute per Instancer name (NESTED_INSTANCER_PREFIX
+    + name): instances realised into one mesh keep their own value."""
+    counts, arrays, attrs, uvs = part
+    nv = counts[0]
+    extra = [(NESTED_INSTANCER_PREFIX + n, "POINT", "FLOAT_COLOR", np.tile(np.array(v, np.float32), (nv, 1)))
+             for n, v in sorted(values.items())]
+    return counts, arrays, attrs + extra, uvs
+
+
 def evaluated_meshes(objs, depsgraph):
     """For each object: its evaluated mesh plus the instances it generates (realised),
     in its local space, and the material slots its faces index. One pass over
     depsgraph.object_instances (instance objects are only valid during their iteration
     step, so each is converted right away)."""
-    parts, n_inst, inverse, mats, uvinfo = {}, {}, {}, {}, {}
+    parts, n_inst, inverse, mats, uvinfo, inst_values = {}, {}, {}, {}, {}, {}
+    lookup = [n for n in ATTRIBUTE_LOOKUP_NAMES]
     for o in objs:
         ev = o.evaluated_get(depsgraph)
         mats[key(o)] = []
+        inst_values[key(o)] = InstancerValues(o, ev, lookup) if lookup and any(
+            m.type == "NODES" for m in o.modifiers) else None
         try:
             me = ev.to_mesh()
         except RuntimeError:
@@ -558,10 +652,16 @@ def evaluated_meshes(objs, depsgraph):
         try:
             part = mesh_arrays(ime, f"evaluated[{q(owner)}].instance")
             part = with_materials(part, mats[owner], slot_materials(io, ime))
+            if inst_values[owner] is not None:
+                part = with_instancer_values(part, inst_values[owner].of(list(inst.persistent_id)))
         finally:
             io.to_mesh_clear()
         parts[owner].append(transform_part(part, inverse[owner] @ np.array(inst.matrix_world, dtype=np.float64)))
         n_inst[owner] += 1
+    for name, iv in inst_values.items():
+        if iv is not None and n_inst[name]:
+            # The instancer's own geometry reads the object's value (no instance layer).
+            parts[name][0] = with_instancer_values(parts[name][0], dict(iv.fallback))
     return {name: (concat_meshes(p), n_inst[name], mats[name], uvinfo[name]) for name, p in parts.items()}
 
 

@@ -72,6 +72,9 @@ const ASSERTED: &[&str] = &[
     // Attribute nodes of type Instancer: Geometry Nodes instance attributes, an object's
     // custom property, an RNA path (the object colour), a name found nowhere (zero).
     "instancer_attribute",
+    // Instancer attributes on Geometry Nodes instances nested two deep, realised into
+    // Blender's evaluated mesh: the innermost level that has the name, per instance.
+    "nested_instancer_attribute",
     // Metallic BSDF, Physical Conductor (complex IOR) with Multiscatter GGX and Beckmann,
     // F82 Tint with Beckmann.
     "metallic_conductor",
@@ -108,6 +111,15 @@ const ASSERTED: &[&str] = &[
     "normal_map_scaled",
     "attribute_color",
     "generated_images",
+    // The Principled BSDF's emission: an image texture into Emission Color, and a constant
+    // one under a tinted coat and sheen that attenuate it (corpus VRM material file).
+    "principled_emission",
+    // Geometry Nodes meshes made anew have no material in a data-linked slot (Cycles'
+    // default surface); object-linked slots and the object's own mesh keep theirs.
+    "geonodes_material_slots",
+    // Closure colours below zero (a Mapping node's vector as Color): clamped at zero per
+    // channel as Cycles' bsdf_alloc does, never negative light.
+    "negative_color",
     // Geometry Pointiness and Random Per Island as base colour on a mesh of four islands.
     "pointiness_islands",
     // Mesh objects' ray visibility (camera, shadow, glossy, and an emitter hidden from

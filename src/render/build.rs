@@ -570,7 +570,10 @@ fn new_instance(
     to_world: Affine,
     instance_index: Option<u32>,
 ) -> Result<MeshInstance, RenderError> {
-    // Object-linked slots override the mesh's materials (Blender's slot link).
+    // Object-linked slots override the mesh's materials (Blender's slot link). A slot
+    // linked to the data takes the (evaluated) geometry's material only: a mesh Geometry
+    // Nodes made anew has none there, and Cycles gives it the default surface, not the
+    // material the object's original mesh had (BKE_object_material_get_eval).
     let mesh_materials = info.materials;
     let nslots = mesh_materials.len().max(obj.material_slots.len()).max(1);
     let slots: Vec<Option<usize>> = (0..nslots)
@@ -580,13 +583,7 @@ fn new_instance(
                 .get(s)
                 .filter(|sl| sl.link.as_deref() == Some("OBJECT"))
                 .map(|sl| sl.material.clone());
-            let name = from_obj.unwrap_or_else(|| {
-                mesh_materials
-                    .get(s)
-                    .cloned()
-                    .flatten()
-                    .or_else(|| obj.material_slots.get(s).and_then(|sl| sl.material.clone()))
-            });
+            let name = from_obj.unwrap_or_else(|| mesh_materials.get(s).cloned().flatten());
             material_index(scene, &name)
         })
         .collect();
@@ -706,7 +703,14 @@ pub fn bind_attributes(
             }
             for r in &p.attributes {
                 if let crate::shader::attributes::AttributeRequest::Instancer(name) = r {
-                    if inst.nested_instancer_names.contains(name) {
+                    let carried = inst
+                        .mesh
+                        .attribute(&format!(
+                            "{}{name}",
+                            crate::shader::attributes::NESTED_INSTANCER_PREFIX
+                        ))
+                        .is_some();
+                    if inst.nested_instancer_names.contains(name) && !carried {
                         return Err(RenderError(format!("object {:?}: material {:?} reads the Instancer attribute {name:?}, on instances realised into its mesh (not supported: Blender reads it per instance, blendsynth renders them as one mesh)", inst.name, materials[mi].name)));
                     }
                 }

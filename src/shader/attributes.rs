@@ -54,6 +54,11 @@ impl FacMode {
     }
 }
 
+/// Prefix of the point attribute that holds an Instancer attribute's value per realised
+/// instance, written by the exporter for evaluated meshes whose Geometry Nodes instances
+/// Blender realised (the name starts with "." so no Blender attribute takes it).
+pub const NESTED_INSTANCER_PREFIX: &str = ".instancer.";
+
 #[derive(Debug, Clone)]
 enum Values {
     Missing,
@@ -177,10 +182,19 @@ impl BoundAttributes {
             };
             items.push(match r {
                 AttributeRequest::Named(name) => named(name)?,
-                AttributeRequest::Instancer(name) => Bound {
-                    values: Values::Instancer(name.clone()),
-                    fac: FacMode::Average,
-                },
+                // Instances realised into one mesh carry their own values as a point
+                // attribute (the exporter's, for Blender's evaluated meshes).
+                AttributeRequest::Instancer(name) => {
+                    let nested = format!("{NESTED_INSTANCER_PREFIX}{name}");
+                    if mesh.attribute(&nested).is_some() {
+                        named(&nested)?
+                    } else {
+                        Bound {
+                            values: Values::Instancer(name.clone()),
+                            fac: FacMode::Average,
+                        }
+                    }
+                }
                 AttributeRequest::DefaultColor => match default_color {
                     Some(name) => named(name)?,
                     None => Bound {

@@ -192,6 +192,13 @@ impl LobeSet {
         if !(weight.iter().all(|w| w.is_finite())) {
             return;
         }
+        // Cycles' bsdf_alloc allows no negative weight (a colour input below zero, from a
+        // Mapping node say): each channel is clamped at zero. Transparent and subsurface
+        // closures are allocated without that clamp.
+        let weight = match kind {
+            LobeKind::Transparent | LobeKind::Subsurface(_) => weight,
+            _ => weight.map(|w| w.max(0.0)),
+        };
         // Cycles' bsdf_alloc drops closures whose mean weight is below CLOSURE_WEIGHT_CUTOFF
         // (which matters beyond their light: they would take a share of the selection).
         let mean = (weight[0] + weight[1] + weight[2]).abs() / 3.0;

@@ -580,6 +580,13 @@ fn principled(
     if coat > 0.0 {
         weight = principled_coat(b, s, sp, ctx, out, weight, coat);
     }
+    // Emission below alpha, sheen and coat, above the rest (Cycles' emission_setup with
+    // the layered weight); colour and strength unclamped.
+    let emission = scale(
+        input_c(b, s, "Emission Color", [1.0; 3]),
+        input_f(b, s, "Emission Strength", 0.0),
+    );
+    out.emission = add(out.emission, finite3(mul(emission, weight)));
     if metallic > 0.0 {
         // F82-tint Schlick: b chosen so F(acos 1/7) = Schlick * tint.
         let f = 6.0f32 / 7.0;
