@@ -89,6 +89,8 @@ fn shell(angle: f32) -> f32 {
     }
 }
 
+// Long because it follows BM_mesh_wireframe step by step: the element order Blender's
+// mesh has comes from the order of those steps.
 fn wireframe(m: &Mesh, o: &Options) -> Mesh {
     let ofs_orig = -(((-o.offset_fac + 1.0) * 0.5) * o.offset);
     let ofs_new = o.offset + ofs_orig;
