@@ -157,7 +157,8 @@ fn bad_input_is_a_clean_error_without_output() {
         &[],
     );
     assert_clean_error(&o, 1, &["nope"]);
-    let over = "node_groups[\"Terrain Builder\"].nodes[\"Ico Sphere\"].inputs[\"Subdivisions\"].default_value=3";
+    // An override that makes the tree unsupported (the Noise Texture has no 5D).
+    let over = "node_groups[\"Terrain Builder\"].nodes[\"Noise Texture\"].noise_dimensions=\"5D\"";
     let o = run(
         &[
             "mesh",
@@ -171,7 +172,7 @@ fn bad_input_is_a_clean_error_without_output() {
         ],
         &[],
     );
-    assert_clean_error(&o, 1, &["Ico Sphere"]);
+    assert_clean_error(&o, 1, &["Noise Texture", "5D"]);
     let o = run(
         &[
             "mesh",

@@ -1598,6 +1598,14 @@ fn unsupported_hair_is_refused_by_name() {
         ..Default::default()
     };
     assert!(blendsynth::render::check(&scene, &opts, &[]).is_ok());
+    // Optical flow traces triangles only: hair is refused there, not left out.
+    let RenderError(m) = blendsynth::render::render_with_motion(&scene, &opts, &[], None, 1.0)
+        .err()
+        .expect("flow with hair is refused");
+    assert!(
+        m.contains("optical flow") && m.contains("\"Emitter\""),
+        "{m}"
+    );
     // Render > Curves > Shape 3D Curves.
     refused(
         &|j| j["scene"]["cycles_curves"]["shape"] = "THICK".into(),

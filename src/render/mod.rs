@@ -185,6 +185,14 @@ pub fn render_with_motion(
         )));
     }
     let (out, camera, geo, frame) = render_frame(scene, opts, overrides, control)?;
+    // The flow and its occlusion test trace triangles only: hair would be missing from
+    // both, so its pixels and what it hides would be labelled wrongly.
+    if let Some(h) = geo.instances.iter().find(|i| i.curves.is_some()) {
+        return Err(RenderError(format!(
+            "optical flow: object {:?} has hair curves, which the flow and occlusion passes do not trace (not supported yet)",
+            h.name
+        )));
+    }
     let here = film::flow::FrameView {
         camera: &camera,
         geo: &geo,
