@@ -1599,9 +1599,10 @@ fn unsupported_hair_is_refused_by_name() {
     };
     assert!(blendsynth::render::check(&scene, &opts, &[]).is_ok());
     // Optical flow traces triangles only: hair is refused there, not left out.
-    let RenderError(m) = blendsynth::render::render_with_motion(&scene, &opts, &[], None, 1.0)
-        .err()
-        .expect("flow with hair is refused");
+    let Err(RenderError(m)) = blendsynth::render::render_with_motion(&scene, &opts, &[], None, 1.0)
+    else {
+        panic!("flow with hair is refused");
+    };
     assert!(
         m.contains("optical flow") && m.contains("\"Emitter\""),
         "{m}"
