@@ -11,18 +11,24 @@ use common::*;
 
 const SECRET: &str = "OPENSSH PRIVATE KEY";
 
+/// A temporary folder with the blends `make_blends.py` authors (see its docstring).
+fn authored_blends(py: &std::path::Path) -> tempfile::TempDir {
+    let t = tempfile::tempdir().unwrap();
+    run_python(
+        py,
+        &repo().join("fixtures/convert_paths/make_blends.py"),
+        &[t.path().to_str().unwrap()],
+    );
+    t
+}
+
 #[test]
 fn convert_copies_only_files_inside_the_blends_folder_unless_allowed() {
     let Some(py) = require("a Python with bpy 4.5.4", bpy_python()) else {
         return;
     };
-    let t = tempfile::tempdir().unwrap();
+    let t = authored_blends(&py);
     let root = t.path();
-    run_python(
-        &py,
-        &repo().join("fixtures/convert_paths/make_blends.py"),
-        &[root.to_str().unwrap()],
-    );
     let secret_dir = root.join("secret");
     let proj = root.join("proj");
 
@@ -111,13 +117,8 @@ fn ies_files_follow_the_path_policy() {
     let Some(py) = require("a Python with bpy 4.5.4", bpy_python()) else {
         return;
     };
-    let t = tempfile::tempdir().unwrap();
+    let t = authored_blends(&py);
     let root = t.path();
-    run_python(
-        &py,
-        &repo().join("fixtures/convert_paths/make_blends.py"),
-        &[root.to_str().unwrap()],
-    );
     let proj = root.join("proj");
     let out = root.join("out-ies-outside");
     let o = convert_blend(&py, &proj.join("ies_outside.blend"), &out, &[]);

@@ -1474,6 +1474,36 @@ fn sharp_specular_fireflies_match_cycles() {
     );
 }
 
+/// Edits the export `base` of `dir` and asserts that `inspect` (render::check) and
+/// `render` refuse it with the same message, which names each of `words`.
+fn refused_alike(
+    dir: &std::path::Path,
+    base: &serde_json::Value,
+    edit: &dyn Fn(&mut serde_json::Value),
+    words: &[&str],
+) {
+    let mut json = base.clone();
+    edit(&mut json);
+    let scene = Scene::from_json(dir, json.to_string().as_bytes()).unwrap();
+    let opts = RenderOptions {
+        samples: Some(1),
+        resolution: Some((8, 8)),
+        ..Default::default()
+    };
+    let checked = blendsynth::render::check(&scene, &opts, &[])
+        .err()
+        .map(|RenderError(m)| m)
+        .unwrap_or_default();
+    let rendered = render(&scene, &opts)
+        .err()
+        .map(|RenderError(m)| m)
+        .unwrap_or_default();
+    assert_eq!(checked, rendered, "inspect and render disagree");
+    for w in words {
+        assert!(checked.contains(w), "{checked:?} lacks {w:?}");
+    }
+}
+
 /// Volume features blendsynth does not render are errors naming the object, material or
 /// node, the same from `render::check` (what `inspect` runs) as from `render`: a phase
 /// function other than Henyey-Greenstein and Rayleigh, a world's Volume, and a fluid
@@ -1484,26 +1514,7 @@ fn unsupported_volumes_are_refused_by_name() {
     let base: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join("scene.json")).unwrap()).unwrap();
     let refused = |edit: &dyn Fn(&mut serde_json::Value), words: &[&str]| {
-        let mut json = base.clone();
-        edit(&mut json);
-        let scene = Scene::from_json(&dir, json.to_string().as_bytes()).unwrap();
-        let opts = RenderOptions {
-            samples: Some(1),
-            resolution: Some((8, 8)),
-            ..Default::default()
-        };
-        let checked = blendsynth::render::check(&scene, &opts, &[])
-            .err()
-            .map(|RenderError(m)| m)
-            .unwrap_or_default();
-        let rendered = render(&scene, &opts)
-            .err()
-            .map(|RenderError(m)| m)
-            .unwrap_or_default();
-        assert_eq!(checked, rendered, "inspect and render disagree");
-        for w in words {
-            assert!(checked.contains(w), "{checked:?} lacks {w:?}");
-        }
+        refused_alike(&dir, &base, edit, words)
     };
     let fog = |j: &mut serde_json::Value| -> serde_json::Value {
         j["materials"]
@@ -1569,26 +1580,7 @@ fn unsupported_hair_is_refused_by_name() {
     let base: serde_json::Value =
         serde_json::from_slice(&std::fs::read(dir.join("scene.json")).unwrap()).unwrap();
     let refused = |edit: &dyn Fn(&mut serde_json::Value), words: &[&str]| {
-        let mut json = base.clone();
-        edit(&mut json);
-        let scene = Scene::from_json(&dir, json.to_string().as_bytes()).unwrap();
-        let opts = RenderOptions {
-            samples: Some(1),
-            resolution: Some((8, 8)),
-            ..Default::default()
-        };
-        let checked = blendsynth::render::check(&scene, &opts, &[])
-            .err()
-            .map(|RenderError(m)| m)
-            .unwrap_or_default();
-        let rendered = render(&scene, &opts)
-            .err()
-            .map(|RenderError(m)| m)
-            .unwrap_or_default();
-        assert_eq!(checked, rendered, "inspect and render disagree");
-        for w in words {
-            assert!(checked.contains(w), "{checked:?} lacks {w:?}");
-        }
+        refused_alike(&dir, &base, edit, words)
     };
     // The export as made renders.
     let scene = Scene::from_json(&dir, base.to_string().as_bytes()).unwrap();

@@ -5,17 +5,18 @@
 use std::cell::RefCell;
 
 use crate::render::math::*;
+use crate::shader::bump::ObjectTransform;
 use crate::shader::point::{ObjectInfo, ShadingPoint};
 use crate::shader::program::Program;
 
 #[derive(Debug)]
 pub struct LightShader {
     program: Program,
-    /// The light object (location, world-to-object transform, for object-space
-    /// coordinates as Cycles reads them at a light).
+    /// The light object (Object Info values, its world-to-object transform).
     object: ObjectInfo,
-    /// The object-to-world rows, whose transpose takes normals to object space.
-    to_world: [[f32; 4]; 3],
+    /// Its transforms both ways, for object-space coordinates as Cycles reads them at a
+    /// light.
+    transform: ObjectTransform,
 }
 
 thread_local! {
@@ -28,7 +29,10 @@ impl LightShader {
         LightShader {
             program,
             object,
-            to_world,
+            transform: ObjectTransform {
+                to_world,
+                to_object: object.world_to_object,
+            },
         }
     }
 
@@ -41,11 +45,7 @@ impl LightShader {
     /// ls->Ng), lighting along `incoming` (from the light toward the lit point, -ls->D)
     /// at distance `t`.
     pub fn emission(&self, p: V3, ng: V3, incoming: V3, t: f32) -> V3 {
-        let m = &self.object.world_to_object;
-        let object_position = [0, 1, 2].map(|r| dot([m[r][0], m[r][1], m[r][2]], p) + m[r][3]);
-        // Cycles' object_inverse_normal_transform: the transpose of the object's matrix.
-        let w = &self.to_world;
-        let on = [0, 1, 2].map(|c| w[0][c] * ng[0] + w[1][c] * ng[1] + w[2][c] * ng[2]);
+        let object_position = self.transform.inverse_point(p);
         let sp = ShadingPoint {
             position: p,
             normal: ng,
@@ -54,10 +54,11 @@ impl LightShader {
             incoming,
             ray_length: t,
             object_position,
-            object_normal: normalize(on),
+            object_normal: self.transform.inverse_normal(ng),
             // No Generated attribute at a light: Cycles falls back to object space.
             generated: object_position,
             object: self.object,
+            transform: self.transform,
             ..Default::default()
         };
         STACK.with(|s| {
