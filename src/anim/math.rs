@@ -10,7 +10,7 @@
 
 pub type Mat4 = [[f64; 4]; 4];
 pub type Mat3 = [[f64; 3]; 3];
-pub type V3 = [f32; 3];
+pub use crate::foundation::math::{add, cross, dot, is_zero, len, scale, sub, V3};
 pub type Quat = [f32; 4];
 
 pub const IDENTITY: Mat4 = [
@@ -336,35 +336,9 @@ pub fn interp_mat4(a: &Mat4, b: &Mat4, t: f64) -> Mat4 {
 
 // ---- f32 vectors and quaternions (curve path) -------------------------------------------
 
-pub fn dot(a: V3, b: V3) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-pub fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-pub fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-pub fn scale(a: V3, f: f32) -> V3 {
-    [a[0] * f, a[1] * f, a[2] * f]
-}
-pub fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-pub fn len(a: V3) -> f32 {
-    dot(a, a).sqrt()
-}
 pub fn len_between(a: V3, b: V3) -> f32 {
     len(sub(a, b))
 }
-pub fn is_zero(a: V3) -> bool {
-    a[0] == 0.0 && a[1] == 0.0 && a[2] == 0.0
-}
-
 /// Blender's `normalize_v3`: multiplies by the reciprocal length, zeroes tiny vectors.
 pub fn normalize(v: &mut V3) -> f32 {
     let d = dot(*v, *v);

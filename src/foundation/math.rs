@@ -56,6 +56,25 @@ pub fn neg(a: V3) -> V3 {
 pub fn madd(a: V3, b: V3, f: f32) -> V3 {
     [a[0] + b[0] * f, a[1] + b[1] * f, a[2] + b[2] * f]
 }
+/// Cycles' `Transform`: a 3x4 row-major affine matrix (the last column translates).
+pub type Transform = [[f32; 4]; 3];
+
+/// Cycles' `transform_point`.
+#[inline(always)]
+pub fn transform_point(m: &Transform, p: V3) -> V3 {
+    std::array::from_fn(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3])
+}
+/// Cycles' `transform_direction`: the 3x3 part only.
+#[inline(always)]
+pub fn transform_direction(m: &Transform, d: V3) -> V3 {
+    std::array::from_fn(|r| m[r][0] * d[0] + m[r][1] * d[1] + m[r][2] * d[2])
+}
+/// Cycles' `transform_direction_transposed`: by the transpose of the 3x3 part (normals
+/// go through the transposed inverse).
+#[inline(always)]
+pub fn transform_direction_transposed(m: &Transform, d: V3) -> V3 {
+    std::array::from_fn(|c| m[0][c] * d[0] + m[1][c] * d[1] + m[2][c] * d[2])
+}
 /// A ray origin just off a surface at `p` (true normal `ng`), on the side `dir` leaves
 /// toward, so the ray does not hit the surface it starts on.
 #[inline]

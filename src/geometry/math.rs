@@ -4,7 +4,7 @@
 //! Matrices are `m[col][row]` as Blender's `float4x4` stores them (column 3 is the
 //! translation), which is also the column-major order of FLOAT4X4 attributes.
 
-pub type V3 = [f32; 3];
+pub use crate::foundation::math::{add, cross, dot, len as length, mul, scale, sub, V3};
 pub type Mat4f = [[f32; 4]; 4];
 pub type Mat3f = [[f32; 3]; 3];
 
@@ -15,38 +15,6 @@ pub const MAT4_IDENTITY: Mat4f = [
     [0.0, 0.0, 0.0, 1.0],
 ];
 
-#[inline]
-pub fn add(a: V3, b: V3) -> V3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-#[inline]
-pub fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-#[inline]
-pub fn mul(a: V3, b: V3) -> V3 {
-    [a[0] * b[0], a[1] * b[1], a[2] * b[2]]
-}
-#[inline]
-pub fn scale(a: V3, s: f32) -> V3 {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-#[inline]
-pub fn dot(a: V3, b: V3) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-#[inline]
-pub fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-#[inline]
-pub fn length(a: V3) -> f32 {
-    dot(a, a).sqrt()
-}
 /// Blender's C++ `math::normalize`: zero below a tiny squared length, else each component
 /// divided by the length.
 pub fn normalize(a: V3) -> V3 {

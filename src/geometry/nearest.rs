@@ -7,22 +7,9 @@
 //! choice at a tie depends on its tree's layout; here the lowest element index wins, which
 //! is deterministic (the parity fixtures keep their sample points away from ties).
 
+use crate::foundation::math::{dot, madd, sub};
+
 use super::math::V3;
-
-#[inline]
-fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline]
-fn dot(a: V3, b: V3) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-#[inline]
-fn madd(a: V3, d: V3, t: f32) -> V3 {
-    [a[0] + d[0] * t, a[1] + d[1] * t, a[2] + d[2] * t]
-}
 
 /// `len_squared_v3v3`.
 #[inline]

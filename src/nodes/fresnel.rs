@@ -1,11 +1,9 @@
 //! Fresnel and Layer Weight (Cycles' svm/fresnel.h): dielectric reflectance of the
 //! incoming direction against a normal, and the facing ratio.
 
-use super::math::Vec3;
+use crate::foundation::math::dot;
 
-fn dot(a: Vec3, b: Vec3) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
+use super::math::Vec3;
 
 /// Unpolarised dielectric Fresnel reflectance for cos(theta_i) and relative IOR `eta`
 /// (Cycles' `fresnel_dielectric_cos`): 1 under total internal reflection.

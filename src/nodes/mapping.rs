@@ -1,6 +1,8 @@
 //! Mapping node (Cycles `svm_mapping`): point, texture, vector and normal mappings with
 //! an XYZ Euler rotation.
 
+use crate::foundation::math::dot;
+
 use super::math::Vec3;
 
 blender_enum! {
@@ -21,10 +23,6 @@ pub(crate) fn euler_rows(e: Vec3) -> [Vec3; 3] {
         [cy * sz, sy * sx * sz + cx * cz, sy * cx * sz - sx * cz],
         [-sy, cy * sx, cy * cx],
     ]
-}
-
-fn dot(a: Vec3, b: Vec3) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
 pub(crate) fn rotate(r: &[Vec3; 3], a: Vec3) -> Vec3 {

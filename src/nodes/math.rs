@@ -7,7 +7,12 @@
 //! (Cycles' AVX2 kernel fuses some multiply-adds; plain Rust does not).
 
 /// A 3-component vector or colour (Cycles `float3`).
-pub type Vec3 = [f32; 3];
+pub use crate::foundation::math::V3 as Vec3;
+// Cycles' float3 helpers under the names the node code uses (util/math_float3.h).
+pub use crate::foundation::math::{
+    add as add3, cross as cross3, dot as dot3, len as length3, mul as mul3, scale as scale3,
+    sub as sub3,
+};
 
 // --- Scalar helpers (Cycles util/math_base.h) -------------------------------------------
 
@@ -288,26 +293,6 @@ pub fn math_node(op: MathOp, use_clamp: bool, a: f32, b: f32, c: f32) -> f32 {
 // --- Vector helpers (Cycles util/math_float3.h) -----------------------------------------
 
 #[inline]
-pub fn add3(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-
-#[inline]
-pub fn sub3(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline]
-pub fn mul3(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] * b[0], a[1] * b[1], a[2] * b[2]]
-}
-
-#[inline]
-pub fn scale3(a: Vec3, s: f32) -> Vec3 {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-
-#[inline]
 pub fn map3(a: Vec3, f: impl Fn(f32) -> f32) -> Vec3 {
     [f(a[0]), f(a[1]), f(a[2])]
 }
@@ -315,25 +300,6 @@ pub fn map3(a: Vec3, f: impl Fn(f32) -> f32) -> Vec3 {
 #[inline]
 pub fn zip3(a: Vec3, b: Vec3, f: impl Fn(f32, f32) -> f32) -> Vec3 {
     [f(a[0], b[0]), f(a[1], b[1]), f(a[2], b[2])]
-}
-
-#[inline]
-pub fn dot3(a: Vec3, b: Vec3) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-#[inline]
-pub fn length3(a: Vec3) -> f32 {
-    dot3(a, a).sqrt()
-}
-
-#[inline]
-pub fn cross3(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// Unit vector; a zero vector stays zero.

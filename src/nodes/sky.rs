@@ -18,6 +18,8 @@
 
 use std::f32::consts::{FRAC_PI_2, PI};
 
+use crate::foundation::math::{add, dot, len, mul, scale, sub};
+
 use super::color::{mat3_mul, SceneLinear};
 use super::image::{Extension, Interpolation, Pixels};
 use super::math::Vec3;
@@ -431,25 +433,7 @@ const QUADRATURE_WEIGHTS: [f32; 8] = [
     0.3562490486,
 ];
 
-// f32 vector helpers in the operation order of intern/sky's float3.
-fn add(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
-}
-fn sub(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn mul(a: Vec3, b: Vec3) -> Vec3 {
-    [a[0] * b[0], a[1] * b[1], a[2] * b[2]]
-}
-fn scale(a: Vec3, s: f32) -> Vec3 {
-    [a[0] * s, a[1] * s, a[2] * s]
-}
-fn dot(a: Vec3, b: Vec3) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn len(a: Vec3) -> f32 {
-    dot(a, a).sqrt()
-}
+/// intern/sky's `reduce_add`.
 fn reduce_add(a: Vec3) -> f32 {
     a[0] + a[1] + a[2]
 }

@@ -4,6 +4,10 @@
 //! object (a world shader), and converting a space to itself changes nothing (a normal
 //! is then not normalised either).
 
+use crate::foundation::math::{
+    transform_direction, transform_direction_transposed, transform_point,
+};
+
 use super::math::Vec3;
 
 blender_enum! {
@@ -43,19 +47,6 @@ impl Default for Affine {
     }
 }
 
-fn point(m: &[[f32; 4]; 3], p: Vec3) -> Vec3 {
-    std::array::from_fn(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3])
-}
-
-fn direction(m: &[[f32; 4]; 3], d: Vec3) -> Vec3 {
-    std::array::from_fn(|r| m[r][0] * d[0] + m[r][1] * d[1] + m[r][2] * d[2])
-}
-
-/// Cycles' transform_direction_transposed: by the transpose of the 3x3 part.
-fn direction_transposed(m: &[[f32; 4]; 3], d: Vec3) -> Vec3 {
-    std::array::from_fn(|c| m[0][c] * d[0] + m[1][c] * d[1] + m[2][c] * d[2])
-}
-
 fn normalize(v: Vec3) -> Vec3 {
     let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     if l > 0.0 {
@@ -73,9 +64,9 @@ fn apply(kind: VectorTransformType, t: &Affine, inverse: bool, v: Vec3) -> Vec3 
         (&t.forward, &t.inverse)
     };
     match kind {
-        VectorTransformType::Point => point(m, v),
-        VectorTransformType::Vector => direction(m, v),
-        VectorTransformType::Normal => normalize(direction_transposed(other, v)),
+        VectorTransformType::Point => transform_point(m, v),
+        VectorTransformType::Vector => transform_direction(m, v),
+        VectorTransformType::Normal => normalize(transform_direction_transposed(other, v)),
     }
 }
 

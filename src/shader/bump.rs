@@ -3,6 +3,9 @@
 //! dx/dy copies (the bump variants of the coordinate nodes), and the Bump, Displacement,
 //! Vector Displacement and Normal Map nodes (`kernel/svm/displace.h`, `tex_coord.h`).
 
+use crate::foundation::math::{
+    transform_direction, transform_direction_transposed, transform_point,
+};
 use crate::nodes::math::{add3, cross3, dot3, length3, scale3, sub3, Vec3};
 
 use super::point::ShadingPoint;
@@ -30,35 +33,25 @@ impl Default for ObjectTransform {
     }
 }
 
-fn point(m: &[[f32; 4]; 3], p: Vec3) -> Vec3 {
-    std::array::from_fn(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3])
-}
-fn dir(m: &[[f32; 4]; 3], d: Vec3) -> Vec3 {
-    std::array::from_fn(|r| m[r][0] * d[0] + m[r][1] * d[1] + m[r][2] * d[2])
-}
-fn dir_transposed(m: &[[f32; 4]; 3], d: Vec3) -> Vec3 {
-    std::array::from_fn(|c| m[0][c] * d[0] + m[1][c] * d[1] + m[2][c] * d[2])
-}
-
 impl ObjectTransform {
     /// Cycles' object_inverse_position_transform.
     pub fn inverse_point(&self, p: Vec3) -> Vec3 {
-        point(&self.to_object, p)
+        transform_point(&self.to_object, p)
     }
     /// object_dir_transform / object_inverse_dir_transform.
     pub fn dir(&self, d: Vec3) -> Vec3 {
-        dir(&self.to_world, d)
+        transform_direction(&self.to_world, d)
     }
     pub fn inverse_dir(&self, d: Vec3) -> Vec3 {
-        dir(&self.to_object, d)
+        transform_direction(&self.to_object, d)
     }
     /// object_normal_transform: world normal from an object-space one.
     pub fn normal(&self, n: Vec3) -> Vec3 {
-        normalize(dir_transposed(&self.to_object, n))
+        normalize(transform_direction_transposed(&self.to_object, n))
     }
     /// object_inverse_normal_transform: object-space normal from a world one.
     pub fn inverse_normal(&self, n: Vec3) -> Vec3 {
-        normalize(dir_transposed(&self.to_world, n))
+        normalize(transform_direction_transposed(&self.to_world, n))
     }
 }
 

@@ -2,6 +2,7 @@
 //! svm/geometry.h, camera.h, tex_coord.h, light_path.h, fresnel.h, normal.h,
 //! tangent.h): what each output reads from the `ShadingPoint`.
 
+use crate::foundation::math::{cross, dot, len};
 use crate::nodes::fresnel::{fresnel, layer_weight};
 use crate::nodes::light_falloff::light_falloff;
 use crate::nodes::math::Vec3;
@@ -87,25 +88,11 @@ impl Input {
     }
 }
 
-fn dot(a: Vec3, b: Vec3) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn cross(a: Vec3, b: Vec3) -> Vec3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
 /// Cycles' `normalize`: no guard, a zero vector gives NaNs as it does there.
 fn normalize(v: Vec3) -> Vec3 {
     let l = dot(v, v).sqrt();
     [v[0] / l, v[1] / l, v[2] / l]
 }
-fn len(v: Vec3) -> f32 {
-    dot(v, v).sqrt()
-}
-
 /// An object-space direction to world space the way Cycles transforms normals
 /// (`object_normal_transform`: by the transposed world-to-object matrix).
 pub fn object_normal_to_world(sp: &ShadingPoint, n: Vec3) -> Vec3 {
@@ -209,12 +196,6 @@ pub fn light_falloff_node(sp: &ShadingPoint, strength: f32, smooth: f32) -> [f32
 #[inline]
 pub fn normal_dot(direction: Vec3, normal: Vec3) -> f32 {
     dot(direction, normalize(normal))
-}
-
-/// Texture Coordinate > Object relative to another object: its world-to-object transform.
-#[inline]
-pub fn transform_point(m: &[[f32; 4]; 3], p: Vec3) -> Vec3 {
-    std::array::from_fn(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3])
 }
 
 /// Cycles' Wireframe (svm/wireframe.h): 1 where the point lies within half of `size`

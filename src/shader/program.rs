@@ -1473,9 +1473,11 @@ impl Program {
                     normal,
                     dst,
                 } => s[dst as usize] = inputs::normal_dot(direction, v3(s, normal)),
-                Op::ObjectSpace { to_object, dst } => {
-                    put3(s, dst, inputs::transform_point(&to_object, sp.position))
-                }
+                Op::ObjectSpace { to_object, dst } => put3(
+                    s,
+                    dst,
+                    crate::foundation::math::transform_point(&to_object, sp.position),
+                ),
                 Op::TangentRadial { axis, dst } => put3(s, dst, inputs::radial_tangent(&sp, axis)),
                 Op::Attribute {
                     attr,
