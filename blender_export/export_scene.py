@@ -604,7 +604,7 @@ def evaluated_meshes(objs, depsgraph):
     in its local space, and the material slots its faces index. One pass over
     depsgraph.object_instances (instance objects are only valid during their iteration
     step, so each is converted right away)."""
-    parts, n_inst, inverse, mats, uvinfo, inst_values = {}, {}, {}, {}, {}, {}
+    parts, realized_parts, inverse, mats, uvinfo, inst_values = {}, {}, {}, {}, {}, {}
     lookup = [n for n in ATTRIBUTE_LOOKUP_NAMES]
     for o in objs:
         ev = o.evaluated_get(depsgraph)
@@ -632,7 +632,7 @@ def evaluated_meshes(objs, depsgraph):
                                   getattr(me.attributes, "default_color_name", None) or None)
             finally:
                 ev.to_mesh_clear()
-        n_inst[key(o)] = 0
+        realized_parts[key(o)] = []
         inverse[key(o)] = np.linalg.inv(np.array(ev.matrix_world, dtype=np.float64))
     for inst in depsgraph.object_instances:
         if not inst.is_instance or inst.parent is None:
@@ -654,15 +654,32 @@ def evaluated_meshes(objs, depsgraph):
             part = with_materials(part, mats[owner], slot_materials(io, ime))
             if inst_values[owner] is not None:
                 part = with_instancer_values(part, inst_values[owner].of(list(inst.persistent_id)))
+            texspace = (vec(ime.texspace_location), vec(ime.texspace_size)) if io.type == "MESH" else None
         finally:
             io.to_mesh_clear()
-        parts[owner].append(transform_part(part, inverse[owner] @ np.array(inst.matrix_world, dtype=np.float64)))
-        n_inst[owner] += 1
+        rel = inverse[owner] @ np.array(inst.matrix_world, dtype=np.float64)
+        parts[owner].append(transform_part(part, rel))
+        realized_parts[owner].append(realized_instance(part[0], rel, inst, io, texspace))
     for name, iv in inst_values.items():
-        if iv is not None and n_inst[name]:
+        if iv is not None and realized_parts[name]:
             # The instancer's own geometry reads the object's value (no instance layer).
             parts[name][0] = with_instancer_values(parts[name][0], dict(iv.fallback))
-    return {name: (concat_meshes(p), n_inst[name], mats[name], uvinfo[name]) for name, p in parts.items()}
+    realized = {name: {"own_counts": list(map(int, p[0][0])), "instances": realized_parts[name]} if realized_parts[name] else None
+                for name, p in parts.items()}
+    return {name: (concat_meshes(p), realized[name], mats[name], uvinfo[name]) for name, p in parts.items()}
+
+
+def realized_instance(counts, rel, inst, io, texspace):
+    """What Cycles would give an instance realised into its instancer's evaluated mesh,
+    which it renders as an object of its own: the part's element counts (parts follow
+    each other in every domain), its transform in the instancer's space, and its Object
+    Info values (DepsgraphObjectInstance.random_id, the instanced object's colour and pass
+    index) and mesh texture space (Generated)."""
+    return {"counts": list(map(int, counts)), "matrix": [list(map(float, r)) for r in rel],
+            "random_id": int(inst.random_id) & 0xFFFFFFFF, "object": io.original.name,
+            "color": vec(io.color), "pass_index": int(io.pass_index),
+            "texspace_location": texspace[0] if texspace else None,
+            "texspace_size": texspace[1] if texspace else None}
 
 
 def hair_strands(o, depsgraph, path):
@@ -1278,11 +1295,12 @@ def evaluated_frames(evaluated, by_key, index, out, frames):
         got = evaluated_meshes([by_key[e["object"]] for e in moving], depsgraph)
         for e in moving:
             name = e["object"]
-            (counts, arrays, attrs, uvs), n_inst, mats, (uv_layers, render_uv, color) = got[name]
+            (counts, arrays, attrs, uvs), realized, mats, (uv_layers, render_uv, color) = got[name]
             rel = f"evaluated/{safe_name(index[name], name)[:-4]}.f{f}.glb"
             write_mesh_glb(os.path.join(out, rel), name, counts, arrays, attrs, uvs)
             extra.append(dict(e, frame=scene.frame_current + scene.frame_subframe, file=rel,
-                              vertex_count=counts[0], face_count=counts[2], instances_realized=n_inst,
+                              vertex_count=counts[0], face_count=counts[2],
+                              instances_realized=len(realized["instances"]) if realized else 0, realized=realized,
                               materials=mats, uv_layers=uv_layers, active_render_uv=render_uv,
                               default_color_attribute=color))
     return extra
@@ -1368,13 +1386,13 @@ def main():
         with RenderSettings():
             frozen_meshes = evaluated_meshes(targets, bpy.context.evaluated_depsgraph_get())
             hair = export_hair(targets, out, index)
-        for name, ((counts, arrays, attrs, uvs), n_inst, mats, (uv_layers, render_uv, color)) in frozen_meshes.items():
+        for name, ((counts, arrays, attrs, uvs), realized, mats, (uv_layers, render_uv, color)) in frozen_meshes.items():
             rel = f"evaluated/{safe_name(index[name], name)}"
             write_mesh_glb(os.path.join(out, rel), name, counts, arrays, attrs, uvs)
             reads, animated, unsupported = frozen_inputs(by_key[name])
             evaluated.append({"object": name, "frame": scene.frame_current + scene.frame_subframe, "file": rel,
-                              "vertex_count": counts[0], "face_count": counts[2], "instances_realized": n_inst,
-                              "reads": reads, "animated": animated, "unsupported": unsupported,
+                              "vertex_count": counts[0], "face_count": counts[2], "instances_realized": len(realized["instances"]) if realized else 0,
+                              "realized": realized, "reads": reads, "animated": animated, "unsupported": unsupported,
                               "materials": mats, "uv_layers": uv_layers, "active_render_uv": render_uv,
                               "default_color_attribute": color, "hair": hair.get(name)})
 

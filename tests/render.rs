@@ -75,6 +75,10 @@ const ASSERTED: &[&str] = &[
     // Instancer attributes on Geometry Nodes instances nested two deep, realised into
     // Blender's evaluated mesh: the innermost level that has the name, per instance.
     "nested_instancer_attribute",
+    // Particles, a collection instance and vertex instancing, realised into Blender's
+    // evaluated mesh, each shaded in its own object space (Object and Generated
+    // coordinates, Object Info Random, Location, Color), as Cycles renders instances.
+    "instance_object_space",
     // Metallic BSDF, Physical Conductor (complex IOR) with Multiscatter GGX and Beckmann,
     // F82 Tint with Beckmann.
     "metallic_conductor",

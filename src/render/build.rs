@@ -236,12 +236,27 @@ pub fn build(
                     texspace,
                 };
                 let before = instances.len();
-                push_instance(&mut instances, scene, oi, obj, &info, m, to_world, None)?;
-                if e.instances_realized.unwrap_or(0) > 0 && instances.len() > before {
+                match &e.realized {
+                    Some(r) => push_realized(
+                        &mut instances,
+                        scene,
+                        (oi, obj),
+                        &info,
+                        &m,
+                        r,
+                        &eval.world_matrices[oi],
+                    )?,
+                    None => {
+                        push_instance(&mut instances, scene, oi, obj, &info, m, to_world, None)?
+                    }
+                }
+                if e.instances_realized.unwrap_or(0) > 0 {
                     // Blender realised instances into this mesh; Cycles would read an
-                    // Instancer attribute per instance (refused in bind_attributes).
-                    let pushed = instances.last_mut().expect("pushed");
-                    pushed.nested_instancer_names = obj.attribute_lookups.keys().cloned().collect();
+                    // Instancer attribute per nested instance (refused in bind_attributes).
+                    for pushed in &mut instances[before..] {
+                        pushed.nested_instancer_names =
+                            obj.attribute_lookups.keys().cloned().collect();
+                    }
                 }
                 let hair = scene
                     .load_hair(ei)
@@ -506,6 +521,67 @@ fn push_instance(
         to_world,
         instance_index,
     )?);
+    Ok(())
+}
+
+/// An evaluated mesh with realised instances (`render::realized`) as the objects Cycles
+/// renders: the instancer's own geometry, then each instance in its own object space at
+/// the instancer's transform times its own, with its Object Info (random id, colour, pass
+/// index) and texture space, numbered as instances are.
+fn push_realized(
+    instances: &mut Vec<MeshInstance>,
+    scene: &Scene,
+    (oi, obj): (usize, &crate::scene::Object),
+    info: &MeshInfo,
+    mesh: &MeshData,
+    realized: &crate::scene::Realized,
+    world: &[[f64; 4]; 4],
+) -> Result<(), RenderError> {
+    let parts = crate::render::realized::split(mesh, realized)
+        .map_err(|e| RenderError(format!("object {:?}: evaluated mesh: {e}", obj.name)))?;
+    for part in parts {
+        let Some((k, inst)) = part.instance else {
+            push_instance(
+                instances,
+                scene,
+                oi,
+                obj,
+                info,
+                Arc::new(part.mesh),
+                Affine::from_rows(world),
+                None,
+            )?;
+            continue;
+        };
+        let rows: [[f64; 4]; 4] = std::array::from_fn(|r| {
+            std::array::from_fn(|c| (0..4).map(|j| world[r][j] * inst.matrix[j][c]).sum())
+        });
+        let texspace = inst.texspace_location.zip(inst.texspace_size);
+        let part_info = MeshInfo {
+            materials: info.materials,
+            uv_name: info.uv_name.clone(),
+            default_color: info.default_color.clone(),
+            texspace,
+        };
+        let before = instances.len();
+        push_instance(
+            instances,
+            scene,
+            oi,
+            obj,
+            &part_info,
+            Arc::new(part.mesh),
+            Affine::from_rows(&rows),
+            Some(k as u32),
+        )?;
+        if let Some(pushed) = instances.get_mut(before) {
+            // Cycles syncs an instance as an object: Object Info reads the dupli's random
+            // id and the instanced object's colour and pass index.
+            pushed.info.random = inst.random_id as f32 * (1.0 / 0xFFFF_FFFFu32 as f32);
+            pushed.info.color = inst.color.map(|c| c as f32);
+            pushed.info.pass_index = inst.pass_index as f32;
+        }
+    }
     Ok(())
 }
 

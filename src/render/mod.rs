@@ -27,6 +27,7 @@ pub mod light;
 pub mod limits;
 pub use crate::foundation::math;
 pub mod motion;
+pub mod realized;
 pub mod sampler;
 pub mod scene_mesh;
 pub mod shader_rays;

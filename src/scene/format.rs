@@ -643,6 +643,40 @@ pub struct Evaluated {
     /// systems), None when it has none (`scene::hair`).
     #[serde(default)]
     pub hair: Option<HairRef>,
+    /// The instances Blender realised into the evaluated mesh, each of which Cycles
+    /// renders as an object of its own; None without instances (and in exports made
+    /// before it was written).
+    #[serde(default)]
+    pub realized: Option<Realized>,
+}
+
+/// How an evaluated mesh splits into the instancer's own geometry and the instances
+/// realised after it: parts follow each other in every domain, in this order.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Realized {
+    /// Vertex, edge, face, corner and triangle counts of the instancer's own geometry.
+    pub own_counts: [usize; 5],
+    pub instances: Vec<RealizedInstance>,
+}
+
+/// One realised instance: its part's counts, its transform in the instancer's object
+/// space (rows), and what Object Info and Generated read on it in Cycles.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct RealizedInstance {
+    pub counts: [usize; 5],
+    pub matrix: [[f64; 4]; 4],
+    /// Blender's DepsgraphObjectInstance.random_id (Object Info > Random).
+    pub random_id: u32,
+    /// The instanced object (its colour and pass index below).
+    pub object: String,
+    pub color: [f64; 4],
+    pub pass_index: i64,
+    /// The instanced mesh's texture space; None for other object types (Generated then
+    /// spans the part's bounds).
+    #[serde(default)]
+    pub texspace_location: Option<[f32; 3]>,
+    #[serde(default)]
+    pub texspace_size: Option<[f32; 3]>,
 }
 
 /// An object's hair strands: a file of x, y, z, radius per key (little-endian f32,
