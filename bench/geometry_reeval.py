@@ -20,7 +20,8 @@ one). The vertex column counts both with the instances' vertices.
 blendsynth: the file is converted once into the work folder; per value `blendsynth mesh
 --set PATH=VALUE` evaluates the object from scratch and prints its own evaluation time
 (Geometry Nodes evaluation and realisation; scene loading and the file write excluded).
-The table gives each value's times and the medians; the JSON has the same.
+The table gives each value's times and the medians, and blendsynth's peak memory for the
+whole `mesh` process (GNU time); the JSON has the same.
 """
 import argparse
 import json
@@ -112,20 +113,25 @@ def main():
     subprocess.run([a.blendsynth, "convert", a.blend, "-o", export], check=True, env=env,
                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     ours = []
+    # GNU time's %M: the whole `mesh` process's peak resident set, in kB.
+    timer = ["/usr/bin/time", "-f", "PEAK_KB %M"] if os.path.exists("/usr/bin/time") else []
     for v in values:
-        r = subprocess.run([a.blendsynth, "mesh", export, "--object", a.object, "--set", f"{a.path}={v}",
-                            "-o", os.path.join(a.work, "mesh.glb")], capture_output=True, text=True, check=True)
+        r = subprocess.run(timer + [a.blendsynth, "mesh", export, "--object", a.object, "--set", f"{a.path}={v}",
+                                    "-o", os.path.join(a.work, "mesh.glb")], capture_output=True, text=True, check=True)
         m = re.search(r"(\d+) vertices.*evaluated in ([0-9.]+) s", r.stdout)
-        ours.append({"value": v, "seconds": float(m.group(2)), "vertices": int(m.group(1))})
+        peak = re.search(r"PEAK_KB (\d+)", r.stderr)
+        ours.append({"value": v, "seconds": float(m.group(2)), "vertices": int(m.group(1)),
+                     "peak_mb": int(peak.group(1)) / 1024 if peak else None})
 
     print(f"{a.object} in {os.path.basename(a.blend)}, {a.path}")
-    print("| value | Blender s | blendsynth s | vertices Blender / blendsynth |")
-    print("|---|---|---|---|")
+    print("| value | Blender s | blendsynth s | vertices Blender / blendsynth | blendsynth peak MB |")
+    print("|---|---|---|---|---|")
     for b, o in zip(blender["runs"], ours):
-        print(f"| {b['value']} | {b['seconds']:.3f} | {o['seconds']:.3f} | {b['vertices']} / {o['vertices']} |")
+        peak = f"{o['peak_mb']:.0f}" if o["peak_mb"] else "-"
+        print(f"| {b['value']} | {b['seconds']:.3f} | {o['seconds']:.3f} | {b['vertices']} / {o['vertices']} | {peak} |")
     mb = statistics.median(x["seconds"] for x in blender["runs"])
     mo = statistics.median(x["seconds"] for x in ours)
-    print(f"| median | {mb:.3f} | {mo:.3f} | ratio blendsynth / Blender {mo / mb:.2f} |")
+    print(f"| median | {mb:.3f} | {mo:.3f} | ratio blendsynth / Blender {mo / mb:.2f} | |")
     result = {"blend": a.blend, "object": a.object, "path": a.path, "blender": blender["runs"],
               "blendsynth": ours, "median_blender": mb, "median_blendsynth": mo, "ratio": mo / mb}
     with open(a.json or os.path.join(a.work, "geometry_reeval.json"), "w") as f:

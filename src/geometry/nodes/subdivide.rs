@@ -22,7 +22,8 @@ use super::super::value::SocketValue;
 use super::geometry_ops::modify_geometry_sets;
 
 /// A point of a coarse face as weights over its corners (corner index, weight).
-type Weights = Vec<(usize, f64)>;
+/// Source elements and their weights: four for a quad corner, inline (no allocation).
+type Weights = smallvec::SmallVec<[(usize, f64); 4]>;
 
 struct Ctx<'a> {
     m: &'a Mesh,
@@ -131,7 +132,7 @@ impl<'a> Ctx<'a> {
         let r = self.m.face(f);
         let n = r.len();
         let bil = [(1.0 - u) * (1.0 - v), u * (1.0 - v), u * v, (1.0 - u) * v];
-        let mut w: Weights = Vec::new();
+        let mut w = Weights::new();
         if n == 4 {
             for k in 0..4 {
                 w.push((r.start + k, bil[k]));
@@ -157,7 +158,7 @@ impl<'a> Ctx<'a> {
 struct Build {
     positions: Vec<[f32; 3]>,
     /// Per new vertex: weights over coarse vertices.
-    vert_src: Vec<Vec<(usize, f64)>>,
+    vert_src: Vec<Weights>,
     edges: Vec<[u32; 2]>,
     /// Per new edge: the coarse edge it lies on.
     edge_src: Vec<Option<usize>>,
@@ -202,21 +203,28 @@ pub fn subdivide_with_locations(m: &Mesh, level: u32) -> (Mesh, Vec<Loc>) {
     let res = ctx.res;
     let per_edge = res - 2;
     let edges_per_coarse = res - 1;
+    let corner_weights = m.attributes.on(Domain::Corner).next().is_some();
+    // Built in place: `vec![w; n]` would clone an empty SmallVec n times.
+    let empty = |n: usize| {
+        let mut v = Vec::with_capacity(n);
+        v.resize_with(n, Weights::new);
+        v
+    };
     let mut b = Build {
         positions: vec![[0.0; 3]; ctx.n_verts],
-        vert_src: vec![Vec::new(); ctx.n_verts],
+        vert_src: empty(ctx.n_verts),
         edges: vec![[0, 0]; ctx.n_edges],
         edge_src: vec![None; ctx.n_edges],
         corner_verts: vec![0; ctx.n_faces * 4],
         corner_edges: vec![0; ctx.n_faces * 4],
-        corner_src: vec![Vec::new(); ctx.n_faces * 4],
-        corner_weights: m.attributes.on(Domain::Corner).next().is_some(),
+        corner_src: empty(if corner_weights { ctx.n_faces * 4 } else { 0 }),
+        corner_weights,
         face_src: vec![0; ctx.n_faces],
         vert_loc: vec![Loc::Vertex(0); ctx.n_verts],
     };
     // Coarse vertices, then vertices along coarse edges (linear from edge[0]).
     for v in 0..m.vertex_count() {
-        b.vert_src[v] = vec![(v, 1.0)];
+        b.vert_src[v] = smallvec::smallvec![(v, 1.0)];
         b.vert_loc[v] = Loc::Vertex(v);
     }
     let inv = 1.0 / (res - 1) as f64;
@@ -224,11 +232,11 @@ pub fn subdivide_with_locations(m: &Mesh, level: u32) -> (Mesh, Vec<Loc>) {
         for i in 0..per_edge {
             let t = (i + 1) as f64 * inv;
             let idx = (ctx.vertices_edge_offset + e as i64 * per_edge + i) as usize;
-            b.vert_src[idx] = vec![(ev[0] as usize, 1.0 - t), (ev[1] as usize, t)];
+            b.vert_src[idx] = smallvec::smallvec![(ev[0] as usize, 1.0 - t), (ev[1] as usize, t)];
             b.vert_loc[idx] = Loc::Edge(e, i as usize);
         }
     }
-    let corner_to_vert = |w: &Weights| -> Vec<(usize, f64)> {
+    let corner_to_vert = |w: &Weights| -> Weights {
         w.iter()
             .map(|&(c, x)| (m.corner_verts[c] as usize, x))
             .collect()
@@ -304,11 +312,24 @@ pub fn subdivide_with_locations(m: &Mesh, level: u32) -> (Mesh, Vec<Loc>) {
     (out, b.vert_loc)
 }
 
-fn mix_array(src: &Array, weights: &[Vec<(usize, f64)>]) -> Array {
+fn mix_array(src: &Array, weights: &[Weights]) -> Array {
     let n = weights.len();
     let t = src.data_type();
     let mut out = Array::zeros(t, n);
     match (src, &mut out) {
+        // Float lanes without a per-element allocation (the same sums in the same order).
+        (Array::Float(s), Array::Float(o)) => {
+            for (o, w) in o.iter_mut().zip(weights) {
+                if !w.is_empty() {
+                    *o = w.iter().fold(0.0f64, |a, &(k, x)| a + s[k] as f64 * x) as f32;
+                }
+            }
+        }
+        (Array::Float2(s), Array::Float2(o)) => mix_lanes(s, weights, o),
+        (Array::Vector(s), Array::Vector(o)) => mix_lanes(s, weights, o),
+        (Array::Color(s), Array::Color(o)) | (Array::ByteColor(s), Array::ByteColor(o)) => {
+            mix_lanes(s, weights, o)
+        }
         (Array::Bool(s), Array::Bool(o)) => {
             for (i, w) in weights.iter().enumerate() {
                 o[i] = w.iter().any(|&(k, x)| x > 0.0 && s[k]);
@@ -331,6 +352,23 @@ fn mix_array(src: &Array, weights: &[Vec<(usize, f64)>]) -> Array {
         }
     }
     out
+}
+
+/// Each output element the weighted sum of its sources, in double precision; elements
+/// without sources stay zero.
+fn mix_lanes<const N: usize>(src: &[[f32; N]], weights: &[Weights], out: &mut [[f32; N]]) {
+    for (o, w) in out.iter_mut().zip(weights) {
+        if w.is_empty() {
+            continue;
+        }
+        let mut acc = [0.0f64; N];
+        for &(k, x) in w {
+            for (a, &v) in acc.iter_mut().zip(&src[k]) {
+                *a += v as f64 * x;
+            }
+        }
+        *o = acc.map(|a| a as f32);
+    }
 }
 
 fn lanes(v: &super::super::types::Value) -> Vec<f64> {
@@ -376,7 +414,7 @@ fn from_lanes(t: super::super::types::DataType, a: &[f64]) -> super::super::type
 
 fn interpolate_attributes(
     m: &Mesh,
-    verts: &[Vec<(usize, f64)>],
+    verts: &[Weights],
     edges: &[Option<usize>],
     corners: &[Weights],
     faces: &[usize],
