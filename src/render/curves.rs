@@ -467,31 +467,36 @@ pub fn check(
     }
     // The hair BSDFs turn about the curve's tangent: on a mesh Cycles takes the
     // triangle's dP/dv instead, which blendsynth does not have.
+    let hair_bsdf = |mi: usize| {
+        materials[mi].program.as_ref().and_then(|p| {
+            p.bsdfs.iter().find(|b| {
+                matches!(
+                    b.bl_idname.as_str(),
+                    "ShaderNodeBsdfHair" | "ShaderNodeBsdfHairPrincipled"
+                )
+            })
+        })
+    };
+    let with_hair_bsdf: Vec<usize> = (0..materials.len())
+        .filter(|&mi| hair_bsdf(mi).is_some())
+        .collect();
     for inst in geo.instances.iter().filter(|i| i.curves.is_none()) {
-        let mut seen = Vec::new();
-        for t in 0..inst.mesh.triangle_faces.len() {
-            let Some(mi) = inst.material_of(t) else {
-                continue;
-            };
-            if seen.contains(&mi) {
-                continue;
-            }
-            seen.push(mi);
-            let m = &materials[mi];
-            let hair_bsdf = m.program.as_ref().and_then(|p| {
-                p.bsdfs.iter().find(|b| {
-                    matches!(
-                        b.bl_idname.as_str(),
-                        "ShaderNodeBsdfHair" | "ShaderNodeBsdfHairPrincipled"
-                    )
-                })
-            });
-            if let Some(b) = hair_bsdf {
-                return Err(RenderError(format!(
-                    "object {:?}: its material {:?} has node {} on the mesh's faces, which blendsynth renders on hair curves only",
-                    inst.name, m.name, b.bl_idname
-                )));
-            }
+        // Only the slots the mesh's faces use (an emitter's hair material is no face's).
+        if !inst
+            .slots
+            .iter()
+            .flatten()
+            .any(|mi| with_hair_bsdf.contains(mi))
+        {
+            continue;
+        }
+        let mut used = (0..inst.mesh.triangle_faces.len()).filter_map(|t| inst.material_of(t));
+        if let Some(mi) = used.find(|mi| with_hair_bsdf.contains(mi)) {
+            let b = hair_bsdf(mi).map_or("", |b| b.bl_idname.as_str());
+            return Err(RenderError(format!(
+                "object {:?}: its material {:?} has node {b} on the mesh's faces, which blendsynth renders on hair curves only",
+                inst.name, materials[mi].name
+            )));
         }
     }
     for inst in geo.instances.iter().filter(|i| i.curves.is_some()) {

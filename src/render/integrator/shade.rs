@@ -476,7 +476,8 @@ fn hair_bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, 
 }
 
 /// The Principled Hair BSDF node, Chiang model, as Cycles' svm_node_closure_bsdf sets it
-/// up: Random from the linked input or the curve's random number, randomising Roughness
+/// up: Random from the linked input (a constant link reads as unlinked, as Cycles folds
+/// it) or else the curve's random number, randomising Roughness
 /// (and Radial Roughness) and, for Melanin Concentration, the melanin; the absorption
 /// from the parametrization; weight one (the colour is in the absorption). The Huang
 /// model is refused before rendering (`render::curves::check`).
