@@ -23,6 +23,12 @@ const ASSERTED: &[&str] = &[
     "issue26_geo",
     // Particle hair (children) as Cycles' default Rounded Ribbons (render/curves.rs).
     "hair",
+    // Principled Hair BSDF, Chiang (render/bsdf/hair_chiang.rs): Melanin with Coat and
+    // Random Color from the curve's random number; Direct Coloring with Random Roughness
+    // from it; Absorption Coefficient with a linked Random.
+    "hair_chiang_melanin",
+    "hair_chiang_color",
+    "hair_chiang_absorption",
     "adaptive",
     "motion_blur",
     "motion_blur_start",
@@ -270,7 +276,10 @@ const SCALED_SCENES: &[&[&str]] = &[
 const MAX_SCALE_REL: f64 = 0.003;
 
 /// Scenes that do not pass yet, with the reason.
-const KNOWN_FAILURES: &[(&str, &str)] = &[];
+const KNOWN_FAILURES: &[(&str, &str)] = &[(
+    "hair_bsdf",
+    "Hair BSDF Reflection plus Transmission: ratio 1.06, channel means 1.2-1.45% above Cycles' (seed spread 0.1% at 256 samples); Reflection alone matches (0.08%), Transmission alone is 1% bright: under investigation",
+)];
 
 /// Scenes whose one-seed figures are no parity criterion, with the test that compares them
 /// instead (their figures are still printed).
@@ -1573,6 +1582,90 @@ fn unsupported_volumes_are_refused_by_name() {
             }]);
         },
         &["object \"Cube\"", "fluid domain", "\"Fluid\"", "\"Fog\""],
+    );
+}
+
+/// The hair BSDFs render on hair curves with the Chiang model only: the Principled Hair
+/// BSDF's Huang model, and either hair BSDF on a mesh's faces (Cycles turns them about
+/// the triangle's dP/dv, which blendsynth does not have), are errors naming the object,
+/// material and node, alike from `inspect` (render::check) and `render`.
+#[test]
+fn hair_bsdfs_refused_where_not_rendered() {
+    let dir = common::repo().join("fixtures/render/scenes/hair_chiang_melanin");
+    let base: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("scene.json")).unwrap()).unwrap();
+    let refused = |edit: &dyn Fn(&mut serde_json::Value), words: &[&str]| {
+        refused_alike(&dir, &base, edit, words)
+    };
+    let scene = Scene::from_json(&dir, base.to_string().as_bytes()).unwrap();
+    let opts = RenderOptions {
+        samples: Some(1),
+        resolution: Some((8, 8)),
+        ..Default::default()
+    };
+    assert!(blendsynth::render::check(&scene, &opts, &[]).is_ok());
+    let node = |j: &mut serde_json::Value, material: &str, bl_idname: &str| -> serde_json::Value {
+        let ms = j["materials"].as_array_mut().unwrap();
+        let m = ms.iter_mut().find(|m| m["name"] == material).unwrap();
+        let nodes = m["node_tree"]["nodes"].as_array_mut().unwrap();
+        nodes
+            .iter()
+            .find(|n| n["bl_idname"] == bl_idname)
+            .unwrap()
+            .clone()
+    };
+    let set = |j: &mut serde_json::Value,
+               material: &str,
+               bl_idname: &str,
+               f: &dyn Fn(&mut serde_json::Value)| {
+        let ms = j["materials"].as_array_mut().unwrap();
+        let m = ms.iter_mut().find(|m| m["name"] == material).unwrap();
+        let nodes = m["node_tree"]["nodes"].as_array_mut().unwrap();
+        f(nodes
+            .iter_mut()
+            .find(|n| n["bl_idname"] == bl_idname)
+            .unwrap());
+    };
+    // The Huang model on the hair.
+    refused(
+        &|j| {
+            set(j, "HairMelanin", "ShaderNodeBsdfHairPrincipled", &|n| {
+                n["properties"]["model"] = "HUANG".into()
+            })
+        },
+        &[
+            "\"Emitter\"",
+            "\"HairMelanin\"",
+            "ShaderNodeBsdfHairPrincipled",
+            "HUANG",
+        ],
+    );
+    // The Principled Hair BSDF (Chiang) as the emitter mesh's own material.
+    refused(
+        &|j| {
+            let hair = node(j, "HairMelanin", "ShaderNodeBsdfHairPrincipled");
+            set(j, "Skin", "ShaderNodeBsdfDiffuse", &|n| {
+                let mut h = hair.clone();
+                h["name"] = n["name"].clone();
+                *n = h;
+            });
+        },
+        &[
+            "\"Emitter\"",
+            "\"Skin\"",
+            "ShaderNodeBsdfHairPrincipled",
+            "hair curves only",
+        ],
+    );
+    // The Hair BSDF on the floor.
+    refused(
+        &|j| {
+            set(j, "Floor", "ShaderNodeBsdfDiffuse", &|n| {
+                n["bl_idname"] = "ShaderNodeBsdfHair".into();
+                n["properties"]["component"] = "Transmission".into();
+            })
+        },
+        &["\"Floor\"", "ShaderNodeBsdfHair", "hair curves only"],
     );
 }
 

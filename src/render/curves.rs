@@ -314,6 +314,13 @@ pub fn ribbon_shading(c: &[[f32; 4]; 4], pieces: u32, u: f32, v: f32, dir: V3) -
     (p, n, dpdu)
 }
 
+/// Cycles' random number of particle hair curve `i` (its index in the object's hair, in
+/// export order): hash_uint2_to_float(i, 0), as blender/curves.cpp fills
+/// ATTR_STD_CURVE_RANDOM.
+pub fn curve_random(i: u32) -> f32 {
+    crate::nodes::white_noise::lookup3::hash2(i, 0) as f32 / u32::MAX as f32
+}
+
 /// The scene's curve segments behind one ray query.
 pub struct CurveAccel {
     bvh: BoxBvh,
@@ -443,8 +450,9 @@ impl Accel for WithCurves {
 }
 
 /// What blendsynth cannot render on hair, named: materials with volume, true
-/// displacement, emission (Cycles' curves are no lights), the hair BSDFs and the
-/// Subsurface Scattering node; and hair with motion blur or under Embree.
+/// displacement, emission (Cycles' curves are no lights), the Principled Hair BSDF's
+/// Huang model and the Subsurface Scattering node; the hair BSDFs on meshes; and hair
+/// with motion blur or under Embree.
 pub fn check(
     scene: &crate::scene::Scene,
     geo: &crate::render::build::Geometry,
@@ -455,6 +463,40 @@ pub fn check(
         let backend = crate::foundation::bvh::Backend::from_env().map_err(RenderError)?;
         if backend == crate::foundation::bvh::Backend::Embree {
             return Err(RenderError("BLENDSYNTH_ACCEL=embree: the scene has hair curves, which blendsynth's Embree backend does not take yet (use bvh4 or bvh2)".into()));
+        }
+    }
+    // The hair BSDFs turn about the curve's tangent: on a mesh Cycles takes the
+    // triangle's dP/dv instead, which blendsynth does not have.
+    let hair_bsdf = |mi: usize| {
+        materials[mi].program.as_ref().and_then(|p| {
+            p.bsdfs.iter().find(|b| {
+                matches!(
+                    b.bl_idname.as_str(),
+                    "ShaderNodeBsdfHair" | "ShaderNodeBsdfHairPrincipled"
+                )
+            })
+        })
+    };
+    let with_hair_bsdf: Vec<usize> = (0..materials.len())
+        .filter(|&mi| hair_bsdf(mi).is_some())
+        .collect();
+    for inst in geo.instances.iter().filter(|i| i.curves.is_none()) {
+        // Only the slots the mesh's faces use (an emitter's hair material is no face's).
+        if !inst
+            .slots
+            .iter()
+            .flatten()
+            .any(|mi| with_hair_bsdf.contains(mi))
+        {
+            continue;
+        }
+        let mut used = (0..inst.mesh.triangle_faces.len()).filter_map(|t| inst.material_of(t));
+        if let Some(mi) = used.find(|mi| with_hair_bsdf.contains(mi)) {
+            let b = hair_bsdf(mi).map_or("", |b| b.bl_idname.as_str());
+            return Err(RenderError(format!(
+                "object {:?}: its material {:?} has node {b} on the mesh's faces, which blendsynth renders on hair curves only",
+                inst.name, materials[mi].name
+            )));
         }
     }
     for inst in geo.instances.iter().filter(|i| i.curves.is_some()) {
@@ -470,17 +512,17 @@ pub fn check(
             } else if p.emission_estimate.iter().any(|&e| e != 0.0) {
                 Some("emission".to_string())
             } else {
-                p.bsdfs
-                    .iter()
-                    .find(|b| {
-                        matches!(
-                            b.bl_idname.as_str(),
-                            "ShaderNodeBsdfHair"
-                                | "ShaderNodeBsdfHairPrincipled"
-                                | "ShaderNodeSubsurfaceScattering"
-                        )
-                    })
-                    .map(|b| format!("node {}", b.bl_idname))
+                p.bsdfs.iter().find_map(|b| match b.bl_idname.as_str() {
+                    "ShaderNodeSubsurfaceScattering" => Some(format!("node {}", b.bl_idname)),
+                    "ShaderNodeBsdfHairPrincipled" if b.property("model") != Some("CHIANG") => {
+                        Some(format!(
+                            "node {} with model {:?} (only the Chiang model is rendered)",
+                            b.bl_idname,
+                            b.property("model").unwrap_or("?")
+                        ))
+                    }
+                    _ => None,
+                })
             };
             // Hair Info reads zero everywhere but on hair, where the export has none of
             // its values yet.

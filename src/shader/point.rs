@@ -42,6 +42,12 @@ pub struct ShadingPoint {
     pub true_normal: Vec3,
     /// Cycles' barycentric (u, v) in its triangle: Geometry > Parametric is (1-u-v, u, 0).
     pub parametric: [f32; 2],
+    /// On a hair curve (zero elsewhere): the curve's tangent dP/du in world space (Cycles'
+    /// sd->dPdu, which the hair closures turn about).
+    pub dpdu: Vec3,
+    /// On a hair curve: the curve's random number (Cycles' ATTR_STD_CURVE_RANDOM, which the
+    /// Principled Hair BSDF reads when its Random input is unlinked).
+    pub curve_random: f32,
     /// Length of the ray segment that reached the point (Light Path > Ray Length; 1 in a bake).
     pub ray_length: f32,
     /// What kind of ray reached the point, and the path's bounce counts (Light Path).

@@ -5,6 +5,8 @@
 
 pub mod anisotropic;
 pub mod bump_correction;
+pub mod hair;
+pub mod hair_chiang;
 pub mod metallic;
 pub mod microfacet;
 pub mod oren_nayar;
@@ -68,6 +70,10 @@ pub enum LobeKind {
         fresnel: Fresnel,
         energy: f32,
     },
+    /// Hair BSDF, Reflection or Transmission component (hair curves).
+    Hair(crate::render::bsdf::hair::Hair),
+    /// Principled Hair BSDF, Chiang model (hair curves); its normal is the fibre frame's Y.
+    Chiang(crate::render::bsdf::hair_chiang::Chiang),
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -155,6 +161,10 @@ fn excluded(kind: &LobeKind, exclude: u32) -> bool {
         LobeKind::Glass(_) => exclude & ray::TRANSMIT != 0,
         LobeKind::Toon(t) if t.glossy => exclude & ray::GLOSSY != 0,
         LobeKind::Toon(_) => exclude & ray::DIFFUSE != 0,
+        // Cycles' closure ranges: hair transmission is a transmission closure, hair
+        // reflection and the Chiang hair glossy ones.
+        LobeKind::Hair(h) if h.transmission => exclude & ray::TRANSMIT != 0,
+        LobeKind::Hair(_) | LobeKind::Chiang(_) => exclude & ray::GLOSSY != 0,
         LobeKind::Transparent | LobeKind::Subsurface(_) => false,
     }
 }
@@ -166,9 +176,11 @@ impl LobeSet {
     /// Cycles' SD_BSDF_HAS_TRANSMISSION: some closure transmits (translucent, refraction,
     /// glass). Light selection then counts lights behind the surface too.
     pub fn has_transmission(&self) -> bool {
-        self.lobes[..self.len]
-            .iter()
-            .any(|l| matches!(l.kind, LobeKind::Translucent | LobeKind::Glass(_)))
+        self.lobes[..self.len].iter().any(|l| match l.kind {
+            LobeKind::Translucent | LobeKind::Glass(_) | LobeKind::Chiang(_) => true,
+            LobeKind::Hair(h) => h.transmission,
+            _ => false,
+        })
     }
 
     pub fn clear(&mut self) {
@@ -240,50 +252,110 @@ impl LobeSet {
         tables: &Tables,
         exclude: u32,
     ) -> (V3, f32) {
+        let (f, pdf, total) = self.eval_sum(wo, wi, ng, tables, exclude, None);
+        (f, if total > 0.0 { pdf / total } else { pdf })
+    }
+
+    /// The closures' value toward `wi`, their pdfs times selection weights, and the total
+    /// selection weight; lobe `skip` is left out of the first two (Cycles'
+    /// _surface_shader_bsdf_eval_mis, for the lobe that sampled `wi` itself).
+    fn eval_sum(
+        &self,
+        wo: V3,
+        wi: V3,
+        ng: V3,
+        tables: &Tables,
+        exclude: u32,
+        skip: Option<usize>,
+    ) -> (V3, f32, f32) {
         let mut f = [0.0; 3];
         let mut pdf = 0.0;
         let mut total = 0.0;
-        for l in &self.lobes[..self.len] {
+        for (i, l) in self.lobes[..self.len].iter().enumerate() {
             total += l.sample_weight;
-            if exclude != 0 && excluded(&l.kind, exclude) {
+            if skip == Some(i) || (exclude != 0 && excluded(&l.kind, exclude)) {
                 continue;
             }
-            let bump = if is_zero(self.smooth_n) {
-                1.0
-            } else {
-                let diffuse = matches!(
-                    l.kind,
-                    LobeKind::Diffuse | LobeKind::OrenNayar(_) | LobeKind::Translucent
-                );
-                crate::render::bsdf::bump_correction::bump_shadowing_term(
-                    self.smooth_n,
-                    l.n,
-                    wi,
-                    diffuse,
-                    self.bump_correction,
-                )
-            };
+            let bump = self.bump_term(l, wi);
             if bump == 0.0 {
                 continue;
             }
             let (e, p) = eval_lobe(l, wo, wi, ng, tables);
-            let mut e = scale(e, bump);
-            if self.terminator_frequency > 1.0 {
-                let c = dot(wi, l.n);
-                if c >= 0.0 {
-                    e = scale(
-                        e,
-                        crate::render::bsdf::terminator::shift_cos_in(c, self.terminator_frequency),
-                    );
-                }
-            }
+            let e = self.terminator(scale(e, bump), l, wi);
             f = add(f, mul(e, l.weight));
             pdf += p * l.sample_weight;
         }
-        if total > 0.0 {
-            pdf /= total;
+        (f, pdf, total)
+    }
+
+    fn bump_term(&self, l: &Lobe, wi: V3) -> f32 {
+        // Cycles' bsdf_eval shadows bumped diffuse and microfacet closures only; the hair
+        // closures' normals are no bumped shading normals (Chiang's is across the fibre).
+        if is_zero(self.smooth_n) || matches!(l.kind, LobeKind::Hair(_) | LobeKind::Chiang(_)) {
+            return 1.0;
         }
-        (f, pdf)
+        let diffuse = matches!(
+            l.kind,
+            LobeKind::Diffuse | LobeKind::OrenNayar(_) | LobeKind::Translucent
+        );
+        crate::render::bsdf::bump_correction::bump_shadowing_term(
+            self.smooth_n,
+            l.n,
+            wi,
+            diffuse,
+            self.bump_correction,
+        )
+    }
+
+    fn terminator(&self, e: V3, l: &Lobe, wi: V3) -> V3 {
+        if self.terminator_frequency > 1.0 {
+            let c = dot(wi, l.n);
+            if c >= 0.0 {
+                return scale(
+                    e,
+                    crate::render::bsdf::terminator::shift_cos_in(c, self.terminator_frequency),
+                );
+            }
+        }
+        e
+    }
+
+    /// A hair lobe's own sample (Cycles' bsdf_sample with the value and pdf the closure's
+    /// sample function returns, which for the Hair BSDF's reflection differ from its
+    /// evaluation), combined with the other closures' evaluation as Cycles does.
+    fn sample_hair(
+        &self,
+        pick: usize,
+        wo: V3,
+        ng: V3,
+        u: [f32; 3],
+        tables: &Tables,
+    ) -> Option<BsdfSample> {
+        let l = &self.lobes[pick];
+        let (wi, own, own_pdf, transmit) = match l.kind {
+            LobeKind::Hair(h) => {
+                let s = h.sample(wo, [u[0], u[1]])?;
+                (s.wi, [s.pdf; 3], s.pdf, h.transmission)
+            }
+            LobeKind::Chiang(c) => c.sample(l.n, wo, u)?,
+            _ => return None,
+        };
+        let own = self.terminator(scale(own, self.bump_term(l, wi)), l, wi);
+        let (rest, rest_pdf, total) = self.eval_sum(wo, wi, ng, tables, 0, Some(pick));
+        let f = add(rest, mul(own, l.weight));
+        let pdf = (rest_pdf + own_pdf * l.sample_weight) / total;
+        if !(pdf > 0.0) || !pdf.is_finite() || is_zero(f) {
+            return None;
+        }
+        Some(BsdfSample {
+            wi,
+            weight: scale(f, 1.0 / pdf),
+            pdf,
+            singular: false,
+            glossy: true,
+            transmit,
+            kind: l.kind,
+        })
     }
 
     pub fn sample(&self, wo: V3, ng: V3, u: [f32; 3], tables: &Tables) -> Option<BsdfSample> {
@@ -352,6 +424,10 @@ impl LobeSet {
                 transmit,
                 kind: l.kind,
             });
+        }
+        if let LobeKind::Hair(_) | LobeKind::Chiang(_) = l.kind {
+            let u3 = (x / l.sample_weight).clamp(0.0, 1.0 - f32::EPSILON);
+            return self.sample_hair(pick, wo, ng, [u[0], u[1], u3], tables);
         }
         let (wi, singular) = sample_lobe(l, wo, ng, [u[0], u[1]])?;
         // The true normal is checked here, when sampling, and not in `eval_lobe` (as
@@ -607,6 +683,11 @@ fn eval_lobe(l: &Lobe, wo: V3, wi: V3, _ng: V3, _tables: &Tables) -> (V3, f32) {
             let (f, p) = t.eval(l.n, wo, wi);
             ([f; 3], p)
         }
+        LobeKind::Hair(h) => {
+            let p = h.eval(l.n, wo, wi);
+            ([p; 3], p)
+        }
+        LobeKind::Chiang(c) => c.eval(l.n, wo, wi),
         LobeKind::GlossyAniso {
             lobe,
             fresnel,
@@ -638,7 +719,10 @@ fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
             Some((wi, false))
         }
         LobeKind::Transparent => Some((neg(wo), true)),
-        LobeKind::Glass(_) | LobeKind::Subsurface(_) => None, // sampled elsewhere
+        // Sampled elsewhere.
+        LobeKind::Glass(_) | LobeKind::Subsurface(_) | LobeKind::Hair(_) | LobeKind::Chiang(_) => {
+            None
+        }
         LobeKind::Reflection(r) => r.sample(l.n, wo, ng, u),
         LobeKind::Glossy { alpha, .. } => {
             // Cycles' bsdf_microfacet_sample rejects a view below the shading normal, sharp

@@ -286,7 +286,7 @@ impl Scene<'_> {
         let r = self.geo.refs[prim as usize];
         let inst = &self.geo.instances[r.inst as usize];
         let cp = c.control_points(r.tri);
-        let (p, n, _dpdu) = crate::render::curves::ribbon_shading(&cp, c.pieces, u, v, neg(wo));
+        let (p, n, dpdu) = crate::render::curves::ribbon_shading(&cp, c.pieces, u, v, neg(wo));
         let ng = wo;
         let (to_world, to_object) = (&inst.to_world, &inst.to_object);
         let curve = c.segments[r.tri as usize].0 as usize;
@@ -297,6 +297,8 @@ impl Scene<'_> {
             object_position: to_object.point(p),
             object_normal: normalize(Affine::normal_by_inverse(to_world, n)),
             generated: inst.generated(to_object.point([root[0], root[1], root[2]])),
+            dpdu,
+            curve_random: crate::render::curves::curve_random(curve as u32),
             ..Default::default()
         };
         self.fill_context(&mut sp, inst, wo, ng, false, u, v);
@@ -854,6 +856,10 @@ fn filter_glossy(lobes: &mut LobeSet, min_ray_pdf: f32, filter_glossy: f32) {
         if let LobeKind::GlossyAniso { lobe: a, .. } = &mut lobe.kind {
             a.alpha_x = a.alpha_x.max(blur);
             a.alpha_y = a.alpha_y.max(blur);
+        }
+        // Cycles blurs the Chiang hair closure too; the Hair BSDF has no blur.
+        if let LobeKind::Chiang(c) = &mut lobe.kind {
+            c.blur(blur);
         }
     }
 }

@@ -41,8 +41,10 @@ fn counter(kind: &LobeKind, transmit: bool) -> Option<Counter> {
         }
         LobeKind::Toon(t) if t.glossy => Some(Counter::Glossy),
         LobeKind::Toon(_) => Some(Counter::Diffuse),
-        LobeKind::Glass(_) if transmit => Some(Counter::Transmission),
-        LobeKind::Glass(_) => Some(Counter::Glossy),
+        LobeKind::Glass(_) | LobeKind::Hair(_) | LobeKind::Chiang(_) if transmit => {
+            Some(Counter::Transmission)
+        }
+        LobeKind::Glass(_) | LobeKind::Hair(_) | LobeKind::Chiang(_) => Some(Counter::Glossy),
         LobeKind::Transparent | LobeKind::Subsurface(_) => None,
     }
 }
@@ -286,7 +288,7 @@ pub fn bounce_flags(kind: LobeKind, transmit: bool, singular: bool) -> u32 {
         LobeKind::Diffuse => ray::DIFFUSE | ray::REFLECT,
         LobeKind::Translucent => ray::DIFFUSE | ray::TRANSMIT,
         LobeKind::Glossy { .. } => ray::GLOSSY | ray::REFLECT,
-        LobeKind::Glass { .. } => {
+        LobeKind::Glass { .. } | LobeKind::Hair(_) | LobeKind::Chiang(_) => {
             ray::GLOSSY
                 | if transmit {
                     ray::TRANSMIT

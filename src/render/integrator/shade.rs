@@ -439,12 +439,93 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             let n = input_n(b, s, "Normal", sp);
             push_sheen_node(out, b.property("distribution"), scale(c, w), r, n, ctx.wo);
         }
+        "ShaderNodeBsdfHair" => hair_bsdf(b, w, s, sp, ctx, out),
+        "ShaderNodeBsdfHairPrincipled" => principled_hair(b, w, s, sp, ctx, out),
         // Unsupported closures fall back to a diffuse of their colour (documented).
         _ => {
             let c = input_c(b, s, "Color", [0.8; 3]);
             out.push(LobeKind::Diffuse, scale(c, w), sp.normal);
         }
     }
+}
+
+/// The Hair BSDF node as Cycles' svm_node_closure_bsdf sets it up: the tangent is the
+/// linked Tangent input or the curve's dP/du, the Offset negated. Only on hair curves
+/// (`render::curves::check` refuses it elsewhere).
+fn hair_bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet) {
+    let c = input_c(b, s, "Color", [0.8; 3]);
+    let tangent = match b.input("Tangent") {
+        Some((slot, true)) => normalize(finite3(v3(s, slot))),
+        _ => normalize(sp.dpdu),
+    };
+    if is_zero(tangent) || !tangent.iter().all(|t| t.is_finite()) {
+        return;
+    }
+    let hair = crate::render::bsdf::hair::Hair::new(
+        tangent,
+        input_f(b, s, "RoughnessU", 0.1),
+        input_f(b, s, "RoughnessV", 1.0),
+        -input_f(b, s, "Offset", 0.0),
+        b.property("component") == Some("Transmission"),
+    );
+    out.push(
+        LobeKind::Hair(hair),
+        scale(c, w),
+        valid_n(sp, ctx, sp.normal),
+    );
+}
+
+/// The Principled Hair BSDF node, Chiang model, as Cycles' svm_node_closure_bsdf sets it
+/// up: Random from the linked input (a constant link reads as unlinked, as Cycles folds
+/// it) or else the curve's random number, randomising Roughness
+/// (and Radial Roughness) and, for Melanin Concentration, the melanin; the absorption
+/// from the parametrization; weight one (the colour is in the absorption). The Huang
+/// model is refused before rendering (`render::curves::check`).
+fn principled_hair(
+    b: &BsdfNode,
+    w: f32,
+    s: &[f32],
+    sp: &ShadingPoint,
+    ctx: &Context,
+    out: &mut LobeSet,
+) {
+    use crate::render::bsdf::hair_chiang::{self as chiang, Chiang};
+    let random = match b.input("Random") {
+        Some((slot, true)) => finite_or(s[slot as usize], 0.0),
+        _ => sp.curve_random,
+    };
+    let factor = 1.0 + 2.0 * (random - 0.5) * input_f(b, s, "Random Roughness", 0.0);
+    let roughness = input_f(b, s, "Roughness", 0.3) * factor;
+    let radial = input_f(b, s, "Radial Roughness", 0.3) * factor;
+    let sigma = match b.property("parametrization") {
+        Some("ABSORPTION") => input_c(b, s, "Absorption Coefficient", [0.245531, 0.52, 1.365]),
+        Some("MELANIN") => chiang::sigma_from_melanin(
+            input_f(b, s, "Melanin", 0.8),
+            input_f(b, s, "Melanin Redness", 1.0),
+            input_c(b, s, "Tint", [1.0; 3]),
+            random,
+            input_f(b, s, "Random Color", 0.0),
+            radial,
+        ),
+        _ => chiang::sigma_from_reflectance(
+            input_c(b, s, "Color", [0.017513, 0.005763, 0.002059]),
+            radial,
+        ),
+    };
+    let Some((c, y)) = Chiang::new(
+        sigma,
+        roughness,
+        radial,
+        input_f(b, s, "Coat", 0.0),
+        input_f(b, s, "Offset", 2f32.to_radians()),
+        input_f(b, s, "IOR", 1.55),
+        sp.dpdu,
+        ctx.wo,
+        sp.parametric[1],
+    ) else {
+        return;
+    };
+    out.push(LobeKind::Chiang(c), [w; 3], y);
 }
 
 /// The Glossy BSDF node (and the legacy Anisotropic BSDF): GGX, Multiscatter GGX or
