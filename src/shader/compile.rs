@@ -493,9 +493,16 @@ impl<'g, 'a> Compiler<'g, 'a> {
             .iter()
             .filter_map(|(k, v)| v.as_str().map(|s| (k.clone(), s.to_string())))
             .collect();
+        let kind = crate::shader::program::BsdfKind::of(&n.node.bl_idname).ok_or_else(|| {
+            CompileError(format!(
+                "node {:?}: closure type {} has no shading in the renderer",
+                n.path, n.node.bl_idname
+            ))
+        })?;
         self.bsdfs.push(BsdfNode {
             closure,
             bl_idname: n.node.bl_idname.clone(),
+            kind,
             inputs,
             properties,
         });

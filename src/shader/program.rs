@@ -618,10 +618,62 @@ pub struct TrueDisplacement {
 pub struct BsdfNode {
     pub closure: u32,
     pub bl_idname: String,
+    /// What the renderer shades for it, resolved when the material is compiled.
+    pub kind: BsdfKind,
     /// (socket identifier, slot, linked): an unlinked Normal means the shading normal.
     pub inputs: Vec<(String, Slot, bool)>,
     /// The node's enum properties (distribution, subsurface method, ...).
     pub properties: Vec<(String, String)>,
+}
+
+/// The closure nodes the renderer shades, one per Blender node type (the legacy
+/// Anisotropic BSDF is the Glossy BSDF). A closure node without one is a compile error, so
+/// the renderer's dispatch has no fallback.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BsdfKind {
+    Principled,
+    Diffuse,
+    Glossy,
+    Glass,
+    Refraction,
+    Translucent,
+    Transparent,
+    Subsurface,
+    Holdout,
+    Sheen,
+    Metallic,
+    Toon,
+    Hair,
+    PrincipledHair,
+    /// Volume Absorption, Scatter, Principled Volume, Coefficients: shaded in a Volume by
+    /// render/volume.rs; nothing in a Surface (as in Cycles).
+    Volume,
+}
+
+impl BsdfKind {
+    pub fn of(bl_idname: &str) -> Option<BsdfKind> {
+        Some(match bl_idname {
+            "ShaderNodeBsdfPrincipled" => BsdfKind::Principled,
+            "ShaderNodeBsdfDiffuse" => BsdfKind::Diffuse,
+            "ShaderNodeBsdfGlossy" | "ShaderNodeBsdfAnisotropic" => BsdfKind::Glossy,
+            "ShaderNodeBsdfGlass" => BsdfKind::Glass,
+            "ShaderNodeBsdfRefraction" => BsdfKind::Refraction,
+            "ShaderNodeBsdfTranslucent" => BsdfKind::Translucent,
+            "ShaderNodeBsdfTransparent" => BsdfKind::Transparent,
+            "ShaderNodeSubsurfaceScattering" => BsdfKind::Subsurface,
+            "ShaderNodeHoldout" => BsdfKind::Holdout,
+            "ShaderNodeBsdfSheen" => BsdfKind::Sheen,
+            "ShaderNodeBsdfMetallic" => BsdfKind::Metallic,
+            "ShaderNodeBsdfToon" => BsdfKind::Toon,
+            "ShaderNodeBsdfHair" => BsdfKind::Hair,
+            "ShaderNodeBsdfHairPrincipled" => BsdfKind::PrincipledHair,
+            "ShaderNodeVolumeAbsorption"
+            | "ShaderNodeVolumeScatter"
+            | "ShaderNodeVolumePrincipled"
+            | "ShaderNodeVolumeCoefficients" => BsdfKind::Volume,
+            _ => return None,
+        })
+    }
 }
 
 impl BsdfNode {

@@ -3,7 +3,7 @@
 //! Cycles' SVM builds closures (Mix Shader factors clamped, Principled BSDF layered).
 
 use crate::scene::Scene;
-use crate::shader::program::{BsdfNode, Closure, Program};
+use crate::shader::program::{BsdfKind, BsdfNode, Closure, Program};
 use crate::shader::{compile_material, ShadingPoint};
 
 use crate::render::bsdf::tables::Tables;
@@ -56,7 +56,7 @@ pub fn compile_all(scene: &Scene, used: &[bool]) -> Result<Vec<Material>, Render
         // Volume nodes shade only a Volume (render/volume.rs): in a Surface they do
         // nothing, as in Cycles.
         for (bi, b) in p.bsdfs.iter().enumerate() {
-            if b.bl_idname.starts_with("ShaderNodeVolume") {
+            if b.kind == BsdfKind::Volume {
                 continue;
             }
             if let Some(slot) = bsdf_of.get_mut(b.closure as usize) {
@@ -350,8 +350,8 @@ pub(crate) fn dielectric_fss(eta: f32) -> f32 {
 }
 
 fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet) {
-    match b.bl_idname.as_str() {
-        "ShaderNodeBsdfDiffuse" => {
+    match b.kind {
+        BsdfKind::Diffuse => {
             let c = input_c(b, s, "Color", [0.8; 3]);
             let n = input_n(b, s, "Normal", sp);
             let r = input_f(b, s, "Roughness", 0.0);
@@ -362,7 +362,7 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
                 out.push(LobeKind::Diffuse, scale(c, w), n);
             }
         }
-        "ShaderNodeBsdfTranslucent" => {
+        BsdfKind::Translucent => {
             let c = input_c(b, s, "Color", [0.8; 3]);
             out.push(
                 LobeKind::Translucent,
@@ -370,17 +370,17 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
                 valid_n(sp, ctx, input_n(b, s, "Normal", sp)),
             );
         }
-        "ShaderNodeBsdfTransparent" => {
+        BsdfKind::Transparent => {
             let c = input_c(b, s, "Color", [1.0; 3]);
             out.push(LobeKind::Transparent, scale(c, w), sp.normal);
         }
-        "ShaderNodeHoldout" => {
+        BsdfKind::Holdout => {
             out.holdout = add(out.holdout, [w; 3]);
         }
-        "ShaderNodeBsdfAnisotropic" | "ShaderNodeBsdfGlossy" => glossy(b, w, s, sp, ctx, out),
-        "ShaderNodeBsdfPrincipled" => principled(b, w, s, sp, ctx, out),
-        "ShaderNodeBsdfMetallic" => crate::render::bsdf::metallic::metallic(b, w, s, sp, ctx, out),
-        "ShaderNodeBsdfToon" => {
+        BsdfKind::Glossy => glossy(b, w, s, sp, ctx, out),
+        BsdfKind::Principled => principled(b, w, s, sp, ctx, out),
+        BsdfKind::Metallic => crate::render::bsdf::metallic::metallic(b, w, s, sp, ctx, out),
+        BsdfKind::Toon => {
             let c = input_c(b, s, "Color", [0.8; 3]);
             let toon = crate::render::bsdf::toon::Toon::new(
                 input_f(b, s, "Size", 0.5),
@@ -394,12 +394,12 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
                 input_n(b, s, "Normal", sp),
             );
         }
-        "ShaderNodeBsdfGlass" | "ShaderNodeBsdfRefraction" => {
+        BsdfKind::Glass | BsdfKind::Refraction => {
             let c = input_c(b, s, "Color", [1.0; 3]);
             let ior = input_f(b, s, "IOR", 1.45);
             let r = input_f(b, s, "Roughness", 0.0);
             let n = valid_n(sp, ctx, input_n(b, s, "Normal", sp));
-            let refract_only = b.bl_idname == "ShaderNodeBsdfRefraction";
+            let refract_only = b.kind == BsdfKind::Refraction;
             let g = crate::render::bsdf::microfacet::glass_closure(
                 ctx.tables,
                 b.property("distribution"),
@@ -411,7 +411,7 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             );
             out.push(LobeKind::Glass(g), scale(c, w), n);
         }
-        "ShaderNodeSubsurfaceScattering" => {
+        BsdfKind::Subsurface => {
             let c = input_c(b, s, "Color", [0.8; 3]);
             let radius = scale(
                 input_c(b, s, "Radius", [1.0, 0.2, 0.1]),
@@ -433,19 +433,16 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
                 valid_n(sp, ctx, input_n(b, s, "Normal", sp)),
             );
         }
-        "ShaderNodeBsdfSheen" => {
+        BsdfKind::Sheen => {
             let c = input_c(b, s, "Color", [0.8; 3]);
             let r = input_f(b, s, "Roughness", 0.5);
             let n = input_n(b, s, "Normal", sp);
             push_sheen_node(out, b.property("distribution"), scale(c, w), r, n, ctx.wo);
         }
-        "ShaderNodeBsdfHair" => hair_bsdf(b, w, s, sp, ctx, out),
-        "ShaderNodeBsdfHairPrincipled" => principled_hair(b, w, s, sp, ctx, out),
-        // Unsupported closures fall back to a diffuse of their colour (documented).
-        _ => {
-            let c = input_c(b, s, "Color", [0.8; 3]);
-            out.push(LobeKind::Diffuse, scale(c, w), sp.normal);
-        }
+        BsdfKind::Hair => hair_bsdf(b, w, s, sp, ctx, out),
+        BsdfKind::PrincipledHair => principled_hair(b, w, s, sp, ctx, out),
+        // Volume closures shade only a material's Volume (render/volume.rs).
+        BsdfKind::Volume => {}
     }
 }
 
