@@ -635,6 +635,8 @@ pub fn extrude_mesh(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             &[(&sel, DataType::Bool), (&off, DataType::Vector)],
         )?;
         let (sv, ov) = (r[0].as_bool().into_owned(), r[1].as_vector().into_owned());
+        // Our reference would make `mesh_mut` deep-copy the mesh.
+        drop(m);
         let mm = s.mesh_mut().unwrap();
         let outs = match domain {
             Domain::Point => extrude_vertices(mm, &sv, &ov),

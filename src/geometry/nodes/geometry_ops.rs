@@ -191,6 +191,8 @@ pub fn set_material(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             )?;
             let sel = r[0].as_bool();
             let count = sel.iter().filter(|x| **x).count();
+            // Our reference would make `mesh_mut` deep-copy the mesh.
+            drop(m);
             let mm = s.mesh_mut().unwrap();
             if count != mm.face_count() && mm.materials.is_empty() {
                 mm.materials.push(None);
@@ -261,6 +263,8 @@ pub fn set_shade_smooth(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             &[(&sel, DataType::Bool), (&smooth, DataType::Bool)],
         )?;
         let (sel, smooth) = (r[0].as_bool(), r[1].as_bool());
+        // Our reference would make `mesh_mut` deep-copy the mesh.
+        drop(m);
         let mm = s.mesh_mut().unwrap();
         let mut sharp = match mm.attributes.named(name) {
             Some(a) if a.domain == domain => a.data.as_bool().into_owned(),

@@ -45,7 +45,8 @@ pub fn split_edges(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         if !sel.iter().any(|&b| b) {
             return Ok(());
         }
-        *s.mesh_mut().unwrap() = split(&m, &sel);
+        // A new Arc: `mesh_mut` would first deep-copy the shared input.
+        s.mesh = Some(std::sync::Arc::new(split(&m, &sel)));
         Ok(())
     })
     .map_err(|e| ctx.err(e))?;

@@ -98,7 +98,8 @@ pub fn subdivision_surface_node(ctx: &NodeCtx) -> Result<Outputs, GeometryError>
                 Domain::Point,
                 &[(&vert_crease, DataType::Float)],
             )?;
-            *s.mesh_mut().unwrap() = subdivision_surface(
+            // A new Arc: `mesh_mut` would first deep-copy the shared input.
+            s.mesh = Some(std::sync::Arc::new(subdivision_surface(
                 &m,
                 level,
                 level,
@@ -106,7 +107,7 @@ pub fn subdivision_surface_node(ctx: &NodeCtx) -> Result<Outputs, GeometryError>
                 &vc[0].as_float(),
                 boundary_corners,
                 limit,
-            );
+            )));
             Ok(())
         })
         .map_err(|e| ctx.err(e))?;
