@@ -599,6 +599,10 @@ def with_instancer_values(part, values):
     return counts, arrays, attrs + extra, uvs
 
 
+# Per object: the points of the point clouds its evaluation makes (`evaluated_meshes`).
+POINT_CLOUDS = {}
+
+
 def evaluated_meshes(objs, depsgraph):
     """For each object: its evaluated mesh plus the instances it generates (realised),
     in its local space, and the material slots its faces index. One pass over
@@ -642,6 +646,11 @@ def evaluated_meshes(objs, depsgraph):
             continue
         io = inst.object  # the instanced geometry (inst.parent is the instancer)
         if io.type in NON_GEOMETRY:
+            continue
+        if io.type == "POINTCLOUD" and len(io.data.points):
+            # Cycles renders these points as spheres; the evaluated mesh cannot carry them.
+            POINT_CLOUDS.setdefault(owner, 0)
+            POINT_CLOUDS[owner] += len(io.data.points)
             continue
         try:
             ime = io.to_mesh()
@@ -744,8 +753,64 @@ def export_hair(objs, out, index):
     return got
 
 
-FROZEN_TYPES = {"CURVE", "SURFACE", "FONT", "META"}
-ID_COLLECTIONS = {"OBJECT": "objects", "MESH": "meshes", "CURVE": "curves", "KEY": "shape_keys",
+def curves_keys(o, depsgraph, path):
+    """The curves Cycles renders for a Curves object (`type == 'CURVES'`, Blender 3.3+ hair),
+    as its blender/curves.cpp (export_hair_curves) syncs them from the evaluated Curves:
+    the control points as keys whatever the curve type, the `radius` point attribute
+    (0.005 where the Curves have none), every curve with the object's first material
+    slot. Writes x, y, z, radius per key (object space, little-endian float32), then
+    the point count per curve (little-endian uint32) to `path`; returns the system
+    entry, or None when there are no curves."""
+    cv = o.evaluated_get(depsgraph).data
+    n_points, n_curves = len(cv.points), len(cv.curves)
+    if n_curves == 0 or n_points == 0:
+        return None
+    pos = np.zeros(n_points * 3, np.float32)
+    cv.points.foreach_get("position", pos)
+    keys = np.zeros((n_points, 4), np.float32)
+    keys[:, :3] = pos.reshape(-1, 3)
+    radius = cv.attributes.get("radius")
+    if radius is not None and radius.domain == "POINT" and radius.data_type == "FLOAT":
+        r = np.zeros(n_points, np.float32)
+        radius.data.foreach_get("value", r)
+        keys[:, 3] = r
+    else:
+        keys[:, 3] = 0.005
+    offsets = np.zeros(n_curves + 1, np.int64)
+    cv.curve_offset_data.foreach_get("value", offsets)
+    counts = np.diff(offsets).astype("<u4")
+    with open(path, "wb") as f:
+        f.write(keys.astype("<f4").tobytes())
+        f.write(counts.tobytes())
+    return {"name": key(o.data), "material_slot": 0, "curve_count": n_curves, "keys_per_curve": 0,
+            "key_count": n_points, "children": False}
+
+
+def export_curves(objs, out, index, frozen_meshes):
+    """Each Curves object's curves (`curves_keys`) in hair/, by object name, as a hair
+    entry of one system; the object's first material slot is appended to its evaluated
+    entry's materials (Cycles gives all its curves shader 0: the first slot)."""
+    got = {}
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    for o in objs:
+        if o.type != "CURVES":
+            continue
+        rel = f"hair/{safe_name(index[key(o)], key(o))[:-4]}.bin"
+        os.makedirs(os.path.join(out, "hair"), exist_ok=True)
+        system = curves_keys(o, depsgraph, os.path.join(out, rel))
+        if system is None:
+            continue
+        mats = frozen_meshes[key(o)][2]
+        ev = o.evaluated_get(depsgraph)
+        first = slot_materials(ev, ev.data)[:1] or [None]
+        system["material_slot"] = len(mats)
+        mats.extend(first)
+        got[key(o)] = {"file": rel, "systems": [system]}
+    return got
+
+
+FROZEN_TYPES = {"CURVE", "SURFACE", "FONT", "META", "CURVES"}
+ID_COLLECTIONS = {"OBJECT": "objects", "MESH": "meshes", "CURVE": "curves", "CURVES": "hair_curves", "KEY": "shape_keys",
                   "ARMATURE": "armatures", "META": "metaballs", "METABALL": "metaballs", "LATTICE": "lattices",
                   "PARTICLE": "particles", "COLLECTION": "collections", "TEXTURE": "textures",
                   "NODETREE": "node_groups", "IMAGE": "images", "FONT": "fonts"}
@@ -1368,10 +1433,13 @@ def main():
         with RenderSettings():
             frozen_meshes = evaluated_meshes(targets, bpy.context.evaluated_depsgraph_get())
             hair = export_hair(targets, out, index)
+            hair.update(export_curves(targets, out, index, frozen_meshes))
         for name, ((counts, arrays, attrs, uvs), n_inst, mats, (uv_layers, render_uv, color)) in frozen_meshes.items():
             rel = f"evaluated/{safe_name(index[name], name)}"
             write_mesh_glb(os.path.join(out, rel), name, counts, arrays, attrs, uvs)
             reads, animated, unsupported = frozen_inputs(by_key[name])
+            if POINT_CLOUDS.get(name):
+                unsupported.append(f"a point cloud of {POINT_CLOUDS[name]} points (rendered by Cycles as spheres)")
             evaluated.append({"object": name, "frame": scene.frame_current + scene.frame_subframe, "file": rel,
                               "vertex_count": counts[0], "face_count": counts[2], "instances_realized": n_inst,
                               "reads": reads, "animated": animated, "unsupported": unsupported,

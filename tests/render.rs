@@ -23,6 +23,8 @@ const ASSERTED: &[&str] = &[
     "issue26_geo",
     // Particle hair (children) as Cycles' default Rounded Ribbons (render/curves.rs).
     "hair",
+    // A Curves object with Geometry Nodes: its evaluated strands as hair.
+    "curves_object",
     "adaptive",
     "motion_blur",
     "motion_blur_start",
@@ -1626,5 +1628,47 @@ fn unsupported_hair_is_refused_by_name() {
             e[0]["hair"]["systems"][0]["curve_count"] = 481.into();
         },
         &["evaluated[0].hair.file", "\"Emitter\"", "bytes"],
+    );
+}
+
+/// A Curves object renders from the export's evaluated curves (parity scene
+/// `curves_object`); without them, or with curves the file does not hold, `inspect` and
+/// `render` refuse it alike, by name.
+#[test]
+fn curves_objects_without_their_curves_are_refused_by_name() {
+    let dir = common::repo().join("fixtures/render/scenes/curves_object");
+    let base: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("scene.json")).unwrap()).unwrap();
+    let scene = Scene::from_json(&dir, base.to_string().as_bytes()).unwrap();
+    let opts = RenderOptions {
+        samples: Some(1),
+        resolution: Some((8, 8)),
+        ..Default::default()
+    };
+    assert!(blendsynth::render::check(&scene, &opts, &[]).is_ok());
+    let o = base["objects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|o| o["name"] == "Strands")
+        .unwrap();
+    assert_eq!(o["type"], "CURVES");
+    // An export without Blender's evaluation (convert --no-evaluated, or an old one).
+    refused_alike(
+        &dir,
+        &base,
+        &|j| j["evaluated"] = serde_json::json!([]),
+        &["\"Strands\"", "Curves object", "no frozen mesh"],
+    );
+    // Key counts per curve that do not add up to the keys the system declares.
+    refused_alike(
+        &dir,
+        &base,
+        &|j| {
+            let e = j["evaluated"].as_array_mut().unwrap();
+            let e = e.iter_mut().find(|e| e["object"] == "Strands").unwrap();
+            e["hair"]["systems"][0]["key_count"] = 62.into();
+        },
+        &["\"Strands\"", "hair.file", "bytes"],
     );
 }

@@ -273,7 +273,8 @@ pub fn build(
                 let mut rest = set.clone();
                 let instances_component = rest.instances.take();
                 let realise = |g: &crate::geometry::GeometrySet| -> Result<(Arc<MeshData>, Vec<Option<String>>), RenderError> {
-                    let m = crate::geometry::realize_to_mesh(g).map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))?;
+                    let g = cycles_renders(g).map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))?;
+                    let m = crate::geometry::realize_to_mesh(&g).map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))?;
                     let mats = if m.materials.is_empty() { base.materials.to_vec() } else { m.materials.clone() };
                     Ok((Arc::new(m.to_scene(&obj.name)), mats))
                 };
@@ -507,6 +508,26 @@ fn push_instance(
         instance_index,
     )?);
     Ok(())
+}
+
+/// What Cycles renders of a mesh or curve object's Geometry Nodes output, instances
+/// realised: the mesh. Blender hands a curve component on such an object to render
+/// engines as a legacy curve object, which Cycles does not render (its object_is_geometry
+/// takes Curves, point clouds and meshes only), so it is dropped; a point cloud Cycles
+/// renders as spheres, which blendsynth does not yet: refused.
+fn cycles_renders(
+    g: &crate::geometry::GeometrySet,
+) -> Result<crate::geometry::GeometrySet, String> {
+    let mut r = crate::geometry::realize::realize_instances(g);
+    r.curves = None;
+    if let Some(p) = r.points.as_ref().filter(|p| !p.is_empty()) {
+        return Err(format!(
+            "its Geometry Nodes output holds a point cloud ({} points), which Cycles renders as spheres: not supported by the renderer yet",
+            p.len()
+        ));
+    }
+    r.points = None;
+    Ok(r)
 }
 
 /// An object's hair as an instance of its own: the object's material slots, no mesh.
@@ -744,4 +765,38 @@ pub fn bind_attributes(
         inst.attributes = per_slot;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::cycles_renders;
+    use crate::geometry::{curves::Curves, pointcloud::PointCloud, GeometrySet};
+    use std::sync::Arc;
+
+    /// Curves in a mesh object's Geometry Nodes output render as nothing (as in Cycles);
+    /// points are refused, naming how many.
+    #[test]
+    fn mesh_objects_drop_their_curves_and_refuse_their_points() {
+        let curves = Curves {
+            positions: vec![[0.0; 3], [0.0, 0.0, 1.0]],
+            curve_offsets: vec![0, 2],
+            ..Default::default()
+        };
+        let set = GeometrySet {
+            curves: Some(Arc::new(curves)),
+            ..Default::default()
+        };
+        let r = cycles_renders(&set).unwrap();
+        assert!(r.curves.is_none() && r.mesh.is_none());
+        let points = PointCloud {
+            positions: vec![[0.0; 3]; 3],
+            ..Default::default()
+        };
+        let set = GeometrySet {
+            points: Some(Arc::new(points)),
+            ..set
+        };
+        let m = cycles_renders(&set).unwrap_err();
+        assert!(m.contains("point cloud (3 points)"), "{m}");
+    }
 }

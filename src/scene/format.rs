@@ -660,7 +660,12 @@ pub struct HairSystem {
     /// The object's material slot the strands use (Cycles' omat - 1, clamped).
     pub material_slot: usize,
     pub curve_count: usize,
+    /// Keys of every curve (particle hair); 0 for a Curves object's system, whose curves
+    /// differ: its `key_count` keys are then followed by one u32 key count per curve.
     pub keys_per_curve: usize,
+    /// A Curves object's keys in all (with `keys_per_curve` 0).
+    #[serde(default)]
+    pub key_count: Option<usize>,
     /// Whether the strands are the children (the parents then do not render).
     #[serde(default)]
     pub children: bool,

@@ -44,64 +44,119 @@ impl Scene {
 
 /// The strands of `h` from its file's bytes; errors carry a location under `hair`.
 pub fn parse_hair(h: &HairRef, bytes: &[u8]) -> Result<HairData, (String, String)> {
+    // Per system: its keys and, for a Curves object's, the key count of each curve.
     let mut total = 0usize;
+    let mut size = 0usize;
     for (i, s) in h.systems.iter().enumerate() {
-        if !(2..=MAX_KEYS_PER_CURVE).contains(&s.keys_per_curve) {
-            return Err((
-                format!(".systems[{i}].keys_per_curve"),
-                format!(
-                    "is {}; a strand has 2 to {MAX_KEYS_PER_CURVE} keys",
-                    s.keys_per_curve
-                ),
-            ));
-        }
-        total = super::limits::mul_add(s.curve_count, s.keys_per_curve, total)
+        let at = |f: &str| format!(".systems[{i}].{f}");
+        let keys = match s.key_count {
+            Some(n) => {
+                if s.keys_per_curve != 0 {
+                    return Err((
+                        at("keys_per_curve"),
+                        format!(
+                            "is {} with a key_count: a Curves system has keys_per_curve 0",
+                            s.keys_per_curve
+                        ),
+                    ));
+                }
+                if n < s.curve_count {
+                    return Err((
+                        at("key_count"),
+                        format!("is {n}, fewer than the {} curves", s.curve_count),
+                    ));
+                }
+                n
+            }
+            None => {
+                if !(2..=MAX_KEYS_PER_CURVE).contains(&s.keys_per_curve) {
+                    return Err((
+                        at("keys_per_curve"),
+                        format!(
+                            "is {}; a strand has 2 to {MAX_KEYS_PER_CURVE} keys",
+                            s.keys_per_curve
+                        ),
+                    ));
+                }
+                super::limits::mul_add(s.curve_count, s.keys_per_curve, 0)
+                    .ok_or_else(|| (at("curve_count"), "too many keys".to_string()))?
+            }
+        };
+        total = total
+            .checked_add(keys)
             .filter(|&t| t <= u32::MAX as usize)
-            .ok_or_else(|| {
-                (
-                    format!(".systems[{i}].curve_count"),
-                    "too many keys".to_string(),
-                )
-            })?;
+            .ok_or_else(|| (at("curve_count"), "too many keys".to_string()))?;
+        let counts = if s.key_count.is_some() {
+            s.curve_count
+        } else {
+            0
+        };
+        size = super::limits::mul_add(keys, 16, size)
+            .and_then(|z| super::limits::mul_add(counts, 4, z))
+            .ok_or_else(|| (at("curve_count"), "too many keys".to_string()))?;
     }
-    if bytes.len() != total * 16 {
+    if bytes.len() != size {
         return Err((
             ".file".into(),
             format!(
-                "holds {} bytes, the systems declare {total} keys of 16 bytes",
+                "holds {} bytes, the systems declare {total} keys ({size} bytes)",
                 bytes.len()
             ),
         ));
     }
-    let keys: Vec<[f32; 4]> = bytes
-        .chunks_exact(16)
-        .map(|c| {
-            [0, 1, 2, 3]
-                .map(|k| f32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]]))
-        })
-        .collect();
-    if let Some(k) = keys
-        .iter()
-        .position(|k| !k.iter().all(|x| x.is_finite()) || k[3] < 0.0)
-    {
-        return Err((
-            ".file".into(),
-            format!(
-                "key {k} is {:?}: positions must be finite, radii finite and >= 0",
-                keys[k]
-            ),
-        ));
-    }
-    let mut data = HairData {
-        keys,
-        ..HairData::default()
-    };
-    let mut first = 0u32;
-    for s in &h.systems {
-        for _ in 0..s.curve_count {
-            data.curves.push((first, s.keys_per_curve as u32));
+    let f32_at =
+        |o: usize| f32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]);
+    let mut data = HairData::default();
+    data.keys.reserve(total);
+    let mut at = 0usize;
+    for (i, s) in h.systems.iter().enumerate() {
+        let first_key = data.keys.len();
+        let n = s.key_count.unwrap_or(s.curve_count * s.keys_per_curve);
+        for k in 0..n {
+            let o = at + 16 * k;
+            let key = [f32_at(o), f32_at(o + 4), f32_at(o + 8), f32_at(o + 12)];
+            if !key.iter().all(|x| x.is_finite()) || key[3] < 0.0 {
+                return Err((
+                    ".file".into(),
+                    format!(
+                        "key {} is {key:?}: positions must be finite, radii finite and >= 0",
+                        first_key + k
+                    ),
+                ));
+            }
+            data.keys.push(key);
+        }
+        at += 16 * n;
+        let mut first = first_key as u32;
+        for c in 0..s.curve_count {
+            let count = match s.key_count {
+                Some(_) => {
+                    let o = at + 4 * c;
+                    u32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]])
+                }
+                None => s.keys_per_curve as u32,
+            };
+            if count == 0 || first as usize + count as usize > first_key + n {
+                return Err((
+                    format!(".systems[{i}]"),
+                    format!("curve {c} has {count} keys: each curve has at least one, and all fit in key_count {n}"),
+                ));
+            }
+            data.curves.push((first, count));
             data.curve_slot.push(s.material_slot as u32);
-            first += s.keys_per_curve as u32;
+            first += count;
+        }
+        if s.key_count.is_some() {
+            if first as usize != first_key + n {
+                return Err((
+                    format!(".systems[{i}].key_count"),
+                    format!(
+                        "is {n}, the curves' key counts add up to {}",
+                        first as usize - first_key
+                    ),
+                ));
+            }
+            at += 4 * s.curve_count;
         }
     }
     Ok(data)
@@ -120,6 +175,7 @@ mod tests {
                 material_slot: 1,
                 curve_count: curves,
                 keys_per_curve: keys,
+                key_count: None,
                 children: false,
             }],
         }
@@ -138,6 +194,43 @@ mod tests {
         assert_eq!(d.curves, vec![(0, 2), (2, 2)]);
         assert_eq!(d.curve_slot, vec![1, 1]);
         assert_eq!(d.keys[2], [1., 0., 0., 0.2]);
+    }
+
+    fn curves_system(curves: usize, keys: usize) -> HairRef {
+        let mut h = hair(curves, 0);
+        h.systems[0].key_count = Some(keys);
+        h
+    }
+
+    #[test]
+    fn reads_a_curves_objects_curves_of_different_lengths() {
+        let mut b = bytes(&[0.5; 5 * 4]);
+        b.extend([2u32, 3].iter().flat_map(|c| c.to_le_bytes()));
+        let d = parse_hair(&curves_system(2, 5), &b).unwrap();
+        assert_eq!(d.curves, vec![(0, 2), (2, 3)]);
+        // Counts that do not add up to the keys, a zero count, a wrong size.
+        let mut bad = bytes(&[0.5; 5 * 4]);
+        bad.extend([2u32, 2].iter().flat_map(|c| c.to_le_bytes()));
+        assert!(parse_hair(&curves_system(2, 5), &bad)
+            .unwrap_err()
+            .1
+            .contains("add up"));
+        let mut zero = bytes(&[0.5; 5 * 4]);
+        zero.extend([0u32, 5].iter().flat_map(|c| c.to_le_bytes()));
+        assert!(parse_hair(&curves_system(2, 5), &zero)
+            .unwrap_err()
+            .1
+            .contains("at least one"));
+        assert!(parse_hair(&curves_system(2, 5), &b[..b.len() - 4])
+            .unwrap_err()
+            .1
+            .contains("bytes"));
+        let mut both = curves_system(2, 5);
+        both.systems[0].keys_per_curve = 3;
+        assert!(parse_hair(&both, &b)
+            .unwrap_err()
+            .0
+            .contains("keys_per_curve"));
     }
 
     #[test]
