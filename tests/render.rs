@@ -25,6 +25,8 @@ const ASSERTED: &[&str] = &[
     "hair",
     // A Curves object with Geometry Nodes: its evaluated strands as hair.
     "curves_object",
+    // Hair Info, each output into a colour, on a Curves object and on particle hair.
+    "hair_info",
     "adaptive",
     "motion_blur",
     "motion_blur_start",
@@ -1605,21 +1607,6 @@ fn unsupported_hair_is_refused_by_name() {
     refused(
         &|j| j["scene"]["cycles_curves"]["shape"] = "THICK".into(),
         &["\"Emitter\"", "THICK"],
-    );
-    // A Hair Info node in the hair's material.
-    refused(
-        &|j| {
-            let ms = j["materials"].as_array_mut().unwrap();
-            let m = ms.iter_mut().find(|m| m["name"] == "Hair").unwrap();
-            let nodes = m["node_tree"]["nodes"].as_array_mut().unwrap();
-            let mut info = nodes[0].clone();
-            info["name"] = "Hair Info".into();
-            info["bl_idname"] = "ShaderNodeHairInfo".into();
-            info["inputs"] = serde_json::json!([]);
-            info["outputs"] = serde_json::json!([]);
-            nodes.push(info);
-        },
-        &["\"Emitter\"", "material \"Hair\"", "Hair Info"],
     );
     // A hair file that does not hold what scene.json declares.
     refused(

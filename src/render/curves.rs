@@ -102,6 +102,24 @@ impl ObjectCurves {
         k.map(|i| self.keys[i as usize])
     }
 
+    /// What Hair Info reads at `u` along segment `seg`, with the curve's tangent `dpdu`
+    /// there and `wi` the unit direction back along the ray (Cycles' sd->wi).
+    pub fn hair_point(&self, seg: u32, u: f32, dpdu: V3, wi: V3) -> crate::shader::HairPoint {
+        let (c, k0) = self.segments[seg as usize];
+        let (k0, k1) = (k0 as usize, k0 as usize + 1);
+        let lerp = |a: f32, b: f32| (b - a) * u + a;
+        let d2 = dot(dpdu, dpdu);
+        let along = if d2 > 0.0 { dot(dpdu, wi) / d2 } else { 0.0 };
+        crate::shader::HairPoint {
+            is_strand: 1.0,
+            intercept: lerp(self.intercept[k0], self.intercept[k1]),
+            length: self.length[c as usize],
+            thickness: 2.0 * lerp(self.keys[k0][3], self.keys[k1][3]),
+            tangent_normal: normalize(sub(wi, scale(dpdu, along))),
+            random: crate::nodes::random::hash_to_float2(c, 0),
+        }
+    }
+
     /// World-space bounds of segment `seg` with its radius: the Bezier form of the
     /// Catmull-Rom segment lies in its control points' hull.
     pub fn segment_bounds(&self, seg: u32) -> (V3, V3) {
@@ -446,7 +464,7 @@ impl Accel for WithCurves {
 /// displacement, emission (Cycles' curves are no lights), the hair BSDFs and the
 /// Subsurface Scattering node; and hair with motion blur or under Embree.
 pub fn check(
-    scene: &crate::scene::Scene,
+    _scene: &crate::scene::Scene,
     geo: &crate::render::build::Geometry,
     materials: &[crate::render::integrator::shade::Material],
 ) -> Result<(), crate::render::RenderError> {
@@ -482,15 +500,6 @@ pub fn check(
                     })
                     .map(|b| format!("node {}", b.bl_idname))
             };
-            // Hair Info reads zero everywhere but on hair, where the export has none of
-            // its values yet.
-            let why = why.or_else(|| {
-                scene
-                    .material(&m.name)
-                    .and_then(|mat| mat.node_tree.as_ref())
-                    .is_some_and(|t| uses_node(scene, t, "ShaderNodeHairInfo", 0))
-                    .then(|| "node ShaderNodeHairInfo (Hair Info)".to_string())
-            });
             if let Some(why) = why {
                 return Err(RenderError(format!(
                     "object {:?}: its hair's material {:?} has {why}, which blendsynth does not render on hair curves",
@@ -500,23 +509,6 @@ pub fn check(
         }
     }
     Ok(())
-}
-
-/// Whether tree `t` or a group it uses (to a depth of 64) holds an unmuted `bl_idname`.
-fn uses_node(
-    scene: &crate::scene::Scene,
-    t: &crate::scene::NodeTree,
-    bl_idname: &str,
-    depth: u32,
-) -> bool {
-    depth < 64
-        && t.nodes.iter().any(|n| {
-            (!n.mute && n.bl_idname == bl_idname)
-                || n.node_tree
-                    .as_deref()
-                    .and_then(|g| scene.node_group(g))
-                    .is_some_and(|g| uses_node(scene, g, bl_idname, depth + 1))
-        })
 }
 
 #[cfg(test)]

@@ -286,7 +286,7 @@ impl Scene<'_> {
         let r = self.geo.refs[prim as usize];
         let inst = &self.geo.instances[r.inst as usize];
         let cp = c.control_points(r.tri);
-        let (p, n, _dpdu) = crate::render::curves::ribbon_shading(&cp, c.pieces, u, v, neg(wo));
+        let (p, n, dpdu) = crate::render::curves::ribbon_shading(&cp, c.pieces, u, v, neg(wo));
         let ng = wo;
         let (to_world, to_object) = (&inst.to_world, &inst.to_object);
         let curve = c.segments[r.tri as usize].0 as usize;
@@ -297,6 +297,7 @@ impl Scene<'_> {
             object_position: to_object.point(p),
             object_normal: normalize(Affine::normal_by_inverse(to_world, n)),
             generated: inst.generated(to_object.point([root[0], root[1], root[2]])),
+            hair: c.hair_point(r.tri, u, dpdu, wo),
             ..Default::default()
         };
         self.fill_context(&mut sp, inst, wo, ng, false, u, v);
