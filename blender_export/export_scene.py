@@ -737,6 +737,103 @@ def hair_strands(o, depsgraph, path):
     return systems
 
 
+def rendered_path_systems(ev):
+    """(modifier, system, first particle, count) of each hair system Cycles renders as
+    strands, in `hair_strands`' order."""
+    for m in ev.modifiers:
+        if m.type != "PARTICLE_SYSTEM" or not m.show_render:
+            continue
+        psys = m.particle_system
+        st = psys.settings
+        if st.type != "HAIR" or st.render_type != "PATH":
+            continue
+        totpart, totchild = len(psys.particles), len(psys.child_particles)
+        first = totpart if (st.child_type != "NONE" and totchild) else 0
+        if totpart + totchild - first > 0:
+            yield m, psys, first, totpart + totchild - first
+
+
+def particle_hair_attributes(o, depsgraph):
+    """What Cycles' blender/curves.cpp gives particle hair from its emitter, per curve:
+    each UV map (ObtainCacheParticleUV: the active render one is the hair's UV) and each
+    byte colour corner attribute, sRGB-decoded (ObtainCacheParticleVcol), by name.
+    Returns ([(name, domain, data_type, float32 array)], uv name)."""
+    ev = o.evaluated_get(depsgraph)
+    me = o.data
+    uv_names = [uv.name for uv in me.uv_layers]
+    vcol_names = [a.name for a in me.attributes if a.data_type == "BYTE_COLOR" and a.domain == "CORNER"]
+    uvs = {n: [] for n in uv_names}
+    cols = {n: [] for n in vcol_names}
+    for m, psys, first, count in rendered_path_systems(ev):
+        parts = psys.particles
+        for c in range(count):
+            pa_no = first + c
+            # Cycles passes the parent particle for parents and the first one for children.
+            pa = parts[pa_no] if pa_no < len(parts) else parts[0]
+            for i, n in enumerate(uv_names):
+                uvs[n].append(tuple(psys.uv_on_emitter(m, particle=pa, particle_no=pa_no, uv_no=i)))
+            for i, n in enumerate(vcol_names):
+                cols[n].append(tuple(psys.mcol_on_emitter(m, particle=pa, particle_no=pa_no, vcol_no=i)) + (1.0,))
+    attrs = [(n, "CURVE", "FLOAT2", np.array(v, np.float32).reshape(-1, 2)) for n, v in uvs.items() if v]
+    for n, v in cols.items():
+        if v:
+            a = np.array(v, np.float64).reshape(-1, 4)
+            rgb = a[:, :3]
+            a[:, :3] = np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+            attrs.append((n, "CURVE", "FLOAT_COLOR", a.astype(np.float32)))
+    render_uv = next((uv.name for uv in me.uv_layers if uv.active_render), None)
+    return attrs, render_uv
+
+
+CURVES_ATTRIBUTE_WIDTH = {"FLOAT": 1, "INT": 1, "INT8": 1, "BOOLEAN": 1, "FLOAT2": 2, "INT32_2D": 2,
+                          "FLOAT_VECTOR": 3, "FLOAT_COLOR": 4, "BYTE_COLOR": 4}
+
+
+def curves_attributes(o, depsgraph):
+    """A Curves object's point and curve attributes as Cycles' attr_create_generic reads
+    them (numbers as float32, colours linear), by name, and its UV: the first 2D vector
+    curve attribute. Types Cycles cannot read in shaders (quaternions, matrices) are left
+    out. Returns ([(name, domain, data_type, float32 array)], uv name)."""
+    cv = o.evaluated_get(depsgraph).data
+    attrs, uv = [], None
+    for a in cv.attributes:
+        w = CURVES_ATTRIBUTE_WIDTH.get(a.data_type)
+        if a.name.startswith(".") or w is None or a.domain not in ("POINT", "CURVE"):
+            continue
+        n = len(a.data)
+        if a.data_type in ("FLOAT_COLOR", "BYTE_COLOR"):
+            field = "color"
+        elif a.data_type in ("FLOAT_VECTOR", "FLOAT2", "INT32_2D"):
+            field = "vector"
+        else:
+            field = "value"
+        dtype = {"BOOLEAN": bool, "INT": np.int32, "INT8": np.int32, "INT32_2D": np.int32}.get(a.data_type, np.float32)
+        raw = np.zeros(n * w, dtype)
+        try:
+            a.data.foreach_get(field, raw)
+        except (AttributeError, RuntimeError, TypeError):
+            continue
+        v = raw.astype(np.float32).reshape(n, w)
+        kind = {1: "FLOAT", 2: "FLOAT2", 3: "FLOAT_VECTOR", 4: "FLOAT_COLOR"}[w]
+        if uv is None and kind == "FLOAT2" and a.domain == "CURVE":
+            uv = a.name
+        attrs.append((a.name, a.domain, kind, v))
+    return attrs, uv
+
+
+def write_hair_attributes(entry, attrs, uv, out):
+    """Adds the hair attributes to a hair entry: one float32 file of every attribute in
+    order, each count x width values."""
+    if not attrs:
+        return entry
+    rel = entry["file"][:-4] + ".attributes.bin"
+    with open(os.path.join(out, rel), "wb") as f:
+        for _, _, _, v in attrs:
+            f.write(v.astype("<f4").tobytes())
+    return dict(entry, attributes_file=rel, uv=uv,
+                attributes=[{"name": n, "domain": d, "data_type": t} for n, d, t, _ in attrs])
+
+
 def export_hair(objs, out, index):
     """Each object's hair strands (`hair_strands`) in hair/, by object name: the file and
     its systems."""
@@ -749,7 +846,8 @@ def export_hair(objs, out, index):
         os.makedirs(os.path.join(out, "hair"), exist_ok=True)
         systems = hair_strands(o, depsgraph, os.path.join(out, rel))
         if systems is not None:
-            got[key(o)] = {"file": rel, "systems": systems}
+            got[key(o)] = write_hair_attributes({"file": rel, "systems": systems},
+                                                *particle_hair_attributes(o, depsgraph), out)
     return got
 
 
@@ -805,7 +903,7 @@ def export_curves(objs, out, index, frozen_meshes):
         first = slot_materials(ev, ev.data)[:1] or [None]
         system["material_slot"] = len(mats)
         mats.extend(first)
-        got[key(o)] = {"file": rel, "systems": [system]}
+        got[key(o)] = write_hair_attributes({"file": rel, "systems": [system]}, *curves_attributes(o, depsgraph), out)
     return got
 
 

@@ -27,6 +27,8 @@ const ASSERTED: &[&str] = &[
     "curves_object",
     // Hair Info, each output into a colour, on a Curves object and on particle hair.
     "hair_info",
+    // Attributes on hair: a Curves object's, and the emitter's UV and colour on particle hair.
+    "hair_attributes",
     "adaptive",
     "motion_blur",
     "motion_blur_start",

@@ -719,8 +719,20 @@ pub fn bind_attributes(
                 per_slot.push(None);
                 continue;
             }
-            if inst.curves.is_some() {
-                return Err(RenderError(format!("object {:?}: material {:?} on its hair reads attributes ({:?}), which the export does not carry for hair strands (not supported yet)", inst.name, materials[mi].name, p.attributes)));
+            if let Some(c) = &inst.curves {
+                let b = BoundAttributes::bind_curves(
+                    &c.attributes,
+                    &p.attributes,
+                    inst.default_color.as_deref(),
+                )
+                .map_err(|e| {
+                    RenderError(format!(
+                        "object {:?}, material {:?} on its hair: {e}",
+                        inst.name, materials[mi].name
+                    ))
+                })?;
+                per_slot.push(Some(Arc::new(b)));
+                continue;
             }
             for r in &p.attributes {
                 if let crate::shader::attributes::AttributeRequest::Instancer(name) = r {

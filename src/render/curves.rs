@@ -34,6 +34,10 @@ pub struct ObjectCurves {
     pub segments: Vec<(u32, u32)>,
     /// Ribbons: straight pieces per segment are 2^subdivisions.
     pub pieces: u32,
+    /// Attributes by name, per key (true) or per curve (`HairData::attributes`).
+    pub attributes: Vec<(String, bool, crate::scene::mesh::AttributeData)>,
+    /// The hair's UV (Texture Coordinate > UV): one value per curve or per key.
+    pub uv: Option<(bool, Vec<[f32; 2]>)>,
 }
 
 impl ObjectCurves {
@@ -83,6 +87,29 @@ impl ObjectCurves {
             intercept,
             segments,
             pieces: 1 << subdivisions.min(24),
+            attributes: hair.attributes.clone(),
+            uv: hair.uv.as_deref().and_then(|n| {
+                hair.attributes
+                    .iter()
+                    .find(|a| a.0 == n)
+                    .and_then(|a| match &a.2 {
+                        crate::scene::mesh::AttributeData::Float2(v) => Some((a.1, v.clone())),
+                        _ => None,
+                    })
+            }),
+        }
+    }
+
+    /// The hair's UV at `u` along segment `seg` (zero without one).
+    pub fn uv_at(&self, seg: u32, u: f32) -> [f32; 3] {
+        let (c, k0) = self.segments[seg as usize];
+        match &self.uv {
+            Some((true, v)) => {
+                let (a, b) = (v[k0 as usize], v[k0 as usize + 1]);
+                [(b[0] - a[0]) * u + a[0], (b[1] - a[1]) * u + a[1], 0.0]
+            }
+            Some((false, v)) => [v[c as usize][0], v[c as usize][1], 0.0],
+            None => [0.0; 3],
         }
     }
 

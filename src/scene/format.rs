@@ -651,6 +651,24 @@ pub struct Evaluated {
 pub struct HairRef {
     pub file: String,
     pub systems: Vec<HairSystem>,
+    /// Per-curve and per-key attributes (UV maps and colours from the emitter, a Curves
+    /// object's attributes): float32 values, attribute after attribute, in this file.
+    #[serde(default)]
+    pub attributes_file: Option<String>,
+    #[serde(default)]
+    pub attributes: Vec<HairAttribute>,
+    /// The attribute Cycles reads as the hair's UV (Texture Coordinate / UV Map default).
+    #[serde(default)]
+    pub uv: Option<String>,
+}
+
+/// One hair attribute: `domain` CURVE (a value per curve) or POINT (per key);
+/// `data_type` FLOAT, FLOAT2, FLOAT_VECTOR or FLOAT_COLOR (1 to 4 floats).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct HairAttribute {
+    pub name: String,
+    pub domain: String,
+    pub data_type: String,
 }
 
 /// One hair particle system's strands as Cycles syncs them.

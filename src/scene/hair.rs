@@ -13,6 +13,10 @@ pub struct HairData {
     pub curves: Vec<(u32, u32)>,
     /// Per curve: the object's material slot.
     pub curve_slot: Vec<u32>,
+    /// Attributes by name: per key (true) or per curve, and their values.
+    pub attributes: Vec<(String, bool, crate::scene::mesh::AttributeData)>,
+    /// The attribute read as the hair's UV.
+    pub uv: Option<String>,
 }
 
 /// The strands in one hair file: a curve has at most this many keys (Cycles' render steps
@@ -30,16 +34,112 @@ impl Scene {
         let path = self.resolve(&h.file, &format!("{at}.file"))?;
         let bytes = super::file::read_regular(&path, super::limits::MAX_GLB_BYTES)
             .map_err(|m| SceneError::new(&path, "", m))?;
-        parse_hair(h, &bytes)
-            .map_err(|(loc, m)| {
+        let mut data = parse_hair(h, &bytes).map_err(|(loc, m)| {
+            SceneError::new(
+                &self.json_path(),
+                format!("{at}{loc}"),
+                format!("{m} (object {}, file {})", quote(&e.object), path.display()),
+            )
+        })?;
+        if let Some(f) = &h.attributes_file {
+            let apath = self.resolve(f, &format!("{at}.attributes_file"))?;
+            let bytes = super::file::read_regular(&apath, super::limits::MAX_GLB_BYTES)
+                .map_err(|m| SceneError::new(&apath, "", m))?;
+            data.attributes = parse_hair_attributes(h, &data, &bytes).map_err(|(loc, m)| {
                 SceneError::new(
                     &self.json_path(),
                     format!("{at}{loc}"),
-                    format!("{m} (object {}, file {})", quote(&e.object), path.display()),
+                    format!(
+                        "{m} (object {}, file {})",
+                        quote(&e.object),
+                        apath.display()
+                    ),
                 )
-            })
-            .map(Some)
+            })?;
+        }
+        data.uv = h.uv.clone();
+        Ok(Some(data))
     }
+}
+
+/// The attributes `h` declares, from their file's bytes, for the curves and keys of `d`.
+pub fn parse_hair_attributes(
+    h: &HairRef,
+    d: &HairData,
+    bytes: &[u8],
+) -> Result<Vec<(String, bool, crate::scene::mesh::AttributeData)>, (String, String)> {
+    use crate::scene::mesh::AttributeData as A;
+    let mut at = 0usize;
+    let mut out = Vec::with_capacity(h.attributes.len());
+    for (i, a) in h.attributes.iter().enumerate() {
+        let loc = |f: &str| format!(".attributes[{i}].{f}");
+        let per_key = match a.domain.as_str() {
+            "POINT" => true,
+            "CURVE" => false,
+            other => {
+                return Err((
+                    loc("domain"),
+                    format!("is {other:?}: hair attributes are on POINT or CURVE"),
+                ))
+            }
+        };
+        let width = match a.data_type.as_str() {
+            "FLOAT" => 1,
+            "FLOAT2" => 2,
+            "FLOAT_VECTOR" => 3,
+            "FLOAT_COLOR" => 4,
+            other => {
+                return Err((
+                    loc("data_type"),
+                    format!("is {other:?}: FLOAT, FLOAT2, FLOAT_VECTOR or FLOAT_COLOR"),
+                ))
+            }
+        };
+        let n = if per_key {
+            d.keys.len()
+        } else {
+            d.curves.len()
+        };
+        let size = n * width * 4;
+        let Some(chunk) = bytes.get(at..at + size) else {
+            return Err((
+                ".attributes_file".into(),
+                format!(
+                    "holds {} bytes, fewer than the attributes declare",
+                    bytes.len()
+                ),
+            ));
+        };
+        at += size;
+        let v: Vec<f32> = chunk
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect();
+        if v.iter().any(|x| !x.is_finite()) {
+            return Err((
+                loc("name"),
+                format!("{:?} holds a value that is not finite", a.name),
+            ));
+        }
+        let data = match width {
+            1 => A::Float(v),
+            2 => A::Float2(v.chunks_exact(2).map(|c| [c[0], c[1]]).collect()),
+            3 => A::Float3(v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()),
+            _ => A::Color(
+                v.chunks_exact(4)
+                    .map(|c| [c[0], c[1], c[2], c[3]])
+                    .collect(),
+            ),
+        };
+        out.push((a.name.clone(), per_key, data));
+    }
+    if at != bytes.len() {
+        return Err((
+            ".attributes_file".into(),
+            format!("holds {} bytes, the attributes declare {at}", bytes.len()),
+        ));
+    }
+    Ok(out)
 }
 
 /// The strands of `h` from its file's bytes; errors carry a location under `hair`.
@@ -170,6 +270,9 @@ mod tests {
     fn hair(curves: usize, keys: usize) -> HairRef {
         HairRef {
             file: "h.bin".into(),
+            attributes_file: None,
+            attributes: Vec::new(),
+            uv: None,
             systems: vec![HairSystem {
                 name: "Hair".into(),
                 material_slot: 1,

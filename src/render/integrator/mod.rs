@@ -298,9 +298,14 @@ impl Scene<'_> {
             object_normal: normalize(Affine::normal_by_inverse(to_world, n)),
             generated: inst.generated(to_object.point([root[0], root[1], root[2]])),
             hair: c.hair_point(r.tri, u, dpdu, wo),
+            uv: c.uv_at(r.tri, u),
             ..Default::default()
         };
         self.fill_context(&mut sp, inst, wo, ng, false, u, v);
+        let (_, k0) = c.segments[r.tri as usize];
+        if let Some(Some(bound)) = inst.attributes.get(c.slot[curve] as usize) {
+            bound.fill_curve(curve, k0 as usize, u, &inst.instancer_values, &mut sp);
+        }
         sp.transform = crate::shader::bump::ObjectTransform {
             to_world: to_world.m,
             to_object: to_object.m,
