@@ -1605,6 +1605,21 @@ fn unsupported_hair_is_refused_by_name() {
         m.contains("optical flow") && m.contains("\"Emitter\""),
         "{m}"
     );
+    // A dataset asking for flow is refused before anything renders or is written.
+    let spec = blendsynth::dataset::Spec::parse(
+        "[render]\nresolution = [8, 8]\nsamples = 1\ndenoise = false\n[labels]\nflow = true\n",
+    )
+    .unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("ds");
+    let r = blendsynth::dataset::renderer::path_tracer(&scene).unwrap();
+    let opts = blendsynth::dataset::GenerateOptions {
+        frames: 1,
+        ..Default::default()
+    };
+    let e = blendsynth::dataset::generate(&scene, &spec, r.as_ref(), &out, &opts).unwrap_err();
+    assert_eq!(e, m, "generate and render_with_motion refuse alike");
+    assert!(!out.exists(), "nothing written");
     // Render > Curves > Shape 3D Curves.
     refused(
         &|j| j["scene"]["cycles_curves"]["shape"] = "THICK".into(),

@@ -548,6 +548,7 @@ mod tests {
             keys: (0..4).map(|i| [i as f32, 0.0, 0.0, 0.1]).collect(),
             curves: vec![(0, 4)],
             curve_slot: vec![0],
+            ..HairData::default()
         };
         let id = Affine {
             m: [

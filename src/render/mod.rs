@@ -168,6 +168,35 @@ pub fn render_controlled(
     render_frame(scene, opts, overrides, control).map(|(out, ..)| out)
 }
 
+/// Why optical flow and occlusion cannot be labelled on `scene`, before anything renders:
+/// an object rendered with hair curves (its export's strands, particle hair or a Curves
+/// object), which the flow and occlusion passes do not trace. The same words as
+/// `render_with_motion` gives at the frame.
+pub fn flow_refusal(scene: &Scene) -> Option<String> {
+    scene
+        .file
+        .evaluated
+        .iter()
+        .filter(|e| {
+            e.hair
+                .as_ref()
+                .is_some_and(|h| h.systems.iter().any(|s| s.curve_count > 0))
+        })
+        .find(|e| {
+            scene
+                .file
+                .objects
+                .iter()
+                .any(|o| o.name == e.object && !o.hide_render && o.in_render_layer)
+        })
+        .map(|e| {
+            format!(
+                "optical flow: object {:?} has hair curves, which the flow and occlusion passes do not trace (not supported yet)",
+                e.object
+            )
+        })
+}
+
 /// `render_controlled` with optical flow and occlusion (`flow`) to the scene frames
 /// `frame + step` (forward) and `frame - step` (backward; a sequence's step may be
 /// negative), from the primary hits the label passes use. Panoramic cameras are refused
