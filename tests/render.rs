@@ -29,6 +29,8 @@ const ASSERTED: &[&str] = &[
     "hair_info",
     // Attributes on hair: a Curves object's, and the emitter's UV and colour on particle hair.
     "hair_attributes",
+    // A Geometry Nodes point cloud (Mesh to Points, a varying radius) as spheres.
+    "points",
     "adaptive",
     "motion_blur",
     "motion_blur_start",
@@ -1674,5 +1676,38 @@ fn curves_objects_without_their_curves_are_refused_by_name() {
             e["hair"]["systems"][0]["key_count"] = 62.into();
         },
         &["\"Strands\"", "hair.file", "bytes"],
+    );
+}
+
+/// What blendsynth does not render on a Geometry Nodes point cloud is an error naming the
+/// object, material and node, the same from `inspect` (render::check) and `render`.
+#[test]
+fn unsupported_points_are_refused_by_name() {
+    let dir = common::repo().join("fixtures/render/scenes/points");
+    let base: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("scene.json")).unwrap()).unwrap();
+    let scene = Scene::from_json(&dir, base.to_string().as_bytes()).unwrap();
+    let opts = RenderOptions {
+        samples: Some(1),
+        resolution: Some((8, 8)),
+        ..Default::default()
+    };
+    assert!(blendsynth::render::check(&scene, &opts, &[]).is_ok());
+    // A Point Info node in the points' material (its values on points are not carried).
+    refused_alike(
+        &dir,
+        &base,
+        &|j| {
+            let ms = j["materials"].as_array_mut().unwrap();
+            let m = ms.iter_mut().find(|m| m["name"] == "Bead").unwrap();
+            let nodes = m["node_tree"]["nodes"].as_array_mut().unwrap();
+            let mut info = nodes[0].clone();
+            info["name"] = "Point Info".into();
+            info["bl_idname"] = "ShaderNodePointInfo".into();
+            info["inputs"] = serde_json::json!([]);
+            info["outputs"] = serde_json::json!([]);
+            nodes.push(info);
+        },
+        &["\"Points\"", "material \"Bead\"", "Point Info"],
     );
 }

@@ -38,6 +38,9 @@ pub struct ObjectCurves {
     pub attributes: Vec<(String, bool, crate::scene::mesh::AttributeData)>,
     /// The hair's UV (Texture Coordinate > UV): one value per curve or per key.
     pub uv: Option<(bool, Vec<[f32; 2]>)>,
+    /// A point cloud instead (`render::points`): each key a sphere (centre, radius),
+    /// each its own "curve" and "segment"; `pieces` is 0.
+    pub points: bool,
 }
 
 impl ObjectCurves {
@@ -97,6 +100,7 @@ impl ObjectCurves {
                         _ => None,
                     })
             }),
+            points: false,
         }
     }
 
@@ -104,6 +108,7 @@ impl ObjectCurves {
     pub fn uv_at(&self, seg: u32, u: f32) -> [f32; 3] {
         let (c, k0) = self.segments[seg as usize];
         match &self.uv {
+            _ if self.points => [0.0; 3],
             Some((true, v)) => {
                 let (a, b) = (v[k0 as usize], v[k0 as usize + 1]);
                 [(b[0] - a[0]) * u + a[0], (b[1] - a[1]) * u + a[1], 0.0]
@@ -117,6 +122,9 @@ impl ObjectCurves {
     /// the end keys repeated at a curve's ends (Cycles' ka, k0, k1, kb).
     #[inline]
     pub fn control_points(&self, seg: u32) -> [[f32; 4]; 4] {
+        if self.points {
+            return [self.keys[seg as usize]; 4];
+        }
         let (c, k0) = self.segments[seg as usize];
         let (first, count) = self.curves[c as usize];
         let last = first + count - 1;
@@ -132,6 +140,10 @@ impl ObjectCurves {
     /// What Hair Info reads at `u` along segment `seg`, with the curve's tangent `dpdu`
     /// there and `wi` the unit direction back along the ray (Cycles' sd->wi).
     pub fn hair_point(&self, seg: u32, u: f32, dpdu: V3, wi: V3) -> crate::shader::HairPoint {
+        if self.points {
+            // Cycles' Hair Info reads nothing on points.
+            return crate::shader::HairPoint::default();
+        }
         let (c, k0) = self.segments[seg as usize];
         let (k0, k1) = (k0 as usize, k0 as usize + 1);
         let lerp = |a: f32, b: f32| (b - a) * u + a;
@@ -150,6 +162,14 @@ impl ObjectCurves {
     /// World-space bounds of segment `seg` with its radius: the Bezier form of the
     /// Catmull-Rom segment lies in its control points' hull.
     pub fn segment_bounds(&self, seg: u32) -> (V3, V3) {
+        if self.points {
+            let k = self.keys[seg as usize];
+            let r = k[3].abs();
+            return (
+                [k[0] - r, k[1] - r, k[2] - r],
+                [k[0] + r, k[1] + r, k[2] + r],
+            );
+        }
         let p = self.control_points(seg);
         let b = [
             p[1],
@@ -405,7 +425,11 @@ impl CurveAccel {
             if self.masks[i] & mask == 0 {
                 return None;
             }
-            let h = ribbon_intersect(org, dir, tmin, far, self.pieces[i], &self.points[i])?;
+            let h = if self.pieces[i] == 0 {
+                crate::render::points::sphere_intersect(org, dir, tmin, far, self.points[i][0])?
+            } else {
+                ribbon_intersect(org, dir, tmin, far, self.pieces[i], &self.points[i])?
+            };
             best = Some(Hit {
                 t: h.t,
                 prim: self.prims[i],

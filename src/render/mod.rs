@@ -27,6 +27,7 @@ pub mod light;
 pub mod limits;
 pub use crate::foundation::math;
 pub mod motion;
+pub mod points;
 pub mod sampler;
 pub mod scene_mesh;
 pub mod shader_rays;
@@ -714,6 +715,7 @@ fn prepare(
         }
     }
     let materials = integrator::shade::compile_all(scene, &used)?;
+    points::check(scene, &geo, &materials)?;
     curves::check(scene, &geo, &materials)?;
     build::bind_attributes(&mut geo, &materials)?;
     if displace::apply(&mut geo, &materials) > 0 {
