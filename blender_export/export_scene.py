@@ -599,8 +599,60 @@ def with_instancer_values(part, values):
     return counts, arrays, attrs + extra, uvs
 
 
-# Per object: the points of the point clouds its evaluation makes (`evaluated_meshes`).
+# Per object: the point clouds its evaluation makes as instances (`evaluated_meshes`):
+# (keys, matrix into the object's space, material).
 POINT_CLOUDS = {}
+
+
+def pointcloud_keys(pc):
+    """x, y, z, radius per point of a point cloud as Cycles' export_pointcloud reads it:
+    the `radius` point attribute, 0.01 where there is none."""
+    n = len(pc.points)
+    keys = np.zeros((n, 4), np.float64)
+    pos = np.zeros(n * 3, np.float32)
+    pc.attributes["position"].data.foreach_get("vector", pos)
+    keys[:, :3] = pos.reshape(-1, 3)
+    radius = pc.attributes.get("radius")
+    if radius is not None and radius.domain == "POINT" and radius.data_type == "FLOAT":
+        r = np.zeros(n, np.float32)
+        radius.data.foreach_get("value", r)
+        keys[:, 3] = r
+    else:
+        keys[:, 3] = 0.01
+    return keys
+
+
+def export_points(objs, out, index, frozen_meshes, depsgraph):
+    """Each object's point clouds (a point cloud object's own points, and those its
+    Geometry Nodes make as instances) in points/, by object name, in the object's space
+    (radii scaled by the cube root of the instance transform's determinant, as Cycles
+    scales them): x, y, z, radius per point (float32), then each point's index into the
+    entry's `materials` (uint32; each cloud's first material is appended there)."""
+    got = {}
+    for o in objs:
+        clouds = list(POINT_CLOUDS.get(key(o), []))
+        if o.type == "POINTCLOUD":
+            ev = o.evaluated_get(depsgraph)
+            if len(ev.data.points):
+                clouds.insert(0, (pointcloud_keys(ev.data), np.identity(4), (slot_materials(ev, ev.data)[:1] or [None])[0]))
+        if not clouds:
+            continue
+        mats = frozen_meshes[key(o)][2]
+        keys, slots = [], []
+        for k, m, mat in clouds:
+            k = k.copy()
+            k[:, :3] = k[:, :3] @ m[:3, :3].T + m[:3, 3]
+            k[:, 3] *= abs(np.linalg.det(m[:3, :3])) ** (1.0 / 3.0)
+            keys.append(k)
+            slots.append(np.full(len(k), len(mats), np.uint32))
+            mats.append(mat)
+        rel = f"points/{safe_name(index[key(o)], key(o))[:-4]}.bin"
+        os.makedirs(os.path.join(out, "points"), exist_ok=True)
+        with open(os.path.join(out, rel), "wb") as f:
+            f.write(np.concatenate(keys).astype("<f4").tobytes())
+            f.write(np.concatenate(slots).astype("<u4").tobytes())
+        got[key(o)] = {"file": rel, "count": int(sum(len(k) for k in keys))}
+    return got
 
 
 def evaluated_meshes(objs, depsgraph):
@@ -647,10 +699,12 @@ def evaluated_meshes(objs, depsgraph):
         io = inst.object  # the instanced geometry (inst.parent is the instancer)
         if io.type in NON_GEOMETRY:
             continue
-        if io.type == "POINTCLOUD" and len(io.data.points):
-            # Cycles renders these points as spheres; the evaluated mesh cannot carry them.
-            POINT_CLOUDS.setdefault(owner, 0)
-            POINT_CLOUDS[owner] += len(io.data.points)
+        if io.type == "POINTCLOUD":
+            # Cycles renders these points as spheres: exported apart (`export_points`).
+            if len(io.data.points):
+                POINT_CLOUDS.setdefault(owner, []).append(
+                    (pointcloud_keys(io.data), inverse[owner] @ np.array(inst.matrix_world, dtype=np.float64),
+                     (slot_materials(io, io.data)[:1] or [None])[0]))
             continue
         try:
             ime = io.to_mesh()
@@ -907,8 +961,9 @@ def export_curves(objs, out, index, frozen_meshes):
     return got
 
 
-FROZEN_TYPES = {"CURVE", "SURFACE", "FONT", "META", "CURVES"}
-ID_COLLECTIONS = {"OBJECT": "objects", "MESH": "meshes", "CURVE": "curves", "CURVES": "hair_curves", "KEY": "shape_keys",
+FROZEN_TYPES = {"CURVE", "SURFACE", "FONT", "META", "CURVES", "POINTCLOUD"}
+ID_COLLECTIONS = {"OBJECT": "objects", "MESH": "meshes", "CURVE": "curves", "CURVES": "hair_curves",
+                  "POINTCLOUD": "pointclouds", "KEY": "shape_keys",
                   "ARMATURE": "armatures", "META": "metaballs", "METABALL": "metaballs", "LATTICE": "lattices",
                   "PARTICLE": "particles", "COLLECTION": "collections", "TEXTURE": "textures",
                   "NODETREE": "node_groups", "IMAGE": "images", "FONT": "fonts"}
@@ -1532,17 +1587,17 @@ def main():
             frozen_meshes = evaluated_meshes(targets, bpy.context.evaluated_depsgraph_get())
             hair = export_hair(targets, out, index)
             hair.update(export_curves(targets, out, index, frozen_meshes))
+            points = export_points(targets, out, index, frozen_meshes, bpy.context.evaluated_depsgraph_get())
         for name, ((counts, arrays, attrs, uvs), n_inst, mats, (uv_layers, render_uv, color)) in frozen_meshes.items():
             rel = f"evaluated/{safe_name(index[name], name)}"
             write_mesh_glb(os.path.join(out, rel), name, counts, arrays, attrs, uvs)
             reads, animated, unsupported = frozen_inputs(by_key[name])
-            if POINT_CLOUDS.get(name):
-                unsupported.append(f"a point cloud of {POINT_CLOUDS[name]} points (rendered by Cycles as spheres)")
             evaluated.append({"object": name, "frame": scene.frame_current + scene.frame_subframe, "file": rel,
                               "vertex_count": counts[0], "face_count": counts[2], "instances_realized": n_inst,
                               "reads": reads, "animated": animated, "unsupported": unsupported,
                               "materials": mats, "uv_layers": uv_layers, "active_render_uv": render_uv,
-                              "default_color_attribute": color, "hair": hair.get(name)})
+                              "default_color_attribute": color, "hair": hair.get(name),
+                              "points": points.get(name)})
 
     RENDER_LAYER.update(render_layer_objects(view_layer))
     used_images = set()

@@ -31,6 +31,8 @@ const ASSERTED: &[&str] = &[
     "hair_attributes",
     // A Geometry Nodes point cloud (Mesh to Points, a varying radius) as spheres.
     "points",
+    // A point cloud object (POINTCLOUD, Geometry Nodes Points) from the export's points.
+    "pointcloud_object",
     "adaptive",
     "motion_blur",
     "motion_blur_start",
@@ -1709,5 +1711,16 @@ fn unsupported_points_are_refused_by_name() {
             nodes.push(info);
         },
         &["\"Points\"", "material \"Bead\"", "Point Info"],
+    );
+    // A non-uniform scale: Cycles renders the points as ellipsoids.
+    refused_alike(
+        &dir,
+        &base,
+        &|j| {
+            let os = j["objects"].as_array_mut().unwrap();
+            let o = os.iter_mut().find(|o| o["name"] == "Points").unwrap();
+            o["scale"] = serde_json::json!([1.0, 1.0, 1.3]);
+        },
+        &["\"Points\"", "non-uniform scale"],
     );
 }

@@ -249,6 +249,21 @@ pub fn build(
                 if let Some(h) = hair {
                     push_curves(&mut instances, scene, oi, obj, &info, &h, to_world)?;
                 }
+                let points = scene
+                    .load_points(ei)
+                    .map_err(|err| RenderError(format!("object {:?}: {err}", obj.name)))?;
+                if let Some((keys, slots)) = points.filter(|p| !p.0.is_empty()) {
+                    push_points(
+                        &mut instances,
+                        scene,
+                        oi,
+                        obj,
+                        &info,
+                        &keys,
+                        &slots,
+                        to_world,
+                    )?;
+                }
             }
             Source::Evaluate => {
                 let curve_materials = obj
@@ -304,7 +319,36 @@ pub fn build(
                     pushed.nested_instancer_names = obj.attribute_lookups.keys().cloned().collect();
                 }
                 if let Some(p) = points {
-                    push_points(&mut instances, scene, oi, obj, &p, to_world)?;
+                    let radius = match p.attributes.named("radius").map(|a| &a.data) {
+                        Some(crate::geometry::types::Array::Float(r)) if r.len() == p.len() => {
+                            r.clone()
+                        }
+                        _ => vec![0.01; p.len()],
+                    };
+                    let keys: Vec<[f32; 4]> = p
+                        .positions
+                        .iter()
+                        .zip(&radius)
+                        .map(|(q, &r)| [q[0], q[1], q[2], r])
+                        .collect();
+                    let materials = vec![p.materials.first().cloned().flatten()];
+                    let info = MeshInfo {
+                        materials: &materials,
+                        uv_name: None,
+                        default_color: None,
+                        texspace: None,
+                    };
+                    let slots = vec![0; keys.len()];
+                    push_points(
+                        &mut instances,
+                        scene,
+                        oi,
+                        obj,
+                        &info,
+                        &keys,
+                        &slots,
+                        to_world,
+                    )?;
                 }
                 if let Some(inst) = instances_component {
                     let mut by_handle: HashMap<u32, (Arc<MeshData>, Vec<Option<String>>)> =
@@ -534,27 +578,20 @@ fn cycles_renders(
     (r, points)
 }
 
-/// A Geometry Nodes point cloud as an instance of its own (`render::points`): a sphere
-/// per point of its `radius` attribute (0.01 without one, as Cycles' export_pointcloud),
-/// all in its first material (Cycles gives every point shader 0).
+/// A point cloud as an instance of its own (`render::points`): a sphere per key (x, y,
+/// z, radius in object space) in material slot `slots[i]` of `info`'s materials (Cycles
+/// gives every point of a cloud shader 0: its first material).
+#[allow(clippy::too_many_arguments)]
 fn push_points(
     instances: &mut Vec<MeshInstance>,
     scene: &Scene,
     oi: usize,
     obj: &crate::scene::Object,
-    p: &crate::geometry::pointcloud::PointCloud,
+    info: &MeshInfo,
+    pts: &[[f32; 4]],
+    slots: &[u32],
     to_world: Affine,
 ) -> Result<(), RenderError> {
-    let radius = match p.attributes.named("radius").map(|a| &a.data) {
-        Some(crate::geometry::types::Array::Float(r)) if r.len() == p.len() => r.clone(),
-        _ => vec![0.01; p.len()],
-    };
-    let pts: Vec<[f32; 4]> = p
-        .positions
-        .iter()
-        .zip(&radius)
-        .map(|(q, &r)| [q[0], q[1], q[2], r])
-        .collect();
     if let Some(k) = pts
         .iter()
         .position(|k| !k.iter().all(|x| x.is_finite()) || k[3] < 0.0)
@@ -564,19 +601,13 @@ fn push_points(
             obj.name, pts[k]
         )));
     }
-    let materials = vec![p.materials.first().cloned().flatten()];
-    let info = MeshInfo {
-        materials: &materials,
-        uv_name: None,
-        default_color: None,
-        texspace: None,
-    };
-    let points = crate::render::points::object_points(&pts, &to_world);
+    let mut points = crate::render::points::object_points(pts, &to_world);
+    points.slot = slots.to_vec();
     let mut inst = new_instance(
         scene,
         oi,
         obj,
-        &info,
+        info,
         Arc::new(MeshData::default()),
         to_world,
         None,
@@ -590,7 +621,7 @@ fn push_points(
     inst.world_bounds = (lo, hi);
     // Generated spans the points' object-space bounds.
     let (mut a, mut b) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for k in &pts {
+    for k in pts {
         a = vmin(a, [k[0], k[1], k[2]]);
         b = vmax(b, [k[0], k[1], k[2]]);
     }

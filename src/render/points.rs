@@ -86,6 +86,15 @@ pub fn check(
         .iter()
         .filter(|i| i.curves.as_ref().is_some_and(|c| c.points));
     for inst in points {
+        if !similarity(&inst.to_world) {
+            // Cycles applies only uniform scales to a point cloud; under another it keeps
+            // the points in object space, so they render as ellipsoids (measured: a
+            // (1, 1, 1.3) scale gave parity ratio 1.6 as spheres).
+            return Err(crate::render::RenderError(format!(
+                "object {:?}: its point cloud is under a non-uniform scale or shear, which Cycles renders as ellipsoids: not supported by the renderer yet",
+                inst.name
+            )));
+        }
         for mi in inst.slots.iter().flatten() {
             let m = &materials[*mi];
             let Some(p) = &m.program else {
@@ -124,6 +133,20 @@ pub fn check(
     Ok(())
 }
 
+/// Whether `t`'s linear part is a rotation times one scale (columns of one length, at
+/// right angles), to a relative 1e-5.
+fn similarity(t: &Affine) -> bool {
+    let col = |j: usize| [t.m[0][j], t.m[1][j], t.m[2][j]];
+    let c = [col(0), col(1), col(2)];
+    let s = dot(c[0], c[0]);
+    let eps = 1e-5 * s;
+    (dot(c[1], c[1]) - s).abs() <= eps
+        && (dot(c[2], c[2]) - s).abs() <= eps
+        && dot(c[0], c[1]).abs() <= eps
+        && dot(c[0], c[2]).abs() <= eps
+        && dot(c[1], c[2]).abs() <= eps
+}
+
 /// Whether tree `t` or a group it uses (to a depth of 64) holds an unmuted `bl_idname`.
 fn uses_node(
     scene: &crate::scene::Scene,
@@ -144,6 +167,19 @@ fn uses_node(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn only_uniform_scales_keep_spheres() {
+        let t = |d: [f32; 3]| Affine {
+            m: [
+                [d[0], 0.0, 0.0, 1.0],
+                [0.0, d[1], 0.0, 2.0],
+                [0.0, 0.0, d[2], 3.0],
+            ],
+        };
+        assert!(similarity(&t([1.3, 1.3, 1.3])));
+        assert!(!similarity(&t([1.0, 1.0, 1.3])));
+    }
 
     #[test]
     fn a_ray_hits_the_front_of_the_sphere_only() {

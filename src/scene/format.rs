@@ -643,6 +643,17 @@ pub struct Evaluated {
     /// systems), None when it has none (`scene::hair`).
     #[serde(default)]
     pub hair: Option<HairRef>,
+    /// The object's point clouds (its own points, and those its Geometry Nodes make):
+    /// `count` x, y, z, radius (float32, object space), then a uint32 index into
+    /// `materials` per point.
+    #[serde(default)]
+    pub points: Option<PointsRef>,
+}
+
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct PointsRef {
+    pub file: String,
+    pub count: usize,
 }
 
 /// An object's hair strands: a file of x, y, z, radius per key (little-endian f32,

@@ -62,6 +62,69 @@ impl Scene {
     }
 }
 
+impl Scene {
+    /// Reads `evaluated[index].points`' file: per point x, y, z, radius (object space)
+    /// and its index into the entry's materials.
+    pub fn load_points(
+        &self,
+        index: usize,
+    ) -> Result<Option<(Vec<[f32; 4]>, Vec<u32>)>, SceneError> {
+        let e = &self.file.evaluated[index];
+        let Some(p) = &e.points else {
+            return Ok(None);
+        };
+        let at = format!("evaluated[{index}].points");
+        let path = self.resolve(&p.file, &format!("{at}.file"))?;
+        let bytes = super::file::read_regular(&path, super::limits::MAX_GLB_BYTES)
+            .map_err(|m| SceneError::new(&path, "", m))?;
+        let fail = |m: String| {
+            SceneError::new(
+                &self.json_path(),
+                format!("{at}.file"),
+                format!("{m} (object {}, file {})", quote(&e.object), path.display()),
+            )
+        };
+        if Some(bytes.len()) != p.count.checked_mul(20) {
+            return Err(fail(format!(
+                "holds {} bytes, not the 20 per point of its {} points",
+                bytes.len(),
+                p.count
+            )));
+        }
+        let f = |o: usize| f32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]]);
+        let keys: Vec<[f32; 4]> = (0..p.count)
+            .map(|i| [f(16 * i), f(16 * i + 4), f(16 * i + 8), f(16 * i + 12)])
+            .collect();
+        let base = 16 * p.count;
+        let slots: Vec<u32> = (0..p.count)
+            .map(|i| {
+                let o = base + 4 * i;
+                u32::from_le_bytes([bytes[o], bytes[o + 1], bytes[o + 2], bytes[o + 3]])
+            })
+            .collect();
+        if let Some(k) = keys
+            .iter()
+            .position(|k| !k.iter().all(|x| x.is_finite()) || k[3] < 0.0)
+        {
+            return Err(fail(format!(
+                "point {k} is {:?}: positions must be finite, radii finite and >= 0",
+                keys[k]
+            )));
+        }
+        if let Some(i) = slots
+            .iter()
+            .position(|&s| s as usize >= e.materials.len().max(1))
+        {
+            return Err(fail(format!(
+                "point {i} has material index {}, the entry has {} materials",
+                slots[i],
+                e.materials.len()
+            )));
+        }
+        Ok(Some((keys, slots)))
+    }
+}
+
 /// The attributes `h` declares, from their file's bytes, for the curves and keys of `d`.
 pub fn parse_hair_attributes(
     h: &HairRef,
