@@ -4,6 +4,13 @@
 
 use super::{quote, HairRef, Scene, SceneError};
 
+/// Hair attributes by name: per key (true) or per curve, and their values.
+pub type HairAttributes = Vec<(String, bool, crate::scene::mesh::AttributeData)>;
+
+/// An object's point clouds: x, y, z, radius per point (object space), and each point's
+/// index into its evaluated entry's materials.
+pub type PointsData = (Vec<[f32; 4]>, Vec<u32>);
+
 /// One object's strands, all systems in order.
 #[derive(Debug, Clone, Default)]
 pub struct HairData {
@@ -14,7 +21,7 @@ pub struct HairData {
     /// Per curve: the object's material slot.
     pub curve_slot: Vec<u32>,
     /// Attributes by name: per key (true) or per curve, and their values.
-    pub attributes: Vec<(String, bool, crate::scene::mesh::AttributeData)>,
+    pub attributes: HairAttributes,
     /// The attribute read as the hair's UV.
     pub uv: Option<String>,
 }
@@ -65,10 +72,7 @@ impl Scene {
 impl Scene {
     /// Reads `evaluated[index].points`' file: per point x, y, z, radius (object space)
     /// and its index into the entry's materials.
-    pub fn load_points(
-        &self,
-        index: usize,
-    ) -> Result<Option<(Vec<[f32; 4]>, Vec<u32>)>, SceneError> {
+    pub fn load_points(&self, index: usize) -> Result<Option<PointsData>, SceneError> {
         let e = &self.file.evaluated[index];
         let Some(p) = &e.points else {
             return Ok(None);
@@ -130,7 +134,7 @@ pub fn parse_hair_attributes(
     h: &HairRef,
     d: &HairData,
     bytes: &[u8],
-) -> Result<Vec<(String, bool, crate::scene::mesh::AttributeData)>, (String, String)> {
+) -> Result<HairAttributes, (String, String)> {
     use crate::scene::mesh::AttributeData as A;
     let mut at = 0usize;
     let mut out = Vec::with_capacity(h.attributes.len());
