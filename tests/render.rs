@@ -1723,4 +1723,15 @@ fn unsupported_points_are_refused_by_name() {
         },
         &["\"Points\"", "non-uniform scale"],
     );
+    // Optical flow traces triangles only: points are refused there, not left out.
+    let Err(RenderError(m)) = blendsynth::render::render_with_motion(&scene, &opts, &[], None, 1.0)
+    else {
+        panic!("flow with points is refused");
+    };
+    assert!(m.contains("\"Points\" has a point cloud"), "{m}");
+    // A point cloud object's exported points: refused before a dataset renders.
+    let dir = common::repo().join("fixtures/render/scenes/pointcloud_object");
+    let scene = Scene::load(&dir).unwrap();
+    let m = blendsynth::render::flow_refusal(&scene).unwrap();
+    assert!(m.contains("\"Cloud\" has a point cloud"), "{m}");
 }
