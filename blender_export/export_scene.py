@@ -599,6 +599,62 @@ def with_instancer_values(part, values):
     return counts, arrays, attrs + extra, uvs
 
 
+# Per object: the point clouds its evaluation makes as instances (`evaluated_meshes`):
+# (keys, matrix into the object's space, material).
+POINT_CLOUDS = {}
+
+
+def pointcloud_keys(pc):
+    """x, y, z, radius per point of a point cloud as Cycles' export_pointcloud reads it:
+    the `radius` point attribute, 0.01 where there is none."""
+    n = len(pc.points)
+    keys = np.zeros((n, 4), np.float64)
+    pos = np.zeros(n * 3, np.float32)
+    pc.attributes["position"].data.foreach_get("vector", pos)
+    keys[:, :3] = pos.reshape(-1, 3)
+    radius = pc.attributes.get("radius")
+    if radius is not None and radius.domain == "POINT" and radius.data_type == "FLOAT":
+        r = np.zeros(n, np.float32)
+        radius.data.foreach_get("value", r)
+        keys[:, 3] = r
+    else:
+        keys[:, 3] = 0.01
+    return keys
+
+
+def export_points(objs, out, index, frozen_meshes, depsgraph):
+    """Each object's point clouds (a point cloud object's own points, and those its
+    Geometry Nodes make as instances) in points/, by object name, in the object's space
+    (radii scaled by the cube root of the instance transform's determinant, as Cycles
+    scales them): x, y, z, radius per point (float32), then each point's index into the
+    entry's `materials` (uint32; each cloud's first material is appended there)."""
+    got = {}
+    for o in objs:
+        clouds = list(POINT_CLOUDS.get(key(o), []))
+        if o.type == "POINTCLOUD":
+            ev = o.evaluated_get(depsgraph)
+            if len(ev.data.points):
+                clouds.insert(0, (pointcloud_keys(ev.data), np.identity(4), (slot_materials(ev, ev.data)[:1] or [None])[0]))
+        if not clouds:
+            continue
+        mats = frozen_meshes[key(o)][2]
+        keys, slots = [], []
+        for k, m, mat in clouds:
+            k = k.copy()
+            k[:, :3] = k[:, :3] @ m[:3, :3].T + m[:3, 3]
+            k[:, 3] *= abs(np.linalg.det(m[:3, :3])) ** (1.0 / 3.0)
+            keys.append(k)
+            slots.append(np.full(len(k), len(mats), np.uint32))
+            mats.append(mat)
+        rel = f"points/{safe_name(index[key(o)], key(o))[:-4]}.bin"
+        os.makedirs(os.path.join(out, "points"), exist_ok=True)
+        with open(os.path.join(out, rel), "wb") as f:
+            f.write(np.concatenate(keys).astype("<f4").tobytes())
+            f.write(np.concatenate(slots).astype("<u4").tobytes())
+        got[key(o)] = {"file": rel, "count": int(sum(len(k) for k in keys))}
+    return got
+
+
 def evaluated_meshes(objs, depsgraph):
     """For each object: its evaluated mesh plus the instances it generates (realised),
     in its local space, and the material slots its faces index. One pass over
@@ -642,6 +698,13 @@ def evaluated_meshes(objs, depsgraph):
             continue
         io = inst.object  # the instanced geometry (inst.parent is the instancer)
         if io.type in NON_GEOMETRY:
+            continue
+        if io.type == "POINTCLOUD":
+            # Cycles renders these points as spheres: exported apart (`export_points`).
+            if len(io.data.points):
+                POINT_CLOUDS.setdefault(owner, []).append(
+                    (pointcloud_keys(io.data), inverse[owner] @ np.array(inst.matrix_world, dtype=np.float64),
+                     (slot_materials(io, io.data)[:1] or [None])[0]))
             continue
         try:
             ime = io.to_mesh()
@@ -745,6 +808,103 @@ def hair_strands(o, depsgraph, path):
     return systems
 
 
+def rendered_path_systems(ev):
+    """(modifier, system, first particle, count) of each hair system Cycles renders as
+    strands, in `hair_strands`' order."""
+    for m in ev.modifiers:
+        if m.type != "PARTICLE_SYSTEM" or not m.show_render:
+            continue
+        psys = m.particle_system
+        st = psys.settings
+        if st.type != "HAIR" or st.render_type != "PATH":
+            continue
+        totpart, totchild = len(psys.particles), len(psys.child_particles)
+        first = totpart if (st.child_type != "NONE" and totchild) else 0
+        if totpart + totchild - first > 0:
+            yield m, psys, first, totpart + totchild - first
+
+
+def particle_hair_attributes(o, depsgraph):
+    """What Cycles' blender/curves.cpp gives particle hair from its emitter, per curve:
+    each UV map (ObtainCacheParticleUV: the active render one is the hair's UV) and each
+    byte colour corner attribute, sRGB-decoded (ObtainCacheParticleVcol), by name.
+    Returns ([(name, domain, data_type, float32 array)], uv name)."""
+    ev = o.evaluated_get(depsgraph)
+    me = o.data
+    uv_names = [uv.name for uv in me.uv_layers]
+    vcol_names = [a.name for a in me.attributes if a.data_type == "BYTE_COLOR" and a.domain == "CORNER"]
+    uvs = {n: [] for n in uv_names}
+    cols = {n: [] for n in vcol_names}
+    for m, psys, first, count in rendered_path_systems(ev):
+        parts = psys.particles
+        for c in range(count):
+            pa_no = first + c
+            # Cycles passes the parent particle for parents and the first one for children.
+            pa = parts[pa_no] if pa_no < len(parts) else parts[0]
+            for i, n in enumerate(uv_names):
+                uvs[n].append(tuple(psys.uv_on_emitter(m, particle=pa, particle_no=pa_no, uv_no=i)))
+            for i, n in enumerate(vcol_names):
+                cols[n].append(tuple(psys.mcol_on_emitter(m, particle=pa, particle_no=pa_no, vcol_no=i)) + (1.0,))
+    attrs = [(n, "CURVE", "FLOAT2", np.array(v, np.float32).reshape(-1, 2)) for n, v in uvs.items() if v]
+    for n, v in cols.items():
+        if v:
+            a = np.array(v, np.float64).reshape(-1, 4)
+            rgb = a[:, :3]
+            a[:, :3] = np.where(rgb <= 0.04045, rgb / 12.92, ((rgb + 0.055) / 1.055) ** 2.4)
+            attrs.append((n, "CURVE", "FLOAT_COLOR", a.astype(np.float32)))
+    render_uv = next((uv.name for uv in me.uv_layers if uv.active_render), None)
+    return attrs, render_uv
+
+
+CURVES_ATTRIBUTE_WIDTH = {"FLOAT": 1, "INT": 1, "INT8": 1, "BOOLEAN": 1, "FLOAT2": 2, "INT32_2D": 2,
+                          "FLOAT_VECTOR": 3, "FLOAT_COLOR": 4, "BYTE_COLOR": 4}
+
+
+def curves_attributes(o, depsgraph):
+    """A Curves object's point and curve attributes as Cycles' attr_create_generic reads
+    them (numbers as float32, colours linear), by name, and its UV: the first 2D vector
+    curve attribute. Types Cycles cannot read in shaders (quaternions, matrices) are left
+    out. Returns ([(name, domain, data_type, float32 array)], uv name)."""
+    cv = o.evaluated_get(depsgraph).data
+    attrs, uv = [], None
+    for a in cv.attributes:
+        w = CURVES_ATTRIBUTE_WIDTH.get(a.data_type)
+        if a.name.startswith(".") or w is None or a.domain not in ("POINT", "CURVE"):
+            continue
+        n = len(a.data)
+        if a.data_type in ("FLOAT_COLOR", "BYTE_COLOR"):
+            field = "color"
+        elif a.data_type in ("FLOAT_VECTOR", "FLOAT2", "INT32_2D"):
+            field = "vector"
+        else:
+            field = "value"
+        dtype = {"BOOLEAN": bool, "INT": np.int32, "INT8": np.int32, "INT32_2D": np.int32}.get(a.data_type, np.float32)
+        raw = np.zeros(n * w, dtype)
+        try:
+            a.data.foreach_get(field, raw)
+        except (AttributeError, RuntimeError, TypeError):
+            continue
+        v = raw.astype(np.float32).reshape(n, w)
+        kind = {1: "FLOAT", 2: "FLOAT2", 3: "FLOAT_VECTOR", 4: "FLOAT_COLOR"}[w]
+        if uv is None and kind == "FLOAT2" and a.domain == "CURVE":
+            uv = a.name
+        attrs.append((a.name, a.domain, kind, v))
+    return attrs, uv
+
+
+def write_hair_attributes(entry, attrs, uv, out):
+    """Adds the hair attributes to a hair entry: one float32 file of every attribute in
+    order, each count x width values."""
+    if not attrs:
+        return entry
+    rel = entry["file"][:-4] + ".attributes.bin"
+    with open(os.path.join(out, rel), "wb") as f:
+        for _, _, _, v in attrs:
+            f.write(v.astype("<f4").tobytes())
+    return dict(entry, attributes_file=rel, uv=uv,
+                attributes=[{"name": n, "domain": d, "data_type": t} for n, d, t, _ in attrs])
+
+
 def export_hair(objs, out, index):
     """Each object's hair strands (`hair_strands`) in hair/, by object name: the file and
     its systems."""
@@ -757,12 +917,70 @@ def export_hair(objs, out, index):
         os.makedirs(os.path.join(out, "hair"), exist_ok=True)
         systems = hair_strands(o, depsgraph, os.path.join(out, rel))
         if systems is not None:
-            got[key(o)] = {"file": rel, "systems": systems}
+            got[key(o)] = write_hair_attributes({"file": rel, "systems": systems},
+                                                *particle_hair_attributes(o, depsgraph), out)
     return got
 
 
-FROZEN_TYPES = {"CURVE", "SURFACE", "FONT", "META"}
-ID_COLLECTIONS = {"OBJECT": "objects", "MESH": "meshes", "CURVE": "curves", "KEY": "shape_keys",
+def curves_keys(o, depsgraph, path):
+    """The curves Cycles renders for a Curves object (`type == 'CURVES'`, Blender 3.3+ hair),
+    as its blender/curves.cpp (export_hair_curves) syncs them from the evaluated Curves:
+    the control points as keys whatever the curve type, the `radius` point attribute
+    (0.005 where the Curves have none), every curve with the object's first material
+    slot. Writes x, y, z, radius per key (object space, little-endian float32), then
+    the point count per curve (little-endian uint32) to `path`; returns the system
+    entry, or None when there are no curves."""
+    cv = o.evaluated_get(depsgraph).data
+    n_points, n_curves = len(cv.points), len(cv.curves)
+    if n_curves == 0 or n_points == 0:
+        return None
+    pos = np.zeros(n_points * 3, np.float32)
+    cv.points.foreach_get("position", pos)
+    keys = np.zeros((n_points, 4), np.float32)
+    keys[:, :3] = pos.reshape(-1, 3)
+    radius = cv.attributes.get("radius")
+    if radius is not None and radius.domain == "POINT" and radius.data_type == "FLOAT":
+        r = np.zeros(n_points, np.float32)
+        radius.data.foreach_get("value", r)
+        keys[:, 3] = r
+    else:
+        keys[:, 3] = 0.005
+    offsets = np.zeros(n_curves + 1, np.int64)
+    cv.curve_offset_data.foreach_get("value", offsets)
+    counts = np.diff(offsets).astype("<u4")
+    with open(path, "wb") as f:
+        f.write(keys.astype("<f4").tobytes())
+        f.write(counts.tobytes())
+    return {"name": key(o.data), "material_slot": 0, "curve_count": n_curves, "keys_per_curve": 0,
+            "key_count": n_points, "children": False}
+
+
+def export_curves(objs, out, index, frozen_meshes):
+    """Each Curves object's curves (`curves_keys`) in hair/, by object name, as a hair
+    entry of one system; the object's first material slot is appended to its evaluated
+    entry's materials (Cycles gives all its curves shader 0: the first slot)."""
+    got = {}
+    depsgraph = bpy.context.evaluated_depsgraph_get()
+    for o in objs:
+        if o.type != "CURVES":
+            continue
+        rel = f"hair/{safe_name(index[key(o)], key(o))[:-4]}.bin"
+        os.makedirs(os.path.join(out, "hair"), exist_ok=True)
+        system = curves_keys(o, depsgraph, os.path.join(out, rel))
+        if system is None:
+            continue
+        mats = frozen_meshes[key(o)][2]
+        ev = o.evaluated_get(depsgraph)
+        first = slot_materials(ev, ev.data)[:1] or [None]
+        system["material_slot"] = len(mats)
+        mats.extend(first)
+        got[key(o)] = write_hair_attributes({"file": rel, "systems": [system]}, *curves_attributes(o, depsgraph), out)
+    return got
+
+
+FROZEN_TYPES = {"CURVE", "SURFACE", "FONT", "META", "CURVES", "POINTCLOUD"}
+ID_COLLECTIONS = {"OBJECT": "objects", "MESH": "meshes", "CURVE": "curves", "CURVES": "hair_curves",
+                  "POINTCLOUD": "pointclouds", "KEY": "shape_keys",
                   "ARMATURE": "armatures", "META": "metaballs", "METABALL": "metaballs", "LATTICE": "lattices",
                   "PARTICLE": "particles", "COLLECTION": "collections", "TEXTURE": "textures",
                   "NODETREE": "node_groups", "IMAGE": "images", "FONT": "fonts"}
@@ -1386,6 +1604,8 @@ def main():
         with RenderSettings():
             frozen_meshes = evaluated_meshes(targets, bpy.context.evaluated_depsgraph_get())
             hair = export_hair(targets, out, index)
+            hair.update(export_curves(targets, out, index, frozen_meshes))
+            points = export_points(targets, out, index, frozen_meshes, bpy.context.evaluated_depsgraph_get())
         for name, ((counts, arrays, attrs, uvs), realized, mats, (uv_layers, render_uv, color)) in frozen_meshes.items():
             rel = f"evaluated/{safe_name(index[name], name)}"
             write_mesh_glb(os.path.join(out, rel), name, counts, arrays, attrs, uvs)
@@ -1394,7 +1614,8 @@ def main():
                               "vertex_count": counts[0], "face_count": counts[2], "instances_realized": len(realized["instances"]) if realized else 0,
                               "realized": realized, "reads": reads, "animated": animated, "unsupported": unsupported,
                               "materials": mats, "uv_layers": uv_layers, "active_render_uv": render_uv,
-                              "default_color_attribute": color, "hair": hair.get(name)})
+                              "default_color_attribute": color, "hair": hair.get(name),
+                              "points": points.get(name)})
 
     RENDER_LAYER.update(render_layer_objects(view_layer))
     used_images = set()

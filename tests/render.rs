@@ -29,6 +29,16 @@ const ASSERTED: &[&str] = &[
     "hair_chiang_melanin",
     "hair_chiang_color",
     "hair_chiang_absorption",
+    // A Curves object with Geometry Nodes: its evaluated strands as hair.
+    "curves_object",
+    // Hair Info, each output into a colour, on a Curves object and on particle hair.
+    "hair_info",
+    // Attributes on hair: a Curves object's, and the emitter's UV and colour on particle hair.
+    "hair_attributes",
+    // A Geometry Nodes point cloud (Mesh to Points, a varying radius) as spheres.
+    "points",
+    // A point cloud object (POINTCLOUD, Geometry Nodes Points) from the export's points.
+    "pointcloud_object",
     "adaptive",
     "motion_blur",
     "motion_blur_start",
@@ -1696,25 +1706,25 @@ fn unsupported_hair_is_refused_by_name() {
         m.contains("optical flow") && m.contains("\"Emitter\""),
         "{m}"
     );
+    // A dataset asking for flow is refused before anything renders or is written.
+    let spec = blendsynth::dataset::Spec::parse(
+        "[render]\nresolution = [8, 8]\nsamples = 1\ndenoise = false\n[labels]\nflow = true\n",
+    )
+    .unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    let out = tmp.path().join("ds");
+    let r = blendsynth::dataset::renderer::path_tracer(&scene).unwrap();
+    let opts = blendsynth::dataset::GenerateOptions {
+        frames: 1,
+        ..Default::default()
+    };
+    let e = blendsynth::dataset::generate(&scene, &spec, r.as_ref(), &out, &opts).unwrap_err();
+    assert_eq!(e, m, "generate and render_with_motion refuse alike");
+    assert!(!out.exists(), "nothing written");
     // Render > Curves > Shape 3D Curves.
     refused(
         &|j| j["scene"]["cycles_curves"]["shape"] = "THICK".into(),
         &["\"Emitter\"", "THICK"],
-    );
-    // A Hair Info node in the hair's material.
-    refused(
-        &|j| {
-            let ms = j["materials"].as_array_mut().unwrap();
-            let m = ms.iter_mut().find(|m| m["name"] == "Hair").unwrap();
-            let nodes = m["node_tree"]["nodes"].as_array_mut().unwrap();
-            let mut info = nodes[0].clone();
-            info["name"] = "Hair Info".into();
-            info["bl_idname"] = "ShaderNodeHairInfo".into();
-            info["inputs"] = serde_json::json!([]);
-            info["outputs"] = serde_json::json!([]);
-            nodes.push(info);
-        },
-        &["\"Emitter\"", "material \"Hair\"", "Hair Info"],
     );
     // A hair file that does not hold what scene.json declares.
     refused(
@@ -1724,4 +1734,101 @@ fn unsupported_hair_is_refused_by_name() {
         },
         &["evaluated[0].hair.file", "\"Emitter\"", "bytes"],
     );
+}
+
+/// A Curves object renders from the export's evaluated curves (parity scene
+/// `curves_object`); without them, or with curves the file does not hold, `inspect` and
+/// `render` refuse it alike, by name.
+#[test]
+fn curves_objects_without_their_curves_are_refused_by_name() {
+    let dir = common::repo().join("fixtures/render/scenes/curves_object");
+    let base: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("scene.json")).unwrap()).unwrap();
+    let scene = Scene::from_json(&dir, base.to_string().as_bytes()).unwrap();
+    let opts = RenderOptions {
+        samples: Some(1),
+        resolution: Some((8, 8)),
+        ..Default::default()
+    };
+    assert!(blendsynth::render::check(&scene, &opts, &[]).is_ok());
+    let o = base["objects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|o| o["name"] == "Strands")
+        .unwrap();
+    assert_eq!(o["type"], "CURVES");
+    // An export without Blender's evaluation (convert --no-evaluated, or an old one).
+    refused_alike(
+        &dir,
+        &base,
+        &|j| j["evaluated"] = serde_json::json!([]),
+        &["\"Strands\"", "Curves object", "no frozen mesh"],
+    );
+    // Key counts per curve that do not add up to the keys the system declares.
+    refused_alike(
+        &dir,
+        &base,
+        &|j| {
+            let e = j["evaluated"].as_array_mut().unwrap();
+            let e = e.iter_mut().find(|e| e["object"] == "Strands").unwrap();
+            e["hair"]["systems"][0]["key_count"] = 62.into();
+        },
+        &["\"Strands\"", "hair.file", "bytes"],
+    );
+}
+
+/// What blendsynth does not render on a Geometry Nodes point cloud is an error naming the
+/// object, material and node, the same from `inspect` (render::check) and `render`.
+#[test]
+fn unsupported_points_are_refused_by_name() {
+    let dir = common::repo().join("fixtures/render/scenes/points");
+    let base: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("scene.json")).unwrap()).unwrap();
+    let scene = Scene::from_json(&dir, base.to_string().as_bytes()).unwrap();
+    let opts = RenderOptions {
+        samples: Some(1),
+        resolution: Some((8, 8)),
+        ..Default::default()
+    };
+    assert!(blendsynth::render::check(&scene, &opts, &[]).is_ok());
+    // A Point Info node in the points' material (its values on points are not carried).
+    refused_alike(
+        &dir,
+        &base,
+        &|j| {
+            let ms = j["materials"].as_array_mut().unwrap();
+            let m = ms.iter_mut().find(|m| m["name"] == "Bead").unwrap();
+            let nodes = m["node_tree"]["nodes"].as_array_mut().unwrap();
+            let mut info = nodes[0].clone();
+            info["name"] = "Point Info".into();
+            info["bl_idname"] = "ShaderNodePointInfo".into();
+            info["inputs"] = serde_json::json!([]);
+            info["outputs"] = serde_json::json!([]);
+            nodes.push(info);
+        },
+        &["\"Points\"", "material \"Bead\"", "Point Info"],
+    );
+    // A non-uniform scale: Cycles renders the points as ellipsoids.
+    refused_alike(
+        &dir,
+        &base,
+        &|j| {
+            let os = j["objects"].as_array_mut().unwrap();
+            let o = os.iter_mut().find(|o| o["name"] == "Points").unwrap();
+            o["scale"] = serde_json::json!([1.0, 1.0, 1.3]);
+        },
+        &["\"Points\"", "non-uniform scale"],
+    );
+    // Optical flow traces triangles only: points are refused there, not left out.
+    let Err(RenderError(m)) = blendsynth::render::render_with_motion(&scene, &opts, &[], None, 1.0)
+    else {
+        panic!("flow with points is refused");
+    };
+    assert!(m.contains("\"Points\" has a point cloud"), "{m}");
+    // A point cloud object's exported points: refused before a dataset renders.
+    let dir = common::repo().join("fixtures/render/scenes/pointcloud_object");
+    let scene = Scene::load(&dir).unwrap();
+    let m = blendsynth::render::flow_refusal(&scene).unwrap();
+    assert!(m.contains("\"Cloud\" has a point cloud"), "{m}");
 }

@@ -310,6 +310,12 @@ pub fn generate(
     for w in spec.validate(scene).map_err(|e| e.to_string())? {
         eprintln!("warning: {w}");
     }
+    // Refused up front, not at the first frame after the output folder is made.
+    if spec.labels.motion() {
+        if let Some(m) = crate::render::flow_refusal(scene) {
+            return Err(m);
+        }
+    }
     let current = scene.file.scene.frame_current as i64;
     // Splits and shards hold whole sequences: the unit is a sequence, or a frame.
     let (units, length) = match &spec.sequence {

@@ -139,6 +139,11 @@ pub fn frozen_reason(scene: &Scene, o: &Object) -> Option<String> {
                 None
             }
         }
+        // Cycles renders a Curves object's evaluated curves as hair (the export's
+        // strands) and any mesh its Geometry Nodes make; blendsynth evaluates neither.
+        "CURVES" => Some("Curves object".into()),
+        // Cycles renders a point cloud object's points as spheres (the export's points).
+        "POINTCLOUD" => Some("point cloud object".into()),
         "SURFACE" => Some("NURBS surface object".into()),
         "FONT" => Some("text object".into()),
         "META" => Some("metaball object".into()),

@@ -264,6 +264,21 @@ pub fn build(
                 if let Some(h) = hair {
                     push_curves(&mut instances, scene, oi, obj, &info, &h, to_world)?;
                 }
+                let points = scene
+                    .load_points(ei)
+                    .map_err(|err| RenderError(format!("object {:?}: {err}", obj.name)))?;
+                if let Some((keys, slots)) = points.filter(|p| !p.0.is_empty()) {
+                    push_points(
+                        &mut instances,
+                        scene,
+                        oi,
+                        obj,
+                        &info,
+                        &keys,
+                        &slots,
+                        to_world,
+                    )?;
+                }
             }
             Source::Evaluate => {
                 let curve_materials = obj
@@ -288,10 +303,15 @@ pub fn build(
                 let mut rest = set.clone();
                 let instances_component = rest.instances.take();
                 let realise = |g: &crate::geometry::GeometrySet| -> Result<(Arc<MeshData>, Vec<Option<String>>), RenderError> {
-                    let m = crate::geometry::realize_to_mesh(g).map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))?;
+                    let (g, points) = cycles_renders(g);
+                    if let Some(p) = points {
+                        return Err(RenderError(format!("object {:?}: its Geometry Nodes instances hold a point cloud ({} points), which Cycles renders as spheres: points in instances are not supported by the renderer yet", obj.name, p.len())));
+                    }
+                    let m = crate::geometry::realize_to_mesh(&g).map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))?;
                     let mats = if m.materials.is_empty() { base.materials.to_vec() } else { m.materials.clone() };
                     Ok((Arc::new(m.to_scene(&obj.name)), mats))
                 };
+                let (rest, points) = cycles_renders(&rest);
                 let (mesh, mats) = realise(&rest)?;
                 let info = MeshInfo {
                     materials: &mats,
@@ -312,6 +332,38 @@ pub fn build(
                     // instance: an Instancer read there is refused (see bind_attributes).
                     let pushed = instances.last_mut().expect("pushed");
                     pushed.nested_instancer_names = obj.attribute_lookups.keys().cloned().collect();
+                }
+                if let Some(p) = points {
+                    let radius = match p.attributes.named("radius").map(|a| &a.data) {
+                        Some(crate::geometry::types::Array::Float(r)) if r.len() == p.len() => {
+                            r.clone()
+                        }
+                        _ => vec![0.01; p.len()],
+                    };
+                    let keys: Vec<[f32; 4]> = p
+                        .positions
+                        .iter()
+                        .zip(&radius)
+                        .map(|(q, &r)| [q[0], q[1], q[2], r])
+                        .collect();
+                    let materials = vec![p.materials.first().cloned().flatten()];
+                    let info = MeshInfo {
+                        materials: &materials,
+                        uv_name: None,
+                        default_color: None,
+                        texspace: None,
+                    };
+                    let slots = vec![0; keys.len()];
+                    push_points(
+                        &mut instances,
+                        scene,
+                        oi,
+                        obj,
+                        &info,
+                        &keys,
+                        &slots,
+                        to_world,
+                    )?;
                 }
                 if let Some(inst) = instances_component {
                     let mut by_handle: HashMap<u32, (Arc<MeshData>, Vec<Option<String>>)> =
@@ -585,6 +637,77 @@ fn push_realized(
     Ok(())
 }
 
+/// What Cycles renders of a mesh or curve object's Geometry Nodes output, instances
+/// realised: the mesh, and the point cloud apart (`push_points`). Blender hands a curve
+/// component on such an object to render engines as a legacy curve object, which Cycles
+/// does not render (its object_is_geometry takes Curves, point clouds and meshes only),
+/// so it is dropped.
+fn cycles_renders(
+    g: &crate::geometry::GeometrySet,
+) -> (
+    crate::geometry::GeometrySet,
+    Option<Arc<crate::geometry::pointcloud::PointCloud>>,
+) {
+    let mut r = crate::geometry::realize::realize_instances(g);
+    r.curves = None;
+    let points = r.points.take().filter(|p| !p.is_empty());
+    (r, points)
+}
+
+/// A point cloud as an instance of its own (`render::points`): a sphere per key (x, y,
+/// z, radius in object space) in material slot `slots[i]` of `info`'s materials (Cycles
+/// gives every point of a cloud shader 0: its first material).
+#[allow(clippy::too_many_arguments)]
+fn push_points(
+    instances: &mut Vec<MeshInstance>,
+    scene: &Scene,
+    oi: usize,
+    obj: &crate::scene::Object,
+    info: &MeshInfo,
+    pts: &[[f32; 4]],
+    slots: &[u32],
+    to_world: Affine,
+) -> Result<(), RenderError> {
+    if let Some(k) = pts
+        .iter()
+        .position(|k| !k.iter().all(|x| x.is_finite()) || k[3] < 0.0)
+    {
+        return Err(RenderError(format!(
+            "object {:?}: point {k} of its point cloud is {:?}: positions must be finite, radii finite and >= 0",
+            obj.name, pts[k]
+        )));
+    }
+    let mut points = crate::render::points::object_points(pts, &to_world);
+    points.slot = slots.to_vec();
+    let mut inst = new_instance(
+        scene,
+        oi,
+        obj,
+        info,
+        Arc::new(MeshData::default()),
+        to_world,
+        None,
+    )?;
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for s in 0..points.segments.len() {
+        let (a, b) = points.segment_bounds(s as u32);
+        lo = vmin(lo, a);
+        hi = vmax(hi, b);
+    }
+    inst.world_bounds = (lo, hi);
+    // Generated spans the points' object-space bounds.
+    let (mut a, mut b) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for k in pts {
+        a = vmin(a, [k[0], k[1], k[2]]);
+        b = vmax(b, [k[0], k[1], k[2]]);
+    }
+    inst.tex_loc = scale(add(a, b), 0.5);
+    inst.tex_size = scale(sub(b, a), 0.5).map(|x| if x > 0.0 { x } else { 1.0 });
+    inst.curves = Some(Arc::new(points));
+    instances.push(inst);
+    Ok(())
+}
+
 /// An object's hair as an instance of its own: the object's material slots, no mesh.
 fn push_curves(
     instances: &mut Vec<MeshInstance>,
@@ -774,8 +897,23 @@ pub fn bind_attributes(
                 per_slot.push(None);
                 continue;
             }
-            if inst.curves.is_some() {
-                return Err(RenderError(format!("object {:?}: material {:?} on its hair reads attributes ({:?}), which the export does not carry for hair strands (not supported yet)", inst.name, materials[mi].name, p.attributes)));
+            if inst.curves.as_ref().is_some_and(|c| c.points) {
+                return Err(RenderError(format!("object {:?}: material {:?} on its point cloud reads attributes ({:?}), which blendsynth does not carry for points yet", inst.name, materials[mi].name, p.attributes)));
+            }
+            if let Some(c) = &inst.curves {
+                let b = BoundAttributes::bind_curves(
+                    &c.attributes,
+                    &p.attributes,
+                    inst.default_color.as_deref(),
+                )
+                .map_err(|e| {
+                    RenderError(format!(
+                        "object {:?}, material {:?} on its hair: {e}",
+                        inst.name, materials[mi].name
+                    ))
+                })?;
+                per_slot.push(Some(Arc::new(b)));
+                continue;
             }
             for r in &p.attributes {
                 if let crate::shader::attributes::AttributeRequest::Instancer(name) = r {
@@ -820,4 +958,39 @@ pub fn bind_attributes(
         inst.attributes = per_slot;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::cycles_renders;
+    use crate::geometry::{curves::Curves, pointcloud::PointCloud, GeometrySet};
+    use std::sync::Arc;
+
+    /// Curves in a mesh object's Geometry Nodes output render as nothing (as in Cycles);
+    /// points are taken apart to render as spheres.
+    #[test]
+    fn mesh_objects_drop_their_curves_and_keep_their_points_apart() {
+        let curves = Curves {
+            positions: vec![[0.0; 3], [0.0, 0.0, 1.0]],
+            curve_offsets: vec![0, 2],
+            ..Default::default()
+        };
+        let set = GeometrySet {
+            curves: Some(Arc::new(curves)),
+            ..Default::default()
+        };
+        let (r, points) = cycles_renders(&set);
+        assert!(r.curves.is_none() && r.mesh.is_none() && points.is_none());
+        let points = PointCloud {
+            positions: vec![[0.0; 3]; 3],
+            ..Default::default()
+        };
+        let set = GeometrySet {
+            points: Some(Arc::new(points)),
+            ..set
+        };
+        let (r, points) = cycles_renders(&set);
+        assert!(r.points.is_none());
+        assert_eq!(points.map(|p| p.len()), Some(3));
+    }
 }

@@ -34,6 +34,13 @@ pub struct ObjectCurves {
     pub segments: Vec<(u32, u32)>,
     /// Ribbons: straight pieces per segment are 2^subdivisions.
     pub pieces: u32,
+    /// Attributes by name, per key (true) or per curve (`HairData::attributes`).
+    pub attributes: Vec<(String, bool, crate::scene::mesh::AttributeData)>,
+    /// The hair's UV (Texture Coordinate > UV): one value per curve or per key.
+    pub uv: Option<(bool, Vec<[f32; 2]>)>,
+    /// A point cloud instead (`render::points`): each key a sphere (centre, radius),
+    /// each its own "curve" and "segment"; `pieces` is 0.
+    pub points: bool,
 }
 
 impl ObjectCurves {
@@ -83,6 +90,31 @@ impl ObjectCurves {
             intercept,
             segments,
             pieces: 1 << subdivisions.min(24),
+            attributes: hair.attributes.clone(),
+            uv: hair.uv.as_deref().and_then(|n| {
+                hair.attributes
+                    .iter()
+                    .find(|a| a.0 == n)
+                    .and_then(|a| match &a.2 {
+                        crate::scene::mesh::AttributeData::Float2(v) => Some((a.1, v.clone())),
+                        _ => None,
+                    })
+            }),
+            points: false,
+        }
+    }
+
+    /// The hair's UV at `u` along segment `seg` (zero without one).
+    pub fn uv_at(&self, seg: u32, u: f32) -> [f32; 3] {
+        let (c, k0) = self.segments[seg as usize];
+        match &self.uv {
+            _ if self.points => [0.0; 3],
+            Some((true, v)) => {
+                let (a, b) = (v[k0 as usize], v[k0 as usize + 1]);
+                [(b[0] - a[0]) * u + a[0], (b[1] - a[1]) * u + a[1], 0.0]
+            }
+            Some((false, v)) => [v[c as usize][0], v[c as usize][1], 0.0],
+            None => [0.0; 3],
         }
     }
 
@@ -90,6 +122,9 @@ impl ObjectCurves {
     /// the end keys repeated at a curve's ends (Cycles' ka, k0, k1, kb).
     #[inline]
     pub fn control_points(&self, seg: u32) -> [[f32; 4]; 4] {
+        if self.points {
+            return [self.keys[seg as usize]; 4];
+        }
         let (c, k0) = self.segments[seg as usize];
         let (first, count) = self.curves[c as usize];
         let last = first + count - 1;
@@ -102,9 +137,39 @@ impl ObjectCurves {
         k.map(|i| self.keys[i as usize])
     }
 
+    /// What Hair Info reads at `u` along segment `seg`, with the curve's tangent `dpdu`
+    /// there and `wi` the unit direction back along the ray (Cycles' sd->wi).
+    pub fn hair_point(&self, seg: u32, u: f32, dpdu: V3, wi: V3) -> crate::shader::HairPoint {
+        if self.points {
+            // Cycles' Hair Info reads nothing on points.
+            return crate::shader::HairPoint::default();
+        }
+        let (c, k0) = self.segments[seg as usize];
+        let (k0, k1) = (k0 as usize, k0 as usize + 1);
+        let lerp = |a: f32, b: f32| (b - a) * u + a;
+        let d2 = dot(dpdu, dpdu);
+        let along = if d2 > 0.0 { dot(dpdu, wi) / d2 } else { 0.0 };
+        crate::shader::HairPoint {
+            is_strand: 1.0,
+            intercept: lerp(self.intercept[k0], self.intercept[k1]),
+            length: self.length[c as usize],
+            thickness: 2.0 * lerp(self.keys[k0][3], self.keys[k1][3]),
+            tangent_normal: normalize(sub(wi, scale(dpdu, along))),
+            random: crate::nodes::random::hash_to_float2(c, 0),
+        }
+    }
+
     /// World-space bounds of segment `seg` with its radius: the Bezier form of the
     /// Catmull-Rom segment lies in its control points' hull.
     pub fn segment_bounds(&self, seg: u32) -> (V3, V3) {
+        if self.points {
+            let k = self.keys[seg as usize];
+            let r = k[3].abs();
+            return (
+                [k[0] - r, k[1] - r, k[2] - r],
+                [k[0] + r, k[1] + r, k[2] + r],
+            );
+        }
         let p = self.control_points(seg);
         let b = [
             p[1],
@@ -314,13 +379,6 @@ pub fn ribbon_shading(c: &[[f32; 4]; 4], pieces: u32, u: f32, v: f32, dir: V3) -
     (p, n, dpdu)
 }
 
-/// Cycles' random number of particle hair curve `i` (its index in the object's hair, in
-/// export order): hash_uint2_to_float(i, 0), as blender/curves.cpp fills
-/// ATTR_STD_CURVE_RANDOM.
-pub fn curve_random(i: u32) -> f32 {
-    crate::nodes::white_noise::lookup3::hash2(i, 0) as f32 / u32::MAX as f32
-}
-
 /// The scene's curve segments behind one ray query.
 pub struct CurveAccel {
     bvh: BoxBvh,
@@ -367,7 +425,11 @@ impl CurveAccel {
             if self.masks[i] & mask == 0 {
                 return None;
             }
-            let h = ribbon_intersect(org, dir, tmin, far, self.pieces[i], &self.points[i])?;
+            let h = if self.pieces[i] == 0 {
+                crate::render::points::sphere_intersect(org, dir, tmin, far, self.points[i][0])?
+            } else {
+                ribbon_intersect(org, dir, tmin, far, self.pieces[i], &self.points[i])?
+            };
             best = Some(Hit {
                 t: h.t,
                 prim: self.prims[i],
@@ -454,7 +516,7 @@ impl Accel for WithCurves {
 /// Huang model and the Subsurface Scattering node; the hair BSDFs on meshes; and hair
 /// with motion blur or under Embree.
 pub fn check(
-    scene: &crate::scene::Scene,
+    _scene: &crate::scene::Scene,
     geo: &crate::render::build::Geometry,
     materials: &[crate::render::integrator::shade::Material],
 ) -> Result<(), crate::render::RenderError> {
@@ -524,15 +586,6 @@ pub fn check(
                     _ => None,
                 })
             };
-            // Hair Info reads zero everywhere but on hair, where the export has none of
-            // its values yet.
-            let why = why.or_else(|| {
-                scene
-                    .material(&m.name)
-                    .and_then(|mat| mat.node_tree.as_ref())
-                    .is_some_and(|t| uses_node(scene, t, "ShaderNodeHairInfo", 0))
-                    .then(|| "node ShaderNodeHairInfo (Hair Info)".to_string())
-            });
             if let Some(why) = why {
                 return Err(RenderError(format!(
                     "object {:?}: its hair's material {:?} has {why}, which blendsynth does not render on hair curves",
@@ -542,23 +595,6 @@ pub fn check(
         }
     }
     Ok(())
-}
-
-/// Whether tree `t` or a group it uses (to a depth of 64) holds an unmuted `bl_idname`.
-fn uses_node(
-    scene: &crate::scene::Scene,
-    t: &crate::scene::NodeTree,
-    bl_idname: &str,
-    depth: u32,
-) -> bool {
-    depth < 64
-        && t.nodes.iter().any(|n| {
-            (!n.mute && n.bl_idname == bl_idname)
-                || n.node_tree
-                    .as_deref()
-                    .and_then(|g| scene.node_group(g))
-                    .is_some_and(|g| uses_node(scene, g, bl_idname, depth + 1))
-        })
 }
 
 #[cfg(test)]
@@ -571,6 +607,7 @@ mod tests {
             keys: (0..4).map(|i| [i as f32, 0.0, 0.0, 0.1]).collect(),
             curves: vec![(0, 4)],
             curve_slot: vec![0],
+            ..HairData::default()
         };
         let id = Affine {
             m: [

@@ -27,6 +27,7 @@ pub mod light;
 pub mod limits;
 pub use crate::foundation::math;
 pub mod motion;
+pub mod points;
 pub mod realized;
 pub mod sampler;
 pub mod scene_mesh;
@@ -169,6 +170,48 @@ pub fn render_controlled(
     render_frame(scene, opts, overrides, control).map(|(out, ..)| out)
 }
 
+/// Why optical flow and occlusion cannot be labelled on `scene`, before anything renders:
+/// an object rendered with hair curves (its export's strands, particle hair or a Curves
+/// object) or exported points, which the flow and occlusion passes do not trace (point
+/// clouds blendsynth's Geometry Nodes make are refused at the frame). The same words as
+/// `render_with_motion` gives at the frame.
+pub fn flow_refusal(scene: &Scene) -> Option<String> {
+    scene
+        .file
+        .evaluated
+        .iter()
+        .filter(|e| {
+            e.hair
+                .as_ref()
+                .is_some_and(|h| h.systems.iter().any(|s| s.curve_count > 0))
+                || e.points.as_ref().is_some_and(|p| p.count > 0)
+        })
+        .find(|e| {
+            scene
+                .file
+                .objects
+                .iter()
+                .any(|o| o.name == e.object && !o.hide_render && o.in_render_layer)
+        })
+        .map(|e| {
+            let hair = e
+                .hair
+                .as_ref()
+                .is_some_and(|h| h.systems.iter().any(|s| s.curve_count > 0));
+            flow_refused(&e.object, !hair)
+        })
+}
+
+/// Why optical flow is refused on `object`'s hair curves or point cloud (`points`).
+fn flow_refused(object: &str, points: bool) -> String {
+    let what = if points {
+        "a point cloud"
+    } else {
+        "hair curves"
+    };
+    format!("optical flow: object {object:?} has {what}, which the flow and occlusion passes do not trace (not supported yet)")
+}
+
 /// `render_controlled` with optical flow and occlusion (`flow`) to the scene frames
 /// `frame + step` (forward) and `frame - step` (backward; a sequence's step may be
 /// negative), from the primary hits the label passes use. Panoramic cameras are refused
@@ -188,11 +231,12 @@ pub fn render_with_motion(
     let (out, camera, geo, frame) = render_frame(scene, opts, overrides, control)?;
     // The flow and its occlusion test trace triangles only: hair would be missing from
     // both, so its pixels and what it hides would be labelled wrongly.
-    if let Some(h) = geo.instances.iter().find(|i| i.curves.is_some()) {
-        return Err(RenderError(format!(
-            "optical flow: object {:?} has hair curves, which the flow and occlusion passes do not trace (not supported yet)",
-            h.name
-        )));
+    if let Some((h, c)) = geo
+        .instances
+        .iter()
+        .find_map(|i| i.curves.as_ref().map(|c| (i, c)))
+    {
+        return Err(RenderError(flow_refused(&h.name, c.points)));
     }
     let here = film::flow::FrameView {
         camera: &camera,
@@ -686,6 +730,7 @@ fn prepare(
         }
     }
     let materials = integrator::shade::compile_all(scene, &used)?;
+    points::check(scene, &geo, &materials)?;
     curves::check(scene, &geo, &materials)?;
     build::bind_attributes(&mut geo, &materials)?;
     if displace::apply(&mut geo, &materials) > 0 {

@@ -648,6 +648,11 @@ pub struct Evaluated {
     /// before it was written).
     #[serde(default)]
     pub realized: Option<Realized>,
+    /// The object's point clouds (its own points, and those its Geometry Nodes make):
+    /// `count` x, y, z, radius (float32, object space), then a uint32 index into
+    /// `materials` per point.
+    #[serde(default)]
+    pub points: Option<PointsRef>,
 }
 
 /// How an evaluated mesh splits into the instancer's own geometry and the instances
@@ -679,12 +684,36 @@ pub struct RealizedInstance {
     pub texspace_size: Option<[f32; 3]>,
 }
 
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct PointsRef {
+    pub file: String,
+    pub count: usize,
+}
+
 /// An object's hair strands: a file of x, y, z, radius per key (little-endian f32,
 /// object space), curve after curve, system after system.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct HairRef {
     pub file: String,
     pub systems: Vec<HairSystem>,
+    /// Per-curve and per-key attributes (UV maps and colours from the emitter, a Curves
+    /// object's attributes): float32 values, attribute after attribute, in this file.
+    #[serde(default)]
+    pub attributes_file: Option<String>,
+    #[serde(default)]
+    pub attributes: Vec<HairAttribute>,
+    /// The attribute Cycles reads as the hair's UV (Texture Coordinate / UV Map default).
+    #[serde(default)]
+    pub uv: Option<String>,
+}
+
+/// One hair attribute: `domain` CURVE (a value per curve) or POINT (per key);
+/// `data_type` FLOAT, FLOAT2, FLOAT_VECTOR or FLOAT_COLOR (1 to 4 floats).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct HairAttribute {
+    pub name: String,
+    pub domain: String,
+    pub data_type: String,
 }
 
 /// One hair particle system's strands as Cycles syncs them.
@@ -694,7 +723,12 @@ pub struct HairSystem {
     /// The object's material slot the strands use (Cycles' omat - 1, clamped).
     pub material_slot: usize,
     pub curve_count: usize,
+    /// Keys of every curve (particle hair); 0 for a Curves object's system, whose curves
+    /// differ: its `key_count` keys are then followed by one u32 key count per curve.
     pub keys_per_curve: usize,
+    /// A Curves object's keys in all (with `keys_per_curve` 0).
+    #[serde(default)]
+    pub key_count: Option<usize>,
     /// Whether the strands are the children (the parents then do not render).
     #[serde(default)]
     pub children: bool,

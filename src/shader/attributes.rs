@@ -312,6 +312,97 @@ impl BoundAttributes {
         }
     }
 
+    /// Resolves `requests` on hair: `attributes` by name, per key (true) or per curve, as
+    /// Cycles exports them for particle hair (the emitter's UV maps and colours) and for
+    /// Curves (their attributes). What hair has none of (tangents, the normal map's,
+    /// Pointiness, Random Per Island) is an error naming it.
+    pub fn bind_curves(
+        attributes: &[(String, bool, AttributeData)],
+        requests: &[AttributeRequest],
+        default_color: Option<&str>,
+    ) -> Result<BoundAttributes, String> {
+        let named = |name: &str| -> Result<Bound, String> {
+            let Some((_, per_key, data)) = attributes.iter().find(|a| a.0 == name) else {
+                return Ok(Bound {
+                    values: Values::Missing,
+                    fac: FacMode::Average,
+                });
+            };
+            let (v, fac) = convert(name, data)?;
+            Ok(Bound {
+                values: if *per_key {
+                    Values::Point(v)
+                } else {
+                    Values::Face(v)
+                },
+                fac,
+            })
+        };
+        let mut items = Vec::with_capacity(requests.len());
+        for r in requests {
+            items.push(match r {
+                AttributeRequest::Named(name) => named(name)?,
+                AttributeRequest::Instancer(name) => Bound {
+                    values: Values::Instancer(name.clone()),
+                    fac: FacMode::Average,
+                },
+                AttributeRequest::DefaultColor => match default_color {
+                    Some(name) => named(name)?,
+                    None => Bound {
+                        values: Values::Missing,
+                        fac: FacMode::Average,
+                    },
+                },
+                other => {
+                    return Err(format!(
+                        "{other:?} on hair curves is not supported (hair has no faces to derive it from)"
+                    ))
+                }
+            });
+        }
+        if items.len() > MAX_ATTRIBUTES {
+            return Err(format!(
+                "the material reads {} attributes; at most {MAX_ATTRIBUTES} are supported",
+                items.len()
+            ));
+        }
+        Ok(BoundAttributes { items })
+    }
+
+    /// Writes the attribute values at `u` along the hair segment from key `k0` to the
+    /// next, on curve `curve` (per-key values linear along it, as Cycles'
+    /// curve_attribute), into `sp`.
+    pub fn fill_curve(
+        &self,
+        curve: usize,
+        k0: usize,
+        u: f32,
+        instancer: &[(String, [f32; 4])],
+        sp: &mut ShadingPoint,
+    ) {
+        sp.attr_missing = 0;
+        for (i, b) in self.items.iter().enumerate() {
+            let v = match &b.values {
+                Values::Point(p) => {
+                    let (a, c) = (p[k0], p[k0 + 1]);
+                    std::array::from_fn(|k| (c[k] - a[k]) * u + a[k])
+                }
+                Values::Face(p) => p[curve],
+                Values::Instancer(name) => instancer
+                    .iter()
+                    .find(|(n, _)| n == name)
+                    .map(|(_, v)| *v)
+                    .unwrap_or([0.0; 4]),
+                _ => {
+                    sp.attr_missing |= 1 << i;
+                    [0.0; 4]
+                }
+            };
+            sp.attrs[i] = v;
+            sp.attr_fac[i] = b.fac.of(v);
+        }
+    }
+
     /// Writes the attributes' differentials into `sp.attrs_d` / `sp.attr_fac_d` for the
     /// hit's barycentric differentials `d` ([du, dv] along x and along y, as
     /// `bump::differential_dudv` gives them), for a Bump's offset points. Per-face values
@@ -345,5 +436,42 @@ impl BoundAttributes {
                 sp.attr_fac_d[i][k] = b.fac.of(dv);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Hair attributes: per key linear along the segment, per curve constant, a missing
+    /// name flagged; what hair cannot have is an error naming it.
+    #[test]
+    fn hair_attributes_interpolate_along_the_segment() {
+        let attrs = vec![
+            (
+                "along".to_string(),
+                true,
+                AttributeData::Float(vec![0.0, 0.5, 1.0]),
+            ),
+            (
+                "tint".to_string(),
+                false,
+                AttributeData::Color(vec![[0.2, 0.4, 0.6, 1.0]]),
+            ),
+        ];
+        let req = [
+            AttributeRequest::Named("along".into()),
+            AttributeRequest::Named("tint".into()),
+            AttributeRequest::Named("none".into()),
+        ];
+        let b = BoundAttributes::bind_curves(&attrs, &req, None).unwrap();
+        let mut sp = ShadingPoint::default();
+        b.fill_curve(0, 1, 0.25, &[], &mut sp);
+        assert_eq!(sp.attrs[0], [0.625, 0.625, 0.625, 1.0]);
+        assert_eq!(sp.attrs[1], [0.2, 0.4, 0.6, 1.0]);
+        assert_eq!(sp.attr_missing, 0b100);
+        let e = BoundAttributes::bind_curves(&attrs, &[AttributeRequest::Tangent(None)], None)
+            .unwrap_err();
+        assert!(e.contains("Tangent") && e.contains("hair"), "{e}");
     }
 }

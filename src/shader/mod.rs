@@ -16,5 +16,5 @@ pub mod trace;
 pub mod view;
 
 pub use compile::{compile_material, CompileError};
-pub use point::ShadingPoint;
+pub use point::{HairPoint, ShadingPoint};
 pub use program::Program;

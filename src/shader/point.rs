@@ -45,9 +45,6 @@ pub struct ShadingPoint {
     /// On a hair curve (zero elsewhere): the curve's tangent dP/du in world space (Cycles'
     /// sd->dPdu, which the hair closures turn about).
     pub dpdu: Vec3,
-    /// On a hair curve: the curve's random number (Cycles' ATTR_STD_CURVE_RANDOM, which the
-    /// Principled Hair BSDF reads when its Random input is unlinked).
-    pub curve_random: f32,
     /// Length of the ray segment that reached the point (Light Path > Ray Length; 1 in a bake).
     pub ray_length: f32,
     /// What kind of ray reached the point, and the path's bounce counts (Light Path).
@@ -78,6 +75,27 @@ pub struct ShadingPoint {
     /// On a truly displaced mesh: the point before displacement, which the material's
     /// displacement bump reads ("Both").
     pub undisplaced: Option<Undisplaced>,
+    /// What the Hair Info node reads: zero everywhere but on hair curves.
+    pub hair: HairPoint,
+}
+
+/// A hair hit as Cycles' Hair Info node reads it (svm_node_hair_info, geom/curve.h).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct HairPoint {
+    /// 1 on a curve.
+    pub is_strand: f32,
+    /// The fraction of the curve's length at the hit (its keys' values, linear along
+    /// the segment: an ATTR_STD_CURVE_INTERCEPT key attribute).
+    pub intercept: f32,
+    /// The curve's length in object space (ATTR_STD_CURVE_LENGTH).
+    pub length: f32,
+    /// Twice the radius, linear between the segment's keys (curve_thickness).
+    pub thickness: f32,
+    /// The incoming direction with its part along the curve removed, unit
+    /// (curve_tangent_normal).
+    pub tangent_normal: Vec3,
+    /// hash_uint2_to_float(curve index, 0) (ATTR_STD_CURVE_RANDOM).
+    pub random: f32,
 }
 
 /// A shading point's position and differentials before true displacement (Cycles'

@@ -335,6 +335,11 @@ pub enum Op {
         pixel_size: bool,
         dst: Slot,
     },
+    /// Hair Info's outputs from the shading point's `hair` (is strand, intercept,
+    /// length, thickness, tangent normal (3 slots), random).
+    HairInfo {
+        dst: [Slot; 6],
+    },
     /// Ambient Occlusion (svm/ao.h), traced through the `Trace` the program runs with
     /// (`inside` turns the normal around before tracing).
     AmbientOcclusion {
@@ -1181,6 +1186,15 @@ impl Program {
                     pixel_size,
                     dst,
                 } => s[dst as usize] = inputs::wireframe_node(&sp, s[size as usize], pixel_size),
+                Op::HairInfo { dst } => {
+                    let h = &sp.hair;
+                    s[dst[0] as usize] = h.is_strand;
+                    s[dst[1] as usize] = h.intercept;
+                    s[dst[2] as usize] = h.length;
+                    s[dst[3] as usize] = h.thickness;
+                    put3(s, dst[4], h.tangent_normal);
+                    s[dst[5] as usize] = h.random;
+                }
                 Op::AmbientOcclusion {
                     color,
                     distance,

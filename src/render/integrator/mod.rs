@@ -285,6 +285,9 @@ impl Scene<'_> {
     ) -> SurfaceHit {
         let r = self.geo.refs[prim as usize];
         let inst = &self.geo.instances[r.inst as usize];
+        if c.points {
+            return self.point_surface(c, prim, u, v, wo, time);
+        }
         let cp = c.control_points(r.tri);
         let (p, n, dpdu) = crate::render::curves::ribbon_shading(&cp, c.pieces, u, v, neg(wo));
         let ng = wo;
@@ -298,10 +301,15 @@ impl Scene<'_> {
             object_normal: normalize(Affine::normal_by_inverse(to_world, n)),
             generated: inst.generated(to_object.point([root[0], root[1], root[2]])),
             dpdu,
-            curve_random: crate::render::curves::curve_random(curve as u32),
+            hair: c.hair_point(r.tri, u, dpdu, wo),
+            uv: c.uv_at(r.tri, u),
             ..Default::default()
         };
         self.fill_context(&mut sp, inst, wo, ng, false, u, v);
+        let (_, k0) = c.segments[r.tri as usize];
+        if let Some(Some(bound)) = inst.attributes.get(c.slot[curve] as usize) {
+            bound.fill_curve(curve, k0 as usize, u, &inst.instancer_values, &mut sp);
+        }
         sp.transform = crate::shader::bump::ObjectTransform {
             to_world: to_world.m,
             to_object: to_object.m,
@@ -316,6 +324,51 @@ impl Scene<'_> {
             time,
             prim,
             uv: [u, v],
+        }
+    }
+
+    /// A point cloud hit (`render::points`) as Cycles' point_shader_setup gives it: on the
+    /// sphere, its normal as both the shading and the true normal, never backfacing.
+    fn point_surface(
+        &self,
+        c: &crate::render::curves::ObjectCurves,
+        prim: u32,
+        u: f32,
+        v: f32,
+        wo: V3,
+        time: f32,
+    ) -> SurfaceHit {
+        let r = self.geo.refs[prim as usize];
+        let inst = &self.geo.instances[r.inst as usize];
+        let k = c.keys[r.tri as usize];
+        let center = [k[0], k[1], k[2]];
+        let n = crate::render::points::normal_of(u, v);
+        let p = add(center, scale(n, k[3]));
+        let (to_world, to_object) = (&inst.to_world, &inst.to_object);
+        let mut sp = ShadingPoint {
+            position: p,
+            normal: n,
+            object_position: to_object.point(p),
+            object_normal: normalize(Affine::normal_by_inverse(to_world, n)),
+            generated: inst.generated(to_object.point(center)),
+            ..Default::default()
+        };
+        // Cycles gives points no parametric coordinates (sd->u = sd->v = 0).
+        self.fill_context(&mut sp, inst, wo, n, false, 0.0, 0.0);
+        sp.transform = crate::shader::bump::ObjectTransform {
+            to_world: to_world.m,
+            to_object: to_object.m,
+        };
+        SurfaceHit {
+            p,
+            ng: n,
+            sp,
+            inst: r.inst,
+            material: inst.material_of(r.tri as usize),
+            backfacing: false,
+            time,
+            prim,
+            uv: [0.0, 0.0],
         }
     }
 
@@ -357,7 +410,11 @@ impl Scene<'_> {
         lobes: &mut LobeSet,
         trace: &dyn Trace,
     ) {
-        let curve = self.geo.instances[hit.inst as usize].curves.is_some();
+        // Points are shaded as surfaces: only hair ribbons skip the specular correction.
+        let curve = self.geo.instances[hit.inst as usize]
+            .curves
+            .as_ref()
+            .is_some_and(|c| !c.points);
         let ctx = Context {
             tables: self.tables,
             wo,

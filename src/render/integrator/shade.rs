@@ -489,7 +489,8 @@ fn principled_hair(
     use crate::render::bsdf::hair_chiang::{self as chiang, Chiang};
     let random = match b.input("Random") {
         Some((slot, true)) => finite_or(s[slot as usize], 0.0),
-        _ => sp.curve_random,
+        // The curve's random number (ATTR_STD_CURVE_RANDOM, as Hair Info > Random).
+        _ => sp.hair.random,
     };
     let factor = 1.0 + 2.0 * (random - 0.5) * input_f(b, s, "Random Roughness", 0.0);
     let roughness = input_f(b, s, "Roughness", 0.3) * factor;

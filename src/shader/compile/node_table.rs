@@ -84,6 +84,8 @@ const PARTICLE_INFO: &str =
     "on a mesh not instanced by particles, Cycles' dummy particle (all zero, Random the hash of index 0), Cycles' EMIT bakes in tests/bake.rs; in a scene with a particle system a compile error (particle instances are frozen meshes without their particle data)";
 const INFO_ON_MESH: &str =
     "on a mesh (the only primitive blendsynth renders; hair curves, point clouds and volumes are refused) every output is zero as in Cycles, Cycles' EMIT bakes in tests/bake.rs";
+const HAIR_INFO: &str =
+    "every output as Cycles 4.5 computes it on hair curves (svm_node_hair_info, geom/curve.h: intercept and length from the keys, thickness, tangent normal, random by curve index), zero on meshes; Cycles parity scene hair_info in tests/render.rs";
 const AOV: &str =
     "Cycles writes it to its AOV pass only, never the image: nothing to evaluate (blendsynth writes no AOV passes)";
 const LIGHT_OUTPUT: &str =
@@ -146,7 +148,7 @@ pub const NODES: &[ShaderNode] = &[
     node("ShaderNodeBevel", bevel, RAY_TRACED),
     node("ShaderNodeParticleInfo", info_on_mesh, PARTICLE_INFO),
     node("ShaderNodePointInfo", info_on_mesh, INFO_ON_MESH),
-    node("ShaderNodeHairInfo", info_on_mesh, INFO_ON_MESH),
+    node("ShaderNodeHairInfo", hair_info, HAIR_INFO),
     node("ShaderNodeVolumeInfo", info_on_mesh, INFO_ON_MESH),
     // Output
     node("ShaderNodeOutputMaterial", material_output, OUTPUT),
@@ -427,6 +429,26 @@ fn info_on_mesh(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), 
         slots.push((o.identifier.as_str(), s, kind));
     }
     c.outputs(i, n, &slots);
+    Ok(())
+}
+
+/// Hair Info: the shading point's hair values (zero off hair, as in Cycles).
+fn hair_info(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let dst = [F, F, F, F, V, F].map(|k| c.alloc(k));
+    c.ops.push(Op::HairInfo { dst });
+    c.outputs(
+        i,
+        n,
+        &[
+            ("Is Strand", dst[0], F),
+            ("Intercept", dst[1], F),
+            ("Length", dst[2], F),
+            ("Thickness", dst[3], F),
+            ("Tangent Normal", dst[4], V),
+            ("Random", dst[5], F),
+        ],
+    );
     Ok(())
 }
 
