@@ -143,10 +143,10 @@ pub struct Bvh {
     pub(super) nodes: Vec<Node>,
     /// Triangles in leaf order, with their index in the caller's list.
     pub(super) tris: Vec<[V3; 3]>,
-    ids: Vec<u32>,
+    pub(super) ids: Vec<u32>,
     /// Per triangle in leaf order: the visibility mask of its object; empty when every
     /// triangle is visible to every ray (then no test is made).
-    masks: Vec<u32>,
+    pub(super) masks: Vec<u32>,
 }
 
 const BINS: usize = 16;
@@ -494,12 +494,12 @@ fn slab(n: &Node, org: V3, inv: V3, tmin: f32, tmax: f32) -> Option<f32> {
 
 /// Per-ray precomputation of the watertight test.
 pub(super) struct Watertight {
-    kx: usize,
-    ky: usize,
-    kz: usize,
-    sx: f32,
-    sy: f32,
-    sz: f32,
+    pub(super) kx: usize,
+    pub(super) ky: usize,
+    pub(super) kz: usize,
+    pub(super) sx: f32,
+    pub(super) sy: f32,
+    pub(super) sz: f32,
 }
 
 impl Watertight {
