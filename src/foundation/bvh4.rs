@@ -23,7 +23,7 @@ const EMPTY: u32 = u32::MAX;
 struct Node4 {
     lo: [[f32; 4]; 3],
     hi: [[f32; 4]; 3],
-    /// Inner child: its node index; leaf child: its first triangle.
+    /// Inner child: its node index; leaf child: its first triangle pack.
     child: [u32; 4],
     /// Leaf child: its triangle count; 0 for an inner child, `EMPTY` for no child.
     count: [u32; 4],
@@ -31,9 +31,30 @@ struct Node4 {
     valid: u32,
 }
 
+/// Up to four consecutive triangles of one leaf as structure-of-arrays lanes, tested at
+/// once (`tri4`): `v[vertex][axis][lane]`.
+#[derive(Debug, Clone, Copy)]
+#[repr(C, align(16))]
+struct TriPack {
+    v: [[[f32; 4]; 3]; 3],
+    /// Leaf-order index of lane 0's triangle; lane `l` holds triangle `first + l`.
+    first: u32,
+    /// Lanes holding a triangle (1 to 4).
+    n: u32,
+}
+
+impl TriPack {
+    fn tri(&self, lane: usize) -> [V3; 3] {
+        std::array::from_fn(|k| std::array::from_fn(|a| self.v[k][a][lane]))
+    }
+}
+
 pub struct Bvh4 {
     nodes: Vec<Node4>,
-    /// Triangles, ids and masks, in the binary BVH's leaf order.
+    /// A leaf's triangles, in the binary BVH's leaf order, four to a pack.
+    packs: Vec<TriPack>,
+    /// Ids and masks in the binary BVH's leaf order (its triangle list is dropped: the
+    /// packs hold the triangles).
     bin: Bvh,
 }
 
@@ -52,8 +73,10 @@ impl Bvh4 {
     pub fn from_binary(mut bin: Bvh) -> Bvh4 {
         let src = std::mem::take(&mut bin.nodes);
         let mut nodes: Vec<Node4> = Vec::with_capacity(src.len() / 2 + 1);
-        if src.is_empty() || bin.tris.is_empty() {
-            return Bvh4 { nodes, bin };
+        let tris = std::mem::take(&mut bin.tris);
+        let mut packs: Vec<TriPack> = Vec::with_capacity(tris.len() / 2 + 1);
+        if src.is_empty() || tris.is_empty() {
+            return Bvh4 { nodes, packs, bin };
         }
         let blank = Node4 {
             lo: [[f32::INFINITY; 4]; 3],
@@ -94,8 +117,26 @@ impl Bvh4 {
                     node.hi[a][lane] = src[k].max[a];
                 }
                 if src[k].count > 0 {
-                    node.child[lane] = src[k].start;
+                    node.child[lane] = packs.len() as u32;
                     node.count[lane] = src[k].count;
+                    let (start, end) = (src[k].start, src[k].start + src[k].count);
+                    for first in (start..end).step_by(4) {
+                        let n = (end - first).min(4);
+                        let mut pack = TriPack {
+                            v: [[[0.0; 4]; 3]; 3],
+                            first,
+                            n,
+                        };
+                        for l in 0..n as usize {
+                            let t = &tris[first as usize + l];
+                            for (k, vert) in t.iter().enumerate() {
+                                for a in 0..3 {
+                                    pack.v[k][a][l] = vert[a];
+                                }
+                            }
+                        }
+                        packs.push(pack);
+                    }
                 } else {
                     node.child[lane] = nodes.len() as u32;
                     node.count[lane] = 0;
@@ -105,7 +146,62 @@ impl Bvh4 {
             }
             nodes[at] = node;
         }
-        Bvh4 { nodes, bin }
+        Bvh4 { nodes, packs, bin }
+    }
+
+    /// `Bvh::leaf` over the packs of a leaf of `count` triangles from pack `first`: the
+    /// same tests and tie rule in the same triangle order, the watertight test four
+    /// triangles at a time (`tri4`), so the same hit.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn leaf<const ANY: bool>(
+        &self,
+        first: u32,
+        count: u32,
+        wt: &Watertight,
+        org: V3,
+        tmin: f32,
+        tfar: &mut f32,
+        best: &mut Option<Hit>,
+        filter: bool,
+        mask: u32,
+    ) -> bool {
+        let mut found = false;
+        for p in &self.packs[first as usize..(first + count.div_ceil(4)) as usize] {
+            let lanes = (1u32 << p.n) - 1;
+            let (t, u, v, pass, exact) = tri4(p, wt, org, tmin);
+            let (pass, exact) = (pass & lanes, exact & lanes);
+            if pass | exact == 0 {
+                continue;
+            }
+            for l in 0..p.n as usize {
+                let i = p.first as usize + l;
+                if filter && self.bin.masks[i] & mask == 0 {
+                    continue;
+                }
+                let hit = if exact >> l & 1 != 0 {
+                    // An edge function rounded to zero: the scalar test's double path.
+                    wt.intersect(org, &p.tri(l), tmin, *tfar)
+                } else if pass >> l & 1 != 0 && t[l] <= *tfar {
+                    Some((t[l], u[l], v[l]))
+                } else {
+                    None
+                };
+                if let Some((t, u, v)) = hit {
+                    let prim = self.bin.ids[i];
+                    if t == *tfar && best.is_none_or(|b| prim > b.prim) {
+                        continue;
+                    }
+                    *tfar = t;
+                    *best = Some(Hit { t, prim, u, v });
+                    found = true;
+                    if ANY {
+                        return true;
+                    }
+                }
+            }
+        }
+        found
     }
 
     #[inline(always)]
@@ -141,11 +237,9 @@ impl Bvh4 {
                 continue;
             }
             if count > 0 {
-                let range = idx..idx + count;
-                if self
-                    .bin
-                    .leaf::<ANY>(range, &wt, org, tmin, &mut tfar, &mut best, filter, mask)
-                    && ANY
+                if self.leaf::<ANY>(
+                    idx, count, &wt, org, tmin, &mut tfar, &mut best, filter, mask,
+                ) && ANY
                 {
                     return best;
                 }
@@ -188,6 +282,97 @@ impl Bvh4 {
         mask: u32,
     ) -> Option<Hit> {
         self.traverse::<ANY>(org, dir, tmin, tmax, mask)
+    }
+}
+
+/// `Watertight::intersect` of a pack's four triangles at once, without its upper bound
+/// (the caller compares with the best distance as it goes through the lanes in order):
+/// (t, u, v, lanes that hit beyond `tmin`, lanes whose single-precision edge functions
+/// include a zero, which the scalar test recomputes in double). The same operations in
+/// the same order as the scalar test, lane by lane, so the same bits.
+#[inline(always)]
+fn tri4(
+    p: &TriPack,
+    wt: &Watertight,
+    org: V3,
+    tmin: f32,
+) -> ([f32; 4], [f32; 4], [f32; 4], u32, u32) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::*;
+        // SAFETY: SSE2 is always available on x86_64; the loads read the pack's own
+        // [f32; 4] rows (16-byte aligned by `TriPack`'s alignment).
+        unsafe {
+            let (kx, ky, kz) = (wt.kx, wt.ky, wt.kz);
+            let (sx, sy, sz) = (_mm_set1_ps(wt.sx), _mm_set1_ps(wt.sy), _mm_set1_ps(wt.sz));
+            let rel = |k: usize, a: usize| {
+                _mm_sub_ps(_mm_load_ps(p.v[k][a].as_ptr()), _mm_set1_ps(org[a]))
+            };
+            // Vertex k relative to the origin, sheared: (x, y, z before scaling).
+            let shear = |k: usize| {
+                let z = rel(k, kz);
+                (
+                    _mm_sub_ps(rel(k, kx), _mm_mul_ps(sx, z)),
+                    _mm_sub_ps(rel(k, ky), _mm_mul_ps(sy, z)),
+                    z,
+                )
+            };
+            let (ax, ay, az) = shear(0);
+            let (bx, by, bz) = shear(1);
+            let (cx, cy, cz) = shear(2);
+            let u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
+            let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
+            let w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
+            let zero = _mm_setzero_ps();
+            let either = |x: __m128, y: __m128, z: __m128| _mm_or_ps(_mm_or_ps(x, y), z);
+            let exact = _mm_movemask_ps(either(
+                _mm_cmpeq_ps(u, zero),
+                _mm_cmpeq_ps(v, zero),
+                _mm_cmpeq_ps(w, zero),
+            )) as u32;
+            let outside = _mm_and_ps(
+                either(
+                    _mm_cmplt_ps(u, zero),
+                    _mm_cmplt_ps(v, zero),
+                    _mm_cmplt_ps(w, zero),
+                ),
+                either(
+                    _mm_cmpgt_ps(u, zero),
+                    _mm_cmpgt_ps(v, zero),
+                    _mm_cmpgt_ps(w, zero),
+                ),
+            );
+            let det = _mm_add_ps(_mm_add_ps(u, v), w);
+            let (az, bz, cz) = (_mm_mul_ps(sz, az), _mm_mul_ps(sz, bz), _mm_mul_ps(sz, cz));
+            let t = _mm_add_ps(
+                _mm_add_ps(_mm_mul_ps(u, az), _mm_mul_ps(v, bz)),
+                _mm_mul_ps(w, cz),
+            );
+            let inv = _mm_div_ps(_mm_set1_ps(1.0), det);
+            let t = _mm_mul_ps(t, inv);
+            let pass = _mm_andnot_ps(
+                _mm_or_ps(outside, _mm_cmpeq_ps(det, zero)),
+                _mm_cmpgt_ps(t, _mm_set1_ps(tmin)),
+            );
+            let arr = |x: __m128| {
+                let mut o = [0.0f32; 4];
+                _mm_storeu_ps(o.as_mut_ptr(), x);
+                o
+            };
+            (
+                arr(t),
+                arr(_mm_mul_ps(v, inv)),
+                arr(_mm_mul_ps(w, inv)),
+                _mm_movemask_ps(pass) as u32 & !exact,
+                exact,
+            )
+        }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        // Every lane through the scalar test.
+        let _ = (p, wt, org, tmin);
+        ([0.0; 4], [0.0; 4], [0.0; 4], 0, 0b1111)
     }
 }
 

@@ -245,6 +245,13 @@ pub trait NoisePoint: Copy {
     /// Whether `a * b + c` is one fused operation, as in Cycles' FMA-built CPU kernels
     /// (GCC contracts them); Blender's own CPU code is built without FMA.
     const FUSED: bool = false;
+    /// `perlin_signed` of each point of `ps` into `out` (as long as `ps`). Points whose
+    /// flavour has a lane-parallel kernel override it (the same bits); the rest loop.
+    fn perlin_signed_batch(ps: &[Self], out: &mut [f32]) {
+        for (o, p) in out.iter_mut().zip(ps) {
+            *o = p.perlin_signed();
+        }
+    }
 }
 
 #[inline]
@@ -452,6 +459,24 @@ pub fn fbm<P: NoisePoint>(
     lacunarity: f32,
     normalize: bool,
 ) -> f32 {
+    // The octaves' noise values do not depend on each other, only their sum does: up to
+    // MAX_BATCH of them are evaluated first, as one batch (lanes of the Cycles kernel),
+    // then summed in the loop's order, so the result is the same bits.
+    const MAX_BATCH: usize = 17;
+    let whole = detail as i32;
+    let rmd = detail - detail.floor();
+    let count = if whole < 0 { 0 } else { whole as usize + 1 } + (rmd != 0.0) as usize;
+    if count <= MAX_BATCH {
+        let mut pts = [p; MAX_BATCH];
+        let mut fscale = 1.0f32;
+        for q in pts.iter_mut().take(count) {
+            *q = p.scaled(fscale);
+            fscale *= lacunarity;
+        }
+        let mut t = [0.0f32; MAX_BATCH];
+        P::perlin_signed_batch(&pts[..count], &mut t[..count]);
+        return fbm_sum::<P>(&t[..count], detail, roughness, normalize);
+    }
     let mut fscale = 1.0f32;
     let mut amp = 1.0f32;
     let mut maxamp = 0.0f32;
@@ -467,6 +492,39 @@ pub fn fbm<P: NoisePoint>(
     if rmd != 0.0 {
         let t = p.scaled(fscale).perlin_signed();
         let sum2 = madd::<P>(t, amp, sum);
+        return if normalize {
+            blend::<P>(
+                0.5 * sum / maxamp + 0.5,
+                0.5 * sum2 / (maxamp + amp) + 0.5,
+                rmd,
+            )
+        } else {
+            blend::<P>(sum, sum2, rmd)
+        };
+    }
+    if normalize {
+        0.5 * sum / maxamp + 0.5
+    } else {
+        sum
+    }
+}
+
+/// `fbm`'s sum over the octaves' noise values `t` (the whole octaves, then the fraction's
+/// one when `detail` has a fraction), in `fbm`'s order of operations.
+#[inline(always)]
+fn fbm_sum<P: NoisePoint>(t: &[f32], detail: f32, roughness: f32, normalize: bool) -> f32 {
+    let mut amp = 1.0f32;
+    let mut maxamp = 0.0f32;
+    let mut sum = 0.0f32;
+    let rmd = detail - detail.floor();
+    let whole = t.len() - (rmd != 0.0) as usize;
+    for &t in &t[..whole] {
+        sum = madd::<P>(t, amp, sum);
+        maxamp += amp;
+        amp *= roughness;
+    }
+    if rmd != 0.0 {
+        let sum2 = madd::<P>(t[whole], amp, sum);
         return if normalize {
             blend::<P>(
                 0.5 * sum / maxamp + 0.5,
@@ -751,6 +809,79 @@ fn cy_perlin3(p: [f32; 3]) -> f32 {
     cy_tri(g, cy_fade(fx), cy_fade(fy), cy_fade(fz))
 }
 
+/// `cy_perlin3(cycles_fmod(p))` of 8 points at once, a point per lane: each lane does
+/// the scalar kernel's operations in its order (floor, the corner hashes and gradients,
+/// FMA fades and blends), so the same bits. `None` when a coordinate is not finite or not
+/// below the wrap period (`cycles_fmod` would change it): the caller goes scalar.
+#[cfg(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    target_feature = "fma"
+))]
+#[inline]
+fn cy_perlin3_x8(p: &[[f32; 3]; 8]) -> Option<[f32; 8]> {
+    use std::arch::x86_64::*;
+    // SAFETY: AVX2 and FMA are enabled for the whole build (the cfg above); loads and
+    // stores are unaligned ones of whole 8-lane arrays.
+    unsafe {
+        let abs = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fff_ffff));
+        let period = _mm256_set1_ps(100000.0);
+        let mut inside = 0xff;
+        let mut cell = [[0i32; 8]; 3];
+        let mut frac = [_mm256_setzero_ps(); 3];
+        for a in 0..3 {
+            let v = _mm256_setr_ps(
+                p[0][a], p[1][a], p[2][a], p[3][a], p[4][a], p[5][a], p[6][a], p[7][a],
+            );
+            // |v| < 1e5 (false for NaN): `wrap` leaves v alone and `correction` adds +0.
+            inside &=
+                _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_and_ps(v, abs), period));
+            let v = _mm256_add_ps(v, _mm256_setzero_ps());
+            let f = _mm256_floor_ps(v);
+            _mm256_storeu_si256(cell[a].as_mut_ptr().cast(), _mm256_cvttps_epi32(f));
+            frac[a] = _mm256_sub_ps(v, f);
+        }
+        if inside != 0xff {
+            return None;
+        }
+        let arr = |v: __m256| {
+            let mut o = [0.0f32; 8];
+            _mm256_storeu_ps(o.as_mut_ptr(), v);
+            o
+        };
+        // Corner c (bit 0: x + 1, bit 1: y + 1, bit 2: z + 1), all 8 points.
+        let mut g = [_mm256_setzero_ps(); 8];
+        for (c, g) in g.iter_mut().enumerate() {
+            let d = [c & 1, c >> 1 & 1, c >> 2 & 1];
+            let k = |a: usize| cell[a].map(|x| x.wrapping_add(d[a] as i32) as u32);
+            let h = hash3_x8(k(0), k(1), k(2));
+            let at = |a: usize| arr(_mm256_sub_ps(frac[a], _mm256_set1_ps(d[a] as f32)));
+            *g = _mm256_loadu_ps(grad3_x8(h, at(0), at(1), at(2)).as_ptr());
+        }
+        let fade = |t: __m256| {
+            let a = _mm256_fmadd_ps(t, _mm256_set1_ps(6.0), _mm256_set1_ps(-15.0));
+            let b = _mm256_fmadd_ps(t, a, _mm256_set1_ps(10.0));
+            _mm256_mul_ps(_mm256_mul_ps(t, t), _mm256_mul_ps(t, b))
+        };
+        let mix = |a: __m256, b: __m256, t: __m256| _mm256_fmadd_ps(t, _mm256_sub_ps(b, a), a);
+        let (u, v, w) = (fade(frac[0]), fade(frac[1]), fade(frac[2]));
+        let x00 = mix(g[0], g[1], u);
+        let x10 = mix(g[2], g[3], u);
+        let x01 = mix(g[4], g[5], u);
+        let x11 = mix(g[6], g[7], u);
+        Some(arr(mix(mix(x00, x10, v), mix(x01, x11, v), w)))
+    }
+}
+#[cfg(not(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    target_feature = "fma"
+)))]
+#[inline]
+fn cy_perlin3_x8(_: &[[f32; 3]; 8]) -> Option<[f32; 8]> {
+    None
+}
+
 #[inline(always)]
 fn cy_perlin4(p: [f32; 4]) -> f32 {
     let (g, [fx, fy, fz, fw]) = corners4(p);
@@ -766,7 +897,11 @@ pub struct Cycles<P>(pub P);
 
 macro_rules! cycles_point {
     ($t:ty, $perlin:ident, $scale:expr) => {
+        cycles_point!($t, $perlin, $scale, {});
+    };
+    ($t:ty, $perlin:ident, $scale:expr, { $($batch:item)* }) => {
         impl NoisePoint for Cycles<$t> {
+            $($batch)*
             fn all(self, f: impl Fn(f32) -> bool) -> bool {
                 self.0.all_c(f)
             }
@@ -861,7 +996,28 @@ fn set<T: Comps>(p: &mut T, i: usize, v: f32) {
 
 cycles_point!(f32, cy_perlin1, 0.25);
 cycles_point!([f32; 2], cy_perlin2, 0.6616);
-cycles_point!([f32; 3], cy_perlin3, 0.9820);
+cycles_point!([f32; 3], cy_perlin3, 0.9820, {
+    fn perlin_signed_batch(ps: &[Self], out: &mut [f32]) {
+        for (ps, out) in ps.chunks(8).zip(out.chunks_mut(8)) {
+            let mut lanes = [[0.0f32; 3]; 8];
+            for (l, p) in lanes.iter_mut().zip(ps) {
+                *l = p.0;
+            }
+            match cy_perlin3_x8(&lanes) {
+                Some(v) => {
+                    for (o, v) in out.iter_mut().zip(v) {
+                        *o = v * 0.9820;
+                    }
+                }
+                None => {
+                    for (o, p) in out.iter_mut().zip(ps) {
+                        *o = p.perlin_signed();
+                    }
+                }
+            }
+        }
+    }
+});
 cycles_point!([f32; 4], cy_perlin4, 0.8344);
 
 /// The Noise Texture node as Cycles' shader kernel evaluates it: (Fac, Color).

@@ -36,7 +36,7 @@ use crate::nodes::image::{
 
 use super::bump::{
     bump_normal, differential_from_compact, differential_make_compact, displacement,
-    displacement_bump, normal_map, offset_point, vector_displacement, BumpPoint, BumpSettings,
+    displacement_bump, normal_map, offset_point_into, vector_displacement, BumpPoint, BumpSettings,
     MapSpace,
 };
 use super::images::TexImage;
@@ -1419,7 +1419,7 @@ impl Program {
                     put3(s, color, [r[0], r[1], r[2]]);
                     s[alpha as usize] = r[3];
                 }
-                Op::BumpPoint { point, width } => sp = offset_point(&base, point, width),
+                Op::BumpPoint { point, width } => offset_point_into(&mut sp, &base, point, width),
                 Op::Bump {
                     settings,
                     normal,
