@@ -757,18 +757,8 @@ def hair_strands(o, depsgraph, path):
     inverse = np.linalg.inv(np.array(ev.matrix_world, dtype=np.float64))
     n_slots = max(len(ev.material_slots), 1)
     systems, chunks = [], []
-    for m in ev.modifiers:
-        if m.type != "PARTICLE_SYSTEM" or not m.show_render:
-            continue
-        psys = m.particle_system
+    for _, psys, first, count in rendered_path_systems(ev):
         st = psys.settings
-        if st.type != "HAIR" or st.render_type != "PATH":
-            continue
-        totpart, totchild = len(psys.particles), len(psys.child_particles)
-        first = totpart if (st.child_type != "NONE" and totchild) else 0
-        count = totpart + totchild - first
-        if count <= 0:
-            continue
         steps = (1 << st.render_step) + 1
         if st.kink == "SPIRAL":
             steps += st.kink_extra_steps

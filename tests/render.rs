@@ -1499,6 +1499,29 @@ fn sharp_specular_fireflies_match_cycles() {
 
 /// Edits the export `base` of `dir` and asserts that `inspect` (render::check) and
 /// `render` refuse it with the same message, which names each of `words`.
+/// The small render `refused_alike` and `assert_renders` check with.
+fn check_opts() -> RenderOptions {
+    RenderOptions {
+        samples: Some(1),
+        resolution: Some((8, 8)),
+        ..Default::default()
+    }
+}
+
+/// A render fixture's folder and scene.json.
+fn fixture_json(name: &str) -> (std::path::PathBuf, serde_json::Value) {
+    let dir = common::repo().join("fixtures/render/scenes").join(name);
+    let base = serde_json::from_slice(&std::fs::read(dir.join("scene.json")).unwrap()).unwrap();
+    (dir, base)
+}
+
+/// The export as made passes `render::check` (what `inspect` runs); its scene.
+fn assert_renders(dir: &std::path::Path, base: &serde_json::Value) -> Scene {
+    let scene = Scene::from_json(dir, base.to_string().as_bytes()).unwrap();
+    assert!(blendsynth::render::check(&scene, &check_opts(), &[]).is_ok());
+    scene
+}
+
 fn refused_alike(
     dir: &std::path::Path,
     base: &serde_json::Value,
@@ -1508,11 +1531,7 @@ fn refused_alike(
     let mut json = base.clone();
     edit(&mut json);
     let scene = Scene::from_json(dir, json.to_string().as_bytes()).unwrap();
-    let opts = RenderOptions {
-        samples: Some(1),
-        resolution: Some((8, 8)),
-        ..Default::default()
-    };
+    let opts = check_opts();
     let checked = blendsynth::render::check(&scene, &opts, &[])
         .err()
         .map(|RenderError(m)| m)
@@ -1533,9 +1552,7 @@ fn refused_alike(
 /// (smoke) domain, whose grids the export does not carry.
 #[test]
 fn unsupported_volumes_are_refused_by_name() {
-    let dir = common::repo().join("fixtures/render/scenes/volume_scatter_spot");
-    let base: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("scene.json")).unwrap()).unwrap();
+    let (dir, base) = fixture_json("volume_scatter_spot");
     let refused = |edit: &dyn Fn(&mut serde_json::Value), words: &[&str]| {
         refused_alike(&dir, &base, edit, words)
     };
@@ -1601,19 +1618,11 @@ fn unsupported_volumes_are_refused_by_name() {
 /// material and node, alike from `inspect` (render::check) and `render`.
 #[test]
 fn hair_bsdfs_refused_where_not_rendered() {
-    let dir = common::repo().join("fixtures/render/scenes/hair_chiang_melanin");
-    let base: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("scene.json")).unwrap()).unwrap();
+    let (dir, base) = fixture_json("hair_chiang_melanin");
     let refused = |edit: &dyn Fn(&mut serde_json::Value), words: &[&str]| {
         refused_alike(&dir, &base, edit, words)
     };
-    let scene = Scene::from_json(&dir, base.to_string().as_bytes()).unwrap();
-    let opts = RenderOptions {
-        samples: Some(1),
-        resolution: Some((8, 8)),
-        ..Default::default()
-    };
-    assert!(blendsynth::render::check(&scene, &opts, &[]).is_ok());
+    assert_renders(&dir, &base);
     let node = |j: &mut serde_json::Value, material: &str, bl_idname: &str| -> serde_json::Value {
         let ms = j["materials"].as_array_mut().unwrap();
         let m = ms.iter_mut().find(|m| m["name"] == material).unwrap();
@@ -1683,20 +1692,13 @@ fn hair_bsdfs_refused_where_not_rendered() {
 /// has, the same from `inspect` (render::check) and `render`.
 #[test]
 fn unsupported_hair_is_refused_by_name() {
-    let dir = common::repo().join("fixtures/render/scenes/hair");
-    let base: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("scene.json")).unwrap()).unwrap();
+    let (dir, base) = fixture_json("hair");
     let refused = |edit: &dyn Fn(&mut serde_json::Value), words: &[&str]| {
         refused_alike(&dir, &base, edit, words)
     };
     // The export as made renders.
-    let scene = Scene::from_json(&dir, base.to_string().as_bytes()).unwrap();
-    let opts = RenderOptions {
-        samples: Some(1),
-        resolution: Some((8, 8)),
-        ..Default::default()
-    };
-    assert!(blendsynth::render::check(&scene, &opts, &[]).is_ok());
+    let scene = assert_renders(&dir, &base);
+    let opts = check_opts();
     // Optical flow traces triangles only: hair is refused there, not left out.
     let Err(RenderError(m)) = blendsynth::render::render_with_motion(&scene, &opts, &[], None, 1.0)
     else {
@@ -1741,16 +1743,8 @@ fn unsupported_hair_is_refused_by_name() {
 /// `render` refuse it alike, by name.
 #[test]
 fn curves_objects_without_their_curves_are_refused_by_name() {
-    let dir = common::repo().join("fixtures/render/scenes/curves_object");
-    let base: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("scene.json")).unwrap()).unwrap();
-    let scene = Scene::from_json(&dir, base.to_string().as_bytes()).unwrap();
-    let opts = RenderOptions {
-        samples: Some(1),
-        resolution: Some((8, 8)),
-        ..Default::default()
-    };
-    assert!(blendsynth::render::check(&scene, &opts, &[]).is_ok());
+    let (dir, base) = fixture_json("curves_object");
+    assert_renders(&dir, &base);
     let o = base["objects"]
         .as_array()
         .unwrap()
@@ -1782,16 +1776,9 @@ fn curves_objects_without_their_curves_are_refused_by_name() {
 /// object, material and node, the same from `inspect` (render::check) and `render`.
 #[test]
 fn unsupported_points_are_refused_by_name() {
-    let dir = common::repo().join("fixtures/render/scenes/points");
-    let base: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(dir.join("scene.json")).unwrap()).unwrap();
-    let scene = Scene::from_json(&dir, base.to_string().as_bytes()).unwrap();
-    let opts = RenderOptions {
-        samples: Some(1),
-        resolution: Some((8, 8)),
-        ..Default::default()
-    };
-    assert!(blendsynth::render::check(&scene, &opts, &[]).is_ok());
+    let (dir, base) = fixture_json("points");
+    let scene = assert_renders(&dir, &base);
+    let opts = check_opts();
     // A Point Info node in the points' material (its values on points are not carried).
     refused_alike(
         &dir,

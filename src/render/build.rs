@@ -679,33 +679,17 @@ fn push_points(
     }
     let mut points = crate::render::points::object_points(pts, &to_world);
     points.slot = slots.to_vec();
-    let mut inst = new_instance(
+    // Generated spans the points' object-space bounds, whatever the mesh's texture space.
+    push_prims(
+        instances,
         scene,
-        oi,
-        obj,
+        (oi, obj),
         info,
-        Arc::new(MeshData::default()),
+        points,
+        pts,
         to_world,
-        None,
-    )?;
-    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for s in 0..points.segments.len() {
-        let (a, b) = points.segment_bounds(s as u32);
-        lo = vmin(lo, a);
-        hi = vmax(hi, b);
-    }
-    inst.world_bounds = (lo, hi);
-    // Generated spans the points' object-space bounds.
-    let (mut a, mut b) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for k in pts {
-        a = vmin(a, [k[0], k[1], k[2]]);
-        b = vmax(b, [k[0], k[1], k[2]]);
-    }
-    inst.tex_loc = scale(add(a, b), 0.5);
-    inst.tex_size = scale(sub(b, a), 0.5).map(|x| if x > 0.0 { x } else { 1.0 });
-    inst.curves = Some(Arc::new(points));
-    instances.push(inst);
-    Ok(())
+        false,
+    )
 }
 
 /// An object's hair as an instance of its own: the object's material slots, no mesh.
@@ -729,6 +713,33 @@ fn push_curves(
         )));
     }
     let curves = crate::render::curves::ObjectCurves::new(hair, &to_world, c.subdivisions);
+    let keep = info.texspace.is_some();
+    push_prims(
+        instances,
+        scene,
+        (oi, obj),
+        info,
+        curves,
+        &hair.keys,
+        to_world,
+        keep,
+    )
+}
+
+/// Hair or points (`prims`, made from `keys` in object space) as an instance of their
+/// own, with no mesh: world bounds over the segments, and Generated over the keys'
+/// bounds unless the mesh's texture space is kept (`keep_texspace`).
+#[allow(clippy::too_many_arguments)]
+fn push_prims(
+    instances: &mut Vec<MeshInstance>,
+    scene: &Scene,
+    (oi, obj): (usize, &crate::scene::Object),
+    info: &MeshInfo,
+    prims: crate::render::curves::ObjectCurves,
+    keys: &[[f32; 4]],
+    to_world: Affine,
+    keep_texspace: bool,
+) -> Result<(), RenderError> {
     let mut inst = new_instance(
         scene,
         oi,
@@ -739,23 +750,22 @@ fn push_curves(
         None,
     )?;
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for s in 0..curves.segments.len() {
-        let (a, b) = curves.segment_bounds(s as u32);
+    for s in 0..prims.segments.len() {
+        let (a, b) = prims.segment_bounds(s as u32);
         lo = vmin(lo, a);
         hi = vmax(hi, b);
     }
     inst.world_bounds = (lo, hi);
-    if info.texspace.is_none() {
-        // No mesh texture space: Generated spans the strands' object-space bounds.
+    if !keep_texspace {
         let (mut a, mut b) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-        for k in &hair.keys {
+        for k in keys {
             a = vmin(a, [k[0], k[1], k[2]]);
             b = vmax(b, [k[0], k[1], k[2]]);
         }
         inst.tex_loc = scale(add(a, b), 0.5);
         inst.tex_size = scale(sub(b, a), 0.5).map(|x| if x > 0.0 { x } else { 1.0 });
     }
-    inst.curves = Some(Arc::new(curves));
+    inst.curves = Some(Arc::new(prims));
     instances.push(inst);
     Ok(())
 }

@@ -283,11 +283,11 @@ impl Scene<'_> {
         wo: V3,
         time: f32,
     ) -> SurfaceHit {
-        let r = self.geo.refs[prim as usize];
-        let inst = &self.geo.instances[r.inst as usize];
         if c.points {
             return self.point_surface(c, prim, u, v, wo, time);
         }
+        let r = self.geo.refs[prim as usize];
+        let inst = &self.geo.instances[r.inst as usize];
         let cp = c.control_points(r.tri);
         let (p, n, dpdu) = crate::render::curves::ribbon_shading(&cp, c.pieces, u, v, neg(wo));
         let ng = wo;
