@@ -17,6 +17,9 @@ const MAX_MEAN_REL: f64 = 0.01;
 
 /// Scenes that must pass.
 const ASSERTED: &[&str] = &[
+    // Ray Portal BSDF: moved and turned rays, a portal mixed with diffuse and with
+    // Transparent (shadow rays stop at a portal alone, pass it beside a Transparent).
+    "ray_portal",
     // A Solidify modifier evaluated natively: shell, rim and even-thickness normals.
     "solidify",
     // Issue 26's second part: Ico Sphere at Subdivisions 3, Edge Split, Mirror Bisect (64 px).

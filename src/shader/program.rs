@@ -650,6 +650,7 @@ pub enum BsdfKind {
     Toon,
     Hair,
     PrincipledHair,
+    RayPortal,
     /// Volume Absorption, Scatter, Principled Volume, Coefficients: shaded in a Volume by
     /// render/volume.rs; nothing in a Surface (as in Cycles).
     Volume,
@@ -672,6 +673,7 @@ impl BsdfKind {
             "ShaderNodeBsdfToon" => BsdfKind::Toon,
             "ShaderNodeBsdfHair" => BsdfKind::Hair,
             "ShaderNodeBsdfHairPrincipled" => BsdfKind::PrincipledHair,
+            "ShaderNodeBsdfRayPortal" => BsdfKind::RayPortal,
             "ShaderNodeVolumeAbsorption"
             | "ShaderNodeVolumeScatter"
             | "ShaderNodeVolumePrincipled"

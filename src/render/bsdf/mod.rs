@@ -10,6 +10,7 @@ pub mod hair_chiang;
 pub mod metallic;
 pub mod microfacet;
 pub mod oren_nayar;
+pub mod ray_portal;
 pub mod sheen;
 pub mod sheen_ltc;
 pub mod tables;
@@ -74,6 +75,8 @@ pub enum LobeKind {
     Hair(crate::render::bsdf::hair::Hair),
     /// Principled Hair BSDF, Chiang model (hair curves); its normal is the fibre frame's Y.
     Chiang(crate::render::bsdf::hair_chiang::Chiang),
+    /// Ray Portal BSDF: the path goes on from another position and direction.
+    RayPortal(crate::render::bsdf::ray_portal::RayPortal),
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -95,6 +98,9 @@ pub struct LobeSet {
     pub emission: V3,
     pub holdout: V3,
     pub transparent: V3,
+    /// The Ray Portal closures' weights, which Cycles adds to the surface's transparency
+    /// (`closure_transparent_extinction`).
+    pub portal_extinction: V3,
     /// The smooth shading normal (Cycles' sd->N, after the displacement's bump): lobes
     /// bumped away from it get Cycles' bump shadowing term. Zero when unset.
     pub smooth_n: V3,
@@ -136,6 +142,7 @@ impl Default for LobeSet {
             emission: [0.0; 3],
             holdout: [0.0; 3],
             transparent: [0.0; 3],
+            portal_extinction: [0.0; 3],
             smooth_n: [0.0; 3],
             bump_correction: true,
             terminator_frequency: 1.0,
@@ -165,7 +172,7 @@ fn excluded(kind: &LobeKind, exclude: u32) -> bool {
         // reflection and the Chiang hair glossy ones.
         LobeKind::Hair(h) if h.transmission => exclude & ray::TRANSMIT != 0,
         LobeKind::Hair(_) | LobeKind::Chiang(_) => exclude & ray::GLOSSY != 0,
-        LobeKind::Transparent | LobeKind::Subsurface(_) => false,
+        LobeKind::Transparent | LobeKind::Subsurface(_) | LobeKind::RayPortal(_) => false,
     }
 }
 
@@ -183,11 +190,23 @@ impl LobeSet {
         })
     }
 
+    /// What a shadow ray passes here (Cycles' surface_shader_transparency under a shadow
+    /// ray, which allocates no closures): the transparent weights, and the portals' with
+    /// them; a portal alone lets nothing through, as SD_TRANSPARENT is then unset.
+    pub fn shadow_transparency(&self) -> V3 {
+        if is_zero(self.transparent) {
+            self.transparent
+        } else {
+            add(self.transparent, self.portal_extinction)
+        }
+    }
+
     pub fn clear(&mut self) {
         self.len = 0;
         self.emission = [0.0; 3];
         self.holdout = [0.0; 3];
         self.transparent = [0.0; 3];
+        self.portal_extinction = [0.0; 3];
         self.smooth_n = [0.0; 3];
         self.bump_correction = true;
         self.terminator_frequency = 1.0;
@@ -208,7 +227,8 @@ impl LobeSet {
         // Mapping node say): each channel is clamped at zero. Transparent and subsurface
         // closures are allocated without that clamp.
         let weight = match kind {
-            LobeKind::Transparent | LobeKind::Subsurface(_) => weight,
+            // Ray Portal too (closure_alloc, not bsdf_alloc).
+            LobeKind::Transparent | LobeKind::Subsurface(_) | LobeKind::RayPortal(_) => weight,
             _ => weight.map(|w| w.max(0.0)),
         };
         // Cycles' bsdf_alloc drops closures whose mean weight is below CLOSURE_WEIGHT_CUTOFF
@@ -223,6 +243,9 @@ impl LobeSet {
         }
         if let LobeKind::Transparent = kind {
             self.transparent = add(self.transparent, weight);
+        }
+        if let LobeKind::RayPortal(_) = kind {
+            self.portal_extinction = add(self.portal_extinction, weight);
         }
         if self.len < MAX_LOBES {
             self.lobes[self.len] = Lobe {
@@ -439,7 +462,10 @@ impl LobeSet {
         let glossy = matches!(l.kind, LobeKind::Glossy { .. } | LobeKind::Reflection(_));
         let glossy = glossy || matches!(l.kind, LobeKind::GlossyAniso { .. });
         let glossy = glossy || matches!(l.kind, LobeKind::Toon(t) if t.glossy);
-        let transmit = matches!(l.kind, LobeKind::Translucent | LobeKind::Transparent);
+        let transmit = matches!(
+            l.kind,
+            LobeKind::Translucent | LobeKind::Transparent | LobeKind::RayPortal(_)
+        );
         if singular {
             // Mirror or pass-through: only this lobe contributes, with its discrete probability.
             let w = match l.kind {
@@ -632,7 +658,7 @@ fn eval_lobe(l: &Lobe, wo: V3, wi: V3, _ng: V3, _tables: &Tables) -> (V3, f32) {
                 ([0.0; 3], 0.0)
             }
         }
-        LobeKind::Transparent | LobeKind::Subsurface(_) => ([0.0; 3], 0.0),
+        LobeKind::Transparent | LobeKind::Subsurface(_) | LobeKind::RayPortal(_) => ([0.0; 3], 0.0),
         LobeKind::Reflection(r) => {
             let (f, p) = r.eval(l.n, wo, wi, ng);
             let h = normalize(add(wo, wi));
@@ -719,6 +745,7 @@ fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
             Some((wi, false))
         }
         LobeKind::Transparent => Some((neg(wo), true)),
+        LobeKind::RayPortal(r) => Some((r.direction, true)),
         // Sampled elsewhere.
         LobeKind::Glass(_) | LobeKind::Subsurface(_) | LobeKind::Hair(_) | LobeKind::Chiang(_) => {
             None

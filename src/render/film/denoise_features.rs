@@ -40,7 +40,8 @@ impl Default for Features {
 /// alpha_x * alpha_y, everything else (diffuse-like, BSSRDF) 1.
 fn roughness_squared(k: &LobeKind) -> f32 {
     match k {
-        LobeKind::Transparent => 0.0,
+        // Cycles: singular closures (CLOSURE_IS_BSDF_SINGULAR).
+        LobeKind::Transparent | LobeKind::RayPortal(_) => 0.0,
         LobeKind::Glossy { alpha, .. } => alpha * alpha,
         LobeKind::Glass(g) => g.alpha * g.alpha,
         LobeKind::Reflection(r) => r.alpha * r.alpha,

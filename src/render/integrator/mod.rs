@@ -1097,7 +1097,7 @@ impl Scene<'_> {
                         &mut scratch.light_lobes,
                         &NoTrace,
                     );
-                    through = mul(through, scratch.light_lobes.transparent);
+                    through = mul(through, scratch.light_lobes.shadow_transparency());
                     if is_zero(through) {
                         return [0.0; 3];
                     }

@@ -45,7 +45,7 @@ fn counter(kind: &LobeKind, transmit: bool) -> Option<Counter> {
             Some(Counter::Transmission)
         }
         LobeKind::Glass(_) | LobeKind::Hair(_) | LobeKind::Chiang(_) => Some(Counter::Glossy),
-        LobeKind::Transparent | LobeKind::Subsurface(_) => None,
+        LobeKind::Transparent | LobeKind::Subsurface(_) | LobeKind::RayPortal(_) => None,
     }
 }
 
@@ -223,6 +223,26 @@ impl Path {
             self.t1 = f32::INFINITY;
             return Next::Continue;
         }
+        if let LobeKind::RayPortal(portal) = bs.kind {
+            // Cycles' integrate_surface_ray_portal and path_state_next: a transparent
+            // bounce (flags kept, the transparent count and limit) whose next hit skips
+            // MIS (PATH_RAY_MIS_SKIP), as nothing was light-sampled for it.
+            self.state.transparent += 1;
+            self.state.flags |= ray::TRANSPARENT;
+            if self.state.transparent > st.max_transparent {
+                return Next::Stop;
+            }
+            self.prev_singular = true;
+            self.o = if portal.moved {
+                portal.position
+            } else {
+                offset_origin(p, ng, portal.direction)
+            };
+            self.d = portal.direction;
+            self.t0 = 0.0;
+            self.t1 = f32::INFINITY;
+            return Next::Continue;
+        }
         if let Some(c) = counter(&bs.kind, bs.transmit) {
             let s = &mut self.state;
             let (count, max) = match c {
@@ -296,7 +316,7 @@ pub fn bounce_flags(kind: LobeKind, transmit: bool, singular: bool) -> u32 {
                     ray::REFLECT
                 }
         }
-        LobeKind::Transparent => ray::TRANSPARENT,
+        LobeKind::Transparent | LobeKind::RayPortal(_) => ray::TRANSPARENT,
         // The walk's exit scatters diffusely, as Cycles' subsurface exit closure does.
         LobeKind::OrenNayar(_) | LobeKind::Subsurface(_) => ray::DIFFUSE | ray::REFLECT,
         LobeKind::Reflection(_) => ray::GLOSSY | ray::REFLECT,

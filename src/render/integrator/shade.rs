@@ -6,6 +6,7 @@ use crate::scene::Scene;
 use crate::shader::program::{BsdfKind, BsdfNode, Closure, Program};
 use crate::shader::{compile_material, ShadingPoint};
 
+use crate::render::bsdf::ray_portal::RayPortal;
 use crate::render::bsdf::tables::Tables;
 use crate::render::bsdf::{Fresnel, LobeKind, LobeSet};
 use crate::render::math::*;
@@ -376,6 +377,17 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
         }
         BsdfKind::Holdout => {
             out.holdout = add(out.holdout, [w; 3]);
+        }
+        BsdfKind::RayPortal => {
+            let c = input_c(b, s, "Color", [1.0; 3]);
+            // Position is Cycles' LINK_POSITION socket: unlinked, the hit point.
+            let position = match b.input("Position") {
+                Some((slot, true)) => finite3(v3(s, slot)),
+                _ => sp.position,
+            };
+            let direction = input_c(b, s, "Direction", [0.0; 3]);
+            let portal = RayPortal::new(sp.position, position, direction, sp.incoming);
+            out.push(LobeKind::RayPortal(portal), scale(c, w), sp.normal);
         }
         BsdfKind::Glossy => glossy(b, w, s, sp, ctx, out),
         BsdfKind::Principled => principled(b, w, s, sp, ctx, out),

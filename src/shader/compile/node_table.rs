@@ -96,6 +96,8 @@ const HAIR: &str =
     "render/bsdf/hair.rs (closure/bsdf_hair.h): Reflection and Transmission on hair curves (refused on meshes); Cycles parity scene tests/render.rs hair_bsdf, a known failure (means 1.2-1.45% bright)";
 const PRINCIPLED_HAIR: &str =
     "render/bsdf/hair_chiang.rs (closure/bsdf_principled_hair_chiang.h): Chiang model, every parametrization, on hair curves (refused on meshes; the Huang model is refused by name), Cycles parity scenes in tests/render.rs (hair_chiang_melanin, hair_chiang_color, hair_chiang_absorption)";
+const RAY_PORTAL: &str =
+    "render/bsdf/ray_portal.rs (closure/bsdf_ray_portal.h, integrate_surface_ray_portal): the path goes on from Position (unlinked: the hit) in Direction (unlinked: the ray's own) as a transparent bounce that skips MIS, and shadow rays stop at it; Cycles parity scene ray_portal in tests/render.rs";
 const TOON: &str =
     "render/bsdf/toon.rs (closure/bsdf_toon.h): Diffuse and Glossy components, a Cycles parity scene in tests/render.rs (toon)";
 const OUTPUT: &str =
@@ -168,6 +170,7 @@ pub const NODES: &[ShaderNode] = &[
     node("ShaderNodeBsdfRefraction", bsdf, CLOSURE),
     node("ShaderNodeBsdfTranslucent", bsdf, CLOSURE),
     node("ShaderNodeBsdfTransparent", bsdf, CLOSURE),
+    node("ShaderNodeBsdfRayPortal", bsdf, RAY_PORTAL),
     node("ShaderNodeSubsurfaceScattering", bsdf, CLOSURE),
     node("ShaderNodeHoldout", bsdf, CLOSURE),
     node("ShaderNodeBsdfSheen", bsdf, CLOSURE),
