@@ -208,9 +208,48 @@ def ies_content(n, where):
         return f.read().decode("latin-1")
 
 
+# Where Point Density grids go (set by main) and how many were written.
+POINT_DENSITY = {"out": None, "count": 0}
+# The node properties Blender's point density grid depends on.
+POINT_DENSITY_PROPS = ("point_source", "object", "particle_system", "resolution", "radius", "space",
+                       "particle_color_source", "vertex_color_source", "vertex_attribute_name")
+# Largest grid side written (256^3 RGBA floats are 256 MB).
+POINT_DENSITY_MAX_RESOLUTION = 256
+
+
+def point_density_grid(n, where):
+    """The voxel grid Cycles renders a Point Density node with: Blender computes it at sync
+    (`calc_point_density` on the render depsgraph, Cycles' BlenderPointDensityLoader) over
+    the bounds `calc_point_density_minmax` gives; written as RGBA float32, x fastest. The
+    properties it depends on are recorded, so blendsynth can refuse an override of them."""
+    res = n.resolution
+    if res > POINT_DENSITY_MAX_RESOLUTION:
+        fail(f"{where}: Point Density resolution {res} is over {POINT_DENSITY_MAX_RESOLUTION}")
+    scene = bpy.context.scene
+    entry = {"resolution": res, "frame": scene.frame_current + scene.frame_subframe,
+             "properties": {k: v for k, v in rna_value(n, 0, where, skip=NODE_BASE).items() if k in POINT_DENSITY_PROPS},
+             "object_matrix": [list(r) for r in n.object.matrix_world] if n.object else None}
+    with RenderSettings():
+        dg = bpy.context.evaluated_depsgraph_get()
+        # As Cycles: the bounds from the cache, then the grid (sampling frees the cache).
+        n.cache_point_density(depsgraph=dg)
+        mn, mx = n.calc_point_density_minmax(depsgraph=dg)
+        values = np.array(n.calc_point_density(depsgraph=dg), dtype="<f4")
+    if values.size != res ** 3 * 4:
+        fail(f"{where}: Blender's point density grid has {values.size} values, not {res}^3 x 4")
+    rel = f"point_density/{POINT_DENSITY['count']:04d}.bin"
+    POINT_DENSITY["count"] += 1
+    os.makedirs(os.path.join(POINT_DENSITY["out"], "point_density"), exist_ok=True)
+    with open(os.path.join(POINT_DENSITY["out"], rel), "wb") as f:
+        f.write(values.tobytes())
+    return entry | {"file": rel, "min": vec(mn), "max": vec(mx)}
+
+
 def node_entry(n, where):
     group = getattr(n, "node_tree", None)
     extra = {"ies": ies_content(n, where)} if n.bl_idname == "ShaderNodeTexIES" else {}
+    if n.bl_idname == "ShaderNodeTexPointDensity":
+        extra = {"point_density": point_density_grid(n, where)}
     return extra | {
         "name": n.name, "bl_idname": n.bl_idname, "label": n.label, "mute": n.mute,
         "parent": n.parent.name if n.parent else None,
@@ -1554,6 +1593,7 @@ def main():
     except OSError as e:
         fail(f"cannot create output folder {out}: {e}")
 
+    POINT_DENSITY["out"] = out
     data = bpy.data
     scene = bpy.context.scene
     view_layer = bpy.context.view_layer

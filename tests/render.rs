@@ -20,6 +20,9 @@ const ASSERTED: &[&str] = &[
     // Ray Portal BSDF: moved and turned rays, a portal mixed with diffuse and with
     // Transparent (shadow rays stop at a portal alone, pass it beside a Transparent).
     "ray_portal",
+    // Point Density in volumes (Object and World space, Linear and Closest), zero on a
+    // surface; negative colours clamp in the scatter weight as Cycles' bsdf_alloc does.
+    "point_density",
     // A Solidify modifier evaluated natively: shell, rim and even-thickness normals.
     "solidify",
     // Issue 26's second part: Ico Sphere at Subdivisions 3, Edge Split, Mirror Bisect (64 px).

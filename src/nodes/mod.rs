@@ -72,6 +72,7 @@ pub mod brick;
 pub mod image;
 // IES Texture.
 pub mod ies;
+pub mod point_density;
 // Input nodes that read the shading context.
 pub mod fresnel;
 pub mod light_falloff;

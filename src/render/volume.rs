@@ -486,6 +486,9 @@ impl Coefficients {
     }
 
     fn add_scatter(&mut self, w: V3, phase: Phase) {
+        // Cycles' bsdf_alloc allows no negative weight (a colour below zero, from a Point
+        // Density's normals say); the extinction keeps the weight as it is.
+        let w = w.map(|x| x.max(0.0));
         if max3(w.map(f32::abs)) < 1e-5 {
             return;
         }
@@ -759,6 +762,7 @@ impl Scene<'_> {
                 object: inst.info,
                 path: state,
                 ray_length: 1.0,
+                volume_texspace: Some((inst.tex_loc, inst.tex_size)),
                 ..Default::default()
             };
             sp.generated = inst.generated(local);

@@ -447,6 +447,27 @@ pub struct Node {
     /// (Internal) or the file's (External); "\n" where Cycles finds none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ies: Option<String>,
+    /// The Point Density node's voxel grid as Blender computed it for Cycles.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub point_density: Option<PointDensityGrid>,
+}
+
+/// A Point Density node's grid (`point_density/*.bin`: RGBA float32 little-endian, x
+/// fastest), computed by Blender at the exported frame over the bounds `min`..`max` in
+/// the points object's space (`calc_point_density`, `calc_point_density_minmax`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct PointDensityGrid {
+    pub file: String,
+    pub resolution: u32,
+    pub min: [f32; 3],
+    pub max: [f32; 3],
+    /// The points object's world matrix (rows), None without an object.
+    #[serde(default)]
+    pub object_matrix: Option<[[f32; 4]; 4]>,
+    pub frame: f64,
+    /// The node properties the grid was computed with.
+    #[serde(default)]
+    pub properties: serde_json::Map<String, serde_json::Value>,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]

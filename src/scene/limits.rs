@@ -18,3 +18,6 @@ pub const MAX_COLOR_FILE_BYTES: u64 = 1 << 30;
 pub fn mul_add(a: usize, b: usize, c: usize) -> Option<usize> {
     a.checked_mul(b)?.checked_add(c)
 }
+
+/// Largest Point Density grid side read (the exporter writes at most 256).
+pub const MAX_POINT_DENSITY_RESOLUTION: u32 = 256;

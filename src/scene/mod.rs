@@ -106,6 +106,42 @@ impl Scene {
         Ok(m)
     }
 
+    /// Reads a Point Density node's grid: resolution^3 RGBA voxels, x fastest. `location`
+    /// names the node for errors.
+    pub fn load_point_density(
+        &self,
+        grid: &format::PointDensityGrid,
+        location: &str,
+    ) -> Result<Vec<[f32; 4]>, SceneError> {
+        let err = |m: String| SceneError::new(&self.json_path(), location, m);
+        let res = grid.resolution;
+        if res == 0 || res > limits::MAX_POINT_DENSITY_RESOLUTION {
+            return Err(err(format!(
+                "point_density.resolution {res} is outside 1..={}",
+                limits::MAX_POINT_DENSITY_RESOLUTION
+            )));
+        }
+        let voxels = (res as usize).pow(3);
+        let path = self.resolve(&grid.file, &format!("{location}.point_density.file"))?;
+        let bytes = file::read_regular(&path, (voxels * 16) as u64)
+            .map_err(|m| err(format!("{}: {m}", path.display())))?;
+        if bytes.len() != voxels * 16 {
+            return Err(err(format!(
+                "{} holds {} bytes, not {res}^3 RGBA float32 voxels ({})",
+                path.display(),
+                bytes.len(),
+                voxels * 16
+            )));
+        }
+        Ok(bytes
+            .chunks_exact(16)
+            .map(|c| {
+                let f = |i: usize| f32::from_le_bytes([c[i], c[i + 1], c[i + 2], c[i + 3]]);
+                [f(0), f(4), f(8), f(12)]
+            })
+            .collect())
+    }
+
     /// Reads an evaluated (reference) mesh written by the exporter.
     pub fn load_evaluated(&self, index: usize) -> Result<MeshData, SceneError> {
         let e = &self.file.evaluated[index];

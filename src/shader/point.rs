@@ -77,6 +77,10 @@ pub struct ShadingPoint {
     pub undisplaced: Option<Undisplaced>,
     /// What the Hair Info node reads: zero everywhere but on hair curves.
     pub hair: HairPoint,
+    /// Evaluating a Volume: the shaded object's texture space (location, size), which
+    /// Point Density's Object space maps into; None on surfaces (where Cycles leaves the
+    /// volume-only nodes out).
+    pub volume_texspace: Option<([f32; 3], [f32; 3])>,
 }
 
 /// A hair hit as Cycles' Hair Info node reads it (svm_node_hair_info, geom/curve.h).

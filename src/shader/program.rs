@@ -408,6 +408,15 @@ pub enum Op {
         color: Slot,
         generated: bool,
     },
+    /// Point Density: the grid Blender computed, in volumes only (zero on surfaces).
+    TexPointDensity {
+        grid: crate::nodes::point_density::VoxelGrid,
+        interpolation: crate::nodes::point_density::Interpolation,
+        space: crate::nodes::point_density::Space,
+        vector: Slot,
+        density: Slot,
+        color: Slot,
+    },
     /// IES Texture: Fac from the photometric table at the vector's direction.
     TexIes {
         table: std::sync::Arc<crate::nodes::ies::IesTable>,
@@ -1392,6 +1401,36 @@ impl Program {
                     color,
                     ..
                 } => put3(s, color, sky.eval(v3(s, vector), &LINEAR_REC709)),
+                Op::TexPointDensity {
+                    ref grid,
+                    interpolation,
+                    space,
+                    vector,
+                    density,
+                    color,
+                } => {
+                    use crate::nodes::point_density::Space;
+                    let r = match sp.volume_texspace {
+                        None => [0.0; 4],
+                        Some((loc, size)) => {
+                            let co = v3(s, vector);
+                            let tex = match space {
+                                // Cycles' volume_normalized_position.
+                                Space::Object => {
+                                    let o = crate::foundation::math::transform_point(
+                                        &sp.transform.to_object,
+                                        co,
+                                    );
+                                    [0, 1, 2].map(|k| (o[k] - loc[k]) / (2.0 * size[k]) + 0.5)
+                                }
+                                Space::World(t) => crate::foundation::math::transform_point(&t, co),
+                            };
+                            grid.sample(tex, interpolation)
+                        }
+                    };
+                    s[density as usize] = r[3];
+                    put3(s, color, [r[0], r[1], r[2]]);
+                }
                 Op::TexIes {
                     ref table,
                     vector,

@@ -116,6 +116,8 @@ const SKY: &str =
     "nodes/sky.rs, sky_hosek.rs: Nishita, Preetham and Hosek/Wilkie, every option, within 1e-4 of Cycles' bakes (tests/sky_texture.rs)";
 const IES: &str =
     "nodes/ies.rs: Cycles 4.5's IES parsing and processing (types B and C, TILT, half and quarter files) and its bicubic lookup: within 1e-4 of Cycles' EMIT bakes (tests/bake.rs, fixtures/bake/nodes, cases ies_*), and on lights the Cycles parity scene light_ies in tests/render.rs";
+const POINT_DENSITY: &str =
+    "nodes/point_density.rs: the voxel grid Blender computes for Cycles (exported per node), read as Cycles' svm_node_tex_voxel reads it: in volumes only (zero on surfaces), Object space through the volume object's texture space, World space through the points object, Closest, Linear and Cubic with Clip; Cycles parity scene point_density in tests/render.rs; an override of a property the grid depends on is a compile error naming the node";
 const IMAGE: &str =
     "nodes/brick.rs, image.rs, shader/images.rs: every interpolation, extension, projection and alpha mode in tests/textures.rs; colour spaces other than sRGB, Non-Color and Linear Rec.709, sequences and UDIM are compile errors naming the image";
 const COLOR: &str = "nodes/color.rs, mix.rs, curves.rs; tests/shader_conformance.rs";
@@ -197,6 +199,11 @@ pub const NODES: &[ShaderNode] = &[
     node("ShaderNodeTexGabor", gabor_texture, GABOR),
     node("ShaderNodeTexSky", sky_texture, SKY),
     node("ShaderNodeTexIES", ies_texture, IES),
+    node(
+        "ShaderNodeTexPointDensity",
+        point_density_texture,
+        POINT_DENSITY,
+    ),
     node("ShaderNodeTexBrick", brick_texture, IMAGE),
     node("ShaderNodeTexImage", image_texture, IMAGE),
     node("ShaderNodeTexEnvironment", environment_texture, IMAGE),
@@ -861,6 +868,74 @@ fn ies_texture(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), C
         fac,
     });
     c.outputs(i, n, &[("Fac", fac, F)]);
+    Ok(())
+}
+
+/// Point Density: the grid Blender computed at export, which Cycles samples in volumes
+/// (nodes/point_density.rs). The properties it was computed with must still hold: an
+/// override of one would need Blender to compute it again.
+fn point_density_texture(
+    c: &mut Compiler<'_, '_>,
+    i: usize,
+    _: &Schedule,
+) -> Result<(), CompileError> {
+    use crate::nodes::point_density::{world_space, Interpolation, Space, VoxelGrid};
+    let n = &c.g.nodes[i];
+    let pd = n.node.point_density.as_ref().ok_or_else(|| {
+        CompileError(format!(
+            "node {:?}: the export has no point density grid for it (convert the .blend again)",
+            n.path
+        ))
+    })?;
+    for (k, v) in &pd.properties {
+        if n.property(k) != Some(v) {
+            return Err(CompileError(format!(
+                "node {:?}: Point Density property {k:?} differs from the one Blender computed its grid with at export ({v}): convert the .blend again with the new value",
+                n.path
+            )));
+        }
+    }
+    let interpolation = mode(n, "interpolation", Interpolation::from_blender)?;
+    let space = match prop_str(n, "space")? {
+        "OBJECT" => Space::Object,
+        // Without an object, or with empty bounds, Blender's grid is all zero.
+        _ => Space::World(
+            pd.object_matrix
+                .and_then(|m| world_space(&m, pd.min, pd.max))
+                .unwrap_or([[0.0; 4]; 3]),
+        ),
+    };
+    let scene = c.scene.ok_or_else(|| {
+        CompileError(format!(
+            "node {:?}: Point Density needs the scene's files",
+            n.path
+        ))
+    })?;
+    let voxels = scene
+        .load_point_density(pd, &n.path)
+        .map_err(|e| CompileError(e.to_string()))?;
+    let grid = VoxelGrid {
+        resolution: pd.resolution as usize,
+        voxels: std::sync::Arc::new(voxels),
+    };
+    // Cycles' LINK_POSITION: an unlinked vector is the shading point's position.
+    let vector = if linked(n, "Vector") {
+        c.input(n, "Vector", V)?
+    } else {
+        let d = c.alloc(V);
+        c.ops.push(Op::Position { dst: d });
+        d
+    };
+    let (density, color) = (c.alloc(F), c.alloc(C));
+    c.ops.push(Op::TexPointDensity {
+        grid,
+        interpolation,
+        space,
+        vector,
+        density,
+        color,
+    });
+    c.outputs(i, n, &[("Density", density, F), ("Color", color, C)]);
     Ok(())
 }
 
