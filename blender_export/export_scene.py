@@ -1179,6 +1179,91 @@ def frozen_inputs(o):
 
 # ---------------------------------------------------------------- other datablocks
 
+# ---------------------------------------------------------------- smoke domain grids
+
+# The grids Cycles reads from a gas domain (blender/volume.cpp, sync_smoke_volume), by the
+# attribute name materials read them with, and the channels Cycles 4.5 keeps of each (the
+# RGBA colour grid becomes RGB: its NanoVDB grids have no four-channel type).
+SMOKE_GRIDS = {"density": 1, "color": 3, "flame": 1, "heat": 1, "temperature": 1, "velocity": 3}
+SMOKE_GRID_CHANNELS = {"color": 4, "velocity": 3}
+
+
+def attribute_names_read(tree, seen):
+    """Attribute names a node tree (and the groups in it) reads: Attribute nodes of
+    Geometry type and Principled Volume's Density/Color/Temperature Attribute."""
+    names = set()
+    if tree is None or tree.as_pointer() in seen:
+        return names
+    seen.add(tree.as_pointer())
+    for n in tree.nodes:
+        if n.bl_idname == "ShaderNodeAttribute" and n.attribute_type == "GEOMETRY":
+            names.add(n.attribute_name)
+        elif n.bl_idname == "ShaderNodeVolumePrincipled":
+            for s in ("Density Attribute", "Color Attribute", "Temperature Attribute"):
+                if s in n.inputs and n.inputs[s].default_value:
+                    names.add(n.inputs[s].default_value)
+        elif getattr(n, "node_tree", None) is not None:
+            names |= attribute_names_read(n.node_tree, seen)
+    return names
+
+
+def smoke_domain_entries(objs, out, depsgraph):
+    """Per gas domain with a material: the grids its materials read, as Blender gives them
+    at the current frame (read from the evaluated object, as Cycles does; the original's
+    would read a missing simulation), written as voxel grid files (FORMAT.md)."""
+    entries = []
+    frame = bpy.context.scene.frame_current + bpy.context.scene.frame_subframe
+    for i, o in enumerate(objs):
+        md = next((m for m in o.modifiers if m.type == "FLUID" and m.fluid_type == "DOMAIN"
+                   and m.show_render), None)
+        if md is None or o.type != "MESH" or md.domain_settings.domain_type != "GAS":
+            continue
+        wanted = set()
+        for slot in o.material_slots:
+            if slot.material is not None and slot.material.node_tree is not None:
+                wanted |= attribute_names_read(slot.material.node_tree, set())
+        wanted = sorted(n for n in wanted if n in SMOKE_GRIDS)
+        ev = o.evaluated_get(depsgraph)
+        ds = ev.modifiers[md.name].domain_settings
+        entry = {"object": key(o), "modifier": md.name, "frame": frame,
+                 "in_cache_range": ds.cache_frame_start <= frame <= ds.cache_frame_end,
+                 "clipping": ds.clipping, "grids": [], "unread": []}
+        lo = np.array(ev.data.texspace_location, dtype=np.float32)
+        size = np.array(ev.data.texspace_size, dtype=np.float32)
+        res = np.array(ds.domain_resolution, dtype=np.int64)
+        for name in wanted:
+            if not entry["in_cache_range"]:
+                entry["unread"].append([name, f"frame {frame:g} is outside the cache's frames "
+                                              f"{ds.cache_frame_start}..{ds.cache_frame_end}"])
+                continue
+            amplify = ds.noise_scale if ds.use_noise and name not in ("velocity", "heat") else 1
+            dims = res * amplify
+            channels = SMOKE_GRID_CHANNELS.get(name, 1)
+            prop = getattr(ds, f"{name}_grid")
+            expect = int(dims.prod()) * channels
+            if len(prop) != expect or expect == 0:
+                entry["unread"].append([name, f"Blender gives {len(prop)} values, not {expect} "
+                                              f"(resolution {list(map(int, dims))}): not baked at the frame?"])
+                continue
+            values = np.empty(expect, dtype=np.float32)
+            try:
+                prop.foreach_get(values)
+            except (AttributeError, TypeError):
+                values = np.array(prop[:], dtype=np.float32)
+            keep = SMOKE_GRIDS[name]
+            values = values.reshape(-1, channels)[:, :keep]
+            rel = f"volumes/{safe_name(i, key(o))[:-4]}_{name}.grid"
+            os.makedirs(os.path.join(out, "volumes"), exist_ok=True)
+            with open(os.path.join(out, rel), "wb") as f:
+                f.write(b"BSVGRID1")
+                f.write(struct.pack("<4I", keep, *map(int, dims)))
+                f.write(np.concatenate([lo - size, lo + size]).astype("<f4").tobytes())
+                f.write(np.ascontiguousarray(values, dtype="<f4").tobytes())
+            entry["grids"].append({"name": name, "file": rel})
+        entries.append(entry)
+    return entries
+
+
 def matrix(m):
     return [[float(m[r][c]) for c in range(4)] for r in range(4)]
 
@@ -1647,6 +1732,9 @@ def main():
                               "default_color_attribute": color, "hair": hair.get(name),
                               "points": points.get(name)})
 
+    with RenderSettings():
+        smoke_domains = smoke_domain_entries(list(data.objects), out, bpy.context.evaluated_depsgraph_get())
+
     RENDER_LAYER.update(render_layer_objects(view_layer))
     used_images = set()
     images = [image_entry(im, out, used_images) for im in data.images
@@ -1709,6 +1797,7 @@ def main():
         "images": images,
         "animation": animation(data),
         "evaluated": evaluated,
+        "smoke_domains": smoke_domains,
         "color_management": cm,
     }
     if args.frames is not None and not args.no_evaluated:

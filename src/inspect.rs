@@ -33,6 +33,8 @@ pub struct Report {
     /// Objects rendered from Blender's evaluated mesh in the export, and what would
     /// make it stale.
     pub frozen: Vec<FrozenSummary>,
+    /// Smoke domains and the grids they render from (or why they render nothing).
+    pub smoke_domains: Vec<SmokeSummary>,
     /// The frame the checks ran at.
     pub frame: f64,
     /// `render`'s verdict at the frame: None when it would render.
@@ -354,12 +356,55 @@ pub fn report_at(scene: &Scene, frame: Option<f64>) -> Report {
         coverage,
         material_status,
         frozen,
+        smoke_domains: smoke_summaries(scene),
         frame,
         render_error,
         mesh_errors,
         all_supported,
         warnings: f.warnings.clone(),
     }
+}
+
+/// A smoke domain in the export: the frame its grids are of, the grids its materials read
+/// that Blender gave, and, when it renders nothing (as Cycles does then), why.
+#[derive(Debug, Serialize)]
+pub struct SmokeSummary {
+    pub object: String,
+    pub frame: f64,
+    pub grids: Vec<String>,
+    pub empty: Option<String>,
+}
+
+fn smoke_summaries(scene: &Scene) -> Vec<SmokeSummary> {
+    let f = &scene.file;
+    f.smoke_domains
+        .iter()
+        .enumerate()
+        .map(|(i, d)| {
+            let unread: Vec<String> = d.unread.iter().map(|(n, why)| format!("{n}: {why}")).collect();
+            let empty = match scene.load_smoke_grids(i) {
+                Err(e) => Some(format!("its grids do not load: {e}")),
+                Ok(g) if g.is_empty() && unread.is_empty() => {
+                    Some("its materials read no grid (density, color, flame, heat, temperature, velocity)".into())
+                }
+                Ok(g) if g.is_empty() => Some(format!("no grid at the frame ({})", unread.join("; "))),
+                Ok(g) => {
+                    let any = g.iter().any(|g| {
+                        g.values
+                            .chunks(g.channels)
+                            .any(|v| v.iter().any(|x| x.abs() > d.clipping))
+                    });
+                    (!any).then(|| "every voxel is at or below the domain's clipping (an empty or unbaked cache)".into())
+                }
+            };
+            SmokeSummary {
+                object: d.object.clone(),
+                frame: d.frame,
+                grids: d.grids.iter().map(|g| g.name.clone()).collect(),
+                empty,
+            }
+        })
+        .collect()
 }
 
 /// Frozen objects, and `mesh`'s errors for every object with geometry, at `frame`.
@@ -664,6 +709,25 @@ impl Report {
                         format!("; ANIMATED {} (no other frame)", z.animated.join(", "))
                     }
                 )?;
+            }
+        }
+        if !self.smoke_domains.is_empty() {
+            writeln!(o, "\nSmoke domains (voxel grids from the export)")?;
+            for d in &self.smoke_domains {
+                match &d.empty {
+                    None => writeln!(
+                        o,
+                        "  {:?}: grids {} (frame {})",
+                        d.object,
+                        d.grids.join(", "),
+                        d.frame
+                    )?,
+                    Some(why) => writeln!(
+                        o,
+                        "  {:?}: renders nothing, as in Cycles: {why} (frame {})",
+                        d.object, d.frame
+                    )?,
+                }
             }
         }
         writeln!(o, "\nChecks at frame {}", self.frame)?;

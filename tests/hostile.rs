@@ -594,3 +594,56 @@ fn bake_size_beyond_the_limits_is_an_error_before_allocating() {
         assert!(!out.exists());
     }
 }
+
+/// A smoke domain's grid file that lies about its size, or a grid path leaving the
+/// scene folder: a one-line error naming the file, before anything is allocated from it.
+#[test]
+fn hostile_smoke_grids_are_clean_errors() {
+    let src = repo().join("fixtures/render/scenes/smoke_grid_gradient");
+    let render = |dir: &Path| {
+        let out = dir.join("out.exr");
+        run(
+            &[
+                "render",
+                dir.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+                "--samples",
+                "1",
+                "--resolution",
+                "8x8",
+            ],
+            &[],
+        )
+    };
+    // A header declaring a huge resolution over a small file.
+    let t = tempfile::tempdir().unwrap();
+    copy_dir(&src, t.path());
+    let grid = t.path().join("volumes/0001_Domain_density.grid");
+    let mut b = std::fs::read(&grid).unwrap();
+    for at in [12, 16, 20] {
+        b[at..at + 4].copy_from_slice(&60000u32.to_le_bytes());
+    }
+    std::fs::write(&grid, &b).unwrap();
+    let o = render(t.path());
+    assert_clean_error(&o, 1, &["Domain", "0001_Domain_density.grid", "density"]);
+    // A file cut short.
+    let t = tempfile::tempdir().unwrap();
+    copy_dir(&src, t.path());
+    let grid = t.path().join("volumes/0001_Domain_color.grid");
+    let b = std::fs::read(&grid).unwrap();
+    std::fs::write(&grid, &b[..b.len() - 3]).unwrap();
+    assert_clean_error(&render(t.path()), 1, &["0001_Domain_color.grid", "bytes"]);
+    // A grid path out of the scene folder.
+    let t = tempfile::tempdir().unwrap();
+    copy_dir(&src, t.path());
+    let json = t.path().join("scene.json");
+    let mut j: Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    j["smoke_domains"][0]["grids"][0]["file"] = "../../etc/passwd".into();
+    std::fs::write(&json, serde_json::to_vec(&j).unwrap()).unwrap();
+    assert_clean_error(
+        &render(t.path()),
+        1,
+        &["smoke_domains[0].grids[0].file", ".."],
+    );
+}

@@ -123,3 +123,23 @@ fn materials_report_whether_they_compile() {
     let m = &r["material_status"][0];
     assert!(m["error"].is_null(), "{m}");
 }
+
+/// Smoke domains are listed with the grids they render from, or why they render nothing
+/// (as Cycles renders them then): an unbaked cache, a material that reads no grid.
+#[test]
+fn smoke_domains_say_what_they_render_from() {
+    let (_, r) = report("fixtures/render/scenes/smoke_unbaked");
+    let d = r["smoke_domains"].as_array().unwrap();
+    let a = d.iter().find(|x| x["object"] == "DomainA").unwrap();
+    assert!(a["empty"].as_str().unwrap().contains("clipping"), "{a}");
+    let b = d.iter().find(|x| x["object"] == "DomainB").unwrap();
+    assert!(b["empty"].as_str().unwrap().contains("read no grid"), "{b}");
+    assert_eq!(r["render_error"], Value::Null);
+    let (_, r) = report("fixtures/render/scenes/smoke_grid_gradient");
+    let g = &r["smoke_domains"][0];
+    assert_eq!(g["empty"], Value::Null, "{g}");
+    assert_eq!(
+        g["grids"],
+        serde_json::json!(["color", "density", "temperature"])
+    );
+}

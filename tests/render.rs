@@ -275,6 +275,12 @@ const ASSERTED: &[&str] = &[
     "volume_camera_inside",
     "volume_sampling_equiangular",
     "volume_sampling_distance",
+    // Smoke domains (render/volume_grid.rs): two unbaked domains Cycles renders empty (its
+    // volume mesh comes from the grids' active voxels), and density, colour and temperature
+    // grids read by Principled Volume (written by the fixture script, as Mantaflow cannot
+    // bake in the bpy wheel; Cycles renders the same gradients computed on a mesh cube).
+    "smoke_unbaked",
+    "smoke_grid_gradient",
 ];
 
 /// Scenes at several scales (lengths, radii and light energy scaled alike: Cycles' image
@@ -1554,8 +1560,9 @@ fn refused_alike(
 
 /// Volume features blendsynth does not render are errors naming the object, material or
 /// node, the same from `render::check` (what `inspect` runs) as from `render`: a phase
-/// function other than Henyey-Greenstein and Rayleigh, a world's Volume, and a fluid
-/// (smoke) domain, whose grids the export does not carry.
+/// function other than Henyey-Greenstein and Rayleigh, a world's Volume, a fluid (smoke)
+/// domain in an export that carries no grids for it, and a smoke domain whose material
+/// has a Surface too.
 #[test]
 fn unsupported_volumes_are_refused_by_name() {
     let (dir, base) = fixture_json("volume_scatter_spot");
@@ -1615,6 +1622,29 @@ fn unsupported_volumes_are_refused_by_name() {
             }]);
         },
         &["object \"Cube\"", "fluid domain", "\"Fluid\"", "\"Fog\""],
+    );
+    // A smoke domain with its grids whose material also has a Surface.
+    refused(
+        &|j| {
+            let objs = j["objects"].as_array_mut().unwrap();
+            let cube = objs.iter_mut().find(|o| o["name"] == "Cube").unwrap();
+            cube["modifiers"] = serde_json::json!([{
+                "name": "Fluid", "type": "FLUID", "show_render": true, "show_viewport": true,
+                "properties": {"fluid_type": "DOMAIN", "domain_settings": {"domain_type": "GAS"}}
+            }]);
+            j["smoke_domains"] = serde_json::json!([{
+                "object": "Cube", "modifier": "Fluid", "frame": 1.0, "in_cache_range": true,
+                "grids": [], "unread": []
+            }]);
+            let ms = j["materials"].as_array_mut().unwrap();
+            let fog = ms.iter_mut().find(|m| m["name"] == "Fog").unwrap();
+            let links = fog["node_tree"]["links"].as_array_mut().unwrap();
+            let mut l = links[0].clone();
+            l["to_socket"] = "Surface".into();
+            l["to_index"] = 0.into();
+            links.push(l);
+        },
+        &["object \"Cube\"", "\"Fog\"", "smoke domain", "Surface"],
     );
 }
 

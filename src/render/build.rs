@@ -64,6 +64,9 @@ pub struct MeshInstance {
     /// Hair: the object's curves (`render::curves`); the instance then has no triangles
     /// and its prims are curve segments.
     pub curves: Option<Arc<crate::render::curves::ObjectCurves>>,
+    /// A smoke domain's voxel grids (`volume_grid`); the instance's mesh is then the box
+    /// they tile.
+    pub grids: Option<Arc<crate::render::volume_grid::DomainGrids>>,
 }
 
 impl MeshInstance {
@@ -174,6 +177,11 @@ pub fn build(
     for (oi, obj) in eval.data.objects.iter().enumerate() {
         // Cycles does not sync an object no ray can see.
         if !renders_itself(eval, obj) {
+            continue;
+        }
+        if let Some((di, _)) = scene.smoke_domain(&obj.name) {
+            let to_world = Affine::from_rows(&eval.world_matrices[oi]);
+            push_smoke_domain(&mut instances, scene, (oi, obj), di, eval.frame, to_world)?;
             continue;
         }
         let source = object_source(scene, obj, eval.frame, &overridden)
@@ -576,6 +584,128 @@ fn push_instance(
     Ok(())
 }
 
+/// A smoke domain as Cycles renders it: its grids (exported at the frame) over the box
+/// of its texture space, with the domain mesh's materials; nothing when no grid has a
+/// voxel above the clipping (Cycles' volume mesh is then empty).
+fn push_smoke_domain(
+    instances: &mut Vec<MeshInstance>,
+    scene: &Scene,
+    (oi, obj): (usize, &crate::scene::Object),
+    di: usize,
+    frame: f64,
+    to_world: Affine,
+) -> Result<(), RenderError> {
+    let d = &scene.file.smoke_domains[di];
+    if d.frame != frame && !d.grids.is_empty() {
+        return Err(RenderError(format!(
+            "object {:?}: its smoke grids were exported at frame {}, not {frame}: convert the file at this frame",
+            obj.name, d.frame
+        )));
+    }
+    let grids = scene
+        .load_smoke_grids(di)
+        .map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))?;
+    if let Some(g) = grids
+        .iter()
+        .find(|g| g.min != grids[0].min || g.max != grids[0].max)
+    {
+        return Err(RenderError(format!(
+            "object {:?}: smoke grid {:?} covers another box than {:?}",
+            obj.name, g.name, grids[0].name
+        )));
+    }
+    let Some(domain) = crate::render::volume_grid::DomainGrids::new(grids, d.clipping) else {
+        return Ok(());
+    };
+    let mesh_ref = obj
+        .data
+        .as_deref()
+        .and_then(|n| scene.file.meshes.iter().find(|m| m.name == n));
+    let no_materials: Vec<Option<String>> = Vec::new();
+    let (lo, hi) = (domain.min, domain.max);
+    let info = MeshInfo {
+        materials: mesh_ref.map_or(&no_materials[..], |m| &m.materials[..]),
+        uv_name: None,
+        default_color: None,
+        texspace: Some((scale(add(lo, hi), 0.5), scale(sub(hi, lo), 0.5))),
+    };
+    // Cycles' volume mesh bounds the active voxels dilated by the interpolation's reach
+    // (1 voxel linear, 2 cubic; GeometryManager::create_volume_mesh): two voxels of the
+    // coarsest grid around the box cover both. Past it every value is 0.
+    let pad = domain.grids.iter().fold([0.0f32; 3], |p, g| {
+        [0, 1, 2].map(|k| p[k].max(2.0 * (hi[k] - lo[k]) / g.resolution[k] as f32))
+    });
+    let mut inst = new_instance(
+        scene,
+        oi,
+        obj,
+        &info,
+        Arc::new(box_mesh(sub(lo, pad), add(hi, pad))),
+        to_world,
+        None,
+    )?;
+    inst.grids = Some(Arc::new(domain));
+    instances.push(inst);
+    Ok(())
+}
+
+/// An axis-aligned box from `lo` to `hi` as a closed mesh of six outward-facing quads.
+fn box_mesh(lo: V3, hi: V3) -> MeshData {
+    let positions: Vec<V3> = (0..8)
+        .map(|i| {
+            [
+                if i & 1 != 0 { hi[0] } else { lo[0] },
+                if i & 2 != 0 { hi[1] } else { lo[1] },
+                if i & 4 != 0 { hi[2] } else { lo[2] },
+            ]
+        })
+        .collect();
+    // Counter-clockwise seen from outside.
+    let quads: [[u32; 4]; 6] = [
+        [0, 2, 3, 1], // -z
+        [4, 5, 7, 6], // +z
+        [0, 1, 5, 4], // -y
+        [2, 6, 7, 3], // +y
+        [0, 4, 6, 2], // -x
+        [1, 3, 7, 5], // +x
+    ];
+    let normals: [V3; 6] = [
+        [0.0, 0.0, -1.0],
+        [0.0, 0.0, 1.0],
+        [0.0, -1.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [-1.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+    ];
+    let mut edges: Vec<[u32; 2]> = Vec::new();
+    let mut corner_edges = Vec::new();
+    for q in &quads {
+        for k in 0..4 {
+            let (a, b) = (q[k], q[(k + 1) % 4]);
+            let e = [a.min(b), a.max(b)];
+            let at = edges.iter().position(|x| *x == e).unwrap_or_else(|| {
+                edges.push(e);
+                edges.len() - 1
+            });
+            corner_edges.push(at as u32);
+        }
+    }
+    MeshData {
+        name: "smoke domain".into(),
+        positions,
+        edges,
+        face_offsets: (0..=6).map(|f| 4 * f).collect(),
+        corner_verts: quads.iter().flatten().copied().collect(),
+        corner_edges,
+        corner_normals: normals.iter().flat_map(|n| [*n; 4]).collect(),
+        triangles: (0..6u32)
+            .flat_map(|f| [[4 * f, 4 * f + 1, 4 * f + 2], [4 * f, 4 * f + 2, 4 * f + 3]])
+            .collect(),
+        triangle_faces: (0..6u32).flat_map(|f| [f, f]).collect(),
+        attributes: Vec::new(),
+    }
+}
+
 /// An evaluated mesh with realised instances (`render::realized`) as the objects Cycles
 /// renders: the instancer's own geometry, then each instance in its own object space at
 /// the instancer's transform times its own, with its Object Info (random id, colour, pass
@@ -869,6 +999,7 @@ fn new_instance(
         // Cycles' kernel keeps the shading offset as a frequency multiplier (object.cpp).
         terminator_frequency: 1.0 / (1.0 - 0.5 * obj.shadow_terminator_shading_offset),
         curves: None,
+        grids: None,
     })
 }
 

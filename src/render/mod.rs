@@ -34,6 +34,7 @@ pub mod scene_mesh;
 pub mod shader_rays;
 pub mod subsurface;
 pub mod volume;
+pub mod volume_grid;
 
 use std::time::Instant;
 

@@ -80,6 +80,8 @@ struct VolumeMaterial {
     step_rate: f32,
     /// Volume > Sampling.
     sampling: VolumeSampling,
+    /// Volume > Interpolation is Cubic: voxel grids are sampled tricubically.
+    cubic: bool,
 }
 
 /// Every volume of the scene and the render's volume settings.
@@ -101,6 +103,9 @@ pub struct Volumes {
     pub any: bool,
     /// World bounds of the instances with a volume (where a camera may be inside one).
     bounds: Vec<(V3, V3)>,
+    /// Per mesh instance with voxel grids: per volume material of its slots, which grid
+    /// each of the material's attribute requests reads.
+    grid_binds: Vec<Vec<(u32, super::volume_grid::GridBinding)>>,
 }
 
 impl Volumes {
@@ -126,6 +131,7 @@ impl Volumes {
                     sampling: settings
                         .as_ref()
                         .map_or(VolumeSampling::MultipleImportance, |s| s.volume_sampling),
+                    cubic: settings.as_ref().is_some_and(|s| s.volume_cubic),
                 }
             }));
             v.only_volume.push(p.is_some_and(|p| p.surface.is_none()));
@@ -153,11 +159,35 @@ impl Volumes {
             {
                 v.bounds.push(inst.world_bounds);
             }
-            v.step.push(if rate.is_finite() {
-                0.1 * size * rate * render_rate
+            let mut binds = Vec::new();
+            if let Some(g) = &inst.grids {
+                // Cycles: reading voxel attributes makes a volume heterogeneous, and the
+                // step follows the voxel size (Object::compute_volume_step_size).
+                let mut rate = f32::INFINITY;
+                for &m in inst.slots.iter().flatten() {
+                    let (Some(Some(vm)), Some(p)) =
+                        (v.materials.get(m), materials[m].program.as_ref())
+                    else {
+                        continue;
+                    };
+                    rate = rate.min(vm.step_rate);
+                    binds.push((m as u32, g.bind(&p.attributes)));
+                }
+                let voxel = g.voxel_step(&inst.to_world);
+                let step = if voxel.is_finite() { voxel } else { 0.1 * size };
+                v.step.push(if rate.is_finite() {
+                    step * rate * render_rate
+                } else {
+                    f32::INFINITY
+                });
             } else {
-                f32::INFINITY
-            });
+                v.step.push(if rate.is_finite() {
+                    0.1 * size * rate * render_rate
+                } else {
+                    f32::INFINITY
+                });
+            }
+            v.grid_binds.push(binds);
         }
         v
     }
@@ -172,6 +202,20 @@ impl Volumes {
     /// Whether material `m` has a volume.
     pub fn has_volume(&self, m: usize) -> bool {
         matches!(self.materials.get(m), Some(Some(_)))
+    }
+
+    /// Which grid each attribute request of material `m` reads inside instance `inst`.
+    fn grid_bind(&self, inst: u32, m: u32) -> Option<&super::volume_grid::GridBinding> {
+        self.grid_binds
+            .get(inst as usize)?
+            .iter()
+            .find(|(mi, _)| *mi == m)
+            .map(|(_, b)| b)
+    }
+
+    /// Whether material `m` samples voxel grids tricubically.
+    fn cubic(&self, m: u32) -> bool {
+        matches!(self.materials.get(m as usize), Some(Some(v)) if v.cubic)
     }
 
     /// Whether material `m` is a volume with no surface.
@@ -284,20 +328,16 @@ struct AheadLight {
 }
 
 /// Volumes blendsynth cannot render, refused by name (for `render` and `inspect`): a
-/// fluid (smoke or fire) domain whose material has a Volume, which Cycles renders from
-/// the simulation's grids (density, flame, temperature, velocity); the export does not
-/// carry them, and its material over the bare domain box would be a stand-in. Checked
-/// before the geometry (a domain's mesh is frozen, which is not the reason it fails).
+/// fluid (smoke or fire) domain whose material has a Volume, when the export carries no
+/// grids for it (an export older than the grid writer) or the material also has a
+/// Surface (Cycles would shade the voxel hull with it; not matched yet). Checked before
+/// the geometry (a domain's mesh is frozen, which is not the reason it fails).
 pub fn check_objects(scene: &BlendScene) -> Result<(), super::RenderError> {
-    let has_volume = |name: &str| {
+    let linked = |name: &str, socket: &str| {
         scene
             .material(name)
             .and_then(|m| m.node_tree.as_ref())
-            .is_some_and(|t| {
-                t.links
-                    .iter()
-                    .any(|l| l.to_socket == "Volume" && !l.is_muted)
-            })
+            .is_some_and(|t| t.links.iter().any(|l| l.to_socket == socket && !l.is_muted))
     };
     for obj in scene.file.objects.iter().filter(|o| !o.hide_render) {
         let domain = obj.modifiers.iter().find(|md| {
@@ -317,10 +357,17 @@ pub fn check_objects(scene: &BlendScene) -> Result<(), super::RenderError> {
             .iter()
             .filter_map(|s| s.material.clone())
             .chain(mesh_materials.into_iter().flatten())
-            .find(|m| has_volume(m));
-        if let Some(m) = volume {
+            .find(|m| linked(m, "Volume"));
+        let Some(m) = volume else { continue };
+        if scene.smoke_domain(&obj.name).is_none() {
             return Err(super::RenderError(format!(
-                "object {:?}: the volume of its fluid domain (modifier {:?}, material {m:?}) is rendered from the simulation's grids, which blendsynth does not read: smoke and fire domains are not supported yet",
+                "object {:?}: the volume of its fluid domain (modifier {:?}, material {m:?}) is rendered from the simulation's grids, which this export does not carry: convert the .blend again with this version's exporter",
+                obj.name, md.name
+            )));
+        }
+        if linked(&m, "Surface") {
+            return Err(super::RenderError(format!(
+                "object {:?}: material {m:?} of its smoke domain (modifier {:?}) has a Surface as well as a Volume: a surface on a smoke domain is not supported yet",
                 obj.name, md.name
             )));
         }
@@ -503,7 +550,7 @@ impl Coefficients {
     }
 
     /// Adds closure `c` of program `p` (stack `s`, already run) with mix weight `w`.
-    fn closure(&mut self, p: &Program, c: u32, w: f32, s: &[f32], shadow: bool) {
+    fn closure(&mut self, p: &Program, c: u32, w: f32, s: &[f32], sp: &ShadingPoint, shadow: bool) {
         match p.closures[c as usize] {
             Closure::Emission { color, strength } => {
                 if !shadow {
@@ -514,20 +561,20 @@ impl Coefficients {
             Closure::Mix { fac, a, b } => {
                 let f = finite_or(s[fac as usize], 0.0).clamp(0.0, 1.0);
                 if let Some(a) = a.filter(|_| w * (1.0 - f) > 0.0) {
-                    self.closure(p, a, w * (1.0 - f), s, shadow);
+                    self.closure(p, a, w * (1.0 - f), s, sp, shadow);
                 }
                 if let Some(b) = b.filter(|_| w * f > 0.0) {
-                    self.closure(p, b, w * f, s, shadow);
+                    self.closure(p, b, w * f, s, sp, shadow);
                 }
             }
             Closure::Add { a, b } => {
                 for x in [a, b].into_iter().flatten() {
-                    self.closure(p, x, w, s, shadow);
+                    self.closure(p, x, w, s, sp, shadow);
                 }
             }
             Closure::Bsdf { .. } => {
                 if let Some(b) = p.bsdfs.iter().find(|b| b.closure == c) {
-                    self.volume_node(b, w, s, shadow);
+                    self.volume_node(b, w, s, sp, shadow);
                 }
             }
         }
@@ -539,8 +586,15 @@ impl Coefficients {
         b: &crate::shader::program::BsdfNode,
         w: f32,
         s: &[f32],
+        sp: &ShadingPoint,
         shadow: bool,
     ) {
+        // Principled Volume's Density/Color/Temperature Attribute: the request index the
+        // compiler recorded, when the point has that attribute (a voxel grid).
+        let attr = |id: &str| -> Option<[f32; 4]> {
+            let k: usize = b.property(&format!("attribute:{id}"))?.parse().ok()?;
+            (k < sp.attrs.len() && sp.attr_missing & (1 << k) == 0).then(|| sp.attrs[k])
+        };
         let f = |id: &str, d: f32| {
             b.input(id)
                 .map_or(d, |(at, _)| finite_or(s[at as usize], d))
@@ -580,12 +634,20 @@ impl Coefficients {
                     self.add_emission(scale(emission, w));
                 }
             }
-            // svm_node_principled_volume (no density, colour or temperature attribute on
-            // a mesh: Cycles finds none there).
+            // svm_node_principled_volume: the density, colour and temperature scaled by
+            // their attributes where the point has them (voxel grids; a mesh has none).
             "ShaderNodeVolumePrincipled" => {
-                let density = w * f("Density", 1.0).max(0.0);
+                let mut density = w * f("Density", 1.0).max(0.0);
                 if density > 0.0 {
-                    let color = c("Color", [0.5; 3]);
+                    if let Some(a) = attr("Density Attribute") {
+                        density = (density * (a[0] + a[1] + a[2]) / 3.0).max(0.0);
+                    }
+                }
+                if density > 0.0 {
+                    let mut color = c("Color", [0.5; 3]);
+                    if let Some(a) = attr("Color Attribute") {
+                        color = mul(color, [a[0], a[1], a[2]]);
+                    }
                     self.add_scatter(
                         scale(color, density),
                         Phase::henyey_greenstein(f("Anisotropy", 0.0)),
@@ -605,7 +667,11 @@ impl Coefficients {
                 }
                 let blackbody = f("Blackbody Intensity", 0.0);
                 if blackbody > 0.0 {
-                    let t = f("Temperature", 1000.0).max(0.0);
+                    let mut t = f("Temperature", 1000.0);
+                    if let Some(a) = attr("Temperature Attribute") {
+                        t *= ((a[0] + a[1] + a[2]) / 3.0).max(0.0);
+                    }
+                    let t = t.max(0.0);
                     let t4 = (t * t) * (t * t);
                     // Stefan-Boltzmann, in Cycles' units.
                     let sigma = 5.670373e-8 * 1e-6 / std::f32::consts::PI;
@@ -775,8 +841,13 @@ impl Scene<'_> {
                 stack.clear();
                 stack.extend_from_slice(&prog.initial);
             }
+            match (&inst.grids, self.volumes.grid_bind(inst_i, mi)) {
+                (Some(g), Some(bind)) => g.fill(bind, local, self.volumes.cubic(mi), &mut sp),
+                // Cycles finds no volume attribute on a mesh.
+                _ => sp.attr_missing = !0,
+            }
             prog.run(&sp, stack);
-            co.closure(prog, vc, 1.0, stack, shadow);
+            co.closure(prog, vc, 1.0, stack, &sp, shadow);
         }
         co
     }

@@ -13,6 +13,7 @@ pub mod mesh;
 pub mod overrides;
 pub mod settings;
 mod validate;
+pub mod volume_grid;
 
 use std::path::{Component, Path, PathBuf};
 

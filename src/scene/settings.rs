@@ -516,6 +516,8 @@ pub struct MaterialSettings {
     pub volume_sampling: VolumeSampling,
     /// Volume > Step Rate: scales the object's ray-marching step.
     pub volume_step_rate: f64,
+    /// Volume > Interpolation is Cubic (else Linear): how voxel grids are sampled.
+    pub volume_cubic: bool,
 }
 
 impl MaterialSettings {
@@ -540,6 +542,7 @@ impl MaterialSettings {
                 _ => VolumeSampling::MultipleImportance,
             },
             volume_step_rate: cy.and_then(|c| num(c, "volume_step_rate")).unwrap_or(1.0),
+            volume_cubic: cy.and_then(|c| text(c, "volume_interpolation")) == Some("CUBIC"),
         }
     }
 }

@@ -119,6 +119,19 @@ pub(super) fn validate(scene: &Scene, json: &Path) -> Result<(), SceneError> {
             );
         }
     }
+    for (i, d) in f.smoke_domains.iter().enumerate() {
+        if !objects.contains(d.object.as_str()) {
+            return err(
+                format!("smoke_domains[{i}].object"),
+                format!("names object {:?}, which does not exist", d.object),
+            );
+        }
+        for (g, grid) in d.grids.iter().enumerate() {
+            resolve_inside(&scene.dir, &grid.file).map_err(|m| {
+                SceneError::new(json, format!("smoke_domains[{i}].grids[{g}].file"), m)
+            })?;
+        }
+    }
     for (i, im) in f.images.iter().enumerate() {
         if let Some(p) = &im.file {
             resolve_inside(&scene.dir, p)

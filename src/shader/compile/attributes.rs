@@ -150,6 +150,52 @@ impl<'g, 'a> Compiler<'g, 'a> {
         Ok(())
     }
 
+    /// Principled Volume's Density, Color and Temperature Attribute names: each a named
+    /// attribute request (Cycles finds voxel grids by them), recorded on the node as the
+    /// property `attribute:<socket>` = request index for the renderer's volume shading.
+    pub(super) fn principled_volume_attributes(&mut self, i: usize) -> Result<(), CompileError> {
+        let n = &self.g.nodes[i];
+        let mut found = Vec::new();
+        for id in [
+            "Density Attribute",
+            "Color Attribute",
+            "Temperature Attribute",
+        ] {
+            let Some(inp) = n.input(id) else { continue };
+            let name = match inp.sources.first() {
+                Some(crate::nodes::graph::Source::Default(sock)) => sock
+                    .default_value
+                    .as_ref()
+                    .and_then(Value::as_str)
+                    .unwrap_or(""),
+                None => inp
+                    .socket
+                    .default_value
+                    .as_ref()
+                    .and_then(Value::as_str)
+                    .unwrap_or(""),
+                Some(_) => {
+                    return Err(CompileError(format!(
+                        "node {:?}: a link into {id} is not supported (a fixed attribute name is)",
+                        n.path
+                    )))
+                }
+            };
+            if !name.is_empty() {
+                found.push((id, name.to_string()));
+            }
+        }
+        let path = n.path.clone();
+        for (id, name) in found {
+            let k = self.request(&path, AttributeRequest::Named(name))?;
+            if let Some(b) = self.bsdfs.last_mut() {
+                b.properties
+                    .push((format!("attribute:{id}"), k.to_string()));
+            }
+        }
+        Ok(())
+    }
+
     /// Geometry > Pointiness and Random Per Island: Cycles compiles them as float
     /// attribute reads of its derived mesh attributes.
     pub(super) fn geometry_derived(&mut self, i: usize) -> Result<(), CompileError> {

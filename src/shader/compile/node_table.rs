@@ -632,7 +632,11 @@ fn volume(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), Compil
         }
     }
     c.closure(i, Closure::Bsdf { emission: None });
-    c.record_bsdf(i)
+    c.record_bsdf(i)?;
+    if n.node.bl_idname == "ShaderNodeVolumePrincipled" {
+        c.principled_volume_attributes(i)?;
+    }
+    Ok(())
 }
 
 // Texture.
