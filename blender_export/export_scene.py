@@ -1194,6 +1194,14 @@ def render_layer_objects(view_layer):
     return found
 
 
+def view_layer_entry(view_layer):
+    """The rendered view layer's shader AOVs (Cycles writes one pass per valid AOV) and
+    the alpha threshold Cycles' data and AOV passes stop at."""
+    return {"name": view_layer.name,
+            "pass_alpha_threshold": view_layer.pass_alpha_threshold,
+            "aovs": [{"name": a.name, "type": a.type, "is_valid": a.is_valid} for a in view_layer.aovs]}
+
+
 def in_view_layer(o, view_layer):
     """Whether object O is in the view layer (by identity: a linked object may share its
     name with a local one)."""
@@ -1643,6 +1651,7 @@ def main():
             "view_settings": rna_value(scene.view_settings, 0, "scene.view_settings"),
             "display_settings": rna_value(scene.display_settings, 0, "scene.display_settings"),
             "unit_settings": rna_value(scene.unit_settings, 0, "scene.unit_settings"),
+            "view_layer": view_layer_entry(view_layer),
         },
         "objects": [object_entry(o, view_layer) for o in data.objects],
         "meshes": meshes,

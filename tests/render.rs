@@ -17,6 +17,10 @@ const MAX_MEAN_REL: f64 = 0.01;
 
 /// Scenes that must pass.
 const ASSERTED: &[&str] = &[
+    // Shader AOVs (render/film/aov.rs): a Color and a Value AOV, one behind a pane under
+    // the Alpha Threshold (its values add), the world's, an unwritten one; every channel
+    // against Cycles' AOV passes by the same criteria as the image.
+    "aov",
     // A Solidify modifier evaluated natively: shell, rim and even-thickness normals.
     "solidify",
     // Issue 26's second part: Ico Sphere at Subdivisions 3, Edge Split, Mirror Bisect (64 px).
@@ -349,6 +353,86 @@ struct Row {
     spp: (f64, Option<f64>),
     /// The alpha channel's figures, for scenes whose Cycles film has alpha.
     alpha: Option<Alpha>,
+    /// Each shader AOV channel's figures (name, ratio, mean error, ours, Cycles A), for
+    /// scenes with AOV references (aov_a.exr, aov_b.exr).
+    aovs: Vec<(String, f64, f64, f64, f64)>,
+}
+
+/// The float channels of an EXR by name (each row by row from the top).
+fn read_exr_channels(p: &Path) -> Vec<(String, Vec<f32>)> {
+    use exr::prelude::*;
+    let img = read_all_flat_layers_from_file(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+    let mut out = Vec::new();
+    for layer in &img.layer_data {
+        for c in &layer.channel_data.list {
+            let data = match &c.sample_data {
+                FlatSamples::F32(v) => v.clone(),
+                FlatSamples::F16(v) => v.iter().map(|x| x.to_f32()).collect(),
+                FlatSamples::U32(v) => v.iter().map(|&x| x as f32).collect(),
+            };
+            out.push((c.name.to_string(), data));
+        }
+    }
+    out
+}
+
+/// Our AOV passes against Cycles' (seeds A and B) channel by channel, the channels named
+/// as blendsynth writes them (`aovs.exr`, Blender's multilayer EXR names).
+fn aov_figures(
+    dir: &Path,
+    scene: &Scene,
+    out: &blendsynth::render::RenderOutput,
+) -> Vec<(String, f64, f64, f64, f64)> {
+    let (a, b) = (
+        read_exr_channels(&dir.join("aov_a.exr")),
+        read_exr_channels(&dir.join("aov_b.exr")),
+    );
+    let images = blendsynth::label::passes::PassImages {
+        width: out.width,
+        height: out.height,
+        depth: &[],
+        distance: &[],
+        object_index: &[],
+        instance_id: &[],
+        material_index: &[],
+        normal: &[],
+        albedo: &[],
+        uv: &[],
+        instance_objects: &[],
+        aovs: out
+            .passes
+            .aovs
+            .iter()
+            .map(|a| blendsynth::label::passes::AovPlane {
+                name: &a.name,
+                channels: if a.color { 4 } else { 1 },
+                data: &a.data,
+            })
+            .collect(),
+        view_layer: &scene.file.scene.view_layer.name,
+    };
+    let ours = blendsynth::label::passes::aov_channels(&images).unwrap();
+    let mut names: Vec<&String> = ours.iter().map(|c| &c.0).collect();
+    let mut theirs: Vec<&String> = a.iter().map(|c| &c.0).collect();
+    names.sort();
+    theirs.sort();
+    assert_eq!(names, theirs, "{}: AOV channels", dir.display());
+    let grey = |v: &[f32]| v.iter().map(|&x| [x; 3]).collect::<Vec<_>>();
+    let find = |l: &[(String, Vec<f32>)], n: &str| grey(&l.iter().find(|c| c.0 == n).unwrap().1);
+    ours.iter()
+        .map(|(n, o)| {
+            let (o, ca, cb) = (grey(o), find(&a, n), find(&b, n));
+            let ratio = rmse(&o, &ca) / rmse(&cb, &ca).max(1e-12);
+            let (mo, ma) = (means(&o)[0], means(&ca)[0]);
+            (
+                n.clone(),
+                ratio,
+                (mo - ma).abs() / ma.abs().max(1e-6),
+                mo,
+                ma,
+            )
+        })
+        .collect()
 }
 
 struct Alpha {
@@ -415,6 +499,14 @@ fn evaluate(dir: &Path) -> Row {
     });
     let ratio = ratio.max(alpha.as_ref().map_or(0.0, |a| a.ratio));
     let worst_mean = worst_mean.max(alpha.as_ref().map_or(0.0, |a| a.mean_err));
+    // Shader AOVs, where Cycles wrote them: every channel by the same criteria.
+    let aovs = if dir.join("aov_a.exr").exists() {
+        aov_figures(dir, &scene, &out)
+    } else {
+        Vec::new()
+    };
+    let ratio = aovs.iter().map(|a| a.1).fold(ratio, f64::max);
+    let worst_mean = aovs.iter().map(|a| a.2).fold(worst_mean, f64::max);
     Row {
         name,
         ratio,
@@ -424,6 +516,7 @@ fn evaluate(dir: &Path) -> Row {
         seconds: out.stats.wall_seconds,
         spp,
         alpha,
+        aovs,
     }
 }
 
@@ -519,8 +612,15 @@ fn parity_with_cycles() {
                 )
             })
             .unwrap_or_default();
+        let aovs: String = r
+            .aovs
+            .iter()
+            .map(|(n, ratio, _, o, c)| {
+                format!("\n    AOV {n}: ratio {ratio:.3}, mean {o:.4} / {c:.4}")
+            })
+            .collect();
         println!(
-            "{:<16} {:>7.3} {:>7.2}%  {:<26} {:<26} {:>6.2}  {status}{spp}{alpha}",
+            "{:<16} {:>7.3} {:>7.2}%  {:<26} {:<26} {:>6.2}  {status}{spp}{alpha}{aovs}",
             r.name,
             r.ratio,
             100.0 * r.worst_mean,
@@ -1818,4 +1918,68 @@ fn unsupported_points_are_refused_by_name() {
     let scene = Scene::load(&dir).unwrap();
     let m = blendsynth::render::flow_refusal(&scene).unwrap();
     assert!(m.contains("\"Cloud\" has a point cloud"), "{m}");
+}
+
+/// `render --passes` writes the view layer's AOVs to aovs.exr (in either pass format),
+/// one float channel per AOV channel, named as Blender's multilayer EXR names them; a
+/// scene without AOVs writes no aovs.exr.
+#[test]
+fn aov_passes_are_written_with_blenders_names() {
+    let tmp = tempfile::tempdir().unwrap();
+    for (scene, format, expect) in [
+        ("aov", "png", true),
+        ("aov", "exr", true),
+        ("diffuse_point", "exr", false),
+    ] {
+        let dir = tmp.path().join(format!("{scene}_{format}"));
+        let st = std::process::Command::new(env!("CARGO_BIN_EXE_blendsynth"))
+            .args([
+                "render",
+                common::repo()
+                    .join("fixtures/render/scenes")
+                    .join(scene)
+                    .to_str()
+                    .unwrap(),
+                "--samples",
+                "2",
+                "--resolution",
+                "24x24",
+                "--pass-format",
+                format,
+                "--passes",
+                dir.to_str().unwrap(),
+                "-o",
+                tmp.path()
+                    .join(format!("{scene}_{format}.exr"))
+                    .to_str()
+                    .unwrap(),
+            ])
+            .status()
+            .unwrap();
+        assert!(st.success(), "{scene} {format}");
+        let file = dir.join("aovs.exr");
+        assert_eq!(file.exists(), expect, "{scene} {format}");
+        if !expect {
+            continue;
+        }
+        let mut names: Vec<String> = read_exr_channels(&file)
+            .into_iter()
+            .map(|(n, v)| {
+                assert_eq!(v.len(), 24 * 24, "{n}");
+                n
+            })
+            .collect();
+        names.sort();
+        assert_eq!(
+            names,
+            [
+                "ViewLayer.mask.X",
+                "ViewLayer.tint.A",
+                "ViewLayer.tint.B",
+                "ViewLayer.tint.G",
+                "ViewLayer.tint.R",
+                "ViewLayer.unused.X"
+            ]
+        );
+    }
 }

@@ -92,6 +92,46 @@ pub struct SceneSettings {
     pub display_settings: Rna,
     #[serde(default)]
     pub unit_settings: Rna,
+    /// The rendered view layer (absent in older exports: no AOVs).
+    #[serde(default)]
+    pub view_layer: ViewLayer,
+}
+
+/// The view layer a render writes: its shader AOVs and the Alpha Threshold.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ViewLayer {
+    #[serde(default)]
+    pub name: String,
+    #[serde(default = "half_f64")]
+    pub pass_alpha_threshold: f64,
+    #[serde(default)]
+    pub aovs: Vec<Aov>,
+}
+
+impl Default for ViewLayer {
+    fn default() -> ViewLayer {
+        ViewLayer {
+            name: "ViewLayer".into(),
+            pass_alpha_threshold: 0.5,
+            aovs: Vec::new(),
+        }
+    }
+}
+
+/// One of a view layer's shader AOVs (`view_layer.aovs`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Aov {
+    pub name: String,
+    /// "COLOR" or "VALUE".
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// False for a repeated name or one a built-in pass has: Cycles writes no pass.
+    #[serde(default = "yes")]
+    pub is_valid: bool,
+}
+
+fn half_f64() -> f64 {
+    0.5
 }
 
 fn one_i32() -> i32 {

@@ -603,6 +603,18 @@ pub struct Program {
     /// Cycles' emission estimate of the surface (Shader::estimate_emission): zero means
     /// the material never emits; its size decides whether emitters are light-sampled.
     pub emission_estimate: [f32; 3],
+    /// The AOV Outputs Cycles runs (naming a valid AOV of the view layer): after `run`
+    /// their values are in the stack, for the renderer's AOV passes.
+    pub aovs: Vec<AovWrite>,
+}
+
+/// An AOV Output node: the view-layer AOV it writes (index into the exported list) and
+/// where its value lands, the Color input for a colour AOV, else the Value input.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AovWrite {
+    pub aov: u32,
+    pub color: bool,
+    pub slot: Slot,
 }
 
 /// Where a material's true displacement lives in its program. Ops `..center_end`

@@ -3,6 +3,7 @@
 //! normal features (`denoise_features`) and optical flow (`flow`).
 
 pub mod adaptive;
+pub mod aov;
 pub mod denoise_features;
 pub mod filter;
 pub mod flow;

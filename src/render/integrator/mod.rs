@@ -86,6 +86,8 @@ pub struct Scene<'a> {
     pub local: &'a crate::render::shader_rays::LocalAccels,
     /// The materials' volumes (render/volume.rs).
     pub volumes: &'a crate::render::volume::Volumes,
+    /// The view layer's shader AOV passes (`film::aov`).
+    pub aovs: &'a crate::render::film::aov::Layout,
 }
 
 /// Per-thread scratch, reused across samples (no allocation per ray).
@@ -110,6 +112,10 @@ pub struct Scratch {
     /// The volumes the path being traced is inside, and its volume bounces so far.
     pub volume_stack: super::volume::Stack,
     pub volume_bounce: u32,
+    /// The AOV values of the sample `radiance` last traced (`film::aov::Layout`), and
+    /// whether a surface has ended its AOV writes (Cycles' PATH_RAY_SINGLE_PASS_DONE).
+    pub aov: Vec<f32>,
+    pub aov_done: bool,
 }
 
 impl Scratch {
@@ -126,6 +132,8 @@ impl Scratch {
             transparent: 0.0,
             volume_stack: Default::default(),
             volume_bounce: 0,
+            aov: Vec::new(),
+            aov_done: false,
         }
     }
 }
@@ -454,6 +462,9 @@ impl Scene<'_> {
         let st = &self.settings;
         scratch.features = Default::default();
         scratch.transparent = 0.0;
+        scratch.aov.clear();
+        scratch.aov.resize(self.aovs.stride, 0.0);
+        scratch.aov_done = false;
         self.volume_stack_init(org, scratch);
         scratch.volume_bounce = 0;
         let mut path = Path::camera(org, dir, tmin, tmax, scratch.ray_dp, scratch.ray_dd);
@@ -524,6 +535,11 @@ impl Scene<'_> {
             // guides there).
             if from_sss.is_none() {
                 scratch.features.surface(&scratch.lobes);
+                // Cycles' film_write_data_passes: a surface opaque enough ends the
+                // sample's AOV writes.
+                if path.transparent_bg && self.aovs.ends_primary(scratch.lobes.transparent) {
+                    scratch.aov_done = true;
+                }
             }
             let u_bsdf = rng.get4(index, path.set);
             let u_light = rng.get4(index, path.set + 1);
@@ -650,6 +666,13 @@ impl Scene<'_> {
         let d = path.d;
         let w = self.world_mis_weight(d, path.prev_singular, path.prev_pdf, path.mis_viewer());
         let bg = scale(mul(path.throughput, self.background_toward(d, scratch)), w);
+        // The world's AOV Outputs, run with it (Cycles evaluates the background shader
+        // with the render buffer).
+        if path.transparent_bg && !scratch.aov_done {
+            if let (Some(world), Some(stack)) = (self.world, scratch.stacks.last()) {
+                self.write_aovs(&world.program, stack, &mut scratch.aov);
+            }
+        }
         scratch.features.add_emission(bg);
         let c = clamp_contrib(bg, clamp);
         if finite(c) {
@@ -711,6 +734,16 @@ impl Scene<'_> {
             return true;
         }
         self.shade_path(hit, wo, path, rng, index, scratch);
+        // Cycles runs the AOV Outputs with the shader, before the holdout.
+        if path.transparent_bg && !scratch.aov_done {
+            if let Some(p) = hit
+                .material
+                .and_then(|mi| self.materials[mi].program.as_ref())
+            {
+                let stack = &scratch.stacks[hit.material.unwrap_or(0)];
+                self.write_aovs(p, stack, &mut scratch.aov);
+            }
+        }
         // A holdout object seen by the camera (directly or through transparent
         // surfaces: Cycles' PATH_RAY_TRANSPARENT_BACKGROUND) keeps only its
         // transparency; the rest is a hole in the film.
@@ -734,6 +767,25 @@ impl Scene<'_> {
             }
         }
         true
+    }
+
+    /// Adds the values of program `p`'s AOV Outputs (in `stack` after it ran) to the
+    /// sample's AOV values, as Cycles' film_write_aov_pass_value / _color do.
+    fn write_aovs(&self, p: &crate::shader::Program, stack: &[f32], out: &mut [f32]) {
+        for w in &p.aovs {
+            let Some(pass) = self.aovs.pass(w.aov) else {
+                continue;
+            };
+            let (s, o) = (w.slot as usize, pass.offset);
+            if w.color {
+                for k in 0..3 {
+                    out[o + k] += stack[s + k];
+                }
+                out[o + 3] += 1.0;
+            } else {
+                out[o] += stack[s];
+            }
+        }
     }
 
     /// Emission of the surface the ray found, shared by MIS with light sampling on the

@@ -25,9 +25,10 @@ use crate::nodes::{Support, IGNORED_BY_CYCLES, STRUCTURAL};
 use super::super::bump::{BumpSettings, MapSpace};
 use super::super::bump_graph::{self, Schedule};
 use super::{
-    dimensions, floats, kind_of, linked, mode, prop, prop_bool, prop_str, Closure, CompileError,
-    Compiler, Kind, Op,
+    aov_index, dimensions, floats, kind_of, linked, mode, prop, prop_bool, prop_str, Closure,
+    CompileError, Compiler, Kind, Op,
 };
+use crate::shader::program::AovWrite;
 use Kind::{Color as C, Float as F, Vector as V};
 
 /// One node type's compile step: node `i` of the compiler's graph into ops, output slots
@@ -87,7 +88,7 @@ const INFO_ON_MESH: &str =
 const HAIR_INFO: &str =
     "every output as Cycles 4.5 computes it on hair curves (svm_node_hair_info, geom/curve.h: intercept and length from the keys, thickness, tangent normal, random by curve index), zero on meshes; Cycles parity scene hair_info in tests/render.rs";
 const AOV: &str =
-    "Cycles writes it to its AOV pass only, never the image: nothing to evaluate (blendsynth writes no AOV passes)";
+    "written to the view layer's AOV pass it names (render/film/aov.rs, Cycles' svm/aov.h): Color or Value by the AOV's type, on camera rays and through transparent bounces until a surface reaches the Alpha Threshold, in materials and the world; a name the view layer lacks writes nothing; `render --passes` writes aovs.exr with Blender's channel names; Cycles parity scene aov in tests/render.rs (every channel); inside a node group a compile error naming the group node";
 const LIGHT_OUTPUT: &str =
     "the output of a light's node tree (shader::compile_light, evaluated at every light sample by render/light/shader.rs; nodes that read what a light sample lacks are errors naming the light and node); Cycles parity scene light_ies in tests/render.rs; in a material Cycles renders only the Material Output (fixtures/bake/nodes, case freestyle_and_light_nodes)";
 const METALLIC: &str =
@@ -472,9 +473,20 @@ fn material_output(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(
     Ok(())
 }
 
-/// AOV Output has no outputs, so no material output reaches it; Cycles evaluates it
-/// only into its AOV pass.
-fn aov_output(_: &mut Compiler<'_, '_>, _: usize, _: &Schedule) -> Result<(), CompileError> {
+/// AOV Output: its input for the view-layer AOV it names (Color for a colour AOV, else
+/// Value), read by the renderer after the program runs (Cycles' svm_node_aov_color /
+/// svm_node_aov_value). Only nodes naming a valid AOV reach the graph (`aov_outputs`).
+fn aov_output(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let Some((aov, color)) = c.scene.and_then(|s| aov_index(s, n.node)) else {
+        return Ok(());
+    };
+    let slot = if color {
+        c.input(n, "Color", C)?
+    } else {
+        c.input(n, "Value", F)?
+    };
+    c.aovs.push(AovWrite { aov, color, slot });
     Ok(())
 }
 
