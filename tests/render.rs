@@ -21,6 +21,9 @@ const ASSERTED: &[&str] = &[
     // the Alpha Threshold (its values add), the world's, an unwritten one; every channel
     // against Cycles' AOV passes by the same criteria as the image.
     "aov",
+    // Point Info on point clouds (Geometry Nodes points and a scaled point cloud object):
+    // the centre, the world-space radius, the random of the point's index in its cloud.
+    "point_info",
     // A Solidify modifier evaluated natively: shell, rim and even-thickness normals.
     "solidify",
     // Issue 26's second part: Ico Sphere at Subdivisions 3, Edge Split, Mirror Bisect (64 px).
@@ -1879,23 +1882,6 @@ fn unsupported_points_are_refused_by_name() {
     let (dir, base) = fixture_json("points");
     let scene = assert_renders(&dir, &base);
     let opts = check_opts();
-    // A Point Info node in the points' material (its values on points are not carried).
-    refused_alike(
-        &dir,
-        &base,
-        &|j| {
-            let ms = j["materials"].as_array_mut().unwrap();
-            let m = ms.iter_mut().find(|m| m["name"] == "Bead").unwrap();
-            let nodes = m["node_tree"]["nodes"].as_array_mut().unwrap();
-            let mut info = nodes[0].clone();
-            info["name"] = "Point Info".into();
-            info["bl_idname"] = "ShaderNodePointInfo".into();
-            info["inputs"] = serde_json::json!([]);
-            info["outputs"] = serde_json::json!([]);
-            nodes.push(info);
-        },
-        &["\"Points\"", "material \"Bead\"", "Point Info"],
-    );
     // A non-uniform scale: Cycles renders the points as ellipsoids.
     refused_alike(
         &dir,

@@ -679,6 +679,7 @@ fn push_points(
     }
     let mut points = crate::render::points::object_points(pts, &to_world);
     points.slot = slots.to_vec();
+    points.point_index = crate::render::points::index_in_cloud(slots);
     // Generated spans the points' object-space bounds, whatever the mesh's texture space.
     push_prims(
         instances,

@@ -763,7 +763,7 @@ fn prepare(
         }
     }
     let materials = integrator::shade::compile_all(scene, &used)?;
-    points::check(scene, &geo, &materials)?;
+    points::check(&geo, &materials)?;
     curves::check(scene, &geo, &materials)?;
     build::bind_attributes(&mut geo, &materials)?;
     if displace::apply(&mut geo, &materials) > 0 {

@@ -77,6 +77,20 @@ pub struct ShadingPoint {
     pub undisplaced: Option<Undisplaced>,
     /// What the Hair Info node reads: zero everywhere but on hair curves.
     pub hair: HairPoint,
+    /// What the Point Info node reads: zero everywhere but on point clouds.
+    pub point: PointPoint,
+}
+
+/// A point-cloud hit as Cycles' Point Info node reads it (svm_node_point_info,
+/// geom/point.h).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PointPoint {
+    /// The point's centre in world space (point_position).
+    pub position: Vec3,
+    /// Its radius in world space (point_radius).
+    pub radius: f32,
+    /// hash_uint2_to_float(point index in its cloud, 0) (ATTR_STD_POINT_RANDOM).
+    pub random: f32,
 }
 
 /// A hair hit as Cycles' Hair Info node reads it (svm_node_hair_info, geom/curve.h).

@@ -340,6 +340,11 @@ pub enum Op {
     HairInfo {
         dst: [Slot; 6],
     },
+    /// Point Info's outputs from the shading point's `point` (position (3 slots),
+    /// radius, random).
+    PointInfo {
+        dst: [Slot; 3],
+    },
     /// Ambient Occlusion (svm/ao.h), traced through the `Trace` the program runs with
     /// (`inside` turns the normal around before tracing).
     AmbientOcclusion {
@@ -1206,6 +1211,12 @@ impl Program {
                     s[dst[3] as usize] = h.thickness;
                     put3(s, dst[4], h.tangent_normal);
                     s[dst[5] as usize] = h.random;
+                }
+                Op::PointInfo { dst } => {
+                    let p = &sp.point;
+                    put3(s, dst[0], p.position);
+                    s[dst[1] as usize] = p.radius;
+                    s[dst[2] as usize] = p.random;
                 }
                 Op::AmbientOcclusion {
                     color,

@@ -359,6 +359,14 @@ impl Scene<'_> {
             object_position: to_object.point(p),
             object_normal: normalize(Affine::normal_by_inverse(to_world, n)),
             generated: inst.generated(to_object.point(center)),
+            point: crate::shader::point::PointPoint {
+                position: center,
+                radius: k[3],
+                random: crate::nodes::random::hash_to_float2(
+                    c.point_index.get(r.tri as usize).copied().unwrap_or(r.tri),
+                    0,
+                ),
+            },
             ..Default::default()
         };
         // Cycles gives points no parametric coordinates (sd->u = sd->v = 0).

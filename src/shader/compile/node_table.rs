@@ -85,6 +85,8 @@ const PARTICLE_INFO: &str =
     "on a mesh not instanced by particles, Cycles' dummy particle (all zero, Random the hash of index 0), Cycles' EMIT bakes in tests/bake.rs; in a scene with a particle system a compile error (particle instances are frozen meshes without their particle data)";
 const INFO_ON_MESH: &str =
     "on a mesh (the only primitive blendsynth renders; hair curves, point clouds and volumes are refused) every output is zero as in Cycles, Cycles' EMIT bakes in tests/bake.rs";
+const POINT_INFO: &str =
+    "every output as Cycles 4.5 computes it on point clouds (svm_node_point_info, geom/point.h: the point's world-space centre and radius, random by the point's index in its cloud, as blender/pointcloud.cpp makes ATTR_STD_POINT_RANDOM), zero on meshes and hair; Cycles parity scene point_info in tests/render.rs";
 const HAIR_INFO: &str =
     "every output as Cycles 4.5 computes it on hair curves (svm_node_hair_info, geom/curve.h: intercept and length from the keys, thickness, tangent normal, random by curve index), zero on meshes; Cycles parity scene hair_info in tests/render.rs";
 const AOV: &str =
@@ -148,7 +150,7 @@ pub const NODES: &[ShaderNode] = &[
     node("ShaderNodeAmbientOcclusion", ambient_occlusion, RAY_TRACED),
     node("ShaderNodeBevel", bevel, RAY_TRACED),
     node("ShaderNodeParticleInfo", info_on_mesh, PARTICLE_INFO),
-    node("ShaderNodePointInfo", info_on_mesh, INFO_ON_MESH),
+    node("ShaderNodePointInfo", point_info, POINT_INFO),
     node("ShaderNodeHairInfo", hair_info, HAIR_INFO),
     node("ShaderNodeVolumeInfo", info_on_mesh, INFO_ON_MESH),
     // Output
@@ -448,6 +450,23 @@ fn hair_info(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), Com
             ("Thickness", dst[3], F),
             ("Tangent Normal", dst[4], V),
             ("Random", dst[5], F),
+        ],
+    );
+    Ok(())
+}
+
+/// Point Info: the shading point's point-cloud values (zero off points, as in Cycles).
+fn point_info(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let dst = [V, F, F].map(|k| c.alloc(k));
+    c.ops.push(Op::PointInfo { dst });
+    c.outputs(
+        i,
+        n,
+        &[
+            ("Position", dst[0], V),
+            ("Radius", dst[1], F),
+            ("Random", dst[2], F),
         ],
     );
     Ok(())
