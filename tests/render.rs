@@ -24,6 +24,12 @@ const ASSERTED: &[&str] = &[
     // Point Info on point clouds (Geometry Nodes points and a scaled point cloud object):
     // the centre, the world-space radius, the random of the point's index in its cloud.
     "point_info",
+    // Particle Info on objects a particle system instances (the realised instances'
+    // particle record: index, random, age, lifetime, location, size, velocities).
+    "particle_info",
+    // Generic attributes on Geometry Nodes points (a Float and a Color on the point
+    // domain, read by Attribute nodes).
+    "point_attributes",
     // A Solidify modifier evaluated natively: shell, rim and even-thickness normals.
     "solidify",
     // Issue 26's second part: Ico Sphere at Subdivisions 3, Edge Split, Mirror Bisect (64 px).
@@ -1968,4 +1974,122 @@ fn aov_passes_are_written_with_blenders_names() {
             ]
         );
     }
+}
+
+/// Particle Info reads each realised instance's particle record; an export older than the
+/// record is refused by name rather than rendered with Cycles' dummy particle.
+#[test]
+fn particle_info_needs_the_particle_record() {
+    let (dir, base) = fixture_json("particle_info");
+    assert_renders(&dir, &base);
+    refused_alike(
+        &dir,
+        &base,
+        &|j| {
+            for e in j["evaluated"].as_array_mut().unwrap() {
+                if let Some(is) = e["realized"]["instances"].as_array_mut() {
+                    for i in is {
+                        i.as_object_mut().unwrap().remove("particle");
+                    }
+                }
+            }
+        },
+        &["Particle Info", "\"Emitter\"", "convert the .blend again"],
+    );
+}
+
+/// An AOV Output inside a node group (naming a valid AOV) is refused naming the group
+/// node; one naming an AOV the view layer lacks is left out, as Cycles drops it.
+#[test]
+fn aov_outputs_in_groups_are_refused_by_name() {
+    let (dir, base) = fixture_json("aov");
+    assert_renders(&dir, &base);
+    let with_group = |aov: &str| {
+        let aov = aov.to_string();
+        move |j: &mut serde_json::Value| {
+            let ms = j["materials"].as_array_mut().unwrap();
+            let m = ms.iter_mut().find(|m| m["name"] == "Blue").unwrap();
+            let nodes = m["node_tree"]["nodes"].as_array_mut().unwrap();
+            let mut out = nodes
+                .iter()
+                .find(|n| n["bl_idname"] == "ShaderNodeOutputAOV")
+                .unwrap()
+                .clone();
+            out["properties"]["aov_name"] = aov.clone().into();
+            let mut group = out.clone();
+            group["name"] = "Wrapped".into();
+            group["bl_idname"] = "ShaderNodeGroup".into();
+            group["node_tree"] = "AOVGroup".into();
+            group["inputs"] = serde_json::json!([]);
+            group["outputs"] = serde_json::json!([]);
+            nodes.push(group);
+            j["node_groups"]
+                .as_array_mut()
+                .unwrap()
+                .push(serde_json::json!({
+                    "name": "AOVGroup", "bl_idname": "ShaderNodeTree", "interface": [],
+                    "nodes": [out], "links": []
+                }));
+        }
+    };
+    refused_alike(
+        &dir,
+        &base,
+        &with_group("mask"),
+        &[
+            "material \"Blue\"",
+            "node \"Wrapped\"",
+            "AOV Output inside a node group",
+        ],
+    );
+    let mut json = base.clone();
+    with_group("nowhere")(&mut json);
+    let scene = Scene::from_json(&dir, json.to_string().as_bytes()).unwrap();
+    assert!(blendsynth::render::check(&scene, &check_opts(), &[]).is_ok());
+}
+
+/// Attribute reads on points: generic attributes of points blendsynth evaluates render
+/// (scene point_attributes); "radius" and "position", and any read on exported (frozen)
+/// points, which carry no attributes, are refused by name.
+#[test]
+fn point_attribute_reads_blendsynth_cannot_carry_are_refused() {
+    let (dir, base) = fixture_json("point_attributes");
+    assert_renders(&dir, &base);
+    let tinted = base["materials"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["name"] == "Tinted")
+        .unwrap()
+        .clone();
+    refused_alike(
+        &dir,
+        &base,
+        &|j| {
+            let ms = j["materials"].as_array_mut().unwrap();
+            let m = ms.iter_mut().find(|m| m["name"] == "Tinted").unwrap();
+            for n in m["node_tree"]["nodes"].as_array_mut().unwrap() {
+                if n["properties"]["attribute_name"] == "tint" {
+                    n["properties"]["attribute_name"] = "radius".into();
+                }
+            }
+        },
+        &[
+            "\"Points\"",
+            "material \"Tinted\"",
+            "radius",
+            "does not carry",
+        ],
+    );
+    let (dir, base) = fixture_json("pointcloud_object");
+    refused_alike(
+        &dir,
+        &base,
+        &|j| {
+            let ms = j["materials"].as_array_mut().unwrap();
+            let m = ms.iter_mut().find(|m| m["name"] == "Grain").unwrap();
+            m["node_tree"] = tinted["node_tree"].clone();
+        },
+        &["\"Cloud\"", "material \"Grain\"", "does not carry"],
+    );
 }

@@ -164,6 +164,9 @@ pub struct ObjectInfo {
     pub random: f32,
     /// World to object transform, rows of an affine 3x4 matrix.
     pub world_to_object: [[f32; 4]; 3],
+    /// The particle an instance stands for (Particle Info); None: Cycles' dummy particle
+    /// (every value zero, index 0).
+    pub particle: Option<crate::scene::format::Particle>,
 }
 
 impl Default for ObjectInfo {
@@ -178,6 +181,7 @@ impl Default for ObjectInfo {
                 [0.0, 1.0, 0.0, 0.0],
                 [0.0, 0.0, 1.0, 0.0],
             ],
+            particle: None,
         }
     }
 }

@@ -371,6 +371,15 @@ impl Scene<'_> {
         };
         // Cycles gives points no parametric coordinates (sd->u = sd->v = 0).
         self.fill_context(&mut sp, inst, wo, n, false, 0.0, 0.0);
+        // Point attributes: one value per point, each point its own "curve".
+        let point = r.tri as usize;
+        if let Some(Some(bound)) = c
+            .slot
+            .get(point)
+            .and_then(|&s| inst.attributes.get(s as usize))
+        {
+            bound.fill_curve(point, point, 0.0, &inst.instancer_values, &mut sp);
+        }
         sp.transform = crate::shader::bump::ObjectTransform {
             to_world: to_world.m,
             to_object: to_object.m,

@@ -82,9 +82,9 @@ const WIREFRAME: &str =
 const RAY_TRACED: &str =
     "ray-traced at the shading point (shader/trace.rs, render/shader_rays.rs: Cycles' svm/ao.h and svm/bevel.h; 1 and the shading normal where Cycles cannot trace: displacement, shadow and light shading, the world); Cycles parity scenes in tests/render.rs (ambient_occlusion*, bevel*); AO's Distance 0 (the world's AO distance) and `bake` of such a material are errors naming the node";
 const PARTICLE_INFO: &str =
-    "on a mesh not instanced by particles, Cycles' dummy particle (all zero, Random the hash of index 0), Cycles' EMIT bakes in tests/bake.rs; in a scene with a particle system a compile error (particle instances are frozen meshes without their particle data)";
+    "on an object a particle system instances, its particle as Cycles' sync_dupli_particle reads it (the realised instance's particle record: index, Random the hash of the index, age, lifetime, location, size, velocity, angular velocity at the frame), Cycles parity scene particle_info in tests/render.rs; elsewhere and on child particles Cycles' dummy particle (all zero, Random the hash of index 0), Cycles' EMIT bakes in tests/bake.rs; an export without the record is a compile error naming the object";
 const INFO_ON_MESH: &str =
-    "on a mesh (the only primitive blendsynth renders; hair curves, point clouds and volumes are refused) every output is zero as in Cycles, Cycles' EMIT bakes in tests/bake.rs";
+    "on meshes, hair and points every output is zero as in Cycles, Cycles' EMIT bakes in tests/bake.rs";
 const POINT_INFO: &str =
     "every output as Cycles 4.5 computes it on point clouds (svm_node_point_info, geom/point.h: the point's world-space centre and radius, random by the point's index in its cloud, as blender/pointcloud.cpp makes ATTR_STD_POINT_RANDOM), zero on meshes and hair; Cycles parity scene point_info in tests/render.rs";
 const HAIR_INFO: &str =
@@ -149,7 +149,7 @@ pub const NODES: &[ShaderNode] = &[
     node("ShaderNodeWireframe", wireframe, WIREFRAME),
     node("ShaderNodeAmbientOcclusion", ambient_occlusion, RAY_TRACED),
     node("ShaderNodeBevel", bevel, RAY_TRACED),
-    node("ShaderNodeParticleInfo", info_on_mesh, PARTICLE_INFO),
+    node("ShaderNodeParticleInfo", particle_info, PARTICLE_INFO),
     node("ShaderNodePointInfo", point_info, POINT_INFO),
     node("ShaderNodeHairInfo", hair_info, HAIR_INFO),
     node("ShaderNodeVolumeInfo", info_on_mesh, INFO_ON_MESH),
@@ -401,36 +401,55 @@ fn bevel(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), Compile
     Ok(())
 }
 
-/// Particle, Point, Curves and Volume Info on a triangle mesh, as Cycles evaluates them
-/// there: the point, curve and volume data are absent (zero), and the particle is Cycles'
-/// dummy particle 0, whose Random is the hash of its index.
+/// Point, Curves and Volume Info on a triangle mesh, as Cycles evaluates them there: the
+/// point, curve and volume data are absent (zero).
 fn info_on_mesh(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
     let n = &c.g.nodes[i];
-    let particle = n.node.bl_idname == "ShaderNodeParticleInfo";
-    if particle {
-        if let Some(o) = c.scene.and_then(|s| {
-            s.file
-                .objects
-                .iter()
-                .find(|o| o.modifiers.iter().any(|m| m.kind == "PARTICLE_SYSTEM"))
-        }) {
-            return Err(CompileError(format!(
-                "node {:?}: Particle Info in a scene with a particle system (object {:?}) is not supported yet: its particle instances are rendered without their particle data",
-                n.path, o.name
-            )));
-        }
-    }
     let mut slots = Vec::new();
     for o in &n.node.outputs {
         let kind = kind_of(&o.kind).unwrap_or(F);
-        let v = if particle && o.identifier == "Random" {
-            crate::nodes::random::hash_to_float2(0, 0)
-        } else {
-            0.0
-        };
-        let s = c.constant(kind, [v; 3]);
+        let s = c.constant(kind, [0.0; 3]);
         slots.push((o.identifier.as_str(), s, kind));
     }
+    c.outputs(i, n, &slots);
+    Ok(())
+}
+
+/// Particle Info: the values of the particle the object stands for (its realised
+/// instance's record), Cycles' dummy particle elsewhere. An export older than the record
+/// is refused where particle systems instance objects.
+fn particle_info(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    if let Some(e) = c.scene.and_then(|s| {
+        s.file.evaluated.iter().find(|e| {
+            e.realized
+                .as_ref()
+                .is_some_and(|r| r.instances.iter().any(|i| i.particle.is_none()))
+        })
+    }) {
+        return Err(CompileError(format!(
+            "node {:?}: Particle Info, and the export of object {:?} predates the particle record of its instances: convert the .blend again",
+            n.path, e.object
+        )));
+    }
+    let kinds = [F, F, F, F, V, F, V, V];
+    let dst = kinds.map(|k| c.alloc(k));
+    c.ops.push(Op::ParticleInfo { dst });
+    let names = [
+        "Index",
+        "Random",
+        "Age",
+        "Lifetime",
+        "Location",
+        "Size",
+        "Velocity",
+        "Angular Velocity",
+    ];
+    let slots: Vec<(&str, u32, Kind)> = names
+        .iter()
+        .zip(dst.iter().zip(kinds))
+        .map(|(n, (d, k))| (*n, *d, k))
+        .collect();
     c.outputs(i, n, &slots);
     Ok(())
 }
