@@ -2093,3 +2093,65 @@ fn point_attribute_reads_blendsynth_cannot_carry_are_refused() {
         &["\"Cloud\"", "material \"Grain\"", "does not carry"],
     );
 }
+
+/// A dataset with `[labels] aovs = true` writes each frame's AOV passes to
+/// aovs/SPLIT/N.exr, the same channels (and values) as `render` gives at those
+/// settings; asking for them in a scene without AOVs is an error.
+#[test]
+fn dataset_writes_the_aov_passes() {
+    use blendsynth::dataset::{generate, renderer::path_tracer, GenerateOptions, Spec};
+    let spec = |labels: &str| {
+        Spec::parse(&format!(
+            "[render]\nresolution = [24, 24]\nsamples = 2\ndenoise = false\n[labels]\n{labels}\n"
+        ))
+        .unwrap()
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = Scene::load(&common::repo().join("fixtures/render/scenes/aov")).unwrap();
+    let r = path_tracer(&scene).unwrap();
+    let out = tmp.path().join("a");
+    generate(
+        &scene,
+        &spec("aovs = true"),
+        r.as_ref(),
+        &out,
+        &GenerateOptions::default(),
+    )
+    .unwrap();
+    let files: Vec<_> = std::fs::read_dir(out.join("aovs/train"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(files.len(), 1, "{files:?}");
+    let mut names: Vec<String> = read_exr_channels(&files[0])
+        .into_iter()
+        .map(|(n, v)| {
+            assert_eq!(v.len(), 24 * 24, "{n}");
+            n
+        })
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "ViewLayer.mask.X",
+            "ViewLayer.tint.A",
+            "ViewLayer.tint.B",
+            "ViewLayer.tint.G",
+            "ViewLayer.tint.R",
+            "ViewLayer.unused.X"
+        ]
+    );
+    let plain = Scene::load(&common::repo().join("fixtures/render/scenes/diffuse_point")).unwrap();
+    let e = generate(
+        &plain,
+        &spec("aovs = true"),
+        r.as_ref(),
+        &tmp.path().join("b"),
+        &GenerateOptions::default(),
+    )
+    .err()
+    .map(|e| e.to_string())
+    .unwrap_or_default();
+    assert!(e.contains("no shader AOVs"), "{e}");
+}

@@ -119,6 +119,17 @@ pub struct Scratch {
 }
 
 impl Scratch {
+    /// Clears what a camera sample leaves besides its colour (guides, transparency, AOV
+    /// values with `aov_stride` floats, volume bounces) before `radiance` traces it.
+    fn start_sample(&mut self, aov_stride: usize) {
+        self.features = Default::default();
+        self.transparent = 0.0;
+        self.aov.clear();
+        self.aov.resize(aov_stride, 0.0);
+        self.aov_done = false;
+        self.volume_bounce = 0;
+    }
+
     pub fn new(n_materials: usize) -> Scratch {
         Scratch {
             stacks: vec![Vec::new(); n_materials + 1],
@@ -477,13 +488,8 @@ impl Scene<'_> {
         scratch: &mut Scratch,
     ) -> V3 {
         let st = &self.settings;
-        scratch.features = Default::default();
-        scratch.transparent = 0.0;
-        scratch.aov.clear();
-        scratch.aov.resize(self.aovs.stride, 0.0);
-        scratch.aov_done = false;
+        scratch.start_sample(self.aovs.stride);
         self.volume_stack_init(org, scratch);
-        scratch.volume_bounce = 0;
         let mut path = Path::camera(org, dir, tmin, tmax, scratch.ray_dp, scratch.ray_dd);
         loop {
             let from_sss = path.sss_exit.take();
@@ -552,11 +558,7 @@ impl Scene<'_> {
             // guides there).
             if from_sss.is_none() {
                 scratch.features.surface(&scratch.lobes);
-                // Cycles' film_write_data_passes: a surface opaque enough ends the
-                // sample's AOV writes.
-                if path.transparent_bg && self.aovs.ends_primary(scratch.lobes.transparent) {
-                    scratch.aov_done = true;
-                }
+                self.end_aov_writes(&path, scratch);
             }
             let u_bsdf = rng.get4(index, path.set);
             let u_light = rng.get4(index, path.set + 1);
@@ -784,6 +786,14 @@ impl Scene<'_> {
             }
         }
         true
+    }
+
+    /// Cycles' film_write_data_passes: a surface the camera sees that is opaque enough
+    /// ends its sample's AOV writes (PATH_RAY_SINGLE_PASS_DONE).
+    fn end_aov_writes(&self, path: &Path, scratch: &mut Scratch) {
+        if path.transparent_bg && self.aovs.ends_primary(scratch.lobes.transparent) {
+            scratch.aov_done = true;
+        }
     }
 
     /// Adds the values of program `p`'s AOV Outputs (in `stack` after it ran) to the
