@@ -120,17 +120,18 @@ pub fn check(
                 Some("true displacement".to_string())
             } else if p.emission_estimate.iter().any(|&e| e != 0.0) {
                 Some("emission".to_string())
-            } else if let Some(b) = p.bsdfs.iter().find(|b| {
-                matches!(
-                    b.bl_idname.as_str(),
-                    "ShaderNodeBsdfHair"
-                        | "ShaderNodeBsdfHairPrincipled"
-                        | "ShaderNodeSubsurfaceScattering"
-                )
-            }) {
-                Some(format!("node {}", b.bl_idname))
             } else {
-                None
+                p.bsdfs
+                    .iter()
+                    .find(|b| {
+                        matches!(
+                            b.bl_idname.as_str(),
+                            "ShaderNodeBsdfHair"
+                                | "ShaderNodeBsdfHairPrincipled"
+                                | "ShaderNodeSubsurfaceScattering"
+                        )
+                    })
+                    .map(|b| format!("node {}", b.bl_idname))
             };
             if let Some(why) = why {
                 return Err(crate::render::RenderError(format!(
