@@ -21,6 +21,7 @@ const ASSERTED: &[&str] = &[
     // the Alpha Threshold (its values add), the world's, an unwritten one; every channel
     // against Cycles' AOV passes by the same criteria as the image.
     "aov",
+    "aov_transparent",
     // Point Info on point clouds (Geometry Nodes points and a scaled point cloud object):
     // the centre, the world-space radius, the random of the point's index in its cloud.
     "point_info",
