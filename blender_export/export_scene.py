@@ -761,7 +761,7 @@ def evaluated_meshes(objs, depsgraph):
             io.to_mesh_clear()
         rel = inverse[owner] @ np.array(inst.matrix_world, dtype=np.float64)
         parts[owner].append(transform_part(part, rel))
-        realized_parts[owner].append(realized_instance(part[0], rel, inst, io, texspace))
+        realized_parts[owner].append(realized_instance(part[0], rel, inst, io, texspace, particle_state(inst)))
     for name, iv in inst_values.items():
         if iv is not None and realized_parts[name]:
             # The instancer's own geometry reads the object's value (no instance layer).
@@ -771,17 +771,36 @@ def evaluated_meshes(objs, depsgraph):
     return {name: (concat_meshes(p), realized[name], mats[name], uvinfo[name]) for name, p in parts.items()}
 
 
-def realized_instance(counts, rel, inst, io, texspace):
+def realized_instance(counts, rel, inst, io, texspace, particle):
     """What Cycles would give an instance realised into its instancer's evaluated mesh,
     which it renders as an object of its own: the part's element counts (parts follow
-    each other in every domain), its transform in the instancer's space, and its Object
+    each other in every domain), its transform in the instancer's space, its Object
     Info values (DepsgraphObjectInstance.random_id, the instanced object's colour and pass
-    index) and mesh texture space (Generated)."""
+    index), mesh texture space (Generated) and particle (`particle_state`)."""
     return {"counts": list(map(int, counts)), "matrix": [list(map(float, r)) for r in rel],
             "random_id": int(inst.random_id) & 0xFFFFFFFF, "object": io.original.name,
             "color": vec(io.color), "pass_index": int(io.pass_index),
             "texspace_location": texspace[0] if texspace else None,
-            "texspace_size": texspace[1] if texspace else None}
+            "texspace_size": texspace[1] if texspace else None,
+            "particle": particle}
+
+
+def particle_state(inst):
+    """The particle an instance stands for, as Cycles' sync_dupli_particle reads it for
+    Particle Info: its index among the system's particles (persistent_id[0]), age
+    (frame_current_final - birth time), lifetime, location, size, velocity and angular
+    velocity at the frame. None when no particle system made the instance, or for a
+    child particle (Cycles then gives the instance its dummy particle)."""
+    psys = inst.particle_system
+    if psys is None:
+        return None
+    i = int(inst.persistent_id[0])
+    if i < 0 or i >= len(psys.particles):
+        return None
+    pa = psys.particles[i]
+    return {"index": i, "age": bpy.context.scene.frame_current_final - pa.birth_time,
+            "lifetime": pa.lifetime, "location": vec(pa.location), "size": pa.size,
+            "velocity": vec(pa.velocity), "angular_velocity": vec(pa.angular_velocity)}
 
 
 def hair_strands(o, depsgraph, path):
@@ -1318,6 +1337,14 @@ def render_layer_objects(view_layer):
     return found
 
 
+def view_layer_entry(view_layer):
+    """The rendered view layer's shader AOVs (Cycles writes one pass per valid AOV) and
+    the alpha threshold Cycles' data and AOV passes stop at."""
+    return {"name": view_layer.name,
+            "pass_alpha_threshold": view_layer.pass_alpha_threshold,
+            "aovs": [{"name": a.name, "type": a.type, "is_valid": a.is_valid} for a in view_layer.aovs]}
+
+
 def in_view_layer(o, view_layer):
     """Whether object O is in the view layer (by identity: a linked object may share its
     name with a local one)."""
@@ -1771,6 +1798,7 @@ def main():
             "view_settings": rna_value(scene.view_settings, 0, "scene.view_settings"),
             "display_settings": rna_value(scene.display_settings, 0, "scene.display_settings"),
             "unit_settings": rna_value(scene.unit_settings, 0, "scene.unit_settings"),
+            "view_layer": view_layer_entry(view_layer),
         },
         "objects": [object_entry(o, view_layer) for o in data.objects],
         "meshes": meshes,

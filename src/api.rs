@@ -238,6 +238,8 @@ pub fn semantic(out: &RenderOutput, classes: &crate::label::ClassMap) -> Vec<u32
         albedo: &p.albedo,
         uv: &p.uv,
         instance_objects: &objects,
+        aovs: Vec::new(),
+        view_layer: "",
     };
     crate::label::passes::semantic(&images, classes)
 }

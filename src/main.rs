@@ -469,6 +469,16 @@ fn run_render(a: RenderArgs) -> Result<()> {
             albedo: &p.albedo,
             uv: &p.uv,
             instance_objects: &objects,
+            aovs: p
+                .aovs
+                .iter()
+                .map(|a| blendsynth::label::passes::AovPlane {
+                    name: &a.name,
+                    channels: if a.color { 4 } else { 1 },
+                    data: &a.data,
+                })
+                .collect(),
+            view_layer: &scene.file.scene.view_layer.name,
         };
         let format = if a.pass_format == PassFormatArg::Png {
             PassFormat::Png

@@ -94,6 +94,7 @@ impl FrameRenderer for SquaresRenderer {
                 depth: None,
                 normal: None,
                 instances,
+                aov_channels: Vec::new(),
             },
         })
     }

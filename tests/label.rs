@@ -160,6 +160,7 @@ fn boxes_masks_and_drop_rule() {
             inst("Liver"),
             inst("Gallbladder"),
         ],
+        aov_channels: Vec::new(),
     };
     let labels = extract(&frame, &classes, 4).unwrap();
     assert_eq!(labels.len(), 2, "{labels:?}");

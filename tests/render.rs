@@ -23,6 +23,20 @@ const ASSERTED: &[&str] = &[
     // Point Density in volumes (Object and World space, Linear and Closest), zero on a
     // surface; negative colours clamp in the scatter weight as Cycles' bsdf_alloc does.
     "point_density",
+    // Shader AOVs (render/film/aov.rs): a Color and a Value AOV, one behind a pane under
+    // the Alpha Threshold (its values add), the world's, an unwritten one; every channel
+    // against Cycles' AOV passes by the same criteria as the image.
+    "aov",
+    "aov_transparent",
+    // Point Info on point clouds (Geometry Nodes points and a scaled point cloud object):
+    // the centre, the world-space radius, the random of the point's index in its cloud.
+    "point_info",
+    // Particle Info on objects a particle system instances (the realised instances'
+    // particle record: index, random, age, lifetime, location, size, velocities).
+    "particle_info",
+    // Generic attributes on Geometry Nodes points (a Float and a Color on the point
+    // domain, read by Attribute nodes).
+    "point_attributes",
     // A Solidify modifier evaluated natively: shell, rim and even-thickness normals.
     "solidify",
     // Issue 26's second part: Ico Sphere at Subdivisions 3, Edge Split, Mirror Bisect (64 px).
@@ -361,6 +375,86 @@ struct Row {
     spp: (f64, Option<f64>),
     /// The alpha channel's figures, for scenes whose Cycles film has alpha.
     alpha: Option<Alpha>,
+    /// Each shader AOV channel's figures (name, ratio, mean error, ours, Cycles A), for
+    /// scenes with AOV references (aov_a.exr, aov_b.exr).
+    aovs: Vec<(String, f64, f64, f64, f64)>,
+}
+
+/// The float channels of an EXR by name (each row by row from the top).
+fn read_exr_channels(p: &Path) -> Vec<(String, Vec<f32>)> {
+    use exr::prelude::*;
+    let img = read_all_flat_layers_from_file(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()));
+    let mut out = Vec::new();
+    for layer in &img.layer_data {
+        for c in &layer.channel_data.list {
+            let data = match &c.sample_data {
+                FlatSamples::F32(v) => v.clone(),
+                FlatSamples::F16(v) => v.iter().map(|x| x.to_f32()).collect(),
+                FlatSamples::U32(v) => v.iter().map(|&x| x as f32).collect(),
+            };
+            out.push((c.name.to_string(), data));
+        }
+    }
+    out
+}
+
+/// Our AOV passes against Cycles' (seeds A and B) channel by channel, the channels named
+/// as blendsynth writes them (`aovs.exr`, Blender's multilayer EXR names).
+fn aov_figures(
+    dir: &Path,
+    scene: &Scene,
+    out: &blendsynth::render::RenderOutput,
+) -> Vec<(String, f64, f64, f64, f64)> {
+    let (a, b) = (
+        read_exr_channels(&dir.join("aov_a.exr")),
+        read_exr_channels(&dir.join("aov_b.exr")),
+    );
+    let images = blendsynth::label::passes::PassImages {
+        width: out.width,
+        height: out.height,
+        depth: &[],
+        distance: &[],
+        object_index: &[],
+        instance_id: &[],
+        material_index: &[],
+        normal: &[],
+        albedo: &[],
+        uv: &[],
+        instance_objects: &[],
+        aovs: out
+            .passes
+            .aovs
+            .iter()
+            .map(|a| blendsynth::label::passes::AovPlane {
+                name: &a.name,
+                channels: if a.color { 4 } else { 1 },
+                data: &a.data,
+            })
+            .collect(),
+        view_layer: &scene.file.scene.view_layer.name,
+    };
+    let ours = blendsynth::label::passes::aov_channels(&images).unwrap();
+    let mut names: Vec<&String> = ours.iter().map(|c| &c.0).collect();
+    let mut theirs: Vec<&String> = a.iter().map(|c| &c.0).collect();
+    names.sort();
+    theirs.sort();
+    assert_eq!(names, theirs, "{}: AOV channels", dir.display());
+    let grey = |v: &[f32]| v.iter().map(|&x| [x; 3]).collect::<Vec<_>>();
+    let find = |l: &[(String, Vec<f32>)], n: &str| grey(&l.iter().find(|c| c.0 == n).unwrap().1);
+    ours.iter()
+        .map(|(n, o)| {
+            let (o, ca, cb) = (grey(o), find(&a, n), find(&b, n));
+            let ratio = rmse(&o, &ca) / rmse(&cb, &ca).max(1e-12);
+            let (mo, ma) = (means(&o)[0], means(&ca)[0]);
+            (
+                n.clone(),
+                ratio,
+                (mo - ma).abs() / ma.abs().max(1e-6),
+                mo,
+                ma,
+            )
+        })
+        .collect()
 }
 
 struct Alpha {
@@ -427,6 +521,14 @@ fn evaluate(dir: &Path) -> Row {
     });
     let ratio = ratio.max(alpha.as_ref().map_or(0.0, |a| a.ratio));
     let worst_mean = worst_mean.max(alpha.as_ref().map_or(0.0, |a| a.mean_err));
+    // Shader AOVs, where Cycles wrote them: every channel by the same criteria.
+    let aovs = if dir.join("aov_a.exr").exists() {
+        aov_figures(dir, &scene, &out)
+    } else {
+        Vec::new()
+    };
+    let ratio = aovs.iter().map(|a| a.1).fold(ratio, f64::max);
+    let worst_mean = aovs.iter().map(|a| a.2).fold(worst_mean, f64::max);
     Row {
         name,
         ratio,
@@ -436,6 +538,7 @@ fn evaluate(dir: &Path) -> Row {
         seconds: out.stats.wall_seconds,
         spp,
         alpha,
+        aovs,
     }
 }
 
@@ -531,8 +634,15 @@ fn parity_with_cycles() {
                 )
             })
             .unwrap_or_default();
+        let aovs: String = r
+            .aovs
+            .iter()
+            .map(|(n, ratio, _, o, c)| {
+                format!("\n    AOV {n}: ratio {ratio:.3}, mean {o:.4} / {c:.4}")
+            })
+            .collect();
         println!(
-            "{:<16} {:>7.3} {:>7.2}%  {:<26} {:<26} {:>6.2}  {status}{spp}{alpha}",
+            "{:<16} {:>7.3} {:>7.2}%  {:<26} {:<26} {:>6.2}  {status}{spp}{alpha}{aovs}",
             r.name,
             r.ratio,
             100.0 * r.worst_mean,
@@ -1815,23 +1925,6 @@ fn unsupported_points_are_refused_by_name() {
     let (dir, base) = fixture_json("points");
     let scene = assert_renders(&dir, &base);
     let opts = check_opts();
-    // A Point Info node in the points' material (its values on points are not carried).
-    refused_alike(
-        &dir,
-        &base,
-        &|j| {
-            let ms = j["materials"].as_array_mut().unwrap();
-            let m = ms.iter_mut().find(|m| m["name"] == "Bead").unwrap();
-            let nodes = m["node_tree"]["nodes"].as_array_mut().unwrap();
-            let mut info = nodes[0].clone();
-            info["name"] = "Point Info".into();
-            info["bl_idname"] = "ShaderNodePointInfo".into();
-            info["inputs"] = serde_json::json!([]);
-            info["outputs"] = serde_json::json!([]);
-            nodes.push(info);
-        },
-        &["\"Points\"", "material \"Bead\"", "Point Info"],
-    );
     // A non-uniform scale: Cycles renders the points as ellipsoids.
     refused_alike(
         &dir,
@@ -1854,4 +1947,248 @@ fn unsupported_points_are_refused_by_name() {
     let scene = Scene::load(&dir).unwrap();
     let m = blendsynth::render::flow_refusal(&scene).unwrap();
     assert!(m.contains("\"Cloud\" has a point cloud"), "{m}");
+}
+
+/// `render --passes` writes the view layer's AOVs to aovs.exr (in either pass format),
+/// one float channel per AOV channel, named as Blender's multilayer EXR names them; a
+/// scene without AOVs writes no aovs.exr.
+#[test]
+fn aov_passes_are_written_with_blenders_names() {
+    let tmp = tempfile::tempdir().unwrap();
+    for (scene, format, expect) in [
+        ("aov", "png", true),
+        ("aov", "exr", true),
+        ("diffuse_point", "exr", false),
+    ] {
+        let dir = tmp.path().join(format!("{scene}_{format}"));
+        let st = std::process::Command::new(env!("CARGO_BIN_EXE_blendsynth"))
+            .args([
+                "render",
+                common::repo()
+                    .join("fixtures/render/scenes")
+                    .join(scene)
+                    .to_str()
+                    .unwrap(),
+                "--samples",
+                "2",
+                "--resolution",
+                "24x24",
+                "--pass-format",
+                format,
+                "--passes",
+                dir.to_str().unwrap(),
+                "-o",
+                tmp.path()
+                    .join(format!("{scene}_{format}.exr"))
+                    .to_str()
+                    .unwrap(),
+            ])
+            .status()
+            .unwrap();
+        assert!(st.success(), "{scene} {format}");
+        let file = dir.join("aovs.exr");
+        assert_eq!(file.exists(), expect, "{scene} {format}");
+        if !expect {
+            continue;
+        }
+        let mut names: Vec<String> = read_exr_channels(&file)
+            .into_iter()
+            .map(|(n, v)| {
+                assert_eq!(v.len(), 24 * 24, "{n}");
+                n
+            })
+            .collect();
+        names.sort();
+        assert_eq!(
+            names,
+            [
+                "ViewLayer.mask.X",
+                "ViewLayer.tint.A",
+                "ViewLayer.tint.B",
+                "ViewLayer.tint.G",
+                "ViewLayer.tint.R",
+                "ViewLayer.unused.X"
+            ]
+        );
+    }
+}
+
+/// Particle Info reads each realised instance's particle record; an export older than the
+/// record is refused by name rather than rendered with Cycles' dummy particle.
+#[test]
+fn particle_info_needs_the_particle_record() {
+    let (dir, base) = fixture_json("particle_info");
+    assert_renders(&dir, &base);
+    refused_alike(
+        &dir,
+        &base,
+        &|j| {
+            for e in j["evaluated"].as_array_mut().unwrap() {
+                if let Some(is) = e["realized"]["instances"].as_array_mut() {
+                    for i in is {
+                        i.as_object_mut().unwrap().remove("particle");
+                    }
+                }
+            }
+        },
+        &["Particle Info", "\"Emitter\"", "convert the .blend again"],
+    );
+}
+
+/// An AOV Output inside a node group (naming a valid AOV) is refused naming the group
+/// node; one naming an AOV the view layer lacks is left out, as Cycles drops it.
+#[test]
+fn aov_outputs_in_groups_are_refused_by_name() {
+    let (dir, base) = fixture_json("aov");
+    assert_renders(&dir, &base);
+    let with_group = |aov: &str| {
+        let aov = aov.to_string();
+        move |j: &mut serde_json::Value| {
+            let ms = j["materials"].as_array_mut().unwrap();
+            let m = ms.iter_mut().find(|m| m["name"] == "Blue").unwrap();
+            let nodes = m["node_tree"]["nodes"].as_array_mut().unwrap();
+            let mut out = nodes
+                .iter()
+                .find(|n| n["bl_idname"] == "ShaderNodeOutputAOV")
+                .unwrap()
+                .clone();
+            out["properties"]["aov_name"] = aov.clone().into();
+            let mut group = out.clone();
+            group["name"] = "Wrapped".into();
+            group["bl_idname"] = "ShaderNodeGroup".into();
+            group["node_tree"] = "AOVGroup".into();
+            group["inputs"] = serde_json::json!([]);
+            group["outputs"] = serde_json::json!([]);
+            nodes.push(group);
+            j["node_groups"]
+                .as_array_mut()
+                .unwrap()
+                .push(serde_json::json!({
+                    "name": "AOVGroup", "bl_idname": "ShaderNodeTree", "interface": [],
+                    "nodes": [out], "links": []
+                }));
+        }
+    };
+    refused_alike(
+        &dir,
+        &base,
+        &with_group("mask"),
+        &[
+            "material \"Blue\"",
+            "node \"Wrapped\"",
+            "AOV Output inside a node group",
+        ],
+    );
+    let mut json = base.clone();
+    with_group("nowhere")(&mut json);
+    let scene = Scene::from_json(&dir, json.to_string().as_bytes()).unwrap();
+    assert!(blendsynth::render::check(&scene, &check_opts(), &[]).is_ok());
+}
+
+/// Attribute reads on points: generic attributes of points blendsynth evaluates render
+/// (scene point_attributes); "radius" and "position", and any read on exported (frozen)
+/// points, which carry no attributes, are refused by name.
+#[test]
+fn point_attribute_reads_blendsynth_cannot_carry_are_refused() {
+    let (dir, base) = fixture_json("point_attributes");
+    assert_renders(&dir, &base);
+    let tinted = base["materials"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["name"] == "Tinted")
+        .unwrap()
+        .clone();
+    refused_alike(
+        &dir,
+        &base,
+        &|j| {
+            let ms = j["materials"].as_array_mut().unwrap();
+            let m = ms.iter_mut().find(|m| m["name"] == "Tinted").unwrap();
+            for n in m["node_tree"]["nodes"].as_array_mut().unwrap() {
+                if n["properties"]["attribute_name"] == "tint" {
+                    n["properties"]["attribute_name"] = "radius".into();
+                }
+            }
+        },
+        &[
+            "\"Points\"",
+            "material \"Tinted\"",
+            "radius",
+            "does not carry",
+        ],
+    );
+    let (dir, base) = fixture_json("pointcloud_object");
+    refused_alike(
+        &dir,
+        &base,
+        &|j| {
+            let ms = j["materials"].as_array_mut().unwrap();
+            let m = ms.iter_mut().find(|m| m["name"] == "Grain").unwrap();
+            m["node_tree"] = tinted["node_tree"].clone();
+        },
+        &["\"Cloud\"", "material \"Grain\"", "does not carry"],
+    );
+}
+
+/// A dataset with `[labels] aovs = true` writes each frame's AOV passes to
+/// aovs/SPLIT/N.exr, the same channels (and values) as `render` gives at those
+/// settings; asking for them in a scene without AOVs is an error.
+#[test]
+fn dataset_writes_the_aov_passes() {
+    use blendsynth::dataset::{generate, renderer::path_tracer, GenerateOptions, Spec};
+    let spec = |labels: &str| {
+        Spec::parse(&format!(
+            "[render]\nresolution = [24, 24]\nsamples = 2\ndenoise = false\n[labels]\n{labels}\n"
+        ))
+        .unwrap()
+    };
+    let tmp = tempfile::tempdir().unwrap();
+    let scene = Scene::load(&common::repo().join("fixtures/render/scenes/aov")).unwrap();
+    let r = path_tracer(&scene).unwrap();
+    let out = tmp.path().join("a");
+    generate(
+        &scene,
+        &spec("aovs = true"),
+        r.as_ref(),
+        &out,
+        &GenerateOptions::default(),
+    )
+    .unwrap();
+    let files: Vec<_> = std::fs::read_dir(out.join("aovs/train"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(files.len(), 1, "{files:?}");
+    let mut names: Vec<String> = read_exr_channels(&files[0])
+        .into_iter()
+        .map(|(n, v)| {
+            assert_eq!(v.len(), 24 * 24, "{n}");
+            n
+        })
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "ViewLayer.mask.X",
+            "ViewLayer.tint.A",
+            "ViewLayer.tint.B",
+            "ViewLayer.tint.G",
+            "ViewLayer.tint.R",
+            "ViewLayer.unused.X"
+        ]
+    );
+    let plain = Scene::load(&common::repo().join("fixtures/render/scenes/diffuse_point")).unwrap();
+    let e = generate(
+        &plain,
+        &spec("aovs = true"),
+        r.as_ref(),
+        &tmp.path().join("b"),
+        &GenerateOptions::default(),
+    )
+    .err()
+    .map(|e| e.to_string())
+    .unwrap_or_default();
+    assert!(e.contains("no shader AOVs"), "{e}");
 }

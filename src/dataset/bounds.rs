@@ -177,6 +177,7 @@ impl FrameRenderer for BoundsRenderer {
                 depth: Some(depth),
                 normal: None,
                 instances,
+                aov_channels: Vec::new(),
             },
         })
     }

@@ -659,6 +659,23 @@ impl FrameContext<'_> {
             write_atomic(&p, &layout::exr_rgb_bytes(r.width, r.height, &cam)?)?;
             hook(&p)?;
         }
+        if labels_spec.aovs {
+            if r.ids.aov_channels.is_empty() {
+                return Err("the spec asks for aovs but the scene's view layer has no shader AOVs (or the renderer gave none)".into());
+            }
+            let list: Vec<(&str, Vec<f32>)> = r
+                .ids
+                .aov_channels
+                .iter()
+                .map(|(n, v)| (n.as_str(), v.clone()))
+                .collect();
+            let p = layout::aov_path(self.out, split, i);
+            write_atomic(
+                &p,
+                &crate::foundation::exr::channels_bytes(r.width, r.height, &list)?,
+            )?;
+            hook(&p)?;
+        }
         if let Some(m) = &motion {
             self.write_motion(m, &r, split, i, &hook)?;
         }

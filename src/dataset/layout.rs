@@ -10,6 +10,8 @@
 //! OUT/depth/SPLIT/NNNNNNNNN.exr|npy     optional: metric depth, float32 (0: none)
 //! OUT/normals/SPLIT/NNNNNNNNN.exr       optional: world-space normals, float RGB
 //! OUT/normals_camera/SPLIT/NNNNNNNNN.exr optional: normals in OpenCV camera axes
+//! OUT/aovs/SPLIT/NNNNNNNNN.exr          optional: the view layer's shader AOVs, float
+//!                                       channels named as Blender names them
 //! OUT/flow_fw|flow_bw/SPLIT/NNNNNNNNN.exr optional: optical flow to the next / previous
 //!                                       frame of the step, float R (x) G (y), pixels;
 //!                                       NaN where invalid (also .flo with flow_flo)
@@ -88,6 +90,11 @@ pub fn depth_float_path(out: &Path, split: &str, index: u64, ext: &str) -> PathB
         .join(split)
         .join(format!("{}.{ext}", frame_name(index)))
 }
+pub fn aov_path(out: &Path, split: &str, index: u64) -> PathBuf {
+    out.join("aovs")
+        .join(split)
+        .join(format!("{}.exr", frame_name(index)))
+}
 pub fn normal_camera_path(out: &Path, split: &str, index: u64) -> PathBuf {
     out.join("normals_camera")
         .join(split)
@@ -108,6 +115,7 @@ pub fn optional_frame_files(out: &Path, split: &str, index: u64) -> Vec<PathBuf>
         depth_float_path(out, split, index, "npy"),
         normal_path(out, split, index),
         normal_camera_path(out, split, index),
+        aov_path(out, split, index),
     ];
     for (kind, ext) in [
         ("flow_fw", "exr"),

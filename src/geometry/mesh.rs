@@ -209,20 +209,7 @@ impl Mesh {
                 Domain::Corner => scene::Domain::Corner,
                 _ => continue,
             };
-            let data = match &a.data {
-                Array::Float(v) => AttributeData::Float(v.clone()),
-                Array::Int(v) => AttributeData::Int(v.clone()),
-                Array::Bool(v) => AttributeData::Bool(v.clone()),
-                Array::Float2(v) => AttributeData::Float2(v.clone()),
-                Array::Vector(v) => AttributeData::Float3(v.clone()),
-                Array::Color(v) | Array::ByteColor(v) => AttributeData::Color(v.clone()),
-                Array::Quaternion(v) => AttributeData::Quaternion(v.clone()),
-                Array::Matrix(v) => {
-                    AttributeData::Float4x4(v.iter().map(super::math::flatten).collect())
-                }
-                Array::Int8(v) => AttributeData::Int8(v.clone()),
-                Array::Int2(v) => AttributeData::Int2(v.clone()),
-            };
+            let data = scene_data(&a.data);
             m.attributes.push(scene::Attribute {
                 name: name.to_string(),
                 domain,
@@ -531,5 +518,22 @@ pub fn saturate_acos(f: f32) -> f32 {
         0.0
     } else {
         f.acos()
+    }
+}
+
+/// An attribute's values as the exchange format's `AttributeData` (what `to_scene` and the
+/// renderer's point clouds carry).
+pub fn scene_data(a: &Array) -> AttributeData {
+    match a {
+        Array::Float(v) => AttributeData::Float(v.clone()),
+        Array::Int(v) => AttributeData::Int(v.clone()),
+        Array::Bool(v) => AttributeData::Bool(v.clone()),
+        Array::Float2(v) => AttributeData::Float2(v.clone()),
+        Array::Vector(v) => AttributeData::Float3(v.clone()),
+        Array::Color(v) | Array::ByteColor(v) => AttributeData::Color(v.clone()),
+        Array::Quaternion(v) => AttributeData::Quaternion(v.clone()),
+        Array::Matrix(v) => AttributeData::Float4x4(v.iter().map(super::math::flatten).collect()),
+        Array::Int8(v) => AttributeData::Int8(v.clone()),
+        Array::Int2(v) => AttributeData::Int2(v.clone()),
     }
 }

@@ -38,6 +38,8 @@ pub struct LabelSpec {
     pub depth_float_mm: bool,
     /// Also write normals in OpenCV camera axes (x right, y down, z forward).
     pub normals_camera: bool,
+    /// The view layer's shader AOV passes, one float EXR per frame (`aovs/`).
+    pub aovs: bool,
     /// Optical flow to the next and previous frame of the sequence step (float EXR,
     /// pixels, x right, y down; NaN where invalid): `flow_fw/`, `flow_bw/`.
     pub flow: bool,
@@ -89,6 +91,7 @@ impl Default for LabelSpec {
             depth_float: None,
             depth_float_mm: false,
             normals_camera: false,
+            aovs: false,
             flow: false,
             flow_flo: false,
             occlusion: false,
@@ -115,6 +118,7 @@ impl LabelSpec {
                 "depth" => s.depth = x.as_bool().ok_or("depth must be true or false")?,
                 "normals" => s.normals = x.as_bool().ok_or("normals must be true or false")?,
                 "normals_camera" => s.normals_camera = x.as_bool().ok_or("normals_camera must be true or false")?,
+                "aovs" => s.aovs = x.as_bool().ok_or("aovs must be true or false")?,
                 "flow" => s.flow = x.as_bool().ok_or("flow must be true or false")?,
                 "flow_flo" => s.flow_flo = x.as_bool().ok_or("flow_flo must be true or false")?,
                 "occlusion" => s.occlusion = x.as_bool().ok_or("occlusion must be true or false")?,
@@ -172,7 +176,7 @@ impl LabelSpec {
                         s.classes.push(ClassSpec { name, objects, mask });
                     }
                 }
-                other => return Err(format!("unknown key {other:?} (expected class, class_property, min_pixels, mm_per_unit, depth, depth_png_max_mm, depth_float, depth_float_unit, normals, normals_camera, flow, flow_flo, occlusion, mesh_glb)")),
+                other => return Err(format!("unknown key {other:?} (expected class, class_property, min_pixels, mm_per_unit, depth, depth_png_max_mm, depth_float, depth_float_unit, normals, normals_camera, aovs, flow, flow_flo, occlusion, mesh_glb)")),
             }
         }
         if s.flow_flo && !s.flow {

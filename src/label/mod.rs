@@ -46,6 +46,9 @@ pub struct FrameIds {
     /// World-space shading normal of the first hit, when rendered.
     pub normal: Option<Vec<[f32; 3]>>,
     pub instances: Vec<Instance>,
+    /// The view layer's shader AOV passes as float channels named as Blender's
+    /// multilayer EXR names them (`passes::aov_channels`); empty without AOVs.
+    pub aov_channels: Vec<(String, Vec<f32>)>,
 }
 
 impl FrameIds {

@@ -37,6 +37,49 @@ pub struct PassImages<'a> {
     pub uv: &'a [[f32; 2]],
     /// Object name of each instance id - 1.
     pub instance_objects: &'a [String],
+    /// The view layer's shader AOV passes (written to `aovs.exr`), and the view layer's
+    /// name their channels start with.
+    pub aovs: Vec<AovPlane<'a>>,
+    pub view_layer: &'a str,
+}
+
+/// One shader AOV pass: its name, and `channels` floats per pixel (1 for a Value AOV,
+/// RGBA for a Color AOV).
+pub struct AovPlane<'a> {
+    pub name: &'a str,
+    pub channels: usize,
+    pub data: &'a [f32],
+}
+
+/// The channels of the AOV passes as Blender names them in a multilayer EXR:
+/// "<view layer>.<AOV>.X" for a Value AOV, ".R", ".G", ".B", ".A" for a Color AOV.
+pub fn aov_channels(p: &PassImages) -> Result<Vec<(String, Vec<f32>)>, String> {
+    let n = (p.width * p.height) as usize;
+    let mut out = Vec::new();
+    for a in &p.aovs {
+        let names: &[&str] = match a.channels {
+            1 => &["X"],
+            4 => &["R", "G", "B", "A"],
+            c => return Err(format!("AOV {:?}: {c} channels (1 or 4 expected)", a.name)),
+        };
+        if a.data.len() != n * a.channels {
+            return Err(format!(
+                "AOV {:?}: {} values, {}x{} needs {}",
+                a.name,
+                a.data.len(),
+                p.width,
+                p.height,
+                n * a.channels
+            ));
+        }
+        for (k, c) in names.iter().enumerate() {
+            out.push((
+                format!("{}.{}.{c}", p.view_layer, a.name),
+                a.data.iter().skip(k).step_by(a.channels).copied().collect(),
+            ));
+        }
+    }
+    Ok(out)
 }
 
 /// A depth in scene units to 16-bit millimetres: 0 for the background and for what
@@ -195,6 +238,19 @@ pub fn write_passes(
                 png16_bytes(w, h, &p.uv.iter().map(|u| q16(u[1])).collect::<Vec<_>>())?,
             )?;
         }
+    }
+    // Shader AOVs are float data in either format: one EXR, channels named as Blender's
+    // multilayer EXR names them.
+    if !p.aovs.is_empty() {
+        let channels = aov_channels(p)?;
+        let list: Vec<(&str, Vec<f32>)> = channels
+            .iter()
+            .map(|(n, v)| (n.as_str(), v.clone()))
+            .collect();
+        put(
+            "aovs.exr".into(),
+            crate::foundation::exr::channels_bytes(w, h, &list)?,
+        )?;
     }
     let names: serde_json::Map<String, serde_json::Value> =
         std::iter::once(("0".to_string(), serde_json::Value::from("background")))

@@ -102,6 +102,17 @@ pub fn flatten<'a>(
     groups: &'a [NodeTree],
     root: &str,
 ) -> Result<FlatGraph<'a>, GraphError> {
+    flatten_with(tree, groups, root, &[]).map(|(g, _)| g)
+}
+
+/// `flatten`, also evaluating the nodes named `extra` of the top tree (outputs Cycles
+/// runs beside the main one, such as AOV Outputs); returns their flat indices too.
+pub fn flatten_with<'a>(
+    tree: &'a NodeTree,
+    groups: &'a [NodeTree],
+    root: &str,
+    extra: &[&str],
+) -> Result<(FlatGraph<'a>, Vec<usize>), GraphError> {
     let mut b = Builder {
         groups,
         instances: vec![Instance {
@@ -117,10 +128,19 @@ pub fn flatten<'a>(
     let node = find(tree, root)
         .ok_or_else(|| GraphError(format!("node tree {:?} has no node {root:?}", tree.name)))?;
     let root = b.node(0, node)?;
-    Ok(FlatGraph {
-        nodes: b.nodes,
-        root,
-    })
+    let mut more = Vec::with_capacity(extra.len());
+    for name in extra {
+        let node = find(tree, name)
+            .ok_or_else(|| GraphError(format!("node tree {:?} has no node {name:?}", tree.name)))?;
+        more.push(b.node(0, node)?);
+    }
+    Ok((
+        FlatGraph {
+            nodes: b.nodes,
+            root,
+        },
+        more,
+    ))
 }
 
 /// The output node Blender renders with: among nodes of type `bl_idname` whose

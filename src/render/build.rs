@@ -276,14 +276,15 @@ pub fn build(
                     .load_points(ei)
                     .map_err(|err| RenderError(format!("object {:?}: {err}", obj.name)))?;
                 if let Some((keys, slots)) = points.filter(|p| !p.0.is_empty()) {
+                    // The export carries no point attributes (reads are refused).
                     push_points(
                         &mut instances,
                         scene,
                         oi,
                         obj,
                         &info,
-                        &keys,
-                        &slots,
+                        (&keys, &slots),
+                        Vec::new(),
                         to_world,
                     )?;
                 }
@@ -362,14 +363,31 @@ pub fn build(
                         texspace: None,
                     };
                     let slots = vec![0; keys.len()];
+                    // Generic point attributes, as Cycles' copy_attributes gives them to
+                    // the Attribute node (position and radius are the points themselves).
+                    let attributes = p
+                        .attributes
+                        .iter()
+                        .filter(|a| a.domain == crate::geometry::types::Domain::Point)
+                        .filter_map(|a| {
+                            let name = a.id.name()?;
+                            (name != "position" && name != "radius").then(|| {
+                                (
+                                    name.to_string(),
+                                    false,
+                                    crate::geometry::mesh::scene_data(&a.data),
+                                )
+                            })
+                        })
+                        .collect();
                     push_points(
                         &mut instances,
                         scene,
                         oi,
                         obj,
                         &info,
-                        &keys,
-                        &slots,
+                        (&keys, &slots),
+                        attributes,
                         to_world,
                     )?;
                 }
@@ -762,6 +780,7 @@ fn push_realized(
             pushed.info.random = inst.random_id as f32 * (1.0 / 0xFFFF_FFFFu32 as f32);
             pushed.info.color = inst.color.map(|c| c as f32);
             pushed.info.pass_index = inst.pass_index as f32;
+            pushed.info.particle = inst.particle.flatten();
         }
     }
     Ok(())
@@ -786,7 +805,8 @@ fn cycles_renders(
 
 /// A point cloud as an instance of its own (`render::points`): a sphere per key (x, y,
 /// z, radius in object space) in material slot `slots[i]` of `info`'s materials (Cycles
-/// gives every point of a cloud shader 0: its first material).
+/// gives every point of a cloud shader 0: its first material), with its generic
+/// attributes per point (`ObjectCurves::attributes`, one "curve" per point).
 #[allow(clippy::too_many_arguments)]
 fn push_points(
     instances: &mut Vec<MeshInstance>,
@@ -794,8 +814,8 @@ fn push_points(
     oi: usize,
     obj: &crate::scene::Object,
     info: &MeshInfo,
-    pts: &[[f32; 4]],
-    slots: &[u32],
+    (pts, slots): (&[[f32; 4]], &[u32]),
+    attributes: Vec<(String, bool, crate::scene::mesh::AttributeData)>,
     to_world: Affine,
 ) -> Result<(), RenderError> {
     if let Some(k) = pts
@@ -809,6 +829,8 @@ fn push_points(
     }
     let mut points = crate::render::points::object_points(pts, &to_world);
     points.slot = slots.to_vec();
+    points.point_index = crate::render::points::index_in_cloud(slots);
+    points.attributes = attributes;
     // Generated spans the points' object-space bounds, whatever the mesh's texture space.
     push_prims(
         instances,
@@ -1038,8 +1060,15 @@ pub fn bind_attributes(
                 per_slot.push(None);
                 continue;
             }
-            if inst.curves.as_ref().is_some_and(|c| c.points) {
-                return Err(RenderError(format!("object {:?}: material {:?} on its point cloud reads attributes ({:?}), which blendsynth does not carry for points yet", inst.name, materials[mi].name, p.attributes)));
+            if let Some(c) = inst.curves.as_ref().filter(|c| c.points) {
+                use crate::shader::attributes::AttributeRequest;
+                // Only generic attributes of points blendsynth evaluated itself are carried.
+                let builtin = p.attributes.iter().any(
+                    |r| matches!(r, AttributeRequest::Named(n) if n == "position" || n == "radius"),
+                );
+                if c.attributes.is_empty() || builtin {
+                    return Err(RenderError(format!("object {:?}: material {:?} on its point cloud reads attributes ({:?}), which blendsynth does not carry for these points yet (only generic attributes of Geometry Nodes points it evaluates)", inst.name, materials[mi].name, p.attributes)));
+                }
             }
             if let Some(c) = &inst.curves {
                 let b = BoundAttributes::bind_curves(

@@ -41,6 +41,8 @@ pub struct ObjectCurves {
     /// A point cloud instead (`render::points`): each key a sphere (centre, radius),
     /// each its own "curve" and "segment"; `pieces` is 0.
     pub points: bool,
+    /// Points: each one's index in its own cloud (Point Info > Random hashes it).
+    pub point_index: Vec<u32>,
 }
 
 impl ObjectCurves {
@@ -101,6 +103,7 @@ impl ObjectCurves {
                     })
             }),
             points: false,
+            point_index: Vec::new(),
         }
     }
 

@@ -118,6 +118,8 @@ pub struct Passes {
     pub instances: Vec<InstanceInfo>,
     /// What each pixel centre's primary ray hit (None: background), for `flow`.
     pub hits: Vec<Option<film::flow::PixelHit>>,
+    /// The view layer's shader AOV passes, in its order (`film::aov`).
+    pub aovs: Vec<film::aov::AovImage>,
 }
 
 #[derive(Debug, Clone)]
@@ -344,7 +346,9 @@ fn render_frame(
     };
     let local = shader_rays::LocalAccels::new(&geo);
     let volumes = volume::Volumes::build(scene, &geo, &materials, &integrator);
+    let aovs = film::aov::Layout::of(&scene.file.scene.view_layer);
     let tracer = integrator::Scene {
+        aovs: &aovs,
         local: &local,
         light_select: &light_select,
         accel,
@@ -440,6 +444,7 @@ fn render_frame(
                             k += 1;
                             if first {
                                 primary_passes(&tracer, &camera, x, y, scratch, &mut tile.passes);
+                                tile.passes.aov.resize(k * aovs.stride, 0.0);
                             }
                             if px.converged {
                                 continue;
@@ -474,9 +479,17 @@ fn render_frame(
                                 } else {
                                     scratch.transparent = 0.0;
                                     scratch.features = Default::default();
+                                    scratch.aov.iter_mut().for_each(|v| *v = 0.0);
                                     [0.0; 3]
                                 };
                                 px.add(i, c, scratch.transparent);
+                                let stride = aovs.stride;
+                                for (a, v) in tile.passes.aov[(k - 1) * stride..k * stride]
+                                    .iter_mut()
+                                    .zip(&scratch.aov)
+                                {
+                                    *a += v;
+                                }
                                 let f = &scratch.features;
                                 tile.passes.feature_normal[k - 1] =
                                     add(tile.passes.feature_normal[k - 1], f.normal);
@@ -556,6 +569,7 @@ fn render_frame(
         uv: vec![[0.0; 2]; npix],
         sample_count,
         hits: vec![None; npix],
+        aovs: Vec::new(),
         instances: geo
             .instances
             .iter()
@@ -567,6 +581,15 @@ fn render_frame(
             })
             .collect(),
     };
+    let mut aov_images: Vec<film::aov::AovImage> = aovs
+        .passes
+        .iter()
+        .map(|p| film::aov::AovImage {
+            name: p.name.clone(),
+            color: p.color,
+            data: vec![0.0; npix * p.channels()],
+        })
+        .collect();
     let mut rays = 0;
     for t in &tiles {
         rays += t.rays;
@@ -587,10 +610,20 @@ fn render_frame(
                 passes.denoise_normal[i] = scale(p.feature_normal[k], inv);
                 passes.uv[i] = p.uv[k];
                 passes.hits[i] = p.hits[k];
+                // AOVs: the samples' sum over the pixel's sample count, as Cycles reads
+                // its AOV passes.
+                for (img, pass) in aov_images.iter_mut().zip(&aovs.passes) {
+                    let c = pass.channels();
+                    let src = &p.aov[k * aovs.stride + pass.offset..][..c];
+                    for (d, v) in img.data[i * c..(i + 1) * c].iter_mut().zip(src) {
+                        *d = v * inv;
+                    }
+                }
                 k += 1;
             }
         }
     }
+    passes.aovs = aov_images;
     let triangles = build::triangle_count(&geo);
     drop(motion_accel);
     Ok((
@@ -731,7 +764,7 @@ fn prepare(
         }
     }
     let materials = integrator::shade::compile_all(scene, &used)?;
-    points::check(scene, &geo, &materials)?;
+    points::check(&geo, &materials)?;
     curves::check(scene, &geo, &materials)?;
     build::bind_attributes(&mut geo, &materials)?;
     if displace::apply(&mut geo, &materials) > 0 {
@@ -1022,6 +1055,9 @@ struct TilePasses {
     /// Sums over the pixel's samples of the denoiser's guides (`denoise_features`).
     feature_normal: Vec<[f32; 3]>,
     feature_albedo: Vec<[f32; 3]>,
+    /// Sums over the pixel's samples of its AOV values (`film::aov::Layout::stride` per
+    /// pixel).
+    aov: Vec<f32>,
 }
 
 /// Label passes from the primary ray through the pixel centre (exact ids, unfiltered), at

@@ -66,6 +66,22 @@ pub fn sphere_intersect(org: V3, dir: V3, tmin: f32, tmax: f32, p: [f32; 4]) -> 
     })
 }
 
+/// Each point's index in its own cloud: the clouds of an object follow each other, each
+/// in a material slot of its own (`slots`), and Cycles numbers every cloud from 0.
+pub fn index_in_cloud(slots: &[u32]) -> Vec<u32> {
+    let mut out = Vec::with_capacity(slots.len());
+    let mut k = 0u32;
+    for (i, s) in slots.iter().enumerate() {
+        k = if i > 0 && slots[i - 1] == *s {
+            k + 1
+        } else {
+            0
+        };
+        out.push(k);
+    }
+    out
+}
+
 /// The unit normal a `sphere_intersect` hit carries in (u, v).
 #[inline]
 pub fn normal_of(u: f32, v: f32) -> V3 {
@@ -74,10 +90,8 @@ pub fn normal_of(u: f32, v: f32) -> V3 {
 }
 
 /// What blendsynth cannot render on point clouds, named: materials with a volume, true
-/// displacement, emission, the Hair BSDFs or Subsurface Scattering (as on hair), and the
-/// Point Info node (its values on points are not carried yet).
+/// displacement, emission, the Hair BSDFs or Subsurface Scattering (as on hair).
 pub fn check(
-    scene: &crate::scene::Scene,
     geo: &crate::render::build::Geometry,
     materials: &[crate::render::integrator::shade::Material],
 ) -> Result<(), crate::render::RenderError> {
@@ -106,21 +120,18 @@ pub fn check(
                 Some("true displacement".to_string())
             } else if p.emission_estimate.iter().any(|&e| e != 0.0) {
                 Some("emission".to_string())
-            } else if let Some(b) = p.bsdfs.iter().find(|b| {
-                matches!(
-                    b.bl_idname.as_str(),
-                    "ShaderNodeBsdfHair"
-                        | "ShaderNodeBsdfHairPrincipled"
-                        | "ShaderNodeSubsurfaceScattering"
-                )
-            }) {
-                Some(format!("node {}", b.bl_idname))
             } else {
-                scene
-                    .material(&m.name)
-                    .and_then(|mat| mat.node_tree.as_ref())
-                    .is_some_and(|t| uses_node(scene, t, "ShaderNodePointInfo", 0))
-                    .then(|| "node ShaderNodePointInfo (Point Info)".to_string())
+                p.bsdfs
+                    .iter()
+                    .find(|b| {
+                        matches!(
+                            b.bl_idname.as_str(),
+                            "ShaderNodeBsdfHair"
+                                | "ShaderNodeBsdfHairPrincipled"
+                                | "ShaderNodeSubsurfaceScattering"
+                        )
+                    })
+                    .map(|b| format!("node {}", b.bl_idname))
             };
             if let Some(why) = why {
                 return Err(crate::render::RenderError(format!(
@@ -147,26 +158,15 @@ fn similarity(t: &Affine) -> bool {
         && dot(c[1], c[2]).abs() <= eps
 }
 
-/// Whether tree `t` or a group it uses (to a depth of 64) holds an unmuted `bl_idname`.
-fn uses_node(
-    scene: &crate::scene::Scene,
-    t: &crate::scene::NodeTree,
-    bl_idname: &str,
-    depth: u32,
-) -> bool {
-    depth < 64
-        && t.nodes.iter().any(|n| {
-            (!n.mute && n.bl_idname == bl_idname)
-                || n.node_tree
-                    .as_deref()
-                    .and_then(|g| scene.node_group(g))
-                    .is_some_and(|g| uses_node(scene, g, bl_idname, depth + 1))
-        })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn points_are_numbered_within_their_own_cloud() {
+        assert_eq!(index_in_cloud(&[3, 3, 3, 4, 4, 0]), vec![0, 1, 2, 0, 1, 0]);
+        assert!(index_in_cloud(&[]).is_empty());
+    }
 
     #[test]
     fn only_uniform_scales_keep_spheres() {

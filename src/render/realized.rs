@@ -249,6 +249,7 @@ mod tests {
             pass_index: 0,
             texspace_location: None,
             texspace_size: None,
+            particle: Some(None),
         }
     }
 

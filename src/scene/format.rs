@@ -96,6 +96,46 @@ pub struct SceneSettings {
     pub display_settings: Rna,
     #[serde(default)]
     pub unit_settings: Rna,
+    /// The rendered view layer (absent in older exports: no AOVs).
+    #[serde(default)]
+    pub view_layer: ViewLayer,
+}
+
+/// The view layer a render writes: its shader AOVs and the Alpha Threshold.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ViewLayer {
+    #[serde(default)]
+    pub name: String,
+    #[serde(default = "half_f64")]
+    pub pass_alpha_threshold: f64,
+    #[serde(default)]
+    pub aovs: Vec<Aov>,
+}
+
+impl Default for ViewLayer {
+    fn default() -> ViewLayer {
+        ViewLayer {
+            name: "ViewLayer".into(),
+            pass_alpha_threshold: 0.5,
+            aovs: Vec::new(),
+        }
+    }
+}
+
+/// One of a view layer's shader AOVs (`view_layer.aovs`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct Aov {
+    pub name: String,
+    /// "COLOR" or "VALUE".
+    #[serde(rename = "type")]
+    pub kind: String,
+    /// False for a repeated name or one a built-in pass has: Cycles writes no pass.
+    #[serde(default = "yes")]
+    pub is_valid: bool,
+}
+
+fn half_f64() -> f64 {
+    0.5
 }
 
 fn one_i32() -> i32 {
@@ -707,6 +747,38 @@ pub struct RealizedInstance {
     pub texspace_location: Option<[f32; 3]>,
     #[serde(default)]
     pub texspace_size: Option<[f32; 3]>,
+    /// The particle it stands for (Particle Info): `Some(None)` for an instance no
+    /// particle made (or a child particle: Cycles' dummy particle), `None` in exports
+    /// older than the record.
+    #[serde(
+        default,
+        deserialize_with = "present",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub particle: Option<Option<Particle>>,
+}
+
+/// A key that is present, even as null, deserializes to `Some` (absent: the default).
+fn present<'de, D, T>(d: D) -> Result<Option<T>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+    T: Deserialize<'de>,
+{
+    T::deserialize(d).map(Some)
+}
+
+/// A particle as Cycles' sync_dupli_particle reads it from Blender at the frame.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Particle {
+    /// Its index among the system's particles.
+    pub index: u32,
+    /// The frame (with subframe) minus its birth time.
+    pub age: f32,
+    pub lifetime: f32,
+    pub location: [f32; 3],
+    pub size: f32,
+    pub velocity: [f32; 3],
+    pub angular_velocity: [f32; 3],
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]

@@ -6,13 +6,13 @@ use serde_json::Value;
 
 use crate::nodes::color::{rgb_to_bw, LINEAR_REC709};
 use crate::nodes::curves::{mapping_from_json, CurveKind, CurveTable};
-use crate::nodes::graph::{active_output, flatten, FlatGraph, FlatNode, Source};
+use crate::nodes::graph::{active_output, flatten, flatten_with, FlatGraph, FlatNode, Source};
 use crate::nodes::mix::MixBlend;
 use crate::nodes::ramp::{band_from_json, RampTable};
 use crate::scene::{Scene, Socket};
 
 use super::bump_graph::{self, Schedule, Step};
-use super::program::{BsdfNode, Closure, Kind, Op, Program, Slot};
+use super::program::{AovWrite, BsdfNode, Closure, Kind, Op, Program, Slot};
 
 /// Compiling the nodes that read mesh attributes and tangents.
 mod attributes;
@@ -48,7 +48,9 @@ pub fn compile_material(scene: &Scene, name: &str) -> Result<Program, CompileErr
     let Some(out) = active_output(tree, "ShaderNodeOutputMaterial", "CYCLES") else {
         return Ok(empty_surface());
     };
-    let graph = flatten(tree, &scene.file.node_groups, &out.name)
+    let aovs =
+        aov_outputs(scene, tree).map_err(|e| CompileError(format!("material {name:?}: {e}")))?;
+    let (graph, _) = flatten_with(tree, &scene.file.node_groups, &out.name, &aovs)
         .map_err(|e| CompileError(format!("material {name:?}: {e}")))?;
     let mut c = Compiler::new(&graph);
     c.scene = Some(scene);
@@ -61,6 +63,56 @@ pub fn compile_material(scene: &Scene, name: &str) -> Result<Program, CompileErr
     c.material_pass_index = mat.pass_index as f32;
     c.run()
         .map_err(|e| CompileError(format!("material {name:?}: {}", e.0)))
+}
+
+/// The AOV Output nodes of `tree` Cycles runs: unmuted, naming a valid AOV of the view
+/// layer (Cycles drops the others, and what only they read). Such a node inside a node
+/// group is an error naming the group node.
+fn aov_outputs<'t>(
+    scene: &Scene,
+    tree: &'t crate::scene::NodeTree,
+) -> Result<Vec<&'t str>, String> {
+    for n in tree.nodes.iter().filter(|n| !n.mute) {
+        if let Some(g) = n.node_tree.as_deref().and_then(|g| scene.node_group(g)) {
+            if group_has_aov(scene, g, 0) {
+                return Err(format!(
+                    "node {:?}: an AOV Output inside a node group is not supported yet",
+                    n.name
+                ));
+            }
+        }
+    }
+    Ok(tree
+        .nodes
+        .iter()
+        .filter(|n| runs_aov(scene, n))
+        .map(|n| n.name.as_str())
+        .collect())
+}
+
+/// Whether `n` is an unmuted AOV Output naming a valid AOV of the view layer.
+fn runs_aov(scene: &Scene, n: &crate::scene::Node) -> bool {
+    !n.mute && n.bl_idname == "ShaderNodeOutputAOV" && aov_index(scene, n).is_some()
+}
+
+/// The view-layer AOV node `n` names, if valid: its index and whether it is a colour.
+fn aov_index(scene: &Scene, n: &crate::scene::Node) -> Option<(u32, bool)> {
+    let name = n.properties.get("aov_name").and_then(Value::as_str)?;
+    let aovs = &scene.file.scene.view_layer.aovs;
+    let i = aovs.iter().position(|a| a.is_valid && a.name == name)?;
+    Some((i as u32, aovs[i].kind == "COLOR"))
+}
+
+fn group_has_aov(scene: &Scene, t: &crate::scene::NodeTree, depth: u32) -> bool {
+    depth < 64
+        && t.nodes.iter().any(|n| {
+            runs_aov(scene, n)
+                || (!n.mute
+                    && n.node_tree
+                        .as_deref()
+                        .and_then(|g| scene.node_group(g))
+                        .is_some_and(|g| group_has_aov(scene, g, depth + 1)))
+        })
 }
 
 /// The program of a material with no surface: no closure, no displacement.
@@ -77,6 +129,7 @@ fn empty_surface() -> Program {
         attributes: Vec::new(),
         displacement: None,
         emission_estimate: [0.0; 3],
+        aovs: Vec::new(),
         volume: None,
         volume_varying: false,
     }
@@ -137,6 +190,8 @@ struct Compiler<'g, 'a> {
     attributes: Vec<super::attributes::AttributeRequest>,
     /// Compiling a world's shader: no object, no camera-space view of the point.
     world: bool,
+    /// The AOV Outputs compiled (`Program::aovs`).
+    pub(super) aovs: Vec<AovWrite>,
 }
 
 fn kind_of(socket_type: &str) -> Option<Kind> {
@@ -257,6 +312,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
             material_pass_index: 0.0,
             attributes: Vec::new(),
             world: false,
+            aovs: Vec::new(),
         }
     }
 
@@ -466,6 +522,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
             attributes: self.attributes,
             displacement: self.displacement,
             emission_estimate,
+            aovs: self.aovs,
         })
     }
 
@@ -784,7 +841,9 @@ pub fn compile_world(scene: &Scene, name: &str) -> Result<Program, CompileError>
         .ok_or_else(|| CompileError(format!("world {name:?} has no node tree")))?;
     let out = active_output(tree, "ShaderNodeOutputWorld", "CYCLES")
         .ok_or_else(|| CompileError(format!("world {name:?} has no World Output")))?;
-    let graph = flatten(tree, &scene.file.node_groups, &out.name)
+    let aovs =
+        aov_outputs(scene, tree).map_err(|e| CompileError(format!("world {name:?}: {e}")))?;
+    let (graph, _) = flatten_with(tree, &scene.file.node_groups, &out.name, &aovs)
         .map_err(|e| CompileError(format!("world {name:?}: {e}")))?;
     let mut c = Compiler::new(&graph);
     c.scene = Some(scene);

@@ -81,6 +81,20 @@ pub struct ShadingPoint {
     /// Point Density's Object space maps into; None on surfaces (where Cycles leaves the
     /// volume-only nodes out).
     pub volume_texspace: Option<([f32; 3], [f32; 3])>,
+    /// What the Point Info node reads: zero everywhere but on point clouds.
+    pub point: PointPoint,
+}
+
+/// A point-cloud hit as Cycles' Point Info node reads it (svm_node_point_info,
+/// geom/point.h).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PointPoint {
+    /// The point's centre in world space (point_position).
+    pub position: Vec3,
+    /// Its radius in world space (point_radius).
+    pub radius: f32,
+    /// hash_uint2_to_float(point index in its cloud, 0) (ATTR_STD_POINT_RANDOM).
+    pub random: f32,
 }
 
 /// A hair hit as Cycles' Hair Info node reads it (svm_node_hair_info, geom/curve.h).
@@ -154,6 +168,9 @@ pub struct ObjectInfo {
     pub random: f32,
     /// World to object transform, rows of an affine 3x4 matrix.
     pub world_to_object: [[f32; 4]; 3],
+    /// The particle an instance stands for (Particle Info); None: Cycles' dummy particle
+    /// (every value zero, index 0).
+    pub particle: Option<crate::scene::format::Particle>,
 }
 
 impl Default for ObjectInfo {
@@ -168,6 +185,7 @@ impl Default for ObjectInfo {
                 [0.0, 1.0, 0.0, 0.0],
                 [0.0, 0.0, 1.0, 0.0],
             ],
+            particle: None,
         }
     }
 }

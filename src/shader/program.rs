@@ -340,6 +340,16 @@ pub enum Op {
     HairInfo {
         dst: [Slot; 6],
     },
+    /// Point Info's outputs from the shading point's `point` (position (3 slots),
+    /// radius, random).
+    PointInfo {
+        dst: [Slot; 3],
+    },
+    /// Particle Info's outputs from the object's particle (index, random, age,
+    /// lifetime, location (3 slots), size, velocity (3), angular velocity (3)).
+    ParticleInfo {
+        dst: [Slot; 8],
+    },
     /// Ambient Occlusion (svm/ao.h), traced through the `Trace` the program runs with
     /// (`inside` turns the normal around before tracing).
     AmbientOcclusion {
@@ -612,6 +622,18 @@ pub struct Program {
     /// Cycles' emission estimate of the surface (Shader::estimate_emission): zero means
     /// the material never emits; its size decides whether emitters are light-sampled.
     pub emission_estimate: [f32; 3],
+    /// The AOV Outputs Cycles runs (naming a valid AOV of the view layer): after `run`
+    /// their values are in the stack, for the renderer's AOV passes.
+    pub aovs: Vec<AovWrite>,
+}
+
+/// An AOV Output node: the view-layer AOV it writes (index into the exported list) and
+/// where its value lands, the Color input for a colour AOV, else the Value input.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct AovWrite {
+    pub aov: u32,
+    pub color: bool,
+    pub slot: Slot,
 }
 
 /// Where a material's true displacement lives in its program. Ops `..center_end`
@@ -1205,6 +1227,36 @@ impl Program {
                     s[dst[3] as usize] = h.thickness;
                     put3(s, dst[4], h.tangent_normal);
                     s[dst[5] as usize] = h.random;
+                }
+                Op::ParticleInfo { dst } => {
+                    // Cycles' svm_node_particle_info; without a particle its dummy
+                    // particle: all zero, index 0.
+                    let p = sp
+                        .object
+                        .particle
+                        .unwrap_or(crate::scene::format::Particle {
+                            index: 0,
+                            age: 0.0,
+                            lifetime: 0.0,
+                            location: [0.0; 3],
+                            size: 0.0,
+                            velocity: [0.0; 3],
+                            angular_velocity: [0.0; 3],
+                        });
+                    s[dst[0] as usize] = p.index as f32;
+                    s[dst[1] as usize] = crate::nodes::random::hash_to_float2(p.index, 0);
+                    s[dst[2] as usize] = p.age;
+                    s[dst[3] as usize] = p.lifetime;
+                    put3(s, dst[4], p.location);
+                    s[dst[5] as usize] = p.size;
+                    put3(s, dst[6], p.velocity);
+                    put3(s, dst[7], p.angular_velocity);
+                }
+                Op::PointInfo { dst } => {
+                    let p = &sp.point;
+                    put3(s, dst[0], p.position);
+                    s[dst[1] as usize] = p.radius;
+                    s[dst[2] as usize] = p.random;
                 }
                 Op::AmbientOcclusion {
                     color,

@@ -170,6 +170,7 @@ pub fn object_info(obj: &Object, to_world: &[[f64; 4]; 4]) -> ObjectInfo {
         pass_index: obj.pass_index as f32,
         random: object_random(&obj.name),
         world_to_object: std::array::from_fn(|r| std::array::from_fn(|c| inv[r][c] as f32)),
+        particle: None,
     }
 }
 

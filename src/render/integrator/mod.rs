@@ -86,6 +86,8 @@ pub struct Scene<'a> {
     pub local: &'a crate::render::shader_rays::LocalAccels,
     /// The materials' volumes (render/volume.rs).
     pub volumes: &'a crate::render::volume::Volumes,
+    /// The view layer's shader AOV passes (`film::aov`).
+    pub aovs: &'a crate::render::film::aov::Layout,
 }
 
 /// Per-thread scratch, reused across samples (no allocation per ray).
@@ -110,9 +112,24 @@ pub struct Scratch {
     /// The volumes the path being traced is inside, and its volume bounces so far.
     pub volume_stack: super::volume::Stack,
     pub volume_bounce: u32,
+    /// The AOV values of the sample `radiance` last traced (`film::aov::Layout`), and
+    /// whether a surface has ended its AOV writes (Cycles' PATH_RAY_SINGLE_PASS_DONE).
+    pub aov: Vec<f32>,
+    pub aov_done: bool,
 }
 
 impl Scratch {
+    /// Clears what a camera sample leaves besides its colour (guides, transparency, AOV
+    /// values with `aov_stride` floats, volume bounces) before `radiance` traces it.
+    fn start_sample(&mut self, aov_stride: usize) {
+        self.features = Default::default();
+        self.transparent = 0.0;
+        self.aov.clear();
+        self.aov.resize(aov_stride, 0.0);
+        self.aov_done = false;
+        self.volume_bounce = 0;
+    }
+
     pub fn new(n_materials: usize) -> Scratch {
         Scratch {
             stacks: vec![Vec::new(); n_materials + 1],
@@ -126,6 +143,8 @@ impl Scratch {
             transparent: 0.0,
             volume_stack: Default::default(),
             volume_bounce: 0,
+            aov: Vec::new(),
+            aov_done: false,
         }
     }
 }
@@ -351,10 +370,27 @@ impl Scene<'_> {
             object_position: to_object.point(p),
             object_normal: normalize(Affine::normal_by_inverse(to_world, n)),
             generated: inst.generated(to_object.point(center)),
+            point: crate::shader::point::PointPoint {
+                position: center,
+                radius: k[3],
+                random: crate::nodes::random::hash_to_float2(
+                    c.point_index.get(r.tri as usize).copied().unwrap_or(r.tri),
+                    0,
+                ),
+            },
             ..Default::default()
         };
         // Cycles gives points no parametric coordinates (sd->u = sd->v = 0).
         self.fill_context(&mut sp, inst, wo, n, false, 0.0, 0.0);
+        // Point attributes: one value per point, each point its own "curve".
+        let point = r.tri as usize;
+        if let Some(Some(bound)) = c
+            .slot
+            .get(point)
+            .and_then(|&s| inst.attributes.get(s as usize))
+        {
+            bound.fill_curve(point, point, 0.0, &inst.instancer_values, &mut sp);
+        }
         sp.transform = crate::shader::bump::ObjectTransform {
             to_world: to_world.m,
             to_object: to_object.m,
@@ -452,10 +488,8 @@ impl Scene<'_> {
         scratch: &mut Scratch,
     ) -> V3 {
         let st = &self.settings;
-        scratch.features = Default::default();
-        scratch.transparent = 0.0;
+        scratch.start_sample(self.aovs.stride);
         self.volume_stack_init(org, scratch);
-        scratch.volume_bounce = 0;
         let mut path = Path::camera(org, dir, tmin, tmax, scratch.ray_dp, scratch.ray_dd);
         loop {
             let from_sss = path.sss_exit.take();
@@ -524,6 +558,7 @@ impl Scene<'_> {
             // guides there).
             if from_sss.is_none() {
                 scratch.features.surface(&scratch.lobes);
+                self.end_aov_writes(&path, scratch);
             }
             let u_bsdf = rng.get4(index, path.set);
             let u_light = rng.get4(index, path.set + 1);
@@ -650,6 +685,13 @@ impl Scene<'_> {
         let d = path.d;
         let w = self.world_mis_weight(d, path.prev_singular, path.prev_pdf, path.mis_viewer());
         let bg = scale(mul(path.throughput, self.background_toward(d, scratch)), w);
+        // The world's AOV Outputs, run with it (Cycles evaluates the background shader
+        // with the render buffer).
+        if path.transparent_bg && !scratch.aov_done {
+            if let (Some(world), Some(stack)) = (self.world, scratch.stacks.last()) {
+                self.write_aovs(&world.program, stack, &mut scratch.aov);
+            }
+        }
         scratch.features.add_emission(bg);
         let c = clamp_contrib(bg, clamp);
         if finite(c) {
@@ -711,6 +753,16 @@ impl Scene<'_> {
             return true;
         }
         self.shade_path(hit, wo, path, rng, index, scratch);
+        // Cycles runs the AOV Outputs with the shader, before the holdout.
+        if path.transparent_bg && !scratch.aov_done {
+            if let Some(p) = hit
+                .material
+                .and_then(|mi| self.materials[mi].program.as_ref())
+            {
+                let stack = &scratch.stacks[hit.material.unwrap_or(0)];
+                self.write_aovs(p, stack, &mut scratch.aov);
+            }
+        }
         // A holdout object seen by the camera (directly or through transparent
         // surfaces: Cycles' PATH_RAY_TRANSPARENT_BACKGROUND) keeps only its
         // transparency; the rest is a hole in the film.
@@ -734,6 +786,33 @@ impl Scene<'_> {
             }
         }
         true
+    }
+
+    /// Cycles' film_write_data_passes: a surface the camera sees that is opaque enough
+    /// ends its sample's AOV writes (PATH_RAY_SINGLE_PASS_DONE).
+    fn end_aov_writes(&self, path: &Path, scratch: &mut Scratch) {
+        if path.transparent_bg && self.aovs.ends_primary(scratch.lobes.transparent) {
+            scratch.aov_done = true;
+        }
+    }
+
+    /// Adds the values of program `p`'s AOV Outputs (in `stack` after it ran) to the
+    /// sample's AOV values, as Cycles' film_write_aov_pass_value / _color do.
+    fn write_aovs(&self, p: &crate::shader::Program, stack: &[f32], out: &mut [f32]) {
+        for w in &p.aovs {
+            let Some(pass) = self.aovs.pass(w.aov) else {
+                continue;
+            };
+            let (s, o) = (w.slot as usize, pass.offset);
+            if w.color {
+                for k in 0..3 {
+                    out[o + k] += stack[s + k];
+                }
+                out[o + 3] += 1.0;
+            } else {
+                out[o] += stack[s];
+            }
+        }
     }
 
     /// Emission of the surface the ray found, shared by MIS with light sampling on the

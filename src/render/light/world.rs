@@ -174,6 +174,14 @@ fn is_constant(tree: &crate::scene::NodeTree) -> bool {
     // The output the world's program is compiled from (shader::compile), so the two agree.
     let out = crate::nodes::graph::active_output(tree, "ShaderNodeOutputWorld", "CYCLES");
     let Some(out) = out else { return true };
+    // AOV Outputs run with the world's program (the camera rays' AOV passes).
+    if tree
+        .nodes
+        .iter()
+        .any(|n| !n.mute && n.bl_idname == "ShaderNodeOutputAOV")
+    {
+        return false;
+    }
     let Some(link) = tree
         .links
         .iter()

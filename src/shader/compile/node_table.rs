@@ -25,9 +25,10 @@ use crate::nodes::{Support, IGNORED_BY_CYCLES, STRUCTURAL};
 use super::super::bump::{BumpSettings, MapSpace};
 use super::super::bump_graph::{self, Schedule};
 use super::{
-    dimensions, floats, kind_of, linked, mode, prop, prop_bool, prop_str, Closure, CompileError,
-    Compiler, Kind, Op,
+    aov_index, dimensions, floats, kind_of, linked, mode, prop, prop_bool, prop_str, Closure,
+    CompileError, Compiler, Kind, Op,
 };
+use crate::shader::program::AovWrite;
 use Kind::{Color as C, Float as F, Vector as V};
 
 /// One node type's compile step: node `i` of the compiler's graph into ops, output slots
@@ -81,13 +82,15 @@ const WIREFRAME: &str =
 const RAY_TRACED: &str =
     "ray-traced at the shading point (shader/trace.rs, render/shader_rays.rs: Cycles' svm/ao.h and svm/bevel.h; 1 and the shading normal where Cycles cannot trace: displacement, shadow and light shading, the world); Cycles parity scenes in tests/render.rs (ambient_occlusion*, bevel*); AO's Distance 0 (the world's AO distance) and `bake` of such a material are errors naming the node";
 const PARTICLE_INFO: &str =
-    "on a mesh not instanced by particles, Cycles' dummy particle (all zero, Random the hash of index 0), Cycles' EMIT bakes in tests/bake.rs; in a scene with a particle system a compile error (particle instances are frozen meshes without their particle data)";
+    "on an object a particle system instances, its particle as Cycles' sync_dupli_particle reads it (the realised instance's particle record: index, Random the hash of the index, age, lifetime, location, size, velocity, angular velocity at the frame), Cycles parity scene particle_info in tests/render.rs; elsewhere and on child particles Cycles' dummy particle (all zero, Random the hash of index 0), Cycles' EMIT bakes in tests/bake.rs; an export without the record is a compile error naming the object";
 const INFO_ON_MESH: &str =
-    "on a mesh (the only primitive blendsynth renders; hair curves, point clouds and volumes are refused) every output is zero as in Cycles, Cycles' EMIT bakes in tests/bake.rs";
+    "on meshes, hair and points every output is zero as in Cycles, Cycles' EMIT bakes in tests/bake.rs";
+const POINT_INFO: &str =
+    "every output as Cycles 4.5 computes it on point clouds (svm_node_point_info, geom/point.h: the point's world-space centre and radius, random by the point's index in its cloud, as blender/pointcloud.cpp makes ATTR_STD_POINT_RANDOM), zero on meshes and hair; Cycles parity scene point_info in tests/render.rs";
 const HAIR_INFO: &str =
     "every output as Cycles 4.5 computes it on hair curves (svm_node_hair_info, geom/curve.h: intercept and length from the keys, thickness, tangent normal, random by curve index), zero on meshes; Cycles parity scene hair_info in tests/render.rs";
 const AOV: &str =
-    "Cycles writes it to its AOV pass only, never the image: nothing to evaluate (blendsynth writes no AOV passes)";
+    "written to the view layer's AOV pass it names (render/film/aov.rs, Cycles' svm/aov.h): Color or Value by the AOV's type, on camera rays and through transparent bounces until a surface reaches the Alpha Threshold, in materials and the world; a name the view layer lacks writes nothing; `render --passes` writes aovs.exr with Blender's channel names; Cycles parity scene aov in tests/render.rs (every channel); inside a node group a compile error naming the group node";
 const LIGHT_OUTPUT: &str =
     "the output of a light's node tree (shader::compile_light, evaluated at every light sample by render/light/shader.rs; nodes that read what a light sample lacks are errors naming the light and node); Cycles parity scene light_ies in tests/render.rs; in a material Cycles renders only the Material Output (fixtures/bake/nodes, case freestyle_and_light_nodes)";
 const METALLIC: &str =
@@ -150,8 +153,8 @@ pub const NODES: &[ShaderNode] = &[
     node("ShaderNodeWireframe", wireframe, WIREFRAME),
     node("ShaderNodeAmbientOcclusion", ambient_occlusion, RAY_TRACED),
     node("ShaderNodeBevel", bevel, RAY_TRACED),
-    node("ShaderNodeParticleInfo", info_on_mesh, PARTICLE_INFO),
-    node("ShaderNodePointInfo", info_on_mesh, INFO_ON_MESH),
+    node("ShaderNodeParticleInfo", particle_info, PARTICLE_INFO),
+    node("ShaderNodePointInfo", point_info, POINT_INFO),
     node("ShaderNodeHairInfo", hair_info, HAIR_INFO),
     node("ShaderNodeVolumeInfo", info_on_mesh, INFO_ON_MESH),
     // Output
@@ -408,36 +411,55 @@ fn bevel(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), Compile
     Ok(())
 }
 
-/// Particle, Point, Curves and Volume Info on a triangle mesh, as Cycles evaluates them
-/// there: the point, curve and volume data are absent (zero), and the particle is Cycles'
-/// dummy particle 0, whose Random is the hash of its index.
+/// Point, Curves and Volume Info on a triangle mesh, as Cycles evaluates them there: the
+/// point, curve and volume data are absent (zero).
 fn info_on_mesh(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
     let n = &c.g.nodes[i];
-    let particle = n.node.bl_idname == "ShaderNodeParticleInfo";
-    if particle {
-        if let Some(o) = c.scene.and_then(|s| {
-            s.file
-                .objects
-                .iter()
-                .find(|o| o.modifiers.iter().any(|m| m.kind == "PARTICLE_SYSTEM"))
-        }) {
-            return Err(CompileError(format!(
-                "node {:?}: Particle Info in a scene with a particle system (object {:?}) is not supported yet: its particle instances are rendered without their particle data",
-                n.path, o.name
-            )));
-        }
-    }
     let mut slots = Vec::new();
     for o in &n.node.outputs {
         let kind = kind_of(&o.kind).unwrap_or(F);
-        let v = if particle && o.identifier == "Random" {
-            crate::nodes::random::hash_to_float2(0, 0)
-        } else {
-            0.0
-        };
-        let s = c.constant(kind, [v; 3]);
+        let s = c.constant(kind, [0.0; 3]);
         slots.push((o.identifier.as_str(), s, kind));
     }
+    c.outputs(i, n, &slots);
+    Ok(())
+}
+
+/// Particle Info: the values of the particle the object stands for (its realised
+/// instance's record), Cycles' dummy particle elsewhere. An export older than the record
+/// is refused where particle systems instance objects.
+fn particle_info(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    if let Some(e) = c.scene.and_then(|s| {
+        s.file.evaluated.iter().find(|e| {
+            e.realized
+                .as_ref()
+                .is_some_and(|r| r.instances.iter().any(|i| i.particle.is_none()))
+        })
+    }) {
+        return Err(CompileError(format!(
+            "node {:?}: Particle Info, and the export of object {:?} predates the particle record of its instances: convert the .blend again",
+            n.path, e.object
+        )));
+    }
+    let kinds = [F, F, F, F, V, F, V, V];
+    let dst = kinds.map(|k| c.alloc(k));
+    c.ops.push(Op::ParticleInfo { dst });
+    let names = [
+        "Index",
+        "Random",
+        "Age",
+        "Lifetime",
+        "Location",
+        "Size",
+        "Velocity",
+        "Angular Velocity",
+    ];
+    let slots: Vec<(&str, u32, Kind)> = names
+        .iter()
+        .zip(dst.iter().zip(kinds))
+        .map(|(n, (d, k))| (*n, *d, k))
+        .collect();
     c.outputs(i, n, &slots);
     Ok(())
 }
@@ -457,6 +479,23 @@ fn hair_info(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), Com
             ("Thickness", dst[3], F),
             ("Tangent Normal", dst[4], V),
             ("Random", dst[5], F),
+        ],
+    );
+    Ok(())
+}
+
+/// Point Info: the shading point's point-cloud values (zero off points, as in Cycles).
+fn point_info(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let dst = [V, F, F].map(|k| c.alloc(k));
+    c.ops.push(Op::PointInfo { dst });
+    c.outputs(
+        i,
+        n,
+        &[
+            ("Position", dst[0], V),
+            ("Radius", dst[1], F),
+            ("Random", dst[2], F),
         ],
     );
     Ok(())
@@ -482,9 +521,20 @@ fn material_output(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(
     Ok(())
 }
 
-/// AOV Output has no outputs, so no material output reaches it; Cycles evaluates it
-/// only into its AOV pass.
-fn aov_output(_: &mut Compiler<'_, '_>, _: usize, _: &Schedule) -> Result<(), CompileError> {
+/// AOV Output: its input for the view-layer AOV it names (Color for a colour AOV, else
+/// Value), read by the renderer after the program runs (Cycles' svm_node_aov_color /
+/// svm_node_aov_value). Only nodes naming a valid AOV reach the graph (`aov_outputs`).
+fn aov_output(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
+    let n = &c.g.nodes[i];
+    let Some((aov, color)) = c.scene.and_then(|s| aov_index(s, n.node)) else {
+        return Ok(());
+    };
+    let slot = if color {
+        c.input(n, "Color", C)?
+    } else {
+        c.input(n, "Value", F)?
+    };
+    c.aovs.push(AovWrite { aov, color, slot });
     Ok(())
 }
 
