@@ -2192,3 +2192,29 @@ fn dataset_writes_the_aov_passes() {
     .unwrap_or_default();
     assert!(e.contains("no shader AOVs"), "{e}");
 }
+
+/// Point Density's grid is Blender's at the exported frame: another frame, or an override
+/// of a property the grid depends on, is an error naming the node, not a stale grid.
+#[test]
+fn point_density_refuses_a_stale_grid_by_name() {
+    let (dir, base) = fixture_json("point_density");
+    let scene = assert_renders(&dir, &base);
+    let opts = RenderOptions {
+        frame: Some(3.0),
+        ..check_opts()
+    };
+    let e = blendsynth::render::check(&scene, &opts, &[])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("Point Density") && e.contains("frame 1"), "{e}");
+    let path = r#"materials["PDObject"].node_tree.nodes["Point Density"].radius"#;
+    let o = blendsynth::scene::overrides::Override {
+        path: path.into(),
+        value: 0.5.into(),
+    };
+    let changed = scene.with_overrides(&[o]).unwrap();
+    let e = blendsynth::render::check(&changed, &check_opts(), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("Point Density") && e.contains("radius"), "{e}");
+}

@@ -677,6 +677,42 @@ pub fn check(
     prepare(scene, opts, overrides).map(|p| build::triangle_count(&p.geo))
 }
 
+/// A Point Density grid is Blender's at the exported frame (particles and animated points
+/// move): rendering a used material's grid at another frame is an error naming the node.
+fn check_point_density_frames(scene: &Scene, used: &[bool], frame: f64) -> Result<(), RenderError> {
+    fn walk(
+        scene: &Scene,
+        tree: &crate::scene::format::NodeTree,
+        path: &str,
+        frame: f64,
+        depth: u32,
+    ) -> Result<(), RenderError> {
+        if depth > 64 {
+            return Ok(());
+        }
+        for n in &tree.nodes {
+            if let Some(pd) = &n.point_density {
+                if (pd.frame - frame).abs() > 1e-6 {
+                    return Err(RenderError(format!(
+                        "{path}: node {:?}: its Point Density grid was computed by Blender at frame {}, not {frame}: convert the file at this frame (`convert --frame`)",
+                        n.name, pd.frame
+                    )));
+                }
+            }
+            if let Some(g) = n.node_tree.as_deref().and_then(|g| scene.node_group(g)) {
+                walk(scene, g, path, frame, depth + 1)?;
+            }
+        }
+        Ok(())
+    }
+    for (m, _) in scene.file.materials.iter().zip(used).filter(|(_, u)| **u) {
+        if let Some(t) = &m.node_tree {
+            walk(scene, t, &format!("material {:?}", m.name), frame, 0)?;
+        }
+    }
+    Ok(())
+}
+
 fn prepare(
     scene: &Scene,
     opts: &RenderOptions,
@@ -764,6 +800,7 @@ fn prepare(
         }
     }
     let materials = integrator::shade::compile_all(scene, &used)?;
+    check_point_density_frames(scene, &used, frame)?;
     points::check(&geo, &materials)?;
     curves::check(scene, &geo, &materials)?;
     build::bind_attributes(&mut geo, &materials)?;
