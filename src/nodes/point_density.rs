@@ -46,8 +46,9 @@ pub struct VoxelGrid {
     pub voxels: Arc<Vec<[f32; 4]>>,
 }
 
-/// Cycles' SET_CUBIC_SPLINE_WEIGHTS (uniform cubic B-spline).
-fn cubic_weights(t: f32) -> [f32; 4] {
+/// Cycles' SET_CUBIC_SPLINE_WEIGHTS (uniform cubic B-spline), for 3D images and voxel
+/// grids alike.
+pub fn cubic_weights(t: f32) -> [f32; 4] {
     [
         (((-1.0 / 6.0) * t + 0.5) * t - 0.5) * t + (1.0 / 6.0),
         ((0.5 * t - 1.0) * t) * t + (2.0 / 3.0),

@@ -112,16 +112,6 @@ fn voxel(g: &VoxelGrid, i: i64, j: i64, k: i64) -> [f32; 4] {
     }
 }
 
-/// Cycles' cubic B-spline weights (SET_CUBIC_SPLINE_WEIGHTS) for fraction `t`.
-fn bspline(t: f32) -> [f32; 4] {
-    [
-        (((-1.0 / 6.0) * t + 0.5) * t - 0.5) * t + 1.0 / 6.0,
-        ((0.5 * t - 1.0) * t) * t + 2.0 / 3.0,
-        ((-0.5 * t + 0.5) * t + 0.5) * t + 1.0 / 6.0,
-        (1.0 / 6.0) * t * t * t,
-    ]
-}
-
 /// Grid `g` at voxel index coordinates `x` (Cycles' kernel_tex_image_interp_nanovdb:
 /// trilinear, or tricubic B-spline, around x - 0.5).
 pub fn sample(g: &VoxelGrid, x: V3, cubic: bool) -> [f32; 4] {
@@ -131,7 +121,7 @@ pub fn sample(g: &VoxelGrid, x: V3, cubic: bool) -> [f32; 4] {
     let b = base.map(|c| c as i64);
     let mut out = [0.0f32; 3];
     if cubic {
-        let w = t.map(bspline);
+        let w = t.map(crate::nodes::point_density::cubic_weights);
         for (dz, wz) in w[2].iter().enumerate() {
             for (dy, wy) in w[1].iter().enumerate() {
                 for (dx, wx) in w[0].iter().enumerate() {
