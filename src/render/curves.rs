@@ -512,11 +512,12 @@ impl Accel for WithCurves {
 }
 
 /// What blendsynth cannot render on hair, named: materials with volume, true
-/// displacement, emission (Cycles' curves are no lights), the Principled Hair BSDF's
-/// Huang model and the Subsurface Scattering node; the hair BSDFs on meshes; and hair
-/// with motion blur or under Embree.
+/// displacement, emission (Cycles' curves are no lights), the Subsurface Scattering node,
+/// a Principled Hair BSDF model it does not know, and the Huang model's elliptical fibre
+/// on a Curves object; the hair BSDFs on meshes; and hair with motion blur or under
+/// Embree.
 pub fn check(
-    _scene: &crate::scene::Scene,
+    scene: &crate::scene::Scene,
     geo: &crate::render::build::Geometry,
     materials: &[crate::render::integrator::shade::Material],
 ) -> Result<(), crate::render::RenderError> {
@@ -576,11 +577,26 @@ pub fn check(
             } else {
                 p.bsdfs.iter().find_map(|b| match b.bl_idname.as_str() {
                     "ShaderNodeSubsurfaceScattering" => Some(format!("node {}", b.bl_idname)),
-                    "ShaderNodeBsdfHairPrincipled" if b.property("model") != Some("CHIANG") => {
+                    "ShaderNodeBsdfHairPrincipled"
+                        if !matches!(b.property("model"), Some("CHIANG" | "HUANG")) =>
+                    {
                         Some(format!(
-                            "node {} with model {:?} (only the Chiang model is rendered)",
+                            "node {} with model {:?} (the Chiang and Huang models are rendered)",
                             b.bl_idname,
                             b.property("model").unwrap_or("?")
+                        ))
+                    }
+                    // Cycles turns an elliptical fibre about the curve's normal attribute,
+                    // which particle hair lacks (an arbitrary frame then) but a Curves
+                    // object may carry; blendsynth exports none.
+                    "ShaderNodeBsdfHairPrincipled"
+                        if b.property("model") == Some("HUANG")
+                            && is_curves_object(scene, &inst.name)
+                            && huang_aspect_ratio(p, b) != Some(1.0) =>
+                    {
+                        Some(format!(
+                            "node {} (Huang model) with an Aspect Ratio other than 1 on a Curves object (blendsynth does not carry the curves' normals the ellipse turns about)",
+                            b.bl_idname
                         ))
                     }
                     _ => None,
@@ -595,6 +611,27 @@ pub fn check(
         }
     }
     Ok(())
+}
+
+/// Whether the instance named `name` is a Curves object's (not particle hair).
+fn is_curves_object(scene: &crate::scene::Scene, name: &str) -> bool {
+    scene
+        .file
+        .objects
+        .iter()
+        .any(|o| o.name == name && o.kind == "CURVES")
+}
+
+/// The Huang node's Aspect Ratio when it is a constant (None when linked).
+fn huang_aspect_ratio(
+    p: &crate::shader::program::Program,
+    b: &crate::shader::program::BsdfNode,
+) -> Option<f32> {
+    match b.input("Aspect Ratio") {
+        Some((_, true)) => None,
+        Some((slot, false)) => p.initial.get(slot as usize).copied(),
+        None => Some(0.85),
+    }
 }
 
 #[cfg(test)]

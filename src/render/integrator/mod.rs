@@ -914,8 +914,11 @@ fn filter_glossy(lobes: &mut LobeSet, min_ray_pdf: f32, filter_glossy: f32) {
             a.alpha_x = a.alpha_x.max(blur);
             a.alpha_y = a.alpha_y.max(blur);
         }
-        // Cycles blurs the Chiang hair closure too; the Hair BSDF has no blur.
+        // Cycles blurs the Principled Hair closures too; the Hair BSDF has no blur.
         if let LobeKind::Chiang(c) = &mut lobe.kind {
+            c.blur(blur);
+        }
+        if let LobeKind::Huang(c) = &mut lobe.kind {
             c.blur(blur);
         }
     }
