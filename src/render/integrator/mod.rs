@@ -452,6 +452,9 @@ impl Scene<'_> {
         scratch: &mut Scratch,
     ) -> V3 {
         let st = &self.settings;
+        // Rays leaving a hair skip its curve (Cycles' self prim); none on the camera ray.
+        crate::render::curves::set_ray_self(None);
+        let _self_guard = crate::render::curves::RaySelfGuard;
         scratch.features = Default::default();
         scratch.transparent = 0.0;
         self.volume_stack_init(org, scratch);
@@ -501,6 +504,7 @@ impl Scene<'_> {
             if from_sss.is_none() {
                 self.lights_along(&mut path, hit_opt.map(|h| h.t), clamp_limit, scratch);
             }
+            crate::render::curves::set_ray_self(hit_opt.as_ref().map(|h| h.prim));
             let Some(h) = hit_opt else {
                 self.miss(&mut path, clamp_limit, scratch);
                 break;

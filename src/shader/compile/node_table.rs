@@ -93,7 +93,7 @@ const LIGHT_OUTPUT: &str =
 const METALLIC: &str =
     "render/bsdf/metallic.rs: F82 Tint and Physical Conductor (Cycles' fresnel_conductor) with GGX, Multiscatter GGX and Beckmann, Cycles parity scenes in tests/render.rs (metallic_bsdf, metallic_conductor); anisotropic Beckmann is a compile error naming the node";
 const HAIR: &str =
-    "render/bsdf/hair.rs (closure/bsdf_hair.h): Reflection and Transmission on hair curves (refused on meshes); Cycles parity scene tests/render.rs hair_bsdf, a known failure (means 1.2-1.45% bright)";
+    "render/bsdf/hair.rs (closure/bsdf_hair.h): Reflection and Transmission on hair curves (refused on meshes); Cycles parity scene tests/render.rs hair_bsdf";
 const PRINCIPLED_HAIR: &str =
     "render/bsdf/hair_chiang.rs (closure/bsdf_principled_hair_chiang.h) and render/bsdf/hair_huang.rs (closure/bsdf_principled_hair_huang.h): Chiang and Huang models, every parametrization, on hair curves (refused on meshes; Huang's elliptical fibre is refused on Curves objects, whose normals the export does not carry), Cycles parity scenes in tests/render.rs (hair_chiang_melanin, hair_chiang_color, hair_chiang_absorption, hair_huang_melanin, hair_huang_color, hair_huang_absorption)";
 const TOON: &str =
