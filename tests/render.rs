@@ -49,6 +49,16 @@ const ASSERTED: &[&str] = &[
     "hair_chiang_melanin",
     "hair_chiang_color",
     "hair_chiang_absorption",
+    // Hair BSDF, Reflection plus Transmission (render/bsdf/hair.rs): the transmitted rays
+    // skip their own curve as Cycles' do (render/curves.rs, set_ray_self).
+    "hair_bsdf",
+    // Principled Hair BSDF, Huang (render/bsdf/hair_huang.rs): Melanin on a circular fibre
+    // (near field at the roots, far field at the tips); Direct Coloring on an ellipse
+    // (Aspect Ratio 0.6) with R/TT/TRT multipliers 1.5/0.6/2 and Random Roughness;
+    // Absorption Coefficient with Aspect Ratio 1.6 (axes swapped).
+    "hair_huang_melanin",
+    "hair_huang_color",
+    "hair_huang_absorption",
     // A Curves object with Geometry Nodes: its evaluated strands as hair.
     "curves_object",
     // Hair Info, each output into a colour, on a Curves object and on particle hair.
@@ -312,10 +322,7 @@ const SCALED_SCENES: &[&[&str]] = &[
 const MAX_SCALE_REL: f64 = 0.003;
 
 /// Scenes that do not pass yet, with the reason.
-const KNOWN_FAILURES: &[(&str, &str)] = &[(
-    "hair_bsdf",
-    "Hair BSDF Reflection plus Transmission: ratio 1.06, channel means 1.2-1.45% above Cycles' (seed spread 0.1% at 256 samples); Reflection alone matches (0.08%), Transmission alone is 1% bright: under investigation",
-)];
+const KNOWN_FAILURES: &[(&str, &str)] = &[];
 
 /// Scenes whose one-seed figures are no parity criterion, with the test that compares them
 /// instead (their figures are still printed).
@@ -1758,10 +1765,12 @@ fn unsupported_volumes_are_refused_by_name() {
     );
 }
 
-/// The hair BSDFs render on hair curves with the Chiang model only: the Principled Hair
-/// BSDF's Huang model, and either hair BSDF on a mesh's faces (Cycles turns them about
-/// the triangle's dP/dv, which blendsynth does not have), are errors naming the object,
-/// material and node, alike from `inspect` (render::check) and `render`.
+/// The hair BSDFs render on hair curves only: either hair BSDF on a mesh's faces (Cycles
+/// turns them about the triangle's dP/dv, which blendsynth does not have), a Principled
+/// Hair BSDF model other than Chiang and Huang, and an elliptical Huang fibre on a Curves
+/// object (Cycles turns it about the curves' normals, which the export does not carry)
+/// are errors naming the object, material and node, alike from `inspect`
+/// (render::check) and `render`.
 #[test]
 fn hair_bsdfs_refused_where_not_rendered() {
     let (dir, base) = fixture_json("hair_chiang_melanin");
@@ -1791,20 +1800,73 @@ fn hair_bsdfs_refused_where_not_rendered() {
             .find(|n| n["bl_idname"] == bl_idname)
             .unwrap());
     };
-    // The Huang model on the hair.
+    // A model blendsynth does not know (Blender 4.5 has Chiang and Huang).
     refused(
         &|j| {
             set(j, "HairMelanin", "ShaderNodeBsdfHairPrincipled", &|n| {
-                n["properties"]["model"] = "HUANG".into()
+                n["properties"]["model"] = "MARSCHNER".into()
             })
         },
         &[
             "\"Emitter\"",
             "\"HairMelanin\"",
             "ShaderNodeBsdfHairPrincipled",
-            "HUANG",
+            "MARSCHNER",
         ],
     );
+    // The Huang model on particle hair renders, elliptical or not.
+    for aspect in [1.0, 0.6] {
+        let mut huang = base.clone();
+        set(
+            &mut huang,
+            "HairMelanin",
+            "ShaderNodeBsdfHairPrincipled",
+            &|n| {
+                n["properties"]["model"] = "HUANG".into();
+                for i in n["inputs"].as_array_mut().unwrap() {
+                    if i["identifier"] == "Aspect Ratio" {
+                        i["default_value"] = aspect.into();
+                    }
+                }
+            },
+        );
+        assert_renders(&dir, &huang);
+    }
+    // An elliptical Huang fibre on a Curves object; a circular one renders there.
+    let (cdir, cbase) = fixture_json("curves_object");
+    let (_, hbase) = fixture_json("hair_huang_color");
+    let on_strands = |j: &mut serde_json::Value, aspect: f64| {
+        let mut h = node(
+            &mut hbase.clone(),
+            "HuangColor",
+            "ShaderNodeBsdfHairPrincipled",
+        );
+        for i in h["inputs"].as_array_mut().unwrap() {
+            if i["identifier"] == "Aspect Ratio" {
+                i["default_value"] = aspect.into();
+            }
+        }
+        set(j, "Strand", "ShaderNodeBsdfPrincipled", &|n| {
+            let mut h = h.clone();
+            h["name"] = n["name"].clone();
+            *n = h;
+        });
+    };
+    refused_alike(
+        &cdir,
+        &cbase,
+        &|j| on_strands(j, 0.6),
+        &[
+            "\"Strands\"",
+            "\"Strand\"",
+            "ShaderNodeBsdfHairPrincipled",
+            "Aspect Ratio",
+            "Curves object",
+        ],
+    );
+    let mut circular = cbase.clone();
+    on_strands(&mut circular, 1.0);
+    assert_renders(&cdir, &circular);
     // The Principled Hair BSDF (Chiang) as the emitter mesh's own material.
     refused(
         &|j| {

@@ -391,6 +391,35 @@ pub struct CurveAccel {
     points: Vec<[[f32; 4]; 4]>,
     pieces: Vec<u32>,
     masks: Vec<u32>,
+    /// Per segment: its curve (instance and curve index), and per scene prim the curve
+    /// it belongs to (u32::MAX for triangles): what a ray leaving a curve skips.
+    curve_of: Vec<u32>,
+    curve_by_prim: Vec<u32>,
+}
+
+thread_local! {
+    /// The scene prim the current path vertex lies on (Cycles' ray->self.prim): rays
+    /// traced from it on this thread skip every segment of its curve.
+    static RAY_SELF: std::cell::Cell<Option<u32>> = const { std::cell::Cell::new(None) };
+}
+
+/// Sets the prim the rays traced next on this thread leave from (None: the camera, or
+/// no surface). Cycles' rays skip the curve they leave (intersection_skip_self: its self
+/// prim is the curve, not the segment) besides the hits nearer than twice the radius:
+/// without the skip a transmitted ray met its own strand again further on, and
+/// `tests/render.rs` scene hair_bsdf rendered 1.45% bright (0.31% with it).
+pub fn set_ray_self(prim: Option<u32>) {
+    RAY_SELF.with(|c| c.set(prim));
+}
+
+/// Clears the ray's self prim when dropped, so that no other ray on the thread
+/// inherits it.
+pub struct RaySelfGuard;
+
+impl Drop for RaySelfGuard {
+    fn drop(&mut self) {
+        set_ray_self(None);
+    }
 }
 
 impl CurveAccel {
@@ -398,11 +427,23 @@ impl CurveAccel {
     pub fn build(geo: &crate::render::build::Geometry) -> Option<CurveAccel> {
         let (mut prims, mut points, mut pieces, mut masks, mut boxes) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let mut curve_of = Vec::new();
+        let mut curve_by_prim = vec![u32::MAX; geo.refs.len()];
+        // Curves numbered in order: an instance's segments are consecutive, and a curve's.
+        let (mut last, mut next_id) = (None, 0u32);
         for (prim, r) in geo.refs.iter().enumerate() {
             let inst = &geo.instances[r.inst as usize];
             let Some(c) = &inst.curves else {
                 continue;
             };
+            let key = (r.inst, c.segments[r.tri as usize].0);
+            if last != Some(key) {
+                last = Some(key);
+                next_id += 1;
+            }
+            let cid = next_id - 1;
+            curve_of.push(cid);
+            curve_by_prim[prim] = cid;
             prims.push(prim as u32);
             points.push(c.control_points(r.tri));
             pieces.push(c.pieces);
@@ -418,14 +459,23 @@ impl CurveAccel {
             points,
             pieces,
             masks,
+            curve_of,
+            curve_by_prim,
         })
     }
 
     fn query(&self, org: V3, dir: V3, tmin: f32, tmax: f32, mask: u32, any: bool) -> Option<Hit> {
         let mut best = None;
+        let skip = RAY_SELF
+            .with(|c| c.get())
+            .and_then(|p| self.curve_by_prim.get(p as usize).copied())
+            .filter(|&c| c != u32::MAX);
         self.bvh.traverse(org, dir, tmin, tmax, any, |i, far| {
             let i = i as usize;
             if self.masks[i] & mask == 0 {
+                return None;
+            }
+            if skip == Some(self.curve_of[i]) {
                 return None;
             }
             let h = if self.pieces[i] == 0 {
@@ -515,11 +565,12 @@ impl Accel for WithCurves {
 }
 
 /// What blendsynth cannot render on hair, named: materials with volume, true
-/// displacement, emission (Cycles' curves are no lights), the Principled Hair BSDF's
-/// Huang model and the Subsurface Scattering node; the hair BSDFs on meshes; and hair
-/// with motion blur or under Embree.
+/// displacement, emission (Cycles' curves are no lights), the Subsurface Scattering node,
+/// a Principled Hair BSDF model it does not know, and the Huang model's elliptical fibre
+/// on a Curves object; the hair BSDFs on meshes; and hair with motion blur or under
+/// Embree.
 pub fn check(
-    _scene: &crate::scene::Scene,
+    scene: &crate::scene::Scene,
     geo: &crate::render::build::Geometry,
     materials: &[crate::render::integrator::shade::Material],
 ) -> Result<(), crate::render::RenderError> {
@@ -579,11 +630,26 @@ pub fn check(
             } else {
                 p.bsdfs.iter().find_map(|b| match b.bl_idname.as_str() {
                     "ShaderNodeSubsurfaceScattering" => Some(format!("node {}", b.bl_idname)),
-                    "ShaderNodeBsdfHairPrincipled" if b.property("model") != Some("CHIANG") => {
+                    "ShaderNodeBsdfHairPrincipled"
+                        if !matches!(b.property("model"), Some("CHIANG" | "HUANG")) =>
+                    {
                         Some(format!(
-                            "node {} with model {:?} (only the Chiang model is rendered)",
+                            "node {} with model {:?} (the Chiang and Huang models are rendered)",
                             b.bl_idname,
                             b.property("model").unwrap_or("?")
+                        ))
+                    }
+                    // Cycles turns an elliptical fibre about the curve's normal attribute,
+                    // which particle hair lacks (an arbitrary frame then) but a Curves
+                    // object may carry; blendsynth exports none.
+                    "ShaderNodeBsdfHairPrincipled"
+                        if b.property("model") == Some("HUANG")
+                            && is_curves_object(scene, &inst.name)
+                            && huang_aspect_ratio(p, b) != Some(1.0) =>
+                    {
+                        Some(format!(
+                            "node {} (Huang model) with an Aspect Ratio other than 1 on a Curves object (blendsynth does not carry the curves' normals the ellipse turns about)",
+                            b.bl_idname
                         ))
                     }
                     _ => None,
@@ -598,6 +664,27 @@ pub fn check(
         }
     }
     Ok(())
+}
+
+/// Whether the instance named `name` is a Curves object's (not particle hair).
+fn is_curves_object(scene: &crate::scene::Scene, name: &str) -> bool {
+    scene
+        .file
+        .objects
+        .iter()
+        .any(|o| o.name == name && o.kind == "CURVES")
+}
+
+/// The Huang node's Aspect Ratio when it is a constant (None when linked).
+fn huang_aspect_ratio(
+    p: &crate::shader::program::Program,
+    b: &crate::shader::program::BsdfNode,
+) -> Option<f32> {
+    match b.input("Aspect Ratio") {
+        Some((_, true)) => None,
+        Some((slot, false)) => p.initial.get(slot as usize).copied(),
+        None => Some(0.85),
+    }
 }
 
 #[cfg(test)]
@@ -724,6 +811,11 @@ mod tests {
             points,
             pieces: vec![4; 3],
             masks: vec![crate::foundation::bvh::visibility::ALL; 3],
+            // Scene prim 0 is the floor triangle, 10..12 the strand's segments (curve 0).
+            curve_of: vec![0; 3],
+            curve_by_prim: (0..13)
+                .map(|p| if p >= 10 { 0 } else { u32::MAX })
+                .collect(),
         };
         // A floor triangle below the strand at z = -1.
         let tri = [[-5.0, -5.0, -1.0], [5.0, -5.0, -1.0], [0.0, 5.0, -1.0]];
@@ -742,5 +834,26 @@ mod tests {
         assert_eq!(h.prim, 0);
         assert!(!acc.occluded([0.5, 0.0, 3.0], [0.0, 0.0, -1.0], 0.0, 2.0));
         assert!(acc.occluded([0.5, 0.0, 3.0], [0.0, 0.0, -1.0], 0.0, 3.5));
+        // A ray leaving any segment of the strand skips the whole curve (Cycles' self
+        // prim is the curve): it reaches the floor; leaving the floor, it hits the strand.
+        {
+            let _guard = RaySelfGuard;
+            set_ray_self(Some(10));
+            let h = acc
+                .intersect([2.5, 0.0, 3.0], [0.0, 0.0, -1.0], 0.0, 100.0)
+                .unwrap();
+            assert_eq!(h.prim, 0);
+            assert!((h.t - 4.0).abs() < 1e-5);
+            assert!(!acc.occluded([2.5, 0.0, 3.0], [0.0, 0.0, -1.0], 0.0, 3.5));
+            set_ray_self(Some(0));
+            let h = acc
+                .intersect([2.5, 0.0, 3.0], [0.0, 0.0, -1.0], 0.0, 100.0)
+                .unwrap();
+            assert_eq!(h.prim, 12);
+        }
+        let h = acc
+            .intersect([2.5, 0.0, 3.0], [0.0, 0.0, -1.0], 0.0, 100.0)
+            .unwrap();
+        assert_eq!(h.prim, 12, "the guard cleared the self prim");
     }
 }

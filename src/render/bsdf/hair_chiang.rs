@@ -154,9 +154,10 @@ fn azimuthal(phi: f32, p: i32, s: f32, gamma_o: f32, gamma_t: f32) -> f32 {
     trimmed_logistic(wrap_angle(phi - delta_phi(p, gamma_o, gamma_t)), s)
 }
 
+/// Cycles' longitudinal_scattering (the Huang model's TRRT+ lobe uses it too).
 // Cycles writes ln 2 as 0.6931, kept for the same figures.
 #[allow(clippy::approx_constant)]
-fn longitudinal(sin_i: f32, cos_i: f32, sin_o: f32, cos_o: f32, v: f32) -> f32 {
+pub fn longitudinal_scattering(sin_i: f32, cos_i: f32, sin_o: f32, cos_o: f32, v: f32) -> f32 {
     let inv_v = 1.0 / v;
     let cos_arg = cos_i * cos_o * inv_v;
     let sin_arg = sin_i * sin_o * inv_v;
@@ -268,7 +269,7 @@ impl Chiang {
                 1 => 0.25 * self.v,
                 _ => 4.0 * self.v,
             };
-            let mp = longitudinal(
+            let mp = longitudinal_scattering(
                 sin_theta_i,
                 cos_theta_i,
                 fr.angles[2 * i],
@@ -279,7 +280,7 @@ impl Chiang {
             f = add(f, scale(fr.ap[i], mp * np));
             energy += fr.ap_energy[i] * mp * np;
         }
-        let mp = longitudinal(
+        let mp = longitudinal_scattering(
             sin_theta_i,
             cos_theta_i,
             fr.sin_theta_o,

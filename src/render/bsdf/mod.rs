@@ -7,6 +7,7 @@ pub mod anisotropic;
 pub mod bump_correction;
 pub mod hair;
 pub mod hair_chiang;
+pub mod hair_huang;
 pub mod metallic;
 pub mod microfacet;
 pub mod oren_nayar;
@@ -77,6 +78,8 @@ pub enum LobeKind {
     Chiang(crate::render::bsdf::hair_chiang::Chiang),
     /// Ray Portal BSDF: the path goes on from another position and direction.
     RayPortal(crate::render::bsdf::ray_portal::RayPortal),
+    /// Principled Hair BSDF, Huang model (hair curves); its normal is the frame's x axis.
+    Huang(crate::render::bsdf::hair_huang::Huang),
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -171,7 +174,7 @@ fn excluded(kind: &LobeKind, exclude: u32) -> bool {
         // Cycles' closure ranges: hair transmission is a transmission closure, hair
         // reflection and the Chiang hair glossy ones.
         LobeKind::Hair(h) if h.transmission => exclude & ray::TRANSMIT != 0,
-        LobeKind::Hair(_) | LobeKind::Chiang(_) => exclude & ray::GLOSSY != 0,
+        LobeKind::Hair(_) | LobeKind::Chiang(_) | LobeKind::Huang(_) => exclude & ray::GLOSSY != 0,
         LobeKind::Transparent | LobeKind::Subsurface(_) | LobeKind::RayPortal(_) => false,
     }
 }
@@ -184,7 +187,10 @@ impl LobeSet {
     /// glass). Light selection then counts lights behind the surface too.
     pub fn has_transmission(&self) -> bool {
         self.lobes[..self.len].iter().any(|l| match l.kind {
-            LobeKind::Translucent | LobeKind::Glass(_) | LobeKind::Chiang(_) => true,
+            LobeKind::Translucent
+            | LobeKind::Glass(_)
+            | LobeKind::Chiang(_)
+            | LobeKind::Huang(_) => true,
             LobeKind::Hair(h) => h.transmission,
             _ => false,
         })
@@ -314,7 +320,12 @@ impl LobeSet {
     fn bump_term(&self, l: &Lobe, wi: V3) -> f32 {
         // Cycles' bsdf_eval shadows bumped diffuse and microfacet closures only; the hair
         // closures' normals are no bumped shading normals (Chiang's is across the fibre).
-        if is_zero(self.smooth_n) || matches!(l.kind, LobeKind::Hair(_) | LobeKind::Chiang(_)) {
+        if is_zero(self.smooth_n)
+            || matches!(
+                l.kind,
+                LobeKind::Hair(_) | LobeKind::Chiang(_) | LobeKind::Huang(_)
+            )
+        {
             return 1.0;
         }
         let diffuse = matches!(
@@ -361,6 +372,11 @@ impl LobeSet {
                 (s.wi, [s.pdf; 3], s.pdf, h.transmission)
             }
             LobeKind::Chiang(c) => c.sample(l.n, wo, u)?,
+            // Cycles labels every Huang sample a glossy reflection.
+            LobeKind::Huang(c) => {
+                let (wi, f, pdf) = c.sample(u, tables)?;
+                (wi, f, pdf, false)
+            }
             _ => return None,
         };
         let own = self.terminator(scale(own, self.bump_term(l, wi)), l, wi);
@@ -448,7 +464,7 @@ impl LobeSet {
                 kind: l.kind,
             });
         }
-        if let LobeKind::Hair(_) | LobeKind::Chiang(_) = l.kind {
+        if let LobeKind::Hair(_) | LobeKind::Chiang(_) | LobeKind::Huang(_) = l.kind {
             let u3 = (x / l.sample_weight).clamp(0.0, 1.0 - f32::EPSILON);
             return self.sample_hair(pick, wo, ng, [u[0], u[1], u3], tables);
         }
@@ -632,7 +648,7 @@ fn from_local(n: V3, v: V3) -> V3 {
 }
 
 /// (BSDF * cos without the closure weight, pdf) of one lobe.
-fn eval_lobe(l: &Lobe, wo: V3, wi: V3, _ng: V3, _tables: &Tables) -> (V3, f32) {
+fn eval_lobe(l: &Lobe, wo: V3, wi: V3, _ng: V3, tables: &Tables) -> (V3, f32) {
     // Cycles checks directions against the true normal only when sampling, never when
     // evaluating (bsdf_microfacet_sample: "required in order to avoid shadow terminator
     // artifacts on smooth geometry"; the same for every closure): a light below a smooth
@@ -714,6 +730,7 @@ fn eval_lobe(l: &Lobe, wo: V3, wi: V3, _ng: V3, _tables: &Tables) -> (V3, f32) {
             ([p; 3], p)
         }
         LobeKind::Chiang(c) => c.eval(l.n, wo, wi),
+        LobeKind::Huang(c) => c.eval(wi, tables),
         LobeKind::GlossyAniso {
             lobe,
             fresnel,
@@ -747,9 +764,11 @@ fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
         LobeKind::Transparent => Some((neg(wo), true)),
         LobeKind::RayPortal(r) => Some((r.direction, true)),
         // Sampled elsewhere.
-        LobeKind::Glass(_) | LobeKind::Subsurface(_) | LobeKind::Hair(_) | LobeKind::Chiang(_) => {
-            None
-        }
+        LobeKind::Glass(_)
+        | LobeKind::Subsurface(_)
+        | LobeKind::Hair(_)
+        | LobeKind::Chiang(_)
+        | LobeKind::Huang(_) => None,
         LobeKind::Reflection(r) => r.sample(l.n, wo, ng, u),
         LobeKind::Glossy { alpha, .. } => {
             // Cycles' bsdf_microfacet_sample rejects a view below the shading normal, sharp

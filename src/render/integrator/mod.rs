@@ -121,13 +121,19 @@ pub struct Scratch {
 impl Scratch {
     /// Clears what a camera sample leaves besides its colour (guides, transparency, AOV
     /// values with `aov_stride` floats, volume bounces) before `radiance` traces it.
-    fn start_sample(&mut self, aov_stride: usize) {
+    /// Resets what one sample accumulates. Rays leaving a hair skip its curve (Cycles'
+    /// self prim): none on the camera ray, and none left for other rays once the sample
+    /// ends (the returned guard clears it).
+    #[must_use]
+    fn start_sample(&mut self, aov_stride: usize) -> crate::render::curves::RaySelfGuard {
+        crate::render::curves::set_ray_self(None);
         self.features = Default::default();
         self.transparent = 0.0;
         self.aov.clear();
         self.aov.resize(aov_stride, 0.0);
         self.aov_done = false;
         self.volume_bounce = 0;
+        crate::render::curves::RaySelfGuard
     }
 
     pub fn new(n_materials: usize) -> Scratch {
@@ -488,7 +494,7 @@ impl Scene<'_> {
         scratch: &mut Scratch,
     ) -> V3 {
         let st = &self.settings;
-        scratch.start_sample(self.aovs.stride);
+        let _self_guard = scratch.start_sample(self.aovs.stride);
         self.volume_stack_init(org, scratch);
         let mut path = Path::camera(org, dir, tmin, tmax, scratch.ray_dp, scratch.ray_dd);
         loop {
@@ -535,6 +541,7 @@ impl Scene<'_> {
             if from_sss.is_none() {
                 self.lights_along(&mut path, hit_opt.map(|h| h.t), clamp_limit, scratch);
             }
+            crate::render::curves::set_ray_self(hit_opt.as_ref().map(|h| h.prim));
             let Some(h) = hit_opt else {
                 self.miss(&mut path, clamp_limit, scratch);
                 break;
@@ -993,8 +1000,11 @@ fn filter_glossy(lobes: &mut LobeSet, min_ray_pdf: f32, filter_glossy: f32) {
             a.alpha_x = a.alpha_x.max(blur);
             a.alpha_y = a.alpha_y.max(blur);
         }
-        // Cycles blurs the Chiang hair closure too; the Hair BSDF has no blur.
+        // Cycles blurs the Principled Hair closures too; the Hair BSDF has no blur.
         if let LobeKind::Chiang(c) = &mut lobe.kind {
+            c.blur(blur);
+        }
+        if let LobeKind::Huang(c) = &mut lobe.kind {
             c.blur(blur);
         }
     }

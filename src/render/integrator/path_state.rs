@@ -36,9 +36,11 @@ fn counter(kind: &LobeKind, transmit: bool) -> Option<Counter> {
         | LobeKind::OrenNayar(_)
         | LobeKind::Sheen(_)
         | LobeKind::Velvet(_) => Some(Counter::Diffuse),
-        LobeKind::Glossy { .. } | LobeKind::Reflection(_) | LobeKind::GlossyAniso { .. } => {
-            Some(Counter::Glossy)
-        }
+        // Cycles labels every Huang hair sample a glossy reflection, through the fibre or not.
+        LobeKind::Glossy { .. }
+        | LobeKind::Reflection(_)
+        | LobeKind::GlossyAniso { .. }
+        | LobeKind::Huang(_) => Some(Counter::Glossy),
         LobeKind::Toon(t) if t.glossy => Some(Counter::Glossy),
         LobeKind::Toon(_) => Some(Counter::Diffuse),
         LobeKind::Glass(_) | LobeKind::Hair(_) | LobeKind::Chiang(_) if transmit => {
@@ -321,7 +323,7 @@ pub fn bounce_flags(kind: LobeKind, transmit: bool, singular: bool) -> u32 {
         LobeKind::OrenNayar(_) | LobeKind::Subsurface(_) => ray::DIFFUSE | ray::REFLECT,
         LobeKind::Reflection(_) => ray::GLOSSY | ray::REFLECT,
         LobeKind::Sheen(_) | LobeKind::Velvet(_) => ray::DIFFUSE | ray::REFLECT,
-        LobeKind::GlossyAniso { .. } => ray::GLOSSY | ray::REFLECT,
+        LobeKind::GlossyAniso { .. } | LobeKind::Huang(_) => ray::GLOSSY | ray::REFLECT,
         LobeKind::Toon(t) if t.glossy => ray::GLOSSY | ray::REFLECT,
         LobeKind::Toon(_) => ray::DIFFUSE | ray::REFLECT,
     };

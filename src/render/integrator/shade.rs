@@ -30,8 +30,8 @@ pub struct Material {
     /// it instead of stopping at it.
     pub transparent_shadow: bool,
     /// The material can make a Multiscatter GGX glass closure (Glass BSDF, or a
-    /// Principled BSDF whose Transmission Weight is linked or above zero), which reads the
-    /// glass albedo table.
+    /// Principled BSDF whose Transmission Weight is linked or above zero) or a Huang hair
+    /// closure (its energy scale), which read the glass albedo table.
     pub multiscatter_glass: bool,
 }
 
@@ -134,6 +134,7 @@ pub(crate) fn is_multiggx(b: &BsdfNode) -> bool {
 fn has_multiscatter_glass(p: &Program) -> bool {
     p.bsdfs.iter().any(|b| match b.bl_idname.as_str() {
         "ShaderNodeBsdfGlass" => is_multiggx(b),
+        "ShaderNodeBsdfHairPrincipled" => b.property("model") == Some("HUANG"),
         "ShaderNodeBsdfPrincipled" => {
             is_multiggx(b) && linked_or_constant(p, b, "Transmission Weight", |w| w > 0.0)
         }
@@ -147,6 +148,11 @@ fn can_be_transparent(p: &Program) -> bool {
     p.bsdfs.iter().any(|b| match b.bl_idname.as_str() {
         "ShaderNodeBsdfTransparent" => true,
         "ShaderNodeBsdfPrincipled" => linked_or_constant(p, b, "Alpha", |a| a < 1.0),
+        // Not the Huang hair BSDF, though Cycles flags an elliptical one so
+        // (has_surface_transparent): its shadow rays run shaders with no closure slots, so
+        // the Huang setup, which makes its transparency, never runs there and the fibre
+        // stays opaque to shadows (scene hair_huang_color matches so, and is 3% bright
+        // with transparent shadows).
         _ => false,
     })
 }
@@ -484,12 +490,12 @@ fn hair_bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, 
     );
 }
 
-/// The Principled Hair BSDF node, Chiang model, as Cycles' svm_node_closure_bsdf sets it
-/// up: Random from the linked input (a constant link reads as unlinked, as Cycles folds
-/// it) or else the curve's random number, randomising Roughness
-/// (and Radial Roughness) and, for Melanin Concentration, the melanin; the absorption
-/// from the parametrization; weight one (the colour is in the absorption). The Huang
-/// model is refused before rendering (`render::curves::check`).
+/// The Principled Hair BSDF node as Cycles' svm_node_closure_bsdf sets it up: Random from
+/// the linked input (a constant link reads as unlinked, as Cycles folds it) or else the
+/// curve's random number, randomising Roughness (and the Chiang model's Radial
+/// Roughness) and, for Melanin Concentration, the melanin; the absorption from the
+/// parametrization (the Huang model takes its Roughness where Chiang's takes the Radial
+/// Roughness); weight one (the colour is in the absorption).
 fn principled_hair(
     b: &BsdfNode,
     w: f32,
@@ -499,6 +505,7 @@ fn principled_hair(
     out: &mut LobeSet,
 ) {
     use crate::render::bsdf::hair_chiang::{self as chiang, Chiang};
+    let huang = b.property("model") == Some("HUANG");
     let random = match b.input("Random") {
         Some((slot, true)) => finite_or(s[slot as usize], 0.0),
         // The curve's random number (ATTR_STD_CURVE_RANDOM, as Hair Info > Random).
@@ -506,7 +513,11 @@ fn principled_hair(
     };
     let factor = 1.0 + 2.0 * (random - 0.5) * input_f(b, s, "Random Roughness", 0.0);
     let roughness = input_f(b, s, "Roughness", 0.3) * factor;
-    let radial = input_f(b, s, "Radial Roughness", 0.3) * factor;
+    let radial = if huang {
+        roughness
+    } else {
+        input_f(b, s, "Radial Roughness", 0.3) * factor
+    };
     let sigma = match b.property("parametrization") {
         Some("ABSORPTION") => input_c(b, s, "Absorption Coefficient", [0.245531, 0.52, 1.365]),
         Some("MELANIN") => chiang::sigma_from_melanin(
@@ -522,13 +533,19 @@ fn principled_hair(
             radial,
         ),
     };
+    let offset = input_f(b, s, "Offset", 2f32.to_radians());
+    let ior = input_f(b, s, "IOR", 1.55);
+    if huang {
+        huang_hair(b, w, s, sp, ctx, out, sigma, roughness, offset, ior);
+        return;
+    }
     let Some((c, y)) = Chiang::new(
         sigma,
         roughness,
         radial,
         input_f(b, s, "Coat", 0.0),
-        input_f(b, s, "Offset", 2f32.to_radians()),
-        input_f(b, s, "IOR", 1.55),
+        offset,
+        ior,
         sp.dpdu,
         ctx.wo,
         sp.parametric[1],
@@ -536,6 +553,64 @@ fn principled_hair(
         return;
     };
     out.push(LobeKind::Chiang(c), [w; 3], y);
+}
+
+/// The Huang model's closure (Cycles' svm_node_closure_bsdf and bsdf_hair_huang_setup):
+/// none when every lobe multiplier is at most zero; on camera rays the half pixel over
+/// the fibre's radius for the near field; Aspect Ratio about the curve's normal, which
+/// particle hair lacks (Cycles then takes an arbitrary frame about the tangent); a hit
+/// outside the fibre's projected width is transparent.
+#[allow(clippy::too_many_arguments)]
+fn huang_hair(
+    b: &BsdfNode,
+    w: f32,
+    s: &[f32],
+    sp: &ShadingPoint,
+    ctx: &Context,
+    out: &mut LobeSet,
+    sigma: V3,
+    roughness: f32,
+    offset: f32,
+    ior: f32,
+) {
+    use crate::render::bsdf::hair_huang::{Huang, Params, Setup};
+    // Reflection, Transmission and Secondary Reflection, by their identifiers.
+    let lobes = [
+        input_f(b, s, "R lobe", 1.0),
+        input_f(b, s, "TT lobe", 1.0),
+        input_f(b, s, "TRT lobe", 1.0),
+    ];
+    if lobes.iter().all(|&l| l <= 0.0) {
+        return;
+    }
+    let radius = 0.5 * sp.hair.thickness;
+    // Cycles' sd->dP: the compact differential the hit's dP/dx was expanded from.
+    let dp = dot(sp.dp_dx, sp.dp_dx).sqrt();
+    let pixel_coverage = if sp.path.flags & crate::shader::point::ray::CAMERA != 0 && radius > 0.0 {
+        0.5 * dp / radius
+    } else {
+        1.0
+    };
+    let p = Params {
+        sigma,
+        roughness,
+        offset,
+        ior,
+        aspect_ratio: input_f(b, s, "Aspect Ratio", 0.85),
+        lobes,
+    };
+    match Huang::setup(
+        &p,
+        sp.dpdu,
+        ctx.wo,
+        sp.parametric[1],
+        [0.0; 3],
+        pixel_coverage,
+    ) {
+        Some(Setup::Closure(c)) => out.push(LobeKind::Huang(c), [w; 3], c.n),
+        Some(Setup::Transparent) => out.push(LobeKind::Transparent, [w; 3], sp.normal),
+        None => {}
+    }
 }
 
 /// The Glossy BSDF node (and the legacy Anisotropic BSDF): GGX, Multiscatter GGX or
