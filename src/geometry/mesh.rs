@@ -350,16 +350,24 @@ impl Mesh {
             }
             r
         }
-        // For each edge, the corners using it (both directions).
-        let mut by_edge: Vec<Vec<usize>> = vec![Vec::new(); self.edge_count()];
+        // For each edge, the first two corners using it (both directions), in corner
+        // order: only edges with exactly two join fans. Two flat arrays rather than a list
+        // per edge (a million small allocations on the colon).
+        let mut first = vec![usize::MAX; self.edge_count()];
+        let mut second = vec![usize::MAX; self.edge_count()];
         for (c, &e) in self.corner_edges.iter().enumerate() {
-            by_edge[e as usize].push(c);
+            let e = e as usize;
+            if first[e] == usize::MAX {
+                first[e] = c;
+            } else if second[e] == usize::MAX {
+                second[e] = c;
+            }
         }
-        for (e, cs) in by_edge.iter().enumerate() {
-            if edge_sharp[e] || cs.len() != 2 {
+        for e in 0..self.edge_count() {
+            if edge_sharp[e] || edge_faces[e] != 2 {
                 continue;
             }
-            let (a, b) = (cs[0], cs[1]);
+            let (a, b) = (first[e], second[e]);
             // corner a is edge (v_a -> next); corner b is the other face's corner of it.
             let fa = corner_face[a] as usize;
             let fb = corner_face[b] as usize;
