@@ -472,11 +472,7 @@ fn run_render(a: RenderArgs) -> Result<()> {
             aovs: p
                 .aovs
                 .iter()
-                .map(|a| blendsynth::label::passes::AovPlane {
-                    name: &a.name,
-                    channels: if a.color { 4 } else { 1 },
-                    data: &a.data,
-                })
+                .map(blendsynth::label::passes::AovPlane::of)
                 .collect(),
             view_layer: &scene.file.scene.view_layer.name,
         };

@@ -416,30 +416,12 @@ fn aov_figures(
         read_exr_channels(&dir.join("aov_a.exr")),
         read_exr_channels(&dir.join("aov_b.exr")),
     );
-    let images = blendsynth::label::passes::PassImages {
-        width: out.width,
-        height: out.height,
-        depth: &[],
-        distance: &[],
-        object_index: &[],
-        instance_id: &[],
-        material_index: &[],
-        normal: &[],
-        albedo: &[],
-        uv: &[],
-        instance_objects: &[],
-        aovs: out
-            .passes
-            .aovs
-            .iter()
-            .map(|a| blendsynth::label::passes::AovPlane {
-                name: &a.name,
-                channels: if a.color { 4 } else { 1 },
-                data: &a.data,
-            })
-            .collect(),
-        view_layer: &scene.file.scene.view_layer.name,
-    };
+    let images = blendsynth::label::passes::PassImages::aovs_only(
+        out.width,
+        out.height,
+        &out.passes.aovs,
+        &scene.file.scene.view_layer.name,
+    );
     let ours = blendsynth::label::passes::aov_channels(&images).unwrap();
     let mut names: Vec<&String> = ours.iter().map(|c| &c.0).collect();
     let mut theirs: Vec<&String> = a.iter().map(|c| &c.0).collect();

@@ -145,30 +145,13 @@ impl PathTracer {
                 world_transform: i.world_transform,
             })
             .collect();
-        let planes: Vec<crate::label::passes::AovPlane> = p
-            .aovs
-            .iter()
-            .map(|a| crate::label::passes::AovPlane {
-                name: &a.name,
-                channels: if a.color { 4 } else { 1 },
-                data: &a.data,
-            })
-            .collect();
-        let aov_channels = crate::label::passes::aov_channels(&crate::label::passes::PassImages {
-            width: out.width,
-            height: out.height,
-            depth: &[],
-            distance: &[],
-            object_index: &[],
-            instance_id: &[],
-            material_index: &[],
-            normal: &[],
-            albedo: &[],
-            uv: &[],
-            instance_objects: &[],
-            aovs: planes,
-            view_layer: &scene.file.scene.view_layer.name,
-        })?;
+        let aov_channels =
+            crate::label::passes::aov_channels(&crate::label::passes::PassImages::aovs_only(
+                out.width,
+                out.height,
+                &p.aovs,
+                &scene.file.scene.view_layer.name,
+            ))?;
         let frame = RenderedFrame {
             width: out.width,
             height: out.height,

@@ -51,6 +51,43 @@ pub struct AovPlane<'a> {
     pub data: &'a [f32],
 }
 
+impl<'a> AovPlane<'a> {
+    /// A render's AOV pass as a plane.
+    pub fn of(a: &'a crate::render::film::aov::AovImage) -> AovPlane<'a> {
+        AovPlane {
+            name: &a.name,
+            channels: if a.color { 4 } else { 1 },
+            data: &a.data,
+        }
+    }
+}
+
+impl<'a> PassImages<'a> {
+    /// Only the AOV passes of a render (the other passes empty), for `aov_channels`.
+    pub fn aovs_only(
+        width: u32,
+        height: u32,
+        aovs: &'a [crate::render::film::aov::AovImage],
+        view_layer: &'a str,
+    ) -> PassImages<'a> {
+        PassImages {
+            width,
+            height,
+            depth: &[],
+            distance: &[],
+            object_index: &[],
+            instance_id: &[],
+            material_index: &[],
+            normal: &[],
+            albedo: &[],
+            uv: &[],
+            instance_objects: &[],
+            aovs: aovs.iter().map(AovPlane::of).collect(),
+            view_layer,
+        }
+    }
+}
+
 /// The channels of the AOV passes as Blender names them in a multilayer EXR:
 /// "<view layer>.<AOV>.X" for a Value AOV, ".R", ".G", ".B", ".A" for a Color AOV.
 pub fn aov_channels(p: &PassImages) -> Result<Vec<(String, Vec<f32>)>, String> {
