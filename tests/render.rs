@@ -28,6 +28,8 @@ const ASSERTED: &[&str] = &[
     // against Cycles' AOV passes by the same criteria as the image.
     "aov",
     "aov_transparent",
+    // AOV Outputs in node groups: nested, used twice, unlinked, muted.
+    "aov_groups",
     // Point Info on point clouds (Geometry Nodes points and a scaled point cloud object):
     // the centre, the world-space radius, the random of the point's index in its cloud.
     "point_info",
@@ -59,6 +61,7 @@ const ASSERTED: &[&str] = &[
     "hair_huang_melanin",
     "hair_huang_color",
     "hair_huang_absorption",
+    "hair_on_mesh",
     // A Curves object with Geometry Nodes: its evaluated strands as hair.
     "curves_object",
     // Hair Info, each output into a colour, on a Curves object and on particle hair.
@@ -1747,12 +1750,11 @@ fn unsupported_volumes_are_refused_by_name() {
     );
 }
 
-/// The hair BSDFs render on hair curves only: either hair BSDF on a mesh's faces (Cycles
-/// turns them about the triangle's dP/dv, which blendsynth does not have), a Principled
-/// Hair BSDF model other than Chiang and Huang, and an elliptical Huang fibre on a Curves
-/// object (Cycles turns it about the curves' normals, which the export does not carry)
-/// are errors naming the object, material and node, alike from `inspect`
-/// (render::check) and `render`.
+/// Where the hair BSDFs are refused: a Principled Hair BSDF model other than Chiang and
+/// Huang, and an elliptical Huang fibre on a Curves object (Cycles turns it about the
+/// curves' normals, which the export does not carry) are errors naming the object,
+/// material and node, alike from `inspect` (render::check) and `render`. Both hair BSDFs
+/// on a mesh's faces render.
 #[test]
 fn hair_bsdfs_refused_where_not_rendered() {
     let (dir, base) = fixture_json("hair_chiang_melanin");
@@ -1849,33 +1851,20 @@ fn hair_bsdfs_refused_where_not_rendered() {
     let mut circular = cbase.clone();
     on_strands(&mut circular, 1.0);
     assert_renders(&cdir, &circular);
-    // The Principled Hair BSDF (Chiang) as the emitter mesh's own material.
-    refused(
-        &|j| {
-            let hair = node(j, "HairMelanin", "ShaderNodeBsdfHairPrincipled");
-            set(j, "Skin", "ShaderNodeBsdfDiffuse", &|n| {
-                let mut h = hair.clone();
-                h["name"] = n["name"].clone();
-                *n = h;
-            });
-        },
-        &[
-            "\"Emitter\"",
-            "\"Skin\"",
-            "ShaderNodeBsdfHairPrincipled",
-            "hair curves only",
-        ],
-    );
-    // The Hair BSDF on the floor.
-    refused(
-        &|j| {
-            set(j, "Floor", "ShaderNodeBsdfDiffuse", &|n| {
-                n["bl_idname"] = "ShaderNodeBsdfHair".into();
-                n["properties"]["component"] = "Transmission".into();
-            })
-        },
-        &["\"Floor\"", "ShaderNodeBsdfHair", "hair curves only"],
-    );
+    // Both hair BSDFs on a mesh's faces render (Cycles turns them about the triangle's
+    // edges; scene hair_on_mesh checks the values).
+    let mut on_mesh = base.clone();
+    let hair = node(&mut on_mesh, "HairMelanin", "ShaderNodeBsdfHairPrincipled");
+    set(&mut on_mesh, "Skin", "ShaderNodeBsdfDiffuse", &|n| {
+        let mut h = hair.clone();
+        h["name"] = n["name"].clone();
+        *n = h;
+    });
+    set(&mut on_mesh, "Floor", "ShaderNodeBsdfDiffuse", &|n| {
+        n["bl_idname"] = "ShaderNodeBsdfHair".into();
+        n["properties"]["component"] = "Transmission".into();
+    });
+    assert_renders(&dir, &on_mesh);
 }
 
 /// What blendsynth does not render on hair is an error naming the object and what it
@@ -2079,10 +2068,10 @@ fn particle_info_needs_the_particle_record() {
     );
 }
 
-/// An AOV Output inside a node group (naming a valid AOV) is refused naming the group
-/// node; one naming an AOV the view layer lacks is left out, as Cycles drops it.
+/// An AOV Output inside a node group renders, whether it names an AOV of the view layer
+/// or one it lacks (left out, as Cycles drops it); scene aov_groups checks the values.
 #[test]
-fn aov_outputs_in_groups_are_refused_by_name() {
+fn aov_outputs_in_groups_render() {
     let (dir, base) = fixture_json("aov");
     assert_renders(&dir, &base);
     let with_group = |aov: &str| {
@@ -2113,20 +2102,11 @@ fn aov_outputs_in_groups_are_refused_by_name() {
                 }));
         }
     };
-    refused_alike(
-        &dir,
-        &base,
-        &with_group("mask"),
-        &[
-            "material \"Blue\"",
-            "node \"Wrapped\"",
-            "AOV Output inside a node group",
-        ],
-    );
-    let mut json = base.clone();
-    with_group("nowhere")(&mut json);
-    let scene = Scene::from_json(&dir, json.to_string().as_bytes()).unwrap();
-    assert!(blendsynth::render::check(&scene, &check_opts(), &[]).is_ok());
+    for aov in ["mask", "nowhere"] {
+        let mut json = base.clone();
+        with_group(aov)(&mut json);
+        assert_renders(&dir, &json);
+    }
 }
 
 /// Attribute reads on points: generic attributes of points blendsynth evaluates render

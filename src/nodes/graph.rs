@@ -105,13 +105,14 @@ pub fn flatten<'a>(
     flatten_with(tree, groups, root, &[]).map(|(g, _)| g)
 }
 
-/// `flatten`, also evaluating the nodes named `extra` of the top tree (outputs Cycles
-/// runs beside the main one, such as AOV Outputs); returns their flat indices too.
+/// `flatten`, also evaluating the nodes at the paths `extra` (outputs Cycles runs beside
+/// the main one, such as AOV Outputs: the names of the group nodes down to the node,
+/// then its own); returns their flat indices too.
 pub fn flatten_with<'a>(
     tree: &'a NodeTree,
     groups: &'a [NodeTree],
     root: &str,
-    extra: &[&str],
+    extra: &[Vec<&str>],
 ) -> Result<(FlatGraph<'a>, Vec<usize>), GraphError> {
     let mut b = Builder {
         groups,
@@ -129,10 +130,19 @@ pub fn flatten_with<'a>(
         .ok_or_else(|| GraphError(format!("node tree {:?} has no node {root:?}", tree.name)))?;
     let root = b.node(0, node)?;
     let mut more = Vec::with_capacity(extra.len());
-    for name in extra {
-        let node = find(tree, name)
-            .ok_or_else(|| GraphError(format!("node tree {:?} has no node {name:?}", tree.name)))?;
-        more.push(b.node(0, node)?);
+    for path in extra {
+        let mut inst = 0;
+        for (depth, name) in path.iter().enumerate() {
+            let t = b.instances[inst].tree;
+            let node = find(t, name).ok_or_else(|| {
+                GraphError(format!("node tree {:?} has no node {name:?}", t.name))
+            })?;
+            if depth + 1 < path.len() {
+                inst = b.group_instance(inst, node)?;
+            } else {
+                more.push(b.node(inst, node)?);
+            }
+        }
     }
     Ok((
         FlatGraph {

@@ -567,8 +567,7 @@ impl Accel for WithCurves {
 /// What blendsynth cannot render on hair, named: materials with volume, true
 /// displacement, emission (Cycles' curves are no lights), the Subsurface Scattering node,
 /// a Principled Hair BSDF model it does not know, and the Huang model's elliptical fibre
-/// on a Curves object; the hair BSDFs on meshes; and hair with motion blur or under
-/// Embree.
+/// on a Curves object; and hair with motion blur or under Embree.
 pub fn check(
     scene: &crate::scene::Scene,
     geo: &crate::render::build::Geometry,
@@ -579,40 +578,6 @@ pub fn check(
         let backend = crate::foundation::bvh::Backend::from_env().map_err(RenderError)?;
         if backend == crate::foundation::bvh::Backend::Embree {
             return Err(RenderError("BLENDSYNTH_ACCEL=embree: the scene has hair curves, which blendsynth's Embree backend does not take yet (use bvh4 or bvh2)".into()));
-        }
-    }
-    // The hair BSDFs turn about the curve's tangent: on a mesh Cycles takes the
-    // triangle's dP/dv instead, which blendsynth does not have.
-    let hair_bsdf = |mi: usize| {
-        materials[mi].program.as_ref().and_then(|p| {
-            p.bsdfs.iter().find(|b| {
-                matches!(
-                    b.bl_idname.as_str(),
-                    "ShaderNodeBsdfHair" | "ShaderNodeBsdfHairPrincipled"
-                )
-            })
-        })
-    };
-    let with_hair_bsdf: Vec<usize> = (0..materials.len())
-        .filter(|&mi| hair_bsdf(mi).is_some())
-        .collect();
-    for inst in geo.instances.iter().filter(|i| i.curves.is_none()) {
-        // Only the slots the mesh's faces use (an emitter's hair material is no face's).
-        if !inst
-            .slots
-            .iter()
-            .flatten()
-            .any(|mi| with_hair_bsdf.contains(mi))
-        {
-            continue;
-        }
-        let mut used = (0..inst.mesh.triangle_faces.len()).filter_map(|t| inst.material_of(t));
-        if let Some(mi) = used.find(|mi| with_hair_bsdf.contains(mi)) {
-            let b = hair_bsdf(mi).map_or("", |b| b.bl_idname.as_str());
-            return Err(RenderError(format!(
-                "object {:?}: its material {:?} has node {b} on the mesh's faces, which blendsynth renders on hair curves only",
-                inst.name, materials[mi].name
-            )));
         }
     }
     for inst in geo.instances.iter().filter(|i| i.curves.is_some()) {

@@ -48,8 +48,7 @@ pub fn compile_material(scene: &Scene, name: &str) -> Result<Program, CompileErr
     let Some(out) = active_output(tree, "ShaderNodeOutputMaterial", "CYCLES") else {
         return Ok(empty_surface());
     };
-    let aovs =
-        aov_outputs(scene, tree).map_err(|e| CompileError(format!("material {name:?}: {e}")))?;
+    let aovs = aov_outputs(scene, tree);
     let (graph, _) = flatten_with(tree, &scene.file.node_groups, &out.name, &aovs)
         .map_err(|e| CompileError(format!("material {name:?}: {e}")))?;
     let mut c = Compiler::new(&graph);
@@ -66,28 +65,37 @@ pub fn compile_material(scene: &Scene, name: &str) -> Result<Program, CompileErr
 }
 
 /// The AOV Output nodes of `tree` Cycles runs: unmuted, naming a valid AOV of the view
-/// layer (Cycles drops the others, and what only they read). Such a node inside a node
-/// group is an error naming the group node.
-fn aov_outputs<'t>(
-    scene: &Scene,
+/// layer (Cycles drops the others, and what only they read), in the tree itself or in
+/// any unmuted group node's tree, at any depth, used or not (Cycles' sync adds every
+/// node of every group and keeps AOV Outputs as outputs). Each is its path: the group
+/// nodes down to it, then its name.
+fn aov_outputs<'t>(scene: &'t Scene, tree: &'t crate::scene::NodeTree) -> Vec<Vec<&'t str>> {
+    let mut out = Vec::new();
+    collect_aovs(scene, tree, &mut Vec::new(), &mut out);
+    out
+}
+
+fn collect_aovs<'t>(
+    scene: &'t Scene,
     tree: &'t crate::scene::NodeTree,
-) -> Result<Vec<&'t str>, String> {
+    path: &mut Vec<&'t str>,
+    out: &mut Vec<Vec<&'t str>>,
+) {
+    // Deeper nesting is a group containing itself, which flattening refuses by name.
+    if path.len() > 64 {
+        return;
+    }
     for n in tree.nodes.iter().filter(|n| !n.mute) {
-        if let Some(g) = n.node_tree.as_deref().and_then(|g| scene.node_group(g)) {
-            if group_has_aov(scene, g, 0) {
-                return Err(format!(
-                    "node {:?}: an AOV Output inside a node group is not supported yet",
-                    n.name
-                ));
-            }
+        if runs_aov(scene, n) {
+            let mut p = path.clone();
+            p.push(n.name.as_str());
+            out.push(p);
+        } else if let Some(g) = n.node_tree.as_deref().and_then(|g| scene.node_group(g)) {
+            path.push(n.name.as_str());
+            collect_aovs(scene, g, path, out);
+            path.pop();
         }
     }
-    Ok(tree
-        .nodes
-        .iter()
-        .filter(|n| runs_aov(scene, n))
-        .map(|n| n.name.as_str())
-        .collect())
 }
 
 /// Whether `n` is an unmuted AOV Output naming a valid AOV of the view layer.
@@ -101,18 +109,6 @@ fn aov_index(scene: &Scene, n: &crate::scene::Node) -> Option<(u32, bool)> {
     let aovs = &scene.file.scene.view_layer.aovs;
     let i = aovs.iter().position(|a| a.is_valid && a.name == name)?;
     Some((i as u32, aovs[i].kind == "COLOR"))
-}
-
-fn group_has_aov(scene: &Scene, t: &crate::scene::NodeTree, depth: u32) -> bool {
-    depth < 64
-        && t.nodes.iter().any(|n| {
-            runs_aov(scene, n)
-                || (!n.mute
-                    && n.node_tree
-                        .as_deref()
-                        .and_then(|g| scene.node_group(g))
-                        .is_some_and(|g| group_has_aov(scene, g, depth + 1)))
-        })
 }
 
 /// The program of a material with no surface: no closure, no displacement.
@@ -841,8 +837,7 @@ pub fn compile_world(scene: &Scene, name: &str) -> Result<Program, CompileError>
         .ok_or_else(|| CompileError(format!("world {name:?} has no node tree")))?;
     let out = active_output(tree, "ShaderNodeOutputWorld", "CYCLES")
         .ok_or_else(|| CompileError(format!("world {name:?} has no World Output")))?;
-    let aovs =
-        aov_outputs(scene, tree).map_err(|e| CompileError(format!("world {name:?}: {e}")))?;
+    let aovs = aov_outputs(scene, tree);
     let (graph, _) = flatten_with(tree, &scene.file.node_groups, &out.name, &aovs)
         .map_err(|e| CompileError(format!("world {name:?}: {e}")))?;
     let mut c = Compiler::new(&graph);

@@ -11,6 +11,7 @@
 
 use std::f32::consts::PI;
 
+use crate::render::bsdf::hair::Across;
 use crate::render::math::*;
 
 /// Rec.709 luminance, Cycles' spectrum_to_gray in a linear Rec.709 scene.
@@ -201,7 +202,7 @@ impl Chiang {
         eta: f32,
         dpdu: V3,
         wo: V3,
-        v: f32,
+        across: Across,
     ) -> Option<(Chiang, V3)> {
         let r = roughness.clamp(0.001, 1.0);
         let s = radial_roughness.clamp(0.001, 1.0);
@@ -210,6 +211,11 @@ impl Chiang {
         let s = (0.265 * s + 1.194 * sqr(s) + 5.372 * s.powi(22)) * (PI / 8.0).sqrt();
         let x = safe_normalize(dpdu)?;
         let y = safe_normalize(cross(x, wo))?;
+        // The sine of the angle between the true normal and Z, seen along the tangent.
+        let h = match across {
+            Across::Ribbon { v } => -v,
+            Across::Surface { ng, .. } => dot(cross(ng, x), normalize(cross(x, y))),
+        };
         Some((
             Chiang {
                 sigma,
@@ -218,7 +224,7 @@ impl Chiang {
                 alpha: -alpha,
                 eta,
                 m0_roughness: map_v(m0),
-                h: -v,
+                h,
                 x,
             },
             y,
@@ -434,7 +440,7 @@ mod tests {
             1.55,
             [0.0, 0.0, 1.0],
             wo,
-            h,
+            Across::Ribbon { v: h },
         )
         .unwrap();
         (c, y, wo)

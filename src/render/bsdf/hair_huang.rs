@@ -20,6 +20,7 @@
 
 use std::f32::consts::PI;
 
+use crate::render::bsdf::hair::Across;
 use crate::render::bsdf::microfacet::sample_ggx_vndf;
 use crate::render::bsdf::tables::Tables;
 use crate::render::math::*;
@@ -84,7 +85,7 @@ impl Huang {
         p: &Params,
         dpdu: V3,
         wi: V3,
-        v: f32,
+        across: Across,
         major_axis: V3,
         pixel_coverage: f32,
     ) -> Option<Setup> {
@@ -92,10 +93,15 @@ impl Huang {
         let tilt = -p.offset;
         let y = safe_normalize(dpdu);
         let x = safe_normalize(cross(dpdu, wi));
-        let h = -v;
+        let h = match across {
+            Across::Ribbon { v } => -v,
+            Across::Surface { n, .. } => -dot(x, n),
+        };
         let mut b = p.aspect_ratio;
         let mut n = x;
-        if b != 1.0 {
+        // Only a curve turns the frame to the ellipse's axis; on a mesh's faces Cycles keeps
+        // the frame facing the ray but still takes the Aspect Ratio's eccentricity.
+        if b != 1.0 && matches!(across, Across::Ribbon { .. }) {
             n = safe_normalize(cross(dpdu, safe_normalize(cross(major_axis, dpdu))));
             if b > 1.0 {
                 b = 1.0 / b;
@@ -851,7 +857,14 @@ mod tests {
             lobes: [1.0; 3],
         };
         let wo = normalize([0.3, 1.0, 0.5]);
-        match Huang::setup(&p, [0.0, 0.0, 1.0], wo, v, [0.0; 3], coverage) {
+        match Huang::setup(
+            &p,
+            [0.0, 0.0, 1.0],
+            wo,
+            Across::Ribbon { v },
+            [0.0; 3],
+            coverage,
+        ) {
             Some(Setup::Closure(c)) => c,
             _ => panic!("no closure"),
         }
@@ -953,8 +966,14 @@ mod tests {
         };
         // Tangent z: the arbitrary frame's x is (1,1,1) x z normalised's cross.
         let wi = [1.0, 0.0, 0.0];
-        let Some(Setup::Closure(c)) = Huang::setup(&p, [0.0, 0.0, 1.0], wi, 0.1, [0.0; 3], 1.0)
-        else {
+        let Some(Setup::Closure(c)) = Huang::setup(
+            &p,
+            [0.0, 0.0, 1.0],
+            wi,
+            Across::Ribbon { v: 0.1 },
+            [0.0; 3],
+            1.0,
+        ) else {
             panic!()
         };
         let li = c.wi;
@@ -962,15 +981,28 @@ mod tests {
         assert!((c.radius - expect).abs() < 1e-6 && c.radius < 1.0);
         let beyond = -(c.radius + 0.01);
         assert!(matches!(
-            Huang::setup(&p, [0.0, 0.0, 1.0], wi, -beyond, [0.0; 3], 1.0),
+            Huang::setup(
+                &p,
+                [0.0, 0.0, 1.0],
+                wi,
+                Across::Ribbon { v: -beyond },
+                [0.0; 3],
+                1.0
+            ),
             Some(Setup::Transparent)
         ));
         let wide = Params {
             aspect_ratio: 2.0,
             ..p
         };
-        let Some(Setup::Closure(w)) = Huang::setup(&wide, [0.0, 0.0, 1.0], wi, 0.1, [0.0; 3], 1.0)
-        else {
+        let Some(Setup::Closure(w)) = Huang::setup(
+            &wide,
+            [0.0, 0.0, 1.0],
+            wi,
+            Across::Ribbon { v: 0.1 },
+            [0.0; 3],
+            1.0,
+        ) else {
             panic!()
         };
         assert_eq!(w.b, 0.5);

@@ -464,14 +464,48 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
     }
 }
 
+/// Cycles' sd->dPdu and sd->dPdv where the hair closures read them: the curve's tangent
+/// on hair; on a triangle its edges from the first corner (triangle_dPdudv), turned over
+/// with the normals when seen from the back.
+fn hair_frame(sp: &ShadingPoint) -> (V3, V3) {
+    if sp.hair.is_strand > 0.0 {
+        return (sp.dpdu, [0.0; 3]);
+    }
+    let t = &sp.triangle;
+    let (u, v) = (sub(t[1], t[0]), sub(t[2], t[0]));
+    if sp.backfacing {
+        (neg(u), neg(v))
+    } else {
+        (u, v)
+    }
+}
+
+/// Where the hit lies across the fibre (`hair::Across`): a ribbon's v, or on a mesh's
+/// faces the true and shading normals.
+fn across_fibre(sp: &ShadingPoint) -> crate::render::bsdf::hair::Across {
+    use crate::render::bsdf::hair::Across;
+    if sp.hair.is_strand > 0.0 {
+        Across::Ribbon {
+            v: sp.parametric[1],
+        }
+    } else {
+        Across::Surface {
+            ng: sp.true_normal,
+            n: sp.normal,
+        }
+    }
+}
+
 /// The Hair BSDF node as Cycles' svm_node_closure_bsdf sets it up: the tangent is the
-/// linked Tangent input or the curve's dP/du, the Offset negated. Only on hair curves
-/// (`render::curves::check` refuses it elsewhere).
+/// linked Tangent input, or the curve's dP/du with the Offset negated; on a mesh's faces
+/// the triangle's dP/dv, and no Offset.
 fn hair_bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet) {
     let c = input_c(b, s, "Color", [0.8; 3]);
-    let tangent = match b.input("Tangent") {
-        Some((slot, true)) => normalize(finite3(v3(s, slot))),
-        _ => normalize(sp.dpdu),
+    let offset = -input_f(b, s, "Offset", 0.0);
+    let (tangent, offset) = match b.input("Tangent") {
+        Some((slot, true)) => (normalize(finite3(v3(s, slot))), offset),
+        _ if sp.hair.is_strand > 0.0 => (normalize(sp.dpdu), offset),
+        _ => (normalize(hair_frame(sp).1), 0.0),
     };
     if is_zero(tangent) || !tangent.iter().all(|t| t.is_finite()) {
         return;
@@ -480,7 +514,7 @@ fn hair_bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, 
         tangent,
         input_f(b, s, "RoughnessU", 0.1),
         input_f(b, s, "RoughnessV", 1.0),
-        -input_f(b, s, "Offset", 0.0),
+        offset,
         b.property("component") == Some("Transmission"),
     );
     out.push(
@@ -546,9 +580,9 @@ fn principled_hair(
         input_f(b, s, "Coat", 0.0),
         offset,
         ior,
-        sp.dpdu,
+        hair_frame(sp).0,
         ctx.wo,
-        sp.parametric[1],
+        across_fibre(sp),
     ) else {
         return;
     };
@@ -601,9 +635,9 @@ fn huang_hair(
     };
     match Huang::setup(
         &p,
-        sp.dpdu,
+        hair_frame(sp).0,
         ctx.wo,
-        sp.parametric[1],
+        across_fibre(sp),
         [0.0; 3],
         pixel_coverage,
     ) {
