@@ -78,6 +78,7 @@ PASSES: Tuple[str, ...] = (
     "material_index",
     "semantic",
     "sample_count",
+    "aovs",
 )
 #: What ``Scene.render`` returns when ``passes`` is not given.
 DEFAULT_PASSES: Tuple[str, ...] = ("image", "depth", "normal", "instance_id", "semantic")
@@ -100,6 +101,9 @@ class RenderResult:
     - ``semantic``: uint32 (H, W), 0 background, else class index + 1
       (``class_names[id - 1]``).
     - ``sample_count``: uint32 (H, W), samples taken per pixel.
+    - ``aovs``: the view layer's shader AOVs by name (what AOV Output nodes write), float32
+      (H, W) for a Value AOV, (H, W, 4) for a Color AOV: the values ``render --passes``
+      writes to aovs.exr. Empty when the view layer has none.
     """
 
     width: int
@@ -116,13 +120,14 @@ class RenderResult:
     material_index: Optional[np.ndarray] = None
     semantic: Optional[np.ndarray] = None
     sample_count: Optional[np.ndarray] = None
+    aovs: Optional[Dict[str, np.ndarray]] = None
     instance_objects: List[str] = field(default_factory=list)
     class_names: List[str] = field(default_factory=list)
     denoised: bool = False
     #: samples, samples_taken, seconds, setup_seconds, triangles
     stats: Dict[str, Any] = field(default_factory=dict)
 
-    def __getitem__(self, name: str) -> np.ndarray:
+    def __getitem__(self, name: str) -> Any:
         if name not in PASSES:
             raise KeyError(name)
         v = getattr(self, name)
@@ -341,7 +346,10 @@ class Scene:
         meta = d.pop("_meta")
         if meta.get("notice"):
             print(f"notice: {meta['notice']}", file=sys.stderr)
-        arrays = {k: _array(v) for k, v in d.items()}
+        arrays: Dict[str, Any] = {
+            k: {n: _array(a) for n, a in v.items()} if k == "aovs" else _array(v)
+            for k, v in d.items()
+        }
         return RenderResult(
             width=meta["width"],
             height=meta["height"],

@@ -6,6 +6,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import blendsynth
 from conftest import SCENE, read_exr, read_png, run_cli
@@ -67,3 +68,33 @@ def test_default_passes_and_settings(tmp_path: Path):
     assert r.image.dtype == np.float32 and r.image.shape == (8, 16, 4)
     assert r.image.flags.writeable
     assert r.stats["samples"] == 1
+
+
+AOV_SCENE = SCENE.parent / "aov"
+
+
+def test_aovs_are_bit_identical_to_cli_aovs_exr(tmp_path: Path):
+    """The view layer's AOV passes (scene `aov`: a Color AOV "tint", Value AOVs "mask" and
+    "unused") as arrays by name, the values `render --passes` writes to aovs.exr."""
+    OpenEXR = pytest.importorskip("OpenEXR")
+    args = dict(samples=2, seed=1, resolution=(40, 30), denoise=False)
+    r = blendsynth.Scene.load(AOV_SCENE).render(passes=["aovs"], **args)
+    assert sorted(r.aovs) == ["mask", "tint", "unused"]
+    assert r.aovs["tint"].shape == (30, 40, 4) and r.aovs["mask"].shape == (30, 40)
+    assert r["aovs"] is r.aovs
+    passes = tmp_path / "passes"
+    run_cli(
+        "render", str(AOV_SCENE), "--samples", "2", "--seed", "1", "--resolution", "40x30",
+        "--denoise", "off", "--passes", str(passes), "--pass-format", "exr",
+        "-o", str(tmp_path / "img.exr"),
+    )
+    with OpenEXR.File(str(passes / "aovs.exr"), separate_channels=True) as f:
+        ch = {k: np.asarray(v.pixels, dtype=np.float32) for k, v in f.channels().items()}
+    layer = next(k for k in ch if k.endswith(".mask.X")).removesuffix(".mask.X")
+    for name, a in r.aovs.items():
+        cli = (np.stack([ch[f"{layer}.{name}.{c}"] for c in "RGBA"], axis=-1)
+               if a.ndim == 3 else ch[f"{layer}.{name}.X"])
+        assert np.array_equal(cli.view(np.uint32), a.view(np.uint32)), name
+    # Something was written: the floor's checker into tint, the sphere's facing into mask.
+    assert r.aovs["tint"][..., :3].max() > 0.3 and r.aovs["mask"].max() > 0.2
+    assert not r.aovs["unused"].any()

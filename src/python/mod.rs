@@ -305,6 +305,7 @@ impl PyScene {
             "material_index",
             "semantic",
             "sample_count",
+            "aovs",
         ];
         if let Some(p) = passes.iter().find(|p| !KNOWN.contains(&p.as_str())) {
             return Err(PyValueError::new_err(format!(
@@ -365,6 +366,17 @@ impl PyScene {
                 "semantic" => {
                     let (map, _) = classes.as_ref().expect("made above for semantic");
                     (bytes(py, &api::semantic(out, map))?, vec![h, w], "uint32")
+                }
+                "aovs" => {
+                    // The view layer's AOV passes by name: (H, W) for a Value AOV,
+                    // (H, W, 4) for a Color AOV, as aovs.exr holds them.
+                    let aovs = PyDict::new(py);
+                    for a in &p.aovs {
+                        let shape = if a.color { vec![h, w, 4] } else { vec![h, w] };
+                        aovs.set_item(&a.name, (bytes(py, &a.data)?, shape, "float32"))?;
+                    }
+                    d.set_item(name, aovs)?;
+                    continue;
                 }
                 _ => unreachable!("checked against KNOWN"),
             };
