@@ -29,6 +29,7 @@ pub mod instance_transform;
 pub mod menu_switch;
 pub mod merge_by_distance;
 pub mod mesh_to_curve;
+pub mod mesh_topology;
 pub mod primitives;
 pub mod proximity;
 pub mod radius;
@@ -236,6 +237,45 @@ pub const NODES: &[(&str, Evaluate)] = &[
         collection_info::collection_info,
     ),
     ("GeometryNodeSplitEdges", split_edges::split_edges),
+    // Mesh topology fields (issue 26).
+    (
+        "GeometryNodeInputMeshEdgeNeighbors",
+        mesh_topology::edge_neighbors,
+    ),
+    (
+        "GeometryNodeInputMeshFaceNeighbors",
+        mesh_topology::face_neighbors,
+    ),
+    (
+        "GeometryNodeInputMeshVertexNeighbors",
+        mesh_topology::vertex_neighbors,
+    ),
+    (
+        "GeometryNodeInputMeshEdgeVertices",
+        mesh_topology::edge_vertices,
+    ),
+    ("GeometryNodeInputMeshEdgeAngle", mesh_topology::edge_angle),
+    ("GeometryNodeInputMeshIsland", mesh_topology::mesh_island),
+    (
+        "GeometryNodeInputMeshFaceIsPlanar",
+        mesh_topology::face_is_planar,
+    ),
+    ("GeometryNodeCornersOfFace", mesh_topology::corners_of_face),
+    (
+        "GeometryNodeCornersOfVertex",
+        mesh_topology::corners_of_vertex,
+    ),
+    ("GeometryNodeEdgesOfVertex", mesh_topology::edges_of_vertex),
+    ("GeometryNodeEdgesOfCorner", mesh_topology::edges_of_corner),
+    ("GeometryNodeFaceOfCorner", mesh_topology::face_of_corner),
+    (
+        "GeometryNodeVertexOfCorner",
+        mesh_topology::vertex_of_corner,
+    ),
+    (
+        "GeometryNodeOffsetCornerInFace",
+        mesh_topology::offset_corner_in_face,
+    ),
 ];
 
 /// The `bl_idname`s of `NODES`.

@@ -88,7 +88,7 @@ fn mat3_vec(m: &Mat3f, v: V3) -> V3 {
 }
 
 /// `angle_normalized_v3v3`: the angle between unit vectors, accurate near 0 and pi.
-fn angle_normalized(a: V3, b: V3) -> f32 {
+pub(crate) fn angle_normalized(a: V3, b: V3) -> f32 {
     let d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let len = |v: V3| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     if d >= 0.0 {
