@@ -1,8 +1,10 @@
 //! Geometry Nodes node implementations, dispatched by `bl_idname`. A node type missing
 //! here is an error naming the tree and node: it is never evaluated as something else.
 
+pub mod accumulate_field;
 pub mod attribute;
 pub mod attribute_statistic;
+pub mod blur_attribute;
 pub mod bounding_box;
 pub mod collection_info;
 pub mod color;
@@ -26,10 +28,13 @@ pub mod ico_sphere;
 pub mod image_texture;
 pub mod input;
 pub mod instance_transform;
+pub mod integer_math;
+pub mod matrix;
 pub mod menu_switch;
 pub mod merge_by_distance;
 pub mod mesh_to_curve;
 pub mod mesh_topology;
+pub mod points;
 pub mod primitives;
 pub mod proximity;
 pub mod radius;
@@ -276,6 +281,51 @@ pub const NODES: &[(&str, Evaluate)] = &[
         "GeometryNodeOffsetCornerInFace",
         mesh_topology::offset_corner_in_face,
     ),
+    (
+        "GeometryNodeAccumulateField",
+        accumulate_field::accumulate_field,
+    ),
+    ("GeometryNodeBlurAttribute", blur_attribute::blur_attribute),
+    ("FunctionNodeIntegerMath", integer_math::integer_math),
+    ("FunctionNodeBitMath", integer_math::bit_math),
+    ("FunctionNodeHashValue", integer_math::hash_value),
+    ("FunctionNodeInvertRotation", rotation::invert_rotation),
+    (
+        "FunctionNodeQuaternionToRotation",
+        rotation::quaternion_to_rotation,
+    ),
+    (
+        "FunctionNodeRotationToQuaternion",
+        rotation::rotation_to_quaternion,
+    ),
+    (
+        "FunctionNodeRotationToAxisAngle",
+        rotation::rotation_to_axis_angle,
+    ),
+    ("FunctionNodeCombineTransform", matrix::combine_transform),
+    ("FunctionNodeSeparateTransform", matrix::separate_transform),
+    ("FunctionNodeTransformPoint", matrix::transform_point_node),
+    (
+        "FunctionNodeTransformDirection",
+        matrix::transform_direction_node,
+    ),
+    ("FunctionNodeProjectPoint", matrix::project_point_node),
+    ("FunctionNodeInvertMatrix", matrix::invert_matrix),
+    ("FunctionNodeMatrixMultiply", matrix::multiply_matrices),
+    ("FunctionNodeTransposeMatrix", matrix::transpose_matrix),
+    ("FunctionNodeMatrixDeterminant", matrix::matrix_determinant),
+    ("FunctionNodeCombineMatrix", matrix::combine_matrix),
+    ("FunctionNodeSeparateMatrix", matrix::separate_matrix),
+    ("GeometryNodePoints", points::points),
+    ("GeometryNodeSetPointRadius", points::set_point_radius),
+    ("GeometryNodeSetID", points::set_id),
+    ("GeometryNodeInstancesToPoints", points::instances_to_points),
+    ("GeometryNodeInstanceTransform", points::instance_transform),
+    (
+        "GeometryNodeInputInstanceRotation",
+        points::instance_rotation,
+    ),
+    ("GeometryNodeInputInstanceScale", points::instance_scale),
 ];
 
 /// The `bl_idname`s of `NODES`.
