@@ -76,8 +76,15 @@ fn integer_op(op: &str) -> Option<fn(i32, i32, i32) -> i32> {
             }
         },
         "DIVIDE_ROUND" => |a, b, _| divide_round(a, b),
-        // `std::pow(int, int)` in double, converted back.
-        "POWER" => |a, b, _| (a as f64).powf(b as f64) as i32,
+        // `std::pow(int, int)` in double, converted back (x86 gives INT_MIN out of range).
+        "POWER" => |a, b, _| {
+            let p = (a as f64).powf(b as f64).trunc();
+            if p >= i32::MIN as f64 && p <= i32::MAX as f64 {
+                p as i32
+            } else {
+                i32::MIN
+            }
+        },
         "MULTIPLY_ADD" => |a, b, c| a.wrapping_mul(b).wrapping_add(c),
         "FLOORED_MODULO" => |a, b, _| {
             if b != 0 {

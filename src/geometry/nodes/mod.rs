@@ -42,10 +42,12 @@ pub mod raycast;
 pub mod rotation;
 pub mod sample_curve;
 pub mod sample_nearest;
+pub mod scale_elements;
 pub mod split_edges;
 pub mod subdivide;
 pub mod subdivision_surface;
 pub mod texture;
+pub mod triangulate;
 
 use super::error::GeometryError;
 use super::eval::{NodeCtx, Outputs};
@@ -326,6 +328,8 @@ pub const NODES: &[(&str, Evaluate)] = &[
         points::instance_rotation,
     ),
     ("GeometryNodeInputInstanceScale", points::instance_scale),
+    ("GeometryNodeTriangulate", triangulate::triangulate_node),
+    ("GeometryNodeScaleElements", scale_elements::scale_elements),
 ];
 
 /// The `bl_idname`s of `NODES`.

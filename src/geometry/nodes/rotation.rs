@@ -345,14 +345,14 @@ pub fn rotation_to_quaternion(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         .collect())
 }
 
-/// `math::to_axis_angle(Quaternion)`: the vector part over sin(angle / 2) (with Y set to 1
-/// and no division when that is below 0.0005), the angle 2 atan2(sin, cos) of the halves.
+/// `math::to_axis_angle(Quaternion)`: the vector part over sin(angle / 2), the angle
+/// 2 atan2(sin, cos) of the halves; below a sine of 0.0005 the identity, +Y and 0 (as
+/// Blender 4.5 gives it, fixture `rotation_matrix`).
 fn to_axis_angle(q: [f32; 4]) -> (V3, f32) {
-    let mut axis = [q[1], q[2], q[3]];
-    let mut sin_half = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+    let axis = [q[1], q[2], q[3]];
+    let sin_half = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
     if sin_half < 0.0005 {
-        sin_half = 1.0;
-        axis[1] = 1.0;
+        return ([0.0, 1.0, 0.0], 0.0);
     }
     let axis = axis.map(|v| v / sin_half);
     (axis, sin_half.atan2(q[0]) * 2.0)
