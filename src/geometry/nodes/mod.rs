@@ -43,6 +43,7 @@ pub mod rotation;
 pub mod sample_curve;
 pub mod sample_nearest;
 pub mod scale_elements;
+pub mod sort_elements;
 pub mod split_edges;
 pub mod subdivide;
 pub mod subdivision_surface;
@@ -330,6 +331,7 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ("GeometryNodeInputInstanceScale", points::instance_scale),
     ("GeometryNodeTriangulate", triangulate::triangulate_node),
     ("GeometryNodeScaleElements", scale_elements::scale_elements),
+    ("GeometryNodeSortElements", sort_elements::sort_elements),
 ];
 
 /// The `bl_idname`s of `NODES`.
