@@ -563,10 +563,12 @@ fn parity_fixtures_stay_small() {
     }
     let total = size(&scenes_dir());
     // 6 MB held the Geometry Nodes scenes; the modifier scenes (mirror, triangulate,
-    // deform, solidify: 0.45 MB, inputs shared between cases) raised it to 7 MB.
+    // deform, solidify: 0.45 MB, inputs shared between cases) raised it to 7 MB; the
+    // mesh topology, accumulate/blur, point/instance and function node scenes
+    // (gn_mesh_nodes.py: 0.75 MB, mostly their node trees in scene.json) to 8 MB.
     assert!(
-        total < 7_000_000,
-        "fixtures/geometry/scenes holds {total} bytes; keep it under 7 MB"
+        total < 8_000_000,
+        "fixtures/geometry/scenes holds {total} bytes; keep it under 8 MB"
     );
 }
 

@@ -104,7 +104,7 @@ fn face_tris(m: &Mesh, f: usize, quad: &str, ngon_beauty: bool) -> Vec<[usize; 3
 }
 
 /// `is_quad_flip_v3`: bit 0 when the (1-3) diagonal gives flipped triangles, bit 1 (2-4).
-fn quad_flip(v1: [f32; 3], v2: [f32; 3], v3: [f32; 3], v4: [f32; 3]) -> u32 {
+pub(crate) fn quad_flip(v1: [f32; 3], v2: [f32; 3], v3: [f32; 3], v4: [f32; 3]) -> u32 {
     use super::super::math::{cross, dot, sub};
     let (d12, d23, d34, d41) = (sub(v1, v2), sub(v2, v3), sub(v3, v4), sub(v4, v1));
     let mut r = 0;

@@ -1,8 +1,10 @@
 //! Geometry Nodes node implementations, dispatched by `bl_idname`. A node type missing
 //! here is an error naming the tree and node: it is never evaluated as something else.
 
+pub mod accumulate_field;
 pub mod attribute;
 pub mod attribute_statistic;
+pub mod blur_attribute;
 pub mod bounding_box;
 pub mod collection_info;
 pub mod color;
@@ -26,9 +28,13 @@ pub mod ico_sphere;
 pub mod image_texture;
 pub mod input;
 pub mod instance_transform;
+pub mod integer_math;
+pub mod matrix;
 pub mod menu_switch;
 pub mod merge_by_distance;
 pub mod mesh_to_curve;
+pub mod mesh_topology;
+pub mod points;
 pub mod primitives;
 pub mod proximity;
 pub mod radius;
@@ -36,10 +42,13 @@ pub mod raycast;
 pub mod rotation;
 pub mod sample_curve;
 pub mod sample_nearest;
+pub mod scale_elements;
+pub mod sort_elements;
 pub mod split_edges;
 pub mod subdivide;
 pub mod subdivision_surface;
 pub mod texture;
+pub mod triangulate;
 
 use super::error::GeometryError;
 use super::eval::{NodeCtx, Outputs};
@@ -236,6 +245,93 @@ pub const NODES: &[(&str, Evaluate)] = &[
         collection_info::collection_info,
     ),
     ("GeometryNodeSplitEdges", split_edges::split_edges),
+    // Mesh topology fields (issue 26).
+    (
+        "GeometryNodeInputMeshEdgeNeighbors",
+        mesh_topology::edge_neighbors,
+    ),
+    (
+        "GeometryNodeInputMeshFaceNeighbors",
+        mesh_topology::face_neighbors,
+    ),
+    (
+        "GeometryNodeInputMeshVertexNeighbors",
+        mesh_topology::vertex_neighbors,
+    ),
+    (
+        "GeometryNodeInputMeshEdgeVertices",
+        mesh_topology::edge_vertices,
+    ),
+    ("GeometryNodeInputMeshEdgeAngle", mesh_topology::edge_angle),
+    ("GeometryNodeInputMeshIsland", mesh_topology::mesh_island),
+    (
+        "GeometryNodeInputMeshFaceIsPlanar",
+        mesh_topology::face_is_planar,
+    ),
+    ("GeometryNodeCornersOfFace", mesh_topology::corners_of_face),
+    (
+        "GeometryNodeCornersOfVertex",
+        mesh_topology::corners_of_vertex,
+    ),
+    ("GeometryNodeEdgesOfVertex", mesh_topology::edges_of_vertex),
+    ("GeometryNodeEdgesOfCorner", mesh_topology::edges_of_corner),
+    ("GeometryNodeFaceOfCorner", mesh_topology::face_of_corner),
+    (
+        "GeometryNodeVertexOfCorner",
+        mesh_topology::vertex_of_corner,
+    ),
+    (
+        "GeometryNodeOffsetCornerInFace",
+        mesh_topology::offset_corner_in_face,
+    ),
+    (
+        "GeometryNodeAccumulateField",
+        accumulate_field::accumulate_field,
+    ),
+    ("GeometryNodeBlurAttribute", blur_attribute::blur_attribute),
+    ("FunctionNodeIntegerMath", integer_math::integer_math),
+    ("FunctionNodeBitMath", integer_math::bit_math),
+    ("FunctionNodeHashValue", integer_math::hash_value),
+    ("FunctionNodeInvertRotation", rotation::invert_rotation),
+    (
+        "FunctionNodeQuaternionToRotation",
+        rotation::quaternion_to_rotation,
+    ),
+    (
+        "FunctionNodeRotationToQuaternion",
+        rotation::rotation_to_quaternion,
+    ),
+    (
+        "FunctionNodeRotationToAxisAngle",
+        rotation::rotation_to_axis_angle,
+    ),
+    ("FunctionNodeCombineTransform", matrix::combine_transform),
+    ("FunctionNodeSeparateTransform", matrix::separate_transform),
+    ("FunctionNodeTransformPoint", matrix::transform_point_node),
+    (
+        "FunctionNodeTransformDirection",
+        matrix::transform_direction_node,
+    ),
+    ("FunctionNodeProjectPoint", matrix::project_point_node),
+    ("FunctionNodeInvertMatrix", matrix::invert_matrix),
+    ("FunctionNodeMatrixMultiply", matrix::multiply_matrices),
+    ("FunctionNodeTransposeMatrix", matrix::transpose_matrix),
+    ("FunctionNodeMatrixDeterminant", matrix::matrix_determinant),
+    ("FunctionNodeCombineMatrix", matrix::combine_matrix),
+    ("FunctionNodeSeparateMatrix", matrix::separate_matrix),
+    ("GeometryNodePoints", points::points),
+    ("GeometryNodeSetPointRadius", points::set_point_radius),
+    ("GeometryNodeSetID", points::set_id),
+    ("GeometryNodeInstancesToPoints", points::instances_to_points),
+    ("GeometryNodeInstanceTransform", points::instance_transform),
+    (
+        "GeometryNodeInputInstanceRotation",
+        points::instance_rotation,
+    ),
+    ("GeometryNodeInputInstanceScale", points::instance_scale),
+    ("GeometryNodeTriangulate", triangulate::triangulate_node),
+    ("GeometryNodeScaleElements", scale_elements::scale_elements),
+    ("GeometryNodeSortElements", sort_elements::sort_elements),
 ];
 
 /// The `bl_idname`s of `NODES`.

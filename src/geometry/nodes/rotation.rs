@@ -88,7 +88,7 @@ fn mat3_vec(m: &Mat3f, v: V3) -> V3 {
 }
 
 /// `angle_normalized_v3v3`: the angle between unit vectors, accurate near 0 and pi.
-fn angle_normalized(a: V3, b: V3) -> f32 {
+pub(crate) fn angle_normalized(a: V3, b: V3) -> f32 {
     let d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let len = |v: V3| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     if d >= 0.0 {
@@ -279,4 +279,101 @@ pub fn rotate_euler(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
 /// Each column scaled to unit length (`mat3_to_eul` normalizes before converting).
 fn normalized(m: &Mat3f) -> Mat3f {
     [normalize(m[0]), normalize(m[1]), normalize(m[2])]
+}
+
+/// Invert Rotation: the conjugate (`invert_normalized`).
+pub fn invert_rotation(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
+    let r = ctx.field("Rotation", DataType::Quaternion)?;
+    let f = Field::op1("Invert Rotation", vec![r], DataType::Quaternion, |_, x| {
+        Ok(Array::Quaternion(
+            x[0].as_quat()
+                .iter()
+                .map(|q| [q[0], -q[1], -q[2], -q[3]])
+                .collect(),
+        ))
+    })
+    .map_err(|e| ctx.err(e))?;
+    Ok(outputs([("Rotation", SocketValue::Field(f))]))
+}
+
+/// Quaternion to Rotation: the components, normalized.
+pub fn quaternion_to_rotation(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
+    let inputs = ["W", "X", "Y", "Z"]
+        .iter()
+        .map(|k| ctx.field(k, DataType::Float))
+        .collect::<Result<Vec<_>, _>>()?;
+    let f = Field::op1(
+        "Quaternion to Rotation",
+        inputs,
+        DataType::Quaternion,
+        |n, x| {
+            let c: Vec<_> = x.iter().map(|a| a.as_float()).collect();
+            Ok(Array::Quaternion(
+                (0..n)
+                    .map(|i| {
+                        let q = [c[0][i], c[1][i], c[2][i], c[3][i]];
+                        let len = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+                        let inv = if len != 0.0 { 1.0 / len } else { 0.0 };
+                        q.map(|v| v * inv)
+                    })
+                    .collect(),
+            ))
+        },
+    )
+    .map_err(|e| ctx.err(e))?;
+    Ok(outputs([("Rotation", SocketValue::Field(f))]))
+}
+
+pub fn rotation_to_quaternion(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
+    let r = ctx.field("Rotation", DataType::Quaternion)?;
+    let fs = Field::op(
+        "Rotation to Quaternion",
+        vec![r],
+        vec![DataType::Float; 4],
+        |_, x| {
+            let q = x[0].as_quat();
+            Ok((0..4)
+                .map(|k| Array::Float(q.iter().map(|q| q[k]).collect()))
+                .collect())
+        },
+    )
+    .map_err(|e| ctx.err(e))?;
+    Ok(["W", "X", "Y", "Z"]
+        .iter()
+        .zip(fs)
+        .map(|(k, f)| (k.to_string(), SocketValue::Field(f)))
+        .collect())
+}
+
+/// `math::to_axis_angle(Quaternion)`: the vector part over sin(angle / 2), the angle
+/// 2 atan2(sin, cos) of the halves; below a sine of 0.0005 the identity, +Y and 0 (as
+/// Blender 4.5 gives it, fixture `rotation_matrix`).
+fn to_axis_angle(q: [f32; 4]) -> (V3, f32) {
+    let axis = [q[1], q[2], q[3]];
+    let sin_half = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+    if sin_half < 0.0005 {
+        return ([0.0, 1.0, 0.0], 0.0);
+    }
+    let axis = axis.map(|v| v / sin_half);
+    (axis, sin_half.atan2(q[0]) * 2.0)
+}
+
+pub fn rotation_to_axis_angle(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
+    let r = ctx.field("Rotation", DataType::Quaternion)?;
+    let fs = Field::op(
+        "Rotation to Axis Angle",
+        vec![r],
+        vec![DataType::Vector, DataType::Float],
+        |_, x| {
+            let (axes, angles): (Vec<V3>, Vec<f32>) =
+                x[0].as_quat().iter().map(|q| to_axis_angle(*q)).unzip();
+            Ok(vec![Array::Vector(axes), Array::Float(angles)])
+        },
+    )
+    .map_err(|e| ctx.err(e))?;
+    let mut it = fs.into_iter();
+    Ok(outputs([
+        ("Axis", SocketValue::Field(it.next().unwrap())),
+        ("Angle", SocketValue::Field(it.next().unwrap())),
+    ]))
 }
