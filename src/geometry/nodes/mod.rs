@@ -33,6 +33,7 @@ pub mod primitives;
 pub mod proximity;
 pub mod radius;
 pub mod raycast;
+pub mod repeat_zone;
 pub mod rotation;
 pub mod sample_curve;
 pub mod sample_nearest;
@@ -236,6 +237,8 @@ pub const NODES: &[(&str, Evaluate)] = &[
         collection_info::collection_info,
     ),
     ("GeometryNodeSplitEdges", split_edges::split_edges),
+    ("GeometryNodeRepeatInput", repeat_zone::repeat_input),
+    ("GeometryNodeRepeatOutput", repeat_zone::repeat_output),
 ];
 
 /// The `bl_idname`s of `NODES`.

@@ -1,0 +1,96 @@
+//! Geometry Nodes zones beyond the parity cases (those are in tests/geometry.rs, scene
+//! `zones`): hostile Iterations and fields that grow without bound, errors naming the
+//! tree and the zone's node (docs/limits.md). (Geometry a zone doubles stops at the
+//! element limit too, but reaching 2^26 elements takes seconds and gigabytes: untested.)
+
+use std::path::PathBuf;
+
+use blendsynth::geometry;
+use blendsynth::scene::Scene;
+
+fn load(name: &str) -> Scene {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/geometry/scenes");
+    Scene::load(&dir.join(name)).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn evaluate(
+    scene: &Scene,
+    object: &str,
+    overrides: &[(&str, serde_json::Value)],
+) -> Result<usize, String> {
+    let over: Vec<(String, serde_json::Value)> = overrides
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.clone()))
+        .collect();
+    geometry::evaluate_object(scene, object, 1.0, &over)
+        .and_then(|g| geometry::realize_to_mesh(&g))
+        .map(|m| m.vertex_count())
+        .map_err(|e| e.to_string())
+}
+
+fn iterations(tree: &str, node: &str) -> String {
+    format!("node_groups[\"{tree}\"].nodes[\"{node}\"].inputs[\"Iterations\"].default_value")
+}
+
+#[test]
+fn hostile_iterations_are_an_error_naming_the_zone() {
+    let scene = load("zones");
+    let e = evaluate(
+        &scene,
+        "repeat_fields",
+        &[(
+            &iterations("repeat_fields", "Repeat Input"),
+            1_000_000_000.into(),
+        )],
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("repeat_fields") && e.contains("Repeat Output") && e.contains("1000000000"),
+        "{e}"
+    );
+    // Just under the limit per zone, but nested: the budget is for all zones together.
+    let e = evaluate(
+        &scene,
+        "repeat_nested",
+        &[
+            (&iterations("repeat_nested", "Repeat Input"), 1000.into()),
+            (
+                &iterations("repeat_nested", "Repeat Input.001"),
+                1_048_000.into(),
+            ),
+        ],
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("Repeat Output.001") && e.contains("limit"),
+        "{e}"
+    );
+    // The same zones at a few iterations evaluate.
+    assert_eq!(evaluate(&scene, "repeat_nested", &[]).unwrap(), 64);
+}
+
+#[test]
+fn a_field_growing_with_the_iterations_stops_at_the_depth_limit() {
+    // Acc = Acc * 0.5 + Iteration + Index * 0.1 wraps the field item in more operations
+    // every iteration: evaluating it would recurse thousands deep.
+    let scene = load("zones");
+    let e = evaluate(
+        &scene,
+        "repeat_fields",
+        &[(&iterations("repeat_fields", "Repeat Input"), 5000.into())],
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("Repeat Output") && e.contains("\"Item_1\"") && e.contains("deep"),
+        "{e}"
+    );
+    // Zero and negative counts pass the items through (the parity cases compare them).
+    for n in [0, -1, -1_000_000_000] {
+        evaluate(
+            &scene,
+            "repeat_fields",
+            &[(&iterations("repeat_fields", "Repeat Input"), n.into())],
+        )
+        .unwrap();
+    }
+}
