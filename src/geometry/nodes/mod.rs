@@ -20,6 +20,7 @@ pub mod field_nodes;
 pub mod fill_curve;
 pub mod flip_faces;
 pub mod float_curve;
+pub mod foreach_element;
 pub mod function;
 pub mod geometry_ops;
 pub mod ico_sphere;
@@ -239,6 +240,14 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ("GeometryNodeSplitEdges", split_edges::split_edges),
     ("GeometryNodeRepeatInput", repeat_zone::repeat_input),
     ("GeometryNodeRepeatOutput", repeat_zone::repeat_output),
+    (
+        "GeometryNodeForeachGeometryElementInput",
+        foreach_element::foreach_input,
+    ),
+    (
+        "GeometryNodeForeachGeometryElementOutput",
+        foreach_element::foreach_output,
+    ),
 ];
 
 /// The `bl_idname`s of `NODES`.
