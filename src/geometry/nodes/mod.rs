@@ -39,6 +39,7 @@ pub mod rotation;
 pub mod sample_curve;
 pub mod sample_nearest;
 pub mod split_edges;
+pub mod string;
 pub mod subdivide;
 pub mod subdivision_surface;
 pub mod texture;
@@ -248,6 +249,17 @@ pub const NODES: &[(&str, Evaluate)] = &[
         "GeometryNodeForeachGeometryElementOutput",
         foreach_element::foreach_output,
     ),
+    ("FunctionNodeValueToString", string::value_to_string),
+    ("GeometryNodeStringJoin", string::join_strings),
+    ("FunctionNodeSliceString", string::slice_string),
+    ("FunctionNodeStringLength", string::string_length),
+    (
+        "FunctionNodeInputSpecialCharacters",
+        string::special_characters,
+    ),
+    ("FunctionNodeReplaceString", string::replace_string),
+    ("FunctionNodeFindInString", string::find_in_string),
+    ("FunctionNodeMatchString", string::match_string),
 ];
 
 /// The `bl_idname`s of `NODES`.
