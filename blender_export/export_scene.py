@@ -1797,6 +1797,10 @@ def main():
         "scene": {
             "name": scene.name, "frame_start": scene.frame_start, "frame_end": scene.frame_end,
             "frame_current": scene.frame_current, "frame_step": scene.frame_step,
+            # Where Geometry Nodes simulation zones start (the scene's custom simulation
+            # range, else its frame range).
+            "simulation_frame_start": (scene.simulation_frame_start if scene.use_custom_simulation_range
+                                       else scene.frame_start),
             "fps": scene.render.fps, "fps_base": scene.render.fps_base,
             "camera": key(scene.camera) if scene.camera else None, "world": key(scene.world) if scene.world else None,
             "render": rna_value(scene.render, 0, "scene.render"),

@@ -94,3 +94,25 @@ fn a_field_growing_with_the_iterations_stops_at_the_depth_limit() {
         .unwrap();
     }
 }
+
+#[test]
+fn a_simulation_zone_is_evaluated_at_its_start_frame_only() {
+    // (Frame 1, the start, is a parity case: the body runs once with Delta Time 0.)
+    let scene = load("zones");
+    let mesh = |frame: f64| {
+        geometry::evaluate_object(&scene, "simulation_start", frame, &[])
+            .and_then(|g| geometry::realize_to_mesh(&g))
+            .map(|m| m.vertex_count())
+            .map_err(|e| e.to_string())
+    };
+    assert_eq!(mesh(1.0).unwrap(), 8);
+    for frame in [2.0, 0.0, 1.5] {
+        let e = mesh(frame).unwrap_err();
+        assert!(
+            e.contains("simulation_start")
+                && e.contains("Simulation Output")
+                && e.contains("start frame 1"),
+            "{e}"
+        );
+    }
+}

@@ -38,6 +38,7 @@ pub mod repeat_zone;
 pub mod rotation;
 pub mod sample_curve;
 pub mod sample_nearest;
+pub mod simulation_zone;
 pub mod split_edges;
 pub mod string;
 pub mod subdivide;
@@ -260,6 +261,14 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ("FunctionNodeReplaceString", string::replace_string),
     ("FunctionNodeFindInString", string::find_in_string),
     ("FunctionNodeMatchString", string::match_string),
+    (
+        "GeometryNodeSimulationInput",
+        simulation_zone::simulation_input,
+    ),
+    (
+        "GeometryNodeSimulationOutput",
+        simulation_zone::simulation_output,
+    ),
 ];
 
 /// The `bl_idname`s of `NODES`.
