@@ -116,3 +116,47 @@ fn a_simulation_zone_is_evaluated_at_its_start_frame_only() {
         );
     }
 }
+
+#[test]
+fn objects_with_a_simulation_zone_are_frozen_after_the_start_frame() {
+    // `render`, `mesh` and `inspect` ask `object_source`: at the start frame blendsynth
+    // evaluates the zone; at any other frame the object is Blender's evaluated mesh,
+    // which the export has only for its own frame (the zone depends on the frame), so
+    // another frame is an error naming the object and the zone.
+    let scene = load("zones");
+    let o = scene.object("simulation_start").unwrap();
+    let at = |frame: f64| geometry::source::object_source(&scene, o, frame, &[]);
+    assert!(!matches!(at(1.0), Ok(geometry::source::Source::Frozen(_))));
+    let e = match at(2.0) {
+        Err(e) => e.to_string(),
+        Ok(_) => panic!("frame 2 of a simulation evaluated"),
+    };
+    assert!(
+        e.contains("simulation_start") && e.contains("Simulation Output") && e.contains("frame 2"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_for_each_zone_over_too_many_elements_is_an_error_naming_it() {
+    // 3000 x 1000 grid points, every other one selected: 1.5 million runs.
+    let scene = load("zones");
+    let grid = |input: &str| {
+        format!("node_groups[\"foreach_points\"].nodes[\"Grid\"].inputs[\"{input}\"].default_value")
+    };
+    let e = evaluate(
+        &scene,
+        "foreach_points",
+        &[
+            (&grid("Vertices X"), 3000.into()),
+            (&grid("Vertices Y"), 1000.into()),
+        ],
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("foreach_points")
+            && e.contains("For Each Geometry Element Output")
+            && e.contains("1500000 elements"),
+        "{e}"
+    );
+}
