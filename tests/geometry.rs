@@ -564,7 +564,7 @@ fn parity_fixtures_stay_small() {
     let total = size(&scenes_dir());
     // 6 MB held the Geometry Nodes scenes; the modifier scenes (mirror, triangulate,
     // deform, solidify: 0.45 MB, inputs shared between cases) raised it to 7 MB; the
-    // zone and string scenes (issue 26: 0.3 MB, most of it node trees) to 7.5 MB.
+    // zone and string scenes (issue 26: 0.57 MB, most of it scene.json) to 7.5 MB.
     assert!(
         total < 7_500_000,
         "fixtures/geometry/scenes holds {total} bytes; keep it under 7.5 MB"
