@@ -245,6 +245,13 @@ def point_density_grid(n, where):
     return entry | {"file": rel, "min": vec(mn), "max": vec(mx)}
 
 
+def zone_pairing(n):
+    """A zone input node (Repeat, For Each Element, Simulation) names its output node:
+    the pointer is a node, which the generic walk would write out whole."""
+    paired = getattr(n, "paired_output", None)
+    return {"paired_output": paired.name} if isinstance(paired, bpy.types.Node) else {}
+
+
 def node_entry(n, where):
     group = getattr(n, "node_tree", None)
     extra = {"ies": ies_content(n, where)} if n.bl_idname == "ShaderNodeTexIES" else {}
@@ -255,7 +262,7 @@ def node_entry(n, where):
         "parent": n.parent.name if n.parent else None,
         "location": [n.location[0], n.location[1]], "hide": n.hide,
         "node_tree": key(group) if isinstance(group, bpy.types.NodeTree) else None,
-        "properties": rna_value(n, 0, where, skip=NODE_BASE),
+        "properties": rna_value(n, 0, where, skip=NODE_BASE | {"paired_output"}) | zone_pairing(n),
         "inputs": [socket_entry(s, i, f"{where}.inputs[{i}]") for i, s in enumerate(n.inputs)],
         "outputs": [socket_entry(s, i, f"{where}.outputs[{i}]") for i, s in enumerate(n.outputs)],
     }
@@ -1790,6 +1797,10 @@ def main():
         "scene": {
             "name": scene.name, "frame_start": scene.frame_start, "frame_end": scene.frame_end,
             "frame_current": scene.frame_current, "frame_step": scene.frame_step,
+            # Where Geometry Nodes simulation zones start (the scene's custom simulation
+            # range, else its frame range).
+            "simulation_frame_start": (scene.simulation_frame_start if scene.use_custom_simulation_range
+                                       else scene.frame_start),
             "fps": scene.render.fps, "fps_base": scene.render.fps_base,
             "camera": key(scene.camera) if scene.camera else None, "world": key(scene.world) if scene.world else None,
             "render": rna_value(scene.render, 0, "scene.render"),

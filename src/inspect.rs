@@ -409,7 +409,9 @@ fn smoke_summaries(scene: &Scene) -> Vec<SmokeSummary> {
 
 /// Frozen objects, and `mesh`'s errors for every object with geometry, at `frame`.
 fn geometry_checks(scene: &Scene, frame: f64) -> (Vec<FrozenSummary>, Vec<ObjectError>) {
-    use crate::geometry::source::{frozen_reason, object_source, unsupported_gn_node, Source};
+    use crate::geometry::source::{
+        frozen_reason, object_source, simulation_after_start, unsupported_gn_node, Source,
+    };
     let mut frozen = Vec::new();
     let mut errors = Vec::new();
     for o in &scene.file.objects {
@@ -425,6 +427,7 @@ fn geometry_checks(scene: &Scene, frame: f64) -> (Vec<FrozenSummary>, Vec<Object
                                 format!("Geometry Nodes node {n} that blendsynth does not evaluate")
                             })
                         })
+                        .or_else(|| simulation_after_start(scene, o, frame))
                         .unwrap_or_default(),
                     frame: e.frame,
                     reads: e.reads.clone().unwrap_or_default(),

@@ -565,10 +565,11 @@ fn parity_fixtures_stay_small() {
     // 6 MB held the Geometry Nodes scenes; the modifier scenes (mirror, triangulate,
     // deform, solidify: 0.45 MB, inputs shared between cases) raised it to 7 MB; the
     // mesh topology, accumulate/blur, point/instance and function node scenes
-    // (gn_mesh_nodes.py: 0.75 MB, mostly their node trees in scene.json) to 8 MB.
+    // (gn_mesh_nodes.py: 0.75 MB, mostly their node trees in scene.json) and the zone and
+    // string scenes (gn_zones.py: 0.57 MB, most of it scene.json) to 9 MB.
     assert!(
-        total < 8_000_000,
-        "fixtures/geometry/scenes holds {total} bytes; keep it under 8 MB"
+        total < 9_000_000,
+        "fixtures/geometry/scenes holds {total} bytes; keep it under 9 MB"
     );
 }
 

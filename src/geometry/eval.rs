@@ -258,6 +258,7 @@ impl<'s> Session<'s> {
             object: o,
             memo: RefCell::new(HashMap::new()),
             busy: RefCell::new(HashSet::new()),
+            zone_iterations: std::cell::Cell::new(0),
         };
         let root = &ev.graph.nodes[ev.graph.root];
         let ctx = NodeCtx {
@@ -326,6 +327,8 @@ pub struct Evaluator<'a> {
     pub object: &'a Object,
     memo: RefCell<HashMap<usize, Rc<Outputs>>>,
     busy: RefCell<HashSet<usize>>,
+    /// Zone body runs so far, all zones together (`zones`: bounded by a limit).
+    pub(super) zone_iterations: std::cell::Cell<u64>,
 }
 
 impl<'a> Evaluator<'a> {
@@ -342,6 +345,21 @@ impl<'a> Evaluator<'a> {
         let out = Rc::new(r?);
         self.memo.borrow_mut().insert(idx, out.clone());
         Ok(out)
+    }
+
+    /// Drops the results of `nodes`, so they are evaluated afresh (a zone's body, once
+    /// per iteration).
+    pub(super) fn forget(&self, nodes: &[usize]) {
+        let mut memo = self.memo.borrow_mut();
+        for n in nodes {
+            memo.remove(n);
+        }
+    }
+
+    /// Gives node `idx` these results without evaluating it (a zone input node's
+    /// values for one iteration).
+    pub(super) fn preset(&self, idx: usize, outputs: Outputs) {
+        self.memo.borrow_mut().insert(idx, Rc::new(outputs));
     }
 
     /// The node tree whose node list holds `node` (to find its links).

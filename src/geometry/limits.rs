@@ -8,6 +8,18 @@
 /// 2^26, about 67 million, a few GB of mesh. Blender itself stops at 2^31 - 1.
 pub const MAX_ELEMENTS: u64 = 1 << 26;
 
+/// Most runs of zone bodies (Repeat iterations, For Each elements) in one Geometry Nodes
+/// evaluation, all zones together (nested zones multiply): 2^20. Blender has no limit, so
+/// a hostile Iterations of 1e9 would run for hours; past this it is an error naming the
+/// zone's node.
+pub const MAX_ZONE_ITERATIONS: u64 = 1 << 20;
+
+/// Deepest field carried through a Repeat zone's iterations (operations from the field's
+/// output to its deepest input). Each iteration can wrap a field item in more operations
+/// and evaluating a field recurses through them, so a field item that grows with the
+/// iterations stops here with an error naming the zone instead of exhausting the stack.
+pub const MAX_FIELD_DEPTH: usize = 2000;
+
 /// `Ok` when `count` (None: it overflowed) is within MAX_ELEMENTS; the error names the
 /// input(s) the count came from, for the caller to prefix with the node.
 pub fn check(count: Option<u64>, input: &str) -> Result<(), String> {

@@ -54,6 +54,7 @@ pub mod source;
 pub mod types;
 pub mod value;
 pub mod weld;
+pub mod zones;
 
 pub use error::GeometryError;
 pub use export::{write_glb, write_mesh, write_obj, write_ply};

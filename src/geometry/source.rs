@@ -190,15 +190,16 @@ pub fn object_source(
     // A Geometry Nodes stack with a node blendsynth does not evaluate (the Auto Smooth
     // modifier 4.1 adds to old files, ...): Blender's evaluated mesh, while valid.
     if matches!(o.kind.as_str(), "MESH" | "CURVE") {
-        if let Some(node) = unsupported_gn_node(scene, o) {
+        let reason = unsupported_gn_node(scene, o)
+            .map(|node| format!("Geometry Nodes node {node} that blendsynth does not evaluate"))
+            .or_else(|| simulation_after_start(scene, o, frame));
+        if let Some(reason) = reason {
             let has_frozen = scene
                 .file
                 .evaluated
                 .iter()
                 .any(|e| e.object == o.name && e.reads.is_some());
             if has_frozen {
-                let reason =
-                    format!("Geometry Nodes node {node} that blendsynth does not evaluate");
                 return frozen(scene, o, frame, overrides, &reason).map(Source::Frozen);
             }
         }
@@ -259,6 +260,44 @@ pub fn unsupported_gn_node(scene: &Scene, o: &Object) -> Option<String> {
         .filter(|m| m.show_render && m.kind == "NODES")
         .filter_map(|m| m.node_group.as_deref())
         .find_map(|g| walk(scene, g, &mut seen))
+}
+
+/// Why `o` is frozen at `frame` when its Geometry Nodes hold a Simulation zone: blendsynth
+/// evaluates one only at its start frame; any other frame continues Blender's simulation
+/// state, which only Blender's evaluated mesh (the export's, or `convert --frames`) has.
+pub fn simulation_after_start(scene: &Scene, o: &Object, frame: f64) -> Option<String> {
+    let start = scene.file.scene.simulation_frame_start;
+    if start.is_some_and(|s| f64::from(s) == frame) {
+        return None;
+    }
+    let mut seen: Vec<&str> = Vec::new();
+    let mut todo: Vec<&str> = o
+        .modifiers
+        .iter()
+        .filter(|m| m.show_render && m.kind == "NODES")
+        .filter_map(|m| m.node_group.as_deref())
+        .collect();
+    while let Some(g) = todo.pop() {
+        if seen.contains(&g) {
+            continue;
+        }
+        seen.push(g);
+        let Some(tree) = scene.node_group(g) else {
+            continue;
+        };
+        for n in &tree.nodes {
+            if n.bl_idname == "GeometryNodeSimulationOutput" {
+                let start = start.map_or("unknown".to_string(), |s| s.to_string());
+                return Some(format!(
+                    "Simulation zone {:?} at frame {frame}: blendsynth evaluates it only at \
+                     its start frame {start}",
+                    n.name
+                ));
+            }
+            todo.extend(n.node_tree.as_deref());
+        }
+    }
+    None
 }
 
 /// The export's evaluated mesh of `o`, when it may stand for the object at `frame` with

@@ -210,6 +210,15 @@ impl<'a> Builder<'a> {
             return Err(self.err(inst, node, "is part of a cycle of links"));
         }
         self.in_progress.push(key);
+        // A zone's output node needs its input node (Repeat's Iterations, For Each's
+        // Geometry) even when nothing in the zone reads the input node's outputs; it
+        // comes first, so a zone's nodes lie between its input and output in flat order.
+        let tree = self.instances[inst].tree;
+        if let Some(input) = tree.nodes.iter().find(|n| {
+            n.properties.get("paired_output").and_then(Value::as_str) == Some(node.name.as_str())
+        }) {
+            self.node(inst, input)?;
+        }
         let mut inputs = Vec::with_capacity(node.inputs.len());
         for s in node.inputs.iter().filter(|s| s.enabled) {
             let sources = self.input(inst, node, s)?;

@@ -76,6 +76,9 @@ pub struct SceneSettings {
     pub frame_current: i32,
     #[serde(default = "one_i32")]
     pub frame_step: i32,
+    /// Where Geometry Nodes simulation zones start (absent in older exports).
+    #[serde(default)]
+    pub simulation_frame_start: Option<i32>,
     pub fps: f64,
     #[serde(default = "one_f64")]
     pub fps_base: f64,

@@ -224,6 +224,9 @@ pub fn vector_math_node(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
 
 pub fn compare(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let dt = ctx.prop_str("data_type")?;
+    if dt == "STRING" {
+        return super::string::compare_strings(ctx);
+    }
     let op = ctx.prop_str("operation")?.to_string();
     let mode = ctx
         .prop("mode")

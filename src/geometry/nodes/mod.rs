@@ -22,6 +22,7 @@ pub mod field_nodes;
 pub mod fill_curve;
 pub mod flip_faces;
 pub mod float_curve;
+pub mod foreach_element;
 pub mod function;
 pub mod geometry_ops;
 pub mod ico_sphere;
@@ -39,12 +40,15 @@ pub mod primitives;
 pub mod proximity;
 pub mod radius;
 pub mod raycast;
+pub mod repeat_zone;
 pub mod rotation;
 pub mod sample_curve;
 pub mod sample_nearest;
 pub mod scale_elements;
+pub mod simulation_zone;
 pub mod sort_elements;
 pub mod split_edges;
+pub mod string;
 pub mod subdivide;
 pub mod subdivision_surface;
 pub mod texture;
@@ -332,6 +336,35 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ("GeometryNodeTriangulate", triangulate::triangulate_node),
     ("GeometryNodeScaleElements", scale_elements::scale_elements),
     ("GeometryNodeSortElements", sort_elements::sort_elements),
+    ("GeometryNodeRepeatInput", repeat_zone::repeat_input),
+    ("GeometryNodeRepeatOutput", repeat_zone::repeat_output),
+    (
+        "GeometryNodeForeachGeometryElementInput",
+        foreach_element::foreach_input,
+    ),
+    (
+        "GeometryNodeForeachGeometryElementOutput",
+        foreach_element::foreach_output,
+    ),
+    ("FunctionNodeValueToString", string::value_to_string),
+    ("GeometryNodeStringJoin", string::join_strings),
+    ("FunctionNodeSliceString", string::slice_string),
+    ("FunctionNodeStringLength", string::string_length),
+    (
+        "FunctionNodeInputSpecialCharacters",
+        string::special_characters,
+    ),
+    ("FunctionNodeReplaceString", string::replace_string),
+    ("FunctionNodeFindInString", string::find_in_string),
+    ("FunctionNodeMatchString", string::match_string),
+    (
+        "GeometryNodeSimulationInput",
+        simulation_zone::simulation_input,
+    ),
+    (
+        "GeometryNodeSimulationOutput",
+        simulation_zone::simulation_output,
+    ),
 ];
 
 /// The `bl_idname`s of `NODES`.
