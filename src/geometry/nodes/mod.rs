@@ -16,6 +16,7 @@ pub mod curve_tangent;
 pub mod curve_to_points;
 pub mod delete;
 pub mod distribute;
+pub mod domain_size;
 pub mod dual_mesh;
 pub mod extrude;
 pub mod field_nodes;
@@ -30,6 +31,7 @@ pub mod image_texture;
 pub mod input;
 pub mod instance_transform;
 pub mod integer_math;
+pub mod is_smooth;
 pub mod matrix;
 pub mod menu_switch;
 pub mod merge_by_distance;
@@ -249,6 +251,9 @@ pub const NODES: &[(&str, Evaluate)] = &[
         collection_info::collection_info,
     ),
     ("GeometryNodeSplitEdges", split_edges::split_edges),
+    ("GeometryNodeAttributeDomainSize", domain_size::domain_size),
+    ("GeometryNodeInputShadeSmooth", is_smooth::is_face_smooth),
+    ("GeometryNodeInputEdgeSmooth", is_smooth::is_edge_smooth),
     // Mesh topology fields (issue 26).
     (
         "GeometryNodeInputMeshEdgeNeighbors",
