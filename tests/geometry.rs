@@ -563,10 +563,11 @@ fn parity_fixtures_stay_small() {
     }
     let total = size(&scenes_dir());
     // 6 MB held the Geometry Nodes scenes; the modifier scenes (mirror, triangulate,
-    // deform, solidify: 0.45 MB, inputs shared between cases) raised it to 7 MB.
+    // deform, solidify: 0.45 MB, inputs shared between cases) raised it to 7 MB; the curve
+    // node scenes (curve_edit, curve_fields: 0.44 MB, mostly node trees) to 7.5 MB.
     assert!(
-        total < 7_000_000,
-        "fixtures/geometry/scenes holds {total} bytes; keep it under 7 MB"
+        total < 7_500_000,
+        "fixtures/geometry/scenes holds {total} bytes; keep it under 7.5 MB"
     );
 }
 

@@ -26,6 +26,7 @@
 pub mod animated;
 pub mod attribute;
 pub mod beautify;
+pub mod bezier_handles;
 pub mod bisect_plane;
 pub mod bmesh;
 pub mod catmull_clark;
