@@ -564,10 +564,10 @@ fn parity_fixtures_stay_small() {
     let total = size(&scenes_dir());
     // 6 MB held the Geometry Nodes scenes; the modifier scenes (mirror, triangulate,
     // deform, solidify: 0.45 MB, inputs shared between cases) raised it to 7 MB; the curve
-    // node scenes (curve_edit, curve_fields: 0.44 MB, mostly node trees) to 7.5 MB.
+    // node scenes (curve_edit, curve_fields: 0.6 MB, mostly node trees) to 7.7 MB.
     assert!(
-        total < 7_500_000,
-        "fixtures/geometry/scenes holds {total} bytes; keep it under 7.5 MB"
+        total < 7_700_000,
+        "fixtures/geometry/scenes holds {total} bytes; keep it under 7.7 MB"
     );
 }
 

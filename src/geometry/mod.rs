@@ -52,6 +52,7 @@ pub mod polyfill;
 pub mod realize;
 pub mod set;
 pub mod source;
+pub mod subdivide_curves;
 pub mod types;
 pub mod value;
 pub mod weld;

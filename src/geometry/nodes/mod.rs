@@ -43,6 +43,7 @@ pub mod sample_nearest;
 pub mod set_spline_type;
 pub mod split_edges;
 pub mod subdivide;
+pub mod subdivide_curve;
 pub mod subdivision_surface;
 pub mod texture;
 
@@ -287,6 +288,10 @@ pub const NODES: &[(&str, Evaluate)] = &[
     (
         "GeometryNodeCurveSplineType",
         set_spline_type::set_spline_type,
+    ),
+    (
+        "GeometryNodeSubdivideCurve",
+        subdivide_curve::subdivide_curve,
     ),
 ];
 
