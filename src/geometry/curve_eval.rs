@@ -503,3 +503,22 @@ pub fn normals(tangents: &[V3], cyclic: bool, mode: i8, tilts: &[f32]) -> Vec<V3
 pub fn point_floats(c: &Curves, name: &str, default: f32) -> Vec<f32> {
     point_float(c, name, default)
 }
+
+/// Per control point, the evaluated normal where it lies (`curve_normal_point_domain`):
+/// poly points their own, Bezier points their segment's first evaluated point.
+pub fn control_point_normals(c: &Curves) -> Result<Vec<V3>, String> {
+    let ev = Evaluated::new(c)?;
+    let pos = ev.positions(c);
+    let tangents = ev.tangents(c, &pos);
+    let normals = ev.normals(c, &tangents);
+    let mut out = vec![[0.0f32; 3]; c.point_count()];
+    for i in 0..c.curve_count() {
+        let r = ev.range(i);
+        for (k, p) in c.points(i).enumerate() {
+            if let Some(n) = normals.get(r.start + ev.control_point_evaluated(i, k)) {
+                out[p] = *n;
+            }
+        }
+    }
+    Ok(out)
+}

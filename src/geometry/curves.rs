@@ -3,18 +3,24 @@
 //! `cyclic`, `resolution`, `handle_left`, `handle_right`, `radius`, `tilt`,
 //! `nurbs_weight`, `nurbs_order`, ...) on the POINT or CURVE domain.
 //!
-//! No curve node is evaluated yet; the type exists so geometry sets can carry curves
-//! through joins, transforms and instancing without losing them.
+//! The typed accessors below read a built-in with Blender's default where it is absent
+//! and write it back under its built-in type, so the curve nodes agree on both.
 
-use super::attribute::Attributes;
+use super::attribute::{AttrId, Attributes};
 use super::math::V3;
-use super::types::Domain;
+use super::types::{Array, Domain};
 
 /// Blender's `CurveType` values as stored in the `curve_type` attribute.
 pub const CURVE_TYPE_CATMULL_ROM: i8 = 0;
 pub const CURVE_TYPE_POLY: i8 = 1;
 pub const CURVE_TYPE_BEZIER: i8 = 2;
 pub const CURVE_TYPE_NURBS: i8 = 3;
+
+/// Blender's `HandleType` values as stored in `handle_type_left` / `handle_type_right`.
+pub const HANDLE_FREE: i8 = 0;
+pub const HANDLE_AUTO: i8 = 1;
+pub const HANDLE_VECTOR: i8 = 2;
+pub const HANDLE_ALIGN: i8 = 3;
 
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Curves {
@@ -41,5 +47,49 @@ impl Curves {
     }
     pub fn points(&self, c: usize) -> std::ops::Range<usize> {
         self.curve_offsets[c] as usize..self.curve_offsets[c + 1] as usize
+    }
+}
+
+impl Curves {
+    /// An integer built-in (`curve_type`, `resolution`, handle types, ...) on `domain`, or
+    /// `default` everywhere when absent.
+    pub fn ints(&self, name: &str, domain: Domain, default: i32) -> Vec<i32> {
+        match self.attributes.named(name) {
+            Some(a) if a.domain == domain => a.data.as_int().into_owned(),
+            _ => vec![default; self.domain_size(domain)],
+        }
+    }
+    /// A float point built-in (`radius`, `tilt`, `nurbs_weight`), `default` when absent.
+    pub fn point_floats(&self, name: &str, default: f32) -> Vec<f32> {
+        match self.attributes.named(name) {
+            Some(a) if a.domain == Domain::Point => a.data.as_float().into_owned(),
+            _ => vec![default; self.point_count()],
+        }
+    }
+    /// A vector point built-in (`handle_left`, `handle_right`), or `None` when absent.
+    pub fn point_vectors(&self, name: &str) -> Option<Vec<V3>> {
+        match self.attributes.named(name) {
+            Some(a) if a.domain == Domain::Point => Some(a.data.as_vector().into_owned()),
+            _ => None,
+        }
+    }
+    pub fn cyclic(&self) -> Vec<bool> {
+        match self.attributes.named("cyclic") {
+            Some(a) if a.domain == Domain::Curve => a.data.as_bool().into_owned(),
+            _ => vec![false; self.curve_count()],
+        }
+    }
+    /// Writes an 8-bit built-in (`curve_type`, `normal_mode`, handle types).
+    pub fn set_i8(&mut self, name: &str, domain: Domain, v: Vec<i8>) {
+        self.attributes
+            .set(AttrId::named(name), domain, Array::Int8(v));
+    }
+    /// The curve of every point.
+    pub fn point_to_curve(&self) -> Vec<usize> {
+        let mut out = Vec::with_capacity(self.point_count());
+        for c in 0..self.curve_count() {
+            out.extend(self.points(c).map(|_| c));
+        }
+        out
     }
 }

@@ -408,6 +408,8 @@ fn implicit_field(bl_idname: &str, identifier: &str) -> Option<Field> {
         ("GeometryNodeSampleIndex", "Index") | ("GeometryNodeFieldAtIndex", "Index") => {
             Some(Field::input(IndexInput))
         }
+        ("GeometryNodeCurveOfPoint" | "GeometryNodeOffsetPointInCurve", "Point Index")
+        | ("GeometryNodePointsOfCurve", "Curve Index") => Some(Field::input(IndexInput)),
         _ => None,
     }
 }

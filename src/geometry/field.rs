@@ -390,7 +390,14 @@ impl FieldInput for NormalInput {
             ComponentRef::Points(p) => {
                 Ok(Array::Vector(vec![[0.0, 0.0, 1.0]; p.domain_size(domain)]))
             }
-            _ => Err("the Normal input is only supported on meshes and point clouds".into()),
+            ComponentRef::Curves(c) => Ok(ctx.component.adapt(
+                &Array::Vector(super::curve_eval::control_point_normals(c)?),
+                Domain::Point,
+                domain,
+            )),
+            _ => {
+                Err("the Normal input is only supported on meshes, curves and point clouds".into())
+            }
         }
     }
     fn preferred_domain(&self, ctx: &FieldContext) -> Option<Domain> {

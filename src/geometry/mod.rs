@@ -26,6 +26,7 @@
 pub mod animated;
 pub mod attribute;
 pub mod beautify;
+pub mod bezier_handles;
 pub mod bisect_plane;
 pub mod bmesh;
 pub mod catmull_clark;
@@ -51,6 +52,7 @@ pub mod polyfill;
 pub mod realize;
 pub mod set;
 pub mod source;
+pub mod subdivide_curves;
 pub mod types;
 pub mod value;
 pub mod weld;

@@ -12,8 +12,11 @@ pub mod curve;
 pub mod curve_arc;
 pub mod curve_fields;
 pub mod curve_primitives;
+pub mod curve_read;
 pub mod curve_tangent;
 pub mod curve_to_points;
+pub mod curve_topology;
+pub mod curve_write;
 pub mod delete;
 pub mod distribute;
 pub mod domain_size;
@@ -43,15 +46,18 @@ pub mod proximity;
 pub mod radius;
 pub mod raycast;
 pub mod repeat_zone;
+pub mod reverse_curve;
 pub mod rotation;
 pub mod sample_curve;
 pub mod sample_nearest;
 pub mod scale_elements;
+pub mod set_spline_type;
 pub mod simulation_zone;
 pub mod sort_elements;
 pub mod split_edges;
 pub mod string;
 pub mod subdivide;
+pub mod subdivide_curve;
 pub mod subdivision_surface;
 pub mod texture;
 pub mod triangulate;
@@ -369,6 +375,57 @@ pub const NODES: &[(&str, Evaluate)] = &[
     (
         "GeometryNodeSimulationOutput",
         simulation_zone::simulation_output,
+    ),
+    ("GeometryNodeReverseCurve", reverse_curve::reverse_curve),
+    (
+        "GeometryNodeSetSplineCyclic",
+        curve_write::set_spline_cyclic,
+    ),
+    (
+        "GeometryNodeSetSplineResolution",
+        curve_write::set_spline_resolution,
+    ),
+    ("GeometryNodeCurveSetHandles", curve_write::set_handle_type),
+    (
+        "GeometryNodeSetCurveHandlePositions",
+        curve_write::set_handle_positions,
+    ),
+    ("GeometryNodeSetCurveNormal", curve_write::set_curve_normal),
+    (
+        "GeometryNodeInputCurveHandlePositions",
+        curve_read::curve_handle_positions,
+    ),
+    (
+        "GeometryNodeCurveHandleTypeSelection",
+        curve_read::handle_type_selection,
+    ),
+    (
+        "GeometryNodeCurveEndpointSelection",
+        curve_read::endpoint_selection,
+    ),
+    (
+        "GeometryNodeInputSplineCyclic",
+        curve_read::is_spline_cyclic,
+    ),
+    (
+        "GeometryNodeInputSplineResolution",
+        curve_read::spline_resolution,
+    ),
+    ("GeometryNodeSplineLength", curve_read::spline_length),
+    ("GeometryNodeInputCurveTilt", curve_read::curve_tilt),
+    ("GeometryNodeCurveOfPoint", curve_topology::curve_of_point),
+    ("GeometryNodePointsOfCurve", curve_topology::points_of_curve),
+    (
+        "GeometryNodeOffsetPointInCurve",
+        curve_topology::offset_point_in_curve,
+    ),
+    (
+        "GeometryNodeCurveSplineType",
+        set_spline_type::set_spline_type,
+    ),
+    (
+        "GeometryNodeSubdivideCurve",
+        subdivide_curve::subdivide_curve,
     ),
 ];
 
