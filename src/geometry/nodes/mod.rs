@@ -35,6 +35,7 @@ pub mod input;
 pub mod instance_transform;
 pub mod integer_math;
 pub mod is_smooth;
+pub mod material_selection;
 pub mod matrix;
 pub mod menu_switch;
 pub mod merge_by_distance;
@@ -260,6 +261,10 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ("GeometryNodeAttributeDomainSize", domain_size::domain_size),
     ("GeometryNodeInputShadeSmooth", is_smooth::is_face_smooth),
     ("GeometryNodeInputEdgeSmooth", is_smooth::is_edge_smooth),
+    (
+        "GeometryNodeMaterialSelection",
+        material_selection::material_selection,
+    ),
     // Mesh topology fields (issue 26).
     (
         "GeometryNodeInputMeshEdgeNeighbors",
