@@ -52,6 +52,7 @@ pub mod rotation;
 pub mod sample_curve;
 pub mod sample_nearest;
 pub mod scale_elements;
+pub mod separate_components;
 pub mod set_spline_type;
 pub mod simulation_zone;
 pub mod sort_elements;
@@ -264,6 +265,10 @@ pub const NODES: &[(&str, Evaluate)] = &[
     (
         "GeometryNodeMaterialSelection",
         material_selection::material_selection,
+    ),
+    (
+        "GeometryNodeSeparateComponents",
+        separate_components::separate_components,
     ),
     // Mesh topology fields (issue 26).
     (
