@@ -29,6 +29,7 @@ pub mod float_curve;
 pub mod foreach_element;
 pub mod function;
 pub mod geometry_ops;
+pub mod geometry_to_instance;
 pub mod ico_sphere;
 pub mod image_texture;
 pub mod input;
@@ -269,6 +270,10 @@ pub const NODES: &[(&str, Evaluate)] = &[
     (
         "GeometryNodeSeparateComponents",
         separate_components::separate_components,
+    ),
+    (
+        "GeometryNodeGeometryToInstance",
+        geometry_to_instance::geometry_to_instance,
     ),
     // Mesh topology fields (issue 26).
     (
