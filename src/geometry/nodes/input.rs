@@ -104,11 +104,6 @@ pub fn object_info(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             .map(|s| (s.identifier.clone(), SocketValue::zero(&s.kind)))
             .collect());
     };
-    if name == ctx.ev.object.name {
-        return Err(
-            ctx.err("Object Info cannot read its own object (Blender reports a dependency cycle)")
-        );
-    }
     let session = ctx.session();
     let world = session
         .world_matrix(&name)
@@ -121,15 +116,19 @@ pub fn object_info(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let out_t = if relative { transform } else { world };
     let (loc, rot, scale) = decompose(&out_t);
     let as_instance = ctx.bool("As Instance")?;
-    let geometry = session.evaluate_object(&name).map_err(|e| ctx.err(e))?;
-    let g = if as_instance {
+    // Its own object gives its transform but no geometry (Blender: "Geometry cannot be
+    // retrieved from the modifier object").
+    let g = if name == ctx.ev.object.name {
+        GeometrySet::default()
+    } else if as_instance {
+        let geometry = session.evaluate_object(&name).map_err(|e| ctx.err(e))?;
         let t = if relative { transform } else { MAT4_IDENTITY };
         GeometrySet::from_instances(single_instance(
             InstanceReference::Object(name.clone(), geometry),
             t,
         ))
     } else {
-        let mut g = geometry;
+        let mut g = session.evaluate_object(&name).map_err(|e| ctx.err(e))?;
         if relative {
             transform_set(&mut g, &transform);
         }
