@@ -62,6 +62,8 @@ const ASSERTED: &[&str] = &[
     "hair_huang_color",
     "hair_huang_absorption",
     "hair_on_mesh",
+    // Chiang (Melanin) and circular Huang on Curves objects.
+    "hair_curves_object",
     // A Curves object with Geometry Nodes: its evaluated strands as hair.
     "curves_object",
     // Hair Info, each output into a colour, on a Curves object and on particle hair.
