@@ -67,6 +67,25 @@ fn point_handles(types: (i8, i8), position: V3, prev: V3, next: V3, left: &mut V
     }
 }
 
+/// Writes the Bezier handle types and positions of every point, then recomputes the
+/// auto and vector handles from them (Blender's `calculate_bezier_auto_handles` after a
+/// handle edit).
+pub fn write_handles(c: &mut Curves, left: Vec<i8>, right: Vec<i8>, hl: Vec<V3>, hr: Vec<V3>) {
+    c.set_i8("handle_type_left", Domain::Point, left);
+    c.set_i8("handle_type_right", Domain::Point, right);
+    c.attributes.set(
+        super::attribute::AttrId::named("handle_left"),
+        Domain::Point,
+        super::types::Array::Vector(hl),
+    );
+    c.attributes.set(
+        super::attribute::AttrId::named("handle_right"),
+        Domain::Point,
+        super::types::Array::Vector(hr),
+    );
+    calculate_auto_handles(c);
+}
+
 /// Recomputes the derived handles of every Bezier curve
 /// (`CurvesGeometry::calculate_bezier_auto_handles`). Curves without handle attributes
 /// are left alone.

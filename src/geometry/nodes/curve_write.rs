@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use super::super::attribute::AttrId;
 use super::super::bezier_handles::{
-    calculate_auto_handles, set_handle_position, types_for_movement,
+    calculate_auto_handles, set_handle_position, types_for_movement, write_handles,
 };
 use super::super::curve_eval::{NORMAL_MODE_MINIMUM_TWIST, NORMAL_MODE_Z_UP};
 use super::super::curves::{Curves, HANDLE_FREE};
@@ -205,19 +205,7 @@ pub fn set_handle_positions(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
                     }
                 }
             }
-            c.set_i8("handle_type_left", Domain::Point, tl);
-            c.set_i8("handle_type_right", Domain::Point, tr);
-            c.attributes.set(
-                AttrId::named("handle_left"),
-                Domain::Point,
-                Array::Vector(hl),
-            );
-            c.attributes.set(
-                AttrId::named("handle_right"),
-                Domain::Point,
-                Array::Vector(hr),
-            );
-            calculate_auto_handles(c);
+            write_handles(c, tl, tr, hl, hr);
             Ok(())
         },
     )

@@ -6,7 +6,7 @@
 //! by name (it depends on the knots mode, which curve objects do not carry here yet).
 
 use super::super::attribute::AttrId;
-use super::super::bezier_handles::calculate_auto_handles;
+use super::super::bezier_handles::write_handles;
 use super::super::curves::{
     Curves, CURVE_TYPE_BEZIER, CURVE_TYPE_CATMULL_ROM, CURVE_TYPE_NURBS, CURVE_TYPE_POLY,
     HANDLE_ALIGN, HANDLE_VECTOR,
@@ -124,19 +124,7 @@ fn to_bezier(c: &mut Curves, sel: &[bool]) -> Result<(), String> {
         }
     }
     c.set_i8("curve_type", Domain::Curve, t);
-    c.set_i8("handle_type_left", Domain::Point, tl);
-    c.set_i8("handle_type_right", Domain::Point, tr);
-    c.attributes.set(
-        AttrId::named("handle_left"),
-        Domain::Point,
-        Array::Vector(hl),
-    );
-    c.attributes.set(
-        AttrId::named("handle_right"),
-        Domain::Point,
-        Array::Vector(hr),
-    );
-    calculate_auto_handles(c);
+    write_handles(c, tl, tr, hl, hr);
     Ok(())
 }
 
