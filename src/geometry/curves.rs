@@ -84,6 +84,28 @@ impl Curves {
         self.attributes
             .set(AttrId::named(name), domain, Array::Int8(v));
     }
+    /// Sets an 8-bit built-in to `value` on the selected elements, keeping the others'
+    /// (their stored value, or `default` where it is absent).
+    pub fn set_i8_selected(
+        &mut self,
+        name: &str,
+        domain: Domain,
+        default: i32,
+        sel: &[bool],
+        value: i8,
+    ) {
+        let mut v: Vec<i8> = self
+            .ints(name, domain, default)
+            .iter()
+            .map(|v| *v as i8)
+            .collect();
+        for (x, s) in v.iter_mut().zip(sel) {
+            if *s {
+                *x = value;
+            }
+        }
+        self.set_i8(name, domain, v);
+    }
     /// The curve of every point.
     pub fn point_to_curve(&self) -> Vec<usize> {
         let mut out = Vec::with_capacity(self.point_count());

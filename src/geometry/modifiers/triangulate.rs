@@ -104,6 +104,32 @@ fn face_tris(m: &Mesh, f: usize, quad: &str, ngon_beauty: bool) -> Vec<[usize; 3
 }
 
 /// `is_quad_flip_v3`: bit 0 when the (1-3) diagonal gives flipped triangles, bit 1 (2-4).
+/// Carries `m`'s attributes onto its triangulation `out`, as both Triangulate the modifier
+/// and the node do: points unchanged, the `new_edges` added edges default, each face and
+/// corner from its source (`face_src`, `corner_src`).
+pub(crate) fn carry_attributes(
+    m: &Mesh,
+    out: &mut Mesh,
+    new_edges: usize,
+    face_src: &[usize],
+    corner_src: &[usize],
+) {
+    for a in m.attributes.iter() {
+        let data = match a.domain {
+            Domain::Point => a.data.clone(),
+            Domain::Edge => {
+                let mut d = a.data.clone();
+                d.extend_default(new_edges);
+                d
+            }
+            Domain::Face => a.data.gather(face_src),
+            Domain::Corner => a.data.gather(corner_src),
+            _ => continue,
+        };
+        out.attributes.set(a.id.clone(), a.domain, data);
+    }
+}
+
 pub(crate) fn quad_flip(v1: [f32; 3], v2: [f32; 3], v3: [f32; 3], v4: [f32; 3]) -> u32 {
     use super::super::math::{cross, dot, sub};
     let (d12, d23, d34, d41) = (sub(v1, v2), sub(v2, v3), sub(v3, v4), sub(v4, v1));
@@ -179,19 +205,6 @@ fn triangulate(m: &Mesh, quad: &str, ngon_beauty: bool, min_vertices: usize) -> 
         }
         out.face_offsets.push(out.corner_verts.len() as u32);
     }
-    for a in m.attributes.iter() {
-        let data = match a.domain {
-            Domain::Point => a.data.clone(),
-            Domain::Edge => {
-                let mut d = a.data.clone();
-                d.extend_default(new_edges);
-                d
-            }
-            Domain::Face => a.data.gather(&face_src),
-            Domain::Corner => a.data.gather(&corner_src),
-            _ => continue,
-        };
-        out.attributes.set(a.id.clone(), a.domain, data);
-    }
+    carry_attributes(m, &mut out, new_edges, &face_src, &corner_src);
     out
 }

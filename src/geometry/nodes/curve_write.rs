@@ -228,18 +228,7 @@ pub fn set_curve_normal(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         Domain::Curve,
         &[(&sel, DataType::Bool)],
         &mut |c, r| {
-            let sel = r[0].as_bool();
-            let mut cur: Vec<i8> = c
-                .ints("normal_mode", Domain::Curve, 0)
-                .iter()
-                .map(|v| *v as i8)
-                .collect();
-            for i in 0..cur.len() {
-                if sel[i] {
-                    cur[i] = mode;
-                }
-            }
-            c.set_i8("normal_mode", Domain::Curve, cur);
+            c.set_i8_selected("normal_mode", Domain::Curve, 0, &r[0].as_bool(), mode);
             Ok(())
         },
     )

@@ -117,13 +117,7 @@ fn to_bezier(c: &mut Curves, sel: &[bool]) -> Result<(), String> {
             }
         }
     }
-    let mut t: Vec<i8> = types.iter().map(|v| *v as i8).collect();
-    for i in 0..t.len() {
-        if sel[i] {
-            t[i] = CURVE_TYPE_BEZIER;
-        }
-    }
-    c.set_i8("curve_type", Domain::Curve, t);
+    c.set_i8_selected("curve_type", Domain::Curve, 0, sel, CURVE_TYPE_BEZIER);
     write_handles(c, tl, tr, hl, hr);
     Ok(())
 }
@@ -252,17 +246,7 @@ pub fn set_spline_type(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
                 CURVE_TYPE_NURBS => *c = to_nurbs(c, &sel),
                 _ => {
                     // Poly and Catmull-Rom keep the points as they are.
-                    let mut types: Vec<i8> = c
-                        .ints("curve_type", Domain::Curve, 0)
-                        .iter()
-                        .map(|v| *v as i8)
-                        .collect();
-                    for i in 0..types.len() {
-                        if sel[i] {
-                            types[i] = target;
-                        }
-                    }
-                    c.set_i8("curve_type", Domain::Curve, types);
+                    c.set_i8_selected("curve_type", Domain::Curve, 0, &sel, target);
                 }
             }
             remove_attributes_based_on_types(c);

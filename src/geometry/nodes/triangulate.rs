@@ -11,7 +11,7 @@ use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::ComponentRef;
 use super::super::mesh::Mesh;
-use super::super::modifiers::triangulate::quad_flip;
+use super::super::modifiers::triangulate::{carry_attributes, quad_flip};
 use super::super::polyfill::{polyfill, project};
 use super::super::types::{DataType, Domain};
 use super::super::value::SocketValue;
@@ -166,20 +166,7 @@ fn triangulate(m: &Mesh, selected: &[bool], quad_mode: &str, ngon_beauty: bool) 
         })
         .collect();
     let new_edges = out.edges.len() - m.edges.len();
-    for a in m.attributes.iter() {
-        let data = match a.domain {
-            Domain::Point => a.data.clone(),
-            Domain::Edge => {
-                let mut d = a.data.clone();
-                d.extend_default(new_edges);
-                d
-            }
-            Domain::Face => a.data.gather(&face_src),
-            Domain::Corner => a.data.gather(&corner_src),
-            _ => continue,
-        };
-        out.attributes.set(a.id.clone(), a.domain, data);
-    }
+    carry_attributes(m, &mut out, new_edges, &face_src, &corner_src);
     Some(out)
 }
 
