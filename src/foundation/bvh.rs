@@ -3,6 +3,7 @@
 //! so rays through shared edges and vertices never slip between triangles.
 
 use super::math::*;
+use rayon::prelude::*;
 
 /// A ray hit: distance, triangle (index into the scene's triangle list) and barycentrics
 /// (`u` weights vertex 1, `v` vertex 2).
@@ -169,6 +170,220 @@ pub(super) fn area(min: V3, max: V3) -> f32 {
     2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0])
 }
 
+/// Below this many triangles a subtree is built by the one-thread loop (a rayon task per
+/// node would cost more than it saves).
+const PAR_MIN: usize = 16 * 1024;
+
+/// A node's bounds and, when it is split, where its items are partitioned (left items
+/// first): binned SAH over the three axes, binned in one pass, chosen in axis order.
+fn split(slice: &mut [Item]) -> (V3, V3, Option<usize>) {
+    let count = slice.len();
+    let (mut bmin, mut bmax) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    let (mut cmin, mut cmax) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for it in slice.iter() {
+        bmin = vmin(bmin, it.lo);
+        bmax = vmax(bmax, it.hi);
+        cmin = vmin(cmin, it.c);
+        cmax = vmax(cmax, it.c);
+    }
+    if count <= MAX_LEAF {
+        return (bmin, bmax, None);
+    }
+    let mut best = (f32::INFINITY, 0usize, 0usize);
+    let ext = sub(cmax, cmin);
+    let k = [0, 1, 2].map(|a| BINS as f32 / ext[a]);
+    let mut bins = [[([f32::INFINITY; 3], [f32::NEG_INFINITY; 3], 0usize); BINS]; 3];
+    for it in slice.iter() {
+        for axis in 0..3 {
+            if ext[axis] <= 0.0 {
+                continue;
+            }
+            let b = (((it.c[axis] - cmin[axis]) * k[axis]) as usize).min(BINS - 1);
+            let bin = &mut bins[axis][b];
+            bin.0 = vmin(bin.0, it.lo);
+            bin.1 = vmax(bin.1, it.hi);
+            bin.2 += 1;
+        }
+    }
+    for (axis, bins) in bins.iter().enumerate() {
+        if ext[axis] <= 0.0 {
+            continue;
+        }
+        let mut right_cost = [0.0f32; BINS];
+        let (mut rmin, mut rmax, mut rc) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3], 0usize);
+        for i in (1..BINS).rev() {
+            rmin = vmin(rmin, bins[i].0);
+            rmax = vmax(rmax, bins[i].1);
+            rc += bins[i].2;
+            right_cost[i] = area(rmin, rmax) * rc as f32;
+        }
+        let (mut lmin, mut lmax, mut lc) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3], 0usize);
+        for i in 0..BINS - 1 {
+            lmin = vmin(lmin, bins[i].0);
+            lmax = vmax(lmax, bins[i].1);
+            lc += bins[i].2;
+            let cost = area(lmin, lmax) * lc as f32 + right_cost[i + 1];
+            if lc > 0 && lc < count && cost < best.0 {
+                best = (cost, axis, i);
+            }
+        }
+    }
+    let leaf_cost = area(bmin, bmax) * count as f32;
+    let mid = if best.0.is_finite() && (best.0 < leaf_cost || count > 16) {
+        let (axis, split) = (best.1, best.2);
+        let k = k[axis];
+        let mut i = 0;
+        let mut j = slice.len();
+        while i < j {
+            let b = (((slice[i].c[axis] - cmin[axis]) * k) as usize).min(BINS - 1);
+            if b <= split {
+                i += 1;
+            } else {
+                j -= 1;
+                slice.swap(i, j);
+            }
+        }
+        i
+    } else if count > 16 {
+        // All centroids equal: split in the middle of the list.
+        count / 2
+    } else {
+        return (bmin, bmax, None);
+    };
+    (bmin, bmax, (mid != 0 && mid != count).then_some(mid))
+}
+
+/// The one-thread build of the items `slice` (the `offset`-th onwards of the whole list):
+/// its nodes with the subtree's root at 0, numbered in the loop's order (a split node's
+/// children are appended as a pair; the right child's subtree is built before the left's).
+fn build_serial(slice: &mut [Item], offset: usize) -> Vec<Node> {
+    let mut nodes = Vec::with_capacity(2 * slice.len().max(1));
+    nodes.push(Node {
+        min: [f32::INFINITY; 3],
+        max: [f32::NEG_INFINITY; 3],
+        start: offset as u32,
+        count: slice.len() as u32,
+    });
+    let mut stack = vec![0usize];
+    while let Some(ni) = stack.pop() {
+        let (start, count) = (nodes[ni].start as usize, nodes[ni].count as usize);
+        let (bmin, bmax, mid) = split(&mut slice[start - offset..start - offset + count]);
+        nodes[ni].min = bmin;
+        nodes[ni].max = bmax;
+        let Some(mid) = mid else { continue };
+        let left = nodes.len();
+        for (s, c) in [(start, mid), (start + mid, count - mid)] {
+            nodes.push(Node {
+                min: bmin,
+                max: bmax,
+                start: s as u32,
+                count: c as u32,
+            });
+        }
+        nodes[ni].start = left as u32;
+        nodes[ni].count = 0;
+        stack.push(left);
+        stack.push(left + 1);
+    }
+    nodes
+}
+
+/// The top of a parallel build: splits made on rayon's threads down to subtrees small
+/// enough for `build_serial`, kept apart until their sizes are known and they can be
+/// written where the one-thread loop would have put them.
+enum Subtree {
+    Serial(Vec<Node>),
+    Split {
+        min: V3,
+        max: V3,
+        left: Box<Subtree>,
+        right: Box<Subtree>,
+        /// Nodes below this one.
+        size: usize,
+    },
+}
+
+impl Subtree {
+    /// Splits stop `MAX_PAR_DEPTH` levels down whatever the sizes: an input whose splits
+    /// peel off a few items at a time must not recurse as deep as it has items.
+    fn build(slice: &mut [Item], offset: usize, par_min: usize, depth: u32) -> Subtree {
+        const MAX_PAR_DEPTH: u32 = 20;
+        if slice.len() < par_min || depth >= MAX_PAR_DEPTH {
+            return Subtree::Serial(build_serial(slice, offset));
+        }
+        let (min, max, mid) = split(slice);
+        let Some(mid) = mid else {
+            return Subtree::Serial(vec![Node {
+                min,
+                max,
+                start: offset as u32,
+                count: slice.len() as u32,
+            }]);
+        };
+        let (l, r) = slice.split_at_mut(mid);
+        let (left, right) = rayon::join(
+            || Subtree::build(l, offset, par_min, depth + 1),
+            || Subtree::build(r, offset + mid, par_min, depth + 1),
+        );
+        let size = 2 + left.descendants() + right.descendants();
+        Subtree::Split {
+            min,
+            max,
+            left: Box::new(left),
+            right: Box::new(right),
+            size,
+        }
+    }
+
+    fn descendants(&self) -> usize {
+        match self {
+            Subtree::Serial(nodes) => nodes.len() - 1,
+            Subtree::Split { size, .. } => *size,
+        }
+    }
+
+    /// Writes the nodes below this subtree's root from `out[base]` on and returns the
+    /// root: a split's two children first, then the right child's nodes, then the left's.
+    fn emit(self, base: usize, out: &mut [Node]) -> Node {
+        match self {
+            Subtree::Serial(nodes) => {
+                // Local index i > 0 lands at base + i - 1.
+                let shift = |n: Node| {
+                    if n.count == 0 {
+                        Node {
+                            start: n.start + base as u32 - 1,
+                            ..n
+                        }
+                    } else {
+                        n
+                    }
+                };
+                for (o, n) in out[base..].iter_mut().zip(&nodes[1..]) {
+                    *o = shift(*n);
+                }
+                shift(nodes[0])
+            }
+            Subtree::Split {
+                min,
+                max,
+                left,
+                right,
+                ..
+            } => {
+                let right_size = right.descendants();
+                out[base + 1] = right.emit(base + 2, out);
+                out[base] = left.emit(base + 2 + right_size, out);
+                Node {
+                    min,
+                    max,
+                    start: base as u32,
+                    count: 0,
+                }
+            }
+        }
+    }
+}
+
 impl Bvh {
     /// A BVH whose triangle `i` is seen only by rays sharing a bit with `masks[i]`
     /// (`visibility`); `masks` empty, or every mask `visibility::ALL`, means all visible.
@@ -185,13 +400,20 @@ impl Bvh {
     }
 
     pub fn build(tris: &[[V3; 3]]) -> Bvh {
-        let n = tris.len();
+        Bvh::build_split_from(tris, PAR_MIN)
+    }
+
+    /// The build, with subtrees of at least `par_min` triangles split on rayon's threads.
+    /// Every slice is partitioned by the same `split` whichever thread runs it, and the
+    /// nodes are numbered as the one-thread loop numbers them, so the tree is the same
+    /// node for node at any thread count (images stay bit-identical).
+    fn build_split_from(tris: &[[V3; 3]], par_min: usize) -> Bvh {
         // Each triangle's box, centroid and index side by side, partitioned in place: the
         // passes over a node read them in order (separate arrays indexed through a
         // shuffled id list missed the cache on every item; the build was 15% of a
         // published-colon render at 64x64).
         let mut items: Vec<Item> = tris
-            .iter()
+            .par_iter()
             .enumerate()
             .map(|(i, t)| {
                 let (lo, hi) = (vmin(vmin(t[0], t[1]), t[2]), vmax(vmax(t[0], t[1]), t[2]));
@@ -203,116 +425,18 @@ impl Bvh {
                 }
             })
             .collect();
-        let mut nodes = Vec::with_capacity(2 * n.max(1));
-        nodes.push(Node {
-            min: [f32::INFINITY; 3],
-            max: [f32::NEG_INFINITY; 3],
-            start: 0,
-            count: n as u32,
-        });
-        let mut stack = vec![0usize];
-        while let Some(ni) = stack.pop() {
-            let (start, count) = (nodes[ni].start as usize, nodes[ni].count as usize);
-            let slice = &mut items[start..start + count];
-            let (mut bmin, mut bmax) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-            let (mut cmin, mut cmax) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-            for it in slice.iter() {
-                bmin = vmin(bmin, it.lo);
-                bmax = vmax(bmax, it.hi);
-                cmin = vmin(cmin, it.c);
-                cmax = vmax(cmax, it.c);
-            }
-            nodes[ni].min = bmin;
-            nodes[ni].max = bmax;
-            if count <= MAX_LEAF {
-                continue;
-            }
-            // Binned SAH over the three axes (binned in one pass, chosen in axis order).
-            let mut best = (f32::INFINITY, 0usize, 0usize);
-            let ext = sub(cmax, cmin);
-            let k = [0, 1, 2].map(|a| BINS as f32 / ext[a]);
-            let mut bins = [[([f32::INFINITY; 3], [f32::NEG_INFINITY; 3], 0usize); BINS]; 3];
-            for it in slice.iter() {
-                for axis in 0..3 {
-                    if ext[axis] <= 0.0 {
-                        continue;
-                    }
-                    let b = (((it.c[axis] - cmin[axis]) * k[axis]) as usize).min(BINS - 1);
-                    let bin = &mut bins[axis][b];
-                    bin.0 = vmin(bin.0, it.lo);
-                    bin.1 = vmax(bin.1, it.hi);
-                    bin.2 += 1;
-                }
-            }
-            for (axis, bins) in bins.iter().enumerate() {
-                if ext[axis] <= 0.0 {
-                    continue;
-                }
-                let mut right_cost = [0.0f32; BINS];
-                let (mut rmin, mut rmax, mut rc) =
-                    ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3], 0usize);
-                for i in (1..BINS).rev() {
-                    rmin = vmin(rmin, bins[i].0);
-                    rmax = vmax(rmax, bins[i].1);
-                    rc += bins[i].2;
-                    right_cost[i] = area(rmin, rmax) * rc as f32;
-                }
-                let (mut lmin, mut lmax, mut lc) =
-                    ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3], 0usize);
-                for i in 0..BINS - 1 {
-                    lmin = vmin(lmin, bins[i].0);
-                    lmax = vmax(lmax, bins[i].1);
-                    lc += bins[i].2;
-                    let cost = area(lmin, lmax) * lc as f32 + right_cost[i + 1];
-                    if lc > 0 && lc < count && cost < best.0 {
-                        best = (cost, axis, i);
-                    }
-                }
-            }
-            let leaf_cost = area(bmin, bmax) * count as f32;
-            let mid = if best.0.is_finite() && (best.0 < leaf_cost || count > 16) {
-                let (axis, split) = (best.1, best.2);
-                let k = k[axis];
-                let mut i = 0;
-                let mut j = slice.len();
-                while i < j {
-                    let b = (((slice[i].c[axis] - cmin[axis]) * k) as usize).min(BINS - 1);
-                    if b <= split {
-                        i += 1;
-                    } else {
-                        j -= 1;
-                        slice.swap(i, j);
-                    }
-                }
-                i
-            } else if count > 16 {
-                // All centroids equal: split in the middle of the list.
-                count / 2
-            } else {
-                continue;
+        let top = Subtree::build(&mut items, 0, par_min, 0);
+        let mut nodes = vec![
+            Node {
+                min: [0.0; 3],
+                max: [0.0; 3],
+                start: 0,
+                count: 0,
             };
-            if mid == 0 || mid == count {
-                continue;
-            }
-            let left = nodes.len();
-            nodes.push(Node {
-                min: bmin,
-                max: bmax,
-                start: start as u32,
-                count: mid as u32,
-            });
-            nodes.push(Node {
-                min: bmin,
-                max: bmax,
-                start: (start + mid) as u32,
-                count: (count - mid) as u32,
-            });
-            nodes[ni].start = left as u32;
-            nodes[ni].count = 0;
-            stack.push(left);
-            stack.push(left + 1);
-        }
-        let tris_sorted = items.iter().map(|it| tris[it.id as usize]).collect();
+            1 + top.descendants()
+        ];
+        nodes[0] = top.emit(1, &mut nodes);
+        let tris_sorted = items.par_iter().map(|it| tris[it.id as usize]).collect();
         Bvh {
             nodes,
             tris: tris_sorted,
@@ -856,9 +980,16 @@ mod tests {
 
     #[test]
     fn build_matches_the_reference_build_node_for_node() {
-        for (n, seed) in [(0, 1), (1, 2), (5, 3), (300, 4), (5000, 5)] {
+        // par_min 1 and 40 split nearly every node on rayon's threads; 64k items take
+        // the default split point.
+        let cases = [(0, 1), (1, 2), (5, 3), (300, 4), (5000, 5)]
+            .into_iter()
+            .flat_map(|c| [(c, PAR_MIN), (c, 1), (c, 40)])
+            .chain([((64 * 1024, 6), PAR_MIN)]);
+        for ((n, seed), par_min) in cases {
             let tris = soup(n, seed);
-            let (a, b) = (Bvh::build(&tris), reference_build(&tris));
+            let a = Bvh::build_split_from(&tris, par_min);
+            let b = reference_build(&tris);
             assert_eq!(a.ids, b.ids, "{n}");
             assert_eq!(a.nodes.len(), b.nodes.len(), "{n}");
             for (x, y) in a.nodes.iter().zip(&b.nodes) {
