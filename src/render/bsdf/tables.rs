@@ -6,6 +6,7 @@
 
 use crate::render::bsdf::{f0_from_ior, fresnel_dielectric, ggx_lambda, sample_vndf};
 use crate::render::sampler::PixelSampler;
+use rayon::prelude::*;
 
 const N1: usize = 32;
 const N3: usize = 16;
@@ -87,16 +88,17 @@ impl Tables {
         SHARED.get_or_init(Tables::new)
     }
 
+    /// Integrates the tables, on rayon's threads when called outside its pool (a worker
+    /// asking for `shared` while it is built must not be handed its own job). Each row is
+    /// a pure function of its grid point, so the bits are the same either way.
     pub fn new() -> Tables {
         let samples = table_samples(E_SAMPLES);
-        let mut ggx_e = vec![0.0; N1 * N1];
-        let mut ggx_e_avg = vec![0.0; N1];
-        for ri in 0..N1 {
+        let parallel = rayon::current_thread_index().is_none();
+        let ggx_row = |ri: usize| {
             let alpha = rough_to_alpha(ri as f32 / (N1 - 1) as f32);
-            for mi in 0..N1 {
-                let mu = mi as f32 / (N1 - 1) as f32;
-                ggx_e[ri * N1 + mi] = albedo_parts(mu, alpha, None, &samples).0;
-            }
+            let e: Vec<f32> = (0..N1)
+                .map(|mi| albedo_parts(mi as f32 / (N1 - 1) as f32, alpha, None, &samples).0)
+                .collect();
             // The cosine-weighted mean 2 * integral of E(mu) mu, by the midpoint rule on
             // its own finer grid: the 32-point table's Riemann sum read up to 0.005 off
             // Cycles' ggx_Eavg at high roughness.
@@ -105,11 +107,12 @@ impl Tables {
                 let mu = (k as f32 + 0.5) / EAVG_POINTS as f32;
                 avg += (2.0 * mu * albedo_parts(mu, alpha, None, &samples).0) as f64;
             }
-            ggx_e_avg[ri] = (avg / EAVG_POINTS as f64) as f32;
-        }
-        let mut dielectric_s = vec![0.0; N3 * N3 * N3];
-        for zi in 0..N3 {
+            (e, (avg / EAVG_POINTS as f64) as f32)
+        };
+        let dielectric_slice = |zi: usize| {
             let eta = grid_eta(zi);
+            let f = f0_from_ior(eta);
+            let mut out = Vec::with_capacity(N3 * N3);
             for ri in 0..N3 {
                 let alpha = rough_to_alpha(ri as f32 / (N3 - 1) as f32);
                 for mi in 0..N3 {
@@ -121,16 +124,27 @@ impl Tables {
                     // interpolated apart drift (and a near-mirror's masking is not lost).
                     let (gf, g) = albedo_parts(mu, alpha, Some(eta), &samples[..128]);
                     let ratio = if g > 0.0 { gf / g } else { 1.0 };
-                    let f = f0_from_ior(eta);
-                    dielectric_s[(zi * N3 + ri) * N3 + mi] =
-                        ((ratio - f) / (1.0 - f).max(1e-6)).clamp(0.0, 1.0);
+                    out.push(((ratio - f) / (1.0 - f).max(1e-6)).clamp(0.0, 1.0));
                 }
             }
-        }
+            out
+        };
+        let (rows, slices): (Vec<(Vec<f32>, f32)>, Vec<Vec<f32>>) = if parallel {
+            rayon::join(
+                || (0..N1).into_par_iter().map(ggx_row).collect(),
+                || (0..N3).into_par_iter().map(dielectric_slice).collect(),
+            )
+        } else {
+            (
+                (0..N1).map(ggx_row).collect(),
+                (0..N3).map(dielectric_slice).collect(),
+            )
+        };
+        let (e_rows, ggx_e_avg): (Vec<Vec<f32>>, Vec<f32>) = rows.into_iter().unzip();
         Tables {
-            ggx_e,
+            ggx_e: e_rows.concat(),
             ggx_e_avg,
-            dielectric_s,
+            dielectric_s: slices.concat(),
             glass: std::sync::OnceLock::new(),
         }
     }
@@ -227,7 +241,6 @@ fn glass_grid_eta(zi: usize) -> f32 {
 }
 
 fn glass_tables(parallel: bool) -> (Vec<f32>, Vec<f32>) {
-    use rayon::prelude::*;
     let s = PixelSampler::new(7, 11, 17);
     let samples: Vec<[f32; 2]> = (0..GLASS_TABLE_SAMPLES)
         .map(|i| {
