@@ -129,7 +129,9 @@ impl Tables {
             }
             out
         };
-        let (rows, slices): (Vec<(Vec<f32>, f32)>, Vec<Vec<f32>>) = if parallel {
+        // Per roughness row: E over mu, and its cosine-weighted mean.
+        type GgxRow = (Vec<f32>, f32);
+        let (rows, slices): (Vec<GgxRow>, Vec<Vec<f32>>) = if parallel {
             rayon::join(
                 || (0..N1).into_par_iter().map(ggx_row).collect(),
                 || (0..N3).into_par_iter().map(dielectric_slice).collect(),
