@@ -388,7 +388,8 @@ fn implicit_field(bl_idname: &str, identifier: &str) -> Option<Field> {
         | ("GeometryNodeSampleNearestSurface", "Sample Position")
         | ("GeometryNodeProximity", "Source Position")
         | ("GeometryNodeRaycast", "Source Position")
-        | ("GeometryNodeMeshToPoints", "Position") => Some(Field::input(PositionInput)),
+        | ("GeometryNodeMeshToPoints", "Position")
+        | ("GeometryNodeIndexOfNearest", "Position") => Some(Field::input(PositionInput)),
         // Texture nodes in Geometry Nodes read the position when their vector is unlinked.
         (
             "ShaderNodeTexNoise"
@@ -403,7 +404,9 @@ fn implicit_field(bl_idname: &str, identifier: &str) -> Option<Field> {
             | "GeometryNodeImageTexture",
             "Vector",
         ) => Some(Field::input(PositionInput)),
-        ("FunctionNodeRandomValue", "ID") => Some(Field::input(IdInput)),
+        ("FunctionNodeRandomValue", "ID") | ("GeometryNodeInstanceOnPoints", "Instance Index") => {
+            Some(Field::input(IdInput))
+        }
         ("GeometryNodeExtrudeMesh", "Offset") => Some(Field::input(super::field::NormalInput)),
         ("GeometryNodeSampleIndex", "Index") | ("GeometryNodeFieldAtIndex", "Index") => {
             Some(Field::input(IndexInput))

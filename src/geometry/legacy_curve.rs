@@ -33,6 +33,7 @@ pub fn to_curves(cu: &Curve) -> Result<Curves, GeometryError> {
     let (mut hl, mut hr, mut htl, mut htr) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let (mut radius, mut tilt, mut weight, mut order) =
         (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    let mut knots: Vec<i8> = Vec::new();
     let mut any_bezier = false;
     let mut any_nurbs = false;
     for (i, s) in cu.splines.iter().enumerate() {
@@ -76,6 +77,13 @@ pub fn to_curves(cu: &Curve) -> Result<Curves, GeometryError> {
         cyclic.push(s.use_cyclic_u);
         res.push(s.resolution_u as i32);
         order.push(s.order_u as i32);
+        // `knots_mode_from_legacy`: the endpoint and Bezier flags.
+        knots.push(match (s.use_endpoint_u, s.use_bezier_u) {
+            (false, false) => 0i8,
+            (true, false) => 1,
+            (false, true) => 2,
+            (true, true) => 3,
+        });
         c.curve_offsets.push(c.positions.len() as u32);
     }
     let twist = cu
@@ -136,6 +144,11 @@ pub fn to_curves(cu: &Curve) -> Result<Curves, GeometryError> {
             AttrId::named("nurbs_order"),
             Domain::Curve,
             Array::Int8(order.iter().map(|t| *t as i8).collect()),
+        );
+        a.set(
+            AttrId::named("knots_mode"),
+            Domain::Curve,
+            Array::Int8(knots),
         );
     }
     c.materials = cu.materials.clone();

@@ -47,6 +47,7 @@ pub mod mesh_sample;
 pub mod modifiers;
 pub mod nearest;
 pub mod nodes;
+pub mod nurbs;
 pub mod pointcloud;
 pub mod polyfill;
 pub mod realize;

@@ -420,7 +420,7 @@ pub fn merge(m: &Mesh, dest: &[i32]) -> Result<Mesh, String> {
 /// The order `BLI_kdtree_3d_balance` leaves points in (a quick-select about the median on
 /// x, y, z in turn, recursively), which is the order `calc_duplicates_fast` visits them
 /// when it is not asked for index order.
-fn kdtree_balanced_order(positions: &[[f32; 3]], nodes: &mut [usize], axis: usize) {
+pub(crate) fn kdtree_balanced_order(positions: &[[f32; 3]], nodes: &mut [usize], axis: usize) {
     let n = nodes.len();
     if n <= 1 {
         return;

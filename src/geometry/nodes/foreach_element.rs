@@ -469,7 +469,8 @@ fn propagation_domain(kind: ComponentType) -> Domain {
     }
 }
 
-fn is_builtin(kind: ComponentType, id: &AttrId) -> bool {
+/// Whether `id` is one of Blender's built-in attributes on a component of this type.
+pub(crate) fn is_builtin(kind: ComponentType, id: &AttrId) -> bool {
     let Some(name) = id.name() else { return false };
     match kind {
         ComponentType::Mesh => name == "position" || MESH_BUILTIN.iter().any(|(n, _)| *n == name),

@@ -13,9 +13,10 @@ use super::super::math::{from_loc_rot_scale, mat4_mul, transform_point, Mat4f};
 use super::super::mesh::Mesh;
 use super::super::pointcloud::PointCloud;
 use super::super::realize::{join_geometries, realize_instances};
-use super::super::set::GeometrySet;
+use super::super::set::{ComponentType, GeometrySet};
 use super::super::types::{Array, DataType, Domain, Value};
 use super::super::value::SocketValue;
+use super::foreach_element::is_builtin;
 
 pub fn geo(g: GeometrySet) -> SocketValue {
     SocketValue::Geometry(g)
@@ -341,12 +342,12 @@ pub fn instance_on_points(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             },
         ];
         for c in &comps {
-            let comp = if let Some(m) = &c.mesh {
-                ComponentRef::Mesh(m)
+            let (comp, kind) = if let Some(m) = &c.mesh {
+                (ComponentRef::Mesh(m), ComponentType::Mesh)
             } else if let Some(p) = &c.points {
-                ComponentRef::Points(p)
+                (ComponentRef::Points(p), ComponentType::PointCloud)
             } else if let Some(cu) = &c.curves {
-                ComponentRef::Curves(cu)
+                (ComponentRef::Curves(cu), ComponentType::Curves)
             } else {
                 continue;
             };
@@ -361,7 +362,7 @@ pub fn instance_on_points(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
                     (&scale, DataType::Vector),
                 ],
             )?;
-            let (sel, pick, _index, rot, scale) = (
+            let (sel, pick, index, rot, scale) = (
                 r[0].as_bool(),
                 r[1].as_bool(),
                 r[2].as_int(),
@@ -372,18 +373,44 @@ pub fn instance_on_points(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             if selected.is_empty() {
                 continue;
             }
-            if selected.iter().any(|&i| pick[i]) {
-                return Err("Pick Instance is not supported yet".into());
-            }
             let (_, pos) = comp
                 .attribute(&AttrId::named("position"))
                 .ok_or("no positions")?;
             let pos = pos.as_vector().into_owned();
             let start = dst.len();
-            let handle = dst.add_reference(InstanceReference::Geometry(instance.clone()));
+            // Pick Instance: the Instance Index-th top-level instance of the Instance
+            // input (wrapping, -1 the last), its transform after the point's; none when
+            // the input has no instances. References are added only where used.
+            let src_inst = instance.instances.as_deref();
+            let mut picked: Vec<Option<u32>> =
+                vec![None; src_inst.map_or(0, |s| s.references.len())];
+            let mut whole = None;
+            let mut empty = None;
             for &i in &selected {
-                dst.transforms
-                    .push(from_loc_rot_scale(pos[i], rot[i], scale[i]));
+                let base = from_loc_rot_scale(pos[i], rot[i], scale[i]);
+                let (handle, transform) = if !pick[i] {
+                    let h = *whole.get_or_insert_with(|| {
+                        dst.add_reference(InstanceReference::Geometry(instance.clone()))
+                    });
+                    (h, base)
+                } else {
+                    match src_inst.filter(|s| !s.is_empty()) {
+                        Some(s) => {
+                            let k = index[i].rem_euclid(s.len() as i32) as usize;
+                            let src_handle = s.handles[k] as usize;
+                            let h = *picked[src_handle].get_or_insert_with(|| {
+                                dst.add_reference(s.references[src_handle].clone())
+                            });
+                            (h, mat4_mul(&base, &s.transforms[k]))
+                        }
+                        None => {
+                            let h = *empty
+                                .get_or_insert_with(|| dst.add_reference(InstanceReference::None));
+                            (h, base)
+                        }
+                    }
+                };
+                dst.transforms.push(transform);
                 dst.handles.push(handle);
             }
             // Point attributes move to the new instances.
@@ -392,6 +419,12 @@ pub fn instance_on_points(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
                     .name()
                     .is_some_and(|n| n == "position" || n.starts_with('.'))
                 {
+                    continue;
+                }
+                // A source built-in goes along only where instances have it built in too
+                // (`gather_attributes_for_propagation`): a mesh's sharp_face or
+                // material_index, a point cloud's radius, a curve's tilt stay behind.
+                if is_builtin(kind, &id) && !is_builtin(ComponentType::Instances, &id) {
                     continue;
                 }
                 let on_points = comp.adapt(&data, domain, Domain::Point).gather(&selected);

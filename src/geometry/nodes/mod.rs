@@ -21,9 +21,12 @@ pub mod delete;
 pub mod distribute;
 pub mod domain_size;
 pub mod dual_mesh;
+pub mod edge_paths_to_curves;
+pub mod edge_paths_to_selection;
 pub mod extrude;
 pub mod field_nodes;
 pub mod fill_curve;
+pub mod fillet_curve;
 pub mod flip_faces;
 pub mod float_curve;
 pub mod foreach_element;
@@ -32,6 +35,7 @@ pub mod geometry_ops;
 pub mod geometry_to_instance;
 pub mod ico_sphere;
 pub mod image_texture;
+pub mod index_of_nearest;
 pub mod input;
 pub mod instance_transform;
 pub mod integer_math;
@@ -55,6 +59,7 @@ pub mod sample_nearest;
 pub mod scale_elements;
 pub mod separate_components;
 pub mod set_spline_type;
+pub mod shortest_edge_paths;
 pub mod simulation_zone;
 pub mod sort_elements;
 pub mod split_edges;
@@ -64,6 +69,7 @@ pub mod subdivide_curve;
 pub mod subdivision_surface;
 pub mod texture;
 pub mod triangulate;
+pub mod trim_curve;
 
 use super::error::GeometryError;
 use super::eval::{NodeCtx, Outputs};
@@ -442,6 +448,24 @@ pub const NODES: &[(&str, Evaluate)] = &[
         "GeometryNodeSubdivideCurve",
         subdivide_curve::subdivide_curve,
     ),
+    ("GeometryNodeTrimCurve", trim_curve::trim_curve),
+    (
+        "GeometryNodeIndexOfNearest",
+        index_of_nearest::index_of_nearest,
+    ),
+    (
+        "GeometryNodeInputShortestEdgePaths",
+        shortest_edge_paths::shortest_edge_paths,
+    ),
+    (
+        "GeometryNodeEdgePathsToSelection",
+        edge_paths_to_selection::edge_paths_to_selection,
+    ),
+    (
+        "GeometryNodeEdgePathsToCurves",
+        edge_paths_to_curves::edge_paths_to_curves,
+    ),
+    ("GeometryNodeFilletCurve", fillet_curve::fillet_curve_node),
 ];
 
 /// The `bl_idname`s of `NODES`.
