@@ -310,6 +310,13 @@ const ASSERTED: &[&str] = &[
     // bake in the bpy wheel; Cycles renders the same gradients computed on a mesh cube).
     "smoke_unbaked",
     "smoke_grid_gradient",
+    // The world volume (render/volume_world.rs), filling all space with the camera inside:
+    // homogeneous scatter under a point light and a sun it extinguishes, absorption that
+    // spares one channel (the sky and the sun stay in red), and a noise-texture density
+    // ray-marched at the world's Step Size.
+    "volume_world_fog",
+    "volume_world_absorb",
+    "volume_world_noise",
 ];
 
 /// Scenes at several scales (lengths, radii and light energy scaled alike: Cycles' image
@@ -1664,7 +1671,7 @@ fn refused_alike(
 
 /// Volume features blendsynth does not render are errors naming the object, material or
 /// node, the same from `render::check` (what `inspect` runs) as from `render`: a phase
-/// function other than Henyey-Greenstein and Rayleigh, a world's Volume, a fluid (smoke)
+/// function other than Henyey-Greenstein and Rayleigh (in a material or the world's Volume), a fluid (smoke)
 /// domain in an export that carries no grids for it, and a smoke domain whose material
 /// has a Surface too.
 #[test]
@@ -1704,16 +1711,40 @@ fn unsupported_volumes_are_refused_by_name() {
             ],
         );
     }
-    // The world's Background also into its Volume.
+    // A world volume (render/volume_world.rs) is refused where its closures are: Fog's
+    // Volume Scatter with Mie's phase function moved into the world's Volume.
     refused(
         &|j| {
-            let links = j["worlds"][0]["node_tree"]["links"].as_array_mut().unwrap();
+            let mut m = fog(j);
+            let mut scatter = m["node_tree"]["nodes"]
+                .as_array_mut()
+                .unwrap()
+                .iter()
+                .find(|n| n["bl_idname"] == "ShaderNodeVolumeScatter")
+                .unwrap()
+                .clone();
+            scatter["properties"]["phase"] = "MIE".into();
+            let tree = &mut j["worlds"][0]["node_tree"];
+            tree["nodes"].as_array_mut().unwrap().push(scatter);
+            let links = tree["links"].as_array_mut().unwrap();
             let mut l = links[0].clone();
+            l["from_node"] = "Volume Scatter".into();
+            l["from_socket"] = "Volume".into();
             l["to_socket"] = "Volume".into();
             l["to_index"] = 1.into();
             links.push(l);
         },
-        &["World Output", "world volume", "not supported"],
+        &["world \"World\"", "Volume Scatter", "phase function", "MIE"],
+    );
+    // A Volume object (OpenVDB grids, from a .vdb file or Geometry Nodes): not rendered
+    // yet, refused by name.
+    refused(
+        &|j| {
+            let objs = j["objects"].as_array_mut().unwrap();
+            let cube = objs.iter_mut().find(|o| o["name"] == "Cube").unwrap();
+            cube["type"] = "VOLUME".into();
+        },
+        &["object \"Cube\"", "Volume object", "OpenVDB"],
     );
     // A smoke domain (the exporter's Fluid modifier record).
     refused(

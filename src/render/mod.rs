@@ -35,6 +35,7 @@ pub mod shader_rays;
 pub mod subsurface;
 pub mod volume;
 pub mod volume_grid;
+pub mod volume_world;
 
 use std::time::Instant;
 

@@ -25,6 +25,7 @@ use super::integrator::{Scene, Scratch, SurfaceHit};
 use super::light::tree::{Pick, Viewer};
 use super::math::*;
 use super::sampler::PixelSampler;
+use super::volume_world::{WorldVolume, ESCAPE, WORLD};
 
 /// Volumes a path can be inside at once (Cycles sizes its stack from the scene; deeper
 /// nesting is ignored, as Cycles ignores entries past its stack).
@@ -48,6 +49,21 @@ impl Stack {
 
     pub fn clear(&mut self) {
         self.len = 0;
+    }
+
+    /// Cycles' volume_stack_clean for a ray that escapes the scene: every volume but the
+    /// world's is left (only precision errors leave a mesh's volume open there).
+    pub fn keep_world(&mut self) {
+        let world = self.entries().first() == Some(&(WORLD, WORLD));
+        self.len = usize::from(world);
+    }
+
+    /// The world volume, entered first (Cycles' stack init) and never left.
+    fn push_world(&mut self) {
+        if self.len < STACK_SIZE - 1 {
+            self.entries[self.len] = (WORLD, WORLD);
+            self.len += 1;
+        }
     }
 
     pub fn entries(&self) -> &[(u32, u32)] {
@@ -106,6 +122,10 @@ pub struct Volumes {
     /// Per mesh instance with voxel grids: per volume material of its slots, which grid
     /// each of the material's attribute requests reads.
     grid_binds: Vec<Vec<(u32, super::volume_grid::GridBinding)>>,
+    /// The world volume (render/volume_world.rs), and its ray-marching step (its Step
+    /// Size times the render's step rate; infinite when it does not vary).
+    world: Option<WorldVolume>,
+    world_step: f32,
 }
 
 impl Volumes {
@@ -136,8 +156,15 @@ impl Volumes {
             }));
             v.only_volume.push(p.is_some_and(|p| p.surface.is_none()));
         }
-        v.any = v.materials.iter().any(Option::is_some);
         let render_rate = integrator.volume_step_rate as f32;
+        // `check_objects` has refused a world volume that does not compile.
+        v.world = super::volume_world::world_volume(scene).ok().flatten();
+        v.world_step = match &v.world {
+            // Cycles' background volume_step_size times the render's step rate.
+            Some(w) if w.varying => w.step_size * render_rate,
+            _ => f32::INFINITY,
+        };
+        v.any = v.materials.iter().any(Option::is_some) || v.world.is_some();
         for inst in &geo.instances {
             // Cycles' Object::compute_volume_step_size: the smallest step rate of its
             // varying volumes times a tenth of the average size of its world bounds.
@@ -230,6 +257,9 @@ impl Volumes {
             .entries()
             .iter()
             .map(|&(inst, _)| {
+                if inst == WORLD {
+                    return self.world_step;
+                }
                 self.step
                     .get(inst as usize)
                     .copied()
@@ -243,10 +273,18 @@ impl Volumes {
     fn sample_method(&self, stack: &Stack) -> Method {
         let mut method = None;
         for &(_, mi) in stack.entries() {
-            let Some(Some(m)) = self.materials.get(mi as usize) else {
-                continue;
+            let sampling = if mi == WORLD {
+                match &self.world {
+                    Some(w) => w.sampling,
+                    None => continue,
+                }
+            } else {
+                match self.materials.get(mi as usize) {
+                    Some(Some(m)) => m.sampling,
+                    _ => continue,
+                }
             };
-            let this = match m.sampling {
+            let this = match sampling {
                 VolumeSampling::MultipleImportance => return Method::Mis,
                 VolumeSampling::Equiangular => Method::Equiangular,
                 VolumeSampling::Distance => Method::Distance,
@@ -339,6 +377,20 @@ pub fn check_objects(scene: &BlendScene) -> Result<(), super::RenderError> {
             .and_then(|m| m.node_tree.as_ref())
             .is_some_and(|t| t.links.iter().any(|l| l.to_socket == socket && !l.is_muted))
     };
+    super::volume_world::world_volume(scene)?;
+    // Volume objects hold OpenVDB grids (a .vdb file, or made by Geometry Nodes) that the
+    // export does not carry.
+    if let Some(obj) = scene
+        .file
+        .objects
+        .iter()
+        .find(|o| !o.hide_render && o.kind == "VOLUME")
+    {
+        return Err(super::RenderError(format!(
+            "object {:?}: a Volume object (OpenVDB grids, from a .vdb file or Geometry Nodes) is not supported yet: blendsynth renders volumes in meshes, smoke domains and the world",
+            obj.name
+        )));
+    }
     for obj in scene.file.objects.iter().filter(|o| !o.hide_render) {
         let domain = obj.modifiers.iter().find(|md| {
             md.show_render
@@ -730,6 +782,9 @@ impl Scene<'_> {
     /// boundary is crossed from the inside before it was entered encloses the origin.
     pub(super) fn volume_stack_init(&self, org: V3, scratch: &mut Scratch) {
         scratch.volume_stack.clear();
+        if self.volumes.world.is_some() {
+            scratch.volume_stack.push_world();
+        }
         if !self.volumes.any || !self.volumes.near_volume(org) {
             return;
         }
@@ -805,6 +860,12 @@ impl Scene<'_> {
         let mut co = Coefficients::default();
         let shadow = state.flags & ray::SHADOW != 0;
         for &(inst_i, mi) in stack.entries() {
+            if inst_i == WORLD {
+                if let Some(w) = &self.volumes.world {
+                    self.world_volume_closures(w, p, d, state, shadow, &mut co, scratch);
+                }
+                continue;
+            }
             let Some(prog) = self.materials[mi as usize].program.as_ref() else {
                 continue;
             };
@@ -852,6 +913,63 @@ impl Scene<'_> {
         co
     }
 
+    /// Adds the world volume's closures at `p` on a ray along `d` to `co`: shaded with no
+    /// object (Cycles' OBJECT_NONE), every coordinate the world-space point.
+    #[allow(clippy::too_many_arguments)]
+    fn world_volume_closures(
+        &self,
+        w: &WorldVolume,
+        p: V3,
+        d: V3,
+        state: PathState,
+        shadow: bool,
+        co: &mut Coefficients,
+        scratch: &mut Scratch,
+    ) {
+        let prog = &w.program;
+        let Some(vc) = prog.volume else { return };
+        let n = neg(d);
+        let camera_position = self.view.camera_space(p);
+        let sp = ShadingPoint {
+            position: p,
+            normal: n,
+            true_normal: n,
+            object_position: p,
+            object_normal: n,
+            generated: p,
+            incoming: n,
+            camera_position,
+            camera: self.view.camera(),
+            window: self.view.window(camera_position),
+            path: state,
+            ray_length: 1.0,
+            // A world has no volume attributes.
+            attr_missing: !0,
+            ..Default::default()
+        };
+        // The world program's own stack (shared with the world surface: the same program).
+        let Some(stack) = scratch.stacks.last_mut() else {
+            return;
+        };
+        if stack.len() != prog.initial.len() {
+            stack.clear();
+            stack.extend_from_slice(&prog.initial);
+        }
+        prog.run(&sp, stack);
+        co.closure(prog, vc, 1.0, stack, &sp, shadow);
+    }
+
+    /// The transmittance of the world volume alone along a shadow ray from `o` along `d`
+    /// that escapes the scene (Cycles: up to FLT_MAX); 1 without a world volume.
+    pub(super) fn world_escape_transmittance(&self, o: V3, d: V3, scratch: &mut Scratch) -> V3 {
+        if self.volumes.world.is_none() {
+            return [1.0; 3];
+        }
+        let mut world = Stack::default();
+        world.push_world();
+        self.volume_transmittance(o, d, ESCAPE, &world, scratch)
+    }
+
     /// The transmittance of the volumes in `stack` along `dist` of the ray from `o` along
     /// `d` (Cycles' volume_shadow_heterogeneous; a varying medium is sampled at the middle
     /// of each step).
@@ -890,7 +1008,10 @@ impl Scene<'_> {
             let co = self.volume_coefficients(stack, p, d, state, scratch);
             if co.extinction {
                 sum = madd(sum, co.sigma_t, t1 - t0);
-                if max3(sum) > 50.0 {
+                // Stop once every channel is blocked (Cycles: the largest channel of the
+                // transmittance below its epsilon); a channel that does not extinguish
+                // still passes.
+                if sum.iter().all(|&s| s > 50.0) {
                     return [0.0; 3];
                 }
             }
@@ -929,12 +1050,20 @@ impl Scene<'_> {
         } else {
             (tmax - tmin, 1, 1.0, 0.0)
         };
+        // The segment's length as light selection sees it: an escaping ray's (FLT_MAX in
+        // Cycles) is unbounded, which gives suns and the world their ray length of 1
+        // (distant_light_tree_parameters: t == FLT_MAX).
+        let light_len = if tmax >= ESCAPE {
+            f32::INFINITY
+        } else {
+            tmax - tmin
+        };
         // The light is picked before stepping, so that the direct-light scatter point can
         // be drawn toward it; a world or sun light keeps distance sampling.
         let ahead = if path.terminate_next {
             None
         } else {
-            self.volume_light_ahead(path, tmax - tmin, u_light)
+            self.volume_light_ahead(path, light_len, u_light)
         };
         let equiangular = ahead.and_then(|a| {
             let (t0, t1) = self.lit_range(a.pick, path.o, path.d, tmin, tmax)?;
@@ -1098,7 +1227,7 @@ impl Scene<'_> {
         let Some(q) = path.continuation(st, u_light[3]) else {
             return Segment::Stop;
         };
-        let segment = (path.o, path.d, tmax - tmin);
+        let segment = (path.o, path.d, light_len);
         if let (Some((t, phases)), Some(light)) = (direct, ahead) {
             let p = madd(path.o, path.d, t);
             let tp = scale(direct_tp, 1.0 / q);

@@ -481,6 +481,12 @@ pub struct WorldSettings {
     /// Ray visibility (Cycles' world `visibility`): camera, diffuse, glossy,
     /// transmission, volume scatter; true where absent.
     pub visible_to: [bool; 5],
+    /// Settings > Volume > Homogeneous: the world volume is evaluated once per segment.
+    pub homogeneous_volume: bool,
+    /// Settings > Volume > Sampling (Blender's default for a world is Equiangular).
+    pub volume_sampling: VolumeSampling,
+    /// Settings > Volume > Step Size: the ray-marching step of a varying world volume.
+    pub volume_step_size: f64,
 }
 
 impl WorldSettings {
@@ -488,8 +494,18 @@ impl WorldSettings {
         let p = &w.properties;
         let vis = group(p, "cycles_visibility");
         let see = |k: &str| vis.and_then(|v| flag(v, k)) != Some(false);
+        let cy = group(p, "cycles");
         WorldSettings {
-            sampled: group(p, "cycles").and_then(|c| text(c, "sampling_method")) != Some("NONE"),
+            sampled: cy.and_then(|c| text(c, "sampling_method")) != Some("NONE"),
+            homogeneous_volume: cy
+                .and_then(|c| flag(c, "homogeneous_volume"))
+                .unwrap_or(false),
+            volume_sampling: match cy.and_then(|c| text(c, "volume_sampling")) {
+                Some("DISTANCE") => VolumeSampling::Distance,
+                Some("MULTIPLE_IMPORTANCE") => VolumeSampling::MultipleImportance,
+                _ => VolumeSampling::Equiangular,
+            },
+            volume_step_size: cy.and_then(|c| num(c, "volume_step_size")).unwrap_or(1.0),
             visible_to: [
                 see("camera"),
                 see("diffuse"),

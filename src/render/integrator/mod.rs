@@ -513,28 +513,28 @@ impl Scene<'_> {
                 )
             };
             // Inside volumes the segment to the hit runs first (render/volume.rs); a ray
-            // leaving the scene leaves every volume (Cycles' volume_stack_clean).
+            // leaving the scene leaves every volume but the world's (Cycles'
+            // volume_stack_clean), and crosses that one to FLT_MAX (volume_world.rs).
+            if from_sss.is_none() && hit_opt.is_none() {
+                scratch.volume_stack.keep_world();
+            }
             if from_sss.is_none() && !scratch.volume_stack.is_empty() {
-                match hit_opt {
-                    None => scratch.volume_stack.clear(),
-                    Some(h) => {
-                        // A light inside the volume ends the segment: it is reached with
-                        // the transmittance up to it, and the ray goes on past it (Cycles'
-                        // shade_light continues the path).
-                        let t_light = self.light_in_segment(&path, h.t);
-                        let t_end = t_light.unwrap_or(h.t);
-                        match self.volume_segment(&mut path, t_end, rng, index, scratch) {
-                            super::volume::Segment::Passed => {}
-                            super::volume::Segment::Scattered => continue,
-                            super::volume::Segment::Stop => break,
-                        }
-                        if let Some(t) = t_light {
-                            let clamp = path.hit_clamp(st);
-                            self.lights_along(&mut path, Some(t), clamp, scratch);
-                            self.past_light(&mut path, t);
-                            continue;
-                        }
-                    }
+                let t_hit = hit_opt.map_or(crate::render::volume_world::ESCAPE, |h| h.t);
+                // A light inside the volume ends the segment: it is reached with the
+                // transmittance up to it, and the ray goes on past it (Cycles'
+                // shade_light continues the path).
+                let t_light = self.light_in_segment(&path, t_hit);
+                let t_end = t_light.unwrap_or(t_hit);
+                match self.volume_segment(&mut path, t_end, rng, index, scratch) {
+                    super::volume::Segment::Passed => {}
+                    super::volume::Segment::Scattered => continue,
+                    super::volume::Segment::Stop => break,
+                }
+                if let Some(t) = t_light {
+                    let clamp = path.hit_clamp(st);
+                    self.lights_along(&mut path, Some(t), clamp, scratch);
+                    self.past_light(&mut path, t);
+                    continue;
                 }
             }
             let clamp_limit = path.hit_clamp(st);
@@ -1164,6 +1164,10 @@ impl Scene<'_> {
                 }
             }
             let Some(h) = found else {
+                if !seg.is_finite() {
+                    // Escaping the scene: the world volume's extinction to FLT_MAX.
+                    through = mul(through, self.world_escape_transmittance(o, dir, scratch));
+                }
                 return through;
             };
             let mut hit = self.surface_at(h.prim, h.u, h.v, neg(dir), scratch.time);

@@ -135,16 +135,8 @@ pub fn shader(scene: &Scene) -> Result<Option<WorldShader>, RenderError> {
         (Some(t), true) => t,
         _ => return Ok(None),
     };
-    // A world volume is refused by the compiler, so a constant world with one compiles
-    // too (render/volume.rs has no world volume).
-    if tree
-        .links
-        .iter()
-        .any(|l| l.to_socket == "Volume" && !l.is_muted)
-    {
-        crate::shader::compile::compile_world(scene, name)
-            .map_err(|e| RenderError(e.to_string()))?;
-    }
+    // A constant surface needs no program; the world's Volume is compiled and checked by
+    // render/volume_world.rs.
     if is_constant(tree) {
         return Ok(None);
     }

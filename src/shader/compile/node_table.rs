@@ -105,12 +105,12 @@ const TOON: &str =
     "render/bsdf/toon.rs (closure/bsdf_toon.h): Diffuse and Glossy components, a Cycles parity scene in tests/render.rs (toon)";
 const OUTPUT: &str =
     "closure weights and emission, whole-material bakes (tests/bake.rs); a Displacement the material's method does not use is a compile error";
-const WORLD: &str = "world surfaces (render/light/world.rs); tests/world.rs";
+const WORLD: &str = "world surfaces (render/light/world.rs); tests/world.rs; a world's Volume: render/volume_world.rs, Cycles parity scenes volume_world_* in tests/render.rs";
 const SHADER_STRUCTURE: &str = "closure weights and emission, whole-material bakes (tests/bake.rs)";
 const CLOSURE: &str =
     "light transport in render/ (bsdf.rs and the closure files), a Cycles parity scene in tests/render.rs";
 const VOLUME: &str =
-    "in a material's Volume: render/volume.rs (Cycles' svm_node_closure_volume, principled_volume, volume_coefficients; Henyey-Greenstein and Rayleigh phases, other phase functions are compile errors naming the node), Cycles parity scenes volume_* in tests/render.rs; in a Surface it does nothing, as in Cycles; a world's Volume is a compile error";
+    "in a material's Volume: render/volume.rs (Cycles' svm_node_closure_volume, principled_volume, volume_coefficients; Henyey-Greenstein and Rayleigh phases, other phase functions are compile errors naming the node), Cycles parity scenes volume_* in tests/render.rs; in a Surface it does nothing, as in Cycles; in a world's Volume: render/volume_world.rs (volume_world_* parity scenes)";
 const TEXTURE: &str =
     "nodes/<texture>.rs (Cycles flavour); every mode in tests/shader_conformance.rs";
 const GABOR: &str =
@@ -548,13 +548,9 @@ fn light_output(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), 
 
 fn world_output(c: &mut Compiler<'_, '_>, i: usize, _: &Schedule) -> Result<(), CompileError> {
     let n = &c.g.nodes[i];
-    if linked(n, "Volume") {
-        return Err(CompileError(format!(
-            "node {:?}: a world volume (volume shading of the World Output: its Volume input is linked) is not supported yet",
-            n.path
-        )));
-    }
     c.surface = c.closure_input(n, "Surface")?;
+    // The world volume, filling all space (render/volume_world.rs).
+    c.volume = c.closure_input(n, "Volume")?;
     Ok(())
 }
 
