@@ -1029,8 +1029,25 @@ def export_curves(objs, out, index, frozen_meshes):
         first = slot_materials(ev, ev.data)[:1] or [None]
         system["material_slot"] = len(mats)
         mats.extend(first)
-        got[key(o)] = write_hair_attributes({"file": rel, "systems": [system]}, *curves_attributes(o, depsgraph), out)
+        entry = {"file": rel, "systems": [system]}
+        entry["normals_file"] = curves_normals(o, depsgraph, out, rel[:-4] + ".normals.bin")
+        got[key(o)] = write_hair_attributes(entry, *curves_attributes(o, depsgraph), out)
     return got
+
+
+def curves_normals(o, depsgraph, out, rel):
+    """A Curves object's normals at its control points (`Curves.normals`: the evaluated
+    normals of each curve's Normal Mode, Minimum Twist, Z Up or Free, at its points), which
+    Cycles' export_hair_curves passes as the curves' normal attribute
+    (curves_normals_point_domain_calc) and the Principled Hair BSDF's Huang model turns an
+    elliptical fibre about. Writes x, y, z per key (object space, little-endian float32)
+    to `rel`; returns `rel`."""
+    cv = o.evaluated_get(depsgraph).data
+    n = np.zeros(len(cv.points) * 3, np.float32)
+    cv.normals.foreach_get("vector", n)
+    with open(os.path.join(out, rel), "wb") as f:
+        f.write(n.astype("<f4").tobytes())
+    return rel
 
 
 FROZEN_TYPES = {"CURVE", "SURFACE", "FONT", "META", "CURVES", "POINTCLOUD"}

@@ -64,6 +64,11 @@ const ASSERTED: &[&str] = &[
     "hair_on_mesh",
     // Chiang (Melanin) and circular Huang on Curves objects.
     "hair_curves_object",
+    // Huang's elliptical fibre on Curves objects, turned about their exported normals
+    // (Minimum Twist, and Z Up from a Set Curve Normal).
+    "hair_huang_elliptic_curves",
+    // 3D Curves (render/thick_curves.rs): tubes close up, Diffuse and Principled Hair.
+    "hair_thick",
     // A Curves object with Geometry Nodes: its evaluated strands as hair.
     "curves_object",
     // Hair Info, each output into a colour, on a Curves object and on particle hair.
@@ -74,6 +79,8 @@ const ASSERTED: &[&str] = &[
     "points",
     // A point cloud object (POINTCLOUD, Geometry Nodes Points) from the export's points.
     "pointcloud_object",
+    // Geometry Nodes points under a non-uniform scale: ellipsoids (render/points.rs).
+    "points_nonuniform_scale",
     "adaptive",
     "motion_blur",
     "motion_blur_start",
@@ -1849,7 +1856,8 @@ fn hair_bsdfs_refused_where_not_rendered() {
         );
         assert_renders(&dir, &huang);
     }
-    // An elliptical Huang fibre on a Curves object; a circular one renders there.
+    // An elliptical Huang fibre on a Curves object exported before its normals were (scene
+    // hair_huang_elliptic_curves renders one with them); a circular one renders there.
     let (cdir, cbase) = fixture_json("curves_object");
     let (_, hbase) = fixture_json("hair_huang_color");
     let on_strands = |j: &mut serde_json::Value, aspect: f64| {
@@ -1935,10 +1943,21 @@ fn unsupported_hair_is_refused_by_name() {
     let e = blendsynth::dataset::generate(&scene, &spec, r.as_ref(), &out, &opts).unwrap_err();
     assert_eq!(e, m, "generate and render_with_motion refuse alike");
     assert!(!out.exists(), "nothing written");
-    // Render > Curves > Shape 3D Curves.
+    // A Render > Curves > Shape Cycles does not have.
     refused(
-        &|j| j["scene"]["cycles_curves"]["shape"] = "THICK".into(),
-        &["\"Emitter\"", "THICK"],
+        &|j| j["scene"]["cycles_curves"]["shape"] = "FLAT".into(),
+        &["\"Emitter\"", "FLAT"],
+    );
+    // 3D Curves under a non-uniform scale: Cycles keeps such hair in object space (tubes
+    // of elliptical section); uniformly scaled, they render.
+    refused(
+        &|j| {
+            j["scene"]["cycles_curves"]["shape"] = "THICK".into();
+            let os = j["objects"].as_array_mut().unwrap();
+            let o = os.iter_mut().find(|o| o["name"] == "Emitter").unwrap();
+            o["scale"] = serde_json::json!([1.0, 1.0, 1.3]);
+        },
+        &["\"Emitter\"", "THICK", "non-uniform scale"],
     );
     // A hair file that does not hold what scene.json declares.
     refused(
@@ -1991,17 +2010,6 @@ fn unsupported_points_are_refused_by_name() {
     let (dir, base) = fixture_json("points");
     let scene = assert_renders(&dir, &base);
     let opts = check_opts();
-    // A non-uniform scale: Cycles renders the points as ellipsoids.
-    refused_alike(
-        &dir,
-        &base,
-        &|j| {
-            let os = j["objects"].as_array_mut().unwrap();
-            let o = os.iter_mut().find(|o| o["name"] == "Points").unwrap();
-            o["scale"] = serde_json::json!([1.0, 1.0, 1.3]);
-        },
-        &["\"Points\"", "non-uniform scale"],
-    );
     // Optical flow traces triangles only: points are refused there, not left out.
     let Err(RenderError(m)) = blendsynth::render::render_with_motion(&scene, &opts, &[], None, 1.0)
     else {

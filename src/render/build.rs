@@ -858,13 +858,25 @@ fn push_curves(
         return Ok(());
     }
     let c = crate::scene::settings::CurveSettings::of(&scene.file.scene);
-    if c.shape != "RIBBONS" {
+    let thick = match c.shape.as_str() {
+        "RIBBONS" => false,
+        "THICK" => true,
+        other => {
+            return Err(RenderError(format!(
+                "object {:?}: hair curve shape {other:?} (Render > Curves > Shape) is not supported: Rounded Ribbons (RIBBONS) and 3D Curves (THICK) are rendered",
+                obj.name
+            )))
+        }
+    };
+    if thick && !crate::render::points::similarity(&to_world) {
+        // Cycles keeps such hair in object space (its transform is not applied): tubes of
+        // elliptical section, which blendsynth does not intersect.
         return Err(RenderError(format!(
-            "object {:?}: hair curve shape {:?} (Render > Curves > Shape) is not supported: only Rounded Ribbons (RIBBONS) is rendered",
-            obj.name, c.shape
+            "object {:?}: 3D Curves (Render > Curves > Shape THICK) under a non-uniform scale or shear are not supported",
+            obj.name
         )));
     }
-    let curves = crate::render::curves::ObjectCurves::new(hair, &to_world, c.subdivisions);
+    let curves = crate::render::curves::ObjectCurves::new(hair, &to_world, c.subdivisions, thick);
     let keep = info.texspace.is_some();
     push_prims(
         instances,

@@ -17,6 +17,9 @@ use crate::foundation::bvh_boxes::BoxBvh;
 use crate::render::math::*;
 use crate::scene::hair::HairData;
 
+/// A 3x3 matrix by rows.
+pub type Mat3 = [[f32; 3]; 3];
+
 /// One object's hair in world space.
 #[derive(Debug, Clone, Default)]
 pub struct ObjectCurves {
@@ -34,6 +37,14 @@ pub struct ObjectCurves {
     pub segments: Vec<(u32, u32)>,
     /// Ribbons: straight pieces per segment are 2^subdivisions.
     pub pieces: u32,
+    /// Cycles' 3D Curves (`render::thick_curves`) instead of ribbons.
+    pub thick: bool,
+    /// Per key: the curves' normal attribute (a Curves object's exported normals, object
+    /// space, as Cycles reads them: its hair transform leaves them as they are); empty
+    /// without.
+    pub normals: Vec<[f32; 3]>,
+    /// Whether the export carried the normals (`HairData::has_normals`).
+    pub has_normals: bool,
     /// Attributes by name, per key (true) or per curve (`HairData::attributes`).
     pub attributes: Vec<(String, bool, crate::scene::mesh::AttributeData)>,
     /// The hair's UV (Texture Coordinate > UV): one value per curve or per key.
@@ -43,12 +54,16 @@ pub struct ObjectCurves {
     pub points: bool,
     /// Points: each one's index in its own cloud (Point Info > Random hashes it).
     pub point_index: Vec<u32>,
+    /// Points under a transform that is no rotation times one scale: its linear part and
+    /// that part's inverse. Cycles then keeps the cloud in object space, so each point is
+    /// the ellipsoid its sphere becomes (keys hold world centres and object radii).
+    pub ellipsoid: Option<(Mat3, Mat3)>,
 }
 
 impl ObjectCurves {
     /// `hair` (object space) placed by `to_world`, each curve of n keys as n - 1
     /// segments (Cycles' curve segments).
-    pub fn new(hair: &HairData, to_world: &Affine, subdivisions: u32) -> ObjectCurves {
+    pub fn new(hair: &HairData, to_world: &Affine, subdivisions: u32, thick: bool) -> ObjectCurves {
         let det = {
             let m = &to_world.m;
             m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
@@ -92,6 +107,9 @@ impl ObjectCurves {
             intercept,
             segments,
             pieces: 1 << subdivisions.min(24),
+            thick,
+            normals: hair.normals.clone(),
+            has_normals: hair.has_normals,
             attributes: hair.attributes.clone(),
             uv: hair.uv.as_deref().and_then(|n| {
                 hair.attributes
@@ -104,7 +122,45 @@ impl ObjectCurves {
             }),
             points: false,
             point_index: Vec::new(),
+            ellipsoid: None,
         }
+    }
+
+    /// The curves' normal attribute at `u` along segment `seg`, linear between its keys
+    /// as Cycles' curve_attribute reads a key attribute (zero without one).
+    pub fn normal_at(&self, seg: u32, u: f32) -> V3 {
+        if self.points || self.normals.is_empty() {
+            return [0.0; 3];
+        }
+        let k0 = self.segments[seg as usize].1 as usize;
+        let (a, b) = (self.normals[k0], self.normals[k0 + 1]);
+        std::array::from_fn(|i| (b[i] - a[i]) * u + a[i])
+    }
+
+    /// What a ray query needs of segment `seg`: its shape and four points (a point's
+    /// centre and radius first; for an ellipsoid then the rows of its inverse linear map).
+    pub fn query_prim(&self, seg: u32) -> (Shape, [[f32; 4]; 4]) {
+        if self.points {
+            let k = self.keys[seg as usize];
+            return match &self.ellipsoid {
+                None => (Shape::Sphere, [k; 4]),
+                Some((_, inv)) => (
+                    Shape::Ellipsoid,
+                    [
+                        k,
+                        [inv[0][0], inv[0][1], inv[0][2], 0.0],
+                        [inv[1][0], inv[1][1], inv[1][2], 0.0],
+                        [inv[2][0], inv[2][1], inv[2][2], 0.0],
+                    ],
+                ),
+            };
+        }
+        let shape = if self.thick {
+            Shape::Thick
+        } else {
+            Shape::Ribbon(self.pieces)
+        };
+        (shape, self.control_points(seg))
     }
 
     /// The hair's UV at `u` along segment `seg` (zero without one).
@@ -159,6 +215,8 @@ impl ObjectCurves {
             thickness: 2.0 * lerp(self.keys[k0][3], self.keys[k1][3]),
             tangent_normal: normalize(sub(wi, scale(dpdu, along))),
             random: crate::nodes::random::hash_to_float2(c, 0),
+            thick: self.thick,
+            curve_normal: self.normal_at(seg, u),
         }
     }
 
@@ -168,10 +226,12 @@ impl ObjectCurves {
         if self.points {
             let k = self.keys[seg as usize];
             let r = k[3].abs();
-            return (
-                [k[0] - r, k[1] - r, k[2] - r],
-                [k[0] + r, k[1] + r, k[2] + r],
-            );
+            // An ellipsoid reaches r times its linear map's row length along each axis.
+            let e: V3 = match &self.ellipsoid {
+                None => [r; 3],
+                Some((m, _)) => std::array::from_fn(|i| r * len(m[i])),
+            };
+            return (sub([k[0], k[1], k[2]], e), add([k[0], k[1], k[2]], e));
         }
         let p = self.control_points(seg);
         let b = [
@@ -382,14 +442,26 @@ pub fn ribbon_shading(c: &[[f32; 4]; 4], pieces: u32, u: f32, v: f32, dir: V3) -
     (p, n, dpdu)
 }
 
+/// How a prim of the curve structure is intersected.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Shape {
+    /// Rounded Ribbons cut into this many straight pieces per segment.
+    Ribbon(u32),
+    /// 3D Curves (`render::thick_curves`).
+    Thick,
+    /// A point's sphere, or its ellipsoid under a non-uniform scale (`render::points`).
+    Sphere,
+    Ellipsoid,
+}
+
 /// The scene's curve segments behind one ray query.
 pub struct CurveAccel {
     bvh: BoxBvh,
-    /// Per segment in the BVH: its scene prim id, control points, ribbon pieces and the
+    /// Per segment in the BVH: its scene prim id, control points, shape and the
     /// visibility mask of its object.
     prims: Vec<u32>,
     points: Vec<[[f32; 4]; 4]>,
-    pieces: Vec<u32>,
+    shapes: Vec<Shape>,
     masks: Vec<u32>,
     /// Per segment: its curve (instance and curve index), and per scene prim the curve
     /// it belongs to (u32::MAX for triangles): what a ray leaving a curve skips.
@@ -425,7 +497,7 @@ impl Drop for RaySelfGuard {
 impl CurveAccel {
     /// The segments of `geo`'s curve instances (their prims after the triangles).
     pub fn build(geo: &crate::render::build::Geometry) -> Option<CurveAccel> {
-        let (mut prims, mut points, mut pieces, mut masks, mut boxes) =
+        let (mut prims, mut points, mut shapes, mut masks, mut boxes) =
             (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
         let mut curve_of = Vec::new();
         let mut curve_by_prim = vec![u32::MAX; geo.refs.len()];
@@ -445,8 +517,9 @@ impl CurveAccel {
             curve_of.push(cid);
             curve_by_prim[prim] = cid;
             prims.push(prim as u32);
-            points.push(c.control_points(r.tri));
-            pieces.push(c.pieces);
+            let (shape, p) = c.query_prim(r.tri);
+            points.push(p);
+            shapes.push(shape);
             masks.push(inst.visibility);
             boxes.push(c.segment_bounds(r.tri));
         }
@@ -457,7 +530,7 @@ impl CurveAccel {
             bvh: BoxBvh::build(&boxes),
             prims,
             points,
-            pieces,
+            shapes,
             masks,
             curve_of,
             curve_by_prim,
@@ -478,10 +551,18 @@ impl CurveAccel {
             if skip == Some(self.curve_of[i]) {
                 return None;
             }
-            let h = if self.pieces[i] == 0 {
-                crate::render::points::sphere_intersect(org, dir, tmin, far, self.points[i][0])?
-            } else {
-                ribbon_intersect(org, dir, tmin, far, self.pieces[i], &self.points[i])?
+            let p = &self.points[i];
+            let h = match self.shapes[i] {
+                Shape::Ribbon(pieces) => ribbon_intersect(org, dir, tmin, far, pieces, p)?,
+                Shape::Thick => {
+                    crate::render::thick_curves::thick_intersect(org, dir, tmin, far, p)?
+                }
+                Shape::Sphere => {
+                    crate::render::points::sphere_intersect(org, dir, tmin, far, p[0])?
+                }
+                Shape::Ellipsoid => {
+                    crate::render::points::ellipsoid_intersect(org, dir, tmin, far, p)?
+                }
             };
             best = Some(Hit {
                 t: h.t,
@@ -567,7 +648,8 @@ impl Accel for WithCurves {
 /// What blendsynth cannot render on hair, named: materials with volume, true
 /// displacement, emission (Cycles' curves are no lights), the Subsurface Scattering node,
 /// a Principled Hair BSDF model it does not know, and the Huang model's elliptical fibre
-/// on a Curves object; and hair with motion blur or under Embree.
+/// on a Curves object exported without its normals; and hair with motion blur or under
+/// Embree.
 pub fn check(
     scene: &crate::scene::Scene,
     geo: &crate::render::build::Geometry,
@@ -606,14 +688,15 @@ pub fn check(
                     }
                     // Cycles turns an elliptical fibre about the curve's normal attribute,
                     // which particle hair lacks (an arbitrary frame then) but a Curves
-                    // object may carry; blendsynth exports none.
+                    // object carries; exports made before the normals were exported lack it.
                     "ShaderNodeBsdfHairPrincipled"
                         if b.property("model") == Some("HUANG")
                             && is_curves_object(scene, &inst.name)
+                            && inst.curves.as_ref().is_some_and(|c| !c.has_normals)
                             && huang_aspect_ratio(p, b) != Some(1.0) =>
                     {
                         Some(format!(
-                            "node {} (Huang model) with an Aspect Ratio other than 1 on a Curves object (blendsynth does not carry the curves' normals the ellipse turns about)",
+                            "node {} (Huang model) with an Aspect Ratio other than 1 on a Curves object whose export lacks the curves' normals the ellipse turns about (convert the .blend again)",
                             b.bl_idname
                         ))
                     }
@@ -671,7 +754,7 @@ mod tests {
                 [0.0, 0.0, 1.0, 0.0],
             ],
         };
-        ObjectCurves::new(&hair, &id, 2)
+        ObjectCurves::new(&hair, &id, 2, false)
     }
 
     #[test]
@@ -774,7 +857,7 @@ mod tests {
             bvh: BoxBvh::build(&boxes),
             prims: vec![10, 11, 12],
             points,
-            pieces: vec![4; 3],
+            shapes: vec![Shape::Ribbon(4); 3],
             masks: vec![crate::foundation::bvh::visibility::ALL; 3],
             // Scene prim 0 is the floor triangle, 10..12 the strand's segments (curve 0).
             curve_of: vec![0; 3],

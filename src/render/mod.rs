@@ -25,6 +25,7 @@ pub mod film;
 pub mod integrator;
 pub mod light;
 pub mod limits;
+pub mod thick_curves;
 pub use crate::foundation::math;
 pub mod motion;
 pub mod points;

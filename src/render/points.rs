@@ -1,7 +1,10 @@
 //! Point clouds as Cycles 4.5 renders them: each point a sphere of its radius
 //! (kernel/geom/point_intersect.h): the ray's first crossing into the sphere only
 //! (Cycles culls its back faces, so a ray leaving a point never hits it again), shaded
-//! with the sphere's normal, true and shading alike (point_shader_setup). A point cloud
+//! with the sphere's normal, true and shading alike (point_shader_setup). Under a
+//! transform that is no rotation times one scale Cycles keeps the cloud in object space
+//! (its transform is not applied), so a point is the ellipsoid its sphere becomes, and
+//! point_shader_setup still takes the direction from the centre as the normal. A point cloud
 //! rides the hair machinery (`render::curves`): an `ObjectCurves` with `points` set,
 //! each key a sphere, in the same box BVH beside the triangles.
 
@@ -10,13 +13,20 @@ use crate::render::math::*;
 
 /// `points` (object space: x, y, z, radius) placed by `to_world`: centres in world
 /// space, radii scaled by the cube root of the transform's determinant, as Cycles
-/// applies an object's transform to its points.
+/// applies an object's transform to its points; under a transform that is no rotation
+/// times one scale, object radii and the transform's linear part (`ellipsoid`).
 pub fn object_points(points: &[[f32; 4]], to_world: &Affine) -> ObjectCurves {
     let m = &to_world.m;
     let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
         - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
         + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-    let scale_r = det.abs().cbrt();
+    let linear: [[f32; 3]; 3] = std::array::from_fn(|i| [m[i][0], m[i][1], m[i][2]]);
+    let ellipsoid = (!similarity(to_world)).then(|| (linear, inverse3(&linear, det)));
+    let scale_r = if ellipsoid.is_some() {
+        1.0
+    } else {
+        det.abs().cbrt()
+    };
     let keys: Vec<[f32; 4]> = points
         .iter()
         .map(|k| {
@@ -34,6 +44,7 @@ pub fn object_points(points: &[[f32; 4]], to_world: &Affine) -> ObjectCurves {
         keys,
         pieces: 0,
         points: true,
+        ellipsoid,
         ..ObjectCurves::default()
     }
 }
@@ -64,6 +75,72 @@ pub fn sphere_intersect(org: V3, dir: V3, tmin: f32, tmax: f32, p: [f32; 4]) -> 
         u: n[2].clamp(-1.0, 1.0).acos(),
         v: n[1].atan2(n[0]),
     })
+}
+
+/// The ray against the ellipsoid `p`: its centre and radius in `p[0]`, the rows of the
+/// inverse of its transform's linear part in `p[1..4]`. The ray is taken to the sphere's
+/// space (t unchanged) and met there as Cycles meets a point in object space; the hit's
+/// (u, v) carry the unit direction from the centre in that space (`normal_of`).
+pub fn ellipsoid_intersect(
+    org: V3,
+    dir: V3,
+    tmin: f32,
+    tmax: f32,
+    p: &[[f32; 4]; 4],
+) -> Option<RibbonHit> {
+    let inv = |v: V3| std::array::from_fn(|i| dot([p[i + 1][0], p[i + 1][1], p[i + 1][2]], v));
+    let o = inv(sub(org, [p[0][0], p[0][1], p[0][2]]));
+    sphere_intersect(o, inv(dir), tmin, tmax, [0.0, 0.0, 0.0, p[0][3]])
+}
+
+/// The inverse of `m` whose determinant is `det` (zero when `det` is zero: a flattened
+/// cloud then hits nothing).
+fn inverse3(m: &[[f32; 3]; 3], det: f32) -> [[f32; 3]; 3] {
+    if det == 0.0 || !det.is_finite() {
+        return [[0.0; 3]; 3];
+    }
+    let c =
+        |r0: usize, c0: usize, r1: usize, c1: usize| m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0];
+    let r = 1.0 / det;
+    [
+        [c(1, 1, 2, 2) * r, -c(0, 1, 2, 2) * r, c(0, 1, 1, 2) * r],
+        [-c(1, 0, 2, 2) * r, c(0, 0, 2, 2) * r, -c(0, 0, 1, 2) * r],
+        [c(1, 0, 2, 1) * r, -c(0, 0, 2, 1) * r, c(0, 0, 1, 1) * r],
+    ]
+}
+
+/// The world position and normal of a point hit whose (u, v) carry the direction from
+/// the centre (`normal_of`) in the point's own space: on a sphere the point at its
+/// radius; on an ellipsoid that point mapped by the linear part, the normal pointing from
+/// the centre to it (Cycles' point_shader_setup: normalize(P - centre), not the
+/// ellipsoid's surface normal).
+pub fn point_hit(c: &ObjectCurves, point: usize, u: f32, v: f32) -> (V3, V3) {
+    let k = c.keys[point];
+    let center = [k[0], k[1], k[2]];
+    let n = normal_of(u, v);
+    match &c.ellipsoid {
+        None => (add(center, scale(n, k[3])), n),
+        Some((m, _)) => {
+            let local = scale(n, k[3]);
+            let off: V3 = std::array::from_fn(|i| dot(m[i], local));
+            let n = if is_zero(off) { n } else { normalize(off) };
+            (add(center, off), n)
+        }
+    }
+}
+
+/// What Point Info > Radius reads for `point`: its radius, or on an ellipsoid the length
+/// of the linear part applied to (r, r, r) / sqrt(3) (Cycles' point_radius when the
+/// object's transform is not applied).
+pub fn point_radius(c: &ObjectCurves, point: usize) -> f32 {
+    let r = c.keys[point][3];
+    match &c.ellipsoid {
+        None => r,
+        Some((m, _)) => {
+            let d = [r * (1.0 / 3f32.sqrt()); 3];
+            len(std::array::from_fn(|i| dot(m[i], d)))
+        }
+    }
 }
 
 /// Each point's index in its own cloud: the clouds of an object follow each other, each
@@ -100,15 +177,6 @@ pub fn check(
         .iter()
         .filter(|i| i.curves.as_ref().is_some_and(|c| c.points));
     for inst in points {
-        if !similarity(&inst.to_world) {
-            // Cycles applies only uniform scales to a point cloud; under another it keeps
-            // the points in object space, so they render as ellipsoids (measured: a
-            // (1, 1, 1.3) scale gave parity ratio 1.6 as spheres).
-            return Err(crate::render::RenderError(format!(
-                "object {:?}: its point cloud is under a non-uniform scale or shear, which Cycles renders as ellipsoids: not supported by the renderer yet",
-                inst.name
-            )));
-        }
         for mi in inst.slots.iter().flatten() {
             let m = &materials[*mi];
             let Some(p) = &m.program else {
@@ -146,7 +214,7 @@ pub fn check(
 
 /// Whether `t`'s linear part is a rotation times one scale (columns of one length, at
 /// right angles), to a relative 1e-5.
-fn similarity(t: &Affine) -> bool {
+pub fn similarity(t: &Affine) -> bool {
     let col = |j: usize| [t.m[0][j], t.m[1][j], t.m[2][j]];
     let c = [col(0), col(1), col(2)];
     let s = dot(c[0], c[0]);
@@ -179,6 +247,47 @@ mod tests {
         };
         assert!(similarity(&t([1.3, 1.3, 1.3])));
         assert!(!similarity(&t([1.0, 1.0, 1.3])));
+    }
+
+    #[test]
+    fn a_non_uniform_scale_makes_ellipsoids() {
+        let t = Affine {
+            m: [
+                [2.0, 0.0, 0.0, 1.0],
+                [0.0, 1.0, 0.0, 0.0],
+                [0.0, 0.0, 0.5, 0.0],
+            ],
+        };
+        let c = object_points(&[[0.0, 0.0, 0.0, 0.1]], &t);
+        assert_eq!(c.keys[0], [1.0, 0.0, 0.0, 0.1]);
+        let (_, p) = c.query_prim(0);
+        // Along x the point reaches 0.2 from its centre, along z 0.05.
+        let h = ellipsoid_intersect([-5.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.0, 100.0, &p).unwrap();
+        assert!((h.t - 5.8).abs() < 1e-5, "{h:?}");
+        let h = ellipsoid_intersect([1.0, 0.0, 5.0], [0.0, 0.0, -1.0], 0.0, 100.0, &p).unwrap();
+        assert!((h.t - 4.95).abs() < 1e-5, "{h:?}");
+        let (q, n) = point_hit(&c, 0, h.u, h.v);
+        assert!(len(sub(q, [1.0, 0.0, 0.05])) < 1e-5 && (n[2] - 1.0).abs() < 1e-5);
+        // Off the axes the normal points from the centre, not across the surface.
+        let h = ellipsoid_intersect([1.1, 0.0, 5.0], [0.0, 0.0, -1.0], 0.0, 100.0, &p).unwrap();
+        let (q, n) = point_hit(&c, 0, h.u, h.v);
+        assert!(
+            (q[0] - 1.1).abs() < 1e-5 && len(sub(n, normalize(sub(q, [1.0, 0.0, 0.0])))) < 1e-5
+        );
+        let (lo, hi) = c.segment_bounds(0);
+        assert!((hi[0] - 1.2).abs() < 1e-6 && (lo[2] + 0.05).abs() < 1e-6);
+        // A uniform scale keeps spheres of the scaled radius.
+        let u = object_points(
+            &[[0.0, 0.0, 0.0, 0.1]],
+            &Affine {
+                m: [
+                    [2.0, 0.0, 0.0, 0.0],
+                    [0.0, 2.0, 0.0, 0.0],
+                    [0.0, 0.0, 2.0, 0.0],
+                ],
+            },
+        );
+        assert!(u.ellipsoid.is_none() && (u.keys[0][3] - 0.2).abs() < 1e-6);
     }
 
     #[test]

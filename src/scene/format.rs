@@ -805,6 +805,11 @@ pub struct HairRef {
     /// The attribute Cycles reads as the hair's UV (Texture Coordinate / UV Map default).
     #[serde(default)]
     pub uv: Option<String>,
+    /// A Curves object's normals at its keys (little-endian f32 x, y, z per key, object
+    /// space): the normal attribute Cycles gives its curves. None for particle hair and
+    /// exports made before normals were exported.
+    #[serde(default)]
+    pub normals_file: Option<String>,
 }
 
 /// One hair attribute: `domain` CURVE (a value per curve) or POINT (per key);

@@ -24,6 +24,11 @@ pub struct HairData {
     pub attributes: HairAttributes,
     /// The attribute read as the hair's UV.
     pub uv: Option<String>,
+    /// Per key: a Curves object's normals (object space); empty without.
+    pub normals: Vec<[f32; 3]>,
+    /// Whether the export carries the normals (`normals_file`): particle hair has none
+    /// (Cycles gives it none either); a Curves object exported before they were, lacks them.
+    pub has_normals: bool,
 }
 
 /// The strands in one hair file: a curve has at most this many keys (Cycles' render steps
@@ -65,6 +70,23 @@ impl Scene {
             })?;
         }
         data.uv = h.uv.clone();
+        if let Some(f) = &h.normals_file {
+            let npath = self.resolve(f, &format!("{at}.normals_file"))?;
+            let bytes = super::file::read_regular(&npath, super::limits::MAX_GLB_BYTES)
+                .map_err(|m| SceneError::new(&npath, "", m))?;
+            data.normals = parse_hair_normals(data.keys.len(), &bytes).map_err(|m| {
+                SceneError::new(
+                    &self.json_path(),
+                    format!("{at}.normals_file"),
+                    format!(
+                        "{m} (object {}, file {})",
+                        quote(&e.object),
+                        npath.display()
+                    ),
+                )
+            })?;
+            data.has_normals = true;
+        }
         Ok(Some(data))
     }
 }
@@ -127,6 +149,28 @@ impl Scene {
         }
         Ok(Some((keys, slots)))
     }
+}
+
+/// `keys` normals (x, y, z little-endian f32 each) from a normals file's bytes.
+fn parse_hair_normals(keys: usize, bytes: &[u8]) -> Result<Vec<[f32; 3]>, String> {
+    if Some(bytes.len()) != keys.checked_mul(12) {
+        return Err(format!(
+            "holds {} bytes, not the 12 per key of its {keys} keys",
+            bytes.len()
+        ));
+    }
+    let v: Vec<[f32; 3]> = bytes
+        .chunks_exact(12)
+        .map(|c| {
+            std::array::from_fn(|i| {
+                f32::from_le_bytes([c[4 * i], c[4 * i + 1], c[4 * i + 2], c[4 * i + 3]])
+            })
+        })
+        .collect();
+    if let Some(k) = v.iter().position(|n| !n.iter().all(|x| x.is_finite())) {
+        return Err(format!("normal {k} is {:?}: normals must be finite", v[k]));
+    }
+    Ok(v)
 }
 
 /// The attributes `h` declares, from their file's bytes, for the curves and keys of `d`.
@@ -340,6 +384,7 @@ mod tests {
             attributes_file: None,
             attributes: Vec::new(),
             uv: None,
+            normals_file: None,
             systems: vec![HairSystem {
                 name: "Hair".into(),
                 material_slot: 1,

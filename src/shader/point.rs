@@ -114,6 +114,12 @@ pub struct HairPoint {
     pub tangent_normal: Vec3,
     /// hash_uint2_to_float(curve index, 0) (ATTR_STD_CURVE_RANDOM).
     pub random: f32,
+    /// On a thick curve (3D Curves: a tube whose true normal the hair closures read)
+    /// rather than a ribbon.
+    pub thick: bool,
+    /// The curves' normal attribute at the hit (ATTR_STD_VERTEX_NORMAL on curves: a
+    /// Curves object's normals), zero without one.
+    pub curve_normal: Vec3,
 }
 
 /// A shading point's position and differentials before true displacement (Cycles'

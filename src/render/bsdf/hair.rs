@@ -14,12 +14,14 @@ use std::f32::consts::{FRAC_PI_2, PI};
 use crate::render::math::*;
 
 /// Where a hit lies across the fibre, for the Principled Hair models' offset h: on a hair
-/// ribbon from its parametric v (h = -v); on a mesh's faces, which Cycles shades with
-/// the same closures, from the triangle's true normal `ng` (Chiang) or its shading normal
-/// `n` (Huang), both facing the ray.
+/// ribbon from its parametric v (h = -v); on a thick curve from the tube's normal `n`
+/// (true and shading alike); on a mesh's faces, which Cycles shades with the same
+/// closures, from the triangle's true normal `ng` (Chiang) or its shading normal `n`
+/// (Huang), both facing the ray.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Across {
     Ribbon { v: f32 },
+    Tube { n: V3 },
     Surface { ng: V3, n: V3 },
 }
 

@@ -214,7 +214,9 @@ impl Chiang {
         // The sine of the angle between the true normal and Z, seen along the tangent.
         let h = match across {
             Across::Ribbon { v } => -v,
-            Across::Surface { ng, .. } => dot(cross(ng, x), normalize(cross(x, y))),
+            Across::Tube { n: ng } | Across::Surface { ng, .. } => {
+                dot(cross(ng, x), normalize(cross(x, y)))
+            }
         };
         Some((
             Chiang {

@@ -95,13 +95,13 @@ impl Huang {
         let x = safe_normalize(cross(dpdu, wi));
         let h = match across {
             Across::Ribbon { v } => -v,
-            Across::Surface { n, .. } => -dot(x, n),
+            Across::Tube { n } | Across::Surface { n, .. } => -dot(x, n),
         };
         let mut b = p.aspect_ratio;
         let mut n = x;
         // Only a curve turns the frame to the ellipse's axis; on a mesh's faces Cycles keeps
         // the frame facing the ray but still takes the Aspect Ratio's eccentricity.
-        if b != 1.0 && matches!(across, Across::Ribbon { .. }) {
+        if b != 1.0 && matches!(across, Across::Ribbon { .. } | Across::Tube { .. }) {
             n = safe_normalize(cross(dpdu, safe_normalize(cross(major_axis, dpdu))));
             if b > 1.0 {
                 b = 1.0 / b;

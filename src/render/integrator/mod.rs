@@ -314,8 +314,22 @@ impl Scene<'_> {
         let r = self.geo.refs[prim as usize];
         let inst = &self.geo.instances[r.inst as usize];
         let cp = c.control_points(r.tri);
-        let (p, n, dpdu) = crate::render::curves::ribbon_shading(&cp, c.pieces, u, v, neg(wo));
-        let ng = wo;
+        // Thick curves: the tube's normal is the true normal too, turned to the viewer
+        // (Cycles' backfacing flip) and v reads 0; ribbons face the ray.
+        let (p, mut n, dpdu, ng, v_read, backfacing) = if c.thick {
+            let (p, n, dpdu) = crate::render::thick_curves::tube_point(&cp, u, v);
+            if dot(n, wo) < 0.0 {
+                (p, neg(n), dpdu, neg(n), 0.0, true)
+            } else {
+                (p, n, dpdu, n, 0.0, false)
+            }
+        } else {
+            let (p, n, dpdu) = crate::render::curves::ribbon_shading(&cp, c.pieces, u, v, neg(wo));
+            (p, n, dpdu, wo, v, false)
+        };
+        if !finite(n) {
+            n = wo;
+        }
         let (to_world, to_object) = (&inst.to_world, &inst.to_object);
         let curve = c.segments[r.tri as usize].0 as usize;
         let root = c.keys[c.curves[curve].0 as usize];
@@ -330,7 +344,7 @@ impl Scene<'_> {
             uv: c.uv_at(r.tri, u),
             ..Default::default()
         };
-        self.fill_context(&mut sp, inst, wo, ng, false, u, v);
+        self.fill_context(&mut sp, inst, wo, ng, backfacing, u, v_read);
         let (_, k0) = c.segments[r.tri as usize];
         if let Some(Some(bound)) = inst.attributes.get(c.slot[curve] as usize) {
             bound.fill_curve(curve, k0 as usize, u, &inst.instancer_values, &mut sp);
@@ -345,7 +359,7 @@ impl Scene<'_> {
             sp,
             inst: r.inst,
             material: inst.material_of(r.tri as usize),
-            backfacing: false,
+            backfacing,
             time,
             prim,
             uv: [u, v],
@@ -367,8 +381,7 @@ impl Scene<'_> {
         let inst = &self.geo.instances[r.inst as usize];
         let k = c.keys[r.tri as usize];
         let center = [k[0], k[1], k[2]];
-        let n = crate::render::points::normal_of(u, v);
-        let p = add(center, scale(n, k[3]));
+        let (p, n) = crate::render::points::point_hit(c, r.tri as usize, u, v);
         let (to_world, to_object) = (&inst.to_world, &inst.to_object);
         let mut sp = ShadingPoint {
             position: p,
@@ -378,7 +391,7 @@ impl Scene<'_> {
             generated: inst.generated(to_object.point(center)),
             point: crate::shader::point::PointPoint {
                 position: center,
-                radius: k[3],
+                radius: crate::render::points::point_radius(c, r.tri as usize),
                 random: crate::nodes::random::hash_to_float2(
                     c.point_index.get(r.tri as usize).copied().unwrap_or(r.tri),
                     0,

@@ -484,7 +484,9 @@ fn hair_frame(sp: &ShadingPoint) -> (V3, V3) {
 /// faces the true and shading normals.
 fn across_fibre(sp: &ShadingPoint) -> crate::render::bsdf::hair::Across {
     use crate::render::bsdf::hair::Across;
-    if sp.hair.is_strand > 0.0 {
+    if sp.hair.thick {
+        Across::Tube { n: sp.true_normal }
+    } else if sp.hair.is_strand > 0.0 {
         Across::Ribbon {
             v: sp.parametric[1],
         }
@@ -638,7 +640,7 @@ fn huang_hair(
         hair_frame(sp).0,
         ctx.wo,
         across_fibre(sp),
-        [0.0; 3],
+        sp.hair.curve_normal,
         pixel_coverage,
     ) {
         Some(Setup::Closure(c)) => out.push(LobeKind::Huang(c), [w; 3], c.n),
