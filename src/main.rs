@@ -3,6 +3,9 @@
 //! Exit codes: 0 success, 1 failure (one line naming what was wrong), 2 bad usage,
 //! 3 `inspect` found something `render` or `mesh` would refuse.
 
+#[global_allocator]
+static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 use std::path::PathBuf;
 use std::process::ExitCode;
 
