@@ -133,6 +133,9 @@ const ASSERTED: &[&str] = &[
     // Instancer attributes on Geometry Nodes instances nested two deep, realised into
     // Blender's evaluated mesh: the innermost level that has the name, per instance.
     "nested_instancer_attribute",
+    // The same without the shape key: blendsynth evaluates the nodes, and renders
+    // Blender's evaluated mesh instead, whose realised instances keep their values.
+    "nested_instancer_native",
     // Particles, a collection instance and vertex instancing, realised into Blender's
     // evaluated mesh, each shaded in its own object space (Object and Generated
     // coordinates, Object Info Random, Location, Color), as Cycles renders instances.

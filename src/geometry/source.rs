@@ -303,6 +303,25 @@ pub fn simulation_after_start(scene: &Scene, o: &Object, frame: f64) -> Option<S
 /// The export's evaluated mesh of `o`, when it may stand for the object at `frame` with
 /// the scene's overrides: nothing it reads is animated (or the frame is the exported
 /// one) and no override changed what it reads.
+/// Blender's evaluated mesh of `o` in place of blendsynth's own evaluation, for `reason`,
+/// when the export has one that is valid at the frame and overrides; None otherwise.
+pub fn frozen_instead(
+    scene: &Scene,
+    o: &Object,
+    frame: f64,
+    overrides: &[String],
+    reason: &str,
+) -> Option<usize> {
+    let has_frozen = scene
+        .file
+        .evaluated
+        .iter()
+        .any(|e| e.object == o.name && e.reads.is_some());
+    has_frozen
+        .then(|| frozen(scene, o, frame, overrides, reason).ok())
+        .flatten()
+}
+
 fn frozen(
     scene: &Scene,
     o: &Object,

@@ -197,121 +197,125 @@ pub fn build(
             .data
             .as_deref()
             .and_then(|d| scene.file.meshes.iter().find(|m| m.name == d));
-        match source {
-            Source::None => {}
-            Source::Mesh(mi) => {
-                let info = &scene.file.meshes[mi];
-                let m = match cache.get(&mi) {
-                    Some(m) => m.clone(),
-                    None => {
-                        let m = Arc::new(
-                            scene
-                                .load_mesh(mi)
-                                .map_err(|e| RenderError(e.to_string()))?,
-                        );
-                        cache.insert(mi, m.clone());
-                        m
-                    }
-                };
-                push_instance(
-                    &mut instances,
-                    scene,
-                    oi,
-                    obj,
-                    &MeshInfo::of_mesh(info),
-                    m,
-                    to_world,
-                    None,
-                )?;
-            }
-            Source::Frozen(ei) => {
-                let e = &scene.file.evaluated[ei];
-                let m = Arc::new(
-                    scene
-                        .load_evaluated(ei)
-                        .map_err(|err| RenderError(format!("object {:?}: {err}", obj.name)))?,
-                );
-                // Cycles' Generated coordinates of a modified mesh follow the mesh's
-                // texture space; other types' follow the evaluated bounds.
-                let texspace = mesh_ref.and_then(|r| MeshInfo::of_mesh(r).texspace);
-                let info = MeshInfo {
-                    materials: &e.materials,
-                    uv_name: e
-                        .active_render_uv
-                        .clone()
-                        .or_else(|| e.uv_layers.first().cloned()),
-                    default_color: e.default_color_attribute.clone(),
-                    texspace,
-                };
-                let before = instances.len();
-                match &e.realized {
-                    Some(r) => push_realized(
-                        &mut instances,
-                        scene,
-                        (oi, obj),
-                        &info,
-                        &m,
-                        r,
-                        &eval.world_matrices[oi],
-                    )?,
-                    None => {
-                        push_instance(&mut instances, scene, oi, obj, &info, m, to_world, None)?
-                    }
-                }
-                if e.instances_realized.unwrap_or(0) > 0 {
-                    // Blender realised instances into this mesh; Cycles would read an
-                    // Instancer attribute per nested instance (refused in bind_attributes).
-                    for pushed in &mut instances[before..] {
-                        pushed.nested_instancer_names =
-                            obj.attribute_lookups.keys().cloned().collect();
-                    }
-                }
-                let hair = scene
-                    .load_hair(ei)
-                    .map_err(|err| RenderError(format!("object {:?}: {err}", obj.name)))?;
-                if let Some(h) = hair {
-                    push_curves(&mut instances, scene, oi, obj, &info, &h, to_world)?;
-                }
-                let points = scene
-                    .load_points(ei)
-                    .map_err(|err| RenderError(format!("object {:?}: {err}", obj.name)))?;
-                if let Some((keys, slots)) = points.filter(|p| !p.0.is_empty()) {
-                    // The export carries no point attributes (reads are refused).
-                    push_points(
+        let start = instances.len();
+        let mut source = source;
+        loop {
+            match source {
+                Source::None => {}
+                Source::Mesh(mi) => {
+                    let info = &scene.file.meshes[mi];
+                    let m = match cache.get(&mi) {
+                        Some(m) => m.clone(),
+                        None => {
+                            let m = Arc::new(
+                                scene
+                                    .load_mesh(mi)
+                                    .map_err(|e| RenderError(e.to_string()))?,
+                            );
+                            cache.insert(mi, m.clone());
+                            m
+                        }
+                    };
+                    push_instance(
                         &mut instances,
                         scene,
                         oi,
                         obj,
-                        &info,
-                        (&keys, &slots),
-                        Vec::new(),
+                        &MeshInfo::of_mesh(info),
+                        m,
                         to_world,
+                        None,
                     )?;
                 }
-            }
-            Source::Evaluate => {
-                let curve_materials = obj
-                    .data
-                    .as_deref()
-                    .and_then(|d| scene.file.curves.iter().find(|c| c.name == d))
-                    .map(|c| c.materials.clone())
-                    .unwrap_or_default();
-                let base = match mesh_ref {
-                    Some(r) => MeshInfo::of_mesh(r),
-                    None => MeshInfo {
-                        materials: &curve_materials,
-                        uv_name: None,
-                        default_color: None,
-                        texspace: None,
-                    },
-                };
-                let set = crate::geometry::evaluate_object(scene, &obj.name, eval.frame, overrides)
-                    .map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))?;
-                // Top-level instances stay separate, each with its own id, sharing the
-                // realised mesh of its reference; the rest of the set is one mesh.
-                let mut rest = set.clone();
-                let instances_component = rest.instances.take();
-                let realise = |g: &crate::geometry::GeometrySet| -> Result<(Arc<MeshData>, Vec<Option<String>>), RenderError> {
+                Source::Frozen(ei) => {
+                    let e = &scene.file.evaluated[ei];
+                    let m = Arc::new(
+                        scene
+                            .load_evaluated(ei)
+                            .map_err(|err| RenderError(format!("object {:?}: {err}", obj.name)))?,
+                    );
+                    // Cycles' Generated coordinates of a modified mesh follow the mesh's
+                    // texture space; other types' follow the evaluated bounds.
+                    let texspace = mesh_ref.and_then(|r| MeshInfo::of_mesh(r).texspace);
+                    let info = MeshInfo {
+                        materials: &e.materials,
+                        uv_name: e
+                            .active_render_uv
+                            .clone()
+                            .or_else(|| e.uv_layers.first().cloned()),
+                        default_color: e.default_color_attribute.clone(),
+                        texspace,
+                    };
+                    let before = instances.len();
+                    match &e.realized {
+                        Some(r) => push_realized(
+                            &mut instances,
+                            scene,
+                            (oi, obj),
+                            &info,
+                            &m,
+                            r,
+                            &eval.world_matrices[oi],
+                        )?,
+                        None => {
+                            push_instance(&mut instances, scene, oi, obj, &info, m, to_world, None)?
+                        }
+                    }
+                    if e.instances_realized.unwrap_or(0) > 0 {
+                        // Blender realised instances into this mesh; Cycles would read an
+                        // Instancer attribute per nested instance (refused in bind_attributes).
+                        for pushed in &mut instances[before..] {
+                            pushed.nested_instancer_names =
+                                obj.attribute_lookups.keys().cloned().collect();
+                        }
+                    }
+                    let hair = scene
+                        .load_hair(ei)
+                        .map_err(|err| RenderError(format!("object {:?}: {err}", obj.name)))?;
+                    if let Some(h) = hair {
+                        push_curves(&mut instances, scene, oi, obj, &info, &h, to_world)?;
+                    }
+                    let points = scene
+                        .load_points(ei)
+                        .map_err(|err| RenderError(format!("object {:?}: {err}", obj.name)))?;
+                    if let Some((keys, slots)) = points.filter(|p| !p.0.is_empty()) {
+                        // The export carries no point attributes (reads are refused).
+                        push_points(
+                            &mut instances,
+                            scene,
+                            oi,
+                            obj,
+                            &info,
+                            (&keys, &slots),
+                            Vec::new(),
+                            to_world,
+                        )?;
+                    }
+                }
+                Source::Evaluate => {
+                    let curve_materials = obj
+                        .data
+                        .as_deref()
+                        .and_then(|d| scene.file.curves.iter().find(|c| c.name == d))
+                        .map(|c| c.materials.clone())
+                        .unwrap_or_default();
+                    let base = match mesh_ref {
+                        Some(r) => MeshInfo::of_mesh(r),
+                        None => MeshInfo {
+                            materials: &curve_materials,
+                            uv_name: None,
+                            default_color: None,
+                            texspace: None,
+                        },
+                    };
+                    let set =
+                        crate::geometry::evaluate_object(scene, &obj.name, eval.frame, overrides)
+                            .map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))?;
+                    // Top-level instances stay separate, each with its own id, sharing the
+                    // realised mesh of its reference; the rest of the set is one mesh.
+                    let mut rest = set.clone();
+                    let instances_component = rest.instances.take();
+                    let realise = |g: &crate::geometry::GeometrySet| -> Result<(Arc<MeshData>, Vec<Option<String>>), RenderError> {
                     let (g, points) = cycles_renders(g);
                     if let Some(p) = points {
                         return Err(RenderError(format!("object {:?}: its Geometry Nodes instances hold a point cloud ({} points), which Cycles renders as spheres: points in instances are not supported by the renderer yet", obj.name, p.len())));
@@ -320,137 +324,160 @@ pub fn build(
                     let mats = if m.materials.is_empty() { base.materials.to_vec() } else { m.materials.clone() };
                     Ok((Arc::new(m.to_scene(&obj.name)), mats))
                 };
-                let (rest, points) = cycles_renders(&rest);
-                let (mesh, mats) = realise(&rest)?;
-                let info = MeshInfo {
-                    materials: &mats,
-                    uv_name: base.uv_name.clone(),
-                    default_color: base.default_color.clone(),
-                    // Generated geometry: the bounds.
-                    texspace: None,
-                };
-                let before = instances.len();
-                push_instance(&mut instances, scene, oi, obj, &info, mesh, to_world, None)?;
-                let has_nodes = obj
-                    .modifiers
-                    .iter()
-                    .any(|m| m.kind == "NODES" && m.show_render);
-                if has_nodes && instances.len() > before {
-                    // Geometry Nodes output other than its top-level instances may hold
-                    // realised instances whose attributes Blender would read per nested
-                    // instance: an Instancer read there is refused (see bind_attributes).
-                    let pushed = instances.last_mut().expect("pushed");
-                    pushed.nested_instancer_names = obj.attribute_lookups.keys().cloned().collect();
-                }
-                if let Some(p) = points {
-                    let radius = match p.attributes.named("radius").map(|a| &a.data) {
-                        Some(crate::geometry::types::Array::Float(r)) if r.len() == p.len() => {
-                            r.clone()
-                        }
-                        _ => vec![0.01; p.len()],
-                    };
-                    let keys: Vec<[f32; 4]> = p
-                        .positions
-                        .iter()
-                        .zip(&radius)
-                        .map(|(q, &r)| [q[0], q[1], q[2], r])
-                        .collect();
-                    let materials = vec![p.materials.first().cloned().flatten()];
+                    let (rest, points) = cycles_renders(&rest);
+                    let (mesh, mats) = realise(&rest)?;
                     let info = MeshInfo {
-                        materials: &materials,
-                        uv_name: None,
-                        default_color: None,
+                        materials: &mats,
+                        uv_name: base.uv_name.clone(),
+                        default_color: base.default_color.clone(),
+                        // Generated geometry: the bounds.
                         texspace: None,
                     };
-                    let slots = vec![0; keys.len()];
-                    // Generic point attributes, as Cycles' copy_attributes gives them to
-                    // the Attribute node (position and radius are the points themselves).
-                    let attributes = p
-                        .attributes
+                    let before = instances.len();
+                    push_instance(&mut instances, scene, oi, obj, &info, mesh, to_world, None)?;
+                    let has_nodes = obj
+                        .modifiers
                         .iter()
-                        .filter(|a| a.domain == crate::geometry::types::Domain::Point)
-                        .filter_map(|a| {
-                            let name = a.id.name()?;
-                            (name != "position" && name != "radius").then(|| {
-                                (
-                                    name.to_string(),
-                                    false,
-                                    crate::geometry::mesh::scene_data(&a.data),
-                                )
-                            })
-                        })
-                        .collect();
-                    push_points(
-                        &mut instances,
-                        scene,
-                        oi,
-                        obj,
-                        &info,
-                        (&keys, &slots),
-                        attributes,
-                        to_world,
-                    )?;
-                }
-                if let Some(inst) = instances_component {
-                    let mut by_handle: HashMap<u32, (Arc<MeshData>, Vec<Option<String>>)> =
-                        HashMap::new();
-                    for (i, (&h, t)) in inst.handles.iter().zip(&inst.transforms).enumerate() {
-                        let Some(g) = inst.references.get(h as usize).and_then(|r| r.geometry())
-                        else {
-                            continue;
-                        };
-                        let (mesh, mats) = match by_handle.get(&h) {
-                            Some(x) => x.clone(),
-                            None => {
-                                let x = realise(g)?;
-                                by_handle.insert(h, x.clone());
-                                x
+                        .any(|m| m.kind == "NODES" && m.show_render);
+                    if has_nodes && instances.len() > before {
+                        // Geometry Nodes output other than its top-level instances may hold
+                        // realised instances whose attributes Blender would read per nested
+                        // instance: an Instancer read there is refused (see bind_attributes).
+                        let pushed = instances.last_mut().expect("pushed");
+                        pushed.nested_instancer_names =
+                            obj.attribute_lookups.keys().cloned().collect();
+                    }
+                    if let Some(p) = points {
+                        let radius = match p.attributes.named("radius").map(|a| &a.data) {
+                            Some(crate::geometry::types::Array::Float(r)) if r.len() == p.len() => {
+                                r.clone()
                             }
+                            _ => vec![0.01; p.len()],
                         };
-                        // Instance transforms are column-major (`m[col][row]`).
-                        let mut local = Affine { m: [[0.0; 4]; 3] };
-                        for r in 0..3 {
-                            for c in 0..4 {
-                                local.m[r][c] = t[c][r];
-                            }
-                        }
-                        let world = compose(&to_world, &local);
+                        let keys: Vec<[f32; 4]> = p
+                            .positions
+                            .iter()
+                            .zip(&radius)
+                            .map(|(q, &r)| [q[0], q[1], q[2], r])
+                            .collect();
+                        let materials = vec![p.materials.first().cloned().flatten()];
                         let info = MeshInfo {
-                            materials: &mats,
-                            uv_name: base.uv_name.clone(),
-                            default_color: base.default_color.clone(),
+                            materials: &materials,
+                            uv_name: None,
+                            default_color: None,
                             texspace: None,
                         };
-                        let before = instances.len();
-                        push_instance(
+                        let slots = vec![0; keys.len()];
+                        // Generic point attributes, as Cycles' copy_attributes gives them to
+                        // the Attribute node (position and radius are the points themselves).
+                        let attributes = p
+                            .attributes
+                            .iter()
+                            .filter(|a| a.domain == crate::geometry::types::Domain::Point)
+                            .filter_map(|a| {
+                                let name = a.id.name()?;
+                                (name != "position" && name != "radius").then(|| {
+                                    (
+                                        name.to_string(),
+                                        false,
+                                        crate::geometry::mesh::scene_data(&a.data),
+                                    )
+                                })
+                            })
+                            .collect();
+                        push_points(
                             &mut instances,
                             scene,
                             oi,
                             obj,
                             &info,
-                            mesh,
-                            world,
-                            Some(i as u32),
+                            (&keys, &slots),
+                            attributes,
+                            to_world,
                         )?;
-                        if instances.len() > before {
-                            let pushed = instances.last_mut().expect("pushed");
-                            pushed.nested_instancer_names = obj
-                                .attribute_lookups
-                                .keys()
-                                .filter(|n| nested_instance_attribute(g, n))
-                                .cloned()
-                                .collect();
-                            for (name, value) in &mut pushed.instancer_values {
-                                if let Some(v) = inst.attributes.named(name).and_then(|a| {
-                                    crate::geometry::instances::instance_rgba(&a.data, i)
-                                }) {
-                                    *value = v;
+                    }
+                    if let Some(inst) = instances_component {
+                        let mut by_handle: HashMap<u32, (Arc<MeshData>, Vec<Option<String>>)> =
+                            HashMap::new();
+                        for (i, (&h, t)) in inst.handles.iter().zip(&inst.transforms).enumerate() {
+                            let Some(g) =
+                                inst.references.get(h as usize).and_then(|r| r.geometry())
+                            else {
+                                continue;
+                            };
+                            let (mesh, mats) = match by_handle.get(&h) {
+                                Some(x) => x.clone(),
+                                None => {
+                                    let x = realise(g)?;
+                                    by_handle.insert(h, x.clone());
+                                    x
+                                }
+                            };
+                            // Instance transforms are column-major (`m[col][row]`).
+                            let mut local = Affine { m: [[0.0; 4]; 3] };
+                            for r in 0..3 {
+                                for c in 0..4 {
+                                    local.m[r][c] = t[c][r];
+                                }
+                            }
+                            let world = compose(&to_world, &local);
+                            let info = MeshInfo {
+                                materials: &mats,
+                                uv_name: base.uv_name.clone(),
+                                default_color: base.default_color.clone(),
+                                texspace: None,
+                            };
+                            let before = instances.len();
+                            push_instance(
+                                &mut instances,
+                                scene,
+                                oi,
+                                obj,
+                                &info,
+                                mesh,
+                                world,
+                                Some(i as u32),
+                            )?;
+                            if instances.len() > before {
+                                let pushed = instances.last_mut().expect("pushed");
+                                pushed.nested_instancer_names = obj
+                                    .attribute_lookups
+                                    .keys()
+                                    .filter(|n| nested_instance_attribute(g, n))
+                                    .cloned()
+                                    .collect();
+                                for (name, value) in &mut pushed.instancer_values {
+                                    if let Some(v) = inst.attributes.named(name).and_then(|a| {
+                                        crate::geometry::instances::instance_rgba(&a.data, i)
+                                    }) {
+                                        *value = v;
+                                    }
                                 }
                             }
                         }
                     }
+                    // Instances realised into the mesh whose Instancer attributes its materials
+                    // read: Blender's evaluated mesh carries them per instance, where ours would
+                    // be refused (bind_attributes), so the frozen mesh renders while it is valid.
+                    if instances[start..]
+                        .iter()
+                        .any(|i| !i.nested_instancer_names.is_empty())
+                    {
+                        if let Some(ei) = crate::geometry::source::frozen_instead(
+                            scene,
+                            obj,
+                            eval.frame,
+                            &overridden,
+                            "its materials read Instancer attributes of instances it realises",
+                        ) {
+                            instances.truncate(start);
+                            source = Source::Frozen(ei);
+                            continue;
+                        }
+                    }
                 }
             }
+            break;
         }
     }
     let (tris, refs) = world_triangles(&instances);
