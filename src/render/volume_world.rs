@@ -36,16 +36,10 @@ pub struct WorldVolume {
 /// The scene world's volume, if its active World Output has a linked Volume; an error
 /// naming the world for what blendsynth cannot evaluate in it.
 pub fn world_volume(scene: &BlendScene) -> Result<Option<WorldVolume>, RenderError> {
-    let Some(name) = scene.file.scene.world.as_deref() else {
+    let Some((w, tree)) = super::light::world::node_tree(scene) else {
         return Ok(None);
     };
-    let Some(w) = scene.file.worlds.iter().find(|w| w.name == name) else {
-        return Ok(None);
-    };
-    let tree = match (&w.node_tree, w.use_nodes) {
-        (Some(t), true) => t,
-        _ => return Ok(None),
-    };
+    let name = w.name.as_str();
     let Some(out) = crate::nodes::graph::active_output(tree, "ShaderNodeOutputWorld", "CYCLES")
     else {
         return Ok(None);

@@ -122,19 +122,23 @@ impl WorldShader {
     }
 }
 
+/// The scene world and its node tree, when it has one in use (Use Nodes on).
+pub(crate) fn node_tree(scene: &Scene) -> Option<(&crate::scene::World, &crate::scene::NodeTree)> {
+    let name = scene.file.scene.world.as_deref()?;
+    let w = scene.file.worlds.iter().find(|w| w.name == name)?;
+    match (&w.node_tree, w.use_nodes) {
+        (Some(t), true) => Some((w, t)),
+        _ => None,
+    }
+}
+
 /// The scene world's shader when it is not a constant colour (None: `background`
 /// gives its constant radiance).
 pub fn shader(scene: &Scene) -> Result<Option<WorldShader>, RenderError> {
-    let Some(name) = scene.file.scene.world.as_deref() else {
+    let Some((w, tree)) = node_tree(scene) else {
         return Ok(None);
     };
-    let Some(w) = scene.file.worlds.iter().find(|w| w.name == name) else {
-        return Ok(None);
-    };
-    let tree = match (&w.node_tree, w.use_nodes) {
-        (Some(t), true) => t,
-        _ => return Ok(None),
-    };
+    let name = w.name.as_str();
     // A constant surface needs no program; the world's Volume is compiled and checked by
     // render/volume_world.rs.
     if is_constant(tree) {
