@@ -323,14 +323,32 @@ pub fn report_at(scene: &Scene, frame: Option<f64>) -> Report {
             error: Some(e),
         }],
     };
-    let (frozen, mesh_errors) = geometry_checks(scene, frame);
+    let (mut frozen, mesh_errors) = geometry_checks(scene, frame);
     let opts = crate::render::RenderOptions {
         frame: Some(frame),
         ..Default::default()
     };
-    let render_error = crate::render::check(scene, &opts, &[])
-        .err()
-        .map(|e| e.to_string());
+    let render_error = match crate::render::check(scene, &opts, &[]) {
+        Ok(checked) => {
+            // Objects `render` draws from Blender's evaluated mesh although `mesh`
+            // evaluates them (instances whose Instancer attributes the materials read).
+            for z in checked.frozen_instead {
+                if frozen.iter().any(|f| f.object == z.object) {
+                    continue;
+                }
+                let e = &f.evaluated[z.evaluated];
+                frozen.push(FrozenSummary {
+                    object: z.object,
+                    reason: format!("in renders: {}", z.reason),
+                    frame: e.frame,
+                    reads: e.reads.clone().unwrap_or_default(),
+                    animated: e.animated.clone(),
+                });
+            }
+            None
+        }
+        Err(e) => Some(e.to_string()),
+    };
     // The render's verdict and mesh's, nothing else: the coverage table and material
     // list also show what nothing renders, which refuses nothing.
     let all_supported = render_error.is_none() && mesh_errors.is_empty();

@@ -143,3 +143,23 @@ fn smoke_domains_say_what_they_render_from() {
         serde_json::json!(["color", "density", "temperature"])
     );
 }
+
+#[test]
+fn an_object_rendered_from_blenders_mesh_instead_is_listed_as_frozen() {
+    // Blendsynth evaluates this Geometry Nodes object, but its material reads an Instancer
+    // attribute of instances it realises, so `render` draws Blender's evaluated mesh of it
+    // (render/build.rs, geometry::source::frozen_instead): inspect must say so.
+    let (code, r) = report("fixtures/render/scenes/nested_instancer_native");
+    assert_eq!(code, Some(0), "{r}");
+    let frozen = r["frozen"].as_array().unwrap();
+    let z = frozen
+        .iter()
+        .find(|z| {
+            z["reason"]
+                .as_str()
+                .unwrap()
+                .contains("Instancer attributes")
+        })
+        .unwrap_or_else(|| panic!("no object frozen for its Instancer attributes: {r}"));
+    assert!(z["reads"].as_array().is_some_and(|a| !a.is_empty()), "{z}");
+}

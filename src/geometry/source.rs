@@ -300,9 +300,6 @@ pub fn simulation_after_start(scene: &Scene, o: &Object, frame: f64) -> Option<S
     None
 }
 
-/// The export's evaluated mesh of `o`, when it may stand for the object at `frame` with
-/// the scene's overrides: nothing it reads is animated (or the frame is the exported
-/// one) and no override changed what it reads.
 /// Blender's evaluated mesh of `o` in place of blendsynth's own evaluation, for `reason`,
 /// when the export has one that is valid at the frame and overrides; None otherwise.
 pub fn frozen_instead(
@@ -322,6 +319,9 @@ pub fn frozen_instead(
         .flatten()
 }
 
+/// The export's evaluated mesh of `o`, when it may stand for the object at `frame` with
+/// the scene's overrides: nothing it reads is animated (or the frame is the exported
+/// one) and no override changed what it reads.
 fn frozen(
     scene: &Scene,
     o: &Object,

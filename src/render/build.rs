@@ -114,6 +114,18 @@ pub struct Geometry {
     pub instances: Vec<MeshInstance>,
     pub tris: Vec<[V3; 3]>,
     pub refs: Vec<TriRef>,
+    /// Objects blendsynth evaluates but renders from Blender's evaluated mesh instead
+    /// (`geometry::source::frozen_instead`), so `inspect` lists them as frozen.
+    pub frozen_instead: Vec<FrozenInstead>,
+}
+
+/// An object rendered from the export's evaluated mesh although blendsynth evaluates it.
+#[derive(Debug, Clone)]
+pub struct FrozenInstead {
+    pub object: String,
+    /// Its entry in `scene.file.evaluated`.
+    pub evaluated: usize,
+    pub reason: &'static str,
 }
 
 fn material_index(scene: &Scene, name: &Option<String>) -> Option<usize> {
@@ -173,6 +185,7 @@ pub fn build(
     use crate::geometry::source::{object_source, Source};
     let mut cache: HashMap<usize, Arc<MeshData>> = HashMap::new();
     let mut instances = Vec::new();
+    let mut frozen_instead = Vec::new();
     let overridden: Vec<String> = overrides.iter().map(|(p, _)| p.clone()).collect();
     for (oi, obj) in eval.data.objects.iter().enumerate() {
         // Cycles does not sync an object no ray can see.
@@ -463,13 +476,20 @@ pub fn build(
                         .iter()
                         .any(|i| !i.nested_instancer_names.is_empty())
                     {
+                        const REASON: &str =
+                            "its materials read Instancer attributes of instances it realises";
                         if let Some(ei) = crate::geometry::source::frozen_instead(
                             scene,
                             obj,
                             eval.frame,
                             &overridden,
-                            "its materials read Instancer attributes of instances it realises",
+                            REASON,
                         ) {
+                            frozen_instead.push(FrozenInstead {
+                                object: obj.name.clone(),
+                                evaluated: ei,
+                                reason: REASON,
+                            });
                             instances.truncate(start);
                             source = Source::Frozen(ei);
                             continue;
@@ -485,6 +505,7 @@ pub fn build(
         instances,
         tris,
         refs,
+        frozen_instead,
     })
 }
 

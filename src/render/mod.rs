@@ -669,14 +669,24 @@ struct Prepared {
 
 /// Every check `render` makes of the scene (objects, modifiers, frozen geometry, nodes,
 /// materials, lights, world, camera, options) at the options' frame, without tracing a
-/// ray: `inspect` runs this, so its exit status is the render's. Returns the number of
-/// triangles the render would trace.
+/// ray: `inspect` runs this, so its exit status is the render's.
 pub fn check(
     scene: &Scene,
     opts: &RenderOptions,
     overrides: &[(String, Value)],
-) -> Result<usize, RenderError> {
-    prepare(scene, opts, overrides).map(|p| build::triangle_count(&p.geo))
+) -> Result<Checked, RenderError> {
+    prepare(scene, opts, overrides).map(|p| Checked {
+        triangles: build::triangle_count(&p.geo),
+        frozen_instead: p.geo.frozen_instead,
+    })
+}
+
+/// What `check` found: the triangles the render would trace, and the objects it would
+/// render from Blender's evaluated mesh although blendsynth evaluates them.
+#[derive(Debug)]
+pub struct Checked {
+    pub triangles: usize,
+    pub frozen_instead: Vec<build::FrozenInstead>,
 }
 
 /// A Point Density grid is Blender's at the exported frame (particles and animated points
