@@ -538,8 +538,18 @@ impl Scene<'_> {
                 // shade_light continues the path).
                 let t_light = self.light_in_segment(&path, t_hit);
                 let t_end = t_light.unwrap_or(t_hit);
+                // Cycles plays Russian roulette when a ray is cast
+                // (integrator_intersect_terminate); inside a volume also for a ray that
+                // leaves the scene or meets a light, whose survivor neither the background
+                // nor the light divides by its probability. Such paths lose 1 - q of what
+                // they bring back: a bias (a darker world-volume scene), which we match.
+                let survives = (hit_opt.is_some() && t_light.is_none())
+                    || path
+                        .continuation(st, rng.get4(index, path.set + 1)[3])
+                        .is_some();
                 match self.volume_segment(&mut path, t_end, rng, index, scratch) {
-                    super::volume::Segment::Passed => {}
+                    super::volume::Segment::Passed if survives => {}
+                    super::volume::Segment::Passed => break,
                     super::volume::Segment::Scattered => continue,
                     super::volume::Segment::Stop => break,
                 }
