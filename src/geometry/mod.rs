@@ -85,7 +85,7 @@ pub fn evaluate_object(
     // Simulation zones continue the state of the frame before: play them from their
     // start, one whole evaluation per frame (nodes::simulation_zone).
     let mut states = eval::SimulationStates::new();
-    for f in nodes::simulation_zone::playback_frames(scene, frame)? {
+    for f in nodes::simulation_zone::playback_frames(scene, object, frame)? {
         let scene = animated::scene_at(scene, f, overrides)?;
         let session = session_at(&scene, f)?.with_simulation_states(states);
         session.evaluate_object(object).map_err(|e| {

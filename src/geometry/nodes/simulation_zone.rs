@@ -424,11 +424,49 @@ pub fn unavailable_reason(scene: &Scene, o: &Object, frame: f64) -> Option<Strin
     None
 }
 
-/// The frames `geometry::evaluate_object` evaluates, in order, before `frame` so that
-/// every Simulation zone of the scene has played up to it: each whole frame from the
-/// earliest zone start to the frame before `frame` (up to the latest zone end, past
-/// which states stay). Empty when the scene has no Simulation zone.
-pub fn playback_frames(scene: &Scene, frame: f64) -> Result<Vec<f64>, GeometryError> {
+/// Whether `o`'s geometry may depend on a Simulation zone: its own Geometry Nodes hold
+/// one, or read other objects' geometry (Object Info, Collection Info), which may.
+fn may_simulate(scene: &Scene, o: &Object) -> bool {
+    let reads_objects = o
+        .modifiers
+        .iter()
+        .filter(|m| m.show_render && m.kind == "NODES")
+        .filter_map(|m| m.node_group.as_deref())
+        .any(|g| {
+            let mut seen: Vec<&str> = Vec::new();
+            let mut todo = vec![g];
+            while let Some(g) = todo.pop() {
+                if seen.contains(&g) {
+                    continue;
+                }
+                seen.push(g);
+                let Some(tree) = scene.node_group(g) else {
+                    continue;
+                };
+                for n in &tree.nodes {
+                    if matches!(
+                        n.bl_idname.as_str(),
+                        "GeometryNodeObjectInfo" | "GeometryNodeCollectionInfo"
+                    ) {
+                        return true;
+                    }
+                    todo.extend(n.node_tree.as_deref());
+                }
+            }
+            false
+        });
+    reads_objects || !zones_of(scene, o).is_empty()
+}
+
+/// The frames `geometry::evaluate_object` evaluates `object` at, in order, before `frame`
+/// so that every Simulation zone of the scene has played up to it: each whole frame from
+/// the earliest zone start to the frame before `frame` (up to the latest zone end, past
+/// which states stay). Empty when the scene has no Simulation zone or the object's
+/// geometry cannot depend on one.
+pub fn playback_frames(scene: &Scene, object: &str, frame: f64) -> Result<Vec<f64>, GeometryError> {
+    if !scene.object(object).is_some_and(|o| may_simulate(scene, o)) {
+        return Ok(Vec::new());
+    }
     let mut first: Option<i32> = None;
     let mut last: Option<i32> = None;
     let mut unbounded = false;
