@@ -1329,14 +1329,49 @@ def custom_props(idb, where):
 
 def modifier_entry(m, where):
     d = {"name": m.name, "type": m.type, "show_render": m.show_render, "show_viewport": m.show_viewport,
-         "properties": rna_value(m, 0, where, skip={"name", "type", "show_render", "show_viewport"}),
+         # A NODES modifier's bakes are `bake_states` below (their RNA repeats each
+         # zone's whole node, tens of kB per modifier).
+         "properties": rna_value(m, 0, where, skip={"name", "type", "show_render", "show_viewport", "bakes"}),
          "node_group": None, "inputs": {}}
     if m.type == "NODES":
         d["node_group"] = key(m.node_group) if m.node_group else None
         # Group input values live in the modifier's ID properties, keyed by the group's
         # interface identifiers (Socket_2, Socket_2_use_attribute, ...).
         d["inputs"] = {k: py_value(m[k], f"{where}[{q(k)}]", 0) for k in m.keys()}
+        d["bake_states"] = [bake_state(m, b) for b in m.bakes]
     return d
+
+
+def bake_state(m, b):
+    """A Geometry Nodes modifier's bake item (one per Simulation zone or Bake node): its
+    node, the frame range it sets, and whether baked data exists, which Blender reads
+    instead of simulating. RNA does not say whether a packed bake exists; the DNA struct
+    (NodesModifierBake: packed at byte 48, after id, flag, mode, target, directory,
+    frame_start at 24 and frame_end at 28) does, read only when those fields match RNA;
+    None when unknown. A disk bake exists when its folder holds meta/*.json files."""
+    import ctypes
+    node = b.node
+    baked = None
+    try:
+        p = b.as_pointer()
+        same = (ctypes.c_int32.from_address(p).value == b.bake_id
+                and ctypes.c_int32.from_address(p + 24).value == b.frame_start
+                and ctypes.c_int32.from_address(p + 28).value == b.frame_end)
+        if same and bpy.app.version[:2] == (4, 5):
+            baked = bool(ctypes.c_void_p.from_address(p + 48).value)
+    except Exception:
+        baked = None
+    target = b.bake_target if b.bake_target != "INHERIT" else m.bake_target
+    if target == "DISK" and not baked:
+        folder = b.directory if b.use_custom_path else (
+            os.path.join(m.bake_directory, str(b.bake_id)) if m.bake_directory else "")
+        meta = os.path.join(bpy.path.abspath(folder), "meta") if folder else ""
+        baked = bool(meta) and os.path.isdir(meta) and any(f.endswith(".json") for f in os.listdir(meta))
+    return {"bake_id": b.bake_id, "node": node.name if node else None,
+            "node_tree": node.id_data.name if node else None,
+            "use_custom_simulation_frame_range": b.use_custom_simulation_frame_range,
+            "frame_start": b.frame_start, "frame_end": b.frame_end,
+            "target": target, "baked": baked}
 
 
 RENDER_LAYER = set()  # as_pointer() of the objects the view layer renders (render_layer_objects)
@@ -1428,6 +1463,8 @@ def object_entry(o, view_layer):
         "delta_location": vec(o.delta_location), "delta_rotation_euler": vec(o.delta_rotation_euler),
         "delta_rotation_quaternion": vec(o.delta_rotation_quaternion), "delta_scale": vec(o.delta_scale),
         "hide_render": o.hide_render, "hide_viewport": o.hide_viewport,
+        # Object > Simulation Cache: without it a simulation keeps stepping past its end.
+        "use_simulation_cache": o.use_simulation_cache,
         "in_render_layer": o.as_pointer() in RENDER_LAYER,
         "visible": o.visible_get(view_layer=view_layer) if in_view_layer(o, view_layer) else False,
         "pass_index": o.pass_index, "collections": [key(c) for c in o.users_collection],
@@ -1818,6 +1855,8 @@ def main():
             # range, else its frame range).
             "simulation_frame_start": (scene.simulation_frame_start if scene.use_custom_simulation_range
                                        else scene.frame_start),
+            "simulation_frame_end": (scene.simulation_frame_end if scene.use_custom_simulation_range
+                                     else scene.frame_end),
             "fps": scene.render.fps, "fps_base": scene.render.fps_base,
             "camera": key(scene.camera) if scene.camera else None, "world": key(scene.world) if scene.world else None,
             "render": rna_value(scene.render, 0, "scene.render"),

@@ -338,6 +338,13 @@ fn run_scene(dir: &Path, r: &mut Report) -> usize {
         if let Ok(geometry::source::Source::Frozen(_)) =
             geometry::source::object_source(&scene, object, e.frame, &[])
         {
+            // A baked Simulation zone is Blender's mesh by design (tests below).
+            if let Some(why) = geometry::source::simulation_after_start(&scene, object, e.frame) {
+                if why.contains("baked data") {
+                    r.lines.push(format!("{case:28} FROZEN (baked simulation)"));
+                    continue;
+                }
+            }
             let node = geometry::source::unsupported_gn_node(&scene, object);
             r.failures.push(format!(
                 "{case}: frozen, blendsynth does not evaluate it (unsupported node: {node:?})"
@@ -569,10 +576,12 @@ fn parity_fixtures_stay_small() {
     // string scenes (gn_zones.py: 0.57 MB, most of it scene.json) and the curve node
     // scenes (gn_curve_nodes.py: 0.66 MB, mostly node trees) to 10 MB; Trim Curve, Fillet
     // Curve, Index of Nearest, Shortest Edge Paths, instance propagation and Pick Instance
-    // (gn_more_nodes.py: 0.97 MB, three quarters of it scene.json) to 10.5 MB.
+    // (gn_more_nodes.py: 0.97 MB, three quarters of it scene.json) to 10.5 MB; the
+    // Simulation zone scene (gn_zones.py scene_simulation: 0.2 MB, three quarters of it
+    // node trees; its per-frame references are simulation_refs.json, 11 kB) to 10.6 MB.
     assert!(
-        total < 10_500_000,
-        "fixtures/geometry/scenes holds {total} bytes; keep it under 10.5 MB"
+        total < 10_600_000,
+        "fixtures/geometry/scenes holds {total} bytes; keep it under 10.6 MB"
     );
 }
 
@@ -940,4 +949,124 @@ fn trim_curve_refuses_catmull_rom_by_name() {
     )
     .unwrap_err();
     assert!(e.contains("Trim Curve") && e.contains("Catmull-Rom"), "{e}");
+}
+
+/// Simulation zones played from their start (fixtures/geometry/make_simulation_refs.py:
+/// Blender opened afresh and played from frame 1 to each frame): positions and the
+/// stored state items (single values, captured fields, a face-domain field) at frames
+/// before the range, its start, steps, a subframe, its end and past it, for the scene's
+/// range, a zone's own range, Simulation Cache off, Skip from Scene Time and a zone in a
+/// node group; at 30/1.001 fps.
+#[test]
+fn simulation_zones_match_blender_played_to_each_frame() {
+    let scene = load("simulation");
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/geometry/simulation_refs.json");
+    let refs: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let mut failures = Vec::new();
+    let mut worst = 0.0f64;
+    let mut checked = 0;
+    for (case, frames) in refs.as_object().unwrap() {
+        for (frame, want) in frames.as_object().unwrap() {
+            let f: f64 = frame.parse().unwrap();
+            let m = match mesh_of(&scene, case, f, &[]) {
+                Ok(m) => m,
+                Err(e) => {
+                    failures.push(format!("{case} at {frame}: {e}"));
+                    continue;
+                }
+            };
+            let pos = want["positions"].as_array().unwrap();
+            if pos.len() != m.vertex_count() {
+                failures.push(format!(
+                    "{case} at {frame}: {} vertices, Blender {}",
+                    m.vertex_count(),
+                    pos.len()
+                ));
+                continue;
+            }
+            let mut err = 0.0f64;
+            for (p, q) in m.positions.iter().zip(pos) {
+                for k in 0..3 {
+                    err = err.max((p[k] as f64 - q[k].as_f64().unwrap()).abs());
+                }
+            }
+            for (name, values) in want["attributes"].as_object().unwrap() {
+                let Some(a) = m.attributes.named(name) else {
+                    failures.push(format!("{case} at {frame}: no attribute {name:?}"));
+                    continue;
+                };
+                let ours = our_values(&a.data);
+                let theirs: Vec<Vec<f64>> = values
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|v| match v.as_array() {
+                        Some(c) => c.iter().map(|x| x.as_f64().unwrap()).collect(),
+                        None => vec![v.as_f64().unwrap()],
+                    })
+                    .collect();
+                if ours.len() != theirs.len() {
+                    failures.push(format!(
+                        "{case} at {frame}: {name:?} has {} values, Blender {}",
+                        ours.len(),
+                        theirs.len()
+                    ));
+                    continue;
+                }
+                for (a, b) in ours.iter().zip(&theirs) {
+                    for (x, y) in a.iter().zip(b) {
+                        // Relative above 1: the doubling items reach 1024.
+                        err = err.max((x - y).abs() / y.abs().max(1.0));
+                    }
+                }
+            }
+            // References are rounded to 1e-6; float steps accumulate a few ulps.
+            if err > 2e-5 {
+                failures.push(format!("{case} at {frame}: largest difference {err:.2e}"));
+            }
+            worst = worst.max(err);
+            checked += 1;
+        }
+    }
+    println!("simulation playback: {checked} case frames, worst difference {worst:.2e}");
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    assert!(checked >= 40, "{checked} case frames");
+}
+
+/// A zone whose bake is packed in the .blend is Blender's (baked) mesh at the exported
+/// frame and an error naming the object and the zone at any other frame, never a
+/// simulation of ours in place of the bake.
+#[test]
+fn baked_simulation_zones_are_refused_by_name() {
+    let scene = load("simulation");
+    let o = scene.object("sim_baked").unwrap();
+    let frame = scene.file.scene.frame_current as f64;
+    assert!(matches!(
+        geometry::source::object_source(&scene, o, frame, &[]),
+        Ok(geometry::source::Source::Frozen(_))
+    ));
+    let e = match geometry::source::object_source(&scene, o, 5.0, &[]) {
+        Err(e) => e.to_string(),
+        Ok(_) => panic!("frame 5 of a baked simulation evaluated"),
+    };
+    assert!(
+        e.contains("sim_baked") && e.contains("Simulation Output") && e.contains("baked data"),
+        "{e}"
+    );
+    // The same zone unbaked plays (sim_rise is that tree).
+    let o = scene.object("sim_rise").unwrap();
+    assert!(!matches!(
+        geometry::source::object_source(&scene, o, 5.0, &[]),
+        Ok(geometry::source::Source::Frozen(_))
+    ));
+}
+
+/// A frame far past the start is an error naming the limit, not hours of playback.
+#[test]
+fn simulation_playback_is_limited() {
+    let scene = load("simulation");
+    let e = mesh_of(&scene, "sim_rise", 1e9, &[]).unwrap_err();
+    assert!(e.contains("limit") && e.contains("limits.md"), "{e}");
 }

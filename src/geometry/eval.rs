@@ -34,7 +34,20 @@ pub struct Session<'s> {
     pub sort_ids: HashMap<String, Vec<i64>>,
     cache: RefCell<HashMap<String, GeometrySet>>,
     in_progress: RefCell<Vec<String>>,
+    /// Simulation zone states, carried from the previous frame's session to this one
+    /// (`nodes::simulation_zone`).
+    pub(super) simulation: RefCell<SimulationStates>,
 }
+
+/// One Simulation zone's state after the frame it was last stepped at.
+#[derive(Clone)]
+pub struct SimulationState {
+    pub frame: f64,
+    pub items: Vec<SocketValue>,
+}
+
+/// Simulation states by zone (object, modifier and the zone's output node path).
+pub type SimulationStates = HashMap<String, SimulationState>;
 
 impl<'s> Session<'s> {
     pub fn new(
@@ -50,7 +63,19 @@ impl<'s> Session<'s> {
             sort_ids,
             cache: RefCell::new(HashMap::new()),
             in_progress: RefCell::new(Vec::new()),
+            simulation: RefCell::new(HashMap::new()),
         }
+    }
+
+    /// This session continuing the simulation states of the previous frame's.
+    pub fn with_simulation_states(self, states: SimulationStates) -> Self {
+        *self.simulation.borrow_mut() = states;
+        self
+    }
+
+    /// The simulation states after this session's evaluations.
+    pub fn into_simulation_states(self) -> SimulationStates {
+        self.simulation.into_inner()
     }
 
     pub fn world_matrix(&self, object: &str) -> Option<Mat4f> {
@@ -256,6 +281,7 @@ impl<'s> Session<'s> {
             graph,
             group_inputs: inputs,
             object: o,
+            modifier: m,
             memo: RefCell::new(HashMap::new()),
             busy: RefCell::new(HashSet::new()),
             zone_iterations: std::cell::Cell::new(0),
@@ -325,6 +351,8 @@ pub struct Evaluator<'a> {
     pub group_inputs: HashMap<String, SocketValue>,
     /// The object whose modifier this is (Self Object, relative transforms).
     pub object: &'a Object,
+    /// The modifier whose tree this is (its bakes, the simulation state's key).
+    pub modifier: &'a Modifier,
     memo: RefCell<HashMap<usize, Rc<Outputs>>>,
     busy: RefCell<HashSet<usize>>,
     /// Zone body runs so far, all zones together (`zones`: bounded by a limit).

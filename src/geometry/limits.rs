@@ -14,6 +14,10 @@ pub const MAX_ELEMENTS: u64 = 1 << 26;
 /// zone's node.
 pub const MAX_ZONE_ITERATIONS: u64 = 1 << 20;
 
+/// Most frames a Simulation zone is played for to reach the frame asked for (each one
+/// a whole evaluation of the object): 2^16, about 45 minutes at 24 fps.
+pub const MAX_SIMULATION_FRAMES: u64 = 1 << 16;
+
 /// Deepest field carried through a Repeat zone's iterations (operations from the field's
 /// output to its deepest input). Each iteration can wrap a field item in more operations
 /// and evaluating a field recurses through them, so a field item that grows with the

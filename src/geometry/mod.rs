@@ -82,16 +82,33 @@ pub fn evaluate_object(
     if !frame.is_finite() {
         return Err(GeometryError::new(format!("frame {frame} is not finite")));
     }
+    // Simulation zones continue the state of the frame before: play them from their
+    // start, one whole evaluation per frame (nodes::simulation_zone).
+    let mut states = eval::SimulationStates::new();
+    for f in nodes::simulation_zone::playback_frames(scene, object, frame)? {
+        let scene = animated::scene_at(scene, f, overrides)?;
+        let session = session_at(&scene, f)?.with_simulation_states(states);
+        session.evaluate_object(object).map_err(|e| {
+            GeometryError::new(format!(
+                "playing the simulation to frame {frame}, at frame {f}: {e}"
+            ))
+        })?;
+        states = session.into_simulation_states();
+    }
     let scene = animated::scene_at(scene, frame, overrides)?;
-    let anim = crate::anim::evaluate_scene(&scene, frame)?;
+    let session = session_at(&scene, frame)?.with_simulation_states(states);
+    session.evaluate_object(object)
+}
+
+fn session_at(scene: &Scene, frame: f64) -> Result<eval::Session<'_>, GeometryError> {
+    let anim = crate::anim::evaluate_scene(scene, frame)?;
     let world = anim
         .world_matrices
         .iter()
         .map(math::from_rows_f64)
         .collect();
-    let sort_ids = animated::link_sort_ids(&scene)?;
-    let session = eval::Session::new(&scene, frame, world, sort_ids);
-    session.evaluate_object(object)
+    let sort_ids = animated::link_sort_ids(scene)?;
+    Ok(eval::Session::new(scene, frame, world, sort_ids))
 }
 
 /// The geometry as one mesh: instances realized (Blender's Realize Instances order),

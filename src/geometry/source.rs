@@ -262,42 +262,12 @@ pub fn unsupported_gn_node(scene: &Scene, o: &Object) -> Option<String> {
         .find_map(|g| walk(scene, g, &mut seen))
 }
 
-/// Why `o` is frozen at `frame` when its Geometry Nodes hold a Simulation zone: blendsynth
-/// evaluates one only at its start frame; any other frame continues Blender's simulation
-/// state, which only Blender's evaluated mesh (the export's, or `convert --frames`) has.
+/// Why `o` is frozen at `frame` when its Geometry Nodes hold a Simulation zone blendsynth
+/// cannot play: one with baked data (Blender reads the bake instead of simulating), or
+/// an older export that does not say whether it is baked, at any frame but the start.
+/// Only Blender's evaluated mesh (the export's, or `convert --frames`) has it then.
 pub fn simulation_after_start(scene: &Scene, o: &Object, frame: f64) -> Option<String> {
-    let start = scene.file.scene.simulation_frame_start;
-    if start.is_some_and(|s| f64::from(s) == frame) {
-        return None;
-    }
-    let mut seen: Vec<&str> = Vec::new();
-    let mut todo: Vec<&str> = o
-        .modifiers
-        .iter()
-        .filter(|m| m.show_render && m.kind == "NODES")
-        .filter_map(|m| m.node_group.as_deref())
-        .collect();
-    while let Some(g) = todo.pop() {
-        if seen.contains(&g) {
-            continue;
-        }
-        seen.push(g);
-        let Some(tree) = scene.node_group(g) else {
-            continue;
-        };
-        for n in &tree.nodes {
-            if n.bl_idname == "GeometryNodeSimulationOutput" {
-                let start = start.map_or("unknown".to_string(), |s| s.to_string());
-                return Some(format!(
-                    "Simulation zone {:?} at frame {frame}: blendsynth evaluates it only at \
-                     its start frame {start}",
-                    n.name
-                ));
-            }
-            todo.extend(n.node_tree.as_deref());
-        }
-    }
-    None
+    super::nodes::simulation_zone::unavailable_reason(scene, o, frame)
 }
 
 /// Blender's evaluated mesh of `o` in place of blendsynth's own evaluation, for `reason`,

@@ -79,6 +79,9 @@ pub struct SceneSettings {
     /// Where Geometry Nodes simulation zones start (absent in older exports).
     #[serde(default)]
     pub simulation_frame_start: Option<i32>,
+    /// Where they end (absent in older exports).
+    #[serde(default)]
+    pub simulation_frame_end: Option<i32>,
     pub fps: f64,
     #[serde(default = "one_f64")]
     pub fps_base: f64,
@@ -197,6 +200,10 @@ pub struct Object {
     pub hide_render: bool,
     #[serde(default)]
     pub hide_viewport: bool,
+    /// Object > Simulation Cache (on by default): Simulation zones stop at the end of
+    /// their frame range; without it they keep stepping.
+    #[serde(default = "yes")]
+    pub use_simulation_cache: bool,
     #[serde(default = "yes")]
     pub visible: bool,
     /// In a view-layer collection that is neither excluded nor disabled in renders (nor
@@ -286,6 +293,33 @@ pub struct Modifier {
     pub node_group: Option<String>,
     #[serde(default)]
     pub inputs: Rna,
+    /// A Geometry Nodes modifier's bake items, one per Simulation zone or Bake node
+    /// (absent in older exports).
+    #[serde(default)]
+    pub bake_states: Option<Vec<BakeState>>,
+}
+
+/// One bake item of a Geometry Nodes modifier (FORMAT.md, `bake_states`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct BakeState {
+    pub bake_id: i64,
+    /// The zone's output node (or Bake node) and the node tree holding it.
+    #[serde(default)]
+    pub node: Option<String>,
+    #[serde(default)]
+    pub node_tree: Option<String>,
+    #[serde(default)]
+    pub use_custom_simulation_frame_range: bool,
+    #[serde(default)]
+    pub frame_start: i32,
+    #[serde(default)]
+    pub frame_end: i32,
+    #[serde(default)]
+    pub target: Option<String>,
+    /// Whether baked data exists (packed in the file or on disk); None when the exporter
+    /// could not tell.
+    #[serde(default)]
+    pub baked: Option<bool>,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]
