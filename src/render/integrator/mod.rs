@@ -532,32 +532,10 @@ impl Scene<'_> {
                 scratch.volume_stack.keep_world();
             }
             if from_sss.is_none() && !scratch.volume_stack.is_empty() {
-                let t_hit = hit_opt.map_or(crate::render::volume_world::ESCAPE, |h| h.t);
-                // A light inside the volume ends the segment: it is reached with the
-                // transmittance up to it, and the ray goes on past it (Cycles'
-                // shade_light continues the path).
-                let t_light = self.light_in_segment(&path, t_hit);
-                let t_end = t_light.unwrap_or(t_hit);
-                // Cycles plays Russian roulette when a ray is cast
-                // (integrator_intersect_terminate); inside a volume also for a ray that
-                // leaves the scene or meets a light, whose survivor neither the background
-                // nor the light divides by its probability. Such paths lose 1 - q of what
-                // they bring back: a bias (a darker world-volume scene), which we match.
-                let survives = (hit_opt.is_some() && t_light.is_none())
-                    || path
-                        .continuation(st, rng.get4(index, path.set + 1)[3])
-                        .is_some();
-                match self.volume_segment(&mut path, t_end, rng, index, scratch) {
-                    super::volume::Segment::Passed if survives => {}
-                    super::volume::Segment::Passed => break,
-                    super::volume::Segment::Scattered => continue,
-                    super::volume::Segment::Stop => break,
-                }
-                if let Some(t) = t_light {
-                    let clamp = path.hit_clamp(st);
-                    self.lights_along(&mut path, Some(t), clamp, scratch);
-                    self.past_light(&mut path, t);
-                    continue;
+                match self.through_volumes(&mut path, hit_opt.map(|h| h.t), rng, index, scratch) {
+                    Through::Surface => {}
+                    Through::Again => continue,
+                    Through::End => break,
                 }
             }
             let clamp_limit = path.hit_clamp(st);
@@ -1388,5 +1366,57 @@ impl Scene<'_> {
             &NoTrace,
         );
         scratch.light_lobes.emission
+    }
+}
+
+/// What a path does after the volume segment in front of it.
+enum Through {
+    /// Go on to the surface hit (or the miss).
+    Surface,
+    /// Trace again: it scattered, or passed a light inside the volume.
+    Again,
+    End,
+}
+
+impl Scene<'_> {
+    /// The volume segment up to the hit at `t_hit` (None: the ray leaves the scene and
+    /// crosses the world volume to FLT_MAX), or up to a light inside it, which the path
+    /// reaches with the transmittance up to it and then goes past (Cycles' shade_light
+    /// continues the path).
+    fn through_volumes(
+        &self,
+        path: &mut Path,
+        t_hit: Option<f32>,
+        rng: &PixelSampler,
+        index: u32,
+        scratch: &mut Scratch,
+    ) -> Through {
+        let st = &self.settings;
+        let t_hit_or_escape = t_hit.unwrap_or(crate::render::volume_world::ESCAPE);
+        let t_light = self.light_in_segment(path, t_hit_or_escape);
+        let t_end = t_light.unwrap_or(t_hit_or_escape);
+        // Cycles plays Russian roulette when a ray is cast (integrator_intersect_terminate);
+        // inside a volume also for a ray that leaves the scene or meets a light, whose
+        // survivor neither the background nor the light divides by its probability. Such
+        // paths lose 1 - q of what they bring back: a bias (a darker world-volume scene),
+        // which we match.
+        let survives = (t_hit.is_some() && t_light.is_none())
+            || path
+                .continuation(st, rng.get4(index, path.set + 1)[3])
+                .is_some();
+        match self.volume_segment(path, t_end, rng, index, scratch) {
+            super::volume::Segment::Passed if survives => {}
+            super::volume::Segment::Passed | super::volume::Segment::Stop => return Through::End,
+            super::volume::Segment::Scattered => return Through::Again,
+        }
+        match t_light {
+            Some(t) => {
+                let clamp = path.hit_clamp(st);
+                self.lights_along(path, Some(t), clamp, scratch);
+                self.past_light(path, t);
+                Through::Again
+            }
+            None => Through::Surface,
+        }
     }
 }
