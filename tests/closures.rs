@@ -242,3 +242,27 @@ fn glass_albedo_tables_match_cycles() {
         );
     }
 }
+
+/// The albedo tables the renderer embeds (src/render/bsdf/tables.bin) are the bits this
+/// code integrates, so embedding them changes no image. After a change to the tables'
+/// integration, rewrite them with
+/// `BLENDSYNTH_UPDATE_TABLES=1 cargo test --release --test closures embedded`.
+#[test]
+fn embedded_albedo_tables_are_the_integrated_ones() {
+    let integrated = Tables::new().to_le_bytes();
+    if std::env::var_os("BLENDSYNTH_UPDATE_TABLES").is_some() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/render/bsdf/tables.bin");
+        std::fs::write(path, &integrated).unwrap();
+        return;
+    }
+    assert!(
+        integrated == blendsynth::render::bsdf::tables::EMBEDDED,
+        "src/render/bsdf/tables.bin is not what the code integrates: rewrite it with \
+         BLENDSYNTH_UPDATE_TABLES=1 cargo test --release --test closures embedded"
+    );
+    // The round trip gives back the same tables.
+    let back = Tables::from_le_bytes(&integrated).unwrap();
+    assert!(back.to_le_bytes() == integrated);
+    assert!(Tables::from_le_bytes(&integrated[4..]).is_none());
+}

@@ -252,6 +252,16 @@ pub trait NoisePoint: Copy {
             *o = p.perlin_signed();
         }
     }
+    /// `perlin_signed` of `self.scaled(s)` for each scale `s` of `scales` into `out`:
+    /// fBm's octaves. Flavours with a lane-parallel kernel override it (the same bits).
+    fn perlin_signed_scaled(self, scales: &[f32], out: &mut [f32]) {
+        const MAX: usize = 17;
+        let mut pts = [self; MAX];
+        for (q, &s) in pts.iter_mut().zip(scales) {
+            *q = self.scaled(s);
+        }
+        Self::perlin_signed_batch(&pts[..scales.len()], out);
+    }
 }
 
 #[inline]
@@ -467,14 +477,14 @@ pub fn fbm<P: NoisePoint>(
     let rmd = detail - detail.floor();
     let count = if whole < 0 { 0 } else { whole as usize + 1 } + (rmd != 0.0) as usize;
     if count <= MAX_BATCH {
-        let mut pts = [p; MAX_BATCH];
+        let mut scales = [0.0f32; MAX_BATCH];
         let mut fscale = 1.0f32;
-        for q in pts.iter_mut().take(count) {
-            *q = p.scaled(fscale);
+        for s in scales.iter_mut().take(count) {
+            *s = fscale;
             fscale *= lacunarity;
         }
         let mut t = [0.0f32; MAX_BATCH];
-        P::perlin_signed_batch(&pts[..count], &mut t[..count]);
+        p.perlin_signed_scaled(&scales[..count], &mut t[..count]);
         return fbm_sum::<P>(&t[..count], detail, roughness, normalize);
     }
     let mut fscale = 1.0f32;
@@ -820,6 +830,18 @@ fn cy_perlin3(p: [f32; 3]) -> f32 {
 ))]
 #[inline]
 fn cy_perlin3_x8(p: &[[f32; 3]; 8]) -> Option<[f32; 8]> {
+    cy_perlin3_soa(&std::array::from_fn(|a| std::array::from_fn(|l| p[l][a])))
+}
+
+/// `cy_perlin3_x8` of points given as one 8-lane array per axis (`p[axis][lane]`), which
+/// fBm's octaves are built as directly.
+#[cfg(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    target_feature = "fma"
+))]
+#[inline]
+fn cy_perlin3_soa(p: &[[f32; 8]; 3]) -> Option<[f32; 8]> {
     use std::arch::x86_64::*;
     // SAFETY: AVX2 and FMA are enabled for the whole build (the cfg above); loads and
     // stores are unaligned ones of whole 8-lane arrays.
@@ -830,9 +852,7 @@ fn cy_perlin3_x8(p: &[[f32; 3]; 8]) -> Option<[f32; 8]> {
         let mut cell = [[0i32; 8]; 3];
         let mut frac = [_mm256_setzero_ps(); 3];
         for a in 0..3 {
-            let v = _mm256_setr_ps(
-                p[0][a], p[1][a], p[2][a], p[3][a], p[4][a], p[5][a], p[6][a], p[7][a],
-            );
+            let v = _mm256_loadu_ps(p[a].as_ptr());
             // |v| < 1e5 (false for NaN): `wrap` leaves v alone and `correction` adds +0.
             inside &=
                 _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(_mm256_and_ps(v, abs), period));
@@ -879,6 +899,15 @@ fn cy_perlin3_x8(p: &[[f32; 3]; 8]) -> Option<[f32; 8]> {
 )))]
 #[inline]
 fn cy_perlin3_x8(_: &[[f32; 3]; 8]) -> Option<[f32; 8]> {
+    None
+}
+#[cfg(not(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    target_feature = "fma"
+)))]
+#[inline]
+fn cy_perlin3_soa(_: &[[f32; 8]; 3]) -> Option<[f32; 8]> {
     None
 }
 
@@ -1012,6 +1041,28 @@ cycles_point!([f32; 3], cy_perlin3, 0.9820, {
                 None => {
                     for (o, p) in out.iter_mut().zip(ps) {
                         *o = p.perlin_signed();
+                    }
+                }
+            }
+        }
+    }
+    fn perlin_signed_scaled(self, scales: &[f32], out: &mut [f32]) {
+        // The octaves' points go straight into per-axis lanes (`scaled` is one product
+        // per component, so the same bits); copying whole points into lanes and
+        // gathering them again stalled on store forwarding. Unused lanes hold 0.
+        for (scales, out) in scales.chunks(8).zip(out.chunks_mut(8)) {
+            let mut s8 = [0.0f32; 8];
+            s8[..scales.len()].copy_from_slice(scales);
+            let lanes: [[f32; 8]; 3] = std::array::from_fn(|a| s8.map(|s| s * self.0[a]));
+            match cy_perlin3_soa(&lanes) {
+                Some(v) => {
+                    for (o, v) in out.iter_mut().zip(v) {
+                        *o = v * 0.9820;
+                    }
+                }
+                None => {
+                    for (o, &s) in out.iter_mut().zip(scales) {
+                        *o = self.scaled(s).perlin_signed();
                     }
                 }
             }

@@ -1,8 +1,9 @@
-//! Directional albedo tables of GGX, integrated here at start-up (as Cycles precomputes
-//! its own): E(mu, roughness) with Fresnel one, for multiple-scattering energy
-//! compensation, and the dielectric Fresnel average (Cycles' ggx_gen_schlick_ior_s, the
-//! Fresnel-weighted albedo over the Fresnel-one albedo, stored as a blend from F0 to 1)
-//! for layering Principled's specular and coat over what lies beneath.
+//! Directional albedo tables of GGX, integrated here and embedded in the binary as
+//! integrated (`tables.bin`; Cycles precomputes its own too): E(mu, roughness) with
+//! Fresnel one, for multiple-scattering energy compensation, and the dielectric Fresnel
+//! average (Cycles' ggx_gen_schlick_ior_s, the Fresnel-weighted albedo over the
+//! Fresnel-one albedo, stored as a blend from F0 to 1) for layering Principled's specular
+//! and coat over what lies beneath.
 
 use crate::render::bsdf::{f0_from_ior, fresnel_dielectric, ggx_lambda, sample_vndf};
 use crate::render::sampler::PixelSampler;
@@ -82,10 +83,47 @@ fn grid_eta(zi: usize) -> f32 {
 
 static SHARED: std::sync::OnceLock<Tables> = std::sync::OnceLock::new();
 
+/// `Tables::new()`'s tables as integrated by this code, little-endian f32s in the order
+/// of `Tables::to_le_bytes`: integrating them took a third of a second of CPU time in
+/// every process (two thirds more with the glass tables), as much as a quarter of a small
+/// render. tests/closures.rs checks they are the integration's bits and rewrites them
+/// with BLENDSYNTH_UPDATE_TABLES=1.
+pub const EMBEDDED: &[u8] = include_bytes!("tables.bin");
+
+const TABLE_LEN: [usize; 5] = [N1 * N1, N1, N3 * N3 * N3, N3 * N3 * N3, N3 * N3 * N3];
+
 impl Tables {
-    /// The tables, integrated once per process.
+    /// The tables, once per process: the embedded ones, integrated only if those are
+    /// missing (a file of another length).
     pub fn shared() -> &'static Tables {
-        SHARED.get_or_init(Tables::new)
+        SHARED.get_or_init(|| Tables::from_le_bytes(EMBEDDED).unwrap_or_default())
+    }
+
+    /// Every table (the glass ones integrated if they were not yet) as little-endian f32s:
+    /// GGX albedo, its means, the dielectric Fresnel averages, glass, inverse glass.
+    pub fn to_le_bytes(&self) -> Vec<u8> {
+        let (g, gi) = self.glass();
+        [&self.ggx_e, &self.ggx_e_avg, &self.dielectric_s, g, gi]
+            .iter()
+            .flat_map(|t| t.iter().flat_map(|x| x.to_le_bytes()))
+            .collect()
+    }
+
+    /// Tables from `to_le_bytes`' bytes; `None` when their length is not the tables'.
+    pub fn from_le_bytes(b: &[u8]) -> Option<Tables> {
+        if b.len() != TABLE_LEN.iter().sum::<usize>() * 4 {
+            return None;
+        }
+        let mut floats = b
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]));
+        let [e, avg, s, g, gi] = TABLE_LEN.map(|n| floats.by_ref().take(n).collect::<Vec<_>>());
+        Some(Tables {
+            ggx_e: e,
+            ggx_e_avg: avg,
+            dielectric_s: s,
+            glass: std::sync::OnceLock::from((g, gi)),
+        })
     }
 
     /// Integrates the tables, on rayon's threads when called outside its pool (a worker
