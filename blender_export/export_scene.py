@@ -1307,6 +1307,155 @@ def smoke_domain_entries(objs, out, depsgraph):
     return entries
 
 
+# Volume grids the exporter writes densely: OpenVDB value type -> channels.
+VDB_GRID_CHANNELS = {"float": 1, "vec3s": 3}
+# Values (voxels times channels) of one exported Volume grid: 2^28 floats is 1 GiB.
+MAX_VDB_GRID_VALUES = 1 << 28
+
+
+def openvdb_module():
+    """The OpenVDB Python module the bpy wheel ships beside Blender's own Python packages
+    (not on sys.path), or the reason it cannot be loaded."""
+    try:
+        import openvdb  # noqa: F401 (a Blender build with it on the path)
+        return openvdb, None
+    except ImportError:
+        pass
+    import glob
+    import importlib.util
+    root = os.path.join(bpy.utils.resource_path("LOCAL"), "python", "lib")
+    found = sorted(glob.glob(os.path.join(root, "python3*", "site-packages", "openvdb*.so")))
+    if not found:
+        return None, f"Blender's OpenVDB Python module was not found under {root}"
+    try:
+        spec = importlib.util.spec_from_file_location("openvdb", found[0])
+        mod = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(mod)
+        return mod, None
+    except Exception as e:  # a broken or foreign module: recorded, blendsynth refuses
+        return None, f"Blender's OpenVDB Python module at {found[0]} does not load ({e})"
+
+
+def index_to_object(grid):
+    """Grid GRID's index-to-object transform as (origin, per-axis voxel size), or None
+    when it rotates, shears or mirrors (not handled)."""
+    t = grid.transform
+    if not t.isLinear:
+        return None
+    o = np.array(t.indexToWorld((0, 0, 0)), dtype=np.float64)
+    axes = np.array([np.array(t.indexToWorld(e), dtype=np.float64) - o
+                     for e in ((1, 0, 0), (0, 1, 0), (0, 0, 1))])
+    size = np.diag(axes).copy()
+    off = axes - np.diag(size)
+    if np.any(size <= 0) or np.any(np.abs(off) > 1e-6 * np.max(np.abs(size))):
+        return None
+    return o, size
+
+
+def volume_object_entries(objs, out, depsgraph):
+    """Per Volume object: the grids its materials read (or the velocity grid), from its
+    evaluated Volume at the current frame (the file sequence frame, Geometry Nodes or
+    modifiers applied), saved by Blender to a .vdb and read with OpenVDB, each written
+    densely over its active voxels' bounding box as a voxel grid file (FORMAT.md)."""
+    entries = []
+    frame = bpy.context.scene.frame_current + bpy.context.scene.frame_subframe
+    vdb = None
+    vdb_error = None
+    for i, o in enumerate(objs):
+        if o.type != "VOLUME" or o.data is None:
+            continue
+        if vdb is None and vdb_error is None:
+            vdb, vdb_error = openvdb_module()
+        v = o.data
+        ev = o.evaluated_get(depsgraph).data
+        materials = [key(m) if m else None for m in v.materials]
+        wanted = set()
+        for slot in o.material_slots:
+            if slot.material is not None and slot.material.node_tree is not None:
+                wanted |= attribute_names_read(slot.material.node_tree, set())
+        r = v.render
+        entry = {"object": key(o), "volume": key(v), "frame": frame, "materials": materials,
+                 "space": r.space, "step_size": r.step_size, "clipping": r.clipping,
+                 "precision": r.precision, "velocity_grid": None,
+                 "velocity_scale": v.velocity_scale, "grids": [], "unread": [], "error": None}
+        if vdb is None:
+            entry["error"] = vdb_error
+            entries.append(entry)
+            continue
+        grids = ev.grids
+        if not grids.load():
+            entry["error"] = f"Blender could not load its grids: {grids.error_message or 'no message'}"
+            entries.append(entry)
+            continue
+        names = [g.name for g in grids]
+        vel = [n for n in (v.velocity_grid, v.velocity_x_grid, v.velocity_y_grid, v.velocity_z_grid)
+               if n and n in names]
+        entry["velocity_grid"] = vel[0] if vel else None
+        wanted = sorted(n for n in wanted if n in names)
+        if not wanted:
+            entries.append(entry)
+            continue
+        os.makedirs(os.path.join(out, "volumes"), exist_ok=True)
+        tmp = os.path.join(out, "volumes", f"{safe_name(i, key(o))[:-4]}.evaluated.vdb")
+        try:
+            grids.save(filepath=tmp)
+            read, _meta = vdb.readAll(tmp)
+        except Exception as e:
+            entry["error"] = f"its evaluated grids could not be saved and read back ({e})"
+            entries.append(entry)
+            continue
+        finally:
+            if os.path.exists(tmp):
+                os.remove(tmp)
+        by_name = {g.name: g for g in read}
+        for name in wanted:
+            g = by_name.get(name)
+            if g is None:
+                entry["unread"].append([name, "Blender's saved grids do not hold it"])
+                continue
+            channels = VDB_GRID_CHANNELS.get(g.valueTypeName)
+            if channels is None:
+                entry["unread"].append([name, f"OpenVDB value type {g.valueTypeName} is not handled (float and vec3s are)"])
+                continue
+            if "level" in str(g.gridClass).lower():
+                entry["unread"].append([name, "a level set grid is not handled"])
+                continue
+            tfm = index_to_object(g)
+            if tfm is None:
+                entry["unread"].append([name, "its transform rotates, shears or mirrors the voxels, which is not handled"])
+                continue
+            if g.activeVoxelCount() == 0:
+                entry["unread"].append([name, "it has no active voxel"])
+                continue
+            lo, hi = g.evalActiveVoxelBoundingBox()
+            dims = [int(hi[k]) - int(lo[k]) + 1 for k in range(3)]
+            if int(np.prod(dims)) * channels > MAX_VDB_GRID_VALUES:
+                entry["unread"].append([name, f"its active voxels span {dims}, more than {MAX_VDB_GRID_VALUES} values"])
+                continue
+            # copyToArray fills a (x, y, z[, c]) array from the index LO.
+            shape = tuple(dims) + ((3,) if channels == 3 else ())
+            dense = np.zeros(shape, dtype=np.float32)
+            g.copyToArray(dense, ijk=tuple(int(x) for x in lo))
+            # The file is x fastest: transpose to (z, y, x[, c]).
+            values = np.ascontiguousarray(dense.transpose((2, 1, 0) + ((3,) if channels == 3 else ())))
+            origin, size = tfm
+            # Cycles samples voxel ijk at index ijk + 0.5 (kernel_tex_image_interp_3d's
+            # -0.5 after the inverse index-to-object transform): the box starts at LO.
+            box_lo = origin + size * np.array(lo, dtype=np.float64)
+            box_hi = box_lo + size * np.array(dims, dtype=np.float64)
+            rel = f"volumes/{safe_name(i, key(o))[:-4]}_{name}.grid"
+            with open(os.path.join(out, rel), "wb") as f:
+                f.write(b"BSVGRID1")
+                f.write(struct.pack("<4I", channels, *dims))
+                f.write(np.concatenate([box_lo, box_hi]).astype("<f4").tobytes())
+                f.write(values.astype("<f4").tobytes())
+            entry["grids"].append({"name": name, "file": rel, "class": str(g.gridClass),
+                                   "index_min": [int(x) for x in lo],
+                                   "voxel_size": [float(x) for x in size]})
+        entries.append(entry)
+    return entries
+
+
 def matrix(m):
     return [[float(m[r][c]) for c in range(4)] for r in range(4)]
 
@@ -1822,6 +1971,7 @@ def main():
 
     with RenderSettings():
         smoke_domains = smoke_domain_entries(list(data.objects), out, bpy.context.evaluated_depsgraph_get())
+        volume_objects = volume_object_entries(list(data.objects), out, bpy.context.evaluated_depsgraph_get())
 
     RENDER_LAYER.update(render_layer_objects(view_layer))
     used_images = set()
@@ -1893,6 +2043,7 @@ def main():
         "animation": animation(data),
         "evaluated": evaluated,
         "smoke_domains": smoke_domains,
+        "volume_objects": volume_objects,
         "color_management": cm,
     }
     if args.frames is not None and not args.no_evaluated:

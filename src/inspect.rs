@@ -34,7 +34,10 @@ pub struct Report {
     /// make it stale.
     pub frozen: Vec<FrozenSummary>,
     /// Smoke domains and the grids they render from (or why they render nothing).
-    pub smoke_domains: Vec<SmokeSummary>,
+    pub smoke_domains: Vec<GridSummary>,
+    /// Volume objects (OpenVDB) and the grids they render from (or why they render
+    /// nothing).
+    pub volume_objects: Vec<GridSummary>,
     /// The frame the checks ran at.
     pub frame: f64,
     /// `render`'s verdict at the frame: None when it would render.
@@ -375,6 +378,7 @@ pub fn report_at(scene: &Scene, frame: Option<f64>) -> Report {
         material_status,
         frozen,
         smoke_domains: smoke_summaries(scene),
+        volume_objects: volume_summaries(scene),
         frame,
         render_error,
         mesh_errors,
@@ -383,17 +387,48 @@ pub fn report_at(scene: &Scene, frame: Option<f64>) -> Report {
     }
 }
 
-/// A smoke domain in the export: the frame its grids are of, the grids its materials read
-/// that Blender gave, and, when it renders nothing (as Cycles does then), why.
+/// A smoke domain or Volume object in the export: the frame its grids are of, the grids
+/// its materials read that Blender gave, and, when it renders nothing (as Cycles does
+/// then), why.
 #[derive(Debug, Serialize)]
-pub struct SmokeSummary {
+pub struct GridSummary {
     pub object: String,
     pub frame: f64,
     pub grids: Vec<String>,
     pub empty: Option<String>,
 }
 
-fn smoke_summaries(scene: &Scene) -> Vec<SmokeSummary> {
+/// Volume objects with a readable record (`render`'s check refuses the others by name).
+fn volume_summaries(scene: &Scene) -> Vec<GridSummary> {
+    let f = &scene.file;
+    f.volume_objects
+        .iter()
+        .enumerate()
+        .filter(|(_, v)| v.error.is_none() && v.unread.is_empty())
+        .map(|(i, v)| {
+            let empty = match scene.load_volume_grids(i) {
+                Err(e) => Some(format!("its grids do not load: {e}")),
+                Ok(g) if g.is_empty() => Some("its materials read none of its grids".into()),
+                Ok(g) => all_clipped(g, v.clipping)
+                    .then(|| "every voxel is at or below the Volume's clipping".into()),
+            };
+            GridSummary {
+                object: v.object.clone(),
+                frame: v.frame,
+                grids: v.grids.iter().map(|g| g.name.clone()).collect(),
+                empty,
+            }
+        })
+        .collect()
+}
+
+/// Whether no voxel of `grids` is above `clipping`: the renderer's rule
+/// (`DomainGrids::new`), under which the object renders nothing.
+fn all_clipped(grids: Vec<crate::scene::volume_grid::VoxelGrid>, clipping: f32) -> bool {
+    crate::render::volume_grid::DomainGrids::new(grids, clipping).is_none()
+}
+
+fn smoke_summaries(scene: &Scene) -> Vec<GridSummary> {
     let f = &scene.file;
     f.smoke_domains
         .iter()
@@ -406,16 +441,11 @@ fn smoke_summaries(scene: &Scene) -> Vec<SmokeSummary> {
                     Some("its materials read no grid (density, color, flame, heat, temperature, velocity)".into())
                 }
                 Ok(g) if g.is_empty() => Some(format!("no grid at the frame ({})", unread.join("; "))),
-                Ok(g) => {
-                    let any = g.iter().any(|g| {
-                        g.values
-                            .chunks(g.channels)
-                            .any(|v| v.iter().any(|x| x.abs() > d.clipping))
-                    });
-                    (!any).then(|| "every voxel is at or below the domain's clipping (an empty or unbaked cache)".into())
-                }
+                Ok(g) => all_clipped(g, d.clipping).then(|| {
+                    "every voxel is at or below the domain's clipping (an empty or unbaked cache)".into()
+                }),
             };
-            SmokeSummary {
+            GridSummary {
                 object: d.object.clone(),
                 frame: d.frame,
                 grids: d.grids.iter().map(|g| g.name.clone()).collect(),
@@ -432,7 +462,9 @@ fn geometry_checks(scene: &Scene, frame: f64) -> (Vec<FrozenSummary>, Vec<Object
     };
     let mut frozen = Vec::new();
     let mut errors = Vec::new();
-    for o in &scene.file.objects {
+    // A Volume object's geometry is its voxel grids, which `render`'s checks read; it
+    // has no mesh.
+    for o in scene.file.objects.iter().filter(|o| o.kind != "VOLUME") {
         match object_source(scene, o, frame, &[]) {
             Ok(Source::None) => continue,
             Ok(Source::Frozen(i)) => {
@@ -732,9 +764,13 @@ impl Report {
                 )?;
             }
         }
-        if !self.smoke_domains.is_empty() {
-            writeln!(o, "\nSmoke domains (voxel grids from the export)")?;
-            for d in &self.smoke_domains {
+        let grid_lists = [
+            ("Smoke domains", &self.smoke_domains),
+            ("Volume objects (OpenVDB)", &self.volume_objects),
+        ];
+        for (title, list) in grid_lists.into_iter().filter(|l| !l.1.is_empty()) {
+            writeln!(o, "\n{title} (voxel grids from the export)")?;
+            for d in list {
                 match &d.empty {
                     None => writeln!(
                         o,

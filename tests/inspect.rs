@@ -162,4 +162,68 @@ fn an_object_rendered_from_blenders_mesh_instead_is_listed_as_frozen() {
         })
         .unwrap_or_else(|| panic!("no object frozen for its Instancer attributes: {r}"));
     assert!(z["reads"].as_array().is_some_and(|a| !a.is_empty()), "{z}");
+/// Volume objects (OpenVDB) are listed with the grids they render from, `inspect` exits 0
+/// on them; a Volume object blendsynth cannot read is refused by name, by `inspect` and
+/// `render` alike: an export without its grids, the OpenVDB module missing, a grid type
+/// not handled, and motion blur by its velocity grid.
+#[test]
+fn volume_objects_render_from_their_grids_or_are_refused_by_name() {
+    let (code, r) = report("fixtures/render/scenes/volume_vdb_fog");
+    assert_eq!(code, Some(0), "{r}");
+    assert_eq!(r["render_error"], Value::Null);
+    let v = &r["volume_objects"][0];
+    assert_eq!(v["object"], "FogBall");
+    assert_eq!(v["grids"], serde_json::json!(["color", "density"]));
+    assert_eq!(v["empty"], Value::Null, "{v}");
+    let src = repo().join("fixtures/render/scenes/volume_vdb_fog");
+    let edited = |edit: &dyn Fn(&mut Value), must: &[&str]| {
+        let t = tempfile::tempdir().unwrap();
+        copy_dir(&src, t.path());
+        let json = t.path().join("scene.json");
+        let mut j: Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+        edit(&mut j);
+        std::fs::write(&json, serde_json::to_vec(&j).unwrap()).unwrap();
+        let o = run(&["inspect", "--json", t.path().to_str().unwrap()], &[]);
+        assert_ne!(o.status.code(), Some(0));
+        let r: Value = serde_json::from_slice(&o.stdout).unwrap();
+        let e = r["render_error"].as_str().unwrap_or_default().to_string();
+        for m in must.iter().chain(&["\"FogBall\"", "Volume object"]) {
+            assert!(e.contains(m), "{m:?} not in {e:?}");
+        }
+        let out = t.path().join("out.exr");
+        let o = run(
+            &[
+                "render",
+                t.path().to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+            ],
+            &[],
+        );
+        assert_clean_error(&o, 1, must);
+    };
+    edited(
+        &|j| j["volume_objects"] = serde_json::json!([]),
+        &["does not carry"],
+    );
+    edited(
+        &|j| {
+            j["volume_objects"][0]["error"] = "Blender's OpenVDB Python module was not found".into()
+        },
+        &["OpenVDB Python module"],
+    );
+    edited(
+        &|j| {
+            j["volume_objects"][0]["unread"] =
+                serde_json::json!([["mask", "OpenVDB value type bool is not handled"]])
+        },
+        &["\"mask\"", "bool"],
+    );
+    edited(
+        &|j| {
+            j["volume_objects"][0]["velocity_grid"] = "velocity".into();
+            j["scene"]["render"]["use_motion_blur"] = true.into();
+        },
+        &["velocity", "motion blur"],
+    );
 }

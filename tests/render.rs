@@ -320,6 +320,14 @@ const ASSERTED: &[&str] = &[
     // bake in the bpy wheel; Cycles renders the same gradients computed on a mesh cube).
     "smoke_unbaked",
     "smoke_grid_gradient",
+    // Volume objects (OpenVDB; render/volume_grid.rs): a 24^3 fog ball written with the
+    // wheel's OpenVDB module, its density and vec3 colour grids read by Principled Volume;
+    // the same with another voxel size, active voxels away from the index origin and a
+    // rotated, unevenly scaled object (Object space scales the density); and that with
+    // Space World and a Step Size.
+    "volume_vdb_fog",
+    "volume_vdb_transformed",
+    "volume_vdb_world_step",
     // The world volume (render/volume_world.rs), filling all space with the camera inside:
     // homogeneous scatter under a point light and a sun it extinguishes, absorption that
     // spares one channel (the sky and the sun stay in red), and a noise-texture density

@@ -11,6 +11,7 @@ use crate::shader::attributes::BoundAttributes;
 
 use super::RenderError;
 use crate::render::math::*;
+use crate::render::volume_grid::{DomainGrids, GridStep};
 
 /// One renderable mesh instance.
 pub struct MeshInstance {
@@ -64,9 +65,9 @@ pub struct MeshInstance {
     /// Hair: the object's curves (`render::curves`); the instance then has no triangles
     /// and its prims are curve segments.
     pub curves: Option<Arc<crate::render::curves::ObjectCurves>>,
-    /// A smoke domain's voxel grids (`volume_grid`); the instance's mesh is then the box
-    /// they tile.
-    pub grids: Option<Arc<crate::render::volume_grid::DomainGrids>>,
+    /// A smoke domain's or Volume object's voxel grids (`volume_grid`); the instance's
+    /// mesh is then a box around them.
+    pub grids: Option<Arc<DomainGrids>>,
 }
 
 impl MeshInstance {
@@ -195,6 +196,11 @@ pub fn build(
         if let Some((di, _)) = scene.smoke_domain(&obj.name) {
             let to_world = Affine::from_rows(&eval.world_matrices[oi]);
             push_smoke_domain(&mut instances, scene, (oi, obj), di, eval.frame, to_world)?;
+            continue;
+        }
+        if obj.kind == "VOLUME" {
+            let to_world = Affine::from_rows(&eval.world_matrices[oi]);
+            push_volume_object(&mut instances, scene, (oi, obj), eval.frame, to_world)?;
             continue;
         }
         let source = object_source(scene, obj, eval.frame, &overridden)
@@ -680,17 +686,77 @@ fn push_smoke_domain(
             obj.name, g.name, grids[0].name
         )));
     }
-    let Some(domain) = crate::render::volume_grid::DomainGrids::new(grids, d.clipping) else {
+    let Some(domain) = DomainGrids::new(grids, d.clipping) else {
         return Ok(());
     };
-    let mesh_ref = obj
+    let mesh_materials = obj
         .data
         .as_deref()
-        .and_then(|n| scene.file.meshes.iter().find(|m| m.name == n));
-    let no_materials: Vec<Option<String>> = Vec::new();
+        .and_then(|n| scene.file.meshes.iter().find(|m| m.name == n))
+        .map_or(&[][..], |m| &m.materials[..]);
+    push_grid_volume(
+        instances,
+        scene,
+        (oi, obj),
+        mesh_materials,
+        domain,
+        to_world,
+    )
+}
+
+/// A Volume object (OpenVDB) as Cycles renders it (blender/volume.cpp, scene/volume.cpp):
+/// its grids from the export at the frame, each over its box of active voxels, with the
+/// Volume's materials, its Render settings' clipping and step size, and Object space's
+/// density scaling; nothing when no voxel is above the clipping.
+fn push_volume_object(
+    instances: &mut Vec<MeshInstance>,
+    scene: &Scene,
+    (oi, obj): (usize, &crate::scene::Object),
+    frame: f64,
+    to_world: Affine,
+) -> Result<(), RenderError> {
+    // `volume::check_objects` has refused a Volume object without a readable record.
+    let Some((vi, v)) = scene.volume_object(&obj.name) else {
+        return Ok(());
+    };
+    if v.frame != frame && !v.grids.is_empty() {
+        return Err(RenderError(format!(
+            "object {:?}: its Volume grids were exported at frame {}, not {frame}: convert the file at this frame",
+            obj.name, v.frame
+        )));
+    }
+    let grids = scene
+        .load_volume_grids(vi)
+        .map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))?;
+    let Some(mut domain) = DomainGrids::new(grids, v.clipping) else {
+        return Ok(());
+    };
+    let object_space = v.space != "WORLD";
+    domain.step = match (v.step_size > 0.0, object_space) {
+        (false, _) => GridStep::Voxel,
+        (true, true) => GridStep::Object(v.step_size),
+        (true, false) => GridStep::World(v.step_size),
+    };
+    if object_space {
+        domain.density_scale = crate::render::volume_grid::object_space_density(&to_world);
+    }
+    push_grid_volume(instances, scene, (oi, obj), &v.materials, domain, to_world)
+}
+
+/// Voxel grids in an object (a smoke domain, a Volume object) as the instance Cycles
+/// builds for them: a box around the grids with the data's materials (`materials`, the
+/// object's slots overriding them).
+fn push_grid_volume(
+    instances: &mut Vec<MeshInstance>,
+    scene: &Scene,
+    (oi, obj): (usize, &crate::scene::Object),
+    materials: &[Option<String>],
+    domain: DomainGrids,
+    to_world: Affine,
+) -> Result<(), RenderError> {
     let (lo, hi) = (domain.min, domain.max);
     let info = MeshInfo {
-        materials: mesh_ref.map_or(&no_materials[..], |m| &m.materials[..]),
+        materials,
         uv_name: None,
         default_color: None,
         texspace: Some((scale(add(lo, hi), 0.5), scale(sub(hi, lo), 0.5))),
@@ -699,7 +765,7 @@ fn push_smoke_domain(
     // (1 voxel linear, 2 cubic; GeometryManager::create_volume_mesh): two voxels of the
     // coarsest grid around the box cover both. Past it every value is 0.
     let pad = domain.grids.iter().fold([0.0f32; 3], |p, g| {
-        [0, 1, 2].map(|k| p[k].max(2.0 * (hi[k] - lo[k]) / g.resolution[k] as f32))
+        [0, 1, 2].map(|k| p[k].max(2.0 * (g.max[k] - g.min[k]) / g.resolution[k] as f32))
     });
     let mut inst = new_instance(
         scene,

@@ -200,7 +200,7 @@ impl Volumes {
                     rate = rate.min(vm.step_rate);
                     binds.push((m as u32, g.bind(&p.attributes)));
                 }
-                let voxel = g.voxel_step(&inst.to_world);
+                let voxel = g.step(&inst.to_world);
                 let step = if voxel.is_finite() { voxel } else { 0.1 * size };
                 v.step.push(if rate.is_finite() {
                     step * rate * render_rate
@@ -365,7 +365,8 @@ struct AheadLight {
     toward: Option<V3>,
 }
 
-/// Volumes blendsynth cannot render, refused by name (for `render` and `inspect`): a
+/// Volumes blendsynth cannot render, refused by name (for `render` and `inspect`): Volume
+/// objects it cannot read (`check_volume_object`), a
 /// fluid (smoke or fire) domain whose material has a Volume, when the export carries no
 /// grids for it (an export older than the grid writer) or the material also has a
 /// Surface (Cycles would shade the voxel hull with it; not matched yet). Checked before
@@ -378,18 +379,13 @@ pub fn check_objects(scene: &BlendScene) -> Result<(), super::RenderError> {
             .is_some_and(|t| t.links.iter().any(|l| l.to_socket == socket && !l.is_muted))
     };
     super::volume_world::world_volume(scene)?;
-    // Volume objects hold OpenVDB grids (a .vdb file, or made by Geometry Nodes) that the
-    // export does not carry.
-    if let Some(obj) = scene
+    for obj in scene
         .file
         .objects
         .iter()
-        .find(|o| !o.hide_render && o.kind == "VOLUME")
+        .filter(|o| !o.hide_render && o.kind == "VOLUME")
     {
-        return Err(super::RenderError(format!(
-            "object {:?}: a Volume object (OpenVDB grids, from a .vdb file or Geometry Nodes) is not supported yet: blendsynth renders volumes in meshes, smoke domains and the world",
-            obj.name
-        )));
+        check_volume_object(scene, obj, &linked)?;
     }
     for obj in scene.file.objects.iter().filter(|o| !o.hide_render) {
         let domain = obj.modifiers.iter().find(|md| {
@@ -423,6 +419,63 @@ pub fn check_objects(scene: &BlendScene) -> Result<(), super::RenderError> {
                 obj.name, md.name
             )));
         }
+    }
+    Ok(())
+}
+
+/// A Volume object (OpenVDB grids) is rendered from the grids the export carries for it;
+/// refused by name: an export without them, grids that could not be read (the OpenVDB
+/// module missing, a value type, level set or transform not handled), a material with a
+/// Surface as well (Cycles would shade the voxel hull), and motion blur of a Volume with a
+/// velocity grid (Cycles moves the voxels by it; not done).
+fn check_volume_object(
+    scene: &BlendScene,
+    obj: &crate::scene::Object,
+    linked: &dyn Fn(&str, &str) -> bool,
+) -> Result<(), super::RenderError> {
+    let fail = |why: String| {
+        Err(super::RenderError(format!(
+            "object {:?}: Volume object {why}",
+            obj.name
+        )))
+    };
+    let Some((_, v)) = scene.volume_object(&obj.name) else {
+        return fail(
+            "is rendered from its OpenVDB grids, which this export does not carry: convert the .blend again with this version's exporter".into(),
+        );
+    };
+    if let Some(e) = &v.error {
+        return fail(format!("{:?}: its grids could not be read: {e}", v.volume));
+    }
+    if let Some((g, why)) = v.unread.first() {
+        return fail(format!(
+            "{:?}: grid {g:?} is not supported: {why}",
+            v.volume
+        ));
+    }
+    let materials = obj
+        .material_slots
+        .iter()
+        .filter_map(|s| s.material.clone())
+        .chain(v.materials.iter().flatten().cloned());
+    for m in materials {
+        if linked(&m, "Volume") && linked(&m, "Surface") {
+            return fail(format!(
+                "{:?}: material {m:?} has a Surface as well as a Volume: a surface on a Volume object is not supported yet",
+                v.volume
+            ));
+        }
+    }
+    let blur = crate::scene::settings::MotionBlur::of(&scene.file.scene).is_ok_and(|m| m.enabled);
+    if let Some(g) = v
+        .velocity_grid
+        .as_ref()
+        .filter(|_| blur && v.velocity_scale != 0.0)
+    {
+        return fail(format!(
+            "{:?}: motion blur by its velocity grid {g:?} is not supported yet (turn off Render > Motion Blur, or set the Volume's Velocity Scale to 0)",
+            v.volume
+        ));
     }
     Ok(())
 }
@@ -908,7 +961,9 @@ impl Scene<'_> {
                 _ => sp.attr_missing = !0,
             }
             prog.run(&sp, stack);
-            co.closure(prog, vc, 1.0, stack, &sp, shadow);
+            // Cycles' object_volume_density (a Volume object in Object space).
+            let w = inst.grids.as_ref().map_or(1.0, |g| g.density_scale);
+            co.closure(prog, vc, w, stack, &sp, shadow);
         }
         co
     }

@@ -1,5 +1,6 @@
 //! Voxel grids inside a volume as Cycles 4.5 samples them (kernel image_3d NanoVDB
-//! lookups, geom/volume.h): a smoke domain's grids over its texture-space box, read by
+//! lookups, geom/volume.h): a smoke domain's grids over its texture-space box, or a Volume
+//! object's OpenVDB grids each over its own box of active voxels, read by
 //! Attribute nodes and Principled Volume's Density/Color/Temperature attributes at each
 //! ray-marching step, with trilinear or tricubic B-spline interpolation in voxel index
 //! space (a voxel spans [i, i + 1], its value at i + 0.5; outside the grid every value is
@@ -11,13 +12,31 @@ use crate::shader::point::ShadingPoint;
 
 use super::math::*;
 
-/// The grids of one domain, in its object space.
+/// The grids of one smoke domain or Volume object, in its object space.
 #[derive(Debug, Clone)]
 pub struct DomainGrids {
     pub grids: Vec<VoxelGrid>,
-    /// The box every grid tiles (the domain's texture space).
+    /// The box the grids tile together (a smoke domain's texture space; the union of a
+    /// Volume object's grid boxes).
     pub min: V3,
     pub max: V3,
+    /// The ray-marching step before step rates (Cycles' Object::compute_volume_step_size).
+    pub step: GridStep,
+    /// Cycles' object_volume_density: every volume closure's weight (extinction,
+    /// scattering, emission) is multiplied by it. 1 but for a Volume object in Object
+    /// space, where it undoes the object's scale.
+    pub density_scale: f32,
+}
+
+/// Where the ray-marching step of grids comes from.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GridStep {
+    /// From the voxel size (smoke domains; a Volume's Step Size 0).
+    Voxel,
+    /// A Volume's Step Size in object space (Volume > Render > Space Object).
+    Object(f32),
+    /// A Volume's Step Size in world space.
+    World(f32),
 }
 
 /// Per attribute request of a program: the grid it reads, if the domain has one of
@@ -30,7 +49,11 @@ impl DomainGrids {
     /// where Cycles builds no volume mesh and the domain renders nothing.
     pub fn new(mut grids: Vec<VoxelGrid>, clipping: f32) -> Option<DomainGrids> {
         let first = grids.first()?;
-        let (min, max) = (first.min, first.max);
+        let (mut min, mut max) = (first.min, first.max);
+        for g in &grids {
+            min = vmin(min, g.min);
+            max = vmax(max, g.max);
+        }
         let mut any = false;
         for g in &mut grids {
             for voxel in g.values.chunks_mut(g.channels) {
@@ -41,7 +64,27 @@ impl DomainGrids {
                 }
             }
         }
-        any.then_some(DomainGrids { grids, min, max })
+        any.then_some(DomainGrids {
+            grids,
+            min,
+            max,
+            step: GridStep::Voxel,
+            density_scale: 1.0,
+        })
+    }
+
+    /// Cycles' Object::compute_volume_step_size for grids before the step rates: the
+    /// Volume's Step Size (in object space through `to_world`, the smallest component
+    /// of a step along each axis), or from the voxels.
+    pub fn step(&self, to_world: &Affine) -> f32 {
+        match self.step {
+            GridStep::Voxel => self.voxel_step(to_world),
+            GridStep::World(s) => s,
+            GridStep::Object(s) => {
+                let w = to_world.vector([s; 3]);
+                w[0].abs().min(w[1].abs()).min(w[2].abs())
+            }
+        }
     }
 
     /// Binds a program's attribute requests to grids by name.
@@ -65,7 +108,7 @@ impl DomainGrids {
         self.grids
             .iter()
             .map(|g| {
-                let d = [0, 1, 2].map(|k| (self.max[k] - self.min[k]) / g.resolution[k] as f32);
+                let d = [0, 1, 2].map(|k| (g.max[k] - g.min[k]) / g.resolution[k] as f32);
                 let w = to_world.vector(d);
                 w[0].abs().min(w[1].abs()).min(w[2].abs())
             })
@@ -81,17 +124,28 @@ impl DomainGrids {
         for (k, b) in bind.iter().enumerate() {
             let Some(gi) = b else { continue };
             let g = &self.grids[*gi as usize];
-            let v = sample(g, self.index_coords(g, local), cubic);
+            let v = sample(g, index_coords(g, local), cubic);
             sp.attrs[k] = v;
             sp.attr_fac[k] = (v[0] + v[1] + v[2]) * (1.0 / 3.0);
             sp.attr_missing &= !(1 << k);
         }
     }
+}
 
-    /// Voxel index coordinates of object-space point `p` in grid `g`.
-    fn index_coords(&self, g: &VoxelGrid, p: V3) -> V3 {
-        [0, 1, 2]
-            .map(|k| (p[k] - self.min[k]) / (self.max[k] - self.min[k]) * g.resolution[k] as f32)
+/// Voxel index coordinates of object-space point `p` in grid `g` (0 at its box's minimum).
+fn index_coords(g: &VoxelGrid, p: V3) -> V3 {
+    [0, 1, 2].map(|k| (p[k] - g.min[k]) / (g.max[k] - g.min[k]) * g.resolution[k] as f32)
+}
+
+/// Cycles' object_volume_density for a Volume in Object space: 1 over the length of the
+/// object's transform applied to the unit diagonal.
+pub fn object_space_density(to_world: &Affine) -> f32 {
+    let d = 1.0 / 3f32.sqrt();
+    let l = len(to_world.vector([d; 3]));
+    if l > 0.0 && l.is_finite() {
+        1.0 / l
+    } else {
+        1.0
     }
 }
 
@@ -264,5 +318,55 @@ mod tests {
         let d = DomainGrids::new(vec![g], 1e-6).unwrap();
         assert_eq!(d.grids[0].values[0], 0.0);
         assert_eq!(d.grids[0].values[3], 0.5);
+    }
+
+    #[test]
+    fn volume_object_grids_keep_their_own_boxes_steps_and_density_scale() {
+        // Two grids over different boxes (a Volume object's grids each cover their own
+        // active voxels): each is sampled through its own box, the union is marched.
+        let mut a = grid();
+        a.values = vec![1.0; 8];
+        let mut b = a.clone();
+        b.name = "color".into();
+        b.min = [10.0; 3];
+        b.max = [12.0; 3];
+        b.values = vec![2.0; 8];
+        let d = DomainGrids::new(vec![a, b], 1e-3).unwrap();
+        assert_eq!((d.min, d.max), ([0.0; 3], [12.0; 3]));
+        let bind = d.bind(&[
+            AttributeRequest::Named("density".into()),
+            AttributeRequest::Named("color".into()),
+        ]);
+        let mut sp = ShadingPoint::default();
+        d.fill(&bind, [11.0; 3], false, &mut sp);
+        assert_eq!(sp.attrs[0][0], 0.0);
+        assert_eq!(sp.attrs[1][0], 2.0);
+        d.fill(&bind, [1.0; 3], false, &mut sp);
+        assert_eq!((sp.attrs[0][0], sp.attrs[1][0]), (1.0, 0.0));
+        // A Step Size in object space goes through the transform (smallest axis); in
+        // world space it is as given.
+        let to_world = Affine {
+            m: [
+                [2.0, 0.0, 0.0, 0.0],
+                [0.0, 0.5, 0.0, 0.0],
+                [0.0, 0.0, 1.0, 0.0],
+            ],
+        };
+        let mut d = d;
+        d.step = GridStep::Object(0.2);
+        assert_eq!(d.step(&to_world), 0.1);
+        d.step = GridStep::World(0.2);
+        assert_eq!(d.step(&to_world), 0.2);
+        // Object space's density: 1 / |M (1, 1, 1) / sqrt 3|; a uniform scale of 2 halves it.
+        let two = Affine {
+            m: [
+                [2.0, 0.0, 0.0, 1.0],
+                [0.0, 2.0, 0.0, 0.0],
+                [0.0, 0.0, 2.0, 0.0],
+            ],
+        };
+        assert!((object_space_density(&two) - 0.5).abs() < 1e-6);
+        let expect = 1.0 / ((4.0f32 + 0.25 + 1.0) / 3.0).sqrt();
+        assert!((object_space_density(&to_world) - expect).abs() < 1e-6);
     }
 }

@@ -58,6 +58,10 @@ pub struct SceneFile {
     /// frame (`scene::volume_grid`); absent in older exports.
     #[serde(default)]
     pub smoke_domains: Vec<super::volume_grid::SmokeDomain>,
+    /// Volume objects (OpenVDB) and the grids their materials read at the exported
+    /// frame (`scene::volume_grid`); absent in older exports.
+    #[serde(default)]
+    pub volume_objects: Vec<super::volume_grid::VolumeObject>,
     /// Data paths changed by `--set` or a spec since the export (not in scene.json as
     /// written): frozen geometry that reads one of them is refused.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]

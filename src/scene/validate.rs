@@ -119,18 +119,29 @@ pub(super) fn validate(scene: &Scene, json: &Path) -> Result<(), SceneError> {
             );
         }
     }
-    for (i, d) in f.smoke_domains.iter().enumerate() {
-        if !objects.contains(d.object.as_str()) {
+    let grid_owners = f
+        .smoke_domains
+        .iter()
+        .map(|d| ("smoke_domains", &d.object, &d.grids))
+        .chain(
+            f.volume_objects
+                .iter()
+                .map(|v| ("volume_objects", &v.object, &v.grids)),
+        );
+    let mut counts: HashMap<&str, usize> = HashMap::new();
+    for (list, object, grids) in grid_owners {
+        let i = counts.entry(list).or_default();
+        if !objects.contains(object.as_str()) {
             return err(
-                format!("smoke_domains[{i}].object"),
-                format!("names object {:?}, which does not exist", d.object),
+                format!("{list}[{i}].object"),
+                format!("names object {object:?}, which does not exist"),
             );
         }
-        for (g, grid) in d.grids.iter().enumerate() {
-            resolve_inside(&scene.dir, &grid.file).map_err(|m| {
-                SceneError::new(json, format!("smoke_domains[{i}].grids[{g}].file"), m)
-            })?;
+        for (g, grid) in grids.iter().enumerate() {
+            resolve_inside(&scene.dir, &grid.file)
+                .map_err(|m| SceneError::new(json, format!("{list}[{i}].grids[{g}].file"), m))?;
         }
+        *i += 1;
     }
     for (i, im) in f.images.iter().enumerate() {
         if let Some(p) = &im.file {

@@ -1,7 +1,8 @@
-//! Voxel grids of smoke (gas fluid) domains as the exporter writes them: per domain, the
-//! record in scene.json (`SmokeDomain`) and one binary file per grid a material reads
-//! (blender_export/FORMAT.md, "Smoke domains"). Reading a grid checks its header against
-//! the file's length before anything is allocated, so a hostile size is an error.
+//! Voxel grids as the exporter writes them, for smoke (gas fluid) domains and Volume
+//! objects (OpenVDB): per domain or object, the record in scene.json (`SmokeDomain`,
+//! `VolumeObject`) and one binary file per grid a material reads (blender_export/FORMAT.md,
+//! "Smoke domains", "Volume objects"). Reading a grid checks its header against the file's
+//! length before anything is allocated, so a hostile size is an error.
 
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -45,6 +46,48 @@ pub struct SmokeDomain {
     /// with the reason: Cycles renders them as absent.
     #[serde(default)]
     pub unread: Vec<(String, String)>,
+}
+
+/// One Volume object (OpenVDB grids) at the exported frame: its evaluated Volume's grids
+/// that its materials read, each dense over its active voxels, and the Volume's render
+/// settings.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct VolumeObject {
+    /// The object.
+    pub object: String,
+    /// Its Volume data.
+    pub volume: String,
+    /// The frame the grids are of.
+    pub frame: f64,
+    /// The Volume's material slots.
+    #[serde(default)]
+    pub materials: Vec<Option<String>>,
+    /// Volume > Render > Space: "OBJECT" (density and step size scale with the object)
+    /// or "WORLD".
+    pub space: String,
+    /// Volume > Render > Step Size (0: from the voxel size).
+    pub step_size: f32,
+    /// Volume > Render > Clipping: values at or below it are empty space.
+    pub clipping: f32,
+    /// Volume > Render > Precision (Cycles' NanoVDB encoding: FULL, HALF, VARIABLE).
+    #[serde(default)]
+    pub precision: String,
+    /// The velocity grid (Volume > Attributes > Velocity Grid) if the Volume has it.
+    #[serde(default)]
+    pub velocity_grid: Option<String>,
+    /// Volume > Attributes > Velocity Scale.
+    #[serde(default)]
+    pub velocity_scale: f32,
+    /// The grids the materials read that were written.
+    #[serde(default)]
+    pub grids: Vec<GridRef>,
+    /// Grids the materials read that were not written, with the reason (a value type or
+    /// transform not handled, ...): blendsynth refuses the object.
+    #[serde(default)]
+    pub unread: Vec<(String, String)>,
+    /// Why no grid could be read at all (the OpenVDB module missing, ...): refused.
+    #[serde(default)]
+    pub error: Option<String>,
 }
 
 /// A grid file and the attribute name materials read it by.
@@ -155,12 +198,31 @@ impl Scene {
             .find(|(_, d)| d.object == name)
     }
 
+    /// The Volume object record of object `name`, if the export has one.
+    pub fn volume_object(&self, name: &str) -> Option<(usize, &VolumeObject)> {
+        self.file
+            .volume_objects
+            .iter()
+            .enumerate()
+            .find(|(_, v)| v.object == name)
+    }
+
     /// Reads every grid of smoke domain `index`.
     pub fn load_smoke_grids(&self, index: usize) -> Result<Vec<VoxelGrid>, SceneError> {
         let d = &self.file.smoke_domains[index];
-        let mut out = Vec::with_capacity(d.grids.len());
-        for (g, r) in d.grids.iter().enumerate() {
-            let location = format!("smoke_domains[{index}].grids[{g}].file");
+        self.load_grids(&d.grids, &format!("smoke_domains[{index}]"))
+    }
+
+    /// Reads every grid of Volume object record `index`.
+    pub fn load_volume_grids(&self, index: usize) -> Result<Vec<VoxelGrid>, SceneError> {
+        let v = &self.file.volume_objects[index];
+        self.load_grids(&v.grids, &format!("volume_objects[{index}]"))
+    }
+
+    fn load_grids(&self, refs: &[GridRef], owner: &str) -> Result<Vec<VoxelGrid>, SceneError> {
+        let mut out = Vec::with_capacity(refs.len());
+        for (g, r) in refs.iter().enumerate() {
+            let location = format!("{owner}.grids[{g}].file");
             let path = self.resolve(&r.file, &location)?;
             out.push(read_grid(&r.name, &path)?);
         }
