@@ -162,6 +162,8 @@ fn an_object_rendered_from_blenders_mesh_instead_is_listed_as_frozen() {
         })
         .unwrap_or_else(|| panic!("no object frozen for its Instancer attributes: {r}"));
     assert!(z["reads"].as_array().is_some_and(|a| !a.is_empty()), "{z}");
+}
+
 /// Volume objects (OpenVDB) are listed with the grids they render from, `inspect` exits 0
 /// on them; a Volume object blendsynth cannot read is refused by name, by `inspect` and
 /// `render` alike: an export without its grids, the OpenVDB module missing, a grid type
