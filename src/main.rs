@@ -682,11 +682,13 @@ fn run(cli: Cli) -> Result<Outcome> {
             let overrides: Vec<(String, serde_json::Value)> =
                 overrides.into_iter().map(|o| (o.path, o.value)).collect();
             let scene = Scene::load(&a.dir)?;
-            // Objects without geometry would evaluate to an empty mesh: say so instead.
+            // Objects without geometry would evaluate to an empty mesh: say so instead, as
+            // Blender's to_mesh does ("Object does not have geometry data"; a Volume's
+            // voxels are not a mesh).
             if let Some(o) = scene.object(&a.object) {
                 if matches!(
                     o.kind.as_str(),
-                    "EMPTY" | "CAMERA" | "LIGHT" | "LIGHT_PROBE" | "SPEAKER"
+                    "EMPTY" | "CAMERA" | "LIGHT" | "LIGHT_PROBE" | "SPEAKER" | "VOLUME"
                 ) {
                     anyhow::bail!(
                         "mesh {:?}: not a geometry object (it is a {} object)",

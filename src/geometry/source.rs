@@ -225,6 +225,9 @@ pub fn object_source(
         }
         "CURVE" if !has_mods => Ok(Source::None),
         "CURVE" => Ok(Source::Evaluate),
+        // Voxel grids, no mesh: `render` draws them (render/build.rs push_volume_object),
+        // and Blender's `Object.to_mesh` of one is empty.
+        "VOLUME" => Ok(Source::None),
         other => Err(GeometryError::new(format!(
             "{here}: {other} objects are not supported by the renderer"
         ))),
