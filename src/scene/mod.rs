@@ -80,6 +80,28 @@ impl Scene {
     pub fn node_group(&self, name: &str) -> Option<&NodeTree> {
         self.file.node_groups.iter().find(|g| g.name == name)
     }
+
+    /// Every node of the node group `root` and of the groups nested in it (each group
+    /// once, whatever the nesting), with the tree that holds it.
+    pub fn group_nodes(&self, root: &str) -> Vec<(&NodeTree, &format::Node)> {
+        let mut found = Vec::new();
+        let mut seen: Vec<&str> = Vec::new();
+        let mut todo = vec![root];
+        while let Some(g) = todo.pop() {
+            if seen.contains(&g) {
+                continue;
+            }
+            seen.push(g);
+            let Some(tree) = self.file.node_groups.iter().find(|t| t.name == g) else {
+                continue;
+            };
+            for n in &tree.nodes {
+                found.push((tree, n));
+                todo.extend(n.node_tree.as_deref());
+            }
+        }
+        found
+    }
     pub fn mesh_ref(&self, name: &str) -> Option<&MeshRef> {
         self.file.meshes.iter().find(|m| m.name == name)
     }

@@ -360,21 +360,13 @@ fn zones_of<'s>(scene: &'s Scene, o: &'s Object) -> Vec<(&'s Modifier, &'s str, 
         .iter()
         .filter(|m| m.show_render && m.kind == "NODES")
     {
-        let mut seen: Vec<&str> = Vec::new();
-        let mut todo: Vec<&str> = m.node_group.as_deref().into_iter().collect();
-        while let Some(g) = todo.pop() {
-            if seen.contains(&g) {
-                continue;
-            }
-            seen.push(g);
-            let Some(tree) = scene.node_group(g) else {
-                continue;
-            };
-            for n in &tree.nodes {
-                if n.bl_idname == "GeometryNodeSimulationOutput" {
-                    found.push((m, n.name.as_str(), tree.name.as_str()));
-                }
-                todo.extend(n.node_tree.as_deref());
+        for (tree, n) in m
+            .node_group
+            .as_deref()
+            .map_or_else(Vec::new, |g| scene.group_nodes(g))
+        {
+            if n.bl_idname == "GeometryNodeSimulationOutput" {
+                found.push((m, n.name.as_str(), tree.name.as_str()));
             }
         }
     }
@@ -433,27 +425,12 @@ fn may_simulate(scene: &Scene, o: &Object) -> bool {
         .filter(|m| m.show_render && m.kind == "NODES")
         .filter_map(|m| m.node_group.as_deref())
         .any(|g| {
-            let mut seen: Vec<&str> = Vec::new();
-            let mut todo = vec![g];
-            while let Some(g) = todo.pop() {
-                if seen.contains(&g) {
-                    continue;
-                }
-                seen.push(g);
-                let Some(tree) = scene.node_group(g) else {
-                    continue;
-                };
-                for n in &tree.nodes {
-                    if matches!(
-                        n.bl_idname.as_str(),
-                        "GeometryNodeObjectInfo" | "GeometryNodeCollectionInfo"
-                    ) {
-                        return true;
-                    }
-                    todo.extend(n.node_tree.as_deref());
-                }
-            }
-            false
+            scene.group_nodes(g).iter().any(|(_, n)| {
+                matches!(
+                    n.bl_idname.as_str(),
+                    "GeometryNodeObjectInfo" | "GeometryNodeCollectionInfo"
+                )
+            })
         });
     reads_objects || !zones_of(scene, o).is_empty()
 }
