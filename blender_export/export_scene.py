@@ -1425,7 +1425,9 @@ def volume_object_entries(objs, out, depsgraph):
                 entry["unread"].append([name, "its transform rotates, shears or mirrors the voxels, which is not handled"])
                 continue
             if g.activeVoxelCount() == 0:
-                entry["unread"].append([name, "it has no active voxel"])
+                # Cycles builds nothing from an empty fog grid and reads 0 from it (a
+                # Volume whose grids are all empty renders nothing): not written, read as
+                # a missing grid.
                 continue
             lo, hi = g.evalActiveVoxelBoundingBox()
             dims = [int(hi[k]) - int(lo[k]) + 1 for k in range(3)]
