@@ -668,15 +668,9 @@ fn push_smoke_domain(
     to_world: Affine,
 ) -> Result<(), RenderError> {
     let d = &scene.file.smoke_domains[di];
-    if d.frame != frame && !d.grids.is_empty() {
-        return Err(RenderError(format!(
-            "object {:?}: its smoke grids were exported at frame {}, not {frame}: convert the file at this frame",
-            obj.name, d.frame
-        )));
-    }
-    let grids = scene
-        .load_smoke_grids(di)
-        .map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))?;
+    let grids = grids_at(obj, "smoke", (d.frame, d.grids.len()), frame, || {
+        scene.load_smoke_grids(di)
+    })?;
     if let Some(g) = grids
         .iter()
         .find(|g| g.min != grids[0].min || g.max != grids[0].max)
@@ -704,6 +698,25 @@ fn push_smoke_domain(
     )
 }
 
+/// The `what` grids (smoke, Volume) of `obj` the export holds, `exported` = (the frame
+/// they are of, how many), read by `load`: an error naming the object when they are of
+/// another frame than `frame` (no grid is valid at any frame).
+fn grids_at(
+    obj: &crate::scene::Object,
+    what: &str,
+    (at, count): (f64, usize),
+    frame: f64,
+    load: impl FnOnce() -> Result<Vec<crate::scene::volume_grid::VoxelGrid>, crate::scene::SceneError>,
+) -> Result<Vec<crate::scene::volume_grid::VoxelGrid>, RenderError> {
+    if at != frame && count > 0 {
+        return Err(RenderError(format!(
+            "object {:?}: its {what} grids were exported at frame {at}, not {frame}: convert the file at this frame",
+            obj.name
+        )));
+    }
+    load().map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))
+}
+
 /// A Volume object (OpenVDB) as Cycles renders it (blender/volume.cpp, scene/volume.cpp):
 /// its grids from the export at the frame, each over its box of active voxels, with the
 /// Volume's materials, its Render settings' clipping and step size, and Object space's
@@ -719,15 +732,9 @@ fn push_volume_object(
     let Some((vi, v)) = scene.volume_object(&obj.name) else {
         return Ok(());
     };
-    if v.frame != frame && !v.grids.is_empty() {
-        return Err(RenderError(format!(
-            "object {:?}: its Volume grids were exported at frame {}, not {frame}: convert the file at this frame",
-            obj.name, v.frame
-        )));
-    }
-    let grids = scene
-        .load_volume_grids(vi)
-        .map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))?;
+    let grids = grids_at(obj, "Volume", (v.frame, v.grids.len()), frame, || {
+        scene.load_volume_grids(vi)
+    })?;
     let Some(mut domain) = DomainGrids::new(grids, v.clipping) else {
         return Ok(());
     };
