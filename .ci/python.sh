@@ -17,7 +17,13 @@ if [ ! -x "$work/tools/bin/maturin" ]; then
 fi
 
 # The `blendsynth` command inside the wheel (python/blendsynth/_cli.py execs it).
-cargo build --release --bin blendsynth
+# .ci/run sets BLENDSYNTH_CLI_BUILT=1 after `cargo test --release`, which built this binary
+# for the CLI tests: a `cargo build` here would compile the crate again (about 2 minutes),
+# only because proptest, a dev-dependency, turns on features of a shared dependency
+# (getrandom) and so changes the build's hash, not its code.
+if [ "${BLENDSYNTH_CLI_BUILT:-}" != 1 ] || [ ! -x target/release/blendsynth ]; then
+  cargo build --release --bin blendsynth
+fi
 mkdir -p python/blendsynth/bin
 cp target/release/blendsynth python/blendsynth/bin/blendsynth
 # The release profile keeps line tables (symbols and lines for profiles); the wheel drops them.
