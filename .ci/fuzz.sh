@@ -20,20 +20,45 @@ else
   FLAGS=(-O -a --sanitizer none)
 fi
 cargo fuzz build "${FLAGS[@]}"
-for target in ${FUZZ_TARGETS:-scene_json glb spec set_value}; do
+# libFuzzer runs one thread per target: run the targets side by side, one per core, so
+# each still gets its full time and the step takes about a fraction 1/cores of it.
+jobs=$(nproc 2>/dev/null || echo 1)
+targets=(${FUZZ_TARGETS:-scene_json glb spec set_value})
+run_one() {
+  local target=$1 work status=0
   work=$(mktemp -d)
-  echo "fuzz: $target for ${SECONDS_EACH}s"
   # The committed seeds are read only; new inputs go to a scratch folder.
-  status=0
   cargo fuzz run "${FLAGS[@]}" "$target" "$work" "fuzz/seeds/$target" -- \
     -max_total_time="$SECONDS_EACH" -timeout=10 -rss_limit_mb=4096 -max_len=262144 \
-    -print_final_stats=1 >"$work.log" 2>&1 || status=$?
-  grep -E "^(stat::(number_of_executed_units|new_units_added|peak_rss_mb)|Done|SUMMARY|==[0-9]+== ERROR)" "$work.log" || true
-  [ "$status" -eq 0 ] || tail -n 40 "$work.log" >&2
-  rm -rf "$work" "$work.log"
+    -print_final_stats=1 >"$logs/$target.log" 2>&1 || status=$?
+  rm -rf "$work"
+  return $status
+}
+logs=$(mktemp -d)
+declare -A pid
+failed=0
+report() {
+  local target=$1 status=0
+  wait "${pid[$target]}" || status=$?
+  echo "fuzz: $target for ${SECONDS_EACH}s"
+  grep -E "^(stat::(number_of_executed_units|new_units_added|peak_rss_mb)|Done|SUMMARY|==[0-9]+== ERROR)" "$logs/$target.log" || true
   if [ "$status" -ne 0 ]; then
+    tail -n 40 "$logs/$target.log" >&2
     echo "fuzz: $target FAILED (exit $status); see fuzz/artifacts/$target/" >&2
-    exit 1
+    failed=1
   fi
+}
+running=()
+for target in "${targets[@]}"; do
+  if [ "${#running[@]}" -ge "$jobs" ]; then
+    report "${running[0]}"
+    running=("${running[@]:1}")
+  fi
+  run_one "$target" &
+  pid[$target]=$!
+  running+=("$target")
 done
+for target in "${running[@]}"; do report "$target"; done
+rm -rf "$logs"
+[ "$failed" = 0 ] || exit 1
 echo "fuzz: all targets ran clean"

@@ -36,7 +36,7 @@ fn features_page() -> String {
     o.push_str(&format!(
         "- modifiers evaluated by blendsynth (an option one does not evaluate keeps the \
          object frozen, named by `inspect`; see coverage.md): {}\n",
-        list(blendsynth::geometry::source::NATIVE_MODIFIERS)
+        list(&blendsynth::geometry::source::native_modifiers())
     ));
     o.push_str(
         "- every other renderable object (curves, surfaces, text, metaballs, meshes with \

@@ -93,18 +93,7 @@ impl<'s> Session<'s> {
         let here = format!("objects[{}]", quote(&o.name));
         match o.kind.as_str() {
             "MESH" => {
-                let data = o.data.as_deref().ok_or_else(|| {
-                    GeometryError::new(format!("{here}: mesh object without mesh data"))
-                })?;
-                let index = self
-                    .scene
-                    .file
-                    .meshes
-                    .iter()
-                    .position(|m| m.name == data)
-                    .ok_or_else(|| {
-                        GeometryError::new(format!("{here}: mesh {data:?} is not in the export"))
-                    })?;
+                let index = super::source::mesh_index(self.scene, o)?;
                 let md = self.scene.load_mesh(index)?;
                 Ok(GeometrySet::from_mesh(Mesh::from_scene(
                     &md,

@@ -22,21 +22,15 @@ pub const NO_GEOMETRY: &[&str] = &[
     "GREASEPENCIL",
 ];
 
-/// Modifiers blendsynth evaluates itself (`eval::Session::evaluate_stack`); those with
-/// a module in `geometry::modifiers` only with the options it evaluates.
-pub const NATIVE_MODIFIERS: &[&str] = &[
-    "NODES",
-    "SUBSURF",
-    "ARRAY",
-    "MIRROR",
-    "TRIANGULATE",
-    "SMOOTH",
-    "WELD",
-    "DISPLACE",
-    "SOLIDIFY",
-    "EDGE_SPLIT",
-    "WIREFRAME",
-];
+/// Modifiers blendsynth evaluates outside `geometry::modifiers` (`eval::Session::
+/// evaluate_stack`): Geometry Nodes and Subdivision Surface. With `modifiers::KINDS`,
+/// these are the native ones.
+const EVALUATED_ELSEWHERE: &[&str] = &["NODES", "SUBSURF"];
+
+/// Every modifier type blendsynth evaluates itself (some only with some options).
+pub fn native_modifiers() -> Vec<&'static str> {
+    [EVALUATED_ELSEWHERE, super::modifiers::KINDS].concat()
+}
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Source {
@@ -51,15 +45,16 @@ pub enum Source {
     Frozen(usize),
 }
 
-/// Why an object needs Blender's evaluated mesh, or None when blendsynth builds it.
 /// Whether blendsynth evaluates this modifier itself (one of `modifiers::KINDS` only
 /// with the options its module evaluates).
 fn native(m: &crate::scene::Modifier) -> bool {
-    NATIVE_MODIFIERS.contains(&m.kind.as_str())
-        && !(super::modifiers::KINDS.contains(&m.kind.as_str())
-            && super::modifiers::unsupported(&m.kind, &m.properties).is_some())
+    let kind = m.kind.as_str();
+    EVALUATED_ELSEWHERE.contains(&kind)
+        || (super::modifiers::KINDS.contains(&kind)
+            && super::modifiers::unsupported(kind, &m.properties).is_none())
 }
 
+/// Why an object needs Blender's evaluated mesh, or None when blendsynth builds it.
 pub fn frozen_reason(scene: &Scene, o: &Object) -> Option<String> {
     let mods: Vec<_> = o.modifiers.iter().filter(|m| m.show_render).collect();
     match o.kind.as_str() {
@@ -206,17 +201,7 @@ pub fn object_source(
     }
     match o.kind.as_str() {
         "MESH" => {
-            let data = o.data.as_deref().ok_or_else(|| {
-                GeometryError::new(format!("{here}: mesh object without mesh data"))
-            })?;
-            let mi = scene
-                .file
-                .meshes
-                .iter()
-                .position(|m| m.name == data)
-                .ok_or_else(|| {
-                    GeometryError::new(format!("{here}: mesh {data:?} is not in the export"))
-                })?;
+            let mi = mesh_index(scene, o)?;
             Ok(if has_mods {
                 Source::Evaluate
             } else {
@@ -382,6 +367,21 @@ fn under(p: &str, prefix: &str) -> bool {
         || (p.starts_with(prefix) && matches!(p.as_bytes().get(prefix.len()), Some(b'.' | b'[')))
         // An override of the whole container also changes what is inside it.
         || (prefix.starts_with(p) && matches!(prefix.as_bytes().get(p.len()), Some(b'.' | b'[')))
+}
+
+/// The index in the export's meshes of a mesh object's data.
+pub(super) fn mesh_index(scene: &Scene, o: &Object) -> Result<usize, GeometryError> {
+    let here = format!("objects[{}]", quote(&o.name));
+    let data = o
+        .data
+        .as_deref()
+        .ok_or_else(|| GeometryError::new(format!("{here}: mesh object without mesh data")))?;
+    scene
+        .file
+        .meshes
+        .iter()
+        .position(|m| m.name == data)
+        .ok_or_else(|| GeometryError::new(format!("{here}: mesh {data:?} is not in the export")))
 }
 
 #[cfg(test)]
