@@ -36,6 +36,7 @@ pub const NATIVE_MODIFIERS: &[&str] = &[
     "SOLIDIFY",
     "EDGE_SPLIT",
     "WIREFRAME",
+    "SCREW",
 ];
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
