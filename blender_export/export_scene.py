@@ -1061,7 +1061,8 @@ ID_COLLECTIONS = {"OBJECT": "objects", "MESH": "meshes", "CURVE": "curves", "CUR
 class RenderSettings:
     """While active, the viewport settings Blender evaluates with are set to their render
     values: the depsgraph Python gets is the viewport's, and Cycles renders with modifiers
-    shown in renders only, Subdivision Surface / Multires render levels, particle render
+    shown in renders only, Subdivision Surface / Multires render levels, Screw render
+    steps, particle render
     amounts and curve / metaball render resolutions. Restored on exit, so the export's
     properties stay the file's. (A Geometry Nodes Is Viewport node still reads true.)"""
 
@@ -1072,6 +1073,8 @@ class RenderSettings:
                 self.put(m, "show_viewport", m.show_render)
                 if m.type in ("SUBSURF", "MULTIRES"):
                     self.put(m, "levels", m.render_levels)
+                if m.type == "SCREW":
+                    self.put(m, "steps", m.render_steps)
             for ps in getattr(o, "particle_systems", []):
                 st = ps.settings
                 self.put(st, "display_percentage", 100)

@@ -654,6 +654,59 @@ fn modifier_overrides_evaluate_or_are_refused_by_name() {
     );
 }
 
+/// The Screw modifier takes `--set` overrides natively: one of the fixture's cases with
+/// another case's settings (axis, angle, offset, iterations, render steps, order, flip,
+/// shading, UV stretch) set on it gives what Blender gave that case, UVs included.
+#[test]
+fn screw_overrides_evaluate_natively() {
+    use serde_json::json;
+    let scene = load("screw");
+    let frame = scene.file.scene.frame_current as f64;
+    let want = evaluated(&scene, "screw_open_offset");
+    let path = |k: &str| format!("objects[\"screw_stretch_uv\"].modifiers[\"Screw0\"].{k}");
+    let set: Vec<(String, serde_json::Value)> = [
+        ("axis", json!("Y")),
+        ("angle", json!(-(270f64.to_radians()))),
+        ("screw_offset", json!(0.6)),
+        ("iterations", json!(2)),
+        ("render_steps", json!(5)),
+        ("use_normal_calculate", json!(true)),
+        ("use_normal_flip", json!(true)),
+        ("use_smooth_shade", json!(false)),
+        ("use_stretch_u", json!(false)),
+        ("use_stretch_v", json!(false)),
+    ]
+    .into_iter()
+    .map(|(k, v)| (path(k), v))
+    .collect();
+    let m = mesh_of(&scene, "screw_stretch_uv", frame, &set).unwrap();
+    assert_eq!(m.corner_verts, want.corner_verts);
+    assert_eq!(m.edges, want.edges);
+    assert!(max_diff(&m.positions, &want.positions) <= POS_TOL);
+    let uv = |d: &[[f32; 2]], e: &[[f32; 2]]| {
+        d.iter()
+            .zip(e)
+            .map(|(a, b)| (a[0] - b[0]).abs().max((a[1] - b[1]).abs()))
+            .fold(0.0f32, f32::max)
+    };
+    let Array::Float2(ours) = &m.attributes.named("UVMap").expect("UV map").data else {
+        panic!("UVMap is not FLOAT2 here");
+    };
+    let AttributeData::Float2(theirs) = &want.attribute("UVMap").expect("UV map").data else {
+        panic!("UVMap is not FLOAT2");
+    };
+    assert_eq!(ours.len(), theirs.len());
+    assert!(uv(ours, theirs) <= 1e-5);
+    // An axis that is not X, Y or Z is named.
+    let mut p = scene.object("screw_loop_z").unwrap().modifiers[0]
+        .properties
+        .clone();
+    assert_eq!(geometry::modifiers::unsupported("SCREW", &p), None);
+    p.insert("axis".into(), json!("W"));
+    let why = geometry::modifiers::unsupported("SCREW", &p).unwrap();
+    assert!(why.contains("axis"), "{why}");
+}
+
 /// Every option a native modifier does not evaluate is named (in the words `inspect` and
 /// `render` print), starting from each fixture case's own settings, which are evaluated.
 #[test]

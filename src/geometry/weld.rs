@@ -206,8 +206,19 @@ fn mix_domain(src: &Attributes, dst: &mut Attributes, domain: Domain, groups: &[
 }
 
 /// The mesh with vertices merged by `dest` (from `duplicates_all` / `duplicates_connected`).
-// Long because it follows Blender's vertex merge step by step.
 pub fn merge(m: &Mesh, dest: &[i32]) -> Result<Mesh, String> {
+    merge_with(m, dest, true)
+}
+
+/// `merge` as Blender's `mesh_merge_verts` without mixing (`do_mix_data` false, as the
+/// Screw modifier asks): merged vertices and edges keep their target's data (position
+/// included); corners still mix.
+pub fn merge_keeping_targets(m: &Mesh, dest: &[i32]) -> Result<Mesh, String> {
+    merge_with(m, dest, false)
+}
+
+// Long because it follows Blender's vertex merge step by step.
+fn merge_with(m: &Mesh, dest: &[i32], mix: bool) -> Result<Mesh, String> {
     let nv = m.vertex_count();
     let in_ctx = |v: usize| dest[v] != OUT;
     let vmap = |v: usize| if dest[v] == OUT { v } else { dest[v] as usize };
@@ -228,6 +239,12 @@ pub fn merge(m: &Mesh, dest: &[i32]) -> Result<Mesh, String> {
             let d = dest[v] as usize;
             vert_final[v] = vert_final[d];
             vgroups[group_of[d]].push(v as u32);
+        }
+    }
+    if !mix {
+        // The target was pushed first.
+        for g in vgroups.iter_mut() {
+            g.truncate(1);
         }
     }
     for g in vgroups.iter_mut() {
@@ -386,6 +403,11 @@ pub fn merge(m: &Mesh, dest: &[i32]) -> Result<Mesh, String> {
             [vert_final[e[0] as usize], vert_final[e[1] as usize]]
         })
         .collect();
+    if !mix {
+        for g in egroups.iter_mut() {
+            g.truncate(1);
+        }
+    }
     mix_domain(&m.attributes, &mut out.attributes, Domain::Edge, &egroups);
     let mut face_src = Vec::new();
     let mut cgroups: Vec<Vec<u32>> = Vec::new();

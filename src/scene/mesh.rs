@@ -76,6 +76,24 @@ impl AttributeData {
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
+
+    /// No values of Blender data type `data_type` (None: a type the format does not hold).
+    pub fn empty(data_type: &str) -> Option<AttributeData> {
+        use AttributeData as A;
+        Some(match data_type {
+            "FLOAT" => A::Float(vec![]),
+            "FLOAT2" => A::Float2(vec![]),
+            "FLOAT_VECTOR" => A::Float3(vec![]),
+            "FLOAT_COLOR" | "BYTE_COLOR" => A::Color(vec![]),
+            "QUATERNION" => A::Quaternion(vec![]),
+            "FLOAT4X4" => A::Float4x4(vec![]),
+            "INT" => A::Int(vec![]),
+            "INT32_2D" => A::Int2(vec![]),
+            "INT8" => A::Int8(vec![]),
+            "BOOLEAN" => A::Bool(vec![]),
+            _ => return None,
+        })
+    }
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -120,7 +138,7 @@ impl MeshData {
     pub fn attribute(&self, name: &str) -> Option<&Attribute> {
         self.attributes.iter().find(|a| a.name == name)
     }
-    fn domain_size(&self, d: Domain) -> usize {
+    pub fn domain_size(&self, d: Domain) -> usize {
         match d {
             Domain::Point => self.vertex_count(),
             Domain::Edge => self.edges.len(),

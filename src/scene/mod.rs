@@ -126,6 +126,25 @@ impl Scene {
                 ));
             }
         }
+        // glTF has no empty accessors, so an attribute of a domain without elements (a UV
+        // map of an edge-only mesh, which the Screw modifier fills) is only listed here.
+        let mut m = m;
+        for a in &r.attributes {
+            let Some(domain) = Domain::parse(&a.domain) else {
+                continue;
+            };
+            if a.name != "position" && m.attribute(&a.name).is_none() && m.domain_size(domain) == 0
+            {
+                if let Some(data) = AttributeData::empty(&a.data_type) {
+                    m.attributes.push(Attribute {
+                        name: a.name.clone(),
+                        domain,
+                        data_type: a.data_type.clone(),
+                        data,
+                    });
+                }
+            }
+        }
         Ok(m)
     }
 

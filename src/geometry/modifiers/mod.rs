@@ -12,6 +12,7 @@ pub mod array;
 pub mod displace;
 pub mod edge_split;
 pub mod mirror;
+pub mod screw;
 pub mod smooth;
 pub mod solidify;
 pub mod triangulate;
@@ -31,10 +32,11 @@ pub const KINDS: &[&str] = &[
     "SOLIDIFY",
     "EDGE_SPLIT",
     "WIREFRAME",
+    "SCREW",
 ];
 
 /// What a modifier may read besides its mesh: the object's name and objects' world
-/// matrices (offset and mirror objects).
+/// matrices (offset, mirror and axis objects).
 pub struct Context<'a> {
     pub object: &'a str,
     pub world: &'a dyn Fn(&str) -> Option<Mat4f>,
@@ -53,6 +55,7 @@ pub fn unsupported(kind: &str, p: &Props) -> Option<String> {
         "SOLIDIFY" => solidify::unsupported(p),
         "EDGE_SPLIT" => edge_split::unsupported(p),
         "WIREFRAME" => wireframe::unsupported(p),
+        "SCREW" => screw::unsupported(p),
         _ => Some("not evaluated by blendsynth".into()),
     }
 }
@@ -72,6 +75,7 @@ pub fn apply(kind: &str, p: &Props, ctx: &Context, g: GeometrySet) -> Result<Geo
         "SOLIDIFY" => solidify::apply(p, g),
         "EDGE_SPLIT" => edge_split::apply(p, g),
         "WIREFRAME" => wireframe::apply(p, g),
+        "SCREW" => screw::apply(p, ctx, g),
         _ => unreachable!("unsupported() refuses other kinds"),
     }
 }
