@@ -89,10 +89,12 @@ impl Bvh4 {
         // (binary node whose children fill wide node `at`, at)
         let mut work = vec![(0usize, 0usize)];
         while let Some((b, at)) = work.pop() {
-            let mut kids: Vec<usize> = if src[b].count > 0 {
-                vec![b]
+            // At most four, kept inline: a heap list per node was an allocation per wide
+            // node of the published colon's (serial) collapse.
+            let mut kids: smallvec::SmallVec<[usize; 4]> = if src[b].count > 0 {
+                smallvec::smallvec![b]
             } else {
-                vec![src[b].start as usize, src[b].start as usize + 1]
+                smallvec::smallvec![src[b].start as usize, src[b].start as usize + 1]
             };
             while kids.len() < 4 {
                 let open = kids

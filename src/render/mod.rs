@@ -275,14 +275,36 @@ pub fn evaluated_scene_mesh(
     prepare(scene, opts, overrides).map(|p| scene_mesh::scene_mesh(&p.geo))
 }
 
-/// The render, with the camera and geometry it traced and the frame it rendered.
-// Long because the render driver still holds film, tiles, adaptive ranges and passes; separating them is open work (issue 25).
+type FrameResult = Result<(RenderOutput, camera::Camera, build::Geometry, f64), RenderError>;
+
+/// The render, with the camera and geometry it traced and the frame it rendered. With
+/// `opts.threads` the whole of it (Geometry Nodes, displacement, BVH build, tiles) runs on
+/// a pool of that many threads: a one-thread render uses one core from start to end.
 fn render_frame(
     scene: &Scene,
     opts: &RenderOptions,
     overrides: &[(String, Value)],
     control: Option<&control::Control>,
-) -> Result<(RenderOutput, camera::Camera, build::Geometry, f64), RenderError> {
+) -> FrameResult {
+    let Some(n) = opts.threads else {
+        return render_frame_here(scene, opts, overrides, control);
+    };
+    limits::check_threads(n)?;
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(n)
+        .build()
+        .map_err(|e| RenderError(format!("thread pool: {e}")))?
+        .install(|| render_frame_here(scene, opts, overrides, control))
+}
+
+/// `render_frame` on the current rayon pool.
+// Long because the render driver still holds film, tiles, adaptive ranges and passes; separating them is open work (issue 25).
+fn render_frame_here(
+    scene: &Scene,
+    opts: &RenderOptions,
+    overrides: &[(String, Value)],
+    control: Option<&control::Control>,
+) -> FrameResult {
     let frame = opts.frame.unwrap_or(scene.file.scene.frame_current as f64);
     let Prepared {
         start,
@@ -408,15 +430,6 @@ fn render_frame(
         .collect();
     let mut start_sample = 0u32;
     let mut taken = 0u64;
-    let pool = match opts.threads {
-        Some(n) => Some(
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(n)
-                .build()
-                .map_err(|e| RenderError(format!("thread pool: {e}")))?,
-        ),
-        None => None,
-    };
     while start_sample < samples {
         // Sample ranges end where Cycles would run its convergence check, so the
         // check sees the same sample counts whatever the thread count or timing.
@@ -507,10 +520,7 @@ fn render_frame(
                 },
             )
         };
-        match &pool {
-            Some(p) => p.install(|| run(&mut tiles)),
-            None => run(&mut tiles),
-        }
+        run(&mut tiles);
         if cancelled() {
             return Err(RenderError(control::CANCELLED.into()));
         }
