@@ -8,6 +8,7 @@ pub mod blur_attribute;
 pub mod bounding_box;
 pub mod collection_info;
 pub mod color;
+pub mod convex_hull;
 pub mod curve;
 pub mod curve_arc;
 pub mod curve_fields;
@@ -190,6 +191,7 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ),
     ("GeometryNodeFlipFaces", flip_faces::flip_faces),
     ("GeometryNodeBoundBox", bounding_box::bounding_box),
+    ("GeometryNodeConvexHull", convex_hull::convex_hull),
     (
         "GeometryNodeTranslateInstances",
         instance_transform::translate_instances,
