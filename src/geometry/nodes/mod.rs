@@ -41,6 +41,7 @@ pub mod input;
 pub mod instance_transform;
 pub mod integer_math;
 pub mod is_smooth;
+pub mod material_index;
 pub mod material_selection;
 pub mod matrix;
 pub mod menu_switch;
@@ -192,6 +193,14 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ("GeometryNodeFlipFaces", flip_faces::flip_faces),
     ("GeometryNodeBoundBox", bounding_box::bounding_box),
     ("GeometryNodeConvexHull", convex_hull::convex_hull),
+    (
+        "GeometryNodeInputMaterialIndex",
+        material_index::material_index,
+    ),
+    (
+        "GeometryNodeSetMaterialIndex",
+        material_index::set_material_index,
+    ),
     (
         "GeometryNodeTranslateInstances",
         instance_transform::translate_instances,
