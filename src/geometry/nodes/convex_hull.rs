@@ -508,6 +508,23 @@ mod tests {
     }
 
     #[test]
+    fn many_points_on_a_sphere_stay_quick() {
+        // Every point near the hull: the worst case for the conflict lists.
+        let p: Vec<V3> = (0..50_000)
+            .map(|i| {
+                let z = 1.0 - 2.0 * (i as f32 + 0.5) / 50_000.0;
+                let r = (1.0 - z * z).sqrt();
+                let a = i as f32 * 2.399_963;
+                [r * a.cos(), r * a.sin(), z]
+            })
+            .collect();
+        let t = std::time::Instant::now();
+        let h = hull(&p);
+        assert!(h.vertices.len() > 1000 && h.faces.len() > 1000);
+        assert!(t.elapsed().as_secs_f32() < 5.0, "{:?}", t.elapsed());
+    }
+
+    #[test]
     fn degenerate_sets() {
         assert_eq!(hull(&[]), Hull::default());
         assert_eq!(hull(&[[1.0, 2.0, 3.0]]).vertices, vec![0]);
