@@ -54,7 +54,7 @@ fn shared_maths_counts_only_where_an_evaluator_runs_it() {
         Support::Supported
     ));
     assert!(matches!(
-        support_in("GeometryNodeTree", "GeometryNodeConvexHull"),
+        support_in("GeometryNodeTree", "GeometryNodeMeshBoolean"),
         Support::Unsupported
     ));
     assert!(matches!(

@@ -8,6 +8,7 @@ pub mod blur_attribute;
 pub mod bounding_box;
 pub mod collection_info;
 pub mod color;
+pub mod convex_hull;
 pub mod curve;
 pub mod curve_arc;
 pub mod curve_fields;
@@ -40,6 +41,7 @@ pub mod input;
 pub mod instance_transform;
 pub mod integer_math;
 pub mod is_smooth;
+pub mod material_index;
 pub mod material_selection;
 pub mod matrix;
 pub mod menu_switch;
@@ -190,6 +192,15 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ),
     ("GeometryNodeFlipFaces", flip_faces::flip_faces),
     ("GeometryNodeBoundBox", bounding_box::bounding_box),
+    ("GeometryNodeConvexHull", convex_hull::convex_hull),
+    (
+        "GeometryNodeInputMaterialIndex",
+        material_index::material_index,
+    ),
+    (
+        "GeometryNodeSetMaterialIndex",
+        material_index::set_material_index,
+    ),
     (
         "GeometryNodeTranslateInstances",
         instance_transform::translate_instances,
