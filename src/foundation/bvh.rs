@@ -2,6 +2,7 @@
 //! default implementation and a watertight ray/triangle test (Woop, Benthin, Wald 2013),
 //! so rays through shared edges and vertices never slip between triangles.
 
+use super::box_tree::{BoxTree, Node, PAR_MIN};
 use super::math::*;
 use rayon::prelude::*;
 
@@ -130,258 +131,14 @@ impl Backend {
     }
 }
 
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Node {
-    pub(super) min: V3,
-    pub(super) max: V3,
-    /// Leaf: first primitive; inner: index of the left child (right = left + 1).
-    pub(super) start: u32,
-    /// Primitive count; 0 for inner nodes.
-    pub(super) count: u32,
-}
-
 pub struct Bvh {
-    pub(super) nodes: Vec<Node>,
-    /// Triangles in leaf order, with their index in the caller's list.
+    /// The tree over the triangles' boxes (`box_tree`, binned SAH).
+    pub(super) tree: BoxTree,
+    /// Triangles in leaf order (`tree.ids` holds their index in the caller's list).
     pub(super) tris: Vec<[V3; 3]>,
-    pub(super) ids: Vec<u32>,
     /// Per triangle in leaf order: the visibility mask of its object; empty when every
     /// triangle is visible to every ray (then no test is made).
     pub(super) masks: Vec<u32>,
-}
-
-const BINS: usize = 16;
-
-/// A triangle while the BVH is built: its box, the box's centre, its index.
-#[derive(Clone, Copy)]
-struct Item {
-    lo: V3,
-    hi: V3,
-    c: V3,
-    id: u32,
-}
-const MAX_LEAF: usize = 4;
-
-pub(super) fn area(min: V3, max: V3) -> f32 {
-    let d = sub(max, min);
-    if d[0] < 0.0 {
-        return 0.0;
-    }
-    2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0])
-}
-
-/// Below this many triangles a subtree is built by the one-thread loop (a rayon task per
-/// node would cost more than it saves).
-const PAR_MIN: usize = 16 * 1024;
-
-/// A node's bounds and, when it is split, where its items are partitioned (left items
-/// first): binned SAH over the three axes, binned in one pass, chosen in axis order.
-fn split(slice: &mut [Item]) -> (V3, V3, Option<usize>) {
-    let count = slice.len();
-    let (mut bmin, mut bmax) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    let (mut cmin, mut cmax) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for it in slice.iter() {
-        bmin = vmin(bmin, it.lo);
-        bmax = vmax(bmax, it.hi);
-        cmin = vmin(cmin, it.c);
-        cmax = vmax(cmax, it.c);
-    }
-    if count <= MAX_LEAF {
-        return (bmin, bmax, None);
-    }
-    let mut best = (f32::INFINITY, 0usize, 0usize);
-    let ext = sub(cmax, cmin);
-    let k = [0, 1, 2].map(|a| BINS as f32 / ext[a]);
-    let mut bins = [[([f32::INFINITY; 3], [f32::NEG_INFINITY; 3], 0usize); BINS]; 3];
-    for it in slice.iter() {
-        for axis in 0..3 {
-            if ext[axis] <= 0.0 {
-                continue;
-            }
-            let b = (((it.c[axis] - cmin[axis]) * k[axis]) as usize).min(BINS - 1);
-            let bin = &mut bins[axis][b];
-            bin.0 = vmin(bin.0, it.lo);
-            bin.1 = vmax(bin.1, it.hi);
-            bin.2 += 1;
-        }
-    }
-    for (axis, bins) in bins.iter().enumerate() {
-        if ext[axis] <= 0.0 {
-            continue;
-        }
-        let mut right_cost = [0.0f32; BINS];
-        let (mut rmin, mut rmax, mut rc) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3], 0usize);
-        for i in (1..BINS).rev() {
-            rmin = vmin(rmin, bins[i].0);
-            rmax = vmax(rmax, bins[i].1);
-            rc += bins[i].2;
-            right_cost[i] = area(rmin, rmax) * rc as f32;
-        }
-        let (mut lmin, mut lmax, mut lc) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3], 0usize);
-        for i in 0..BINS - 1 {
-            lmin = vmin(lmin, bins[i].0);
-            lmax = vmax(lmax, bins[i].1);
-            lc += bins[i].2;
-            let cost = area(lmin, lmax) * lc as f32 + right_cost[i + 1];
-            if lc > 0 && lc < count && cost < best.0 {
-                best = (cost, axis, i);
-            }
-        }
-    }
-    let leaf_cost = area(bmin, bmax) * count as f32;
-    let mid = if best.0.is_finite() && (best.0 < leaf_cost || count > 16) {
-        let (axis, split) = (best.1, best.2);
-        let k = k[axis];
-        let mut i = 0;
-        let mut j = slice.len();
-        while i < j {
-            let b = (((slice[i].c[axis] - cmin[axis]) * k) as usize).min(BINS - 1);
-            if b <= split {
-                i += 1;
-            } else {
-                j -= 1;
-                slice.swap(i, j);
-            }
-        }
-        i
-    } else if count > 16 {
-        // All centroids equal: split in the middle of the list.
-        count / 2
-    } else {
-        return (bmin, bmax, None);
-    };
-    (bmin, bmax, (mid != 0 && mid != count).then_some(mid))
-}
-
-/// The one-thread build of the items `slice` (the `offset`-th onwards of the whole list):
-/// its nodes with the subtree's root at 0, numbered in the loop's order (a split node's
-/// children are appended as a pair; the right child's subtree is built before the left's).
-fn build_serial(slice: &mut [Item], offset: usize) -> Vec<Node> {
-    let mut nodes = Vec::with_capacity(2 * slice.len().max(1));
-    nodes.push(Node {
-        min: [f32::INFINITY; 3],
-        max: [f32::NEG_INFINITY; 3],
-        start: offset as u32,
-        count: slice.len() as u32,
-    });
-    let mut stack = vec![0usize];
-    while let Some(ni) = stack.pop() {
-        let (start, count) = (nodes[ni].start as usize, nodes[ni].count as usize);
-        let (bmin, bmax, mid) = split(&mut slice[start - offset..start - offset + count]);
-        nodes[ni].min = bmin;
-        nodes[ni].max = bmax;
-        let Some(mid) = mid else { continue };
-        let left = nodes.len();
-        for (s, c) in [(start, mid), (start + mid, count - mid)] {
-            nodes.push(Node {
-                min: bmin,
-                max: bmax,
-                start: s as u32,
-                count: c as u32,
-            });
-        }
-        nodes[ni].start = left as u32;
-        nodes[ni].count = 0;
-        stack.push(left);
-        stack.push(left + 1);
-    }
-    nodes
-}
-
-/// The top of a parallel build: splits made on rayon's threads down to subtrees small
-/// enough for `build_serial`, kept apart until their sizes are known and they can be
-/// written where the one-thread loop would have put them.
-enum Subtree {
-    Serial(Vec<Node>),
-    Split {
-        min: V3,
-        max: V3,
-        left: Box<Subtree>,
-        right: Box<Subtree>,
-        /// Nodes below this one.
-        size: usize,
-    },
-}
-
-impl Subtree {
-    /// Splits stop `MAX_PAR_DEPTH` levels down whatever the sizes: an input whose splits
-    /// peel off a few items at a time must not recurse as deep as it has items.
-    fn build(slice: &mut [Item], offset: usize, par_min: usize, depth: u32) -> Subtree {
-        const MAX_PAR_DEPTH: u32 = 20;
-        if slice.len() < par_min || depth >= MAX_PAR_DEPTH {
-            return Subtree::Serial(build_serial(slice, offset));
-        }
-        let (min, max, mid) = split(slice);
-        let Some(mid) = mid else {
-            return Subtree::Serial(vec![Node {
-                min,
-                max,
-                start: offset as u32,
-                count: slice.len() as u32,
-            }]);
-        };
-        let (l, r) = slice.split_at_mut(mid);
-        let (left, right) = rayon::join(
-            || Subtree::build(l, offset, par_min, depth + 1),
-            || Subtree::build(r, offset + mid, par_min, depth + 1),
-        );
-        let size = 2 + left.descendants() + right.descendants();
-        Subtree::Split {
-            min,
-            max,
-            left: Box::new(left),
-            right: Box::new(right),
-            size,
-        }
-    }
-
-    fn descendants(&self) -> usize {
-        match self {
-            Subtree::Serial(nodes) => nodes.len() - 1,
-            Subtree::Split { size, .. } => *size,
-        }
-    }
-
-    /// Writes the nodes below this subtree's root from `out[base]` on and returns the
-    /// root: a split's two children first, then the right child's nodes, then the left's.
-    fn emit(self, base: usize, out: &mut [Node]) -> Node {
-        match self {
-            Subtree::Serial(nodes) => {
-                // Local index i > 0 lands at base + i - 1.
-                let shift = |n: Node| {
-                    if n.count == 0 {
-                        Node {
-                            start: n.start + base as u32 - 1,
-                            ..n
-                        }
-                    } else {
-                        n
-                    }
-                };
-                for (o, n) in out[base..].iter_mut().zip(&nodes[1..]) {
-                    *o = shift(*n);
-                }
-                shift(nodes[0])
-            }
-            Subtree::Split {
-                min,
-                max,
-                left,
-                right,
-                ..
-            } => {
-                let right_size = right.descendants();
-                out[base + 1] = right.emit(base + 2, out);
-                out[base] = left.emit(base + 2 + right_size, out);
-                Node {
-                    min,
-                    max,
-                    start: base as u32,
-                    count: 0,
-                }
-            }
-        }
-    }
 }
 
 impl Bvh {
@@ -394,7 +151,7 @@ impl Bvh {
                 .iter()
                 .any(|&m| m & visibility::ALL != visibility::ALL)
         {
-            bvh.masks = bvh.ids.iter().map(|&i| masks[i as usize]).collect();
+            bvh.masks = bvh.tree.ids.iter().map(|&i| masks[i as usize]).collect();
         }
         bvh
     }
@@ -403,44 +160,21 @@ impl Bvh {
         Bvh::build_split_from(tris, PAR_MIN)
     }
 
-    /// The build, with subtrees of at least `par_min` triangles split on rayon's threads.
-    /// Every slice is partitioned by the same `split` whichever thread runs it, and the
-    /// nodes are numbered as the one-thread loop numbers them, so the tree is the same
-    /// node for node at any thread count (images stay bit-identical).
+    /// The build, with subtrees of at least `par_min` triangles split on rayon's threads
+    /// (`BoxTree::build_sah`: the same tree at any thread count).
     fn build_split_from(tris: &[[V3; 3]], par_min: usize) -> Bvh {
-        // Each triangle's box, centroid and index side by side, partitioned in place: the
-        // passes over a node read them in order (separate arrays indexed through a
-        // shuffled id list missed the cache on every item; the build was 15% of a
-        // published-colon render at 64x64).
-        let mut items: Vec<Item> = tris
-            .par_iter()
-            .enumerate()
-            .map(|(i, t)| {
-                let (lo, hi) = (vmin(vmin(t[0], t[1]), t[2]), vmax(vmax(t[0], t[1]), t[2]));
-                Item {
-                    lo,
-                    hi,
-                    c: scale(add(lo, hi), 0.5),
-                    id: i as u32,
-                }
-            })
-            .collect();
-        let top = Subtree::build(&mut items, 0, par_min, 0);
-        let mut nodes = vec![
-            Node {
-                min: [0.0; 3],
-                max: [0.0; 3],
-                start: 0,
-                count: 0,
-            };
-            1 + top.descendants()
-        ];
-        nodes[0] = top.emit(1, &mut nodes);
-        let tris_sorted = items.par_iter().map(|it| tris[it.id as usize]).collect();
+        let tree = BoxTree::build_sah(
+            tris.len(),
+            |i| {
+                let t = &tris[i];
+                (vmin(vmin(t[0], t[1]), t[2]), vmax(vmax(t[0], t[1]), t[2]))
+            },
+            par_min,
+        );
+        let tris_sorted = tree.ids.par_iter().map(|&i| tris[i as usize]).collect();
         Bvh {
-            nodes,
+            tree,
             tris: tris_sorted,
-            ids: items.iter().map(|it| it.id).collect(),
             masks: Vec::new(),
         }
     }
@@ -467,7 +201,7 @@ impl Bvh {
         let mut sp = 0usize;
         let mut ni = 0u32;
         loop {
-            let node = &self.nodes[ni as usize];
+            let node = &self.tree.nodes[ni as usize];
             if node.count > 0 {
                 let range = node.start..node.start + node.count;
                 if self.leaf::<ANY>(range, &wt, org, tmin, &mut tfar, &mut best, filter, mask)
@@ -476,8 +210,8 @@ impl Bvh {
                     return best;
                 }
             } else {
-                let l = &self.nodes[node.start as usize];
-                let r = &self.nodes[node.start as usize + 1];
+                let l = &self.tree.nodes[node.start as usize];
+                let r = &self.tree.nodes[node.start as usize + 1];
                 let tl = slab(l, org, inv, tmin, tfar);
                 let tr = slab(r, org, inv, tmin, tfar);
                 match (tl, tr) {
@@ -540,7 +274,7 @@ impl Bvh {
                 continue;
             }
             if let Some((t, u, v)) = wt.intersect(org, &self.tris[i as usize], tmin, *tfar) {
-                let prim = self.ids[i as usize];
+                let prim = self.tree.ids[i as usize];
                 if t == *tfar && best.is_none_or(|b| prim > b.prim) {
                     continue;
                 }
@@ -744,6 +478,7 @@ impl Bvh {
 
 #[cfg(test)]
 mod tests {
+    use super::super::box_tree::{area, BINS, MAX_LEAF};
     use super::*;
 
     #[test]
@@ -938,9 +673,8 @@ mod tests {
         }
         let tris_sorted = ids.iter().map(|&i| tris[i as usize]).collect();
         Bvh {
-            nodes,
+            tree: BoxTree { nodes, ids },
             tris: tris_sorted,
-            ids,
             masks: Vec::new(),
         }
     }
@@ -990,9 +724,9 @@ mod tests {
             let tris = soup(n, seed);
             let a = Bvh::build_split_from(&tris, par_min);
             let b = reference_build(&tris);
-            assert_eq!(a.ids, b.ids, "{n}");
-            assert_eq!(a.nodes.len(), b.nodes.len(), "{n}");
-            for (x, y) in a.nodes.iter().zip(&b.nodes) {
+            assert_eq!(a.tree.ids, b.tree.ids, "{n}");
+            assert_eq!(a.tree.nodes.len(), b.tree.nodes.len(), "{n}");
+            for (x, y) in a.tree.nodes.iter().zip(&b.tree.nodes) {
                 assert_eq!((x.start, x.count), (y.start, y.count), "{n}");
                 assert_eq!(x.min.map(f32::to_bits), y.min.map(f32::to_bits), "{n}");
                 assert_eq!(x.max.map(f32::to_bits), y.max.map(f32::to_bits), "{n}");

@@ -71,7 +71,7 @@ impl Bvh4 {
     /// Collapses a binary BVH: each wide node takes a binary node's children and keeps
     /// opening its largest inner child (by surface area) until it has four.
     pub fn from_binary(mut bin: Bvh) -> Bvh4 {
-        let src = std::mem::take(&mut bin.nodes);
+        let src = std::mem::take(&mut bin.tree.nodes);
         let mut nodes: Vec<Node4> = Vec::with_capacity(src.len() / 2 + 1);
         let tris = std::mem::take(&mut bin.tris);
         let mut packs: Vec<TriPack> = Vec::with_capacity(tris.len() / 2 + 1);
@@ -102,8 +102,8 @@ impl Bvh4 {
                     .enumerate()
                     .filter(|(_, &k)| src[k].count == 0)
                     .max_by(|(_, &x), (_, &y)| {
-                        super::bvh::area(src[x].min, src[x].max)
-                            .total_cmp(&super::bvh::area(src[y].min, src[y].max))
+                        super::box_tree::area(src[x].min, src[x].max)
+                            .total_cmp(&super::box_tree::area(src[y].min, src[y].max))
                     })
                     .map(|(i, _)| i);
                 let Some(i) = open else { break };
@@ -190,7 +190,7 @@ impl Bvh4 {
                     None
                 };
                 if let Some((t, u, v)) = hit {
-                    let prim = self.bin.ids[i];
+                    let prim = self.bin.tree.ids[i];
                     if t == *tfar && best.is_none_or(|b| prim > b.prim) {
                         continue;
                     }

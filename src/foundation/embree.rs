@@ -318,6 +318,7 @@ impl EmbreeAccel {
         // our test never hits) must not make every box infinite.
         let finite = |x: f32| if x.is_finite() { x.abs() } else { 0.0 };
         let extent = bvh
+            .tree
             .nodes
             .iter()
             .filter(|n| n.count > 0)
@@ -329,6 +330,7 @@ impl EmbreeAccel {
         // is not finite; such a leaf (which may hold other, finite triangles) is clamped
         // to +-1e18 instead (so only hits farther than that could differ).
         let leaves: Vec<(u32, u32, V3, V3)> = bvh
+            .tree
             .nodes
             .iter()
             .filter(|n| n.count > 0)

@@ -1,12 +1,14 @@
 //! Nearest-element search as Blender's `BLI_bvhtree_find_nearest` callbacks do it: the
 //! closest point on a triangle (`closest_on_tri_to_point_v3`) or segment
-//! (`closest_to_line_segment_v3`) in single precision, and a bounding-box tree over the
-//! elements that finds the one with the smallest squared distance.
+//! (`closest_to_line_segment_v3`) in single precision, and the foundation's box tree
+//! (`foundation::box_tree`) over the elements, which finds the one with the smallest
+//! squared distance.
 //!
 //! Blender keeps the first element its BVH visits among exactly equal distances, so its
 //! choice at a tie depends on its tree's layout; here the lowest element index wins, which
 //! is deterministic (the parity fixtures keep their sample points away from ties).
 
+use crate::foundation::box_tree::{BoxTree, Split};
 use crate::foundation::math::{dot, madd, sub};
 
 use super::math::V3;
@@ -109,152 +111,10 @@ pub fn interp_weights_tri(a: V3, b: V3, c: V3, p: V3) -> V3 {
     }
 }
 
-#[derive(Clone, Copy)]
-struct Node {
-    min: V3,
-    max: V3,
-    /// Leaf: first entry in `order`; inner: index of the left child (right = left + 1).
-    start: u32,
-    /// Element count; 0 for inner nodes.
-    count: u32,
-}
-
-/// A bounding-box tree over elements for nearest queries.
-pub struct NearestTree {
-    nodes: Vec<Node>,
-    /// Element indices in leaf order.
-    order: Vec<u32>,
-}
-
-const LEAF: usize = 4;
-
-impl NearestTree {
-    /// A tree over elements with these bounds (`(min, max)` per element).
-    pub fn build(bounds: &[(V3, V3)]) -> NearestTree {
-        let n = bounds.len();
-        let mut order: Vec<u32> = (0..n as u32).collect();
-        let mut nodes = vec![Node {
-            min: [0.0; 3],
-            max: [0.0; 3],
-            start: 0,
-            count: n as u32,
-        }];
-        let mut stack = vec![0usize];
-        let centre = |i: u32, a: usize| bounds[i as usize].0[a] + bounds[i as usize].1[a];
-        while let Some(ni) = stack.pop() {
-            let (start, count) = (nodes[ni].start as usize, nodes[ni].count as usize);
-            let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-            let (mut clo, mut chi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-            for &i in &order[start..start + count] {
-                let (a, b) = bounds[i as usize];
-                for k in 0..3 {
-                    lo[k] = lo[k].min(a[k]);
-                    hi[k] = hi[k].max(b[k]);
-                    clo[k] = clo[k].min(centre(i, k));
-                    chi[k] = chi[k].max(centre(i, k));
-                }
-            }
-            nodes[ni].min = lo;
-            nodes[ni].max = hi;
-            if count <= LEAF {
-                continue;
-            }
-            // Median split along the widest spread of element centres.
-            let axis = (0..3)
-                .max_by(|&a, &b| (chi[a] - clo[a]).total_cmp(&(chi[b] - clo[b])))
-                .unwrap();
-            let mid = count / 2;
-            order[start..start + count].select_nth_unstable_by(mid, |&x, &y| {
-                centre(x, axis).total_cmp(&centre(y, axis)).then(x.cmp(&y))
-            });
-            let left = nodes.len();
-            nodes.push(Node {
-                min: lo,
-                max: hi,
-                start: start as u32,
-                count: mid as u32,
-            });
-            nodes.push(Node {
-                min: lo,
-                max: hi,
-                start: (start + mid) as u32,
-                count: (count - mid) as u32,
-            });
-            nodes[ni].start = left as u32;
-            nodes[ni].count = 0;
-            stack.push(left);
-            stack.push(left + 1);
-        }
-        NearestTree { nodes, order }
-    }
-
-    /// The element with the smallest `dist(element)` (a squared distance from `q`, with any
-    /// payload it computed along), the lowest index among equal ones; None when there are
-    /// no elements or no distance is a number.
-    pub fn nearest<T>(
-        &self,
-        q: V3,
-        mut dist: impl FnMut(u32) -> (f32, T),
-    ) -> Option<(u32, f32, T)> {
-        if self.order.is_empty() {
-            return None;
-        }
-        let mut best: Option<(u32, f32, T)> = None;
-        let mut stack: Vec<u32> = Vec::with_capacity(64);
-        stack.push(0);
-        while let Some(ni) = stack.pop() {
-            let node = &self.nodes[ni as usize];
-            // Box distances are rounded differently from element distances: prune only
-            // boxes clearly beyond the best, so equal elements still meet the tie rule.
-            if let Some((_, d, _)) = &best {
-                if box_dist_sq(node, q) > *d * (1.0 + 1e-5) {
-                    continue;
-                }
-            }
-            if node.count > 0 {
-                for &i in &self.order[node.start as usize..(node.start + node.count) as usize] {
-                    let (d, payload) = dist(i);
-                    let better = match &best {
-                        None => !d.is_nan(),
-                        Some((bi, bd, _)) => d < *bd || (d == *bd && i < *bi),
-                    };
-                    if better {
-                        best = Some((i, d, payload));
-                    }
-                }
-            } else {
-                let (l, r) = (node.start, node.start + 1);
-                let (dl, dr) = (
-                    box_dist_sq(&self.nodes[l as usize], q),
-                    box_dist_sq(&self.nodes[r as usize], q),
-                );
-                // The nearer child is searched first (pushed last).
-                if dl <= dr {
-                    stack.push(r);
-                    stack.push(l);
-                } else {
-                    stack.push(l);
-                    stack.push(r);
-                }
-            }
-        }
-        best
-    }
-}
-
-fn box_dist_sq(n: &Node, q: V3) -> f32 {
-    let mut d = 0.0f32;
-    for k in 0..3 {
-        let g = if q[k] < n.min[k] {
-            n.min[k] - q[k]
-        } else if q[k] > n.max[k] {
-            q[k] - n.max[k]
-        } else {
-            0.0
-        };
-        d += g * g;
-    }
-    d
+/// The tree for nearest queries over elements with these bounds (`(min, max)` each), by
+/// the split rule these queries' results were made with.
+pub fn nearest_tree(bounds: &[(V3, V3)]) -> BoxTree {
+    BoxTree::build(bounds, Split::MedianByIndex)
 }
 
 /// Bounds of a triangle or segment's corners.
@@ -273,33 +133,6 @@ pub fn bounds_of(points: &[V3]) -> (V3, V3) {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn tree_finds_what_a_scan_finds_and_lowest_index_on_ties() {
-        // A pseudo-random cloud with duplicated points (exact ties).
-        let mut s = 12345u32;
-        let mut r = || {
-            s = s.wrapping_mul(1664525).wrapping_add(1013904223);
-            (s >> 8) as f32 / (1u32 << 24) as f32 - 0.5
-        };
-        let mut pts: Vec<V3> = (0..300).map(|_| [r(), r(), r()]).collect();
-        pts.extend_from_slice(&pts.clone()[..50]);
-        let tree = NearestTree::build(&pts.iter().map(|p| (*p, *p)).collect::<Vec<_>>());
-        for _ in 0..200 {
-            let q = [r() * 1.5, r() * 1.5, r() * 1.5];
-            let (i, d, _) = tree
-                .nearest(q, |i| (dist_sq(pts[i as usize], q), ()))
-                .unwrap();
-            let mut best = (0u32, f32::INFINITY);
-            for (k, p) in pts.iter().enumerate() {
-                let dk = dist_sq(*p, q);
-                if dk < best.1 {
-                    best = (k as u32, dk);
-                }
-            }
-            assert_eq!((i, d), best);
-        }
-    }
 
     #[test]
     fn barycentric_weights_reproduce_the_point() {

@@ -12,8 +12,8 @@
 
 use std::sync::Arc;
 
+use crate::foundation::box_tree::{BoxTree, Split};
 use crate::foundation::bvh::{Accel, Hit};
-use crate::foundation::bvh_boxes::BoxBvh;
 use crate::render::math::*;
 use crate::scene::hair::HairData;
 
@@ -456,7 +456,7 @@ pub enum Shape {
 
 /// The scene's curve segments behind one ray query.
 pub struct CurveAccel {
-    bvh: BoxBvh,
+    bvh: BoxTree,
     /// Per segment in the BVH: its scene prim id, control points, shape and the
     /// visibility mask of its object.
     prims: Vec<u32>,
@@ -527,7 +527,7 @@ impl CurveAccel {
             return None;
         }
         Some(CurveAccel {
-            bvh: BoxBvh::build(&boxes),
+            bvh: BoxTree::build(&boxes, Split::Median),
             prims,
             points,
             shapes,
@@ -854,7 +854,7 @@ mod tests {
         let points: Vec<_> = (0..3).map(|i| s.control_points(i)).collect();
         let boxes: Vec<_> = (0..3).map(|i| s.segment_bounds(i)).collect();
         let curves = CurveAccel {
-            bvh: BoxBvh::build(&boxes),
+            bvh: BoxTree::build(&boxes, Split::Median),
             prims: vec![10, 11, 12],
             points,
             shapes: vec![Shape::Ribbon(4); 3],

@@ -8,11 +8,12 @@ use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::Field;
 use super::super::math::V3;
 use super::super::nearest::{
-    bounds_of, closest_on_segment, closest_on_triangle, dist_sq, NearestTree,
+    bounds_of, closest_on_segment, closest_on_triangle, dist_sq, nearest_tree,
 };
 use super::super::realize::realize_instances;
 use super::super::types::{Array, DataType};
 use super::super::value::SocketValue;
+use crate::foundation::box_tree::BoxTree;
 
 /// Target points sorted by x, so a query scans outwards from its own x and stops once
 /// the x gap alone exceeds the best distance found.
@@ -155,17 +156,17 @@ pub fn geometry_proximity(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
 
 enum Target {
     Points(SortedPoints),
-    Edges(Vec<[V3; 2]>, NearestTree),
-    Faces(Vec<[V3; 3]>, NearestTree),
+    Edges(Vec<[V3; 2]>, BoxTree),
+    Faces(Vec<[V3; 3]>, BoxTree),
 }
 
 impl Target {
     fn edges(segs: Vec<[V3; 2]>) -> Target {
-        let tree = NearestTree::build(&segs.iter().map(|s| bounds_of(s)).collect::<Vec<_>>());
+        let tree = nearest_tree(&segs.iter().map(|s| bounds_of(s)).collect::<Vec<_>>());
         Target::Edges(segs, tree)
     }
     fn faces(tris: Vec<[V3; 3]>) -> Target {
-        let tree = NearestTree::build(&tris.iter().map(|t| bounds_of(t)).collect::<Vec<_>>());
+        let tree = nearest_tree(&tris.iter().map(|t| bounds_of(t)).collect::<Vec<_>>());
         Target::Faces(tris, tree)
     }
     fn nearest(&self, q: V3) -> Option<(V3, f32)> {

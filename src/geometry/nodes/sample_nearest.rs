@@ -24,29 +24,30 @@ use super::super::math::V3;
 use super::super::mesh::Mesh;
 use super::super::mesh_sample::{cleared, corner_values, sample, Triangles};
 use super::super::nearest::{
-    bounds_of, closest_on_segment, closest_on_triangle, dist_sq, NearestTree,
+    bounds_of, closest_on_segment, closest_on_triangle, dist_sq, nearest_tree,
 };
 use super::super::types::{Array, DataType, Domain, Value};
 use super::super::value::SocketValue;
 use super::raycast::sample_data_type;
+use crate::foundation::box_tree::BoxTree;
 
 /// What Sample Nearest searches.
 enum Target {
     /// Every index 0 (no component has elements of the domain).
     Nothing,
-    Points(Vec<V3>, NearestTree),
-    Edges(Vec<[V3; 2]>, NearestTree),
+    Points(Vec<V3>, BoxTree),
+    Edges(Vec<[V3; 2]>, BoxTree),
     /// Triangles and the face of each.
-    Faces(Triangles, NearestTree),
+    Faces(Triangles, BoxTree),
     /// Triangles, and the mesh for the corners of the nearest face.
-    Corners(Triangles, NearestTree, Arc<Mesh>),
+    Corners(Triangles, BoxTree, Arc<Mesh>),
 }
 
-fn tri_tree(t: &Triangles) -> NearestTree {
-    NearestTree::build(&t.positions.iter().map(|p| bounds_of(p)).collect::<Vec<_>>())
+fn tri_tree(t: &Triangles) -> BoxTree {
+    nearest_tree(&t.positions.iter().map(|p| bounds_of(p)).collect::<Vec<_>>())
 }
 
-fn nearest_tri(tris: &Triangles, tree: &NearestTree, q: V3) -> Option<(u32, V3)> {
+fn nearest_tri(tris: &Triangles, tree: &BoxTree, q: V3) -> Option<(u32, V3)> {
     tree.nearest(q, |t| {
         let [a, b, c] = tris.positions[t as usize];
         let p = closest_on_triangle(q, a, b, c);
@@ -108,7 +109,7 @@ pub fn sample_nearest(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         match domain {
             Domain::Point => Target::Points(
                 m.positions.clone(),
-                NearestTree::build(&m.positions.iter().map(|p| (*p, *p)).collect::<Vec<_>>()),
+                nearest_tree(&m.positions.iter().map(|p| (*p, *p)).collect::<Vec<_>>()),
             ),
             Domain::Edge => {
                 let segs: Vec<[V3; 2]> = m
@@ -116,8 +117,7 @@ pub fn sample_nearest(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
                     .iter()
                     .map(|e| [m.positions[e[0] as usize], m.positions[e[1] as usize]])
                     .collect();
-                let tree =
-                    NearestTree::build(&segs.iter().map(|s| bounds_of(s)).collect::<Vec<_>>());
+                let tree = nearest_tree(&segs.iter().map(|s| bounds_of(s)).collect::<Vec<_>>());
                 Target::Edges(segs, tree)
             }
             Domain::Face => {
@@ -134,7 +134,7 @@ pub fn sample_nearest(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     } else if let Some(p) = points {
         Target::Points(
             p.positions.clone(),
-            NearestTree::build(&p.positions.iter().map(|p| (*p, *p)).collect::<Vec<_>>()),
+            nearest_tree(&p.positions.iter().map(|p| (*p, *p)).collect::<Vec<_>>()),
         )
     } else {
         Target::Nothing
@@ -153,7 +153,7 @@ pub fn sample_nearest(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
 /// The triangles of one Group ID and their tree.
 struct Group {
     tris: Vec<u32>,
-    tree: NearestTree,
+    tree: BoxTree,
 }
 
 pub fn sample_nearest_surface(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -197,7 +197,7 @@ pub fn sample_nearest_surface(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let groups: Vec<Group> = groups
         .into_iter()
         .map(|tris_of| {
-            let tree = NearestTree::build(
+            let tree = nearest_tree(
                 &tris_of
                     .iter()
                     .map(|&t| bounds_of(&tris.positions[t as usize]))
