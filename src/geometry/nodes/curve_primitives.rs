@@ -5,7 +5,7 @@ use std::f64::consts::PI;
 use std::sync::Arc;
 
 use super::super::attribute::AttrId;
-use super::super::curves::{Curves, CURVE_TYPE_BEZIER, CURVE_TYPE_POLY};
+use super::super::curves::{Curves, CURVE_TYPE_BEZIER, CURVE_TYPE_POLY, HANDLE_ALIGN};
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::math::{add, normalize, scale, sub, V3};
@@ -174,5 +174,9 @@ pub fn bezier_segment(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         Domain::Point,
         Array::Vector(vec![right0, right1]),
     );
+    // Blender makes both handles Aligned (so Set Handle Type and Handle Type Selection see
+    // a Bezier curve, and moved points keep their handles aligned).
+    c.set_i8("handle_type_left", Domain::Point, vec![HANDLE_ALIGN; 2]);
+    c.set_i8("handle_type_right", Domain::Point, vec![HANDLE_ALIGN; 2]);
     Ok(out(c))
 }

@@ -123,9 +123,11 @@ impl FieldInput for CurveInput {
                 ctx.component.domain_size(domain),
             ));
         };
-        // Endpoint Selection has no value off the point domain (false), as in Blender,
-        // rather than its points' adapted to curves.
-        if matches!(self.0, Kind::Endpoints { .. }) && domain != Domain::Point {
+        // Endpoint and Handle Type Selection have no value off the point domain (false),
+        // as in Blender, rather than their points' adapted to curves.
+        if matches!(self.0, Kind::Endpoints { .. } | Kind::HandleType { .. })
+            && domain != Domain::Point
+        {
             return Ok(Array::Bool(vec![false; ctx.component.domain_size(domain)]));
         }
         let (from, data) = self.values(ctx, c)?;
