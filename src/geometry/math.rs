@@ -37,6 +37,25 @@ pub fn normalize_v3(a: V3) -> (V3, f32) {
     }
 }
 
+/// `axis_angle_normalized_to_mat3`: rotation by `angle` about the unit `axis`, with
+/// Blender's operation order (Screw's steps, Fillet Curve's arcs).
+pub fn axis_angle_normalized_to_mat3(axis: V3, angle: f32) -> Mat3f {
+    let (s, c) = (angle.sin(), angle.cos());
+    let ico = 1.0 - c;
+    let nsi = scale(axis, s);
+    let n00 = (axis[0] * axis[0]) * ico;
+    let n01 = (axis[0] * axis[1]) * ico;
+    let n11 = (axis[1] * axis[1]) * ico;
+    let n02 = (axis[0] * axis[2]) * ico;
+    let n12 = (axis[1] * axis[2]) * ico;
+    let n22 = (axis[2] * axis[2]) * ico;
+    [
+        [n00 + c, n01 + nsi[2], n02 - nsi[1]],
+        [n01 - nsi[2], n11 + c, n12 + nsi[0]],
+        [n02 + nsi[1], n12 - nsi[0], n22 + c],
+    ]
+}
+
 pub fn mat4_mul(a: &Mat4f, b: &Mat4f) -> Mat4f {
     let mut r = [[0.0f32; 4]; 4];
     for j in 0..4 {

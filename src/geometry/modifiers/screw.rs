@@ -14,7 +14,10 @@
 //!
 //! Edge attributes start at their defaults, as in Blender (it copies no edge data).
 
-use super::super::math::{mat4_invert, mat4_mul, transform_point, Mat4f, V3};
+use super::super::math::{
+    axis_angle_normalized_to_mat3, dot, mat3_to_mat4, mat4_invert, mat4_mul, normalize_v3,
+    transform_point, Mat4f, V3,
+};
 use super::super::mesh::Mesh;
 use super::super::set::GeometrySet;
 use super::super::types::{Array, Domain};
@@ -131,41 +134,6 @@ fn rotation_about(axis: usize, angle: f32) -> Mat4f {
         }
     }
     m
-}
-
-/// `axis_angle_normalized_to_mat3` as a 4x4.
-fn rotation_about_vector(a: V3, angle: f32) -> Mat4f {
-    let (s, c) = (angle.sin(), angle.cos());
-    let ico = 1.0 - c;
-    let nsi = [a[0] * s, a[1] * s, a[2] * s];
-    let n00 = (a[0] * a[0]) * ico;
-    let n01 = (a[0] * a[1]) * ico;
-    let n11 = (a[1] * a[1]) * ico;
-    let n02 = (a[0] * a[2]) * ico;
-    let n12 = (a[1] * a[2]) * ico;
-    let n22 = (a[2] * a[2]) * ico;
-    [
-        [n00 + c, n01 + nsi[2], n02 - nsi[1], 0.0],
-        [n01 - nsi[2], n11 + c, n12 + nsi[0], 0.0],
-        [n02 + nsi[1], n12 - nsi[0], n22 + c, 0.0],
-        [0.0, 0.0, 0.0, 1.0],
-    ]
-}
-
-fn dot(a: V3, b: V3) -> f32 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-/// `normalize_v3` (a zero vector stays zero).
-fn normalized(a: V3) -> V3 {
-    let d = dot(a, a);
-    if d > 1.0e-35 {
-        let l = d.sqrt();
-        let inv = 1.0 / l;
-        [a[0] * inv, a[1] * inv, a[2] * inv]
-    } else {
-        [0.0; 3]
-    }
 }
 
 /// One vertex of the profile graph (`ScrewVertConnect`).
@@ -310,8 +278,8 @@ fn order_edges(
             } else if v1 > vb && vb > v2 {
                 true
             } else {
-                let t1 = normalized([f1[0] - b.co[0], f1[1] - b.co[1], f1[2] - b.co[2]]);
-                let t2 = normalized([f2[0] - b.co[0], f2[1] - b.co[1], f2[2] - b.co[2]]);
+                let t1 = normalize_v3([f1[0] - b.co[0], f1[1] - b.co[1], f1[2] - b.co[2]]).0;
+                let t2 = normalize_v3([f2[0] - b.co[0], f2[1] - b.co[1], f2[2] - b.co[2]]).0;
                 t1[axis] < t2[axis]
             };
         } else if valid(b.v[0]) {
@@ -378,11 +346,12 @@ fn screw(m: &Mesh, s: &Settings) -> Result<Mesh, String> {
     if let Some((t, object_offset)) = &s.axis_object {
         // The rotation part only.
         let a = axis_vec;
-        axis_vec = normalized([
+        axis_vec = normalize_v3([
             t[0][0] * a[0] + t[1][0] * a[1] + t[2][0] * a[2],
             t[0][1] * a[0] + t[1][1] * a[1] + t[2][1] * a[2],
             t[0][2] * a[0] + t[1][2] * a[1] + t[2][2] * a[2],
-        ]);
+        ])
+        .0;
         if *object_offset {
             let o = [t[3][0], t[3][1], t[3][2]];
             screw_ofs = if dot(o, o).sqrt() != 0.0 {
@@ -445,7 +414,7 @@ fn screw(m: &Mesh, s: &Settings) -> Result<Mesh, String> {
     for step in 1..step_tot {
         let step_angle = (angle / (step_tot - (!close) as usize) as f32) * step as f32;
         let mut mat = if tx.is_some() {
-            rotation_about_vector(axis_vec, step_angle)
+            mat3_to_mat4(&axis_angle_normalized_to_mat3(axis_vec, step_angle))
         } else {
             rotation_about(s.axis, step_angle)
         };

@@ -14,7 +14,9 @@ use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::{ComponentRef, Field};
 use super::super::limits;
-use super::super::math::{add, cross, dot, normalize, normalize_v3, scale, sub, V3};
+use super::super::math::{
+    add, axis_angle_normalized_to_mat3, cross, dot, normalize, normalize_v3, scale, sub, V3,
+};
 use super::super::types::{Array, DataType, Domain, Value};
 use super::geometry_ops::{eval_fields, geo, modify_geometry_sets};
 use super::rotation::angle_normalized;
@@ -34,20 +36,7 @@ fn angle_v3v3(a: V3, b: V3) -> f32 {
 
 /// `math::rotate_around_axis` (`axis_angle_normalized_to_mat3` about `center`).
 fn rotate_around_axis(v: V3, center: V3, axis: V3, angle: f32) -> V3 {
-    let (s, c) = (angle.sin(), angle.cos());
-    let ico = 1.0 - c;
-    let nsi = scale(axis, s);
-    let n00 = (axis[0] * axis[0]) * ico;
-    let n01 = (axis[0] * axis[1]) * ico;
-    let n11 = (axis[1] * axis[1]) * ico;
-    let n02 = (axis[0] * axis[2]) * ico;
-    let n12 = (axis[1] * axis[2]) * ico;
-    let n22 = (axis[2] * axis[2]) * ico;
-    let m = [
-        [n00 + c, n01 + nsi[2], n02 - nsi[1]],
-        [n01 - nsi[2], n11 + c, n12 + nsi[0]],
-        [n02 + nsi[1], n12 - nsi[0], n22 + c],
-    ];
+    let m = axis_angle_normalized_to_mat3(axis, angle);
     let d = sub(v, center);
     let r = [0, 1, 2].map(|i| m[0][i] * d[0] + m[1][i] * d[1] + m[2][i] * d[2]);
     add(r, center)
