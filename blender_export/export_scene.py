@@ -1253,13 +1253,17 @@ def attribute_names_read(tree, seen):
     return names
 
 
-def smoke_domain_entries(objs, out, depsgraph):
+def smoke_domain_entries(objs, out, depsgraph, suffix="", only=None):
     """Per gas domain with a material: the grids its materials read, as Blender gives them
     at the current frame (read from the evaluated object, as Cycles does; the original's
-    would read a missing simulation), written as voxel grid files (FORMAT.md)."""
+    would read a missing simulation), written as voxel grid files (FORMAT.md). SUFFIX goes
+    into the file names (`.fN` for --frames); ONLY, a set of object keys, limits the
+    domains."""
     entries = []
     frame = bpy.context.scene.frame_current + bpy.context.scene.frame_subframe
     for i, o in enumerate(objs):
+        if only is not None and key(o) not in only:
+            continue
         md = next((m for m in o.modifiers if m.type == "FLUID" and m.fluid_type == "DOMAIN"
                    and m.show_render), None)
         if md is None or o.type != "MESH" or md.domain_settings.domain_type != "GAS":
@@ -1298,16 +1302,41 @@ def smoke_domain_entries(objs, out, depsgraph):
                 values = np.array(prop[:], dtype=np.float32)
             keep = SMOKE_GRIDS[name]
             values = values.reshape(-1, channels)[:, :keep]
-            rel = f"volumes/{safe_name(i, key(o))[:-4]}_{name}.grid"
-            os.makedirs(os.path.join(out, "volumes"), exist_ok=True)
-            with open(os.path.join(out, rel), "wb") as f:
-                f.write(b"BSVGRID1")
-                f.write(struct.pack("<4I", keep, *map(int, dims)))
-                f.write(np.concatenate([lo - size, lo + size]).astype("<f4").tobytes())
-                f.write(np.ascontiguousarray(values, dtype="<f4").tobytes())
+            rel = f"volumes/{safe_name(i, key(o))[:-4]}_{name}{suffix}.grid"
+            rel = write_grid_file(out, rel, keep, dims, np.concatenate([lo - size, lo + size]), values)
             entry["grids"].append({"name": name, "file": rel})
         entries.append(entry)
     return entries
+
+
+# Grid files written in this run by content (sha256 -> relative path): --frames writes a
+# grid again only where it changed (a sequence holding a file over several frames).
+GRID_FILES = {}
+
+
+def write_grid_file(out, rel, channels, dims, box, values):
+    """Writes one voxel grid file (FORMAT.md, "Voxel grid files") at REL under OUT, or
+    returns the path of an identical one written before."""
+    import hashlib
+    data = b"".join([b"BSVGRID1", struct.pack("<4I", channels, *map(int, dims)),
+                     np.asarray(box).astype("<f4").tobytes(),
+                     np.ascontiguousarray(values, dtype="<f4").tobytes()])
+    digest = hashlib.sha256(data).hexdigest()
+    if digest in GRID_FILES:
+        return GRID_FILES[digest]
+    os.makedirs(os.path.join(out, os.path.dirname(rel)), exist_ok=True)
+    with open(os.path.join(out, rel), "wb") as f:
+        f.write(data)
+    GRID_FILES[digest] = rel
+    return rel
+
+
+def volume_grids_every_frame(o):
+    """Whether Volume object O's evaluated grids are the same at every frame: one .vdb
+    file (not a sequence), no modifier in renders, no animation on the Volume."""
+    v = o.data
+    return (not v.is_sequence and not any(m.show_render for m in o.modifiers)
+            and v.animation_data is None)
 
 
 # Volume grids the exporter writes densely: OpenVDB value type -> channels.
@@ -1355,17 +1384,21 @@ def index_to_object(grid):
     return o, size
 
 
-def volume_object_entries(objs, out, depsgraph):
+def volume_object_entries(objs, out, depsgraph, suffix="", only=None):
     """Per Volume object: the grids its materials read (or the velocity grid), from its
     evaluated Volume at the current frame (the file sequence frame, Geometry Nodes or
     modifiers applied), saved by Blender to a .vdb and read with OpenVDB, each written
-    densely over its active voxels' bounding box as a voxel grid file (FORMAT.md)."""
+    densely over its active voxels' bounding box as a voxel grid file (FORMAT.md). SUFFIX
+    goes into the file names (`.fN` for --frames); ONLY, a set of object keys, limits the
+    objects."""
     entries = []
     frame = bpy.context.scene.frame_current + bpy.context.scene.frame_subframe
     vdb = None
     vdb_error = None
     for i, o in enumerate(objs):
         if o.type != "VOLUME" or o.data is None:
+            continue
+        if only is not None and key(o) not in only:
             continue
         if vdb is None and vdb_error is None:
             vdb, vdb_error = openvdb_module()
@@ -1377,7 +1410,8 @@ def volume_object_entries(objs, out, depsgraph):
             if slot.material is not None and slot.material.node_tree is not None:
                 wanted |= attribute_names_read(slot.material.node_tree, set())
         r = v.render
-        entry = {"object": key(o), "volume": key(v), "frame": frame, "materials": materials,
+        entry = {"object": key(o), "volume": key(v), "frame": frame,
+                 "every_frame": volume_grids_every_frame(o), "materials": materials,
                  "space": r.space, "step_size": r.step_size, "clipping": r.clipping,
                  "precision": r.precision, "velocity_grid": None,
                  "velocity_scale": v.velocity_scale, "grids": [], "unread": [], "error": None}
@@ -1399,7 +1433,7 @@ def volume_object_entries(objs, out, depsgraph):
             entries.append(entry)
             continue
         os.makedirs(os.path.join(out, "volumes"), exist_ok=True)
-        tmp = os.path.join(out, "volumes", f"{safe_name(i, key(o))[:-4]}.evaluated.vdb")
+        tmp = os.path.join(out, "volumes", f"{safe_name(i, key(o))[:-4]}{suffix}.evaluated.vdb")
         try:
             grids.save(filepath=tmp)
             read, _meta = vdb.readAll(tmp)
@@ -1448,12 +1482,8 @@ def volume_object_entries(objs, out, depsgraph):
             # -0.5 after the inverse index-to-object transform): the box starts at LO.
             box_lo = origin + size * np.array(lo, dtype=np.float64)
             box_hi = box_lo + size * np.array(dims, dtype=np.float64)
-            rel = f"volumes/{safe_name(i, key(o))[:-4]}_{name}.grid"
-            with open(os.path.join(out, rel), "wb") as f:
-                f.write(b"BSVGRID1")
-                f.write(struct.pack("<4I", channels, *dims))
-                f.write(np.concatenate([box_lo, box_hi]).astype("<f4").tobytes())
-                f.write(values.astype("<f4").tobytes())
+            rel = f"volumes/{safe_name(i, key(o))[:-4]}_{name}{suffix}.grid"
+            rel = write_grid_file(out, rel, channels, dims, np.concatenate([box_lo, box_hi]), values)
             entry["grids"].append({"name": name, "file": rel, "class": str(g.gridClass),
                                    "index_min": [int(x) for x in lo],
                                    "voxel_size": [float(x) for x in size]})
@@ -1880,6 +1910,27 @@ def evaluated_frames(evaluated, by_key, index, out, frames):
     return extra
 
 
+def grid_frames(smoke, volumes, out, frames):
+    """--frames A..B: the grids of every smoke domain and of every Volume object whose
+    grids change with the frame (`every_frame` false) at each frame A+1..B (the entries at
+    A are SMOKE and VOLUMES), one entry per object and frame."""
+    scene = bpy.context.scene
+    objs = list(bpy.data.objects)
+    smoke_only = {e["object"] for e in smoke}
+    volume_only = {e["object"] for e in volumes if not e["every_frame"] and e["error"] is None}
+    more_smoke, more_volumes = [], []
+    if not smoke_only and not volume_only:
+        return more_smoke, more_volumes
+    for f in range(frames[0] + 1, frames[1] + 1):
+        scene.frame_set(f)
+        depsgraph = bpy.context.evaluated_depsgraph_get()
+        if smoke_only:
+            more_smoke += smoke_domain_entries(objs, out, depsgraph, f".f{f}", smoke_only)
+        if volume_only:
+            more_volumes += volume_object_entries(objs, out, depsgraph, f".f{f}", volume_only)
+    return more_smoke, more_volumes
+
+
 def main():
     t0 = time.time()
     argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else sys.argv[1:]
@@ -2055,6 +2106,11 @@ def main():
         # Last: frame_set flushes each frame's animated values into the data read above.
         with RenderSettings():
             doc["evaluated"] += evaluated_frames(evaluated, by_key, index, out, args.frames)
+    if args.frames is not None:
+        with RenderSettings():
+            more_smoke, more_volumes = grid_frames(smoke_domains, volume_objects, out, args.frames)
+        doc["smoke_domains"] += more_smoke
+        doc["volume_objects"] += more_volumes
     nan_warnings = []
     doc = sanitize(doc, "", nan_warnings)
     doc["warnings"] = WARNINGS + nan_warnings

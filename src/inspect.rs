@@ -377,8 +377,8 @@ pub fn report_at(scene: &Scene, frame: Option<f64>) -> Report {
         coverage,
         material_status,
         frozen,
-        smoke_domains: smoke_summaries(scene),
-        volume_objects: volume_summaries(scene),
+        smoke_domains: smoke_summaries(scene, frame),
+        volume_objects: volume_summaries(scene, frame),
         frame,
         render_error,
         mesh_errors,
@@ -398,12 +398,18 @@ pub struct GridSummary {
     pub empty: Option<String>,
 }
 
-/// Volume objects with a readable record (`render`'s check refuses the others by name).
-fn volume_summaries(scene: &Scene) -> Vec<GridSummary> {
+/// Volume objects with a readable record, the one `render` uses at `frame` (`render`'s
+/// check refuses the others by name).
+fn volume_summaries(scene: &Scene, frame: f64) -> Vec<GridSummary> {
     let f = &scene.file;
     f.volume_objects
         .iter()
         .enumerate()
+        .filter(|(i, v)| {
+            scene
+                .volume_object(&v.object, frame)
+                .is_some_and(|(j, _)| j == *i)
+        })
         .filter(|(_, v)| v.error.is_none() && v.unread.is_empty())
         .map(|(i, v)| {
             let empty = match scene.load_volume_grids(i) {
@@ -428,11 +434,12 @@ fn all_clipped(grids: Vec<crate::scene::volume_grid::VoxelGrid>, clipping: f32) 
     crate::render::volume_grid::DomainGrids::new(grids, clipping).is_none()
 }
 
-fn smoke_summaries(scene: &Scene) -> Vec<GridSummary> {
+fn smoke_summaries(scene: &Scene, frame: f64) -> Vec<GridSummary> {
     let f = &scene.file;
     f.smoke_domains
         .iter()
         .enumerate()
+        .filter(|(i, d)| scene.smoke_domain(&d.object, frame).is_some_and(|(j, _)| j == *i))
         .map(|(i, d)| {
             let unread: Vec<String> = d.unread.iter().map(|(n, why)| format!("{n}: {why}")).collect();
             let empty = match scene.load_smoke_grids(i) {

@@ -328,6 +328,9 @@ const ASSERTED: &[&str] = &[
     "volume_vdb_fog",
     "volume_vdb_transformed",
     "volume_vdb_world_step",
+    // A Volume reading a .vdb sequence, exported with `convert --frames 1..3` and rendered
+    // at frame 3 (the per-frame grids), beside a single-file Volume exported once.
+    "volume_vdb_sequence",
     // The world volume (render/volume_world.rs), filling all space with the camera inside:
     // homogeneous scatter under a point light and a sun it extinguishes, absorption that
     // spares one channel (the sky and the sun stay in red), and a noise-texture density
@@ -766,6 +769,30 @@ fn same_bits_for_any_thread_count() {
     )
     .unwrap();
     assert_ne!(bits(&a), bits(&c));
+}
+
+/// `convert --frames 1..3` gave the sequence Volume grids at frames 1 to 3 (the parity
+/// scene renders frame 3 against Cycles): frame 4 is refused naming the object and the
+/// frames the export holds, while the one-file Volume beside it holds at every frame.
+#[test]
+fn volume_grids_at_a_frame_the_export_lacks_are_refused_by_name() {
+    let dir = common::repo().join("fixtures/render/scenes/volume_vdb_sequence");
+    let scene = Scene::load(&dir).unwrap();
+    let at = |f: f64| RenderOptions {
+        samples: Some(1),
+        resolution: Some((8, 8)),
+        frame: Some(f),
+        ..Default::default()
+    };
+    let e = render(&scene, &at(4.0)).unwrap_err().to_string();
+    assert!(
+        e.contains("\"Moving\"") && e.contains("frames 1, 2, 3, not 4"),
+        "{e}"
+    );
+    assert!(!e.contains("Still"), "{e}");
+    render(&scene, &at(2.0)).unwrap();
+    assert_eq!(scene.volume_object("Moving", 2.0).unwrap().1.frame, 2.0);
+    assert_eq!(scene.volume_object("Still", 4.0).unwrap().1.frame, 1.0);
 }
 
 #[test]

@@ -195,7 +195,7 @@ pub fn build(
         if !renders_itself(eval, obj) {
             continue;
         }
-        if let Some((di, _)) = scene.smoke_domain(&obj.name) {
+        if let Some((di, _)) = scene.smoke_domain(&obj.name, eval.frame) {
             let to_world = Affine::from_rows(&eval.world_matrices[oi]);
             push_smoke_domain(&mut instances, scene, (oi, obj), di, eval.frame, to_world)?;
             continue;
@@ -680,7 +680,8 @@ fn push_smoke_domain(
     to_world: Affine,
 ) -> Result<(), RenderError> {
     let d = &scene.file.smoke_domains[di];
-    let grids = grids_at(obj, "smoke", (d.frame, d.grids.len()), frame, || {
+    let valid = d.frame == frame || d.grids.is_empty();
+    let grids = grids_at(scene, obj, "smoke", valid, frame, || {
         scene.load_smoke_grids(di)
     })?;
     if let Some(g) = grids
@@ -710,20 +711,28 @@ fn push_smoke_domain(
     )
 }
 
-/// The `what` grids (smoke, Volume) of `obj` the export holds, `exported` = (the frame
-/// they are of, how many), read by `load`: an error naming the object when they are of
-/// another frame than `frame` (no grid is valid at any frame).
+/// The `what` grids (smoke, Volume) of `obj` the export holds, read by `load` when the
+/// record `Scene::smoke_domain` / `volume_object` found is `valid` at `frame`; otherwise
+/// an error naming the object and the frames the export has grids of.
 fn grids_at(
+    scene: &Scene,
     obj: &crate::scene::Object,
     what: &str,
-    (at, count): (f64, usize),
+    valid: bool,
     frame: f64,
     load: impl FnOnce() -> Result<Vec<crate::scene::volume_grid::VoxelGrid>, crate::scene::SceneError>,
 ) -> Result<Vec<crate::scene::volume_grid::VoxelGrid>, RenderError> {
-    if at != frame && count > 0 {
+    if !valid {
+        let frames: Vec<String> = scene
+            .grid_frames(&obj.name)
+            .iter()
+            .map(|f| f.to_string())
+            .collect();
         return Err(RenderError(format!(
-            "object {:?}: its {what} grids were exported at frame {at}, not {frame}: convert the file at this frame",
-            obj.name
+            "object {:?}: its {what} grids were exported at frame{} {}, not {frame}: convert the file at this frame, or with --frames over a range holding it",
+            obj.name,
+            if frames.len() > 1 { "s" } else { "" },
+            frames.join(", ")
         )));
     }
     load().map_err(|e| RenderError(format!("object {:?}: {e}", obj.name)))
@@ -741,10 +750,11 @@ fn push_volume_object(
     to_world: Affine,
 ) -> Result<(), RenderError> {
     // `volume::check_objects` has refused a Volume object without a readable record.
-    let Some((vi, v)) = scene.volume_object(&obj.name) else {
+    let Some((vi, v)) = scene.volume_object(&obj.name, frame) else {
         return Ok(());
     };
-    let grids = grids_at(obj, "Volume", (v.frame, v.grids.len()), frame, || {
+    let valid = v.frame == frame || v.every_frame || v.grids.is_empty();
+    let grids = grids_at(scene, obj, "Volume", valid, frame, || {
         scene.load_volume_grids(vi)
     })?;
     let Some(mut domain) = DomainGrids::new(grids, v.clipping) else {

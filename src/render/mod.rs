@@ -813,7 +813,7 @@ fn prepare(
         motion::object::warn_deformation(&eval);
         camera.set_motion(&steps);
     }
-    volume::check_objects(scene)?;
+    volume::check_objects(scene, frame)?;
     let mut geo = build::build(scene, &eval, overrides)?;
     let mut used = vec![false; scene.file.materials.len()];
     for inst in &geo.instances {

@@ -371,7 +371,7 @@ struct AheadLight {
 /// grids for it (an export older than the grid writer) or the material also has a
 /// Surface (Cycles would shade the voxel hull with it; not matched yet). Checked before
 /// the geometry (a domain's mesh is frozen, which is not the reason it fails).
-pub fn check_objects(scene: &BlendScene) -> Result<(), super::RenderError> {
+pub fn check_objects(scene: &BlendScene, frame: f64) -> Result<(), super::RenderError> {
     let linked = |name: &str, socket: &str| {
         scene
             .material(name)
@@ -385,7 +385,7 @@ pub fn check_objects(scene: &BlendScene) -> Result<(), super::RenderError> {
         .iter()
         .filter(|o| !o.hide_render && o.kind == "VOLUME")
     {
-        check_volume_object(scene, obj, &linked)?;
+        check_volume_object(scene, obj, frame, &linked)?;
     }
     for obj in scene.file.objects.iter().filter(|o| !o.hide_render) {
         let domain = obj.modifiers.iter().find(|md| {
@@ -407,7 +407,7 @@ pub fn check_objects(scene: &BlendScene) -> Result<(), super::RenderError> {
             .chain(mesh_materials.into_iter().flatten())
             .find(|m| linked(m, "Volume"));
         let Some(m) = volume else { continue };
-        if scene.smoke_domain(&obj.name).is_none() {
+        if !scene.is_smoke_domain(&obj.name) {
             return Err(super::RenderError(format!(
                 "object {:?}: the volume of its fluid domain (modifier {:?}, material {m:?}) is rendered from the simulation's grids, which this export does not carry: convert the .blend again with this version's exporter",
                 obj.name, md.name
@@ -431,6 +431,7 @@ pub fn check_objects(scene: &BlendScene) -> Result<(), super::RenderError> {
 fn check_volume_object(
     scene: &BlendScene,
     obj: &crate::scene::Object,
+    frame: f64,
     linked: &dyn Fn(&str, &str) -> bool,
 ) -> Result<(), super::RenderError> {
     let fail = |why: String| {
@@ -439,7 +440,7 @@ fn check_volume_object(
             obj.name
         )))
     };
-    let Some((_, v)) = scene.volume_object(&obj.name) else {
+    let Some((_, v)) = scene.volume_object(&obj.name, frame) else {
         return fail(
             "is rendered from its OpenVDB grids, which this export does not carry: convert the .blend again with this version's exporter".into(),
         );

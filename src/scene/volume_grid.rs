@@ -24,7 +24,8 @@ pub const MAX_GRID_VALUES: usize = 1 << 30;
 /// upres; one axis of a plausible grid is far smaller).
 pub const MAX_GRID_AXIS: u32 = 1 << 16;
 
-/// One smoke domain at the exported frame.
+/// One smoke domain at one exported frame (`convert --frames A..B` writes a record per
+/// frame).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct SmokeDomain {
     /// The domain object.
@@ -48,9 +49,9 @@ pub struct SmokeDomain {
     pub unread: Vec<(String, String)>,
 }
 
-/// One Volume object (OpenVDB grids) at the exported frame: its evaluated Volume's grids
-/// that its materials read, each dense over its active voxels, and the Volume's render
-/// settings.
+/// One Volume object (OpenVDB grids) at one exported frame (`convert --frames A..B` writes
+/// a record per frame for grids that change): its evaluated Volume's grids that its
+/// materials read, each dense over its active voxels, and the Volume's render settings.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct VolumeObject {
     /// The object.
@@ -59,6 +60,11 @@ pub struct VolumeObject {
     pub volume: String,
     /// The frame the grids are of.
     pub frame: f64,
+    /// The grids are the same at every frame (one .vdb file, not a sequence, no modifier,
+    /// no animation on the Volume), so this record holds at any frame. False in exports
+    /// older than the field.
+    #[serde(default)]
+    pub every_frame: bool,
     /// The Volume's material slots.
     #[serde(default)]
     pub materials: Vec<Option<String>>,
@@ -189,22 +195,58 @@ pub fn grid_bytes(g: &VoxelGrid) -> Vec<u8> {
 }
 
 impl Scene {
-    /// The smoke domain record of object `name`, if the export has one.
-    pub fn smoke_domain(&self, name: &str) -> Option<(usize, &SmokeDomain)> {
-        self.file
+    /// Whether the export has a smoke domain record of object `name` (at any frame).
+    pub fn is_smoke_domain(&self, name: &str) -> bool {
+        self.file.smoke_domains.iter().any(|d| d.object == name)
+    }
+
+    /// The smoke domain record of object `name` at `frame`, else its first record (whose
+    /// frame the caller's error then names); none when the export has no record of it.
+    pub fn smoke_domain(&self, name: &str, frame: f64) -> Option<(usize, &SmokeDomain)> {
+        let mut of = self
+            .file
             .smoke_domains
             .iter()
             .enumerate()
-            .find(|(_, d)| d.object == name)
+            .filter(|(_, d)| d.object == name);
+        let first = of.next()?;
+        Some(
+            std::iter::once(first)
+                .chain(of)
+                .find(|(_, d)| d.frame == frame)
+                .unwrap_or(first),
+        )
     }
 
-    /// The Volume object record of object `name`, if the export has one.
-    pub fn volume_object(&self, name: &str) -> Option<(usize, &VolumeObject)> {
-        self.file
+    /// The Volume object record of object `name` at `frame` (or one valid at every
+    /// frame), else its first record (whose frame the caller's error then names); none
+    /// when the export has no record of it.
+    pub fn volume_object(&self, name: &str, frame: f64) -> Option<(usize, &VolumeObject)> {
+        let mut of = self
+            .file
             .volume_objects
             .iter()
             .enumerate()
-            .find(|(_, v)| v.object == name)
+            .filter(|(_, v)| v.object == name);
+        let first = of.next()?;
+        Some(
+            std::iter::once(first)
+                .chain(of)
+                .find(|(_, v)| v.frame == frame || v.every_frame)
+                .unwrap_or(first),
+        )
+    }
+
+    /// The frames the export holds grids of for object `name` (smoke or Volume), sorted.
+    pub fn grid_frames(&self, name: &str) -> Vec<f64> {
+        let f = &self.file;
+        let mut frames: Vec<f64> = (f.smoke_domains.iter().filter(|d| d.object == name))
+            .map(|d| d.frame)
+            .chain((f.volume_objects.iter().filter(|v| v.object == name)).map(|v| v.frame))
+            .collect();
+        frames.sort_by(f64::total_cmp);
+        frames.dedup();
+        frames
     }
 
     /// Reads every grid of smoke domain `index`.
