@@ -898,6 +898,8 @@ impl Scene<'_> {
             path.t1 -= t;
         }
         path.set += SETS_PER_VERTEX;
+        let o = path.o;
+        path.passed_through(o);
     }
 
     /// The volume coefficients of every volume in `stack` at `p` on a ray along `d`
@@ -1435,6 +1437,7 @@ impl Scene<'_> {
         path.d = wi;
         path.t0 = 0.0;
         path.t1 = f32::INFINITY;
+        path.new_origin();
         path.set += SETS_PER_VERTEX;
     }
 
@@ -1571,6 +1574,7 @@ impl Scene<'_> {
         path.o = offset_origin(hit.p, hit.ng, path.d);
         path.t0 = 0.0;
         path.t1 = f32::INFINITY;
+        path.passed_through(hit.p);
         // Fresh dimensions for what lies beyond: the segment's own were drawn from
         // this set's spare one.
         path.set += SETS_PER_VERTEX;

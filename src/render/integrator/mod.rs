@@ -655,7 +655,9 @@ impl Scene<'_> {
             if !light.mis && flags & ray::CAMERA == 0 {
                 continue;
             }
-            if let Some(lh) = light.intersect(path.o, path.d, t_surface) {
+            // From Cycles' ray origin (`mis_o`), beyond the surfaces passed since.
+            let found = light.intersect(path.mis_o, path.d, path.mis_t + t_surface);
+            if let Some(lh) = found.filter(|lh| lh.t > path.mis_t) {
                 let w = if path.prev_singular {
                     1.0
                 } else {
@@ -849,9 +851,9 @@ impl Scene<'_> {
                     path.prev_pdf,
                     pick * crate::render::light::triangle::pdf(
                         &self.geo.tris[h.prim as usize],
-                        path.o,
+                        path.mis_o,
                         path.d,
-                        h.t,
+                        path.mis_t + h.t,
                     ),
                 )
             } else {

@@ -86,6 +86,14 @@ pub struct Path {
     /// the ray finds, for its MIS weight, is computed there.
     pub mis_n: V3,
     pub mis_trans: bool,
+    /// Where the ray being traced started as Cycles sees it, and `o`'s distance from
+    /// there: past a transparent surface or a volume boundary Cycles keeps the ray's
+    /// origin and only raises its start distance (integrate_surface_volume_only_bounce,
+    /// the transparent case of integrate_surface_bsdf_bssrdf_bounce), so what the ray
+    /// then finds is light-selected from that origin and its pdf taken at the whole
+    /// distance. blendsynth moves `o` past such surfaces; these keep Cycles' view.
+    pub mis_o: V3,
+    pub mis_t: f32,
     /// After a volume scatter, the segment it scattered in (origin, direction, length):
     /// its light was picked for the whole segment (Cycles' in_volume_segment light
     /// selection), and what the next ray hits is weighted by that selection's pdf.
@@ -125,6 +133,8 @@ impl Path {
             min_ray_pdf: f32::INFINITY,
             mis_n: [0.0; 3],
             mis_trans: false,
+            mis_o: o,
+            mis_t: 0.0,
             mis_segment: None,
             sss_exit: None,
             diffuse_ancestor: false,
@@ -141,7 +151,7 @@ impl Path {
         match self.mis_segment {
             Some((p, d, t)) => Viewer::Segment { p, d, t },
             None => Viewer::Point {
-                p: self.o,
+                p: self.mis_o,
                 n: self.mis_n,
                 trans: self.mis_trans,
             },
@@ -223,6 +233,7 @@ impl Path {
             self.o = offset_origin(p, ng, self.d);
             self.t0 = 0.0;
             self.t1 = f32::INFINITY;
+            self.passed_through(p);
             return Next::Continue;
         }
         if let LobeKind::RayPortal(portal) = bs.kind {
@@ -243,6 +254,7 @@ impl Path {
             self.d = portal.direction;
             self.t0 = 0.0;
             self.t1 = f32::INFINITY;
+            self.new_origin();
             return Next::Continue;
         }
         if let Some(c) = counter(&bs.kind, bs.transmit) {
@@ -287,7 +299,20 @@ impl Path {
         self.d = bs.wi;
         self.t0 = 0.0;
         self.t1 = f32::INFINITY;
+        self.new_origin();
         Next::Continue
+    }
+
+    /// The ray starts afresh at `o` (a bounce): Cycles' ray origin is there too.
+    pub fn new_origin(&mut self) {
+        self.mis_o = self.o;
+        self.mis_t = 0.0;
+    }
+
+    /// The ray went on past a surface at `p` without a bounce (transparency, a volume
+    /// boundary): Cycles' ray keeps its origin, so `o`'s distance from it grows.
+    pub fn passed_through(&mut self, p: V3) {
+        self.mis_t = len(sub(p, self.mis_o));
     }
 
     /// After a subsurface walk left the object at `exit` in direction `dir` (toward the
