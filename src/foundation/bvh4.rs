@@ -267,6 +267,17 @@ impl Bvh4 {
                 // such entries too).
                 hit &= (1 << (STACK - sp)) - 1;
             }
+            if ANY {
+                // Any hit ends the walk and only whether there is one is returned, so the
+                // order does not matter: no sorting.
+                while hit != 0 {
+                    let lane = hit.trailing_zeros() as usize;
+                    hit &= hit - 1;
+                    stack[sp].write((n.child[lane], n.count[lane], near[lane]));
+                    sp += 1;
+                }
+                continue;
+            }
             // Insert the hit children farthest first, so the nearest is visited next.
             let base = sp;
             while hit != 0 {
