@@ -9,6 +9,7 @@
 
 use super::bvh::{Bvh, Hit, Watertight};
 use super::math::*;
+use rayon::prelude::*;
 use std::mem::MaybeUninit;
 
 /// Traversal stack entries: up to three per level of a tree far deeper than SAH builds.
@@ -74,9 +75,16 @@ impl Bvh4 {
         let src = std::mem::take(&mut bin.tree.nodes);
         let mut nodes: Vec<Node4> = Vec::with_capacity(src.len() / 2 + 1);
         let tris = std::mem::take(&mut bin.tris);
-        let mut packs: Vec<TriPack> = Vec::with_capacity(tris.len() / 2 + 1);
+        // Each pack's (first triangle, lanes), in pack order; the packs themselves are
+        // filled afterwards on rayon's threads (filling them here, on one thread, was a
+        // serial part of the published colon's set-up).
+        let mut spans: Vec<(u32, u32)> = Vec::with_capacity(tris.len() / 2 + 1);
         if src.is_empty() || tris.is_empty() {
-            return Bvh4 { nodes, packs, bin };
+            return Bvh4 {
+                nodes,
+                packs: Vec::new(),
+                bin,
+            };
         }
         let blank = Node4 {
             lo: [[f32::INFINITY; 4]; 3],
@@ -119,25 +127,11 @@ impl Bvh4 {
                     node.hi[a][lane] = src[k].max[a];
                 }
                 if src[k].count > 0 {
-                    node.child[lane] = packs.len() as u32;
+                    node.child[lane] = spans.len() as u32;
                     node.count[lane] = src[k].count;
                     let (start, end) = (src[k].start, src[k].start + src[k].count);
                     for first in (start..end).step_by(4) {
-                        let n = (end - first).min(4);
-                        let mut pack = TriPack {
-                            v: [[[0.0; 4]; 3]; 3],
-                            first,
-                            n,
-                        };
-                        for l in 0..n as usize {
-                            let t = &tris[first as usize + l];
-                            for (k, vert) in t.iter().enumerate() {
-                                for a in 0..3 {
-                                    pack.v[k][a][l] = vert[a];
-                                }
-                            }
-                        }
-                        packs.push(pack);
+                        spans.push((first, (end - first).min(4)));
                     }
                 } else {
                     node.child[lane] = nodes.len() as u32;
@@ -148,6 +142,25 @@ impl Bvh4 {
             }
             nodes[at] = node;
         }
+        let packs = spans
+            .par_iter()
+            .map(|&(first, n)| {
+                let mut pack = TriPack {
+                    v: [[[0.0; 4]; 3]; 3],
+                    first,
+                    n,
+                };
+                for l in 0..n as usize {
+                    let t = &tris[first as usize + l];
+                    for (k, vert) in t.iter().enumerate() {
+                        for a in 0..3 {
+                            pack.v[k][a][l] = vert[a];
+                        }
+                    }
+                }
+                pack
+            })
+            .collect();
         Bvh4 { nodes, packs, bin }
     }
 
@@ -253,6 +266,17 @@ impl Bvh4 {
                 // Deeper than any SAH tree over f32 boxes gets (the binary BVH drops
                 // such entries too).
                 hit &= (1 << (STACK - sp)) - 1;
+            }
+            if ANY {
+                // Any hit ends the walk and only whether there is one is returned, so the
+                // order does not matter: no sorting.
+                while hit != 0 {
+                    let lane = hit.trailing_zeros() as usize;
+                    hit &= hit - 1;
+                    stack[sp].write((n.child[lane], n.count[lane], near[lane]));
+                    sp += 1;
+                }
+                continue;
             }
             // Insert the hit children farthest first, so the nearest is visited next.
             let base = sp;

@@ -36,9 +36,20 @@ pub fn apply(geo: &mut Geometry, materials: &[Material]) -> usize {
         }
         let key = Arc::as_ptr(&inst.mesh);
         if let std::collections::hash_map::Entry::Vacant(e) = done.entry(key) {
-            let (mesh, n) = displace(inst, materials);
-            moved += n;
-            e.insert((Arc::new(mesh), Arc::new(inst.mesh.positions.clone())));
+            let undisplaced = Arc::new(inst.mesh.positions.clone());
+            let (offsets, recompute) = displace(inst, materials);
+            moved += offsets.len();
+            // In place when this instance holds the only reference (the published colon:
+            // copying its 1.3 M-triangle mesh was a serial part of the set-up); a copy
+            // otherwise, so the other holders keep the undisplaced mesh.
+            let mesh = Arc::make_mut(&mut inst.mesh);
+            for (v, d) in offsets {
+                mesh.positions[v as usize] = add(mesh.positions[v as usize], d);
+            }
+            if recompute.iter().any(|&r| r) {
+                recompute_normals(mesh, &recompute);
+            }
+            e.insert((inst.mesh.clone(), undisplaced));
         }
         let (mesh, undisplaced) = done[&key].clone();
         inst.mesh = mesh;
@@ -60,7 +71,9 @@ fn program_of<'m>(
     p.displacement.map(|_| (mi, p))
 }
 
-fn displace(inst: &MeshInstance, materials: &[Material]) -> (MeshData, usize) {
+/// Each displaced vertex with its object-space offset, and per triangle whether its
+/// normals are recomputed from the moved vertices.
+fn displace(inst: &MeshInstance, materials: &[Material]) -> (Vec<(u32, V3)>, Vec<bool>) {
     let m = &inst.mesh;
     // Per vertex: the first displacing triangle corner that uses it (3 * triangle + k).
     let mut owner = vec![u32::MAX; m.vertex_count()];
@@ -89,14 +102,14 @@ fn displace(inst: &MeshInstance, materials: &[Material]) -> (MeshData, usize) {
         to_world: inst.to_world.m,
         to_object: inst.to_object.m,
     };
-    let offsets: Vec<V3> = jobs
+    let offsets: Vec<(u32, V3)> = jobs
         .par_iter()
         .map_init(
             || vec![Vec::new(); materials.len()],
             |stacks, &(v, o)| {
                 let (t, k) = ((o / 3) as usize, (o % 3) as usize);
                 let Some((mi, p)) = program_of(inst, materials, t) else {
-                    return [0.0; 3];
+                    return (v, [0.0; 3]);
                 };
                 let sp = vertex_point(inst, &vertex_normals, transform, t, k, v as usize);
                 let stack = &mut stacks[mi];
@@ -105,19 +118,14 @@ fn displace(inst: &MeshInstance, materials: &[Material]) -> (MeshData, usize) {
                 }
                 let d = p.displacement_at(&sp, stack).unwrap_or([0.0; 3]);
                 // Cycles' ensure_finite, then back to object space (the mesh's).
-                inst.to_object
-                    .vector(d.map(|x| if x.is_finite() { x } else { 0.0 }))
+                let d = inst
+                    .to_object
+                    .vector(d.map(|x| if x.is_finite() { x } else { 0.0 }));
+                (v, d)
             },
         )
         .collect();
-    let mut out = MeshData::clone(m);
-    for (&(v, _), d) in jobs.iter().zip(&offsets) {
-        out.positions[v as usize] = add(out.positions[v as usize], *d);
-    }
-    if recompute.iter().any(|&r| r) {
-        recompute_normals(&mut out, &recompute);
-    }
-    (out, jobs.len())
+    (offsets, recompute)
 }
 
 /// The shading point Cycles' displacement shader sees at vertex `v`, corner `k` of

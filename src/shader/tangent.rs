@@ -5,6 +5,7 @@
 
 use crate::nodes::math::{add3, cross3, normalize3, safe_normalize3, scale3, sub3, Vec3};
 use crate::scene::{AttributeData, MeshData};
+use rayon::prelude::*;
 
 use super::point::ShadingPoint;
 
@@ -222,40 +223,46 @@ pub fn vertex_normals(mesh: &MeshData) -> Vec<Vec3> {
         }
         return out;
     }
-    let mut acc = vec![[0.0f32; 3]; mesh.vertex_count()];
     let pos = |c: usize| mesh.positions[mesh.corner_verts[c] as usize];
-    for f in 0..mesh.face_count() {
-        let (a, b) = (
-            mesh.face_offsets[f] as usize,
-            mesh.face_offsets[f + 1] as usize,
-        );
-        let n = b - a;
-        if n < 3 {
-            continue;
-        }
-        let fno = match n {
-            3 => normalize3(cross3(
-                sub3(pos(a), pos(a + 1)),
-                sub3(pos(a + 1), pos(a + 2)),
-            )),
-            4 => normalize3(cross3(
-                sub3(pos(a), pos(a + 2)),
-                sub3(pos(a + 1), pos(a + 3)),
-            )),
-            _ => {
-                // Newell's method.
-                let mut s = [0.0f32; 3];
-                for k in 0..n {
-                    let (p, q) = (pos(a + k), pos(a + (k + 1) % n));
-                    s[0] += (p[1] - q[1]) * (p[2] + q[2]);
-                    s[1] += (p[2] - q[2]) * (p[0] + q[0]);
-                    s[2] += (p[0] - q[0]) * (p[1] + q[1]);
-                }
-                normalize3(s)
+    let face_normal = |a: usize, n: usize| match n {
+        3 => normalize3(cross3(
+            sub3(pos(a), pos(a + 1)),
+            sub3(pos(a + 1), pos(a + 2)),
+        )),
+        4 => normalize3(cross3(
+            sub3(pos(a), pos(a + 2)),
+            sub3(pos(a + 1), pos(a + 3)),
+        )),
+        _ => {
+            // Newell's method.
+            let mut s = [0.0f32; 3];
+            for k in 0..n {
+                let (p, q) = (pos(a + k), pos(a + (k + 1) % n));
+                s[0] += (p[1] - q[1]) * (p[2] + q[2]);
+                s[1] += (p[2] - q[2]) * (p[0] + q[0]);
+                s[2] += (p[0] - q[0]) * (p[1] + q[1]);
             }
-        };
-        for k in 0..n {
-            let c = a + k;
+            normalize3(s)
+        }
+    };
+    // Each corner's weighted face normal on rayon's threads (the arc cosines were a serial
+    // part of the published colon's set-up), then summed per vertex in corner order, the
+    // order of the one-thread loop, so the same bits.
+    let first = mesh.face_offsets.first().map_or(0, |&o| o as usize);
+    let end = mesh.face_offsets.last().map_or(0, |&o| o as usize);
+    let weighted: Vec<Option<Vec3>> = (first..end.max(first))
+        .into_par_iter()
+        .map(|c| {
+            let f = mesh.face_offsets.partition_point(|&o| o as usize <= c) - 1;
+            let (a, b) = (
+                mesh.face_offsets[f] as usize,
+                mesh.face_offsets[f + 1] as usize,
+            );
+            let n = b - a;
+            if n < 3 {
+                return None;
+            }
+            let k = c - a;
             let prev = a + (k + n - 1) % n;
             let next = a + (k + 1) % n;
             let d1 = safe_normalize3(sub3(pos(prev), pos(c)));
@@ -263,8 +270,14 @@ pub fn vertex_normals(mesh: &MeshData) -> Vec<Vec3> {
             let angle = (d1[0] * d2[0] + d1[1] * d2[1] + d1[2] * d2[2])
                 .clamp(-1.0, 1.0)
                 .acos();
+            Some(scale3(face_normal(a, n), angle))
+        })
+        .collect();
+    let mut acc = vec![[0.0f32; 3]; mesh.vertex_count()];
+    for (c, w) in (first..).zip(&weighted) {
+        if let Some(w) = w {
             let v = mesh.corner_verts[c] as usize;
-            acc[v] = add3(acc[v], scale3(fno, angle));
+            acc[v] = add3(acc[v], *w);
         }
     }
     acc.into_iter().map(safe_normalize3).collect()
