@@ -13,6 +13,7 @@ pub mod curve;
 pub mod curve_arc;
 pub mod curve_fields;
 pub mod curve_primitives;
+pub mod curve_quadratic_bezier;
 pub mod curve_read;
 pub mod curve_tangent;
 pub mod curve_to_points;
@@ -22,6 +23,7 @@ pub mod delete;
 pub mod distribute;
 pub mod domain_size;
 pub mod dual_mesh;
+pub mod duplicate_elements;
 pub mod edge_paths_to_curves;
 pub mod edge_paths_to_selection;
 pub mod extrude;
@@ -477,6 +479,15 @@ pub const NODES: &[(&str, Evaluate)] = &[
         edge_paths_to_curves::edge_paths_to_curves,
     ),
     ("GeometryNodeFilletCurve", fillet_curve::fillet_curve_node),
+    // Topology and curve nodes (issue 26 item 4).
+    (
+        "GeometryNodeDuplicateElements",
+        duplicate_elements::duplicate_elements,
+    ),
+    (
+        "GeometryNodeCurveQuadraticBezier",
+        curve_quadratic_bezier::quadratic_bezier,
+    ),
 ];
 
 /// The `bl_idname`s of `NODES`.
