@@ -48,9 +48,11 @@ pub mod material_selection;
 pub mod matrix;
 pub mod menu_switch;
 pub mod merge_by_distance;
+pub mod mesh_face_set_boundaries;
 pub mod mesh_to_curve;
 pub mod mesh_topology;
 pub mod points;
+pub mod points_to_curves;
 pub mod primitives;
 pub mod proximity;
 pub mod radius;
@@ -487,6 +489,14 @@ pub const NODES: &[(&str, Evaluate)] = &[
     (
         "GeometryNodeCurveQuadraticBezier",
         curve_quadratic_bezier::quadratic_bezier,
+    ),
+    (
+        "GeometryNodePointsToCurves",
+        points_to_curves::points_to_curves,
+    ),
+    (
+        "GeometryNodeMeshFaceSetBoundaries",
+        mesh_face_set_boundaries::face_set_boundaries,
     ),
 ];
 
