@@ -26,6 +26,7 @@ pub mod dual_mesh;
 pub mod duplicate_elements;
 pub mod edge_paths_to_curves;
 pub mod edge_paths_to_selection;
+pub mod edges_to_face_groups;
 pub mod extrude;
 pub mod field_nodes;
 pub mod fill_curve;
@@ -497,6 +498,10 @@ pub const NODES: &[(&str, Evaluate)] = &[
     (
         "GeometryNodeMeshFaceSetBoundaries",
         mesh_face_set_boundaries::face_set_boundaries,
+    ),
+    (
+        "GeometryNodeEdgesToFaceGroups",
+        edges_to_face_groups::edges_to_face_groups,
     ),
 ];
 
