@@ -691,10 +691,12 @@ fn parity_fixtures_stay_small() {
     // Curve, Index of Nearest, Shortest Edge Paths, instance propagation and Pick Instance
     // (gn_more_nodes.py: 0.97 MB, three quarters of it scene.json) to 10.5 MB; the
     // Simulation zone scene (gn_zones.py scene_simulation: 0.2 MB, three quarters of it
-    // node trees; its per-frame references are simulation_refs.json, 11 kB) to 10.6 MB.
+    // node trees; its per-frame references are simulation_refs.json, 11 kB) to 10.6 MB;
+    // Duplicate Elements, Quadratic Bezier, Points to Curves and Face Set Boundaries
+    // (gn_topo_nodes.py: 0.54 MB, nearly all of it scene.json) to 11 MB.
     assert!(
-        total < 10_600_000,
-        "fixtures/geometry/scenes holds {total} bytes; keep it under 10.6 MB"
+        total < 11_000_000,
+        "fixtures/geometry/scenes holds {total} bytes; keep it under 11 MB"
     );
 }
 

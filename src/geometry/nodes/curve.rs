@@ -303,8 +303,9 @@ fn is_builtin_curve_attribute(n: &str) -> bool {
     )
 }
 
+/// `bke::curves::segments_num`: a one-point curve has no segment, cyclic or not.
 fn segments(n: usize, cyclic: bool) -> usize {
-    if cyclic {
+    if cyclic && n > 1 {
         n
     } else {
         n.saturating_sub(1)

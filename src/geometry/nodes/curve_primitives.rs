@@ -13,7 +13,7 @@ use super::super::set::GeometrySet;
 use super::super::types::{Array, Domain};
 use super::geometry_ops::geo;
 
-fn single(positions: Vec<V3>, kind: i8, cyclic: bool) -> Curves {
+pub(super) fn single(positions: Vec<V3>, kind: i8, cyclic: bool) -> Curves {
     let n = positions.len() as u32;
     let mut c = Curves {
         positions,
@@ -35,7 +35,7 @@ fn single(positions: Vec<V3>, kind: i8, cyclic: bool) -> Curves {
     c
 }
 
-fn out(c: Curves) -> Outputs {
+pub(super) fn out(c: Curves) -> Outputs {
     outputs([(
         "Curve",
         geo(GeometrySet {

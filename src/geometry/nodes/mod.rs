@@ -13,6 +13,7 @@ pub mod curve;
 pub mod curve_arc;
 pub mod curve_fields;
 pub mod curve_primitives;
+pub mod curve_quadratic_bezier;
 pub mod curve_read;
 pub mod curve_tangent;
 pub mod curve_to_points;
@@ -22,8 +23,10 @@ pub mod delete;
 pub mod distribute;
 pub mod domain_size;
 pub mod dual_mesh;
+pub mod duplicate_elements;
 pub mod edge_paths_to_curves;
 pub mod edge_paths_to_selection;
+pub mod edges_to_face_groups;
 pub mod extrude;
 pub mod field_nodes;
 pub mod fill_curve;
@@ -46,9 +49,11 @@ pub mod material_selection;
 pub mod matrix;
 pub mod menu_switch;
 pub mod merge_by_distance;
+pub mod mesh_face_set_boundaries;
 pub mod mesh_to_curve;
 pub mod mesh_topology;
 pub mod points;
+pub mod points_to_curves;
 pub mod primitives;
 pub mod proximity;
 pub mod radius;
@@ -477,6 +482,27 @@ pub const NODES: &[(&str, Evaluate)] = &[
         edge_paths_to_curves::edge_paths_to_curves,
     ),
     ("GeometryNodeFilletCurve", fillet_curve::fillet_curve_node),
+    // Topology and curve nodes (issue 26 item 4).
+    (
+        "GeometryNodeDuplicateElements",
+        duplicate_elements::duplicate_elements,
+    ),
+    (
+        "GeometryNodeCurveQuadraticBezier",
+        curve_quadratic_bezier::quadratic_bezier,
+    ),
+    (
+        "GeometryNodePointsToCurves",
+        points_to_curves::points_to_curves,
+    ),
+    (
+        "GeometryNodeMeshFaceSetBoundaries",
+        mesh_face_set_boundaries::face_set_boundaries,
+    ),
+    (
+        "GeometryNodeEdgesToFaceGroups",
+        edges_to_face_groups::edges_to_face_groups,
+    ),
 ];
 
 /// The `bl_idname`s of `NODES`.
