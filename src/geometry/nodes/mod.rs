@@ -4,6 +4,7 @@
 pub mod accumulate_field;
 pub mod attribute;
 pub mod attribute_statistic;
+pub mod bake;
 pub mod blur_attribute;
 pub mod bounding_box;
 pub mod collection_info;
@@ -53,13 +54,16 @@ pub mod primitives;
 pub mod proximity;
 pub mod radius;
 pub mod raycast;
+pub mod remove_attribute;
 pub mod repeat_zone;
+pub mod replace_material;
 pub mod reverse_curve;
 pub mod rotation;
 pub mod sample_curve;
 pub mod sample_nearest;
 pub mod scale_elements;
 pub mod separate_components;
+pub mod set_geometry_name;
 pub mod set_spline_type;
 pub mod shortest_edge_paths;
 pub mod simulation_zone;
@@ -72,6 +76,8 @@ pub mod subdivision_surface;
 pub mod texture;
 pub mod triangulate;
 pub mod trim_curve;
+pub mod viewer;
+pub mod warning;
 
 use super::error::GeometryError;
 use super::eval::{NodeCtx, Outputs};
@@ -477,6 +483,30 @@ pub const NODES: &[(&str, Evaluate)] = &[
         edge_paths_to_curves::edge_paths_to_curves,
     ),
     ("GeometryNodeFilletCurve", fillet_curve::fillet_curve_node),
+    // Inputs and pass-throughs (issue 26 item 4).
+    ("FunctionNodeInputColor", input::input_color),
+    ("GeometryNodeInputObject", input::input_object),
+    ("GeometryNodeInputCollection", input::input_collection),
+    ("GeometryNodeViewer", viewer::viewer),
+    ("GeometryNodeWarning", warning::warning),
+    ("GeometryNodeBake", bake::bake),
+    (
+        "GeometryNodeSetGeometryName",
+        set_geometry_name::set_geometry_name,
+    ),
+    (
+        "GeometryNodeRemoveAttribute",
+        remove_attribute::remove_attribute,
+    ),
+    (
+        "GeometryNodeReplaceMaterial",
+        replace_material::replace_material,
+    ),
+    (
+        "GeometryNodeSetInstanceTransform",
+        instance_transform::set_instance_transform,
+    ),
+    ("FunctionNodeAxesToRotation", rotation::axes_to_rotation),
 ];
 
 /// The `bl_idname`s of `NODES`.
