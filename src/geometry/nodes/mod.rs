@@ -507,6 +507,7 @@ pub const NODES: &[(&str, Evaluate)] = &[
         instance_transform::set_instance_transform,
     ),
     ("FunctionNodeAxesToRotation", rotation::axes_to_rotation),
+    ("GeometryNodeCornersOfEdge", mesh_topology::corners_of_edge),
 ];
 
 /// The `bl_idname`s of `NODES`.
