@@ -39,6 +39,7 @@ pub mod ico_sphere;
 pub mod image_texture;
 pub mod index_of_nearest;
 pub mod input;
+pub mod instance_bounds;
 pub mod instance_transform;
 pub mod integer_math;
 pub mod is_smooth;
@@ -508,6 +509,10 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ),
     ("FunctionNodeAxesToRotation", rotation::axes_to_rotation),
     ("GeometryNodeCornersOfEdge", mesh_topology::corners_of_edge),
+    (
+        "GeometryNodeInputInstanceBounds",
+        instance_bounds::instance_bounds,
+    ),
 ];
 
 /// The `bl_idname`s of `NODES`.
