@@ -425,6 +425,9 @@ fn implicit_field(bl_idname: &str, identifier: &str) -> Option<Field> {
             Some(Field::input(IdInput))
         }
         ("GeometryNodeExtrudeMesh", "Offset") => Some(Field::input(super::field::NormalInput)),
+        ("GeometryNodeSetInstanceTransform", "Transform") => {
+            Some(super::nodes::points::instance_transform_field())
+        }
         ("GeometryNodeSampleIndex", "Index") | ("GeometryNodeFieldAtIndex", "Index") => {
             Some(Field::input(IndexInput))
         }

@@ -252,10 +252,12 @@ pub fn unsupported_gn_node(scene: &Scene, o: &Object) -> Option<String> {
 
 /// Why `o` is frozen at `frame` when its Geometry Nodes hold a Simulation zone blendsynth
 /// cannot play: one with baked data (Blender reads the bake instead of simulating), or
-/// an older export that does not say whether it is baked, at any frame but the start.
+/// an older export that does not say whether it is baked, at any frame but the start;
+/// or a Bake node with baked data (or an export that cannot tell), at any frame.
 /// Only Blender's evaluated mesh (the export's, or `convert --frames`) has it then.
 pub fn simulation_after_start(scene: &Scene, o: &Object, frame: f64) -> Option<String> {
     super::nodes::simulation_zone::unavailable_reason(scene, o, frame)
+        .or_else(|| super::nodes::bake::baked_reason(scene, o))
 }
 
 /// Blender's evaluated mesh of `o` in place of blendsynth's own evaluation, for `reason`,

@@ -1,5 +1,5 @@
 //! Input nodes: Position, Index, Normal, ID, Object Info, Self Object, Scene Time,
-//! Material, String, Is Viewport.
+//! Material, String, Is Viewport, Color, Object, Collection.
 
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
@@ -52,6 +52,34 @@ pub fn input_material(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         .and_then(|v| v.as_str())
         .map(str::to_string);
     Ok(outputs([("Material", SocketValue::Material(m))]))
+}
+
+/// An ID input node's datablock (`object`, `collection`), as its socket would hold it.
+fn id_input(ctx: &NodeCtx, prop: &str, kind: &str, output: &str) -> Result<Outputs, GeometryError> {
+    let v = match ctx.prop(prop) {
+        Some(j) => SocketValue::from_json(kind, j).map_err(|e| ctx.err(e))?,
+        None => SocketValue::zero(kind),
+    };
+    Ok(outputs([(output, v)]))
+}
+
+/// Object (`node_geo_input_object`): the node's object, for Object Info and others.
+pub fn input_object(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
+    id_input(ctx, "object", "OBJECT", "Object")
+}
+
+/// Collection (`node_geo_input_collection`).
+pub fn input_collection(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
+    id_input(ctx, "collection", "COLLECTION", "Collection")
+}
+
+/// Color (`node_input_color`): the node's RGBA value as it is stored (scene linear).
+pub fn input_color(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
+    let v = ctx
+        .prop("value")
+        .ok_or_else(|| ctx.err("property \"value\" missing"))?;
+    let c = SocketValue::from_json("RGBA", v).map_err(|e| ctx.err(e))?;
+    Ok(outputs([("Color", c)]))
 }
 
 pub fn input_string(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {

@@ -1,5 +1,6 @@
 //! Translate, Rotate and Scale Instances: change the selected instances' transforms in
-//! world space or in each instance's own space (`node_geo_{translate,rotate,scale}_instances`).
+//! world space or in each instance's own space (`node_geo_{translate,rotate,scale}_instances`);
+//! Set Instance Transform replaces them (`node_geo_set_instance_transform`).
 
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
@@ -41,6 +42,13 @@ fn modify(
         }
     }
     Ok(outputs([("Instances", SocketValue::Geometry(g))]))
+}
+
+/// Set Instance Transform: the selected instances take Transform (unlinked: their own).
+pub fn set_instance_transform(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
+    modify(ctx, &[("Transform", DataType::Matrix)], &|m, v, i| {
+        *m = v[0].as_matrix()[i];
+    })
 }
 
 pub fn translate_instances(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {

@@ -1,6 +1,6 @@
 //! Mesh topology fields (`node_geo_input_mesh_*` and `node_geo_mesh_topology_*`): Edge,
 //! Face and Vertex Neighbors, Edge Vertices, Edge Angle, Mesh Island, Face is Planar, and
-//! the index lookups (Corners of Face / Vertex, Edges of Vertex / Corner, Face / Vertex of
+//! the index lookups (Corners of Face / Vertex / Edge, Edges of Vertex / Corner, Face / Vertex of
 //! Corner, Offset Corner in Face). Each is computed on its own domain and moved to the
 //! one asked for, as Blender's `adapt_domain` does; on other components they are zero.
 
@@ -353,6 +353,7 @@ enum Lookup {
     CornersOfFace,
     CornersOfVertex,
     EdgesOfVertex,
+    CornersOfEdge,
     /// Per corner: the edge after / before it, its face, its index in the face, its
     /// vertex.
     NextEdge,
@@ -364,6 +365,7 @@ enum Lookup {
     FaceCornerCount,
     VertexCornerCount,
     VertexEdgeCount,
+    EdgeCornerCount,
 }
 
 impl Lookup {
@@ -374,6 +376,7 @@ impl Lookup {
             | Lookup::EdgesOfVertex
             | Lookup::VertexCornerCount
             | Lookup::VertexEdgeCount => Domain::Point,
+            Lookup::CornersOfEdge | Lookup::EdgeCornerCount => Domain::Edge,
             _ => Domain::Corner,
         }
     }
@@ -402,6 +405,14 @@ fn groups(kind: Lookup, m: &Mesh) -> Vec<Vec<u32>> {
             .map(|f| m.face(f).map(|c| c as u32).collect())
             .collect(),
         Lookup::CornersOfVertex => m.vert_to_corner(),
+        // Each edge's corners in corner order (`build_edge_to_corner_map`).
+        Lookup::CornersOfEdge => {
+            let mut out = vec![Vec::new(); m.edge_count()];
+            for (c, &e) in m.corner_edges.iter().enumerate() {
+                out[e as usize].push(c as u32);
+            }
+            out
+        }
         _ => {
             let mut out = vec![Vec::new(); m.vertex_count()];
             for (i, e) in m.edges.iter().enumerate() {
@@ -427,7 +438,10 @@ impl FieldInput for IndexLookup {
         let source_len = m.domain_size(self.kind.source_domain()) as i64;
         let in_range = |i: i32| (i as i64) >= 0 && (i as i64) < source_len;
         let out: Vec<i32> = match self.kind {
-            Lookup::CornersOfFace | Lookup::CornersOfVertex | Lookup::EdgesOfVertex => {
+            Lookup::CornersOfFace
+            | Lookup::CornersOfVertex
+            | Lookup::EdgesOfVertex
+            | Lookup::CornersOfEdge => {
                 let groups = groups(self.kind, m);
                 let sort = ctx.eval(&self.sort, domain, DataType::Int)?;
                 let sort = sort.as_int();
@@ -467,6 +481,13 @@ impl FieldInput for IndexLookup {
                 let counts = match kind {
                     Lookup::VertexCornerCount => Topo::VertexCornerCount.compute(m),
                     Lookup::VertexEdgeCount => Topo::VertexEdgeCount.compute(m),
+                    Lookup::EdgeCornerCount => {
+                        let mut counts = vec![0; m.edge_count()];
+                        for &e in &m.corner_edges {
+                            counts[e as usize] += 1;
+                        }
+                        Array::Int(counts)
+                    }
                     _ => Array::Int(Vec::new()),
                 };
                 let counts = counts.as_int();
@@ -543,6 +564,17 @@ pub fn corners_of_vertex(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         "Vertex Index",
         Lookup::CornersOfVertex,
         Lookup::VertexCornerCount,
+        "Corner Index",
+    )
+}
+
+/// Corners of Edge (`node_geo_mesh_topology_corners_of_edge`).
+pub fn corners_of_edge(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
+    sorted_lookup(
+        ctx,
+        "Edge Index",
+        Lookup::CornersOfEdge,
+        Lookup::EdgeCornerCount,
         "Corner Index",
     )
 }

@@ -4,6 +4,7 @@
 pub mod accumulate_field;
 pub mod attribute;
 pub mod attribute_statistic;
+pub mod bake;
 pub mod blur_attribute;
 pub mod bounding_box;
 pub mod collection_info;
@@ -41,6 +42,7 @@ pub mod ico_sphere;
 pub mod image_texture;
 pub mod index_of_nearest;
 pub mod input;
+pub mod instance_bounds;
 pub mod instance_transform;
 pub mod integer_math;
 pub mod is_smooth;
@@ -58,13 +60,16 @@ pub mod primitives;
 pub mod proximity;
 pub mod radius;
 pub mod raycast;
+pub mod remove_attribute;
 pub mod repeat_zone;
+pub mod replace_material;
 pub mod reverse_curve;
 pub mod rotation;
 pub mod sample_curve;
 pub mod sample_nearest;
 pub mod scale_elements;
 pub mod separate_components;
+pub mod set_geometry_name;
 pub mod set_spline_type;
 pub mod shortest_edge_paths;
 pub mod simulation_zone;
@@ -77,6 +82,8 @@ pub mod subdivision_surface;
 pub mod texture;
 pub mod triangulate;
 pub mod trim_curve;
+pub mod viewer;
+pub mod warning;
 
 use super::error::GeometryError;
 use super::eval::{NodeCtx, Outputs};
@@ -502,6 +509,35 @@ pub const NODES: &[(&str, Evaluate)] = &[
     (
         "GeometryNodeEdgesToFaceGroups",
         edges_to_face_groups::edges_to_face_groups,
+    ),
+    // Inputs and pass-throughs (issue 26 item 4).
+    ("FunctionNodeInputColor", input::input_color),
+    ("GeometryNodeInputObject", input::input_object),
+    ("GeometryNodeInputCollection", input::input_collection),
+    ("GeometryNodeViewer", viewer::viewer),
+    ("GeometryNodeWarning", warning::warning),
+    ("GeometryNodeBake", bake::bake),
+    (
+        "GeometryNodeSetGeometryName",
+        set_geometry_name::set_geometry_name,
+    ),
+    (
+        "GeometryNodeRemoveAttribute",
+        remove_attribute::remove_attribute,
+    ),
+    (
+        "GeometryNodeReplaceMaterial",
+        replace_material::replace_material,
+    ),
+    (
+        "GeometryNodeSetInstanceTransform",
+        instance_transform::set_instance_transform,
+    ),
+    ("FunctionNodeAxesToRotation", rotation::axes_to_rotation),
+    ("GeometryNodeCornersOfEdge", mesh_topology::corners_of_edge),
+    (
+        "GeometryNodeInputInstanceBounds",
+        instance_bounds::instance_bounds,
     ),
 ];
 

@@ -263,6 +263,11 @@ impl FieldInput for InstanceInput {
     }
 }
 
+/// The Instance Transform field (also Set Instance Transform's unlinked Transform).
+pub fn instance_transform_field() -> Field {
+    Field::input(InstanceInput(InstanceValue::Transform))
+}
+
 pub fn instance_transform(_: &NodeCtx) -> Result<Outputs, GeometryError> {
     Ok(outputs([(
         "Transform",

@@ -48,7 +48,11 @@ struct Settings {
 
 /// The bake item of the Simulation Output node `node` in tree `tree` (by node name and
 /// tree: a group holding a zone used twice shares its item's settings).
-fn bake_of<'m>(m: &'m Modifier, node: &str, tree: Option<&str>) -> Option<&'m BakeState> {
+pub(super) fn bake_of<'m>(
+    m: &'m Modifier,
+    node: &str,
+    tree: Option<&str>,
+) -> Option<&'m BakeState> {
     let bakes = m.bake_states.as_deref()?;
     let named = |b: &&BakeState| b.node.as_deref() == Some(node);
     bakes
@@ -120,7 +124,7 @@ pub fn simulation_output(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         ctx.flat().path
     );
     let ids = item_ids(&ctx.node().outputs, "Item_");
-    let items = item_types(ctx, &ids)?;
+    let items = item_types(ctx, &ids, "state_items")?;
     // A state from a later frame means time moved back: Blender starts again.
     let prev = session
         .simulation
@@ -206,15 +210,20 @@ fn step(
     to_state(stepped, items).map_err(|e| ctx.err(e))
 }
 
-/// Each item's socket type and attribute domain (the node's `state_items`, in order).
-fn item_types(ctx: &NodeCtx, ids: &[String]) -> Result<Vec<(String, Domain)>, GeometryError> {
+/// Each item's socket type and attribute domain (the node's `items` property, e.g.
+/// `state_items`, in order).
+pub(super) fn item_types(
+    ctx: &NodeCtx,
+    ids: &[String],
+    items: &str,
+) -> Result<Vec<(String, Domain)>, GeometryError> {
     let props = ctx
-        .prop("state_items")
+        .prop(items)
         .and_then(|v| v.as_array())
-        .ok_or_else(|| ctx.err("the export has no state_items"))?;
+        .ok_or_else(|| ctx.err(format!("the export has no {items}")))?;
     if props.len() != ids.len() {
         return Err(ctx.err(format!(
-            "{} state items but {} item sockets",
+            "{} {items} but {} item sockets",
             props.len(),
             ids.len()
         )));
@@ -245,7 +254,7 @@ fn item_value(ctx: &NodeCtx, id: &str, kind: &str) -> Result<SocketValue, Geomet
     convert_item(v, kind).map_err(|e| ctx.err(e))
 }
 
-fn convert_item(v: SocketValue, kind: &str) -> Result<SocketValue, String> {
+pub(super) fn convert_item(v: SocketValue, kind: &str) -> Result<SocketValue, String> {
     Ok(match (v, DataType::from_socket(kind)) {
         (SocketValue::Field(f), Some(ty)) => SocketValue::Field(f.convert(ty)),
         (v, _) => v,
@@ -256,7 +265,7 @@ fn convert_item(v: SocketValue, kind: &str) -> Result<SocketValue, String> {
 /// and back): a field item captured on the last geometry item before it and read back
 /// as that attribute (an attribute of no geometry, read as zeros, when there is none);
 /// anonymous attributes of the geometries removed, nested instances included.
-fn to_state(
+pub(super) fn to_state(
     mut values: Vec<SocketValue>,
     items: &[(String, Domain)],
 ) -> Result<Vec<SocketValue>, String> {
