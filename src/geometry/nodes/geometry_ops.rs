@@ -149,7 +149,28 @@ pub fn set_position(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     }
     if let Some(c) = g.curves.clone() {
         let r = eval_fields(ComponentRef::Curves(&c), Domain::Point, &fields).map_err(e)?;
-        apply(&mut g.curves_mut().unwrap().positions, r);
+        let cm = g.curves_mut().unwrap();
+        match (cm.point_vectors("handle_left"), cm.point_vectors("handle_right")) {
+            // Blender (node_geo_set_position) moves both handles of a moved point by its
+            // move, then recomputes the auto and vector handles from the new positions.
+            (Some(mut hl), Some(mut hr)) => {
+                let before = cm.positions.clone();
+                apply(&mut cm.positions, r);
+                for (i, (new, old)) in cm.positions.iter().zip(&before).enumerate() {
+                    if new != old {
+                        let d = [new[0] - old[0], new[1] - old[1], new[2] - old[2]];
+                        hl[i] = [hl[i][0] + d[0], hl[i][1] + d[1], hl[i][2] + d[2]];
+                        hr[i] = [hr[i][0] + d[0], hr[i][1] + d[1], hr[i][2] + d[2]];
+                    }
+                }
+                for (name, v) in [("handle_left", hl), ("handle_right", hr)] {
+                    cm.attributes
+                        .set(AttrId::named(name), Domain::Point, Array::Vector(v));
+                }
+                crate::geometry::bezier_handles::calculate_auto_handles(cm);
+            }
+            _ => apply(&mut cm.positions, r),
+        }
     }
     if let Some(inst) = g.instances.clone() {
         let r =
