@@ -150,7 +150,10 @@ pub fn set_position(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     if let Some(c) = g.curves.clone() {
         let r = eval_fields(ComponentRef::Curves(&c), Domain::Point, &fields).map_err(e)?;
         let cm = g.curves_mut().unwrap();
-        match (cm.point_vectors("handle_left"), cm.point_vectors("handle_right")) {
+        match (
+            cm.point_vectors("handle_left"),
+            cm.point_vectors("handle_right"),
+        ) {
             // Blender (node_geo_set_position) moves both handles of a moved point by its
             // move, then recomputes the auto and vector handles from the new positions.
             (Some(mut hl), Some(mut hr)) => {
