@@ -207,6 +207,11 @@ pub fn join_curves(parts: &[(&Curves, Mat4f)]) -> Curves {
                     }
                     data.extend(&v);
                 }
+                // A curve without a resolution has Blender's default, 12, which the
+                // join writes out (realize_instances fills it so), not zero.
+                None if id.name() == Some("resolution") && *ty == DataType::Int => {
+                    data.extend(&Array::Int(vec![12; c.domain_size(*d)]))
+                }
                 None => data.extend_default(c.domain_size(*d)),
             }
         }
