@@ -11,7 +11,7 @@
 use super::super::error::GeometryError;
 use super::super::eval::{NodeCtx, Outputs};
 use super::super::zones::item_ids;
-use super::simulation_zone::{bake_of, convert_item, item_types, to_state};
+use super::simulation_zone::{bake_of, baked_verdict, convert_item, item_types, to_state};
 use crate::scene::{Object, Scene};
 
 pub fn bake(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -57,28 +57,9 @@ pub fn baked_reason(scene: &Scene, o: &Object) -> Option<String> {
                     m.name
                 ));
             }
-            let bake = bake_of(m, node, Some(tree.name.as_str()));
-            match bake.and_then(|b| b.baked) {
-                Some(false) => {}
-                None if bake.is_none() => {}
-                Some(true) => {
-                    let place = match bake.and_then(|b| b.target.as_deref()) {
-                        Some("DISK") => "on disk",
-                        _ => "packed in the .blend",
-                    };
-                    return Some(format!(
-                        "Bake node {node:?} (modifier {:?}) holds baked data ({place}) that \
-                         Blender reads instead of its inputs; blendsynth does not read bakes",
-                        m.name
-                    ));
-                }
-                None => {
-                    return Some(format!(
-                        "Bake node {node:?} (modifier {:?}): the exporter could not tell \
-                         whether it holds baked data",
-                        m.name
-                    ))
-                }
+            if let Some(why) = baked_verdict(m, node, tree.name.as_str(), "Bake node", "its inputs")
+            {
+                return Some(why);
             }
         }
     }

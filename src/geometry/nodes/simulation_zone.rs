@@ -382,6 +382,38 @@ fn zones_of<'s>(scene: &'s Scene, o: &'s Object) -> Vec<(&'s Modifier, &'s str, 
     found
 }
 
+/// Why node `node` of tree `tree` (a Simulation zone or a Bake node, `what`) in modifier
+/// `m`, whose export records bake states, cannot be evaluated: it holds baked data Blender
+/// reads instead of `instead`, or the exporter could not tell whether it does.
+pub(super) fn baked_verdict(
+    m: &Modifier,
+    node: &str,
+    tree: &str,
+    what: &str,
+    instead: &str,
+) -> Option<String> {
+    let bake = bake_of(m, node, Some(tree))?;
+    match bake.baked {
+        Some(false) => None,
+        Some(true) => {
+            let place = match bake.target.as_deref() {
+                Some("DISK") => "on disk",
+                _ => "packed in the .blend",
+            };
+            Some(format!(
+                "{what} {node:?} (modifier {:?}) holds baked data ({place}) that Blender reads \
+                 instead of {instead}; blendsynth does not read bakes",
+                m.name
+            ))
+        }
+        None => Some(format!(
+            "{what} {node:?} (modifier {:?}): the exporter could not tell whether it holds \
+             baked data",
+            m.name
+        )),
+    }
+}
+
 /// Why blendsynth cannot evaluate `o`'s Simulation zones at `frame`: a zone whose baked
 /// data Blender reads instead of simulating, or, at any frame but the start, an older
 /// export that does not say whether a zone is baked. None when every zone plays natively.
@@ -397,29 +429,8 @@ pub fn unavailable_reason(scene: &Scene, o: &Object, frame: f64) -> Option<Strin
                  it is baked (convert the .blend again with this version)"
             ));
         };
-        let bake = bake_of(m, node, Some(tree));
-        match bake.and_then(|b| b.baked) {
-            Some(false) => {}
-            Some(true) => {
-                let b = bake.unwrap();
-                let place = match b.target.as_deref() {
-                    Some("DISK") => "on disk",
-                    _ => "packed in the .blend",
-                };
-                return Some(format!(
-                    "Simulation zone {node:?} (modifier {:?}) holds baked data ({place}) that \
-                     Blender reads instead of simulating; blendsynth does not read bakes",
-                    m.name
-                ));
-            }
-            None if bake.is_none() => {}
-            None => {
-                return Some(format!(
-                    "Simulation zone {node:?} (modifier {:?}): the exporter could not tell \
-                     whether it holds baked data",
-                    m.name
-                ))
-            }
+        if let Some(why) = baked_verdict(m, node, tree, "Simulation zone", "simulating") {
+            return Some(why);
         }
     }
     None
