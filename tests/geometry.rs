@@ -695,10 +695,12 @@ fn parity_fixtures_stay_small() {
     // Duplicate Elements, Quadratic Bezier, Points to Curves and Face Set Boundaries
     // (gn_topo_nodes.py: 0.54 MB, nearly all of it scene.json), and the input,
     // pass-through, Remove Named Attribute and Replace Material scenes (gn_input_nodes.py:
-    // 0.26 MB) to 11.4 MB.
+    // 0.26 MB) to 11.4 MB; the NURBS and Catmull-Rom scene (gn_curve_nodes.py
+    // scene_curve_types: 0.31 MB, 0.19 MB of it scene.json) and the join defaults
+    // (gn_mesh_nodes.py: 0.09 MB) to 11.8 MB.
     assert!(
-        total < 11_400_000,
-        "fixtures/geometry/scenes holds {total} bytes; keep it under 11.4 MB"
+        total < 11_800_000,
+        "fixtures/geometry/scenes holds {total} bytes; keep it under 11.8 MB"
     );
 }
 

@@ -3,10 +3,15 @@
 //! at the curve's resolution, poly points as they are), attributes interpolated to the
 //! evaluated points, segment lengths, tangents, and minimum-twist / Z-up normals with tilt.
 //!
-//! NURBS and Catmull-Rom curves are reported as unsupported rather than approximated.
+//! Catmull-Rom curves by their uniform cubic basis (`curves::catmull_rom`), NURBS by their
+//! basis (`nurbs.rs`); NURBS control points are not on the curve, so per-control-point
+//! values (normals, tangents, lengths) treat them as a poly curve, as Blender does.
 
-use super::curves::{Curves, CURVE_TYPE_BEZIER, CURVE_TYPE_POLY};
+use super::curves::{
+    Curves, CURVE_TYPE_BEZIER, CURVE_TYPE_CATMULL_ROM, CURVE_TYPE_NURBS, CURVE_TYPE_POLY,
+};
 use super::math::{add, cross, dot, length, normalize, scale, sub, V3};
+use super::nurbs::Basis;
 use super::types::{Array, Domain};
 
 /// Blender's `NormalMode` values as stored in the `normal_mode` curve attribute.
@@ -69,15 +74,26 @@ fn point_vec(c: &Curves, name: &str) -> Vec<V3> {
     }
 }
 
-/// Per-curve facts needed to evaluate: evaluated point offsets and, for Bezier curves,
-/// each control point's first evaluated point.
+/// How one curve's evaluated points come from its control points.
+enum Kind {
+    Poly,
+    /// Per control point, the offset of its segment's first evaluated point within the
+    /// curve (`n + 1` entries: point order plus one).
+    Bezier(Vec<u32>),
+    /// Evaluated points per segment (the curve's resolution).
+    CatmullRom(usize),
+    /// The curve's basis, or `None` when it evaluates to its control points.
+    Nurbs(Option<Basis>),
+}
+
+/// Per-curve facts needed to evaluate: evaluated point offsets and how each curve's
+/// evaluated points are made.
 pub struct Evaluated {
     pub offsets: Vec<u32>,
     pub cyclic: Vec<bool>,
-    types: Vec<i8>,
-    /// For Bezier curves: per control point, the offset of its segment's first evaluated
-    /// point within the curve (`n + 1` entries per curve, in point order plus one).
-    bezier_offsets: Vec<Vec<u32>>,
+    kinds: Vec<Kind>,
+    /// The `nurbs_weight` point attribute, when there is one (rational NURBS).
+    nurbs_weights: Option<Vec<f32>>,
 }
 
 impl Evaluated {
@@ -87,16 +103,18 @@ impl Evaluated {
         let res = resolutions(c);
         let hl = point_i8(c, "handle_type_left");
         let hr = point_i8(c, "handle_type_right");
+        let (mut orders, mut knots_modes) = (Vec::new(), Vec::new());
+        if types.contains(&CURVE_TYPE_NURBS) {
+            orders = c.ints("nurbs_order", Domain::Curve, 4);
+            knots_modes = c.ints("knots_mode", Domain::Curve, 0);
+        }
         let mut offsets = vec![0u32];
-        let mut bezier_offsets = Vec::with_capacity(c.curve_count());
+        let mut kinds = Vec::with_capacity(c.curve_count());
         for i in 0..c.curve_count() {
             let pts = c.points(i);
             let n = pts.len();
-            let count = match types[i] {
-                CURVE_TYPE_POLY => {
-                    bezier_offsets.push(Vec::new());
-                    n
-                }
+            let (kind, count) = match types[i] {
+                CURVE_TYPE_POLY => (Kind::Poly, n),
                 CURVE_TYPE_BEZIER => {
                     // Each segment gets `resolution` points, or one when both of its
                     // handles are vector handles (a straight segment); an open curve
@@ -116,37 +134,68 @@ impl Evaluated {
                         acc += if vector { 1 } else { r };
                     }
                     offs.push(acc);
-                    bezier_offsets.push(offs);
-                    if n == 0 {
-                        0
-                    } else {
-                        acc as usize
-                    }
+                    let count = if n == 0 { 0 } else { acc as usize };
+                    (Kind::Bezier(offs), count)
+                }
+                CURVE_TYPE_CATMULL_ROM => {
+                    // `catmull_rom::calculate_evaluated_num`: `resolution` points per
+                    // segment, plus the last control point of an open curve.
+                    let r = res[i].max(1) as usize;
+                    let segments = if cyclic[i] { n } else { n.saturating_sub(1) };
+                    super::limits::check(
+                        super::limits::product(&[r as u64, segments as u64]),
+                        "the Catmull-Rom curve's resolution",
+                    )?;
+                    let count = match (n, cyclic[i]) {
+                        (0, _) => 0,
+                        (_, true) => (r * segments).max(1),
+                        (_, false) => r * segments + 1,
+                    };
+                    (Kind::CatmullRom(r), count)
+                }
+                CURVE_TYPE_NURBS => {
+                    let basis = Basis::new(n, orders[i], cyclic[i], res[i], knots_modes[i] as i8)
+                        .map_err(|e| format!("curve {i}: {e}"))?;
+                    let count = basis.as_ref().map_or(n, |b| b.len());
+                    (Kind::Nurbs(basis), count)
                 }
                 t => {
                     return Err(format!(
-                        "curve {i}: {} curves are not supported yet (only Bezier and poly)",
+                        "curve {i}: curve type {} is not supported",
                         type_name(t)
                     ))
                 }
             };
+            kinds.push(kind);
             offsets.push(offsets[i] + count as u32);
         }
+        let nurbs_weights = match c.attributes.named("nurbs_weight") {
+            Some(a) if a.domain == Domain::Point && types.contains(&CURVE_TYPE_NURBS) => {
+                Some(a.data.as_float().into_owned())
+            }
+            _ => None,
+        };
         Ok(Evaluated {
             offsets,
             cyclic,
-            types,
-            bezier_offsets,
+            kinds,
+            nurbs_weights,
         })
     }
 
     /// The evaluated point (within curve `i`) where control point `p` (within the curve)
-    /// lies.
-    pub fn control_point_evaluated(&self, i: usize, p: usize) -> usize {
-        match self.types[i] {
-            CURVE_TYPE_BEZIER => self.bezier_offsets[i][p] as usize,
-            _ => p,
+    /// lies; `None` for NURBS curves, whose control points are not on the curve.
+    pub fn control_point_evaluated(&self, i: usize, p: usize) -> Option<usize> {
+        match &self.kinds[i] {
+            Kind::Poly => Some(p),
+            Kind::Bezier(offs) => Some(offs[p] as usize),
+            Kind::CatmullRom(r) => Some(r * p),
+            Kind::Nurbs(_) => None,
         }
+    }
+
+    pub fn is_nurbs(&self, i: usize) -> bool {
+        matches!(self.kinds[i], Kind::Nurbs(_))
     }
 
     pub fn total(&self) -> usize {
@@ -157,6 +206,10 @@ impl Evaluated {
         self.offsets[i] as usize..self.offsets[i + 1] as usize
     }
 
+    fn weights(&self, pts: std::ops::Range<usize>) -> Option<&[f32]> {
+        self.nurbs_weights.as_deref().map(|w| &w[pts])
+    }
+
     /// Evaluated positions of every curve, concatenated.
     pub fn positions(&self, c: &Curves) -> Vec<V3> {
         let mut out = vec![[0.0f32; 3]; self.total()];
@@ -165,9 +218,8 @@ impl Evaluated {
         for i in 0..c.curve_count() {
             let pts = c.points(i);
             let dst = &mut out[self.range(i)];
-            match self.types[i] {
-                CURVE_TYPE_BEZIER => {
-                    let offs = &self.bezier_offsets[i];
+            match &self.kinds[i] {
+                Kind::Bezier(offs) => {
                     let n = pts.len();
                     for s in 0..n {
                         let seg = offs[s] as usize..offs[s + 1] as usize;
@@ -183,7 +235,13 @@ impl Evaluated {
                         bezier_segment(c.positions[a], hr[a], hl[b], c.positions[b], &mut dst[seg]);
                     }
                 }
-                _ => dst.copy_from_slice(&c.positions[pts]),
+                Kind::CatmullRom(r) => {
+                    catmull_rom(&c.positions[pts], self.cyclic[i], *r, dst, &mix_vector)
+                }
+                Kind::Nurbs(Some(b)) => dst.copy_from_slice(
+                    &b.evaluate_vectors(&c.positions[pts.clone()], self.weights(pts)),
+                ),
+                Kind::Poly | Kind::Nurbs(None) => dst.copy_from_slice(&c.positions[pts]),
             }
         }
         out
@@ -200,7 +258,7 @@ impl Evaluated {
             let start = out.len();
             out.extend(tangents(&evaluated[r.clone()], self.cyclic[i]));
             let pts = c.points(i);
-            if self.types[i] == CURVE_TYPE_BEZIER
+            if matches!(self.kinds[i], Kind::Bezier(_))
                 && !self.cyclic[i]
                 && !r.is_empty()
                 && !pts.is_empty()
@@ -219,14 +277,14 @@ impl Evaluated {
     }
 
     /// Evaluated normals of every curve (normal mode per curve, tilt interpolated).
-    pub fn normals(&self, c: &Curves, tangents_all: &[V3]) -> Vec<V3> {
+    pub fn normals(&self, c: &Curves, tangents_all: &[V3]) -> Result<Vec<V3>, String> {
         let tilt = match c.attributes.named("tilt") {
             Some(a) if a.domain == Domain::Point => {
-                self.interpolate(c, &a.data).as_float().into_owned()
+                self.interpolate(c, &a.data)?.as_float().into_owned()
             }
             _ => vec![0.0; self.total()],
         };
-        let modes = normal_modes(c);
+        let modes = checked_normal_modes(c)?;
         let mut out = Vec::with_capacity(self.total());
         for i in 0..c.curve_count() {
             let r = self.range(i);
@@ -237,20 +295,57 @@ impl Evaluated {
                 &tilt[r],
             ));
         }
-        out
+        Ok(out)
     }
 
-    /// A point-domain attribute interpolated to the evaluated points (Bezier segments
-    /// linearly, as Blender does for generic attributes).
-    pub fn interpolate(&self, c: &Curves, data: &Array) -> Array {
-        let mut idx_a = Vec::with_capacity(self.total());
-        let mut idx_b = Vec::with_capacity(self.total());
-        let mut fac = Vec::with_capacity(self.total());
+    /// A point-domain attribute interpolated to the evaluated points as Blender's
+    /// `interpolate_to_evaluated` does per curve type: Bezier segments linearly, Catmull-Rom
+    /// by its cubic basis, NURBS by the curve's basis (rational with `nurbs_weight`).
+    pub fn interpolate(&self, c: &Curves, data: &Array) -> Result<Array, String> {
+        let simple = self
+            .kinds
+            .iter()
+            .all(|k| matches!(k, Kind::Poly | Kind::Bezier(_)));
+        if simple {
+            return Ok(self.interpolate_linear(c, data, 0..c.curve_count()));
+        }
+        let mut out = Array::zeros(data.data_type(), 0);
         for i in 0..c.curve_count() {
             let pts = c.points(i);
-            match self.types[i] {
-                CURVE_TYPE_BEZIER => {
-                    let offs = &self.bezier_offsets[i];
+            let piece = match &self.kinds[i] {
+                Kind::Poly | Kind::Bezier(_) => self.interpolate_linear(c, data, i..i + 1),
+                Kind::CatmullRom(r) => {
+                    catmull_rom_array(&data.gather(&pts.collect::<Vec<_>>()), self.cyclic[i], *r)
+                        .ok_or_else(|| unmixable(data, "Catmull-Rom", i))?
+                }
+                Kind::Nurbs(None) => data.gather(&pts.collect::<Vec<_>>()),
+                Kind::Nurbs(Some(b)) => b
+                    .evaluate(
+                        &data.gather(&pts.clone().collect::<Vec<_>>()),
+                        self.weights(pts),
+                    )
+                    .ok_or_else(|| unmixable(data, "NURBS", i))?,
+            };
+            out.extend(&piece);
+        }
+        Ok(out)
+    }
+
+    /// Poly and Bezier curves `curves`: control values, or Bezier segments mixed linearly.
+    fn interpolate_linear(
+        &self,
+        c: &Curves,
+        data: &Array,
+        curves: std::ops::Range<usize>,
+    ) -> Array {
+        let size = self.offsets[curves.end] as usize - self.offsets[curves.start] as usize;
+        let mut idx_a = Vec::with_capacity(size);
+        let mut idx_b = Vec::with_capacity(size);
+        let mut fac = Vec::with_capacity(size);
+        for i in curves {
+            let pts = c.points(i);
+            match &self.kinds[i] {
+                Kind::Bezier(offs) => {
                     let n = pts.len();
                     for s in 0..n {
                         let len = (offs[s + 1] - offs[s]) as usize;
@@ -275,6 +370,179 @@ impl Evaluated {
         }
         lerp_gather(data, &idx_a, &idx_b, &fac)
     }
+}
+
+fn unmixable(data: &Array, kind: &str, i: usize) -> String {
+    format!(
+        "curve {i}: a {:?} attribute cannot be interpolated along a {kind} curve",
+        data.data_type()
+    )
+}
+
+/// The curves' normal modes, refusing the ones not evaluated (Free: custom normals).
+fn checked_normal_modes(c: &Curves) -> Result<Vec<i8>, String> {
+    let modes = normal_modes(c);
+    if let Some(i) = modes
+        .iter()
+        .position(|m| *m != NORMAL_MODE_MINIMUM_TWIST && *m != NORMAL_MODE_Z_UP)
+    {
+        return Err(format!(
+            "curve {i}: normal mode {} (Free: custom normals) is not supported (Minimum Twist and Z Up are)",
+            modes[i]
+        ));
+    }
+    Ok(modes)
+}
+
+/// `catmull_rom::calculate_basis`: the uniform Catmull-Rom weights, twice their value.
+fn catmull_rom_basis(t: f32) -> [f32; 4] {
+    let s = 1.0 - t;
+    [
+        -t * s * s,
+        2.0 + t * t * (3.0 * t - 5.0),
+        2.0 + s * s * (3.0 * s - 5.0),
+        -s * t * t,
+    ]
+}
+
+/// `catmull_rom::interpolate` for float vectors: mixed with the doubled weights, then
+/// halved (Blender saves the multiplications so for float types).
+fn mix_vector(v: [&V3; 4], t: f32) -> V3 {
+    let w = catmull_rom_basis(t);
+    let mut o = [0.0f32; 3];
+    for k in 0..3 {
+        o[k] = 0.5 * (w[0] * v[0][k] + w[1] * v[1][k] + w[2] * v[2][k] + w[3] * v[3][k]);
+    }
+    o
+}
+
+/// `catmull_rom::interpolate_to_evaluated`: one curve's control values `src` to its
+/// evaluated points `dst`, segment by segment, the end segments of an open curve
+/// repeating the end points.
+fn catmull_rom<T: Copy>(
+    src: &[T],
+    cyclic: bool,
+    resolution: usize,
+    dst: &mut [T],
+    mix: &dyn Fn([&T; 4], f32) -> T,
+) {
+    let n = src.len();
+    if n == 0 || dst.is_empty() {
+        return;
+    }
+    if n == 1 {
+        dst[0] = src[0];
+        return;
+    }
+    let segment = |a: &T, b: &T, c: &T, d: &T, out: &mut [T]| {
+        let step = 1.0 / out.len() as f32;
+        out[0] = *b;
+        for (j, o) in out.iter_mut().enumerate().skip(1) {
+            *o = mix([a, b, c, d], j as f32 * step);
+        }
+    };
+    let range = |s: usize| s * resolution..(s + 1) * resolution;
+    if n == 2 {
+        segment(&src[0], &src[0], &src[1], &src[1], &mut dst[range(0)]);
+        if cyclic {
+            segment(&src[1], &src[1], &src[0], &src[0], &mut dst[range(1)]);
+        } else {
+            dst[dst.len() - 1] = src[1];
+        }
+        return;
+    }
+    if cyclic {
+        segment(&src[n - 1], &src[0], &src[1], &src[2], &mut dst[range(0)]);
+        segment(
+            &src[n - 3],
+            &src[n - 2],
+            &src[n - 1],
+            &src[0],
+            &mut dst[range(n - 2)],
+        );
+        segment(
+            &src[n - 2],
+            &src[n - 1],
+            &src[0],
+            &src[1],
+            &mut dst[range(n - 1)],
+        );
+    } else {
+        segment(&src[0], &src[0], &src[1], &src[2], &mut dst[range(0)]);
+        segment(
+            &src[n - 3],
+            &src[n - 2],
+            &src[n - 1],
+            &src[n - 1],
+            &mut dst[range(n - 2)],
+        );
+        dst[dst.len() - 1] = src[n - 1];
+    }
+    for s in 1..n - 2 {
+        segment(
+            &src[s - 1],
+            &src[s],
+            &src[s + 1],
+            &src[s + 2],
+            &mut dst[range(s)],
+        );
+    }
+}
+
+/// One curve's control values on its Catmull-Rom evaluated points, mixed as Blender's
+/// `mix4` mixes each type; `None` for types it does not mix here.
+fn catmull_rom_array(src: &Array, cyclic: bool, resolution: usize) -> Option<Array> {
+    let n = src.len();
+    let count = match (n, cyclic) {
+        (0, _) => 0,
+        (_, true) => (resolution * n).max(1),
+        (_, false) => resolution * (n - 1) + 1,
+    };
+    fn run<T: Copy + Default>(
+        v: &[T],
+        cyclic: bool,
+        r: usize,
+        count: usize,
+        mix: &dyn Fn([&T; 4], f32) -> T,
+    ) -> Vec<T> {
+        let mut out = vec![T::default(); count];
+        catmull_rom(v, cyclic, r, &mut out, mix);
+        out
+    }
+    // Types other than float, float2 and float3 mix with halved weights.
+    let halved = |t: f32| catmull_rom_basis(t).map(|w| w * 0.5);
+    Some(match src {
+        Array::Float(v) => Array::Float(run(v, cyclic, resolution, count, &|x, t| {
+            let w = catmull_rom_basis(t);
+            0.5 * (w[0] * x[0] + w[1] * x[1] + w[2] * x[2] + w[3] * x[3])
+        })),
+        Array::Float2(v) => Array::Float2(run(v, cyclic, resolution, count, &|x, t| {
+            let w = catmull_rom_basis(t);
+            [0, 1]
+                .map(|k| 0.5 * (w[0] * x[0][k] + w[1] * x[1][k] + w[2] * x[2][k] + w[3] * x[3][k]))
+        })),
+        Array::Vector(v) => Array::Vector(run(v, cyclic, resolution, count, &mix_vector)),
+        Array::Color(v) => Array::Color(run(v, cyclic, resolution, count, &|x, t| {
+            let w = halved(t);
+            [0, 1, 2, 3].map(|k| x[0][k] * w[0] + x[1][k] * w[1] + x[2][k] * w[2] + x[3][k] * w[3])
+        })),
+        Array::Int(v) => Array::Int(run(v, cyclic, resolution, count, &|x, t| {
+            let w = halved(t);
+            (w[0] * *x[0] as f32 + w[1] * *x[1] as f32 + w[2] * *x[2] as f32 + w[3] * *x[3] as f32)
+                .round() as i32
+        })),
+        Array::Int8(v) => Array::Int8(run(v, cyclic, resolution, count, &|x, t| {
+            let w = halved(t);
+            (w[0] * *x[0] as f32 + w[1] * *x[1] as f32 + w[2] * *x[2] as f32 + w[3] * *x[3] as f32)
+                .round() as i8
+        })),
+        Array::Bool(v) => Array::Bool(run(v, cyclic, resolution, count, &|x, t| {
+            let w = halved(t);
+            let f = |b: &bool| *b as u8 as f32;
+            w[0] * f(x[0]) + w[1] * f(x[1]) + w[2] * f(x[2]) + w[3] * f(x[3]) >= 0.5
+        })),
+        _ => return None,
+    })
 }
 
 fn type_name(t: i8) -> &'static str {
@@ -505,17 +773,30 @@ pub fn point_floats(c: &Curves, name: &str, default: f32) -> Vec<f32> {
 }
 
 /// Per control point, the evaluated normal where it lies (`curve_normal_point_domain`):
-/// poly points their own, Bezier points their segment's first evaluated point.
+/// poly points their own, Bezier and Catmull-Rom points the evaluated point where they
+/// lie; NURBS control points, not on the curve, the normals of their control polygon
+/// taken as a poly curve (without tilt, as Blender does).
 pub fn control_point_normals(c: &Curves) -> Result<Vec<V3>, String> {
     let ev = Evaluated::new(c)?;
     let pos = ev.positions(c);
-    let tangents = ev.tangents(c, &pos);
-    let normals = ev.normals(c, &tangents);
+    let tangents_all = ev.tangents(c, &pos);
+    let normals_all = ev.normals(c, &tangents_all)?;
+    let modes = normal_modes(c);
     let mut out = vec![[0.0f32; 3]; c.point_count()];
     for i in 0..c.curve_count() {
         let r = ev.range(i);
-        for (k, p) in c.points(i).enumerate() {
-            if let Some(n) = normals.get(r.start + ev.control_point_evaluated(i, k)) {
+        let pts = c.points(i);
+        if ev.is_nurbs(i) {
+            let t = tangents(&c.positions[pts.clone()], ev.cyclic[i]);
+            let zero = vec![0.0; t.len()];
+            out[pts].copy_from_slice(&normals(&t, ev.cyclic[i], modes[i], &zero));
+            continue;
+        }
+        for (k, p) in pts.enumerate() {
+            if let Some(n) = ev
+                .control_point_evaluated(i, k)
+                .and_then(|e| normals_all.get(r.start + e))
+            {
                 out[p] = *n;
             }
         }

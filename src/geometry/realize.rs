@@ -166,6 +166,10 @@ pub fn join_points(parts: &[(&PointCloud, Mat4f)]) -> PointCloud {
         for (p, _) in parts {
             match p.attributes.get(id) {
                 Some(a) => data.extend(&a.data.convert(*ty)),
+                // A point cloud without radii has Blender's 0.01 once joined.
+                None if id.name() == Some("radius") && *ty == DataType::Float => {
+                    data.extend(&Array::Float(vec![0.01; p.len()]))
+                }
                 None => data.extend_default(p.len()),
             }
         }
@@ -207,10 +211,16 @@ pub fn join_curves(parts: &[(&Curves, Mat4f)]) -> Curves {
                     }
                     data.extend(&v);
                 }
-                // A curve without a resolution has Blender's default, 12, which the
-                // join writes out (realize_instances fills it so), not zero.
+                // Built-ins a part lacks get Blender's defaults, which the join writes
+                // out (realize_instances fills them so), not zero: resolution 12,
+                // radius and nurbs_weight 1 (handles stay zero, as in Blender).
                 None if id.name() == Some("resolution") && *ty == DataType::Int => {
                     data.extend(&Array::Int(vec![12; c.domain_size(*d)]))
+                }
+                None if matches!(id.name(), Some("radius" | "nurbs_weight"))
+                    && *ty == DataType::Float =>
+                {
+                    data.extend(&Array::Float(vec![1.0; c.domain_size(*d)]))
                 }
                 None => data.extend_default(c.domain_size(*d)),
             }

@@ -140,7 +140,7 @@ pub fn resample_indexed(
                 }) {
                     continue;
                 }
-                let evaluated = ev.interpolate(c, &a.data);
+                let evaluated = ev.interpolate(c, &a.data)?;
                 out.attributes.set(
                     a.id.clone(),
                     Domain::Point,
@@ -324,9 +324,9 @@ fn sweep(
     let mev = Evaluated::new(main)?;
     let mpos = mev.positions(main);
     let mtan = mev.tangents(main, &mpos);
-    let mnorm = mev.normals(main, &mtan);
+    let mnorm = mev.normals(main, &mtan)?;
     let mscale = mev
-        .interpolate(main, &Array::Float(scale_field.to_vec()))
+        .interpolate(main, &Array::Float(scale_field.to_vec()))?
         .as_float()
         .into_owned();
     // Without a profile Blender sweeps a single point at the origin.
@@ -460,7 +460,7 @@ fn sweep(
         if a.domain != Domain::Point || a.id.name().is_some_and(is_builtin_curve_attribute) {
             continue;
         }
-        let evaluated = mev.interpolate(main, &a.data);
+        let evaluated = mev.interpolate(main, &a.data)?;
         let mut idx = Vec::with_capacity(m.vertex_count());
         for im in 0..main.curve_count() {
             for ip in 0..profile.curve_count() {

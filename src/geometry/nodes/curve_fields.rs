@@ -6,25 +6,49 @@ use super::super::curves::Curves;
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::{ComponentRef, Field, FieldContext, FieldInput};
+use super::super::math::{length as length_of, sub};
 use super::super::types::{Array, DataType, Domain};
 use super::super::value::SocketValue;
 
-/// Per control point: length from the curve's start; per curve: total length.
-fn point_lengths(c: &Curves) -> Result<(Vec<f32>, Vec<f32>), String> {
+/// Lengths per control point, per-curve totals for factors, per-curve evaluated lengths.
+type PointLengths = (Vec<f32>, Vec<f32>, Vec<f32>);
+
+/// Per control point: length from the curve's start; per curve: the total its factors
+/// divide by, and the evaluated length. NURBS control points are not on the curve, so
+/// Blender measures them along the control polygon, and their factors by its length.
+fn point_lengths(c: &Curves) -> Result<PointLengths, String> {
     let ev = Evaluated::new(c)?;
     let pos = ev.positions(c);
     let mut out = vec![0.0f32; c.point_count()];
+    let mut point_totals = Vec::with_capacity(c.curve_count());
     let mut totals = Vec::with_capacity(c.curve_count());
     for i in 0..c.curve_count() {
         let lengths = accumulated_lengths(&pos[ev.range(i)], ev.cyclic[i]);
+        let total = lengths.last().copied().unwrap_or(0.0);
+        totals.push(total);
         let pts = c.points(i);
+        if ev.is_nurbs(i) {
+            let p = &c.positions[pts.clone()];
+            let mut length = 0.0f32;
+            for k in 0..p.len() {
+                out[pts.start + k] = length;
+                if k + 1 < p.len() {
+                    length += length_of(sub(p[k + 1], p[k]));
+                }
+            }
+            if ev.cyclic[i] && !p.is_empty() {
+                length += length_of(sub(p[0], p[p.len() - 1]));
+            }
+            point_totals.push(length);
+            continue;
+        }
         for (k, p) in pts.clone().enumerate().skip(1) {
-            let e = ev.control_point_evaluated(i, k);
+            let e = ev.control_point_evaluated(i, k).unwrap_or(0);
             out[p] = if e == 0 { 0.0 } else { lengths[e - 1] };
         }
-        totals.push(lengths.last().copied().unwrap_or(0.0));
+        point_totals.push(total);
     }
-    Ok((out, totals))
+    Ok((out, point_totals, totals))
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -62,7 +86,7 @@ impl FieldInput for SplineParameter {
                     }
                     return Ok(Array::Int(idx));
                 }
-                let (mut lengths, totals) = point_lengths(c)?;
+                let (mut lengths, totals, _) = point_lengths(c)?;
                 if self.0 == Param::Factor {
                     for i in 0..c.curve_count() {
                         let pts = c.points(i);
@@ -88,7 +112,7 @@ impl FieldInput for SplineParameter {
                 if self.0 == Param::Index {
                     return Ok(Array::Int((0..n as i32).collect()));
                 }
-                let (_, totals) = point_lengths(c)?;
+                let (_, _, totals) = point_lengths(c)?;
                 let mut acc = vec![0.0f32; n];
                 let mut sum = 0.0f32;
                 for i in 0..n {
@@ -138,7 +162,7 @@ pub fn curve_length(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let total = match &g.curves {
         Some(c) => point_lengths(c)
             .map_err(|e| ctx.err(e))?
-            .1
+            .2
             .iter()
             .sum::<f32>(),
         None => 0.0,

@@ -2,7 +2,7 @@
 //! evaluated curve where the point lies; on the curve domain their average. Zero on
 //! other components.
 
-use super::super::curve_eval::Evaluated;
+use super::super::curve_eval::{self, Evaluated};
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::{ComponentRef, Field, FieldContext, FieldInput};
@@ -27,8 +27,19 @@ impl FieldInput for Tangent {
         let mut out = vec![[0.0f32; 3]; c.point_count()];
         for i in 0..c.curve_count() {
             let r = ev.range(i);
-            for (k, p) in c.points(i).enumerate() {
-                if let Some(t) = tangents.get(r.start + ev.control_point_evaluated(i, k)) {
+            let pts = c.points(i);
+            if ev.is_nurbs(i) {
+                // NURBS control points are not on the curve: Blender takes the tangents
+                // of the control polygon as a poly curve.
+                let t = curve_eval::tangents(&c.positions[pts.clone()], ev.cyclic[i]);
+                out[pts].copy_from_slice(&t);
+                continue;
+            }
+            for (k, p) in pts.enumerate() {
+                if let Some(t) = ev
+                    .control_point_evaluated(i, k)
+                    .and_then(|e| tangents.get(r.start + e))
+                {
                     out[p] = *t;
                 }
             }

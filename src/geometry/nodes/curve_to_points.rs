@@ -113,7 +113,7 @@ pub fn curve_to_points(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         if tan_id.is_some() || nor_id.is_some() || rot_id.is_some() {
             let eval_pos = ev.positions(&c);
             let tangents = ev.tangents(&c, &eval_pos);
-            let normals = ev.normals(&c, &tangents);
+            let normals = ev.normals(&c, &tangents)?;
             let t = lerp_normalized(&tangents, &samples.a, &samples.b, &samples.factor);
             let n = lerp_normalized(&normals, &samples.a, &samples.b, &samples.factor);
             if let Some(id) = &rot_id {

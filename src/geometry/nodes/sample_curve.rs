@@ -163,9 +163,9 @@ fn build_source(c: &Curves, value: &Field, ty: DataType) -> Result<Source, Strin
     let ev = Evaluated::new(c)?;
     let positions = ev.positions(c);
     let tangents = ev.tangents(c, &positions);
-    let normals = ev.normals(c, &tangents);
+    let normals = ev.normals(c, &tangents)?;
     let on_points = FieldContext::new(ComponentRef::Curves(c)).eval(value, Domain::Point, ty)?;
-    let values = ev.interpolate(c, &on_points);
+    let values = ev.interpolate(c, &on_points)?;
     let mut lengths = Vec::with_capacity(c.curve_count());
     let mut curve_ends = Vec::with_capacity(c.curve_count());
     let mut acc = 0.0f32;
