@@ -203,18 +203,10 @@ impl Scene {
     /// The smoke domain record of object `name` at `frame`, else its first record (whose
     /// frame the caller's error then names); none when the export has no record of it.
     pub fn smoke_domain(&self, name: &str, frame: f64) -> Option<(usize, &SmokeDomain)> {
-        let mut of = self
-            .file
-            .smoke_domains
-            .iter()
-            .enumerate()
-            .filter(|(_, d)| d.object == name);
-        let first = of.next()?;
-        Some(
-            std::iter::once(first)
-                .chain(of)
-                .find(|(_, d)| d.frame == frame)
-                .unwrap_or(first),
+        record_at(
+            &self.file.smoke_domains,
+            |d| d.object == name,
+            |d| d.frame == frame,
         )
     }
 
@@ -222,18 +214,10 @@ impl Scene {
     /// frame), else its first record (whose frame the caller's error then names); none
     /// when the export has no record of it.
     pub fn volume_object(&self, name: &str, frame: f64) -> Option<(usize, &VolumeObject)> {
-        let mut of = self
-            .file
-            .volume_objects
-            .iter()
-            .enumerate()
-            .filter(|(_, v)| v.object == name);
-        let first = of.next()?;
-        Some(
-            std::iter::once(first)
-                .chain(of)
-                .find(|(_, v)| v.frame == frame || v.every_frame)
-                .unwrap_or(first),
+        record_at(
+            &self.file.volume_objects,
+            |v| v.object == name,
+            |v| v.frame == frame || v.every_frame,
         )
     }
 
@@ -277,6 +261,23 @@ pub fn read_grid(name: &str, path: &Path) -> Result<VoxelGrid, SceneError> {
     let limit = (HEADER_BYTES + 4 * MAX_GRID_VALUES) as u64;
     let bytes = super::file::read_regular(path, limit).map_err(|m| SceneError::new(path, "", m))?;
     parse_grid(name, &bytes).map_err(|m| SceneError::new(path, "", format!("grid {name:?} {m}")))
+}
+
+/// Of the records that are `mine`, the first one valid `at` the frame, else the first
+/// (whose frame the caller's error then names); none when there is no record.
+fn record_at<T>(
+    records: &[T],
+    mine: impl Fn(&T) -> bool,
+    at: impl Fn(&T) -> bool,
+) -> Option<(usize, &T)> {
+    let mut of = records.iter().enumerate().filter(|(_, r)| mine(r));
+    let first = of.next()?;
+    Some(
+        std::iter::once(first)
+            .chain(of)
+            .find(|(_, r)| at(r))
+            .unwrap_or(first),
+    )
 }
 
 #[cfg(test)]
