@@ -504,6 +504,9 @@ impl<'g, 'a> Compiler<'g, 'a> {
         self.switch_copy(&schedule, 0);
         let emission_estimate = self.emission_estimate(self.surface);
         let volume_varying = self.volume.is_some_and(|v| self.closure_varies(v));
+        for b in &mut self.bsdfs {
+            b.index_sockets();
+        }
         Ok(Program {
             ops: self.ops,
             initial: self.initial,
@@ -558,6 +561,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
             kind,
             inputs,
             properties,
+            by_socket: Vec::new(),
         });
         Ok(())
     }

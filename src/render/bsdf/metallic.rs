@@ -7,7 +7,7 @@
 //! Principled stretches it; Beckmann isotropic (anisotropic Beckmann is a compile error
 //! naming the node, shader/compile/node_table.rs).
 
-use crate::shader::program::BsdfNode;
+use crate::shader::program::{socket, BsdfNode};
 use crate::shader::ShadingPoint;
 
 use crate::render::bsdf::{fresnel_conductor, Fresnel, LobeKind, LobeSet};
@@ -46,16 +46,16 @@ pub(crate) fn f82_fss(f0: [f32; 3], b: [f32; 3]) -> [f32; 3] {
 fn fresnel_of(b: &BsdfNode, s: &[f32]) -> (Fresnel, [f32; 3]) {
     if b.property("fresnel_type") == Some("PHYSICAL_CONDUCTOR") {
         let non_negative = |c: [f32; 3]| c.map(|x| x.max(0.0));
-        let eta = non_negative(input_c(b, s, "IOR", [2.757, 2.513, 2.231]));
-        let k = non_negative(input_c(b, s, "Extinction", [3.867, 3.404, 3.009]));
+        let eta = non_negative(input_c(b, s, socket!("IOR"), [2.757, 2.513, 2.231]));
+        let k = non_negative(input_c(b, s, socket!("Extinction"), [3.867, 3.404, 3.009]));
         let f0 = fresnel_conductor(1.0, eta, k);
         let f82 = fresnel_conductor(1.0 / 7.0, eta, k);
         let fss = f82_fss(f0, f82_b(f0, f82)).map(|x| x.clamp(0.0, 1.0));
         return (Fresnel::Conductor { eta, k }, fss);
     }
     let unit = |c: [f32; 3]| c.map(|x| x.clamp(0.0, 1.0));
-    let color = unit(input_c(b, s, "Base Color", [0.617, 0.577, 0.54]));
-    let tint = unit(input_c(b, s, "Edge Tint", [0.695, 0.726, 0.77]));
+    let color = unit(input_c(b, s, socket!("Base Color"), [0.617, 0.577, 0.54]));
+    let tint = unit(input_c(b, s, socket!("Edge Tint"), [0.695, 0.726, 0.77]));
     let fresnel = f82_tint(color, tint);
     let Fresnel::F82 { f0, b: bb } = fresnel else {
         unreachable!("f82_tint gives an F82 Fresnel")
@@ -72,8 +72,8 @@ pub(crate) fn metallic(
     ctx: &Context,
     out: &mut LobeSet,
 ) {
-    let roughness = input_f(b, s, "Roughness", 0.5).clamp(0.0, 1.0);
-    let n = input_n(b, s, "Normal", sp);
+    let roughness = input_f(b, s, socket!("Roughness"), 0.5).clamp(0.0, 1.0);
+    let n = input_n(b, s, socket!("Normal"), sp);
     let vn = valid_n(sp, ctx, n);
     let multi = is_multiggx(b);
     let (fresnel, fss) = fresnel_of(b, s);
@@ -92,7 +92,7 @@ pub(crate) fn metallic(
     }
     let (ax, ay) = crate::render::bsdf::anisotropic::principled_alphas(
         roughness,
-        input_f(b, s, "Anisotropy", 0.0),
+        input_f(b, s, socket!("Anisotropy"), 0.0),
     );
     let weight = if multi {
         let rough = (ax * ay).sqrt().sqrt();
@@ -101,7 +101,14 @@ pub(crate) fn metallic(
         [w; 3]
     };
     if ax != ay {
-        let t = tangent_input(b, s, sp, "Tangent", input_f(b, s, "Rotation", 0.0), n);
+        let t = tangent_input(
+            b,
+            s,
+            sp,
+            socket!("Tangent"),
+            input_f(b, s, socket!("Rotation"), 0.0),
+            n,
+        );
         push_glossy(out, ctx, ax, ay, t, fresnel, multi, weight, vn, albedo);
         return;
     }

@@ -201,22 +201,21 @@ impl Scene<'_> {
         let mut ng = normalize(cross(sub(tri[1], tri[0]), sub(tri[2], tri[0])));
         let lp = c.map(|c| m.positions[m.corner_verts[c] as usize]);
         let local = add(add(scale(lp[0], w0), scale(lp[1], u)), scale(lp[2], v));
-        let mut n_obj = if m.corner_normals.len() == m.corner_verts.len() {
-            let cn = c.map(|c| m.corner_normals[c]);
-            normalize(add(add(scale(cn[0], w0), scale(cn[1], u)), scale(cn[2], v)))
-        } else {
-            normalize(cross(sub(lp[1], lp[0]), sub(lp[2], lp[0])))
-        };
-        let mut n = normalize(Affine::normal_by_inverse(&to_object, n_obj));
         // Cycles applies the object transform to the mesh: each vertex normal goes to world
         // space before interpolation (it differs under non-uniform scale), and Texture
         // Coordinate > Normal transforms the result back.
-        if m.corner_normals.len() == m.corner_verts.len() {
+        let (mut n, mut n_obj) = if m.corner_normals.len() == m.corner_verts.len() {
             let cn =
                 c.map(|c| normalize(Affine::normal_by_inverse(&to_object, m.corner_normals[c])));
-            n = normalize(add(add(scale(cn[0], w0), scale(cn[1], u)), scale(cn[2], v)));
-            n_obj = normalize(Affine::normal_by_inverse(&to_world, n));
-        }
+            let n = normalize(add(add(scale(cn[0], w0), scale(cn[1], u)), scale(cn[2], v)));
+            (n, normalize(Affine::normal_by_inverse(&to_world, n)))
+        } else {
+            let n_obj = normalize(cross(sub(lp[1], lp[0]), sub(lp[2], lp[0])));
+            (
+                normalize(Affine::normal_by_inverse(&to_object, n_obj)),
+                n_obj,
+            )
+        };
         if !finite(n) || is_zero(n) {
             n = ng;
         }

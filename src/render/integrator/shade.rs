@@ -3,7 +3,7 @@
 //! Cycles' SVM builds closures (Mix Shader factors clamped, Principled BSDF layered).
 
 use crate::scene::Scene;
-use crate::shader::program::{BsdfKind, BsdfNode, Closure, Program};
+use crate::shader::program::{socket, BsdfKind, BsdfNode, Closure, Program};
 use crate::shader::{compile_material, ShadingPoint};
 
 use crate::render::bsdf::ray_portal::RayPortal;
@@ -170,7 +170,7 @@ fn has_bssrdf_bump(p: &Program) -> bool {
                 }
                 _ => false,
             };
-            bssrdf && matches!(b.input("Normal"), Some((_, true)))
+            bssrdf && matches!(b.input_at(socket!("Normal")), Some((_, true)))
         })
 }
 
@@ -303,18 +303,22 @@ impl Material {
     }
 }
 
-pub(crate) fn input_f(b: &BsdfNode, s: &[f32], id: &str, d: f32) -> f32 {
-    b.input(id)
+/// Input `id` (a `socket!` index) of `b` from stack `s`, or `d` where `b` has none.
+#[inline]
+pub(crate) fn input_f(b: &BsdfNode, s: &[f32], id: usize, d: f32) -> f32 {
+    b.input_at(id)
         .map(|(slot, _)| finite_or(s[slot as usize], d))
         .unwrap_or(d)
 }
-pub(crate) fn input_c(b: &BsdfNode, s: &[f32], id: &str, d: V3) -> V3 {
-    b.input(id)
+#[inline]
+pub(crate) fn input_c(b: &BsdfNode, s: &[f32], id: usize, d: V3) -> V3 {
+    b.input_at(id)
         .map(|(slot, _)| finite3(v3(s, slot)))
         .unwrap_or(d)
 }
-pub(crate) fn input_n(b: &BsdfNode, s: &[f32], id: &str, sp: &ShadingPoint) -> V3 {
-    match b.input(id) {
+#[inline]
+pub(crate) fn input_n(b: &BsdfNode, s: &[f32], id: usize, sp: &ShadingPoint) -> V3 {
+    match b.input_at(id) {
         Some((slot, true)) => {
             let n = normalize(finite3(v3(s, slot)));
             if is_zero(n) {
@@ -359,9 +363,9 @@ pub(crate) fn dielectric_fss(eta: f32) -> f32 {
 fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet) {
     match b.kind {
         BsdfKind::Diffuse => {
-            let c = input_c(b, s, "Color", [0.8; 3]);
-            let n = input_n(b, s, "Normal", sp);
-            let r = input_f(b, s, "Roughness", 0.0);
+            let c = input_c(b, s, socket!("Color"), [0.8; 3]);
+            let n = input_n(b, s, socket!("Normal"), sp);
+            let r = input_f(b, s, socket!("Roughness"), 0.0);
             if r >= 1e-5 {
                 let on = crate::render::bsdf::oren_nayar::OrenNayar::new(r, c, dot(n, ctx.wo));
                 out.push(LobeKind::OrenNayar(on), scale(c, w), n);
@@ -370,28 +374,28 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             }
         }
         BsdfKind::Translucent => {
-            let c = input_c(b, s, "Color", [0.8; 3]);
+            let c = input_c(b, s, socket!("Color"), [0.8; 3]);
             out.push(
                 LobeKind::Translucent,
                 scale(c, w),
-                valid_n(sp, ctx, input_n(b, s, "Normal", sp)),
+                valid_n(sp, ctx, input_n(b, s, socket!("Normal"), sp)),
             );
         }
         BsdfKind::Transparent => {
-            let c = input_c(b, s, "Color", [1.0; 3]);
+            let c = input_c(b, s, socket!("Color"), [1.0; 3]);
             out.push(LobeKind::Transparent, scale(c, w), sp.normal);
         }
         BsdfKind::Holdout => {
             out.holdout = add(out.holdout, [w; 3]);
         }
         BsdfKind::RayPortal => {
-            let c = input_c(b, s, "Color", [1.0; 3]);
+            let c = input_c(b, s, socket!("Color"), [1.0; 3]);
             // Position is Cycles' LINK_POSITION socket: unlinked, the hit point.
-            let position = match b.input("Position") {
+            let position = match b.input_at(socket!("Position")) {
                 Some((slot, true)) => finite3(v3(s, slot)),
                 _ => sp.position,
             };
-            let direction = input_c(b, s, "Direction", [0.0; 3]);
+            let direction = input_c(b, s, socket!("Direction"), [0.0; 3]);
             let portal = RayPortal::new(sp.position, position, direction, sp.incoming);
             out.push(LobeKind::RayPortal(portal), scale(c, w), sp.normal);
         }
@@ -399,24 +403,24 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
         BsdfKind::Principled => principled(b, w, s, sp, ctx, out),
         BsdfKind::Metallic => crate::render::bsdf::metallic::metallic(b, w, s, sp, ctx, out),
         BsdfKind::Toon => {
-            let c = input_c(b, s, "Color", [0.8; 3]);
+            let c = input_c(b, s, socket!("Color"), [0.8; 3]);
             let toon = crate::render::bsdf::toon::Toon::new(
-                input_f(b, s, "Size", 0.5),
-                input_f(b, s, "Smooth", 0.0),
+                input_f(b, s, socket!("Size"), 0.5),
+                input_f(b, s, socket!("Smooth"), 0.0),
                 b.property("component") == Some("GLOSSY"),
             );
             // Cycles gives the toon closures the normal as given (no specular correction).
             out.push(
                 LobeKind::Toon(toon),
                 scale(c, w),
-                input_n(b, s, "Normal", sp),
+                input_n(b, s, socket!("Normal"), sp),
             );
         }
         BsdfKind::Glass | BsdfKind::Refraction => {
-            let c = input_c(b, s, "Color", [1.0; 3]);
-            let ior = input_f(b, s, "IOR", 1.45);
-            let r = input_f(b, s, "Roughness", 0.0);
-            let n = valid_n(sp, ctx, input_n(b, s, "Normal", sp));
+            let c = input_c(b, s, socket!("Color"), [1.0; 3]);
+            let ior = input_f(b, s, socket!("IOR"), 1.45);
+            let r = input_f(b, s, socket!("Roughness"), 0.0);
+            let n = valid_n(sp, ctx, input_n(b, s, socket!("Normal"), sp));
             let refract_only = b.kind == BsdfKind::Refraction;
             let g = crate::render::bsdf::microfacet::glass_closure(
                 ctx.tables,
@@ -430,15 +434,15 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
             out.push(LobeKind::Glass(g), scale(c, w), n);
         }
         BsdfKind::Subsurface => {
-            let c = input_c(b, s, "Color", [0.8; 3]);
+            let c = input_c(b, s, socket!("Color"), [0.8; 3]);
             let radius = scale(
-                input_c(b, s, "Radius", [1.0, 0.2, 0.1]),
-                input_f(b, s, "Scale", 0.05),
+                input_c(b, s, socket!("Radius"), [1.0, 0.2, 0.1]),
+                input_f(b, s, socket!("Scale"), 0.05),
             );
             let method = Method::from_property(b.property("falloff"));
-            let ior = input_f(b, s, "IOR", 1.4);
-            let r = input_f(b, s, "Roughness", 1.0);
-            let aniso = input_f(b, s, "Anisotropy", 0.0);
+            let ior = input_f(b, s, socket!("IOR"), 1.4);
+            let r = input_f(b, s, socket!("Roughness"), 1.0);
+            let aniso = input_f(b, s, socket!("Anisotropy"), 0.0);
             push_bssrdf(
                 out,
                 scale(c, w),
@@ -448,13 +452,13 @@ fn bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: 
                 ior,
                 r,
                 method,
-                valid_n(sp, ctx, input_n(b, s, "Normal", sp)),
+                valid_n(sp, ctx, input_n(b, s, socket!("Normal"), sp)),
             );
         }
         BsdfKind::Sheen => {
-            let c = input_c(b, s, "Color", [0.8; 3]);
-            let r = input_f(b, s, "Roughness", 0.5);
-            let n = input_n(b, s, "Normal", sp);
+            let c = input_c(b, s, socket!("Color"), [0.8; 3]);
+            let r = input_f(b, s, socket!("Roughness"), 0.5);
+            let n = input_n(b, s, socket!("Normal"), sp);
             push_sheen_node(out, b.property("distribution"), scale(c, w), r, n, ctx.wo);
         }
         BsdfKind::Hair => hair_bsdf(b, w, s, sp, ctx, out),
@@ -502,9 +506,9 @@ fn across_fibre(sp: &ShadingPoint) -> crate::render::bsdf::hair::Across {
 /// linked Tangent input, or the curve's dP/du with the Offset negated; on a mesh's faces
 /// the triangle's dP/dv, and no Offset.
 fn hair_bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet) {
-    let c = input_c(b, s, "Color", [0.8; 3]);
-    let offset = -input_f(b, s, "Offset", 0.0);
-    let (tangent, offset) = match b.input("Tangent") {
+    let c = input_c(b, s, socket!("Color"), [0.8; 3]);
+    let offset = -input_f(b, s, socket!("Offset"), 0.0);
+    let (tangent, offset) = match b.input_at(socket!("Tangent")) {
         Some((slot, true)) => (normalize(finite3(v3(s, slot))), offset),
         _ if sp.hair.is_strand > 0.0 => (normalize(sp.dpdu), offset),
         _ => (normalize(hair_frame(sp).1), 0.0),
@@ -514,8 +518,8 @@ fn hair_bsdf(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, 
     }
     let hair = crate::render::bsdf::hair::Hair::new(
         tangent,
-        input_f(b, s, "RoughnessU", 0.1),
-        input_f(b, s, "RoughnessV", 1.0),
+        input_f(b, s, socket!("RoughnessU"), 0.1),
+        input_f(b, s, socket!("RoughnessV"), 1.0),
         offset,
         b.property("component") == Some("Transmission"),
     );
@@ -542,35 +546,40 @@ fn principled_hair(
 ) {
     use crate::render::bsdf::hair_chiang::{self as chiang, Chiang};
     let huang = b.property("model") == Some("HUANG");
-    let random = match b.input("Random") {
+    let random = match b.input_at(socket!("Random")) {
         Some((slot, true)) => finite_or(s[slot as usize], 0.0),
         // The curve's random number (ATTR_STD_CURVE_RANDOM, as Hair Info > Random).
         _ => sp.hair.random,
     };
-    let factor = 1.0 + 2.0 * (random - 0.5) * input_f(b, s, "Random Roughness", 0.0);
-    let roughness = input_f(b, s, "Roughness", 0.3) * factor;
+    let factor = 1.0 + 2.0 * (random - 0.5) * input_f(b, s, socket!("Random Roughness"), 0.0);
+    let roughness = input_f(b, s, socket!("Roughness"), 0.3) * factor;
     let radial = if huang {
         roughness
     } else {
-        input_f(b, s, "Radial Roughness", 0.3) * factor
+        input_f(b, s, socket!("Radial Roughness"), 0.3) * factor
     };
     let sigma = match b.property("parametrization") {
-        Some("ABSORPTION") => input_c(b, s, "Absorption Coefficient", [0.245531, 0.52, 1.365]),
+        Some("ABSORPTION") => input_c(
+            b,
+            s,
+            socket!("Absorption Coefficient"),
+            [0.245531, 0.52, 1.365],
+        ),
         Some("MELANIN") => chiang::sigma_from_melanin(
-            input_f(b, s, "Melanin", 0.8),
-            input_f(b, s, "Melanin Redness", 1.0),
-            input_c(b, s, "Tint", [1.0; 3]),
+            input_f(b, s, socket!("Melanin"), 0.8),
+            input_f(b, s, socket!("Melanin Redness"), 1.0),
+            input_c(b, s, socket!("Tint"), [1.0; 3]),
             random,
-            input_f(b, s, "Random Color", 0.0),
+            input_f(b, s, socket!("Random Color"), 0.0),
             radial,
         ),
         _ => chiang::sigma_from_reflectance(
-            input_c(b, s, "Color", [0.017513, 0.005763, 0.002059]),
+            input_c(b, s, socket!("Color"), [0.017513, 0.005763, 0.002059]),
             radial,
         ),
     };
-    let offset = input_f(b, s, "Offset", 2f32.to_radians());
-    let ior = input_f(b, s, "IOR", 1.55);
+    let offset = input_f(b, s, socket!("Offset"), 2f32.to_radians());
+    let ior = input_f(b, s, socket!("IOR"), 1.55);
     if huang {
         huang_hair(b, w, s, sp, ctx, out, sigma, roughness, offset, ior);
         return;
@@ -579,7 +588,7 @@ fn principled_hair(
         sigma,
         roughness,
         radial,
-        input_f(b, s, "Coat", 0.0),
+        input_f(b, s, socket!("Coat"), 0.0),
         offset,
         ior,
         hair_frame(sp).0,
@@ -612,9 +621,9 @@ fn huang_hair(
     use crate::render::bsdf::hair_huang::{Huang, Params, Setup};
     // Reflection, Transmission and Secondary Reflection, by their identifiers.
     let lobes = [
-        input_f(b, s, "R lobe", 1.0),
-        input_f(b, s, "TT lobe", 1.0),
-        input_f(b, s, "TRT lobe", 1.0),
+        input_f(b, s, socket!("R lobe"), 1.0),
+        input_f(b, s, socket!("TT lobe"), 1.0),
+        input_f(b, s, socket!("TRT lobe"), 1.0),
     ];
     if lobes.iter().all(|&l| l <= 0.0) {
         return;
@@ -632,7 +641,7 @@ fn huang_hair(
         roughness,
         offset,
         ior,
-        aspect_ratio: input_f(b, s, "Aspect Ratio", 0.85),
+        aspect_ratio: input_f(b, s, socket!("Aspect Ratio"), 0.85),
         lobes,
     };
     match Huang::setup(
@@ -652,9 +661,9 @@ fn huang_hair(
 /// The Glossy BSDF node (and the legacy Anisotropic BSDF): GGX, Multiscatter GGX or
 /// Beckmann, isotropic or anisotropic.
 fn glossy(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out: &mut LobeSet) {
-    let c = input_c(b, s, "Color", [0.8; 3]);
-    let r = input_f(b, s, "Roughness", 0.5).clamp(0.0, 1.0);
-    let n = valid_n(sp, ctx, input_n(b, s, "Normal", sp));
+    let c = input_c(b, s, socket!("Color"), [0.8; 3]);
+    let r = input_f(b, s, socket!("Roughness"), 0.5).clamp(0.0, 1.0);
+    let n = valid_n(sp, ctx, input_n(b, s, socket!("Normal"), sp));
     if b.property("distribution") == Some("BECKMANN") {
         let r = crate::render::bsdf::microfacet::Reflection {
             dist: crate::render::bsdf::microfacet::Distribution::Beckmann,
@@ -666,7 +675,7 @@ fn glossy(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out
     }
     let multi = is_multiggx(b);
     let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
-    let aniso = input_f(b, s, "Anisotropy", 0.0).clamp(-0.99, 0.99);
+    let aniso = input_f(b, s, socket!("Anisotropy"), 0.0).clamp(-0.99, 0.99);
     // Multiscatter GGX takes the colour as its Fresnel (Cycles'
     // bsdf_microfacet_setup_fresnel_constant): a colour below white gets back less
     // of the energy lost between microfacets.
@@ -684,7 +693,14 @@ fn glossy(b: &BsdfNode, w: f32, s: &[f32], sp: &ShadingPoint, ctx: &Context, out
     };
     if aniso.abs() > 1e-4 {
         let (ax, ay) = crate::render::bsdf::anisotropic::glossy_alphas(r, aniso);
-        let t = tangent_input(b, s, sp, "Tangent", input_f(b, s, "Rotation", 0.0), n);
+        let t = tangent_input(
+            b,
+            s,
+            sp,
+            socket!("Tangent"),
+            input_f(b, s, socket!("Rotation"), 0.0),
+            n,
+        );
         push_glossy(
             out,
             ctx,
@@ -724,18 +740,18 @@ fn principled(
     ctx: &Context,
     out: &mut LobeSet,
 ) {
-    let base = input_c(b, s, "Base Color", [0.8; 3]).map(|x| x.max(0.0));
-    let metallic = input_f(b, s, "Metallic", 0.0).clamp(0.0, 1.0);
-    let roughness = input_f(b, s, "Roughness", 0.5).clamp(0.0, 1.0);
-    let ior = input_f(b, s, "IOR", 1.5).max(1e-5);
-    let alpha = input_f(b, s, "Alpha", 1.0).clamp(0.0, 1.0);
-    let transmission = input_f(b, s, "Transmission Weight", 0.0).clamp(0.0, 1.0);
-    let spec_level = input_f(b, s, "Specular IOR Level", 0.5).max(0.0);
-    let spec_tint = input_c(b, s, "Specular Tint", [1.0; 3]).map(|x| x.max(0.0));
+    let base = input_c(b, s, socket!("Base Color"), [0.8; 3]).map(|x| x.max(0.0));
+    let metallic = input_f(b, s, socket!("Metallic"), 0.0).clamp(0.0, 1.0);
+    let roughness = input_f(b, s, socket!("Roughness"), 0.5).clamp(0.0, 1.0);
+    let ior = input_f(b, s, socket!("IOR"), 1.5).max(1e-5);
+    let alpha = input_f(b, s, socket!("Alpha"), 1.0).clamp(0.0, 1.0);
+    let transmission = input_f(b, s, socket!("Transmission Weight"), 0.0).clamp(0.0, 1.0);
+    let spec_level = input_f(b, s, socket!("Specular IOR Level"), 0.5).max(0.0);
+    let spec_tint = input_c(b, s, socket!("Specular Tint"), [1.0; 3]).map(|x| x.max(0.0));
     // Cycles clamps the base colour to 1 for the layers that must conserve energy
     // (metallic F0, transmission tint, subsurface); only the diffuse takes it unclamped.
     let clamped = base.map(|x| x.min(1.0));
-    let n = input_n(b, s, "Normal", sp);
+    let n = input_n(b, s, socket!("Normal"), sp);
     // The reflecting layers and the BSSRDF use the bump-corrected normal; diffuse and
     // sheen the normal as given (Cycles' valid_reflection_N).
     let vn = valid_n(sp, ctx, n);
@@ -758,25 +774,25 @@ fn principled(
     // Anisotropic metallic and specular layers (alphas stretched along the tangent).
     let (ax, ay) = crate::render::bsdf::anisotropic::principled_alphas(
         roughness,
-        input_f(b, s, "Anisotropic", 0.0),
+        input_f(b, s, socket!("Anisotropic"), 0.0),
     );
     let tangent = if ax != ay {
         tangent_input(
             b,
             s,
             sp,
-            "Tangent",
-            input_f(b, s, "Anisotropic Rotation", 0.0),
+            socket!("Tangent"),
+            input_f(b, s, socket!("Anisotropic Rotation"), 0.0),
             n,
         )
     } else {
         [0.0; 3]
     };
-    let coat = input_f(b, s, "Coat Weight", 0.0).clamp(0.0, 1.0);
+    let coat = input_f(b, s, socket!("Coat Weight"), 0.0).clamp(0.0, 1.0);
     // Thin film (4.2+): on the dielectric specular layer and the transmission; Cycles 4.5
     // leaves the metallic layer without it.
-    let film_thickness = input_f(b, s, "Thin Film Thickness", 0.0).max(1e-5);
-    let film_ior = input_f(b, s, "Thin Film IOR", 1.33).max(1e-5);
+    let film_thickness = input_f(b, s, socket!("Thin Film Thickness"), 0.0).max(1e-5);
+    let film_ior = input_f(b, s, socket!("Thin Film IOR"), 1.33).max(1e-5);
     let film = film_thickness > crate::render::bsdf::thin_film::CUTOFF;
     weight = principled_sheen(b, s, sp, ctx, out, weight, n, coat);
     if coat > 0.0 {
@@ -785,8 +801,8 @@ fn principled(
     // Emission below alpha, sheen and coat, above the rest (Cycles' emission_setup with
     // the layered weight); colour and strength unclamped.
     let emission = scale(
-        input_c(b, s, "Emission Color", [1.0; 3]),
-        input_f(b, s, "Emission Strength", 0.0),
+        input_c(b, s, socket!("Emission Color"), [1.0; 3]),
+        input_f(b, s, socket!("Emission Strength"), 0.0),
     );
     out.emission = add(out.emission, finite3(mul(emission, weight)));
     if metallic > 0.0 {
@@ -950,20 +966,20 @@ fn principled(
         let albedo = mul(scale(spec_tint, e), darkening);
         weight = scale(weight, (1.0 - max3(albedo)).clamp(0.0, 1.0));
     }
-    let ss = input_f(b, s, "Subsurface Weight", 0.0).clamp(0.0, 1.0);
+    let ss = input_f(b, s, socket!("Subsurface Weight"), 0.0).clamp(0.0, 1.0);
     if ss > 0.0 {
         let radius = scale(
-            input_c(b, s, "Subsurface Radius", [1.0, 0.2, 0.1]),
-            input_f(b, s, "Subsurface Scale", 0.05),
+            input_c(b, s, socket!("Subsurface Radius"), [1.0, 0.2, 0.1]),
+            input_f(b, s, socket!("Subsurface Scale"), 0.05),
         );
         let method = Method::from_property(b.property("subsurface_method"));
         // Random Walk (Skin) has its own IOR input; the other methods use the BSDF's.
         let ss_ior = if method == Method::RandomWalkSkin {
-            input_f(b, s, "Subsurface IOR", 1.4)
+            input_f(b, s, socket!("Subsurface IOR"), 1.4)
         } else {
             ior
         };
-        let aniso = input_f(b, s, "Subsurface Anisotropy", 0.0);
+        let aniso = input_f(b, s, socket!("Subsurface Anisotropy"), 0.0);
         push_bssrdf(
             out,
             scale(mul(weight, clamped), ss),
@@ -977,7 +993,7 @@ fn principled(
         );
         weight = scale(weight, 1.0 - ss);
     }
-    let diffuse_roughness = input_f(b, s, "Diffuse Roughness", 0.0);
+    let diffuse_roughness = input_f(b, s, socket!("Diffuse Roughness"), 0.0);
     if diffuse_roughness >= 1e-5 {
         let on = crate::render::bsdf::oren_nayar::OrenNayar::new(
             diffuse_roughness,
@@ -1092,10 +1108,10 @@ fn principled_coat(
     weight: V3,
     coat: f32,
 ) -> V3 {
-    let rough = input_f(b, s, "Coat Roughness", 0.03).clamp(0.0, 1.0);
-    let coat_ior = input_f(b, s, "Coat IOR", 1.5).max(1.0);
-    let tint = input_c(b, s, "Coat Tint", [1.0; 3]).map(|x| x.max(0.0));
-    let n = valid_n(sp, ctx, input_n(b, s, "Coat Normal", sp));
+    let rough = input_f(b, s, socket!("Coat Roughness"), 0.03).clamp(0.0, 1.0);
+    let coat_ior = input_f(b, s, socket!("Coat IOR"), 1.5).max(1.0);
+    let tint = input_c(b, s, socket!("Coat Tint"), [1.0; 3]).map(|x| x.max(0.0));
+    let n = valid_n(sp, ctx, input_n(b, s, socket!("Coat Normal"), sp));
     let mu = dot(n, ctx.wo).clamp(0.0, 1.0);
     let energy = multiscatter_energy(ctx.tables, mu, rough);
     let e = ctx
@@ -1162,13 +1178,13 @@ fn principled_sheen(
     n: V3,
     coat: f32,
 ) -> V3 {
-    let sheen_w = input_f(b, s, "Sheen Weight", 0.0).max(0.0);
+    let sheen_w = input_f(b, s, socket!("Sheen Weight"), 0.0).max(0.0);
     if sheen_w <= 1e-5 {
         return weight;
     }
-    let tint = input_c(b, s, "Sheen Tint", [1.0; 3]).map(|x| x.max(0.0));
-    let r = input_f(b, s, "Sheen Roughness", 0.5).clamp(0.0, 1.0);
-    let coat_n = input_n(b, s, "Coat Normal", sp);
+    let tint = input_c(b, s, socket!("Sheen Tint"), [1.0; 3]).map(|x| x.max(0.0));
+    let r = input_f(b, s, socket!("Sheen Roughness"), 0.5).clamp(0.0, 1.0);
+    let coat_n = input_n(b, s, socket!("Coat Normal"), sp);
     let sn = normalize(add(scale(n, 1.0 - coat), scale(coat_n, coat)));
     let sn = if is_zero(sn) || !sn.iter().all(|x| x.is_finite()) {
         n
@@ -1193,11 +1209,11 @@ pub(crate) fn tangent_input(
     b: &BsdfNode,
     s: &[f32],
     sp: &ShadingPoint,
-    id: &str,
+    id: usize,
     rotation: f32,
     n: V3,
 ) -> V3 {
-    let t = match b.input(id) {
+    let t = match b.input_at(id) {
         Some((slot, true)) => finite3(v3(s, slot)),
         _ => crate::shader::inputs::radial_tangent(sp, 2),
     };

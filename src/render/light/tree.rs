@@ -147,6 +147,54 @@ impl Cone {
     }
 }
 
+/// A cone's trigonometry, computed once when the tree is built: every importance
+/// evaluation needs it (five per light sample and five per MIS weight in a scene of
+/// four lights), and sin, cos of the same angles gives the same bits either way.
+#[derive(Clone, Copy, Debug)]
+struct ConeTrig {
+    sin_o: f32,
+    cos_o: f32,
+    /// cos(theta_o + theta_e)
+    cos_o_plus_e: f32,
+    /// cos(theta_e - theta_o)
+    cos_e_minus_o: f32,
+    cos_e: f32,
+}
+
+impl ConeTrig {
+    /// Placeholder until `LightTree::build` fills it in at the end.
+    const UNSET: ConeTrig = ConeTrig {
+        sin_o: f32::NAN,
+        cos_o: f32::NAN,
+        cos_o_plus_e: f32::NAN,
+        cos_e_minus_o: f32::NAN,
+        cos_e: f32::NAN,
+    };
+
+    fn of(c: &Cone) -> ConeTrig {
+        let (sin_o, cos_o) = c.theta_o.sin_cos();
+        ConeTrig {
+            sin_o,
+            cos_o,
+            cos_o_plus_e: (c.theta_o + c.theta_e).cos(),
+            cos_e_minus_o: (c.theta_e - c.theta_o).cos(),
+            cos_e: c.theta_e.cos(),
+        }
+    }
+
+    /// The trigonometry of the cone with theta_o set to 0 (a point light's disk facing
+    /// the viewer): sin 0 = 0 and cos 0 = 1 exactly, and theta_e +- 0 is theta_e.
+    fn with_zero_theta_o(self) -> ConeTrig {
+        ConeTrig {
+            sin_o: 0.0,
+            cos_o: 1.0,
+            cos_o_plus_e: self.cos_e,
+            cos_e_minus_o: self.cos_e,
+            cos_e: self.cos_e,
+        }
+    }
+}
+
 /// Cycles' LightTreeMeasure: bounds, orientation and energy of a cluster.
 #[derive(Clone, Copy, Debug)]
 pub struct Measure {
@@ -233,6 +281,8 @@ struct Stored {
     bit_trail: u64,
     /// For a triangle, the index of its object's mesh emitter.
     parent: u32,
+    /// Of `e.measure.cone`.
+    trig: ConeTrig,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -246,6 +296,8 @@ enum NodeKind {
 struct Node {
     m: Measure,
     kind: NodeKind,
+    /// Of `m.cone`.
+    trig: ConeTrig,
 }
 
 pub struct LightTree {
@@ -321,6 +373,7 @@ fn importance(
     ptc: V3,
     cos_u: f32,
     cone: Cone,
+    trig: &ConeTrig,
     max_d: f32,
     min_d: f32,
     energy: f32,
@@ -353,12 +406,10 @@ fn importance(
         (c, sin_from_cos(c))
     };
     let cos_t_minus_u = cos_t * cos_u + sin_t * sin_u;
-    let (sin_o, cos_o) = cone.theta_o.sin_cos();
+    let (sin_o, cos_o) = (trig.sin_o, trig.cos_o);
     let cos_min_outgoing = if cos_t >= cos_u || cos_t_minus_u >= cos_o {
         1.0
-    } else if cone.theta_o + cone.theta_e > PI
-        || cos_t_minus_u > (cone.theta_o + cone.theta_e).cos()
-    {
+    } else if cone.theta_o + cone.theta_e > PI || cos_t_minus_u > trig.cos_o_plus_e {
         let sin_t_minus_u = sin_from_cos(cos_t_minus_u);
         cos_t_minus_u * cos_o + sin_t_minus_u * sin_o
     } else {
@@ -372,7 +423,7 @@ fn importance(
     let min_imp = if cone.theta_e - cone.theta_o < 0.0
         || cos_t < 0.0
         || cos_u < 0.0
-        || cos_t_plus_u < (cone.theta_e - cone.theta_o).cos()
+        || cos_t_plus_u < trig.cos_e_minus_o
     {
         0.0
     } else {
@@ -473,6 +524,7 @@ impl LightTree {
         t.nodes.push(Node {
             m: Measure::EMPTY,
             kind: NodeKind::Leaf { first: 0, count: 0 },
+            trig: ConeTrig::UNSET,
         });
         let mut top: Vec<Emitter> = local;
         let mut mesh_ranges = Vec::new();
@@ -482,6 +534,7 @@ impl LightTree {
                 e,
                 bit_trail: 0,
                 parent: u32::MAX,
+                trig: ConeTrig::UNSET,
             }));
             let end = t.emitters.len();
             let root = t.recursive_build(start, end, 0, 0);
@@ -499,6 +552,7 @@ impl LightTree {
             e,
             bit_trail: 0,
             parent: u32::MAX,
+            trig: ConeTrig::UNSET,
         }));
         let end = t.emitters.len();
         let left = t.recursive_build(start, end, 0, 1);
@@ -511,6 +565,7 @@ impl LightTree {
             e,
             bit_trail: 1,
             parent: u32::MAX,
+            trig: ConeTrig::UNSET,
         }));
         let right = t.nodes.len() as u32;
         t.nodes.push(Node {
@@ -519,13 +574,21 @@ impl LightTree {
                 first: dstart as u32,
                 count: (t.emitters.len() - dstart) as u32,
             },
+            trig: ConeTrig::UNSET,
         });
         let mut rm = t.nodes[left as usize].m;
         rm.add(&dm);
         t.nodes[0] = Node {
             m: rm,
             kind: NodeKind::Inner { left, right },
+            trig: ConeTrig::UNSET,
         };
+        for n in &mut t.nodes {
+            n.trig = ConeTrig::of(&n.m.cone);
+        }
+        for s in &mut t.emitters {
+            s.trig = ConeTrig::of(&s.e.measure.cone);
+        }
         // Lookups from what light sampling knows (a light, a triangle) to emitters.
         for (i, s) in t.emitters.iter().enumerate() {
             match s.e.pick {
@@ -574,6 +637,7 @@ impl LightTree {
                 first: start as u32,
                 count: (end - start) as u32,
             },
+            trig: ConeTrig::UNSET,
         });
         let (split, middle, dim, m) = self.should_split(start, end);
         self.nodes[idx].m = m;
@@ -689,12 +753,7 @@ impl LightTree {
             Viewer::Segment { p, d, t } => {
                 let (ptc, cos_u, distance, theta_d) = if let NodeKind::Distant { .. } = node.kind {
                     let theta_d = if t.is_finite() { t } else { 1.0 };
-                    (
-                        neg(m.cone.axis),
-                        (m.cone.theta_o + m.cone.theta_e).cos(),
-                        1.0,
-                        theta_d,
-                    )
+                    (neg(m.cone.axis), node.trig.cos_o_plus_e, 1.0, theta_d)
                 } else {
                     let centroid = m.centre();
                     let (closest, dist, theta_d) = segment_view(p, d, t, centroid);
@@ -711,6 +770,7 @@ impl LightTree {
                     ptc,
                     cos_u,
                     m.cone,
+                    &node.trig,
                     distance,
                     distance,
                     m.energy,
@@ -719,11 +779,7 @@ impl LightTree {
             }
         };
         let (ptc, cos_u, distance) = if let NodeKind::Distant { .. } = node.kind {
-            (
-                neg(m.cone.axis),
-                (m.cone.theta_o + m.cone.theta_e).cos(),
-                1.0,
-            )
+            (neg(m.cone.axis), node.trig.cos_o_plus_e, 1.0)
         } else {
             let centroid = m.centre();
             let ext = sub(m.bmax, centroid);
@@ -737,18 +793,20 @@ impl LightTree {
             (ptc, cos_u, (0.5 * len(sub(centroid, m.bmax))).max(d))
         };
         importance(
-            n, trans, ptc, cos_u, m.cone, distance, distance, m.energy, None,
+            n, trans, ptc, cos_u, m.cone, &node.trig, distance, distance, m.energy, None,
         )
     }
 
     /// Cycles' light_tree_emitter_importance.
-    fn emitter_importance(&self, v: Viewer, e: &Emitter) -> (f32, f32) {
+    fn emitter_importance(&self, v: Viewer, st: &Stored) -> (f32, f32) {
         let (p, n, trans) = match v {
             Viewer::Point { p, n, trans } => (p, n, trans),
-            Viewer::Segment { p, d, t } => return self.emitter_importance_segment(p, d, t, e),
+            Viewer::Segment { p, d, t } => return self.emitter_importance_segment(p, d, t, st),
         };
+        let e = &st.e;
         let m = &e.measure;
         let mut cone = m.cone;
+        let mut trig = st.trig;
         let mut energy = m.energy;
         let centroid = e.centroid;
         let (visible, ptc, cos_u, dist) = match e.shape {
@@ -776,16 +834,17 @@ impl LightTree {
                         // Disk-oriented: facing the shading point.
                         cone.axis = normalize(sub(p, pos));
                         cone.theta_o = 0.0;
+                        trig = trig.with_zero_theta_o();
                     }
                     Some(smooth) => {
                         let cos_min_out = (dot(cone.axis, neg(ptc)).clamp(-1.0, 1.0).acos()
                             - cos_u.clamp(-1.0, 1.0).acos())
                         .max(0.0)
                         .cos();
-                        let x = (cos_min_out - cone.theta_e.cos()) * smooth;
+                        let x = (cos_min_out - trig.cos_e) * smooth;
                         energy *= if smooth.is_finite() {
                             smoothstep(x)
-                        } else if cos_min_out > cone.theta_e.cos() {
+                        } else if cos_min_out > trig.cos_e {
                             1.0
                         } else {
                             0.0
@@ -803,7 +862,7 @@ impl LightTree {
                 (front && above, ptc, cos_u, dist)
             }
             Shape::Distant => {
-                let cos_u = cone.theta_e.cos();
+                let cos_u = trig.cos_e;
                 (true, neg(centroid), cos_u, [1.0 / cos_u, 1.0])
             }
             Shape::World => {
@@ -828,15 +887,19 @@ impl LightTree {
         if !(visible || trans) {
             return (0.0, 0.0);
         }
-        importance(n, trans, ptc, cos_u, cone, dist[0], dist[1], energy, None)
+        importance(
+            n, trans, ptc, cos_u, cone, &trig, dist[0], dist[1], energy, None,
+        )
     }
 
     /// Cycles' light_tree_emitter_importance<in_volume_segment = true> for the segment
     /// from `p` along `d` for `t`: the emitter's parameters seen from the segment's point
     /// nearest it, its direction term from the segment's best-aligned point.
-    fn emitter_importance_segment(&self, p: V3, d: V3, t: f32, e: &Emitter) -> (f32, f32) {
+    fn emitter_importance_segment(&self, p: V3, d: V3, t: f32, st: &Stored) -> (f32, f32) {
+        let e = &st.e;
         let m = &e.measure;
         let mut cone = m.cone;
+        let mut trig = st.trig;
         let ray_length = if t.is_finite() { t } else { 1.0 };
         let (centroid, cos_u, dist, theta_d) = match e.shape {
             Shape::Mesh { root } => {
@@ -844,7 +907,7 @@ impl LightTree {
                     .node_importance(Viewer::Segment { p, d, t }, &self.nodes[root as usize])
             }
             Shape::Distant => {
-                let cos_u = cone.theta_e.cos();
+                let cos_u = trig.cos_e;
                 let ptc = neg(e.centroid);
                 return importance(
                     d,
@@ -852,6 +915,7 @@ impl LightTree {
                     ptc,
                     cos_u,
                     cone,
+                    &trig,
                     1.0 / cos_u,
                     1.0,
                     m.energy,
@@ -876,6 +940,7 @@ impl LightTree {
                         // Disk-oriented, facing the segment's start.
                         cone.axis = normalize(sub(p, pos));
                         cone.theta_o = 0.0;
+                        trig = trig.with_zero_theta_o();
                         1.0
                     }
                     Some(_) if sphere => {
@@ -910,6 +975,7 @@ impl LightTree {
             ptc,
             cos_u,
             cone,
+            &trig,
             dist[0],
             dist[1],
             m.energy,
@@ -922,7 +988,7 @@ impl LightTree {
         let nd = &self.nodes[node as usize];
         match nd.kind {
             NodeKind::Leaf { first, count } | NodeKind::Distant { first, count } if count == 1 => {
-                self.emitter_importance(v, &self.emitters[first as usize].e)
+                self.emitter_importance(v, &self.emitters[first as usize])
             }
             NodeKind::Leaf { count: 0, .. } | NodeKind::Distant { count: 0, .. } => (0.0, 0.0),
             _ => self.node_importance(v, nd),
@@ -1012,7 +1078,7 @@ impl LightTree {
         }
         let range = first as usize..(first + count) as usize;
         for (i, ei) in range.clone().enumerate() {
-            let (imax, imin) = self.emitter_importance(v, &self.emitters[ei].e);
+            let (imax, imin) = self.emitter_importance(v, &self.emitters[ei]);
             let imp = [imax, imin];
             reservoir(
                 ei,
@@ -1052,7 +1118,7 @@ impl LightTree {
                     );
                     hi >>= 1;
                 }
-                sel_imp[0] = self.emitter_importance(v, &self.emitters[selected?].e).0;
+                sel_imp[0] = self.emitter_importance(v, &self.emitters[selected?]).0;
             }
         }
         *pdf *= 0.5 * (sel_imp[0] / total[0] + sel_imp[1] / total[1]);
@@ -1093,8 +1159,7 @@ impl LightTree {
                     let (mut tmax, mut tmin, mut total_max, mut total_min, mut num) =
                         (0.0f32, 0.0f32, 0.0f32, 0.0f32, 0u32);
                     for ei in first..first + count {
-                        let (imax, imin) =
-                            self.emitter_importance(v, &self.emitters[ei as usize].e);
+                        let (imax, imin) = self.emitter_importance(v, &self.emitters[ei as usize]);
                         num += (imax > 0.0) as u32;
                         if ei == target {
                             tmax = imax;
