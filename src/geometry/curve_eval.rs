@@ -417,12 +417,29 @@ fn mix_vector(v: [&V3; 4], t: f32) -> V3 {
 }
 
 /// `catmull_rom::interpolate_to_evaluated`: one curve's control values `src` to its
-/// evaluated points `dst`, segment by segment, the end segments of an open curve
-/// repeating the end points.
+/// evaluated points `dst` at `resolution` points per segment.
 fn catmull_rom<T: Copy>(
     src: &[T],
     cyclic: bool,
     resolution: usize,
+    dst: &mut [T],
+    mix: &dyn Fn([&T; 4], f32) -> T,
+) {
+    catmull_rom_segments(
+        src,
+        cyclic,
+        &|s| s * resolution..(s + 1) * resolution,
+        dst,
+        mix,
+    )
+}
+
+/// `catmull_rom::interpolate_to_evaluated` with segment `s` written to `range(s)` of
+/// `dst`, segment by segment, the end segments of an open curve repeating the end points.
+fn catmull_rom_segments<T: Copy>(
+    src: &[T],
+    cyclic: bool,
+    range: &dyn Fn(usize) -> std::ops::Range<usize>,
     dst: &mut [T],
     mix: &dyn Fn([&T; 4], f32) -> T,
 ) {
@@ -441,7 +458,6 @@ fn catmull_rom<T: Copy>(
             *o = mix([a, b, c, d], j as f32 * step);
         }
     };
-    let range = |s: usize| s * resolution..(s + 1) * resolution;
     if n == 2 {
         segment(&src[0], &src[0], &src[1], &src[1], &mut dst[range(0)]);
         if cyclic {
@@ -498,45 +514,58 @@ fn catmull_rom_array(src: &Array, cyclic: bool, resolution: usize) -> Option<Arr
         (_, true) => (resolution * n).max(1),
         (_, false) => resolution * (n - 1) + 1,
     };
+    catmull_rom_array_segments(src, cyclic, count, &|s| {
+        s * resolution..(s + 1) * resolution
+    })
+}
+
+/// `catmull_rom_array` with `count` points, segment `s` at `range(s)` (as Subdivide
+/// Curve places its cuts).
+pub fn catmull_rom_array_segments(
+    src: &Array,
+    cyclic: bool,
+    count: usize,
+    range: &dyn Fn(usize) -> std::ops::Range<usize>,
+) -> Option<Array> {
     fn run<T: Copy + Default>(
         v: &[T],
         cyclic: bool,
-        r: usize,
+        range: &dyn Fn(usize) -> std::ops::Range<usize>,
         count: usize,
         mix: &dyn Fn([&T; 4], f32) -> T,
     ) -> Vec<T> {
         let mut out = vec![T::default(); count];
-        catmull_rom(v, cyclic, r, &mut out, mix);
+        catmull_rom_segments(v, cyclic, range, &mut out, mix);
         out
     }
     // Types other than float, float2 and float3 mix with halved weights.
     let halved = |t: f32| catmull_rom_basis(t).map(|w| w * 0.5);
     Some(match src {
-        Array::Float(v) => Array::Float(run(v, cyclic, resolution, count, &|x, t| {
+        Array::Float(v) => Array::Float(run(v, cyclic, range, count, &|x, t| {
             let w = catmull_rom_basis(t);
             0.5 * (w[0] * x[0] + w[1] * x[1] + w[2] * x[2] + w[3] * x[3])
         })),
-        Array::Float2(v) => Array::Float2(run(v, cyclic, resolution, count, &|x, t| {
+        Array::Float2(v) => Array::Float2(run(v, cyclic, range, count, &|x, t| {
             let w = catmull_rom_basis(t);
             [0, 1]
                 .map(|k| 0.5 * (w[0] * x[0][k] + w[1] * x[1][k] + w[2] * x[2][k] + w[3] * x[3][k]))
         })),
-        Array::Vector(v) => Array::Vector(run(v, cyclic, resolution, count, &mix_vector)),
-        Array::Color(v) => Array::Color(run(v, cyclic, resolution, count, &|x, t| {
+        Array::Vector(v) => Array::Vector(run(v, cyclic, range, count, &mix_vector)),
+        Array::Color(v) => Array::Color(run(v, cyclic, range, count, &|x, t| {
             let w = halved(t);
             [0, 1, 2, 3].map(|k| x[0][k] * w[0] + x[1][k] * w[1] + x[2][k] * w[2] + x[3][k] * w[3])
         })),
-        Array::Int(v) => Array::Int(run(v, cyclic, resolution, count, &|x, t| {
+        Array::Int(v) => Array::Int(run(v, cyclic, range, count, &|x, t| {
             let w = halved(t);
             (w[0] * *x[0] as f32 + w[1] * *x[1] as f32 + w[2] * *x[2] as f32 + w[3] * *x[3] as f32)
                 .round() as i32
         })),
-        Array::Int8(v) => Array::Int8(run(v, cyclic, resolution, count, &|x, t| {
+        Array::Int8(v) => Array::Int8(run(v, cyclic, range, count, &|x, t| {
             let w = halved(t);
             (w[0] * *x[0] as f32 + w[1] * *x[1] as f32 + w[2] * *x[2] as f32 + w[3] * *x[3] as f32)
                 .round() as i8
         })),
-        Array::Bool(v) => Array::Bool(run(v, cyclic, resolution, count, &|x, t| {
+        Array::Bool(v) => Array::Bool(run(v, cyclic, range, count, &|x, t| {
             let w = halved(t);
             let f = |b: &bool| *b as u8 as f32;
             w[0] * f(x[0]) + w[1] * f(x[1]) + w[2] * f(x[2]) + w[3] * f(x[3]) >= 0.5

@@ -1,11 +1,11 @@
 //! Curve subdivision as Blender's `geometry::subdivide_curves`: each segment gets `cuts`
 //! new points (the segment's first point's value), attributes interpolated linearly; Bezier
 //! segments are split by De Casteljau so the shape stays (aligned handles on the new
-//! points, vector segments kept straight); NURBS curves are treated as poly curves. Catmull-Rom
-//! curves are refused (they need Catmull-Rom attribute interpolation).
+//! points, vector segments kept straight); NURBS curves are treated as poly curves;
+//! Catmull-Rom curves place the new points (and every point attribute) on their cubic.
 
 use super::bezier_handles::calculate_auto_handles;
-use super::curve_eval::lerp_gather;
+use super::curve_eval::{catmull_rom_array_segments, lerp_gather};
 use super::curves::{
     Curves, CURVE_TYPE_BEZIER, CURVE_TYPE_CATMULL_ROM, HANDLE_ALIGN, HANDLE_AUTO, HANDLE_FREE,
     HANDLE_VECTOR,
@@ -43,14 +43,6 @@ fn aligned_or_free(t: i8) -> i8 {
 /// Subdivides every curve; `cuts` is per point (the segment starting there).
 pub fn subdivide_curves(c: &Curves, cuts: &[i32]) -> Result<Curves, String> {
     let types = c.ints("curve_type", Domain::Curve, 0);
-    if let Some(i) = types
-        .iter()
-        .position(|t| *t as i8 == CURVE_TYPE_CATMULL_ROM)
-    {
-        return Err(format!(
-            "curve {i}: subdividing Catmull-Rom curves is not supported"
-        ));
-    }
     let cyclic = c.cyclic();
     // Per source point: its segment's first point in the result (within the curve), and
     // the result's curve offsets.
@@ -101,9 +93,19 @@ pub fn subdivide_curves(c: &Curves, cuts: &[i32]) -> Result<Curves, String> {
     out.positions = lerp_gather(&Array::Vector(c.positions.clone()), &ia, &ib, &fac)
         .as_vector()
         .into_owned();
+    let catmull_rom = types.iter().any(|t| *t as i8 == CURVE_TYPE_CATMULL_ROM);
+    if catmull_rom {
+        let pos = Array::Vector(c.positions.clone());
+        out.positions = catmull_rom_points(c, &types, &cyclic, &seg_start, &seg_len, &out, &pos)?
+            .as_vector()
+            .into_owned();
+    }
     for a in c.attributes.iter() {
         let data = match a.domain {
             Domain::Curve => a.data.clone(),
+            Domain::Point if catmull_rom => {
+                catmull_rom_points(c, &types, &cyclic, &seg_start, &seg_len, &out, &a.data)?
+            }
             Domain::Point => lerp_gather(&a.data, &ia, &ib, &fac),
             _ => continue,
         };
@@ -116,6 +118,49 @@ pub fn subdivide_curves(c: &Curves, cuts: &[i32]) -> Result<Curves, String> {
         subdivide_bezier(c, &types, &cyclic, &seg_start, &hl, &hr, &mut out);
     }
     Ok(out)
+}
+
+/// A point attribute of the subdivided curves: Catmull-Rom curves' new points on their
+/// cubic (`subdivide_attribute_catmull_rom`), the others' mixed linearly.
+fn catmull_rom_points(
+    c: &Curves,
+    types: &[i32],
+    cyclic: &[bool],
+    seg_start: &[usize],
+    seg_len: &[usize],
+    out: &Curves,
+    data: &Array,
+) -> Result<Array, String> {
+    let mut result = Array::zeros(data.data_type(), 0);
+    for i in 0..c.curve_count() {
+        let r = c.points(i);
+        let count = out.points(i).len();
+        let src = data.gather(&r.clone().collect::<Vec<_>>());
+        let piece = if types[i] as i8 == CURVE_TYPE_CATMULL_ROM {
+            let range =
+                |s: usize| seg_start[r.start + s]..seg_start[r.start + s] + seg_len[r.start + s];
+            catmull_rom_array_segments(&src, cyclic[i], count, &range).ok_or_else(|| {
+                format!(
+                    "curve {i}: a {:?} attribute cannot be subdivided along a Catmull-Rom curve",
+                    data.data_type()
+                )
+            })?
+        } else {
+            let (mut ia, mut ib, mut fac) = (Vec::new(), Vec::new(), Vec::new());
+            for p in 0..r.len() {
+                let next = if p + 1 == r.len() { 0 } else { p + 1 };
+                let step = 1.0 / seg_len[r.start + p] as f32;
+                for k in 0..seg_len[r.start + p] {
+                    ia.push(p);
+                    ib.push(next);
+                    fac.push(k as f32 * step);
+                }
+            }
+            lerp_gather(&src, &ia, &ib, &fac)
+        };
+        result.extend(&piece);
+    }
+    Ok(result)
 }
 
 /// Positions, handles and handle types of the Bezier curves
