@@ -1401,3 +1401,26 @@ fn active_camera_with_camera_markers_is_refused_by_name() {
         "{err}"
     );
 }
+
+/// Camera Info with a depth-of-field focus on a bone (Blender measures to the bone) is
+/// an error naming the node and the bone, not the focus object's origin distance.
+#[test]
+fn camera_info_focus_on_a_bone_is_refused_by_name() {
+    let mut scene = load("camera_image");
+    let cam = scene
+        .file
+        .cameras
+        .iter_mut()
+        .find(|c| c.name == "CamData")
+        .expect("camera data");
+    cam.properties
+        .get_mut("dof")
+        .and_then(|d| d.as_object_mut())
+        .expect("dof")
+        .insert("focus_subtarget".into(), "Head".into());
+    let err = mesh_of(&scene, "camera_image", 3.0, &[]).unwrap_err();
+    assert!(
+        err.contains("GeometryNodeCameraInfo") && err.contains("\"Head\""),
+        "{err}"
+    );
+}

@@ -253,6 +253,8 @@ pub struct DepthOfField {
     pub aperture_ratio: f64,
     pub focus_distance: f64,
     pub focus_object: Option<String>,
+    /// The focus object's bone to focus on (empty: its origin).
+    pub focus_subtarget: String,
 }
 
 /// A camera's data block (after animation), with Blender's DNA defaults.
@@ -314,6 +316,7 @@ impl CameraSettings {
             aperture_ratio: num(d, "aperture_ratio").unwrap_or(1.0),
             focus_distance: num(d, "focus_distance").unwrap_or(10.0),
             focus_object: id_name(d, "focus_object").map(str::to_string),
+            focus_subtarget: text(d, "focus_subtarget").unwrap_or("").to_string(),
         });
         let n = |k: &str, d: f64| num(p, k).unwrap_or(d);
         use std::f64::consts::{FRAC_PI_2, PI};

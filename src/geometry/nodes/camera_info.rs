@@ -180,6 +180,12 @@ fn focus_distance(ctx: &NodeCtx, camera: &str, c: &CameraSettings) -> Result<f32
     let Some(target) = &dof.focus_object else {
         return Ok(dof.focus_distance as f32);
     };
+    if !dof.focus_subtarget.is_empty() {
+        return Err(ctx.err(format!(
+            "camera {camera:?} focuses on bone {:?} of {target:?}: focus on a bone is not supported",
+            dof.focus_subtarget
+        )));
+    }
     let session = ctx.session();
     let world = |n: &str| {
         session

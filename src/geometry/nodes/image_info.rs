@@ -9,6 +9,8 @@ use image::ColorType;
 
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
+use super::super::field::Field;
+use super::super::types::Value;
 use super::super::value::SocketValue;
 use crate::shader::images::image_file;
 
@@ -63,9 +65,7 @@ pub fn image_info(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         ("Height", int(img.height())),
         (
             "Has Alpha",
-            SocketValue::Field(super::super::field::Field::Constant(
-                super::super::types::Value::Bool(alpha),
-            )),
+            SocketValue::Field(Field::Constant(Value::Bool(alpha))),
         ),
         ("Frame Count", SocketValue::int(1)),
         ("FPS", SocketValue::float(0.0)),
