@@ -2065,6 +2065,9 @@ def main():
                                      else scene.frame_end),
             "fps": scene.render.fps, "fps_base": scene.render.fps_base,
             "camera": key(scene.camera) if scene.camera else None, "world": key(scene.world) if scene.world else None,
+            # Timeline markers bound to a camera switch the active camera during playback.
+            "camera_markers": [{"frame": m.frame, "camera": key(m.camera)} for m in scene.timeline_markers
+                               if m.camera],
             "render": rna_value(scene.render, 0, "scene.render"),
             "cycles": rna_value(scene.cycles, 0, "scene.cycles") if hasattr(scene, "cycles") else {},
             "cycles_curves": rna_value(scene.cycles_curves, 0, "scene.cycles_curves") if hasattr(scene, "cycles_curves") else {},

@@ -32,6 +32,8 @@ pub struct Session<'s> {
     pub world: Vec<Mat4f>,
     /// Per node group: each link's `multi_input_sort_id` (0 when the export has none).
     pub sort_ids: HashMap<String, Vec<i64>>,
+    /// Camera data blocks at `frame` (animated), for Camera Info.
+    pub cameras: Vec<crate::scene::Camera>,
     cache: RefCell<HashMap<String, GeometrySet>>,
     in_progress: RefCell<Vec<String>>,
     /// Simulation zone states, carried from the previous frame's session to this one
@@ -55,12 +57,14 @@ impl<'s> Session<'s> {
         frame: f64,
         world: Vec<Mat4f>,
         sort_ids: HashMap<String, Vec<i64>>,
+        cameras: Vec<crate::scene::Camera>,
     ) -> Self {
         Session {
             scene,
             frame,
             world,
             sort_ids,
+            cameras,
             cache: RefCell::new(HashMap::new()),
             in_progress: RefCell::new(Vec::new()),
             simulation: RefCell::new(HashMap::new()),

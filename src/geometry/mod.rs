@@ -108,7 +108,13 @@ fn session_at(scene: &Scene, frame: f64) -> Result<eval::Session<'_>, GeometryEr
         .map(math::from_rows_f64)
         .collect();
     let sort_ids = animated::link_sort_ids(scene)?;
-    Ok(eval::Session::new(scene, frame, world, sort_ids))
+    Ok(eval::Session::new(
+        scene,
+        frame,
+        world,
+        sort_ids,
+        anim.data.cameras,
+    ))
 }
 
 /// The geometry as one mesh: instances realized (Blender's Realize Instances order),

@@ -72,6 +72,13 @@ pub struct SceneFile {
     pub warnings: Vec<String>,
 }
 
+/// A timeline marker that binds a camera (`scene.timeline_markers[i].camera`).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct CameraMarker {
+    pub frame: i32,
+    pub camera: String,
+}
+
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct SceneSettings {
     pub name: String,
@@ -90,6 +97,10 @@ pub struct SceneSettings {
     #[serde(default = "one_f64")]
     pub fps_base: f64,
     pub camera: Option<String>,
+    /// Timeline markers bound to a camera (absent in older exports): Blender switches the
+    /// active camera at them.
+    #[serde(default)]
+    pub camera_markers: Vec<CameraMarker>,
     #[serde(default)]
     pub world: Option<String>,
     #[serde(default)]

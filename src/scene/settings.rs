@@ -24,6 +24,13 @@ fn text<'a>(m: &'a Rna, k: &str) -> Option<&'a str> {
     m.get(k).and_then(Value::as_str)
 }
 
+/// An ID pointer: the exporter writes `{"id_type": ..., "name": ...}` (older exports, and
+/// hand-written ones, a plain name).
+fn id_name<'a>(m: &'a Rna, k: &str) -> Option<&'a str> {
+    let v = m.get(k)?;
+    v.as_str().or_else(|| v.get("name").and_then(Value::as_str))
+}
+
 fn group<'a>(m: &'a Rna, k: &str) -> Option<&'a Rna> {
     m.get(k).and_then(Value::as_object)
 }
@@ -246,6 +253,8 @@ pub struct DepthOfField {
     pub aperture_ratio: f64,
     pub focus_distance: f64,
     pub focus_object: Option<String>,
+    /// The focus object's bone to focus on (empty: its origin).
+    pub focus_subtarget: String,
 }
 
 /// A camera's data block (after animation), with Blender's DNA defaults.
@@ -306,7 +315,8 @@ impl CameraSettings {
             aperture_rotation: num(d, "aperture_rotation").unwrap_or(0.0),
             aperture_ratio: num(d, "aperture_ratio").unwrap_or(1.0),
             focus_distance: num(d, "focus_distance").unwrap_or(10.0),
-            focus_object: text(d, "focus_object").map(str::to_string),
+            focus_object: id_name(d, "focus_object").map(str::to_string),
+            focus_subtarget: text(d, "focus_subtarget").unwrap_or("").to_string(),
         });
         let n = |k: &str, d: f64| num(p, k).unwrap_or(d);
         use std::f64::consts::{FRAC_PI_2, PI};

@@ -55,7 +55,12 @@ pub fn input_material(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
 }
 
 /// An ID input node's datablock (`object`, `collection`), as its socket would hold it.
-fn id_input(ctx: &NodeCtx, prop: &str, kind: &str, output: &str) -> Result<Outputs, GeometryError> {
+pub(super) fn id_input(
+    ctx: &NodeCtx,
+    prop: &str,
+    kind: &str,
+    output: &str,
+) -> Result<Outputs, GeometryError> {
     let v = match ctx.prop(prop) {
         Some(j) => SocketValue::from_json(kind, j).map_err(|e| ctx.err(e))?,
         None => SocketValue::zero(kind),

@@ -7,6 +7,7 @@ pub mod attribute_statistic;
 pub mod bake;
 pub mod blur_attribute;
 pub mod bounding_box;
+pub mod camera_info;
 pub mod collection_info;
 pub mod color;
 pub mod convex_hull;
@@ -29,7 +30,11 @@ pub mod edge_paths_to_curves;
 pub mod edge_paths_to_selection;
 pub mod edges_to_face_groups;
 pub mod extrude;
+pub mod field_average;
+pub mod field_min_and_max;
 pub mod field_nodes;
+pub mod field_statistics;
+pub mod field_variance;
 pub mod fill_curve;
 pub mod fillet_curve;
 pub mod flip_faces;
@@ -38,10 +43,16 @@ pub mod foreach_element;
 pub mod function;
 pub mod geometry_ops;
 pub mod geometry_to_instance;
+pub mod gizmo_dial;
+pub mod gizmo_linear;
+pub mod gizmo_transform;
 pub mod ico_sphere;
+pub mod image_info;
 pub mod image_texture;
 pub mod index_of_nearest;
 pub mod input;
+pub mod input_active_camera;
+pub mod input_image;
 pub mod instance_bounds;
 pub mod instance_transform;
 pub mod integer_math;
@@ -538,6 +549,28 @@ pub const NODES: &[(&str, Evaluate)] = &[
     (
         "GeometryNodeInputInstanceBounds",
         instance_bounds::instance_bounds,
+    ),
+    // Field statistics (issue 26 item 4).
+    ("GeometryNodeFieldAverage", field_average::field_average),
+    (
+        "GeometryNodeFieldMinAndMax",
+        field_min_and_max::field_min_and_max,
+    ),
+    ("GeometryNodeFieldVariance", field_variance::field_variance),
+    // Camera and image inputs (issue 26 item 4).
+    (
+        "GeometryNodeInputActiveCamera",
+        input_active_camera::active_camera,
+    ),
+    ("GeometryNodeCameraInfo", camera_info::camera_info),
+    ("GeometryNodeInputImage", input_image::input_image),
+    ("GeometryNodeImageInfo", image_info::image_info),
+    // Gizmos: nothing in a render evaluation (issue 26 item 4).
+    ("GeometryNodeGizmoDial", gizmo_dial::gizmo_dial),
+    ("GeometryNodeGizmoLinear", gizmo_linear::gizmo_linear),
+    (
+        "GeometryNodeGizmoTransform",
+        gizmo_transform::gizmo_transform,
     ),
 ];
 
