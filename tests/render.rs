@@ -89,6 +89,7 @@ const ASSERTED: &[&str] = &[
     "diffuse_point",
     "diffuse_sun",
     "dof",
+    "dof_focus_object",
     "emission_mesh",
     "glossy",
     "metallic",
@@ -1712,6 +1713,21 @@ fn refused_alike(
     for w in words {
         assert!(checked.contains(w), "{checked:?} lacks {w:?}");
     }
+}
+
+/// Depth of field focused on a bone of the focus object is refused by name (the renderer
+/// focuses on an object's origin), the same from `render::check` (what `inspect` runs) as
+/// from `render`; the object's origin itself renders (parity scene dof_focus_object).
+#[test]
+fn depth_of_field_focus_on_a_bone_is_refused_by_name() {
+    let (dir, base) = fixture_json("dof_focus_object");
+    assert_renders(&dir, &base);
+    refused_alike(
+        &dir,
+        &base,
+        &|j| j["cameras"][0]["properties"]["dof"]["focus_subtarget"] = "Head".into(),
+        &["\"Head\"", "\"FocusHere\"", "depth of field"],
+    );
 }
 
 /// Volume features blendsynth does not render are errors naming the object, material or

@@ -69,7 +69,7 @@ fn bounds(g: &GeometrySet, use_radius: bool) -> Result<Option<(V3, V3)>, String>
                 // Radii are interpolated to the evaluated points as any point attribute.
                 Radii::Each(v) => Radii::Each(
                     evaluated
-                        .interpolate(c, &Array::Float(v))
+                        .interpolate(c, &Array::Float(v))?
                         .as_float()
                         .into_owned(),
                 ),

@@ -130,6 +130,12 @@ impl Camera {
             ratio = d.aperture_ratio as f32;
             focus = d.focus_distance as f32;
             if let Some(fo) = d.focus_object.as_deref() {
+                if !d.focus_subtarget.is_empty() {
+                    return Err(RenderError(format!(
+                        "camera {data:?}: depth of field focusing on bone {:?} of {fo:?} is not supported (an object's origin is)",
+                        d.focus_subtarget
+                    )));
+                }
                 if let Some(fi) = eval.data.objects.iter().position(|o| o.name == fo) {
                     // Distance along the view axis to the focus object's origin.
                     let t = eval.world_matrices[fi];
