@@ -695,10 +695,11 @@ fn parity_fixtures_stay_small() {
     // Duplicate Elements, Quadratic Bezier, Points to Curves and Face Set Boundaries
     // (gn_topo_nodes.py: 0.54 MB, nearly all of it scene.json), and the input,
     // pass-through, Remove Named Attribute and Replace Material scenes (gn_input_nodes.py:
-    // 0.26 MB) to 11.4 MB.
+    // 0.26 MB) to 11.4 MB; Sample UV Surface and Split to Instances (gn_sample_nodes.py:
+    // 0.34 MB, mostly scene.json) to 11.8 MB.
     assert!(
-        total < 11_400_000,
-        "fixtures/geometry/scenes holds {total} bytes; keep it under 11.4 MB"
+        total < 11_800_000,
+        "fixtures/geometry/scenes holds {total} bytes; keep it under 11.8 MB"
     );
 }
 
