@@ -695,11 +695,11 @@ fn parity_fixtures_stay_small() {
     // Duplicate Elements, Quadratic Bezier, Points to Curves and Face Set Boundaries
     // (gn_topo_nodes.py: 0.54 MB, nearly all of it scene.json), and the input,
     // pass-through, Remove Named Attribute and Replace Material scenes (gn_input_nodes.py:
-    // 0.26 MB) to 11.4 MB; Sample UV Surface and Split to Instances (gn_sample_nodes.py:
-    // 0.34 MB, mostly scene.json) to 11.8 MB.
+    // 0.26 MB) to 11.4 MB; Sample UV Surface, Split to Instances and Set Mesh Normal
+    // (gn_sample_nodes.py: 0.5 MB, mostly scene.json) to 11.9 MB.
     assert!(
-        total < 11_800_000,
-        "fixtures/geometry/scenes holds {total} bytes; keep it under 11.8 MB"
+        total < 11_900_000,
+        "fixtures/geometry/scenes holds {total} bytes; keep it under 11.9 MB"
     );
 }
 
@@ -1334,4 +1334,60 @@ fn baked_bake_nodes_are_refused_by_name() {
     )
     .unwrap_err();
     assert!(e.contains("Bake") && e.contains("baked data"), "{e}");
+}
+
+/// Set Mesh Normal: the corner normals blendsynth renders a Geometry Nodes mesh with
+/// (`Mesh::corner_normals`, what `to_scene` hands the renderer) are Blender's evaluated
+/// corner normals (the export's per-corner normals): Free custom normals on points, faces
+/// and corners used unnormalized as Blender does, and Sharpness with the custom normals
+/// removed or kept. Tangent Space is refused by name.
+#[test]
+fn set_mesh_normal_corner_normals_are_blenders() {
+    let scene = load("set_mesh_normal");
+    let cases = [
+        "smn_free_point",
+        "smn_free_face",
+        "smn_free_corner",
+        "smn_sharp_remove",
+        "smn_sharp_keep",
+    ];
+    for case in cases {
+        let theirs = evaluated(&scene, case);
+        let ours = mesh_of(&scene, case, 1.0, &[]).unwrap();
+        let cn = ours.corner_normals();
+        assert_eq!(cn.len(), theirs.corner_normals.len(), "{case}");
+        let err = max_diff(&cn, &theirs.corner_normals);
+        assert!(err < 1e-5, "{case}: corner normals differ by {err:e}");
+        // What the renderer is given is the same.
+        let sd = ours.to_scene(case);
+        assert_eq!(sd.corner_normals, cn, "{case}");
+    }
+    // The cases are meaningful: unnormalized custom normals reach the corners, and
+    // keeping or removing them changes the normals.
+    let keep = mesh_of(&scene, "smn_sharp_keep", 1.0, &[])
+        .unwrap()
+        .corner_normals();
+    let remove = mesh_of(&scene, "smn_sharp_remove", 1.0, &[])
+        .unwrap()
+        .corner_normals();
+    assert!(max_diff(&keep, &remove) > 0.1);
+    let free = evaluated(&scene, "smn_free_point");
+    let len = |n: [f32; 3]| (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    assert!(free
+        .corner_normals
+        .iter()
+        .any(|n| (len(*n) - 1.0).abs() > 0.1));
+    // Tangent Space (corner fan spaces) is an error naming the node and the mode.
+    let path = "node_groups[\"smn_free_corner\"].nodes[\"Set Mesh Normal\"].mode";
+    let e = mesh_of(
+        &scene,
+        "smn_free_corner",
+        1.0,
+        &[(path.to_string(), serde_json::json!("TANGENT_SPACE"))],
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("Set Mesh Normal") && e.contains("Tangent Space"),
+        "{e}"
+    );
 }

@@ -71,6 +71,7 @@ pub mod sample_uv_surface;
 pub mod scale_elements;
 pub mod separate_components;
 pub mod set_geometry_name;
+pub mod set_mesh_normal;
 pub mod set_spline_type;
 pub mod shortest_edge_paths;
 pub mod simulation_zone;
@@ -134,6 +135,10 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ("GeometryNodeJoinGeometry", geometry_ops::join),
     ("GeometryNodeSetMaterial", geometry_ops::set_material),
     ("GeometryNodeSetShadeSmooth", geometry_ops::set_shade_smooth),
+    (
+        "GeometryNodeSetMeshNormal",
+        set_mesh_normal::set_mesh_normal,
+    ),
     ("GeometryNodeMeshGrid", primitives::grid),
     ("GeometryNodeMeshCube", primitives::cube),
     ("GeometryNodeMeshUVSphere", primitives::uv_sphere),
