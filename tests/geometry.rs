@@ -1358,9 +1358,35 @@ fn set_mesh_normal_corner_normals_are_blenders() {
         assert_eq!(cn.len(), theirs.corner_normals.len(), "{case}");
         let err = max_diff(&cn, &theirs.corner_normals);
         assert!(err < 1e-5, "{case}: corner normals differ by {err:e}");
-        // What the renderer is given is the same.
+        // What the renderer is given is the same where Cycles reads Blender's corner
+        // normals (corner custom normals, or none); point and face ones Cycles reads per
+        // vertex on smooth faces only (`Mesh::shading_corner_normals`), and these meshes'
+        // faces are all flat.
         let sd = ours.to_scene(case);
-        assert_eq!(sd.corner_normals, cn, "{case}");
+        if matches!(case, "smn_free_corner" | "smn_sharp_remove") {
+            assert_eq!(sd.corner_normals, cn, "{case}");
+        } else {
+            // Smooth faces: Blender's corner normals; flat faces: the face normal.
+            let sharp = ours.sharp_faces();
+            let has_sharp = ours.attributes.named("sharp_face").is_some();
+            for f in 0..ours.face_count() {
+                let smooth = if has_sharp {
+                    !sharp[f]
+                } else {
+                    case != "smn_free_face"
+                };
+                for c in ours.face(f) {
+                    let want = if smooth && case != "smn_free_face" {
+                        cn[c]
+                    } else if smooth {
+                        sd.corner_normals[c]
+                    } else {
+                        ours.face_normal(f)
+                    };
+                    assert_eq!(sd.corner_normals[c], want, "{case} corner {c}");
+                }
+            }
+        }
     }
     // The cases are meaningful: unnormalized custom normals reach the corners, and
     // keeping or removing them changes the normals.

@@ -198,7 +198,7 @@ impl Mesh {
             }
         }
         if self.face_count() > 0 {
-            m.corner_normals = self.corner_normals();
+            m.corner_normals = self.shading_corner_normals();
         }
         for a in self.attributes.iter() {
             let Some(name) = a.id.name() else { continue };
@@ -269,7 +269,11 @@ impl Mesh {
                 return n.clone();
             }
         }
-        let fnorm = self.face_normals();
+        self.vertex_normals_from(&self.face_normals())
+    }
+
+    /// `normals_calc_verts` from the given face normals.
+    pub fn vertex_normals_from(&self, fnorm: &[V3]) -> Vec<V3> {
         let mut acc = vec![[0.0f32; 3]; self.vertex_count()];
         let mut used = vec![false; self.vertex_count()];
         // Blender sums per vertex over its faces in face order (vert_to_face_map), each
@@ -361,6 +365,43 @@ impl Mesh {
                 y.name()
             )),
         })
+    }
+
+    /// The corner normals Cycles shades the mesh with (`blender/mesh.cpp` `create_mesh`):
+    /// Blender's corner normals, except with free custom normals on points or faces, which
+    /// Cycles reads as vertex normals on smooth faces: point ones as they are; face ones
+    /// mixed to the vertices (`Mesh::vert_normals`: angle-weighted, normalized), and only
+    /// where the mesh has a `sharp_face` attribute (without one every face is flat). Flat
+    /// faces take the true face normal.
+    pub fn shading_corner_normals(&self) -> Vec<V3> {
+        let Some((d, n)) = self
+            .free_custom_normals()
+            .filter(|(d, _)| *d != Domain::Corner)
+        else {
+            return self.corner_normals();
+        };
+        let sharp = match self.attributes.named("sharp_face") {
+            Some(a) if a.domain == Domain::Face => Some(a.data.as_bool().into_owned()),
+            _ => None,
+        };
+        let vn: Vec<V3> = if d == Domain::Point {
+            n.to_vec()
+        } else {
+            self.vertex_normals_from(n)
+        };
+        let smooth = |f: usize| match (&sharp, d) {
+            (Some(s), _) => !s[f],
+            (None, Domain::Point) => true,
+            (None, _) => false,
+        };
+        let mut out = Vec::with_capacity(self.corner_count());
+        for f in 0..self.face_count() {
+            let flat = (!smooth(f)).then(|| self.face_normal(f));
+            for c in self.face(f) {
+                out.push(flat.unwrap_or(vn[self.corner_verts[c] as usize]));
+            }
+        }
+        out
     }
 
     /// Corner normals as Blender 4.1+ defines them: free custom normals where the mesh has
