@@ -697,12 +697,13 @@ fn parity_fixtures_stay_small() {
     // pass-through, Remove Named Attribute and Replace Material scenes (gn_input_nodes.py:
     // 0.26 MB) to 11.4 MB; the NURBS and Catmull-Rom scene (gn_curve_nodes.py
     // scene_curve_types: 0.31 MB, 0.19 MB of it scene.json), the join defaults
-    // (gn_mesh_nodes.py: 0.09 MB) and the field statistics, gizmo, curve Bounding Box,
+    // (gn_mesh_nodes.py: 0.09 MB), the field statistics, gizmo, curve Bounding Box,
     // camera and image scenes (gn_field_stats.py: 0.38 MB, nearly all of it scene.json)
-    // to 12.2 MB.
+    // and Sample UV Surface, Split to Instances and Set Mesh Normal (gn_sample_nodes.py:
+    // 0.5 MB, mostly scene.json) to 12.7 MB.
     assert!(
-        total < 12_200_000,
-        "fixtures/geometry/scenes holds {total} bytes; keep it under 12.2 MB"
+        total < 12_700_000,
+        "fixtures/geometry/scenes holds {total} bytes; keep it under 12.7 MB"
     );
 }
 
@@ -1425,5 +1426,84 @@ fn camera_info_focus_on_a_bone_is_refused_by_name() {
     assert!(
         err.contains("GeometryNodeCameraInfo") && err.contains("\"Head\""),
         "{err}"
+/// Set Mesh Normal: the corner normals blendsynth renders a Geometry Nodes mesh with
+/// (`Mesh::corner_normals`, what `to_scene` hands the renderer) are Blender's evaluated
+/// corner normals (the export's per-corner normals): Free custom normals on points, faces
+/// and corners used unnormalized as Blender does, and Sharpness with the custom normals
+/// removed or kept. Tangent Space is refused by name.
+#[test]
+fn set_mesh_normal_corner_normals_are_blenders() {
+    let scene = load("set_mesh_normal");
+    let cases = [
+        "smn_free_point",
+        "smn_free_face",
+        "smn_free_corner",
+        "smn_sharp_remove",
+        "smn_sharp_keep",
+    ];
+    for case in cases {
+        let theirs = evaluated(&scene, case);
+        let ours = mesh_of(&scene, case, 1.0, &[]).unwrap();
+        let cn = ours.corner_normals();
+        assert_eq!(cn.len(), theirs.corner_normals.len(), "{case}");
+        let err = max_diff(&cn, &theirs.corner_normals);
+        assert!(err < 1e-5, "{case}: corner normals differ by {err:e}");
+        // What the renderer is given is the same where Cycles reads Blender's corner
+        // normals (corner custom normals, or none); point and face ones Cycles reads per
+        // vertex on smooth faces only (`Mesh::shading_corner_normals`), and these meshes'
+        // faces are all flat.
+        let sd = ours.to_scene(case);
+        if matches!(case, "smn_free_corner" | "smn_sharp_remove") {
+            assert_eq!(sd.corner_normals, cn, "{case}");
+        } else {
+            // Smooth faces: Blender's corner normals; flat faces: the face normal.
+            let sharp = ours.sharp_faces();
+            let has_sharp = ours.attributes.named("sharp_face").is_some();
+            for f in 0..ours.face_count() {
+                let smooth = if has_sharp {
+                    !sharp[f]
+                } else {
+                    case != "smn_free_face"
+                };
+                for c in ours.face(f) {
+                    let want = if smooth && case != "smn_free_face" {
+                        cn[c]
+                    } else if smooth {
+                        sd.corner_normals[c]
+                    } else {
+                        ours.face_normal(f)
+                    };
+                    assert_eq!(sd.corner_normals[c], want, "{case} corner {c}");
+                }
+            }
+        }
+    }
+    // The cases are meaningful: unnormalized custom normals reach the corners, and
+    // keeping or removing them changes the normals.
+    let keep = mesh_of(&scene, "smn_sharp_keep", 1.0, &[])
+        .unwrap()
+        .corner_normals();
+    let remove = mesh_of(&scene, "smn_sharp_remove", 1.0, &[])
+        .unwrap()
+        .corner_normals();
+    assert!(max_diff(&keep, &remove) > 0.1);
+    let free = evaluated(&scene, "smn_free_point");
+    let len = |n: [f32; 3]| (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    assert!(free
+        .corner_normals
+        .iter()
+        .any(|n| (len(*n) - 1.0).abs() > 0.1));
+    // Tangent Space (corner fan spaces) is an error naming the node and the mode.
+    let path = "node_groups[\"smn_free_corner\"].nodes[\"Set Mesh Normal\"].mode";
+    let e = mesh_of(
+        &scene,
+        "smn_free_corner",
+        1.0,
+        &[(path.to_string(), serde_json::json!("TANGENT_SPACE"))],
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("Set Mesh Normal") && e.contains("Tangent Space"),
+        "{e}"
     );
 }

@@ -367,6 +367,9 @@ impl FieldInput for NormalInput {
     }
     fn evaluate(&self, ctx: &FieldContext, domain: Domain) -> Result<Array, String> {
         match ctx.component {
+            ComponentRef::Mesh(m) if m.free_custom_normals().is_some() => {
+                m.custom_normals_on(domain).unwrap().map(Array::Vector)
+            }
             ComponentRef::Mesh(m) => Ok(Array::Vector(match domain {
                 Domain::Point => m.vertex_normals(),
                 Domain::Face => m.face_normals(),

@@ -198,7 +198,7 @@ impl Mesh {
             }
         }
         if self.face_count() > 0 {
-            m.corner_normals = self.corner_normals();
+            m.corner_normals = self.shading_corner_normals();
         }
         for a in self.attributes.iter() {
             let Some(name) = a.id.name() else { continue };
@@ -269,7 +269,11 @@ impl Mesh {
                 return n.clone();
             }
         }
-        let fnorm = self.face_normals();
+        self.vertex_normals_from(&self.face_normals())
+    }
+
+    /// `normals_calc_verts` from the given face normals.
+    pub fn vertex_normals_from(&self, fnorm: &[V3]) -> Vec<V3> {
         let mut acc = vec![[0.0f32; 3]; self.vertex_count()];
         let mut used = vec![false; self.vertex_count()];
         // Blender sums per vertex over its faces in face order (vert_to_face_map), each
@@ -307,9 +311,110 @@ impl Mesh {
         }
     }
 
-    /// Corner normals as Blender 4.1+ defines them: face normals on flat faces, vertex
-    /// normals where nothing is sharp, and fans split at sharp edges otherwise.
+    /// Free custom normals: Blender 4.5's `custom_normal` attribute as a float vector on
+    /// points, faces or corners (Set Mesh Normal's Free mode). Blender uses the stored
+    /// vectors as they are, unnormalized, as the normals of that domain.
+    pub fn free_custom_normals(&self) -> Option<(Domain, &[V3])> {
+        match self.attributes.named("custom_normal") {
+            Some(Attribute {
+                domain: d @ (Domain::Point | Domain::Face | Domain::Corner),
+                data: Array::Vector(v),
+                ..
+            }) => Some((*d, v.as_slice())),
+            _ => None,
+        }
+    }
+
+    /// The Normal input on `domain` where free custom normals replace Blender's
+    /// (`Mesh::vert_normals`, `face_normals`, `corner_normals`): None without them. Points
+    /// from face or corner custom normals and edges from face or corner ones (Blender's
+    /// angle-weighted mixes) are errors.
+    pub fn custom_normals_on(&self, domain: Domain) -> Option<Result<Vec<V3>, String>> {
+        let (d, n) = self.free_custom_normals()?;
+        let sum_norm = |it: &mut dyn Iterator<Item = V3>| normalize(it.fold([0.0f32; 3], add));
+        Some(match (domain, d) {
+            (Domain::Corner, _) => Ok(self.corner_normals()),
+            (x, y) if x == y => Ok(n.to_vec()),
+            // `mix_normals_vert_to_face` / `mix_normals_corner_to_face`: normalized sums.
+            (Domain::Face, Domain::Point) => Ok((0..self.face_count())
+                .map(|f| {
+                    sum_norm(&mut self.face(f).map(|c| n[self.corner_verts[c] as usize]))
+                })
+                .collect()),
+            (Domain::Face, Domain::Corner) => Ok((0..self.face_count())
+                .map(|f| sum_norm(&mut self.face(f).map(|c| n[c])))
+                .collect()),
+            (Domain::Edge, Domain::Point) => Ok(self
+                .edges
+                .iter()
+                .map(|e| {
+                    let (a, b) = (n[e[0] as usize], n[e[1] as usize]);
+                    normalize([
+                        a[0] * 0.5 + b[0] * 0.5,
+                        a[1] * 0.5 + b[1] * 0.5,
+                        a[2] * 0.5 + b[2] * 0.5,
+                    ])
+                })
+                .collect()),
+            (x, _) if !matches!(x, Domain::Point | Domain::Edge) => {
+                Ok(vec![[0.0; 3]; self.domain_size(x)])
+            }
+            (x, y) => Err(format!(
+                "the Normal input on the {} domain of a mesh with free custom normals on the {} domain is not supported",
+                x.name(),
+                y.name()
+            )),
+        })
+    }
+
+    /// The corner normals Cycles shades the mesh with (`blender/mesh.cpp` `create_mesh`):
+    /// Blender's corner normals, except with free custom normals on points or faces, which
+    /// Cycles reads as vertex normals on smooth faces: point ones as they are; face ones
+    /// mixed to the vertices (`Mesh::vert_normals`: angle-weighted, normalized), and only
+    /// where the mesh has a `sharp_face` attribute (without one every face is flat). Flat
+    /// faces take the true face normal.
+    pub fn shading_corner_normals(&self) -> Vec<V3> {
+        let Some((d, n)) = self
+            .free_custom_normals()
+            .filter(|(d, _)| *d != Domain::Corner)
+        else {
+            return self.corner_normals();
+        };
+        let sharp = match self.attributes.named("sharp_face") {
+            Some(a) if a.domain == Domain::Face => Some(a.data.as_bool().into_owned()),
+            _ => None,
+        };
+        let vn: Vec<V3> = if d == Domain::Point {
+            n.to_vec()
+        } else {
+            self.vertex_normals_from(n)
+        };
+        let smooth = |f: usize| match (&sharp, d) {
+            (Some(s), _) => !s[f],
+            (None, Domain::Point) => true,
+            (None, _) => false,
+        };
+        let mut out = Vec::with_capacity(self.corner_count());
+        for f in 0..self.face_count() {
+            let flat = (!smooth(f)).then(|| self.face_normal(f));
+            for c in self.face(f) {
+                out.push(flat.unwrap_or(vn[self.corner_verts[c] as usize]));
+            }
+        }
+        out
+    }
+
+    /// Corner normals as Blender 4.1+ defines them: free custom normals where the mesh has
+    /// them, else face normals on flat faces, vertex normals where nothing is sharp, and
+    /// fans split at sharp edges otherwise.
     pub fn corner_normals(&self) -> Vec<V3> {
+        if let Some((d, n)) = self.free_custom_normals() {
+            return match d {
+                Domain::Point => self.corner_verts.iter().map(|&v| n[v as usize]).collect(),
+                Domain::Face => self.corner_faces().iter().map(|&f| n[f as usize]).collect(),
+                _ => n.to_vec(),
+            };
+        }
         let sharp_face = self.sharp_faces();
         let sharp_edge = match self.attributes.named("sharp_edge") {
             Some(a) if a.domain == Domain::Edge => a.data.as_bool().into_owned(),

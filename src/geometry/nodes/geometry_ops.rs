@@ -282,6 +282,22 @@ pub fn set_shade_smooth(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         if n == 0 {
             return Ok(());
         }
+        // `try_removing_sharp_attribute`: constant inputs either change nothing (nothing
+        // selected) or, all smooth, remove the attribute rather than store falses (Cycles
+        // tells the two apart: see `Mesh::shading_corner_normals`).
+        if let (Some(sel), Some(smooth)) = (sel.as_constant(), smooth.as_constant()) {
+            if !sel.as_bool() {
+                return Ok(());
+            }
+            if smooth.as_bool() {
+                drop(m);
+                s.mesh_mut()
+                    .unwrap()
+                    .attributes
+                    .remove(&AttrId::named(name));
+                return Ok(());
+            }
+        }
         let r = eval_fields(
             ComponentRef::Mesh(&m),
             domain,

@@ -78,14 +78,17 @@ pub mod reverse_curve;
 pub mod rotation;
 pub mod sample_curve;
 pub mod sample_nearest;
+pub mod sample_uv_surface;
 pub mod scale_elements;
 pub mod separate_components;
 pub mod set_geometry_name;
+pub mod set_mesh_normal;
 pub mod set_spline_type;
 pub mod shortest_edge_paths;
 pub mod simulation_zone;
 pub mod sort_elements;
 pub mod split_edges;
+pub mod split_to_instances;
 pub mod string;
 pub mod subdivide;
 pub mod subdivide_curve;
@@ -143,6 +146,10 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ("GeometryNodeJoinGeometry", geometry_ops::join),
     ("GeometryNodeSetMaterial", geometry_ops::set_material),
     ("GeometryNodeSetShadeSmooth", geometry_ops::set_shade_smooth),
+    (
+        "GeometryNodeSetMeshNormal",
+        set_mesh_normal::set_mesh_normal,
+    ),
     ("GeometryNodeMeshGrid", primitives::grid),
     ("GeometryNodeMeshCube", primitives::cube),
     ("GeometryNodeMeshUVSphere", primitives::uv_sphere),
@@ -269,6 +276,10 @@ pub const NODES: &[(&str, Evaluate)] = &[
         sample_nearest::sample_nearest_surface,
     ),
     ("GeometryNodeSampleNearest", sample_nearest::sample_nearest),
+    (
+        "GeometryNodeSampleUVSurface",
+        sample_uv_surface::sample_uv_surface,
+    ),
     ("ShaderNodeTexVoronoi", texture::voronoi),
     ("ShaderNodeTexWhiteNoise", texture::white_noise_node),
     ("ShaderNodeTexGradient", texture::gradient_node),
@@ -300,6 +311,10 @@ pub const NODES: &[(&str, Evaluate)] = &[
         collection_info::collection_info,
     ),
     ("GeometryNodeSplitEdges", split_edges::split_edges),
+    (
+        "GeometryNodeSplitToInstances",
+        split_to_instances::split_to_instances,
+    ),
     ("GeometryNodeAttributeDomainSize", domain_size::domain_size),
     ("GeometryNodeInputShadeSmooth", is_smooth::is_face_smooth),
     ("GeometryNodeInputEdgeSmooth", is_smooth::is_edge_smooth),
