@@ -11,6 +11,7 @@ use crate::nodes::mix::MixBlend;
 use crate::nodes::ramp::{band_from_json, RampTable};
 use crate::scene::{Scene, Socket};
 
+use super::bump::BumpPoint;
 use super::bump_graph::{self, Schedule, Step};
 use super::program::{AovWrite, BsdfNode, Closure, Kind, Op, Program, Slot};
 
@@ -126,6 +127,7 @@ fn empty_surface() -> Program {
         displacement: None,
         emission_estimate: [0.0; 3],
         aovs: Vec::new(),
+        reads_differentials: false,
         volume: None,
         volume_varying: false,
     }
@@ -507,6 +509,15 @@ impl<'g, 'a> Compiler<'g, 'a> {
         for b in &mut self.bsdfs {
             b.index_sockets();
         }
+        let reads_differentials = self.ops.iter().any(|op| {
+            matches!(
+                op,
+                Op::BumpPoint {
+                    point: BumpPoint::Dx | BumpPoint::Dy,
+                    ..
+                }
+            )
+        });
         Ok(Program {
             ops: self.ops,
             initial: self.initial,
@@ -522,6 +533,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
             displacement: self.displacement,
             emission_estimate,
             aovs: self.aovs,
+            reads_differentials,
         })
     }
 

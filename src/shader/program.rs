@@ -625,6 +625,10 @@ pub struct Program {
     /// The AOV Outputs Cycles runs (naming a valid AOV of the view layer): after `run`
     /// their values are in the stack, for the renderer's AOV passes.
     pub aovs: Vec<AovWrite>,
+    /// Some op moves the shading point to a Bump's dx/dy copy, the only reader of the
+    /// Generated, UV and attribute differentials: without one the renderer skips them,
+    /// as Cycles' SVM computes them only for the nodes that ask.
+    pub reads_differentials: bool,
 }
 
 /// An AOV Output node: the view-layer AOV it writes (index into the exported list) and

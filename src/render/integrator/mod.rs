@@ -1231,13 +1231,6 @@ impl Scene<'_> {
         let m = &inst.mesh;
         let c = m.triangles[r.tri as usize].map(|c| c as usize);
         let (to_world, to_object) = inst.pose_at(hit.time);
-        let tri = &inst.posed_triangle(&self.geo.tris[prim as usize], r.tri, &to_world);
-        // Seen from the back, Cycles flips dPdu and dPdv with the normals, so every
-        // attribute differential (and the bump read from them) turns over too.
-        let (mut dpdu, mut dpdv) = (sub(tri[1], tri[0]), sub(tri[2], tri[0]));
-        if hit.backfacing {
-            (dpdu, dpdv) = (neg(dpdu), neg(dpdv));
-        }
         let sp = &mut hit.sp;
         sp.ng = hit.ng;
         sp.backfacing = hit.backfacing;
@@ -1248,6 +1241,22 @@ impl Scene<'_> {
         let (dx, dy) = differential_from_compact(hit.ng, dp);
         sp.dp_dx = dx;
         sp.dp_dy = dy;
+        // Only a Bump's dx/dy copies read the attribute differentials (and the displacement
+        // bump the undisplaced ones): elsewhere they stay zero and unread.
+        let reads = hit
+            .material
+            .and_then(|mi| self.materials[mi].program.as_ref())
+            .is_some_and(|p| p.reads_differentials);
+        if !reads && sp.undisplaced.is_none() {
+            return;
+        }
+        let tri = &inst.posed_triangle(&self.geo.tris[prim as usize], r.tri, &to_world);
+        // Seen from the back, Cycles flips dPdu and dPdv with the normals, so every
+        // attribute differential (and the bump read from them) turns over too.
+        let (mut dpdu, mut dpdv) = (sub(tri[1], tri[0]), sub(tri[2], tri[0]));
+        if hit.backfacing {
+            (dpdu, dpdv) = (neg(dpdu), neg(dpdv));
+        }
         let d = differential_dudv(dpdu, dpdv, [dx, dy], hit.ng);
         let lp = match &inst.undisplaced {
             Some(u) => c.map(|c| u[m.corner_verts[c] as usize]),
@@ -1259,6 +1268,9 @@ impl Scene<'_> {
             let w = lp.map(|l| to_world.point(l));
             und.dp_dx = attribute_differential(w, d[0]);
             und.dp_dy = attribute_differential(w, d[1]);
+        }
+        if !reads {
+            return;
         }
         let generated = lp.map(|l| inst.generated(l));
         sp.generated_dx = attribute_differential(generated, d[0]);
