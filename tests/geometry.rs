@@ -1426,6 +1426,9 @@ fn camera_info_focus_on_a_bone_is_refused_by_name() {
     assert!(
         err.contains("GeometryNodeCameraInfo") && err.contains("\"Head\""),
         "{err}"
+    );
+}
+
 /// Set Mesh Normal: the corner normals blendsynth renders a Geometry Nodes mesh with
 /// (`Mesh::corner_normals`, what `to_scene` hands the renderer) are Blender's evaluated
 /// corner normals (the export's per-corner normals): Free custom normals on points, faces
