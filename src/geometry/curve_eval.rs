@@ -138,20 +138,14 @@ impl Evaluated {
                     (Kind::Bezier(offs), count)
                 }
                 CURVE_TYPE_CATMULL_ROM => {
-                    // `catmull_rom::calculate_evaluated_num`: `resolution` points per
-                    // segment, plus the last control point of an open curve.
+                    // Checked before allocating: a hostile resolution is an error.
                     let r = res[i].max(1) as usize;
                     let segments = if cyclic[i] { n } else { n.saturating_sub(1) };
                     super::limits::check(
                         super::limits::product(&[r as u64, segments as u64]),
                         "the Catmull-Rom curve's resolution",
                     )?;
-                    let count = match (n, cyclic[i]) {
-                        (0, _) => 0,
-                        (_, true) => (r * segments).max(1),
-                        (_, false) => r * segments + 1,
-                    };
-                    (Kind::CatmullRom(r), count)
+                    (Kind::CatmullRom(r), catmull_rom_count(n, cyclic[i], r))
                 }
                 CURVE_TYPE_NURBS => {
                     let basis = Basis::new(n, orders[i], cyclic[i], res[i], knots_modes[i] as i8)
@@ -394,6 +388,16 @@ fn checked_normal_modes(c: &Curves) -> Result<Vec<i8>, String> {
     Ok(modes)
 }
 
+/// `catmull_rom::calculate_evaluated_num`: `resolution` points per segment, plus the last
+/// control point of an open curve (at least one point for a cyclic curve with points).
+fn catmull_rom_count(points: usize, cyclic: bool, resolution: usize) -> usize {
+    match (points, cyclic) {
+        (0, _) => 0,
+        (_, true) => (resolution * points).max(1),
+        (_, false) => resolution * (points - 1) + 1,
+    }
+}
+
 /// `catmull_rom::calculate_basis`: the uniform Catmull-Rom weights, twice their value.
 fn catmull_rom_basis(t: f32) -> [f32; 4] {
     let s = 1.0 - t;
@@ -508,12 +512,7 @@ fn catmull_rom_segments<T: Copy>(
 /// One curve's control values on its Catmull-Rom evaluated points, mixed as Blender's
 /// `mix4` mixes each type; `None` for types it does not mix here.
 fn catmull_rom_array(src: &Array, cyclic: bool, resolution: usize) -> Option<Array> {
-    let n = src.len();
-    let count = match (n, cyclic) {
-        (0, _) => 0,
-        (_, true) => (resolution * n).max(1),
-        (_, false) => resolution * (n - 1) + 1,
-    };
+    let count = catmull_rom_count(src.len(), cyclic, resolution);
     catmull_rom_array_segments(src, cyclic, count, &|s| {
         s * resolution..(s + 1) * resolution
     })
