@@ -1730,6 +1730,20 @@ fn depth_of_field_focus_on_a_bone_is_refused_by_name() {
     );
 }
 
+/// A scene whose timeline markers switch the active camera (Blender renders each frame
+/// with the marker's camera) is refused by name, the same from `render::check` (what
+/// `inspect` runs) as from `render`, never rendered with the exported camera.
+#[test]
+fn camera_switching_at_markers_is_refused_by_name() {
+    let (dir, base) = fixture_json("dof_focus_object");
+    refused_alike(
+        &dir,
+        &base,
+        &|j| j["scene"]["camera_markers"] = serde_json::json!([{"frame": 10, "camera": "Camera"}]),
+        &["timeline markers", "\"Camera\"", "camera switching"],
+    );
+}
+
 /// Volume features blendsynth does not render are errors naming the object, material or
 /// node, the same from `render::check` (what `inspect` runs) as from `render`: a phase
 /// function other than Henyey-Greenstein and Rayleigh (in a material or the world's Volume), a fluid (smoke)

@@ -79,6 +79,20 @@ pub struct CameraMarker {
     pub camera: String,
 }
 
+impl SceneSettings {
+    /// Why the active camera is not `camera` at every frame: Blender switches it at
+    /// timeline markers bound to cameras, which blendsynth does not follow.
+    pub fn camera_switching(&self) -> Option<String> {
+        self.camera_markers.first().map(|m| {
+            format!(
+                "the scene switches its active camera at timeline markers (frame {} binds {:?}); \
+                 blendsynth does not follow camera switching",
+                m.frame, m.camera
+            )
+        })
+    }
+}
+
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct SceneSettings {
     pub name: String,

@@ -9,12 +9,8 @@ use super::super::value::SocketValue;
 
 pub fn active_camera(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let s = &ctx.session().scene.file.scene;
-    if let Some(m) = s.camera_markers.first() {
-        return Err(ctx.err(format!(
-            "the scene switches its active camera at timeline markers (frame {} binds {:?}); \
-             blendsynth does not follow camera switching",
-            m.frame, m.camera
-        )));
+    if let Some(why) = s.camera_switching() {
+        return Err(ctx.err(why));
     }
     Ok(Outputs::from([(
         "Active Camera".to_string(),

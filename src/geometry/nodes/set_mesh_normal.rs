@@ -46,13 +46,12 @@ pub fn set_mesh_normal(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
                     ("sharp_edge", Domain::Edge, &e[0]),
                     ("sharp_face", Domain::Face, &f[0]),
                 ] {
+                    // All false: no attribute, as Blender stores it.
                     let id = AttrId::named(name);
+                    mm.attributes.remove(&id);
                     if values.as_bool().iter().any(|b| *b) {
-                        mm.attributes.remove(&id);
                         mm.attributes
                             .set(id, domain, Array::Bool(values.as_bool().into_owned()));
-                    } else {
-                        mm.attributes.remove(&id);
                     }
                 }
                 if remove_custom {

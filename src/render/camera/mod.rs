@@ -45,6 +45,10 @@ impl Camera {
         width: u32,
         height: u32,
     ) -> Result<Camera, RenderError> {
+        // The exported camera is the active one only without marker switching.
+        if let Some(why) = scene.file.scene.camera_switching() {
+            return Err(RenderError(why));
+        }
         let cam_name = scene.file.scene.camera.as_deref().ok_or_else(|| {
             RenderError("the scene has no active camera (scene.camera is empty)".into())
         })?;
