@@ -228,11 +228,79 @@ fn load_shared(
 
 /// Reads and decodes an image file, whatever its format; errors name the file.
 pub fn decode(path: &Path) -> Result<image::DynamicImage, String> {
-    image::ImageReader::open(path)
+    let reader = image::ImageReader::open(path)
         .and_then(|r| r.with_guessed_format())
-        .map_err(|e| format!("cannot read {}: {e}", path.display()))?
-        .decode()
-        .map_err(|e| format!("cannot decode {}: {e}", path.display()))
+        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let tiff = reader.format() == Some(image::ImageFormat::Tiff);
+    match reader.decode() {
+        Ok(img) => Ok(img),
+        // The image crate reads TIFF's 8- and 16-bit and float RGB(A) only; Blender (OIIO)
+        // also reads grey and grey-alpha floats and 32-bit integers, as floats.
+        Err(e) if tiff => decode_tiff_as_float(path)
+            .map_err(|t| format!("cannot decode {}: {e} ({t})", path.display())),
+        Err(e) => Err(format!("cannot decode {}: {e}", path.display())),
+    }
+}
+
+/// A TIFF the image crate refuses, as RGBA floats: integers normalised to 0..1 (signed ones
+/// to -1..1), grey spread to RGB, alpha 1 where there is none.
+fn decode_tiff_as_float(path: &Path) -> Result<image::DynamicImage, String> {
+    use tiff::decoder::{Decoder, DecodingResult as R};
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let mut d = Decoder::new(std::io::BufReader::new(file)).map_err(|e| e.to_string())?;
+    let (w, h) = d.dimensions().map_err(|e| e.to_string())?;
+    let channels = match d.colortype().map_err(|e| e.to_string())? {
+        tiff::ColorType::Gray(_) => 1,
+        tiff::ColorType::GrayA(_) => 2,
+        tiff::ColorType::RGB(_) => 3,
+        tiff::ColorType::RGBA(_) => 4,
+        // Grey with an extra sample (the tiff crate's name for grey + alpha it does not
+        // recognise), read as OIIO reads it: grey and alpha.
+        tiff::ColorType::Multiband { num_samples: 2, .. } => 2,
+        other => return Err(format!("TIFF colour type {other:?} is not read")),
+    };
+    let v: Vec<f32> = match d.read_image().map_err(|e| e.to_string())? {
+        R::U8(v) => v.iter().map(|&x| x as f32 / u8::MAX as f32).collect(),
+        R::U16(v) => v.iter().map(|&x| x as f32 / u16::MAX as f32).collect(),
+        R::U32(v) => v
+            .iter()
+            .map(|&x| (x as f64 / u32::MAX as f64) as f32)
+            .collect(),
+        R::U64(v) => v
+            .iter()
+            .map(|&x| (x as f64 / u64::MAX as f64) as f32)
+            .collect(),
+        R::I8(v) => v.iter().map(|&x| x as f32 / i8::MAX as f32).collect(),
+        R::I16(v) => v.iter().map(|&x| x as f32 / i16::MAX as f32).collect(),
+        R::I32(v) => v
+            .iter()
+            .map(|&x| (x as f64 / i32::MAX as f64) as f32)
+            .collect(),
+        R::I64(v) => v
+            .iter()
+            .map(|&x| (x as f64 / i64::MAX as f64) as f32)
+            .collect(),
+        R::F16(v) => v.iter().map(|x| x.to_f32()).collect(),
+        R::F32(v) => v,
+        R::F64(v) => v.iter().map(|&x| x as f32).collect(),
+    };
+    let n = w as usize * h as usize;
+    if v.len() < n * channels {
+        return Err(format!("{} samples for {w}x{h}x{channels}", v.len()));
+    }
+    let mut rgba = Vec::with_capacity(n * 4);
+    for p in v.chunks_exact(channels).take(n) {
+        rgba.extend_from_slice(&match *p {
+            [g] => [g, g, g, 1.0],
+            [g, a] => [g, g, g, a],
+            [r, g, b] => [r, g, b, 1.0],
+            [r, g, b, a] => [r, g, b, a],
+            _ => unreachable!("1 to 4 channels"),
+        });
+    }
+    image::Rgba32FImage::from_raw(w, h, rgba)
+        .map(image::DynamicImage::ImageRgba32F)
+        .ok_or_else(|| "buffer size".to_string())
 }
 
 /// `w` x `h` pixels reordered from the file's top-row-first to Blender's and Cycles'
