@@ -253,6 +253,10 @@ const ASSERTED: &[&str] = &[
     // its map.
     "world_visibility",
     "world_visibility_map",
+    // Colours and values linked into shader sockets become Emission (Cycles'
+    // ShaderGraph::connect), in a material and in a world group; the world shows camera rays
+    // another colour through Light Path > Is Camera Ray, which a world reads from the ray.
+    "shader_socket_values",
     // An area light marked as a portal emits nothing.
     "light_portal",
     // The published colon's two stacked bumps (the displacement's and a Bump node on it) on

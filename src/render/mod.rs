@@ -1076,15 +1076,17 @@ fn light_select(
 
 /// Whether Cycles light-samples a material's emitting triangles (Shader::estimate_emission):
 /// never when its emission estimate is zero; with "Auto" only when the estimate's largest
-/// channel exceeds 0.5 (weaker emitters are found by BSDF rays alone).
+/// channel exceeds 0.5 (weaker emitters are found by BSDF rays alone), a tenth of it for a
+/// colour linked straight into the Surface.
 fn light_sampled(p: &crate::shader::program::Program, sampling: &str) -> bool {
     let e = p.emission_estimate;
     if e.iter().all(|&x| x == 0.0) {
         return false;
     }
+    let scale = if p.surface_from_value { 0.1 } else { 1.0 };
     match sampling {
         "NONE" => false,
-        "AUTO" => e.iter().any(|x| x.abs() > 0.5),
+        "AUTO" => e.iter().any(|x| (x * scale).abs() > 0.5),
         _ => true,
     }
 }

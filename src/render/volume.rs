@@ -1532,7 +1532,12 @@ impl Scene<'_> {
                 if is_zero(tr) {
                     return None;
                 }
-                let le = self.background_toward(wi, scratch);
+                // The Emission flag alone and the path's bounces, as for a surface.
+                let state = crate::shader::point::PathState {
+                    flags: 0,
+                    ..path.state
+                };
+                let le = self.background_toward(wi, state, scratch);
                 let w = super::integrator::power_heuristic(pdf_l, pdf_b);
                 mul(scale(mul(throughput, le), f * w / pdf_l), tr)
             }

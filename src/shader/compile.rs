@@ -126,6 +126,7 @@ fn empty_surface() -> Program {
         attributes: Vec::new(),
         displacement: None,
         emission_estimate: [0.0; 3],
+        surface_from_value: false,
         aovs: Vec::new(),
         reads_differentials: false,
         volume: None,
@@ -165,6 +166,8 @@ struct Compiler<'g, 'a> {
     values: Vec<Vec<Option<(Slot, Kind)>>>,
     /// Per flat node: the closure its (single) shader output makes.
     closure_of: Vec<Option<u32>>,
+    /// The Emissions made of values linked into shader sockets (`closure_input`).
+    value_emissions: Vec<u32>,
     surface: Option<u32>,
     volume: Option<u32>,
     bsdfs: Vec<BsdfNode>,
@@ -296,6 +299,7 @@ impl<'g, 'a> Compiler<'g, 'a> {
             closures: Vec::new(),
             values: vec![Vec::new(); g.nodes.len()],
             closure_of: vec![None; g.nodes.len()],
+            value_emissions: Vec::new(),
             surface: None,
             volume: None,
             bsdfs: Vec::new(),
@@ -462,17 +466,42 @@ impl<'g, 'a> Compiler<'g, 'a> {
         dst
     }
 
-    fn closure_input(&self, n: &FlatNode, id: &str) -> Result<Option<u32>, CompileError> {
-        match n.input(id).and_then(|i| i.sources.first()) {
-            Some(Source::Link { node, .. }) => match self.closure_of[*node] {
-                Some(c) => Ok(Some(c)),
-                None => Err(CompileError(format!(
-                    "node {:?}: input {id:?} is linked to a non-shader output",
+    /// The closure feeding shader socket `id` of node `n`. A colour, vector or value there
+    /// (linked, or a group socket's unlinked default) becomes an Emission, as Cycles'
+    /// `ShaderGraph::connect` converts it: a value sets the Strength (Color white), anything
+    /// else the Color (Strength 1).
+    fn closure_input(&mut self, n: &FlatNode<'a>, id: &str) -> Result<Option<u32>, CompileError> {
+        let value_kind = match n.input(id).and_then(|i| i.sources.first()) {
+            Some(Source::Link { node, .. }) if self.closure_of[*node].is_some() => {
+                return Ok(self.closure_of[*node]);
+            }
+            Some(Source::Link { kind, .. }) => kind_of(kind).ok_or_else(|| {
+                CompileError(format!(
+                    "node {:?}: input {id:?} is linked to a {kind} output, which Cycles cannot make a shader of",
                     n.path
-                ))),
+                ))
+            })?,
+            Some(Source::Default(sock)) => match kind_of(&sock.kind) {
+                Some(k) if sock.default_value.is_some() => k,
+                _ => return Ok(None),
             },
-            _ => Ok(None),
-        }
+            _ => return Ok(None),
+        };
+        let (color, strength) = if value_kind == Kind::Float {
+            (
+                self.constant(Kind::Color, [1.0; 3]),
+                self.input(n, id, Kind::Float)?,
+            )
+        } else {
+            (
+                self.input(n, id, Kind::Color)?,
+                self.constant(Kind::Float, [1.0; 3]),
+            )
+        };
+        self.closures.push(Closure::Emission { color, strength });
+        let c = self.closures.len() as u32 - 1;
+        self.value_emissions.push(c);
+        Ok(Some(c))
     }
 
     fn outputs(&mut self, i: usize, n: &FlatNode, slots: &[(&str, Slot, Kind)]) {
@@ -532,6 +561,9 @@ impl<'g, 'a> Compiler<'g, 'a> {
             attributes: self.attributes,
             displacement: self.displacement,
             emission_estimate,
+            surface_from_value: self
+                .surface
+                .is_some_and(|s| self.value_emissions.contains(&s)),
             aovs: self.aovs,
             reads_differentials,
         })
@@ -977,9 +1009,15 @@ pub fn compile_light(
 /// A world shading point for direction `d` (unit, world space), as Cycles sets up the
 /// background: position, Generated and Object coordinates are the direction, the
 /// normal faces back along the ray, no UV.
-pub fn world_point(d: crate::nodes::math::Vec3) -> super::point::ShadingPoint {
+/// The shading point of the world seen along direction `d`, by a ray in `path` (Light Path
+/// reads it: Cycles evaluates the background with the ray's flags plus Emission).
+pub fn world_point(
+    d: crate::nodes::math::Vec3,
+    path: super::point::PathState,
+) -> super::point::ShadingPoint {
     let n = [-d[0], -d[1], -d[2]];
     super::point::ShadingPoint {
+        path,
         position: d,
         normal: n,
         object_position: d,

@@ -149,6 +149,17 @@ pub struct PathState {
 }
 
 impl PathState {
+    /// An emitter evaluated for light sampling, outside any path (Cycles' bake of the
+    /// world's importance map).
+    pub const EMISSION: PathState = PathState {
+        flags: ray::EMISSION,
+        bounce: 0,
+        diffuse: 0,
+        glossy: 0,
+        transmission: 0,
+        transparent: 0,
+    };
+
     /// A camera ray, as Cycles' EMIT bake and camera rays start.
     pub const CAMERA: PathState = PathState {
         flags: ray::CAMERA,

@@ -622,6 +622,11 @@ pub struct Program {
     /// Cycles' emission estimate of the surface (Shader::estimate_emission): zero means
     /// the material never emits; its size decides whether emitters are light-sampled.
     pub emission_estimate: [f32; 3],
+    /// The Surface is a colour or value linked straight into the output, which Cycles
+    /// makes an Emission of and, as likely a preview, light-samples under Auto emission
+    /// sampling only when a tenth of its estimate passes the threshold
+    /// (Shader::estimate_emission).
+    pub surface_from_value: bool,
     /// The AOV Outputs Cycles runs (naming a valid AOV of the view layer): after `run`
     /// their values are in the stack, for the renderer's AOV passes.
     pub aovs: Vec<AovWrite>,

@@ -693,7 +693,13 @@ impl Scene<'_> {
         }
         let d = path.d;
         let w = self.world_mis_weight(d, path.prev_singular, path.prev_pdf, path.mis_viewer());
-        let bg = scale(mul(path.throughput, self.background_toward(d, scratch)), w);
+        let bg = scale(
+            mul(
+                path.throughput,
+                self.background_toward(d, path.state, scratch),
+            ),
+            w,
+        );
         // The world's AOV Outputs, run with it (Cycles evaluates the background shader
         // with the render buffer).
         if path.transparent_bg && !scratch.aov_done {
@@ -1015,9 +1021,15 @@ fn filter_glossy(lobes: &mut LobeSet, min_ray_pdf: f32, filter_glossy: f32) {
 impl Scene<'_> {
     /// Radiance from the world along a ray leaving the scene in direction `d`. The world
     /// program runs on the scratch's spare stack (the one after the materials').
-    pub fn background_toward(&self, d: V3, scratch: &mut Scratch) -> V3 {
+    /// The world's radiance toward `d` for a ray in `path` (its flags with Emission added,
+    /// as Cycles evaluates the background).
+    pub fn background_toward(&self, d: V3, path: PathState, scratch: &mut Scratch) -> V3 {
+        let path = PathState {
+            flags: path.flags | ray::EMISSION,
+            ..path
+        };
         match (self.world, scratch.stacks.last_mut()) {
-            (Some(w), Some(stack)) => w.eval(d, stack),
+            (Some(w), Some(stack)) => w.eval(d, path, stack),
             _ => self.background,
         }
     }
@@ -1068,7 +1080,13 @@ impl Scene<'_> {
         if is_zero(tr) {
             return [0.0; 3];
         }
-        let le = self.background_toward(wi, scratch);
+        // A light sample sees the world with the Emission flag alone and the shading
+        // point's bounces (Cycles' light_sample_shader_eval).
+        let path = PathState {
+            flags: 0,
+            ..hit.sp.path
+        };
+        let le = self.background_toward(wi, path, scratch);
         mul(scale(mul(f, le), power_heuristic(pdf_l, pdf_b) / pdf_l), tr)
     }
 

@@ -9,6 +9,7 @@ use crate::nodes::sky::SunGuide;
 use crate::render::math::{add, len, normalize, sub, V3};
 use crate::render::RenderError;
 use crate::scene::Scene;
+use crate::shader::point::PathState;
 
 pub fn background(scene: &Scene) -> Result<V3, RenderError> {
     let Some(name) = scene.file.scene.world.as_deref() else {
@@ -110,14 +111,15 @@ pub struct WorldShader {
 
 impl WorldShader {
     /// Radiance arriving along `-d` from the world (`d`: the ray's unit direction), as
-    /// Cycles shades the background with the ray direction as position.
-    pub fn eval(&self, d: V3, stack: &mut Vec<f32>) -> V3 {
+    /// Cycles shades the background with the ray direction as position, for a ray in
+    /// `path` (its flags must include Emission, as Cycles adds it).
+    pub fn eval(&self, d: V3, path: PathState, stack: &mut Vec<f32>) -> V3 {
         let p = &self.program;
         if stack.len() != p.initial.len() {
             stack.clear();
             stack.extend_from_slice(&p.initial);
         }
-        p.run(&crate::shader::compile::world_point(d), stack);
+        p.run(&crate::shader::compile::world_point(d, path), stack);
         p.surface_emission(stack)
     }
 }
@@ -258,7 +260,8 @@ impl WorldMap {
             for i in 0..w {
                 let (d, st) =
                     equirect_direction((i as f32 + 0.5) / w as f32, (j as f32 + 0.5) / h as f32);
-                let c = shader.eval(d, &mut stack);
+                // Cycles bakes its map with the Emission flag alone (shader_eval_background).
+                let c = shader.eval(d, PathState::EMISSION, &mut stack);
                 // Cycles weighs each cell by the mean of its channels' magnitudes
                 // (background_cdf's `average(fabs(color))`), not by luminance.
                 let mean = (c[0].abs() + c[1].abs() + c[2].abs()) / 3.0;
