@@ -715,3 +715,64 @@ pub fn interpolate_curves(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     out.insert("Curves".into(), SocketValue::Geometry(set));
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::mesh::Mesh;
+    use crate::geometry::pointcloud::PointCloud;
+
+    fn guides() -> Curves {
+        let mut g = Curves {
+            positions: vec![[0.0; 3], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [1.0, 0.0, 1.0]],
+            curve_offsets: vec![0, 2, 4],
+            ..Default::default()
+        };
+        g.attributes.set(
+            AttrId::named("turn"),
+            Domain::Point,
+            Array::Quaternion(vec![[1.0, 0.0, 0.0, 0.0]; 4]),
+        );
+        g
+    }
+
+    fn run(g: &Curves, points: PointsRef) -> Result<Curves, String> {
+        let n = points.positions().len();
+        let inp = Inputs {
+            guides: g,
+            points,
+            guide_up: vec![[0.0; 3]; 2],
+            point_up: vec![[0.0; 3]; n],
+            guide_group: vec![0; 2],
+            point_group: vec![0; n],
+            max: 4,
+        };
+        interpolate(&inp, (&None, &None))
+    }
+
+    /// A guide attribute of a type Blender mixes in ways not modelled here, and a mesh's
+    /// non-point attribute Blender would copy by index, are errors naming them.
+    #[test]
+    fn unmodelled_attributes_are_refused_by_name() {
+        let cloud = PointCloud {
+            positions: vec![[0.5, 0.0, 0.0]],
+            ..Default::default()
+        };
+        let e = run(&guides(), PointsRef::Cloud(&cloud)).unwrap_err();
+        assert!(e.contains("turn") && e.contains("QUATERNION"), "{e}");
+        let mut g = guides();
+        g.attributes.remove(&AttrId::named("turn"));
+        let c = run(&g, PointsRef::Cloud(&cloud)).unwrap();
+        // Equidistant guides: the child is their mean shape, rooted at its point.
+        assert_eq!(c.positions, vec![[0.5, 0.0, 0.0], [0.5, 0.0, 1.0]]);
+        let mut m = Mesh::new();
+        m.positions = vec![[0.5, 0.0, 0.0]];
+        m.attributes.set(
+            AttrId::named("face_value"),
+            Domain::Face,
+            Array::Float(vec![]),
+        );
+        let e = run(&g, PointsRef::Mesh(&m)).unwrap_err();
+        assert!(e.contains("face_value") && e.contains("FACE"), "{e}");
+    }
+}
