@@ -12,7 +12,7 @@ use super::curves::{
 };
 use super::math::{add, cross, dot, length, normalize, scale, sub, V3};
 use super::nurbs::Basis;
-use super::types::{Array, Domain};
+use super::types::{Array, Domain, Value};
 
 /// Blender's `NormalMode` values as stored in the `normal_mode` curve attribute.
 pub const NORMAL_MODE_MINIMUM_TWIST: i8 = 0;
@@ -511,7 +511,7 @@ fn catmull_rom_segments<T: Copy>(
 
 /// One curve's control values on its Catmull-Rom evaluated points, mixed as Blender's
 /// `mix4` mixes each type; `None` for types it does not mix here.
-fn catmull_rom_array(src: &Array, cyclic: bool, resolution: usize) -> Option<Array> {
+pub fn catmull_rom_array(src: &Array, cyclic: bool, resolution: usize) -> Option<Array> {
     let count = catmull_rom_count(src.len(), cyclic, resolution);
     catmull_rom_array_segments(src, cyclic, count, &|s| {
         s * resolution..(s + 1) * resolution
@@ -569,6 +569,52 @@ pub fn catmull_rom_array_segments(
             let f = |b: &bool| *b as u8 as f32;
             w[0] * f(x[0]) + w[1] * f(x[1]) + w[2] * f(x[2]) + w[3] * f(x[3]) >= 0.5
         })),
+        _ => return None,
+    })
+}
+
+/// `catmull_rom::interpolate` of the values at `idx` (previous, start, end, next) at `t`
+/// (as Trim Curve inserts a point on a Catmull-Rom segment), mixed per type as
+/// `catmull_rom_array` mixes them; `None` for types Blender's mixers do not take here.
+pub fn catmull_rom_sample(src: &Array, idx: [usize; 4], t: f32) -> Option<Value> {
+    let w = catmull_rom_basis(t);
+    let h = w.map(|x| x * 0.5);
+    Some(match src {
+        Array::Float(v) => {
+            let x = idx.map(|i| v[i]);
+            Value::Float(0.5 * (w[0] * x[0] + w[1] * x[1] + w[2] * x[2] + w[3] * x[3]))
+        }
+        Array::Float2(v) => {
+            let x = idx.map(|i| v[i]);
+            Value::Float2(
+                [0, 1].map(|k| {
+                    0.5 * (w[0] * x[0][k] + w[1] * x[1][k] + w[2] * x[2][k] + w[3] * x[3][k])
+                }),
+            )
+        }
+        Array::Vector(v) => {
+            let x = idx.map(|i| &v[i]);
+            Value::Vector(mix_vector(x, t))
+        }
+        Array::Color(v) => {
+            let x = idx.map(|i| v[i]);
+            Value::Color(
+                [0, 1, 2, 3]
+                    .map(|k| x[0][k] * h[0] + x[1][k] * h[1] + x[2][k] * h[2] + x[3][k] * h[3]),
+            )
+        }
+        Array::Int(v) => {
+            let x = idx.map(|i| v[i] as f32);
+            Value::Int((h[0] * x[0] + h[1] * x[1] + h[2] * x[2] + h[3] * x[3]).round() as i32)
+        }
+        Array::Int8(v) => {
+            let x = idx.map(|i| v[i] as f32);
+            Value::Int8((h[0] * x[0] + h[1] * x[1] + h[2] * x[2] + h[3] * x[3]).round() as i8)
+        }
+        Array::Bool(v) => {
+            let x = idx.map(|i| v[i] as u8 as f32);
+            Value::Bool(h[0] * x[0] + h[1] * x[1] + h[2] * x[2] + h[3] * x[3] >= 0.5)
+        }
         _ => return None,
     })
 }

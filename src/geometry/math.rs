@@ -40,7 +40,11 @@ pub fn normalize_v3(a: V3) -> (V3, f32) {
 /// `axis_angle_normalized_to_mat3`: rotation by `angle` about the unit `axis`, with
 /// Blender's operation order (Screw's steps, Fillet Curve's arcs).
 pub fn axis_angle_normalized_to_mat3(axis: V3, angle: f32) -> Mat3f {
-    let (s, c) = (angle.sin(), angle.cos());
+    axis_angle_normalized_to_mat3_ex(axis, angle.sin(), angle.cos())
+}
+
+/// `axis_angle_normalized_to_mat3_ex`: the rotation from the angle's sine and cosine.
+pub fn axis_angle_normalized_to_mat3_ex(axis: V3, s: f32, c: f32) -> Mat3f {
     let ico = 1.0 - c;
     let nsi = scale(axis, s);
     let n00 = (axis[0] * axis[0]) * ico;
@@ -54,6 +58,51 @@ pub fn axis_angle_normalized_to_mat3(axis: V3, angle: f32) -> Mat3f {
         [n01 - nsi[2], n11 + c, n12 + nsi[0]],
         [n02 + nsi[1], n12 - nsi[0], n22 + c],
     ]
+}
+
+/// `ortho_v3_v3`: a vector perpendicular to `v`, built on its dominant axis.
+pub fn ortho_v3(v: V3) -> V3 {
+    let (x, y, z) = (v[0].abs(), v[1].abs(), v[2].abs());
+    let axis = if x > y {
+        if x > z {
+            0
+        } else {
+            2
+        }
+    } else if y > z {
+        1
+    } else {
+        2
+    };
+    match axis {
+        0 => [-v[1] - v[2], v[0], v[0]],
+        1 => [v[1], -v[0] - v[2], v[1]],
+        _ => [v[2], v[2], -v[0] - v[1]],
+    }
+}
+
+/// `rotation_between_vecs_to_mat3`: the rotation taking unit `v1` to unit `v2` (identity
+/// when they agree, half a turn about a perpendicular when they are opposite).
+pub fn rotation_between_vecs_to_mat3(v1: V3, v2: V3) -> Mat3f {
+    let (axis, sin) = normalize_v3(cross(v1, v2));
+    let cos = dot(v1, v2);
+    if sin > f32::EPSILON {
+        axis_angle_normalized_to_mat3_ex(axis, sin, cos)
+    } else if cos > 0.0 {
+        [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    } else {
+        let (axis, _) = normalize_v3(ortho_v3(v1));
+        axis_angle_normalized_to_mat3_ex(axis, 0.0, -1.0)
+    }
+}
+
+/// `float3x3 * float3`: the columns scaled by the vector's components, summed in order.
+pub fn mat3_mul_v3(m: &Mat3f, v: V3) -> V3 {
+    let mut r = [0.0f32; 3];
+    for i in 0..3 {
+        r[i] = m[0][i] * v[0] + m[1][i] * v[1] + m[2][i] * v[2];
+    }
+    r
 }
 
 pub fn mat4_mul(a: &Mat4f, b: &Mat4f) -> Mat4f {

@@ -39,6 +39,7 @@ pub mod export;
 pub mod field;
 pub mod instances;
 pub mod interpolate;
+pub mod kdtree;
 pub mod legacy_curve;
 pub mod limits;
 pub mod math;

@@ -4,117 +4,16 @@
 //!
 //! Blender searches a balanced `BLI_kdtree_3d` per group; among elements at the same
 //! distance the one it meets first wins, so the tree is rebuilt here in Blender's node
-//! order (`weld::kdtree_balanced_order`) and walked as `BLI_kdtree_3d_find_nearest_cb`
-//! walks it.
+//! order and walked as `BLI_kdtree_3d_find_nearest_cb` walks it (`geometry::kdtree`).
 
 use std::collections::HashMap;
 
 use super::super::error::GeometryError;
 use super::super::eval::{NodeCtx, Outputs};
 use super::super::field::{Field, FieldContext, FieldInput};
+use super::super::kdtree::KdTree;
 use super::super::types::{Array, DataType, Domain};
 use super::super::value::SocketValue;
-use super::super::weld::kdtree_balanced_order;
-
-type V3 = [f32; 3];
-
-/// A balanced kd-tree over some of the points, laid out as Blender's.
-struct KdTree {
-    /// Point index per node.
-    index: Vec<usize>,
-    /// Split axis, left and right child per node (`usize::MAX`: none).
-    axis: Vec<usize>,
-    left: Vec<usize>,
-    right: Vec<usize>,
-    root: usize,
-}
-
-const UNSET: usize = usize::MAX;
-
-impl KdTree {
-    fn new(positions: &[V3], members: Vec<usize>) -> KdTree {
-        let mut index = members;
-        kdtree_balanced_order(positions, &mut index, 0);
-        let n = index.len();
-        let mut t = KdTree {
-            index,
-            axis: vec![0; n],
-            left: vec![UNSET; n],
-            right: vec![UNSET; n],
-            root: UNSET,
-        };
-        t.root = t.link(0, n, 0);
-        t
-    }
-
-    /// `kdtree_balance`'s structure: the median of each slice is its node; a single node
-    /// keeps axis 0.
-    fn link(&mut self, ofs: usize, len: usize, axis: usize) -> usize {
-        if len == 0 {
-            return UNSET;
-        }
-        if len == 1 {
-            return ofs;
-        }
-        let median = len / 2;
-        let node = ofs + median;
-        self.axis[node] = axis;
-        let next = (axis + 1) % 3;
-        self.left[node] = self.link(ofs, median, next);
-        self.right[node] = self.link(node + 1, len - (median + 1), next);
-        node
-    }
-
-    /// The nearest point other than `skip` (`BLI_kdtree_3d_find_nearest_cb` with a filter
-    /// rejecting `skip`), or -1.
-    fn nearest_other(&self, positions: &[V3], co: V3, skip: usize, stack: &mut Vec<usize>) -> i32 {
-        if self.root == UNSET {
-            return -1;
-        }
-        stack.clear();
-        stack.push(self.root);
-        let mut min_dist = f32::MAX;
-        let mut found = -1i32;
-        let test = |node: usize, min_dist: &mut f32, found: &mut i32| {
-            let p = positions[self.index[node]];
-            let mut d = 0.0f32;
-            for k in 0..3 {
-                let x = p[k] - co[k];
-                d += x * x;
-            }
-            if d < *min_dist && self.index[node] != skip {
-                *min_dist = d;
-                *found = self.index[node] as i32;
-            }
-        };
-        while let Some(node) = stack.pop() {
-            let a = self.axis[node];
-            let cur = positions[self.index[node]][a] - co[a];
-            if cur < 0.0 {
-                if cur * cur < min_dist {
-                    test(node, &mut min_dist, &mut found);
-                    if self.left[node] != UNSET {
-                        stack.push(self.left[node]);
-                    }
-                }
-                if self.right[node] != UNSET {
-                    stack.push(self.right[node]);
-                }
-            } else {
-                if cur * cur < min_dist {
-                    test(node, &mut min_dist, &mut found);
-                    if self.right[node] != UNSET {
-                        stack.push(self.right[node]);
-                    }
-                }
-                if self.left[node] != UNSET {
-                    stack.push(self.left[node]);
-                }
-            }
-        }
-        found
-    }
-}
 
 #[derive(Debug)]
 struct IndexOfNearest {

@@ -56,6 +56,7 @@ pub mod input_image;
 pub mod instance_bounds;
 pub mod instance_transform;
 pub mod integer_math;
+pub mod interpolate_curves;
 pub mod is_smooth;
 pub mod material_index;
 pub mod material_selection;
@@ -498,6 +499,10 @@ pub const NODES: &[(&str, Evaluate)] = &[
         subdivide_curve::subdivide_curve,
     ),
     ("GeometryNodeTrimCurve", trim_curve::trim_curve),
+    (
+        "GeometryNodeInterpolateCurves",
+        interpolate_curves::interpolate_curves,
+    ),
     (
         "GeometryNodeIndexOfNearest",
         index_of_nearest::index_of_nearest,

@@ -2,8 +2,7 @@
 //! to Poly or Catmull-Rom keeps the control points as they are (Blender's trivial
 //! conversion: a Bezier curve loses its handles, a NURBS curve its weights and knots);
 //! to Bezier and NURBS as `set_curve_type.cc` converts. Bezier handle and NURBS
-//! attributes are dropped once no curve of that type is left. NURBS to Bezier is refused
-//! by name (it depends on the knots mode, which curve objects do not carry here yet).
+//! attributes are dropped once no curve of that type is left.
 
 use super::super::attribute::AttrId;
 use super::super::bezier_handles::write_handles;
@@ -73,53 +72,197 @@ fn catmull_rom_handles(p: &[V3], cyclic: bool) -> (Vec<V3>, Vec<V3>) {
     (hl, hr)
 }
 
-/// Converts the selected curves to Bezier (`convert_curves_to_bezier`): poly curves get
-/// vector handles, Catmull-Rom curves aligned handles on their tangents, Bezier curves
-/// keep theirs; derived handles are recomputed. NURBS curves are refused.
-fn to_bezier(c: &mut Curves, sel: &[bool]) -> Result<(), String> {
-    let types = c.ints("curve_type", Domain::Curve, 0);
-    let cyclic = c.cyclic();
-    let n = c.point_count();
-    let mut hl = c.point_vectors("handle_left").unwrap_or(vec![[0.0; 3]; n]);
-    let mut hr = c.point_vectors("handle_right").unwrap_or(vec![[0.0; 3]; n]);
-    let mut tl: Vec<i8> = c
-        .ints("handle_type_left", Domain::Point, 0)
-        .iter()
-        .map(|v| *v as i8)
-        .collect();
-    let mut tr: Vec<i8> = c
-        .ints("handle_type_right", Domain::Point, 0)
-        .iter()
-        .map(|v| *v as i8)
-        .collect();
-    for i in 0..c.curve_count() {
-        if !sel[i] {
-            continue;
+/// Whether a NURBS curve's Bezier conversion maps hull segments to Bezier segments one to
+/// one (`is_nurbs_to_bezier_one_to_one`): normal and endpoint knots; the others take every
+/// third control point as a Bezier point.
+fn one_to_one(knots: i8) -> bool {
+    knots == KNOTS_NORMAL || knots == KNOTS_ENDPOINT
+}
+
+/// `create_nurbs_to_bezier_handles`: the Bezier handles, left and right of each point in
+/// turn, placed on the NURBS hull.
+fn nurbs_handles(p: &[V3], knots: i8) -> Vec<V3> {
+    let n = p.len();
+    let third = |a: V3, b: V3| add(b, div(sub(a, b), 3.0));
+    let mut h = Vec::with_capacity(2 * n);
+    if one_to_one(knots) {
+        let periodic = knots == KNOTS_NORMAL;
+        if periodic {
+            h.push(third(p[0], p[1]));
+        } else {
+            h.push(sub(scale(p[0], 2.0), p[1]));
+            h.push(p[1]);
         }
-        let r = c.points(i);
-        match types[i] as i8 {
-            CURVE_TYPE_POLY => {
-                tl[r.clone()].fill(HANDLE_VECTOR);
-                tr[r].fill(HANDLE_VECTOR);
+        // Interior hull segments hold one handle at their middle or two at their thirds.
+        let segments = n - 1;
+        if segments != 3 || periodic {
+            let mid = (segments - 1) as f32 / 2.0;
+            for i in 1..segments.saturating_sub(1) {
+                let divisor = if periodic {
+                    3
+                } else {
+                    3.min((-(i as f32 - mid).abs() + mid + 1.0) as i32)
+                };
+                let d = div(sub(p[i + 1], p[i]), divisor as f32);
+                let count = if divisor < 3 { 1 } else { 2 };
+                for j in 1..=count {
+                    h.push(add(p[i], scale(d, j as f32)));
+                }
             }
-            CURVE_TYPE_CATMULL_ROM => {
-                let (l, rr) = catmull_rom_handles(&c.positions[r.clone()], cyclic[i]);
-                hl[r.clone()].copy_from_slice(&l);
-                hr[r.clone()].copy_from_slice(&rr);
-                tl[r.clone()].fill(HANDLE_ALIGN);
-                tr[r].fill(HANDLE_ALIGN);
-            }
-            CURVE_TYPE_BEZIER => {}
-            _ => {
-                return Err(format!(
-                    "curve {i}: converting NURBS curves to Bezier is not supported"
-                ))
-            }
+        }
+        let l = n - 1;
+        if periodic {
+            h.push(add(p[l - 1], div(sub(p[l], p[l - 1]), 3.0)));
+        } else {
+            h.push(p[l - 1]);
+            h.push(sub(scale(p[l], 2.0), p[l - 1]));
+        }
+    } else {
+        h.extend((0..n).filter(|i| i % 3 != 1).map(|i| p[i]));
+        if n % 3 == 1 {
+            h.pop();
+        } else if n % 3 == 2 {
+            h.push(sub(scale(p[n - 1], 2.0), p[n - 2]));
         }
     }
-    c.set_i8_selected("curve_type", Domain::Curve, 0, sel, CURVE_TYPE_BEZIER);
-    write_handles(c, tl, tr, hl, hr);
-    Ok(())
+    h
+}
+
+fn div(a: V3, d: f32) -> V3 {
+    [a[0] / d, a[1] / d, a[2] / d]
+}
+
+/// The source point of each Bezier point for point attributes (`nurbs_to_bezier_assign`,
+/// by the curve's own knots mode even when cyclic).
+fn nurbs_to_bezier_source(n: usize, dst: usize, knots: i8) -> Vec<usize> {
+    match knots {
+        KNOTS_NORMAL => (0..dst).map(|i| (i + 1) % n).collect(),
+        KNOTS_ENDPOINT => {
+            let mut v: Vec<usize> = (0..dst).map(|i| (i + 1).min(n - 1)).collect();
+            v[0] = 0;
+            v[dst - 1] = n - 1;
+            v
+        }
+        _ => (0..dst).map(|i| i * 3 + 1).collect(),
+    }
+}
+
+/// Converts the selected curves to Bezier (`convert_curves_to_bezier`): poly curves get
+/// vector handles, Catmull-Rom curves aligned handles on their tangents, Bezier curves
+/// keep theirs, NURBS curves aligned handles on their hull (one Bezier segment per hull
+/// segment with normal and endpoint knots, every third point otherwise); derived handles
+/// are recomputed.
+fn to_bezier(c: &Curves, sel: &[bool]) -> Result<Curves, String> {
+    let types = c.ints("curve_type", Domain::Curve, 0);
+    let cyclic = c.cyclic();
+    let knots_modes = c.ints("knots_mode", Domain::Curve, 0);
+    let n = c.point_count();
+    let hl_src = c.point_vectors("handle_left").unwrap_or(vec![[0.0; 3]; n]);
+    let hr_src = c.point_vectors("handle_right").unwrap_or(vec![[0.0; 3]; n]);
+    let tl_src = c.ints("handle_type_left", Domain::Point, 0);
+    let tr_src = c.ints("handle_type_right", Domain::Point, 0);
+    // Per result point: source point (for point attributes), position, handles, types.
+    let (mut src, mut pos) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let (mut hl, mut hr) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let (mut tl, mut tr) = (Vec::with_capacity(n), Vec::with_capacity(n));
+    let mut offsets = vec![0u32];
+    for i in 0..c.curve_count() {
+        let r = c.points(i);
+        let p = &c.positions[r.clone()];
+        let t = types[i] as i8;
+        if sel[i] && t == CURVE_TYPE_NURBS && !p.is_empty() {
+            let knots = knots_modes[i] as i8;
+            let count = if one_to_one(knots) {
+                if cyclic[i] {
+                    p.len()
+                } else {
+                    p.len().saturating_sub(2).max(1)
+                }
+            } else {
+                (p.len() + 1) / 3
+            };
+            if count == 0 {
+                return Err(format!(
+                    "curve {i}: a NURBS curve of {} point(s) with Bezier knots has no Bezier point",
+                    p.len()
+                ));
+            }
+            src.extend(
+                nurbs_to_bezier_source(p.len(), count, knots)
+                    .into_iter()
+                    .map(|k| r.start + k),
+            );
+            tl.extend(std::iter::repeat_n(HANDLE_ALIGN, count));
+            tr.extend(std::iter::repeat_n(HANDLE_ALIGN, count));
+            if count == 1 {
+                pos.push(p[0]);
+                hl.push(p[0]);
+                hr.push(p[0]);
+            } else {
+                // A cyclic curve is converted as a periodic one, its hull extended by its
+                // first two points.
+                let mut hull = p.to_vec();
+                let mut mode = knots;
+                if cyclic[i] && one_to_one(knots) {
+                    hull.push(p[0]);
+                    hull.push(p[1]);
+                    mode = KNOTS_NORMAL;
+                }
+                let h = nurbs_handles(&hull, mode);
+                if h.len() < 2 * count {
+                    return Err(format!("curve {i}: NURBS to Bezier handle count mismatch"));
+                }
+                for k in 0..count {
+                    let (a, b) = (h[2 * k], h[2 * k + 1]);
+                    hl.push(a);
+                    hr.push(b);
+                    pos.push(if one_to_one(mode) {
+                        [0, 1, 2].map(|j| a[j] * (1.0 - 0.5) + b[j] * 0.5)
+                    } else {
+                        hull[3 * k + 1]
+                    });
+                }
+            }
+        } else {
+            src.extend(r.clone());
+            pos.extend_from_slice(p);
+            let (mut l, mut rr) = (hl_src[r.clone()].to_vec(), hr_src[r.clone()].to_vec());
+            let (mut a, mut b): (Vec<i8>, Vec<i8>) = (
+                tl_src[r.clone()].iter().map(|v| *v as i8).collect(),
+                tr_src[r.clone()].iter().map(|v| *v as i8).collect(),
+            );
+            if sel[i] && t == CURVE_TYPE_POLY {
+                a.fill(HANDLE_VECTOR);
+                b.fill(HANDLE_VECTOR);
+            } else if sel[i] && t == CURVE_TYPE_CATMULL_ROM {
+                (l, rr) = catmull_rom_handles(p, cyclic[i]);
+                a.fill(HANDLE_ALIGN);
+                b.fill(HANDLE_ALIGN);
+            }
+            hl.extend(l);
+            hr.extend(rr);
+            tl.extend(a);
+            tr.extend(b);
+        }
+        offsets.push(pos.len() as u32);
+    }
+    let mut out = Curves {
+        positions: pos,
+        curve_offsets: offsets,
+        attributes: Default::default(),
+        materials: c.materials.clone(),
+    };
+    for a in c.attributes.iter() {
+        let data = match a.domain {
+            Domain::Curve => a.data.clone(),
+            Domain::Point => a.data.gather(&src),
+            _ => continue,
+        };
+        out.attributes.set(a.id.clone(), a.domain, data);
+    }
+    out.set_i8_selected("curve_type", Domain::Curve, 0, sel, CURVE_TYPE_BEZIER);
+    write_handles(&mut out, tl, tr, hl, hr);
+    Ok(out)
 }
 
 /// Converts the selected curves to NURBS (`convert_curves_to_nurbs`): order 4; a Bezier
@@ -242,7 +385,7 @@ pub fn set_spline_type(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         &mut |c, r| {
             let sel = r[0].as_bool();
             match target {
-                CURVE_TYPE_BEZIER => to_bezier(c, &sel)?,
+                CURVE_TYPE_BEZIER => *c = to_bezier(c, &sel)?,
                 CURVE_TYPE_NURBS => *c = to_nurbs(c, &sel),
                 _ => {
                     // Poly and Catmull-Rom keep the points as they are.

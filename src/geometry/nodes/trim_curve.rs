@@ -7,14 +7,22 @@
 //! gives one point; on a cyclic curve the trim wraps past the seam, and equal ends cut the
 //! loop open there. Trimmed curves are no longer cyclic.
 //!
-//! NURBS and Catmull-Rom curves are trimmed on their evaluated points in Blender; their
-//! evaluation is not implemented here, so selecting one is an error naming its type.
+//!
+//! The cut points of NURBS and Catmull-Rom curves are found on their evaluated points.
+//! NURBS curves become poly curves of their evaluated points (attributes evaluated by the
+//! basis); Catmull-Rom curves stay Catmull-Rom: their control points are kept and the
+//! ends inserted on the cubic (positions and every point attribute mixed by it).
 
 use std::sync::Arc;
 
 use super::super::attribute::AttrId;
-use super::super::curve_eval::{accumulated_lengths, bezier_segment, curve_types, lerp_gather};
-use super::super::curves::{Curves, CURVE_TYPE_BEZIER, CURVE_TYPE_NURBS, CURVE_TYPE_POLY};
+use super::super::curve_eval::{
+    accumulated_lengths, bezier_segment, catmull_rom_array, catmull_rom_sample, curve_types,
+    lerp_gather,
+};
+use super::super::curves::{
+    Curves, CURVE_TYPE_BEZIER, CURVE_TYPE_CATMULL_ROM, CURVE_TYPE_NURBS, CURVE_TYPE_POLY,
+};
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::ComponentRef;
@@ -570,6 +578,9 @@ fn trim_curves(
     let mut ext_len = c.point_count();
     // Points whose nurbs_weight Blender fills with 0 (trimmed curves).
     let mut trimmed_point = Vec::with_capacity(c.point_count());
+    // Ends inserted on Catmull-Rom segments: new point, the four source points (previous,
+    // start, end, next) and the parameter; their values are mixed by the cubic.
+    let mut cubic: Vec<(usize, [usize; 4], f32)> = Vec::new();
     for i in 0..c.curve_count() {
         let pts = c.points(i);
         let base = pts.start;
@@ -596,6 +607,7 @@ fn trim_curves(
         };
         let mut base = base;
         let mut nurbs_ev = None;
+        let mut catmull_rom = false;
         let (trim, bezier) = match types[i] {
             CURVE_TYPE_POLY => {
                 let lengths = accumulated_lengths(src.pos, cyclic[i]);
@@ -678,11 +690,37 @@ fn trim_curves(
                 nurbs_ev = Some(ev);
                 (t, false)
             }
-            _ => {
-                return Err(format!(
-                    "curve {i}: trimming Catmull-Rom curves is not supported (only Bezier, poly and NURBS)"
-                ))
+            CURVE_TYPE_CATMULL_ROM => {
+                // Looked up on the evaluated points (uniform per segment), but the curve
+                // stays Catmull-Rom: control points are kept and the ends inserted on the
+                // cubic (`trim_catmull_rom_curves`).
+                let r = res[i].max(1) as usize;
+                limits::check(
+                    limits::product(&[r as u64, n as u64]),
+                    &format!("curve {i}: its resolution"),
+                )?;
+                let t = if n == 1 {
+                    plan(&Lookup::Polygonal, &[], false, 1, 1, 0.0, 0.0, factor_mode)
+                } else {
+                    let ev = catmull_rom_array(&Array::Vector(src.pos.to_vec()), cyclic[i], r)
+                        .map(|a| a.as_vector().into_owned())
+                        .unwrap_or_default();
+                    let lengths = accumulated_lengths(&ev, cyclic[i]);
+                    plan(
+                        &Lookup::Uniform(r),
+                        &lengths,
+                        cyclic[i],
+                        n,
+                        ev.len(),
+                        starts[i],
+                        ends[i],
+                        factor_mode,
+                    )
+                };
+                catmull_rom = true;
+                (t, false)
             }
+            t => return Err(format!("curve {i}: unknown curve type {t}")),
         };
         if trim.range.cycles > 1 || trim.range.copied().len() + 2 < trim.count {
             return Err(format!(
@@ -704,7 +742,33 @@ fn trim_curves(
             new_tr.extend(b);
         } else {
             let p = nurbs_ev.as_deref().unwrap_or(src.pos);
-            positions.extend(lin.iter().map(|&(a, b, f)| mix(p[a], p[b], f)));
+            if catmull_rom {
+                let cyc = cyclic[i];
+                let pa = Array::Vector(p.to_vec());
+                for &(a, b, f) in &lin {
+                    if a == b && f == 0.0 {
+                        positions.push(p[a]);
+                        continue;
+                    }
+                    // `interpolate_catmull_rom`: the neighbours, or the ends repeated.
+                    let i0 = match a {
+                        0 if cyc => n - 1,
+                        0 => 0,
+                        _ => a - 1,
+                    };
+                    let i3 = match b + 1 {
+                        x if x == n && cyc => 0,
+                        x if x == n => b,
+                        x => x,
+                    };
+                    let idx = [i0, a, b, i3];
+                    let v = catmull_rom_sample(&pa, idx, f);
+                    cubic.push((positions.len(), idx.map(|k| k + base), f));
+                    positions.push(v.map_or(p[a], |v| v.as_vector()));
+                }
+            } else {
+                positions.extend(lin.iter().map(|&(a, b, f)| mix(p[a], p[b], f)));
+            }
             if any_bezier {
                 // Trimmed poly curves among Bezier ones get zero, free handles.
                 new_hl.extend(lin.iter().map(|_| [0.0f32; 3]));
@@ -783,6 +847,15 @@ fn trim_curves(
                     _ => {
                         let mut d = a.data.gather(&copies);
                         d.scatter(&mi, &lerp_gather(&a.data, &ma, &mb, &mf));
+                        for &(k, idx, f) in &cubic {
+                            let v = catmull_rom_sample(&a.data, idx, f).ok_or_else(|| {
+                                format!(
+                                    "attribute {:?} of a Catmull-Rom curve: its type cannot be mixed",
+                                    a.id.label()
+                                )
+                            })?;
+                            d.set(k, v);
+                        }
                         d
                     }
                 };
