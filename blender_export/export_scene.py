@@ -1919,7 +1919,7 @@ def evaluated_frames(evaluated, by_key, index, out, frames):
                               vertex_count=counts[0], face_count=counts[2],
                               instances_realized=len(realized["instances"]) if realized else 0, realized=realized,
                               materials=mats, uv_layers=uv_layers, active_render_uv=render_uv,
-                              default_color_attribute=color))
+                              default_color_attribute=color, volume_grids=volume_grid_count(by_key[name])))
     return extra
 
 
