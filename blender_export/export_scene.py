@@ -1384,6 +1384,19 @@ def index_to_object(grid):
     return o, size
 
 
+def volume_grid_count(o):
+    """Grids in the volume component of object O's evaluated geometry (Geometry Nodes on a
+    mesh or curve), which its frozen mesh cannot carry."""
+    try:
+        ev = o.evaluated_get(bpy.context.evaluated_depsgraph_get())
+        # The geometry set owns the volume: keep it alive while the grids are counted.
+        geometry = ev.evaluated_geometry()
+        vol = geometry.volume
+        return len(vol.grids) if vol is not None else 0
+    except (AttributeError, RuntimeError, ReferenceError):
+        return 0
+
+
 def volume_object_entries(objs, out, depsgraph, suffix="", only=None):
     """Per Volume object: the grids its materials read (or the velocity grid), from its
     evaluated Volume at the current frame (the file sequence frame, Geometry Nodes or
@@ -1906,7 +1919,7 @@ def evaluated_frames(evaluated, by_key, index, out, frames):
                               vertex_count=counts[0], face_count=counts[2],
                               instances_realized=len(realized["instances"]) if realized else 0, realized=realized,
                               materials=mats, uv_layers=uv_layers, active_render_uv=render_uv,
-                              default_color_attribute=color))
+                              default_color_attribute=color, volume_grids=volume_grid_count(by_key[name])))
     return extra
 
 
@@ -2014,6 +2027,7 @@ def main():
             hair = export_hair(targets, out, index)
             hair.update(export_curves(targets, out, index, frozen_meshes))
             points = export_points(targets, out, index, frozen_meshes, bpy.context.evaluated_depsgraph_get())
+            volume_grids = {key(o): volume_grid_count(o) for o in targets}
         for name, ((counts, arrays, attrs, uvs), realized, mats, (uv_layers, render_uv, color)) in frozen_meshes.items():
             rel = f"evaluated/{safe_name(index[name], name)}"
             write_mesh_glb(os.path.join(out, rel), name, counts, arrays, attrs, uvs)
@@ -2023,7 +2037,7 @@ def main():
                               "realized": realized, "reads": reads, "animated": animated, "unsupported": unsupported,
                               "materials": mats, "uv_layers": uv_layers, "active_render_uv": render_uv,
                               "default_color_attribute": color, "hair": hair.get(name),
-                              "points": points.get(name)})
+                              "points": points.get(name), "volume_grids": volume_grids.get(name, 0)})
 
     with RenderSettings():
         smoke_domains = smoke_domain_entries(list(data.objects), out, bpy.context.evaluated_depsgraph_get())

@@ -336,6 +336,9 @@ const ASSERTED: &[&str] = &[
     // A Volume reading a .vdb sequence, exported with `convert --frames 1..3` and rendered
     // at frame 3 (the per-frame grids), beside a single-file Volume exported once.
     "volume_vdb_sequence",
+    // Geometry Nodes volumes (geometry/volume.rs, nodes/volume_cube.rs): a Volume Cube with
+    // a Principled Volume by Set Material on a rotated, unevenly scaled object.
+    "gn_volume_cube",
     // The world volume (render/volume_world.rs), filling all space with the camera inside:
     // homogeneous scatter under a point light and a sun it extinguishes, absorption that
     // spares one channel (the sky and the sun stay in red), and a noise-texture density
@@ -2371,5 +2374,36 @@ fn world_volume_escaping_rays_lose_what_roulette_takes() {
         100.0 * r.worst_mean,
         r.ours,
         r.cycles
+    );
+}
+
+/// Geometry Nodes volumes the renderer does not draw are refused by name, the same from
+/// `render::check` (what `inspect` runs) as from `render`: a volume without a material
+/// (Cycles renders it with its default volume shader, whatever the mesh's material) and
+/// a grid whose background is not 0. The fixture itself renders (parity gn_volume_cube).
+#[test]
+fn unrendered_gn_volumes_are_refused_by_name() {
+    let (dir, base) = fixture_json("gn_volume_cube");
+    assert_renders(&dir, &base);
+    fn node<'a>(j: &'a mut serde_json::Value, kind: &str) -> &'a mut serde_json::Value {
+        j["node_groups"]
+            .as_array_mut()
+            .unwrap()
+            .iter_mut()
+            .flat_map(|g| g["nodes"].as_array_mut().unwrap().iter_mut())
+            .find(|n| n["bl_idname"] == kind)
+            .unwrap()
+    }
+    refused_alike(
+        &dir,
+        &base,
+        &|j| node(j, "GeometryNodeSetMaterial")["mute"] = true.into(),
+        &["\"GNCube\"", "no material", "default volume shader"],
+    );
+    refused_alike(
+        &dir,
+        &base,
+        &|j| node(j, "GeometryNodeVolumeCube")["inputs"][1]["default_value"] = 0.5.into(),
+        &["\"GNCube\"", "\"density\"", "background 0.5"],
     );
 }

@@ -109,6 +109,9 @@ type OpCache = RefCell<HashMap<(usize, Domain), Arc<Vec<Array>>>>;
 pub struct FieldContext<'a> {
     pub component: ComponentRef<'a>,
     cache: OpCache,
+    /// Blender's `Grid3DFieldContext` (Volume Cube): only the `position` attribute is
+    /// given, every other context input reads its type's default (0).
+    position_only: bool,
 }
 
 impl<'a> FieldContext<'a> {
@@ -116,6 +119,16 @@ impl<'a> FieldContext<'a> {
         FieldContext {
             component,
             cache: RefCell::new(HashMap::new()),
+            position_only: false,
+        }
+    }
+    /// A context over `points`' positions that gives nothing else, as Blender's
+    /// `Grid3DFieldContext` (Index, ID, Normal, other attributes, and inputs such as
+    /// Evaluate on Domain all read 0 there).
+    pub fn position_only(points: &'a PointCloud) -> Self {
+        FieldContext {
+            position_only: true,
+            ..FieldContext::new(ComponentRef::Points(points))
         }
     }
     /// Evaluates `field` on `domain`, converted to `ty`.
@@ -130,6 +143,11 @@ pub trait FieldInput: fmt::Debug + Send + Sync {
     fn evaluate(&self, ctx: &FieldContext, domain: Domain) -> Result<Array, String>;
     /// The domain the input naturally lives on (for Capture/Store "auto" choices).
     fn preferred_domain(&self, _ctx: &FieldContext) -> Option<Domain> {
+        None
+    }
+    /// The attribute the input reads when it is Blender's `AttributeFieldInput`
+    /// (Position, Named Attribute).
+    fn attribute_name(&self) -> Option<&str> {
         None
     }
 }
@@ -242,6 +260,9 @@ impl Field {
         let n = ctx.component.domain_size(domain);
         match self {
             Field::Constant(v) => Ok(Array::filled(*v, n)),
+            Field::Input(i) if ctx.position_only && i.attribute_name() != Some("position") => {
+                Ok(Array::zeros(i.data_type(), n))
+            }
             Field::Input(i) => {
                 let a = i.evaluate(ctx, domain)?;
                 debug_assert_eq!(a.len(), n);
@@ -302,6 +323,9 @@ impl FieldInput for PositionInput {
     fn preferred_domain(&self, ctx: &FieldContext) -> Option<Domain> {
         Some(ctx.component.point_domain())
     }
+    fn attribute_name(&self) -> Option<&str> {
+        Some("position")
+    }
 }
 
 /// Index of the element in the domain.
@@ -355,6 +379,9 @@ impl FieldInput for AttributeInput {
     }
     fn preferred_domain(&self, ctx: &FieldContext) -> Option<Domain> {
         ctx.component.attribute(&self.id).map(|(d, _)| d)
+    }
+    fn attribute_name(&self) -> Option<&str> {
+        self.id.name()
     }
 }
 

@@ -57,6 +57,7 @@ pub mod source;
 pub mod subdivide_curves;
 pub mod types;
 pub mod value;
+pub mod volume;
 pub mod weld;
 pub mod zones;
 

@@ -287,6 +287,11 @@ pub fn join_geometries(sets: &[GeometrySet]) -> GeometrySet {
     } else if !curves.is_empty() {
         out.curves = Some(Arc::new(join_curves(&curves)));
     }
+    // Blender 4.5 joins no volumes: one passes through, two or more are dropped.
+    let mut volumes = sets.iter().filter_map(|s| s.volume.clone());
+    if let (Some(v), None) = (volumes.next(), volumes.next()) {
+        out.volume = Some(v);
+    }
     let inst: Vec<&Instances> = sets.iter().filter_map(|s| s.instances.as_deref()).collect();
     if inst.len() == 1 {
         out.instances = sets.iter().find_map(|s| s.instances.clone());
@@ -483,6 +488,9 @@ pub fn realize_instances(set: &GeometrySet) -> GeometrySet {
         let refs: Vec<(&Curves, Mat4f)> = curves.iter().map(|(m, t)| (m, *t)).collect();
         out.curves = Some(Arc::new(join_curves(&refs)));
     }
+    // Blender 4.5 realizes no volumes: the first one found is kept as it is, its instance
+    // transform not applied (`first_volume` in realize_instances.cc).
+    out.volume = parts.iter().find_map(|p| p.set.volume.clone());
     out
 }
 

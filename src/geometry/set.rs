@@ -8,6 +8,7 @@ use super::curves::Curves;
 use super::instances::Instances;
 use super::mesh::Mesh;
 use super::pointcloud::PointCloud;
+use super::volume::Volume;
 
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct GeometrySet {
@@ -15,6 +16,8 @@ pub struct GeometrySet {
     pub curves: Option<Arc<Curves>>,
     pub points: Option<Arc<PointCloud>>,
     pub instances: Option<Arc<Instances>>,
+    /// Fog grids (`volume`): not an attribute component, so not in `component_types`.
+    pub volume: Option<Arc<Volume>>,
 }
 
 /// Component types in Blender's order (`GeometryComponent::Type`), which is the order
@@ -51,6 +54,7 @@ impl GeometrySet {
             && self.curves.is_none()
             && self.points.is_none()
             && self.instances.is_none()
+            && self.volume.is_none()
     }
     pub fn mesh_mut(&mut self) -> Option<&mut Mesh> {
         self.mesh.as_mut().map(Arc::make_mut)
@@ -64,7 +68,10 @@ impl GeometrySet {
     pub fn instances_mut(&mut self) -> Option<&mut Instances> {
         self.instances.as_mut().map(Arc::make_mut)
     }
-    /// Present components, in Blender's order.
+    pub fn volume_mut(&mut self) -> Option<&mut Volume> {
+        self.volume.as_mut().map(Arc::make_mut)
+    }
+    /// Present attribute components, in Blender's order (a volume has no attributes).
     pub fn component_types(&self) -> Vec<ComponentType> {
         let mut out = Vec::new();
         if self.mesh.is_some() {
@@ -94,6 +101,9 @@ impl GeometrySet {
         }
         if self.instances.as_ref().is_some_and(|i| i.is_empty()) {
             self.instances = None;
+        }
+        if self.volume.as_ref().is_some_and(|v| v.is_empty()) {
+            self.volume = None;
         }
     }
 }

@@ -318,6 +318,14 @@ fn frozen(
         .collect();
     check_frozen(&o.name, e, frame, &all)
         .map_err(|m| GeometryError::new(format!("{here}: {m}")))?;
+    if e.volume_grids > 0 {
+        // The frozen mesh carries no grids: rendering it would drop the volume.
+        return Err(GeometryError::new(format!(
+            "{here}: Blender's evaluated geometry holds a volume ({} grid{}), which blendsynth does not evaluate from this node tree and the frozen mesh does not carry",
+            e.volume_grids,
+            if e.volume_grids == 1 { "" } else { "s" }
+        )));
+    }
     Ok(i)
 }
 

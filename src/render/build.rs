@@ -345,7 +345,20 @@ pub fn build(
                     let mats = if m.materials.is_empty() { base.materials.to_vec() } else { m.materials.clone() };
                     Ok((Arc::new(m.to_scene(&obj.name)), mats))
                 };
+                    if let Some(inst) = &instances_component {
+                        if inst
+                            .references
+                            .iter()
+                            .filter_map(|r| r.geometry())
+                            .any(holds_volume)
+                        {
+                            return Err(RenderError(format!("object {:?}: its Geometry Nodes instances hold a volume, which Cycles renders per instance: volumes in instances are not supported by the renderer yet (Realize Instances keeps the first one, as Blender does)", obj.name)));
+                        }
+                    }
                     let (rest, points) = cycles_renders(&rest);
+                    if let Some(v) = &rest.volume {
+                        push_gn_volume(&mut instances, scene, (oi, obj), v, to_world)?;
+                    }
                     let (mesh, mats) = realise(&rest)?;
                     let info = MeshInfo {
                         materials: &mats,
@@ -776,6 +789,97 @@ fn push_volume_object(
         domain.density_scale = crate::render::volume_grid::object_space_density(&to_world);
     }
     push_grid_volume(instances, scene, (oi, obj), &v.materials, domain, to_world)
+}
+
+/// Whether a geometry set or any geometry its instances reference holds a volume.
+fn holds_volume(g: &crate::geometry::GeometrySet) -> bool {
+    g.volume.is_some()
+        || g.instances.as_ref().is_some_and(|i| {
+            i.references
+                .iter()
+                .filter_map(|r| r.geometry())
+                .any(holds_volume)
+        })
+}
+
+/// Render > Clipping of the Volume Geometry Nodes make (`BKE_id_new_nomain`'s defaults:
+/// Step Size 0, Space Object).
+const GN_VOLUME_CLIPPING: f32 = 0.001;
+
+/// A volume Geometry Nodes made on a mesh or curve object, as Cycles renders it: its
+/// grids (each dense over its active voxels, its index-to-object transform axis-aligned)
+/// with the volume's material (Set Material; the object's mesh materials are not its),
+/// the default Volume render settings (clipping 0.001, step from the voxels, Object
+/// space). Refused by name: a volume without a material (Cycles' default volume shader),
+/// a grid whose background is not 0 or whose transform rotates, shears or mirrors.
+fn push_gn_volume(
+    instances: &mut Vec<MeshInstance>,
+    scene: &Scene,
+    (oi, obj): (usize, &crate::scene::Object),
+    v: &crate::geometry::volume::Volume,
+    to_world: Affine,
+) -> Result<(), RenderError> {
+    let refuse = |why: String| {
+        Err(RenderError(format!(
+            "object {:?}: its Geometry Nodes volume {why}",
+            obj.name
+        )))
+    };
+    let mut grids = Vec::new();
+    for g in &v.grids {
+        if g.background != 0.0 {
+            return refuse(format!(
+                "grid {:?} has background {} (Cycles reads the background outside the active voxels): a background other than 0 is not supported by the renderer yet",
+                g.name, g.background
+            ));
+        }
+        let Some((origin, size)) = g.axis_aligned() else {
+            return refuse(format!(
+                "grid {:?} has a transform that rotates, shears or mirrors the voxels, which the renderer does not handle yet",
+                g.name
+            ));
+        };
+        if g.active_voxel_count() == 0 {
+            // Cycles builds nothing from an empty grid; a material reading it reads 0.
+            continue;
+        }
+        let lo = [0, 1, 2].map(|k| origin[k] + size[k] * g.origin[k] as f64);
+        let hi = [0, 1, 2].map(|k| lo[k] + size[k] * g.dims[k] as f64);
+        grids.push(crate::scene::volume_grid::VoxelGrid {
+            name: g.name.clone(),
+            channels: 1,
+            resolution: g.dims,
+            min: lo.map(|x| x as f32),
+            max: hi.map(|x| x as f32),
+            values: g.values.clone(),
+        });
+    }
+    let materials: Vec<Option<String>> = if v.materials.is_empty() {
+        vec![None]
+    } else {
+        v.materials.clone()
+    };
+    let from_object = obj
+        .material_slots
+        .first()
+        .filter(|s| s.link.as_deref() == Some("OBJECT"))
+        .map(|s| s.material.clone());
+    if from_object
+        .unwrap_or_else(|| materials[0].clone())
+        .is_none()
+    {
+        // The mesh's materials are not the volume's (checked with Cycles: another mesh
+        // material gives the same image).
+        return refuse(
+            "has no material (Set Material): Cycles renders it with its default volume shader (a Principled Volume), which the renderer does not do yet".into(),
+        );
+    }
+    let Some(mut domain) = DomainGrids::new(grids, GN_VOLUME_CLIPPING) else {
+        return Ok(());
+    };
+    domain.step = GridStep::Voxel;
+    domain.density_scale = crate::render::volume_grid::object_space_density(&to_world);
+    push_grid_volume(instances, scene, (oi, obj), &materials, domain, to_world)
 }
 
 /// Voxel grids in an object (a smoke domain, a Volume object) as the instance Cycles

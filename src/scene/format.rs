@@ -749,6 +749,10 @@ pub struct Evaluated {
     pub face_count: Option<usize>,
     #[serde(default)]
     pub instances_realized: Option<usize>,
+    /// Grids in the volume of Blender's evaluated geometry (Geometry Nodes' volume
+    /// component), which the frozen mesh does not carry; 0 in older exports.
+    #[serde(default)]
+    pub volume_grids: usize,
     /// What the object's evaluation reads, as Blender data path prefixes (its modifiers,
     /// its data, shape keys, objects its modifiers reference); None in exports made
     /// before frozen geometry, which are reference meshes only.

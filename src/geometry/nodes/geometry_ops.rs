@@ -93,6 +93,9 @@ pub fn transform_set(g: &mut GeometrySet, m: &Mat4f) {
             }
         }
     }
+    if let Some(v) = g.volume_mut() {
+        v.apply_transform(m);
+    }
     if let Some(inst) = g.instances_mut() {
         for t in inst.transforms.iter_mut() {
             *t = mat4_mul(m, t);
@@ -250,6 +253,11 @@ pub fn set_material(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         }
         if let Some(c) = s.curves_mut() {
             c.materials = vec![material.clone()];
+        }
+        // A volume takes the material whatever the selection (Blender warns that volumes
+        // support one material and assigns it to the first slot).
+        if let Some(v) = s.volume_mut() {
+            v.materials = vec![material.clone()];
         }
         Ok(())
     })

@@ -98,6 +98,7 @@ pub mod texture;
 pub mod triangulate;
 pub mod trim_curve;
 pub mod viewer;
+pub mod volume_cube;
 pub mod warning;
 
 use super::error::GeometryError;
@@ -405,6 +406,7 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ("FunctionNodeMatrixDeterminant", matrix::matrix_determinant),
     ("FunctionNodeCombineMatrix", matrix::combine_matrix),
     ("FunctionNodeSeparateMatrix", matrix::separate_matrix),
+    ("GeometryNodeVolumeCube", volume_cube::volume_cube),
     ("GeometryNodePoints", points::points),
     ("GeometryNodeSetPointRadius", points::set_point_radius),
     ("GeometryNodeSetID", points::set_id),

@@ -1,6 +1,6 @@
 //! Separate Components (`node_geo_separate_components.cc`): each component of the
-//! geometry on its own output. Volumes and Grease Pencil, which blendsynth's geometry does
-//! not hold, come out empty.
+//! geometry on its own output. Grease Pencil, which blendsynth's geometry does not hold,
+//! comes out empty.
 
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
@@ -39,7 +39,13 @@ pub fn separate_components(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
                 ..GeometrySet::default()
             }),
         ),
-        ("Volume", only(GeometrySet::default())),
+        (
+            "Volume",
+            only(GeometrySet {
+                volume: g.volume.clone(),
+                ..GeometrySet::default()
+            }),
+        ),
         ("Grease Pencil", only(GeometrySet::default())),
     ]))
 }
