@@ -27,6 +27,7 @@ use crate::nodes::voronoi::{voronoi_texture, VoronoiFeature, VoronoiMetric, Voro
 use crate::nodes::wave::{wave, WaveSettings};
 use crate::nodes::white_noise::white_noise;
 use crate::nodes::{blackbody, wavelength};
+use std::borrow::Cow;
 
 use crate::nodes::brick::{brick_texture, BrickSettings};
 use crate::nodes::image::{
@@ -915,7 +916,7 @@ impl Program {
     pub fn run_traced(&self, sp: &ShadingPoint, s: &mut [f32], trace: &dyn Trace) {
         s.copy_from_slice(&self.initial);
         let Some(d) = self.displacement else {
-            self.exec(*sp, s, &self.ops, trace);
+            self.exec(sp, s, &self.ops, trace);
             return;
         };
         match (d.bump_end, self.displaced_normal) {
@@ -939,16 +940,16 @@ impl Program {
                         ..*sp
                     }
                 });
-                self.exec(before, s, &self.ops[..end], trace);
+                self.exec(&before, s, &self.ops[..end], trace);
                 let n = v3(s, normal);
                 let after = ShadingPoint {
                     normal: n,
                     object_normal: sp.transform.inverse_normal(n),
                     ..*sp
                 };
-                self.exec(after, s, &self.ops[end..], trace);
+                self.exec(&after, s, &self.ops[end..], trace);
             }
-            _ => self.exec(*sp, s, &self.ops[d.center_end..], trace),
+            _ => self.exec(sp, s, &self.ops[d.center_end..], trace),
         }
     }
 
@@ -957,15 +958,17 @@ impl Program {
     pub fn displacement_at(&self, sp: &ShadingPoint, s: &mut [f32]) -> Option<Vec3> {
         let d = self.displacement?;
         s.copy_from_slice(&self.initial);
-        self.exec(*sp, s, &self.ops[..d.center_end], &NoTrace);
+        self.exec(sp, s, &self.ops[..d.center_end], &NoTrace);
         Some(v3(s, d.value))
     }
 
     // Long because one arm per op, kept in one function so the interpreter's loop stays one jump table.
-    fn exec(&self, sp: ShadingPoint, s: &mut [f32], ops: &[Op], trace: &dyn Trace) {
-        // `sp` is what the ops read: `base`, or a bump copy's offset point.
-        let mut base = sp;
-        let mut sp = sp;
+    fn exec(&self, sp: &ShadingPoint, s: &mut [f32], ops: &[Op], trace: &dyn Trace) {
+        // `sp` is what the ops read: `base`, or a bump copy's offset point. Both borrow the
+        // caller's point until an op changes one: the point is over a kilobyte, and copying
+        // it twice per run showed as memmove in the profiles.
+        let mut base = Cow::Borrowed(sp);
+        let mut sp = Cow::Borrowed(sp);
         for op in ops {
             match *op {
                 Op::VectorToFloat { src, dst } => {
@@ -1646,7 +1649,9 @@ impl Program {
                     put3(s, color, [r[0], r[1], r[2]]);
                     s[alpha as usize] = r[3];
                 }
-                Op::BumpPoint { point, width } => offset_point_into(&mut sp, &base, point, width),
+                Op::BumpPoint { point, width } => {
+                    offset_point_into(sp.to_mut(), &base, point, width)
+                }
                 Op::Bump {
                     settings,
                     normal,
@@ -1714,15 +1719,16 @@ impl Program {
                 } => {
                     // At the undisplaced surface, Cycles' bump reads the full differential
                     // svm_node_enter_bump_eval saved, not the compact one.
-                    let mut full = base;
+                    let mut full = *base;
                     if let Some(u) = base.undisplaced {
                         (full.dp_dx, full.dp_dy) = (u.dp_dx, u.dp_dy);
                     }
                     let n =
                         displacement_bump(&full, object_space, v3(s, center), v3(s, dx), v3(s, dy));
-                    base.normal = n;
-                    base.object_normal = base.transform.inverse_normal(n);
-                    sp = base;
+                    let b = base.to_mut();
+                    b.normal = n;
+                    b.object_normal = b.transform.inverse_normal(n);
+                    sp = base.clone();
                     put3(s, dst, n);
                 }
                 Op::NormalMap {
