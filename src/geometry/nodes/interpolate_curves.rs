@@ -397,6 +397,8 @@ struct Inputs<'a> {
 }
 
 /// `generate_interpolated_curves`.
+// Long because it follows Blender's generate_interpolated_curves step by step: groups,
+// neighbours, positions per child, then every attribute, in Blender's order.
 fn interpolate(inp: &Inputs, ids: (&Option<AttrId>, &Option<AttrId>)) -> Result<Curves, String> {
     let g = inp.guides;
     let positions = inp.points.positions();
