@@ -379,8 +379,9 @@ mod tests {
             ms[0].positions,
             vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0]]
         );
-        assert_eq!(ms[1].positions.len(), 3);
-        assert_eq!(ms[1].corner_verts, vec![1, 2, 0]);
+        // B uses vertices 2..5 (the dropped two-corner face's too), in file order.
+        assert_eq!(ms[1].positions.len(), 4);
+        assert_eq!(ms[1].corner_verts, vec![1, 3, 2]);
         assert!(read_obj(b"v 0 0 0\nvn 0 0 1\n").is_err());
     }
 }
