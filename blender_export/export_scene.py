@@ -1794,6 +1794,90 @@ def image_entry(im, out_dir, used_names):
     return d
 
 
+# ---------------------------------------------------------------- Import nodes' files
+
+# What the Geometry Nodes Import nodes read (Import STL, PLY, OBJ, CSV, Text, VDB).
+IMPORT_EXTENSIONS = (".stl", ".ply", ".obj", ".csv", ".txt", ".vdb")
+MAX_IMPORT_BYTES = 1 << 30
+
+
+def string_values_of_trees(data):
+    """Every string a Geometry Nodes tree or NODES modifier holds: socket values (linked
+    or not), String nodes, interface defaults and the modifiers' inputs. An Import node's
+    Path comes from one of these unless the tree computes it (String Join, Value to
+    String, ...), which the exporter cannot see."""
+    found = []
+    for g in data.node_groups:
+        if g.bl_idname != "GeometryNodeTree":
+            continue
+        for n in g.nodes:
+            for s in n.inputs:
+                if s.type == "STRING" and isinstance(getattr(s, "default_value", None), str):
+                    found.append(s.default_value)
+            v = getattr(n, "string", None)
+            if isinstance(v, str):
+                found.append(v)
+        for it in g.interface.items_tree:
+            if it.item_type == "SOCKET" and isinstance(getattr(it, "default_value", None), str):
+                found.append(it.default_value)
+    for o in data.objects:
+        for m in o.modifiers:
+            if m.type != "NODES":
+                continue
+            for k in m.keys():
+                v = m[k]
+                if isinstance(v, str):
+                    found.append(v)
+    return found
+
+
+def import_files(data, out):
+    """Copies into DIR/imports/ every file an Import node may read: each string of the
+    Geometry Nodes trees that names a file with an importable extension, as Blender
+    resolves it (`//` against the .blend, absolute paths as they are). Only when some tree
+    has an Import node. blendsynth reads these copies and nothing else (FORMAT.md)."""
+    if not any(n.bl_idname.startswith("GeometryNodeImport")
+               for g in data.node_groups if g.bl_idname == "GeometryNodeTree" for n in g.nodes):
+        return []
+    entries, used = [], set()
+    for s in dict.fromkeys(string_values_of_trees(data)):
+        if not s.lower().endswith(IMPORT_EXTENSIONS):
+            continue
+        if s.startswith("//"):
+            src = bpy.path.abspath(s)
+        elif os.path.isabs(s):
+            src = s
+        else:
+            # Relative to Blender's working folder at evaluation: nothing to copy.
+            continue
+        entry = {"path": s, "file": None, "missing": False, "outside": False}
+        if not os.path.isfile(src):
+            entry["missing"] = True
+            entries.append(entry)
+            continue
+        real = os.path.realpath(src)
+        if not any(os.path.commonpath([real, root]) == root for root in ALLOWED_ROOTS):
+            entry["outside"] = True
+            WARNINGS.append(f"Import node file {s!r} resolves to {real}, outside the .blend's folder "
+                            f"{ALLOWED_ROOTS[0]}: not copied (allow its folder with --allow-path "
+                            f"{os.path.dirname(real)})")
+            entries.append(entry)
+            continue
+        if os.path.getsize(real) > MAX_IMPORT_BYTES:
+            fail(f"Import node file {real} is over {MAX_IMPORT_BYTES >> 20} MB")
+        base = re.sub(r"[^A-Za-z0-9._-]", "_", os.path.basename(real))[:80] or "file"
+        name = f"{len(entries):04d}_{base}"
+        while name in used:
+            name = "_" + name
+        used.add(name)
+        os.makedirs(os.path.join(out, "imports"), exist_ok=True)
+        shutil.copyfile(real, os.path.join(out, "imports", name))
+        COPIED.append({"import": s, "from": real, "to": f"imports/{name}"})
+        entry["file"] = f"imports/{name}"
+        entries.append(entry)
+    return entries
+
+
 # ---------------------------------------------------------------- animation
 
 def action_fcurves(anim):
@@ -2113,6 +2197,7 @@ def main():
                     "properties": rna_value(l, 0, f"lights[{q(key(l))}]", skip={"node_tree", "animation_data"})}
                    for l in data.lights],
         "images": images,
+        "import_files": import_files(data, out),
         "animation": animation(data),
         "evaluated": evaluated,
         "smoke_domains": smoke_domains,

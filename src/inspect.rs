@@ -27,6 +27,8 @@ pub struct Report {
     pub materials: Vec<String>,
     pub node_trees: Vec<TreeSummary>,
     pub images: Vec<ImageSummary>,
+    /// The files the Geometry Nodes Import nodes may read (the export's copies).
+    pub import_files: Vec<ImportFileSummary>,
     pub coverage: Vec<CoverageRow>,
     /// Whether each material compiles for the renderer, and if not, why.
     pub material_status: Vec<MaterialStatus>,
@@ -126,6 +128,15 @@ pub struct ImageSummary {
     pub name: String,
     pub file: Option<String>,
     pub missing: bool,
+}
+
+#[derive(Debug, Serialize)]
+pub struct ImportFileSummary {
+    /// The path string as Blender's Import node passes it to the importer.
+    pub path: String,
+    pub file: Option<String>,
+    /// What an Import node naming it gives.
+    pub state: String,
 }
 
 #[derive(Debug, Serialize)]
@@ -372,6 +383,21 @@ pub fn report_at(scene: &Scene, frame: Option<f64>) -> Report {
                 name: i.name.clone(),
                 file: i.file.clone(),
                 missing: i.missing,
+            })
+            .collect(),
+        import_files: f
+            .import_files
+            .iter()
+            .map(|i| ImportFileSummary {
+                path: i.path.clone(),
+                file: i.file.clone(),
+                state: if i.outside {
+                    "outside the .blend's folder, not exported: an Import node naming it is an error".into()
+                } else if i.missing {
+                    "MISSING when exported: an Import node naming it gives empty geometry (Blender: empty geometry and an error on the node)".into()
+                } else {
+                    "copied".into()
+                },
             })
             .collect(),
         coverage,
@@ -703,6 +729,13 @@ impl Report {
                         opt(&i.file)
                     }
                 )?;
+            }
+        }
+
+        if !self.import_files.is_empty() {
+            writeln!(o, "\nImport node files")?;
+            for i in &self.import_files {
+                writeln!(o, "  {}: {} ({})", i.path, opt(&i.file), i.state)?;
             }
         }
 

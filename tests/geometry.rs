@@ -711,10 +711,12 @@ fn parity_fixtures_stay_small() {
     // 0.5 MB, mostly scene.json) to 12.7 MB; Interpolate Curves, Trim Curve on Catmull-Rom
     // and NURBS to Bezier (gn_curve_nodes.py scene_interpolate_curves: 0.43 MB, nearly all
     // of it scene.json) to 13.1 MB; the volume scene (gn_volume_nodes.py: 0.15 MB, nearly
-    // all of it scene.json; its grids are volume_refs.json, 12 kB) to 13.25 MB.
+    // all of it scene.json; its grids are volume_refs.json, 12 kB) to 13.25 MB; the Import
+    // nodes scene (gn_import_nodes.py: 0.12 MB, 5 kB of it the copied input files) to
+    // 13.35 MB.
     assert!(
-        total < 13_250_000,
-        "fixtures/geometry/scenes holds {total} bytes; keep it under 13.25 MB"
+        total < 13_350_000,
+        "fixtures/geometry/scenes holds {total} bytes; keep it under 13.35 MB"
     );
 }
 
@@ -1603,4 +1605,136 @@ fn unmatched_volume_nodes_are_refused_by_name() {
             .to_string()
             .contains(node));
     }
+}
+
+/// The Import nodes read only the export's copies: a Path the export holds no copy of (as
+/// a string computed at evaluation would be), an entry pointing out of the scene folder,
+/// and a file left outside the .blend's folder are errors naming the node and the path; a
+/// file missing when exported gives Blender's empty geometry.
+#[test]
+fn import_nodes_read_only_the_exports_copies() {
+    let scene = load("import_nodes");
+    let path = "node_groups[\"imp_stl_ascii\"].nodes[\"Import STL\"].inputs[0].default_value";
+    let e = mesh_of(
+        &scene,
+        "imp_stl_ascii",
+        1.0,
+        &[(
+            path.to_string(),
+            serde_json::json!("//organs/liver_f12.stl"),
+        )],
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("Import STL")
+            && e.contains("//organs/liver_f12.stl")
+            && e.contains("not in the export"),
+        "{e}"
+    );
+    let e = mesh_of(
+        &scene,
+        "imp_stl_ascii",
+        1.0,
+        &[(path.to_string(), serde_json::json!("/etc/passwd.stl"))],
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("Import STL") && e.contains("/etc/passwd.stl"),
+        "{e}"
+    );
+    // The exported JSON edited: a copy outside the scene folder, and a file the exporter
+    // left outside the .blend's folder.
+    let dir = scenes_dir().join("import_nodes");
+    let text = std::fs::read_to_string(dir.join("scene.json")).unwrap();
+    let stl = "//../../geometry/import_files/organ_ascii.stl";
+    for (edit, want) in [
+        ("../../../../Cargo.toml", "leaves the scene folder"),
+        ("/etc/hostname", "absolute"),
+    ] {
+        let mut doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+        for f in doc["import_files"].as_array_mut().unwrap() {
+            if f["path"] == stl {
+                f["file"] = serde_json::json!(edit);
+            }
+        }
+        let bad = Scene::from_json(&dir, doc.to_string().as_bytes()).unwrap();
+        let e = mesh_of(&bad, "imp_stl_ascii", 1.0, &[]).unwrap_err();
+        assert!(e.contains("Import STL") && e.contains(want), "{edit}: {e}");
+    }
+    let mut doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for f in doc["import_files"].as_array_mut().unwrap() {
+        if f["path"] == stl {
+            f["file"] = serde_json::Value::Null;
+            f["outside"] = serde_json::json!(true);
+        }
+    }
+    let bad = Scene::from_json(&dir, doc.to_string().as_bytes()).unwrap();
+    let e = mesh_of(&bad, "imp_stl_ascii", 1.0, &[]).unwrap_err();
+    assert!(
+        e.contains("Import STL") && e.contains("outside") && e.contains(stl),
+        "{e}"
+    );
+    // Missing when exported: Blender's node gives empty geometry (and so does ours).
+    let m = mesh_of(&scene, "imp_missing", 1.0, &[]).unwrap();
+    assert_eq!(m.vertex_count(), 0);
+    assert_eq!(evaluated(&scene, "imp_missing").vertex_count(), 0);
+}
+
+/// A PLY file's vertex normals become custom normals: Blender's corner normals (its
+/// 16-bit encoding of them, hence the bound) are the file's, normalized, on every corner.
+#[test]
+fn import_ply_normals_are_blenders_corner_normals() {
+    let scene = load("import_nodes");
+    let theirs = evaluated(&scene, "imp_ply_ascii");
+    let ours = mesh_of(&scene, "imp_ply_ascii", 1.0, &[]).unwrap();
+    let cn = ours.corner_normals();
+    assert_eq!(cn.len(), theirs.corner_normals.len());
+    let err = max_diff(&cn, &theirs.corner_normals);
+    println!("imp_ply_ascii corner normals: max difference {err:.2e}");
+    assert!(err < 2e-4, "corner normals differ by {err:e}");
+    // The renderer is given the same (the faces are smooth).
+    assert_eq!(ours.to_scene("x").corner_normals, cn);
+    // Not the faces' own normals: the file's normals matter.
+    let face = mesh_of(&scene, "imp_ply_le", 1.0, &[]).unwrap();
+    assert!(face.sharp_faces().iter().all(|&s| s));
+    let flat: Vec<[f32; 3]> = (0..ours.face_count())
+        .flat_map(|f| ours.face(f).map(move |_| f))
+        .map(|f| ours.face_normal(f))
+        .collect();
+    assert!(max_diff(&flat, &cn) > 0.1);
+}
+
+/// Import OBJ outputs one instance per object of the file (identity transforms), whose
+/// meshes joined are Blender's realized mesh (the parity case realizes them in the tree).
+#[test]
+fn import_obj_gives_one_instance_per_object() {
+    let dir = scenes_dir().join("import_nodes");
+    let text = std::fs::read_to_string(dir.join("scene.json")).unwrap();
+    let mut doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for g in doc["node_groups"].as_array_mut().unwrap() {
+        if g["name"] == "imp_obj" {
+            for n in g["nodes"].as_array_mut().unwrap() {
+                if n["bl_idname"] == "GeometryNodeRealizeInstances" {
+                    n["mute"] = serde_json::json!(true);
+                }
+            }
+        }
+    }
+    let scene = Scene::from_json(&dir, doc.to_string().as_bytes()).unwrap();
+    let set = geometry::evaluate_object(&scene, "imp_obj", 1.0, &[]).unwrap();
+    assert!(set.mesh.is_none());
+    let inst = set.instances.as_ref().expect("instances");
+    assert_eq!(inst.len(), 2);
+    let counts: Vec<[usize; 3]> = inst
+        .references
+        .iter()
+        .map(|r| {
+            let m = r.geometry().unwrap().mesh.as_ref().unwrap();
+            [m.vertex_count(), m.edge_count(), m.face_count()]
+        })
+        .collect();
+    // Liver: 5 used vertices (the one before `o` is not), the loose edge's object Kidney 4.
+    assert_eq!(counts, vec![[5, 8, 4], [4, 6, 2]]);
+    let theirs = evaluated(&load("import_nodes"), "imp_obj");
+    assert_eq!(theirs.vertex_count(), 9);
 }

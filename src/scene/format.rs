@@ -50,6 +50,10 @@ pub struct SceneFile {
     pub lights: Vec<Light>,
     #[serde(default)]
     pub images: Vec<Image>,
+    /// Files the Geometry Nodes Import nodes may read, copied into the export and keyed
+    /// by Blender's path string (FORMAT.md "Import files"); absent in older exports.
+    #[serde(default)]
+    pub import_files: Vec<ImportFile>,
     #[serde(default)]
     pub animation: Vec<AnimData>,
     #[serde(default)]
@@ -677,6 +681,20 @@ pub struct Image {
     pub alpha_mode: Option<String>,
     #[serde(default)]
     pub size: Option<[u32; 2]>,
+}
+
+/// One file an Import node may read: Blender's path string and the export's copy.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct ImportFile {
+    pub path: String,
+    #[serde(default)]
+    pub file: Option<String>,
+    /// No file there when exported: Blender's node gives empty geometry.
+    #[serde(default)]
+    pub missing: bool,
+    /// Outside the .blend's folder (and every allowed one): not copied.
+    #[serde(default)]
+    pub outside: bool,
 }
 
 #[derive(Debug, Clone, Serialize, Deserialize)]

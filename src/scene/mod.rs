@@ -68,6 +68,39 @@ impl Scene {
         resolve_inside(&self.dir, rel).map_err(|m| SceneError::new(&self.json_path(), location, m))
     }
 
+    /// The export's copy of the file an Import node names by `path` (Blender's string,
+    /// exactly): `Ok(Some(copy))`, `Ok(None)` when Blender found no file there (its node
+    /// gives empty geometry), and an error for a path the export holds no copy of.
+    pub fn import_file(&self, path: &str) -> Result<Option<PathBuf>, String> {
+        let Some((i, f)) = self
+            .file
+            .import_files
+            .iter()
+            .enumerate()
+            .find(|(_, f)| f.path == path)
+        else {
+            return Err(format!(
+                "file {path:?} is not in the export (only files named by a string of the \
+                 Geometry Nodes trees, `//`-relative or absolute, are copied; a path computed \
+                 at evaluation or relative to the working folder is not)"
+            ));
+        };
+        if f.outside {
+            return Err(format!(
+                "file {path:?} is outside the .blend's folder and was not exported (export \
+                 with --allow-path naming its folder)"
+            ));
+        }
+        match f.file.as_deref() {
+            None if f.missing => Ok(None),
+            None => Err(format!("file {path:?} was not exported")),
+            Some(rel) => self
+                .resolve(rel, &format!("import_files[{i}].file"))
+                .map(Some)
+                .map_err(|e| e.to_string()),
+        }
+    }
+
     pub fn object(&self, name: &str) -> Option<&Object> {
         self.file.objects.iter().find(|o| o.name == name)
     }

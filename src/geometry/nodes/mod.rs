@@ -49,6 +49,10 @@ pub mod gizmo_transform;
 pub mod ico_sphere;
 pub mod image_info;
 pub mod image_texture;
+pub mod import_file;
+pub mod import_obj;
+pub mod import_ply;
+pub mod import_stl;
 pub mod index_of_nearest;
 pub mod input;
 pub mod input_active_camera;
@@ -594,6 +598,10 @@ pub const NODES: &[(&str, Evaluate)] = &[
         "GeometryNodeGizmoTransform",
         gizmo_transform::gizmo_transform,
     ),
+    // Import nodes: the export's copies of the files (issue 26 item 4).
+    ("GeometryNodeImportSTL", import_stl::import_stl),
+    ("GeometryNodeImportPLY", import_ply::import_ply),
+    ("GeometryNodeImportOBJ", import_obj::import_obj),
 ];
 
 /// The `bl_idname`s of `NODES`.
