@@ -328,7 +328,13 @@ fn load_vertices(body: &mut Body, e: &Element, d: &mut Data) -> Result<(), PlyEr
         .collect();
     d.custom = custom
         .iter()
-        .map(|&i| (e.properties[i].name.clone(), Vec::with_capacity(e.count)))
+        // The header's count is the file's claim: reserve no more than its bytes can hold.
+        .map(|&i| {
+            (
+                e.properties[i].name.clone(),
+                Vec::with_capacity(e.count.min(body.bytes.len())),
+            )
+        })
         .collect();
     let norm = |i: usize| e.properties[i].ty.normalizer();
     let mut values = vec![0.0f32; e.properties.len()];
@@ -642,6 +648,16 @@ fn to_mesh(d: Data) -> Result<Mesh, PlyError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A header claiming billions of elements over a few bytes is an error naming the
+    /// file's shortfall, not an allocation the machine cannot make.
+    #[test]
+    fn a_header_count_beyond_the_data_is_an_error() {
+        for format in ["ascii", "binary_little_endian"] {
+            let ply = format!("ply\nformat {format} 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nproperty float foo\nend_header\n0 0 0 1\n");
+            assert!(read_ply(ply.as_bytes()).is_err(), "{format}");
+        }
+    }
 
     #[test]
     fn ascii_and_binary_read_alike() {
