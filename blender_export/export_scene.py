@@ -1393,7 +1393,9 @@ def volume_grid_count(o):
         geometry = ev.evaluated_geometry()
         vol = geometry.volume
         return len(vol.grids) if vol is not None else 0
-    except (AttributeError, RuntimeError, ReferenceError):
+    # TypeError: an object outside the view layer has no evaluated copy (evaluated_get
+    # returns the original), so no evaluated geometry either.
+    except (AttributeError, RuntimeError, ReferenceError, TypeError):
         return 0
 
 
