@@ -233,6 +233,44 @@ fn autorun_script_in_a_blend_never_runs() {
     );
 }
 
+/// An object Blender's viewport depsgraph does not evaluate (its collection disabled in
+/// viewports) converts and renders: the export once stopped on it with "Expected an
+/// evaluated object".
+#[test]
+fn objects_of_viewport_disabled_collections_convert() {
+    let Some(py) = require("a Python with bpy 4.5.4", bpy_python()) else {
+        return;
+    };
+    let t = tempfile::tempdir().unwrap();
+    let blends = t.path().join("blend");
+    run_python(
+        &py,
+        &repo().join("fixtures/make_fixtures.py"),
+        &[
+            "--out",
+            blends.to_str().unwrap(),
+            "--only",
+            "viewport_disabled",
+        ],
+    );
+    let out = t.path().join("export");
+    let o = run(
+        &[
+            "convert",
+            blends.join("viewport_disabled.blend").to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[("BLENDSYNTH_BPY_PYTHON", py.to_str().unwrap())],
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let scene = Scene::load(&out).unwrap();
+    assert!(
+        scene.object("Label").is_some(),
+        "the text object is exported"
+    );
+}
+
 /// The committed copy of Cycles' albedo tables (tests/closures.rs compares ours with it)
 /// is what this Blender's library holds.
 #[test]
