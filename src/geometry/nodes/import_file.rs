@@ -40,6 +40,30 @@ pub fn is_space(b: u8) -> bool {
     b <= b' '
 }
 
+/// The first byte at or after `p` in `s` that is not whitespace (`s.len()` if none).
+pub fn skip_space(s: &[u8], mut p: usize) -> usize {
+    while p < s.len() && is_space(s[p]) {
+        p += 1;
+    }
+    p
+}
+
+/// The first whitespace byte at or after `p` in `s` (`s.len()` if none).
+pub fn skip_word(s: &[u8], mut p: usize) -> usize {
+    while p < s.len() && !is_space(s[p]) {
+        p += 1;
+    }
+    p
+}
+
+/// The integer after the whitespace at `p` (`parse_int` with fallback 0); `p` moves past it.
+pub fn next_int(s: &[u8], p: &mut usize) -> i32 {
+    *p = skip_space(s, *p);
+    let (v, n) = parse_int(&s[*p..], 0);
+    *p += n;
+    v
+}
+
 /// The length of the longest prefix of `s` that `fast_float::from_chars` reads as a
 /// float (sign, digits with an optional point, exponent; or inf/infinity/nan), 0 if none.
 pub fn float_prefix(s: &[u8]) -> usize {

@@ -23,7 +23,7 @@ use super::super::mesh::Mesh;
 use super::super::set::GeometrySet;
 use super::super::types::{Array, Domain};
 use super::super::value::SocketValue;
-use super::import_file::{is_space, parse_float, parse_int, read_path};
+use super::import_file::{is_space, parse_float, parse_int, read_path, skip_space};
 
 pub fn import_obj(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let mut set = GeometrySet::default();
@@ -68,13 +68,6 @@ struct Geometry {
 fn keyword<'a>(line: &'a [u8], k: &[u8]) -> Option<&'a [u8]> {
     (line.len() > k.len() && &line[..k.len()] == k && is_space(line[k.len()]))
         .then(|| &line[k.len() + 1..])
-}
-
-fn skip_space(s: &[u8], mut p: usize) -> usize {
-    while p < s.len() && is_space(s[p]) {
-        p += 1;
-    }
-    p
 }
 
 /// The meshes Blender's OBJ importer makes of `bytes`, one per object with vertices.

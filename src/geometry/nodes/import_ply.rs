@@ -17,7 +17,7 @@ use super::super::mesh::Mesh;
 use super::super::set::GeometrySet;
 use super::super::types::{Array, Domain};
 use super::super::value::SocketValue;
-use super::import_file::{is_space, parse_float, parse_int, read_path};
+use super::import_file::{is_space, next_int, parse_float, read_path, skip_space, skip_word};
 use crate::nodes::image::srgb_to_linear;
 
 pub fn import_ply(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
@@ -271,9 +271,7 @@ fn row(body: &mut Body, e: &Element, values: &mut [f32]) -> Result<(), PlyError>
         let mut p = 0;
         let mut k = 0;
         while p < line.len() && k < values.len() {
-            while p < line.len() && is_space(line[p]) {
-                p += 1;
-            }
+            p = skip_space(line, p);
             let (v, n) = parse_float(&line[p..], 0.0);
             values[k] = v;
             k += 1;
@@ -378,31 +376,14 @@ fn load_faces(body: &mut Body, e: &Element, d: &mut Data) -> Result<(), PlyError
         if body.format == Format::Ascii {
             let line = body.line();
             let mut p = 0;
-            let int = |p: &mut usize| {
-                while *p < line.len() && is_space(line[*p]) {
-                    *p += 1;
-                }
-                let (v, n) = parse_int(&line[*p..], 0);
-                *p += n;
-                v
-            };
+            let int = |p: &mut usize| next_int(line, p);
             for q in &e.properties[..pi] {
                 if q.list.is_none() {
-                    while p < line.len() && is_space(line[p]) {
-                        p += 1;
-                    }
-                    while p < line.len() && !is_space(line[p]) {
-                        p += 1;
-                    }
+                    p = skip_word(line, skip_space(line, p));
                 } else {
                     let n = int(&mut p);
                     for _ in 0..n.max(0) {
-                        while p < line.len() && is_space(line[p]) {
-                            p += 1;
-                        }
-                        while p < line.len() && !is_space(line[p]) {
-                            p += 1;
-                        }
+                        p = skip_word(line, skip_space(line, p));
                     }
                 }
             }
@@ -453,14 +434,7 @@ fn load_tristrips(body: &mut Body, e: &Element, d: &mut Data) -> Result<(), PlyE
     if body.format == Format::Ascii {
         let line = body.line();
         let mut p = 0;
-        let int = |p: &mut usize| {
-            while *p < line.len() && is_space(line[*p]) {
-                *p += 1;
-            }
-            let (v, n) = parse_int(&line[*p..], 0);
-            *p += n;
-            v
-        };
+        let int = |p: &mut usize| next_int(line, p);
         let n = int(&mut p);
         for _ in 0..n.max(0) {
             strip.push(int(&mut p));

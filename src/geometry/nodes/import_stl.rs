@@ -15,7 +15,7 @@ use super::super::mesh::Mesh;
 use super::super::set::GeometrySet;
 use super::super::types::{Array, Domain};
 use super::super::value::SocketValue;
-use super::import_file::{is_space, parse_float, read_path};
+use super::import_file::{is_space, parse_float, read_path, skip_space, skip_word};
 
 const BINARY_HEADER: usize = 80;
 const BINARY_STRIDE: usize = 50;
@@ -66,13 +66,9 @@ fn read_ascii(bytes: &[u8], b: &mut Builder) {
         .iter()
         .position(|&c| c == b'\n')
         .unwrap_or(bytes.len());
-    let skip_space = |p: &mut usize| {
-        while *p < bytes.len() && is_space(bytes[*p]) {
-            *p += 1;
-        }
-    };
+    let skip_ws = |p: &mut usize| *p = skip_space(bytes, *p);
     let token = |p: &mut usize, tok: &[u8]| -> bool {
-        skip_space(p);
+        skip_ws(p);
         let rest = &bytes[*p..];
         if rest.len() < tok.len() + 1 || &rest[..tok.len()] != tok || !is_space(rest[tok.len()]) {
             return false;
@@ -82,7 +78,7 @@ fn read_ascii(bytes: &[u8], b: &mut Builder) {
     };
     let float3 = |p: &mut usize, out: &mut [f32; 3]| {
         for o in out.iter_mut() {
-            skip_space(p);
+            skip_ws(p);
             let (v, n) = parse_float(&bytes[*p..], 0.0);
             *o = v;
             *p += n;
@@ -102,16 +98,12 @@ fn read_ascii(bytes: &[u8], b: &mut Builder) {
             b.add(tri);
         } else if token(&mut p, b"facet") {
             // "normal" and the facet normal, which the node does not use.
-            while p < bytes.len() && !is_space(bytes[p]) {
-                p += 1;
-            }
-            skip_space(&mut p);
+            p = skip_word(bytes, p);
+            skip_ws(&mut p);
             float3(&mut p, &mut normal);
         } else {
-            while p < bytes.len() && !is_space(bytes[p]) {
-                p += 1;
-            }
-            skip_space(&mut p);
+            p = skip_word(bytes, p);
+            skip_ws(&mut p);
         }
     }
 }

@@ -246,20 +246,7 @@ fn to_bezier(c: &Curves, sel: &[bool]) -> Result<Curves, String> {
         }
         offsets.push(pos.len() as u32);
     }
-    let mut out = Curves {
-        positions: pos,
-        curve_offsets: offsets,
-        attributes: Default::default(),
-        materials: c.materials.clone(),
-    };
-    for a in c.attributes.iter() {
-        let data = match a.domain {
-            Domain::Curve => a.data.clone(),
-            Domain::Point => a.data.gather(&src),
-            _ => continue,
-        };
-        out.attributes.set(a.id.clone(), a.domain, data);
-    }
+    let mut out = rebuilt(c, pos, offsets, &src);
     out.set_i8_selected("curve_type", Domain::Curve, 0, sel, CURVE_TYPE_BEZIER);
     write_handles(&mut out, tl, tr, hl, hr);
     Ok(out)
@@ -330,20 +317,7 @@ fn to_nurbs(c: &Curves, sel: &[bool]) -> Curves {
         }
         offsets.push(src.len() as u32);
     }
-    let mut out = Curves {
-        positions: pos,
-        curve_offsets: offsets,
-        attributes: Default::default(),
-        materials: c.materials.clone(),
-    };
-    for a in c.attributes.iter() {
-        let data = match a.domain {
-            Domain::Curve => a.data.clone(),
-            Domain::Point => a.data.gather(&src),
-            _ => continue,
-        };
-        out.attributes.set(a.id.clone(), a.domain, data);
-    }
+    let mut out = rebuilt(c, pos, offsets, &src);
     let mut t: Vec<i8> = types.iter().map(|v| *v as i8).collect();
     for i in 0..t.len() {
         if sel[i] {
@@ -396,4 +370,24 @@ pub fn set_spline_type(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             Ok(())
         },
     )
+}
+
+/// `c`'s curves with new points: `pos` and `offsets`, each point's attributes taken from
+/// source point `src[i]`, the curve attributes and materials kept.
+fn rebuilt(c: &Curves, pos: Vec<V3>, offsets: Vec<u32>, src: &[usize]) -> Curves {
+    let mut out = Curves {
+        positions: pos,
+        curve_offsets: offsets,
+        attributes: Default::default(),
+        materials: c.materials.clone(),
+    };
+    for a in c.attributes.iter() {
+        let data = match a.domain {
+            Domain::Curve => a.data.clone(),
+            Domain::Point => a.data.gather(src),
+            _ => continue,
+        };
+        out.attributes.set(a.id.clone(), a.domain, data);
+    }
+    out
 }
