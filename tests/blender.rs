@@ -20,6 +20,17 @@ fn blender_counts(py: &Path, blend: &Path) -> Value {
         .expect("blender_counts.py prints JSON on its last line")
 }
 
+/// One .blend of fixtures/make_fixtures.py, written under `dir`.
+fn make_fixture(py: &Path, dir: &Path, name: &str) -> std::path::PathBuf {
+    let blends = dir.join("blend");
+    run_python(
+        py,
+        &repo().join("fixtures/make_fixtures.py"),
+        &["--out", blends.to_str().unwrap(), "--only", name],
+    );
+    blends.join(format!("{name}.blend"))
+}
+
 fn convert(py: &Path, blend: &Path, out: &Path) {
     let o = run(
         &[
@@ -186,13 +197,7 @@ fn autorun_script_in_a_blend_never_runs() {
         return;
     };
     let t = tempfile::tempdir().unwrap();
-    let blends = t.path().join("blend");
-    run_python(
-        &py,
-        &repo().join("fixtures/make_fixtures.py"),
-        &["--out", blends.to_str().unwrap(), "--only", "autorun"],
-    );
-    let blend = blends.join("autorun.blend");
+    let blend = make_fixture(&py, t.path(), "autorun");
     let marker = t.path().join("AUTORUN_RAN");
 
     // Control: with auto-run allowed, Blender does run the file's script.
@@ -242,22 +247,12 @@ fn objects_of_viewport_disabled_collections_convert() {
         return;
     };
     let t = tempfile::tempdir().unwrap();
-    let blends = t.path().join("blend");
-    run_python(
-        &py,
-        &repo().join("fixtures/make_fixtures.py"),
-        &[
-            "--out",
-            blends.to_str().unwrap(),
-            "--only",
-            "viewport_disabled",
-        ],
-    );
+    let blend = make_fixture(&py, t.path(), "viewport_disabled");
     let out = t.path().join("export");
     let o = run(
         &[
             "convert",
-            blends.join("viewport_disabled.blend").to_str().unwrap(),
+            blend.to_str().unwrap(),
             "-o",
             out.to_str().unwrap(),
         ],
