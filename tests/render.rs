@@ -257,6 +257,12 @@ const ASSERTED: &[&str] = &[
     // ShaderGraph::connect), in a material and in a world group; the world shows camera rays
     // another colour through Light Path > Is Camera Ray, which a world reads from the ray.
     "shader_socket_values",
+    // A NaN normal (Object-space Normal Map of colour 0.5) leaves the surface dark and
+    // ends the paths that reach it, as in Cycles; a tangent-space map at Strength 0.5 does not.
+    "normal_nan",
+    // Principled specular under a Specular Tint: tinted at normal incidence, white at
+    // grazing (Cycles' generalized Schlick), also at IOR 0 and a low Specular IOR Level.
+    "principled_specular_tint",
     // An area light marked as a portal emits nothing.
     "light_portal",
     // The published colon's two stacked bumps (the displacement's and a Bump node on it) on

@@ -333,14 +333,17 @@ pub fn normal_map(sp: &ShadingPoint, space: MapSpace, color: Vec3, strength: f32
         MapSpace::Object | MapSpace::BlenderObject => sp.transform.normal(c),
         _ => safe_normalize(c),
     };
-    if sp.backfacing {
-        n = scale3(n, -1.0);
-    }
+    // Cycles 4.5 blends by strength before turning the normal to a back face's side.
     if strength != 1.0 {
         let s = strength.max(0.0);
         n = safe_normalize(add3(sp.normal, scale3(sub3(n, sp.normal), s)));
     }
-    if n == [0.0; 3] || !n.iter().all(|x| x.is_finite()) {
+    if sp.backfacing {
+        n = scale3(n, -1.0);
+    }
+    // Only a zero normal falls back (is_zero): a NaN from normalising a zero object-space
+    // vector stays, as in Cycles, and the closures given it reflect nothing.
+    if n == [0.0; 3] {
         n = sp.normal;
     }
     n

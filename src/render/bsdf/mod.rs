@@ -32,6 +32,10 @@ pub enum Fresnel {
     Constant,
     /// Dielectric with relative IOR `eta`, tinted.
     Dielectric { eta: f32 },
+    /// Cycles' generalized Schlick with a negative exponent (the Principled specular
+    /// layer): the dielectric Fresnel of `eta` remapped from its own F0..1 to `f0`..1, so a
+    /// Specular Tint colours normal incidence and grazing reflection stays white.
+    Schlick { f0: V3, eta: f32 },
     /// Metals: F0 colour, F82 tint factor `b` (precomputed).
     F82 { f0: V3, b: V3 },
     /// Dielectric under a thin film (Principled specular layer): coloured by interference.
@@ -116,6 +120,13 @@ pub struct LobeSet {
     /// true normal: Cycles does so on curves, whose ribbons' true normal faces the ray
     /// ("the geometric normal gives too much darkening otherwise", bsdf_sample).
     pub own_normal_as_ng: bool,
+    /// A closure other than a diffuse or translucent one was given a normal that is not a
+    /// number (an Object-space Normal Map of colour 0.5 normalises a zero vector). Cycles
+    /// keeps it, and its evaluation and pdf are NaN, which takes every closure of the point
+    /// with it: the surface reflects nothing and a path that reaches it ends there. (Diffuse
+    /// and translucent closures test their cosine as `> 0`, so with a NaN normal they only
+    /// give nothing themselves: see `nan_normal`.)
+    pub poisoned: bool,
 }
 
 pub struct BsdfSample {
@@ -150,6 +161,7 @@ impl Default for LobeSet {
             bump_correction: true,
             terminator_frequency: 1.0,
             own_normal_as_ng: false,
+            poisoned: false,
         }
     }
 }
@@ -177,6 +189,12 @@ fn excluded(kind: &LobeKind, exclude: u32) -> bool {
         LobeKind::Hair(_) | LobeKind::Chiang(_) | LobeKind::Huang(_) => exclude & ray::GLOSSY != 0,
         LobeKind::Transparent | LobeKind::Subsurface(_) | LobeKind::RayPortal(_) => false,
     }
+}
+
+/// A closure normal that is not a number (see `LobeSet::poisoned`).
+#[inline]
+fn nan_normal(n: V3) -> bool {
+    !(n[0].is_finite() && n[1].is_finite() && n[2].is_finite())
 }
 
 /// Singular (mirror) below this alpha, as Cycles treats very low roughness.
@@ -217,6 +235,7 @@ impl LobeSet {
         self.bump_correction = true;
         self.terminator_frequency = 1.0;
         self.own_normal_as_ng = false;
+        self.poisoned = false;
     }
 
     pub fn push(&mut self, kind: LobeKind, weight: V3, n: V3) {
@@ -246,6 +265,9 @@ impl LobeSet {
         let sw = (weight[0].abs() + weight[1].abs() + weight[2].abs()) * albedo.clamp(0.0, 1.0);
         if sw <= 0.0 {
             return;
+        }
+        if nan_normal(n) && !matches!(kind, LobeKind::Diffuse | LobeKind::Translucent) {
+            self.poisoned = true;
         }
         if let LobeKind::Transparent = kind {
             self.transparent = add(self.transparent, weight);
@@ -300,9 +322,13 @@ impl LobeSet {
         let mut f = [0.0; 3];
         let mut pdf = 0.0;
         let mut total = 0.0;
+        if self.poisoned {
+            let total = self.lobes[..self.len].iter().map(|l| l.sample_weight).sum();
+            return (f, pdf, total);
+        }
         for (i, l) in self.lobes[..self.len].iter().enumerate() {
             total += l.sample_weight;
-            if skip == Some(i) || (exclude != 0 && excluded(&l.kind, exclude)) {
+            if skip == Some(i) || (exclude != 0 && excluded(&l.kind, exclude)) || nan_normal(l.n) {
                 continue;
             }
             let bump = self.bump_term(l, wi);
@@ -399,7 +425,7 @@ impl LobeSet {
 
     pub fn sample(&self, wo: V3, ng: V3, u: [f32; 3], tables: &Tables) -> Option<BsdfSample> {
         let total: f32 = self.lobes[..self.len].iter().map(|l| l.sample_weight).sum();
-        if total <= 0.0 {
+        if total <= 0.0 || self.poisoned {
             return None;
         }
         // Pick a lobe by sample weight; the rest of u[2] (rescaled) is the lobe's own third
@@ -414,6 +440,11 @@ impl LobeSet {
             x -= l.sample_weight;
         }
         let l = &self.lobes[pick];
+        // A diffuse or translucent closure with a NaN normal samples no direction (Cycles'
+        // `dot(Ng, wo) > 0` fails): the path ends.
+        if nan_normal(l.n) {
+            return None;
+        }
         let ng = if self.own_normal_as_ng { l.n } else { ng };
         let sel = l.sample_weight / total;
         if let LobeKind::Subsurface(_) = l.kind {
@@ -563,6 +594,11 @@ fn fresnel_eval(f: Fresnel, cos_h: f32, tint: V3) -> V3 {
     match f {
         Fresnel::Constant => tint,
         Fresnel::Dielectric { eta } => scale(tint, fresnel_dielectric(cos_h, eta)),
+        Fresnel::Schlick { f0, eta } => {
+            let real_f0 = fresnel_dielectric(1.0, eta);
+            let s = (fresnel_dielectric(cos_h, eta) - real_f0) / (1.0 - real_f0);
+            [0, 1, 2].map(|k| (f0[k] + (1.0 - f0[k]) * s) * tint[k])
+        }
         Fresnel::F82 { f0, b } => {
             let c = cos_h.clamp(0.0, 1.0);
             let m = 1.0 - c;

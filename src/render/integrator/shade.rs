@@ -320,7 +320,13 @@ pub(crate) fn input_c(b: &BsdfNode, s: &[f32], id: usize, d: V3) -> V3 {
 pub(crate) fn input_n(b: &BsdfNode, s: &[f32], id: usize, sp: &ShadingPoint) -> V3 {
     match b.input_at(id) {
         Some((slot, true)) => {
-            let n = normalize(finite3(v3(s, slot)));
+            let v = v3(s, slot);
+            // Cycles' safe_normalize keeps a NaN (or infinite) normal; the closure then
+            // poisons the point's lighting (LobeSet::poisoned).
+            if !v.iter().all(|c| c.is_finite()) {
+                return [f32::NAN; 3];
+            }
+            let n = normalize(v);
             if is_zero(n) {
                 sp.normal
             } else {
@@ -890,7 +896,8 @@ fn principled(
     // Dielectric specular: IOR adjusted by the specular IOR level as Cycles does.
     let mut eta = ior;
     if spec_level != 0.5 {
-        let f0 = (crate::render::bsdf::f0_from_ior(ior) * 2.0 * spec_level).min(0.9999);
+        // Cycles' ior_from_F0 clamps F0 to 0.99.
+        let f0 = (crate::render::bsdf::f0_from_ior(ior) * 2.0 * spec_level).clamp(0.0, 0.99);
         let sq = f0.sqrt();
         eta = (1.0 + sq) / (1.0 - sq);
         if ior < 1.0 {
@@ -935,7 +942,22 @@ fn principled(
         } else {
             [1.0; 3]
         };
-        let lobe_weight = mul(mul(weight, spec_tint), darkening);
+        // Cycles' generalized Schlick: F0 (the level's, times the tint) at normal
+        // incidence, white at grazing. Untinted it is the plain dielectric Fresnel of eta.
+        let (fresnel, lobe_weight, albedo) = if spec_tint == [1.0; 3] {
+            (Fresnel::Dielectric { eta }, mul(weight, darkening), [e; 3])
+        } else {
+            let f0 = crate::render::bsdf::f0_from_ior(ior) * 2.0 * spec_level;
+            let f0t = spec_tint.map(|t| (f0 * t).clamp(0.0, 1.0));
+            let real_f0 = crate::render::bsdf::f0_from_ior(eta);
+            let s = ((e - real_f0) / (1.0 - real_f0)).clamp(0.0, 1.0);
+            (
+                Fresnel::Schlick { f0: f0t, eta },
+                mul(weight, darkening),
+                f0t.map(|f| f + (1.0 - f) * s),
+            )
+        };
+        let sel = average(albedo).max(1e-3);
         if ax != ay {
             push_glossy(
                 out,
@@ -943,27 +965,27 @@ fn principled(
                 ax,
                 ay,
                 tangent,
-                Fresnel::Dielectric { eta },
+                fresnel,
                 multi,
                 lobe_weight,
                 vn,
-                e.max(1e-3),
+                sel,
             );
         } else {
             out.push_scaled(
                 LobeKind::Glossy {
                     alpha: a,
-                    fresnel: Fresnel::Dielectric { eta },
+                    fresnel,
                     energy,
                 },
                 lobe_weight,
                 vn,
-                e.max(1e-3),
+                sel,
             );
         }
         // Attenuate the layers below by the specular layer's albedo (Cycles' bsdf_albedo:
         // the closure weight, darkening included, times the estimated albedo).
-        let albedo = mul(scale(spec_tint, e), darkening);
+        let albedo = mul(albedo, darkening);
         weight = scale(weight, (1.0 - max3(albedo)).clamp(0.0, 1.0));
     }
     let ss = input_f(b, s, socket!("Subsurface Weight"), 0.0).clamp(0.0, 1.0);
