@@ -178,3 +178,23 @@ fn only_random_walk_skin_enters_through_a_diffuse_bounce() {
         "skin entries within {nearest} of one direction"
     );
 }
+
+#[test]
+fn the_walks_two_dimension_draws_are_get4s_first_two() {
+    // The walk draws only the first two dimensions of each bounce's second set (`get2`):
+    // they must be `get4`'s bits, or the walk would change.
+    use blendsynth::render::sampler::PixelSampler;
+    for (x, y, seed) in [(0, 0, 0), (3, 5, 7), (127, 64, 0x9e37_79b9)] {
+        let s = PixelSampler::new(x, y, seed);
+        for index in [0, 1, 2, 63, 1000, u32::MAX] {
+            for set in [0, 5, 17, 0x8000_0001] {
+                let a = s.get4(index, set);
+                let b = s.get2(index, set);
+                assert_eq!(
+                    [a[0].to_bits(), a[1].to_bits()],
+                    [b[0].to_bits(), b[1].to_bits()]
+                );
+            }
+        }
+    }
+}

@@ -147,12 +147,24 @@ impl PixelSampler {
     /// shuffled 4D Sobol sequence, so sets are decorrelated).
     #[inline]
     pub fn get4(&self, index: u32, set: u32) -> [f32; 4] {
+        self.first_dims(index, set)
+    }
+
+    /// The first two of `get4`'s dimensions, the same bits, for callers that use only
+    /// those (the subsurface walk's second set of each bounce).
+    #[inline]
+    pub fn get2(&self, index: u32, set: u32) -> [f32; 2] {
+        self.first_dims(index, set)
+    }
+
+    #[inline(always)]
+    fn first_dims<const N: usize>(&self, index: u32, set: u32) -> [f32; N] {
         // Dimension d is nested_uniform_scramble(sobol(i, d), seed_d) with the shuffled
         // index i = nested_uniform_scramble(index, s) = y.reverse_bits(); the reversals
         // next to the Sobol lookup are folded into its table (`sobol_reversed`).
         let s = hash_combine(self.seed, set);
         let y = laine_karras(index.reverse_bits(), s);
-        let mut out = [0.0; 4];
+        let mut out = [0.0; N];
         for (d, o) in out.iter_mut().enumerate() {
             let x = laine_karras(sobol_reversed(y, d), hash_combine(s, d as u32 + 1));
             *o = to_unit(x.reverse_bits());
