@@ -91,7 +91,8 @@ const ASSERTED: &[&str] = &[
     "dof",
     "dof_focus_object",
     // The active camera switched at timeline markers (scene::active_camera): frame 3 by a
-    // moving CamB, frame 7 by CamA; the exported scene.camera is a third camera.
+    // moving CamB, frame 7 by CamA; the exported scene.camera is a third camera. A cube
+    // placed by Active Camera in Geometry Nodes follows the switch too.
     "camera_markers",
     "camera_markers_late",
     // Free custom normals (Set Mesh Normal, Free): point normals that round a cube, and
@@ -1750,7 +1751,9 @@ fn depth_of_field_focus_on_a_bone_is_refused_by_name() {
 /// disabled in renders, a deleted one, none before the first marker), blendsynth's
 /// camera is the same, in the scene, in `inspect` and in the dataset's camera pose. The
 /// exported scene.camera (CamD) is never the answer. The parity scenes camera_markers
-/// (frame 3, CamB moving) and camera_markers_late (frame 7, CamA) render them.
+/// (frame 3, CamB moving) and camera_markers_late (frame 7, CamA) render them, with a cube
+/// Geometry Nodes moves by the Active Camera's location (Cycles' render switches the
+/// camera before it evaluates the frame: with the stored camera there, ratio 6.7).
 #[test]
 fn camera_switches_at_timeline_markers_as_blender() {
     let (dir, base) = fixture_json("camera_markers");
