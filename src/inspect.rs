@@ -59,6 +59,8 @@ pub struct SceneSummary {
     pub frame_start: i32,
     pub frame_end: i32,
     pub frame_current: i32,
+    /// The active camera at the report's frame (timeline markers switch it; an error
+    /// there is the render check's, and the exported camera stands here).
     pub camera: Option<String>,
     pub world: Option<String>,
     pub resolution: Option<[i64; 2]>,
@@ -194,7 +196,10 @@ pub fn report_at(scene: &Scene, frame: Option<f64>) -> Report {
         frame_start: s.frame_start,
         frame_end: s.frame_end,
         frame_current: s.frame_current,
-        camera: s.camera.clone(),
+        camera: scene
+            .camera_at(frame)
+            .unwrap_or(s.camera.as_deref())
+            .map(str::to_string),
         world: s.world.clone(),
         resolution: res,
         resolution_percentage: int(render, "resolution_percentage"),

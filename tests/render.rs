@@ -90,6 +90,14 @@ const ASSERTED: &[&str] = &[
     "diffuse_sun",
     "dof",
     "dof_focus_object",
+    // The active camera switched at timeline markers (scene::active_camera): frame 3 by a
+    // moving CamB, frame 7 by CamA; the exported scene.camera is a third camera. A cube
+    // placed by Active Camera in Geometry Nodes follows the switch too.
+    "camera_markers",
+    "camera_markers_late",
+    // Free custom normals (Set Mesh Normal, Free): point normals that round a cube, and
+    // tilted unnormalized corner normals.
+    "free_custom_normals",
     "emission_mesh",
     "glossy",
     "metallic",
@@ -1743,18 +1751,69 @@ fn depth_of_field_focus_on_a_bone_is_refused_by_name() {
     );
 }
 
-/// A scene whose timeline markers switch the active camera (Blender renders each frame
-/// with the marker's camera) is refused by name, the same from `render::check` (what
-/// `inspect` runs) as from `render`, never rendered with the exported camera.
+/// Timeline markers switch the active camera as Blender's do (BKE_scene_camera_switch_find):
+/// for every frame Blender's scene.camera was baked at after frame_set (fixture
+/// camera_markers: -1..9 and 5.9; the first listed of two markers on a frame, a camera
+/// disabled in renders, a deleted one, none before the first marker), blendsynth's
+/// camera is the same, in the scene, in `inspect` and in the dataset's camera pose. The
+/// exported scene.camera (CamD) is never the answer. The parity scenes camera_markers
+/// (frame 3, CamB moving) and camera_markers_late (frame 7, CamA) render them, with a cube
+/// Geometry Nodes moves by the Active Camera's location (Cycles' render switches the
+/// camera before it evaluates the frame: with the stored camera there, ratio 6.7).
 #[test]
-fn camera_switching_at_markers_is_refused_by_name() {
-    let (dir, base) = fixture_json("dof_focus_object");
+fn camera_switches_at_timeline_markers_as_blender() {
+    let (dir, base) = fixture_json("camera_markers");
+    let scene = assert_renders(&dir, &base);
+    assert_eq!(scene.file.scene.camera.as_deref(), Some("CamD"));
+    let baked: Vec<serde_json::Value> =
+        serde_json::from_slice(&std::fs::read(dir.join("frame_cameras.json")).unwrap()).unwrap();
+    assert_eq!(baked.len(), 12);
+    for row in &baked {
+        let frame = row["frame"].as_f64().unwrap();
+        let want = row["camera"].as_str();
+        assert_eq!(scene.camera_at(frame).unwrap(), want, "frame {frame}");
+        let report = blendsynth::inspect::report_at(&scene, Some(frame));
+        assert_eq!(
+            report.scene.camera.as_deref(),
+            want,
+            "inspect at frame {frame}"
+        );
+        let pose = blendsynth::dataset::generate::scene_camera(&scene, frame, 32, 32).unwrap();
+        assert_eq!(
+            Some(pose.name.as_str()),
+            want,
+            "camera pose at frame {frame}"
+        );
+    }
+    // Without its markers the exported camera is the scene's at every frame.
+    let mut plain = base.clone();
+    plain["scene"]["camera_markers"] = serde_json::json!([]);
+    let plain = Scene::from_json(&dir, plain.to_string().as_bytes()).unwrap();
+    assert_eq!(plain.camera_at(7.0).unwrap(), Some("CamD"));
+}
+
+/// A marker's camera whose Disable in Renders is animated is refused by name (Blender
+/// reads the flag as it stands when it switches), the same from `render::check` (what
+/// `inspect` runs) as from `render`; a marker naming no exported object is a load error.
+#[test]
+fn camera_switching_with_animated_hide_render_is_refused_by_name() {
+    let (dir, base) = fixture_json("camera_markers");
     refused_alike(
         &dir,
         &base,
-        &|j| j["scene"]["camera_markers"] = serde_json::json!([{"frame": 10, "camera": "Camera"}]),
-        &["timeline markers", "\"Camera\"", "camera switching"],
+        &|j| {
+            let mut a = j["animation"][0].clone();
+            a["id_name"] = "CamC".into();
+            a["id_path"] = "objects[\"CamC\"]".into();
+            a["fcurves"][0]["data_path"] = "hide_render".into();
+            j["animation"].as_array_mut().unwrap().push(a);
+        },
+        &["\"CamC\"", "hide_render", "timeline marker"],
     );
+    let mut j = base.clone();
+    j["scene"]["camera_markers"][0]["camera"] = "Gone".into();
+    let err = Scene::from_json(&dir, j.to_string().as_bytes()).unwrap_err();
+    assert!(err.to_string().contains("camera_markers[0]"), "{err}");
 }
 
 /// Volume features blendsynth does not render are errors naming the object, material or

@@ -103,12 +103,17 @@ pub fn evaluate_scene_with(
         export_frame: scene.file.scene.frame_current as f64,
         posed: posed_armatures(scene),
     };
-    // A camera other than the scene's moves nothing that renders (issue 26: a constraint
-    // blendsynth does not evaluate on it must not block the frame).
-    let camera = scene.file.scene.camera.as_deref();
+    // A camera that is never the scene's moves nothing that renders (issue 26: a
+    // constraint blendsynth does not evaluate on it must not block the frame). Every
+    // camera a timeline marker binds is solved: a motion step may fall on the far side
+    // of a marker from the frame whose camera it moves.
+    let s = &scene.file.scene;
+    let is_scene_camera = |name: &str| {
+        s.camera.as_deref() == Some(name) || s.camera_markers.iter().any(|m| m.camera == name)
+    };
     let world_matrices = transform::Solver::new(&data, opts.for_render, &axes)
         .with_bone_parents(bones)
-        .solve_needed(|o| o.kind != "CAMERA" || Some(o.name.as_str()) == camera)?;
+        .solve_needed(|o| o.kind != "CAMERA" || is_scene_camera(&o.name))?;
     Ok(EvaluatedScene {
         frame,
         data,

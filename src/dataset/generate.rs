@@ -799,12 +799,7 @@ pub fn scene_camera(
     width: u32,
     height: u32,
 ) -> Result<CameraInfo, String> {
-    let name = scene
-        .file
-        .scene
-        .camera
-        .as_deref()
-        .ok_or("the scene has no camera")?;
+    let name = scene.camera_at(frame)?.ok_or("the scene has no camera")?;
     let idx = scene
         .file
         .objects

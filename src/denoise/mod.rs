@@ -398,10 +398,8 @@ pub fn denoise_render(
     out: &mut crate::render::RenderOutput,
 ) -> Result<(), DenoiseError> {
     let cam_name = scene
-        .file
-        .scene
-        .camera
-        .as_deref()
+        .camera_at(frame)
+        .map_err(DenoiseError::Input)?
         .ok_or_else(|| DenoiseError::Input("the scene has no camera".into()))?;
     let idx = scene
         .file

@@ -41,6 +41,24 @@ pub struct Session<'s> {
     pub(super) simulation: RefCell<SimulationStates>,
 }
 
+/// Why a mesh of `g` (or of its instances) has custom normals Blender would have moved
+/// with a deformation (`Mesh::relative_normals_moved`).
+fn moved_relative_normals(g: &GeometrySet, depth: u32) -> Option<String> {
+    if let Some(why) = g.mesh.as_ref().and_then(|m| m.relative_normals_moved()) {
+        return Some(why);
+    }
+    // Instance nesting is bounded where instances are made; the cap only guards this walk.
+    if depth > 64 {
+        return None;
+    }
+    g.instances.as_ref().and_then(|i| {
+        i.references
+            .iter()
+            .filter_map(|r| r.geometry())
+            .find_map(|r| moved_relative_normals(r, depth + 1))
+    })
+}
+
 /// One Simulation zone's state after the frame it was last stepped at.
 #[derive(Clone)]
 pub struct SimulationState {
@@ -149,6 +167,12 @@ impl<'s> Session<'s> {
         let result = self.evaluate_stack(o);
         self.in_progress.borrow_mut().pop();
         let g = result?;
+        if let Some(why) = moved_relative_normals(&g, 0) {
+            return Err(GeometryError::new(format!(
+                "objects[{}]: {why}",
+                quote(name)
+            )));
+        }
         self.cache.borrow_mut().insert(name.to_string(), g.clone());
         Ok(g)
     }

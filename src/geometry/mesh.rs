@@ -6,6 +6,10 @@ use super::math::{add, cross, dot, normalize, normalize_v3, scale, sub, V3};
 use super::types::{Array, DataType, Domain};
 use crate::scene::{self, AttributeData, MeshData};
 
+/// Positions at which Import PLY set the mesh's custom normals (`Mesh::relative_normals_moved`);
+/// internal, as Blender's dot-prefixed attributes are.
+pub const RELATIVE_NORMALS_REST: &str = ".relative_normals_rest";
+
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Mesh {
     pub positions: Vec<V3>,
@@ -325,12 +329,36 @@ impl Mesh {
         }
     }
 
+    /// Why the custom normals are not Blender's: Import PLY's come with the positions they
+    /// were set at (`RELATIVE_NORMALS_REST`), because Blender stores them relative to each
+    /// corner's fan and they follow any later deformation, which blendsynth does not
+    /// evaluate. None while every vertex with a custom normal is where it was.
+    pub fn relative_normals_moved(&self) -> Option<String> {
+        let rest = self.attributes.named(RELATIVE_NORMALS_REST)?;
+        let (Domain::Point, Some((Domain::Point, n)), Array::Vector(rest)) =
+            (rest.domain, self.free_custom_normals(), &rest.data)
+        else {
+            return None;
+        };
+        let moved = rest.len() != self.vertex_count()
+            || (0..n.len()).any(|v| n[v] != [0.0; 3] && rest[v] != self.positions[v]);
+        moved.then(|| {
+            "its custom normals come from Import PLY (the file's vertex normals, which Blender \
+             stores relative to each corner's fan) and the mesh was deformed after the import: \
+             Blender's normals follow the deformation, which blendsynth does not evaluate"
+                .to_string()
+        })
+    }
+
     /// The Normal input on `domain` where free custom normals replace Blender's
     /// (`Mesh::vert_normals`, `face_normals`, `corner_normals`): None without them. Points
     /// from face or corner custom normals and edges from face or corner ones (Blender's
     /// angle-weighted mixes) are errors.
     pub fn custom_normals_on(&self, domain: Domain) -> Option<Result<Vec<V3>, String>> {
         let (d, n) = self.free_custom_normals()?;
+        if let Some(why) = self.relative_normals_moved() {
+            return Some(Err(why));
+        }
         let sum_norm = |it: &mut dyn Iterator<Item = V3>| normalize(it.fold([0.0f32; 3], add));
         Some(match (domain, d) {
             (Domain::Corner, _) => Ok(self.corner_normals()),

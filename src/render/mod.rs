@@ -791,7 +791,9 @@ fn prepare(
     let centre = frame + shutter.as_ref().map_or(0.0, |s| s.centre_delta);
     let eval = crate::anim::evaluate_scene(scene, centre)
         .map_err(|e| RenderError(format!("evaluating the scene at frame {centre}: {e}")))?;
-    let mut camera = camera::Camera::new(scene, &eval, w, h)?;
+    // Blender switches the camera at the rendered frame, before Cycles syncs the shutter.
+    let cam_name = camera::active_camera(scene, frame)?;
+    let mut camera = camera::Camera::of_object(scene, &eval, cam_name, w, h)?;
     // Objects' world matrices at the motion steps (`motion::object::evaluate_steps`).
     let mut object_steps: Vec<Vec<crate::anim::Mat4>> = Vec::new();
     if let Some(sh) = &shutter {
@@ -807,7 +809,7 @@ fn prepare(
                 })?)
             };
             let at = e.as_ref().unwrap_or(&eval);
-            steps.push(camera::Camera::new(scene, at, w, h)?.to_world);
+            steps.push(camera::Camera::of_object(scene, at, cam_name, w, h)?.to_world);
         }
         object_steps = motion::object::evaluate_steps(scene, &eval, sh)?;
         motion::object::warn_deformation(&eval);

@@ -83,20 +83,6 @@ pub struct CameraMarker {
     pub camera: String,
 }
 
-impl SceneSettings {
-    /// Why the active camera is not `camera` at every frame: Blender switches it at
-    /// timeline markers bound to cameras, which blendsynth does not follow.
-    pub fn camera_switching(&self) -> Option<String> {
-        self.camera_markers.first().map(|m| {
-            format!(
-                "the scene switches its active camera at timeline markers (frame {} binds {:?}); \
-                 blendsynth does not follow camera switching",
-                m.frame, m.camera
-            )
-        })
-    }
-}
-
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct SceneSettings {
     pub name: String,
@@ -115,8 +101,8 @@ pub struct SceneSettings {
     #[serde(default = "one_f64")]
     pub fps_base: f64,
     pub camera: Option<String>,
-    /// Timeline markers bound to a camera (absent in older exports): Blender switches the
-    /// active camera at them.
+    /// Timeline markers bound to a camera, in Blender's list order (absent in older
+    /// exports): Blender switches the active camera at them (`Scene::camera_at`).
     #[serde(default)]
     pub camera_markers: Vec<CameraMarker>,
     #[serde(default)]

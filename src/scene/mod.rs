@@ -3,6 +3,7 @@
 //! This is the only module that knows the JSON layout; everything downstream works on
 //! the typed structures it returns.
 
+mod active_camera;
 pub mod datapath;
 pub mod error;
 pub mod file;

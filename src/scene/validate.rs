@@ -36,6 +36,14 @@ pub(super) fn validate(scene: &Scene, json: &Path) -> Result<(), SceneError> {
             );
         }
     }
+    for (i, m) in f.scene.camera_markers.iter().enumerate() {
+        if !objects.contains(m.camera.as_str()) {
+            return err(
+                format!("scene.camera_markers[{i}].camera"),
+                format!("names object {:?}, which is not in objects", m.camera),
+            );
+        }
+    }
     if let Some(w) = &f.scene.world {
         if !worlds.contains(w.as_str()) {
             return err(

@@ -6,6 +6,9 @@
 //! corner UV map "UVMap", every other vertex property as a float point attribute of its
 //! name; vertex normals `nx`/`ny`/`nz` as custom normals (faces smooth) when there are
 //! faces, else as a point attribute "normal"; without normals every face is flat.
+//! Blender stores those custom normals relative to each corner's fan, so they follow a
+//! later deformation; blendsynth keeps them fixed and refuses a deformed mesh by name
+//! (`Mesh::relative_normals_moved`).
 //! Edges are the file's then the faces' (`mesh_calc_edges`). Blender's read errors (no
 //! header, a short row or file) give empty geometry; an index out of range is refused.
 
@@ -13,7 +16,7 @@ use super::super::attribute::AttrId;
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::math::normalize;
-use super::super::mesh::Mesh;
+use super::super::mesh::{Mesh, RELATIVE_NORMALS_REST};
 use super::super::set::GeometrySet;
 use super::super::types::{Array, Domain};
 use super::super::value::SocketValue;
@@ -608,6 +611,10 @@ fn to_mesh(d: Data) -> Result<Mesh, PlyError> {
         // every corner of a vertex gets that normal (normalized), and no edge turns sharp.
         let n: Vec<[f32; 3]> = d.normals.iter().map(|&v| normalize(v)).collect();
         set(&mut m, "custom_normal", Domain::Point, Array::Vector(n));
+        // Blender's are relative to the corner fans and follow a later deformation: the
+        // rest positions let a deformed mesh be refused (`Mesh::relative_normals_moved`).
+        let rest = Array::Vector(m.positions.clone());
+        set(&mut m, RELATIVE_NORMALS_REST, Domain::Point, rest);
         let ne = m.edge_count();
         set(
             &mut m,

@@ -83,6 +83,9 @@ pub fn set_mesh_normal(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
                 // Capturing replaces an attribute of another domain or type.
                 mm.attributes.remove(&id);
                 mm.attributes.set(id, domain, r[0].clone());
+                // Free normals stay put: no longer Import PLY's relative ones.
+                mm.attributes
+                    .remove(&AttrId::named(super::super::mesh::RELATIVE_NORMALS_REST));
                 Ok(())
             })
             .map_err(|e| ctx.err(e))?;

@@ -11,6 +11,14 @@ use crate::render::RenderError;
 use crate::scene::settings::{CameraSettings, Output, Projection};
 use crate::scene::Scene;
 
+/// The scene's active camera object at `frame` (Blender's switch at timeline markers).
+pub fn active_camera(scene: &Scene, frame: f64) -> Result<&str, RenderError> {
+    scene
+        .camera_at(frame)
+        .map_err(RenderError)?
+        .ok_or_else(|| RenderError("the scene has no active camera (scene.camera is empty)".into()))
+}
+
 #[derive(Debug, Clone)]
 pub struct Camera {
     pub ortho: bool,
@@ -39,19 +47,26 @@ pub struct Camera {
 }
 
 impl Camera {
+    /// The scene's active camera at the evaluated frame (timeline markers switch it).
     pub fn new(
         scene: &Scene,
         eval: &EvaluatedScene,
         width: u32,
         height: u32,
     ) -> Result<Camera, RenderError> {
-        // The exported camera is the active one only without marker switching.
-        if let Some(why) = scene.file.scene.camera_switching() {
-            return Err(RenderError(why));
-        }
-        let cam_name = scene.file.scene.camera.as_deref().ok_or_else(|| {
-            RenderError("the scene has no active camera (scene.camera is empty)".into())
-        })?;
+        let name = active_camera(scene, eval.frame)?;
+        Camera::of_object(scene, eval, name, width, height)
+    }
+
+    /// Camera object `cam_name` as it stands in `eval` (Cycles keeps the frame's camera
+    /// object for every motion step, whatever the markers say at the step).
+    pub fn of_object(
+        scene: &Scene,
+        eval: &EvaluatedScene,
+        cam_name: &str,
+        width: u32,
+        height: u32,
+    ) -> Result<Camera, RenderError> {
         let oi = eval
             .data
             .objects
