@@ -713,10 +713,11 @@ fn parity_fixtures_stay_small() {
     // of it scene.json) to 13.1 MB; the volume scene (gn_volume_nodes.py: 0.15 MB, nearly
     // all of it scene.json; its grids are volume_refs.json, 12 kB) to 13.25 MB; the Import
     // nodes scene (gn_import_nodes.py: 0.12 MB, 5 kB of it the copied input files) to
-    // 13.35 MB.
+    // 13.35 MB; the Format String, Import CSV / Text and Deform Curves on Surface scenes
+    // (gn_misc_nodes.py: 0.32 MB, nearly all of it scene.json) to 13.7 MB.
     assert!(
-        total < 13_350_000,
-        "fixtures/geometry/scenes holds {total} bytes; keep it under 13.35 MB"
+        total < 13_700_000,
+        "fixtures/geometry/scenes holds {total} bytes; keep it under 13.7 MB"
     );
 }
 
