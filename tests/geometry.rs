@@ -1739,3 +1739,45 @@ fn import_obj_gives_one_instance_per_object() {
     let theirs = evaluated(&load("import_nodes"), "imp_obj");
     assert_eq!(theirs.vertex_count(), 9);
 }
+
+/// What Blender reports as a node error is an error naming the node here: Import Text of
+/// a file that is not UTF-8 (the JSON edited to point at a binary copy: Blender's "File
+/// contains invalid UTF-8 characters"), and a Format String naming an item it lacks
+/// (Blender's "Input does not exist").
+#[test]
+fn format_string_and_import_text_errors_name_the_node() {
+    let dir = scenes_dir().join("import_csv_text");
+    let text = std::fs::read_to_string(dir.join("scene.json")).unwrap();
+    let mut doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for f in doc["import_files"].as_array_mut().unwrap() {
+        if f["file"] == "imports/0003_tag.txt" {
+            f["file"] = serde_json::json!("evaluated/0003_text_import.glb");
+        }
+    }
+    let bad = Scene::from_json(&dir, doc.to_string().as_bytes()).unwrap();
+    let e = mesh_of(&bad, "text_import", 1.0, &[]).unwrap_err();
+    assert!(
+        e.contains("Import Text") && e.contains("tag.txt") && e.contains("not valid UTF-8"),
+        "{e}"
+    );
+    let dir = scenes_dir().join("format_string");
+    let text = std::fs::read_to_string(dir.join("scene.json")).unwrap();
+    let mut doc: serde_json::Value = serde_json::from_str(&text).unwrap();
+    for g in doc["node_groups"].as_array_mut().unwrap() {
+        for n in g["nodes"].as_array_mut().unwrap() {
+            for i in n["inputs"].as_array_mut().unwrap() {
+                if i["default_value"] == "a{}b" {
+                    i["default_value"] = serde_json::json!("a{y}b");
+                }
+            }
+        }
+    }
+    let bad = Scene::from_json(&dir, doc.to_string().as_bytes()).unwrap();
+    let e = mesh_of(&bad, "fmt_0", 1.0, &[]).unwrap_err();
+    assert!(
+        e.contains("\"Format String\"") && e.contains("Input does not exist: \"y\""),
+        "{e}"
+    );
+    // Unedited, both evaluate.
+    assert!(mesh_of(&load("format_string"), "fmt_0", 1.0, &[]).is_ok());
+}

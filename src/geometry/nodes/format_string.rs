@@ -9,6 +9,8 @@
 
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
+use super::super::field::Field;
+use super::super::types::DataType;
 use super::super::value::SocketValue;
 
 /// Largest width or precision formatted: Blender would build the string, but a pattern
@@ -30,9 +32,18 @@ pub fn format_string(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
         if s.identifier == "Format" || s.identifier == "__extend__" {
             continue;
         }
+        // One string is made: an item fed by a field (Blender 4.5 has no string fields
+        // and its node gives no text then) is refused naming the item.
+        let single = |ty: DataType| match ctx.field(&s.identifier, ty)? {
+            Field::Constant(v) => Ok(v),
+            _ => Err(ctx.err(format!(
+                "item {:?} is fed by a field; Format String makes a single string",
+                s.name
+            ))),
+        };
         let item = match s.kind.as_str() {
-            "VALUE" => Item::Float(ctx.float(&s.identifier)?),
-            "INT" => Item::Int(ctx.int(&s.identifier)?),
+            "VALUE" => Item::Float(single(DataType::Float)?.as_float()),
+            "INT" => Item::Int(single(DataType::Int)?.as_int()),
             "STRING" => Item::Str(ctx.string(&s.identifier)?),
             other => {
                 return Err(ctx.err(format!(

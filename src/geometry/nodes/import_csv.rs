@@ -68,9 +68,13 @@ pub fn read_csv(bytes: &[u8]) -> Result<PointCloud, String> {
         let Some(data) = parse_column(rows, field) else {
             continue;
         };
-        // A repeated name: Blender's add fails and the first column stays.
+        // Blender's add fails for a repeated name (the first column stays) and for the
+        // point cloud's built-in attributes of another type: position (a vector) and
+        // radius (a float; an integer column of that name is left out).
+        let builtin_clash =
+            name == "position" || (name == "radius" && !matches!(data, Array::Float(_)));
         let id = AttrId::Named(name);
-        if pc.attributes.get(&id).is_some() || id == AttrId::Named("position".into()) {
+        if pc.attributes.get(&id).is_some() || builtin_clash {
             continue;
         }
         pc.attributes.set(id, Domain::Point, data);
@@ -278,5 +282,15 @@ mod tests {
         let pc = read_csv(b"a,b\n1,2\n3\n").unwrap();
         assert_eq!(attr(&pc, "a"), Some(Array::Int(vec![1, 3])));
         assert_eq!(attr(&pc, "b"), None);
+        // Names as Blender 4.5 keeps them (checked with bpy on the point cloud): an integer
+        // radius and a position column are left out, other names kept.
+        let pc = read_csv(b"radius,__x,x y,position,material_index\n1,2,3,4,5\n").unwrap();
+        assert_eq!(attr(&pc, "radius"), None);
+        assert_eq!(attr(&pc, "position"), None);
+        for n in ["__x", "x y", "material_index"] {
+            assert!(attr(&pc, n).is_some(), "{n}");
+        }
+        let pc = read_csv(b"radius\n0.5\n").unwrap();
+        assert_eq!(attr(&pc, "radius"), Some(Array::Float(vec![0.5])));
     }
 }
