@@ -21,6 +21,7 @@ pub mod curve_tangent;
 pub mod curve_to_points;
 pub mod curve_topology;
 pub mod curve_write;
+pub mod deform_curves_on_surface;
 pub mod delete;
 pub mod distribute;
 pub mod domain_size;
@@ -40,6 +41,7 @@ pub mod fillet_curve;
 pub mod flip_faces;
 pub mod float_curve;
 pub mod foreach_element;
+pub mod format_string;
 pub mod function;
 pub mod geometry_ops;
 pub mod geometry_to_instance;
@@ -49,10 +51,12 @@ pub mod gizmo_transform;
 pub mod ico_sphere;
 pub mod image_info;
 pub mod image_texture;
+pub mod import_csv;
 pub mod import_file;
 pub mod import_obj;
 pub mod import_ply;
 pub mod import_stl;
+pub mod import_text;
 pub mod index_of_nearest;
 pub mod input;
 pub mod input_active_camera;
@@ -435,6 +439,7 @@ pub const NODES: &[(&str, Evaluate)] = &[
         foreach_element::foreach_output,
     ),
     ("FunctionNodeValueToString", string::value_to_string),
+    ("FunctionNodeFormatString", format_string::format_string),
     ("GeometryNodeStringJoin", string::join_strings),
     ("FunctionNodeSliceString", string::slice_string),
     ("FunctionNodeStringLength", string::string_length),
@@ -600,6 +605,12 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ),
     // Import nodes: the export's copies of the files (issue 26 item 4).
     ("GeometryNodeImportSTL", import_stl::import_stl),
+    ("GeometryNodeImportCSV", import_csv::import_csv),
+    (
+        "GeometryNodeDeformCurvesOnSurface",
+        deform_curves_on_surface::deform_curves_on_surface,
+    ),
+    ("GeometryNodeImportText", import_text::import_text),
     ("GeometryNodeImportPLY", import_ply::import_ply),
     ("GeometryNodeImportOBJ", import_obj::import_obj),
 ];
