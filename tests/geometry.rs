@@ -733,6 +733,11 @@ fn parity_fixtures_stay_small() {
     assert!(
         total < 13_700_000,
         "fixtures/geometry/scenes holds {total} bytes; keep it under 13.7 MB"
+    // 13.35 MB; the Volume to Mesh cases (gn_volume_nodes.py: 0.18 MB, 0.1 MB of it the
+    // evaluated meshes) to 13.55 MB.
+    assert!(
+        total < 13_550_000,
+        "fixtures/geometry/scenes holds {total} bytes; keep it under 13.55 MB"
     );
 }
 
@@ -1631,6 +1636,39 @@ fn unmatched_volume_nodes_are_refused_by_name() {
             .unwrap_err()
             .to_string()
             .contains(node));
+    }
+}
+
+/// Volume to Mesh's options OpenVDB evaluates differently (a resampled grid for the Voxel
+/// Amount and Voxel Size resolutions, adaptive merging above Adaptivity 0) are refused
+/// naming the node and the option, never meshed as Grid / Adaptivity 0.
+#[test]
+fn unmatched_volume_to_mesh_options_are_refused_by_name() {
+    let scene = load("volume_nodes");
+    let frame = scene.file.scene.frame_current as f64;
+    let node = "node_groups[\"vtm_ball\"].nodes[\"Volume to Mesh\"]";
+    for (path, value, want) in [
+        (
+            format!("{node}.resolution_mode"),
+            serde_json::json!("VOXEL_AMOUNT"),
+            "Resolution \"VOXEL_AMOUNT\"",
+        ),
+        (
+            format!("{node}.resolution_mode"),
+            serde_json::json!("VOXEL_SIZE"),
+            "Resolution \"VOXEL_SIZE\"",
+        ),
+        (
+            format!("{node}.inputs[\"Adaptivity\"].default_value"),
+            serde_json::json!(0.25),
+            "Adaptivity 0.25",
+        ),
+    ] {
+        let e = mesh_of(&scene, "vtm_ball", frame, &[(path, value)]).unwrap_err();
+        assert!(
+            e.contains("GeometryNodeVolumeToMesh") && e.contains(want),
+            "{e}"
+        );
     }
 }
 

@@ -107,6 +107,7 @@ pub mod triangulate;
 pub mod trim_curve;
 pub mod viewer;
 pub mod volume_cube;
+pub mod volume_to_mesh;
 pub mod warning;
 
 use super::error::GeometryError;
@@ -415,6 +416,7 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ("FunctionNodeCombineMatrix", matrix::combine_matrix),
     ("FunctionNodeSeparateMatrix", matrix::separate_matrix),
     ("GeometryNodeVolumeCube", volume_cube::volume_cube),
+    ("GeometryNodeVolumeToMesh", volume_to_mesh::volume_to_mesh),
     ("GeometryNodePoints", points::points),
     ("GeometryNodeSetPointRadius", points::set_point_radius),
     ("GeometryNodeSetID", points::set_id),
