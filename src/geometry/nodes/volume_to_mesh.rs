@@ -270,7 +270,8 @@ fn inside(v: f32, iso: f32) -> bool {
 }
 
 /// Points (world space, Blender's half-voxel offset added) and quads (OpenVDB's corner
-/// order) of one grid.
+/// order) of one grid. Long because OpenVDB's three passes (signs per cell, one point per
+/// sheet, quads per crossing edge) share the cell indexing and are read in its order.
 #[allow(clippy::type_complexity)]
 fn grid_surface(g: &VolumeGrid, iso: f32) -> Result<(Vec<V3>, Vec<[u32; 4]>), String> {
     if g.dims.contains(&0) {
