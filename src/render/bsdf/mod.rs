@@ -581,7 +581,8 @@ pub fn f0_from_ior(ior: f32) -> f32 {
 pub fn fresnel_dielectric(cosi: f32, eta: f32) -> f32 {
     let c = cosi.abs();
     let g2 = eta * eta - 1.0 + c * c;
-    if g2 < 0.0 {
+    // Cycles: total reflection unless g is positive (g = 0 would divide 0 by 0).
+    if g2 <= 0.0 {
         return 1.0;
     }
     let g = g2.sqrt();
@@ -595,7 +596,9 @@ fn fresnel_eval(f: Fresnel, cos_h: f32, tint: V3) -> V3 {
         Fresnel::Constant => tint,
         Fresnel::Dielectric { eta } => scale(tint, fresnel_dielectric(cos_h, eta)),
         Fresnel::Schlick { f0, eta } => {
-            let real_f0 = fresnel_dielectric(1.0, eta);
+            // F0 of eta by formula: at an IOR near 0 the Fresnel at normal incidence is
+            // total reflection in f32 and the remap would divide 0 by 0.
+            let real_f0 = f0_from_ior(eta);
             let s = (fresnel_dielectric(cos_h, eta) - real_f0) / (1.0 - real_f0);
             [0, 1, 2].map(|k| (f0[k] + (1.0 - f0[k]) * s) * tint[k])
         }
