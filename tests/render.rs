@@ -377,7 +377,12 @@ const SCALED_SCENES: &[&[&str]] = &[
 const MAX_SCALE_REL: f64 = 0.003;
 
 /// Scenes that do not pass yet, with the reason.
-const KNOWN_FAILURES: &[(&str, &str)] = &[];
+const KNOWN_FAILURES: &[(&str, &str)] = &[(
+    "glossy_strong_bump",
+    "a GGX Glossy at Roughness 1 under a strong displacement bump renders darker than \
+     Cycles (the material library's Crushed Velvet; at Roughness 0.5 or without the \
+     displacement within 1%); cause not found yet",
+)];
 
 /// Scenes whose one-seed figures are no parity criterion, with the test that compares them
 /// instead (their figures are still printed).
