@@ -343,6 +343,37 @@ impl LobeSet {
         (f, pdf, total)
     }
 
+    /// The value and pdf toward `wi`, which lobe `pick` sampled: the other closures as in
+    /// `eval`, the sampling one as Cycles' bsdf_sample returns it, where the bump shadowing
+    /// term (with its rejection of directions across the smooth surface) applies to
+    /// diffuse closures only and to no transmission.
+    fn eval_sampled(
+        &self,
+        pick: usize,
+        wo: V3,
+        wi: V3,
+        ng: V3,
+        transmit: bool,
+        tables: &Tables,
+    ) -> (V3, f32) {
+        let (rest, rest_pdf, total) = self.eval_sum(wo, wi, ng, tables, 0, Some(pick));
+        let l = &self.lobes[pick];
+        let diffuse = matches!(
+            l.kind,
+            LobeKind::Diffuse | LobeKind::OrenNayar(_) | LobeKind::Translucent
+        );
+        let bump = if diffuse && !transmit {
+            self.bump_term(l, wi)
+        } else {
+            1.0
+        };
+        let (e, p) = eval_lobe(l, wo, wi, ng, tables);
+        let own = self.terminator(scale(e, bump), l, wi);
+        let f = add(rest, mul(own, l.weight));
+        let pdf = rest_pdf + p * l.sample_weight;
+        (f, if total > 0.0 { pdf / total } else { pdf })
+    }
+
     fn bump_term(&self, l: &Lobe, wi: V3) -> f32 {
         // Cycles' bsdf_eval shadows bumped diffuse and microfacet closures only; the hair
         // closures' normals are no bumped shading normals (Chiang's is across the fibre).
@@ -481,7 +512,7 @@ impl LobeSet {
                     kind: l.kind,
                 });
             }
-            let (f, pdf) = self.eval(wo, ds.l, ng, tables);
+            let (f, pdf) = self.eval_sampled(pick, wo, ds.l, ng, transmit, tables);
             if !(pdf > 0.0) || !pdf.is_finite() {
                 return None;
             }
@@ -547,7 +578,7 @@ impl LobeSet {
                 kind: l.kind,
             });
         }
-        let (f, pdf) = self.eval(wo, wi, ng, tables);
+        let (f, pdf) = self.eval_sampled(pick, wo, wi, ng, transmit, tables);
         if !(pdf > 0.0) || !pdf.is_finite() {
             return None;
         }
