@@ -15,7 +15,7 @@ use super::super::pointcloud::PointCloud;
 use super::super::set::GeometrySet;
 use super::super::types::{Array, Domain};
 use super::super::value::SocketValue;
-use super::import_file::{float_prefix, read_path};
+use super::import_file::{float_of_text, float_prefix, read_path};
 
 const DELIMITER: u8 = b',';
 const QUOTE: u8 = b'"';
@@ -155,17 +155,7 @@ fn parse_float(s: &[u8]) -> Option<f32> {
     if n == 0 || !only_spaces(&s[n..]) {
         return None;
     }
-    let text = std::str::from_utf8(&s[..n]).ok()?;
-    let v: f32 = text.parse().ok()?;
-    let finite_text = !text
-        .trim_start_matches('-')
-        .bytes()
-        .next()
-        .is_some_and(|b| b.is_ascii_alphabetic());
-    if v.is_infinite() && finite_text {
-        return None;
-    }
-    Some(v)
+    float_of_text(std::str::from_utf8(&s[..n]).ok()?)
 }
 
 /// `'""'` and `'\"'` as one quote; the name as text (invalid UTF-8 replaced, as an

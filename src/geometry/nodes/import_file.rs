@@ -120,16 +120,22 @@ pub fn parse_float(s: &[u8], fallback: f32) -> (f32, usize) {
         return (fallback, skip);
     }
     let text = std::str::from_utf8(&t[..n]).unwrap_or("0");
-    let v: f32 = text.parse().unwrap_or(fallback);
+    (float_of_text(text).unwrap_or(fallback), skip + n)
+}
+
+/// A float's text read as `fast_float::from_chars` reads it: None when it does not parse
+/// or when a finite-looking number overflows to infinity ("inf" and "nan" stay).
+pub fn float_of_text(text: &str) -> Option<f32> {
+    let v: f32 = text.parse().ok()?;
     let finite_text = !text
         .trim_start_matches('-')
         .bytes()
         .next()
         .is_some_and(|b| b.is_ascii_alphabetic());
     if v.is_infinite() && finite_text {
-        return (fallback, skip + n);
+        return None;
     }
-    (v, skip + n)
+    Some(v)
 }
 
 /// Parses an integer as `std::from_chars` does after Blender skips a '+': optional '-',
