@@ -730,10 +730,12 @@ fn parity_fixtures_stay_small() {
     // nodes scene (gn_import_nodes.py: 0.12 MB, 5 kB of it the copied input files) to
     // 13.35 MB; the Format String, Import CSV / Text and Deform Curves on Surface scenes
     // (gn_misc_nodes.py: 0.32 MB, nearly all of it scene.json) and the Volume to Mesh cases
-    // (gn_volume_nodes.py: 0.18 MB, 0.1 MB of it the evaluated meshes) to 13.9 MB.
+    // (gn_volume_nodes.py: 0.18 MB, 0.1 MB of it the evaluated meshes) to 13.9 MB; the
+    // cases from Molecular Nodes' files (gn_realfile_nodes.py: 0.27 MB, one scene) to
+    // 14.1 MB.
     assert!(
-        total < 13_900_000,
-        "fixtures/geometry/scenes holds {total} bytes; keep it under 13.9 MB"
+        total < 14_100_000,
+        "fixtures/geometry/scenes holds {total} bytes; keep it under 14.1 MB"
     );
 }
 

@@ -18,7 +18,9 @@ use super::mesh::Mesh;
 use super::set::GeometrySet;
 use super::types::{DataType, Domain, Value};
 use super::value::SocketValue;
-use crate::nodes::graph::{active_output, flatten, FlatGraph, FlatNode, Source};
+use crate::nodes::graph::{
+    active_output, default_input_field, flatten, FlatGraph, FlatNode, Source,
+};
 use crate::scene::{quote, Modifier, Node, NodeTree, Object, Scene};
 
 /// A node's results, by output socket identifier.
@@ -537,15 +539,40 @@ impl<'e, 'a> NodeCtx<'e, 'a> {
                 };
                 SocketValue::from_json(&s.kind, dv).map_err(|e| self.err(e))?
             }
-            Source::GroupInput(id) => self
-                .ev
-                .group_inputs
-                .get(*id)
-                .cloned()
-                .unwrap_or_else(|| SocketValue::zero(consumer_kind)),
+            // A modifier input whose Default Input is a field is not set on the modifier:
+            // Blender evaluates the field.
+            Source::GroupInput(id) => match default_input_field(self.ev.tree, id) {
+                Some(kind) => self.default_input(kind)?,
+                None => self
+                    .ev
+                    .group_inputs
+                    .get(*id)
+                    .cloned()
+                    .unwrap_or_else(|| SocketValue::zero(consumer_kind)),
+            },
+            Source::DefaultInput(kind) => self.default_input(kind)?,
             Source::Nothing => SocketValue::zero(consumer_kind),
         };
         Ok(coerce(v, consumer_kind))
+    }
+
+    /// The field a group input's Default Input names (`NodeDefaultInputType`).
+    fn default_input(&self, kind: &str) -> Result<SocketValue, GeometryError> {
+        let f = match kind {
+            "INDEX" => Field::input(IndexInput),
+            "ID_OR_INDEX" => Field::input(IdInput),
+            "NORMAL" => Field::input(super::field::NormalInput),
+            "POSITION" => Field::input(PositionInput),
+            "INSTANCE_TRANSFORM" => super::nodes::points::instance_transform_field(),
+            "HANDLE_LEFT" => super::nodes::curve_read::handle_positions_field(true),
+            "HANDLE_RIGHT" => super::nodes::curve_read::handle_positions_field(false),
+            other => {
+                return Err(self.err(format!(
+                    "a group input's Default Input {other:?} is not supported"
+                )))
+            }
+        };
+        Ok(SocketValue::Field(f))
     }
 
     fn flat_input(

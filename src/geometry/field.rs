@@ -150,6 +150,12 @@ pub trait FieldInput: fmt::Debug + Send + Sync {
     fn attribute_name(&self) -> Option<&str> {
         None
     }
+    /// Whether the input is one of Blender's multi-functions that read another geometry
+    /// (Sample Index): those work in every context, the grid's included, where the
+    /// context's own inputs read 0.
+    fn samples_other_geometry(&self) -> bool {
+        false
+    }
 }
 
 type OpFn = dyn Fn(usize, &[Array]) -> Result<Vec<Array>, String> + Send + Sync;
@@ -260,7 +266,11 @@ impl Field {
         let n = ctx.component.domain_size(domain);
         match self {
             Field::Constant(v) => Ok(Array::filled(*v, n)),
-            Field::Input(i) if ctx.position_only && i.attribute_name() != Some("position") => {
+            Field::Input(i)
+                if ctx.position_only
+                    && i.attribute_name() != Some("position")
+                    && !i.samples_other_geometry() =>
+            {
                 Ok(Array::zeros(i.data_type(), n))
             }
             Field::Input(i) => {

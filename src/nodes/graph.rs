@@ -26,6 +26,9 @@ pub enum Source<'a> {
     /// An input of the outermost tree (a Geometry Nodes modifier input), by interface
     /// identifier.
     GroupInput(&'a str),
+    /// An unlinked group input whose interface socket has a field as its Default Input
+    /// (`InterfaceItem::default_input_field`: Index, Position, ...).
+    DefaultInput(&'a str),
     /// Nothing: an unlinked reroute, or a muted node's output without a pass-through.
     /// Blender gives the socket type's zero value.
     Nothing,
@@ -303,6 +306,18 @@ impl<'a> Builder<'a> {
                                 format!("has no input {identifier:?} for its group's interface"),
                             )
                         })?;
+                    let linked = self.instances[outer].tree.links.iter().any(|l| {
+                        l.to_node == group_node.name
+                            && l.to_socket == s.identifier
+                            && !l.is_muted
+                            && l.is_valid
+                    });
+                    if !linked {
+                        if let Some(f) = default_input_field(self.instances[inst].tree, identifier)
+                        {
+                            return Ok(Source::DefaultInput(f));
+                        }
+                    }
                     self.single(outer, group_node, s)
                 }
             };
@@ -402,4 +417,15 @@ fn pass_through(node: &Node, index: usize) -> Option<&Socket> {
         return node.inputs.iter().find(|s| s.identifier == link.from);
     }
     node.inputs.iter().find(|s| s.enabled && s.kind == out.kind)
+}
+
+/// The field an unlinked input `identifier` of group `tree` reads, if its Default Input is
+/// one.
+pub fn default_input_field<'a>(tree: &'a NodeTree, identifier: &str) -> Option<&'a str> {
+    tree.interface
+        .iter()
+        .find(|it| {
+            it.identifier.as_deref() == Some(identifier) && it.in_out.as_deref() == Some("INPUT")
+        })
+        .and_then(|it| it.default_input_field())
 }

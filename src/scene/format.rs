@@ -599,6 +599,19 @@ pub struct Socket {
     pub is_multi_input: bool,
 }
 
+impl InterfaceItem {
+    /// A Geometry Nodes group input's Default Input when it is a field (`INDEX`,
+    /// `ID_OR_INDEX`, `NORMAL`, `POSITION`, `INSTANCE_TRANSFORM`, `HANDLE_LEFT`,
+    /// `HANDLE_RIGHT`): what the input gives while its socket is unlinked. `None` for
+    /// the socket's own value (`VALUE`, or an export without the setting).
+    pub fn default_input_field(&self) -> Option<&str> {
+        self.properties
+            .get("default_input")
+            .and_then(|v| v.as_str())
+            .filter(|v| *v != "VALUE")
+    }
+}
+
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct Link {
     pub from_node: String,

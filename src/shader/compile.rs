@@ -435,6 +435,10 @@ impl<'g, 'a> Compiler<'g, 'a> {
                 "node {:?} reads group input {i:?}, which a material cannot provide",
                 n.path
             ))),
+            Some(Source::DefaultInput(k)) => Err(CompileError(format!(
+                "node {:?} reads a group input whose Default Input is the {k} field, which a material cannot provide",
+                n.path
+            ))),
             Some(Source::Link { node, output, .. }) => {
                 let (slot, have) = self.values[*node]
                     .get(*output)

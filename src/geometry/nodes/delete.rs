@@ -6,6 +6,7 @@
 
 use std::sync::Arc;
 
+use super::super::curves::Curves;
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::{ComponentRef, Field};
@@ -114,6 +115,38 @@ pub fn mesh_keep(m: &Mesh, domain: Domain, keep: &[bool], mode: Mode) -> Mesh {
     out
 }
 
+/// The curves' selected points (`curves_copy_point_selection`: a curve keeps the points
+/// selected on it, in order, and goes when none is) or selected curves
+/// (`curves_copy_curve_selection`), with their attributes.
+fn curves_keep(c: &Curves, domain: Domain, keep: &[bool]) -> Curves {
+    let mut points = Vec::new();
+    let mut curves = Vec::new();
+    let mut offsets = vec![0u32];
+    for i in 0..c.curve_count() {
+        let before = points.len();
+        for p in c.points(i) {
+            let on = if domain == Domain::Point {
+                keep[p]
+            } else {
+                keep[i]
+            };
+            if on {
+                points.push(p);
+            }
+        }
+        if points.len() > before {
+            curves.push(i);
+            offsets.push(points.len() as u32);
+        }
+    }
+    let mut out = c.clone();
+    out.positions = points.iter().map(|&p| c.positions[p]).collect();
+    out.curve_offsets = offsets;
+    out.attributes.gather_domain(Domain::Point, &points);
+    out.attributes.gather_domain(Domain::Curve, &curves);
+    out
+}
+
 /// Keeps the selected (or, `invert`, the unselected) elements of every component.
 fn separate(
     s: &mut GeometrySet,
@@ -152,8 +185,16 @@ fn separate(
             s.points = Some(Arc::new(q));
         }
     }
-    if s.curves.is_some() && matches!(domain, Domain::Point | Domain::Curve) {
-        return Err("deleting curve elements is not supported yet".into());
+    if let Some(c) = s.curves.clone() {
+        if matches!(domain, Domain::Point | Domain::Curve) {
+            let r = eval_fields(ComponentRef::Curves(&c), domain, &[(sel, DataType::Bool)])?;
+            let keep = pick(r[0].as_bool());
+            if keep.iter().any(|k| !k) {
+                let kept = curves_keep(&c, domain, &keep);
+                // Blender removes the component when no point is left.
+                s.curves = (kept.point_count() > 0).then(|| Arc::new(kept));
+            }
+        }
     }
     if let Some(i) = s.instances.clone() {
         if domain == Domain::Instance {

@@ -117,6 +117,9 @@ impl FieldInput for SampleIndex {
     fn data_type(&self) -> DataType {
         self.value.data_type()
     }
+    fn samples_other_geometry(&self) -> bool {
+        true
+    }
     fn evaluate(&self, ctx: &FieldContext, domain: Domain) -> Result<Array, String> {
         let n = ctx.component.domain_size(domain);
         let g = &*self.geometry;

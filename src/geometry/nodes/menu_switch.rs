@@ -31,9 +31,18 @@ pub fn menu_switch(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             )))
         }
     };
-    // A menu value that names no item (a modifier menu stored as a number, or a renamed
-    // item) is refused: Blender's own fallback depends on item identifiers the export
-    // does not carry.
+    // An empty value is what the exporter reads for a menu socket whose stored item
+    // Blender cannot resolve (no items reach it, as on a group node of Molecular Nodes'
+    // Style Preset 3): Blender's Menu Switch then matches no item and outputs its
+    // defaults (`set_default_remaining_node_outputs`; checked in bpy, the preset's
+    // spheres give neither points nor instances).
+    if picked.is_empty() {
+        let kind = node.outputs.first().map(|s| s.kind.as_str()).unwrap_or("");
+        return Ok(outputs([("Output", SocketValue::zero(kind))]));
+    }
+    // Any other value that names no item (a modifier menu stored as a number, or a
+    // renamed item) is refused: Blender's own fallback depends on item identifiers the
+    // export does not carry.
     let k = items.iter().position(|i| *i == picked).ok_or_else(|| {
         ctx.err(format!(
             "menu value {picked:?} is none of the items {items:?}"
