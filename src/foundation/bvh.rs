@@ -47,6 +47,26 @@ pub trait Accel: Sync {
     fn occluded_vis(&self, org: V3, dir: V3, tmin: f32, tmax: f32, time: f32, _mask: u32) -> bool {
         self.occluded_at(org, dir, tmin, tmax, time)
     }
+    /// The nearest hit beyond 0 of a ray that starts on triangle `skip` and passes it:
+    /// `intersect_at` from 0 and, when that finds `skip`, again from just past it (the
+    /// subsurface walk's first ray). Returns the hit and whether `skip` came first (the
+    /// definition's second query was needed).
+    fn intersect_past(
+        &self,
+        org: V3,
+        dir: V3,
+        tmax: f32,
+        time: f32,
+        skip: u32,
+    ) -> (Option<Hit>, bool) {
+        let h = self.intersect_at(org, dir, 0.0, tmax, time);
+        match h {
+            Some(s) if s.prim == skip => {
+                (self.intersect_at(org, dir, s.t.next_up(), tmax, time), true)
+            }
+            _ => (h, false),
+        }
+    }
 }
 
 /// Visibility masks: an object's is the `ray::` bits of the rays that see it, a ray's the
@@ -300,7 +320,11 @@ impl Bvh {
 /// layouts answer every query by it (static geometry: the shutter time is ignored).
 macro_rules! accel_by_traverse {
     ($t:ty) => {
+        $crate::foundation::bvh::accel_by_traverse!($t, {});
+    };
+    ($t:ty, { $($extra:item)* }) => {
         impl $crate::foundation::bvh::Accel for $t {
+            $($extra)*
             fn intersect(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> Option<Hit> {
                 self.traverse::<false>(
                     org,
@@ -343,6 +367,21 @@ macro_rules! accel_by_traverse {
                 self.traverse::<true>(org, dir, tmin, tmax, mask).is_some()
             }
         }
+    };
+    // With the layout's own `intersect_past` (one traversal that passes the triangle).
+    ($t:ty, past) => {
+        $crate::foundation::bvh::accel_by_traverse!($t, {
+            fn intersect_past(
+                &self,
+                org: V3,
+                dir: V3,
+                tmax: f32,
+                _time: f32,
+                skip: u32,
+            ) -> (Option<Hit>, bool) {
+                <$t>::intersect_past(self, org, dir, tmax, skip)
+            }
+        });
     };
 }
 pub(crate) use accel_by_traverse;
