@@ -164,8 +164,11 @@ pub struct Bvh {
 impl Bvh {
     /// A BVH whose triangle `i` is seen only by rays sharing a bit with `masks[i]`
     /// (`visibility`); `masks` empty, or every mask `visibility::ALL`, means all visible.
+    /// The render's structures are built this way, with the full SAH sweep when small
+    /// (`box_tree::SWEEP_MAX`); `build` (a node's or a shader's ray queries, built per
+    /// evaluation) keeps the binned build's set-up.
     pub fn build_masked(tris: &[[V3; 3]], masks: &[u32]) -> Bvh {
-        let mut bvh = Bvh::build(tris);
+        let mut bvh = Bvh::build_split_from(tris, PAR_MIN, true);
         if masks.len() == tris.len()
             && masks
                 .iter()
@@ -177,12 +180,12 @@ impl Bvh {
     }
 
     pub fn build(tris: &[[V3; 3]]) -> Bvh {
-        Bvh::build_split_from(tris, PAR_MIN)
+        Bvh::build_split_from(tris, PAR_MIN, false)
     }
 
     /// The build, with subtrees of at least `par_min` triangles split on rayon's threads
     /// (`BoxTree::build_sah`: the same tree at any thread count).
-    fn build_split_from(tris: &[[V3; 3]], par_min: usize) -> Bvh {
+    fn build_split_from(tris: &[[V3; 3]], par_min: usize, sweep: bool) -> Bvh {
         let tree = BoxTree::build_sah(
             tris.len(),
             |i| {
@@ -190,6 +193,7 @@ impl Bvh {
                 (vmin(vmin(t[0], t[1]), t[2]), vmax(vmax(t[0], t[1]), t[2]))
             },
             par_min,
+            sweep,
         );
         let tris_sorted = tree.ids.par_iter().map(|&i| tris[i as usize]).collect();
         Bvh {
@@ -761,7 +765,7 @@ mod tests {
             .chain([((64 * 1024, 6), PAR_MIN)]);
         for ((n, seed), par_min) in cases {
             let tris = soup(n, seed);
-            let a = Bvh::build_split_from(&tris, par_min);
+            let a = Bvh::build_split_from(&tris, par_min, false);
             let b = reference_build(&tris);
             assert_eq!(a.tree.ids, b.tree.ids, "{n}");
             assert_eq!(a.tree.nodes.len(), b.tree.nodes.len(), "{n}");
