@@ -210,7 +210,7 @@ impl Bvh4 {
     /// triangles at a time (`tri4`), so the same hit.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn leaf<const ANY: bool>(
+    fn leaf<const ANY: bool, const SKIP: bool>(
         &self,
         first: u32,
         count: u32,
@@ -249,7 +249,7 @@ impl Bvh4 {
                 };
                 if let Some((t, u, v)) = hit {
                     let prim = p.id[l];
-                    if prim == skip.prim {
+                    if SKIP && prim == skip.prim {
                         // Not a hit; where it was met decides whether the result stands.
                         skip.t = skip.t.min(t);
                         continue;
@@ -279,7 +279,7 @@ impl Bvh4 {
         mask: u32,
     ) -> Option<Hit> {
         let mut none = Skip::NONE;
-        self.traverse_skip::<ANY>(org, dir, tmin, tmax, mask, &mut none)
+        self.traverse_skip::<ANY, false>(org, dir, tmin, tmax, mask, &mut none)
     }
 
     /// `Accel::intersect_past` in one traversal where it can: the traversal leaves out
@@ -294,7 +294,7 @@ impl Bvh4 {
             prim: skip,
             t: f32::INFINITY,
         };
-        let h = self.traverse_skip::<false>(org, dir, 0.0, tmax, visibility::ALL, &mut sk);
+        let h = self.traverse_skip::<false, true>(org, dir, 0.0, tmax, visibility::ALL, &mut sk);
         let ts = sk.t;
         match h {
             _ if ts == f32::INFINITY => (h, false),
@@ -309,7 +309,7 @@ impl Bvh4 {
     }
 
     #[inline(always)]
-    fn traverse_skip<const ANY: bool>(
+    fn traverse_skip<const ANY: bool, const SKIP: bool>(
         &self,
         org: V3,
         dir: V3,
@@ -342,7 +342,7 @@ impl Bvh4 {
                 continue;
             }
             if count > 0 {
-                if self.leaf::<ANY>(
+                if self.leaf::<ANY, SKIP>(
                     idx, count, &wt, org, tmin, &mut tfar, &mut best, filter, mask, skip,
                 ) && ANY
                 {
