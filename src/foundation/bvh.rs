@@ -47,6 +47,26 @@ pub trait Accel: Sync {
     fn occluded_vis(&self, org: V3, dir: V3, tmin: f32, tmax: f32, time: f32, _mask: u32) -> bool {
         self.occluded_at(org, dir, tmin, tmax, time)
     }
+    /// The nearest hit beyond 0 of a ray that starts on triangle `skip` and passes it:
+    /// `intersect_at` from 0 and, when that finds `skip`, again from just past it (the
+    /// subsurface walk's first ray). Returns the hit and whether `skip` came first (the
+    /// definition's second query was needed).
+    fn intersect_past(
+        &self,
+        org: V3,
+        dir: V3,
+        tmax: f32,
+        time: f32,
+        skip: u32,
+    ) -> (Option<Hit>, bool) {
+        let h = self.intersect_at(org, dir, 0.0, tmax, time);
+        match h {
+            Some(s) if s.prim == skip => {
+                (self.intersect_at(org, dir, s.t.next_up(), tmax, time), true)
+            }
+            _ => (h, false),
+        }
+    }
 }
 
 /// Visibility masks: an object's is the `ray::` bits of the rays that see it, a ray's the
@@ -144,8 +164,11 @@ pub struct Bvh {
 impl Bvh {
     /// A BVH whose triangle `i` is seen only by rays sharing a bit with `masks[i]`
     /// (`visibility`); `masks` empty, or every mask `visibility::ALL`, means all visible.
+    /// The render's structures are built this way, with the full SAH sweep when small
+    /// (`box_tree::SWEEP_MAX`); `build` (a node's or a shader's ray queries, built per
+    /// evaluation) keeps the binned build's set-up.
     pub fn build_masked(tris: &[[V3; 3]], masks: &[u32]) -> Bvh {
-        let mut bvh = Bvh::build(tris);
+        let mut bvh = Bvh::build_split_from(tris, PAR_MIN, true);
         if masks.len() == tris.len()
             && masks
                 .iter()
@@ -157,12 +180,12 @@ impl Bvh {
     }
 
     pub fn build(tris: &[[V3; 3]]) -> Bvh {
-        Bvh::build_split_from(tris, PAR_MIN)
+        Bvh::build_split_from(tris, PAR_MIN, false)
     }
 
     /// The build, with subtrees of at least `par_min` triangles split on rayon's threads
     /// (`BoxTree::build_sah`: the same tree at any thread count).
-    fn build_split_from(tris: &[[V3; 3]], par_min: usize) -> Bvh {
+    fn build_split_from(tris: &[[V3; 3]], par_min: usize, sweep: bool) -> Bvh {
         let tree = BoxTree::build_sah(
             tris.len(),
             |i| {
@@ -170,6 +193,7 @@ impl Bvh {
                 (vmin(vmin(t[0], t[1]), t[2]), vmax(vmax(t[0], t[1]), t[2]))
             },
             par_min,
+            sweep,
         );
         let tris_sorted = tree.ids.par_iter().map(|&i| tris[i as usize]).collect();
         Bvh {
@@ -300,7 +324,11 @@ impl Bvh {
 /// layouts answer every query by it (static geometry: the shutter time is ignored).
 macro_rules! accel_by_traverse {
     ($t:ty) => {
+        $crate::foundation::bvh::accel_by_traverse!($t, {});
+    };
+    ($t:ty, { $($extra:item)* }) => {
         impl $crate::foundation::bvh::Accel for $t {
+            $($extra)*
             fn intersect(&self, org: V3, dir: V3, tmin: f32, tmax: f32) -> Option<Hit> {
                 self.traverse::<false>(
                     org,
@@ -343,6 +371,21 @@ macro_rules! accel_by_traverse {
                 self.traverse::<true>(org, dir, tmin, tmax, mask).is_some()
             }
         }
+    };
+    // With the layout's own `intersect_past` (one traversal that passes the triangle).
+    ($t:ty, past) => {
+        $crate::foundation::bvh::accel_by_traverse!($t, {
+            fn intersect_past(
+                &self,
+                org: V3,
+                dir: V3,
+                tmax: f32,
+                _time: f32,
+                skip: u32,
+            ) -> (Option<Hit>, bool) {
+                <$t>::intersect_past(self, org, dir, tmax, skip)
+            }
+        });
     };
 }
 pub(crate) use accel_by_traverse;
@@ -722,7 +765,7 @@ mod tests {
             .chain([((64 * 1024, 6), PAR_MIN)]);
         for ((n, seed), par_min) in cases {
             let tris = soup(n, seed);
-            let a = Bvh::build_split_from(&tris, par_min);
+            let a = Bvh::build_split_from(&tris, par_min, false);
             let b = reference_build(&tris);
             assert_eq!(a.tree.ids, b.tree.ids, "{n}");
             assert_eq!(a.tree.nodes.len(), b.tree.nodes.len(), "{n}");

@@ -7,7 +7,7 @@
 //! the same watertight test and tie rule (`Bvh::leaf`), so every query returns exactly
 //! the hit the binary BVH returns and images are bit-identical.
 
-use super::bvh::{Bvh, Hit, Watertight};
+use super::bvh::{visibility, Bvh, Hit, Watertight};
 use super::math::*;
 use rayon::prelude::*;
 use std::mem::MaybeUninit;
@@ -49,6 +49,19 @@ impl TriPack {
     fn tri(&self, lane: usize) -> [V3; 3] {
         std::array::from_fn(|k| std::array::from_fn(|a| self.v[k][a][lane]))
     }
+}
+
+/// A triangle a traversal passes (`u32::MAX`: none) and the least distance it met it at.
+struct Skip {
+    prim: u32,
+    t: f32,
+}
+
+impl Skip {
+    const NONE: Skip = Skip {
+        prim: u32::MAX,
+        t: f32::INFINITY,
+    };
 }
 
 pub struct Bvh4 {
@@ -197,7 +210,7 @@ impl Bvh4 {
     /// triangles at a time (`tri4`), so the same hit.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn leaf<const ANY: bool>(
+    fn leaf<const ANY: bool, const SKIP: bool>(
         &self,
         first: u32,
         count: u32,
@@ -208,6 +221,7 @@ impl Bvh4 {
         best: &mut Option<Hit>,
         filter: bool,
         mask: u32,
+        skip: &mut Skip,
     ) -> bool {
         let mut found = false;
         let packs = first as usize..(first + count.div_ceil(4)) as usize;
@@ -235,6 +249,11 @@ impl Bvh4 {
                 };
                 if let Some((t, u, v)) = hit {
                     let prim = p.id[l];
+                    if SKIP && prim == skip.prim {
+                        // Not a hit; where it was met decides whether the result stands.
+                        skip.t = skip.t.min(t);
+                        continue;
+                    }
                     if t == *tfar && best.is_none_or(|b| prim > b.prim) {
                         continue;
                     }
@@ -258,6 +277,46 @@ impl Bvh4 {
         tmin: f32,
         tmax: f32,
         mask: u32,
+    ) -> Option<Hit> {
+        let mut none = Skip::NONE;
+        self.traverse_skip::<ANY, false>(org, dir, tmin, tmax, mask, &mut none)
+    }
+
+    /// `Accel::intersect_past` in one traversal where it can: the traversal leaves out
+    /// triangle `skip` and notes the least distance it was met at, t_s. The two-query
+    /// definition returns the nearest other hit h as well unless `skip` comes first
+    /// (t_s, skip) < (h.t, h.prim) and h.t <= next_up(t_s): that second query starts past
+    /// next_up(t_s), and only then can it miss a hit at t_s or next_up(t_s) that h is;
+    /// that case (a tie on a shared edge) is queried again as defined. A `skip` met
+    /// beyond h is not always noted (its box culled), and then it does not matter.
+    pub fn intersect_past(&self, org: V3, dir: V3, tmax: f32, skip: u32) -> (Option<Hit>, bool) {
+        let mut sk = Skip {
+            prim: skip,
+            t: f32::INFINITY,
+        };
+        let h = self.traverse_skip::<false, true>(org, dir, 0.0, tmax, visibility::ALL, &mut sk);
+        let ts = sk.t;
+        match h {
+            _ if ts == f32::INFINITY => (h, false),
+            Some(h) if h.t < ts || (h.t == ts && h.prim < skip) => (Some(h), false),
+            Some(h) if h.t > ts.next_up() => (Some(h), true),
+            None => (None, true),
+            Some(_) => (
+                self.traverse::<false>(org, dir, ts.next_up(), tmax, visibility::ALL),
+                true,
+            ),
+        }
+    }
+
+    #[inline(always)]
+    fn traverse_skip<const ANY: bool, const SKIP: bool>(
+        &self,
+        org: V3,
+        dir: V3,
+        tmin: f32,
+        tmax: f32,
+        mask: u32,
+        skip: &mut Skip,
     ) -> Option<Hit> {
         if self.nodes.is_empty() {
             return None;
@@ -283,8 +342,8 @@ impl Bvh4 {
                 continue;
             }
             if count > 0 {
-                if self.leaf::<ANY>(
-                    idx, count, &wt, org, tmin, &mut tfar, &mut best, filter, mask,
+                if self.leaf::<ANY, SKIP>(
+                    idx, count, &wt, org, tmin, &mut tfar, &mut best, filter, mask, skip,
                 ) && ANY
                 {
                     return best;
@@ -515,4 +574,4 @@ fn slab4(n: &Node4, r: &RaySlab, tmin: f32, tmax: f32) -> ([f32; 4], u32) {
     }
 }
 
-super::bvh::accel_by_traverse!(Bvh4);
+super::bvh::accel_by_traverse!(Bvh4, past);

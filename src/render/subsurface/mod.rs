@@ -523,12 +523,29 @@ impl LocalTrace for Local<'_, '_> {
         // Pass through other objects (Cycles' local intersection sees one object only) and
         // the skipped triangle. The next search starts just past the hit (hits count only
         // beyond t0): no absolute epsilon, which would not scale with the scene.
-        for _ in 0..64 {
-            self.rays += 1;
-            let h = self
-                .scene
-                .accel
-                .intersect_at(org, dir, t0, tmax, self.time)?;
+        let mut searches = 0;
+        while searches < 64 {
+            let h = match skip {
+                // The first search passes the entry triangle in one traversal where the
+                // structure can (half the walks met it first and searched twice); it
+                // counts as the searches it stands for.
+                Some(s) if searches == 0 => {
+                    let (h, twice) = self
+                        .scene
+                        .accel
+                        .intersect_past(org, dir, tmax, self.time, s);
+                    searches += 1 + twice as u32;
+                    self.rays += 1 + twice as u64;
+                    h?
+                }
+                _ => {
+                    self.rays += 1;
+                    searches += 1;
+                    self.scene
+                        .accel
+                        .intersect_at(org, dir, t0, tmax, self.time)?
+                }
+            };
             if self.scene.geo.refs[h.prim as usize].inst == inst && Some(h.prim) != skip {
                 return Some((h.t, h.prim, h.u, h.v));
             }
