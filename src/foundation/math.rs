@@ -443,6 +443,21 @@ impl Affine {
     pub fn column(&self, i: usize) -> V3 {
         [self.m[0][i], self.m[1][i], self.m[2][i]]
     }
+    /// `point` on a `Vec3` (the array forms stay for the modules not yet converted).
+    #[inline]
+    pub fn point_vec3(&self, p: Vec3) -> Vec3 {
+        self.point(p.into()).into()
+    }
+    /// `vector` on a `Vec3`.
+    #[inline]
+    pub fn vector_vec3(&self, v: Vec3) -> Vec3 {
+        self.vector(v.into()).into()
+    }
+    /// `column` as a `Vec3`.
+    #[inline]
+    pub fn column_vec3(&self, i: usize) -> Vec3 {
+        self.column(i).into()
+    }
     /// Inverse (None when singular), computed in f64.
     pub fn inverse(&self) -> Option<Affine> {
         let a = |r: usize, c: usize| self.m[r][c] as f64;
