@@ -6,7 +6,7 @@
 pub mod panorama;
 
 use crate::anim::EvaluatedScene;
-use crate::render::math::*;
+use crate::render::math::{vec3, Affine, Vec3, V3};
 use crate::render::RenderError;
 use crate::scene::settings::{CameraSettings, Output, Projection};
 use crate::scene::Scene;

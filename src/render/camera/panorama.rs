@@ -6,7 +6,7 @@
 
 use crate::scene::settings::CameraSettings;
 
-use crate::render::math::*;
+use crate::render::math::{vec3, Vec3, V3};
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum Panorama {

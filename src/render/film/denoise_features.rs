@@ -12,7 +12,7 @@
 //! albedo. A path that never writes leaves zero.
 
 use crate::render::bsdf::{LobeKind, LobeSet};
-use crate::render::math::*;
+use crate::render::math::{Vec3, V3};
 
 /// One sample's guide values and the state of their path.
 #[derive(Debug, Clone, Copy)]

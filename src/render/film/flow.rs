@@ -19,7 +19,7 @@ use rayon::prelude::*;
 use crate::render::accel::{self, Accel};
 use crate::render::build::Geometry;
 use crate::render::camera::Camera;
-use crate::render::math::*;
+use crate::render::math::{Vec3, V3};
 
 /// What the primary ray through a pixel centre hit: an instance of the frame's geometry,
 /// a triangle of its mesh, and the hit's barycentrics (the corner weights are 1 - u - v,
