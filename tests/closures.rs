@@ -5,14 +5,14 @@
 use blendsynth::render::bsdf::microfacet::{glass_closure, Dielectric, Distribution};
 use blendsynth::render::bsdf::oren_nayar::OrenNayar;
 use blendsynth::render::bsdf::tables::Tables;
-use blendsynth::render::math::{basis, dot, normalize};
+use blendsynth::render::math::{vec3, Vec3};
 use blendsynth::render::sampler::PixelSampler;
 
-fn view(mu: f32) -> [f32; 3] {
-    [(1.0 - mu * mu).sqrt(), 0.0, mu]
+fn view(mu: f32) -> Vec3 {
+    vec3((1.0 - mu * mu).sqrt(), 0.0, mu)
 }
 
-const N: [f32; 3] = [0.0, 0.0, 1.0];
+const N: Vec3 = Vec3::Z;
 
 #[test]
 fn rough_glass_sample_matches_eval() {
@@ -124,7 +124,7 @@ fn oren_nayar_white_furnace() {
                 // Cosine-weighted direction: weight = eval / (cos / pi).
                 let r = u[0].sqrt();
                 let phi = 2.0 * std::f32::consts::PI * u[1];
-                let l = [r * phi.cos(), r * phi.sin(), (1.0 - u[0]).sqrt()];
+                let l = vec3(r * phi.cos(), r * phi.sin(), (1.0 - u[0]).sqrt());
                 let f = on.eval(N, v, l)[0];
                 sum += (f / (l[2] / std::f32::consts::PI)) as f64;
             }
@@ -137,9 +137,9 @@ fn oren_nayar_white_furnace() {
     }
     // And single scattering alone loses energy at high roughness (the term matters).
     let on = OrenNayar::new(1.0, [0.0; 3], 0.5);
-    let l = normalize([0.3, 0.2, 0.9]);
-    let (t, b) = basis(N);
-    assert!(dot(t, b).abs() < 1e-6);
+    let l = vec3(0.3, 0.2, 0.9).normalize();
+    let (t, b) = N.basis();
+    assert!(t.dot(b).abs() < 1e-6);
     assert!(
         on.eval(N, view(0.5), l)[0] < OrenNayar::new(1.0, [1.0; 3], 0.5).eval(N, view(0.5), l)[0]
     );

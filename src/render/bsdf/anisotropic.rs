@@ -8,7 +8,7 @@
 //!
 //! Directions: `v` toward the viewer, `l` toward the light.
 
-use crate::render::bsdf::microfacet::{sample_ggx_vndf, ROUGHNESS_SQ_THRESH};
+use crate::render::bsdf::microfacet::{ggx_vndf, ROUGHNESS_SQ_THRESH};
 use crate::render::math::*;
 use std::f32::consts::PI;
 
@@ -17,17 +17,15 @@ pub struct AnisoGgx {
     pub alpha_x: f32,
     pub alpha_y: f32,
     /// Tangent (alpha_x direction) and bitangent, orthonormal to the closure normal.
-    pub x: V3,
-    pub y: V3,
+    pub x: Vec3,
+    pub y: Vec3,
 }
 
 /// Cycles' rotate_around_axis: `p` rotated by `angle` radians about unit `axis`.
 pub fn rotate_around_axis(p: V3, axis: V3, angle: f32) -> V3 {
+    let (p, axis) = (Vec3::from(p), Vec3::from(axis));
     let (s, c) = angle.sin_cos();
-    add(
-        add(scale(p, c), scale(cross(axis, p), s)),
-        scale(axis, dot(axis, p) * (1.0 - c)),
-    )
+    (p * c + axis.cross(p) * s + axis * (axis.dot(p) * (1.0 - c))).into()
 }
 
 /// Glossy BSDF roughness parameters: alpha = roughness^2 stretched by the anisotropy
@@ -59,12 +57,13 @@ impl AnisoGgx {
     /// The closure for normal `n` and tangent `t` (not necessarily orthogonal to `n`;
     /// Cycles' make_orthonormals_tangent). A tangent along the normal leaves any frame.
     pub fn new(n: V3, t: V3, alpha_x: f32, alpha_y: f32) -> AnisoGgx {
-        let c = cross(n, t);
-        let (x, y) = if dot(c, c) > 1e-12 && c.iter().all(|v| v.is_finite()) {
-            let y = normalize(c);
-            (cross(y, n), y)
+        let (n, t) = (Vec3::from(n), Vec3::from(t));
+        let c = n.cross(t);
+        let (x, y) = if c.dot(c) > 1e-12 && c.is_finite() {
+            let y = c.normalize();
+            (y.cross(n), y)
         } else {
-            basis(n)
+            n.basis()
         };
         AnisoGgx {
             alpha_x,
@@ -84,28 +83,28 @@ impl AnisoGgx {
         (self.alpha_x * self.alpha_y).sqrt().sqrt()
     }
 
-    fn local(&self, n: V3, w: V3) -> V3 {
-        [dot(self.x, w), dot(self.y, w), dot(n, w)]
+    fn local(&self, n: Vec3, w: Vec3) -> Vec3 {
+        vec3(self.x.dot(w), self.y.dot(w), n.dot(w))
     }
 
-    fn lambda(&self, w: V3) -> f32 {
+    fn lambda(&self, w: Vec3) -> f32 {
         let t2 = ((self.alpha_x * w[0]).powi(2) + (self.alpha_y * w[1]).powi(2)) / (w[2] * w[2]);
         0.5 * ((1.0 + t2).sqrt() - 1.0)
     }
 
-    fn d(&self, h: V3) -> f32 {
-        let s = [h[0] / self.alpha_x, h[1] / self.alpha_y, h[2]];
-        let l2 = dot(s, s);
+    fn d(&self, h: Vec3) -> f32 {
+        let s = vec3(h[0] / self.alpha_x, h[1] / self.alpha_y, h[2]);
+        let l2 = s.dot(s);
         1.0 / (PI * self.alpha_x * self.alpha_y * l2 * l2)
     }
 
     /// (BSDF * cos without Fresnel, pdf, cos(view, microfacet normal)) toward `l`.
-    pub fn eval(&self, n: V3, v: V3, l: V3, ng: V3) -> (f32, f32, f32) {
-        let (cos_v, cos_l) = (dot(n, v), dot(n, l));
-        if cos_v <= 0.0 || cos_l <= 0.0 || dot(ng, l) <= 0.0 || self.singular() {
+    pub fn eval(&self, n: Vec3, v: Vec3, l: Vec3, ng: Vec3) -> (f32, f32, f32) {
+        let (cos_v, cos_l) = (n.dot(v), n.dot(l));
+        if cos_v <= 0.0 || cos_l <= 0.0 || ng.dot(l) <= 0.0 || self.singular() {
             return (0.0, 0.0, 0.0);
         }
-        let h = normalize(add(v, l));
+        let h = (v + l).normalize();
         let (lv, ll, lh) = (self.local(n, v), self.local(n, l), self.local(n, h));
         let d = self.d(lh);
         let (lam_v, lam_l) = (self.lambda(lv), self.lambda(ll));
@@ -113,27 +112,24 @@ impl AnisoGgx {
         (
             common / (1.0 + lam_v + lam_l),
             common / (1.0 + lam_v),
-            dot(v, h),
+            v.dot(h),
         )
     }
 
     /// A reflected direction from a visible microfacet normal.
-    pub fn sample(&self, n: V3, v: V3, ng: V3, u: [f32; 2]) -> Option<V3> {
+    pub fn sample(&self, n: Vec3, v: Vec3, ng: Vec3, u: [f32; 2]) -> Option<Vec3> {
         let lv = self.local(n, v);
         if lv[2] <= 0.0 {
             return None;
         }
-        let h = sample_ggx_vndf(lv, self.alpha_x, self.alpha_y, u);
-        let hv = dot(h, lv);
-        let ll = sub(scale(h, 2.0 * hv), lv);
+        let h = ggx_vndf(lv, self.alpha_x, self.alpha_y, u);
+        let hv = h.dot(lv);
+        let ll = h * (2.0 * hv) - lv;
         if ll[2] <= 0.0 {
             return None;
         }
-        let l = add(
-            add(scale(self.x, ll[0]), scale(self.y, ll[1])),
-            scale(n, ll[2]),
-        );
-        if dot(ng, l) <= 0.0 {
+        let l = self.x * ll[0] + self.y * ll[1] + n * ll[2];
+        if ng.dot(l) <= 0.0 {
             return None;
         }
         Some(l)
@@ -147,12 +143,12 @@ mod tests {
     #[test]
     fn isotropic_limit_is_ggx() {
         // With equal alphas the anisotropic lobe is the isotropic GGX of bsdf.rs.
-        let n = [0.0, 0.0, 1.0];
-        let g = AnisoGgx::new(n, [1.0, 0.0, 0.0], 0.3, 0.3);
-        let v = normalize([0.4, 0.1, 0.8]);
-        let l = normalize([-0.3, 0.2, 0.7]);
+        let n = Vec3::Z;
+        let g = AnisoGgx::new(n.into(), [1.0, 0.0, 0.0], 0.3, 0.3);
+        let v = vec3(0.4, 0.1, 0.8).normalize();
+        let l = vec3(-0.3, 0.2, 0.7).normalize();
         let (f, pdf, _) = g.eval(n, v, l, n);
-        let h = normalize(add(v, l));
+        let h = (v + l).normalize();
         let a2 = 0.09;
         let d = crate::render::bsdf::ggx_d(h[2], a2);
         let (lv, ll) = (
@@ -166,9 +162,9 @@ mod tests {
     #[test]
     fn sampling_matches_eval_pdf() {
         // Mean of f / pdf over samples equals the integral of f by uniform sampling.
-        let n = [0.0, 0.0, 1.0];
-        let g = AnisoGgx::new(n, [0.6, 0.8, 0.0], 0.15, 0.6);
-        let v = normalize([0.5, -0.2, 0.6]);
+        let n = Vec3::Z;
+        let g = AnisoGgx::new(n.into(), [0.6, 0.8, 0.0], 0.15, 0.6);
+        let v = vec3(0.5, -0.2, 0.6).normalize();
         let s = crate::render::sampler::PixelSampler::new(4, 5, 6);
         let count = 40000;
         let (mut by_sample, mut uniform) = (0.0f64, 0.0f64);
@@ -183,7 +179,7 @@ mod tests {
             let z = u[2];
             let r = (1.0 - z * z).max(0.0).sqrt();
             let phi = 2.0 * PI * u[3];
-            let (f, _, _) = g.eval(n, v, [r * phi.cos(), r * phi.sin(), z], n);
+            let (f, _, _) = g.eval(n, v, vec3(r * phi.cos(), r * phi.sin(), z), n);
             uniform += (f * 2.0 * PI) as f64;
         }
         let (a, b) = (by_sample / count as f64, uniform / count as f64);

@@ -15,19 +15,23 @@ use crate::render::math::*;
 /// The corrected normal for geometric normal `ng`, direction toward the viewer `i` (on
 /// `ng`'s side) and shading normal `n`; `n` itself when its reflection is valid.
 pub fn ensure_valid_specular_reflection(ng: V3, i: V3, n: V3) -> V3 {
-    let r = sub(scale(n, 2.0 * dot(n, i)), i);
-    let iz = dot(i, ng);
+    ensure_valid(ng.into(), i.into(), n.into()).into()
+}
+
+fn ensure_valid(ng: Vec3, i: Vec3, n: Vec3) -> Vec3 {
+    let r = n * (2.0 * n.dot(i)) - i;
+    let iz = i.dot(ng);
     // A reflection may be as shallow as the incoming ray, up to 0.01.
     let threshold = (0.9 * iz).min(0.01);
-    if dot(ng, r) >= threshold {
+    if ng.dot(r) >= threshold {
         return n;
     }
     // In the plane of ng and n: x is n's part across ng, and n' = nx x + nz ng solves
     // 2 (n'.i) n'.z - i.z = threshold, the root with the sign Cycles takes.
-    let across = sub(n, scale(ng, dot(n, ng)));
-    let l = len(across);
-    let x = if l > 0.0 { scale(across, 1.0 / l) } else { n };
-    let ix = dot(i, x);
+    let across = n - ng * n.dot(ng);
+    let l = across.length();
+    let x = if l > 0.0 { across * (1.0 / l) } else { n };
+    let ix = i.dot(x);
     let a = ix * ix + iz * iz;
     let b = 2.0 * (a + iz * threshold);
     let c = (threshold + iz) * (threshold + iz);
@@ -39,7 +43,7 @@ pub fn ensure_valid_specular_reflection(ng: V3, i: V3, n: V3) -> V3 {
     };
     let nx = (1.0 - nz2).max(0.0).sqrt();
     let nz = nz2.max(0.0).sqrt();
-    add(scale(x, nx), scale(ng, nz))
+    x * nx + ng * nz
 }
 
 /// Cycles' `bump_shadowing_term` for a closure of normal `n` on a surface of smooth
@@ -47,13 +51,13 @@ pub fn ensure_valid_specular_reflection(ng: V3, i: V3, n: V3) -> V3 {
 /// smooth surface relative to the light gets 0 (light leaking to the far side); a diffuse
 /// one (`diffuse`) is further faded by a GGX shadowing term whose roughness grows with
 /// the bump's tilt, when the material's bump map correction (`soften`) is on.
-pub fn bump_shadowing_term(ns: V3, n: V3, i: V3, diffuse: bool, soften: bool) -> f32 {
+pub fn bump_shadowing_term(ns: Vec3, n: Vec3, i: Vec3, diffuse: bool, soften: bool) -> f32 {
     if n == ns {
         return 1.0;
     }
-    let cos_si = dot(ns, i);
-    let cos_sn = dot(ns, n);
-    if cos_si * cos_sn * dot(n, i) < 0.0 {
+    let cos_si = ns.dot(i);
+    let cos_sn = ns.dot(n);
+    if cos_si * cos_sn * n.dot(i) < 0.0 {
         return 0.0;
     }
     if !diffuse || !soften {
@@ -77,54 +81,54 @@ pub fn bump_shadowing_term(ns: V3, n: V3, i: V3, diffuse: bool, soften: bool) ->
 mod tests {
     use super::*;
 
-    fn reflect(n: V3, i: V3) -> V3 {
-        sub(scale(n, 2.0 * dot(n, i)), i)
+    fn reflect(n: Vec3, i: Vec3) -> Vec3 {
+        n * (2.0 * n.dot(i)) - i
     }
 
     #[test]
     fn valid_normals_are_kept_and_invalid_ones_raised_to_the_threshold() {
-        let ng = [0.0, 0.0, 1.0];
+        let ng = Vec3::Z;
         // Head-on view: a normal within 45 degrees of ng reflects above the surface.
         let i = ng;
-        let n = normalize([0.5, 0.0, 1.0]);
-        assert_eq!(ensure_valid_specular_reflection(ng, i, n), n);
+        let n = vec3(0.5, 0.0, 1.0).normalize();
+        assert_eq!(ensure_valid(ng, i, n), n);
         // Tilted 70 degrees: raised until the reflection's height is the threshold 0.01.
-        let n = normalize([2.75, 0.0, 1.0]);
-        let c = ensure_valid_specular_reflection(ng, i, n);
-        assert!((len(c) - 1.0).abs() < 1e-5);
-        assert!((dot(reflect(c, i), ng) - 0.01).abs() < 1e-4, "{c:?}");
+        let n = vec3(2.75, 0.0, 1.0).normalize();
+        let c = ensure_valid(ng, i, n);
+        assert!((c.length() - 1.0).abs() < 1e-5);
+        assert!((reflect(c, i).dot(ng) - 0.01).abs() < 1e-4, "{c:?}");
         assert!(
             c[1].abs() < 1e-6 && c[0] > 0.0,
             "stays in the plane of ng and n: {c:?}"
         );
         // Grazing view from the side the normal leans away from.
-        let i = normalize([-1.0, 0.3, 0.2]);
-        let n = normalize([1.0, 0.2, 0.6]);
-        assert!(dot(reflect(n, i), ng) < 0.0);
-        let c = ensure_valid_specular_reflection(ng, i, n);
-        let t = (0.9 * dot(i, ng)).min(0.01);
-        assert!((dot(reflect(c, i), ng) - t).abs() < 1e-4, "{c:?}");
+        let i = vec3(-1.0, 0.3, 0.2).normalize();
+        let n = vec3(1.0, 0.2, 0.6).normalize();
+        assert!(reflect(n, i).dot(ng) < 0.0);
+        let c = ensure_valid(ng, i, n);
+        let t = (0.9 * i.dot(ng)).min(0.01);
+        assert!((reflect(c, i).dot(ng) - t).abs() < 1e-4, "{c:?}");
     }
 
     #[test]
     fn bump_shadowing_cuts_leaks_and_fades_diffuse_light() {
-        let ns = [0.0, 0.0, 1.0];
-        let n = normalize([0.6, 0.0, 0.8]);
+        let ns = Vec3::Z;
+        let n = vec3(0.6, 0.0, 0.8).normalize();
         // Unbumped closures are untouched.
         assert_eq!(
-            bump_shadowing_term(ns, ns, normalize([1.0, 0.0, -0.1]), true, true),
+            bump_shadowing_term(ns, ns, vec3(1.0, 0.0, -0.1).normalize(), true, true),
             1.0
         );
         // Light below the smooth surface but above the bumped normal: cut for every closure.
-        let below = normalize([1.0, 0.0, -0.1]);
-        assert!(dot(n, below) > 0.0);
+        let below = vec3(1.0, 0.0, -0.1).normalize();
+        assert!(n.dot(below) > 0.0);
         assert_eq!(bump_shadowing_term(ns, n, below, false, true), 0.0);
         // Glossy closures and uncorrected materials get no fading.
-        let i = normalize([-0.3, 0.0, 1.0]);
+        let i = vec3(-0.3, 0.0, 1.0).normalize();
         assert_eq!(bump_shadowing_term(ns, n, i, false, true), 1.0);
         assert_eq!(bump_shadowing_term(ns, n, i, true, false), 1.0);
         // Diffuse: GGX G1 at the light's angle to the smooth normal, alpha^2 = tan^2(tilt) / 8.
-        let (cos_i, cos_d) = (dot(ns, i), dot(ns, n));
+        let (cos_i, cos_d) = (ns.dot(i), ns.dot(n));
         let a2 = (1.0 / (cos_d * cos_d) - 1.0) / 8.0;
         let t2 = 1.0 / (cos_i * cos_i) - 1.0;
         let g1 = 2.0 / (1.0 + (1.0 + a2 * t2).sqrt());

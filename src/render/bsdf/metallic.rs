@@ -48,8 +48,8 @@ fn fresnel_of(b: &BsdfNode, s: &[f32]) -> (Fresnel, [f32; 3]) {
         let non_negative = |c: [f32; 3]| c.map(|x| x.max(0.0));
         let eta = non_negative(input_c(b, s, socket!("IOR"), [2.757, 2.513, 2.231]));
         let k = non_negative(input_c(b, s, socket!("Extinction"), [3.867, 3.404, 3.009]));
-        let f0 = fresnel_conductor(1.0, eta, k);
-        let f82 = fresnel_conductor(1.0 / 7.0, eta, k);
+        let f0 = fresnel_conductor(1.0, eta.into(), k.into()).into();
+        let f82 = fresnel_conductor(1.0 / 7.0, eta.into(), k.into()).into();
         let fss = f82_fss(f0, f82_b(f0, f82)).map(|x| x.clamp(0.0, 1.0));
         return (Fresnel::Conductor { eta, k }, fss);
     }

@@ -97,29 +97,30 @@ pub fn erfinv(x: f32) -> f32 {
 
 /// Visible normal of GGX (Heitz 2018), local frame with N = +z.
 pub fn sample_ggx_vndf(v: V3, ax: f32, ay: f32, u: [f32; 2]) -> V3 {
-    let vh = normalize([ax * v[0], ay * v[1], v[2]]);
+    ggx_vndf(v.into(), ax, ay, u).into()
+}
+
+pub(crate) fn ggx_vndf(v: Vec3, ax: f32, ay: f32, u: [f32; 2]) -> Vec3 {
+    let vh = vec3(ax * v[0], ay * v[1], v[2]).normalize();
     let lensq = vh[0] * vh[0] + vh[1] * vh[1];
     let (t1, t2) = if lensq > 1e-7 {
-        let t1 = scale([-vh[1], vh[0], 0.0], 1.0 / lensq.sqrt());
-        (t1, cross(vh, t1))
+        let t1 = vec3(-vh[1], vh[0], 0.0) * (1.0 / lensq.sqrt());
+        (t1, vh.cross(t1))
     } else {
-        ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+        (Vec3::X, Vec3::Y)
     };
     let t = crate::render::camera::concentric_disk(u);
     let (tx, mut ty) = (t[0], t[1]);
     let s = 0.5 * (1.0 + vh[2]);
     ty = (1.0 - tx * tx).max(0.0).sqrt() * (1.0 - s) + ty * s;
-    let nh = add(
-        add(scale(t1, tx), scale(t2, ty)),
-        scale(vh, (1.0 - tx * tx - ty * ty).max(0.0).sqrt()),
-    );
-    normalize([ax * nh[0], ay * nh[1], nh[2].max(0.0)])
+    let nh = t1 * tx + t2 * ty + vh * (1.0 - tx * tx - ty * ty).max(0.0).sqrt();
+    vec3(ax * nh[0], ay * nh[1], nh[2].max(0.0)).normalize()
 }
 
 /// Visible normal of Beckmann (Heitz and d'Eon 2014 with Jakob's improved slope
 /// inversion), local frame with N = +z.
-pub fn sample_beckmann_vndf(v: V3, ax: f32, ay: f32, u: [f32; 2]) -> V3 {
-    let vs = normalize([ax * v[0], ay * v[1], v[2]]);
+pub fn sample_beckmann_vndf(v: Vec3, ax: f32, ay: f32, u: [f32; 2]) -> Vec3 {
+    let vs = vec3(ax * v[0], ay * v[1], v[2]).normalize();
     let (mut sx, mut sy);
     let (mut cos_phi, mut sin_phi) = (1.0f32, 0.0f32);
     if vs[2] >= 0.99999 {
@@ -175,12 +176,12 @@ pub fn sample_beckmann_vndf(v: V3, ax: f32, ay: f32, u: [f32; 2]) -> V3 {
     let tmp = cos_phi * sx - sin_phi * sy;
     sy = sin_phi * sx + cos_phi * sy;
     sx = tmp;
-    normalize([-ax * sx, -ay * sy, 1.0])
+    vec3(-ax * sx, -ay * sy, 1.0).normalize()
 }
 
-pub fn sample_vndf(dist: Distribution, v: V3, ax: f32, ay: f32, u: [f32; 2]) -> V3 {
+pub fn sample_vndf(dist: Distribution, v: Vec3, ax: f32, ay: f32, u: [f32; 2]) -> Vec3 {
     match dist {
-        Distribution::Ggx => sample_ggx_vndf(v, ax, ay, u),
+        Distribution::Ggx => ggx_vndf(v, ax, ay, u),
         Distribution::Beckmann => sample_beckmann_vndf(v, ax, ay, u),
     }
 }
@@ -221,8 +222,8 @@ pub struct Dielectric {
 /// Result of sampling a dielectric: direction, eval / pdf (without the closure weight)
 /// and pdf (infinite when singular).
 pub struct DielectricSample {
-    pub l: V3,
-    pub weight: V3,
+    pub l: Vec3,
+    pub weight: Vec3,
     pub pdf: f32,
     pub singular: bool,
     pub transmit: bool,
@@ -233,114 +234,105 @@ impl Dielectric {
         self.alpha * self.alpha <= ROUGHNESS_SQ_THRESH
     }
 
-    fn fresnel(&self, cos_hv: f32) -> (V3, V3, f32) {
+    fn fresnel(&self, cos_hv: f32) -> (Vec3, Vec3, f32) {
         let (f, cos_ht) = fresnel_dielectric(cos_hv, self.eta);
         if f >= 1.0 {
             // Total internal reflection.
             let r = if self.refract_only {
-                [0.0; 3]
+                Vec3::ZERO
             } else {
-                self.tint_r
+                self.tint_r.into()
             };
-            return (r, [0.0; 3], cos_ht);
+            return (r, Vec3::ZERO, cos_ht);
         }
         if self.refract_only {
             // Cycles' Refraction BSDF has no Fresnel factor.
-            return ([0.0; 3], self.tint_t, cos_ht);
+            return (Vec3::ZERO, self.tint_t.into(), cos_ht);
         }
         if let Some(film) = &self.film {
-            let r = film.eval(cos_hv);
+            let r = Vec3::from(film.eval(cos_hv));
             return (
-                mul(self.tint_r, r),
-                mul(self.tint_t, r.map(|x| 1.0 - x)),
+                Vec3::from(self.tint_r) * r,
+                Vec3::from(self.tint_t) * r.map(|x| 1.0 - x),
                 cos_ht,
             );
         }
-        (scale(self.tint_r, f), scale(self.tint_t, 1.0 - f), cos_ht)
+        let (tint_r, tint_t) = (Vec3::from(self.tint_r), Vec3::from(self.tint_t));
+        (tint_r * f, tint_t * (1.0 - f), cos_ht)
     }
 
     /// (BSDF * |cos|, pdf) toward `l`; `ng` faces the viewer.
-    pub fn eval(&self, n: V3, v: V3, l: V3, ng: V3) -> (V3, f32) {
-        let cos_nv = dot(n, v);
-        let cos_nl = dot(n, l);
+    pub fn eval(&self, n: Vec3, v: Vec3, l: Vec3, ng: Vec3) -> (Vec3, f32) {
+        let cos_nv = n.dot(v);
+        let cos_nl = n.dot(l);
         let is_t = cos_nl < 0.0;
         if cos_nv <= 0.0
             || self.singular()
-            || (dot(ng, l) < 0.0) != is_t
+            || (ng.dot(l) < 0.0) != is_t
             || (!is_t && self.refract_only)
         {
-            return ([0.0; 3], 0.0);
+            return (Vec3::ZERO, 0.0);
         }
-        let hu = if is_t {
-            neg(add(scale(l, self.eta), v))
-        } else {
-            add(v, l)
-        };
-        let hl = len(hu);
+        let hu = if is_t { -(l * self.eta + v) } else { v + l };
+        let hl = hu.length();
         if !(hl > 0.0) {
-            return ([0.0; 3], 0.0);
+            return (Vec3::ZERO, 0.0);
         }
-        let h = scale(hu, 1.0 / hl);
-        let cos_hv = dot(h, v);
+        let h = hu * (1.0 / hl);
+        let cos_hv = h.dot(v);
         let (r, t, _) = self.fresnel(cos_hv);
-        let sum = average(r) + average(t);
+        let sum = r.average() + t.average();
         if !(sum > 0.0) {
-            return ([0.0; 3], 0.0);
+            return (Vec3::ZERO, 0.0);
         }
         let a2 = self.alpha * self.alpha;
-        let dd = d(self.dist, a2, dot(n, h));
+        let dd = d(self.dist, a2, n.dot(h));
         let lv = lambda(self.dist, a2, cos_nv);
         let ll = lambda(self.dist, a2, cos_nl);
         let common = dd / cos_nv
             * if is_t {
-                (self.eta / hl) * (self.eta / hl) * (cos_hv * dot(h, l)).abs()
+                (self.eta / hl) * (self.eta / hl) * (cos_hv * h.dot(l)).abs()
             } else {
                 0.25
             };
-        let p_r = average(r) / sum;
+        let p_r = r.average() / sum;
         let lobe = if is_t { 1.0 - p_r } else { p_r };
         let pdf = common * lobe / (1.0 + lv);
-        let f = scale(
-            if is_t { t } else { r },
-            common / (1.0 + lv + ll) * self.energy,
-        );
+        let f = (if is_t { t } else { r }) * (common / (1.0 + lv + ll) * self.energy);
         (f, pdf)
     }
 
     /// Samples reflection or refraction with `u[2]`, a microfacet normal with `u[0..2]`.
-    pub fn sample(&self, n: V3, v: V3, ng: V3, u: [f32; 3]) -> Option<DielectricSample> {
-        let cos_nv = dot(n, v);
+    pub fn sample(&self, n: Vec3, v: Vec3, ng: Vec3, u: [f32; 3]) -> Option<DielectricSample> {
+        let cos_nv = n.dot(v);
         if cos_nv <= 0.0 {
             return None;
         }
         let mut singular = self.singular();
-        let (tx, ty) = basis(n);
-        let lv_local = [dot(v, tx), dot(v, ty), cos_nv];
+        let (tx, ty) = n.basis();
+        let lv_local = vec3(v.dot(tx), v.dot(ty), cos_nv);
         let h = if singular {
             n
         } else {
             let hl = sample_vndf(self.dist, lv_local, self.alpha, self.alpha, [u[0], u[1]]);
-            add(add(scale(tx, hl[0]), scale(ty, hl[1])), scale(n, hl[2]))
+            tx * hl[0] + ty * hl[1] + n * hl[2]
         };
-        let cos_hv = dot(h, v);
+        let cos_hv = h.dot(v);
         let (r, t, cos_ht) = self.fresnel(cos_hv);
-        let sum = average(r) + average(t);
+        let sum = r.average() + t.average();
         if !(sum > 0.0) {
             return None;
         }
-        let p_r = average(r) / sum;
+        let p_r = r.average() / sum;
         let refract = u[2] >= p_r;
         let l = if refract {
             // Snell: tangential part scaled by 1/eta, normal part from cos_ht.
-            add(
-                scale(v, -1.0 / self.eta),
-                scale(h, cos_hv / self.eta + cos_ht),
-            )
+            v * (-1.0 / self.eta) + h * (cos_hv / self.eta + cos_ht)
         } else {
-            sub(scale(h, 2.0 * cos_hv), v)
+            h * (2.0 * cos_hv) - v
         };
-        let l = normalize(l);
-        if (dot(ng, l) < 0.0) != refract || (dot(n, l) < 0.0) != refract {
+        let l = l.normalize();
+        if (ng.dot(l) < 0.0) != refract || (n.dot(l) < 0.0) != refract {
             return None;
         }
         let (mut e, mut pdf) = if refract { (t, 1.0 - p_r) } else { (r, p_r) };
@@ -350,18 +342,18 @@ impl Dielectric {
         if singular {
             return Some(DielectricSample {
                 l,
-                weight: scale(e, self.energy / pdf),
+                weight: e * (self.energy / pdf),
                 pdf: f32::INFINITY,
                 singular: true,
                 transmit: refract,
             });
         }
         let a2 = self.alpha * self.alpha;
-        let cos_nl = dot(n, l);
-        let dd = d(self.dist, a2, dot(n, h));
+        let cos_nl = n.dot(l);
+        let dd = d(self.dist, a2, n.dot(h));
         let lv = lambda(self.dist, a2, cos_nv);
         let ll = lambda(self.dist, a2, cos_nl);
-        let cos_hl = dot(h, l);
+        let cos_hl = h.dot(l);
         let common = dd / cos_nv
             * if refract {
                 (cos_hv * cos_hl).abs() / (cos_hl + cos_hv / self.eta).powi(2)
@@ -369,13 +361,13 @@ impl Dielectric {
                 0.25
             };
         pdf *= common / (1.0 + lv);
-        e = scale(e, common / (1.0 + lv + ll) * self.energy);
+        e *= common / (1.0 + lv + ll) * self.energy;
         if !(pdf > 0.0) || !pdf.is_finite() {
             return None;
         }
         Some(DielectricSample {
             l,
-            weight: scale(e, 1.0 / pdf),
+            weight: e * (1.0 / pdf),
             pdf,
             singular: false,
             transmit: refract,
@@ -392,7 +384,7 @@ impl Dielectric {
 /// upward; without it, they match within the noise of the samples (tests/closures.rs).
 pub fn glass_albedo(mu: f32, alpha: f32, eta: f32, samples: &[[f32; 2]]) -> f32 {
     let mu = mu.max(1e-4);
-    let v = [(1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu];
+    let v = vec3((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
     let a2 = alpha * alpha;
     if a2 <= ROUGHNESS_SQ_THRESH {
         // A mirror interface: its reflection and refraction (each chosen by its own
@@ -402,10 +394,10 @@ pub fn glass_albedo(mu: f32, alpha: f32, eta: f32, samples: &[[f32; 2]]) -> f32 
     let lv = lambda(Distribution::Ggx, a2, mu);
     let mut sum = 0.0f64;
     for u in samples {
-        let h = sample_ggx_vndf(v, alpha, alpha, *u);
-        let cos_hv = dot(h, v);
+        let h = ggx_vndf(v, alpha, alpha, *u);
+        let cos_hv = h.dot(v);
         let (f, cos_ht) = fresnel_dielectric(cos_hv, eta);
-        let r = sub(scale(h, 2.0 * cos_hv), v);
+        let r = h * (2.0 * cos_hv) - v;
         if r[2] > 0.0 {
             let ll = lambda(Distribution::Ggx, a2, r[2]);
             sum += (f * (1.0 + lv) / (1.0 + lv + ll)) as f64;
@@ -416,7 +408,7 @@ pub fn glass_albedo(mu: f32, alpha: f32, eta: f32, samples: &[[f32; 2]]) -> f32 
                 // it singular), with no masking.
                 sum += (1.0 - f) as f64;
             } else {
-                let t = normalize(add(scale(v, -1.0 / eta), scale(h, cos_hv / eta + cos_ht)));
+                let t = (v * (-1.0 / eta) + h * (cos_hv / eta + cos_ht)).normalize();
                 let ll = lambda(Distribution::Ggx, a2, t[2]);
                 sum += ((1.0 - f) * (1.0 + lv) / (1.0 + lv + ll)) as f64;
             }
@@ -477,15 +469,15 @@ impl Reflection {
     }
 
     /// (BSDF * cos, pdf) toward `l`.
-    pub fn eval(&self, n: V3, v: V3, l: V3, ng: V3) -> (f32, f32) {
-        let cos_nv = dot(n, v);
-        let cos_nl = dot(n, l);
-        if cos_nv <= 0.0 || cos_nl <= 0.0 || dot(ng, l) <= 0.0 || self.singular() {
+    pub fn eval(&self, n: Vec3, v: Vec3, l: Vec3, ng: Vec3) -> (f32, f32) {
+        let cos_nv = n.dot(v);
+        let cos_nl = n.dot(l);
+        if cos_nv <= 0.0 || cos_nl <= 0.0 || ng.dot(l) <= 0.0 || self.singular() {
             return (0.0, 0.0);
         }
-        let h = normalize(add(v, l));
+        let h = (v + l).normalize();
         let a2 = self.alpha * self.alpha;
-        let dd = d(self.dist, a2, dot(n, h));
+        let dd = d(self.dist, a2, n.dot(h));
         let lv = lambda(self.dist, a2, cos_nv);
         let ll = lambda(self.dist, a2, cos_nl);
         let common = dd / cos_nv * 0.25;
@@ -494,26 +486,26 @@ impl Reflection {
 
     /// A reflected direction from a visible normal (or the mirror direction), and whether
     /// it is singular.
-    pub fn sample(&self, n: V3, v: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
-        let cos_nv = dot(n, v);
+    pub fn sample(&self, n: Vec3, v: Vec3, ng: Vec3, u: [f32; 2]) -> Option<(Vec3, bool)> {
+        let cos_nv = n.dot(v);
         if cos_nv <= 0.0 {
             return None;
         }
         let h = if self.singular() {
             n
         } else {
-            let (tx, ty) = basis(n);
+            let (tx, ty) = n.basis();
             let hl = sample_vndf(
                 self.dist,
-                [dot(v, tx), dot(v, ty), cos_nv],
+                vec3(v.dot(tx), v.dot(ty), cos_nv),
                 self.alpha,
                 self.alpha,
                 u,
             );
-            add(add(scale(tx, hl[0]), scale(ty, hl[1])), scale(n, hl[2]))
+            tx * hl[0] + ty * hl[1] + n * hl[2]
         };
-        let l = sub(scale(h, 2.0 * dot(h, v)), v);
-        if dot(ng, l) <= 0.0 || dot(n, l) <= 0.0 {
+        let l = h * (2.0 * h.dot(v)) - v;
+        if ng.dot(l) <= 0.0 || n.dot(l) <= 0.0 {
             return None;
         }
         Some((l, self.singular()))

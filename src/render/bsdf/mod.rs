@@ -218,10 +218,11 @@ impl LobeSet {
     /// ray, which allocates no closures): the transparent weights, and the portals' with
     /// them; a portal alone lets nothing through, as SD_TRANSPARENT is then unset.
     pub fn shadow_transparency(&self) -> V3 {
-        if is_zero(self.transparent) {
+        let transparent = Vec3::from(self.transparent);
+        if transparent.is_zero() {
             self.transparent
         } else {
-            add(self.transparent, self.portal_extinction)
+            (transparent + self.portal_extinction.into()).into()
         }
     }
 
@@ -270,10 +271,10 @@ impl LobeSet {
             self.poisoned = true;
         }
         if let LobeKind::Transparent = kind {
-            self.transparent = add(self.transparent, weight);
+            self.transparent = (Vec3::from(self.transparent) + weight.into()).into();
         }
         if let LobeKind::RayPortal(_) = kind {
-            self.portal_extinction = add(self.portal_extinction, weight);
+            self.portal_extinction = (Vec3::from(self.portal_extinction) + weight.into()).into();
         }
         if self.len < MAX_LOBES {
             self.lobes[self.len] = Lobe {
@@ -303,8 +304,9 @@ impl LobeSet {
         tables: &Tables,
         exclude: u32,
     ) -> (V3, f32) {
+        let (wo, wi, ng) = (Vec3::from(wo), Vec3::from(wi), Vec3::from(ng));
         let (f, pdf, total) = self.eval_sum(wo, wi, ng, tables, exclude, None);
-        (f, if total > 0.0 { pdf / total } else { pdf })
+        (f.into(), if total > 0.0 { pdf / total } else { pdf })
     }
 
     /// The closures' value toward `wi`, their pdfs times selection weights, and the total
@@ -312,14 +314,14 @@ impl LobeSet {
     /// _surface_shader_bsdf_eval_mis, for the lobe that sampled `wi` itself).
     fn eval_sum(
         &self,
-        wo: V3,
-        wi: V3,
-        ng: V3,
+        wo: Vec3,
+        wi: Vec3,
+        ng: Vec3,
         tables: &Tables,
         exclude: u32,
         skip: Option<usize>,
-    ) -> (V3, f32, f32) {
-        let mut f = [0.0; 3];
+    ) -> (Vec3, f32, f32) {
+        let mut f = Vec3::ZERO;
         let mut pdf = 0.0;
         let mut total = 0.0;
         if self.poisoned {
@@ -336,8 +338,8 @@ impl LobeSet {
                 continue;
             }
             let (e, p) = eval_lobe(l, wo, wi, ng, tables);
-            let e = self.terminator(scale(e, bump), l, wi);
-            f = add(f, mul(e, l.weight));
+            let e = self.terminator(e * bump, l, wi);
+            f += e * Vec3::from(l.weight);
             pdf += p * l.sample_weight;
         }
         (f, pdf, total)
@@ -350,12 +352,12 @@ impl LobeSet {
     fn eval_sampled(
         &self,
         pick: usize,
-        wo: V3,
-        wi: V3,
-        ng: V3,
+        wo: Vec3,
+        wi: Vec3,
+        ng: Vec3,
         transmit: bool,
         tables: &Tables,
-    ) -> (V3, f32) {
+    ) -> (Vec3, f32) {
         let (rest, rest_pdf, total) = self.eval_sum(wo, wi, ng, tables, 0, Some(pick));
         let l = &self.lobes[pick];
         let diffuse = matches!(
@@ -368,16 +370,16 @@ impl LobeSet {
             1.0
         };
         let (e, p) = eval_lobe(l, wo, wi, ng, tables);
-        let own = self.terminator(scale(e, bump), l, wi);
-        let f = add(rest, mul(own, l.weight));
+        let own = self.terminator(e * bump, l, wi);
+        let f = rest + own * Vec3::from(l.weight);
         let pdf = rest_pdf + p * l.sample_weight;
         (f, if total > 0.0 { pdf / total } else { pdf })
     }
 
-    fn bump_term(&self, l: &Lobe, wi: V3) -> f32 {
+    fn bump_term(&self, l: &Lobe, wi: Vec3) -> f32 {
         // Cycles' bsdf_eval shadows bumped diffuse and microfacet closures only; the hair
         // closures' normals are no bumped shading normals (Chiang's is across the fibre).
-        if is_zero(self.smooth_n)
+        if Vec3::from(self.smooth_n).is_zero()
             || matches!(
                 l.kind,
                 LobeKind::Hair(_) | LobeKind::Chiang(_) | LobeKind::Huang(_)
@@ -390,21 +392,21 @@ impl LobeSet {
             LobeKind::Diffuse | LobeKind::OrenNayar(_) | LobeKind::Translucent
         );
         crate::render::bsdf::bump_correction::bump_shadowing_term(
-            self.smooth_n,
-            l.n,
+            self.smooth_n.into(),
+            l.n.into(),
             wi,
             diffuse,
             self.bump_correction,
         )
     }
 
-    fn terminator(&self, e: V3, l: &Lobe, wi: V3) -> V3 {
+    fn terminator(&self, e: Vec3, l: &Lobe, wi: Vec3) -> Vec3 {
         if self.terminator_frequency > 1.0 {
-            let c = dot(wi, l.n);
+            let c = wi.dot(l.n.into());
             if c >= 0.0 {
-                return scale(
-                    e,
-                    crate::render::bsdf::terminator::shift_cos_in(c, self.terminator_frequency),
+                return e * crate::render::bsdf::terminator::shift_cos_in(
+                    c,
+                    self.terminator_frequency,
                 );
             }
         }
@@ -417,35 +419,38 @@ impl LobeSet {
     fn sample_hair(
         &self,
         pick: usize,
-        wo: V3,
-        ng: V3,
+        wo: Vec3,
+        ng: Vec3,
         u: [f32; 3],
         tables: &Tables,
     ) -> Option<BsdfSample> {
         let l = &self.lobes[pick];
         let (wi, own, own_pdf, transmit) = match l.kind {
             LobeKind::Hair(h) => {
-                let s = h.sample(wo, [u[0], u[1]])?;
-                (s.wi, [s.pdf; 3], s.pdf, h.transmission)
+                let s = h.sample(wo.into(), [u[0], u[1]])?;
+                (s.wi.into(), Vec3::splat(s.pdf), s.pdf, h.transmission)
             }
-            LobeKind::Chiang(c) => c.sample(l.n, wo, u)?,
+            LobeKind::Chiang(c) => {
+                let (wi, f, pdf, transmit) = c.sample(l.n, wo.into(), u)?;
+                (wi.into(), f.into(), pdf, transmit)
+            }
             // Cycles labels every Huang sample a glossy reflection.
             LobeKind::Huang(c) => {
                 let (wi, f, pdf) = c.sample(u, tables)?;
-                (wi, f, pdf, false)
+                (wi.into(), f.into(), pdf, false)
             }
             _ => return None,
         };
-        let own = self.terminator(scale(own, self.bump_term(l, wi)), l, wi);
+        let own = self.terminator(own * self.bump_term(l, wi), l, wi);
         let (rest, rest_pdf, total) = self.eval_sum(wo, wi, ng, tables, 0, Some(pick));
-        let f = add(rest, mul(own, l.weight));
+        let f = rest + own * Vec3::from(l.weight);
         let pdf = (rest_pdf + own_pdf * l.sample_weight) / total;
-        if !(pdf > 0.0) || !pdf.is_finite() || is_zero(f) {
+        if !(pdf > 0.0) || !pdf.is_finite() || f.is_zero() {
             return None;
         }
         Some(BsdfSample {
-            wi,
-            weight: scale(f, 1.0 / pdf),
+            wi: wi.into(),
+            weight: (f * (1.0 / pdf)).into(),
             pdf,
             singular: false,
             glossy: true,
@@ -455,6 +460,7 @@ impl LobeSet {
     }
 
     pub fn sample(&self, wo: V3, ng: V3, u: [f32; 3], tables: &Tables) -> Option<BsdfSample> {
+        let (wo, ng) = (Vec3::from(wo), Vec3::from(ng));
         let total: f32 = self.lobes[..self.len].iter().map(|l| l.sample_weight).sum();
         if total <= 0.0 || self.poisoned {
             return None;
@@ -476,12 +482,13 @@ impl LobeSet {
         if nan_normal(l.n) {
             return None;
         }
-        let ng = if self.own_normal_as_ng { l.n } else { ng };
+        let (n, weight) = (Vec3::from(l.n), Vec3::from(l.weight));
+        let ng = if self.own_normal_as_ng { n } else { ng };
         let sel = l.sample_weight / total;
         if let LobeKind::Subsurface(_) = l.kind {
             return Some(BsdfSample {
                 wi: l.n,
-                weight: scale(l.weight, 1.0 / sel),
+                weight: (weight * (1.0 / sel)).into(),
                 pdf: 0.0,
                 singular: false,
                 glossy: false,
@@ -491,20 +498,20 @@ impl LobeSet {
         }
         if let LobeKind::Glass(g) = l.kind {
             let u3 = (x / l.sample_weight).clamp(0.0, 1.0 - f32::EPSILON);
-            let ds = g.sample(l.n, wo, ng, [u[0], u[1], u3])?;
+            let ds = g.sample(n, wo, ng, [u[0], u[1], u3])?;
             let (glossy, transmit) = (!ds.transmit, ds.transmit);
             if ds.singular {
                 let shift = if self.terminator_frequency > 1.0 && !transmit {
                     crate::render::bsdf::terminator::shift_cos_in(
-                        dot(ds.l, l.n),
+                        ds.l.dot(n),
                         self.terminator_frequency,
                     )
                 } else {
                     1.0
                 };
                 return Some(BsdfSample {
-                    wi: ds.l,
-                    weight: scale(mul(ds.weight, l.weight), shift / sel),
+                    wi: ds.l.into(),
+                    weight: (ds.weight * weight * (shift / sel)).into(),
                     pdf: f32::INFINITY,
                     singular: true,
                     glossy,
@@ -517,8 +524,8 @@ impl LobeSet {
                 return None;
             }
             return Some(BsdfSample {
-                wi: ds.l,
-                weight: scale(f, 1.0 / pdf),
+                wi: ds.l.into(),
+                weight: (f * (1.0 / pdf)).into(),
                 pdf,
                 singular: false,
                 glossy,
@@ -534,7 +541,7 @@ impl LobeSet {
         // The true normal is checked here, when sampling, and not in `eval_lobe` (as
         // Cycles): a reflection must leave above the surface, a translucent
         // transmission below it.
-        if !singular && (dot(ng, wi) > 0.0) == matches!(l.kind, LobeKind::Translucent) {
+        if !singular && (ng.dot(wi) > 0.0) == matches!(l.kind, LobeKind::Translucent) {
             return None;
         }
         let glossy = matches!(l.kind, LobeKind::Glossy { .. } | LobeKind::Reflection(_));
@@ -550,27 +557,24 @@ impl LobeSet {
                 LobeKind::Glossy {
                     fresnel, energy, ..
                 } => {
-                    let h = l.n;
-                    scale(fresnel_eval(fresnel, dot(wo, h), l.weight), energy)
+                    let h = n;
+                    fresnel_eval(fresnel, wo.dot(h), weight) * energy
                 }
-                LobeKind::Reflection(r) => fresnel_eval(r.fresnel, dot(wo, l.n), l.weight),
-                _ => l.weight,
+                LobeKind::Reflection(r) => fresnel_eval(r.fresnel, wo.dot(n), weight),
+                _ => weight,
             };
             // Cycles' bsdf_sample shifts every sample that does not transmit.
             let w = if self.terminator_frequency > 1.0 && !transmit {
-                scale(
-                    w,
-                    crate::render::bsdf::terminator::shift_cos_in(
-                        dot(wi, l.n),
-                        self.terminator_frequency,
-                    ),
+                w * crate::render::bsdf::terminator::shift_cos_in(
+                    wi.dot(n),
+                    self.terminator_frequency,
                 )
             } else {
                 w
             };
             return Some(BsdfSample {
-                wi,
-                weight: scale(w, 1.0 / sel),
+                wi: wi.into(),
+                weight: (w * (1.0 / sel)).into(),
                 pdf: f32::INFINITY,
                 singular: true,
                 glossy,
@@ -583,8 +587,8 @@ impl LobeSet {
             return None;
         }
         Some(BsdfSample {
-            wi,
-            weight: scale(f, 1.0 / pdf),
+            wi: wi.into(),
+            weight: (f * (1.0 / pdf)).into(),
             pdf,
             singular: false,
             glossy,
@@ -595,11 +599,11 @@ impl LobeSet {
 
     /// Diffuse-like albedo of the closures (for the albedo pass).
     pub fn albedo(&self) -> V3 {
-        let mut a = [0.0; 3];
+        let mut a = Vec3::ZERO;
         for l in &self.lobes[..self.len] {
-            a = add(a, l.weight);
+            a += l.weight.into();
         }
-        a
+        a.into()
     }
 }
 
@@ -622,41 +626,38 @@ pub fn fresnel_dielectric(cosi: f32, eta: f32) -> f32 {
     0.5 * a * a * (1.0 + b * b)
 }
 
-fn fresnel_eval(f: Fresnel, cos_h: f32, tint: V3) -> V3 {
+fn fresnel_eval(f: Fresnel, cos_h: f32, tint: Vec3) -> Vec3 {
     match f {
         Fresnel::Constant => tint,
-        Fresnel::Dielectric { eta } => scale(tint, fresnel_dielectric(cos_h, eta)),
+        Fresnel::Dielectric { eta } => tint * fresnel_dielectric(cos_h, eta),
         Fresnel::Schlick { f0, eta } => {
             // F0 of eta by formula: at an IOR near 0 the Fresnel at normal incidence is
             // total reflection in f32 and the remap would divide 0 by 0.
             let real_f0 = f0_from_ior(eta);
             let s = (fresnel_dielectric(cos_h, eta) - real_f0) / (1.0 - real_f0);
-            [0, 1, 2].map(|k| (f0[k] + (1.0 - f0[k]) * s) * tint[k])
+            Vec3::from([0, 1, 2].map(|k| (f0[k] + (1.0 - f0[k]) * s) * tint[k]))
         }
         Fresnel::F82 { f0, b } => {
             let c = cos_h.clamp(0.0, 1.0);
             let m = 1.0 - c;
             let m5 = m * m * m * m * m;
-            let mut out = [0.0; 3];
+            let mut out = Vec3::ZERO;
             for k in 0..3 {
                 let s = f0[k] + (1.0 - f0[k]) * m5;
                 out[k] = (s - b[k] * c * m5 * m).clamp(0.0, 1.0) * tint[k];
             }
             out
         }
-        Fresnel::ThinFilm(tf) => mul(tint, tf.eval(cos_h)),
-        Fresnel::Conductor { eta, k } => {
-            let f = fresnel_conductor(cos_h, eta, k);
-            [f[0] * tint[0], f[1] * tint[1], f[2] * tint[2]]
-        }
+        Fresnel::ThinFilm(tf) => tint * Vec3::from(tf.eval(cos_h)),
+        Fresnel::Conductor { eta, k } => fresnel_conductor(cos_h, eta.into(), k.into()) * tint,
     }
 }
 
 /// Cycles' fresnel_conductor: unpolarised reflectance of a conductor with complex IOR
 /// `eta` + i `k` at incidence cosine `cosi`.
-pub fn fresnel_conductor(cosi: f32, eta: V3, k: V3) -> V3 {
+pub fn fresnel_conductor(cosi: f32, eta: Vec3, k: Vec3) -> Vec3 {
     let c2 = cosi * cosi;
-    let mut out = [0.0; 3];
+    let mut out = Vec3::ZERO;
     for i in 0..3 {
         let tmp_f = eta[i] * eta[i] + k[i] * k[i];
         let tmp = tmp_f * c2;
@@ -686,184 +687,188 @@ pub fn ggx_lambda(cos: f32, a2: f32) -> f32 {
 }
 
 /// Visible-normal sampling of isotropic GGX (Heitz 2018), local frame with N = +z.
-pub fn sample_vndf(v: V3, alpha: f32, u: [f32; 2]) -> V3 {
-    let vh = normalize([alpha * v[0], alpha * v[1], v[2]]);
+pub fn sample_vndf(v: Vec3, alpha: f32, u: [f32; 2]) -> Vec3 {
+    let vh = vec3(alpha * v[0], alpha * v[1], v[2]).normalize();
     let lensq = vh[0] * vh[0] + vh[1] * vh[1];
     let t1 = if lensq > 0.0 {
-        scale([-vh[1], vh[0], 0.0], 1.0 / lensq.sqrt())
+        vec3(-vh[1], vh[0], 0.0) * (1.0 / lensq.sqrt())
     } else {
-        [1.0, 0.0, 0.0]
+        Vec3::X
     };
-    let t2 = cross(vh, t1);
+    let t2 = vh.cross(t1);
     let r = u[0].sqrt();
     let phi = 2.0 * PI * u[1];
     let p1 = r * phi.cos();
     let mut p2 = r * phi.sin();
     let s = 0.5 * (1.0 + vh[2]);
     p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * p2;
-    let nh = add(
-        add(scale(t1, p1), scale(t2, p2)),
-        scale(vh, (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt()),
-    );
-    normalize([alpha * nh[0], alpha * nh[1], nh[2].max(0.0)])
+    let nh = t1 * p1 + t2 * p2 + vh * (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
+    vec3(alpha * nh[0], alpha * nh[1], nh[2].max(0.0)).normalize()
 }
 
-fn to_local(n: V3, v: V3) -> V3 {
-    let (t, b) = basis(n);
-    [dot(v, t), dot(v, b), dot(v, n)]
+fn to_local(n: Vec3, v: Vec3) -> Vec3 {
+    let (t, b) = n.basis();
+    vec3(v.dot(t), v.dot(b), v.dot(n))
 }
-fn from_local(n: V3, v: V3) -> V3 {
-    let (t, b) = basis(n);
-    add(add(scale(t, v[0]), scale(b, v[1])), scale(n, v[2]))
+fn from_local(n: Vec3, v: Vec3) -> Vec3 {
+    let (t, b) = n.basis();
+    t * v[0] + b * v[1] + n * v[2]
 }
 
 /// (BSDF * cos without the closure weight, pdf) of one lobe.
-fn eval_lobe(l: &Lobe, wo: V3, wi: V3, _ng: V3, tables: &Tables) -> (V3, f32) {
+fn eval_lobe(l: &Lobe, wo: Vec3, wi: Vec3, _ng: Vec3, tables: &Tables) -> (Vec3, f32) {
     // Cycles checks directions against the true normal only when sampling, never when
     // evaluating (bsdf_microfacet_sample: "required in order to avoid shadow terminator
     // artifacts on smooth geometry"; the same for every closure): a light below a smooth
     // triangle's plane but above its shading normal's horizon is lit if its shadow ray
     // gets through. So evaluation sees only the closure's own normal.
-    let ng = l.n;
-    let cos_i = dot(l.n, wi);
-    let same_side = dot(ng, wi) > 0.0;
+    let n = Vec3::from(l.n);
+    let ng = n;
+    let cos_i = n.dot(wi);
+    let same_side = ng.dot(wi) > 0.0;
     match l.kind {
         LobeKind::Diffuse => {
             if cos_i > 0.0 && same_side {
                 let v = cos_i / PI;
-                ([v; 3], v)
+                (Vec3::splat(v), v)
             } else {
-                ([0.0; 3], 0.0)
+                (Vec3::ZERO, 0.0)
             }
         }
         LobeKind::Translucent => {
             if cos_i < 0.0 && !same_side {
                 let v = -cos_i / PI;
-                ([v; 3], v)
+                (Vec3::splat(v), v)
             } else {
-                ([0.0; 3], 0.0)
+                (Vec3::ZERO, 0.0)
             }
         }
-        LobeKind::Transparent | LobeKind::Subsurface(_) | LobeKind::RayPortal(_) => ([0.0; 3], 0.0),
+        LobeKind::Transparent | LobeKind::Subsurface(_) | LobeKind::RayPortal(_) => {
+            (Vec3::ZERO, 0.0)
+        }
         LobeKind::Reflection(r) => {
-            let (f, p) = r.eval(l.n, wo, wi, ng);
-            let h = normalize(add(wo, wi));
-            (fresnel_eval(r.fresnel, dot(wo, h), [f; 3]), p)
+            let (f, p) = r.eval(n, wo, wi, ng);
+            let h = (wo + wi).normalize();
+            (fresnel_eval(r.fresnel, wo.dot(h), Vec3::splat(f)), p)
         }
         LobeKind::OrenNayar(on) => {
             if cos_i > 0.0 && same_side {
-                (on.eval(l.n, wo, wi), cos_i / PI)
+                (on.eval(n, wo, wi), cos_i / PI)
             } else {
-                ([0.0; 3], 0.0)
+                (Vec3::ZERO, 0.0)
             }
         }
-        LobeKind::Glass(g) => g.eval(l.n, wo, wi, ng),
+        LobeKind::Glass(g) => g.eval(n, wo, wi, ng),
         LobeKind::Glossy {
             alpha,
             fresnel,
             energy,
         } => {
             if alpha < SINGULAR_ALPHA || !same_side || cos_i <= 0.0 {
-                return ([0.0; 3], 0.0);
+                return (Vec3::ZERO, 0.0);
             }
-            let cos_o = dot(l.n, wo);
+            let cos_o = n.dot(wo);
             if cos_o <= 0.0 {
-                return ([0.0; 3], 0.0);
+                return (Vec3::ZERO, 0.0);
             }
-            let h = normalize(add(wo, wi));
-            let cos_h = dot(l.n, h);
+            let h = (wo + wi).normalize();
+            let cos_h = n.dot(h);
             let a2 = alpha * alpha;
             let d = ggx_d(cos_h, a2);
             let lo = ggx_lambda(cos_o, a2);
             let li = ggx_lambda(cos_i, a2);
             let g2 = 1.0 / (1.0 + lo + li);
             let g1 = 1.0 / (1.0 + lo);
-            let f = fresnel_eval(fresnel, dot(wo, h), [1.0; 3]);
+            let f = fresnel_eval(fresnel, wo.dot(h), Vec3::ONE);
             let common = d * g2 / (4.0 * cos_o) * energy;
             let pdf = g1 * d / (4.0 * cos_o);
-            (scale(f, common), pdf)
+            (f * common, pdf)
         }
         LobeKind::Sheen(sh) => {
-            let (f, p) = sh.eval(l.n, wi, ng);
-            ([f; 3], p)
+            let (f, p) = sh.eval(n, wi, ng);
+            (Vec3::splat(f), p)
         }
         LobeKind::Velvet(ve) => {
-            let (f, p) = ve.eval(l.n, wo, wi, ng);
-            ([f; 3], p)
+            let (f, p) = ve.eval(n, wo, wi, ng);
+            (Vec3::splat(f), p)
         }
         LobeKind::Toon(t) => {
-            let (f, p) = t.eval(l.n, wo, wi);
-            ([f; 3], p)
+            let (f, p) = t.eval(n, wo, wi);
+            (Vec3::splat(f), p)
         }
         LobeKind::Hair(h) => {
-            let p = h.eval(l.n, wo, wi);
-            ([p; 3], p)
+            let p = h.eval(l.n, wo.into(), wi.into());
+            (Vec3::splat(p), p)
         }
-        LobeKind::Chiang(c) => c.eval(l.n, wo, wi),
-        LobeKind::Huang(c) => c.eval(wi, tables),
+        LobeKind::Chiang(c) => {
+            let (f, p) = c.eval(l.n, wo.into(), wi.into());
+            (f.into(), p)
+        }
+        LobeKind::Huang(c) => {
+            let (f, p) = c.eval(wi.into(), tables);
+            (f.into(), p)
+        }
         LobeKind::GlossyAniso {
             lobe,
             fresnel,
             energy,
         } => {
-            let (f, p, cos_hv) = lobe.eval(l.n, wo, wi, ng);
+            let (f, p, cos_hv) = lobe.eval(n, wo, wi, ng);
             if !(p > 0.0) {
-                return ([0.0; 3], 0.0);
+                return (Vec3::ZERO, 0.0);
             }
-            (
-                scale(fresnel_eval(fresnel, cos_hv, [1.0; 3]), f * energy),
-                p,
-            )
+            (fresnel_eval(fresnel, cos_hv, Vec3::ONE) * (f * energy), p)
         }
     }
 }
 
-fn sample_lobe(l: &Lobe, wo: V3, ng: V3, u: [f32; 2]) -> Option<(V3, bool)> {
+fn sample_lobe(l: &Lobe, wo: Vec3, ng: Vec3, u: [f32; 2]) -> Option<(Vec3, bool)> {
+    let n = Vec3::from(l.n);
     match l.kind {
         LobeKind::Diffuse | LobeKind::Translucent | LobeKind::OrenNayar(_) => {
             let d = crate::render::camera::concentric_disk(u);
             let z = (1.0 - d[0] * d[0] - d[1] * d[1]).max(0.0).sqrt();
             let n = if let LobeKind::Translucent = l.kind {
-                neg(l.n)
+                -n
             } else {
-                l.n
+                n
             };
-            let wi = from_local(n, [d[0], d[1], z]);
+            let wi = from_local(n, vec3(d[0], d[1], z));
             Some((wi, false))
         }
-        LobeKind::Transparent => Some((neg(wo), true)),
-        LobeKind::RayPortal(r) => Some((r.direction, true)),
+        LobeKind::Transparent => Some((-wo, true)),
+        LobeKind::RayPortal(r) => Some((r.direction.into(), true)),
         // Sampled elsewhere.
         LobeKind::Glass(_)
         | LobeKind::Subsurface(_)
         | LobeKind::Hair(_)
         | LobeKind::Chiang(_)
         | LobeKind::Huang(_) => None,
-        LobeKind::Reflection(r) => r.sample(l.n, wo, ng, u),
+        LobeKind::Reflection(r) => r.sample(n, wo, ng, u),
         LobeKind::Glossy { alpha, .. } => {
             // Cycles' bsdf_microfacet_sample rejects a view below the shading normal, sharp
             // or rough (strong bumps make it common: a mirror would reflect "through" N).
-            let v = to_local(l.n, wo);
+            let v = to_local(n, wo);
             if v[2] <= 0.0 {
                 return None;
             }
             if alpha < SINGULAR_ALPHA {
-                let wi = sub(scale(l.n, 2.0 * v[2]), wo);
-                if dot(wi, ng) <= 0.0 {
+                let wi = n * (2.0 * v[2]) - wo;
+                if wi.dot(ng) <= 0.0 {
                     return None;
                 }
                 return Some((wi, true));
             }
             let h = sample_vndf(v, alpha, u);
-            let wi_l = sub(scale(h, 2.0 * dot(v, h)), v);
+            let wi_l = h * (2.0 * v.dot(h)) - v;
             if wi_l[2] <= 0.0 {
                 return None;
             }
-            Some((from_local(l.n, wi_l), false))
+            Some((from_local(n, wi_l), false))
         }
-        LobeKind::Sheen(sh) => sh.sample(l.n, ng, u).map(|wi| (wi, false)),
-        LobeKind::Velvet(ve) => ve.sample(l.n, ng, u).map(|wi| (wi, false)),
-        LobeKind::Toon(t) => t.sample(l.n, wo, ng, u).map(|wi| (wi, false)),
-        LobeKind::GlossyAniso { lobe, .. } => lobe.sample(l.n, wo, ng, u).map(|wi| (wi, false)),
+        LobeKind::Sheen(sh) => sh.sample(n, ng, u).map(|wi| (wi, false)),
+        LobeKind::Velvet(ve) => ve.sample(n, ng, u).map(|wi| (wi, false)),
+        LobeKind::Toon(t) => t.sample(n, wo, ng, u).map(|wi| (wi, false)),
+        LobeKind::GlossyAniso { lobe, .. } => lobe.sample(n, wo, ng, u).map(|wi| (wi, false)),
     }
 }

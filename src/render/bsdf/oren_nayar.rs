@@ -10,7 +10,7 @@ pub struct OrenNayar {
     pub a: f32,
     pub b: f32,
     /// Multiple-scattering term without its (1 - E(light)) factor.
-    pub ms: V3,
+    pub ms: Vec3,
 }
 
 /// Fujii's directional albedo integral G(cos theta).
@@ -33,7 +33,7 @@ impl OrenNayar {
         let b = sigma * a;
         let e_avg = a * PI + ((2.0 * PI - 5.6) / 3.0) * b;
         let ev = a * PI + b * g(cos_nv.max(0.0));
-        let ms = albedo.map(|c| {
+        let ms = Vec3::from(albedo).map(|c| {
             let c = c.clamp(0.0, 1.0);
             (1.0 / PI) * c * c * (e_avg / (1.0 - e_avg)) / (1.0 - c * (1.0 - e_avg)) * (1.0 - ev)
         });
@@ -41,16 +41,16 @@ impl OrenNayar {
     }
 
     /// BSDF times cos toward `l` (normal `n`, viewer `v`); zero below the surface.
-    pub fn eval(&self, n: V3, v: V3, l: V3) -> V3 {
-        let nl = dot(n, l).max(0.0);
-        let nv = dot(n, v).max(0.0);
-        let mut t = dot(l, v) - nl * nv;
+    pub fn eval(&self, n: Vec3, v: Vec3, l: Vec3) -> Vec3 {
+        let nl = n.dot(l).max(0.0);
+        let nv = n.dot(v).max(0.0);
+        let mut t = l.dot(v) - nl * nv;
         if t > 0.0 {
             t /= nl.max(nv) + f32::MIN_POSITIVE;
         }
         let single = self.a + self.b * t;
         let el = self.a * PI + self.b * g(nl);
-        let ms = scale(self.ms, 1.0 - el);
-        scale(add([single; 3], ms), nl)
+        let ms = self.ms * (1.0 - el);
+        (Vec3::splat(single) + ms) * nl
     }
 }

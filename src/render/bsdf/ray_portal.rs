@@ -26,23 +26,25 @@ impl RayPortal {
     /// a zero direction (the unlinked socket) continues the ray's own direction.
     /// `position` is the hit point when its socket is unlinked (Cycles' LINK_POSITION).
     pub fn new(p: V3, position: V3, direction: V3, incoming: V3) -> RayPortal {
-        let d = if is_zero(direction) {
-            neg(incoming)
+        let (p, position) = (Vec3::from(p), Vec3::from(position));
+        let (direction, incoming) = (Vec3::from(direction), Vec3::from(incoming));
+        let d = if direction.is_zero() {
+            -incoming
         } else {
             direction
         };
         // Cycles keeps the direction as given; the hit along a scaled ray is the same.
-        let n = normalize(d);
-        let direction = if n.iter().all(|c| c.is_finite()) && !is_zero(n) {
+        let n = d.normalize();
+        let direction = if n.is_finite() && !n.is_zero() {
             n
         } else {
-            neg(incoming)
+            -incoming
         };
-        let delta = sub(p, position);
+        let delta = p - position;
         RayPortal {
-            position,
-            direction,
-            moved: dot(delta, delta) > 1e-9,
+            position: position.into(),
+            direction: direction.into(),
+            moved: delta.dot(delta) > 1e-9,
         }
     }
 }

@@ -48,28 +48,29 @@ pub struct Sheen {
     pub a: f32,
     pub b: f32,
     /// Tangent toward the viewer and bitangent (with the normal, a right-handed frame).
-    pub t: V3,
-    pub bt: V3,
+    pub t: Vec3,
+    pub bt: Vec3,
 }
 
 impl Sheen {
     /// Setup for normal `n`, viewer `v` and roughness (clamped to [1e-3, 1]); returns the
     /// lobe and its albedo, which scales the closure weight (and its selection weight).
     pub fn new(n: V3, v: V3, roughness: f32) -> (Sheen, f32) {
+        let (n, v) = (Vec3::from(n), Vec3::from(v));
         let r = if roughness.is_finite() {
             roughness.clamp(1e-3, 1.0)
         } else {
             1.0
         };
         // Cycles' make_orthonormals_tangent(N, view); a viewer along N has any frame.
-        let c = cross(n, v);
-        let (t, bt) = if dot(c, c) > 1e-12 {
-            let bt = normalize(c);
-            (cross(bt, n), bt)
+        let c = n.cross(v);
+        let (t, bt) = if c.dot(c) > 1e-12 {
+            let bt = c.normalize();
+            (bt.cross(n), bt)
         } else {
-            basis(n)
+            n.basis()
         };
-        let mu = dot(n, v);
+        let mu = n.dot(v);
         let a = read_2d(0, mu, r);
         let b = read_2d(1, mu, r);
         let albedo = read_2d(2, mu, r);
@@ -78,7 +79,7 @@ impl Sheen {
 
     /// LTC density at a local direction (z along the normal): the cosine-weighted BSDF,
     /// which is also its sampling pdf.
-    fn density(&self, l: V3) -> f32 {
+    fn density(&self, l: Vec3) -> f32 {
         let (a, b) = (self.a, self.b);
         let len_sq = (a * l[0] + b * l[2]).powi(2) + (a * l[1]).powi(2) + l[2] * l[2];
         if !(len_sq > 0.0) {
@@ -88,29 +89,26 @@ impl Sheen {
     }
 
     /// (BSDF * cos, pdf) toward `l`; `ng` faces the viewer.
-    pub fn eval(&self, n: V3, l: V3, ng: V3) -> (f32, f32) {
-        let z = dot(n, l);
-        if z <= 0.0 || dot(ng, l) <= 0.0 || self.a <= 0.0 {
+    pub fn eval(&self, n: Vec3, l: Vec3, ng: Vec3) -> (f32, f32) {
+        let z = n.dot(l);
+        if z <= 0.0 || ng.dot(l) <= 0.0 || self.a <= 0.0 {
             return (0.0, 0.0);
         }
-        let p = self.density([dot(self.t, l), dot(self.bt, l), z]);
+        let p = self.density(vec3(self.t.dot(l), self.bt.dot(l), z));
         (p, p)
     }
 
     /// A direction drawn from the LTC: a cosine-distributed direction (from the uniform
     /// disk) mapped through the transform.
-    pub fn sample(&self, n: V3, ng: V3, u: [f32; 2]) -> Option<V3> {
+    pub fn sample(&self, n: Vec3, ng: Vec3, u: [f32; 2]) -> Option<Vec3> {
         if self.a <= 0.0 {
             return None;
         }
         let d = crate::render::camera::concentric_disk(u);
         let dz = (1.0 - d[0] * d[0] - d[1] * d[1]).max(0.0).sqrt();
-        let local = normalize([(d[0] - dz * self.b) / self.a, d[1] / self.a, dz]);
-        let l = add(
-            add(scale(self.t, local[0]), scale(self.bt, local[1])),
-            scale(n, local[2]),
-        );
-        if dot(ng, l) <= 0.0 || dot(n, l) <= 0.0 {
+        let local = vec3((d[0] - dz * self.b) / self.a, d[1] / self.a, dz).normalize();
+        let l = self.t * local[0] + self.bt * local[1] + n * local[2];
+        if ng.dot(l) <= 0.0 || n.dot(l) <= 0.0 {
             return None;
         }
         Some(l)
@@ -140,15 +138,15 @@ impl Velvet {
     }
 
     /// (BSDF * cos, pdf) toward `l` for a viewer at `v`.
-    pub fn eval(&self, n: V3, v: V3, l: V3, ng: V3) -> (f32, f32) {
-        let cos_nv = dot(n, v);
-        let cos_nl = dot(n, l);
-        if !(cos_nv > 0.0 && cos_nl > 0.0) || dot(ng, l) <= 0.0 {
+    pub fn eval(&self, n: Vec3, v: Vec3, l: Vec3, ng: Vec3) -> (f32, f32) {
+        let cos_nv = n.dot(v);
+        let cos_nl = n.dot(l);
+        if !(cos_nv > 0.0 && cos_nl > 0.0) || ng.dot(l) <= 0.0 {
             return (0.0, 0.0);
         }
-        let h = normalize(add(v, l));
-        let cos_nh = dot(n, h);
-        let cos_hv = dot(v, h).abs();
+        let h = (v + l).normalize();
+        let cos_nh = n.dot(h);
+        let cos_hv = v.dot(h).abs();
         if !(cos_nh.abs() < 1.0 - 1e-5 && cos_hv > 1e-5) {
             return (0.0, 0.0);
         }
@@ -162,17 +160,14 @@ impl Velvet {
         (0.25 * d * g / cos_nv, 0.5 / PI)
     }
 
-    pub fn sample(&self, n: V3, ng: V3, u: [f32; 2]) -> Option<V3> {
+    pub fn sample(&self, n: Vec3, ng: Vec3, u: [f32; 2]) -> Option<Vec3> {
         // Uniform hemisphere about n.
         let z = u[0];
         let r = (1.0 - z * z).max(0.0).sqrt();
         let phi = 2.0 * PI * u[1];
-        let (t, b) = basis(n);
-        let l = add(
-            add(scale(t, r * phi.cos()), scale(b, r * phi.sin())),
-            scale(n, z),
-        );
-        if dot(ng, l) <= 0.0 {
+        let (t, b) = n.basis();
+        let l = t * (r * phi.cos()) + b * (r * phi.sin()) + n * z;
+        if ng.dot(l) <= 0.0 {
             return None;
         }
         Some(l)
@@ -201,10 +196,10 @@ mod tests {
         // The LTC's integral over the upper hemisphere is at most 1 (the transform keeps
         // the cosine lobe's mass; clipping below the horizon removes some), and the mean
         // of 1 over sampled directions' pdf-weighted counts is consistent with eval.
-        let n = [0.0, 0.0, 1.0];
+        let n = Vec3::Z;
         for (mu, r) in [(0.9f32, 0.3f32), (0.4, 0.7), (0.15, 1.0)] {
-            let v = [(1.0 - mu * mu).sqrt(), 0.0, mu];
-            let (s, _) = Sheen::new(n, v, r);
+            let v = vec3((1.0 - mu * mu).sqrt(), 0.0, mu);
+            let (s, _) = Sheen::new(n.into(), v.into(), r);
             let sampler = crate::render::sampler::PixelSampler::new(1, 2, 3);
             let count = 20000;
             let (mut hits, mut integral) = (0, 0.0f64);
@@ -219,7 +214,7 @@ mod tests {
                 let z = u[2];
                 let rr = (1.0 - z * z).max(0.0).sqrt();
                 let phi = 2.0 * PI * u[3];
-                let (f, _) = s.eval(n, [rr * phi.cos(), rr * phi.sin(), z], n);
+                let (f, _) = s.eval(n, vec3(rr * phi.cos(), rr * phi.sin(), z), n);
                 integral += (f * 2.0 * PI) as f64;
             }
             let integral = integral / count as f64;

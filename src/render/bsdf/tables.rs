@@ -31,7 +31,7 @@ pub struct Tables {
 /// one) over the same VNDF samples.
 fn albedo_parts(mu: f32, alpha: f32, eta: Option<f32>, samples: &[[f32; 2]]) -> (f32, f32) {
     let mu = mu.max(1e-4);
-    let v = [(1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu];
+    let v = crate::render::math::vec3((1.0 - mu * mu).max(0.0).sqrt(), 0.0, mu);
     let a2 = alpha * alpha;
     let mut sum = 0.0f64;
     let mut sum_g = 0.0f64;

@@ -24,16 +24,17 @@ pub fn shift_cos_in(cos_in: f32, frequency: f32) -> f32 {
 /// normal on the ray's side of the surface. Returns (amount, the true normal on the
 /// light's side), the normal `smooth_surface_offset` takes.
 pub fn amount(cutoff: f32, n: V3, ng: V3, l: V3) -> (f32, V3) {
-    let nl = dot(n, l);
-    let ng = if nl < 0.0 { neg(ng) } else { ng };
+    let (n, ng, l) = (Vec3::from(n), Vec3::from(ng), Vec3::from(l));
+    let nl = n.dot(l);
+    let ng = if nl < 0.0 { -ng } else { ng };
     let nl = nl.abs();
-    let ngl = dot(ng, l);
+    let ngl = ng.dot(l);
     let a = if nl < cutoff {
         2.0 - (ngl + nl) / cutoff
     } else {
         1.0 - ngl / cutoff
     };
-    (a.clamp(0.0, 1.0), ng)
+    (a.clamp(0.0, 1.0), ng.into())
 }
 
 /// The lift at barycentrics `b` (weights of corners 0, 1, 2) of the triangle with corners
@@ -41,32 +42,33 @@ pub fn amount(cutoff: f32, n: V3, ng: V3, l: V3) -> (f32, V3) {
 /// `shadow_ray_smooth_surface_offset`, a parabolic height bounded by each corner's
 /// tangent plane (the local linear envelope).
 pub fn smooth_surface_offset(v: [V3; 3], n: [V3; 3], b: [f32; 3], ng: V3) -> V3 {
+    let (v, n, ng) = (v.map(Vec3::from), n.map(Vec3::from), Vec3::from(ng));
     let [u, w1, w2] = b;
-    let p = add(add(scale(v[0], u), scale(v[1], w1)), scale(v[2], w2));
+    let p = v[0] * u + v[1] * w1 + v[2] * w2;
     // Cycles does not normalise the interpolated normal.
-    let ni = add(add(scale(n[0], u), scale(n[1], w1)), scale(n[2], w2));
-    let a = dot(sub(n[2], n[0]), sub(v[0], v[2]));
-    let bb = dot(sub(n[2], n[1]), sub(v[1], v[2]));
-    let c = dot(sub(n[1], n[0]), sub(v[1], v[0]));
+    let ni = n[0] * u + n[1] * w1 + n[2] * w2;
+    let a = (n[2] - n[0]).dot(v[0] - v[2]);
+    let bb = (n[2] - n[1]).dot(v[1] - v[2]);
+    let c = (n[1] - n[0]).dot(v[1] - v[0]);
     let mut h = a * u * (u - 1.0) + (a + bb + c) * u * w1 + bb * w1 * (w1 - 1.0);
     // The corners' envelope: the highest other corner above each corner's tangent plane.
     let reach = |i: usize, j: usize, k: usize, sign: f32| -> f32 {
-        (sign * dot(sub(v[j], v[i]), n[i]))
-            .max(sign * dot(sub(v[k], v[i]), n[i]))
+        (sign * (v[j] - v[i]).dot(n[i]))
+            .max(sign * (v[k] - v[i]).dot(n[i]))
             .max(0.0)
     };
-    if dot(ni, ng) > 0.0 {
-        let h0 = (dot(sub(v[0], p), n[0]) + reach(0, 1, 2, 1.0)).max(0.0);
-        let h1 = (dot(sub(v[1], p), n[1]) + reach(1, 0, 2, 1.0)).max(0.0);
-        let h2 = (dot(sub(v[2], p), n[2]) + reach(2, 0, 1, 1.0)).max(0.0);
+    if ni.dot(ng) > 0.0 {
+        let h0 = ((v[0] - p).dot(n[0]) + reach(0, 1, 2, 1.0)).max(0.0);
+        let h1 = ((v[1] - p).dot(n[1]) + reach(1, 0, 2, 1.0)).max(0.0);
+        let h2 = ((v[2] - p).dot(n[2]) + reach(2, 0, 1, 1.0)).max(0.0);
         h = h0.min(h1).min(h2).max(h * 0.5);
     } else {
-        let h0 = (dot(sub(p, v[0]), n[0]) + reach(0, 1, 2, -1.0)).max(0.0);
-        let h1 = (dot(sub(p, v[1]), n[1]) + reach(1, 0, 2, -1.0)).max(0.0);
-        let h2 = (dot(sub(p, v[2]), n[2]) + reach(2, 0, 1, -1.0)).max(0.0);
+        let h0 = ((p - v[0]).dot(n[0]) + reach(0, 1, 2, -1.0)).max(0.0);
+        let h1 = ((p - v[1]).dot(n[1]) + reach(1, 0, 2, -1.0)).max(0.0);
+        let h2 = ((p - v[2]).dot(n[2]) + reach(2, 0, 1, -1.0)).max(0.0);
         h = (-h0.min(h1).min(h2)).min(h * 0.5);
     }
-    scale(ni, h)
+    (ni * h).into()
 }
 
 #[cfg(test)]
@@ -90,15 +92,15 @@ mod tests {
     fn convex_triangle_is_lifted_inside() {
         let v = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
         let n = [
-            normalize([-0.3, -0.3, 1.0]),
-            normalize([0.3, 0.0, 1.0]),
-            normalize([0.0, 0.3, 1.0]),
+            vec3(-0.3, -0.3, 1.0).normalize().into(),
+            vec3(0.3, 0.0, 1.0).normalize().into(),
+            vec3(0.0, 0.3, 1.0).normalize().into(),
         ];
         let up = [0.0, 0.0, 1.0];
         let mid = smooth_surface_offset(v, n, [1.0 / 3.0; 3], up);
         assert!(mid[2] > 0.01, "{mid:?}");
         let corner = smooth_surface_offset(v, n, [1.0, 0.0, 0.0], up);
-        assert!(dot(corner, corner).sqrt() < 1e-6, "{corner:?}");
+        assert!(Vec3::from(corner).length() < 1e-6, "{corner:?}");
     }
 
     /// Cycles' blend: no lift for a light well above the surface, full lift where the
@@ -107,12 +109,12 @@ mod tests {
     fn amount_follows_the_grazing_angle() {
         let up = [0.0, 0.0, 1.0];
         assert_eq!(amount(0.1, up, up, up).0, 0.0);
-        let grazing = normalize([1.0, 0.0, 0.02]);
+        let grazing: V3 = vec3(1.0, 0.0, 0.02).normalize().into();
         assert_eq!(amount(0.1, up, up, grazing).0, 1.0);
         // Shading normal tilted toward the light, true normal grazing: the band above
         // the cutoff, 1 - NgL / cutoff.
-        let l = normalize([1.0, 0.0, 0.05]);
-        let a = amount(0.1, normalize([0.5, 0.0, 1.0]), up, l).0;
+        let l: V3 = vec3(1.0, 0.0, 0.05).normalize().into();
+        let a = amount(0.1, vec3(0.5, 0.0, 1.0).normalize().into(), up, l).0;
         assert!(
             (a - (1.0 - l[2] / 0.1)).abs() < 1e-6 && a > 0.4 && a < 0.6,
             "{a}"

@@ -48,17 +48,17 @@ impl Toon {
 
     /// The cone's axis for view direction `wo` (toward the viewer): the normal, or the
     /// mirror direction. None where Glossy sees the surface from below.
-    fn axis(&self, n: V3, wo: V3) -> Option<V3> {
+    fn axis(&self, n: Vec3, wo: Vec3) -> Option<Vec3> {
         if !self.glossy {
             return Some(n);
         }
-        let c = dot(n, wo);
-        (c > 0.0).then(|| sub(scale(n, 2.0 * c), wo))
+        let c = n.dot(wo);
+        (c > 0.0).then(|| n * (2.0 * c) - wo)
     }
 
     /// (BSDF times cosine, pdf) toward `wi` (toward the light), seen from `wo`.
-    pub fn eval(&self, n: V3, wo: V3, wi: V3) -> (f32, f32) {
-        let cos_n = dot(n, wi);
+    pub fn eval(&self, n: Vec3, wo: Vec3, wi: Vec3) -> (f32, f32) {
+        let cos_n = n.dot(wi);
         let ok = if self.glossy {
             cos_n > 0.0
         } else {
@@ -68,7 +68,7 @@ impl Toon {
             return (0.0, 0.0);
         };
         // Cycles' safe_acosf(fmaxf(cos, 0)): NaN and rounding past 1 stay in range.
-        let c = dot(axis, wi).max(0.0);
+        let c = axis.dot(wi).max(0.0);
         let angle = if c >= 1.0 { 0.0 } else { c.acos() };
         if angle < self.sample_angle() {
             let pdf = self.pdf();
@@ -80,19 +80,16 @@ impl Toon {
 
     /// A direction uniformly in the cone (Cycles' sample_uniform_cone), above the true
     /// normal `ng` (and above `n` for Glossy).
-    pub fn sample(&self, n: V3, wo: V3, ng: V3, u: [f32; 2]) -> Option<V3> {
+    pub fn sample(&self, n: Vec3, wo: Vec3, ng: Vec3, u: [f32; 2]) -> Option<Vec3> {
         let axis = self.axis(n, wo)?;
         let one_minus_cos = 1.0 - self.sample_angle().cos();
         let d = crate::render::camera::concentric_disk(u);
         let r2 = d[0] * d[0] + d[1] * d[1];
         let cos_theta = 1.0 - r2 * one_minus_cos;
         let k = (one_minus_cos * (2.0 - one_minus_cos * r2)).max(0.0).sqrt();
-        let (t, b) = basis(axis);
-        let wi = add(
-            add(scale(t, d[0] * k), scale(b, d[1] * k)),
-            scale(axis, cos_theta),
-        );
-        if dot(ng, wi) <= 0.0 || (self.glossy && dot(n, wi) <= 0.0) {
+        let (t, b) = axis.basis();
+        let wi = t * (d[0] * k) + b * (d[1] * k) + axis * cos_theta;
+        if ng.dot(wi) <= 0.0 || (self.glossy && n.dot(wi) <= 0.0) {
             return None;
         }
         Some(wi)

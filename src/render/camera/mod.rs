@@ -6,7 +6,7 @@
 pub mod panorama;
 
 use crate::anim::EvaluatedScene;
-use crate::render::math::*;
+use crate::render::math::{vec3, Affine, Vec3, V3};
 use crate::render::RenderError;
 use crate::scene::settings::{CameraSettings, Output, Projection};
 use crate::scene::Scene;
@@ -158,9 +158,9 @@ impl Camera {
                 if let Some(fi) = eval.data.objects.iter().position(|o| o.name == fo) {
                     // Distance along the view axis to the focus object's origin.
                     let t = eval.world_matrices[fi];
-                    let pos = [t[0][3] as f32, t[1][3] as f32, t[2][3] as f32];
-                    let view = neg(normalize(to_world.column(2)));
-                    focus = dot(sub(pos, to_world.column(3)), view).abs();
+                    let pos = vec3(t[0][3] as f32, t[1][3] as f32, t[2][3] as f32);
+                    let view = -to_world.column_vec3(2).normalize();
+                    focus = (pos - to_world.column_vec3(3)).dot(view).abs();
                 }
             }
             focus = focus.max(1e-5);
@@ -223,6 +223,17 @@ impl Camera {
     }
 
     fn ray_with(&self, to_world: &Affine, x: f32, y: f32, lens: [f32; 2]) -> (V3, V3, f32, f32) {
+        let (o, d, tmin, tmax) = self.ray_vec3(to_world, x, y, lens);
+        (o.into(), d.into(), tmin, tmax)
+    }
+
+    fn ray_vec3(
+        &self,
+        to_world: &Affine,
+        x: f32,
+        y: f32,
+        lens: [f32; 2],
+    ) -> (Vec3, Vec3, f32, f32) {
         let vx = self.left + (self.right - self.left) * (x / self.width as f32);
         let vy = self.top - (self.top - self.bottom) * (y / self.height as f32);
         if let Some(pano) = &self.panorama {
@@ -230,11 +241,11 @@ impl Camera {
         }
         // Camera space, looking down -Z.
         let (mut p, mut d) = if self.ortho {
-            ([vx, vy, 0.0], [0.0, 0.0, -1.0])
+            (vec3(vx, vy, 0.0), vec3(0.0, 0.0, -1.0))
         } else {
             (
-                [0.0; 3],
-                normalize([vx * self.tan_half, vy * self.tan_half, -1.0]),
+                Vec3::ZERO,
+                vec3(vx * self.tan_half, vy * self.tan_half, -1.0).normalize(),
             )
         };
         let tmin;
@@ -245,9 +256,9 @@ impl Camera {
             uv[1] *= self.aperture;
             // Point on the plane of focus, then the ray from the lens point through it.
             let ft = self.focus / -d[2];
-            let focus_p = add(p, scale(d, ft));
-            let lp = [p[0] + uv[0], p[1] + uv[1], p[2]];
-            d = normalize(sub(focus_p, lp));
+            let focus_p = p + d * ft;
+            let lp = vec3(p[0] + uv[0], p[1] + uv[1], p[2]);
+            d = (focus_p - lp).normalize();
             p = lp;
         }
         // Clipping planes are planar, along the view axis.
@@ -256,12 +267,12 @@ impl Camera {
             tmin = self.clip_start;
             tmax = self.clip_end;
         } else {
-            p = add(p, scale(d, self.clip_start * zinv));
+            p += d * (self.clip_start * zinv);
             tmin = 0.0;
             tmax = (self.clip_end - self.clip_start) * zinv;
         }
-        let wo = to_world.point(p);
-        let wd = normalize(to_world.vector(d));
+        let wo = to_world.point_vec3(p);
+        let wd = to_world.vector_vec3(d).normalize();
         (wo, wd, tmin, tmax)
     }
 
@@ -275,31 +286,33 @@ impl Camera {
         u: f32,
         v: f32,
         lens: [f32; 2],
-    ) -> (V3, V3, f32, f32) {
-        let mut d = pano.direction(u, v);
-        if d == [0.0; 3] {
-            return (to_world.column(3), [0.0; 3], 0.0, 0.0);
+    ) -> (Vec3, Vec3, f32, f32) {
+        let mut d = Vec3::from(pano.direction(u, v));
+        if d == Vec3::ZERO {
+            return (to_world.column_vec3(3), Vec3::ZERO, 0.0, 0.0);
         }
-        let mut p = [0.0f32; 3];
+        let mut p = Vec3::ZERO;
         if self.aperture > 0.0 {
             let mut uv = self.sample_aperture(lens);
             uv[0] *= self.aperture;
             uv[1] *= self.aperture;
-            let df = normalize(d);
-            let pf = scale(df, self.focus);
-            let mut a = sub([1.0, 0.0, 0.0], scale(df, df[0]));
-            if dot(a, a) < 1e-12 {
-                a = [0.0, 1.0, 0.0];
+            let df = d.normalize();
+            let pf = df * self.focus;
+            let mut a = Vec3::X - df * df[0];
+            if a.dot(a) < 1e-12 {
+                a = Vec3::Y;
             }
-            let a = normalize(a);
-            let b = normalize(cross(df, a));
-            p = add(scale(a, uv[0]), scale(b, uv[1]));
-            d = normalize(sub(pf, p));
+            let a = a.normalize();
+            let b = df.cross(a).normalize();
+            p = a * uv[0] + b * uv[1];
+            d = (pf - p).normalize();
         }
-        let wo = to_world.point(pano.to_blender_camera(p));
-        let wd = normalize(to_world.vector(pano.to_blender_camera(d)));
+        let wo = to_world.point_vec3(pano.to_blender_camera(p.into()).into());
+        let wd = to_world
+            .vector_vec3(pano.to_blender_camera(d.into()).into())
+            .normalize();
         (
-            madd(wo, wd, self.clip_start),
+            wo + wd * self.clip_start,
             wd,
             0.0,
             self.clip_end - self.clip_start,
@@ -309,13 +322,12 @@ impl Camera {
     /// Compact ray differentials (Cycles' ray.dP, ray.dD) of the ray through (x, y): the
     /// mean change of its origin and direction one pixel right and one pixel down.
     pub fn ray_differentials(&self, x: f32, y: f32, lens: [f32; 2]) -> (f32, f32) {
-        let (o, d, ..) = self.ray(x, y, lens);
-        let (ox, dx, ..) = self.ray(x + 1.0, y, lens);
-        let (oy, dy, ..) = self.ray(x, y + 1.0, lens);
-        let len = |v: V3| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let (o, d, ..) = self.ray_vec3(&self.to_world, x, y, lens);
+        let (ox, dx, ..) = self.ray_vec3(&self.to_world, x + 1.0, y, lens);
+        let (oy, dy, ..) = self.ray_vec3(&self.to_world, x, y + 1.0, lens);
         (
-            0.5 * (len(sub(ox, o)) + len(sub(oy, o))),
-            0.5 * (len(sub(dx, d)) + len(sub(dy, d))),
+            0.5 * ((ox - o).length() + (oy - o).length()),
+            0.5 * ((dx - d).length() + (dy - d).length()),
         )
     }
 
@@ -339,7 +351,7 @@ impl Camera {
     pub fn raster_of(&self, w: V3) -> Option<[f64; 2]> {
         let m = &self.to_world.m;
         if let Some(pano) = &self.panorama {
-            let d = sub(w, self.to_world.column(3));
+            let d = Vec3::from(w) - self.to_world.column_vec3(3);
             // Camera space: the transpose of the (scale-free) rotation.
             let c = |i: usize| m[0][i] * d[0] + m[1][i] * d[1] + m[2][i] * d[2];
             let [u, v] = pano.uv_of(pano.from_blender_camera([c(0), c(1), c(2)]))?;
@@ -383,10 +395,10 @@ impl Camera {
     pub fn depth(&self, w: V3) -> f32 {
         // Cycles' camera_z_depth: a panorama has no view axis, so its depth is the distance.
         if self.panorama.is_some() {
-            return len(sub(w, self.to_world.column(3)));
+            return (Vec3::from(w) - self.to_world.column_vec3(3)).length();
         }
-        let view = neg(self.to_world.column(2));
-        dot(sub(w, self.to_world.column(3)), view)
+        let view = -self.to_world.column_vec3(2);
+        (Vec3::from(w) - self.to_world.column_vec3(3)).dot(view)
     }
 
     /// Distance of world point `w` from the camera along its ray: from the eye for a
@@ -395,7 +407,7 @@ impl Camera {
         if self.ortho {
             self.depth(w)
         } else {
-            len(sub(w, self.to_world.column(3)))
+            (Vec3::from(w) - self.to_world.column_vec3(3)).length()
         }
     }
 }
@@ -404,7 +416,7 @@ impl Camera {
 fn without_scale(m: &Affine) -> Affine {
     let mut o = *m;
     for c in 0..3 {
-        let l = len(m.column(c));
+        let l = m.column_vec3(c).length();
         if l > 0.0 {
             for r in 0..3 {
                 o.m[r][c] /= l;

@@ -6,7 +6,7 @@
 
 use crate::scene::settings::CameraSettings;
 
-use crate::render::math::*;
+use crate::render::math::{vec3, Vec3, V3};
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum Panorama {
@@ -97,17 +97,17 @@ impl Panorama {
             Panorama::EquiangularCubemapFace => {
                 let a = ((0.5 - u) * std::f32::consts::FRAC_PI_2).tan();
                 let b = ((v - 0.5) * std::f32::consts::FRAC_PI_2).tan();
-                normalize([1.0, a, b])
+                vec3(1.0, a, b).normalize().into()
             }
             Panorama::MirrorBall => {
                 let (x, z) = (2.0 * u - 1.0, 2.0 * v - 1.0);
                 if x * x + z * z > 1.0 {
                     return [0.0; 3];
                 }
-                let n = [x, -(1.0 - x * x - z * z).max(0.0).sqrt(), z];
+                let n = vec3(x, -(1.0 - x * x - z * z).max(0.0).sqrt(), z);
                 // The view ray (0, -1, 0) reflected about the ball's normal.
-                let i = [0.0, -1.0, 0.0];
-                sub(scale(n, 2.0 * dot(n, i)), i)
+                let i = vec3(0.0, -1.0, 0.0);
+                (n * (2.0 * n.dot(i)) - i).into()
             }
             Panorama::FisheyeEquidistant { fov } => {
                 let (x, y) = ((u - 0.5) * 2.0, (v - 0.5) * 2.0);
@@ -148,11 +148,12 @@ impl Panorama {
     /// of `direction`, as Cycles' direction_to_panorama (which its Vector pass uses). None
     /// for a zero direction and, for the fisheyes and the mirror ball, outside the lens.
     pub fn uv_of(&self, d: V3) -> Option<[f32; 2]> {
-        let l = len(d);
+        let d = Vec3::from(d);
+        let l = d.length();
         if !(l > 0.0) {
             return None;
         }
-        let d = scale(d, 1.0 / l);
+        let d = d * (1.0 / l);
         // The (y, z) direction of a fisheye's image radius.
         let yz = || {
             let r = (d[1] * d[1] + d[2] * d[2]).sqrt();

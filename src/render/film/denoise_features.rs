@@ -12,7 +12,7 @@
 //! albedo. A path that never writes leaves zero.
 
 use crate::render::bsdf::{LobeKind, LobeSet};
-use crate::render::math::*;
+use crate::render::math::{Vec3, V3};
 
 /// One sample's guide values and the state of their path.
 #[derive(Debug, Clone, Copy)]
@@ -55,8 +55,10 @@ impl Features {
     /// a lamp seen directly): Cycles adds it to the albedo guide.
     #[inline]
     pub fn add_emission(&mut self, contribution: V3) {
-        if self.active && finite(contribution) {
-            self.albedo = add(self.albedo, mul(self.throughput, contribution));
+        let contribution = Vec3::from(contribution);
+        if self.active && contribution.is_finite() {
+            let throughput = Vec3::from(self.throughput);
+            self.albedo = (Vec3::from(self.albedo) + throughput * contribution).into();
         }
     }
 
@@ -65,41 +67,43 @@ impl Features {
         if !self.active {
             return;
         }
-        let (mut n, mut diffuse, mut specular) = ([0.0f32; 3], [0.0f32; 3], [0.0f32; 3]);
+        let (mut n, mut diffuse, mut specular) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
         let (mut sum, mut sum_nonspecular) = (0.0f32, 0.0f32);
         for l in &lobes.lobes[..lobes.len] {
-            n = madd(n, l.n, l.sample_weight);
+            let weight = Vec3::from(l.weight);
+            n += Vec3::from(l.n) * l.sample_weight;
             sum += l.sample_weight;
             // Cycles' bsdf_albedo: a BSSRDF's weight (its sample weight counts every
             // channel); otherwise the weight scaled by the albedo estimate that the
             // sample weight was scaled by.
-            let wsum = l.weight[0].abs() + l.weight[1].abs() + l.weight[2].abs();
+            let wsum = weight[0].abs() + weight[1].abs() + weight[2].abs();
             let albedo = match l.kind {
-                LobeKind::Subsurface(_) => l.weight,
-                _ if wsum > 0.0 => scale(l.weight, (l.sample_weight / wsum).min(1.0)),
-                _ => [0.0; 3],
+                LobeKind::Subsurface(_) => weight,
+                _ if wsum > 0.0 => weight * (l.sample_weight / wsum).min(1.0),
+                _ => Vec3::ZERO,
             };
             if roughness_squared(&l.kind) > 0.075 * 0.075 {
-                diffuse = add(diffuse, albedo);
+                diffuse += albedo;
                 sum_nonspecular += l.sample_weight;
             } else {
-                specular = add(specular, albedo);
+                specular += albedo;
             }
         }
+        let throughput = Vec3::from(self.throughput);
         if sum == 0.0 || sum_nonspecular * 4.0 > sum {
             if sum != 0.0 {
-                n = scale(n, 1.0 / sum);
+                n *= 1.0 / sum;
             }
-            if finite(n) {
-                self.normal = n;
+            if n.is_finite() {
+                self.normal = n.into();
             }
-            let a = mul(self.throughput, diffuse);
-            if finite(a) {
-                self.albedo = add(self.albedo, a);
+            let a = throughput * diffuse;
+            if a.is_finite() {
+                self.albedo = (Vec3::from(self.albedo) + a).into();
             }
             self.active = false;
         } else {
-            self.throughput = mul(self.throughput, specular);
+            self.throughput = (throughput * specular).into();
         }
     }
 }

@@ -19,7 +19,7 @@ use rayon::prelude::*;
 use crate::render::accel::{self, Accel};
 use crate::render::build::Geometry;
 use crate::render::camera::Camera;
-use crate::render::math::*;
+use crate::render::math::{Vec3, V3};
 
 /// What the primary ray through a pixel centre hit: an instance of the frame's geometry,
 /// a triangle of its mesh, and the hit's barycentrics (the corner weights are 1 - u - v,
@@ -68,11 +68,13 @@ fn point(geo: &Geometry, inst: usize, tri: u32, u: f32, v: f32) -> Option<V3> {
     let m = &i.mesh;
     let t = m.triangles.get(tri as usize)?;
     let c = t.map(|c| {
-        i.to_world
-            .point(m.positions[m.corner_verts[c as usize] as usize])
+        Vec3::from(
+            i.to_world
+                .point(m.positions[m.corner_verts[c as usize] as usize]),
+        )
     });
     let w0 = 1.0 - u - v;
-    Some(add(add(scale(c[0], w0), scale(c[1], u)), scale(c[2], v)))
+    Some((c[0] * w0 + c[1] * u + c[2] * v).into())
 }
 
 /// For each instance of `here`, its instance in `there` when it is there exactly once
@@ -165,7 +167,7 @@ pub fn flow_to(
 /// camera ray through its raster position `r` hits, within the clipping range.
 fn visible(accel: &dyn Accel, there: &FrameView, inst: u32, tri: u32, p: V3, r: [f64; 2]) -> bool {
     let (o, d, t0, t1) = there.camera.ray(r[0] as f32, r[1] as f32, [0.5, 0.5]);
-    let tp = dot(sub(p, o), d);
+    let tp = (Vec3::from(p) - o.into()).dot(d.into());
     if !(tp > t0) || tp > t1 {
         return false;
     }
