@@ -427,10 +427,20 @@ fn in_reference_order(ours: &Mesh, theirs: &MeshData) -> Result<Mesh, String> {
 
 /// Cases blendsynth refuses by name (Blender's mesh is there to show why), each with the
 /// test that checks its message.
-const REFUSED_CASES: &[(&str, &str)] = &[(
-    "import_nodes/imp_ply_bent",
-    "import_ply_normals_deformed_are_refused_by_name",
-)];
+const REFUSED_CASES: &[(&str, &str)] = &[
+    (
+        "import_nodes/imp_ply_bent",
+        "import_ply_normals_deformed_are_refused_by_name",
+    ),
+    (
+        "volume_nodes/refused_mesh_to_volume",
+        "unmatched_volume_nodes_are_refused_by_name",
+    ),
+    (
+        "volume_nodes/refused_distribute_random",
+        "unmatched_volume_nodes_are_refused_by_name",
+    ),
+];
 
 fn run_scene(dir: &Path, r: &mut Report) -> usize {
     let scene = Scene::load(dir).unwrap_or_else(|e| panic!("{e}"));
@@ -731,11 +741,14 @@ fn parity_fixtures_stay_small() {
     // 13.35 MB; the Format String, Import CSV / Text and Deform Curves on Surface scenes
     // (gn_misc_nodes.py: 0.32 MB, nearly all of it scene.json) and the Volume to Mesh cases
     // (gn_volume_nodes.py: 0.18 MB, 0.1 MB of it the evaluated meshes) to 13.9 MB; the
-    // cases from Molecular Nodes' files (gn_realfile_nodes.py: 0.27 MB, one scene) to
-    // 14.1 MB.
+    // Mesh to Volume cases (gn_volume_nodes.py: 0.1 MB, mostly node trees; their grids
+    // are volume_refs.json, 72 kB in all), the Points to Volume and Distribute Points in
+    // Volume cases (gn_volume_nodes.py: 0.11 MB, mostly node trees; 20 kB the evaluated
+    // points) to 14.1 MB; the cases from Molecular Nodes' files (gn_realfile_nodes.py:
+    // 0.27 MB, one scene) to 14.4 MB.
     assert!(
-        total < 14_100_000,
-        "fixtures/geometry/scenes holds {total} bytes; keep it under 14.1 MB"
+        total < 14_400_000,
+        "fixtures/geometry/scenes holds {total} bytes; keep it under 14.4 MB"
     );
 }
 
@@ -1546,6 +1559,10 @@ fn volume_nodes_match_blenders_grids() {
     let f = |v: &serde_json::Value| v.as_f64().unwrap();
     let (mut worst_value, mut worst_transform, mut voxels) = (0.0f64, 0.0f64, 0usize);
     for (case, want) in refs {
+        // Mesh and Points to Volume's cases: volume_cases_match_blender.
+        if case.starts_with("m2v_") || case.starts_with("p2v_") {
+            continue;
+        }
         let set = geometry::evaluate_object(&scene, case, frame, &[])
             .unwrap_or_else(|e| panic!("{case}: {e}"));
         let Some(want) = want.as_array() else {
@@ -1609,32 +1626,155 @@ fn volume_nodes_match_blenders_grids() {
     );
 }
 
-/// Points to Volume and Mesh to Volume are not evaluated (OpenVDB's particle rasterizer
-/// and mesh-to-level-set conversion are not matched): their object is refused naming the
-/// node, never rendered from Blender's frozen mesh, which cannot carry the volume (the
-/// export's `volume_grids`).
+/// The grids of the cases named `prefix*` against Blender's: every active voxel, values
+/// within 1e-6. Returns a line per case.
+fn volume_cases_match_blender(prefix: &str, min_cases: usize, min_voxels: usize) -> Vec<String> {
+    let scene = load("volume_nodes");
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("fixtures/geometry/volume_refs.json");
+    let refs: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let frame = scene.file.scene.frame_current as f64;
+    let f = |v: &serde_json::Value| v.as_f64().unwrap();
+    let (mut cases, mut voxels, mut worst, mut worst_case) = (0, 0usize, 0.0f64, String::new());
+    let mut report = Vec::new();
+    for (case, want) in refs.as_object().unwrap() {
+        if !case.starts_with(prefix) {
+            continue;
+        }
+        cases += 1;
+        let set = geometry::evaluate_object(&scene, case, frame, &[])
+            .unwrap_or_else(|e| panic!("{case}: {e}"));
+        let Some(want) = want.as_array() else {
+            assert!(set.volume.is_none(), "{case}: Blender has no volume");
+            // The points pass unchanged (Points to Vertices after).
+            assert_eq!(
+                set.mesh.as_ref().map(|m| m.positions.len()),
+                Some(3),
+                "{case}"
+            );
+            continue;
+        };
+        assert!(
+            set.points.is_none() && set.mesh.is_none(),
+            "{case}: only the volume stays"
+        );
+        let vol = set
+            .volume
+            .as_ref()
+            .unwrap_or_else(|| panic!("{case}: no volume"));
+        assert_eq!(vol.grids.len(), want.len(), "{case}");
+        for (g, w) in vol.grids.iter().zip(want) {
+            assert_eq!(g.name, w["name"].as_str().unwrap(), "{case}");
+            assert_eq!(g.background as f64, f(&w["background"]), "{case}");
+            let t = &g.transform;
+            // The voxel size to an ulp: Voxel Amount divides the diagonal of our evaluated
+            // mesh's bounds.
+            for k in 0..3 {
+                assert!(
+                    (t[3][k] - f(&w["origin"][k])).abs() <= 1e-9,
+                    "{case}: origin"
+                );
+                for a in 0..3 {
+                    let (ours, theirs) = (t[a][k], f(&w["axes"][a][k]));
+                    assert!(
+                        (ours - theirs).abs() <= 1e-7 * theirs.abs(),
+                        "{case}: axes {ours} {theirs}"
+                    );
+                }
+            }
+            let (lo, hi) = g.active_bounds().unwrap_or(([0; 3], [-1; 3]));
+            let box_of = |i: usize| -> [i32; 3] {
+                [0, 1, 2].map(|k| w["box"][i][k].as_i64().unwrap() as i32)
+            };
+            let values = w["values"].as_array().unwrap();
+            let (wlo, whi) = (box_of(0), box_of(1));
+            let mut n = 0;
+            let (mut case_worst, mut off) = (0.0f64, 0);
+            for k in wlo[2]..=whi[2] {
+                for j in wlo[1]..=whi[1] {
+                    for i in wlo[0]..=whi[0] {
+                        let d = (g.value([i, j, k]) as f64 - f(&values[n])).abs();
+                        case_worst = case_worst.max(d);
+                        off += (d > 1e-6) as usize;
+                        n += 1;
+                    }
+                }
+            }
+            report.push(format!(
+                "{case}: {} active (Blender {}), box {lo:?}..{hi:?}, {off} of {n} voxels off by more than 1e-6, worst {case_worst:.3e}",
+                g.active_voxel_count(),
+                w["active"]
+            ));
+            assert_eq!((lo, hi), (wlo, whi), "{case}: active box; {report:#?}");
+            assert_eq!(
+                g.active_voxel_count() as u64,
+                w["active"].as_u64().unwrap(),
+                "{case}: active voxels; {report:#?}"
+            );
+            voxels += n;
+            if case_worst > worst {
+                worst = case_worst;
+                worst_case = case.clone();
+            }
+        }
+    }
+    println!("{report:#?}");
+    println!("{prefix}: {cases} cases, {voxels} voxels, worst {worst:e} ({worst_case})");
+    assert!(
+        cases >= min_cases && voxels >= min_voxels,
+        "{cases} cases, {voxels} voxels"
+    );
+    assert!(
+        worst <= 1e-6,
+        "worst voxel value difference {worst:e} in {worst_case}: {report:#?}"
+    );
+    report
+}
+
+/// Mesh to Volume against Blender's grids (gn_volume_nodes.py's `m2v_*` cases, read back
+/// with Blender's OpenVDB module): the voxel size from Voxel Size and from Voxel Amount, the
+/// grid transform (a plain scale: the mesh went in half a voxel shifted), OpenVDB's active
+/// voxels (every voxel inside, those on a face through voxel centres included), the fog
+/// ramp over the interior band (its cutoff the deepest voxel when the band is wider than
+/// the inside), Density, a concave torus, and the components kept (a geometry without a
+/// mesh passes unchanged; a point cloud beside a mesh is dropped).
+#[test]
+fn mesh_to_volume_matches_blenders_grids() {
+    volume_cases_match_blender("m2v_", 8, 4000);
+}
+
+/// Points to Volume against Blender's grids (`p2v_*`): spheres with a core (the fog's
+/// cutoff -1, the cores reading 1) and without (radii under a voxel: the cutoff the
+/// smallest distance), a Radius field, Density, Voxel Amount over a mesh's vertices, and a
+/// mesh's vertices, a point cloud and curve control points together.
+#[test]
+fn points_to_volume_matches_blenders_grids() {
+    volume_cases_match_blender("p2v_", 5, 1500);
+}
+
+/// Mesh to Volume of an open mesh (OpenVDB's exterior flood fill leaks through the
+/// boundary) and Distribute Points in Volume's Random mode (OpenVDB's scatter drawing
+/// from `std::mt19937`) are errors naming the node.
 #[test]
 fn unmatched_volume_nodes_are_refused_by_name() {
     let scene = load("volume_nodes");
     let frame = scene.file.scene.frame_current as f64;
-    for (case, node) in [
-        ("refused_points_to_volume", "GeometryNodePointsToVolume"),
-        ("refused_mesh_to_volume", "GeometryNodeMeshToVolume"),
-    ] {
-        let o = scene.file.objects.iter().find(|o| o.name == case).unwrap();
-        let e = geometry::source::object_source(&scene, o, frame, &[])
-            .map(|_| ())
-            .unwrap_err()
-            .to_string();
-        assert!(
-            e.contains(node) && e.contains("holds a volume (1 grid)"),
-            "{e}"
-        );
-        assert!(geometry::evaluate_object(&scene, case, frame, &[])
-            .unwrap_err()
-            .to_string()
-            .contains(node));
-    }
+    let e = geometry::evaluate_object(&scene, "refused_distribute_random", frame, &[])
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("Distribute Points in Volume") && e.contains("\"DENSITY_RANDOM\""),
+        "{e}"
+    );
+    let e = geometry::evaluate_object(&scene, "refused_mesh_to_volume", frame, &[])
+        .map(|_| ())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("Mesh to Volume") && e.contains("not closed") && e.contains("open edges"),
+        "{e}"
+    );
 }
 
 /// Volume to Mesh's options OpenVDB evaluates differently (a resampled grid for the Voxel

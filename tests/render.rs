@@ -357,6 +357,9 @@ const ASSERTED: &[&str] = &[
     // Geometry Nodes volumes (geometry/volume.rs, nodes/volume_cube.rs): a Volume Cube with
     // a Principled Volume by Set Material on a rotated, unevenly scaled object.
     "gn_volume_cube",
+    // Mesh to Volume (nodes/mesh_to_volume.rs): an ico sphere's fog ramp with a Principled
+    // Volume by Set Material.
+    "gn_mesh_to_volume",
     // The world volume (render/volume_world.rs), filling all space with the camera inside:
     // homogeneous scatter under a point light and a sun it extinguishes, absorption that
     // spares one channel (the sky and the sun stay in red), and a noise-texture density

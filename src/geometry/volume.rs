@@ -103,6 +103,58 @@ impl VolumeGrid {
         g
     }
 
+    /// A grid from values and active flags over the box of `dims` voxels at index
+    /// `origin` (x fastest), the stored box shrunk to the active voxels; inactive ones
+    /// read the background.
+    pub fn from_dense_active(
+        name: &str,
+        transform: [[f64; 4]; 4],
+        background: f32,
+        origin: [i32; 3],
+        dims: [usize; 3],
+        values: &[f32],
+        active: &[bool],
+    ) -> VolumeGrid {
+        let (mut lo, mut hi) = ([usize::MAX; 3], [0usize; 3]);
+        for (n, _) in active.iter().enumerate().filter(|(_, a)| **a) {
+            let ijk = [
+                n % dims[0],
+                (n / dims[0]) % dims[1],
+                n / (dims[0] * dims[1]),
+            ];
+            for a in 0..3 {
+                lo[a] = lo[a].min(ijk[a]);
+                hi[a] = hi[a].max(ijk[a]);
+            }
+        }
+        let mut g = VolumeGrid {
+            name: name.to_string(),
+            transform,
+            background,
+            origin: [0; 3],
+            dims: [0; 3],
+            values: Vec::new(),
+            active: Vec::new(),
+        };
+        if lo[0] == usize::MAX {
+            return g;
+        }
+        let d = [0, 1, 2].map(|a| hi[a] - lo[a] + 1);
+        g.origin = [0, 1, 2].map(|a| origin[a] + lo[a] as i32);
+        g.dims = d;
+        for k in lo[2]..=hi[2] {
+            for j in lo[1]..=hi[1] {
+                for i in lo[0]..=hi[0] {
+                    let n = (k * dims[1] + j) * dims[0] + i;
+                    g.values
+                        .push(if active[n] { values[n] } else { background });
+                    g.active.push(active[n]);
+                }
+            }
+        }
+        g
+    }
+
     pub fn active_voxel_count(&self) -> usize {
         self.active.iter().filter(|a| **a).count()
     }

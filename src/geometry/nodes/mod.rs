@@ -24,6 +24,7 @@ pub mod curve_write;
 pub mod deform_curves_on_surface;
 pub mod delete;
 pub mod distribute;
+pub mod distribute_points_in_volume;
 pub mod domain_size;
 pub mod dual_mesh;
 pub mod duplicate_elements;
@@ -73,9 +74,11 @@ pub mod menu_switch;
 pub mod merge_by_distance;
 pub mod mesh_face_set_boundaries;
 pub mod mesh_to_curve;
+pub mod mesh_to_volume;
 pub mod mesh_topology;
 pub mod points;
 pub mod points_to_curves;
+pub mod points_to_volume;
 pub mod primitives;
 pub mod proximity;
 pub mod radius;
@@ -417,6 +420,15 @@ pub const NODES: &[(&str, Evaluate)] = &[
     ("FunctionNodeSeparateMatrix", matrix::separate_matrix),
     ("GeometryNodeVolumeCube", volume_cube::volume_cube),
     ("GeometryNodeVolumeToMesh", volume_to_mesh::volume_to_mesh),
+    ("GeometryNodeMeshToVolume", mesh_to_volume::mesh_to_volume),
+    (
+        "GeometryNodePointsToVolume",
+        points_to_volume::points_to_volume,
+    ),
+    (
+        "GeometryNodeDistributePointsInVolume",
+        distribute_points_in_volume::distribute_points_in_volume,
+    ),
     ("GeometryNodePoints", points::points),
     ("GeometryNodeSetPointRadius", points::set_point_radius),
     ("GeometryNodeSetID", points::set_id),

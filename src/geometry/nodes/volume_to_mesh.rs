@@ -248,7 +248,7 @@ fn configs() -> &'static [Config; 256] {
 /// Where a cell sits in OpenVDB's default tree (5, 4, 3): the root table sorted by the
 /// 4096^3 node origin, then the 32^3 children, the 16^3 children and the 8^3 voxels of a
 /// leaf, each x-major.
-fn tree_order(c: [i32; 3]) -> (i32, i32, i32, u32) {
+pub(super) fn tree_order(c: [i32; 3]) -> (i32, i32, i32, u32) {
     let part = |shift: u32, bits: u32| -> u32 {
         let m = (1u32 << bits) - 1;
         let a = ((c[0] >> shift) as u32) & m;
