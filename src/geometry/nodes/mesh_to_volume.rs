@@ -430,6 +430,8 @@ fn inside_flags(g: &Grid, points: &[P3], tris: &[[u32; 3]]) -> Vec<bool> {
 }
 
 /// The fog grid: box origin, dims, values and active flags over the box.
+// Long because it runs OpenVDB's meshToVolume steps in their order (voxelize, signs,
+// band growth, renormalize, trim, fog), each reading the previous one's arrays.
 #[allow(clippy::type_complexity)]
 fn fog_grid(
     points: &[P3],
@@ -702,6 +704,8 @@ fn fog_grid(
 
 /// Step 4, `ExpandNarrowband` pass by pass: the voxels face-adjacent to the band that are
 /// within it, measured to the triangles of band voxels near them, by leaf.
+// Long because it keeps OpenVDB's pass in one piece: its leaf order decides which
+// triangle a voxel is measured to first, and splitting it would scatter that state.
 #[allow(clippy::too_many_arguments)]
 fn expand(
     g: &Grid,
