@@ -58,49 +58,11 @@ impl VolumeGrid {
     ) -> VolumeGrid {
         // `isApproxEqual(v, background, 0)`: equal unless |v - background| > 0 (NaN is
         // "equal", so inactive).
-        let on = |v: f32| (v - background).abs() > 0.0;
-        let (mut lo, mut hi) = ([usize::MAX; 3], [0usize; 3]);
-        let mut any = false;
-        for k in 0..dims[2] {
-            for j in 0..dims[1] {
-                for i in 0..dims[0] {
-                    if on(values[(k * dims[1] + j) * dims[0] + i]) {
-                        any = true;
-                        for (a, c) in [i, j, k].into_iter().enumerate() {
-                            lo[a] = lo[a].min(c);
-                            hi[a] = hi[a].max(c);
-                        }
-                    }
-                }
-            }
-        }
-        let mut g = VolumeGrid {
-            name: name.to_string(),
-            transform,
-            background,
-            origin: [0; 3],
-            dims: [0; 3],
-            values: Vec::new(),
-            active: Vec::new(),
-        };
-        if !any {
-            return g;
-        }
-        let d = [0, 1, 2].map(|a| hi[a] - lo[a] + 1);
-        g.origin = lo.map(|c| c as i32);
-        g.dims = d;
-        g.values.reserve(d[0] * d[1] * d[2]);
-        for k in lo[2]..=hi[2] {
-            for j in lo[1]..=hi[1] {
-                for i in lo[0]..=hi[0] {
-                    let v = values[(k * dims[1] + j) * dims[0] + i];
-                    let a = on(v);
-                    g.values.push(if a { v } else { background });
-                    g.active.push(a);
-                }
-            }
-        }
-        g
+        let active: Vec<bool> = values
+            .iter()
+            .map(|v| (v - background).abs() > 0.0)
+            .collect();
+        VolumeGrid::from_dense_active(name, transform, background, [0; 3], dims, values, &active)
     }
 
     /// A grid from values and active flags over the box of `dims` voxels at index
