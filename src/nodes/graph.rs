@@ -8,7 +8,7 @@ use std::collections::HashMap;
 
 use serde_json::Value;
 
-use crate::scene::{Node, NodeTree, Socket};
+use crate::scene::{Link, Node, NodeTree, Socket};
 
 /// Where an input's value comes from after flattening.
 #[derive(Debug, Clone)]
@@ -243,18 +243,7 @@ impl<'a> Builder<'a> {
         s: &'a Socket,
     ) -> Result<Vec<Source<'a>>, GraphError> {
         let tree = self.instances[inst].tree;
-        let links: Vec<_> = tree
-            .links
-            .iter()
-            .filter(|l| {
-                l.to_node == node.name && l.to_socket == s.identifier && !l.is_muted && l.is_valid
-            })
-            // Links from nodes Cycles ignores are dropped, as Cycles' sync drops them.
-            .filter(|l| {
-                find(tree, &l.from_node)
-                    .is_none_or(|n| !super::IGNORED_BY_CYCLES.contains(&n.bl_idname.as_str()))
-            })
-            .collect();
+        let links: Vec<_> = links_into(tree, node, s).collect();
         if links.is_empty() {
             return Ok(vec![if s.default_value.is_some() {
                 Source::Default(s)
@@ -306,13 +295,8 @@ impl<'a> Builder<'a> {
                                 format!("has no input {identifier:?} for its group's interface"),
                             )
                         })?;
-                    let linked = self.instances[outer].tree.links.iter().any(|l| {
-                        l.to_node == group_node.name
-                            && l.to_socket == s.identifier
-                            && !l.is_muted
-                            && l.is_valid
-                    });
-                    if !linked {
+                    let outer_tree = self.instances[outer].tree;
+                    if links_into(outer_tree, group_node, s).next().is_none() {
                         if let Some(f) = default_input_field(self.instances[inst].tree, identifier)
                         {
                             return Ok(Source::DefaultInput(f));
@@ -417,6 +401,24 @@ fn pass_through(node: &Node, index: usize) -> Option<&Socket> {
         return node.inputs.iter().find(|s| s.identifier == link.from);
     }
     node.inputs.iter().find(|s| s.enabled && s.kind == out.kind)
+}
+
+/// The live links into input socket `s` of `node`: not muted, valid, and not from a node
+/// Cycles ignores (Cycles' sync drops those).
+fn links_into<'t>(
+    tree: &'t NodeTree,
+    node: &'t Node,
+    s: &'t Socket,
+) -> impl Iterator<Item = &'t Link> {
+    tree.links
+        .iter()
+        .filter(move |l| {
+            l.to_node == node.name && l.to_socket == s.identifier && !l.is_muted && l.is_valid
+        })
+        .filter(move |l| {
+            find(tree, &l.from_node)
+                .is_none_or(|n| !super::IGNORED_BY_CYCLES.contains(&n.bl_idname.as_str()))
+        })
 }
 
 /// The field an unlinked input `identifier` of group `tree` reads, if its Default Input is
