@@ -10,7 +10,6 @@ use std::sync::OnceLock;
 
 use crate::foundation::bvh::{Accel, Bvh};
 
-use crate::nodes::math::Vec3;
 use crate::shader::trace::Trace;
 use crate::shader::ShadingPoint;
 
@@ -156,7 +155,7 @@ impl Trace for ShaderRays<'_, '_> {
     fn ambient_occlusion(
         &self,
         sp: &ShadingPoint,
-        n: Vec3,
+        n: V3,
         max_dist: f32,
         samples: u32,
         only_local: bool,
@@ -191,7 +190,7 @@ impl Trace for ShaderRays<'_, '_> {
         unoccluded as f32 / samples as f32
     }
 
-    fn bevel(&self, sp: &ShadingPoint, radius: f32, samples: u32) -> Vec3 {
+    fn bevel(&self, sp: &ShadingPoint, radius: f32, samples: u32) -> V3 {
         if self.min_ray_pdf < BEVEL_MIN_RAY_PDF {
             return sp.normal;
         }

@@ -4,7 +4,7 @@
 //! `AttributeRequest`s; whoever shades a mesh binds them once (`BoundAttributes::bind`)
 //! and fills the shading point per hit (`fill`), allocation-free.
 
-use crate::nodes::math::{cross3, normalize3, Vec3};
+use crate::nodes::math::{cross3, normalize3, V3};
 use crate::scene::{AttributeData, Domain, MeshData};
 
 use super::point::ShadingPoint;
@@ -70,7 +70,7 @@ enum Values {
     TriangleCorner(Vec<[f32; 4]>),
     /// Smooth faces: corner normals interpolated; flat ones (per face): the triangle normal.
     MapNormal {
-        normals: Vec<Vec3>,
+        normals: Vec<V3>,
         flat: Vec<bool>,
     },
     /// The instance's value of this name (constant over the mesh).

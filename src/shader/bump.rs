@@ -6,7 +6,7 @@
 use crate::foundation::math::{
     transform_direction, transform_direction_transposed, transform_point,
 };
-use crate::nodes::math::{add3, cross3, dot3, length3, scale3, sub3, Vec3};
+use crate::nodes::math::{add3, cross3, dot3, length3, scale3, sub3, V3};
 
 use super::point::ShadingPoint;
 
@@ -35,32 +35,32 @@ impl Default for ObjectTransform {
 
 impl ObjectTransform {
     /// Cycles' object_inverse_position_transform.
-    pub fn inverse_point(&self, p: Vec3) -> Vec3 {
+    pub fn inverse_point(&self, p: V3) -> V3 {
         transform_point(&self.to_object, p)
     }
     /// object_dir_transform / object_inverse_dir_transform.
-    pub fn dir(&self, d: Vec3) -> Vec3 {
+    pub fn dir(&self, d: V3) -> V3 {
         transform_direction(&self.to_world, d)
     }
-    pub fn inverse_dir(&self, d: Vec3) -> Vec3 {
+    pub fn inverse_dir(&self, d: V3) -> V3 {
         transform_direction(&self.to_object, d)
     }
     /// object_normal_transform: world normal from an object-space one.
-    pub fn normal(&self, n: Vec3) -> Vec3 {
+    pub fn normal(&self, n: V3) -> V3 {
         normalize(transform_direction_transposed(&self.to_object, n))
     }
     /// object_inverse_normal_transform: object-space normal from a world one.
-    pub fn inverse_normal(&self, n: Vec3) -> Vec3 {
+    pub fn inverse_normal(&self, n: V3) -> V3 {
         normalize(transform_direction_transposed(&self.to_world, n))
     }
 }
 
-pub fn normalize(v: Vec3) -> Vec3 {
+pub fn normalize(v: V3) -> V3 {
     let l = length3(v);
     [v[0] / l, v[1] / l, v[2] / l]
 }
 
-pub fn safe_normalize(v: Vec3) -> Vec3 {
+pub fn safe_normalize(v: V3) -> V3 {
     let l = length3(v);
     if l != 0.0 {
         [v[0] / l, v[1] / l, v[2] / l]
@@ -80,7 +80,7 @@ fn signf(x: f32) -> f32 {
 /// Two unit tangents completing `n` to an orthonormal frame (Cycles' make_orthonormals:
 /// (1,1,1) x N, or (-1,1,1) x N when N is on the diagonal), which decides the directions
 /// a compact differential expands to. Bump results depend on it to second order.
-pub fn make_orthonormals(n: Vec3) -> (Vec3, Vec3) {
+pub fn make_orthonormals(n: V3) -> (V3, V3) {
     let a = if n[0] != n[1] || n[0] != n[2] {
         [n[2] - n[1], n[0] - n[2], n[1] - n[0]]
     } else {
@@ -91,25 +91,20 @@ pub fn make_orthonormals(n: Vec3) -> (Vec3, Vec3) {
 }
 
 /// A compact differential (a radius) as the two vectors Cycles expands it to around `d`.
-pub fn differential_from_compact(d: Vec3, radius: f32) -> (Vec3, Vec3) {
+pub fn differential_from_compact(d: V3, radius: f32) -> (V3, V3) {
     let (x, y) = make_orthonormals(d);
     (scale3(x, radius), scale3(y, radius))
 }
 
 /// Cycles' differential_make_compact: the mean length of the two differentials.
-pub fn differential_make_compact(dx: Vec3, dy: Vec3) -> f32 {
+pub fn differential_make_compact(dx: V3, dy: V3) -> f32 {
     0.5 * (length3(dx) + length3(dy))
 }
 
 /// Changes of the barycentric (u, v) of a triangle along `dp` (Cycles' differential_dudv,
 /// Cramer's rule after dropping the axis the normal is largest along). `dpdu`, `dpdv` are
 /// p1 - p0 and p2 - p0 (the point is (1-u-v) p0 + u p1 + v p2).
-pub fn differential_dudv(
-    mut dpdu: Vec3,
-    mut dpdv: Vec3,
-    mut dp: [Vec3; 2],
-    ng: Vec3,
-) -> [[f32; 2]; 2] {
+pub fn differential_dudv(mut dpdu: V3, mut dpdv: V3, mut dp: [V3; 2], ng: V3) -> [[f32; 2]; 2] {
     let (xn, yn, zn) = (ng[0].abs(), ng[1].abs(), ng[2].abs());
     if zn < xn || zn < yn {
         if yn < xn || yn < zn {
@@ -137,7 +132,7 @@ pub fn differential_dudv(
 }
 
 /// The change of a triangle attribute (values at corners `f`) for barycentric changes `d`.
-pub fn attribute_differential(f: [Vec3; 3], d: [f32; 2]) -> Vec3 {
+pub fn attribute_differential(f: [V3; 3], d: [f32; 2]) -> V3 {
     add3(
         scale3(sub3(f[1], f[0]), d[0]),
         scale3(sub3(f[2], f[0]), d[1]),
@@ -230,13 +225,13 @@ pub struct BumpSettings {
 pub fn bump_normal(
     sp: &ShadingPoint,
     set: BumpSettings,
-    normal_in: Vec3,
+    normal_in: V3,
     strength: f32,
     distance: f32,
     h_c: f32,
     h_x: f32,
     h_y: f32,
-) -> Vec3 {
+) -> V3 {
     let (mut n, mut dx, mut dy) = (normal_in, sp.dp_dx, sp.dp_dy);
     if set.object_space {
         n = sp.transform.inverse_normal(n);
@@ -272,8 +267,8 @@ pub fn displacement(
     height: f32,
     midlevel: f32,
     scale: f32,
-    normal: Vec3,
-) -> Vec3 {
+    normal: V3,
+) -> V3 {
     let k = (height - midlevel) * scale;
     if object_space {
         sp.transform
@@ -310,10 +305,10 @@ impl MapSpace {
 pub fn vector_displacement(
     sp: &ShadingPoint,
     space: MapSpace,
-    vector: Vec3,
+    vector: V3,
     midlevel: f32,
     scale: f32,
-) -> Vec3 {
+) -> V3 {
     let d = scale3(sub3(vector, [midlevel; 3]), scale);
     match space {
         MapSpace::World => d,
@@ -323,7 +318,7 @@ pub fn vector_displacement(
 
 /// Normal Map in the non-tangent spaces (Cycles' svm_node_normal_map): the colour read as
 /// a normal, then blended toward the shading normal by strength.
-pub fn normal_map(sp: &ShadingPoint, space: MapSpace, color: Vec3, strength: f32) -> Vec3 {
+pub fn normal_map(sp: &ShadingPoint, space: MapSpace, color: V3, strength: f32) -> V3 {
     let mut c = scale3(sub3(color, [0.5; 3]), 2.0);
     if matches!(space, MapSpace::BlenderObject | MapSpace::BlenderWorld) {
         c[1] = -c[1];
@@ -352,13 +347,7 @@ pub fn normal_map(sp: &ShadingPoint, space: MapSpace, color: Vec3, strength: f32
 /// The normal the displacement bump gives every closure: heights are the displacement
 /// projected on the unperturbed normal (Cycles' bump_from_displacement: distance 1,
 /// strength 1, the Bump node's default filter width).
-pub fn displacement_bump(
-    sp: &ShadingPoint,
-    object_space: bool,
-    d_c: Vec3,
-    d_x: Vec3,
-    d_y: Vec3,
-) -> Vec3 {
+pub fn displacement_bump(sp: &ShadingPoint, object_space: bool, d_c: V3, d_x: V3, d_y: V3) -> V3 {
     let n = sp.normal;
     let set = BumpSettings {
         invert: false,

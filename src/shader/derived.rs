@@ -6,13 +6,13 @@
 
 use std::collections::HashSet;
 
-use crate::nodes::math::{add3, dot3, normalize3, safe_normalize3, scale3, sub3, Vec3};
+use crate::nodes::math::{add3, dot3, normalize3, safe_normalize3, scale3, sub3, V3};
 use crate::nodes::random::hash_to_float1;
 use crate::scene::MeshData;
 
 /// Cycles' Pointiness per vertex, in 0..1 (0.5 on flat ground, more on ridges).
 /// `vertex_normals` are Blender's vertex normals of `mesh`.
-pub fn pointiness(mesh: &MeshData, vertex_normals: &[Vec3]) -> Vec<f32> {
+pub fn pointiness(mesh: &MeshData, vertex_normals: &[V3]) -> Vec<f32> {
     let n = mesh.vertex_count();
     let pos = &mesh.positions;
     let orig = weld(pos);
@@ -74,9 +74,9 @@ pub fn pointiness(mesh: &MeshData, vertex_normals: &[Vec3]) -> Vec<f32> {
 /// coordinate sum, each vertex pointing to the first later one within sqrt(FLT_EPSILON),
 /// chains followed to their end. Exact duplicates sort by descending index, so they
 /// end at the lowest index.
-fn weld(pos: &[Vec3]) -> Vec<u32> {
+fn weld(pos: &[V3]) -> Vec<u32> {
     let n = pos.len();
-    let sum = |p: Vec3| p[0] + p[1] + p[2];
+    let sum = |p: V3| p[0] + p[1] + p[2];
     let mut sorted: Vec<u32> = (0..n as u32).collect();
     sorted.sort_by(|&a, &b| {
         let (pa, pb) = (pos[a as usize], pos[b as usize]);

@@ -5,7 +5,7 @@
 use crate::foundation::math::{cross, dot, len};
 use crate::nodes::fresnel::{fresnel, layer_weight};
 use crate::nodes::light_falloff::light_falloff;
-use crate::nodes::math::Vec3;
+use crate::nodes::math::V3;
 
 use super::point::{ray, ShadingPoint};
 
@@ -89,20 +89,20 @@ impl Input {
 }
 
 /// Cycles' `normalize`: no guard, a zero vector gives NaNs as it does there.
-fn normalize(v: Vec3) -> Vec3 {
+fn normalize(v: V3) -> V3 {
     let l = dot(v, v).sqrt();
     [v[0] / l, v[1] / l, v[2] / l]
 }
 /// An object-space direction to world space the way Cycles transforms normals
 /// (`object_normal_transform`: by the transposed world-to-object matrix).
-pub fn object_normal_to_world(sp: &ShadingPoint, n: Vec3) -> Vec3 {
+pub fn object_normal_to_world(sp: &ShadingPoint, n: V3) -> V3 {
     let m = &sp.object.world_to_object;
     std::array::from_fn(|c| m[0][c] * n[0] + m[1][c] * n[1] + m[2][c] * n[2])
 }
 
 /// Tangent node, radial mode, around `axis` (0 = X, 1 = Y, 2 = Z) of Generated
 /// coordinates; also Geometry > Tangent (axis Z).
-pub fn radial_tangent(sp: &ShadingPoint, axis: u8) -> Vec3 {
+pub fn radial_tangent(sp: &ShadingPoint, axis: u8) -> V3 {
     let g = sp.generated;
     let t = match axis {
         0 => [0.0, -(g[2] - 0.5), g[1] - 0.5],
@@ -119,7 +119,7 @@ pub fn read(what: Input, sp: &ShadingPoint, s: &mut [f32], dst: u32) {
     let d = dst as usize;
     let path = &sp.path;
     let f = |b: bool| if b { 1.0 } else { 0.0 };
-    let v: Vec3 = match what {
+    let v: V3 = match what {
         Input::Position => sp.position,
         Input::Normal => sp.normal,
         Input::Tangent => radial_tangent(sp, 2),
@@ -171,13 +171,13 @@ pub fn read(what: Input, sp: &ShadingPoint, s: &mut [f32], dst: u32) {
 
 /// Fresnel node; `normal` is the linked Normal input, or the shading normal.
 #[inline]
-pub fn fresnel_node(sp: &ShadingPoint, ior: f32, normal: Option<Vec3>) -> f32 {
+pub fn fresnel_node(sp: &ShadingPoint, ior: f32, normal: Option<V3>) -> f32 {
     fresnel(ior, sp.incoming, normal.unwrap_or(sp.normal), sp.backfacing)
 }
 
 /// Layer Weight node: (Fresnel, Facing).
 #[inline]
-pub fn layer_weight_node(sp: &ShadingPoint, blend: f32, normal: Option<Vec3>) -> (f32, f32) {
+pub fn layer_weight_node(sp: &ShadingPoint, blend: f32, normal: Option<V3>) -> (f32, f32) {
     layer_weight(
         blend,
         sp.incoming,
@@ -194,7 +194,7 @@ pub fn light_falloff_node(sp: &ShadingPoint, strength: f32, smooth: f32) -> [f32
 
 /// Normal node's Dot output: its (normalised) direction against the normalised input.
 #[inline]
-pub fn normal_dot(direction: Vec3, normal: Vec3) -> f32 {
+pub fn normal_dot(direction: V3, normal: V3) -> f32 {
     dot(direction, normalize(normal))
 }
 
@@ -207,7 +207,7 @@ pub fn wireframe_node(sp: &ShadingPoint, size: f32, pixel_size: bool) -> f32 {
     if pixel_size {
         // The position's differentials projected onto the plane facing the ray.
         let wi = sp.incoming;
-        let across = |d: Vec3| {
+        let across = |d: V3| {
             let k = dot(d, wi);
             len([d[0] - k * wi[0], d[1] - k * wi[1], d[2] - k * wi[2]])
         };

@@ -3,7 +3,7 @@
 //! nodes that use them: Normal Map and Vector Displacement in tangent space, Tangent in
 //! UV Map mode.
 
-use crate::nodes::math::{add3, cross3, normalize3, safe_normalize3, scale3, sub3, Vec3};
+use crate::nodes::math::{add3, cross3, normalize3, safe_normalize3, scale3, sub3, V3};
 use crate::scene::{AttributeData, MeshData};
 use rayon::prelude::*;
 
@@ -13,7 +13,7 @@ struct MikkMesh<'a> {
     mesh: &'a MeshData,
     uvs: &'a [[f32; 2]],
     flat: Vec<bool>,
-    vertex_normals: Vec<Vec3>,
+    vertex_normals: Vec<V3>,
     out: Vec<[f32; 4]>,
 }
 
@@ -152,10 +152,10 @@ fn scale_down(positions: &[[f32; 3]]) -> Option<Vec<[f32; 3]>> {
 pub fn normal_map_tangent(
     sp: &ShadingPoint,
     tangent: Option<[f32; 4]>,
-    normal: Vec3,
-    color: Vec3,
+    normal: V3,
+    color: V3,
     strength: f32,
-) -> Vec3 {
+) -> V3 {
     let Some(t4) = tangent else { return sp.normal };
     let mut c = scale3(sub3(color, [0.5; 3]), 2.0);
     // Tangent space scales the map's x and y by strength instead of blending normals.
@@ -184,10 +184,10 @@ pub fn normal_map_tangent(
 pub fn vector_displacement_tangent(
     sp: &ShadingPoint,
     tangent: Option<[f32; 4]>,
-    vector: Vec3,
+    vector: V3,
     midlevel: f32,
     scale: f32,
-) -> Vec3 {
+) -> V3 {
     let Some(t4) = tangent else { return [0.0; 3] };
     let d = scale3(sub3(vector, [midlevel; 3]), scale);
     let normal = sp.transform.inverse_normal(sp.normal);
@@ -199,7 +199,7 @@ pub fn vector_displacement_tangent(
 
 /// Tangent node, UV Map mode: the interpolated tangent to world space, made orthogonal to
 /// the shading normal; zero without the UV map.
-pub fn tangent_uv(sp: &ShadingPoint, tangent: Option<[f32; 4]>) -> Vec3 {
+pub fn tangent_uv(sp: &ShadingPoint, tangent: Option<[f32; 4]>) -> V3 {
     let Some(t4) = tangent else { return [0.0; 3] };
     let t = sp.transform.normal([t4[0], t4[1], t4[2]]);
     let n = sp.normal;
@@ -208,7 +208,7 @@ pub fn tangent_uv(sp: &ShadingPoint, tangent: Option<[f32; 4]>) -> Vec3 {
 
 /// Blender's vertex normals (what Cycles' smooth triangles and MikkTSpace read): each
 /// face's normal weighted by its corner angle at the vertex, summed and normalised.
-pub fn vertex_normals(mesh: &MeshData) -> Vec<Vec3> {
+pub fn vertex_normals(mesh: &MeshData) -> Vec<V3> {
     // Without sharp faces, sharp edges or custom normals Blender's corner normals are its
     // vertex normals: take them as Blender rounded them.
     let any = |name: &str| matches!(mesh.attribute(name).map(|a| &a.data), Some(AttributeData::Bool(v)) if v.iter().any(|&b| b));
@@ -250,7 +250,7 @@ pub fn vertex_normals(mesh: &MeshData) -> Vec<Vec3> {
     // order of the one-thread loop, so the same bits.
     let first = mesh.face_offsets.first().map_or(0, |&o| o as usize);
     let end = mesh.face_offsets.last().map_or(0, |&o| o as usize);
-    let weighted: Vec<Option<Vec3>> = (first..end.max(first))
+    let weighted: Vec<Option<V3>> = (first..end.max(first))
         .into_par_iter()
         .map(|c| {
             let f = mesh.face_offsets.partition_point(|&o| o as usize <= c) - 1;
