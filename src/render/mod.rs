@@ -893,7 +893,7 @@ fn light_select(
                 spot,
                 sphere,
             } => {
-                let r = [*radius; 3];
+                let r = Vec3::splat(*radius);
                 let (cone, spot_smooth) = match spot {
                     None => (
                         Cone {
@@ -905,7 +905,7 @@ fn light_select(
                     ),
                     Some(s) => {
                         // Cycles widens the cone by the light's scale (its axes).
-                        let (lu, lv, lw) = (len(s.u), len(s.v), len(s.w));
+                        let (lu, lv, lw) = (s.u.length(), s.v.length(), s.w.length());
                         let stretch = if lu > 0.0 && lv > 0.0 {
                             lw / lu.min(lv)
                         } else {
@@ -922,7 +922,7 @@ fn light_select(
                         )
                     }
                 };
-                let measure = Measure::new(&[sub(l.pos, r), add(l.pos, r)], cone, l.tree_energy);
+                let measure = Measure::new(&[l.pos - r, l.pos + r], cone, l.tree_energy);
                 local.push(Emitter {
                     pick,
                     shape: Shape::Point {
@@ -936,12 +936,12 @@ fn light_select(
                 });
             }
             light::Shape::Area { u, v, .. } => {
-                let (hu, hv) = (scale(*u, 0.5), scale(*v, 0.5));
+                let (hu, hv) = (*u * 0.5, *v * 0.5);
                 let corners = [
-                    add(add(l.pos, hu), hv),
-                    sub(add(l.pos, hu), hv),
-                    add(sub(l.pos, hu), hv),
-                    sub(sub(l.pos, hu), hv),
+                    l.pos + hu + hv,
+                    l.pos + hu - hv,
+                    l.pos - hu + hv,
+                    l.pos - hu - hv,
                 ];
                 let measure = Measure::new(
                     &corners,
@@ -988,7 +988,7 @@ fn light_select(
             let measure = Measure::new(
                 &[],
                 Cone {
-                    axis: [0.0, 0.0, 1.0],
+                    axis: Vec3::Z,
                     theta_o: PI,
                     theta_e: 0.0,
                 },
@@ -997,7 +997,7 @@ fn light_select(
             distant.push(Emitter {
                 pick: Some(Pick::World),
                 shape: Shape::World,
-                centroid: [0.0; 3],
+                centroid: Vec3::ZERO,
                 measure,
             });
             flat_lights.push(Pick::World);
@@ -1028,30 +1028,30 @@ fn light_select(
         let Some(estimate) = sampled[mi] else {
             continue;
         };
-        let v = geo.tris[prim];
-        let n = cross(sub(v[1], v[0]), sub(v[2], v[0]));
-        let area = 0.5 * len(n);
+        let v = geo.tris[prim].map(Vec3::from);
+        let n = (v[1] - v[0]).cross(v[2] - v[0]);
+        let area = 0.5 * n.length();
         if !(area > 0.0) {
             continue;
         }
         let cone = match materials[mi].sampling.as_str() {
             "FRONT" => Cone {
-                axis: normalize(n),
+                axis: n.normalize(),
                 theta_o: 0.0,
                 theta_e: FRAC_PI_2,
             },
             "BACK" => Cone {
-                axis: neg(normalize(n)),
+                axis: -n.normalize(),
                 theta_o: 0.0,
                 theta_e: FRAC_PI_2,
             },
             _ => Cone {
-                axis: normalize(sub(v[0], v[1])),
+                axis: (v[0] - v[1]).normalize(),
                 theta_o: FRAC_PI_2,
                 theta_e: FRAC_PI_2,
             },
         };
-        let centroid = scale(add(add(v[0], v[1]), v[2]), 1.0 / 3.0);
+        let centroid = (v[0] + v[1] + v[2]) * (1.0 / 3.0);
         let e = Emitter {
             pick: Some(light::tree::Pick::Triangle(prim as u32)),
             shape: Shape::Triangle { v },
