@@ -4,9 +4,8 @@
 //! Vector Displacement and Normal Map nodes (`kernel/svm/displace.h`, `tex_coord.h`).
 
 use crate::foundation::math::{
-    transform_direction, transform_direction_transposed, transform_point,
+    transform_direction, transform_direction_transposed, transform_point, Vec3, V3,
 };
-use crate::nodes::math::{add3, cross3, dot3, length3, scale3, sub3, V3};
 
 use super::point::ShadingPoint;
 
@@ -55,17 +54,26 @@ impl ObjectTransform {
     }
 }
 
+/// Cycles' `normalize`: each component divided by the length (NaN for a zero vector).
 pub fn normalize(v: V3) -> V3 {
-    let l = length3(v);
-    [v[0] / l, v[1] / l, v[2] / l]
+    normalize_div(v.into()).into()
 }
 
+fn normalize_div(v: Vec3) -> Vec3 {
+    v / v.length()
+}
+
+/// Cycles' `safe_normalize`: as `normalize`, a zero vector giving zero.
 pub fn safe_normalize(v: V3) -> V3 {
-    let l = length3(v);
+    safe_normalize_div(v.into()).into()
+}
+
+fn safe_normalize_div(v: Vec3) -> Vec3 {
+    let l = v.length();
     if l != 0.0 {
-        [v[0] / l, v[1] / l, v[2] / l]
+        v / l
     } else {
-        [0.0; 3]
+        Vec3::ZERO
     }
 }
 
@@ -80,25 +88,25 @@ fn signf(x: f32) -> f32 {
 /// Two unit tangents completing `n` to an orthonormal frame (Cycles' make_orthonormals:
 /// (1,1,1) x N, or (-1,1,1) x N when N is on the diagonal), which decides the directions
 /// a compact differential expands to. Bump results depend on it to second order.
-pub fn make_orthonormals(n: V3) -> (V3, V3) {
-    let a = if n[0] != n[1] || n[0] != n[2] {
-        [n[2] - n[1], n[0] - n[2], n[1] - n[0]]
+pub fn make_orthonormals(n: Vec3) -> (Vec3, Vec3) {
+    let a = if n.x != n.y || n.x != n.z {
+        Vec3::new(n.z - n.y, n.x - n.z, n.y - n.x)
     } else {
-        [n[2] - n[1], n[0] + n[2], -n[1] - n[0]]
+        Vec3::new(n.z - n.y, n.x + n.z, -n.y - n.x)
     };
-    let a = normalize(a);
-    (a, cross3(n, a))
+    let a = normalize_div(a);
+    (a, n.cross(a))
 }
 
 /// A compact differential (a radius) as the two vectors Cycles expands it to around `d`.
 pub fn differential_from_compact(d: V3, radius: f32) -> (V3, V3) {
-    let (x, y) = make_orthonormals(d);
-    (scale3(x, radius), scale3(y, radius))
+    let (x, y) = make_orthonormals(d.into());
+    ((x * radius).into(), (y * radius).into())
 }
 
 /// Cycles' differential_make_compact: the mean length of the two differentials.
 pub fn differential_make_compact(dx: V3, dy: V3) -> f32 {
-    0.5 * (length3(dx) + length3(dy))
+    0.5 * (Vec3::from(dx).length() + Vec3::from(dy).length())
 }
 
 /// Changes of the barycentric (u, v) of a triangle along `dp` (Cycles' differential_dudv,
@@ -133,10 +141,8 @@ pub fn differential_dudv(mut dpdu: V3, mut dpdv: V3, mut dp: [V3; 2], ng: V3) ->
 
 /// The change of a triangle attribute (values at corners `f`) for barycentric changes `d`.
 pub fn attribute_differential(f: [V3; 3], d: [f32; 2]) -> V3 {
-    add3(
-        scale3(sub3(f[1], f[0]), d[0]),
-        scale3(sub3(f[2], f[0]), d[1]),
-    )
+    let f = f.map(Vec3::from);
+    ((f[1] - f[0]) * d[0] + (f[2] - f[0]) * d[1]).into()
 }
 
 /// Which of the three Height evaluations a bump program is running.
@@ -157,10 +163,10 @@ pub fn offset_point(sp: &ShadingPoint, which: BumpPoint, width: f32) -> ShadingP
         BumpPoint::Dy => (sp.dp_dy, sp.generated_dy, sp.uv_dy, 1),
     };
     let mut o = *sp;
-    o.position = add3(sp.position, scale3(dp, width));
+    o.position = moved(sp.position, dp, width);
     o.object_position = sp.transform.inverse_point(o.position);
-    o.generated = add3(sp.generated, scale3(dg, width));
-    o.uv = add3(sp.uv, scale3(duv, width));
+    o.generated = moved(sp.generated, dg, width);
+    o.uv = moved(sp.uv, duv, width);
     // Mesh attributes extrapolated along the triangle, as Cycles' attribute bump nodes do
     // (f + df * width).
     for (a, da) in o.attrs.iter_mut().zip(&sp.attrs_d) {
@@ -192,10 +198,10 @@ pub fn offset_point_into(sp: &mut ShadingPoint, base: &ShadingPoint, which: Bump
         BumpPoint::Dx => (base.dp_dx, base.generated_dx, base.uv_dx, 0),
         BumpPoint::Dy => (base.dp_dy, base.generated_dy, base.uv_dy, 1),
     };
-    sp.position = add3(base.position, scale3(dp, width));
+    sp.position = moved(base.position, dp, width);
     sp.object_position = base.transform.inverse_point(sp.position);
-    sp.generated = add3(base.generated, scale3(dg, width));
-    sp.uv = add3(base.uv, scale3(duv, width));
+    sp.generated = moved(base.generated, dg, width);
+    sp.uv = moved(base.uv, duv, width);
     for ((a, b), da) in sp.attrs.iter_mut().zip(&base.attrs).zip(&base.attrs_d) {
         for k in 0..4 {
             a[k] = b[k] + da[d][k] * width;
@@ -209,6 +215,11 @@ pub fn offset_point_into(sp: &mut ShadingPoint, base: &ShadingPoint, which: Bump
     {
         *f = b + df[d] * width;
     }
+}
+
+/// `p` moved by `width` times the differential `d`.
+fn moved(p: V3, d: V3, width: f32) -> V3 {
+    (Vec3::from(p) + Vec3::from(d) * width).into()
 }
 
 /// The Bump node's settings that are not stack values.
@@ -238,26 +249,25 @@ pub fn bump_normal(
         dx = sp.transform.inverse_dir(dx);
         dy = sp.transform.inverse_dir(dy);
     }
-    let rx = cross3(dy, n);
-    let ry = cross3(n, dx);
-    let det = dot3(dx, rx);
-    let surfgrad = add3(scale3(rx, h_x - h_c), scale3(ry, h_y - h_c));
+    let (n, dx, dy) = (Vec3::from(n), Vec3::from(dx), Vec3::from(dy));
+    let rx = dy.cross(n);
+    let ry = n.cross(dx);
+    let det = dx.dot(rx);
+    let surfgrad = rx * (h_x - h_c) + ry * (h_y - h_c);
     let absdet = det.abs();
     let scale = if set.invert { -distance } else { distance };
     let strength = strength.max(0.0);
-    let mut out = safe_normalize(sub3(
-        scale3(n, set.filter_width * absdet),
-        scale3(surfgrad, scale * signf(det)),
-    ));
-    if out == [0.0; 3] {
+    let mut out =
+        safe_normalize_div(n * (set.filter_width * absdet) - surfgrad * (scale * signf(det)));
+    if out == Vec3::ZERO {
         out = n;
     } else {
-        out = normalize(add3(scale3(out, strength), scale3(n, 1.0 - strength)));
+        out = normalize_div(out * strength + n * (1.0 - strength));
     }
     if set.object_space {
-        out = sp.transform.normal(out);
+        return sp.transform.normal(out.into());
     }
-    out
+    out.into()
 }
 
 /// Displacement node: the offset along the normal, world or object space.
@@ -271,10 +281,10 @@ pub fn displacement(
 ) -> V3 {
     let k = (height - midlevel) * scale;
     if object_space {
-        sp.transform
-            .dir(scale3(sp.transform.inverse_normal(normal), k))
+        let n = Vec3::from(sp.transform.inverse_normal(normal));
+        sp.transform.dir((n * k).into())
     } else {
-        scale3(normal, k)
+        (Vec3::from(normal) * k).into()
     }
 }
 
@@ -309,7 +319,7 @@ pub fn vector_displacement(
     midlevel: f32,
     scale: f32,
 ) -> V3 {
-    let d = scale3(sub3(vector, [midlevel; 3]), scale);
+    let d = ((Vec3::from(vector) - Vec3::splat(midlevel)) * scale).into();
     match space {
         MapSpace::World => d,
         _ => sp.transform.dir(d),
@@ -319,29 +329,30 @@ pub fn vector_displacement(
 /// Normal Map in the non-tangent spaces (Cycles' svm_node_normal_map): the colour read as
 /// a normal, then blended toward the shading normal by strength.
 pub fn normal_map(sp: &ShadingPoint, space: MapSpace, color: V3, strength: f32) -> V3 {
-    let mut c = scale3(sub3(color, [0.5; 3]), 2.0);
+    let mut c = (Vec3::from(color) - Vec3::splat(0.5)) * 2.0;
     if matches!(space, MapSpace::BlenderObject | MapSpace::BlenderWorld) {
-        c[1] = -c[1];
-        c[2] = -c[2];
+        c.y = -c.y;
+        c.z = -c.z;
     }
     let mut n = match space {
-        MapSpace::Object | MapSpace::BlenderObject => sp.transform.normal(c),
-        _ => safe_normalize(c),
+        MapSpace::Object | MapSpace::BlenderObject => sp.transform.normal(c.into()).into(),
+        _ => safe_normalize_div(c),
     };
     // Cycles 4.5 blends by strength before turning the normal to a back face's side.
     if strength != 1.0 {
         let s = strength.max(0.0);
-        n = safe_normalize(add3(sp.normal, scale3(sub3(n, sp.normal), s)));
+        let normal = Vec3::from(sp.normal);
+        n = safe_normalize_div(normal + (n - normal) * s);
     }
     if sp.backfacing {
-        n = scale3(n, -1.0);
+        n *= -1.0;
     }
     // Only a zero normal falls back (is_zero): a NaN from normalising a zero object-space
     // vector stays, as in Cycles, and the closures given it reflect nothing.
-    if n == [0.0; 3] {
-        n = sp.normal;
+    if n == Vec3::ZERO {
+        return sp.normal;
     }
-    n
+    n.into()
 }
 
 /// The normal the displacement bump gives every closure: heights are the displacement
@@ -349,21 +360,13 @@ pub fn normal_map(sp: &ShadingPoint, space: MapSpace, color: V3, strength: f32) 
 /// strength 1, the Bump node's default filter width).
 pub fn displacement_bump(sp: &ShadingPoint, object_space: bool, d_c: V3, d_x: V3, d_y: V3) -> V3 {
     let n = sp.normal;
+    let along = |d: V3| Vec3::from(d).dot(n.into());
     let set = BumpSettings {
         invert: false,
         object_space,
         filter_width: DEFAULT_FILTER_WIDTH,
     };
-    bump_normal(
-        sp,
-        set,
-        n,
-        1.0,
-        1.0,
-        dot3(d_c, n),
-        dot3(d_x, n),
-        dot3(d_y, n),
-    )
+    bump_normal(sp, set, n, 1.0, 1.0, along(d_c), along(d_x), along(d_y))
 }
 
 /// Cycles' BumpNode default filter width, used by the displacement bump.

@@ -1,6 +1,7 @@
 //! A compiled material: a flat list of operations over a float stack, run once per
 //! shading point with no allocation and no lookups by name (Cycles' SVM idea).
 
+use crate::foundation::math::{Vec3, V3};
 use crate::nodes::checker::checker_texture;
 use crate::nodes::clamp::{clamp_node, ClampType};
 use crate::nodes::color::{
@@ -12,7 +13,7 @@ use crate::nodes::gradient::{gradient, GradientType};
 use crate::nodes::magic::magic;
 use crate::nodes::map_range::{map_range_float, map_range_vector, MapRangeInterpolation};
 use crate::nodes::mapping::{mapping, MappingType};
-use crate::nodes::math::{math_node, vector_math, MathOp, VectorMathOp, V3};
+use crate::nodes::math::{math_node, vector_math, MathOp, VectorMathOp};
 use crate::nodes::mix::{
     mix_color, mix_float, mix_rgb, mix_vector, mix_vector_non_uniform, MixBlend,
 };
@@ -1433,12 +1434,9 @@ impl Program {
                     // A linked Normal keeps its own direction plus the bevel's change.
                     let out = match normal {
                         Some(n) => {
-                            let base = v3(s, n);
-                            crate::nodes::math::normalize3([
-                                base[0] + b[0] - sp.normal[0],
-                                base[1] + b[1] - sp.normal[1],
-                                base[2] + b[2] - sp.normal[2],
-                            ])
+                            let d = Vec3::from(v3(s, n)) + b.into() - sp.normal.into();
+                            // Cycles' normalize: a true division by the length.
+                            (d / d.length()).into()
                         }
                         None => b,
                     };
