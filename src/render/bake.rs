@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::nodes::math::{normalize3, V3};
+use crate::foundation::math::{Vec3, V3};
 use crate::scene::{AttributeData, Scene};
 
 use crate::shader::bump::{
@@ -335,9 +335,11 @@ impl TriangleDifferentials {
         tex_size: [f64; 3],
     ) -> Self {
         let p = local.map(|l| transform_point(world, l));
-        let sub = |a: V3, b: V3| -> V3 { [a[0] - b[0], a[1] - b[1], a[2] - b[2]] };
-        let (dpdu, dpdv) = (sub(p[1], p[0]), sub(p[2], p[0]));
-        let ng = normalize3(crate::nodes::math::cross3(dpdu, dpdv));
+        let ng = flat_normal(p);
+        let (dpdu, dpdv): (V3, V3) = (
+            (Vec3::from(p[1]) - p[0].into()).into(),
+            (Vec3::from(p[2]) - p[0].into()).into(),
+        );
         // Blender's rasteriser coordinates (texel centres at integers).
         let v = uv.map(|t| {
             [
@@ -410,20 +412,14 @@ fn bake_context(
     tri: [V3; 3],
     w: [f32; 3],
 ) -> ShadingPoint {
-    let e1: V3 = std::array::from_fn(|k| tri[1][k] - tri[0][k]);
-    let e2: V3 = std::array::from_fn(|k| tri[2][k] - tri[0][k]);
-    let ng = normalize3([
-        e1[1] * e2[2] - e1[2] * e2[1],
-        e1[2] * e2[0] - e1[0] * e2[2],
-        e1[0] * e2[1] - e1[1] * e2[0],
-    ]);
+    let ng = Vec3::from(flat_normal(tri));
     sp.incoming = sp.normal;
-    sp.backfacing = ng[0] * sp.incoming[0] + ng[1] * sp.incoming[1] + ng[2] * sp.incoming[2] < 0.0;
+    sp.backfacing = ng.dot(sp.incoming.into()) < 0.0;
     if sp.backfacing {
-        sp.true_normal = ng.map(|x| -x);
-        sp.normal = sp.normal.map(|x| -x);
+        sp.true_normal = (-ng).into();
+        sp.normal = (-Vec3::from(sp.normal)).into();
     } else {
-        sp.true_normal = ng;
+        sp.true_normal = ng.into();
     }
     // Cycles' (u, v) are the weights of the triangle's second and third corners.
     sp.parametric = [w[1], w[2]];
@@ -439,9 +435,14 @@ fn bake_context(
 
 /// The unit normal of a triangle (corners counter-clockwise).
 fn flat_normal(p: [V3; 3]) -> V3 {
-    let e1: V3 = std::array::from_fn(|k| p[1][k] - p[0][k]);
-    let e2: V3 = std::array::from_fn(|k| p[2][k] - p[0][k]);
-    normalize3(crate::nodes::math::cross3(e1, e2))
+    let p = p.map(Vec3::from);
+    normalize3((p[1] - p[0]).cross(p[2] - p[0]).into())
+}
+
+/// Cycles' `normalize`: each component divided by the length (NaN for a zero vector).
+fn normalize3(v: V3) -> V3 {
+    let v = Vec3::from(v);
+    (v / v.length()).into()
 }
 
 /// The scene camera's view at the scene's current frame and render resolution, for an

@@ -506,10 +506,13 @@ fn render_frame_here(
                                     *a += v;
                                 }
                                 let f = &scratch.features;
-                                tile.passes.feature_normal[k - 1] =
-                                    add(tile.passes.feature_normal[k - 1], f.normal);
-                                tile.passes.feature_albedo[k - 1] =
-                                    add(tile.passes.feature_albedo[k - 1], f.albedo);
+                                let sum = |a: V3, b: V3| (Vec3::from(a) + b.into()).into();
+                                let (n, a) = (
+                                    &mut tile.passes.feature_normal[k - 1],
+                                    &mut tile.passes.feature_albedo[k - 1],
+                                );
+                                *n = sum(*n, f.normal);
+                                *a = sum(*a, f.albedo);
                             }
                         }
                     }
@@ -618,8 +621,8 @@ fn render_frame_here(
                 passes.normal[i] = p.normal[k];
                 // The guides average the pixel's samples, as Cycles' passes do.
                 let inv = 1.0 / passes.sample_count[i].max(1) as f32;
-                passes.albedo[i] = scale(p.feature_albedo[k], inv);
-                passes.denoise_normal[i] = scale(p.feature_normal[k], inv);
+                passes.albedo[i] = (Vec3::from(p.feature_albedo[k]) * inv).into();
+                passes.denoise_normal[i] = (Vec3::from(p.feature_normal[k]) * inv).into();
                 passes.uv[i] = p.uv[k];
                 passes.hits[i] = p.hits[k];
                 // AOVs: the samples' sum over the pixel's sample count, as Cycles reads
@@ -1146,7 +1149,7 @@ fn primary_passes(
         accel::visibility::of_path(crate::shader::point::ray::CAMERA),
     ) {
         Some(h) => {
-            let wo = neg(d);
+            let wo = (-Vec3::from(d)).into();
             let hit = tracer.surface(h.prim, h.u, h.v, wo);
             tracer.shade(&hit, wo, scratch);
             let inst = &tracer.geo.instances[hit.inst as usize];
