@@ -10,7 +10,7 @@
 
 pub type Mat4 = [[f64; 4]; 4];
 pub type Mat3 = [[f64; 3]; 3];
-pub use crate::foundation::math::{add, cross, dot, is_zero, len, scale, sub, V3};
+pub use crate::foundation::math::{vec3, Vec3};
 pub type Quat = [f32; 4];
 
 pub const IDENTITY: Mat4 = [
@@ -336,23 +336,23 @@ pub fn interp_mat4(a: &Mat4, b: &Mat4, t: f64) -> Mat4 {
 
 // ---- f32 vectors and quaternions (curve path) -------------------------------------------
 
-pub fn len_between(a: V3, b: V3) -> f32 {
-    len(sub(a, b))
+pub fn len_between(a: Vec3, b: Vec3) -> f32 {
+    (a - b).length()
 }
 /// Blender's `normalize_v3`: multiplies by the reciprocal length, zeroes tiny vectors.
-pub fn normalize(v: &mut V3) -> f32 {
-    let d = dot(*v, *v);
+pub fn normalize(v: &mut Vec3) -> f32 {
+    let d = v.dot(*v);
     if d > 1.0e-35 {
         let l = d.sqrt();
-        *v = scale(*v, 1.0 / l);
+        *v *= 1.0 / l;
         l
     } else {
-        *v = [0.0; 3];
+        *v = Vec3::ZERO;
         0.0
     }
 }
 
-pub fn normalized(mut v: V3) -> V3 {
+pub fn normalized(mut v: Vec3) -> Vec3 {
     normalize(&mut v);
     v
 }
@@ -378,21 +378,21 @@ pub fn safe_acos(f: f32) -> f32 {
 }
 
 /// Angle between unit vectors, via asin of the half chord (Blender's more precise form).
-pub fn angle_normalized(a: V3, b: V3) -> f32 {
-    if dot(a, b) >= 0.0 {
+pub fn angle_normalized(a: Vec3, b: Vec3) -> f32 {
+    if a.dot(b) >= 0.0 {
         2.0 * safe_asin(len_between(a, b) / 2.0)
     } else {
-        std::f32::consts::PI - 2.0 * safe_asin(len_between(a, [-b[0], -b[1], -b[2]]) / 2.0)
+        std::f32::consts::PI - 2.0 * safe_asin(len_between(a, -b) / 2.0)
     }
 }
 
 /// Unit bisector direction at `b` of the polyline a-b-c.
-pub fn bisect(a: V3, b: V3, c: V3) -> V3 {
-    let mut d12 = sub(b, a);
-    let mut d23 = sub(c, b);
+pub fn bisect(a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+    let mut d12 = b - a;
+    let mut d23 = c - b;
     normalize(&mut d12);
     normalize(&mut d23);
-    normalized(add(d12, d23))
+    normalized(d12 + d23)
 }
 
 pub const QUAT_IDENTITY: Quat = [1.0, 0.0, 0.0, 0.0];
@@ -406,7 +406,7 @@ pub fn qmul(a: Quat, b: Quat) -> Quat {
 }
 
 /// Rotates `r` by unit quaternion `q` (Blender's `mul_qt_v3`, same operation order).
-pub fn qrotate(q: Quat, r: V3) -> V3 {
+pub fn qrotate(q: Quat, r: Vec3) -> Vec3 {
     let t0 = -q[1] * r[0] - q[2] * r[1] - q[3] * r[2];
     let t1 = q[0] * r[0] + q[2] * r[2] - q[3] * r[1];
     let t2 = q[0] * r[1] + q[3] * r[0] - q[1] * r[2];
@@ -415,7 +415,7 @@ pub fn qrotate(q: Quat, r: V3) -> V3 {
     let o1 = t0 * -q[1] + r0 * q[0] - r1 * q[3] + r2 * q[2];
     let o2 = t0 * -q[2] + r1 * q[0] - r2 * q[1] + r0 * q[3];
     let o3 = t0 * -q[3] + r2 * q[0] - r0 * q[2] + r1 * q[1];
-    [o1, o2, o3]
+    vec3(o1, o2, o3)
 }
 
 pub fn qnormalize(q: &mut Quat) -> f32 {
@@ -431,13 +431,13 @@ pub fn qnormalize(q: &mut Quat) -> f32 {
     l
 }
 
-pub fn axis_angle_normalized_to_quat(axis: V3, angle: f32) -> Quat {
+pub fn axis_angle_normalized_to_quat(axis: Vec3, angle: f32) -> Quat {
     let phi = 0.5 * angle;
     let (si, co) = (phi.sin(), phi.cos());
     [co, axis[0] * si, axis[1] * si, axis[2] * si]
 }
 
-pub fn axis_angle_to_quat(axis: V3, angle: f32) -> Quat {
+pub fn axis_angle_to_quat(axis: Vec3, angle: f32) -> Quat {
     let mut n = axis;
     if normalize(&mut n) != 0.0 {
         axis_angle_normalized_to_quat(n, angle)
@@ -483,33 +483,33 @@ pub fn quat_to_mat3(q: Quat) -> [[f32; 3]; 3] {
 
 /// Blender's `vec_to_quat`: the rotation that points `axis` (0..5 = X,Y,Z,-X,-Y,-Z) along
 /// `vec`, with `upflag` (0..2) kept as close to up as possible.
-pub fn vec_to_quat(vec: V3, axis: i32, upflag: i32) -> Quat {
+pub fn vec_to_quat(vec: Vec3, axis: i32, upflag: i32) -> Quat {
     let eps = 1e-4f32;
-    let l = len(vec);
+    let l = vec.length();
     if l == 0.0 {
         return QUAT_IDENTITY;
     }
     let (tvec, axis) = if axis > 2 {
         (vec, axis - 3)
     } else {
-        ([-vec[0], -vec[1], -vec[2]], axis)
+        (-vec, axis)
     };
     let mut nor;
     let mut co;
     if axis == 0 {
-        nor = [0.0, -tvec[2], tvec[1]];
+        nor = vec3(0.0, -tvec[2], tvec[1]);
         if tvec[1].abs() + tvec[2].abs() < eps {
             nor[1] = 1.0;
         }
         co = tvec[0];
     } else if axis == 1 {
-        nor = [tvec[2], 0.0, -tvec[0]];
+        nor = vec3(tvec[2], 0.0, -tvec[0]);
         if tvec[0].abs() + tvec[2].abs() < eps {
             nor[2] = 1.0;
         }
         co = tvec[1];
     } else {
-        nor = [-tvec[1], tvec[0], 0.0];
+        nor = vec3(-tvec[1], tvec[0], 0.0);
         if tvec[0].abs() + tvec[1].abs() < eps {
             nor[0] = 1.0;
         }
@@ -569,14 +569,8 @@ pub fn quat_apply_track(quat: Quat, axis: i32, upflag: i32) -> Quat {
     q
 }
 
-fn normal_tri(a: V3, b: V3, c: V3) -> (V3, f32) {
-    let n1 = sub(a, b);
-    let n2 = sub(b, c);
-    let mut n = [
-        n1[1] * n2[2] - n1[2] * n2[1],
-        n1[2] * n2[0] - n1[0] * n2[2],
-        n1[0] * n2[1] - n1[1] * n2[0],
-    ];
+fn normal_tri(a: Vec3, b: Vec3, c: Vec3) -> (Vec3, f32) {
+    let mut n = (a - b).cross(b - c);
     let l = normalize(&mut n);
     (n, l)
 }
@@ -606,9 +600,9 @@ fn invert3_f32(m: [[f32; 3]; 3]) -> [[f32; 3]; 3] {
 
 /// Blender's `tri_to_quat`: the rotation taking the XY plane to the triangle's plane with
 /// X along a->b.
-pub fn tri_to_quat(a: V3, b: V3, c: V3) -> Quat {
+pub fn tri_to_quat(a: Vec3, b: Vec3, c: Vec3) -> Quat {
     let (vec, _) = normal_tri(a, b, c);
-    let mut n = [vec[1], -vec[0], 0.0];
+    let mut n = vec3(vec[1], -vec[0], 0.0);
     normalize(&mut n);
     if n[0] == 0.0 && n[1] == 0.0 {
         n[0] = 1.0;
@@ -617,12 +611,12 @@ pub fn tri_to_quat(a: V3, b: V3, c: V3) -> Quat {
     let (co, si) = (angle.cos(), angle.sin());
     let q1 = [co, n[0] * si, n[1] * si, 0.0];
     let imat = invert3_f32(quat_to_mat3(q1));
-    let d = sub(b, a);
-    let mut v = [
+    let d = b - a;
+    let mut v = vec3(
         imat[0][0] * d[0] + imat[0][1] * d[1] + imat[0][2] * d[2],
         imat[1][0] * d[0] + imat[1][1] * d[1] + imat[1][2] * d[2],
         0.0,
-    ];
+    );
     normalize(&mut v);
     let angle = 0.5 * v[1].atan2(v[0]);
     let q2 = [angle.cos(), 0.0, 0.0, angle.sin()];

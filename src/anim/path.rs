@@ -18,10 +18,10 @@ const DEG90: f32 = 90.0 * (std::f64::consts::PI / 180.0) as f32;
 
 #[derive(Debug, Clone, Copy, Default)]
 struct BevPoint {
-    vec: V3,
-    tan: V3,
+    vec: Vec3,
+    tan: Vec3,
     quat: Quat,
-    dir: V3,
+    dir: Vec3,
     tilt: f32,
     radius: f32,
     offset: f32,
@@ -48,7 +48,7 @@ pub struct Path {
 /// A point on the path in the curve object's space.
 #[derive(Debug, Clone, Copy)]
 pub struct PathSample {
-    pub pos: V3,
+    pub pos: Vec3,
     pub quat: Quat,
     pub radius: f32,
 }
@@ -263,8 +263,8 @@ fn forward_diff(q0: f32, q1: f32, q2: f32, q3: f32, it: usize, out: &mut dyn FnM
     }
 }
 
-fn f3(v: [f64; 3]) -> V3 {
-    [v[0] as f32, v[1] as f32, v[2] as f32]
+fn f3(v: [f64; 3]) -> Vec3 {
+    vec3(v[0] as f32, v[1] as f32, v[2] as f32)
 }
 
 fn bezier_list(s: &Spline, cs: &CurveSettings, resolu: usize) -> Result<BevList, AnimError> {
@@ -282,7 +282,7 @@ fn bezier_list(s: &Spline, cs: &CurveSettings, resolu: usize) -> Result<BevList,
     } else {
         (0usize, 1usize, n - 1)
     };
-    p[0].dir = normalized(sub(f3(bz[prev].handle_right), f3(bz[prev].co)));
+    p[0].dir = normalized(f3(bz[prev].handle_right) - f3(bz[prev].co));
     let mut k = 0usize; // write cursor
     while a > 0 {
         a -= 1;
@@ -358,9 +358,9 @@ fn bezier_list(s: &Spline, cs: &CurveSettings, resolu: usize) -> Result<BevList,
             if cs.twist_mode == TwistMode::Tangent {
                 for i in 0..=resolu {
                     let t = i as f32 / resolu as f32;
-                    let mut v = [0.0f32; 3];
-                    for (j, vj) in v.iter_mut().enumerate() {
-                        *vj = (-6.0 * t + 6.0) * q0[j]
+                    let mut v = Vec3::ZERO;
+                    for j in 0..3 {
+                        v[j] = (-6.0 * t + 6.0) * q0[j]
                             + (18.0 * t - 12.0) * q1[j]
                             + (-18.0 * t + 6.0) * q2[j]
                             + (6.0 * t) * q3[j];
@@ -384,7 +384,7 @@ fn bezier_list(s: &Spline, cs: &CurveSettings, resolu: usize) -> Result<BevList,
         p[k].vec = f3(pb.co);
         p[k].tilt = pb.tilt as f32;
         p[k].radius = pb.radius as f32;
-        p[k].dir = normalized(sub(f3(pb.co), f3(pb.handle_left)));
+        p[k].dir = normalized(f3(pb.co) - f3(pb.handle_left));
         k += 1;
     }
     p.truncate(k);
@@ -403,7 +403,7 @@ fn poly_list(s: &Spline, cs: &CurveSettings) -> BevList {
         .points
         .iter()
         .map(|bp| BevPoint {
-            vec: [bp.co[0] as f32, bp.co[1] as f32, bp.co[2] as f32],
+            vec: vec3(bp.co[0] as f32, bp.co[1] as f32, bp.co[2] as f32),
             tilt: bp.tilt as f32,
             radius: bp.radius as f32,
             ..Default::default()
@@ -428,11 +428,11 @@ fn poly_list(s: &Spline, cs: &CurveSettings) -> BevList {
 fn firstlast_dir_from_points(s: &Spline, p: &mut [BevPoint]) {
     let bp = &s.points;
     if bp.len() > 1 && !p.is_empty() {
-        let v = |i: usize| [bp[i].co[0] as f32, bp[i].co[1] as f32, bp[i].co[2] as f32];
+        let v = |i: usize| vec3(bp[i].co[0] as f32, bp[i].co[1] as f32, bp[i].co[2] as f32);
         let n = bp.len();
         let last = p.len() - 1;
-        p[0].dir = normalized(sub(v(1), v(0)));
-        p[last].dir = normalized(sub(v(n - 1), v(n - 2)));
+        p[0].dir = normalized(v(1) - v(0));
+        p[last].dir = normalized(v(n - 1) - v(n - 2));
     }
 }
 
@@ -637,15 +637,15 @@ fn calc_bisect(l: &mut BevList) {
             l.p[b].dir = bisect(l.p[b - 1].vec, l.p[b].vec, l.p[b + 1].vec);
         }
         // Fallback for zero-length end handles (computed from the neighbour instead).
-        if is_zero(l.p[0].dir) {
-            let mut d = sub(l.p[1].vec, l.p[0].vec);
+        if l.p[0].dir.is_zero() {
+            let mut d = l.p[1].vec - l.p[0].vec;
             if normalize(&mut d) == 0.0 {
                 d = l.p[1].dir;
             }
             l.p[0].dir = d;
         }
-        if is_zero(l.p[n - 1].dir) {
-            let mut d = sub(l.p[n - 1].vec, l.p[n - 2].vec);
+        if l.p[n - 1].dir.is_zero() {
+            let mut d = l.p[n - 1].vec - l.p[n - 2].vec;
             if normalize(&mut d) == 0.0 {
                 d = l.p[n - 2].dir;
             }
@@ -657,7 +657,7 @@ fn calc_bisect(l: &mut BevList) {
 fn minimum_twist_between(cur: &mut BevPoint, prev: &BevPoint) {
     let angle = angle_normalized(prev.dir, cur.dir);
     if angle > 0.0 {
-        let q = axis_angle_to_quat(cross(prev.dir, cur.dir), angle);
+        let q = axis_angle_to_quat(prev.dir.cross(cur.dir), angle);
         cur.quat = qmul(q, prev.quat);
     } else {
         cur.quat = prev.quat;
@@ -682,16 +682,16 @@ fn list_minimum_twist(l: &mut BevList) {
         // Spread the roll mismatch between the last and the second last point over the
         // whole loop (Blender's real order is 1, 2, ..., n-1, 0).
         let (first, last) = (n - 1, n - 2);
-        let mut v1 = qrotate(l.p[first].quat, [0.0, 1.0, 0.0]);
-        let mut v2 = qrotate(l.p[last].quat, [0.0, 1.0, 0.0]);
+        let mut v1 = qrotate(l.p[first].quat, Vec3::Y);
+        let mut v2 = qrotate(l.p[last].quat, Vec3::Y);
         normalize(&mut v1);
         normalize(&mut v2);
-        let c = cross(l.p[last].dir, l.p[first].dir);
+        let c = l.p[last].dir.cross(l.p[first].dir);
         let angle = angle_normalized(l.p[first].dir, l.p[last].dir);
         let q = axis_angle_to_quat(c, angle);
         v2 = qrotate(q, v2);
         let mut angle = angle_normalized(v1, v2);
-        let mut c = cross(v1, v2);
+        let mut c = v1.cross(v2);
         normalize(&mut c);
         if angle_normalized(l.p[first].dir, c) < DEG90 {
             angle = -angle;
@@ -717,18 +717,18 @@ fn list_tangent(l: &mut BevList) {
     for k in 0..n {
         let (a, b, _) = ring(n, k);
         if angle_normalized(l.p[a].tan, l.p[b].tan) > DEG90 {
-            l.p[b].tan = scale(l.p[b].tan, -1.0);
+            l.p[b].tan *= -1.0;
         }
     }
     for k in 0..n {
         let (_, b, _) = ring(n, k);
-        let c = cross(l.p[b].tan, l.p[b].dir);
-        l.p[b].tan = normalized(cross(c, l.p[b].dir));
+        let c = l.p[b].tan.cross(l.p[b].dir);
+        l.p[b].tan = normalized(c.cross(l.p[b].dir));
     }
     for k in 0..n {
         let (_, b, _) = ring(n, k);
-        let c = normalized(cross(l.p[b].tan, l.p[b].dir));
-        l.p[b].quat = tri_to_quat([0.0; 3], c, l.p[b].tan);
+        let c = normalized(l.p[b].tan.cross(l.p[b].dir));
+        l.p[b].quat = tri_to_quat(Vec3::ZERO, c, l.p[b].tan);
     }
 }
 
@@ -752,8 +752,8 @@ fn list_smooth(l: &mut BevList, iterations: i32) {
         for &(_, b, c) in &visits {
             let mut q = qslerp(prev_quat, l.p[c].quat, 0.5);
             qnormalize(&mut q);
-            let z = qrotate(q, [0.0, 0.0, 1.0]);
-            let cr = cross(z, l.p[b].dir);
+            let z = qrotate(q, Vec3::Z);
+            let cr = z.cross(l.p[b].dir);
             let mut q2 = axis_angle_to_quat(cr, angle_normalized(z, l.p[b].dir));
             qnormalize(&mut q2);
             prev_quat = l.p[b].quat;
@@ -774,7 +774,7 @@ fn apply_tilt(l: &mut BevList) {
 }
 
 fn segment_3d(l: &mut BevList) {
-    let d = normalized(sub(l.p[1].vec, l.p[0].vec));
+    let d = normalized(l.p[1].vec - l.p[0].vec);
     for i in [1usize, 0] {
         l.p[i].dir = d;
         let q0 = vec_to_quat(d, 5, 1);
@@ -1072,9 +1072,9 @@ impl Path {
         );
         // Poly, Bezier and NURBS paths interpolate linearly between their points.
         let mut w = [0.0f32, -frac + 1.0, frac, 0.0];
-        let mut pos = [0.0f32; 3];
-        for (j, v) in pos.iter_mut().enumerate() {
-            *v = w[0] * p0.vec[j] + w[1] * p1.vec[j] + w[2] * p2.vec[j] + w[3] * p3.vec[j];
+        let mut pos = Vec3::ZERO;
+        for j in 0..3 {
+            pos[j] = w[0] * p0.vec[j] + w[1] * p1.vec[j] + w[2] * p2.vec[j] + w[3] * p3.vec[j];
         }
         for x in w.iter_mut() {
             *x = x.clamp(0.0, 1.0);

@@ -5,7 +5,7 @@
 // The fit coefficients are kept digit for digit as Cycles lists them.
 #![allow(clippy::excessive_precision)]
 
-use super::math::{max_c, Vec3};
+use super::math::{max_c, V3};
 
 // Fit coefficients per temperature band (Cycles `kernel/tables.h`): R and G are
 // a / t + b * t + c, B is ((a * t + b) * t + c) * t + d.
@@ -73,7 +73,7 @@ const TABLE_B: [[f32; 4]; 7] = [
 ];
 
 /// Blackbody colour in linear Rec.709, unclamped (can be negative outside the gamut).
-pub fn blackbody_rec709(t: f32) -> Vec3 {
+pub fn blackbody_rec709(t: f32) -> V3 {
     if t >= 12000.0 {
         return [0.8262954810464208, 0.9945080501520986, 1.566307710274283];
     }
@@ -107,6 +107,6 @@ pub fn blackbody_rec709(t: f32) -> Vec3 {
 
 /// The Blackbody node for a Rec.709 scene-linear space: negative channels clamped to 0.
 /// (Cycles converts Rec.709 to the scene space first when that is not Rec.709.)
-pub fn blackbody(temperature: f32) -> Vec3 {
+pub fn blackbody(temperature: f32) -> V3 {
     blackbody_rec709(temperature).map(|c| max_c(c, 0.0))
 }

@@ -2,7 +2,7 @@
 //! integer hash, mortar by the distance to the brick's edges, and every Nth row offset
 //! and squashed.
 
-use super::math::Vec3;
+use super::math::V3;
 
 /// The node's non-socket settings (Blender's `offset`, `offset_frequency`, `squash`,
 /// `squash_frequency` properties).
@@ -39,7 +39,7 @@ fn smoothstep(f: f32) -> f32 {
 /// (tint, mortar) at `p` (already scaled).
 #[allow(clippy::too_many_arguments)]
 pub fn brick(
-    p: Vec3,
+    p: V3,
     mortar_size: f32,
     mortar_smooth: f32,
     bias: f32,
@@ -78,10 +78,10 @@ pub fn brick(
 /// (Color, Fac) of the Brick Texture node.
 #[allow(clippy::too_many_arguments)]
 pub fn brick_texture(
-    vector: Vec3,
-    color1: Vec3,
-    color2: Vec3,
-    mortar: Vec3,
+    vector: V3,
+    color1: V3,
+    color2: V3,
+    mortar: V3,
     scale: f32,
     mortar_size: f32,
     mortar_smooth: f32,
@@ -89,7 +89,7 @@ pub fn brick_texture(
     brick_width: f32,
     row_height: f32,
     s: BrickSettings,
-) -> (Vec3, f32) {
+) -> (V3, f32) {
     let p = [vector[0] * scale, vector[1] * scale, vector[2] * scale];
     let (tint, f) = brick(
         p,

@@ -7,15 +7,15 @@
 //! by the Color Ramp's HSV/HSL blending, which Blender evaluates before Cycles sees it)
 //! are in [`bli`].
 
-use super::math::{clamp_c, dot3, fract, max_c, min_c, saturate, Vec3};
+use super::math::{clamp_c, dot3, fract, max_c, min_c, saturate, V3};
 
 /// Constants Cycles derives from the OpenColorIO config for the scene-linear space.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SceneLinear {
     /// Luminance weights (RGB to BW, colour-to-float conversion).
-    pub rgb_to_y: Vec3,
+    pub rgb_to_y: V3,
     /// CIE XYZ (D65) to scene-linear RGB, by rows (Wavelength).
-    pub xyz_to_rgb: [Vec3; 3],
+    pub xyz_to_rgb: [V3; 3],
 }
 
 /// Blender's default config (scene linear = Linear Rec.709), as Blender 4.5 computes the
@@ -33,14 +33,14 @@ pub const LINEAR_REC709: SceneLinear = SceneLinear {
 
 /// Multiplies a row-major 3x3 matrix by a vector (each row a dot product, as Cycles).
 #[inline]
-pub fn mat3_mul(m: &[Vec3; 3], v: Vec3) -> Vec3 {
+pub fn mat3_mul(m: &[V3; 3], v: V3) -> V3 {
     [dot3(m[0], v), dot3(m[1], v), dot3(m[2], v)]
 }
 
 // --- Cycles kernel conversions ----------------------------------------------------------
 
 /// Cycles `rgb_to_hsv`.
-pub fn rgb_to_hsv(rgb: Vec3) -> Vec3 {
+pub fn rgb_to_hsv(rgb: V3) -> V3 {
     let [r, g, b] = rgb;
     let cmax = r.max(g.max(b));
     let cmin = min_c(r, min_c(g, b));
@@ -70,7 +70,7 @@ pub fn rgb_to_hsv(rgb: Vec3) -> Vec3 {
 }
 
 /// Cycles `hsv_to_rgb`.
-pub fn hsv_to_rgb(hsv: Vec3) -> Vec3 {
+pub fn hsv_to_rgb(hsv: V3) -> V3 {
     let [mut h, s, v] = hsv;
     if s == 0.0 {
         return [v, v, v];
@@ -100,7 +100,7 @@ pub fn hsv_to_rgb(hsv: Vec3) -> Vec3 {
 }
 
 /// Cycles `rgb_to_hsl` (same arithmetic as Blender's).
-pub fn rgb_to_hsl(rgb: Vec3) -> Vec3 {
+pub fn rgb_to_hsl(rgb: V3) -> V3 {
     let [r, g, b] = rgb;
     let cmax = r.max(g.max(b));
     let cmin = min_c(r, min_c(g, b));
@@ -129,7 +129,7 @@ pub fn rgb_to_hsl(rgb: Vec3) -> Vec3 {
 }
 
 /// Cycles `hsl_to_rgb` (same arithmetic as Blender's).
-pub fn hsl_to_rgb(hsl: Vec3) -> Vec3 {
+pub fn hsl_to_rgb(hsl: V3) -> V3 {
     let [h, s, l] = hsl;
     let nr = clamp_c((h * 6.0 - 3.0).abs() - 1.0, 0.0, 1.0);
     let ng = clamp_c(2.0 - (h * 6.0 - 2.0).abs(), 0.0, 1.0);
@@ -145,10 +145,10 @@ pub fn hsl_to_rgb(hsl: Vec3) -> Vec3 {
 /// Blender's own conversions (`BLI_math_color`), used where Blender, not Cycles, does
 /// the arithmetic (Color Ramp HSV/HSL blending, Geometry Nodes).
 pub mod bli {
-    use super::super::math::{clamp_c, min_c, Vec3};
+    use super::super::math::{clamp_c, min_c, V3};
 
     /// `rgb_to_hsv`: branch-free variant with 1e-20 guards (hue in [0, 1]).
-    pub fn rgb_to_hsv(rgb: Vec3) -> Vec3 {
+    pub fn rgb_to_hsv(rgb: V3) -> V3 {
         let [mut r, mut g, mut b] = rgb;
         let mut k = 0.0f32;
         if g < b {
@@ -168,7 +168,7 @@ pub mod bli {
     }
 
     /// `hsv_to_rgb`: piecewise-linear hue ramps.
-    pub fn hsv_to_rgb(hsv: Vec3) -> Vec3 {
+    pub fn hsv_to_rgb(hsv: V3) -> V3 {
         let [h, s, v] = hsv;
         let nr = clamp_c((h * 6.0 - 3.0).abs() - 1.0, 0.0, 1.0);
         let ng = clamp_c(2.0 - (h * 6.0 - 2.0).abs(), 0.0, 1.0);
@@ -180,11 +180,11 @@ pub mod bli {
         ]
     }
 
-    pub fn rgb_to_hsl(rgb: Vec3) -> Vec3 {
+    pub fn rgb_to_hsl(rgb: V3) -> V3 {
         super::rgb_to_hsl(rgb)
     }
 
-    pub fn hsl_to_rgb(hsl: Vec3) -> Vec3 {
+    pub fn hsl_to_rgb(hsl: V3) -> V3 {
         super::hsl_to_rgb(hsl)
     }
 }
@@ -192,13 +192,13 @@ pub mod bli {
 // --- Nodes ------------------------------------------------------------------------------
 
 /// Invert Color: `fac * (1 - c) + (1 - fac) * c` per channel.
-pub fn invert(fac: f32, color: Vec3) -> Vec3 {
+pub fn invert(fac: f32, color: V3) -> V3 {
     let f = |c: f32| fac * (1.0 - c) + (1.0 - fac) * c;
     [f(color[0]), f(color[1]), f(color[2])]
 }
 
 /// Gamma: `c^gamma` for positive channels (others unchanged); gamma 0 gives white.
-pub fn gamma(color: Vec3, gamma: f32) -> Vec3 {
+pub fn gamma(color: V3, gamma: f32) -> V3 {
     if gamma == 0.0 {
         return [1.0; 3];
     }
@@ -207,7 +207,7 @@ pub fn gamma(color: Vec3, gamma: f32) -> Vec3 {
 }
 
 /// Brightness/Contrast: `max((1 + contrast) * c + bright - contrast / 2, 0)`.
-pub fn bright_contrast(color: Vec3, bright: f32, contrast: f32) -> Vec3 {
+pub fn bright_contrast(color: V3, bright: f32, contrast: f32) -> V3 {
     let a = 1.0 + contrast;
     let b = bright - contrast * 0.5;
     let f = |c: f32| max_c(a * c + b, 0.0);
@@ -216,7 +216,7 @@ pub fn bright_contrast(color: Vec3, bright: f32, contrast: f32) -> Vec3 {
 
 /// Hue/Saturation/Value: shifts hue (0.5 = no change), scales saturation (clamped to
 /// [0, 1]) and value, blends with the input by `fac`, and clamps negatives to 0.
-pub fn hue_saturation(hue: f32, saturation: f32, value: f32, fac: f32, color: Vec3) -> Vec3 {
+pub fn hue_saturation(hue: f32, saturation: f32, value: f32, fac: f32, color: V3) -> V3 {
     let mut hsv = rgb_to_hsv(color);
     hsv[0] = fract(hsv[0] + hue + 0.5);
     hsv[1] = saturate(hsv[1] * saturation);
@@ -227,6 +227,6 @@ pub fn hue_saturation(hue: f32, saturation: f32, value: f32, fac: f32, color: Ve
 }
 
 /// RGB to BW: luminance with the scene-linear space's weights.
-pub fn rgb_to_bw(color: Vec3, space: &SceneLinear) -> f32 {
+pub fn rgb_to_bw(color: V3, space: &SceneLinear) -> f32 {
     dot3(color, space.rgb_to_y)
 }

@@ -3,7 +3,7 @@
 
 use crate::foundation::math::dot;
 
-use super::math::Vec3;
+use super::math::V3;
 
 /// Unpolarised dielectric Fresnel reflectance for cos(theta_i) and relative IOR `eta`
 /// (Cycles' `fresnel_dielectric_cos`): 1 under total internal reflection.
@@ -22,14 +22,14 @@ pub fn fresnel_dielectric_cos(cosi: f32, eta: f32) -> f32 {
 
 /// Fresnel node: `incoming` is the unit direction toward the viewer, `normal` the node's
 /// Normal input (the shading normal when unlinked).
-pub fn fresnel(ior: f32, incoming: Vec3, normal: Vec3, backfacing: bool) -> f32 {
+pub fn fresnel(ior: f32, incoming: V3, normal: V3, backfacing: bool) -> f32 {
     let eta = ior.max(1e-5);
     let eta = if backfacing { 1.0 / eta } else { eta };
     fresnel_dielectric_cos(dot(incoming, normal), eta)
 }
 
 /// Layer Weight node: (Fresnel, Facing).
-pub fn layer_weight(blend: f32, incoming: Vec3, normal: Vec3, backfacing: bool) -> (f32, f32) {
+pub fn layer_weight(blend: f32, incoming: V3, normal: V3, backfacing: bool) -> (f32, f32) {
     let cosi = dot(incoming, normal);
     let eta = (1.0 - blend).max(1e-5);
     let eta = if backfacing { eta } else { 1.0 / eta };

@@ -6,7 +6,7 @@
 
 use std::f32::consts::PI;
 
-use super::math::Vec3;
+use super::math::V3;
 use super::random::{hash_float_to_float3, hash_float_to_float4};
 
 const IMPULSES: i32 = 8;
@@ -21,12 +21,12 @@ blender_enum! {
 /// The node's outputs: (Value, Phase, Intensity).
 pub fn gabor_texture(
     kind: GaborType,
-    vector: Vec3,
+    vector: V3,
     scale: f32,
     frequency: f32,
     anisotropy: f32,
     orientation_2d: f32,
-    orientation_3d: Vec3,
+    orientation_3d: V3,
 ) -> [f32; 3] {
     let p = [vector[0] * scale, vector[1] * scale, vector[2] * scale];
     let isotropy = 1.0 - anisotropy.clamp(0.0, 1.0);
@@ -48,7 +48,7 @@ pub fn gabor_texture(
     [value, phase, intensity]
 }
 
-fn normalize(v: Vec3) -> Vec3 {
+fn normalize(v: V3) -> V3 {
     let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     if l != 0.0 {
         [v[0] / l, v[1] / l, v[2] / l]
@@ -124,12 +124,12 @@ fn cell_2d(
 }
 
 /// Cycles' spherical_to_direction.
-fn spherical_to_direction(theta: f32, phi: f32) -> Vec3 {
+fn spherical_to_direction(theta: f32, phi: f32) -> V3 {
     let s = theta.sin();
     [s * phi.cos(), s * phi.sin(), theta.cos()]
 }
 
-fn orientation_3d(o: Vec3, isotropy: f32, seed: [f32; 4]) -> Vec3 {
+fn orientation_3d(o: V3, isotropy: f32, seed: [f32; 4]) -> V3 {
     if isotropy == 0.0 {
         return o;
     }
@@ -145,7 +145,7 @@ fn orientation_3d(o: Vec3, isotropy: f32, seed: [f32; 4]) -> Vec3 {
     spherical_to_direction(inclination, azimuth)
 }
 
-fn noise_3d(c: Vec3, frequency: f32, isotropy: f32, orientation: Vec3) -> [f32; 2] {
+fn noise_3d(c: V3, frequency: f32, isotropy: f32, orientation: V3) -> [f32; 2] {
     let cell = c.map(f32::floor);
     let local = [c[0] - cell[0], c[1] - cell[1], c[2] - cell[2]];
     let mut sum = [0.0f32; 2];
@@ -167,7 +167,7 @@ fn noise_3d(c: Vec3, frequency: f32, isotropy: f32, orientation: Vec3) -> [f32; 
     sum
 }
 
-fn cell_3d(cell: Vec3, p: Vec3, frequency: f32, isotropy: f32, base: Vec3) -> [f32; 2] {
+fn cell_3d(cell: V3, p: V3, frequency: f32, isotropy: f32, base: V3) -> [f32; 2] {
     let mut noise = [0.0f32; 2];
     for i in 0..IMPULSES {
         let seed = |k: i32| [cell[0], cell[1], cell[2], (i * 3 + k) as f32];

@@ -1,7 +1,7 @@
 //! Gradient Texture (Cycles `svm_gradient`; Geometry Nodes' multi-function is the same
 //! without the final clamp).
 
-use super::math::Vec3;
+use super::math::V3;
 
 blender_enum! {
     pub enum GradientType {
@@ -16,13 +16,13 @@ blender_enum! {
 }
 
 /// Fac (the Color output is Fac in all three channels), clamped to [0, 1] as Cycles does.
-pub fn gradient(kind: GradientType, p: Vec3) -> f32 {
+pub fn gradient(kind: GradientType, p: V3) -> f32 {
     gradient_unclamped(kind, p).clamp(0.0, 1.0)
 }
 
 /// Fac before Cycles' clamp: what Geometry Nodes output (Linear, Quadratic and Diagonal
 /// leave [0, 1] there).
-pub fn gradient_unclamped(kind: GradientType, p: Vec3) -> f32 {
+pub fn gradient_unclamped(kind: GradientType, p: V3) -> f32 {
     let [x, y, z] = p;
     match kind {
         GradientType::Linear => x,

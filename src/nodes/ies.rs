@@ -2,7 +2,7 @@
 //! direction, read from IES LM-63 photometric data as Cycles' `IESFile` parses and
 //! processes it (util/ies.cpp), then looked up with bicubic interpolation.
 
-use super::math::{safe_acos, Vec3};
+use super::math::{safe_acos, V3};
 
 /// Candela to Cycles' Watt: 4π / 177.83 (the luminous efficacy of D65), as Cycles.
 const CANDELA_TO_WATT: f64 = 0.0706650768394;
@@ -107,7 +107,7 @@ fn cubic_interp(a: f32, b: f32, c: f32, d: f32, x: f32) -> f32 {
 
 /// The IES Texture node's Fac for `vector` (the light's object-space normal when
 /// unlinked): Cycles measures the vertical angle from -Z and the horizontal one from +Y.
-pub fn ies(table: &IesTable, vector: Vec3, strength: f32) -> f32 {
+pub fn ies(table: &IesTable, vector: V3, strength: f32) -> f32 {
     // Cycles' `normalize`: a zero vector gives NaN angles, which its lookup rejects.
     let l = (vector[0] * vector[0] + vector[1] * vector[1] + vector[2] * vector[2]).sqrt();
     let n = [vector[0] / l, vector[1] / l, vector[2] / l];

@@ -5,7 +5,7 @@
 //! projections, and the equirectangular and mirror-ball environment mappings.
 //! The pixels themselves live in `shader::images` (loaded once, shared).
 
-use super::math::Vec3;
+use super::math::V3;
 
 blender_enum! {
     /// Image Texture `interpolation`; Cycles' CPU kernel samples Smart as Cubic.
@@ -350,7 +350,7 @@ pub fn finish_lookup(mut r: [f32; 4], unassociate: bool, srgb: bool) -> [f32; 4]
 
 /// Flat-projection coordinates of the Sphere and Tube projections (`map_to_sphere`,
 /// `map_to_tube` of the 0..1 box remapped to -1..1).
-pub fn project(p: Projection, co: Vec3) -> [f32; 2] {
+pub fn project(p: Projection, co: V3) -> [f32; 2] {
     let sq = |v: f32| (v - 0.5) * 2.0;
     match p {
         Projection::Flat | Projection::Box => [co[0], co[1]],
@@ -386,7 +386,7 @@ pub fn project(p: Projection, co: Vec3) -> [f32; 2] {
 
 /// Box projection: the weight of the X, Y and Z facing images for object-space normal
 /// `n` and the node's blend (Cycles' seven zones of the barycentric triangle).
-pub fn box_weights(n: Vec3, blend: f32) -> Vec3 {
+pub fn box_weights(n: V3, blend: f32) -> V3 {
     let mut n = n.map(f32::abs);
     let s = n[0] + n[1] + n[2];
     n = n.map(|x| x / s);
@@ -423,7 +423,7 @@ pub fn box_weights(n: Vec3, blend: f32) -> Vec3 {
 }
 
 /// The image coordinates each box face samples (no face appears mirrored).
-pub fn box_uvs(signed_n: Vec3, co: Vec3) -> [[f32; 2]; 3] {
+pub fn box_uvs(signed_n: V3, co: V3) -> [[f32; 2]; 3] {
     [
         [
             if signed_n[0] < 0.0 {
@@ -453,7 +453,7 @@ pub fn box_uvs(signed_n: Vec3, co: Vec3) -> [[f32; 2]; 3] {
 }
 
 /// Equirectangular image coordinates of a direction (Cycles' default range).
-pub fn direction_to_equirectangular(d: Vec3) -> [f32; 2] {
+pub fn direction_to_equirectangular(d: V3) -> [f32; 2] {
     if d == [0.0; 3] {
         return [0.0, 0.0];
     }
@@ -465,7 +465,7 @@ pub fn direction_to_equirectangular(d: Vec3) -> [f32; 2] {
 }
 
 /// Mirror-ball image coordinates of a direction.
-pub fn direction_to_mirrorball(mut d: Vec3) -> [f32; 2] {
+pub fn direction_to_mirrorball(mut d: V3) -> [f32; 2] {
     d[1] -= 1.0;
     let div = 2.0 * (-0.5 * d[1]).max(0.0).sqrt();
     if div > 0.0 {
@@ -475,7 +475,7 @@ pub fn direction_to_mirrorball(mut d: Vec3) -> [f32; 2] {
 }
 
 /// Cycles' `safe_normalize`: a zero vector stays zero.
-pub fn safe_normalize(v: Vec3) -> Vec3 {
+pub fn safe_normalize(v: V3) -> V3 {
     let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     if l != 0.0 {
         v.map(|x| x / l)

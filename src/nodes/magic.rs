@@ -1,9 +1,9 @@
 //! Magic Texture (Cycles `svm_magic`).
 
-use super::math::Vec3;
+use super::math::V3;
 
 /// (Color, Fac) of the Magic Texture node; `depth` is its Turbulence Depth.
-pub fn magic(p: Vec3, scale: f32, depth: i32, distortion: f32) -> (Vec3, f32) {
+pub fn magic(p: V3, scale: f32, depth: i32, distortion: f32) -> (V3, f32) {
     // Wrapping into one period first keeps large inputs from losing precision.
     let tau = 2.0 * std::f32::consts::PI;
     let (px, py, pz) = (p[0] % tau, p[1] % tau, p[2] % tau);

@@ -6,7 +6,7 @@
 //! the smooth modes. The float "Clamp" is the Clamp node (Range mode) Cycles appends.
 
 use super::clamp::{clamp_node, ClampType};
-use super::math::{clamp_c, safe_divide, Vec3};
+use super::math::{clamp_c, safe_divide, V3};
 
 blender_enum! {
     /// `ShaderNodeMapRange.interpolation_type`.
@@ -95,13 +95,13 @@ pub fn map_range_float(
 pub fn map_range_vector(
     interpolation: MapRangeInterpolation,
     clamp: bool,
-    value: Vec3,
-    from_min: Vec3,
-    from_max: Vec3,
-    to_min: Vec3,
-    to_max: Vec3,
-    steps: Vec3,
-) -> Vec3 {
+    value: V3,
+    from_min: V3,
+    from_max: V3,
+    to_min: V3,
+    to_max: V3,
+    steps: V3,
+) -> V3 {
     use MapRangeInterpolation::*;
     // Cycles applies "Clamp" only to the linear and stepped modes here.
     let use_clamp = clamp && matches!(interpolation, Linear | Stepped);

@@ -3,7 +3,7 @@
 
 use crate::foundation::math::dot;
 
-use super::math::Vec3;
+use super::math::V3;
 
 blender_enum! {
     pub enum MappingType {
@@ -15,7 +15,7 @@ blender_enum! {
 }
 
 /// Rows of Cycles' `euler_to_transform` (rotation part).
-pub(crate) fn euler_rows(e: Vec3) -> [Vec3; 3] {
+pub(crate) fn euler_rows(e: V3) -> [V3; 3] {
     let (cx, cy, cz) = (e[0].cos(), e[1].cos(), e[2].cos());
     let (sx, sy, sz) = (e[0].sin(), e[1].sin(), e[2].sin());
     [
@@ -25,28 +25,22 @@ pub(crate) fn euler_rows(e: Vec3) -> [Vec3; 3] {
     ]
 }
 
-pub(crate) fn rotate(r: &[Vec3; 3], a: Vec3) -> Vec3 {
+pub(crate) fn rotate(r: &[V3; 3], a: V3) -> V3 {
     [dot(a, r[0]), dot(a, r[1]), dot(a, r[2])]
 }
 
-pub(crate) fn rotate_transposed(r: &[Vec3; 3], a: Vec3) -> Vec3 {
+pub(crate) fn rotate_transposed(r: &[V3; 3], a: V3) -> V3 {
     let col = |i: usize| [r[0][i], r[1][i], r[2][i]];
     [dot(a, col(0)), dot(a, col(1)), dot(a, col(2))]
 }
 
-fn safe_div(a: Vec3, b: Vec3) -> Vec3 {
+fn safe_div(a: V3, b: V3) -> V3 {
     std::array::from_fn(|i| if b[i] != 0.0 { a[i] / b[i] } else { 0.0 })
 }
 
-pub fn mapping(
-    kind: MappingType,
-    vector: Vec3,
-    location: Vec3,
-    rotation: Vec3,
-    scale: Vec3,
-) -> Vec3 {
+pub fn mapping(kind: MappingType, vector: V3, location: V3, rotation: V3, scale: V3) -> V3 {
     let r = euler_rows(rotation);
-    let mul = |a: Vec3, b: Vec3| -> Vec3 { std::array::from_fn(|i| a[i] * b[i]) };
+    let mul = |a: V3, b: V3| -> V3 { std::array::from_fn(|i| a[i] * b[i]) };
     match kind {
         MappingType::Point => {
             let v = rotate(&r, mul(vector, scale));

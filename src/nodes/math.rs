@@ -6,8 +6,9 @@
 //! evaluation order of every expression, so results match Cycles to the last bit or two
 //! (Cycles' AVX2 kernel fuses some multiply-adds; plain Rust does not).
 
-/// A 3-component vector or colour (Cycles `float3`).
-pub use crate::foundation::math::V3 as Vec3;
+/// A 3-component vector or colour as a plain array (Cycles `float3`), as the node maths
+/// takes and returns it (`foundation::math::Vec3` is the operator type).
+pub use crate::foundation::math::V3;
 // Cycles' float3 helpers under the names the node code uses (util/math_float3.h).
 pub use crate::foundation::math::{
     add as add3, cross as cross3, dot as dot3, len as length3, mul as mul3, scale as scale3,
@@ -293,18 +294,18 @@ pub fn math_node(op: MathOp, use_clamp: bool, a: f32, b: f32, c: f32) -> f32 {
 // --- Vector helpers (Cycles util/math_float3.h) -----------------------------------------
 
 #[inline]
-pub fn map3(a: Vec3, f: impl Fn(f32) -> f32) -> Vec3 {
+pub fn map3(a: V3, f: impl Fn(f32) -> f32) -> V3 {
     [f(a[0]), f(a[1]), f(a[2])]
 }
 
 #[inline]
-pub fn zip3(a: Vec3, b: Vec3, f: impl Fn(f32, f32) -> f32) -> Vec3 {
+pub fn zip3(a: V3, b: V3, f: impl Fn(f32, f32) -> f32) -> V3 {
     [f(a[0], b[0]), f(a[1], b[1]), f(a[2], b[2])]
 }
 
 /// Unit vector; a zero vector stays zero.
 #[inline]
-pub fn safe_normalize3(a: Vec3) -> Vec3 {
+pub fn safe_normalize3(a: V3) -> V3 {
     let t = length3(a);
     if t != 0.0 {
         scale3(a, 1.0 / t)
@@ -315,20 +316,20 @@ pub fn safe_normalize3(a: Vec3) -> Vec3 {
 
 /// Unit vector, NaN for a zero vector (Cycles `normalize`, true division per component).
 #[inline]
-pub fn normalize3(a: Vec3) -> Vec3 {
+pub fn normalize3(a: V3) -> V3 {
     let t = length3(a);
     [a[0] / t, a[1] / t, a[2] / t]
 }
 
 /// Cycles `saturate(float3)`.
 #[inline]
-pub fn saturate3(a: Vec3) -> Vec3 {
+pub fn saturate3(a: V3) -> V3 {
     map3(a, saturate)
 }
 
 /// Cycles `interp(a, b, t)`: `a + t * (b - a)`.
 #[inline]
-pub fn interp3(a: Vec3, b: Vec3, t: f32) -> Vec3 {
+pub fn interp3(a: V3, b: V3, t: f32) -> V3 {
     [
         a[0] + t * (b[0] - a[0]),
         a[1] + t * (b[1] - a[1]),
@@ -336,7 +337,7 @@ pub fn interp3(a: Vec3, b: Vec3, t: f32) -> Vec3 {
     ]
 }
 
-fn project3(v: Vec3, onto: Vec3) -> Vec3 {
+fn project3(v: V3, onto: V3) -> V3 {
     let len_squared = dot3(onto, onto);
     if len_squared != 0.0 {
         scale3(onto, dot3(v, onto) / len_squared)
@@ -345,13 +346,13 @@ fn project3(v: Vec3, onto: Vec3) -> Vec3 {
     }
 }
 
-fn reflect3(incident: Vec3, unit_normal: Vec3) -> Vec3 {
+fn reflect3(incident: V3, unit_normal: V3) -> V3 {
     let d = dot3(incident, unit_normal);
     let n2 = scale3(unit_normal, 2.0);
     sub3(incident, scale3(n2, d))
 }
 
-fn refract3(incident: Vec3, normal: Vec3, eta: f32) -> Vec3 {
+fn refract3(incident: V3, normal: V3, eta: f32) -> V3 {
     let d = dot3(normal, incident);
     let k = 1.0 - eta * eta * (1.0 - d * d);
     if k < 0.0 {
@@ -412,13 +413,13 @@ impl VectorMathOp {
 /// meaningful (Blender hides the other); it is returned as zero.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VectorMathResult {
-    pub vector: Vec3,
+    pub vector: V3,
     pub value: f32,
 }
 
 /// The Vector Math node: inputs A, B, C (`Vector`, `Vector_001`, `Vector_002`) and the
 /// float `Scale` (also the IOR of Refract).
-pub fn vector_math(op: VectorMathOp, a: Vec3, b: Vec3, c: Vec3, scale: f32) -> VectorMathResult {
+pub fn vector_math(op: VectorMathOp, a: V3, b: V3, c: V3, scale: f32) -> VectorMathResult {
     use VectorMathOp::*;
     let v = |vector| VectorMathResult { vector, value: 0.0 };
     let s = |value| VectorMathResult {

@@ -2,7 +2,7 @@
 //! semantics (`kernel/svm/mix.h`, `kernel/svm/color_util.h`).
 
 use super::color::{hsv_to_rgb, rgb_to_hsv};
-use super::math::{interp3, max_c, min_c, saturate, saturate3, Vec3};
+use super::math::{interp3, max_c, min_c, saturate, saturate3, V3};
 
 blender_enum! {
     /// `blend_type` of the Mix (colour) and MixRGB nodes.
@@ -47,12 +47,12 @@ blender_enum! {
     }
 }
 
-fn per_channel(c1: Vec3, c2: Vec3, f: impl Fn(f32, f32) -> f32) -> Vec3 {
+fn per_channel(c1: V3, c2: V3, f: impl Fn(f32, f32) -> f32) -> V3 {
     [f(c1[0], c2[0]), f(c1[1], c2[1]), f(c1[2], c2[2])]
 }
 
 /// Blends `c2` over `c1` with factor `t` (not clamped here). Cycles `svm_mix`.
-pub fn blend(mode: MixBlend, t: f32, c1: Vec3, c2: Vec3) -> Vec3 {
+pub fn blend(mode: MixBlend, t: f32, c1: V3, c2: V3) -> V3 {
     use MixBlend::*;
     let tm = 1.0 - t;
     match mode {
@@ -154,9 +154,9 @@ pub fn mix_color(
     clamp_factor: bool,
     clamp_result: bool,
     factor: f32,
-    a: Vec3,
-    b: Vec3,
-) -> Vec3 {
+    a: V3,
+    b: V3,
+) -> V3 {
     let t = if clamp_factor {
         saturate(factor)
     } else {
@@ -181,7 +181,7 @@ pub fn mix_float(clamp_factor: bool, factor: f32, a: f32, b: f32) -> f32 {
 }
 
 /// Mix node, vector data type with a uniform (float) factor.
-pub fn mix_vector(clamp_factor: bool, factor: f32, a: Vec3, b: Vec3) -> Vec3 {
+pub fn mix_vector(clamp_factor: bool, factor: f32, a: V3, b: V3) -> V3 {
     let t = if clamp_factor {
         saturate(factor)
     } else {
@@ -195,7 +195,7 @@ pub fn mix_vector(clamp_factor: bool, factor: f32, a: Vec3, b: Vec3) -> Vec3 {
 }
 
 /// Mix node, vector data type with a per-component factor.
-pub fn mix_vector_non_uniform(clamp_factor: bool, factor: Vec3, a: Vec3, b: Vec3) -> Vec3 {
+pub fn mix_vector_non_uniform(clamp_factor: bool, factor: V3, a: V3, b: V3) -> V3 {
     let t = if clamp_factor {
         saturate3(factor)
     } else {
@@ -210,6 +210,6 @@ pub fn mix_vector_non_uniform(clamp_factor: bool, factor: Vec3, a: Vec3, b: Vec3
 
 /// Legacy MixRGB node: the factor is always clamped to [0, 1]; "Clamp" clamps the result.
 /// Its `use_alpha` option is never read by Cycles (colours carry no alpha there).
-pub fn mix_rgb(mode: MixBlend, use_clamp: bool, fac: f32, color1: Vec3, color2: Vec3) -> Vec3 {
+pub fn mix_rgb(mode: MixBlend, use_clamp: bool, fac: f32, color1: V3, color2: V3) -> V3 {
     mix_color(mode, true, use_clamp, fac, color1, color2)
 }

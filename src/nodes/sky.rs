@@ -22,7 +22,7 @@ use crate::foundation::math::{add, dot, len, mul, scale, sub};
 
 use super::color::{mat3_mul, SceneLinear};
 use super::image::{Extension, Interpolation, Pixels};
-use super::math::Vec3;
+use super::math::V3;
 
 const TAU: f32 = 2.0 * PI;
 
@@ -40,7 +40,7 @@ blender_enum! {
 pub struct SkySettings {
     pub sky_type: SkyType,
     /// Preetham and Hosek/Wilkie: towards the sun (normalised by Blender's sync).
-    pub sun_direction: Vec3,
+    pub sun_direction: V3,
     pub turbidity: f32,
     /// Hosek/Wilkie only.
     pub ground_albedo: f32,
@@ -76,8 +76,8 @@ pub enum Sky {
 /// The precomputed Nishita sky.
 #[derive(Debug, Clone)]
 pub struct Nishita {
-    pixel_bottom: Vec3,
-    pixel_top: Vec3,
+    pixel_bottom: V3,
+    pixel_top: V3,
     sun_elevation: f32,
     sun_rotation: f32,
     /// Negative without a sun disc.
@@ -92,7 +92,7 @@ pub struct Nishita {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SunGuide {
     /// Unit direction toward the sun's centre.
-    pub direction: Vec3,
+    pub direction: V3,
     /// Half the sun's angular diameter (radians).
     pub half_angle: f32,
     /// Cycles' `get_sun_average_radiance`: the disc centre's mean XYZ times the squared
@@ -146,7 +146,7 @@ impl Sky {
     }
 
     /// The Color output for direction `dir` (the node's Vector, as given).
-    pub fn eval(&self, dir: Vec3, space: &SceneLinear) -> Vec3 {
+    pub fn eval(&self, dir: V3, space: &SceneLinear) -> V3 {
         let xyz = match self {
             Sky::Analytic {
                 hosek,
@@ -175,16 +175,16 @@ impl Sky {
     }
 }
 
-fn to_rgb_clamped(space: &SceneLinear, xyz: Vec3) -> Vec3 {
+fn to_rgb_clamped(space: &SceneLinear, xyz: V3) -> V3 {
     mat3_mul(&space.xyz_to_rgb, xyz).map(|c| c.max(0.0))
 }
 
 /// Cycles' `direction_to_spherical`: (acos z, atan2(y, x)).
-fn direction_to_spherical(d: Vec3) -> (f32, f32) {
+fn direction_to_spherical(d: V3) -> (f32, f32) {
     (d[2].clamp(-1.0, 1.0).acos(), d[1].atan2(d[0]))
 }
 
-fn spherical_to_direction(theta: f32, phi: f32) -> Vec3 {
+fn spherical_to_direction(theta: f32, phi: f32) -> V3 {
     [
         theta.sin() * phi.cos(),
         theta.sin() * phi.sin(),
@@ -200,7 +200,7 @@ fn angle_between(thetav: f32, phiv: f32, theta: f32, phi: f32) -> f32 {
     cospsi.clamp(-1.0, 1.0).acos()
 }
 
-fn xy_big_y_to_xyz(x: f32, y: f32, big_y: f32) -> Vec3 {
+fn xy_big_y_to_xyz(x: f32, y: f32, big_y: f32) -> V3 {
     let big_x = if y != 0.0 { (x / y) * big_y } else { 0.0 };
     let big_z = if y != 0.0 && big_y != 0.0 {
         (1.0 - x - y) / y * big_y
@@ -221,11 +221,11 @@ fn perez(lam: &[f32; 9], theta: f32, gamma: f32) -> f32 {
 }
 
 /// The sun's (theta, phi) as `SkyTextureNode` takes them: acos z and atan2(x, y).
-fn sun_spherical(dir: Vec3) -> (f32, f32) {
+fn sun_spherical(dir: V3) -> (f32, f32) {
     (dir[2].acos(), dir[0].atan2(dir[1]))
 }
 
-fn preetham(sun_direction: Vec3, turbidity: f32) -> Sky {
+fn preetham(sun_direction: V3, turbidity: f32) -> Sky {
     let (theta, phi) = sun_spherical(sun_direction);
     let theta2 = theta * theta;
     let theta3 = theta2 * theta;
@@ -434,16 +434,16 @@ const QUADRATURE_WEIGHTS: [f32; 8] = [
 ];
 
 /// intern/sky's `reduce_add`.
-fn reduce_add(a: Vec3) -> f32 {
+fn reduce_add(a: V3) -> f32 {
     a[0] + a[1] + a[2]
 }
 
 /// intern/sky's geographical direction: latitude up from the horizon, longitude from x.
-fn geographical_to_direction(lat: f32, lon: f32) -> Vec3 {
+fn geographical_to_direction(lat: f32, lon: f32) -> V3 {
     [lat.cos() * lon.cos(), lat.cos() * lon.sin(), lat.sin()]
 }
 
-fn spec_to_xyz(spectrum: &[f32; WAVELENGTHS]) -> Vec3 {
+fn spec_to_xyz(spectrum: &[f32; WAVELENGTHS]) -> V3 {
     let mut xyz = [0.0f32; 3];
     for (cmf, s) in CMF_XYZ.iter().zip(spectrum) {
         xyz[0] += cmf[0] * s;
@@ -482,7 +482,7 @@ fn phase_mie(mu: f32) -> f32 {
 }
 
 /// Whether the ray from `pos` along `dir` meets the ground.
-fn surface_intersection(pos: Vec3, dir: Vec3) -> bool {
+fn surface_intersection(pos: V3, dir: V3) -> bool {
     if dir[2] >= 0.0 {
         return false;
     }
@@ -491,7 +491,7 @@ fn surface_intersection(pos: Vec3, dir: Vec3) -> bool {
     b * b - 4.0 * c >= 0.0
 }
 
-fn atmosphere_intersection(pos: Vec3, dir: Vec3) -> Vec3 {
+fn atmosphere_intersection(pos: V3, dir: V3) -> V3 {
     let b = -2.0 * dot(dir, scale(pos, -1.0));
     let c = dot(pos, pos) - ATMOSPHERE_RADIUS * ATMOSPHERE_RADIUS;
     let t = (-b + (b * b - 4.0 * c).sqrt()) / 2.0;
@@ -503,7 +503,7 @@ fn atmosphere_intersection(pos: Vec3, dir: Vec3) -> Vec3 {
 }
 
 /// Optical depth factors (Rayleigh, Mie, ozone) from `origin` along `dir` to space.
-fn ray_optical_depth(origin: Vec3, dir: Vec3) -> Vec3 {
+fn ray_optical_depth(origin: V3, dir: V3) -> V3 {
     let end = atmosphere_intersection(origin, dir);
     let ray_length = len(sub(end, origin));
     let segment = scale(dir, ray_length);
@@ -523,10 +523,10 @@ fn ray_optical_depth(origin: Vec3, dir: Vec3) -> Vec3 {
 
 /// Single in-scattering of the sun along a ray through the atmosphere, per wavelength.
 fn single_scattering(
-    ray_dir: Vec3,
-    sun_dir: Vec3,
-    origin: Vec3,
-    density_scale: Vec3,
+    ray_dir: V3,
+    sun_dir: V3,
+    origin: V3,
+    density_scale: V3,
     spectrum: &mut [f32; WAVELENGTHS],
 ) {
     let end = atmosphere_intersection(origin, ray_dir);
@@ -572,7 +572,7 @@ fn single_scattering(
 
 /// The sun's radiance seen along `dir` (its disc's solid angle spreads the irradiance).
 fn sun_radiation(
-    dir: Vec3,
+    dir: V3,
     altitude: f32,
     air: f32,
     dust: f32,
@@ -679,7 +679,7 @@ impl Nishita {
         }
     }
 
-    fn lookup(&self, x: f32, y: f32) -> Vec3 {
+    fn lookup(&self, x: f32, y: f32) -> V3 {
         let r = Pixels {
             data: &self.texels,
             width: TEX_WIDTH as i32,
@@ -690,7 +690,7 @@ impl Nishita {
     }
 
     /// XYZ towards `dir` (`sky_radiance_nishita`).
-    fn eval(&self, dir: Vec3) -> Vec3 {
+    fn eval(&self, dir: V3) -> V3 {
         let (theta, phi) = direction_to_spherical(dir);
         let fract = |v: f32| v - v.floor();
         let x = fract((-phi - FRAC_PI_2 + self.sun_rotation) / TAU);

@@ -32,7 +32,7 @@
 
 use std::f32::consts::FRAC_PI_2;
 
-use super::math::Vec3;
+use super::math::V3;
 
 /// (sun theta, sun phi, radiance per XYZ channel, nine coefficients per channel).
 pub type HosekState = (f32, f32, [f32; 3], [[f32; 9]; 3]);
@@ -41,11 +41,7 @@ pub type HosekState = (f32, f32, [f32; 3], [[f32; 9]; 3]);
 ///
 /// Turbidity below 1 is refused: the model's tables start at 1 and Cycles would read
 /// before them (Blender's own property stops at 1, so only a hand-made file gets there).
-pub fn hosek(
-    sun_direction: Vec3,
-    turbidity: f32,
-    ground_albedo: f32,
-) -> Result<HosekState, String> {
+pub fn hosek(sun_direction: V3, turbidity: f32, ground_albedo: f32) -> Result<HosekState, String> {
     // Cycles clamps turbidity to [0, 10] and the sun to the sky before the model.
     let turbidity = turbidity.clamp(0.0, 10.0);
     if turbidity.is_nan() || turbidity < 1.0 {

@@ -2,7 +2,7 @@
 //! by an angle, or by an XYZ Euler rotation, around a centre; optionally inverted.
 
 use super::mapping::{euler_rows, rotate, rotate_transposed};
-use super::math::Vec3;
+use super::math::V3;
 
 blender_enum! {
     pub enum VectorRotateType {
@@ -15,7 +15,7 @@ blender_enum! {
 }
 
 /// Rodrigues' rotation in the term order of Cycles' `rotate_around_axis`.
-fn rotate_around_axis(p: Vec3, a: Vec3, angle: f32) -> Vec3 {
+fn rotate_around_axis(p: V3, a: V3, angle: f32) -> V3 {
     let (c, s) = (angle.cos(), angle.sin());
     let t = 1.0 - c;
     [
@@ -34,18 +34,18 @@ fn rotate_around_axis(p: Vec3, a: Vec3, angle: f32) -> Vec3 {
 pub fn vector_rotate(
     kind: VectorRotateType,
     invert: bool,
-    vector: Vec3,
-    center: Vec3,
-    axis: Vec3,
+    vector: V3,
+    center: V3,
+    axis: V3,
     angle: f32,
-    rotation: Vec3,
-) -> Vec3 {
+    rotation: V3,
+) -> V3 {
     let d = [
         vector[0] - center[0],
         vector[1] - center[1],
         vector[2] - center[2],
     ];
-    let add_c = |v: Vec3| [v[0] + center[0], v[1] + center[1], v[2] + center[2]];
+    let add_c = |v: V3| [v[0] + center[0], v[1] + center[1], v[2] + center[2]];
     if kind == VectorRotateType::EulerXyz {
         let r = euler_rows(rotation);
         return add_c(if invert {

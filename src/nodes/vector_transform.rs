@@ -8,7 +8,7 @@ use crate::foundation::math::{
     transform_direction, transform_direction_transposed, transform_point,
 };
 
-use super::math::Vec3;
+use super::math::V3;
 
 blender_enum! {
     pub enum VectorTransformType {
@@ -47,7 +47,7 @@ impl Default for Affine {
     }
 }
 
-fn normalize(v: Vec3) -> Vec3 {
+fn normalize(v: V3) -> V3 {
     let l = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     if l > 0.0 {
         [v[0] / l, v[1] / l, v[2] / l]
@@ -57,7 +57,7 @@ fn normalize(v: Vec3) -> Vec3 {
 }
 
 /// `v` through `t` (`inverse` false) or its inverse, as a point, direction or normal.
-fn apply(kind: VectorTransformType, t: &Affine, inverse: bool, v: Vec3) -> Vec3 {
+fn apply(kind: VectorTransformType, t: &Affine, inverse: bool, v: V3) -> V3 {
     let (m, other) = if inverse {
         (&t.inverse, &t.forward)
     } else {
@@ -76,10 +76,10 @@ pub fn vector_transform(
     kind: VectorTransformType,
     from: TransformSpace,
     to: TransformSpace,
-    v: Vec3,
+    v: V3,
     object: Option<&Affine>,
     camera: &Affine,
-) -> Vec3 {
+) -> V3 {
     use TransformSpace::{Camera, Object, World};
     let mut v = v;
     match (from, to) {

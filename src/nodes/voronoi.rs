@@ -15,7 +15,7 @@
 //! the same cells, so their hashes are computed once. Every value is the same bits as the
 //! cell-by-cell evaluation (tests/noise_speed.rs).
 
-use super::math::Vec3;
+use super::math::V3;
 use super::white_noise::{
     hash_f1_to_f1, hash_f1_to_f3, hash_f2_to_f2, hash_f2_to_f3, hash_f3_to_f3, hash_f4_to_f3,
     hash_f4_to_f4,
@@ -58,18 +58,18 @@ pub struct VoronoiParams {
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct VoronoiOutput {
     pub distance: f32,
-    pub color: Vec3,
-    pub position: Vec3,
+    pub color: V3,
+    pub position: V3,
     pub w: f32,
     pub radius: f32,
 }
 
 trait Cell<const N: usize> {
     fn jitter(cell: [f32; N]) -> [f32; N];
-    fn color(cell: [f32; N]) -> Vec3;
+    fn color(cell: [f32; N]) -> V3;
     /// The cell's colour given its jitter hash (in 3D both are the same hash).
     #[inline(always)]
-    fn color_with(cell: [f32; N], _jitter: [f32; N]) -> Vec3 {
+    fn color_with(cell: [f32; N], _jitter: [f32; N]) -> V3 {
         Self::color(cell)
     }
     /// Cycles' `voronoi_position`: where the N components land in (x, y, z, w).
@@ -82,7 +82,7 @@ impl Cell<1> for D {
         [hash_f1_to_f1(c[0])]
     }
     #[inline(always)]
-    fn color(c: [f32; 1]) -> Vec3 {
+    fn color(c: [f32; 1]) -> V3 {
         hash_f1_to_f3(c[0])
     }
     fn position(p: [f32; 1]) -> [f32; 4] {
@@ -95,7 +95,7 @@ impl Cell<2> for D {
         hash_f2_to_f2(c)
     }
     #[inline(always)]
-    fn color(c: [f32; 2]) -> Vec3 {
+    fn color(c: [f32; 2]) -> V3 {
         hash_f2_to_f3(c)
     }
     fn position(p: [f32; 2]) -> [f32; 4] {
@@ -108,11 +108,11 @@ impl Cell<3> for D {
         hash_f3_to_f3(c)
     }
     #[inline(always)]
-    fn color(c: [f32; 3]) -> Vec3 {
+    fn color(c: [f32; 3]) -> V3 {
         hash_f3_to_f3(c)
     }
     #[inline(always)]
-    fn color_with(_: [f32; 3], jitter: [f32; 3]) -> Vec3 {
+    fn color_with(_: [f32; 3], jitter: [f32; 3]) -> V3 {
         jitter
     }
     fn position(p: [f32; 3]) -> [f32; 4] {
@@ -125,7 +125,7 @@ impl Cell<4> for D {
         hash_f4_to_f4(c)
     }
     #[inline(always)]
-    fn color(c: [f32; 4]) -> Vec3 {
+    fn color(c: [f32; 4]) -> V3 {
         hash_f4_to_f3(c)
     }
     fn position(p: [f32; 4]) -> [f32; 4] {
@@ -417,7 +417,7 @@ fn first_min(d: &[f32], m: usize) -> Option<usize> {
 
 struct Octave {
     distance: f32,
-    color: Vec3,
+    color: V3,
     position: [f32; 4],
 }
 
@@ -816,7 +816,7 @@ where
 
 /// The Voronoi Texture node on one point: `dimensions` 1-4 (`vector` for 2-4, `w` for 1
 /// and 4).
-pub fn voronoi_texture(dimensions: u8, vector: Vec3, w: f32, p: VoronoiParams) -> VoronoiOutput {
+pub fn voronoi_texture(dimensions: u8, vector: V3, w: f32, p: VoronoiParams) -> VoronoiOutput {
     let v = vector.map(|x| x * p.scale);
     let w = w * p.scale;
     match dimensions {

@@ -1,7 +1,7 @@
 //! Wave Texture (Cycles `svm_wave`): bands or rings, sine/saw/triangle profiles, with an
 //! fBm distortion.
 
-use super::math::Vec3;
+use super::math::V3;
 use super::noise::{fbm, Cycles};
 
 blender_enum! {
@@ -29,7 +29,7 @@ pub struct WaveSettings {
 #[allow(clippy::too_many_arguments)]
 pub fn wave(
     s: WaveSettings,
-    vector: Vec3,
+    vector: V3,
     scale: f32,
     distortion: f32,
     detail: f32,

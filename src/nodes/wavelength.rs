@@ -3,7 +3,7 @@
 //! the scene-linear space and scaled so every channel stays within [0, 1].
 
 use super::color::{mat3_mul, SceneLinear};
-use super::math::{interp3, max_c, Vec3};
+use super::math::{interp3, max_c, V3};
 
 /// CIE 1931 2-degree observer (x-bar, y-bar, z-bar), 380..=780 nm in 5 nm steps.
 #[rustfmt::skip]
@@ -39,7 +39,7 @@ const CIE_COLOR_MATCH: [[f32; 3]; 81] = [
 
 /// CIE XYZ of a wavelength in nm; black outside the table. As in Cycles, the table index
 /// truncates towards zero, so 376-380 nm extrapolate the first interval.
-pub fn wavelength_xyz(lambda_nm: f32) -> Vec3 {
+pub fn wavelength_xyz(lambda_nm: f32) -> V3 {
     let mut ii = (lambda_nm - 380.0) * (1.0 / 5.0);
     let i = ii as i32;
     if !(0..80).contains(&i) {
@@ -51,7 +51,7 @@ pub fn wavelength_xyz(lambda_nm: f32) -> Vec3 {
 }
 
 /// The Wavelength node: scene-linear RGB, scaled by 1/2.52 and clamped at 0.
-pub fn wavelength(lambda_nm: f32, space: &SceneLinear) -> Vec3 {
+pub fn wavelength(lambda_nm: f32, space: &SceneLinear) -> V3 {
     let rgb = mat3_mul(&space.xyz_to_rgb, wavelength_xyz(lambda_nm));
     rgb.map(|c| max_c(c * (1.0 / 2.52), 0.0))
 }

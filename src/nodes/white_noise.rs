@@ -9,7 +9,7 @@
 //! the previous code). Hashes that share their inputs share work: `hash_float4_to_float`
 //! of (k, 1) and (k, 2) differ only after lookup3's `mix`, which runs once.
 
-use super::math::Vec3;
+use super::math::V3;
 
 /// Bob Jenkins' lookup3 (`final` and `mix`, the constants of Blender's `BLI_hash`); the
 /// Perlin noise hashes its lattice corners with it too.
@@ -148,7 +148,7 @@ pub fn hash_f2_to_f1(k: [f32; 2]) -> f32 {
 }
 /// `hash_float3_to_float`.
 #[inline(always)]
-pub fn hash_f3_to_f1(k: Vec3) -> f32 {
+pub fn hash_f3_to_f1(k: V3) -> f32 {
     let [x, y, z] = bits(k);
     unit(lookup3::hash3(x, y, z))
 }
@@ -160,7 +160,7 @@ pub fn hash_f4_to_f1(k: [f32; 4]) -> f32 {
 }
 
 #[inline(always)]
-pub fn hash_f1_to_f3(k: f32) -> Vec3 {
+pub fn hash_f1_to_f3(k: f32) -> V3 {
     let x = k.to_bits();
     [
         unit(lookup3::hash1(x)),
@@ -177,7 +177,7 @@ pub fn hash_f2_to_f2(k: [f32; 2]) -> [f32; 2] {
     ]
 }
 #[inline(always)]
-pub fn hash_f2_to_f3(k: [f32; 2]) -> Vec3 {
+pub fn hash_f2_to_f3(k: [f32; 2]) -> V3 {
     let [x, y] = bits(k);
     [
         unit(lookup3::hash2(x, y)),
@@ -186,7 +186,7 @@ pub fn hash_f2_to_f3(k: [f32; 2]) -> Vec3 {
     ]
 }
 #[inline(always)]
-pub fn hash_f3_to_f3(k: Vec3) -> Vec3 {
+pub fn hash_f3_to_f3(k: V3) -> V3 {
     let [x, y, z] = bits(k);
     let head = lookup3::hash4_head(x, y, z);
     [
@@ -207,7 +207,7 @@ pub fn hash_f4_to_f4(k: [f32; 4]) -> [f32; 4] {
     ]
 }
 #[inline(always)]
-pub fn hash_f4_to_f3(k: [f32; 4]) -> Vec3 {
+pub fn hash_f4_to_f3(k: [f32; 4]) -> V3 {
     let [x, y, z, w] = bits(k);
     let h = lookup3::hash4;
     [
@@ -219,7 +219,7 @@ pub fn hash_f4_to_f3(k: [f32; 4]) -> Vec3 {
 
 /// The White Noise Texture node: (Value, Color) for `dimensions` 1-4 (`vector` for 2-4,
 /// `w` for 1 and 4).
-pub fn white_noise(dimensions: u8, vector: Vec3, w: f32) -> (f32, Vec3) {
+pub fn white_noise(dimensions: u8, vector: V3, w: f32) -> (f32, V3) {
     let [x, y, z] = vector;
     match dimensions {
         1 => (hash_f1_to_f1(w), hash_f1_to_f3(w)),

@@ -4,7 +4,7 @@
 
 use std::path::Path;
 
-use crate::nodes::math::{normalize3, Vec3};
+use crate::foundation::math::{Vec3, V3};
 use crate::scene::{AttributeData, Scene};
 
 use crate::shader::bump::{
@@ -81,7 +81,7 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
     // custom normals (then its corner normals).
     let vertex_normals = crate::shader::tangent::vertex_normals(&mesh);
     let custom = mesh.attribute("custom_normal").is_some();
-    let smooth_normal = |c: usize| -> Vec3 {
+    let smooth_normal = |c: usize| -> V3 {
         if custom {
             mesh.corner_normals
                 .get(c)
@@ -207,7 +207,7 @@ pub fn bake_emission(scene: &Scene, opts: &BakeOptions) -> Result<Baked, String>
                     continue;
                 }
                 let w = [w0, w1, w2];
-                let lerp = |v: [Vec3; 3]| -> Vec3 {
+                let lerp = |v: [V3; 3]| -> V3 {
                     std::array::from_fn(|k| w[0] * v[0][k] + w[1] * v[1][k] + w[2] * v[2][k])
                 };
                 let local = lerp(c.map(|c| mesh.positions[mesh.corner_verts[c] as usize]));
@@ -278,13 +278,13 @@ fn edge(a: [f32; 2], b: [f32; 2], p: [f32; 2]) -> f32 {
     (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])
 }
 
-fn transform_point(m: &[[f64; 4]; 4], p: Vec3) -> Vec3 {
+fn transform_point(m: &[[f64; 4]; 4], p: V3) -> V3 {
     std::array::from_fn(|r| {
         (m[r][0] * p[0] as f64 + m[r][1] * p[1] as f64 + m[r][2] * p[2] as f64 + m[r][3]) as f32
     })
 }
 
-fn mul3x3(m: &[[f64; 3]; 3], v: Vec3) -> Vec3 {
+fn mul3x3(m: &[[f64; 3]; 3], v: V3) -> V3 {
     std::array::from_fn(|r| {
         (m[r][0] * v[0] as f64 + m[r][1] * v[1] as f64 + m[r][2] * v[2] as f64) as f32
     })
@@ -308,7 +308,7 @@ pub fn write_exr(b: &Baked, path: &Path) -> Result<(), String> {
 }
 
 /// The transpose of the 3x3 part of `m` times `v` (world to object for normals).
-fn mul3x3_transposed(m: &[[f64; 4]; 4], v: Vec3) -> Vec3 {
+fn mul3x3_transposed(m: &[[f64; 4]; 4], v: V3) -> V3 {
     std::array::from_fn(|c| {
         (m[0][c] * v[0] as f64 + m[1][c] * v[1] as f64 + m[2][c] * v[2] as f64) as f32
     })
@@ -319,10 +319,10 @@ fn mul3x3_transposed(m: &[[f64; 4]; 4], v: Vec3) -> Vec3 {
 /// the world-space triangle, compacted to one radius (init_from_bake.h) and expanded again
 /// around the geometric normal when shading, as every Cycles shading point is.
 struct TriangleDifferentials {
-    ng: Vec3,
-    dp: [Vec3; 2],
-    generated: [Vec3; 2],
-    uv: [Vec3; 2],
+    ng: V3,
+    dp: [V3; 2],
+    generated: [V3; 2],
+    uv: [V3; 2],
 }
 
 impl TriangleDifferentials {
@@ -330,14 +330,16 @@ impl TriangleDifferentials {
         world: &[[f64; 4]; 4],
         uv: [[f32; 2]; 3],
         size: u32,
-        local: [Vec3; 3],
+        local: [V3; 3],
         tex_loc: [f64; 3],
         tex_size: [f64; 3],
     ) -> Self {
         let p = local.map(|l| transform_point(world, l));
-        let sub = |a: Vec3, b: Vec3| -> Vec3 { [a[0] - b[0], a[1] - b[1], a[2] - b[2]] };
-        let (dpdu, dpdv) = (sub(p[1], p[0]), sub(p[2], p[0]));
-        let ng = normalize3(crate::nodes::math::cross3(dpdu, dpdv));
+        let ng = flat_normal(p);
+        let (dpdu, dpdv): (V3, V3) = (
+            (Vec3::from(p[1]) - p[0].into()).into(),
+            (Vec3::from(p[2]) - p[0].into()).into(),
+        );
         // Blender's rasteriser coordinates (texel centres at integers).
         let v = uv.map(|t| {
             [
@@ -360,9 +362,8 @@ impl TriangleDifferentials {
         };
         // Blender weighs (corner 0, 1, 2) by (u, v, 1-u-v); Cycles by (1-u-v, u, v).
         let (cu_dx, cv_dx, cu_dy, cv_dy) = (dv_dx, -du_dx - dv_dx, dv_dy, -du_dy - dv_dy);
-        let lin = |a: Vec3, s: f32, b: Vec3, t: f32| -> Vec3 {
-            std::array::from_fn(|k| a[k] * s + b[k] * t)
-        };
+        let lin =
+            |a: V3, s: f32, b: V3, t: f32| -> V3 { std::array::from_fn(|k| a[k] * s + b[k] * t) };
         let full = [lin(dpdu, cu_dx, dpdv, cv_dx), lin(dpdu, cu_dy, dpdv, cv_dy)];
         let (dx, dy) = differential_from_compact(ng, differential_make_compact(full[0], full[1]));
         let duv = differential_dudv(dpdu, dpdv, [dx, dy], ng);
@@ -408,23 +409,17 @@ fn bake_context(
     mut sp: ShadingPoint,
     view: &crate::shader::view::View,
     object: crate::shader::point::ObjectInfo,
-    tri: [Vec3; 3],
+    tri: [V3; 3],
     w: [f32; 3],
 ) -> ShadingPoint {
-    let e1: Vec3 = std::array::from_fn(|k| tri[1][k] - tri[0][k]);
-    let e2: Vec3 = std::array::from_fn(|k| tri[2][k] - tri[0][k]);
-    let ng = normalize3([
-        e1[1] * e2[2] - e1[2] * e2[1],
-        e1[2] * e2[0] - e1[0] * e2[2],
-        e1[0] * e2[1] - e1[1] * e2[0],
-    ]);
+    let ng = Vec3::from(flat_normal(tri));
     sp.incoming = sp.normal;
-    sp.backfacing = ng[0] * sp.incoming[0] + ng[1] * sp.incoming[1] + ng[2] * sp.incoming[2] < 0.0;
+    sp.backfacing = ng.dot(sp.incoming.into()) < 0.0;
     if sp.backfacing {
-        sp.true_normal = ng.map(|x| -x);
-        sp.normal = sp.normal.map(|x| -x);
+        sp.true_normal = (-ng).into();
+        sp.normal = (-Vec3::from(sp.normal)).into();
     } else {
-        sp.true_normal = ng;
+        sp.true_normal = ng.into();
     }
     // Cycles' (u, v) are the weights of the triangle's second and third corners.
     sp.parametric = [w[1], w[2]];
@@ -439,10 +434,15 @@ fn bake_context(
 }
 
 /// The unit normal of a triangle (corners counter-clockwise).
-fn flat_normal(p: [Vec3; 3]) -> Vec3 {
-    let e1: Vec3 = std::array::from_fn(|k| p[1][k] - p[0][k]);
-    let e2: Vec3 = std::array::from_fn(|k| p[2][k] - p[0][k]);
-    normalize3(crate::nodes::math::cross3(e1, e2))
+fn flat_normal(p: [V3; 3]) -> V3 {
+    let p = p.map(Vec3::from);
+    normalize3((p[1] - p[0]).cross(p[2] - p[0]).into())
+}
+
+/// Cycles' `normalize`: each component divided by the length (NaN for a zero vector).
+fn normalize3(v: V3) -> V3 {
+    let v = Vec3::from(v);
+    (v / v.length()).into()
 }
 
 /// The scene camera's view at the scene's current frame and render resolution, for an

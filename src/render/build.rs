@@ -898,7 +898,7 @@ fn push_grid_volume(
         materials,
         uv_name: None,
         default_color: None,
-        texspace: Some((scale(add(lo, hi), 0.5), scale(sub(hi, lo), 0.5))),
+        texspace: Some(centre_and_half(lo, hi)),
     };
     // Cycles' volume mesh bounds the active voxels dilated by the interpolation's reach
     // (1 voxel linear, 2 cubic; GeometryManager::create_volume_mesh): two voxels of the
@@ -911,7 +911,10 @@ fn push_grid_volume(
         oi,
         obj,
         &info,
-        Arc::new(box_mesh(sub(lo, pad), add(hi, pad))),
+        Arc::new(box_mesh(
+            (Vec3::from(lo) - pad.into()).into(),
+            (Vec3::from(hi) + pad.into()).into(),
+        )),
         to_world,
         None,
     )?;
@@ -1179,8 +1182,9 @@ fn push_prims(
             a = vmin(a, [k[0], k[1], k[2]]);
             b = vmax(b, [k[0], k[1], k[2]]);
         }
-        inst.tex_loc = scale(add(a, b), 0.5);
-        inst.tex_size = scale(sub(b, a), 0.5).map(|x| if x > 0.0 { x } else { 1.0 });
+        let (loc, half) = centre_and_half(a, b);
+        inst.tex_loc = loc;
+        inst.tex_size = half.map(|x| if x > 0.0 { x } else { 1.0 });
     }
     inst.curves = Some(Arc::new(prims));
     instances.push(inst);
@@ -1240,10 +1244,10 @@ fn new_instance(
     // The exported texture space for plain meshes; the bounds for generated geometry.
     let (tex_loc, tex_size) = match info.texspace {
         Some(t) => t,
-        None => (
-            scale(add(lo, hi), 0.5),
-            scale(sub(hi, lo), 0.5).map(|x| if x == 0.0 { 1.0 } else { x }),
-        ),
+        None => {
+            let (loc, half) = centre_and_half(lo, hi);
+            (loc, half.map(|x| if x == 0.0 { 1.0 } else { x }))
+        }
     };
     Ok(MeshInstance {
         object: oi,
@@ -1393,6 +1397,12 @@ pub fn bind_attributes(
         inst.attributes = per_slot;
     }
     Ok(())
+}
+
+/// The centre and half size of the box `lo`..`hi` (a texture space).
+fn centre_and_half(lo: V3, hi: V3) -> (V3, V3) {
+    let (lo, hi) = (Vec3::from(lo), Vec3::from(hi));
+    (((lo + hi) * 0.5).into(), ((hi - lo) * 0.5).into())
 }
 
 #[cfg(test)]

@@ -44,7 +44,8 @@ pub fn apply(geo: &mut Geometry, materials: &[Material]) -> usize {
             // otherwise, so the other holders keep the undisplaced mesh.
             let mesh = Arc::make_mut(&mut inst.mesh);
             for (v, d) in offsets {
-                mesh.positions[v as usize] = add(mesh.positions[v as usize], d);
+                let p = &mut mesh.positions[v as usize];
+                *p = (Vec3::from(*p) + d.into()).into();
             }
             if recompute.iter().any(|&r| r) {
                 recompute_normals(mesh, &recompute);
@@ -143,15 +144,18 @@ fn vertex_point(
     let local = m.positions[v];
     let world = inst.to_world.point(local);
     let wv = tri.map(|c| {
-        inst.to_world
-            .point(m.positions[m.corner_verts[c as usize] as usize])
+        Vec3::from(
+            inst.to_world
+                .point(m.positions[m.corner_verts[c as usize] as usize]),
+        )
     });
-    let ng = normalize(cross(sub(wv[1], wv[0]), sub(wv[2], wv[0])));
-    let n_obj = normalize(vertex_normals[v]);
-    let mut n = normalize(Affine::normal_by_inverse(&inst.to_object, n_obj));
-    if !n.iter().all(|x| x.is_finite()) || is_zero(n) {
-        n = ng;
+    let ng: V3 = (wv[1] - wv[0]).cross(wv[2] - wv[0]).normalize().into();
+    let n_obj: V3 = Vec3::from(vertex_normals[v]).normalize().into();
+    let mut n = Vec3::from(Affine::normal_by_inverse(&inst.to_object, n_obj)).normalize();
+    if !n.is_finite() || n.is_zero() {
+        n = ng.into();
     }
+    let n: V3 = n.into();
     let mut sp = ShadingPoint {
         position: world,
         normal: n,
@@ -178,14 +182,14 @@ fn vertex_point(
 /// as Cycles' compute_vertex_normals (unit triangle normals summed per vertex); flat
 /// faces take their triangle's normal.
 fn recompute_normals(m: &mut MeshData, recompute: &[bool]) {
-    let mut acc = vec![[0.0f32; 3]; m.vertex_count()];
+    let mut acc = vec![Vec3::ZERO; m.vertex_count()];
     let tri_normal = |m: &MeshData, tri: &[u32; 3]| {
-        let p = tri.map(|c| m.positions[m.corner_verts[c as usize] as usize]);
-        let n = cross(sub(p[1], p[0]), sub(p[2], p[0]));
-        if is_zero(n) {
-            [1.0, 0.0, 0.0]
+        let p = tri.map(|c| Vec3::from(m.positions[m.corner_verts[c as usize] as usize]));
+        let n = (p[1] - p[0]).cross(p[2] - p[0]);
+        if n.is_zero() {
+            Vec3::X
         } else {
-            normalize(n)
+            n.normalize()
         }
     };
     for (t, tri) in m.triangles.iter().enumerate() {
@@ -193,7 +197,7 @@ fn recompute_normals(m: &mut MeshData, recompute: &[bool]) {
             let n = tri_normal(m, tri);
             for &c in tri {
                 let v = m.corner_verts[c as usize] as usize;
-                acc[v] = add(acc[v], n);
+                acc[v] += n;
             }
         }
     }
@@ -216,7 +220,8 @@ fn recompute_normals(m: &mut MeshData, recompute: &[bool]) {
         let fno = tri_normal(m, &tri);
         for &c in &tri {
             let v = m.corner_verts[c as usize] as usize;
-            m.corner_normals[c as usize] = if is_flat { fno } else { normalize(acc[v]) };
+            let n = if is_flat { fno } else { acc[v].normalize() };
+            m.corner_normals[c as usize] = n.into();
         }
     }
 }

@@ -506,10 +506,13 @@ fn render_frame_here(
                                     *a += v;
                                 }
                                 let f = &scratch.features;
-                                tile.passes.feature_normal[k - 1] =
-                                    add(tile.passes.feature_normal[k - 1], f.normal);
-                                tile.passes.feature_albedo[k - 1] =
-                                    add(tile.passes.feature_albedo[k - 1], f.albedo);
+                                let sum = |a: V3, b: V3| (Vec3::from(a) + b.into()).into();
+                                let (n, a) = (
+                                    &mut tile.passes.feature_normal[k - 1],
+                                    &mut tile.passes.feature_albedo[k - 1],
+                                );
+                                *n = sum(*n, f.normal);
+                                *a = sum(*a, f.albedo);
                             }
                         }
                     }
@@ -618,8 +621,8 @@ fn render_frame_here(
                 passes.normal[i] = p.normal[k];
                 // The guides average the pixel's samples, as Cycles' passes do.
                 let inv = 1.0 / passes.sample_count[i].max(1) as f32;
-                passes.albedo[i] = scale(p.feature_albedo[k], inv);
-                passes.denoise_normal[i] = scale(p.feature_normal[k], inv);
+                passes.albedo[i] = (Vec3::from(p.feature_albedo[k]) * inv).into();
+                passes.denoise_normal[i] = (Vec3::from(p.feature_normal[k]) * inv).into();
                 passes.uv[i] = p.uv[k];
                 passes.hits[i] = p.hits[k];
                 // AOVs: the samples' sum over the pixel's sample count, as Cycles reads
@@ -893,7 +896,7 @@ fn light_select(
                 spot,
                 sphere,
             } => {
-                let r = [*radius; 3];
+                let r = Vec3::splat(*radius);
                 let (cone, spot_smooth) = match spot {
                     None => (
                         Cone {
@@ -905,7 +908,7 @@ fn light_select(
                     ),
                     Some(s) => {
                         // Cycles widens the cone by the light's scale (its axes).
-                        let (lu, lv, lw) = (len(s.u), len(s.v), len(s.w));
+                        let (lu, lv, lw) = (s.u.length(), s.v.length(), s.w.length());
                         let stretch = if lu > 0.0 && lv > 0.0 {
                             lw / lu.min(lv)
                         } else {
@@ -922,7 +925,7 @@ fn light_select(
                         )
                     }
                 };
-                let measure = Measure::new(&[sub(l.pos, r), add(l.pos, r)], cone, l.tree_energy);
+                let measure = Measure::new(&[l.pos - r, l.pos + r], cone, l.tree_energy);
                 local.push(Emitter {
                     pick,
                     shape: Shape::Point {
@@ -936,12 +939,12 @@ fn light_select(
                 });
             }
             light::Shape::Area { u, v, .. } => {
-                let (hu, hv) = (scale(*u, 0.5), scale(*v, 0.5));
+                let (hu, hv) = (*u * 0.5, *v * 0.5);
                 let corners = [
-                    add(add(l.pos, hu), hv),
-                    sub(add(l.pos, hu), hv),
-                    add(sub(l.pos, hu), hv),
-                    sub(sub(l.pos, hu), hv),
+                    l.pos + hu + hv,
+                    l.pos + hu - hv,
+                    l.pos - hu + hv,
+                    l.pos - hu - hv,
                 ];
                 let measure = Measure::new(
                     &corners,
@@ -988,7 +991,7 @@ fn light_select(
             let measure = Measure::new(
                 &[],
                 Cone {
-                    axis: [0.0, 0.0, 1.0],
+                    axis: Vec3::Z,
                     theta_o: PI,
                     theta_e: 0.0,
                 },
@@ -997,7 +1000,7 @@ fn light_select(
             distant.push(Emitter {
                 pick: Some(Pick::World),
                 shape: Shape::World,
-                centroid: [0.0; 3],
+                centroid: Vec3::ZERO,
                 measure,
             });
             flat_lights.push(Pick::World);
@@ -1028,30 +1031,30 @@ fn light_select(
         let Some(estimate) = sampled[mi] else {
             continue;
         };
-        let v = geo.tris[prim];
-        let n = cross(sub(v[1], v[0]), sub(v[2], v[0]));
-        let area = 0.5 * len(n);
+        let v = geo.tris[prim].map(Vec3::from);
+        let n = (v[1] - v[0]).cross(v[2] - v[0]);
+        let area = 0.5 * n.length();
         if !(area > 0.0) {
             continue;
         }
         let cone = match materials[mi].sampling.as_str() {
             "FRONT" => Cone {
-                axis: normalize(n),
+                axis: n.normalize(),
                 theta_o: 0.0,
                 theta_e: FRAC_PI_2,
             },
             "BACK" => Cone {
-                axis: neg(normalize(n)),
+                axis: -n.normalize(),
                 theta_o: 0.0,
                 theta_e: FRAC_PI_2,
             },
             _ => Cone {
-                axis: normalize(sub(v[0], v[1])),
+                axis: (v[0] - v[1]).normalize(),
                 theta_o: FRAC_PI_2,
                 theta_e: FRAC_PI_2,
             },
         };
-        let centroid = scale(add(add(v[0], v[1]), v[2]), 1.0 / 3.0);
+        let centroid = (v[0] + v[1] + v[2]) * (1.0 / 3.0);
         let e = Emitter {
             pick: Some(light::tree::Pick::Triangle(prim as u32)),
             shape: Shape::Triangle { v },
@@ -1146,7 +1149,7 @@ fn primary_passes(
         accel::visibility::of_path(crate::shader::point::ray::CAMERA),
     ) {
         Some(h) => {
-            let wo = neg(d);
+            let wo = (-Vec3::from(d)).into();
             let hit = tracer.surface(h.prim, h.u, h.v, wo);
             tracer.shade(&hit, wo, scratch);
             let inst = &tracer.geo.instances[hit.inst as usize];

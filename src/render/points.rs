@@ -53,13 +53,14 @@ pub fn object_points(points: &[[f32; 4]], to_world: &Affine) -> ObjectCurves {
 /// radius) within [tmin, tmax], front faces only. The hit's (u, v) carry the unit normal
 /// at it as polar and azimuth angles (`normal_of`), since shading gets no ray.
 pub fn sphere_intersect(org: V3, dir: V3, tmin: f32, tmax: f32, p: [f32; 4]) -> Option<RibbonHit> {
-    let center = [p[0], p[1], p[2]];
+    let (org, dir) = (Vec3::from(org), Vec3::from(dir));
+    let center = vec3(p[0], p[1], p[2]);
     let r2 = p[3] * p[3];
-    let rd2 = 1.0 / dot(dir, dir);
-    let c0 = sub(center, org);
-    let proj = dot(c0, dir) * rd2;
-    let perp = sub(c0, scale(dir, proj));
-    let l2 = dot(perp, perp);
+    let rd2 = 1.0 / dir.dot(dir);
+    let c0 = center - org;
+    let proj = c0.dot(dir) * rd2;
+    let perp = c0 - dir * proj;
+    let l2 = perp.dot(perp);
     if !(l2 <= r2) {
         return None;
     }
@@ -67,13 +68,13 @@ pub fn sphere_intersect(org: V3, dir: V3, tmin: f32, tmax: f32, p: [f32; 4]) -> 
     if !(tmin <= t && t <= tmax) {
         return None;
     }
-    let hit = add(org, scale(dir, t));
-    let n = sub(hit, center);
-    let n = if is_zero(n) { neg(dir) } else { normalize(n) };
+    let hit = org + dir * t;
+    let n = hit - center;
+    let n = if n.is_zero() { -dir } else { n.normalize() };
     Some(RibbonHit {
         t,
-        u: n[2].clamp(-1.0, 1.0).acos(),
-        v: n[1].atan2(n[0]),
+        u: n.z.clamp(-1.0, 1.0).acos(),
+        v: n.y.atan2(n.x),
     })
 }
 
@@ -88,9 +89,10 @@ pub fn ellipsoid_intersect(
     tmax: f32,
     p: &[[f32; 4]; 4],
 ) -> Option<RibbonHit> {
-    let inv = |v: V3| std::array::from_fn(|i| dot([p[i + 1][0], p[i + 1][1], p[i + 1][2]], v));
-    let o = inv(sub(org, [p[0][0], p[0][1], p[0][2]]));
-    sphere_intersect(o, inv(dir), tmin, tmax, [0.0, 0.0, 0.0, p[0][3]])
+    let row = |i: usize| vec3(p[i][0], p[i][1], p[i][2]);
+    let inv = |v: Vec3| [row(1).dot(v), row(2).dot(v), row(3).dot(v)];
+    let o = inv(Vec3::from(org) - row(0));
+    sphere_intersect(o, inv(dir.into()), tmin, tmax, [0.0, 0.0, 0.0, p[0][3]])
 }
 
 /// The inverse of `m` whose determinant is `det` (zero when `det` is zero: a flattened
@@ -116,17 +118,22 @@ fn inverse3(m: &[[f32; 3]; 3], det: f32) -> [[f32; 3]; 3] {
 /// ellipsoid's surface normal).
 pub fn point_hit(c: &ObjectCurves, point: usize, u: f32, v: f32) -> (V3, V3) {
     let k = c.keys[point];
-    let center = [k[0], k[1], k[2]];
-    let n = normal_of(u, v);
-    match &c.ellipsoid {
-        None => (add(center, scale(n, k[3])), n),
+    let center = vec3(k[0], k[1], k[2]);
+    let n = Vec3::from(normal_of(u, v));
+    let (p, n) = match &c.ellipsoid {
+        None => (center + n * k[3], n),
         Some((m, _)) => {
-            let local = scale(n, k[3]);
-            let off: V3 = std::array::from_fn(|i| dot(m[i], local));
-            let n = if is_zero(off) { n } else { normalize(off) };
-            (add(center, off), n)
+            let local = n * k[3];
+            let off = vec3(
+                Vec3::from(m[0]).dot(local),
+                Vec3::from(m[1]).dot(local),
+                Vec3::from(m[2]).dot(local),
+            );
+            let n = if off.is_zero() { n } else { off.normalize() };
+            (center + off, n)
         }
-    }
+    };
+    (p.into(), n.into())
 }
 
 /// What Point Info > Radius reads for `point`: its radius, or on an ellipsoid the length
@@ -137,8 +144,9 @@ pub fn point_radius(c: &ObjectCurves, point: usize) -> f32 {
     match &c.ellipsoid {
         None => r,
         Some((m, _)) => {
-            let d = [r * (1.0 / 3f32.sqrt()); 3];
-            len(std::array::from_fn(|i| dot(m[i], d)))
+            let d = Vec3::splat(r * (1.0 / 3f32.sqrt()));
+            let row = |i: usize| Vec3::from(m[i]).dot(d);
+            vec3(row(0), row(1), row(2)).length()
         }
     }
 }
@@ -215,15 +223,14 @@ pub fn check(
 /// Whether `t`'s linear part is a rotation times one scale (columns of one length, at
 /// right angles), to a relative 1e-5.
 pub fn similarity(t: &Affine) -> bool {
-    let col = |j: usize| [t.m[0][j], t.m[1][j], t.m[2][j]];
-    let c = [col(0), col(1), col(2)];
-    let s = dot(c[0], c[0]);
+    let c = [t.column_vec3(0), t.column_vec3(1), t.column_vec3(2)];
+    let s = c[0].dot(c[0]);
     let eps = 1e-5 * s;
-    (dot(c[1], c[1]) - s).abs() <= eps
-        && (dot(c[2], c[2]) - s).abs() <= eps
-        && dot(c[0], c[1]).abs() <= eps
-        && dot(c[0], c[2]).abs() <= eps
-        && dot(c[1], c[2]).abs() <= eps
+    (c[1].dot(c[1]) - s).abs() <= eps
+        && (c[2].dot(c[2]) - s).abs() <= eps
+        && c[0].dot(c[1]).abs() <= eps
+        && c[0].dot(c[2]).abs() <= eps
+        && c[1].dot(c[2]).abs() <= eps
 }
 
 #[cfg(test)]
@@ -267,12 +274,15 @@ mod tests {
         let h = ellipsoid_intersect([1.0, 0.0, 5.0], [0.0, 0.0, -1.0], 0.0, 100.0, &p).unwrap();
         assert!((h.t - 4.95).abs() < 1e-5, "{h:?}");
         let (q, n) = point_hit(&c, 0, h.u, h.v);
-        assert!(len(sub(q, [1.0, 0.0, 0.05])) < 1e-5 && (n[2] - 1.0).abs() < 1e-5);
+        assert!(
+            (Vec3::from(q) - vec3(1.0, 0.0, 0.05)).length() < 1e-5 && (n[2] - 1.0).abs() < 1e-5
+        );
         // Off the axes the normal points from the centre, not across the surface.
         let h = ellipsoid_intersect([1.1, 0.0, 5.0], [0.0, 0.0, -1.0], 0.0, 100.0, &p).unwrap();
         let (q, n) = point_hit(&c, 0, h.u, h.v);
         assert!(
-            (q[0] - 1.1).abs() < 1e-5 && len(sub(n, normalize(sub(q, [1.0, 0.0, 0.0])))) < 1e-5
+            (q[0] - 1.1).abs() < 1e-5
+                && (Vec3::from(n) - (Vec3::from(q) - Vec3::X).normalize()).length() < 1e-5
         );
         let (lo, hi) = c.segment_bounds(0);
         assert!((hi[0] - 1.2).abs() < 1e-6 && (lo[2] + 0.05).abs() < 1e-6);

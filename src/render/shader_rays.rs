@@ -10,7 +10,6 @@ use std::sync::OnceLock;
 
 use crate::foundation::bvh::{Accel, Bvh};
 
-use crate::nodes::math::Vec3;
 use crate::shader::trace::Trace;
 use crate::shader::ShadingPoint;
 
@@ -156,19 +155,20 @@ impl Trace for ShaderRays<'_, '_> {
     fn ambient_occlusion(
         &self,
         sp: &ShadingPoint,
-        n: Vec3,
+        n: V3,
         max_dist: f32,
         samples: u32,
         only_local: bool,
     ) -> f32 {
-        let (t, b) = basis(n);
+        let n = Vec3::from(n);
+        let (t, b) = n.basis();
         let mut unoccluded = 0u32;
         for k in 0..samples {
             let u = self.sample(k, samples, self.set);
             // Cosine-weighted about n: a uniform disk point lifted to the hemisphere.
             let d = super::camera::concentric_disk([u[0], u[1]]);
             let z = (1.0 - d[0] * d[0] - d[1] * d[1]).max(0.0).sqrt();
-            let dir = normalize(add(add(scale(t, d[0]), scale(b, d[1])), scale(n, z)));
+            let dir: V3 = (t * d[0] + b * d[1] + n * z).normalize().into();
             // Off the shaded triangle on the ray's side (Cycles skips its own primitive).
             let o = offset_origin(sp.position, self.hit.ng, dir);
             let blocked = if only_local {
@@ -191,11 +191,11 @@ impl Trace for ShaderRays<'_, '_> {
         unoccluded as f32 / samples as f32
     }
 
-    fn bevel(&self, sp: &ShadingPoint, radius: f32, samples: u32) -> Vec3 {
+    fn bevel(&self, sp: &ShadingPoint, radius: f32, samples: u32) -> V3 {
         if self.min_ray_pdf < BEVEL_MIN_RAY_PDF {
             return sp.normal;
         }
-        let mut sum = [0.0f32; 3];
+        let mut sum = Vec3::ZERO;
         for k in 0..samples {
             let u = self.sample(k, samples, self.set ^ BEVEL_SET);
             let (xi_axis, xi_r) = (u[0], u[1]);
@@ -203,7 +203,7 @@ impl Trace for ShaderRays<'_, '_> {
             let (axis, xi_phi) = ProbeAxis::pick(self.hit.ng, xi_axis);
             let (disk_r, height) = cubic_sample(radius, xi_r);
             let o = axis.origin(sp.position, xi_phi, disk_r, height);
-            let dir = neg(axis.n);
+            let dir: V3 = (-Vec3::from(axis.n)).into();
             let tmax = 2.0 * height;
             // Every hit on the shaded object along the probe; a uniformly random subset
             // of LOCAL_MAX_HITS kept (reservoir sampling, as Cycles' local intersection).
@@ -231,16 +231,17 @@ impl Trace for ShaderRays<'_, '_> {
             let n_kept = (found as usize).min(LOCAL_MAX_HITS);
             let disk_pdf = cubic_pdf(radius, disk_r);
             for h in &kept[..n_kept] {
-                let s = self
-                    .scene
-                    .surface_at(h.prim, h.u, h.v, neg(dir), self.hit.time);
+                let s = self.scene.surface_at(
+                    h.prim,
+                    h.u,
+                    h.v,
+                    (-Vec3::from(dir)).into(),
+                    self.hit.time,
+                );
                 // The hit's own normals, not turned toward the probe.
-                let (ng, n) = if s.backfacing {
-                    (neg(s.ng), neg(s.sp.normal))
-                } else {
-                    (s.ng, s.sp.normal)
-                };
-                let (pn, denom) = axis.mis(ng);
+                let (ng, n) = (Vec3::from(s.ng), Vec3::from(s.sp.normal));
+                let (ng, n) = if s.backfacing { (-ng, -n) } else { (ng, n) };
+                let (pn, denom) = axis.mis(ng.into());
                 if !(denom > 0.0) || !(disk_pdf > 0.0) {
                     continue;
                 }
@@ -248,20 +249,20 @@ impl Trace for ShaderRays<'_, '_> {
                 if found as usize > LOCAL_MAX_HITS {
                     w *= found as f32 / LOCAL_MAX_HITS as f32;
                 }
-                let r = len(sub(s.p, sp.position));
+                let r = (Vec3::from(s.p) - sp.position.into()).length();
                 w *= cubic_pdf(radius, r) / disk_pdf;
-                sum = madd(sum, n, w);
+                sum += n * w;
             }
         }
-        let l = len(sum);
+        let l = sum.length();
         if !(l > 0.0) || !l.is_finite() {
             return sp.normal;
         }
-        let n = scale(sum, 1.0 / l);
+        let n = sum * (1.0 / l);
         if self.hit.backfacing {
-            neg(n)
+            (-n).into()
         } else {
-            n
+            n.into()
         }
     }
 }

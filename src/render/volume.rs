@@ -1321,7 +1321,7 @@ impl Scene<'_> {
             Pick::Lamp(li) => {
                 let light = &self.lights[li as usize];
                 match light.shape {
-                    super::light::Shape::Area { .. } => (light.pos, light.dir),
+                    super::light::Shape::Area { .. } => (light.pos.into(), light.dir.into()),
                     _ => return Some((tmin, tmax)),
                 }
             }
@@ -1372,7 +1372,7 @@ impl Scene<'_> {
                         light
                             .sample(o, [u[0], u[1]])
                             .filter(|ls| ls.dist.is_finite())
-                            .map_or(light.pos, |ls| madd(o, ls.wi, ls.dist)),
+                            .map_or(light.pos.into(), |ls| madd(o, ls.wi, ls.dist)),
                     ),
                 }
             }

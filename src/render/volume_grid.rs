@@ -141,7 +141,7 @@ fn index_coords(g: &VoxelGrid, p: V3) -> V3 {
 /// object's transform applied to the unit diagonal.
 pub fn object_space_density(to_world: &Affine) -> f32 {
     let d = 1.0 / 3f32.sqrt();
-    let l = len(to_world.vector([d; 3]));
+    let l = to_world.vector_vec3(Vec3::splat(d)).length();
     if l > 0.0 && l.is_finite() {
         1.0 / l
     } else {

@@ -4,7 +4,7 @@
 //! `AttributeRequest`s; whoever shades a mesh binds them once (`BoundAttributes::bind`)
 //! and fills the shading point per hit (`fill`), allocation-free.
 
-use crate::nodes::math::{cross3, normalize3, Vec3};
+use crate::foundation::math::{Vec3, V3};
 use crate::scene::{AttributeData, Domain, MeshData};
 
 use super::point::ShadingPoint;
@@ -70,7 +70,7 @@ enum Values {
     TriangleCorner(Vec<[f32; 4]>),
     /// Smooth faces: corner normals interpolated; flat ones (per face): the triangle normal.
     MapNormal {
-        normals: Vec<Vec3>,
+        normals: Vec<V3>,
         flat: Vec<bool>,
     },
     /// The instance's value of this name (constant over the mesh).
@@ -293,11 +293,12 @@ impl BoundAttributes {
                     .unwrap_or([0.0; 4]),
                 Values::MapNormal { normals, flat } => {
                     if flat.get(face).copied().unwrap_or(false) {
-                        let p = c.map(|c| mesh.positions[mesh.corner_verts[c] as usize]);
-                        let e1 = std::array::from_fn(|k| p[1][k] - p[0][k]);
-                        let e2 = std::array::from_fn(|k| p[2][k] - p[0][k]);
-                        let n = normalize3(cross3(e1, e2));
-                        [n[0], n[1], n[2], 0.0]
+                        let p =
+                            c.map(|c| Vec3::from(mesh.positions[mesh.corner_verts[c] as usize]));
+                        let n = (p[1] - p[0]).cross(p[2] - p[0]);
+                        // Cycles' normalize: a true division by the length.
+                        let n = n / n.length();
+                        [n.x, n.y, n.z, 0.0]
                     } else {
                         let n = lerp(c.map(|c| {
                             let n = normals.get(c).copied().unwrap_or([0.0, 0.0, 1.0]);

@@ -4,9 +4,8 @@
 //! Vector Displacement and Normal Map nodes (`kernel/svm/displace.h`, `tex_coord.h`).
 
 use crate::foundation::math::{
-    transform_direction, transform_direction_transposed, transform_point,
+    transform_direction, transform_direction_transposed, transform_point, Vec3, V3,
 };
-use crate::nodes::math::{add3, cross3, dot3, length3, scale3, sub3, Vec3};
 
 use super::point::ShadingPoint;
 
@@ -35,37 +34,46 @@ impl Default for ObjectTransform {
 
 impl ObjectTransform {
     /// Cycles' object_inverse_position_transform.
-    pub fn inverse_point(&self, p: Vec3) -> Vec3 {
+    pub fn inverse_point(&self, p: V3) -> V3 {
         transform_point(&self.to_object, p)
     }
     /// object_dir_transform / object_inverse_dir_transform.
-    pub fn dir(&self, d: Vec3) -> Vec3 {
+    pub fn dir(&self, d: V3) -> V3 {
         transform_direction(&self.to_world, d)
     }
-    pub fn inverse_dir(&self, d: Vec3) -> Vec3 {
+    pub fn inverse_dir(&self, d: V3) -> V3 {
         transform_direction(&self.to_object, d)
     }
     /// object_normal_transform: world normal from an object-space one.
-    pub fn normal(&self, n: Vec3) -> Vec3 {
+    pub fn normal(&self, n: V3) -> V3 {
         normalize(transform_direction_transposed(&self.to_object, n))
     }
     /// object_inverse_normal_transform: object-space normal from a world one.
-    pub fn inverse_normal(&self, n: Vec3) -> Vec3 {
+    pub fn inverse_normal(&self, n: V3) -> V3 {
         normalize(transform_direction_transposed(&self.to_world, n))
     }
 }
 
-pub fn normalize(v: Vec3) -> Vec3 {
-    let l = length3(v);
-    [v[0] / l, v[1] / l, v[2] / l]
+/// Cycles' `normalize`: each component divided by the length (NaN for a zero vector).
+pub fn normalize(v: V3) -> V3 {
+    normalize_div(v.into()).into()
 }
 
-pub fn safe_normalize(v: Vec3) -> Vec3 {
-    let l = length3(v);
+fn normalize_div(v: Vec3) -> Vec3 {
+    v / v.length()
+}
+
+/// Cycles' `safe_normalize`: as `normalize`, a zero vector giving zero.
+pub fn safe_normalize(v: V3) -> V3 {
+    safe_normalize_div(v.into()).into()
+}
+
+fn safe_normalize_div(v: Vec3) -> Vec3 {
+    let l = v.length();
     if l != 0.0 {
-        [v[0] / l, v[1] / l, v[2] / l]
+        v / l
     } else {
-        [0.0; 3]
+        Vec3::ZERO
     }
 }
 
@@ -81,35 +89,30 @@ fn signf(x: f32) -> f32 {
 /// (1,1,1) x N, or (-1,1,1) x N when N is on the diagonal), which decides the directions
 /// a compact differential expands to. Bump results depend on it to second order.
 pub fn make_orthonormals(n: Vec3) -> (Vec3, Vec3) {
-    let a = if n[0] != n[1] || n[0] != n[2] {
-        [n[2] - n[1], n[0] - n[2], n[1] - n[0]]
+    let a = if n.x != n.y || n.x != n.z {
+        Vec3::new(n.z - n.y, n.x - n.z, n.y - n.x)
     } else {
-        [n[2] - n[1], n[0] + n[2], -n[1] - n[0]]
+        Vec3::new(n.z - n.y, n.x + n.z, -n.y - n.x)
     };
-    let a = normalize(a);
-    (a, cross3(n, a))
+    let a = normalize_div(a);
+    (a, n.cross(a))
 }
 
 /// A compact differential (a radius) as the two vectors Cycles expands it to around `d`.
-pub fn differential_from_compact(d: Vec3, radius: f32) -> (Vec3, Vec3) {
-    let (x, y) = make_orthonormals(d);
-    (scale3(x, radius), scale3(y, radius))
+pub fn differential_from_compact(d: V3, radius: f32) -> (V3, V3) {
+    let (x, y) = make_orthonormals(d.into());
+    ((x * radius).into(), (y * radius).into())
 }
 
 /// Cycles' differential_make_compact: the mean length of the two differentials.
-pub fn differential_make_compact(dx: Vec3, dy: Vec3) -> f32 {
-    0.5 * (length3(dx) + length3(dy))
+pub fn differential_make_compact(dx: V3, dy: V3) -> f32 {
+    0.5 * (Vec3::from(dx).length() + Vec3::from(dy).length())
 }
 
 /// Changes of the barycentric (u, v) of a triangle along `dp` (Cycles' differential_dudv,
 /// Cramer's rule after dropping the axis the normal is largest along). `dpdu`, `dpdv` are
 /// p1 - p0 and p2 - p0 (the point is (1-u-v) p0 + u p1 + v p2).
-pub fn differential_dudv(
-    mut dpdu: Vec3,
-    mut dpdv: Vec3,
-    mut dp: [Vec3; 2],
-    ng: Vec3,
-) -> [[f32; 2]; 2] {
+pub fn differential_dudv(mut dpdu: V3, mut dpdv: V3, mut dp: [V3; 2], ng: V3) -> [[f32; 2]; 2] {
     let (xn, yn, zn) = (ng[0].abs(), ng[1].abs(), ng[2].abs());
     if zn < xn || zn < yn {
         if yn < xn || yn < zn {
@@ -137,11 +140,9 @@ pub fn differential_dudv(
 }
 
 /// The change of a triangle attribute (values at corners `f`) for barycentric changes `d`.
-pub fn attribute_differential(f: [Vec3; 3], d: [f32; 2]) -> Vec3 {
-    add3(
-        scale3(sub3(f[1], f[0]), d[0]),
-        scale3(sub3(f[2], f[0]), d[1]),
-    )
+pub fn attribute_differential(f: [V3; 3], d: [f32; 2]) -> V3 {
+    let f = f.map(Vec3::from);
+    ((f[1] - f[0]) * d[0] + (f[2] - f[0]) * d[1]).into()
 }
 
 /// Which of the three Height evaluations a bump program is running.
@@ -162,10 +163,10 @@ pub fn offset_point(sp: &ShadingPoint, which: BumpPoint, width: f32) -> ShadingP
         BumpPoint::Dy => (sp.dp_dy, sp.generated_dy, sp.uv_dy, 1),
     };
     let mut o = *sp;
-    o.position = add3(sp.position, scale3(dp, width));
+    o.position = moved(sp.position, dp, width);
     o.object_position = sp.transform.inverse_point(o.position);
-    o.generated = add3(sp.generated, scale3(dg, width));
-    o.uv = add3(sp.uv, scale3(duv, width));
+    o.generated = moved(sp.generated, dg, width);
+    o.uv = moved(sp.uv, duv, width);
     // Mesh attributes extrapolated along the triangle, as Cycles' attribute bump nodes do
     // (f + df * width).
     for (a, da) in o.attrs.iter_mut().zip(&sp.attrs_d) {
@@ -197,10 +198,10 @@ pub fn offset_point_into(sp: &mut ShadingPoint, base: &ShadingPoint, which: Bump
         BumpPoint::Dx => (base.dp_dx, base.generated_dx, base.uv_dx, 0),
         BumpPoint::Dy => (base.dp_dy, base.generated_dy, base.uv_dy, 1),
     };
-    sp.position = add3(base.position, scale3(dp, width));
+    sp.position = moved(base.position, dp, width);
     sp.object_position = base.transform.inverse_point(sp.position);
-    sp.generated = add3(base.generated, scale3(dg, width));
-    sp.uv = add3(base.uv, scale3(duv, width));
+    sp.generated = moved(base.generated, dg, width);
+    sp.uv = moved(base.uv, duv, width);
     for ((a, b), da) in sp.attrs.iter_mut().zip(&base.attrs).zip(&base.attrs_d) {
         for k in 0..4 {
             a[k] = b[k] + da[d][k] * width;
@@ -214,6 +215,11 @@ pub fn offset_point_into(sp: &mut ShadingPoint, base: &ShadingPoint, which: Bump
     {
         *f = b + df[d] * width;
     }
+}
+
+/// `p` moved by `width` times the differential `d`.
+fn moved(p: V3, d: V3, width: f32) -> V3 {
+    (Vec3::from(p) + Vec3::from(d) * width).into()
 }
 
 /// The Bump node's settings that are not stack values.
@@ -230,39 +236,38 @@ pub struct BumpSettings {
 pub fn bump_normal(
     sp: &ShadingPoint,
     set: BumpSettings,
-    normal_in: Vec3,
+    normal_in: V3,
     strength: f32,
     distance: f32,
     h_c: f32,
     h_x: f32,
     h_y: f32,
-) -> Vec3 {
+) -> V3 {
     let (mut n, mut dx, mut dy) = (normal_in, sp.dp_dx, sp.dp_dy);
     if set.object_space {
         n = sp.transform.inverse_normal(n);
         dx = sp.transform.inverse_dir(dx);
         dy = sp.transform.inverse_dir(dy);
     }
-    let rx = cross3(dy, n);
-    let ry = cross3(n, dx);
-    let det = dot3(dx, rx);
-    let surfgrad = add3(scale3(rx, h_x - h_c), scale3(ry, h_y - h_c));
+    let (n, dx, dy) = (Vec3::from(n), Vec3::from(dx), Vec3::from(dy));
+    let rx = dy.cross(n);
+    let ry = n.cross(dx);
+    let det = dx.dot(rx);
+    let surfgrad = rx * (h_x - h_c) + ry * (h_y - h_c);
     let absdet = det.abs();
     let scale = if set.invert { -distance } else { distance };
     let strength = strength.max(0.0);
-    let mut out = safe_normalize(sub3(
-        scale3(n, set.filter_width * absdet),
-        scale3(surfgrad, scale * signf(det)),
-    ));
-    if out == [0.0; 3] {
+    let mut out =
+        safe_normalize_div(n * (set.filter_width * absdet) - surfgrad * (scale * signf(det)));
+    if out == Vec3::ZERO {
         out = n;
     } else {
-        out = normalize(add3(scale3(out, strength), scale3(n, 1.0 - strength)));
+        out = normalize_div(out * strength + n * (1.0 - strength));
     }
     if set.object_space {
-        out = sp.transform.normal(out);
+        return sp.transform.normal(out.into());
     }
-    out
+    out.into()
 }
 
 /// Displacement node: the offset along the normal, world or object space.
@@ -272,14 +277,14 @@ pub fn displacement(
     height: f32,
     midlevel: f32,
     scale: f32,
-    normal: Vec3,
-) -> Vec3 {
+    normal: V3,
+) -> V3 {
     let k = (height - midlevel) * scale;
     if object_space {
-        sp.transform
-            .dir(scale3(sp.transform.inverse_normal(normal), k))
+        let n = Vec3::from(sp.transform.inverse_normal(normal));
+        sp.transform.dir((n * k).into())
     } else {
-        scale3(normal, k)
+        (Vec3::from(normal) * k).into()
     }
 }
 
@@ -310,11 +315,11 @@ impl MapSpace {
 pub fn vector_displacement(
     sp: &ShadingPoint,
     space: MapSpace,
-    vector: Vec3,
+    vector: V3,
     midlevel: f32,
     scale: f32,
-) -> Vec3 {
-    let d = scale3(sub3(vector, [midlevel; 3]), scale);
+) -> V3 {
+    let d = ((Vec3::from(vector) - Vec3::splat(midlevel)) * scale).into();
     match space {
         MapSpace::World => d,
         _ => sp.transform.dir(d),
@@ -323,58 +328,45 @@ pub fn vector_displacement(
 
 /// Normal Map in the non-tangent spaces (Cycles' svm_node_normal_map): the colour read as
 /// a normal, then blended toward the shading normal by strength.
-pub fn normal_map(sp: &ShadingPoint, space: MapSpace, color: Vec3, strength: f32) -> Vec3 {
-    let mut c = scale3(sub3(color, [0.5; 3]), 2.0);
+pub fn normal_map(sp: &ShadingPoint, space: MapSpace, color: V3, strength: f32) -> V3 {
+    let mut c = (Vec3::from(color) - Vec3::splat(0.5)) * 2.0;
     if matches!(space, MapSpace::BlenderObject | MapSpace::BlenderWorld) {
-        c[1] = -c[1];
-        c[2] = -c[2];
+        c.y = -c.y;
+        c.z = -c.z;
     }
     let mut n = match space {
-        MapSpace::Object | MapSpace::BlenderObject => sp.transform.normal(c),
-        _ => safe_normalize(c),
+        MapSpace::Object | MapSpace::BlenderObject => sp.transform.normal(c.into()).into(),
+        _ => safe_normalize_div(c),
     };
     // Cycles 4.5 blends by strength before turning the normal to a back face's side.
     if strength != 1.0 {
         let s = strength.max(0.0);
-        n = safe_normalize(add3(sp.normal, scale3(sub3(n, sp.normal), s)));
+        let normal = Vec3::from(sp.normal);
+        n = safe_normalize_div(normal + (n - normal) * s);
     }
     if sp.backfacing {
-        n = scale3(n, -1.0);
+        n *= -1.0;
     }
     // Only a zero normal falls back (is_zero): a NaN from normalising a zero object-space
     // vector stays, as in Cycles, and the closures given it reflect nothing.
-    if n == [0.0; 3] {
-        n = sp.normal;
+    if n == Vec3::ZERO {
+        return sp.normal;
     }
-    n
+    n.into()
 }
 
 /// The normal the displacement bump gives every closure: heights are the displacement
 /// projected on the unperturbed normal (Cycles' bump_from_displacement: distance 1,
 /// strength 1, the Bump node's default filter width).
-pub fn displacement_bump(
-    sp: &ShadingPoint,
-    object_space: bool,
-    d_c: Vec3,
-    d_x: Vec3,
-    d_y: Vec3,
-) -> Vec3 {
+pub fn displacement_bump(sp: &ShadingPoint, object_space: bool, d_c: V3, d_x: V3, d_y: V3) -> V3 {
     let n = sp.normal;
+    let along = |d: V3| Vec3::from(d).dot(n.into());
     let set = BumpSettings {
         invert: false,
         object_space,
         filter_width: DEFAULT_FILTER_WIDTH,
     };
-    bump_normal(
-        sp,
-        set,
-        n,
-        1.0,
-        1.0,
-        dot3(d_c, n),
-        dot3(d_x, n),
-        dot3(d_y, n),
-    )
+    bump_normal(sp, set, n, 1.0, 1.0, along(d_c), along(d_x), along(d_y))
 }
 
 /// Cycles' BumpNode default filter width, used by the displacement bump.

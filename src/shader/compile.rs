@@ -1016,7 +1016,7 @@ pub fn compile_light(
 /// The shading point of the world seen along direction `d`, by a ray in `path` (Light Path
 /// reads it: Cycles evaluates the background with the ray's flags plus Emission).
 pub fn world_point(
-    d: crate::nodes::math::Vec3,
+    d: crate::nodes::math::V3,
     path: super::point::PathState,
 ) -> super::point::ShadingPoint {
     let n = [-d[0], -d[1], -d[2]];

@@ -6,29 +6,29 @@
 
 use std::collections::HashSet;
 
-use crate::nodes::math::{add3, dot3, normalize3, safe_normalize3, scale3, sub3, Vec3};
+use crate::foundation::math::{Vec3, V3};
 use crate::nodes::random::hash_to_float1;
 use crate::scene::MeshData;
 
 /// Cycles' Pointiness per vertex, in 0..1 (0.5 on flat ground, more on ridges).
 /// `vertex_normals` are Blender's vertex normals of `mesh`.
-pub fn pointiness(mesh: &MeshData, vertex_normals: &[Vec3]) -> Vec<f32> {
+pub fn pointiness(mesh: &MeshData, vertex_normals: &[V3]) -> Vec<f32> {
     let n = mesh.vertex_count();
     let pos = &mesh.positions;
     let orig = weld(pos);
     // Welded normals: summed on the kept vertex, normalised and shared, in Cycles' order
     // (a kept vertex earlier in index order is already normalised when a later
     // duplicate reads it).
-    let mut normal = vec![[0.0f32; 3]; n];
+    let pos = |v: usize| Vec3::from(pos[v]);
+    let mut normal = vec![Vec3::ZERO; n];
     for v in 0..n {
         let o = orig[v] as usize;
-        normal[o] = add3(
-            normal[o],
-            vertex_normals.get(v).copied().unwrap_or([0.0; 3]),
-        );
+        normal[o] += vertex_normals.get(v).map_or(Vec3::ZERO, |&n| n.into());
     }
     for v in 0..n {
-        normal[v] = normalize3(normal[orig[v] as usize]);
+        // Cycles' normalize: a true division by the length.
+        let s = normal[orig[v] as usize];
+        normal[v] = s / s.length();
     }
     // Each welded edge once.
     let mut edges = Vec::with_capacity(mesh.edges.len());
@@ -40,19 +40,22 @@ pub fn pointiness(mesh: &MeshData, vertex_normals: &[Vec3]) -> Vec<f32> {
         }
     }
     let mut count = vec![0u32; n];
-    let mut accum = vec![[0.0f32; 3]; n];
+    let mut accum = vec![Vec3::ZERO; n];
     for &(a, b) in &edges {
-        let e = safe_normalize3(sub3(pos[b], pos[a]));
-        accum[a] = add3(accum[a], e);
-        accum[b] = sub3(accum[b], e);
+        // Cycles' safe_normalize, by the reciprocal length (a zero edge stays zero).
+        let d = pos(b) - pos(a);
+        let l = d.length();
+        let e = if l != 0.0 { d * (1.0 / l) } else { d };
+        accum[a] += e;
+        accum[b] -= e;
         count[a] += 1;
         count[b] += 1;
     }
     let mut raw = vec![0.0f32; n];
     for v in 0..n {
         if orig[v] as usize == v && count[v] > 0 {
-            let mean = scale3(accum[v], 1.0 / count[v] as f32);
-            raw[v] = dot3(normal[v], mean).clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI;
+            let mean = accum[v] * (1.0 / count[v] as f32);
+            raw[v] = normal[v].dot(mean).clamp(-1.0, 1.0).acos() * std::f32::consts::FRAC_1_PI;
         }
     }
     // One blur over the one-ring approximates a two-ring neighbourhood.
@@ -74,9 +77,9 @@ pub fn pointiness(mesh: &MeshData, vertex_normals: &[Vec3]) -> Vec<f32> {
 /// coordinate sum, each vertex pointing to the first later one within sqrt(FLT_EPSILON),
 /// chains followed to their end. Exact duplicates sort by descending index, so they
 /// end at the lowest index.
-fn weld(pos: &[Vec3]) -> Vec<u32> {
+fn weld(pos: &[V3]) -> Vec<u32> {
     let n = pos.len();
-    let sum = |p: Vec3| p[0] + p[1] + p[2];
+    let sum = |p: V3| p[0] + p[1] + p[2];
     let mut sorted: Vec<u32> = (0..n as u32).collect();
     sorted.sort_by(|&a, &b| {
         let (pa, pb) = (pos[a as usize], pos[b as usize]);
@@ -99,8 +102,8 @@ fn weld(pos: &[Vec3]) -> Vec<u32> {
             if sum(other) - sum(co) > 3.0 * f32::EPSILON {
                 break;
             }
-            let d = sub3(other, co);
-            if dot3(d, d) < f32::EPSILON {
+            let d = Vec3::from(other) - co.into();
+            if d.dot(d) < f32::EPSILON {
                 orig[v] = o;
                 break;
             }

@@ -2,10 +2,9 @@
 //! svm/geometry.h, camera.h, tex_coord.h, light_path.h, fresnel.h, normal.h,
 //! tangent.h): what each output reads from the `ShadingPoint`.
 
-use crate::foundation::math::{cross, dot, len};
+use crate::foundation::math::{Vec3, V3};
 use crate::nodes::fresnel::{fresnel, layer_weight};
 use crate::nodes::light_falloff::light_falloff;
-use crate::nodes::math::Vec3;
 
 use super::point::{ray, ShadingPoint};
 
@@ -90,27 +89,27 @@ impl Input {
 
 /// Cycles' `normalize`: no guard, a zero vector gives NaNs as it does there.
 fn normalize(v: Vec3) -> Vec3 {
-    let l = dot(v, v).sqrt();
-    [v[0] / l, v[1] / l, v[2] / l]
+    v / v.dot(v).sqrt()
 }
 /// An object-space direction to world space the way Cycles transforms normals
 /// (`object_normal_transform`: by the transposed world-to-object matrix).
-pub fn object_normal_to_world(sp: &ShadingPoint, n: Vec3) -> Vec3 {
+pub fn object_normal_to_world(sp: &ShadingPoint, n: V3) -> V3 {
     let m = &sp.object.world_to_object;
     std::array::from_fn(|c| m[0][c] * n[0] + m[1][c] * n[1] + m[2][c] * n[2])
 }
 
 /// Tangent node, radial mode, around `axis` (0 = X, 1 = Y, 2 = Z) of Generated
 /// coordinates; also Geometry > Tangent (axis Z).
-pub fn radial_tangent(sp: &ShadingPoint, axis: u8) -> Vec3 {
+pub fn radial_tangent(sp: &ShadingPoint, axis: u8) -> V3 {
     let g = sp.generated;
     let t = match axis {
         0 => [0.0, -(g[2] - 0.5), g[1] - 0.5],
         1 => [-(g[2] - 0.5), 0.0, g[0] - 0.5],
         _ => [-(g[1] - 0.5), g[0] - 0.5, 0.0],
     };
-    let t = object_normal_to_world(sp, t);
-    cross(sp.normal, normalize(cross(t, sp.normal)))
+    let t = Vec3::from(object_normal_to_world(sp, t));
+    let n = Vec3::from(sp.normal);
+    n.cross(normalize(t.cross(n))).into()
 }
 
 /// Writes input `what` of `sp` to the stack at `dst` (three slots for a vector).
@@ -119,7 +118,7 @@ pub fn read(what: Input, sp: &ShadingPoint, s: &mut [f32], dst: u32) {
     let d = dst as usize;
     let path = &sp.path;
     let f = |b: bool| if b { 1.0 } else { 0.0 };
-    let v: Vec3 = match what {
+    let v: V3 = match what {
         Input::Position => sp.position,
         Input::Normal => sp.normal,
         Input::Tangent => radial_tangent(sp, 2),
@@ -132,16 +131,12 @@ pub fn read(what: Input, sp: &ShadingPoint, s: &mut [f32], dst: u32) {
         ],
         Input::ObjectLocation => sp.object.location,
         Input::ObjectColor => [sp.object.color[0], sp.object.color[1], sp.object.color[2]],
-        Input::ViewVector => normalize(sp.camera_position),
+        Input::ViewVector => normalize(sp.camera_position.into()).into(),
         Input::Camera => sp.camera_position,
         Input::Window => sp.window,
         Input::Reflection => {
-            let k = 2.0 * dot(sp.normal, sp.incoming);
-            [
-                k * sp.normal[0] - sp.incoming[0],
-                k * sp.normal[1] - sp.incoming[1],
-                k * sp.normal[2] - sp.incoming[2],
-            ]
+            let (n, i) = (Vec3::from(sp.normal), Vec3::from(sp.incoming));
+            (2.0 * n.dot(i) * n - i).into()
         }
         scalar => {
             s[d] = match scalar {
@@ -150,7 +145,7 @@ pub fn read(what: Input, sp: &ShadingPoint, s: &mut [f32], dst: u32) {
                 Input::ObjectIndex => sp.object.pass_index,
                 Input::ObjectRandom => sp.object.random,
                 Input::ViewZDepth => sp.camera_position[2],
-                Input::ViewDistance => len(sp.camera_position),
+                Input::ViewDistance => Vec3::from(sp.camera_position).length(),
                 Input::RayFlag(flag) => f(path.flags & flag != 0),
                 Input::RayLength => sp.ray_length,
                 // Shadow rays and light emission are one bounce further (Cycles).
@@ -171,13 +166,13 @@ pub fn read(what: Input, sp: &ShadingPoint, s: &mut [f32], dst: u32) {
 
 /// Fresnel node; `normal` is the linked Normal input, or the shading normal.
 #[inline]
-pub fn fresnel_node(sp: &ShadingPoint, ior: f32, normal: Option<Vec3>) -> f32 {
+pub fn fresnel_node(sp: &ShadingPoint, ior: f32, normal: Option<V3>) -> f32 {
     fresnel(ior, sp.incoming, normal.unwrap_or(sp.normal), sp.backfacing)
 }
 
 /// Layer Weight node: (Fresnel, Facing).
 #[inline]
-pub fn layer_weight_node(sp: &ShadingPoint, blend: f32, normal: Option<Vec3>) -> (f32, f32) {
+pub fn layer_weight_node(sp: &ShadingPoint, blend: f32, normal: Option<V3>) -> (f32, f32) {
     layer_weight(
         blend,
         sp.incoming,
@@ -194,8 +189,8 @@ pub fn light_falloff_node(sp: &ShadingPoint, strength: f32, smooth: f32) -> [f32
 
 /// Normal node's Dot output: its (normalised) direction against the normalised input.
 #[inline]
-pub fn normal_dot(direction: Vec3, normal: Vec3) -> f32 {
-    dot(direction, normalize(normal))
+pub fn normal_dot(direction: V3, normal: V3) -> f32 {
+    Vec3::from(direction).dot(normalize(normal.into()))
 }
 
 /// Cycles' Wireframe (svm/wireframe.h): 1 where the point lies within half of `size`
@@ -206,10 +201,10 @@ pub fn wireframe_node(sp: &ShadingPoint, size: f32, pixel_size: bool) -> f32 {
     let mut width = 1.0;
     if pixel_size {
         // The position's differentials projected onto the plane facing the ray.
-        let wi = sp.incoming;
-        let across = |d: Vec3| {
-            let k = dot(d, wi);
-            len([d[0] - k * wi[0], d[1] - k * wi[1], d[2] - k * wi[2]])
+        let wi = Vec3::from(sp.incoming);
+        let across = |d: V3| {
+            let d = Vec3::from(d);
+            (d - d.dot(wi) * wi).length()
         };
         width = (across(sp.dp_dx) + across(sp.dp_dy)) * 0.5;
     }
@@ -217,16 +212,12 @@ pub fn wireframe_node(sp: &ShadingPoint, size: f32, pixel_size: bool) -> f32 {
     width *= width;
     for i in 0..3 {
         let i2 = if i > 0 { i - 1 } else { 2 };
-        let p = sp.position;
-        let dir = [p[0] - co[i][0], p[1] - co[i][1], p[2] - co[i][2]];
-        let edge = [
-            co[i][0] - co[i2][0],
-            co[i][1] - co[i2][1],
-            co[i][2] - co[i2][2],
-        ];
-        let c = cross(edge, dir);
+        let p = Vec3::from(sp.position);
+        let dir = p - co[i].into();
+        let edge = Vec3::from(co[i]) - co[i2].into();
+        let c = edge.cross(dir);
         // |c|^2 / |edge|^2 is the squared distance to the edge.
-        if dot(c, c) < dot(edge, edge) * width {
+        if c.dot(c) < edge.dot(edge) * width {
             return 1.0;
         }
     }

@@ -1,6 +1,6 @@
 //! What a shader knows about the surface point it shades.
 
-use crate::nodes::math::Vec3;
+use crate::nodes::math::V3;
 
 use super::bump::ObjectTransform;
 
@@ -8,57 +8,57 @@ use super::bump::ObjectTransform;
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct ShadingPoint {
     /// World-space position and shading normal.
-    pub position: Vec3,
-    pub normal: Vec3,
+    pub position: V3,
+    pub normal: V3,
     /// Object-space position (Texture Coordinate > Object) and normal (> Normal).
-    pub object_position: Vec3,
-    pub object_normal: Vec3,
+    pub object_position: V3,
+    pub object_normal: V3,
     /// Position in the mesh's texture space, 0..1 over its bounds (> Generated).
-    pub generated: Vec3,
+    pub generated: V3,
     /// The active render UV map, with w = 0 (> UV).
-    pub uv: Vec3,
+    pub uv: V3,
     /// Geometric (flat triangle) normal in world space, facing the incoming ray as Cycles'
     /// sd->Ng does; zero when unknown (then bumps use the shading normal's frame).
-    pub ng: Vec3,
+    pub ng: V3,
     /// Ray differentials of the position (world units per pixel), expanded from Cycles'
     /// compact form around `ng`: the Bump node's dx/dy offsets. Zero: no bump.
-    pub dp_dx: Vec3,
-    pub dp_dy: Vec3,
+    pub dp_dx: V3,
+    pub dp_dy: V3,
     /// Changes of Generated and UV along `dp_dx` / `dp_dy` (the attribute differentials
     /// of Cycles' bump variants of the coordinate nodes).
-    pub generated_dx: Vec3,
-    pub generated_dy: Vec3,
-    pub uv_dx: Vec3,
-    pub uv_dy: Vec3,
+    pub generated_dx: V3,
+    pub generated_dy: V3,
+    pub uv_dx: V3,
+    pub uv_dy: V3,
     /// The object's transform (object-space bump, displacement and normal maps).
     pub transform: ObjectTransform,
     /// The ray hit the back of the surface (normals already flipped toward it).
     pub backfacing: bool,
     /// Unit vector from the point back along the ray that reached it (Cycles' `sd->wi`,
     /// Geometry > Incoming). An EMIT bake sets it to the shading normal.
-    pub incoming: Vec3,
+    pub incoming: V3,
     /// World-space geometric normal (Geometry > True Normal), flipped with `normal`
     /// when the ray hit the back of the surface.
-    pub true_normal: Vec3,
+    pub true_normal: V3,
     /// Cycles' barycentric (u, v) in its triangle: Geometry > Parametric is (1-u-v, u, 0).
     pub parametric: [f32; 2],
     /// On a hair curve (zero elsewhere): the curve's tangent dP/du in world space (Cycles'
     /// sd->dPdu, which the hair closures turn about).
-    pub dpdu: Vec3,
+    pub dpdu: V3,
     /// Length of the ray segment that reached the point (Light Path > Ray Length; 1 in a bake).
     pub ray_length: f32,
     /// What kind of ray reached the point, and the path's bounce counts (Light Path).
     pub path: PathState,
     /// Position in Cycles' camera space: x right, y up, z forward (Texture Coordinate >
     /// Camera, Camera Data).
-    pub camera_position: Vec3,
+    pub camera_position: V3,
     /// Cycles' camera-to-world transform and its inverse (Vector Transform).
     pub camera: crate::nodes::vector_transform::Affine,
     /// The world-space corners of the triangle hit (Wireframe); zero where there is none.
-    pub triangle: [Vec3; 3],
+    pub triangle: [V3; 3],
     /// Position in the camera's normalised frame, 0..1 over the image, z = 0
     /// (Texture Coordinate > Window).
-    pub window: Vec3,
+    pub window: V3,
     /// The shaded object (Object Info, object-space transforms).
     pub object: ObjectInfo,
     /// Mesh attribute values the program requested (`Program::attributes`, in order), as
@@ -90,7 +90,7 @@ pub struct ShadingPoint {
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct PointPoint {
     /// The point's centre in world space (point_position).
-    pub position: Vec3,
+    pub position: V3,
     /// Its radius in world space (point_radius).
     pub radius: f32,
     /// hash_uint2_to_float(point index in its cloud, 0) (ATTR_STD_POINT_RANDOM).
@@ -111,7 +111,7 @@ pub struct HairPoint {
     pub thickness: f32,
     /// The incoming direction with its part along the curve removed, unit
     /// (curve_tangent_normal).
-    pub tangent_normal: Vec3,
+    pub tangent_normal: V3,
     /// hash_uint2_to_float(curve index, 0) (ATTR_STD_CURVE_RANDOM).
     pub random: f32,
     /// On a thick curve (3D Curves: a tube whose true normal the hair closures read)
@@ -119,17 +119,17 @@ pub struct HairPoint {
     pub thick: bool,
     /// The curves' normal attribute at the hit (ATTR_STD_VERTEX_NORMAL on curves: a
     /// Curves object's normals), zero without one.
-    pub curve_normal: Vec3,
+    pub curve_normal: V3,
 }
 
 /// A shading point's position and differentials before true displacement (Cycles'
 /// undisplaced position attribute, interpolated with the hit's barycentrics).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Undisplaced {
-    pub position: Vec3,
-    pub object_position: Vec3,
-    pub dp_dx: Vec3,
-    pub dp_dy: Vec3,
+    pub position: V3,
+    pub object_position: V3,
+    pub dp_dx: V3,
+    pub dp_dy: V3,
 }
 
 /// Cycles' path flags (`PATH_RAY_*`): defined in the foundation, since the BVH's ray
@@ -176,7 +176,7 @@ impl PathState {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ObjectInfo {
     /// World-space origin of the object.
-    pub location: Vec3,
+    pub location: V3,
     /// Object colour (RGBA; Alpha is the fourth).
     pub color: [f32; 4],
     /// Object pass index (Object Index).

@@ -1,6 +1,7 @@
 //! A compiled material: a flat list of operations over a float stack, run once per
 //! shading point with no allocation and no lookups by name (Cycles' SVM idea).
 
+use crate::foundation::math::{Vec3, V3};
 use crate::nodes::checker::checker_texture;
 use crate::nodes::clamp::{clamp_node, ClampType};
 use crate::nodes::color::{
@@ -12,7 +13,7 @@ use crate::nodes::gradient::{gradient, GradientType};
 use crate::nodes::magic::magic;
 use crate::nodes::map_range::{map_range_float, map_range_vector, MapRangeInterpolation};
 use crate::nodes::mapping::{mapping, MappingType};
-use crate::nodes::math::{math_node, vector_math, MathOp, Vec3, VectorMathOp};
+use crate::nodes::math::{math_node, vector_math, MathOp, VectorMathOp};
 use crate::nodes::mix::{
     mix_color, mix_float, mix_rgb, mix_vector, mix_vector_non_uniform, MixBlend,
 };
@@ -516,7 +517,7 @@ pub enum Op {
     },
     /// Normal node's Dot output (its Normal output is a constant).
     NormalDot {
-        direction: Vec3,
+        direction: V3,
         normal: Slot,
         dst: Slot,
     },
@@ -861,11 +862,11 @@ impl BsdfNode {
     }
 }
 
-fn v3(s: &[f32], at: Slot) -> Vec3 {
+fn v3(s: &[f32], at: Slot) -> V3 {
     let i = at as usize;
     [s[i], s[i + 1], s[i + 2]]
 }
-fn put3(s: &mut [f32], at: Slot, v: Vec3) {
+fn put3(s: &mut [f32], at: Slot, v: V3) {
     let i = at as usize;
     s[i..i + 3].copy_from_slice(&v);
 }
@@ -955,7 +956,7 @@ impl Program {
 
     /// The world-space vector true displacement moves the vertex at `sp` by (None: the
     /// material has no true displacement).
-    pub fn displacement_at(&self, sp: &ShadingPoint, s: &mut [f32]) -> Option<Vec3> {
+    pub fn displacement_at(&self, sp: &ShadingPoint, s: &mut [f32]) -> Option<V3> {
         let d = self.displacement?;
         s.copy_from_slice(&self.initial);
         self.exec(sp, s, &self.ops[..d.center_end], &NoTrace);
@@ -1433,12 +1434,9 @@ impl Program {
                     // A linked Normal keeps its own direction plus the bevel's change.
                     let out = match normal {
                         Some(n) => {
-                            let base = v3(s, n);
-                            crate::nodes::math::normalize3([
-                                base[0] + b[0] - sp.normal[0],
-                                base[1] + b[1] - sp.normal[1],
-                                base[2] + b[2] - sp.normal[2],
-                            ])
+                            let d = Vec3::from(v3(s, n)) + b.into() - sp.normal.into();
+                            // Cycles' normalize: a true division by the length.
+                            (d / d.length()).into()
                         }
                         None => b,
                     };
@@ -1848,15 +1846,15 @@ impl Program {
 
     /// Total emission of the surface closure tree after `run` (what a Cycles EMIT bake
     /// records): Mix Shader weights clamp their factor to [0, 1] as Cycles does.
-    pub fn surface_emission(&self, s: &[f32]) -> Vec3 {
+    pub fn surface_emission(&self, s: &[f32]) -> V3 {
         match self.surface {
             Some(c) => self.emission(c, s, 1.0),
             None => [0.0; 3],
         }
     }
 
-    fn emission(&self, c: u32, s: &[f32], w: f32) -> Vec3 {
-        let add = |a: Vec3, b: Vec3| [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
+    fn emission(&self, c: u32, s: &[f32], w: f32) -> V3 {
+        let add = |a: V3, b: V3| [a[0] + b[0], a[1] + b[1], a[2] + b[2]];
         let sub = |x: Option<u32>, w: f32| match x {
             Some(x) if w != 0.0 => self.emission(x, s, w),
             _ => [0.0; 3],

@@ -3,7 +3,7 @@
 //! nodes that use them: Normal Map and Vector Displacement in tangent space, Tangent in
 //! UV Map mode.
 
-use crate::nodes::math::{add3, cross3, normalize3, safe_normalize3, scale3, sub3, Vec3};
+use crate::foundation::math::{Vec3, V3};
 use crate::scene::{AttributeData, MeshData};
 use rayon::prelude::*;
 
@@ -13,7 +13,7 @@ struct MikkMesh<'a> {
     mesh: &'a MeshData,
     uvs: &'a [[f32; 2]],
     flat: Vec<bool>,
-    vertex_normals: Vec<Vec3>,
+    vertex_normals: Vec<V3>,
     out: Vec<[f32; 4]>,
 }
 
@@ -39,8 +39,8 @@ impl mikktspace::Geometry for MikkMesh<'_> {
     fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
         // Cycles: the vertex normal on a smooth face, the triangle's normal on a flat one.
         if self.flat[self.mesh.triangle_faces[face] as usize] {
-            let p = [self.pos(face, 0), self.pos(face, 1), self.pos(face, 2)];
-            normalize3(cross3(sub3(p[1], p[0]), sub3(p[2], p[0])))
+            let p = [0, 1, 2].map(|k| Vec3::from(self.pos(face, k)));
+            normalize_div((p[1] - p[0]).cross(p[2] - p[0])).into()
         } else {
             self.vertex_normals[self.mesh.corner_verts[self.corner(face, vert)] as usize]
         }
@@ -152,25 +152,23 @@ fn scale_down(positions: &[[f32; 3]]) -> Option<Vec<[f32; 3]>> {
 pub fn normal_map_tangent(
     sp: &ShadingPoint,
     tangent: Option<[f32; 4]>,
-    normal: Vec3,
-    color: Vec3,
+    normal: V3,
+    color: V3,
     strength: f32,
-) -> Vec3 {
+) -> V3 {
     let Some(t4) = tangent else { return sp.normal };
-    let mut c = scale3(sub3(color, [0.5; 3]), 2.0);
+    let (normal, color) = (Vec3::from(normal), Vec3::from(color));
+    let mut c = (color - Vec3::splat(0.5)) * 2.0;
     // Tangent space scales the map's x and y by strength instead of blending normals.
-    c[0] *= strength;
-    c[1] *= strength;
-    c[2] = 1.0 + (c[2] - 1.0) * strength.clamp(0.0, 1.0);
-    let t = [t4[0], t4[1], t4[2]];
-    let b = scale3(cross3(normal, t), t4[3]);
-    let local = safe_normalize3(add3(
-        add3(scale3(t, c[0]), scale3(b, c[1])),
-        scale3(normal, c[2]),
-    ));
-    let mut n = sp.transform.normal(local);
+    c.x *= strength;
+    c.y *= strength;
+    c.z = 1.0 + (c.z - 1.0) * strength.clamp(0.0, 1.0);
+    let t = vec3_of(t4);
+    let b = normal.cross(t) * t4[3];
+    let local = safe_normalize_mul(t * c.x + b * c.y + normal * c.z);
+    let mut n = sp.transform.normal(local.into());
     if sp.backfacing {
-        n = scale3(n, -1.0);
+        n = (Vec3::from(n) * -1.0).into();
     }
     if n == [0.0; 3] {
         n = sp.normal;
@@ -184,31 +182,53 @@ pub fn normal_map_tangent(
 pub fn vector_displacement_tangent(
     sp: &ShadingPoint,
     tangent: Option<[f32; 4]>,
-    vector: Vec3,
+    vector: V3,
     midlevel: f32,
     scale: f32,
-) -> Vec3 {
+) -> V3 {
     let Some(t4) = tangent else { return [0.0; 3] };
-    let d = scale3(sub3(vector, [midlevel; 3]), scale);
-    let normal = sp.transform.inverse_normal(sp.normal);
-    let t = [t4[0], t4[1], t4[2]];
-    let b = scale3(safe_normalize3(cross3(normal, t)), t4[3]);
-    let local = add3(add3(scale3(t, d[0]), scale3(normal, d[1])), scale3(b, d[2]));
-    sp.transform.dir(local)
+    let d = (Vec3::from(vector) - Vec3::splat(midlevel)) * scale;
+    let normal = Vec3::from(sp.transform.inverse_normal(sp.normal));
+    let t = vec3_of(t4);
+    let b = safe_normalize_mul(normal.cross(t)) * t4[3];
+    let local = t * d.x + normal * d.y + b * d.z;
+    sp.transform.dir(local.into())
 }
 
 /// Tangent node, UV Map mode: the interpolated tangent to world space, made orthogonal to
 /// the shading normal; zero without the UV map.
-pub fn tangent_uv(sp: &ShadingPoint, tangent: Option<[f32; 4]>) -> Vec3 {
+pub fn tangent_uv(sp: &ShadingPoint, tangent: Option<[f32; 4]>) -> V3 {
     let Some(t4) = tangent else { return [0.0; 3] };
-    let t = sp.transform.normal([t4[0], t4[1], t4[2]]);
-    let n = sp.normal;
-    cross3(n, normalize3(cross3(t, n)))
+    let t = Vec3::from(sp.transform.normal([t4[0], t4[1], t4[2]]));
+    let n = Vec3::from(sp.normal);
+    n.cross(normalize_div(t.cross(n))).into()
+}
+
+/// The xyz of a MikkTSpace tangent (its w is the bitangent sign).
+fn vec3_of(t4: [f32; 4]) -> Vec3 {
+    Vec3::new(t4[0], t4[1], t4[2])
+}
+
+/// Cycles' `normalize`: each component divided by the length (NaN for a zero vector),
+/// as `nodes::math::normalize3`.
+fn normalize_div(v: Vec3) -> Vec3 {
+    v / v.length()
+}
+
+/// Cycles' `safe_normalize` by the reciprocal length, a zero vector left as it is
+/// (`nodes::math::safe_normalize3`; a NaN length gives NaN, unlike `Vec3::normalize`).
+fn safe_normalize_mul(v: Vec3) -> Vec3 {
+    let t = v.length();
+    if t != 0.0 {
+        v * (1.0 / t)
+    } else {
+        v
+    }
 }
 
 /// Blender's vertex normals (what Cycles' smooth triangles and MikkTSpace read): each
 /// face's normal weighted by its corner angle at the vertex, summed and normalised.
-pub fn vertex_normals(mesh: &MeshData) -> Vec<Vec3> {
+pub fn vertex_normals(mesh: &MeshData) -> Vec<V3> {
     // Without sharp faces, sharp edges or custom normals Blender's corner normals are its
     // vertex normals: take them as Blender rounded them.
     let any = |name: &str| matches!(mesh.attribute(name).map(|a| &a.data), Some(AttributeData::Bool(v)) if v.iter().any(|&b| b));
@@ -223,26 +243,20 @@ pub fn vertex_normals(mesh: &MeshData) -> Vec<Vec3> {
         }
         return out;
     }
-    let pos = |c: usize| mesh.positions[mesh.corner_verts[c] as usize];
+    let pos = |c: usize| Vec3::from(mesh.positions[mesh.corner_verts[c] as usize]);
     let face_normal = |a: usize, n: usize| match n {
-        3 => normalize3(cross3(
-            sub3(pos(a), pos(a + 1)),
-            sub3(pos(a + 1), pos(a + 2)),
-        )),
-        4 => normalize3(cross3(
-            sub3(pos(a), pos(a + 2)),
-            sub3(pos(a + 1), pos(a + 3)),
-        )),
+        3 => normalize_div((pos(a) - pos(a + 1)).cross(pos(a + 1) - pos(a + 2))),
+        4 => normalize_div((pos(a) - pos(a + 2)).cross(pos(a + 1) - pos(a + 3))),
         _ => {
             // Newell's method.
-            let mut s = [0.0f32; 3];
+            let mut s = Vec3::ZERO;
             for k in 0..n {
                 let (p, q) = (pos(a + k), pos(a + (k + 1) % n));
-                s[0] += (p[1] - q[1]) * (p[2] + q[2]);
-                s[1] += (p[2] - q[2]) * (p[0] + q[0]);
-                s[2] += (p[0] - q[0]) * (p[1] + q[1]);
+                s.x += (p.y - q.y) * (p.z + q.z);
+                s.y += (p.z - q.z) * (p.x + q.x);
+                s.z += (p.x - q.x) * (p.y + q.y);
             }
-            normalize3(s)
+            normalize_div(s)
         }
     };
     // Each corner's weighted face normal on rayon's threads (the arc cosines were a serial
@@ -265,22 +279,22 @@ pub fn vertex_normals(mesh: &MeshData) -> Vec<Vec3> {
             let k = c - a;
             let prev = a + (k + n - 1) % n;
             let next = a + (k + 1) % n;
-            let d1 = safe_normalize3(sub3(pos(prev), pos(c)));
-            let d2 = safe_normalize3(sub3(pos(next), pos(c)));
-            let angle = (d1[0] * d2[0] + d1[1] * d2[1] + d1[2] * d2[2])
-                .clamp(-1.0, 1.0)
-                .acos();
-            Some(scale3(face_normal(a, n), angle))
+            let d1 = safe_normalize_mul(pos(prev) - pos(c));
+            let d2 = safe_normalize_mul(pos(next) - pos(c));
+            let angle = d1.dot(d2).clamp(-1.0, 1.0).acos();
+            Some(face_normal(a, n) * angle)
         })
         .collect();
-    let mut acc = vec![[0.0f32; 3]; mesh.vertex_count()];
+    let mut acc = vec![Vec3::ZERO; mesh.vertex_count()];
     for (c, w) in (first..).zip(&weighted) {
         if let Some(w) = w {
             let v = mesh.corner_verts[c] as usize;
-            acc[v] = add3(acc[v], *w);
+            acc[v] += *w;
         }
     }
-    acc.into_iter().map(safe_normalize3).collect()
+    acc.into_iter()
+        .map(|a| safe_normalize_mul(a).into())
+        .collect()
 }
 
 #[cfg(test)]

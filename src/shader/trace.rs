@@ -2,7 +2,7 @@
 //! nodes: Ambient Occlusion and Bevel). The renderer implements `Trace` over its scene; the
 //! shader layer sees only this narrow interface, so it imports nothing from `render`.
 
-use crate::nodes::math::Vec3;
+use crate::nodes::math::V3;
 
 use super::point::ShadingPoint;
 
@@ -16,7 +16,7 @@ pub trait Trace {
     fn ambient_occlusion(
         &self,
         sp: &ShadingPoint,
-        n: Vec3,
+        n: V3,
         max_dist: f32,
         samples: u32,
         only_local: bool,
@@ -24,7 +24,7 @@ pub trait Trace {
 
     /// Cycles' svm_bevel: the shaded object's normals within `radius`, blended by the
     /// cubic falloff over `samples` probes (the shading normal where there is nothing).
-    fn bevel(&self, sp: &ShadingPoint, radius: f32, samples: u32) -> Vec3;
+    fn bevel(&self, sp: &ShadingPoint, radius: f32, samples: u32) -> V3;
 }
 
 /// No ray tracing: Ambient Occlusion is 1 and Bevel the shading normal, as Cycles'
@@ -32,11 +32,11 @@ pub trait Trace {
 pub struct NoTrace;
 
 impl Trace for NoTrace {
-    fn ambient_occlusion(&self, _: &ShadingPoint, _: Vec3, _: f32, _: u32, _: bool) -> f32 {
+    fn ambient_occlusion(&self, _: &ShadingPoint, _: V3, _: f32, _: u32, _: bool) -> f32 {
         1.0
     }
 
-    fn bevel(&self, sp: &ShadingPoint, _: f32, _: u32) -> Vec3 {
+    fn bevel(&self, sp: &ShadingPoint, _: f32, _: u32) -> V3 {
         sp.normal
     }
 }

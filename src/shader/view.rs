@@ -2,7 +2,7 @@
 //! world-to-camera and world-to-NDC transforms (Texture Coordinate > Camera and Window,
 //! Camera Data) and the per-object values of Object Info.
 
-use crate::nodes::math::Vec3;
+use crate::nodes::math::V3;
 use crate::nodes::random::hash2;
 use crate::scene::Object;
 
@@ -117,14 +117,14 @@ impl View {
 
     /// A world point in Cycles' camera space.
     #[inline]
-    pub fn camera_space(&self, p: Vec3) -> Vec3 {
+    pub fn camera_space(&self, p: V3) -> V3 {
         let m = &self.world_to_camera;
         std::array::from_fn(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3])
     }
 
     /// A camera-space point in normalised window coordinates (0..1 over the image, z = 0).
     #[inline]
-    pub fn window(&self, c: Vec3) -> Vec3 {
+    pub fn window(&self, c: V3) -> V3 {
         let (sx, sy) = if self.ortho {
             (c[0], c[1])
         } else {

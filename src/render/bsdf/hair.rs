@@ -11,7 +11,7 @@
 
 use std::f32::consts::{FRAC_PI_2, PI};
 
-use crate::render::math::*;
+use crate::render::math::{Vec3, V3};
 
 /// Where a hit lies across the fibre, for the Principled Hair models' offset h: on a hair
 /// ribbon from its parametric v (h = -v); on a thick curve from the tube's normal `n`
@@ -41,7 +41,7 @@ pub struct Hair {
 /// A sampled direction with the value and pdf Cycles' sample function returns (equal).
 #[derive(Debug, Clone, Copy)]
 pub struct HairSample {
-    pub wi: V3,
+    pub wi: Vec3,
     pub pdf: f32,
 }
 
@@ -79,19 +79,19 @@ impl Hair {
 
     /// BSDF times cosine toward `light` (equal to its pdf) for a viewer along `view`;
     /// `n` is the closure's normal, which only decides the side.
-    pub fn eval(&self, n: V3, view: V3, light: V3) -> f32 {
-        let side = dot(n, light);
+    pub fn eval(&self, n: Vec3, view: Vec3, light: Vec3) -> f32 {
+        let side = n.dot(light);
         if (self.transmission && side >= 0.0) || (!self.transmission && side < 0.0) {
             return 0.0;
         }
-        let t = self.tangent;
-        let iz = dot(t, view);
-        let locy = normalize(sub(view, scale(t, iz)));
+        let t = Vec3::from(self.tangent);
+        let iz = t.dot(view);
+        let locy = (view - t * iz).normalize();
         let theta_r = FRAC_PI_2 - iz.clamp(-1.0, 1.0).acos();
-        let wz = dot(t, light);
-        let wy = normalize(sub(light, scale(t, wz)));
+        let wz = t.dot(light);
+        let wy = (light - t * wz).normalize();
         let theta_i = FRAC_PI_2 - wz.clamp(-1.0, 1.0).acos();
-        let cosphi = dot(wy, locy);
+        let cosphi = wy.dot(locy);
         if FRAC_PI_2 - theta_i.abs() < 0.001 || !cosphi.is_finite() {
             return 0.0;
         }
@@ -122,11 +122,11 @@ impl Hair {
 
     /// Cycles' bsdf_hair_*_sample: a direction and the pdf (= value) Cycles gives it;
     /// None where Cycles' pdf is zero (the path ends there).
-    pub fn sample(&self, view: V3, u: [f32; 2]) -> Option<HairSample> {
-        let t = self.tangent;
-        let iz = dot(t, view);
-        let locy = normalize(sub(view, scale(t, iz)));
-        let locx = cross(locy, t);
+    pub fn sample(&self, view: Vec3, u: [f32; 2]) -> Option<HairSample> {
+        let t = Vec3::from(self.tangent);
+        let iz = t.dot(view);
+        let locy = (view - t * iz).normalize();
+        let locx = locy.cross(t);
         let theta_r = FRAC_PI_2 - iz.clamp(-1.0, 1.0).acos();
         let (a, b) = self.theta_bounds(theta_r);
         let th = self.roughness1 * (u[0] * (a - b) + b).tan();
@@ -143,10 +143,7 @@ impl Hair {
             (phi, (phi * 0.5).cos() * 0.25 / r2)
         };
         let (sin_p, cos_p) = phi.sin_cos();
-        let wi = add(
-            add(scale(locy, cos_p * cos_ti), scale(locx, -sin_p * cos_ti)),
-            scale(t, sin_ti),
-        );
+        let wi = locy * (cos_p * cos_ti) + locx * (-sin_p * cos_ti) + t * sin_ti;
         let pdf = (phi_pdf * theta_pdf).abs();
         if FRAC_PI_2 - theta_i.abs() < 0.001 || !(pdf > 0.0) || !pdf.is_finite() {
             return None;
@@ -159,19 +156,21 @@ impl Hair {
 mod tests {
     use super::*;
 
-    fn dir(theta: f32, phi: f32) -> V3 {
-        [
+    use crate::render::math::vec3;
+
+    fn dir(theta: f32, phi: f32) -> Vec3 {
+        vec3(
             theta.cos() * phi.cos(),
             theta.cos() * phi.sin(),
             theta.sin(),
-        ]
+        )
     }
 
     /// Tangent +z, normal +x toward a viewer in the x-z plane.
-    fn setup(transmission: bool, r1: f32, r2: f32) -> (Hair, V3, V3) {
+    fn setup(transmission: bool, r1: f32, r2: f32) -> (Hair, Vec3, Vec3) {
         let h = Hair::new([0.0, 0.0, 1.0], r1, r2, -0.05, transmission);
-        let view = normalize([1.0, 0.0, 0.4]);
-        (h, [1.0, 0.0, 0.0], view)
+        let view = vec3(1.0, 0.0, 0.4).normalize();
+        (h, Vec3::X, view)
     }
 
     /// The sample's pdf is evaluation's wherever Cycles' two formulas agree: the
@@ -235,8 +234,8 @@ mod tests {
     fn sides() {
         let (r, n, view) = setup(false, 0.2, 0.5);
         let (t, _, _) = setup(true, 0.2, 0.5);
-        let front = normalize([1.0, 0.2, -0.1]);
-        let back = normalize([-1.0, 0.2, -0.1]);
+        let front = vec3(1.0, 0.2, -0.1).normalize();
+        let back = vec3(-1.0, 0.2, -0.1).normalize();
         assert!(r.eval(n, view, front) > 0.0 && r.eval(n, view, back) == 0.0);
         assert!(t.eval(n, view, back) > 0.0 && t.eval(n, view, front) == 0.0);
     }

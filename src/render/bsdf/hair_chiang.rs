@@ -12,15 +12,15 @@
 use std::f32::consts::PI;
 
 use crate::render::bsdf::hair::Across;
-use crate::render::math::*;
+use crate::render::math::{vec3, Vec3, V3};
 
 /// Rec.709 luminance, Cycles' spectrum_to_gray in a linear Rec.709 scene.
-const GRAY: V3 = [0.2126, 0.7152, 0.0722];
+const GRAY: Vec3 = vec3(0.2126, 0.7152, 0.0722);
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Chiang {
     /// Absorption coefficient per unit of fibre radius.
-    pub sigma: V3,
+    pub sigma: Vec3,
     /// Longitudinal variance (mapped from Roughness).
     pub v: f32,
     /// Azimuthal logistic scale (mapped from Radial Roughness).
@@ -33,7 +33,7 @@ pub struct Chiang {
     /// Offset across the fibre, -1..1.
     pub h: f32,
     /// Unit curve tangent (Cycles' normalised dP/du).
-    pub x: V3,
+    pub x: Vec3,
 }
 
 /// Cycles' bsdf_principled_hair_albedo_roughness_scale.
@@ -71,8 +71,8 @@ pub fn sigma_from_melanin(
 ) -> V3 {
     let factor = 1.0 + 2.0 * (random - 0.5) * random_color.clamp(0.0, 1.0);
     let m = -(1.0 - melanin * factor).max(0.0001).ln();
-    let s = sigma_from_concentration(m * (1.0 - redness), m * redness);
-    add(s, sigma_from_reflectance(tint, radial_roughness))
+    let s = Vec3::from(sigma_from_concentration(m * (1.0 - redness), m * redness));
+    (s + sigma_from_reflectance(tint, radial_roughness).into()).into()
 }
 
 fn sqr(x: f32) -> f32 {
@@ -175,14 +175,14 @@ fn fresnel_dielectric_cos(cosi: f32, eta: f32) -> f32 {
 
 /// The viewer's frame quantities shared by evaluation and sampling.
 struct Frame {
-    y: V3,
-    z: V3,
+    y: Vec3,
+    z: Vec3,
     sin_theta_o: f32,
     cos_theta_o: f32,
     phi_o: f32,
     gamma_o: f32,
     gamma_t: f32,
-    ap: [V3; 4],
+    ap: [Vec3; 4],
     ap_energy: [f32; 4],
     angles: [f32; 6],
 }
@@ -209,18 +209,18 @@ impl Chiang {
         let m0 = ((1.0 - coat.clamp(0.0, 1.0)) * r).clamp(0.001, 1.0);
         let map_v = |x: f32| sqr(0.726 * x + 0.812 * sqr(x) + 3.700 * x.powi(20));
         let s = (0.265 * s + 1.194 * sqr(s) + 5.372 * s.powi(22)) * (PI / 8.0).sqrt();
-        let x = safe_normalize(dpdu)?;
-        let y = safe_normalize(cross(x, wo))?;
+        let x = safe_normalize(dpdu.into())?;
+        let y = safe_normalize(x.cross(wo.into()))?;
         // The sine of the angle between the true normal and Z, seen along the tangent.
         let h = match across {
             Across::Ribbon { v } => -v,
             Across::Tube { n: ng } | Across::Surface { ng, .. } => {
-                dot(cross(ng, x), normalize(cross(x, y)))
+                Vec3::from(ng).cross(x).dot(x.cross(y).normalize())
             }
         };
         Some((
             Chiang {
-                sigma,
+                sigma: sigma.into(),
                 v: map_v(r),
                 s,
                 alpha: -alpha,
@@ -229,13 +229,13 @@ impl Chiang {
                 h,
                 x,
             },
-            y,
+            y.into(),
         ))
     }
 
-    fn frame(&self, y: V3, wo: V3) -> Frame {
-        let z = normalize(cross(self.x, y));
-        let o = [dot(wo, self.x), dot(wo, y), dot(wo, z)];
+    fn frame(&self, y: Vec3, wo: Vec3) -> Frame {
+        let z = self.x.cross(y).normalize();
+        let o = [wo.dot(self.x), wo.dot(y), wo.dot(z)];
         let sin_theta_o = o[0];
         let cos_theta_o = cos_from_sin(sin_theta_o);
         let phi_o = o[2].atan2(o[1]);
@@ -267,9 +267,9 @@ impl Chiang {
     }
 
     /// (F, pdf) of the four bounces toward sin(theta_i), phi (relative to the viewer).
-    fn lobes(&self, fr: &Frame, sin_theta_i: f32, phi: f32) -> (V3, f32) {
+    fn lobes(&self, fr: &Frame, sin_theta_i: f32, phi: f32) -> (Vec3, f32) {
         let cos_theta_i = cos_from_sin(sin_theta_i);
-        let mut f = [0.0; 3];
+        let mut f = Vec3::ZERO;
         let mut energy = 0.0;
         for i in 0..3 {
             let v = match i {
@@ -285,7 +285,7 @@ impl Chiang {
                 v,
             );
             let np = azimuthal(phi, i as i32, self.s, fr.gamma_o, fr.gamma_t);
-            f = add(f, scale(fr.ap[i], mp * np));
+            f += fr.ap[i] * (mp * np);
             energy += fr.ap_energy[i] * mp * np;
         }
         let mp = longitudinal_scattering(
@@ -296,28 +296,28 @@ impl Chiang {
             4.0 * self.v,
         );
         let np = 1.0 / (2.0 * PI);
-        f = add(f, scale(fr.ap[3], mp * np));
+        f += fr.ap[3] * (mp * np);
         energy += fr.ap_energy[3] * mp * np;
         (f, energy)
     }
 
     /// (BSDF times cosine, pdf) toward `wi` for a viewer along `wo`; `y` is the
     /// closure's normal.
-    pub fn eval(&self, y: V3, wo: V3, wi: V3) -> (V3, f32) {
+    pub fn eval(&self, y: Vec3, wo: Vec3, wi: Vec3) -> (Vec3, f32) {
         let fr = self.frame(y, wo);
-        let sin_theta_i = dot(wi, self.x);
-        let phi_i = dot(wi, fr.z).atan2(dot(wi, fr.y));
+        let sin_theta_i = wi.dot(self.x);
+        let phi_i = wi.dot(fr.z).atan2(wi.dot(fr.y));
         let (f, pdf) = self.lobes(&fr, sin_theta_i, phi_i - fr.phi_o);
-        if f.iter().all(|c| c.is_finite()) && pdf.is_finite() {
+        if f.is_finite() && pdf.is_finite() {
             (f, pdf)
         } else {
-            ([0.0; 3], 0.0)
+            (Vec3::ZERO, 0.0)
         }
     }
 
     /// Cycles' bsdf_hair_chiang_sample: (direction, F, pdf, transmits). The bounce is
     /// picked by `u[2]`.
-    pub fn sample(&self, y: V3, wo: V3, u: [f32; 3]) -> Option<(V3, V3, f32, bool)> {
+    pub fn sample(&self, y: Vec3, wo: Vec3, u: [f32; 3]) -> Option<(Vec3, Vec3, f32, bool)> {
         let fr = self.frame(y, wo);
         let mut uz = u[2];
         let mut p = 0;
@@ -351,11 +351,8 @@ impl Chiang {
         let phi_i = fr.phi_o + phi;
         let (f, pdf) = self.lobes(&fr, sin_theta_i, phi);
         let c = cos_from_sin(sin_theta_i);
-        let wi = add(
-            add(scale(fr.y, c * phi_i.cos()), scale(fr.z, c * phi_i.sin())),
-            scale(self.x, sin_theta_i),
-        );
-        if !(pdf > 0.0) || !pdf.is_finite() || !f.iter().all(|c| c.is_finite()) {
+        let wi = fr.y * (c * phi_i.cos()) + fr.z * (c * phi_i.sin()) + self.x * sin_theta_i;
+        if !(pdf > 0.0) || !pdf.is_finite() || !f.is_finite() {
             return None;
         }
         Some((wi, f, pdf, p != 0))
@@ -369,37 +366,34 @@ impl Chiang {
     }
 }
 
-fn safe_normalize(v: V3) -> Option<V3> {
-    let l = dot(v, v).sqrt();
-    (l > 0.0 && l.is_finite()).then(|| scale(v, 1.0 / l))
+fn safe_normalize(v: Vec3) -> Option<Vec3> {
+    let l = v.dot(v).sqrt();
+    (l > 0.0 && l.is_finite()).then(|| v * (1.0 / l))
 }
 
 /// Cycles' hair_attenuation: the colour of each bounce for Fresnel `f` and one pass's
 /// transmittance `t`, and their grey energies normalised to sum to one.
-fn attenuation(f: f32, t: V3) -> ([V3; 4], [f32; 4]) {
-    let gray = |c: V3| dot(c, GRAY);
-    let mut ap = [[0.0; 3]; 4];
+fn attenuation(f: f32, t: Vec3) -> ([Vec3; 4], [f32; 4]) {
+    let gray = |c: Vec3| c.dot(GRAY);
+    let mut ap = [Vec3::ZERO; 4];
     let mut e = [0.0; 4];
-    ap[0] = [f; 3];
+    ap[0] = Vec3::splat(f);
     e[0] = f;
-    let mut col = scale(t, sqr(1.0 - f));
+    let mut col = t * sqr(1.0 - f);
     ap[1] = col;
     e[1] = gray(col);
-    col = mul(col, scale(t, f));
+    col *= t * f;
     ap[2] = col;
     e[2] = gray(col);
-    let tf = scale(t, f);
-    col = mul(
-        col,
-        [0, 1, 2].map(|i| {
-            let d = 1.0 - tf[i];
-            if d != 0.0 {
-                tf[i] / d
-            } else {
-                0.0
-            }
-        }),
-    );
+    let tf = t * f;
+    col *= tf.map(|x| {
+        let d = 1.0 - x;
+        if d != 0.0 {
+            x / d
+        } else {
+            0.0
+        }
+    });
     ap[3] = col;
     e[3] = gray(col);
     let total: f32 = e.iter().sum();
@@ -430,8 +424,8 @@ fn alpha_angles(sin_o: f32, cos_o: f32, alpha: f32) -> [f32; 6] {
 mod tests {
     use super::*;
 
-    fn closure(coat: f32, h: f32) -> (Chiang, V3, V3) {
-        let wo = normalize([0.3, 1.0, 0.5]);
+    fn closure(coat: f32, h: f32) -> (Chiang, Vec3, Vec3) {
+        let wo = vec3(0.3, 1.0, 0.5).normalize();
         let sigma = sigma_from_melanin(0.6, 0.3, [1.0; 3], 0.0, 0.0, 0.3);
         let (c, y) = Chiang::new(
             sigma,
@@ -441,19 +435,19 @@ mod tests {
             2f32.to_radians(),
             1.55,
             [0.0, 0.0, 1.0],
-            wo,
+            wo.into(),
             Across::Ribbon { v: h },
         )
         .unwrap();
-        (c, y, wo)
+        (c, y.into(), wo)
     }
 
-    fn sphere_dir(i: usize, j: usize, n: usize) -> (V3, f32) {
+    fn sphere_dir(i: usize, j: usize, n: usize) -> (Vec3, f32) {
         let z = -1.0 + (i as f32 + 0.5) / n as f32 * 2.0;
         let phi = (j as f32 + 0.5) / (2 * n) as f32 * 2.0 * PI;
         let r = (1.0 - z * z).sqrt();
         (
-            [r * phi.cos(), r * phi.sin(), z],
+            vec3(r * phi.cos(), r * phi.sin(), z),
             4.0 * PI / (2 * n * n) as f32,
         )
     }
@@ -495,7 +489,7 @@ mod tests {
     fn pdf_normalised_and_energy_bounded() {
         let (c, y, wo) = closure(0.0, 0.4);
         let mut white = c;
-        white.sigma = [0.0; 3];
+        white.sigma = Vec3::ZERO;
         let n = 400;
         let (mut pdf_sum, mut f_sum, mut white_sum) = (0.0f64, [0.0f64; 3], 0.0f64);
         for i in 0..n {

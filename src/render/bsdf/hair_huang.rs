@@ -21,14 +21,14 @@
 use std::f32::consts::PI;
 
 use crate::render::bsdf::hair::Across;
-use crate::render::bsdf::microfacet::sample_ggx_vndf;
+use crate::render::bsdf::microfacet::ggx_vndf;
 use crate::render::bsdf::tables::Tables;
-use crate::render::math::*;
+use crate::render::math::{vec3, Vec3, V3};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Huang {
     /// Absorption coefficient per unit of fibre radius.
-    pub sigma: V3,
+    pub sigma: Vec3,
     /// GGX alpha, clamped to [0.001, 1].
     pub roughness: f32,
     /// Cuticle tilt, radians, negated as Cycles' setup does.
@@ -42,9 +42,9 @@ pub struct Huang {
     pub lobes: [f32; 3],
     /// The frame: `n` (Cycles' bsdf->N, local x) and the tangent (local y).
     pub n: V3,
-    pub y: V3,
+    pub y: Vec3,
     /// The viewer's direction in the local frame (Cycles' extra->wi).
-    pub wi: V3,
+    pub wi: Vec3,
     /// The fibre's width seen from the viewer, in units of the major axis.
     pub radius: f32,
     /// Squared eccentricity, 1 - b^2.
@@ -89,38 +89,39 @@ impl Huang {
         major_axis: V3,
         pixel_coverage: f32,
     ) -> Option<Setup> {
+        let (dpdu, wi, major_axis) = (Vec3::from(dpdu), Vec3::from(wi), Vec3::from(major_axis));
         let roughness = p.roughness.clamp(0.001, 1.0);
         let tilt = -p.offset;
         let y = safe_normalize(dpdu);
-        let x = safe_normalize(cross(dpdu, wi));
+        let x = safe_normalize(dpdu.cross(wi));
         let h = match across {
             Across::Ribbon { v } => -v,
-            Across::Tube { n } | Across::Surface { n, .. } => -dot(x, n),
+            Across::Tube { n } | Across::Surface { n, .. } => -x.dot(n.into()),
         };
         let mut b = p.aspect_ratio;
         let mut n = x;
         // Only a curve turns the frame to the ellipse's axis; on a mesh's faces Cycles keeps
         // the frame facing the ray but still takes the Aspect Ratio's eccentricity.
         if b != 1.0 && matches!(across, Across::Ribbon { .. } | Across::Tube { .. }) {
-            n = safe_normalize(cross(dpdu, safe_normalize(cross(major_axis, dpdu))));
+            n = safe_normalize(dpdu.cross(safe_normalize(major_axis.cross(dpdu))));
             if b > 1.0 {
                 b = 1.0 / b;
-                let minor = safe_normalize(cross(dpdu, n));
-                n = safe_normalize(cross(minor, dpdu));
+                let minor = safe_normalize(dpdu.cross(n));
+                n = safe_normalize(minor.cross(dpdu));
             }
         }
         let z;
-        if is_zero(n) || !finite(n) {
+        if n.is_zero() || !n.is_finite() {
             let (a, bb) = make_orthonormals(y);
             z = a;
             n = bb;
         } else {
-            z = safe_normalize(cross(n, dpdu));
+            z = safe_normalize(n.cross(dpdu));
         }
-        if is_zero(y) || !finite(y) {
+        if y.is_zero() || !y.is_finite() {
             return None;
         }
-        let li = [dot(wi, n), dot(wi, y), dot(wi, z)];
+        let li = vec3(wi.dot(n), wi.dot(y), wi.dot(z));
         let e2 = 1.0 - b * b;
         let radius = if e2 == 0.0 {
             1.0
@@ -134,14 +135,14 @@ impl Huang {
             return Some(Setup::Transparent);
         }
         Some(Setup::Closure(Huang {
-            sigma: p.sigma,
+            sigma: p.sigma.into(),
             roughness,
             tilt,
             eta: p.ior,
             b,
             h,
             lobes: p.lobes.map(|l| l.max(0.0)),
-            n,
+            n: n.into(),
             y,
             wi: li,
             radius,
@@ -150,19 +151,16 @@ impl Huang {
         }))
     }
 
-    fn z(&self) -> V3 {
-        cross(self.n, self.y)
+    fn z(&self) -> Vec3 {
+        Vec3::from(self.n).cross(self.y)
     }
 
-    fn local_of(&self, w: V3) -> V3 {
-        [dot(w, self.n), dot(w, self.y), dot(w, self.z())]
+    fn local_of(&self, w: Vec3) -> Vec3 {
+        vec3(w.dot(self.n.into()), w.dot(self.y), w.dot(self.z()))
     }
 
-    fn global_of(&self, w: V3) -> V3 {
-        add(
-            add(scale(self.n, w[0]), scale(self.y, w[1])),
-            scale(self.z(), w[2]),
-        )
+    fn global_of(&self, w: Vec3) -> Vec3 {
+        Vec3::from(self.n) * w.x + self.y * w.y + self.z() * w.z
     }
 
     fn circular(&self) -> bool {
@@ -180,27 +178,27 @@ impl Huang {
 
     /// (BSDF times cosine, pdf) toward `wo` (global, away from the hit): Cycles'
     /// bsdf_hair_huang_eval, whose pdf is always 1.
-    pub fn eval(&self, wo: V3, tables: &Tables) -> (V3, f32) {
+    pub fn eval(&self, wo: Vec3, tables: &Tables) -> (Vec3, f32) {
         let o = self.local_of(wo);
         let seed = hash_dirs(self.wi, o, self.h);
         let f = self.eval_local(o, seed, tables);
-        if f.iter().all(|c| c.is_finite() && *c >= 0.0) {
+        if f.is_finite() && f.x >= 0.0 && f.y >= 0.0 && f.z >= 0.0 {
             (f, 1.0)
         } else {
-            ([0.0; 3], 1.0)
+            (Vec3::ZERO, 1.0)
         }
     }
 
-    fn eval_local(&self, o: V3, seed: u32, tables: &Tables) -> V3 {
+    fn eval_local(&self, o: Vec3, seed: u32, tables: &Tables) -> Vec3 {
         let i = self.wi;
         let tan_tilt = self.tilt.tan();
         if tan_tilt * tan_theta(o) < -1.0 {
-            return [0.0; 3];
+            return Vec3::ZERO;
         }
         // The azimuths whose mesonormal the viewer sees.
         let half_span = (-tan_tilt * tan_theta(i)).max(0.0).acos();
         if half_span.is_nan() {
-            return [0.0; 3];
+            return Vec3::ZERO;
         }
         let r = self.radius;
         let b = self.b;
@@ -220,15 +218,13 @@ impl Huang {
         h = (h.0 / r, h.1 / r);
         h = intersect(h, (-0.999, 0.999));
         if h.0 >= h.1 {
-            return [0.0; 3];
+            return Vec3::ZERO;
         }
         let projected_area = cos_theta(i) * dh;
         let mut rng = seed;
-        let f = add(
-            [self.eval_r(i, o, h, tables); 3],
-            self.eval_residual(i, o, h, &mut rng, tables),
-        );
-        scale(f, 1.0 / projected_area)
+        let f = Vec3::splat(self.eval_r(i, o, h, tables))
+            + self.eval_residual(i, o, h, &mut rng, tables);
+        f * (1.0 / projected_area)
     }
 
     fn energy_scale(&self, tables: &Tables, mu: f32, eta: f32) -> f32 {
@@ -236,12 +232,12 @@ impl Huang {
     }
 
     /// The R lobe by Simpson's rule over `h` (Cycles' bsdf_hair_huang_eval_r).
-    fn eval_r(&self, wi: V3, wo: V3, hr: (f32, f32), tables: &Tables) -> f32 {
+    fn eval_r(&self, wi: Vec3, wo: Vec3, hr: (f32, f32), tables: &Tables) -> f32 {
         if self.lobes[0] <= 0.0 {
             return 0.0;
         }
         let b = self.b;
-        let wh = normalize(add(wi, wo));
+        let wh = (wi + wo).normalize();
         let a2 = self.roughness * self.roughness;
         let sc_i = sincos_phi(wi);
         let h_range = hr.1 - hr.0;
@@ -251,29 +247,36 @@ impl Huang {
             let h = hr.0 + k as f32 * res;
             let gamma_m = h_to_gamma(h, b, wi);
             let wm = sphg_dir(self.tilt, gamma_m, b);
-            if visible2(wi, wo, [wm[0], 0.0, wm[2]], wh) {
+            if visible2(wi, wo, vec3(wm.x, 0.0, wm.z), wh) {
                 let weight = simpson_weight(k, intervals) * d_gamma_d_h(sc_i, gamma_m, b);
-                let cos_mi = dot(wm, wi);
-                let g = ggx_g2(a2, cos_mi, dot(wm, wo));
+                let cos_mi = wm.dot(wi);
+                let g = ggx_g2(a2, cos_mi, wm.dot(wo));
                 integral += weight
-                    * ggx_d(a2, dot(wm, wh))
+                    * ggx_d(a2, wm.dot(wh))
                     * g
                     * arc_length(self.e2, gamma_m)
                     * self.energy_scale(tables, cos_mi, self.eta);
             }
         }
         integral *= 2.0 / 3.0 * res;
-        let f = crate::render::bsdf::fresnel_dielectric(dot(wi, wh), self.eta);
+        let f = crate::render::bsdf::fresnel_dielectric(wi.dot(wh), self.eta);
         self.lobes[0] * 0.25 * f * integral
     }
 
     /// TT, TRT and the TRRT+ rest (Cycles' bsdf_hair_huang_eval_residual). Long because
     /// it follows Cycles' function step for step (the quadrature over h with its
     /// per-node microfacet samples), which keeps it checkable against the kernel.
-    fn eval_residual(&self, wi: V3, wo: V3, hr: (f32, f32), rng: &mut u32, tables: &Tables) -> V3 {
+    fn eval_residual(
+        &self,
+        wi: Vec3,
+        wo: Vec3,
+        hr: (f32, f32),
+        rng: &mut u32,
+        tables: &Tables,
+    ) -> Vec3 {
         let [_, tt_mul, trt_mul] = self.lobes;
         if tt_mul <= 0.0 && trt_mul <= 0.0 {
-            return [0.0; 3];
+            return Vec3::ZERO;
         }
         let b = self.b;
         let mu_a = self.sigma;
@@ -283,9 +286,9 @@ impl Huang {
         let sc_i = sincos_phi(wi);
         let h_range = hr.1 - hr.0;
         let (intervals, res) = simpson_grid(h_range, self.roughness * 0.8);
-        let mut s_tt = [0.0; 3];
-        let mut s_trt = [0.0; 3];
-        let mut s_trrt = [0.0; 3];
+        let mut s_tt = Vec3::ZERO;
+        let mut s_trt = Vec3::ZERO;
+        let mut s_trrt = Vec3::ZERO;
         for k in 0..=intervals {
             let h = hr.0 + k as f32 * res;
             let gamma_mi = h_to_gamma(h, b, wi);
@@ -293,11 +296,11 @@ impl Huang {
             let wmi_ = sphg_dir(0.0, gamma_mi, b);
             let u1 = [lcg_float(rng), lcg_float(rng)];
             let wh1 = sample_wh(self.roughness, wi, wmi, u1);
-            let cos_hi1 = dot(wi, wh1);
+            let cos_hi1 = wi.dot(wh1);
             if !(cos_hi1 > 0.0) {
                 continue;
             }
-            let cos_mi1 = dot(wi, wmi);
+            let cos_mi1 = wi.dot(wmi);
             let (f1, cos_theta_t1) = fresnel(cos_hi1, eta);
             let t1 = 1.0 - f1;
             let scale1 = self.energy_scale(tables, cos_mi1, eta);
@@ -307,10 +310,10 @@ impl Huang {
             let gamma_mt = 2.0 * to_phi(phi_t, b) - gamma_mi;
             let wmt = sphg_dir(-self.tilt, gamma_mt, b);
             let wmt_ = sphg_dir(0.0, gamma_mt, b);
-            let cos_mo1 = dot(neg(wt), wmi);
-            let cos_mi2 = dot(neg(wt), wmt);
+            let cos_mo1 = (-wt).dot(wmi);
+            let cos_mi2 = (-wt).dot(wmt);
             let g1o = ggx_go(a2, cos_mi1, cos_mo1);
-            if !visible2(wi, neg(wt), wmi, wh1) || !visible2(wi, neg(wt), wmi_, wh1) {
+            if !visible2(wi, -wt, wmi, wh1) || !visible2(wi, -wt, wmi_, wh1) {
                 continue;
             }
             let weight = simpson_weight(k, intervals) * d_gamma_d_h(sc_i, gamma_mi, b);
@@ -322,15 +325,15 @@ impl Huang {
             let a_t = mu_a.map(|m| (m / cos_theta(wt) * path).exp());
             let scale2 = self.energy_scale(tables, cos_mi2, inv_eta);
 
-            if tt_mul > 0.0 && dot(wo, wt) >= inv_eta - 1e-5 {
-                let wh2 = add(neg(wt), scale(wo, inv_eta));
-                let rcp_norm = 1.0 / len(wh2);
-                let wh2 = scale(wh2, rcp_norm);
-                let cos_mh2 = dot(wmt, wh2);
+            if tt_mul > 0.0 && wo.dot(wt) >= inv_eta - 1e-5 {
+                let wh2 = -wt + wo * inv_eta;
+                let rcp_norm = 1.0 / wh2.length();
+                let wh2 = wh2 * rcp_norm;
+                let cos_mh2 = wmt.dot(wh2);
                 if cos_mh2 >= 0.0 {
-                    let cos_hi2 = dot(neg(wt), wh2);
-                    let cos_ho2 = dot(neg(wo), wh2);
-                    let cos_mo2 = dot(neg(wo), wmt);
+                    let cos_hi2 = (-wt).dot(wh2);
+                    let cos_ho2 = (-wo).dot(wh2);
+                    let cos_mo2 = (-wo).dot(wmt);
                     let t2 = (1.0 - fresnel_cos(cos_hi2, inv_eta)) * scale2;
                     let d2 = ggx_d(a2, cos_mh2);
                     let g2 = ggx_g2(a2, cos_mi2, cos_mo2);
@@ -340,50 +343,49 @@ impl Huang {
                         * cos_ho2
                         * rcp_norm
                         * rcp_norm;
-                    let result = scale(a_t, s);
-                    if finite(result) {
-                        s_tt = add(s_tt, scale(result, tt_mul * arc_length(self.e2, gamma_mt)));
+                    let result = a_t * s;
+                    if result.is_finite() {
+                        s_tt += result * (tt_mul * arc_length(self.e2, gamma_mt));
                     }
                 }
             }
 
             if trt_mul > 0.0 {
                 let u2 = [lcg_float(rng), lcg_float(rng)];
-                let wh2 = sample_wh(self.roughness, neg(wt), wmt, u2);
-                let cos_hi2 = dot(neg(wt), wh2);
+                let wh2 = sample_wh(self.roughness, -wt, wmt, u2);
+                let cos_hi2 = (-wt).dot(wh2);
                 if !(cos_hi2 > 0.0) {
                     continue;
                 }
                 let r2 = fresnel_cos(cos_hi2, inv_eta);
-                let wtr = neg(reflect(wt, wh2));
+                let wtr = -reflect(wt, wh2);
                 let trrt = trrt_series(t1, r2, a_t);
-                if dot(neg(wtr), wo) < inv_eta - 1e-5 {
+                if (-wtr).dot(wo) < inv_eta - 1e-5 {
                     // Total internal reflection.
-                    s_trrt = add(s_trrt, scale(trrt, weight));
+                    s_trrt += trrt * weight;
                     continue;
                 }
-                if !visible2(neg(wt), neg(wtr), wmt, wh2) || !visible2(neg(wt), neg(wtr), wmt_, wh2)
-                {
+                if !visible2(-wt, -wtr, wmt, wh2) || !visible2(-wt, -wtr, wmt_, wh2) {
                     continue;
                 }
                 let phi_tr = dir_phi(wtr);
                 let gamma_mtr = gamma_mi - 2.0 * (to_phi(phi_t, b) - to_phi(phi_tr, b)) + PI;
                 let wmtr = sphg_dir(-self.tilt, gamma_mtr, b);
                 let wmtr_ = sphg_dir(0.0, gamma_mtr, b);
-                let wh3 = add(wtr, scale(wo, inv_eta));
-                let rcp_norm3 = 1.0 / len(wh3);
-                let wh3 = scale(wh3, rcp_norm3);
-                let cos_mh3 = dot(wmtr, wh3);
+                let wh3 = wtr + wo * inv_eta;
+                let rcp_norm3 = 1.0 / wh3.length();
+                let wh3 = wh3 * rcp_norm3;
+                let cos_mh3 = wmtr.dot(wh3);
                 if cos_mh3 < 0.0
-                    || !visible2(wtr, neg(wo), wmtr, wh3)
-                    || !visible2(wtr, neg(wo), wmtr_, wh3)
+                    || !visible2(wtr, -wo, wmtr, wh3)
+                    || !visible2(wtr, -wo, wmtr_, wh3)
                 {
-                    s_trrt = add(s_trrt, scale(trrt, weight));
+                    s_trrt += trrt * weight;
                     continue;
                 }
-                let cos_hi3 = dot(wh3, wtr);
-                let cos_ho3 = dot(wh3, neg(wo));
-                let cos_mi3 = dot(wmtr, wtr);
+                let cos_hi3 = wh3.dot(wtr);
+                let cos_ho3 = wh3.dot(-wo);
+                let cos_mi3 = wmtr.dot(wtr);
                 let t3 = (1.0 - fresnel_cos(cos_hi3, inv_eta))
                     * self.energy_scale(tables, cos_mi3, inv_eta);
                 let d3 = ggx_d(a2, cos_mh3);
@@ -393,9 +395,9 @@ impl Huang {
                     len2(sub2(to_point(gamma_mtr, b), to_point(gamma_mt, b)))
                 };
                 let a_tr = mu_a.map(|m| (m / cos_theta(wtr) * -path_tr).exp());
-                let cos_mo2 = dot(wmt, neg(wtr));
+                let cos_mo2 = wmt.dot(-wtr);
                 let g2o = ggx_go(a2, cos_mi2, cos_mo2);
-                let g3 = ggx_g2(a2, cos_mi3, dot(wmtr, neg(wo)));
+                let g3 = ggx_g2(a2, cos_mi3, wmtr.dot(-wo));
                 let s = weight * t1 * scale1 * r2 * scale2 * t3 * d3 * g1o * g2o * g3
                     / (cos_mo1 * cos_mo2)
                     * cos_mi1
@@ -404,14 +406,11 @@ impl Huang {
                     * cos_ho3
                     * rcp_norm3
                     * rcp_norm3;
-                let result = scale(mul(a_t, a_tr), s);
-                if finite(result) {
-                    s_trt = add(
-                        s_trt,
-                        scale(result, trt_mul * arc_length(self.e2, gamma_mtr)),
-                    );
+                let result = a_t * a_tr * s;
+                if result.is_finite() {
+                    s_trt += result * (trt_mul * arc_length(self.e2, gamma_mtr));
                 }
-                s_trrt = add(s_trrt, scale(trrt, weight));
+                s_trrt += trrt * weight;
             }
         }
         // TRRT+ with Chiang et al.'s longitudinal lobe and a uniform azimuth.
@@ -424,19 +423,13 @@ impl Huang {
         );
         let n = 1.0 / (2.0 * PI);
         let simpson = 2.0 / 3.0 * res;
-        scale(
-            add(
-                scale(add(s_tt, s_trt), inv_eta * inv_eta),
-                scale(s_trrt, m * n * (2.0 / PI)),
-            ),
-            simpson,
-        )
+        ((s_tt + s_trt) * (inv_eta * inv_eta) + s_trrt * (m * n * (2.0 / PI))) * simpson
     }
 
     /// Cycles' bsdf_hair_huang_sample: (direction, value, pdf 1). Cycles labels every
     /// sample a glossy reflection, through the fibre or not. Long because it follows
     /// Cycles' function step for step (R, TT, TRT and TRRT+ chosen by their energies).
-    pub fn sample(&self, u: [f32; 3], tables: &Tables) -> Option<(V3, V3, f32)> {
+    pub fn sample(&self, u: [f32; 3], tables: &Tables) -> Option<(Vec3, Vec3, f32)> {
         let mut rng = hash_u(u);
         let roughness = self.roughness;
         let sample_lobe = u[0];
@@ -455,24 +448,24 @@ impl Huang {
         let gamma_mi = h_to_gamma(h_div_r, b, wi);
         let wmi_ = sphg_dir(0.0, gamma_mi, b);
         let (st, ct) = self.tilt.sin_cos();
-        let wmi = [wmi_[0] * ct, st, wmi_[2] * ct];
-        let cos_mi1 = dot(wmi, wi);
-        if cos_mi1 < 0.0 || dot(wmi_, wi) < 0.0 {
+        let wmi = vec3(wmi_.x * ct, st, wmi_.z * ct);
+        let cos_mi1 = wmi.dot(wi);
+        if cos_mi1 < 0.0 || wmi_.dot(wi) < 0.0 {
             return None;
         }
         let a2 = roughness * roughness;
         let wh1 = sample_wh(roughness, wi, wmi, u_h1);
-        let wr = neg(reflect(wi, wh1));
+        let wr = -reflect(wi, wh1);
         if !visible1(wi, wmi_, wh1) {
             return None;
         }
-        let (r1, cos_theta_t1) = fresnel(dot(wi, wh1), self.eta);
+        let (r1, cos_theta_t1) = fresnel(wi.dot(wh1), self.eta);
         let scale1 = self.energy_scale(tables, cos_mi1, self.eta);
         let r = self.lobes[0]
             * r1
             * scale1
             * if visible1(wr, wmi_, wh1) { 1.0 } else { 0.0 }
-            * ggx_go(a2, cos_mi1, dot(wmi, wr));
+            * ggx_go(a2, cos_mi1, wmi.dot(wr));
 
         let inv_eta = 1.0 / self.eta;
         let wt = refract_angle(wi, wh1, cos_theta_t1, inv_eta);
@@ -480,17 +473,17 @@ impl Huang {
         let gamma_mt = 2.0 * to_phi(phi_t, b) - gamma_mi;
         let wmt = sphg_dir(-self.tilt, gamma_mt, b);
         let wmt_ = sphg_dir(0.0, gamma_mt, b);
-        let wh2 = sample_wh(roughness, neg(wt), wmt, u_h2);
-        let wtr = neg(reflect(wt, wh2));
+        let wh2 = sample_wh(roughness, -wt, wmt, u_h2);
+        let wtr = -reflect(wt, wh2);
 
-        let mut wtt = [0.0; 3];
-        let mut wtrt = [0.0; 3];
-        let mut wtrrt = [0.0; 3];
-        let mut tt = [0.0; 3];
-        let mut trt = [0.0; 3];
-        let mut trrt = [0.0; 3];
-        let cos_mi2 = dot(neg(wt), wmt);
-        if cos_mi2 > 0.0 && visible1(neg(wt), wmi_, wh1) && visible1(neg(wt), wmt_, wh2) {
+        let mut wtt = Vec3::ZERO;
+        let mut wtrt = Vec3::ZERO;
+        let mut wtrrt = Vec3::ZERO;
+        let mut tt = Vec3::ZERO;
+        let mut trt = Vec3::ZERO;
+        let mut trrt = Vec3::ZERO;
+        let cos_mi2 = (-wt).dot(wmt);
+        if cos_mi2 > 0.0 && visible1(-wt, wmi_, wh1) && visible1(-wt, wmt_, wh2) {
             let mu_a = self.sigma;
             let path = if self.circular() {
                 2.0 * (phi_t - gamma_mi).cos()
@@ -498,24 +491,21 @@ impl Huang {
                 -len2(sub2(to_point(gamma_mi, b), to_point(gamma_mt + PI, b)))
             };
             let a_t = mu_a.map(|m| (m / cos_theta(wt) * path).exp());
-            let (r2, cos_theta_t2) = fresnel(dot(neg(wt), wh2), inv_eta);
-            let t1 = (1.0 - r1) * scale1 * ggx_go(a2, cos_mi1, dot(wmi, neg(wt)));
+            let (r2, cos_theta_t2) = fresnel((-wt).dot(wh2), inv_eta);
+            let t1 = (1.0 - r1) * scale1 * ggx_go(a2, cos_mi1, wmi.dot(-wt));
             let t2 = 1.0 - r2;
             let scale2 = self.energy_scale(tables, cos_mi2, inv_eta);
-            wtt = refract_angle(neg(wt), wh2, cos_theta_t2, self.eta);
-            if dot(wmt, neg(wtt)) > 0.0 && t2 > 0.0 && visible1(neg(wtt), wmt_, wh2) {
-                tt = scale(
-                    a_t,
-                    self.lobes[1] * t1 * t2 * scale2 * ggx_go(a2, cos_mi2, dot(wmt, neg(wtt))),
-                );
+            wtt = refract_angle(-wt, wh2, cos_theta_t2, self.eta);
+            if wmt.dot(-wtt) > 0.0 && t2 > 0.0 && visible1(-wtt, wmt_, wh2) {
+                tt = a_t * (self.lobes[1] * t1 * t2 * scale2 * ggx_go(a2, cos_mi2, wmt.dot(-wtt)));
             }
             let phi_tr = dir_phi(wtr);
             let gamma_mtr = gamma_mi - 2.0 * (to_phi(phi_t, b) - to_phi(phi_tr, b)) + PI;
             let wmtr = sphg_dir(-self.tilt, gamma_mtr, b);
             let wh3 = sample_wh(roughness, wtr, wmtr, u_h3);
-            let (r3, cos_theta_t3) = fresnel(dot(wtr, wh3), inv_eta);
+            let (r3, cos_theta_t3) = fresnel(wtr.dot(wh3), inv_eta);
             wtrt = refract_angle(wtr, wh3, cos_theta_t3, self.eta);
-            let cos_mi3 = dot(wmtr, wtr);
+            let cos_mi3 = wmtr.dot(wtr);
             if cos_mi3 > 0.0 {
                 let path_tr = if self.circular() {
                     2.0 * (phi_tr - gamma_mt).cos().abs()
@@ -523,22 +513,19 @@ impl Huang {
                     len2(sub2(to_point(gamma_mt, b), to_point(gamma_mtr, b)))
                 };
                 let a_tr = mu_a.map(|m| (m / cos_theta(wtr) * -path_tr).exp());
-                let tr = scale(
-                    mul(a_t, a_tr),
-                    t1 * r2
+                let tr = a_t
+                    * a_tr
+                    * (t1
+                        * r2
                         * scale2
                         * self.energy_scale(tables, cos_mi3, inv_eta)
-                        * ggx_go(a2, cos_mi2, dot(wmt, neg(wtr))),
-                );
+                        * ggx_go(a2, cos_mi2, wmt.dot(-wtr)));
                 let t3 = 1.0 - r3;
                 if t3 > 0.0
                     && visible1(wtr, wmtr_flat(wmtr), wh3)
-                    && visible1(neg(wtrt), wmtr_flat(wmtr), wh3)
+                    && visible1(-wtrt, wmtr_flat(wmtr), wh3)
                 {
-                    trt = scale(
-                        tr,
-                        self.lobes[2] * t3 * ggx_go(a2, cos_mi3, dot(wmtr, neg(wtrt))),
-                    );
+                    trt = tr * (self.lobes[2] * t3 * ggx_go(a2, cos_mi3, wmtr.dot(-wtrt)));
                 }
                 // TRRT+: Chiang et al.'s longitudinal lobe about the viewer, any azimuth.
                 let rand_theta = lcg_float(&mut rng).max(1e-5);
@@ -551,39 +538,39 @@ impl Huang {
                 let cos_theta_o = cos_from_sin(sin_theta_o);
                 let phi_o = 2.0 * PI * lcg_float(&mut rng);
                 let (sin_phi_o, cos_phi_o) = phi_o.sin_cos();
-                wtrrt = [
+                wtrrt = vec3(
                     sin_phi_o * cos_theta_o,
                     sin_theta_o,
                     cos_phi_o * cos_theta_o,
-                ];
+                );
                 // The series A T + A^2 R T + ..., attenuations from the bounces before.
-                let a_avg = mul(a_t, a_tr).map(|x| x.sqrt());
+                let a_avg = (a_t * a_tr).map(|x| x.sqrt());
                 let t_avg = (0.5 * (t2 + t3)).max(1e-5);
                 let a_res = a_avg.map(|a| a * t_avg / (1.0 - a * (1.0 - t_avg)));
-                trrt = scale(
-                    mul(mul(tr, a_res), [r3; 3]),
-                    ggx_go(a2, cos_mi3, dot(wmtr, neg(reflect(wtr, wh3)))),
-                );
+                trrt = tr
+                    * a_res
+                    * Vec3::splat(r3)
+                    * ggx_go(a2, cos_mi3, wmtr.dot(-reflect(wtr, wh3)));
             }
         }
-        let tt_e = average(tt);
-        let trt_e = average(trt);
-        let trrt_e = average(trrt);
+        let tt_e = tt.average();
+        let trt_e = trt.average();
+        let trrt_e = trrt.average();
         let total = r + tt_e + trt_e + trrt_e;
         if !(total > 0.0) || !total.is_finite() {
             return None;
         }
         let x = sample_lobe * total;
         let (local, value) = if x < r {
-            (wr, [total; 3])
+            (wr, Vec3::splat(total))
         } else if x < r + tt_e {
-            (wtt, scale(tt, total / tt_e))
+            (wtt, tt * (total / tt_e))
         } else if x < r + tt_e + trt_e {
-            (wtrt, scale(trt, total / trt_e))
+            (wtrt, trt * (total / trt_e))
         } else {
-            (wtrrt, scale(trrt, total / trrt_e))
+            (wtrrt, trrt * (total / trrt_e))
         };
-        if !finite(value) || !finite(local) {
+        if !value.is_finite() || !local.is_finite() {
             return None;
         }
         Some((self.global_of(local), value, 1.0))
@@ -591,13 +578,13 @@ impl Huang {
 }
 
 /// Cycles' make_float3(wmtr.x, 0, wmtr.z): the mesonormal's visibility ignores its tilt.
-fn wmtr_flat(w: V3) -> V3 {
-    [w[0], 0.0, w[2]]
+fn wmtr_flat(w: Vec3) -> Vec3 {
+    vec3(w.x, 0.0, w.z)
 }
 
 /// Cycles' bsdf_hair_huang_eval_trrt: TRRT and beyond as a geometric series, with the
 /// attenuations of the bounces before.
-fn trrt_series(t: f32, r: f32, a: V3) -> V3 {
+fn trrt_series(t: f32, r: f32, a: Vec3) -> Vec3 {
     let t_avg = (1.0 - r).max(1e-5);
     a.map(|a| {
         let trrt_avg = t * r * r * t_avg * a * a * a;
@@ -620,24 +607,24 @@ fn simpson_weight(k: usize, intervals: usize) -> f32 {
     }
 }
 
-fn safe_normalize(v: V3) -> V3 {
-    let l = len(v);
+fn safe_normalize(v: Vec3) -> Vec3 {
+    let l = v.length();
     if l > 0.0 {
-        scale(v, 1.0 / l)
+        v * (1.0 / l)
     } else {
-        [0.0; 3]
+        Vec3::ZERO
     }
 }
 
 /// Cycles' make_orthonormals: two unit vectors perpendicular to `n` and each other.
-fn make_orthonormals(n: V3) -> (V3, V3) {
-    let a = if n[0] != n[1] || n[0] != n[2] {
-        [n[2] - n[1], n[0] - n[2], n[1] - n[0]]
+fn make_orthonormals(n: Vec3) -> (Vec3, Vec3) {
+    let a = if n.x != n.y || n.x != n.z {
+        vec3(n.z - n.y, n.x - n.z, n.y - n.x)
     } else {
-        [n[2] - n[1], n[0] + n[2], -n[1] - n[0]]
+        vec3(n.z - n.y, n.x + n.z, -n.y - n.x)
     };
-    let a = normalize(a);
-    (a, cross(n, a))
+    let a = a.normalize();
+    (a, n.cross(a))
 }
 
 fn sqr(x: f32) -> f32 {
@@ -648,26 +635,26 @@ fn cos_from_sin(s: f32) -> f32 {
     (1.0 - s * s).max(0.0).sqrt()
 }
 
-fn sin_theta(w: V3) -> f32 {
-    w[1]
+fn sin_theta(w: Vec3) -> f32 {
+    w.y
 }
 
-fn cos_theta(w: V3) -> f32 {
-    (sqr(w[0]) + sqr(w[2])).max(0.0).sqrt()
+fn cos_theta(w: Vec3) -> f32 {
+    (sqr(w.x) + sqr(w.z)).max(0.0).sqrt()
 }
 
-fn tan_theta(w: V3) -> f32 {
+fn tan_theta(w: Vec3) -> f32 {
     sin_theta(w) / cos_theta(w)
 }
 
-fn sincos_phi(w: V3) -> [f32; 2] {
+fn sincos_phi(w: Vec3) -> [f32; 2] {
     let c = cos_theta(w);
-    [w[0] / c, w[2] / c]
+    [w.x / c, w.z / c]
 }
 
 /// The azimuth, 0 toward local z (the viewer's on a circular fibre).
-fn dir_phi(w: V3) -> f32 {
-    w[0].atan2(w[2])
+fn dir_phi(w: Vec3) -> f32 {
+    w.x.atan2(w.z)
 }
 
 fn to_phi(gamma: f32, b: f32) -> f32 {
@@ -679,7 +666,7 @@ fn to_phi(gamma: f32, b: f32) -> f32 {
 }
 
 /// The offset across the fibre of the ray toward the ellipse point at azimuth `phi`.
-fn phi_to_h(phi: f32, b: f32, wi: V3) -> f32 {
+fn phi_to_h(phi: f32, b: f32, wi: Vec3) -> f32 {
     if b == 1.0 {
         return -phi.sin();
     }
@@ -692,11 +679,11 @@ fn phi_to_h(phi: f32, b: f32, wi: V3) -> f32 {
     -sc[1] * sg + b * sc[0] * cg
 }
 
-fn h_to_gamma(h_div_r: f32, b: f32, wi: V3) -> f32 {
+fn h_to_gamma(h_div_r: f32, b: f32, wi: Vec3) -> f32 {
     if b == 1.0 {
         -h_div_r.asin()
     } else {
-        wi[2].atan2(-b * wi[0]) - (-h_div_r).acos()
+        wi.z.atan2(-b * wi.x) - (-h_div_r).acos()
     }
 }
 
@@ -729,7 +716,7 @@ fn len2(a: [f32; 2]) -> f32 {
 }
 
 /// The direction at elevation `theta` whose azimuth is the ellipse normal's at `gamma`.
-fn sphg_dir(theta: f32, gamma: f32, b: f32) -> V3 {
+fn sphg_dir(theta: f32, gamma: f32, b: f32) -> Vec3 {
     let (st, ct) = theta.sin_cos();
     let (sg, cg) = gamma.sin_cos();
     let (sp, cp) = if b == 1.0 || cg.abs() < 1e-6 {
@@ -739,7 +726,7 @@ fn sphg_dir(theta: f32, gamma: f32, b: f32) -> V3 {
         let cp = cg.signum() / (tan_phi * tan_phi + 1.0).sqrt();
         (cp * tan_phi, cp)
     };
-    [sp * ct, st, cp * ct]
+    vec3(sp * ct, st, cp * ct)
 }
 
 fn arc_length(e2: f32, gamma: f32) -> f32 {
@@ -750,16 +737,13 @@ fn arc_length(e2: f32, gamma: f32) -> f32 {
     }
 }
 
-fn reflect(w: V3, n: V3) -> V3 {
+fn reflect(w: Vec3, n: Vec3) -> Vec3 {
     // Cycles' reflect(incident, unit_normal): incident - 2 n (n . incident).
-    sub(w, scale(n, 2.0 * dot(n, w)))
+    w - n * (2.0 * n.dot(w))
 }
 
-fn refract_angle(incident: V3, normal: V3, cos_theta_t: f32, inv_eta: f32) -> V3 {
-    sub(
-        scale(normal, inv_eta * dot(normal, incident) + cos_theta_t),
-        scale(incident, inv_eta),
-    )
+fn refract_angle(incident: Vec3, normal: Vec3, cos_theta_t: f32, inv_eta: f32) -> Vec3 {
+    normal * (inv_eta * normal.dot(incident) + cos_theta_t) - incident * inv_eta
 }
 
 /// Cycles' fresnel_dielectric with the refracted cosine (negative; 0 on total internal
@@ -807,20 +791,20 @@ fn ggx_go(a2: f32, cos_i: f32, cos_o: f32) -> f32 {
     (1.0 + li) / (1.0 + li + lo)
 }
 
-fn visible1(v: V3, m: V3, h: V3) -> bool {
-    dot(v, h) > 0.0 && dot(v, m) > 0.0
+fn visible1(v: Vec3, m: Vec3, h: Vec3) -> bool {
+    v.dot(h) > 0.0 && v.dot(m) > 0.0
 }
 
-fn visible2(wi: V3, wo: V3, m: V3, h: V3) -> bool {
+fn visible2(wi: Vec3, wo: Vec3, m: Vec3, h: Vec3) -> bool {
     visible1(wi, m, h) && visible1(wo, m, h)
 }
 
 /// A visible microfacet normal about the (tilted) mesonormal `wm` (Cycles' sample_wh).
-fn sample_wh(roughness: f32, wi: V3, wm: V3, u: [f32; 2]) -> V3 {
+fn sample_wh(roughness: f32, wi: Vec3, wm: Vec3, u: [f32; 2]) -> Vec3 {
     let (s, t) = make_orthonormals(wm);
-    let local = [dot(wi, s), dot(wi, t), dot(wi, wm)];
-    let h = sample_ggx_vndf(local, roughness, roughness, u);
-    add(add(scale(s, h[0]), scale(t, h[1])), scale(wm, h[2]))
+    let local = vec3(wi.dot(s), wi.dot(t), wi.dot(wm));
+    let h = ggx_vndf(local, roughness, roughness, u);
+    s * h.x + t * h.y + wm * h.z
 }
 
 fn intersect(a: (f32, f32), b: (f32, f32)) -> (f32, f32) {
@@ -833,10 +817,10 @@ fn lcg_float(rng: &mut u32) -> f32 {
     *rng as f32 * (1.0 / 0xFFFF_FFFFu32 as f32)
 }
 
-fn hash_dirs(a: V3, b: V3, h: f32) -> u32 {
+fn hash_dirs(a: Vec3, b: Vec3, h: f32) -> u32 {
     use crate::nodes::random::hash4;
-    let k = hash4(a[0].to_bits(), a[1].to_bits(), a[2].to_bits(), h.to_bits());
-    hash4(k, b[0].to_bits(), b[1].to_bits(), b[2].to_bits())
+    let k = hash4(a.x.to_bits(), a.y.to_bits(), a.z.to_bits(), h.to_bits());
+    hash4(k, b.x.to_bits(), b.y.to_bits(), b.z.to_bits())
 }
 
 fn hash_u(u: [f32; 3]) -> u32 {
@@ -856,11 +840,11 @@ mod tests {
             aspect_ratio: aspect,
             lobes: [1.0; 3],
         };
-        let wo = normalize([0.3, 1.0, 0.5]);
+        let wo = vec3(0.3, 1.0, 0.5).normalize();
         match Huang::setup(
             &p,
             [0.0, 0.0, 1.0],
-            wo,
+            wo.into(),
             Across::Ribbon { v },
             [0.0; 3],
             coverage,
@@ -870,12 +854,12 @@ mod tests {
         }
     }
 
-    fn sphere_dir(i: usize, j: usize, n: usize) -> (V3, f32) {
+    fn sphere_dir(i: usize, j: usize, n: usize) -> (Vec3, f32) {
         let z = -1.0 + (i as f32 + 0.5) / n as f32 * 2.0;
         let phi = (j as f32 + 0.5) / (2 * n) as f32 * 2.0 * PI;
         let r = (1.0 - z * z).sqrt();
         (
-            [r * phi.cos(), r * phi.sin(), z],
+            vec3(r * phi.cos(), r * phi.sin(), z),
             4.0 * PI / (2 * n * n) as f32,
         )
     }
@@ -911,7 +895,7 @@ mod tests {
                     ];
                     if let Some((wi, f, pdf)) = c.sample(u, tables) {
                         assert_eq!(pdf, 1.0);
-                        assert!((len(wi) - 1.0).abs() < 1e-3, "{wi:?}");
+                        assert!((wi.length() - 1.0).abs() < 1e-3, "{wi:?}");
                         for ch in 0..3 {
                             sum[ch] += f[ch] as f64;
                         }

@@ -15,6 +15,7 @@ use crate::render::integrator::shade::{
     input_c, input_f, input_n, is_multiggx, multiscatter_darkening, multiscatter_energy,
     push_glossy, tangent_input, valid_n, Context,
 };
+use crate::render::math::Vec3;
 
 /// F82-tint Schlick (Cycles' bsdf_microfacet_setup_fresnel_f82_tint): `b` chosen so that
 /// F(acos 1/7) = Schlick's value there times `tint`.
@@ -79,7 +80,7 @@ pub(crate) fn metallic(
     let (fresnel, fss) = fresnel_of(b, s);
     // The lobe's sampling weight: its average single-scattering reflectance.
     let albedo = ((fss[0] + fss[1] + fss[2]) / 3.0).clamp(1e-3, 1.0);
-    let mu = crate::render::math::dot(vn, ctx.wo).clamp(0.0, 1.0);
+    let mu = Vec3::from(vn).dot(ctx.wo.into()).clamp(0.0, 1.0);
     if b.property("distribution") == Some("BECKMANN") {
         // Anisotropic Beckmann is refused at compile time (shader/compile/node_table.rs).
         let r = crate::render::bsdf::microfacet::Reflection {

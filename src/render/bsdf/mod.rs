@@ -427,17 +427,17 @@ impl LobeSet {
         let l = &self.lobes[pick];
         let (wi, own, own_pdf, transmit) = match l.kind {
             LobeKind::Hair(h) => {
-                let s = h.sample(wo.into(), [u[0], u[1]])?;
-                (s.wi.into(), Vec3::splat(s.pdf), s.pdf, h.transmission)
+                let s = h.sample(wo, [u[0], u[1]])?;
+                (s.wi, Vec3::splat(s.pdf), s.pdf, h.transmission)
             }
             LobeKind::Chiang(c) => {
-                let (wi, f, pdf, transmit) = c.sample(l.n, wo.into(), u)?;
-                (wi.into(), f.into(), pdf, transmit)
+                let (wi, f, pdf, transmit) = c.sample(l.n.into(), wo, u)?;
+                (wi, f, pdf, transmit)
             }
             // Cycles labels every Huang sample a glossy reflection.
             LobeKind::Huang(c) => {
                 let (wi, f, pdf) = c.sample(u, tables)?;
-                (wi.into(), f.into(), pdf, false)
+                (wi, f, pdf, false)
             }
             _ => return None,
         };
@@ -797,17 +797,11 @@ fn eval_lobe(l: &Lobe, wo: Vec3, wi: Vec3, _ng: Vec3, tables: &Tables) -> (Vec3,
             (Vec3::splat(f), p)
         }
         LobeKind::Hair(h) => {
-            let p = h.eval(l.n, wo.into(), wi.into());
+            let p = h.eval(l.n.into(), wo, wi);
             (Vec3::splat(p), p)
         }
-        LobeKind::Chiang(c) => {
-            let (f, p) = c.eval(l.n, wo.into(), wi.into());
-            (f.into(), p)
-        }
-        LobeKind::Huang(c) => {
-            let (f, p) = c.eval(wi.into(), tables);
-            (f.into(), p)
-        }
+        LobeKind::Chiang(c) => c.eval(l.n.into(), wo, wi),
+        LobeKind::Huang(c) => c.eval(wi, tables),
         LobeKind::GlossyAniso {
             lobe,
             fresnel,

@@ -7,7 +7,7 @@
 //! the metallic layer.
 
 use crate::render::bsdf::f0_from_ior;
-use crate::render::math::*;
+use crate::render::math::{Vec3, V3};
 use std::f32::consts::PI;
 
 /// Cycles' THINFILM_THICKNESS_CUTOFF: thinner films (nm) are no film at all.
@@ -67,7 +67,7 @@ fn polarized(cos_i: f32, eta: f32) -> Option<([f32; 2], f32, [bool; 2])> {
 /// Belcour and Barla's Fourier-space XYZ sensitivity at optical path difference `opd`
 /// (nm) with no phase shift. Cycles' version takes a shift, but here every shift is a
 /// multiple of pi (dielectric interfaces), which only flips the sign (see `airy`).
-fn sensitivity(opd: f32) -> V3 {
+fn sensitivity(opd: f32) -> Vec3 {
     const VAL: V3 = [5.4856e-13, 4.4201e-13, 5.2481e-13];
     const POS: V3 = [1.6810e+06, 1.7953e+06, 2.2084e+06];
     const VAR: V3 = [4.3278e+09, 9.3046e+09, 6.6121e+09];
@@ -81,25 +81,25 @@ fn sensitivity(opd: f32) -> V3 {
     }
     // The fit's second lobe of X.
     xyz[0] += 1.64408e-8 * (2.2399e+06 * phase).cos() * (-4.5282e+09 * phase * phase).exp();
-    scale(xyz, 1.0 / 1.0685e-7)
+    Vec3::from(xyz) * (1.0 / 1.0685e-7)
 }
 
 /// Airy summation (the paper's equation 10) for one polarization, in XYZ: the film's
 /// first reflection plus the interfering internal paths, to path-order difference 3.
 /// `flip` says the phase shift is an odd multiple of pi (each order m adds m of it).
-fn airy(r12: f32, r23: f32, sens: &[V3; 3], flip: bool) -> V3 {
+fn airy(r12: f32, r23: f32, sens: &[Vec3; 3], flip: bool) -> Vec3 {
     if r23 == 1.0 {
-        return [1.0; 3];
+        return Vec3::ONE;
     }
     let t121 = 1.0 - r12;
     let r123 = r12 * r23;
     let rs = t121 * t121 * r23 / (1.0 - r123);
-    let mut out = [r12 + rs; 3];
+    let mut out = Vec3::splat(r12 + rs);
     let mut cm = rs - t121;
     for (m, s) in sens.iter().enumerate() {
         cm *= r123.sqrt();
         let sign = if flip && m % 2 == 0 { -1.0 } else { 1.0 };
-        out = add(out, scale(*s, 2.0 * cm * sign));
+        out += *s * (2.0 * cm * sign);
     }
     out
 }
@@ -145,8 +145,8 @@ pub fn reflectance(film_ior: f32, eta: f32, cos_i: f32, thickness: f32) -> V3 {
     let flip = |p: usize| neg12[p] == neg23[p];
     let rs = airy(r12[0], r23[0], &sens, flip(0));
     let rp = airy(r12[1], r23[1], &sens, flip(1));
-    let xyz = scale(add(rs, rp), 0.5);
-    XYZ_TO_REC709_WHITE.map(|row| dot(row, xyz).clamp(0.0, 1.0))
+    let xyz = (rs + rp) * 0.5;
+    XYZ_TO_REC709_WHITE.map(|row| Vec3::from(row).dot(xyz).clamp(0.0, 1.0))
 }
 
 #[cfg(test)]

@@ -5,16 +5,16 @@
 
 use std::f32::consts::PI;
 
-use crate::render::math::*;
+use crate::render::math::{vec3, Vec3};
 
 /// The region of an area light that light sampling draws from: the whole light, or (with
 /// a spread) a smaller rectangle, ellipse or circle in its plane.
 #[derive(Debug, Clone, Copy)]
 pub struct Region {
-    pub centre: V3,
-    pub axis_u: V3,
+    pub centre: Vec3,
+    pub axis_u: Vec3,
     pub len_u: f32,
-    pub axis_v: V3,
+    pub axis_v: Vec3,
     pub len_v: f32,
     /// Sampled by solid angle as a rectangle (else uniformly by area as an ellipse).
     pub rectangle: bool,
@@ -53,8 +53,8 @@ impl Spread {
 
     /// The fraction of the light's radiance leaving along `d` (from the shading point
     /// toward the light) past the soft box's slats; `ng` is the light's emission direction.
-    pub fn attenuation(&self, d: V3, ng: V3) -> f32 {
-        let cos_a = -dot(d, ng);
+    pub fn attenuation(&self, d: Vec3, ng: Vec3) -> f32 {
+        let cos_a = -d.dot(ng);
         if self.tan_half == 0.0 {
             // A zero spread emits only along its normal; pi integrates it over the hemisphere.
             return if cos_a > 0.9999997 { PI } else { 0.0 };
@@ -66,14 +66,14 @@ impl Spread {
     /// The smallest region of `full` (the light seen without spread) that light from the
     /// spread can reach `p` through, as Cycles' area_light_spread_clamp_light; None when
     /// no part of the light can.
-    pub fn clamp(&self, p: V3, ng: V3, full: Region) -> Option<Region> {
+    pub fn clamp(&self, p: Vec3, ng: Vec3, full: Region) -> Option<Region> {
         let mut r = full;
-        let closest = sub(p, scale(ng, dot(ng, sub(p, r.centre))));
-        let t = len(sub(closest, p));
+        let closest = p - ng * ng.dot(p - r.centre);
+        let t = (closest - p).length();
         // The circle of the light plane whose light reaches p.
         let r_spread = t * self.tan_half;
-        let su = dot(r.axis_u, sub(closest, r.centre));
-        let sv = dot(r.axis_v, sub(closest, r.centre));
+        let su = r.axis_u.dot(closest - r.centre);
+        let sv = r.axis_v.dot(closest - r.centre);
         let round = !r.rectangle && r.len_u == r.len_v;
         let mut sample_spread = r_spread == 0.0;
         if round && !sample_spread {
@@ -96,13 +96,10 @@ impl Spread {
                 let circle_area = PI * rad * rad;
                 let spread_area = PI * r_spread * r_spread;
                 if rect_area < circle_area.min(spread_area) {
-                    let axis_u = normalize(sub(r.centre, closest));
+                    let axis_u = (r.centre - closest).normalize();
                     // Rotated a quarter turn about the light's normal.
-                    let axis_v = cross(ng, axis_u);
-                    let centre = scale(
-                        add(add(r.centre, closest), scale(axis_u, r_spread - rad)),
-                        0.5,
-                    );
+                    let axis_v = ng.cross(axis_u);
+                    let centre = (r.centre + closest + axis_u * (r_spread - rad)) * 0.5;
                     return Some(Region {
                         centre,
                         axis_u,
@@ -136,7 +133,7 @@ impl Spread {
             if r.rectangle || rect_area < ellipse_area.min(spread_area) {
                 let cu = 0.5 * (min_u + max_u);
                 let cv = 0.5 * (min_v + max_v);
-                r.centre = add(r.centre, add(scale(r.axis_u, cu), scale(r.axis_v, cv)));
+                r.centre += r.axis_u * cu + r.axis_v * cv;
                 r.len_u = lu;
                 r.len_v = lv;
                 r.rectangle = true;
@@ -147,7 +144,7 @@ impl Spread {
         }
         if sample_spread {
             r.rectangle = false;
-            r.centre = add(r.centre, add(scale(r.axis_u, su), scale(r.axis_v, sv)));
+            r.centre += r.axis_u * su + r.axis_v * sv;
             r.len_u = 2.0 * r_spread;
             r.len_v = 2.0 * r_spread;
         }
@@ -159,8 +156,8 @@ impl Spread {
 /// uniformly by solid angle (Ureña et al.'s parametrization, as Cycles'
 /// area_light_rect_sample). Computed in f64: at grazing or far views the f32 angle sum
 /// loses the solid angle to cancellation.
-pub fn rect_solid_angle(p: V3, r: &Region, u: Option<[f32; 2]>) -> (f32, Option<V3>) {
-    let d3 = |a: V3| [a[0] as f64, a[1] as f64, a[2] as f64];
+pub fn rect_solid_angle(p: Vec3, r: &Region, u: Option<[f32; 2]>) -> (f32, Option<Vec3>) {
+    let d3 = |a: Vec3| [a.x as f64, a.y as f64, a.z as f64];
     let dot64 = |a: [f64; 3], b: [f64; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let (x, y) = (d3(r.axis_u), d3(r.axis_v));
     let mut z = [
@@ -218,7 +215,8 @@ pub fn rect_solid_angle(p: V3, r: &Region, u: Option<[f32; 2]>) -> (f32, Option<
         } else {
             y1
         };
-        [0, 1, 2].map(|i| (pp[i] + xu * x[i] + yv * y[i] + z0 * z[i]) as f32)
+        let c = |i: usize| (pp[i] + xu * x[i] + yv * y[i] + z0 * z[i]) as f32;
+        vec3(c(0), c(1), c(2))
     });
     (s as f32, point)
 }
@@ -229,10 +227,10 @@ mod tests {
 
     fn square(len: f32) -> Region {
         Region {
-            centre: [0.0, 0.0, 0.0],
-            axis_u: [1.0, 0.0, 0.0],
+            centre: Vec3::ZERO,
+            axis_u: Vec3::X,
             len_u: len,
-            axis_v: [0.0, 1.0, 0.0],
+            axis_v: Vec3::Y,
             len_v: len,
             rectangle: true,
         }
@@ -242,7 +240,7 @@ mod tests {
     fn solid_angle_of_a_square_matches_the_closed_form() {
         // A square of side 2a seen from height h on its axis: 4 asin(a^2 / (a^2 + h^2)).
         for (a, h) in [(1.0f32, 1.0f32), (0.5, 3.0), (2.0, 0.1), (0.01, 10.0)] {
-            let (s, _) = rect_solid_angle([0.0, 0.0, h], &square(2.0 * a), None);
+            let (s, _) = rect_solid_angle(vec3(0.0, 0.0, h), &square(2.0 * a), None);
             let want = 4.0 * ((a * a) / (a * a + h * h)).asin();
             assert!(
                 (s - want).abs() <= 1e-5 * want.max(1e-3),
@@ -256,10 +254,10 @@ mod tests {
         // Off-axis: split the rectangle into quadrants; each holds its share of the
         // solid angle (the quadrants' own solid angles) to sampling accuracy.
         let r = square(2.0);
-        let p = [0.7, -0.3, 0.8];
+        let p = vec3(0.7, -0.3, 0.8);
         let (s, _) = rect_solid_angle(p, &r, None);
         let quad = |cu: f32, cv: f32| Region {
-            centre: [cu, cv, 0.0],
+            centre: vec3(cu, cv, 0.0),
             len_u: 1.0,
             len_v: 1.0,
             ..r
@@ -301,8 +299,8 @@ mod tests {
             let mut sum = 0.0f64;
             for i in 0..n {
                 let theta = (i as f64 + 0.5) / n as f64 * std::f64::consts::FRAC_PI_2;
-                let d = [-(theta.sin() as f32), 0.0, -(theta.cos() as f32)];
-                let a = sp.attenuation(d, [0.0, 0.0, 1.0]) as f64;
+                let d = vec3(-(theta.sin() as f32), 0.0, -(theta.cos() as f32));
+                let a = sp.attenuation(d, Vec3::Z) as f64;
                 sum += a * theta.cos() * theta.sin() * std::f64::consts::FRAC_PI_2 / n as f64
                     * 2.0
                     * std::f64::consts::PI;

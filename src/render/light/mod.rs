@@ -15,7 +15,7 @@ use std::f32::consts::PI;
 
 use crate::anim::EvaluatedScene;
 use crate::render::light::area::{rect_solid_angle, Region, Spread};
-use crate::render::math::*;
+use crate::render::math::{vec3, Affine, Vec3, V3};
 use crate::render::RenderError;
 use crate::scene::settings::{AreaShape, LightSettings};
 use crate::scene::Scene;
@@ -35,8 +35,8 @@ pub enum Shape {
     },
     /// `u`, `v`: the light's full extent along its axes; `spread`: None at 180 degrees.
     Area {
-        u: V3,
-        v: V3,
+        u: Vec3,
+        v: Vec3,
         ellipse: bool,
         area: f32,
         spread: Option<Spread>,
@@ -51,18 +51,18 @@ pub struct Spot {
     pub cos_half: f32,
     pub smooth: f32,
     /// Axes scaled as Cycles does, for non-uniformly scaled spot cones.
-    pub u: V3,
-    pub v: V3,
-    pub w: V3,
+    pub u: Vec3,
+    pub v: Vec3,
+    pub w: Vec3,
 }
 
 #[derive(Debug, Clone)]
 pub struct Light {
     pub shape: Shape,
-    pub strength: V3,
-    pub pos: V3,
+    pub strength: Vec3,
+    pub pos: Vec3,
     /// Emission direction (-Z of the object), unit.
-    pub dir: V3,
+    pub dir: Vec3,
     pub cast_shadow: bool,
     /// Cycles' SHADER_USE_MIS: light and BSDF sampling share the light (Multiple
     /// Importance on, and a light with extent); otherwise only light sampling and camera
@@ -163,22 +163,22 @@ const NON_EMITTING_CLOSURES: &[&str] = &[
 /// constant (an Emission node with unlinked inputs into the active Light Output, or
 /// nothing that emits): Cycles multiplies the light's strength by the emission its shader
 /// evaluates to. None: the tree varies, and is evaluated per sample (`shader`).
-fn node_factor(l: &crate::scene::format::Light) -> Result<Option<V3>, RenderError> {
+fn node_factor(l: &crate::scene::format::Light) -> Result<Option<Vec3>, RenderError> {
     let use_nodes = LightSettings::of(l).use_nodes;
     let Some(tree) = l.node_tree.as_ref().filter(|_| use_nodes) else {
-        return Ok(Some([1.0; 3]));
+        return Ok(Some(Vec3::ONE));
     };
     // No output, or nothing linked to it: Cycles renders the light black.
     let Some(out) = crate::nodes::graph::active_output(tree, "ShaderNodeOutputLight", "CYCLES")
     else {
-        return Ok(Some([0.0; 3]));
+        return Ok(Some(Vec3::ZERO));
     };
     let Some(link) = tree
         .links
         .iter()
         .find(|k| k.to_node == out.name && k.to_socket == "Surface" && !k.is_muted)
     else {
-        return Ok(Some([0.0; 3]));
+        return Ok(Some(Vec3::ZERO));
     };
     let name = &l.name;
     let node = tree
@@ -193,12 +193,12 @@ fn node_factor(l: &crate::scene::format::Light) -> Result<Option<V3>, RenderErro
         })?;
     // A muted Emission has no closure input to pass through: nothing reaches the output.
     if node.bl_idname == "ShaderNodeEmission" && node.mute {
-        return Ok(Some([0.0; 3]));
+        return Ok(Some(Vec3::ZERO));
     }
     // A closure that cannot emit (a BSDF wired to the Light Output): Cycles' estimate of
     // the shader's emission is zero, so the light has no contribution and is left out.
     if NON_EMITTING_CLOSURES.contains(&node.bl_idname.as_str()) {
-        return Ok(Some([0.0; 3]));
+        return Ok(Some(Vec3::ZERO));
     }
     if node.bl_idname != "ShaderNodeEmission"
         || tree
@@ -214,10 +214,10 @@ fn node_factor(l: &crate::scene::format::Light) -> Result<Option<V3>, RenderErro
             .find(|s| s.identifier == id)
             .and_then(|s| s.default_value.as_ref())
     };
-    let color =
-        crate::scene::settings::rgb(input("Color")).map_or([1.0; 3], |c| c.map(|x| x as f32));
+    let color = crate::scene::settings::rgb(input("Color"))
+        .map_or(Vec3::ONE, |c| Vec3::from(c.map(|x| x as f32)));
     let strength = input("Strength").and_then(Value::as_f64).unwrap_or(1.0) as f32;
-    Ok(Some(scale(color, strength)))
+    Ok(Some(color * strength))
 }
 
 // Long because one arm per light type, reading its settings as Cycles' light sync does.
@@ -235,43 +235,45 @@ pub fn collect(scene: &Scene, eval: &EvaluatedScene) -> Result<Vec<Light>, Rende
         };
         let p = LightSettings::of(l);
         let m = Affine::from_rows(&eval.world_matrices[oi]);
-        let color = p.color.map_or([1.0; 3], |c| c.map(|x| x as f32));
+        let color = p
+            .color
+            .map_or(Vec3::ONE, |c| Vec3::from(c.map(|x| x as f32)));
         let energy = p.energy as f32;
         let exposure = p.exposure as f32;
         let (factor, shader) = match node_factor(l)? {
             Some(f) => (f, None),
             None => match compile_light(scene, l).map_err(|e| RenderError(e.0))? {
                 // No Light Output for Cycles: the light is black.
-                None => ([0.0; 3], None),
+                None => (Vec3::ZERO, None),
                 Some(program) => {
                     let info = object_info(obj, &eval.world_matrices[oi]);
                     let to_world = Affine::from_rows(&eval.world_matrices[oi]).m;
                     (
-                        [1.0; 3],
+                        Vec3::ONE,
                         Some(Arc::new(LightShader::new(program, info, to_world))),
                     )
                 }
             },
         };
-        let mut strength = mul(scale(color, energy * 2f32.powf(exposure)), factor);
+        let mut strength = color * (energy * 2f32.powf(exposure)) * factor;
         // Blender 4.5's light temperature: the colour is multiplied by the blackbody colour
         // Blender computed (`temperature_color`, in the scene's working space).
         if p.use_temperature {
             if let Some(t) = p.temperature_color {
-                strength = mul(strength, t.map(|x| x as f32));
+                strength *= Vec3::from(t.map(|x| x as f32));
             }
         }
         // Cycles weighs a light in its tree by its shader's emission estimate.
-        let estimate = shader.as_ref().map_or([1.0; 3], |s| s.estimate());
-        let tree_energy = average(mul(strength, estimate)).abs()
+        let estimate = shader.as_ref().map_or(Vec3::ONE, |s| s.estimate());
+        let tree_energy = (strength * estimate).average().abs()
             * match l.kind.as_str() {
                 "AREA" => 0.25,
                 "SUN" => 1.0,
                 _ => 0.25 / PI,
             };
         let spread = p.spread as f32;
-        let pos = m.column(3);
-        let dir = normalize(neg(m.column(2)));
+        let pos = m.column_vec3(3);
+        let dir = (-m.column_vec3(2)).normalize();
         let cast_shadow = p.cast_shadow;
         let shape = match l.kind.as_str() {
             "POINT" | "SPOT" => {
@@ -286,10 +288,10 @@ pub fn collect(scene: &Scene, eval: &EvaluatedScene) -> Result<Vec<Light>, Rende
                         f32::INFINITY
                     };
                     // Cycles divides by the axes' squared lengths so scale shapes the cone.
-                    let inv = |a: V3| {
-                        let l2 = dot(a, a);
+                    let inv = |a: Vec3| {
+                        let l2 = a.dot(a);
                         if l2 > 0.0 {
-                            scale(a, 1.0 / l2)
+                            a * (1.0 / l2)
                         } else {
                             a
                         }
@@ -297,9 +299,9 @@ pub fn collect(scene: &Scene, eval: &EvaluatedScene) -> Result<Vec<Light>, Rende
                     Some(Spot {
                         cos_half,
                         smooth,
-                        u: inv(m.column(0)),
-                        v: inv(m.column(1)),
-                        w: inv(neg(m.column(2))),
+                        u: inv(m.column_vec3(0)),
+                        v: inv(m.column_vec3(1)),
+                        w: inv(-m.column_vec3(2)),
                     })
                 } else {
                     None
@@ -320,10 +322,10 @@ pub fn collect(scene: &Scene, eval: &EvaluatedScene) -> Result<Vec<Light>, Rende
                     AreaShape::Rectangle | AreaShape::Ellipse => p.size_y as f32,
                     AreaShape::Square | AreaShape::Disk => size,
                 };
-                let u = scale(m.column(0), size);
-                let v = scale(m.column(1), size_y);
+                let u = m.column_vec3(0) * size;
+                let v = m.column_vec3(1) * size_y;
                 let ellipse = matches!(p.shape, AreaShape::Disk | AreaShape::Ellipse);
-                let mut area = len(u) * len(v);
+                let mut area = u.length() * v.length();
                 if ellipse {
                     area *= PI / 4.0;
                 }
@@ -365,7 +367,7 @@ pub fn collect(scene: &Scene, eval: &EvaluatedScene) -> Result<Vec<Light>, Rende
                     }
                 }
             };
-            strength = scale(strength, area);
+            strength *= area;
         }
         let exclude = excluded_rays(obj.visibility.as_ref());
         let use_mis = p.use_multiple_importance_sampling;
@@ -394,11 +396,11 @@ pub fn collect(scene: &Scene, eval: &EvaluatedScene) -> Result<Vec<Light>, Rende
 
 impl Spot {
     /// Cycles' spot attenuation of light leaving along `ray` (from the light outward).
-    fn attenuation(&self, ray: V3) -> f32 {
-        let sr = normalize([dot(ray, self.u), dot(ray, self.v), dot(ray, self.w)]);
+    fn attenuation(&self, ray: Vec3) -> f32 {
+        let sr = vec3(ray.dot(self.u), ray.dot(self.v), ray.dot(self.w)).normalize();
         if self.smooth.is_finite() {
-            smoothstep((sr[2] - self.cos_half) * self.smooth)
-        } else if sr[2] > self.cos_half {
+            smoothstep((sr.z - self.cos_half) * self.smooth)
+        } else if sr.z > self.cos_half {
             1.0
         } else {
             0.0
@@ -417,17 +419,14 @@ fn one_minus_cos_from_sin2(s2: f32) -> f32 {
 
 /// A direction uniform in the cone about `axis` with 1 - cos(half angle) = `omc`
 /// (Cycles' concentric cone mapping), and its cosine to the axis.
-pub(super) fn sample_cone(axis: V3, omc: f32, u: [f32; 2]) -> (V3, f32) {
+pub(super) fn sample_cone(axis: Vec3, omc: f32, u: [f32; 2]) -> (Vec3, f32) {
     let xy = crate::render::camera::concentric_disk(u);
     let r2 = xy[0] * xy[0] + xy[1] * xy[1];
     let cos_theta = 1.0 - r2 * omc;
     let k = (omc * (2.0 - omc * r2)).max(0.0).sqrt();
-    let (t, b) = basis(axis);
+    let (t, b) = axis.basis();
     (
-        add(
-            add(scale(t, xy[0] * k), scale(b, xy[1] * k)),
-            scale(axis, cos_theta),
-        ),
+        t * (xy[0] * k) + b * (xy[1] * k) + axis * cos_theta,
         cos_theta,
     )
 }
@@ -440,10 +439,10 @@ pub(super) fn sun_one_minus_cos(half_angle: f32) -> f32 {
 }
 
 /// Nearest positive distance along unit `d` from `o` to the sphere, if any.
-fn ray_sphere(o: V3, d: V3, c: V3, r: f32) -> Option<f32> {
-    let oc = sub(c, o);
-    let tc = dot(oc, d);
-    let h2 = r * r - (dot(oc, oc) - tc * tc);
+fn ray_sphere(o: Vec3, d: Vec3, c: Vec3, r: f32) -> Option<f32> {
+    let oc = c - o;
+    let tc = oc.dot(d);
+    let h2 = r * r - (oc.dot(oc) - tc * tc);
     if h2 < 0.0 {
         return None;
     }
@@ -461,34 +460,36 @@ fn smoothstep(x: f32) -> f32 {
 impl Light {
     // Long because one arm per light type, as Cycles' light sample functions.
     pub fn sample(&self, p: V3, u: [f32; 2]) -> Option<LightSample> {
+        let p = Vec3::from(p);
+        let (pos, dir, strength) = (self.pos, self.dir, self.strength);
         match &self.shape {
             Shape::Point {
                 radius,
                 spot,
                 sphere,
             } => {
-                let to = sub(self.pos, p);
-                let d2 = dot(to, to);
+                let to = pos - p;
+                let d2 = to.dot(to);
                 if d2 <= 0.0 {
                     return None;
                 }
                 let d = d2.sqrt();
-                let w = scale(to, 1.0 / d);
+                let w = to * (1.0 / d);
                 if *radius <= 0.0 {
                     let atten = match spot {
-                        Some(s) => s.attenuation(neg(w)),
+                        Some(s) => s.attenuation(-w),
                         None => 1.0,
                     };
                     if atten <= 0.0 {
                         return None;
                     }
                     // Intensity power / (4 pi) over squared distance.
-                    let v = scale(self.strength, atten / (4.0 * PI * d2));
-                    let v = self.shaded(v, self.pos, neg(w), w, d);
+                    let v = strength * (atten / (4.0 * PI * d2));
+                    let v = self.shaded(v, pos, -w, w, d);
                     return Some(LightSample {
-                        wi: w,
+                        wi: w.into(),
                         dist: d,
-                        value: v,
+                        value: v.into(),
                         pdf: f32::INFINITY,
                     });
                 }
@@ -500,30 +501,27 @@ impl Light {
                     // light Cycles samples the hemisphere, unweighted by the cone; rare,
                     // done here as the disk.)
                     let disk = crate::render::camera::concentric_disk(u);
-                    let (t, b) = basis(w);
-                    let q = add(
-                        self.pos,
-                        add(scale(t, disk[0] * radius), scale(b, disk[1] * radius)),
-                    );
-                    let to = sub(q, p);
-                    let dq2 = dot(to, to);
+                    let (t, b) = w.basis();
+                    let q = pos + (t * (disk[0] * radius) + b * (disk[1] * radius));
+                    let to = q - p;
+                    let dq2 = to.dot(to);
                     let dq = dq2.sqrt();
-                    let wi = scale(to, 1.0 / dq);
-                    let cos_l = dot(w, wi).abs();
+                    let wi = to * (1.0 / dq);
+                    let cos_l = w.dot(wi).abs();
                     let atten = match spot {
-                        Some(s) if !*sphere => s.attenuation(neg(wi)),
+                        Some(s) if !*sphere => s.attenuation(-wi),
                         _ => 1.0,
                     };
                     if atten <= 0.0 {
                         return None;
                     }
-                    let v = scale(self.strength, atten * radiance * cos_l * PI * r2 / dq2);
-                    let v = self.shaded(v, q, neg(wi), wi, dq);
+                    let v = strength * (atten * radiance * cos_l * PI * r2 / dq2);
+                    let v = self.shaded(v, q, -wi, wi, dq);
                     let pdf = dq2 / (cos_l.max(1e-8) * PI * r2);
                     return Some(LightSample {
-                        wi,
+                        wi: wi.into(),
                         dist: dq,
-                        value: v,
+                        value: v.into(),
                         pdf,
                     });
                 }
@@ -535,32 +533,32 @@ impl Light {
                 let (axis, omc) = if cap < spread {
                     (w, cap)
                 } else {
-                    (neg(self.dir), spread)
+                    (-dir, spread)
                 };
                 let (wi, cos_theta) = sample_cone(axis, omc, u);
                 let dist = if cap < spread {
                     // Law of cosines: the nearer crossing of the sphere along the cone's ray.
-                    let cos_w = dot(wi, w);
+                    let cos_w = wi.dot(w);
                     d * cos_w - (r2 - d2 + d2 * cos_w * cos_w).max(0.0).sqrt()
                 } else {
                     let _ = cos_theta;
-                    ray_sphere(p, wi, self.pos, *radius)?
+                    ray_sphere(p, wi, pos, *radius)?
                 };
                 let atten = match spot {
-                    Some(s) => s.attenuation(neg(wi)),
+                    Some(s) => s.attenuation(-wi),
                     None => 1.0,
                 };
                 if atten <= 0.0 {
                     return None;
                 }
                 let pdf = 1.0 / (2.0 * PI * omc);
-                let v = scale(self.strength, atten * radiance / pdf);
-                let q = madd(p, wi, dist);
-                let v = self.shaded(v, q, normalize(sub(q, self.pos)), wi, dist);
+                let v = strength * (atten * radiance / pdf);
+                let q = p + wi * dist;
+                let v = self.shaded(v, q, (q - pos).normalize(), wi, dist);
                 Some(LightSample {
-                    wi,
+                    wi: wi.into(),
                     dist,
-                    value: v,
+                    value: v.into(),
                     pdf,
                 })
             }
@@ -572,7 +570,7 @@ impl Light {
                 spread,
             } => {
                 // One-sided: nothing behind the light's plane.
-                if dot(sub(p, self.pos), self.dir) <= 0.0 {
+                if (p - pos).dot(dir) <= 0.0 {
                     return None;
                 }
                 let region = self.area_region(p, *au, *av, *ellipse, spread.as_ref())?;
@@ -581,13 +579,9 @@ impl Light {
                     (q?, 1.0 / s)
                 } else {
                     let d = crate::render::camera::concentric_disk(u);
-                    let q = add(
-                        region.centre,
-                        add(
-                            scale(region.axis_u, d[0] * 0.5 * region.len_u),
-                            scale(region.axis_v, d[1] * 0.5 * region.len_v),
-                        ),
-                    );
+                    let q = region.centre
+                        + (region.axis_u * (d[0] * 0.5 * region.len_u)
+                            + region.axis_v * (d[1] * 0.5 * region.len_v));
                     (q, 4.0 / (PI * region.len_u * region.len_v))
                 };
                 // A region larger than the light (a spread circle, or the rectangle about
@@ -595,18 +589,18 @@ impl Light {
                 if !self.area_contains(q, *au, *av, *ellipse) {
                     return None;
                 }
-                let to = sub(q, p);
-                let d2 = dot(to, to);
+                let to = q - p;
+                let d2 = to.dot(to);
                 if !(d2 > 0.0) || !pdf_region.is_finite() {
                     return None;
                 }
                 let d = d2.sqrt();
-                let wi = scale(to, 1.0 / d);
-                let cos_l = -dot(self.dir, wi);
+                let wi = to * (1.0 / d);
+                let cos_l = -dir.dot(wi);
                 if cos_l <= 0.0 {
                     return None;
                 }
-                let atten = spread.map(|s| s.attenuation(wi, self.dir)).unwrap_or(1.0);
+                let atten = spread.map(|s| s.attenuation(wi, dir)).unwrap_or(1.0);
                 if atten <= 0.0 {
                     return None;
                 }
@@ -617,21 +611,21 @@ impl Light {
                     pdf_region * d2 / cos_l
                 };
                 let radiance = atten / (PI * area);
-                let v = scale(self.strength, radiance / pdf);
+                let v = strength * (radiance / pdf);
                 Some(LightSample {
-                    wi,
+                    wi: wi.into(),
                     dist: d,
-                    value: self.shaded(v, q, self.dir, wi, d),
+                    value: self.shaded(v, q, dir, wi, d).into(),
                     pdf,
                 })
             }
             Shape::Sun { half_angle } => {
-                let toward = neg(self.dir);
+                let toward = -dir;
                 if *half_angle <= 0.0 {
                     return Some(LightSample {
-                        wi: toward,
+                        wi: toward.into(),
                         dist: f32::INFINITY,
-                        value: self.shaded_sun(self.strength, toward),
+                        value: self.shaded_sun(strength, toward).into(),
                         pdf: f32::INFINITY,
                     });
                 }
@@ -645,9 +639,9 @@ impl Light {
                 let radiance = 1.0 / (PI * s * s);
                 let pdf = 1.0 / (2.0 * PI * omc);
                 Some(LightSample {
-                    wi,
+                    wi: wi.into(),
                     dist: f32::INFINITY,
-                    value: self.shaded_sun(scale(self.strength, radiance / pdf), wi),
+                    value: self.shaded_sun(strength * (radiance / pdf), wi).into(),
                     pdf,
                 })
             }
@@ -657,6 +651,8 @@ impl Light {
     /// Where a ray from `o` along unit `d` meets this light before `tmax` (suns: only
     /// rays that leave the scene, `tmax` infinite).
     pub fn intersect(&self, o: V3, d: V3, tmax: f32) -> Option<LightHit> {
+        let (o, d) = (Vec3::from(o), Vec3::from(d));
+        let (pos, dir, strength) = (self.pos, self.dir, self.strength);
         match &self.shape {
             Shape::Point {
                 radius,
@@ -667,55 +663,55 @@ impl Light {
                     return None;
                 }
                 // Rays leaving a spot are not lit by it (Cycles' one-sided test).
-                if spot.is_some() && dot(d, sub(o, self.pos)) >= 0.0 {
+                if spot.is_some() && d.dot(o - pos) >= 0.0 {
                     return None;
                 }
                 if !*sphere {
                     // The disk through the light's centre facing the ray origin.
-                    let to = sub(self.pos, o);
-                    let n = normalize(neg(to));
-                    let denom = dot(d, n);
+                    let to = pos - o;
+                    let n = (-to).normalize();
+                    let denom = d.dot(n);
                     if denom >= 0.0 {
                         return None;
                     }
-                    let t = dot(to, n) / denom;
+                    let t = to.dot(n) / denom;
                     if !(t > 0.0 && t < tmax) {
                         return None;
                     }
-                    let q = sub(madd(o, d, t), self.pos);
-                    if dot(q, q) > radius * radius {
+                    let q = o + d * t - pos;
+                    if q.dot(q) > radius * radius {
                         return None;
                     }
-                    let atten = spot.map(|s| s.attenuation(neg(d))).unwrap_or(1.0);
-                    let radiance = scale(self.strength, atten / (4.0 * PI * PI * radius * radius));
-                    let radiance = self.shaded(radiance, madd(o, d, t), neg(d), d, t);
+                    let atten = spot.map(|s| s.attenuation(-d)).unwrap_or(1.0);
+                    let radiance = strength * (atten / (4.0 * PI * PI * radius * radius));
+                    let radiance = self.shaded(radiance, o + d * t, -d, d, t);
                     return Some(LightHit {
                         t,
-                        radiance,
+                        radiance: radiance.into(),
                         pdf: t * t / ((-denom).max(1e-8) * PI * radius * radius),
                     });
                 }
-                let t = ray_sphere(o, d, self.pos, *radius)?;
+                let t = ray_sphere(o, d, pos, *radius)?;
                 if t >= tmax {
                     return None;
                 }
-                let to = sub(self.pos, o);
-                let (d2, r2) = (dot(to, to), radius * radius);
+                let to = pos - o;
+                let (d2, r2) = (to.dot(to), radius * radius);
                 let mut atten = 1.0;
                 let mut omc = 2.0;
                 if d2 > r2 {
                     omc = one_minus_cos_from_sin2(r2 / d2);
                     if let Some(s) = spot {
-                        atten = s.attenuation(neg(d));
+                        atten = s.attenuation(-d);
                         omc = omc.min(1.0 - s.cos_half);
                     }
                 }
-                let radiance = scale(self.strength, atten / (4.0 * PI * PI * r2));
-                let q = madd(o, d, t);
-                let radiance = self.shaded(radiance, q, normalize(sub(q, self.pos)), d, t);
+                let radiance = strength * (atten / (4.0 * PI * PI * r2));
+                let q = o + d * t;
+                let radiance = self.shaded(radiance, q, (q - pos).normalize(), d, t);
                 Some(LightHit {
                     t,
-                    radiance,
+                    radiance: radiance.into(),
                     pdf: 1.0 / (2.0 * PI * omc),
                 })
             }
@@ -726,15 +722,15 @@ impl Light {
                 area,
                 spread,
             } => {
-                let cos_l = -dot(d, self.dir);
+                let cos_l = -d.dot(dir);
                 if cos_l <= 0.0 {
                     return None;
                 }
-                let t = dot(sub(self.pos, o), self.dir) / dot(d, self.dir);
+                let t = (pos - o).dot(dir) / d.dot(dir);
                 if !(t > 0.0 && t < tmax) {
                     return None;
                 }
-                let q = madd(o, d, t);
+                let q = o + d * t;
                 if !self.area_contains(q, *u, *v, *ellipse) {
                     return None;
                 }
@@ -745,14 +741,14 @@ impl Light {
                 } else {
                     4.0 / (PI * region.len_u * region.len_v) * t * t / cos_l
                 };
-                let atten = spread.map(|s| s.attenuation(d, self.dir)).unwrap_or(1.0);
+                let atten = spread.map(|s| s.attenuation(d, dir)).unwrap_or(1.0);
                 if atten <= 0.0 || !pdf.is_finite() {
                     return None;
                 }
-                let radiance = scale(self.strength, atten / (PI * area));
+                let radiance = strength * (atten / (PI * area));
                 Some(LightHit {
                     t,
-                    radiance: self.shaded(radiance, q, self.dir, d, t),
+                    radiance: self.shaded(radiance, q, dir, d, t).into(),
                     pdf,
                 })
             }
@@ -761,13 +757,13 @@ impl Light {
                     return None;
                 }
                 let cos_max = half_angle.cos();
-                if dot(d, neg(self.dir)) < cos_max {
+                if d.dot(-dir) < cos_max {
                     return None;
                 }
                 let s = half_angle.sin();
                 Some(LightHit {
                     t: f32::INFINITY,
-                    radiance: self.shaded_sun(scale(self.strength, 1.0 / (PI * s * s)), d),
+                    radiance: self.shaded_sun(strength * (1.0 / (PI * s * s)), d).into(),
                     pdf: 1.0 / (2.0 * PI * sun_one_minus_cos(*half_angle)),
                 })
             }
@@ -779,18 +775,18 @@ impl Light {
     /// `v` times the light's varying node tree at light point `q` with normal `ng`, lighting
     /// a point `t` away along -`wi` (`wi` from the lit point toward the light).
     #[inline]
-    fn shaded(&self, v: V3, q: V3, ng: V3, wi: V3, t: f32) -> V3 {
+    fn shaded(&self, v: Vec3, q: Vec3, ng: Vec3, wi: Vec3, t: f32) -> Vec3 {
         match &self.shader {
             None => v,
-            Some(s) => mul(v, s.emission(q, ng, neg(wi), t)),
+            Some(s) => v * s.emission(q, ng, -wi, t),
         }
     }
 
     /// The same for a sun seen along `wi`: Cycles' light point and normal are then the
     /// direction away from the sun, and its distance f32::MAX.
     #[inline]
-    fn shaded_sun(&self, v: V3, wi: V3) -> V3 {
-        let away = neg(wi);
+    fn shaded_sun(&self, v: Vec3, wi: Vec3) -> Vec3 {
+        let away = -wi;
         self.shaded(v, away, away, wi, f32::MAX)
     }
 
@@ -798,18 +794,18 @@ impl Light {
     /// (a rectangle by solid angle, an ellipse by area), or what its spread lets reach `p`.
     fn area_region(
         &self,
-        p: V3,
-        u: V3,
-        v: V3,
+        p: Vec3,
+        u: Vec3,
+        v: Vec3,
         ellipse: bool,
         spread: Option<&Spread>,
     ) -> Option<Region> {
-        let (len_u, len_v) = (len(u), len(v));
+        let (len_u, len_v) = (u.length(), v.length());
         let full = Region {
             centre: self.pos,
-            axis_u: scale(u, 1.0 / len_u),
+            axis_u: u * (1.0 / len_u),
             len_u,
-            axis_v: scale(v, 1.0 / len_v),
+            axis_v: v * (1.0 / len_v),
             len_v,
             rectangle: !ellipse,
         };
@@ -820,10 +816,10 @@ impl Light {
     }
 
     /// Whether point `q` of the light's plane lies on the light.
-    fn area_contains(&self, q: V3, u: V3, v: V3, ellipse: bool) -> bool {
-        let r = sub(q, self.pos);
-        let a = dot(r, u) / dot(u, u);
-        let b = dot(r, v) / dot(v, v);
+    fn area_contains(&self, q: Vec3, u: Vec3, v: Vec3, ellipse: bool) -> bool {
+        let r = q - self.pos;
+        let a = r.dot(u) / u.dot(u);
+        let b = r.dot(v) / v.dot(v);
         if ellipse {
             a * a + b * b <= 0.25
         } else {
@@ -837,7 +833,7 @@ mod tests {
     use super::*;
 
     fn area(ellipse: bool, size: (f32, f32), spread_deg: Option<f32>) -> Light {
-        let (u, v) = ([size.0, 0.0, 0.0], [0.0, size.1, 0.0]);
+        let (u, v) = (vec3(size.0, 0.0, 0.0), vec3(0.0, size.1, 0.0));
         let mut a = size.0 * size.1;
         if ellipse {
             a *= PI / 4.0;
@@ -851,9 +847,9 @@ mod tests {
                 area: a,
                 spread,
             },
-            strength: [100.0; 3],
-            pos: [0.0, 0.0, 2.0],
-            dir: [0.0, 0.0, -1.0],
+            strength: Vec3::splat(100.0),
+            pos: vec3(0.0, 0.0, 2.0),
+            dir: vec3(0.0, 0.0, -1.0),
             cast_shadow: true,
             mis: true,
             max_bounces: 1024,

@@ -4,7 +4,7 @@
 
 use std::cell::RefCell;
 
-use crate::render::math::*;
+use crate::render::math::Vec3;
 use crate::shader::bump::ObjectTransform;
 use crate::shader::point::{ObjectInfo, ShadingPoint};
 use crate::shader::program::Program;
@@ -37,14 +37,15 @@ impl LightShader {
     }
 
     /// Cycles' emission estimate of the tree (its light tree weight).
-    pub fn estimate(&self) -> V3 {
-        self.program.emission_estimate
+    pub fn estimate(&self) -> Vec3 {
+        self.program.emission_estimate.into()
     }
 
     /// The emission of the tree for the light point `p` with normal `ng` (Cycles' ls->P,
     /// ls->Ng), lighting along `incoming` (from the light toward the lit point, -ls->D)
     /// at distance `t`.
-    pub fn emission(&self, p: V3, ng: V3, incoming: V3, t: f32) -> V3 {
+    pub fn emission(&self, p: Vec3, ng: Vec3, incoming: Vec3, t: f32) -> Vec3 {
+        let (p, ng, incoming) = (p.into(), ng.into(), incoming.into());
         let object_position = self.transform.inverse_point(p);
         let sp = ShadingPoint {
             position: p,
@@ -66,7 +67,7 @@ impl LightShader {
             s.clear();
             s.extend_from_slice(&self.program.initial);
             self.program.run(&sp, &mut s);
-            self.program.surface_emission(&s)
+            self.program.surface_emission(&s).into()
         })
     }
 }

@@ -11,7 +11,7 @@
 
 use std::f32::consts::{FRAC_PI_2, PI};
 
-use crate::render::math::*;
+use crate::render::math::{vec3, Vec3, V3};
 
 /// Cycles' max_lights_in_leaf (LightManager::device_update_tree).
 const MAX_IN_LEAF: usize = 8;
@@ -44,22 +44,22 @@ pub enum Viewer {
 pub enum Shape {
     /// Point or spot light. `spot_smooth`: Cycles' spot.spot_smooth (None for a point).
     Point {
-        pos: V3,
+        pos: Vec3,
         radius: f32,
         sphere: bool,
         spot_smooth: Option<f32>,
     },
     /// Area light: centre and full extents along its two axes.
     Area {
-        pos: V3,
-        eu: V3,
-        ev: V3,
+        pos: Vec3,
+        eu: Vec3,
+        ev: Vec3,
     },
     /// Sun: the cone's axis is the direction its light travels.
     Distant,
     World,
     Triangle {
-        v: [V3; 3],
+        v: [Vec3; 3],
     },
     /// An emissive object: the root node of its triangles' subtree.
     Mesh {
@@ -71,20 +71,20 @@ pub enum Shape {
 /// they emit within `theta_e` of their normals.
 #[derive(Clone, Copy, Debug)]
 pub struct Cone {
-    pub axis: V3,
+    pub axis: Vec3,
     pub theta_o: f32,
     pub theta_e: f32,
 }
 
 impl Cone {
     const EMPTY: Cone = Cone {
-        axis: [0.0; 3],
+        axis: Vec3::ZERO,
         theta_o: f32::MIN_POSITIVE,
         theta_e: f32::MIN_POSITIVE,
     };
 
     fn is_empty(&self) -> bool {
-        is_zero(self.axis)
+        self.axis.is_zero()
     }
 
     /// The orientation term of the split cost (Eq. 1 of the paper, as Cycles has it).
@@ -114,7 +114,7 @@ impl Cone {
         } else {
             (a, b)
         };
-        let cos_ab = dot(a.axis, b.axis);
+        let cos_ab = a.axis.dot(b.axis);
         let theta_d = cos_ab.clamp(-1.0, 1.0).acos();
         let theta_e = a.theta_e.max(b.theta_e);
         if a.theta_o + 5e-4 >= PI.min(theta_d + b.theta_o) {
@@ -133,11 +133,11 @@ impl Cone {
             };
         }
         let axis = if cos_ab < -0.9995 {
-            basis(a.axis).0
+            a.axis.basis().0
         } else {
             let theta_r = theta_o - a.theta_o;
-            let ortho = normalize(sub(b.axis, scale(a.axis, cos_ab)));
-            add(scale(a.axis, theta_r.cos()), scale(ortho, theta_r.sin()))
+            let ortho = (b.axis - a.axis * cos_ab).normalize();
+            a.axis * theta_r.cos() + ortho * theta_r.sin()
         };
         Cone {
             axis,
@@ -198,21 +198,21 @@ impl ConeTrig {
 /// Cycles' LightTreeMeasure: bounds, orientation and energy of a cluster.
 #[derive(Clone, Copy, Debug)]
 pub struct Measure {
-    pub bmin: V3,
-    pub bmax: V3,
+    pub bmin: Vec3,
+    pub bmax: Vec3,
     pub cone: Cone,
     pub energy: f32,
 }
 
 impl Measure {
     pub const EMPTY: Measure = Measure {
-        bmin: [f32::INFINITY; 3],
-        bmax: [f32::NEG_INFINITY; 3],
+        bmin: Vec3::splat(f32::INFINITY),
+        bmax: Vec3::splat(f32::NEG_INFINITY),
         cone: Cone::EMPTY,
         energy: 0.0,
     };
 
-    pub fn new(points: &[V3], cone: Cone, energy: f32) -> Measure {
+    pub fn new(points: &[Vec3], cone: Cone, energy: f32) -> Measure {
         let mut m = Measure {
             cone,
             energy,
@@ -224,21 +224,17 @@ impl Measure {
         m
     }
 
-    fn grow(&mut self, p: V3) {
-        for k in 0..3 {
-            self.bmin[k] = self.bmin[k].min(p[k]);
-            self.bmax[k] = self.bmax[k].max(p[k]);
-        }
+    fn grow(&mut self, p: Vec3) {
+        self.bmin = self.bmin.min(p);
+        self.bmax = self.bmax.max(p);
     }
 
     fn add(&mut self, o: &Measure) {
         if o.energy == 0.0 {
             return;
         }
-        for k in 0..3 {
-            self.bmin[k] = self.bmin[k].min(o.bmin[k]);
-            self.bmax[k] = self.bmax[k].max(o.bmax[k]);
-        }
+        self.bmin = self.bmin.min(o.bmin);
+        self.bmax = self.bmax.max(o.bmax);
         self.cone = Cone::merge(self.cone, o.cone);
         self.energy += o.energy;
     }
@@ -248,19 +244,19 @@ impl Measure {
         if self.energy == 0.0 {
             return 0.0;
         }
-        let d = sub(self.bmax, self.bmin);
+        let d = self.bmax - self.bmin;
         let valid = (0..3).all(|k| self.bmin[k] <= self.bmax[k]);
         let area = if valid {
             2.0 * (d[0] * d[1] + d[1] * d[2] + d[2] * d[0])
         } else {
             0.0
         };
-        let area_measure = if area == 0.0 { len(d) } else { area };
+        let area_measure = if area == 0.0 { d.length() } else { area };
         self.energy * area_measure * self.cone.measure()
     }
 
-    fn centre(&self) -> V3 {
-        scale(add(self.bmin, self.bmax), 0.5)
+    fn centre(&self) -> Vec3 {
+        (self.bmin + self.bmax) * 0.5
     }
 }
 
@@ -269,7 +265,7 @@ impl Measure {
 pub struct Emitter {
     pub pick: Option<Pick>,
     pub shape: Shape,
-    pub centroid: V3,
+    pub centroid: Vec3,
     pub measure: Measure,
 }
 
@@ -339,12 +335,12 @@ fn reservoir(
     *rand = rand.clamp(0.0, 1.0);
 }
 
-fn normalize_len(v: V3) -> (V3, f32) {
-    let l = len(v);
+fn normalize_len(v: Vec3) -> (Vec3, f32) {
+    let l = v.length();
     if l > 0.0 {
-        (scale(v, 1.0 / l), l)
+        (v * (1.0 / l), l)
     } else {
-        ([0.0; 3], 0.0)
+        (Vec3::ZERO, 0.0)
     }
 }
 
@@ -368,9 +364,9 @@ fn smoothstep(x: f32) -> f32 {
 /// no incidence term, the distance term theta_d / distance, and no lower bound.
 #[allow(clippy::too_many_arguments)]
 fn importance(
-    n: V3,
+    n: Vec3,
     trans: bool,
-    ptc: V3,
+    ptc: Vec3,
     cos_u: f32,
     cone: Cone,
     trig: &ConeTrig,
@@ -383,11 +379,7 @@ fn importance(
     let (cos_min_incidence, cos_max_incidence) = if theta_d.is_some() {
         (1.0, 1.0)
     } else {
-        let cos_i = if trans {
-            dot(ptc, n).abs()
-        } else {
-            dot(ptc, n)
-        };
+        let cos_i = if trans { ptc.dot(n).abs() } else { ptc.dot(n) };
         let sin_i = sin_from_cos(cos_i);
         let cos_min_incidence = if cos_i >= cos_u {
             1.0
@@ -399,10 +391,10 @@ fn importance(
         }
         (cos_min_incidence, (cos_i * cos_u - sin_i * sin_u).max(0.0))
     };
-    let (cos_t, sin_t) = if cone.axis == neg(ptc) {
+    let (cos_t, sin_t) = if cone.axis == -ptc {
         (1.0, 0.0)
     } else {
-        let c = dot(cone.axis, neg(ptc));
+        let c = cone.axis.dot(-ptc);
         (c, sin_from_cos(c))
     };
     let cos_t_minus_u = cos_t * cos_u + sin_t * sin_u;
@@ -435,32 +427,24 @@ fn importance(
 }
 
 /// The corners of an area light at `pos` with full extents `eu`, `ev`, in Cycles' order.
-fn area_corners(pos: V3, eu: V3, ev: V3) -> [V3; 4] {
-    [0, 1, 2, 3].map(|i| {
-        add(
-            add(
-                scale(eu, (i & 1) as f32 - 0.5),
-                scale(ev, 0.5 * ((i & 2) as f32 - 1.0)),
-            ),
-            pos,
-        )
-    })
+fn area_corners(pos: Vec3, eu: Vec3, ev: Vec3) -> [Vec3; 4] {
+    [0, 1, 2, 3].map(|i| eu * ((i & 1) as f32 - 0.5) + ev * (0.5 * ((i & 2) as f32 - 1.0)) + pos)
 }
 
 /// Seen from `p` looking along `ptc`: the smallest cosine to any of `points`, and the
 /// largest distance to one (Cycles' cos_theta_u and max distance of a polygon emitter).
-fn subtended(p: V3, ptc: V3, points: &[V3]) -> (f32, f32) {
+fn subtended(p: Vec3, ptc: Vec3, points: &[Vec3]) -> (f32, f32) {
     points.iter().fold((f32::MAX, 0.0f32), |(c, d), &q| {
-        let (ptq, dq) = normalize_len(sub(q, p));
-        (c.min(dot(ptc, ptq)), d.max(dq))
+        let (ptq, dq) = normalize_len(q - p);
+        (c.min(ptc.dot(ptq)), d.max(dq))
     })
 }
 
 /// Cycles' light_tree_cos_bound_subtended_angle: the cosine of the half-angle under
 /// which the box's bounding sphere is seen from `p` (-1 from inside it).
-fn cos_sphere_angle(bmax: V3, centroid: V3, p: V3) -> f32 {
-    let d2 = dot(sub(p, centroid), sub(p, centroid));
-    let r2 = dot(sub(bmax, centroid), sub(bmax, centroid));
+fn cos_sphere_angle(bmax: Vec3, centroid: Vec3, p: Vec3) -> f32 {
+    let d2 = (p - centroid).dot(p - centroid);
+    let r2 = (bmax - centroid).dot(bmax - centroid);
     if d2 <= r2 {
         -1.0
     } else {
@@ -470,35 +454,35 @@ fn cos_sphere_angle(bmax: V3, centroid: V3, p: V3) -> f32 {
 
 /// Cycles' compute_v (Fig. 8 of the paper): of the directions from the segment `p + s d`,
 /// s in [0, t], toward `centroid`, the one closest to the cone's axis, negated.
-fn compute_v(centroid: V3, p: V3, d: V3, axis: V3, t: f32) -> V3 {
-    let u0 = sub(p, centroid);
-    let u1 = madd(u0, d, t.min(1e12));
-    let v0 = normalize(u0);
-    let v1 = normalize(u1);
+fn compute_v(centroid: Vec3, p: Vec3, d: Vec3, axis: Vec3, t: f32) -> Vec3 {
+    let u0 = p - centroid;
+    let u1 = u0 + d * t.min(1e12);
+    let v0 = u0.normalize();
+    let v1 = u1.normalize();
     // Cycles' make_orthonormals_tangent(o0, v1): o1 in the plane of v0 and v1.
     let o0 = v0;
-    let o1 = normalize(cross(cross(o0, v1), o0));
-    let a0 = dot(o0, axis);
-    let a1 = dot(o1, axis);
+    let o1 = o0.cross(v1).cross(o0).normalize();
+    let a0 = o0.dot(axis);
+    let a1 = o1.dot(axis);
     let inv_len = 1.0 / (a0 * a0 + a1 * a1).sqrt();
     let cos_phi0 = a0 * inv_len;
-    if a1 < 0.0 || dot(v0, v1) > cos_phi0 {
-        if a0 > dot(v1, axis) {
+    if a1 < 0.0 || v0.dot(v1) > cos_phi0 {
+        if a0 > v1.dot(axis) {
             v0
         } else {
             v1
         }
     } else {
-        add(scale(o0, cos_phi0), scale(o1, a1 * inv_len))
+        o0 * cos_phi0 + o1 * (a1 * inv_len)
     }
 }
 
 /// The segment's point nearest `centroid` (clamped to the segment), the distance from
 /// the segment's line to `centroid`, and the angle the segment spans seen from it.
-fn segment_view(p: V3, d: V3, t: f32, centroid: V3) -> (V3, f32, f32) {
-    let closest_t = dot(sub(centroid, p), d);
-    let closest = madd(p, d, closest_t.clamp(0.0, t));
-    let dist = len(sub(sub(centroid, p), scale(d, closest_t)));
+fn segment_view(p: Vec3, d: Vec3, t: f32, centroid: Vec3) -> (Vec3, f32, f32) {
+    let closest_t = (centroid - p).dot(d);
+    let closest = p + d * closest_t.clamp(0.0, t);
+    let dist = (centroid - p - d * closest_t).length();
     let theta_d = (t - closest_t).atan2(dist) + closest_t.atan2(dist);
     (closest, dist, theta_d)
 }
@@ -673,15 +657,13 @@ impl LightTree {
             return (false, start, None, m);
         }
         let mut middle = (start + end) / 2;
-        let mut cmin = [f32::INFINITY; 3];
-        let mut cmax = [f32::NEG_INFINITY; 3];
+        let mut cmin = Vec3::splat(f32::INFINITY);
+        let mut cmax = Vec3::splat(f32::NEG_INFINITY);
         for s in &self.emitters[start..end] {
-            for k in 0..3 {
-                cmin[k] = cmin[k].min(s.e.centroid[k]);
-                cmax[k] = cmax[k].max(s.e.centroid[k]);
-            }
+            cmin = cmin.min(s.e.centroid);
+            cmax = cmax.max(s.e.centroid);
         }
-        let extent = sub(cmax, cmin);
+        let extent = cmax - cmin;
         let max_extent = extent[0].max(extent[1]).max(extent[2]).max(0.0);
         let mut measure = Measure::EMPTY;
         let mut total_cost = 0.0f32;
@@ -709,7 +691,7 @@ impl LightTree {
             if dim == 0 {
                 measure = left[BUCKETS - 2].0;
                 measure.add(&buckets[BUCKETS - 1].0);
-                if is_zero(extent) {
+                if extent.is_zero() {
                     break;
                 }
                 if extent[0] == 0.0 {
@@ -749,18 +731,19 @@ impl LightTree {
     fn node_importance(&self, v: Viewer, node: &Node) -> (f32, f32) {
         let m = &node.m;
         let (p, n, trans) = match v {
-            Viewer::Point { p, n, trans } => (p, n, trans),
+            Viewer::Point { p, n, trans } => (Vec3::from(p), Vec3::from(n), trans),
             Viewer::Segment { p, d, t } => {
+                let (p, d) = (Vec3::from(p), Vec3::from(d));
                 let (ptc, cos_u, distance, theta_d) = if let NodeKind::Distant { .. } = node.kind {
                     let theta_d = if t.is_finite() { t } else { 1.0 };
-                    (neg(m.cone.axis), node.trig.cos_o_plus_e, 1.0, theta_d)
+                    (-m.cone.axis, node.trig.cos_o_plus_e, 1.0, theta_d)
                 } else {
                     let centroid = m.centre();
                     let (closest, dist, theta_d) = segment_view(p, d, t, centroid);
                     (
-                        neg(compute_v(centroid, p, d, m.cone.axis, t)),
+                        -compute_v(centroid, p, d, m.cone.axis, t),
                         cos_sphere_angle(m.bmax, centroid, closest),
-                        (0.5 * len(sub(centroid, m.bmax))).max(dist),
+                        (0.5 * (centroid - m.bmax).length()).max(dist),
                         theta_d,
                     )
                 };
@@ -779,18 +762,17 @@ impl LightTree {
             }
         };
         let (ptc, cos_u, distance) = if let NodeKind::Distant { .. } = node.kind {
-            (neg(m.cone.axis), node.trig.cos_o_plus_e, 1.0)
+            (-m.cone.axis, node.trig.cos_o_plus_e, 1.0)
         } else {
             let centroid = m.centre();
-            let ext = sub(m.bmax, centroid);
-            let visible =
-                trans || dot(n, sub(centroid, p)) + dot(n.map(f32::abs), ext.map(f32::abs)) > 0.0;
+            let ext = m.bmax - centroid;
+            let visible = trans || n.dot(centroid - p) + n.abs().dot(ext.abs()) > 0.0;
             if !visible {
                 return (0.0, 0.0);
             }
-            let (ptc, d) = normalize_len(sub(centroid, p));
+            let (ptc, d) = normalize_len(centroid - p);
             let cos_u = cos_sphere_angle(m.bmax, centroid, p);
-            (ptc, cos_u, (0.5 * len(sub(centroid, m.bmax))).max(d))
+            (ptc, cos_u, (0.5 * (centroid - m.bmax).length()).max(d))
         };
         importance(
             n, trans, ptc, cos_u, m.cone, &node.trig, distance, distance, m.energy, None,
@@ -800,8 +782,10 @@ impl LightTree {
     /// Cycles' light_tree_emitter_importance.
     fn emitter_importance(&self, v: Viewer, st: &Stored) -> (f32, f32) {
         let (p, n, trans) = match v {
-            Viewer::Point { p, n, trans } => (p, n, trans),
-            Viewer::Segment { p, d, t } => return self.emitter_importance_segment(p, d, t, st),
+            Viewer::Point { p, n, trans } => (Vec3::from(p), Vec3::from(n), trans),
+            Viewer::Segment { p, d, t } => {
+                return self.emitter_importance_segment(p.into(), d.into(), t, st)
+            }
         };
         let e = &st.e;
         let m = &e.measure;
@@ -817,7 +801,7 @@ impl LightTree {
                 sphere,
                 spot_smooth,
             } => {
-                let (ptc, min_d) = normalize_len(sub(pos, p));
+                let (ptc, min_d) = normalize_len(pos - p);
                 let (cos_u, dist) = if sphere {
                     if min_d > radius {
                         let c = sin_from_cos(radius / min_d);
@@ -832,12 +816,12 @@ impl LightTree {
                 match spot_smooth {
                     None => {
                         // Disk-oriented: facing the shading point.
-                        cone.axis = normalize(sub(p, pos));
+                        cone.axis = (p - pos).normalize();
                         cone.theta_o = 0.0;
                         trig = trig.with_zero_theta_o();
                     }
                     Some(smooth) => {
-                        let cos_min_out = (dot(cone.axis, neg(ptc)).clamp(-1.0, 1.0).acos()
+                        let cos_min_out = (cone.axis.dot(-ptc).clamp(-1.0, 1.0).acos()
                             - cos_u.clamp(-1.0, 1.0).acos())
                         .max(0.0)
                         .cos();
@@ -854,33 +838,33 @@ impl LightTree {
                 (true, ptc, cos_u, dist)
             }
             Shape::Area { pos, eu, ev } => {
-                let (ptc, min_d) = normalize_len(sub(pos, p));
+                let (ptc, min_d) = normalize_len(pos - p);
                 let (cos_u, max_d) = subtended(p, ptc, &area_corners(pos, eu, ev));
                 let dist = [max_d.max(min_d), min_d];
-                let front = dot(cone.axis, ptc) < 0.0;
-                let above = dot(n, sub(pos, p)) + dot(n, eu).abs() + dot(n, ev).abs() > 0.0;
+                let front = cone.axis.dot(ptc) < 0.0;
+                let above = n.dot(pos - p) + n.dot(eu).abs() + n.dot(ev).abs() > 0.0;
                 (front && above, ptc, cos_u, dist)
             }
             Shape::Distant => {
                 let cos_u = trig.cos_e;
-                (true, neg(centroid), cos_u, [1.0 / cos_u, 1.0])
+                (true, -centroid, cos_u, [1.0 / cos_u, 1.0])
             }
             Shape::World => {
-                cone.axis = [0.0, 0.0, -1.0];
-                (true, [0.0, 0.0, -1.0], -1.0, [1.0, 1.0])
+                cone.axis = vec3(0.0, 0.0, -1.0);
+                (true, vec3(0.0, 0.0, -1.0), -1.0, [1.0, 1.0])
             }
             Shape::Triangle { v } => {
-                let (ptc, min_d) = normalize_len(sub(centroid, p));
+                let (ptc, min_d) = normalize_len(centroid - p);
                 let mut dist = [min_d, min_d];
                 let mut cos_u = f32::MAX;
                 let mut above = false;
                 for c in v {
-                    let (ptk, dk) = normalize_len(sub(c, p));
-                    cos_u = cos_u.min(dot(ptc, ptk));
-                    above |= dot(ptk, n) > 0.0;
+                    let (ptk, dk) = normalize_len(c - p);
+                    cos_u = cos_u.min(ptc.dot(ptk));
+                    above |= ptk.dot(n) > 0.0;
                     dist[0] = dist[0].max(dk);
                 }
-                let front = cone.theta_o != 0.0 || dot(cone.axis, ptc) < 0.0;
+                let front = cone.theta_o != 0.0 || cone.axis.dot(ptc) < 0.0;
                 (front && above, ptc, cos_u, dist)
             }
         };
@@ -895,7 +879,7 @@ impl LightTree {
     /// Cycles' light_tree_emitter_importance<in_volume_segment = true> for the segment
     /// from `p` along `d` for `t`: the emitter's parameters seen from the segment's point
     /// nearest it, its direction term from the segment's best-aligned point.
-    fn emitter_importance_segment(&self, p: V3, d: V3, t: f32, st: &Stored) -> (f32, f32) {
+    fn emitter_importance_segment(&self, p: Vec3, d: Vec3, t: f32, st: &Stored) -> (f32, f32) {
         let e = &st.e;
         let m = &e.measure;
         let mut cone = m.cone;
@@ -903,12 +887,16 @@ impl LightTree {
         let ray_length = if t.is_finite() { t } else { 1.0 };
         let (centroid, cos_u, dist, theta_d) = match e.shape {
             Shape::Mesh { root } => {
-                return self
-                    .node_importance(Viewer::Segment { p, d, t }, &self.nodes[root as usize])
+                let v = Viewer::Segment {
+                    p: p.into(),
+                    d: d.into(),
+                    t,
+                };
+                return self.node_importance(v, &self.nodes[root as usize]);
             }
             Shape::Distant => {
                 let cos_u = trig.cos_e;
-                let ptc = neg(e.centroid);
+                let ptc = -e.centroid;
                 return importance(
                     d,
                     true,
@@ -924,8 +912,8 @@ impl LightTree {
             }
             Shape::World => {
                 // Cycles' arbitrary centroid and direction for the background.
-                cone.axis = [0.0, 0.0, -1.0];
-                ([0.0, 0.0, 1.0], -1.0, [1.0, 1.0], ray_length)
+                cone.axis = vec3(0.0, 0.0, -1.0);
+                (vec3(0.0, 0.0, 1.0), -1.0, [1.0, 1.0], ray_length)
             }
             Shape::Point {
                 pos,
@@ -934,11 +922,11 @@ impl LightTree {
                 spot_smooth,
             } => {
                 let (pc, _, theta_d) = segment_view(p, d, t, pos);
-                let min_d = len(sub(pos, pc));
+                let min_d = (pos - pc).length();
                 let cos_u = match spot_smooth {
                     None => {
                         // Disk-oriented, facing the segment's start.
-                        cone.axis = normalize(sub(p, pos));
+                        cone.axis = (p - pos).normalize();
                         cone.theta_o = 0.0;
                         trig = trig.with_zero_theta_o();
                         1.0
@@ -956,19 +944,19 @@ impl LightTree {
             }
             Shape::Area { pos, eu, ev } => {
                 let (pc, _, theta_d) = segment_view(p, d, t, pos);
-                let (ptc, min_d) = normalize_len(sub(pos, pc));
+                let (ptc, min_d) = normalize_len(pos - pc);
                 let (cos_u, _) = subtended(pc, ptc, &area_corners(pos, eu, ev));
                 (pos, cos_u, [min_d, min_d], theta_d)
             }
             Shape::Triangle { v } => {
                 let centroid = e.centroid;
                 let (pc, _, theta_d) = segment_view(p, d, t, centroid);
-                let (ptc, min_d) = normalize_len(sub(centroid, pc));
+                let (ptc, min_d) = normalize_len(centroid - pc);
                 let (cos_u, _) = subtended(pc, ptc, &v);
                 (centroid, cos_u, [min_d, min_d], theta_d)
             }
         };
-        let ptc = neg(compute_v(centroid, p, d, cone.axis, t));
+        let ptc = -compute_v(centroid, p, d, cone.axis, t);
         importance(
             d,
             true,
@@ -1338,11 +1326,11 @@ mod tests {
     use super::*;
 
     fn point(l: u32, pos: V3, energy: f32) -> Emitter {
-        let r = 0.1;
+        let (pos, r) = (Vec3::from(pos), 0.1);
         let m = Measure::new(
-            &[sub(pos, [r; 3]), add(pos, [r; 3])],
+            &[pos - Vec3::splat(r), pos + Vec3::splat(r)],
             Cone {
-                axis: [0.0, 0.0, -1.0],
+                axis: vec3(0.0, 0.0, -1.0),
                 theta_o: PI,
                 theta_e: FRAC_PI_2,
             },
@@ -1362,12 +1350,13 @@ mod tests {
     }
 
     fn tri(prim: u32, v: [V3; 3]) -> Emitter {
-        let area = 0.5 * len(cross(sub(v[1], v[0]), sub(v[2], v[0])));
-        let c = scale(add(add(v[0], v[1]), v[2]), 1.0 / 3.0);
+        let v = v.map(Vec3::from);
+        let area = 0.5 * (v[1] - v[0]).cross(v[2] - v[0]).length();
+        let c = (v[0] + v[1] + v[2]) * (1.0 / 3.0);
         let m = Measure::new(
             &v,
             Cone {
-                axis: normalize(sub(v[0], v[1])),
+                axis: (v[0] - v[1]).normalize(),
                 theta_o: FRAC_PI_2,
                 theta_e: FRAC_PI_2,
             },
@@ -1405,11 +1394,11 @@ mod tests {
         let sun = Emitter {
             pick: Some(Pick::Lamp(13)),
             shape: Shape::Distant,
-            centroid: normalize([0.3, 0.2, -1.0]),
+            centroid: vec3(0.3, 0.2, -1.0).normalize(),
             measure: Measure::new(
                 &[],
                 Cone {
-                    axis: normalize([0.3, 0.2, -1.0]),
+                    axis: vec3(0.3, 0.2, -1.0).normalize(),
                     theta_o: 0.0,
                     theta_e: 0.01,
                 },
@@ -1428,7 +1417,7 @@ mod tests {
             },
             Viewer::Point {
                 p: [1.0, 0.5, 2.5],
-                n: normalize([0.2, -0.5, 0.4]),
+                n: vec3(0.2, -0.5, 0.4).normalize().into(),
                 trans: true,
             },
             Viewer::Point {
@@ -1438,7 +1427,7 @@ mod tests {
             },
             Viewer::Segment {
                 p: [-3.0, -2.0, 1.0],
-                d: normalize([1.0, 0.6, 0.3]),
+                d: vec3(1.0, 0.6, 0.3).normalize().into(),
                 t: 7.0,
             },
             Viewer::Segment {

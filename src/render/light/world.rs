@@ -6,7 +6,7 @@
 use serde_json::Value;
 
 use crate::nodes::sky::SunGuide;
-use crate::render::math::{add, len, normalize, sub, V3};
+use crate::render::math::{Vec3, V3};
 use crate::render::RenderError;
 use crate::scene::Scene;
 use crate::shader::point::PathState;
@@ -320,7 +320,8 @@ impl WorldMap {
 
     /// The pdf of the sun cone toward `d` (Cycles' pdf_uniform_cone).
     fn sun_pdf(sun: &SunGuide, d: V3) -> f32 {
-        let angle = 2.0 * len(sub(d, sun.direction)).atan2(len(add(d, sun.direction)));
+        let (d, axis) = (Vec3::from(d), Vec3::from(sun.direction));
+        let angle = 2.0 * (d - axis).length().atan2((d + axis).length());
         if angle < sun.half_angle {
             1.0 / (2.0
                 * std::f32::consts::PI
@@ -338,9 +339,9 @@ impl WorldMap {
         };
         if u[0] < share {
             let omc = crate::render::light::sun_one_minus_cos(sun.half_angle);
-            let (d, _) =
-                crate::render::light::sample_cone(sun.direction, omc, [u[0] / share, u[1]]);
-            let d = normalize(d);
+            let axis = Vec3::from(sun.direction);
+            let (d, _) = crate::render::light::sample_cone(axis, omc, [u[0] / share, u[1]]);
+            let d = d.normalize().into();
             // The cone's own pdf, as Cycles takes it for the direction it sampled (an
             // angle test at the cone's rim could drop it).
             let cone = 1.0 / (2.0 * std::f32::consts::PI * omc);

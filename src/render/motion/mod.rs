@@ -179,32 +179,31 @@ fn quat_from(m: &Affine) -> [f32; 4] {
 /// Cycles' transform_decompose: scale and shear by Gram-Schmidt on the columns, a
 /// negative determinant folded into the scale, the orthonormal rest as a quaternion.
 fn decompose_one(m: &Affine) -> Decomposed {
-    let col = |i: usize| [m.m[0][i], m.m[1][i], m.m[2][i]];
-    let div = |v: V3, d: f32| {
+    let div = |v: Vec3, d: f32| {
         if d != 0.0 {
-            scale(v, 1.0 / d)
+            v * (1.0 / d)
         } else {
-            [0.0; 3]
+            Vec3::ZERO
         }
     };
-    let (mut cx, mut cy, mut cz) = (col(0), col(1), col(2));
-    let sx = len(cx);
+    let (mut cx, mut cy, mut cz) = (m.column_vec3(0), m.column_vec3(1), m.column_vec3(2));
+    let sx = cx.length();
     cx = div(cx, sx);
-    let shz = dot(cx, cy);
-    cy = sub(cy, scale(cx, shz));
-    let sy = len(cy);
+    let shz = cx.dot(cy);
+    cy -= cx * shz;
+    let sy = cy.length();
     cy = div(cy, sy);
-    let shy = dot(cx, cz);
-    cz = sub(cz, scale(cx, shy));
-    let shx = dot(cy, cz);
-    cz = sub(cz, scale(cy, shx));
-    let sz = len(cz);
+    let shy = cx.dot(cz);
+    cz -= cx * shy;
+    let shx = cy.dot(cz);
+    cz -= cy * shx;
+    let sz = cz.length();
     cz = div(cz, sz);
     let mut r = Affine {
         m: std::array::from_fn(|i| [cx[i], cy[i], cz[i], 0.0]),
     };
     let mut sc = [sx, sy, sz];
-    if dot(cross(cx, cy), cz) < 0.0 {
+    if cx.cross(cy).dot(cz) < 0.0 {
         sc = sc.map(|v| -v);
         for row in r.m.iter_mut() {
             for v in row.iter_mut().take(3) {
@@ -321,13 +320,13 @@ impl Decomposed {
     /// two steps the reach stays below the larger of theirs.
     pub fn reach(&self, c: V3, r: f32) -> f32 {
         let s = &self.s;
-        let sc = [
+        let sc = vec3(
             s[0] * c[0] + s[1] * c[1] + s[2] * c[2],
             s[3] * c[1] + s[4] * c[2],
             s[5] * c[2],
-        ];
+        );
         let frobenius = s.iter().map(|v| v * v).sum::<f32>().sqrt();
-        len(sc) + r * frobenius
+        sc.length() + r * frobenius
     }
 }
 

@@ -276,8 +276,9 @@ impl MotionAccel {
 /// Translation is linear between steps and the rest reaches no farther than at a step,
 /// so the steps' translations grown by the largest reach bound it.
 fn reach_bounds(steps: &[Decomposed], olo: V3, ohi: V3) -> (V3, V3) {
-    let c = scale(add(olo, ohi), 0.5);
-    let r = 0.5 * len(sub(ohi, olo));
+    let (olo, ohi) = (Vec3::from(olo), Vec3::from(ohi));
+    let c = ((olo + ohi) * 0.5).into();
+    let r = 0.5 * (ohi - olo).length();
     let reach = steps.iter().map(|s| s.reach(c, r)).fold(0.0f32, f32::max) * (1.0 + 1e-5) + 1e-6;
     let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     for s in steps {
