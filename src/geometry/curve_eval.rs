@@ -656,7 +656,8 @@ fn type_name(t: i8) -> &'static str {
     }
 }
 
-/// `data[a] * (1 - f) + data[b] * f` per output, for the numeric types (others take `a`).
+/// `data[a] * (1 - f) + data[b] * f` per output, for the numeric types; rotations by
+/// Blender's slerp (others take `a`).
 pub fn lerp_gather(data: &Array, a: &[usize], b: &[usize], f: &[f32]) -> Array {
     fn lanes<const K: usize>(v: &[[f32; K]], a: &[usize], b: &[usize], f: &[f32]) -> Vec<[f32; K]> {
         (0..a.len())
@@ -695,8 +696,32 @@ pub fn lerp_gather(data: &Array, a: &[usize], b: &[usize], f: &[f32]) -> Array {
                 .map(|i| (1.0 - f[i]) * v[a[i]] as u8 as f32 + f[i] * v[b[i]] as u8 as f32 >= 0.5)
                 .collect(),
         ),
+        Array::Quaternion(v) => Array::Quaternion(
+            (0..a.len())
+                .map(|i| quaternion_slerp(&v[a[i]], &v[b[i]], f[i]))
+                .collect(),
+        ),
         other => other.gather(a),
     }
+}
+
+/// Blender's `mix2` for rotations: `math::interpolate` of quaternions, the weights of
+/// `interpolate_dot_slerp` (a linear mix where the two are within 1e-4 of parallel; the
+/// shorter way round), applied to the components as stored.
+fn quaternion_slerp(a: &[f32; 4], b: &[f32; 4], t: f32) -> [f32; 4] {
+    let cosom = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
+    let abs_cosom = cosom.abs();
+    let (mut w0, w1) = if abs_cosom < 1.0 - 1e-4 {
+        let omega = abs_cosom.acos();
+        let sinom = omega.sin();
+        (((1.0 - t) * omega).sin() / sinom, (t * omega).sin() / sinom)
+    } else {
+        (1.0 - t, t)
+    };
+    if cosom < 0.0 {
+        w0 = -w0;
+    }
+    [0, 1, 2, 3].map(|k| w0 * a[k] + w1 * b[k])
 }
 
 /// One Bezier segment by forward differencing, `dst.len()` points from `p0` (t = 0)
