@@ -145,6 +145,10 @@ const ASSERTED: &[&str] = &[
     // The same without the shape key: blendsynth evaluates the nodes, and renders
     // Blender's evaluated mesh instead, whose realised instances keep their values.
     "nested_instancer_native",
+    // A Geometry Nodes mesh made by Realize Instances beside top-level instances, its
+    // material adding the Instancer "Color" to the Geometry one (Molecular Nodes' Ball and
+    // Stick): the realised mesh reads the object's value, each instance its own.
+    "instancer_realised_mesh",
     // Particles, a collection instance and vertex instancing, realised into Blender's
     // evaluated mesh, each shaded in its own object space (Object and Generated
     // coordinates, Object Info Random, Location, Color), as Cycles renders instances.

@@ -1,7 +1,8 @@
 //! Evaluated curves as Blender computes them (`bke::curves` and `curves::poly`,
 //! `curves::bezier`): evaluated points per curve (Bezier segments by forward differencing
 //! at the curve's resolution, poly points as they are), attributes interpolated to the
-//! evaluated points, segment lengths, tangents, and minimum-twist / Z-up normals with tilt.
+//! evaluated points, segment lengths, tangents, and minimum-twist / Z-up / free (custom)
+//! normals with tilt.
 //!
 //! Catmull-Rom curves by their uniform cubic basis (`curves::catmull_rom`), NURBS by their
 //! basis (`nurbs.rs`); NURBS control points are not on the curve, so per-control-point
@@ -12,11 +13,13 @@ use super::curves::{
 };
 use super::math::{add, cross, dot, length, normalize, scale, sub, V3};
 use super::nurbs::Basis;
-use super::types::{Array, Domain, Value};
+use super::types::{Array, DataType, Domain, Value};
 
 /// Blender's `NormalMode` values as stored in the `normal_mode` curve attribute.
 pub const NORMAL_MODE_MINIMUM_TWIST: i8 = 0;
 pub const NORMAL_MODE_Z_UP: i8 = 1;
+/// Free: the `custom_normal` point attribute, interpolated to the evaluated points.
+pub const NORMAL_MODE_FREE: i8 = 2;
 
 /// Bezier handle type VECTOR as stored in `handle_type_left` / `handle_type_right`.
 pub const HANDLE_VECTOR: i8 = 2;
@@ -270,7 +273,10 @@ impl Evaluated {
         out
     }
 
-    /// Evaluated normals of every curve (normal mode per curve, tilt interpolated).
+    /// Evaluated normals of every curve (normal mode per curve, tilt interpolated), as
+    /// `CurvesGeometry::evaluated_normals`: Free curves take `custom_normal` interpolated
+    /// to their evaluated points and normalized (Z up without the attribute), then every
+    /// mode is rotated by the tilt.
     pub fn normals(&self, c: &Curves, tangents_all: &[V3]) -> Result<Vec<V3>, String> {
         let tilt = match c.attributes.named("tilt") {
             Some(a) if a.domain == Domain::Point => {
@@ -279,15 +285,25 @@ impl Evaluated {
             _ => vec![0.0; self.total()],
         };
         let modes = checked_normal_modes(c)?;
+        let custom = match custom_normals(c) {
+            Some(n) if modes.contains(&NORMAL_MODE_FREE) => Some(
+                self.interpolate(c, &Array::Vector(n))?
+                    .as_vector()
+                    .into_owned(),
+            ),
+            _ => None,
+        };
         let mut out = Vec::with_capacity(self.total());
         for i in 0..c.curve_count() {
             let r = self.range(i);
-            out.extend(normals(
-                &tangents_all[r.clone()],
-                self.cyclic[i],
-                modes[i],
-                &tilt[r],
-            ));
+            let base = match (&custom, modes[i]) {
+                (Some(n), NORMAL_MODE_FREE) => n[r.clone()].iter().map(|v| normalize(*v)).collect(),
+                (None, NORMAL_MODE_FREE) => {
+                    base_normals(&tangents_all[r.clone()], false, NORMAL_MODE_Z_UP)
+                }
+                (_, mode) => base_normals(&tangents_all[r.clone()], self.cyclic[i], mode),
+            };
+            out.extend(tilted(base, &tangents_all[r.clone()], &tilt[r]));
         }
         Ok(out)
     }
@@ -373,19 +389,30 @@ fn unmixable(data: &Array, kind: &str, i: usize) -> String {
     )
 }
 
-/// The curves' normal modes, refusing the ones not evaluated (Free: custom normals).
+/// The curves' normal modes, refusing values outside Blender's (its attribute validator
+/// clamps them to Minimum Twist ..= Free).
 fn checked_normal_modes(c: &Curves) -> Result<Vec<i8>, String> {
     let modes = normal_modes(c);
     if let Some(i) = modes
         .iter()
-        .position(|m| *m != NORMAL_MODE_MINIMUM_TWIST && *m != NORMAL_MODE_Z_UP)
+        .position(|m| !(NORMAL_MODE_MINIMUM_TWIST..=NORMAL_MODE_FREE).contains(m))
     {
         return Err(format!(
-            "curve {i}: normal mode {} (Free: custom normals) is not supported (Minimum Twist and Z Up are)",
+            "curve {i}: normal mode {} is not one of Blender's",
             modes[i]
         ));
     }
     Ok(modes)
+}
+
+/// The `custom_normal` point attribute Free curves read, when there is one.
+fn custom_normals(c: &Curves) -> Option<Vec<V3>> {
+    match c.attributes.named("custom_normal") {
+        Some(a) if a.domain == Domain::Point && a.data.data_type() == DataType::Vector => {
+            Some(a.data.as_vector().into_owned())
+        }
+        _ => None,
+    }
 }
 
 /// `catmull_rom::calculate_evaluated_num`: `resolution` points per segment, plus the last
@@ -629,7 +656,8 @@ fn type_name(t: i8) -> &'static str {
     }
 }
 
-/// `data[a] * (1 - f) + data[b] * f` per output, for the numeric types (others take `a`).
+/// `data[a] * (1 - f) + data[b] * f` per output, for the numeric types; rotations by
+/// Blender's slerp (others take `a`).
 pub fn lerp_gather(data: &Array, a: &[usize], b: &[usize], f: &[f32]) -> Array {
     fn lanes<const K: usize>(v: &[[f32; K]], a: &[usize], b: &[usize], f: &[f32]) -> Vec<[f32; K]> {
         (0..a.len())
@@ -668,8 +696,32 @@ pub fn lerp_gather(data: &Array, a: &[usize], b: &[usize], f: &[f32]) -> Array {
                 .map(|i| (1.0 - f[i]) * v[a[i]] as u8 as f32 + f[i] * v[b[i]] as u8 as f32 >= 0.5)
                 .collect(),
         ),
+        Array::Quaternion(v) => Array::Quaternion(
+            (0..a.len())
+                .map(|i| quaternion_slerp(&v[a[i]], &v[b[i]], f[i]))
+                .collect(),
+        ),
         other => other.gather(a),
     }
+}
+
+/// Blender's `mix2` for rotations: `math::interpolate` of quaternions, the weights of
+/// `interpolate_dot_slerp` (a linear mix where the two are within 1e-4 of parallel; the
+/// shorter way round), applied to the components as stored.
+fn quaternion_slerp(a: &[f32; 4], b: &[f32; 4], t: f32) -> [f32; 4] {
+    let cosom = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
+    let abs_cosom = cosom.abs();
+    let (mut w0, w1) = if abs_cosom < 1.0 - 1e-4 {
+        let omega = abs_cosom.acos();
+        let sinom = omega.sin();
+        (((1.0 - t) * omega).sin() / sinom, (t * omega).sin() / sinom)
+    } else {
+        (1.0 - t, t)
+    };
+    if cosom < 0.0 {
+        w0 = -w0;
+    }
+    [0, 1, 2, 3].map(|k| w0 * a[k] + w1 * b[k])
 }
 
 /// One Bezier segment by forward differencing, `dst.len()` points from `p0` (t = 0)
@@ -807,6 +859,12 @@ fn angle_signed_on_axis(v1: V3, v2: V3, axis: V3) -> f32 {
 
 /// Normals of one evaluated curve: minimum twist or Z up, then rotated by tilt.
 pub fn normals(tangents: &[V3], cyclic: bool, mode: i8, tilts: &[f32]) -> Vec<V3> {
+    tilted(base_normals(tangents, cyclic, mode), tangents, tilts)
+}
+
+/// Minimum-twist or Z-up normals of one evaluated curve, before tilt
+/// (`curves::poly::calculate_normals_minimum` / `calculate_normals_z_up`).
+fn base_normals(tangents: &[V3], cyclic: bool, mode: i8) -> Vec<V3> {
     let n = tangents.len();
     let mut out = vec![[0.0f32; 3]; n];
     if n == 0 {
@@ -833,12 +891,17 @@ pub fn normals(tangents: &[V3], cyclic: bool, mode: i8, tilts: &[f32]) -> Vec<V3
             }
         }
     }
-    for i in 0..n {
+    out
+}
+
+/// `normals` rotated about the tangents by the tilts (`rotate_directions_around_axes`).
+fn tilted(mut normals: Vec<V3>, tangents: &[V3], tilts: &[f32]) -> Vec<V3> {
+    for i in 0..normals.len() {
         if tilts[i] != 0.0 {
-            out[i] = rotate_around_axis(out[i], tangents[i], tilts[i]);
+            normals[i] = rotate_around_axis(normals[i], tangents[i], tilts[i]);
         }
     }
-    out
+    normals
 }
 
 /// Radius / tilt style float attribute of the control points (default when absent).
@@ -849,17 +912,25 @@ pub fn point_floats(c: &Curves, name: &str, default: f32) -> Vec<f32> {
 /// Per control point, the evaluated normal where it lies (`curve_normal_point_domain`):
 /// poly points their own, Bezier and Catmull-Rom points the evaluated point where they
 /// lie; NURBS control points, not on the curve, the normals of their control polygon
-/// taken as a poly curve (without tilt, as Blender does).
+/// taken as a poly curve (without tilt, as Blender does), or for Free curves their
+/// `custom_normal` as stored ((0, 0, 1) without it).
 pub fn control_point_normals(c: &Curves) -> Result<Vec<V3>, String> {
     let ev = Evaluated::new(c)?;
     let pos = ev.positions(c);
     let tangents_all = ev.tangents(c, &pos);
     let normals_all = ev.normals(c, &tangents_all)?;
     let modes = normal_modes(c);
+    let custom = custom_normals(c);
     let mut out = vec![[0.0f32; 3]; c.point_count()];
     for i in 0..c.curve_count() {
         let r = ev.range(i);
         let pts = c.points(i);
+        if ev.is_nurbs(i) && modes[i] == NORMAL_MODE_FREE {
+            for p in pts {
+                out[p] = custom.as_ref().map_or([0.0, 0.0, 1.0], |n| n[p]);
+            }
+            continue;
+        }
         if ev.is_nurbs(i) {
             let t = tangents(&c.positions[pts.clone()], ev.cyclic[i]);
             let zero = vec![0.0; t.len()];

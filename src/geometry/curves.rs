@@ -7,7 +7,7 @@
 //! and write it back under its built-in type, so the curve nodes agree on both.
 
 use super::attribute::{AttrId, Attributes};
-use super::math::V3;
+use super::math::{mat3_mul_v3, normal_matrix, normalize, Mat4f, V3};
 use super::types::{Array, Domain};
 
 /// Blender's `CurveType` values as stored in the `curve_type` attribute.
@@ -113,5 +113,22 @@ impl Curves {
             out.extend(self.points(c).map(|_| c));
         }
         out
+    }
+}
+
+impl Curves {
+    /// Moves the `custom_normal` point attribute (Free normals) as positions move by `m`,
+    /// as `transform_custom_normal_attribute`: by the inverse transpose of the 3x3 part,
+    /// normalized.
+    pub fn transform_custom_normals(&mut self, m: &Mat4f) {
+        let Some(a) = self.attributes.get_mut(&AttrId::named("custom_normal")) else {
+            return;
+        };
+        if let Array::Vector(v) = &mut a.data {
+            let nm = normal_matrix(m);
+            for n in v.iter_mut() {
+                *n = normalize(mat3_mul_v3(&nm, *n));
+            }
+        }
     }
 }

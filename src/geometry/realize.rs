@@ -13,7 +13,9 @@ use super::attribute::{AttrId, Attributes};
 use super::curves::Curves;
 use super::field::ComponentRef;
 use super::instances::Instances;
-use super::math::{mat4_mul, transform_point, Mat4f, MAT4_IDENTITY};
+use super::math::{
+    mat3_mul_v3, mat4_mul, normal_matrix, normalize, transform_point, Mat4f, MAT4_IDENTITY,
+};
 use super::mesh::Mesh;
 use super::pointcloud::PointCloud;
 use super::set::GeometrySet;
@@ -206,6 +208,16 @@ pub fn join_curves(parts: &[(&Curves, Mat4f)]) -> Curves {
                         if let Array::Vector(h) = &mut v {
                             for x in h.iter_mut() {
                                 *x = transform_point(t, *x);
+                            }
+                        }
+                    }
+                    // Free curve normals turn with the instance (as Transform Geometry's
+                    // `transform_custom_normal_attribute`).
+                    if id.name() == Some("custom_normal") && *t != MAT4_IDENTITY {
+                        if let Array::Vector(n) = &mut v {
+                            let nm = normal_matrix(t);
+                            for x in n.iter_mut() {
+                                *x = normalize(mat3_mul_v3(&nm, *x));
                             }
                         }
                     }

@@ -367,20 +367,11 @@ pub fn build(
                         // Generated geometry: the bounds.
                         texspace: None,
                     };
-                    let before = instances.len();
+                    // The set without its instances holds no dupli for Cycles (a mesh that
+                    // Realize Instances made is one mesh): an Instancer attribute reads the
+                    // object's value there, as for any object (parity scene
+                    // instancer_realised_mesh: Molecular Nodes' Ball and Stick).
                     push_instance(&mut instances, scene, oi, obj, &info, mesh, to_world, None)?;
-                    let has_nodes = obj
-                        .modifiers
-                        .iter()
-                        .any(|m| m.kind == "NODES" && m.show_render);
-                    if has_nodes && instances.len() > before {
-                        // Geometry Nodes output other than its top-level instances may hold
-                        // realised instances whose attributes Blender would read per nested
-                        // instance: an Instancer read there is refused (see bind_attributes).
-                        let pushed = instances.last_mut().expect("pushed");
-                        pushed.nested_instancer_names =
-                            obj.attribute_lookups.keys().cloned().collect();
-                    }
                     if let Some(p) = points {
                         let radius = match p.attributes.named("radius").map(|a| &a.data) {
                             Some(crate::geometry::types::Array::Float(r)) if r.len() == p.len() => {

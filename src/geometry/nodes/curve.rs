@@ -9,7 +9,7 @@ use super::super::curves::{Curves, CURVE_TYPE_POLY};
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::ComponentRef;
-use super::super::math::{add, cross, scale, V3};
+use super::super::math::{add, cross, normalize, scale, V3};
 use super::super::mesh::Mesh;
 use super::super::types::{Array, DataType, Domain};
 use super::geometry_ops::{eval_fields, geo, modify_geometry_sets};
@@ -370,14 +370,20 @@ fn sweep(
             let vert0 = m.positions.len() as u32;
             let edge0 = m.edges.len() as u32;
             for i in mr.clone() {
-                let (n, t) = (mnorm[i], mtan[i]);
-                let b = cross(t, n);
+                // Blender 4.5's point matrix: the normal, the normalized cross product of
+                // tangent and normal, the tangent, each scaled; a Free normal that is not
+                // orthogonal to the tangent stays as it is (measured: Curve to Mesh of
+                // gn_curve_normal_free's curves).
                 let s = mscale[i];
+                let t = scale(mtan[i], s);
+                let n = scale(mnorm[i], s);
+                let b = scale(normalize(cross(mtan[i], mnorm[i])), s);
                 for j in pr.clone() {
                     let p = ppos[j];
+                    // `transform_point`: the 3x3 part times the point, then the location.
                     let v = add(
-                        add(add(mpos[i], scale(n, p[0] * s)), scale(b, p[1] * s)),
-                        scale(t, p[2] * s),
+                        add(add(scale(n, p[0]), scale(b, p[1])), scale(t, p[2])),
+                        mpos[i],
                     );
                     m.positions.push(v);
                 }

@@ -10,7 +10,7 @@ use super::super::attribute::AttrId;
 use super::super::bezier_handles::{
     calculate_auto_handles, set_handle_position, types_for_movement, write_handles,
 };
-use super::super::curve_eval::{NORMAL_MODE_MINIMUM_TWIST, NORMAL_MODE_Z_UP};
+use super::super::curve_eval::{NORMAL_MODE_FREE, NORMAL_MODE_MINIMUM_TWIST, NORMAL_MODE_Z_UP};
 use super::super::curves::{Curves, HANDLE_FREE};
 use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
@@ -211,25 +211,69 @@ pub fn set_handle_positions(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     )
 }
 
+/// Set Curve Normal (`node_geo_set_curve_normal`): the mode on the selected curves; Free
+/// also captures the Normal field (evaluated before the mode changes, so a Normal input
+/// in it reads the old normals) into `custom_normal` on the selected curves' points.
 pub fn set_curve_normal(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
     let mode = match ctx.prop_str("mode")? {
         "MINIMUM_TWIST" => NORMAL_MODE_MINIMUM_TWIST,
         "Z_UP" => NORMAL_MODE_Z_UP,
-        other => {
-            return Err(ctx.err(format!(
-                "normal mode {other:?} is not supported (Minimum Twist and Z Up are)"
-            )))
-        }
+        "FREE" => NORMAL_MODE_FREE,
+        other => return Err(ctx.err(format!("normal mode {other:?} is not supported"))),
     };
     let sel = ctx.field("Selection", DataType::Bool)?;
-    edit_curves(
-        ctx,
-        "Curve",
-        Domain::Curve,
-        &[(&sel, DataType::Bool)],
-        &mut |c, r| {
-            c.set_i8_selected("normal_mode", Domain::Curve, 0, &r[0].as_bool(), mode);
-            Ok(())
-        },
-    )
+    let normal = if mode == NORMAL_MODE_FREE {
+        Some(ctx.field("Normal", DataType::Vector)?)
+    } else {
+        None
+    };
+    let mut g = ctx.geometry("Curve")?;
+    modify_geometry_sets(&mut g, &mut |s| {
+        let Some(c) = s.curves.clone() else {
+            return Ok(());
+        };
+        let picked = eval_fields(
+            ComponentRef::Curves(&c),
+            Domain::Curve,
+            &[(&sel, DataType::Bool)],
+        )?
+        .remove(0)
+        .as_bool()
+        .into_owned();
+        let custom = match &normal {
+            Some(f) => Some(
+                eval_fields(
+                    ComponentRef::Curves(&c),
+                    Domain::Point,
+                    &[(f, DataType::Vector)],
+                )?
+                .remove(0)
+                .as_vector()
+                .into_owned(),
+            ),
+            None => None,
+        };
+        let mut c = Arc::unwrap_or_clone(c);
+        if let Some(values) = custom {
+            // Unselected curves keep their stored normals (zero where there were none).
+            let mut stored = c
+                .point_vectors("custom_normal")
+                .unwrap_or_else(|| vec![[0.0; 3]; c.point_count()]);
+            for (i, _) in picked.iter().enumerate().filter(|(_, p)| **p) {
+                for p in c.points(i) {
+                    stored[p] = values[p];
+                }
+            }
+            c.attributes.set(
+                AttrId::named("custom_normal"),
+                Domain::Point,
+                Array::Vector(stored),
+            );
+        }
+        c.set_i8_selected("normal_mode", Domain::Curve, 0, &picked, mode);
+        s.curves = Some(Arc::new(c));
+        Ok(())
+    })
+    .map_err(|e| ctx.err(e))?;
+    Ok(outputs([("Curve", geo(g))]))
 }

@@ -35,6 +35,10 @@ pub fn domain_size(ctx: &NodeCtx) -> Result<Outputs, GeometryError> {
             "Instance Count",
             n(g.instances.as_deref().map_or(0, |i| i.len())),
         )]),
+        // Blendsynth's geometry holds no Grease Pencil (Cycles does not render it), so the
+        // layer count is Blender's for a geometry without one (Molecular Nodes' Cartoon
+        // asks it of its protein's curves).
+        "GREASEPENCIL" => outputs([("Layer Count", n(0))]),
         other => return Err(ctx.err(format!("component {other} is not supported"))),
     })
 }

@@ -92,6 +92,7 @@ pub fn transform_set(g: &mut GeometrySet, m: &Mat4f) {
                 }
             }
         }
+        c.transform_custom_normals(m);
     }
     if let Some(v) = g.volume_mut() {
         v.apply_transform(m);
