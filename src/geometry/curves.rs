@@ -7,7 +7,7 @@
 //! and write it back under its built-in type, so the curve nodes agree on both.
 
 use super::attribute::{AttrId, Attributes};
-use super::math::{mat3_mul_v3, normal_matrix, normalize, Mat4f, V3};
+use super::math::{transform_normals, Mat4f, V3};
 use super::types::{Array, Domain};
 
 /// Blender's `CurveType` values as stored in the `curve_type` attribute.
@@ -125,10 +125,7 @@ impl Curves {
             return;
         };
         if let Array::Vector(v) = &mut a.data {
-            let nm = normal_matrix(m);
-            for n in v.iter_mut() {
-                *n = normalize(mat3_mul_v3(&nm, *n));
-            }
+            transform_normals(m, v);
         }
     }
 }

@@ -446,6 +446,16 @@ pub fn flatten(m: &Mat4f) -> [f32; 16] {
     out
 }
 
+/// Turns free normals (a `custom_normal` attribute) as positions move by `m`, as Blender's
+/// `transform_custom_normal_attribute`: by the inverse transpose of the 3x3 part,
+/// normalized.
+pub fn transform_normals(m: &Mat4f, normals: &mut [V3]) {
+    let nm = normal_matrix(m);
+    for n in normals.iter_mut() {
+        *n = normalize(mat3_mul_v3(&nm, *n));
+    }
+}
+
 /// The transpose of the inverse of the 3x3 part, to move normals.
 pub fn normal_matrix(m: &Mat4f) -> Mat3f {
     let a = [

@@ -13,9 +13,7 @@ use super::attribute::{AttrId, Attributes};
 use super::curves::Curves;
 use super::field::ComponentRef;
 use super::instances::Instances;
-use super::math::{
-    mat3_mul_v3, mat4_mul, normal_matrix, normalize, transform_point, Mat4f, MAT4_IDENTITY,
-};
+use super::math::{mat4_mul, transform_normals, transform_point, Mat4f, MAT4_IDENTITY};
 use super::mesh::Mesh;
 use super::pointcloud::PointCloud;
 use super::set::GeometrySet;
@@ -133,12 +131,21 @@ pub fn join_meshes(parts: &[(&Mesh, Mat4f)]) -> Mesh {
             continue;
         }
         let mut data = Array::zeros(*t, 0);
-        for (m, _) in parts {
+        for (m, tm) in parts {
             let n = m.domain_size(*d);
             match m.attributes.get(id) {
                 Some(a) => {
-                    let adapted = ComponentRef::Mesh(m).adapt(&a.data, a.domain, *d);
-                    data.extend(&adapted.convert(*t));
+                    let mut adapted = ComponentRef::Mesh(m)
+                        .adapt(&a.data, a.domain, *d)
+                        .convert(*t);
+                    // Free normals turn with the instance, as on curves (checked against
+                    // Blender 4.5: set_mesh_normal/smn_free_realize).
+                    if id.name() == Some("custom_normal") && *tm != MAT4_IDENTITY {
+                        if let Array::Vector(v) = &mut adapted {
+                            transform_normals(tm, v);
+                        }
+                    }
+                    data.extend(&adapted);
                 }
                 None => data.extend_default(n),
             }
@@ -215,10 +222,7 @@ pub fn join_curves(parts: &[(&Curves, Mat4f)]) -> Curves {
                     // `transform_custom_normal_attribute`).
                     if id.name() == Some("custom_normal") && *t != MAT4_IDENTITY {
                         if let Array::Vector(n) = &mut v {
-                            let nm = normal_matrix(t);
-                            for x in n.iter_mut() {
-                                *x = normalize(mat3_mul_v3(&nm, *x));
-                            }
+                            transform_normals(t, n);
                         }
                     }
                     data.extend(&v);

@@ -9,7 +9,7 @@ use super::super::error::GeometryError;
 use super::super::eval::{outputs, NodeCtx, Outputs};
 use super::super::field::{ComponentRef, Field, FieldContext};
 use super::super::instances::{InstanceReference, Instances};
-use super::super::math::{from_loc_rot_scale, mat4_mul, transform_point, Mat4f};
+use super::super::math::{from_loc_rot_scale, mat4_mul, transform_normals, transform_point, Mat4f};
 use super::super::mesh::Mesh;
 use super::super::pointcloud::PointCloud;
 use super::super::realize::{join_geometries, realize_instances};
@@ -73,6 +73,13 @@ pub fn transform_set(g: &mut GeometrySet, m: &Mat4f) {
             *p = transform_point(m, *p);
         }
         mesh.custom_vert_normals = None;
+        // `bke::mesh_transform`: free normals turn with the mesh (set_mesh_normal/
+        // smn_free_transform).
+        if let Some(a) = mesh.attributes.get_mut(&AttrId::named("custom_normal")) {
+            if let Array::Vector(v) = &mut a.data {
+                transform_normals(m, v);
+            }
+        }
     }
     if let Some(pc) = g.points_mut() {
         for p in pc.positions.iter_mut() {
