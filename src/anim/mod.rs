@@ -26,7 +26,7 @@ use std::collections::HashMap;
 pub use animate::{ctime, Datablocks};
 pub use error::AnimError;
 pub use fcurve::{CompiledFCurve, ValueKind};
-pub use math::Mat4;
+pub use math::{qslerp, Mat4};
 pub use transform::basis_matrix;
 
 use crate::scene::{FCurve, Scene};

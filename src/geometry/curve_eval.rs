@@ -14,6 +14,7 @@ use super::curves::{
 use super::math::{add, cross, dot, length, normalize, scale, sub, V3};
 use super::nurbs::Basis;
 use super::types::{Array, DataType, Domain, Value};
+use crate::anim::qslerp;
 
 /// Blender's `NormalMode` values as stored in the `normal_mode` curve attribute.
 pub const NORMAL_MODE_MINIMUM_TWIST: i8 = 0;
@@ -698,30 +699,13 @@ pub fn lerp_gather(data: &Array, a: &[usize], b: &[usize], f: &[f32]) -> Array {
         ),
         Array::Quaternion(v) => Array::Quaternion(
             (0..a.len())
-                .map(|i| quaternion_slerp(&v[a[i]], &v[b[i]], f[i]))
+                // Blender's `mix2` for rotations: `interp_dot_slerp`'s weights, as the
+                // animation system's quaternion interpolation.
+                .map(|i| qslerp(v[a[i]], v[b[i]], f[i]))
                 .collect(),
         ),
         other => other.gather(a),
     }
-}
-
-/// Blender's `mix2` for rotations: `math::interpolate` of quaternions, the weights of
-/// `interpolate_dot_slerp` (a linear mix where the two are within 1e-4 of parallel; the
-/// shorter way round), applied to the components as stored.
-fn quaternion_slerp(a: &[f32; 4], b: &[f32; 4], t: f32) -> [f32; 4] {
-    let cosom = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
-    let abs_cosom = cosom.abs();
-    let (mut w0, w1) = if abs_cosom < 1.0 - 1e-4 {
-        let omega = abs_cosom.acos();
-        let sinom = omega.sin();
-        (((1.0 - t) * omega).sin() / sinom, (t * omega).sin() / sinom)
-    } else {
-        (1.0 - t, t)
-    };
-    if cosom < 0.0 {
-        w0 = -w0;
-    }
-    [0, 1, 2, 3].map(|k| w0 * a[k] + w1 * b[k])
 }
 
 /// One Bezier segment by forward differencing, `dst.len()` points from `p0` (t = 0)
